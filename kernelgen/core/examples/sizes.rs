@@ -1,0 +1,55 @@
+//! Prints the size of every generated kernel program (statements and operation counts).
+use kernelgen_core::{Program, Spec};
+
+fn main() {
+    let mut specs: Vec<Spec> = (2..=7)
+        .map(|n| Spec::free(&format!("general_{n}"), n).unwrap())
+        .collect();
+    specs.extend(
+        (1..=3).map(|x| Spec::propagator(&format!("propagator_{}", 2 * x + 1), x).unwrap()),
+    );
+    let b = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    specs.push(
+        Spec::new(
+            "mode_coupling_2",
+            b(&["k", "q"]),
+            vec![vec![0, 1], vec![1, -1]],
+        )
+        .unwrap(),
+    );
+    specs.push(
+        Spec::new(
+            "mode_coupling_3",
+            b(&["k", "q1", "q2"]),
+            vec![vec![0, 1, 0], vec![0, 0, 1], vec![1, -1, -1]],
+        )
+        .unwrap(),
+    );
+    specs.push(
+        Spec::new(
+            "mode_coupling_4",
+            b(&["k", "q1", "q2"]),
+            vec![vec![0, 1, 0], vec![1, -1, 0], vec![0, 0, 1], vec![0, 0, -1]],
+        )
+        .unwrap(),
+    );
+    println!(
+        "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>8} {:>6}",
+        "kernel", "stmts", "muls", "adds", "recips", "flops", "subkern", "splits"
+    );
+    for s in &specs {
+        let p = Program::build(s);
+        let c = p.op_counts();
+        println!(
+            "{:<18} {:>6} {:>6} {:>6} {:>6} {:>6} {:>8} {:>6}",
+            s.name,
+            c.statements,
+            c.muls,
+            c.adds,
+            c.recips,
+            c.flops(),
+            p.stats.subkernels,
+            p.stats.splits
+        );
+    }
+}

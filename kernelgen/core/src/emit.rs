@@ -1,0 +1,233 @@
+//! Emission of a [`Program`] as a Rust function generic over a scalar type.
+//!
+//! The function takes the Gram matrix of the configuration's basis (`&[T; N]`, upper triangle, row-major)
+//! and returns `[F^s, G^s]`. Each live graph node becomes one `let`; each rational coefficient becomes a
+//! visible `let cJ = T::from_ratio(p, q);` (exact in f64 since |p|, q < 2^53, checked here); sums are
+//! emitted as balanced trees (shorter dependency chains, smaller rounding error). The scalar trait must
+//! provide `from_ratio(i64, i64) -> Self`, `safe_recip(&self) -> Self` (1/x, and 0 at an exact 0), `Clone`
+//! and the four arithmetic operators.
+
+use crate::dag::{as_i64_pair, exact_in_f64, NodeId, Op, Value, Q};
+use crate::program::Program;
+use crate::GENERATOR_VERSION;
+use num_traits::{One, Signed, Zero};
+use proc_macro2::{Ident, Span, TokenStream};
+use quote::{format_ident, quote};
+
+/// Paths the emitted code refers to.
+pub struct Paths {
+    /// The scalar trait, e.g. `crate::Scalar`.
+    pub scalar: syn::Path,
+    /// The metadata struct, e.g. `crate::KernelInfo`.
+    pub info: syn::Path,
+}
+
+struct Emitter {
+    constants: Vec<Q>,
+}
+
+impl Emitter {
+    fn constant(&mut self, r: &Q) -> Ident {
+        let i = match self.constants.iter().position(|c| c == r) {
+            Some(i) => i,
+            None => {
+                self.constants.push(r.clone());
+                self.constants.len() - 1
+            }
+        };
+        format_ident!("c{}", i)
+    }
+
+    fn node(id: NodeId) -> Ident {
+        format_ident!("x{}", id)
+    }
+
+    /// `|r| * x` as tokens, with the sign returned separately.
+    fn scaled(&mut self, r: &Q, x: TokenStream) -> (bool, TokenStream) {
+        let negative = r.is_negative();
+        let mag = r.abs();
+        if mag.is_one() {
+            (negative, x)
+        } else {
+            let c = self.constant(&mag);
+            (negative, quote!(#c.clone() * #x))
+        }
+    }
+
+    fn value(&mut self, v: &Value) -> TokenStream {
+        let (neg, t) = match v.node {
+            None => {
+                let c = self.constant(&v.coef.abs());
+                (v.coef.is_negative(), quote!(#c.clone()))
+            }
+            Some(id) => {
+                let x = Self::node(id);
+                self.scaled(&v.coef, quote!(#x.clone()))
+            }
+        };
+        if neg {
+            quote!(-(#t))
+        } else {
+            t
+        }
+    }
+
+    /// Σ c_i x_i + c_0 with the terms grouped by |c_i|: one multiplication per distinct coefficient.
+    fn lin(&mut self, terms: &[(Q, NodeId)], c0: &Q) -> (bool, TokenStream) {
+        let mut parts: Vec<(bool, TokenStream)> = Vec::new();
+        for (mag, group) in group_by_magnitude(terms) {
+            let signed: Vec<(bool, TokenStream)> = group
+                .iter()
+                .map(|&(neg, id)| {
+                    let x = Self::node(id);
+                    (neg, quote!(#x.clone()))
+                })
+                .collect();
+            if mag.is_one() {
+                parts.extend(signed);
+            } else {
+                let (neg, sum) = balanced_sum(signed);
+                let c = self.constant(&mag);
+                parts.push((neg, quote!(#c.clone() * #sum)));
+            }
+        }
+        if !c0.is_zero() {
+            let c = self.constant(&c0.abs());
+            parts.push((c0.is_negative(), quote!(#c.clone())));
+        }
+        balanced_sum(parts)
+    }
+
+    fn statement(&mut self, id: NodeId, op: &Op) -> TokenStream {
+        let x = Self::node(id);
+        let rhs = match op {
+            Op::Input(i) => quote!(g[#i].clone()),
+            Op::Mul(a, b) => {
+                let (a, b) = (Self::node(*a), Self::node(*b));
+                quote!(#a.clone() * #b.clone())
+            }
+            Op::Recip(a) => {
+                let a = Self::node(*a);
+                quote!(#a.safe_recip())
+            }
+            Op::Lin(terms, c0) => {
+                let (neg, t) = self.lin(terms, c0);
+                if neg {
+                    quote!(-(#t))
+                } else {
+                    t
+                }
+            }
+        };
+        quote!(let #x = #rhs;)
+    }
+}
+
+/// Terms of a linear combination grouped by the magnitude of their coefficient, each with its sign.
+pub fn group_by_magnitude(terms: &[(Q, NodeId)]) -> Vec<(Q, Vec<(bool, NodeId)>)> {
+    let mut groups: Vec<(Q, Vec<(bool, NodeId)>)> = Vec::new();
+    for (c, id) in terms {
+        let mag = c.abs();
+        let entry = (c.is_negative(), *id);
+        match groups.iter_mut().find(|(m, _)| *m == mag) {
+            Some((_, g)) => g.push(entry),
+            None => groups.push((mag, vec![entry])),
+        }
+    }
+    groups
+}
+
+/// Sum of signed terms as a balanced tree; returns (negated, expression).
+fn balanced_sum(mut parts: Vec<(bool, TokenStream)>) -> (bool, TokenStream) {
+    if parts.len() == 1 {
+        return parts.pop().expect("one part");
+    }
+    let right = parts.split_off(parts.len() / 2);
+    let (ln, l) = balanced_sum(parts);
+    let (rn, r) = balanced_sum(right);
+    match (ln, rn) {
+        (false, false) => (false, quote!((#l + #r))),
+        (false, true) => (false, quote!((#l - #r))),
+        (true, false) => (false, quote!((#r - #l))),
+        (true, true) => (true, quote!((#l + #r))),
+    }
+}
+
+/// Emits the function `name<T>(g: &[T; N]) -> [T; 2]` and its `NAME_INFO` metadata constant.
+pub fn emit(program: &Program, paths: &Paths, docs: &[syn::Attribute]) -> syn::Result<TokenStream> {
+    let spec = &program.spec;
+    let mut e = Emitter {
+        constants: Vec::new(),
+    };
+    let live = program.live();
+    let mut body = Vec::new();
+    for (id, op) in program.dag.ops().iter().enumerate() {
+        if live[id] {
+            body.push(e.statement(id, op));
+        }
+    }
+    let f = e.value(&program.f);
+    let g = e.value(&program.g);
+    let mut consts = Vec::new();
+    for (i, c) in e.constants.iter().enumerate() {
+        let Some((n, d)) = as_i64_pair(c).filter(|_| exact_in_f64(c)) else {
+            return Err(syn::Error::new(
+                Span::call_site(),
+                format!("coefficient {c} is not exact in f64"),
+            ));
+        };
+        let ci = format_ident!("c{}", i);
+        consts.push(quote!(let #ci = T::from_ratio(#n, #d);));
+    }
+
+    let name = Ident::new(&spec.name, Span::call_site());
+    let info_name = format_ident!("{}_INFO", spec.name.to_uppercase());
+    let scalar = &paths.scalar;
+    let info = &paths.info;
+    let n_inputs = spec.n_inputs();
+    let order = spec.order();
+    let counts = program.op_counts();
+    let (muls, adds, recips, statements) =
+        (counts.muls, counts.adds, counts.recips, counts.statements);
+    let stats = program.stats;
+    let (subkernels, zero_subsets, splits) =
+        (stats.subkernels, stats.zero_momentum_subsets, stats.splits);
+    let args = spec.arg_names();
+    let inputs = spec.input_names();
+    let header = format!(
+        " Generated by kernelgen {GENERATOR_VERSION}: F_{order}^s and G_{order}^s at ({}).\n\n \
+         Input `g`: the basis Gram matrix [{}]. Output: `[F, G]`.\n \
+         Straight-line code: {statements} statements, {muls} multiplications, {adds} additions, \
+         {recips} reciprocals; {subkernels} sub-kernels, {zero_subsets} zero-momentum subsets removed at \
+         generation time, {splits} subset splits.",
+        args.join(", "),
+        inputs.join(", "),
+    );
+    Ok(quote! {
+        #(#docs)*
+        #[doc = ""]
+        #[doc = #header]
+        #[inline(never)]
+        pub fn #name<T: #scalar>(g: &[T; #n_inputs]) -> [T; 2] {
+            #(#consts)*
+            #(#body)*
+            [#f, #g]
+        }
+
+        #[doc = concat!("How `", stringify!(#name), "` was generated.")]
+        pub const #info_name: #info = #info {
+            name: stringify!(#name),
+            order: #order,
+            arguments: &[#(#args),*],
+            inputs: &[#(#inputs),*],
+            statements: #statements,
+            multiplications: #muls,
+            additions: #adds,
+            reciprocals: #recips,
+            subkernels: #subkernels,
+            zero_momentum_subsets: #zero_subsets,
+            splits: #splits,
+            generator: #GENERATOR_VERSION,
+        };
+    })
+}

@@ -1,0 +1,37 @@
+//! The symbolic engine behind the `kernelgen` procedural macro.
+//!
+//! It expands the symmetrised SPT recursion for F_n^s and G_n^s (n ≤ 7) over subsets of the arguments, in
+//! exact rational arithmetic, for a fixed configuration of arguments ([`spec`]); builds a hash-consed
+//! expression graph in which every constant is folded and every zero-momentum subset is removed
+//! ([`dag`], [`recursion`], [`program`]); and emits it as flattened straight-line Rust generic over a scalar
+//! type ([`emit`]). The same recursion, run with α → 1 and β → 1/3, gives the angle-averaged vertices
+//! ν_n and μ_n exactly ([`recursion::vertices`]).
+//!
+//! The macro crate is a thin shim over [`expand`]; everything here is ordinary, unit-tested Rust.
+
+pub mod dag;
+pub mod emit;
+pub mod parse;
+pub mod program;
+pub mod recursion;
+pub mod spec;
+
+pub use program::{OpCounts, Program};
+pub use recursion::vertices;
+pub use spec::Spec;
+
+use proc_macro2::TokenStream;
+
+/// Version stamped into every generated function's documentation.
+pub const GENERATOR_VERSION: &str = concat!(env!("CARGO_PKG_NAME"), " ", env!("CARGO_PKG_VERSION"));
+
+/// Expands the macro input (see [`parse`]) into the generated functions and their metadata constants.
+pub fn expand(input: TokenStream) -> syn::Result<TokenStream> {
+    let input: parse::Input = syn::parse2(input)?;
+    let mut out = TokenStream::new();
+    for item in &input.items {
+        let program = Program::build(&item.spec);
+        out.extend(emit::emit(&program, &input.paths, &item.docs)?);
+    }
+    Ok(out)
+}

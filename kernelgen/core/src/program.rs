@@ -1,0 +1,269 @@
+//! The recursion run on the expression graph: one straight-line program per kernel configuration.
+//!
+//! Every subset norm k_S² and every dot product k_A·k_B is a linear form in the Gram-matrix inputs that is
+//! known exactly here, so forms that coincide are computed once, forms that vanish are constant zeros, and
+//! a dot product costs two additions of norms already at hand: k_A·k_B = (k_{A∪B}² − k_A² − k_B²)/2.
+
+use crate::dag::{q, Dag, Op, Value, Q};
+use crate::emit::group_by_magnitude;
+use crate::recursion::{momentum, Algebra, Mask, Recursion, RecursionStats};
+use crate::spec::Spec;
+use num_traits::{One, Zero};
+use std::collections::HashMap;
+
+/// The recursion's algebra over the expression graph of one configuration.
+pub struct Graph<'s> {
+    spec: &'s Spec,
+    /// The graph being built.
+    pub dag: Dag,
+    /// Gram-form → value of every norm and dot product built so far.
+    forms: HashMap<Vec<i64>, Value>,
+}
+
+impl<'s> Graph<'s> {
+    fn new(spec: &'s Spec) -> Self {
+        Graph {
+            spec,
+            dag: Dag::new(),
+            forms: HashMap::new(),
+        }
+    }
+
+    /// The Gram form of (Σ_a c1_a e_a)·(Σ_b c2_b e_b): its coefficient on each input.
+    fn form(&self, c1: &[i64], c2: &[i64]) -> Vec<i64> {
+        let mut f = vec![0; self.spec.n_inputs()];
+        for (a, x) in c1.iter().enumerate() {
+            for (b, y) in c2.iter().enumerate() {
+                f[self.spec.gram_index(a, b)] += x * y;
+            }
+        }
+        f
+    }
+
+    /// k_S² as a linear combination of the inputs.
+    fn norm(&mut self, s: Mask) -> Value {
+        let c = momentum(self.spec, s);
+        let f = self.form(&c, &c);
+        if let Some(v) = self.forms.get(&f) {
+            return v.clone();
+        }
+        let terms: Vec<(Q, Value)> = f
+            .iter()
+            .enumerate()
+            .filter(|(_, &x)| x != 0)
+            .map(|(i, &x)| (q(x, 1), self.dag.input(i)))
+            .collect::<Vec<_>>();
+        let v = self.dag.lin(&terms);
+        self.forms.insert(f, v.clone());
+        v
+    }
+
+    /// The value of a Gram form, memoised; `build` makes it from norms the first time.
+    fn form_value(&mut self, f: Vec<i64>, build: impl FnOnce(&mut Self) -> Value) -> Value {
+        if f.iter().all(|&x| x == 0) {
+            return Value::constant(Q::zero());
+        }
+        if let Some(v) = self.forms.get(&f) {
+            return v.clone();
+        }
+        let v = build(self);
+        self.forms.insert(f, v.clone());
+        v
+    }
+
+    /// (k_X² + k_Y² − k_Z²)/2 from three subset norms: a dot product in two additions.
+    fn half_sum(&mut self, x: Mask, y: Mask, z: Mask) -> Value {
+        let (x, y, z) = (self.norm(x), self.norm(y), self.norm(z));
+        self.dag.lin(&[(q(1, 2), x), (q(1, 2), y), (q(-1, 2), z)])
+    }
+}
+
+impl Algebra for Graph<'_> {
+    type V = Value;
+    fn constant(&mut self, r: Q) -> Value {
+        Value::constant(r)
+    }
+    fn is_zero(&self, v: &Value) -> bool {
+        v.is_zero()
+    }
+    fn mul(&mut self, a: &Value, b: &Value) -> Value {
+        self.dag.mul(a, b)
+    }
+    fn lin(&mut self, terms: &[(Q, Value)]) -> Value {
+        self.dag.lin(terms)
+    }
+    fn norm(&mut self, s: Mask) -> Value {
+        Graph::norm(self, s)
+    }
+    fn total_dot(&mut self, s: Mask, a: Mask) -> Value {
+        // k_S·k_A = (k_S² + k_A² − k_B²)/2 with B = S∖A
+        let f = self.form(&momentum(self.spec, s), &momentum(self.spec, a));
+        self.form_value(f, |g| g.half_sum(s, a, s ^ a))
+    }
+    fn pair_dot(&mut self, a: Mask, b: Mask) -> Value {
+        // k_A·k_B = (k_{A∪B}² − k_A² − k_B²)/2
+        let f = self.form(&momentum(self.spec, a), &momentum(self.spec, b));
+        self.form_value(f, |g| {
+            let (s, na, nb) = (g.norm(a | b), g.norm(a), g.norm(b));
+            g.dag.lin(&[(q(1, 2), s), (q(-1, 2), na), (q(-1, 2), nb)])
+        })
+    }
+    fn over_norm(&mut self, a: Mask, g: &Value) -> Value {
+        let n = self.norm(a);
+        let inv = self.dag.recip(&n);
+        self.dag.mul(g, &inv)
+    }
+}
+
+/// A generated kernel: its configuration, its straight-line program and the two outputs.
+pub struct Program {
+    /// The configuration.
+    pub spec: Spec,
+    /// The expression graph (only nodes reachable from the outputs are emitted).
+    pub dag: Dag,
+    /// F^s of the configuration.
+    pub f: Value,
+    /// G^s of the configuration.
+    pub g: Value,
+    /// What the recursion did.
+    pub stats: RecursionStats,
+}
+
+/// Counts of the emitted operations of a program.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OpCounts {
+    /// Multiplications (including multiplication by a constant inside linear combinations).
+    pub muls: usize,
+    /// Additions and subtractions.
+    pub adds: usize,
+    /// Reciprocals (one division each).
+    pub recips: usize,
+    /// Straight-line statements (live graph nodes that are not plain inputs).
+    pub statements: usize,
+}
+
+impl OpCounts {
+    /// All floating-point operations.
+    pub fn flops(&self) -> usize {
+        self.muls + self.adds + self.recips
+    }
+}
+
+impl Program {
+    /// Runs the recursion for `spec` on a fresh graph.
+    pub fn build(spec: &Spec) -> Program {
+        let mut rec = Recursion::new(spec, Graph::new(spec));
+        let (f, g) = rec.top();
+        let stats = rec.stats;
+        Program {
+            spec: spec.clone(),
+            dag: rec.alg.dag,
+            f,
+            g,
+            stats,
+        }
+    }
+
+    /// Which graph nodes the outputs need.
+    pub fn live(&self) -> Vec<bool> {
+        self.dag.live(&[&self.f, &self.g])
+    }
+
+    /// Operation counts of the emitted code.
+    pub fn op_counts(&self) -> OpCounts {
+        let live = self.live();
+        let mut c = OpCounts::default();
+        for (op, _) in self.dag.ops().iter().zip(&live).filter(|(_, &l)| l) {
+            match op {
+                Op::Input(_) => continue,
+                Op::Lin(terms, c0) => {
+                    c.adds += terms.len() - 1 + usize::from(!c0.is_zero());
+                    c.muls += group_by_magnitude(terms)
+                        .iter()
+                        .filter(|(m, _)| !m.is_one())
+                        .count();
+                }
+                Op::Mul(..) => c.muls += 1,
+                Op::Recip(_) => c.recips += 1,
+            }
+            c.statements += 1;
+        }
+        c
+    }
+
+    /// Every rational constant the emitted code uses.
+    pub fn constants(&self) -> Vec<Q> {
+        let live = self.live();
+        let mut out: Vec<Q> = Vec::new();
+        let mut push = |r: &Q| {
+            if !out.contains(r) {
+                out.push(r.clone());
+            }
+        };
+        for (op, _) in self.dag.ops().iter().zip(&live).filter(|(_, &l)| l) {
+            if let Op::Lin(terms, c0) = op {
+                terms.iter().for_each(|(r, _)| push(&r.abs_value()));
+                if !c0.is_zero() {
+                    push(&c0.abs_value());
+                }
+            }
+        }
+        push(&self.f.coef.abs_value());
+        push(&self.g.coef.abs_value());
+        out
+    }
+
+    /// The subsets of the arguments whose total momentum vanishes identically (never evaluated).
+    pub fn zero_momentum_subsets(&self) -> Vec<Mask> {
+        let n = self.spec.order();
+        (1..(1u32 << n))
+            .filter(|s| s.count_ones() >= 2 && momentum(&self.spec, *s).iter().all(|&c| c == 0))
+            .collect()
+    }
+}
+
+trait AbsValue {
+    fn abs_value(&self) -> Q;
+}
+
+impl AbsValue for Q {
+    fn abs_value(&self) -> Q {
+        if self < &Q::zero() {
+            -self.clone()
+        } else {
+            self.clone()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn f2_graph_is_small() {
+        let spec = Spec::free("f2", 2).unwrap();
+        let p = Program::build(&spec);
+        // F2 needs 1/q1², 1/q2², and a handful of products: a sanity bound, not a snapshot.
+        let c = p.op_counts();
+        assert_eq!(c.recips, 2);
+        assert!(c.flops() < 30, "{c:?}");
+    }
+
+    #[test]
+    fn propagator_drops_the_zero_momentum_subsets() {
+        for x in 1..=3 {
+            let spec = Spec::propagator("p", x).unwrap();
+            let p = Program::build(&spec);
+            // Subsets of {±q_i} holding whole pairs only: 2^x − 1 of them.
+            assert_eq!(p.zero_momentum_subsets().len(), (1 << x) - 1);
+            assert_eq!(p.stats.zero_momentum_subsets, (1 << x) - 1);
+            // No norm that is identically zero is ever inverted: every Recip operand is a live, non-constant node.
+            for op in p.dag.ops() {
+                if let Op::Recip(x) = op {
+                    assert!(!matches!(p.dag.ops()[*x], Op::Lin(ref t, _) if t.is_empty()));
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,43 @@
+//! The one place the kernel generator runs.
+//!
+//! Every function here is `name<T: Scalar>(g: &[T; N]) -> [T; 2]`: it takes the Gram matrix of its basis
+//! vectors (upper triangle, row-major; the order is in `NAME_INFO.inputs` and in each function's docs)
+//! and returns `[F^s, G^s]`. Nothing here is hand-written: the bodies are flattened straight-line code
+//! emitted by `kernelgen` from the symmetrised subset recursion, with exact rational coefficients.
+#![allow(clippy::all, clippy::pedantic, unused_parens, missing_docs)]
+
+use crate::{KernelInfo, Scalar};
+
+kernelgen::kernels! {
+    scalar = Scalar;
+    info = KernelInfo;
+
+    /// F_1^s = G_1^s = 1.
+    general_1 = free(1);
+    /// F_2^s, G_2^s of two free vectors.
+    general_2 = free(2);
+    /// F_3^s, G_3^s of three free vectors.
+    general_3 = free(3);
+    /// F_4^s, G_4^s of four free vectors.
+    general_4 = free(4);
+    /// F_5^s, G_5^s of five free vectors.
+    general_5 = free(5);
+    /// F_6^s, G_6^s of six free vectors.
+    general_6 = free(6);
+    /// F_7^s, G_7^s of seven free vectors.
+    general_7 = free(7);
+
+    /// The P13 propagator kernel F_3^s(k, q, −q).
+    propagator_3 = propagator(1);
+    /// The P15 propagator kernel F_5^s(k, q1, −q1, q2, −q2).
+    propagator_5 = propagator(2);
+    /// The P17 propagator kernel F_7^s(k, q1, −q1, q2, −q2, q3, −q3).
+    propagator_7 = propagator(3);
+
+    /// The P22 mode-coupling kernel F_2^s(q, k − q).
+    mode_coupling_2 = basis(k, q) args(q, k - q);
+    /// The P33 mode-coupling kernel F_3^s(q1, q2, k − q1 − q2).
+    mode_coupling_3 = basis(k, q1, q2) args(q1, q2, k - q1 - q2);
+    /// The P24 mode-coupling kernel F_4^s(q1, k − q1, q2, −q2).
+    mode_coupling_4 = basis(k, q1, q2) args(q1, k - q1, q2, -q2);
+}

@@ -1,0 +1,156 @@
+//! The standard-perturbation-theory kernels F_n^s and G_n^s for n ≤ 7, generated at build time.
+//!
+//! The density and velocity-divergence kernels of SPT (Goroff et al. 1986; Gil-Marín et al. 2012,
+//! arXiv:1209.3771, appendix A) are produced by the `kernelgen` macro as flattened straight-line code whose
+//! rational coefficients were folded in exactly at generation time; the n! symmetrisation never runs at run
+//! time. Every generated function is generic over [`Scalar`], so it runs in `f64` (fast) and in exact
+//! [`num_rational::BigRational`] (verification) alike.
+//!
+//! * [`kernels`]: `[F_n^s, G_n^s](q_1, …, q_n)` of free 3-vectors, n = 1..=7, any scalar type;
+//! * [`generated`]: the raw generated functions, including the specialised kernels of the loop integrals
+//!   (propagators F_{2x+1}^s(k, q1, −q1, …) for P13, P15, P17 and the mode-coupling kernels of P22, P33, P24)
+//!   which take the scalar invariants k², k·q_i, q_i·q_j an integrator has;
+//! * [`reference`]: a slow, obviously correct evaluator (the unsymmetrised recursion averaged over all n!
+//!   permutations), the oracle the generated code is tested against.
+//!
+//! ```
+//! use pt_kernels::{kernels, generated::propagator_3};
+//! // F_2^s and G_2^s of two perpendicular unit vectors: 5/7 + 2/7·0 and 3/7.
+//! let [f2, g2] = kernels(&[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]).unwrap();
+//! assert!((f2 - 5.0 / 7.0).abs() < 1e-15 && (g2 - 3.0 / 7.0).abs() < 1e-15);
+//! // The P13 kernel from invariants [k·k, k·q, q·q].
+//! let [f3, _g3] = propagator_3(&[1.0, 0.3, 0.25]);
+//! assert!(f3.is_finite());
+//! ```
+
+pub mod generated;
+mod lanes;
+pub mod reference;
+mod scalar;
+
+pub use lanes::Lanes;
+
+pub use scalar::{dot, one, zero, Scalar};
+
+/// Largest kernel order generated.
+pub const MAX_ORDER: usize = 7;
+
+/// How a generated kernel was made (one constant per generated function, `NAME_INFO`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct KernelInfo {
+    /// Function name.
+    pub name: &'static str,
+    /// Kernel order n.
+    pub order: usize,
+    /// The arguments as combinations of the basis vectors, e.g. `["k", "q1", "-q1"]`.
+    pub arguments: &'static [&'static str],
+    /// The inputs, e.g. `["k.k", "k.q1", "q1.q1"]`.
+    pub inputs: &'static [&'static str],
+    /// Straight-line statements emitted.
+    pub statements: usize,
+    /// Multiplications per evaluation.
+    pub multiplications: usize,
+    /// Additions and subtractions per evaluation.
+    pub additions: usize,
+    /// Reciprocals (divisions) per evaluation.
+    pub reciprocals: usize,
+    /// Distinct sub-kernels the recursion built.
+    pub subkernels: usize,
+    /// Subsets with identically zero momentum, removed at generation time.
+    pub zero_momentum_subsets: usize,
+    /// Subset splits the recursion visited.
+    pub splits: usize,
+    /// Generator name and version.
+    pub generator: &'static str,
+}
+
+/// Why a kernel cannot be evaluated.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum KernelError {
+    /// No argument, or more than [`MAX_ORDER`].
+    #[error("kernel order n = {0} is not supported: n must be between 1 and {MAX_ORDER}")]
+    Order(usize),
+    /// An argument is the zero vector, where the kernels have a pole.
+    #[error("argument q{0} is the zero vector; the kernels are singular there")]
+    ZeroVector(usize),
+}
+
+/// The metadata of the general kernel of order n (1..=7).
+pub fn general_info(n: usize) -> Option<&'static KernelInfo> {
+    use generated::*;
+    [
+        &GENERAL_1_INFO,
+        &GENERAL_2_INFO,
+        &GENERAL_3_INFO,
+        &GENERAL_4_INFO,
+        &GENERAL_5_INFO,
+        &GENERAL_6_INFO,
+        &GENERAL_7_INFO,
+    ]
+    .get(n.wrapping_sub(1))
+    .copied()
+}
+
+/// The metadata of every generated kernel.
+pub fn all_info() -> Vec<&'static KernelInfo> {
+    use generated::*;
+    let mut v: Vec<&'static KernelInfo> = (1..=MAX_ORDER).filter_map(general_info).collect();
+    v.extend([
+        &PROPAGATOR_3_INFO,
+        &PROPAGATOR_5_INFO,
+        &PROPAGATOR_7_INFO,
+        &MODE_COUPLING_2_INFO,
+        &MODE_COUPLING_3_INFO,
+        &MODE_COUPLING_4_INFO,
+    ]);
+    v
+}
+
+/// The Gram matrix of `vectors` (upper triangle, row-major): the input layout of every generated function.
+pub fn gram<T: Scalar>(vectors: &[[T; 3]]) -> Vec<T> {
+    let mut g = Vec::with_capacity(vectors.len() * (vectors.len() + 1) / 2);
+    for (a, va) in vectors.iter().enumerate() {
+        for vb in &vectors[a..] {
+            g.push(dot(va, vb));
+        }
+    }
+    g
+}
+
+/// `[F_n^s, G_n^s]` from the Gram matrix of n free vectors (layout of [`gram`]), n = 1..=7.
+///
+/// Subsets of the arguments whose momenta sum exactly to zero give the kernels' limit (zero contribution),
+/// never NaN.
+pub fn general_from_gram<T: Scalar>(n: usize, g: &[T]) -> Result<[T; 2], KernelError> {
+    use generated::*;
+    fn call<T: Scalar, const N: usize>(g: &[T], f: fn(&[T; N]) -> [T; 2]) -> [T; 2] {
+        f(g.try_into().expect("Gram matrix of the right size"))
+    }
+    if g.len() != n * (n + 1) / 2 {
+        return Err(KernelError::Order(n));
+    }
+    Ok(match n {
+        1 => call(g, general_1),
+        2 => call(g, general_2),
+        3 => call(g, general_3),
+        4 => call(g, general_4),
+        5 => call(g, general_5),
+        6 => call(g, general_6),
+        7 => call(g, general_7),
+        _ => return Err(KernelError::Order(n)),
+    })
+}
+
+/// `[F_n^s, G_n^s](q_1, …, q_n)` of n = 1..=7 free 3-vectors (k in h/Mpc; the kernels are dimensionless).
+///
+/// Errors: n outside 1..=7, or a zero vector. Subsets summing exactly to zero momentum are fine.
+pub fn kernels<T: Scalar>(q: &[[T; 3]]) -> Result<[T; 2], KernelError> {
+    if q.is_empty() || q.len() > MAX_ORDER {
+        return Err(KernelError::Order(q.len()));
+    }
+    if let Some(i) = q.iter().position(|v| v.iter().all(Scalar::is_zero)) {
+        return Err(KernelError::ZeroVector(i + 1));
+    }
+    general_from_gram(q.len(), &gram(q))
+}
