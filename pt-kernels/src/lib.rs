@@ -7,14 +7,17 @@
 //! [`num_rational::BigRational`] (verification) alike.
 //!
 //! * [`kernels`]: `[F_n^s, G_n^s](q_1, …, q_n)` of free 3-vectors, n = 1..=7, any scalar type;
-//! * [`generated`]: the raw generated functions, including the specialised kernels of the loop integrals
-//!   (propagators F_{2x+1}^s(k, q1, −q1, …) for P13, P15, P17 and the mode-coupling kernels of P22, P33, P24)
-//!   which take the scalar invariants k², k·q_i, q_i·q_j an integrator has;
+//! * [`propagator_3`], [`propagator_5`], [`propagator_7`] (P13, P15, P17: F_{2x+1}^s(k, q1, −q1, …)) and
+//!   [`mode_coupling_2`], [`mode_coupling_3`], [`mode_coupling_4`] (P22, P33, P24): the specialised kernels
+//!   of the loop integrals, taking the scalar invariants k², k·q_i, q_i·q_j an integrator has;
+//! * [`generated`]: the raw generic functions behind all of these. Prefer the wrappers above: they call
+//!   instances compiled once in this crate for `f64` and `BigRational` ([`Evaluate`]), whereas a direct
+//!   call instantiates a kernel of up to ~9,000 statements anew in the calling crate;
 //! * [`reference`]: a slow, obviously correct evaluator (the unsymmetrised recursion averaged over all n!
 //!   permutations), the oracle the generated code is tested against.
 //!
 //! ```
-//! use pt_kernels::{kernels, generated::propagator_3};
+//! use pt_kernels::{kernels, propagator_3};
 //! // F_2^s and G_2^s of two perpendicular unit vectors: 5/7 + 2/7·0 and 3/7.
 //! let [f2, g2] = kernels(&[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]).unwrap();
 //! assert!((f2 - 5.0 / 7.0).abs() < 1e-15 && (g2 - 3.0 / 7.0).abs() < 1e-15);
@@ -24,11 +27,11 @@
 //! ```
 
 pub mod generated;
-mod lanes;
+mod instances;
 pub mod reference;
 mod scalar;
 
-pub use lanes::Lanes;
+pub use instances::Evaluate;
 
 pub use scalar::{dot, one, zero, Scalar};
 
@@ -122,30 +125,18 @@ pub fn gram<T: Scalar>(vectors: &[[T; 3]]) -> Vec<T> {
 ///
 /// Subsets of the arguments whose momenta sum exactly to zero give the kernels' limit (zero contribution),
 /// never NaN.
-pub fn general_from_gram<T: Scalar>(n: usize, g: &[T]) -> Result<[T; 2], KernelError> {
-    use generated::*;
-    fn call<T: Scalar, const N: usize>(g: &[T], f: fn(&[T; N]) -> [T; 2]) -> [T; 2] {
-        f(g.try_into().expect("Gram matrix of the right size"))
-    }
-    if g.len() != n * (n + 1) / 2 {
-        return Err(KernelError::Order(n));
-    }
-    Ok(match n {
-        1 => call(g, general_1),
-        2 => call(g, general_2),
-        3 => call(g, general_3),
-        4 => call(g, general_4),
-        5 => call(g, general_5),
-        6 => call(g, general_6),
-        7 => call(g, general_7),
-        _ => return Err(KernelError::Order(n)),
-    })
+///
+/// # Errors
+/// [`KernelError::Order`] if n is outside 1..=7 or `g` does not have n(n+1)/2 entries.
+pub fn general_from_gram<T: Evaluate>(n: usize, g: &[T]) -> Result<[T; 2], KernelError> {
+    T::general(n, g)
 }
 
 /// `[F_n^s, G_n^s](q_1, …, q_n)` of n = 1..=7 free 3-vectors (k in h/Mpc; the kernels are dimensionless).
 ///
-/// Errors: n outside 1..=7, or a zero vector. Subsets summing exactly to zero momentum are fine.
-pub fn kernels<T: Scalar>(q: &[[T; 3]]) -> Result<[T; 2], KernelError> {
+/// # Errors
+/// n outside 1..=7, or a zero vector. Subsets summing exactly to zero momentum are fine.
+pub fn kernels<T: Evaluate>(q: &[[T; 3]]) -> Result<[T; 2], KernelError> {
     if q.is_empty() || q.len() > MAX_ORDER {
         return Err(KernelError::Order(q.len()));
     }
@@ -153,4 +144,30 @@ pub fn kernels<T: Scalar>(q: &[[T; 3]]) -> Result<[T; 2], KernelError> {
         return Err(KernelError::ZeroVector(i + 1));
     }
     general_from_gram(q.len(), &gram(q))
+}
+
+macro_rules! specialised {
+    ($($(#[$doc:meta])* $name:ident: $n:literal;)*) => {$(
+        $(#[$doc])*
+        ///
+        /// Returns `[F^s, G^s]`; the generated code, compiled once in this crate for `f64` and `BigRational`.
+        pub fn $name<T: Evaluate>(g: &[T; $n]) -> [T; 2] {
+            T::$name(g)
+        }
+    )*};
+}
+
+specialised! {
+    /// The P13 propagator kernel F_3^s(k, q, −q) from [k·k, k·q, q·q].
+    propagator_3: 3;
+    /// The P15 propagator kernel F_5^s(k, q1, −q1, q2, −q2) from [k·k, k·q1, k·q2, q1·q1, q1·q2, q2·q2].
+    propagator_5: 6;
+    /// The P17 propagator kernel F_7^s(k, q1, −q1, q2, −q2, q3, −q3) from the Gram matrix of (k, q1, q2, q3).
+    propagator_7: 10;
+    /// The P22 mode-coupling kernel F_2^s(q, k − q) from [k·k, k·q, q·q].
+    mode_coupling_2: 3;
+    /// The P33 mode-coupling kernel F_3^s(q1, q2, k − q1 − q2) from the Gram matrix of (k, q1, q2).
+    mode_coupling_3: 6;
+    /// The P24 mode-coupling kernel F_4^s(q1, k − q1, q2, −q2) from the Gram matrix of (k, q1, q2).
+    mode_coupling_4: 6;
 }
