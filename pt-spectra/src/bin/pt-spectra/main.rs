@@ -1,0 +1,41 @@
+//! The `pt-spectra` command-line tool: perturbation-theory kernels and power spectra.
+//!
+//! Units everywhere: k in h/Mpc, P in (Mpc/h)^3. Every subcommand prints a clear error and exits non-zero
+//! on bad input.
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+mod kernel;
+mod real;
+
+/// Perturbation-theory power spectra of matter and haloes (Gil-Marín et al. 2012, arXiv:1209.3771).
+#[derive(Parser)]
+#[command(name = "pt-spectra", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Evaluate the symmetrised SPT kernel F_n^s or G_n^s (n = number of --q, 1..=7).
+    Kernel(kernel::Args),
+    /// Real-space P_δδ, P_δθ, P_θθ (linear, 1-loop SPT, 1-loop RPT with N0 or N1) on a k grid.
+    Real(real::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Kernel(args) => kernel::run(&args),
+        Command::Real(args) => real::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,170 @@
+//! The crate's error type.
+//!
+//! Every fallible function of `pt-spectra` returns [`Result`]. Each variant carries the offending value and,
+//! for table input, where it came from (`origin` is a file path or a description such as
+//! `embedded gm2012 z=0.0`, `line` is the 1-based line number, or the 1-based row number for in-memory
+//! arrays), so that the message alone says what to fix.
+
+use std::path::PathBuf;
+
+/// All errors of the `pt-spectra` library.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A file could not be opened or read.
+    #[error("cannot read `{}`: {source}", path.display())]
+    Io {
+        /// The file that was asked for.
+        path: PathBuf,
+        /// The operating-system error.
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// A field of a data row is not a number.
+    #[error("{origin}:{line}: cannot parse `{field}` (column {column}, 0-based) as a number")]
+    Parse {
+        /// File path or description of the input.
+        origin: String,
+        /// 1-based line number.
+        line: usize,
+        /// 0-based column index of the field.
+        column: usize,
+        /// The text that failed to parse.
+        field: String,
+    },
+
+    /// A data row has fewer columns than the requested column choice needs.
+    #[error(
+        "{origin}:{line}: column {column} (0-based) was requested but the row has only {found} column(s)"
+    )]
+    MissingColumn {
+        /// File path or description of the input.
+        origin: String,
+        /// 1-based line number.
+        line: usize,
+        /// The 0-based column index that was requested.
+        column: usize,
+        /// Number of columns found on the row.
+        found: usize,
+    },
+
+    /// A wavenumber is zero, negative, infinite or NaN.
+    #[error("{origin}:{line}: k = {k} h/Mpc is not a finite positive number")]
+    InvalidK {
+        /// File path or description of the input.
+        origin: String,
+        /// 1-based line (or row) number.
+        line: usize,
+        /// The offending wavenumber in h/Mpc.
+        k: f64,
+    },
+
+    /// The wavenumbers are not strictly increasing.
+    #[error(
+        "{origin}:{line}: k = {k} h/Mpc does not exceed the previous k = {previous} h/Mpc \
+         (k must be strictly increasing)"
+    )]
+    NonIncreasingK {
+        /// File path or description of the input.
+        origin: String,
+        /// 1-based line (or row) number of the offending row.
+        line: usize,
+        /// The offending wavenumber in h/Mpc.
+        k: f64,
+        /// The wavenumber of the previous row in h/Mpc.
+        previous: f64,
+    },
+
+    /// A power value is zero, negative, infinite or NaN.
+    #[error("{origin}:{line}: P = {p} (Mpc/h)^3 at k = {k} h/Mpc is not a finite positive number")]
+    InvalidPower {
+        /// File path or description of the input.
+        origin: String,
+        /// 1-based line (or row) number.
+        line: usize,
+        /// The wavenumber of the row in h/Mpc.
+        k: f64,
+        /// The offending power in (Mpc/h)^3.
+        p: f64,
+    },
+
+    /// The table has too few rows to be interpolated and extrapolated reliably.
+    #[error("{origin}: {found} data row(s), at least {min} are needed")]
+    TooFewPoints {
+        /// File path or description of the input.
+        origin: String,
+        /// Number of data rows found.
+        found: usize,
+        /// Minimum number of rows required.
+        min: usize,
+    },
+
+    /// Two arrays that must have the same length do not.
+    #[error("{what}: {left} values against {right} values")]
+    LengthMismatch {
+        /// Which arrays (e.g. `k and P`).
+        what: &'static str,
+        /// Length of the first array.
+        left: usize,
+        /// Length of the second array.
+        right: usize,
+    },
+
+    /// A numeric argument or parameter is outside its allowed range.
+    #[error("invalid {name} = {value}: {reason}")]
+    InvalidParameter {
+        /// Name of the parameter, with its unit where it has one.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// What the value must satisfy.
+        reason: &'static str,
+    },
+
+    /// No linear spectrum is embedded for the requested redshift.
+    #[error("no embedded linear spectrum at z = {z}; embedded redshifts: {available}")]
+    NoEmbeddedSpectrum {
+        /// The requested redshift.
+        z: f64,
+        /// The redshifts that are embedded.
+        available: &'static str,
+    },
+
+    /// A model name that is not known.
+    #[error("unknown model `{name}`; available models: {available}")]
+    UnknownModel {
+        /// The name that was given.
+        name: String,
+        /// The names that are accepted.
+        available: &'static str,
+    },
+}
+
+/// `Result` with the crate's [`Error`].
+pub type Result<T> = std::result::Result<T, Error>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_name_the_bad_value() {
+        let e = Error::InvalidPower {
+            origin: "pk.dat".into(),
+            line: 17,
+            k: 0.1,
+            p: -3.0,
+        };
+        assert_eq!(
+            e.to_string(),
+            "pk.dat:17: P = -3 (Mpc/h)^3 at k = 0.1 h/Mpc is not a finite positive number"
+        );
+        let e = Error::InvalidParameter {
+            name: "R [Mpc/h]",
+            value: -8.0,
+            reason: "must be finite and positive",
+        };
+        assert!(e.to_string().contains("R [Mpc/h] = -8"));
+    }
+}

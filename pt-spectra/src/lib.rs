@@ -1,0 +1,29 @@
+//! Eulerian perturbation-theory power spectra of matter and haloes in real and redshift space, after
+//! Gil-Marín, Wagner, Verde, Porciani & Jimenez (2012, arXiv:1209.3771).
+//!
+//! Conventions: k in h/Mpc, P(k) in (Mpc/h)^3, lengths in Mpc/h, ∫d³q/(2π)³.
+//!
+//! Modules:
+//! * [`error`]: the crate's [`Error`](error::Error) and [`Result`](error::Result).
+//! * [`linear`]: the linear spectrum [`LinearSpectrum`](linear::LinearSpectrum): CAMB/CLASS tables, the
+//!   embedded gm2012 CAMB spectra, log-log spline interpolation, power-law extrapolation, σ(R), σ_v².
+//! * [`cosmology`]: flat (or curved) ΛCDM [`Cosmology`](cosmology::Cosmology): exact linear growth D(z), f(z),
+//!   and the Eisenstein & Hu (1998) transfer functions with and without BAO wiggles.
+//!
+//! ```
+//! use pt_spectra::{cosmology::Cosmology, linear::LinearSpectrum};
+//! let cosmo = Cosmology::gm2012();
+//! let p0 = LinearSpectrum::gm2012(0.0)?;
+//! let p1 = cosmo.rescale(&p0, 0.0, 1.0)?; // P ∝ D²
+//! assert!((p1.sigma8() / p0.sigma8() - cosmo.growth_factor(1.0)).abs() < 1e-9);
+//! # Ok::<(), pt_spectra::error::Error>(())
+//! ```
+
+pub mod cosmology;
+pub mod error;
+pub mod integrate;
+pub mod linear;
+pub mod loops;
+pub mod precision;
+pub mod real;
+pub mod resum;

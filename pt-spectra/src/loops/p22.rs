@@ -1,0 +1,272 @@
+//! The mode-coupling terms P22 as a fixed 2-D node set per k.
+//!
+//! P22_XY(k) = 2 ∫d³q/(2π)³ X_2^s(q, k−q) Y_2^s(q, k−q) P(q) P(|k−q|), X, Y ∈ {F, G}. In the variables
+//! q and p = |k − q| (d³q = 2π q p dq dp / k) the integrand is symmetric under q ↔ p, so the half p ≥ q
+//! suffices:
+//!   P22_XY(k) = (1/π² k) ∫ dln q  q² P(q) ∫_{max(q, |k−q|)}^{min(k+q, q_max)} dp  p X₂Y₂ P(p),
+//! with, for c = q·(k−q) = (k² − q² − p²)/2,
+//!   F_2^s = 5/7 + (c/2)(1/q² + 1/p²) + (2/7) c²/(q²p²),  G_2^s = 3/7 + (c/2)(1/q² + 1/p²) + (4/7) c²/(q²p²).
+//! Restricting to p ≥ q removes the integrable singularity at p → 0 (F_2^s ~ 1/p there); what is left is
+//! smooth except for kinks of the outer integrand at q = k/2 (where the lower limit switches from k − q to
+//! q) and at q = q_max − k, which are panel edges.
+//!
+//! Quadrature: Gauss–Legendre panels in ln q (outer) and in p (inner). Panels are at most
+//! `ln_width` wide in ln q, and inside the feature band q, p < `band_end` also at most `linear_width` wide
+//! in q or p, so that baryon acoustic oscillations (period Δk ≈ 2π/r_s ≈ 0.06 h/Mpc) are resolved.
+//! Every node stores its lattice position (P̃ is interpolated there) and the weights of F₂², F₂G₂ and G₂²
+//! including every factor, so that a new spectrum costs one interpolation and three multiply–adds per node.
+
+use super::lattice::Lattice;
+use crate::integrate::{lagrange4, panel_edges, GaussLegendre};
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// The closed forms [F_2^s, G_2^s](q, k − q) from k², q² and p² = |k − q|².
+#[inline]
+pub fn f2_g2(k2: f64, q2: f64, p2: f64) -> [f64; 2] {
+    let c = 0.5 * (k2 - q2 - p2);
+    let a = 0.5 * c * (1.0 / q2 + 1.0 / p2);
+    let b = c * c / (q2 * p2);
+    [5.0 / 7.0 + a + 2.0 / 7.0 * b, 3.0 / 7.0 + a + 4.0 / 7.0 * b]
+}
+
+/// How P22 panels are laid out (from [`crate::precision::Precision`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Layout {
+    /// Gauss–Legendre order per panel (outer, and inner unless narrow).
+    pub order: usize,
+    /// Order of inner ranges narrower than `narrow_width` in ln p.
+    pub narrow_order: usize,
+    /// See `narrow_order`.
+    pub narrow_width: f64,
+    /// Largest panel width in ln q near q ~ k (outer) and in ln p (inner).
+    pub ln_width: f64,
+    /// Growth of the outer ln width with |ln(q/k)|.
+    pub tail_growth: f64,
+    /// Largest panel width in q or p [h/Mpc] below `band_end`.
+    pub linear_width: f64,
+    /// End of the feature band [h/Mpc].
+    pub band_end: f64,
+}
+
+impl Layout {
+    /// Largest inner panel width in p at `p` [h/Mpc].
+    fn width(&self, p: f64) -> f64 {
+        let log = self.ln_width * p;
+        if p < self.band_end {
+            log.min(self.linear_width)
+        } else {
+            log
+        }
+    }
+
+    /// Largest outer panel width in ln q at x = ln q for wavenumber k: `ln_width` near q ~ k, growing
+    /// as ln_width · tail_growth · |ln(q/k)| in the tails, where the kernel is a smooth power law, but
+    /// never wider than `linear_width` in q inside the feature band.
+    fn outer_width(&self, x: f64, k: f64) -> f64 {
+        let q = x.exp();
+        let ln = self.ln_width * (self.tail_growth * (x - k.ln()).abs()).max(1.0);
+        if q < self.band_end {
+            ln.min(self.linear_width / q)
+        } else {
+            ln
+        }
+    }
+}
+
+/// Nodes of all k of a plan, flattened.
+///
+/// Inner nodes store their interpolation stencil (first lattice point and the four Lagrange weights) and
+/// the three kernel weights in `f32`: their rounding (relative 6e-8, unbiased) is far below the
+/// quadrature errors, and halving the memory traffic speeds up [`P22Nodes::evaluate`].
+#[derive(Debug, Clone, Default)]
+pub(crate) struct P22Nodes {
+    /// Per k: the range of outer nodes.
+    pub k_start: Vec<u32>,
+    /// Per outer node: lattice position of q.
+    pub outer_u: Vec<f64>,
+    /// Per outer node: end (exclusive) of its inner nodes.
+    pub outer_end: Vec<u32>,
+    /// Per inner node: first lattice point of the interpolation stencil of p.
+    pub inner_b: Vec<u32>,
+    /// Per inner node: the Lagrange weights of the four stencil points.
+    pub inner_l: Vec<[f32; 4]>,
+    /// Per inner node: weights of F₂², F₂G₂, G₂².
+    pub inner_w: Vec<[f32; 3]>,
+}
+
+/// The rules of one plan.
+struct Rules<'a> {
+    lattice: &'a Lattice,
+    layout: &'a Layout,
+    full: GaussLegendre,
+    narrow: GaussLegendre,
+}
+
+impl P22Nodes {
+    /// The nodes for every k of `ks` (built in parallel over k; the result does not depend on threads).
+    pub fn new(ks: &[f64], lattice: &Lattice, layout: &Layout) -> Self {
+        let rules = Rules {
+            lattice,
+            layout,
+            full: GaussLegendre::new(layout.order),
+            narrow: GaussLegendre::new(layout.narrow_order.min(layout.order)),
+        };
+        let parts: Vec<Self> = ks.par_iter().map(|&k| Self::for_k(k, &rules)).collect();
+        let mut nodes = Self::default();
+        for part in parts {
+            let (outer, inner) = (nodes.outer_u.len() as u32, nodes.inner_b.len() as u32);
+            nodes.k_start.push(outer);
+            nodes.outer_u.extend(part.outer_u);
+            nodes
+                .outer_end
+                .extend(part.outer_end.iter().map(|e| e + inner));
+            nodes.inner_b.extend(part.inner_b);
+            nodes.inner_l.extend(part.inner_l);
+            nodes.inner_w.extend(part.inner_w);
+        }
+        nodes.k_start.push(nodes.outer_u.len() as u32);
+        nodes
+    }
+
+    /// The nodes of one k (without `k_start`).
+    fn for_k(k: f64, rules: &Rules) -> Self {
+        let (lattice, layout) = (rules.lattice, rules.layout);
+        let (x_min, x_max) = (lattice.x0, lattice.x_end());
+        let q_max = x_max.exp();
+        let mut nodes = Self::default();
+        let mut edges = panel_edges(x_min, x_max, |x| layout.outer_width(x, k));
+        // Kinks of the outer integrand; the one at q_max − k only matters when k is not ≪ q_max.
+        let kinks = [0.5 * k, if k > 1e-3 * q_max { q_max - k } else { 0.0 }];
+        edges.extend(
+            kinks
+                .iter()
+                .map(|q| q.ln())
+                .filter(|&x| x > x_min && x < x_max),
+        );
+        edges.sort_by(f64::total_cmp);
+        edges.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        for e in edges.windows(2) {
+            for (x, w) in rules.full.on(e[0], e[1]) {
+                nodes.push_outer(k, x, w, rules);
+            }
+        }
+        nodes
+    }
+
+    /// The inner nodes of outer node (ln q = x, weight w) at wavenumber k.
+    fn push_outer(&mut self, k: f64, x: f64, w: f64, rules: &Rules) {
+        let (lattice, layout) = (rules.lattice, rules.layout);
+        let q = x.exp();
+        let (lo, hi) = (q.max((k - q).abs()), (k + q).min(lattice.x_end().exp()));
+        if hi <= lo {
+            return;
+        }
+        let (k2, q2) = (k * k, q * q);
+        let factor = w * q2 / (PI * PI * k);
+        let narrow = hi - lo < 0.5 * layout.width(lo) && (hi / lo).ln() < layout.narrow_width;
+        let rule = if narrow { &rules.narrow } else { &rules.full };
+        for e in panel_edges(lo, hi, |p| layout.width(p)).windows(2) {
+            for (p, v) in rule.on(e[0], e[1]) {
+                let [f, g] = f2_g2(k2, q2, p * p);
+                let c = factor * v * p;
+                let (b, t) = lattice.stencil(lattice.position(p));
+                self.inner_b.push(b as u32);
+                self.inner_l.push(lagrange4(t).map(|l| l as f32));
+                self.inner_w
+                    .push([c * f * f, c * f * g, c * g * g].map(|v| v as f32));
+            }
+        }
+        self.outer_u.push(lattice.position(q));
+        self.outer_end.push(self.inner_b.len() as u32);
+    }
+
+    /// Total number of inner nodes.
+    pub fn len(&self) -> usize {
+        self.inner_b.len()
+    }
+
+    /// [P22_δδ, P22_δθ, P22_θθ] at k index `i` from the lattice `samples`.
+    pub fn evaluate(&self, i: usize, lattice: &Lattice, samples: &[f64]) -> [f64; 3] {
+        let (o0, o1) = (self.k_start[i] as usize, self.k_start[i + 1] as usize);
+        let mut start = if o0 == 0 {
+            0
+        } else {
+            self.outer_end[o0 - 1] as usize
+        };
+        let mut total = [0.0; 3];
+        for o in o0..o1 {
+            let end = self.outer_end[o] as usize;
+            let mut acc = [0.0; 3];
+            let nodes = self.inner_b[start..end]
+                .iter()
+                .zip(&self.inner_l[start..end])
+                .zip(&self.inner_w[start..end]);
+            for ((&b, l), w) in nodes {
+                let s = &samples[b as usize..b as usize + 4];
+                let l = l.map(f64::from);
+                let pp = (l[0] * s[0] + l[1] * s[1]) + (l[2] * s[2] + l[3] * s[3]);
+                acc[0] += f64::from(w[0]) * pp;
+                acc[1] += f64::from(w[1]) * pp;
+                acc[2] += f64::from(w[2]) * pp;
+            }
+            let pq = lattice.interpolate(samples, self.outer_u[o]);
+            for (t, a) in total.iter_mut().zip(acc) {
+                *t += pq * a;
+            }
+            start = end;
+        }
+        total
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pt_kernels::mode_coupling_2;
+
+    #[test]
+    fn closed_forms_match_generated_kernels() {
+        for (k, q, p) in [
+            (1.0, 0.3, 0.9),
+            (0.1, 2.0, 2.05),
+            (1.0, 1e-3, 1.0005),
+            (0.5, 0.25, 0.25),
+        ] {
+            let (k2, q2, p2) = (k * k, q * q, p * p);
+            let kq = 0.5 * (k2 + q2 - p2);
+            let [f, g] = mode_coupling_2(&[k2, kq, q2]);
+            let [cf, cg] = f2_g2(k2, q2, p2);
+            assert!(
+                (cf - f).abs() < 1e-12 * f.abs().max(1.0),
+                "F2 at {k} {q} {p}"
+            );
+            assert!(
+                (cg - g).abs() < 1e-12 * g.abs().max(1.0),
+                "G2 at {k} {q} {p}"
+            );
+        }
+    }
+
+    #[test]
+    fn panels_split_at_the_kinks() {
+        let lattice = Lattice::new(1e-5, 1e3, 0.01);
+        let layout = Layout {
+            order: 4,
+            narrow_order: 3,
+            narrow_width: 0.05,
+            ln_width: 0.3,
+            tail_growth: 0.3,
+            linear_width: 0.05,
+            band_end: 1.0,
+        };
+        let nodes = P22Nodes::new(&[0.1, 0.2], &lattice, &layout);
+        assert_eq!(nodes.k_start.len(), 3);
+        assert_eq!(*nodes.outer_end.last().unwrap() as usize, nodes.len());
+        // Every inner stencil lies inside the lattice.
+        assert!(nodes
+            .inner_b
+            .iter()
+            .all(|&b| (b as usize) + 4 <= lattice.len));
+    }
+}

@@ -1,0 +1,197 @@
+//! Every accuracy knob of the loop integrals in one place, with presets.
+//!
+//! [`Precision::default`] reaches ≲ 3e-6 relative on the 1-loop terms for 1e-3 ≤ k ≤ 1 h/Mpc on the
+//! CAMB spectra, with error estimates ≲ 4e-5 (see the tests and the README); [`Precision::fast`] is about
+//! twice as fast at ≲ 3e-5; [`Precision::reference`] doubles every resolution and is what convergence
+//! tests compare with. Presets override the default only where they differ. The struct is `#[non_exhaustive]`: start from a preset and
+//! change fields, e.g.
+//!
+//! ```
+//! use pt_spectra::precision::Precision;
+//! let mut p = Precision::default();
+//! p.q_max = 100.0;
+//! assert!(p.validate().is_ok());
+//! ```
+
+use crate::error::{Error, Result};
+
+/// Accuracy settings of the loop integrals. Wavenumbers in h/Mpc.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct Precision {
+    /// Lower limit of every loop integral over q [h/Mpc]; P = 0 below. Default 1e-5, as FAST-PT's
+    /// `low_extrap = −5` with which the reference tables were made; below the linear table the
+    /// spectrum's power-law extrapolation is used.
+    pub q_min: f64,
+    /// Upper limit of every loop integral over q [h/Mpc]; P = 0 above. Default 1e3, as FAST-PT's
+    /// `high_extrap = 3`. The tails beyond the CAMB tables (q < 1e-4 and q > 50 h/Mpc) change σ_v² and
+    /// P13 by ~5e-5 and P22 at k = 0.01 h/Mpc by ~2e-4, so do not cut them unless the spectrum is cut.
+    pub q_max: f64,
+    /// Largest step Δln q of the lattice on which the linear spectrum is sampled and interpolated (cubic
+    /// Lagrange in ln q). Default 0.01 (the CAMB tables have 0.011).
+    pub lattice_step: f64,
+    /// Gauss–Legendre nodes per lattice cell when building the P13 and σ_v² weights (the integrand is a
+    /// cubic times a smooth kernel). Default 4.
+    pub p13_cell_order: usize,
+    /// Gauss–Legendre nodes per panel of the P22 integral, outer (ln q) and inner (p). Default 6.
+    pub p22_order: usize,
+    /// Gauss–Legendre nodes of inner P22 ranges narrower than
+    /// [`p22_narrow_width`](Self::p22_narrow_width) in ln p (q ≪ k or q ≫ k, where the integrand is
+    /// nearly polynomial). Default 4.
+    pub p22_narrow_order: usize,
+    /// See [`p22_narrow_order`](Self::p22_narrow_order). Default 0.05.
+    pub p22_narrow_width: f64,
+    /// Largest P22 panel width in ln q for q ~ k (outer) and in ln p (inner). Default 0.3.
+    pub p22_ln_width: f64,
+    /// Growth of the outer panel width away from q ~ k: the width in ln q is
+    /// `p22_ln_width · max(1, p22_tail_growth · |ln(q/k)|)`, since the kernel is a smooth power law in
+    /// the tails. Default 0.3; 0 keeps the width constant.
+    pub p22_tail_growth: f64,
+    /// Largest P22 panel width in q and p [h/Mpc] below [`p22_band_end`](Self::p22_band_end), which
+    /// resolves the BAO wiggles (period 2π/r_s ≈ 0.06 h/Mpc). Default 0.05.
+    pub p22_linear_width: f64,
+    /// Upper end of the band where [`p22_linear_width`](Self::p22_linear_width) applies [h/Mpc]; the BAO
+    /// are Silk-damped beyond it. Default 1.
+    pub p22_band_end: f64,
+    /// Relative floor of the P22 error estimates. The Gauss–Legendre rules converge erratically below
+    /// ~1e-6 relative on tabulated spectra (a C² spline through a table with percent-level BAO wiggles
+    /// and round-off in its last digits, power-law joins at the table ends), so the order-lowering
+    /// estimate can fall below the actual error there; the floor covers that. Default 3e-6, from the
+    /// convergence study in the tests (default against reference settings on the CAMB tables).
+    pub p22_error_floor: f64,
+}
+
+impl Default for Precision {
+    fn default() -> Self {
+        Self {
+            q_min: 1e-5,
+            q_max: 1e3,
+            lattice_step: 0.01,
+            p13_cell_order: 4,
+            p22_order: 6,
+            p22_narrow_order: 4,
+            p22_narrow_width: 0.05,
+            p22_ln_width: 0.3,
+            p22_tail_growth: 0.3,
+            p22_linear_width: 0.05,
+            p22_band_end: 1.0,
+            p22_error_floor: 3e-6,
+        }
+    }
+}
+
+impl Precision {
+    /// About twice as fast as the default, ≲ 3e-5 relative (error estimates ≲ 2e-4): coarser lattice
+    /// and wider P22 panels.
+    pub fn fast() -> Self {
+        Self {
+            lattice_step: 0.02,
+            p13_cell_order: 3,
+            p22_ln_width: 0.5,
+            p22_tail_growth: 0.5,
+            p22_linear_width: 0.08,
+            p22_error_floor: 3e-5,
+            ..Self::default()
+        }
+    }
+
+    /// Every resolution of the default doubled; for convergence checks.
+    pub fn reference() -> Self {
+        let d = Self::default();
+        Self {
+            lattice_step: d.lattice_step / 2.0,
+            p13_cell_order: 2 * d.p13_cell_order,
+            p22_order: 2 * d.p22_order,
+            p22_narrow_order: 2 * d.p22_narrow_order,
+            p22_ln_width: d.p22_ln_width / 2.0,
+            p22_tail_growth: d.p22_tail_growth / 2.0,
+            p22_linear_width: d.p22_linear_width / 2.0,
+            p22_band_end: 2.0 * d.p22_band_end,
+            p22_error_floor: d.p22_error_floor / 10.0,
+            ..d
+        }
+    }
+
+    /// Checks the settings.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] unless 0 < q_min < q_max < ∞, every width and step is finite and
+    /// positive, the lattice has at least 8 points, and every order is ≥ 1.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |name, value: f64, reason| {
+            Err(Error::InvalidParameter {
+                name,
+                value,
+                reason,
+            })
+        };
+        let positive = "must be finite and positive";
+        for (name, v) in [
+            ("q_min [h/Mpc]", self.q_min),
+            ("q_max [h/Mpc]", self.q_max),
+            ("lattice_step", self.lattice_step),
+            ("p22_ln_width", self.p22_ln_width),
+            ("p22_narrow_width", self.p22_narrow_width),
+            ("p22_linear_width [h/Mpc]", self.p22_linear_width),
+            ("p22_band_end [h/Mpc]", self.p22_band_end),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return bad(name, v, positive);
+            }
+        }
+        for (name, v) in [
+            ("p22_tail_growth", self.p22_tail_growth),
+            ("p22_error_floor", self.p22_error_floor),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(name, v, "must be finite and non-negative");
+            }
+        }
+        if self.q_max <= self.q_min {
+            return bad("q_max [h/Mpc]", self.q_max, "must exceed q_min");
+        }
+        if (self.q_max / self.q_min).ln() < 8.0 * self.lattice_step {
+            return bad(
+                "lattice_step",
+                self.lattice_step,
+                "gives fewer than 8 lattice points",
+            );
+        }
+        for (name, v) in [
+            ("p13_cell_order", self.p13_cell_order),
+            ("p22_order", self.p22_order),
+            ("p22_narrow_order", self.p22_narrow_order),
+        ] {
+            if v == 0 {
+                return bad(name, 0.0, "must be at least 1");
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_validate_and_bad_values_are_named() {
+        for p in [
+            Precision::default(),
+            Precision::fast(),
+            Precision::reference(),
+        ] {
+            p.validate().unwrap();
+        }
+        let p = Precision {
+            q_max: 1e-6,
+            ..Precision::default()
+        };
+        assert!(p.validate().unwrap_err().to_string().contains("q_max"));
+        let p = Precision {
+            p22_order: 0,
+            ..Precision::default()
+        };
+        assert!(p.validate().unwrap_err().to_string().contains("p22_order"));
+    }
+}
