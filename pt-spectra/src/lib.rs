@@ -27,3 +27,8 @@ pub mod loops;
 pub mod precision;
 pub mod real;
 pub mod resum;
+
+/// The README's library example, compiled and run as a doctest.
+#[doc = include_str!("../../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
