@@ -9,6 +9,8 @@
 //!   embedded gm2012 CAMB spectra, log-log spline interpolation, power-law extrapolation, σ(R), σ_v².
 //! * [`cosmology`]: flat (or curved) ΛCDM [`Cosmology`](cosmology::Cosmology): exact linear growth D(z), f(z),
 //!   and the Eisenstein & Hu (1998) transfer functions with and without BAO wiggles.
+//! * [`loops`], [`resum`], [`real`]: 1-loop SPT terms with error estimates, RPT propagators, real-space models.
+//! * [`rsd`]: Kaiser and Scoccimarro redshift-space models, Fingers of God, Legendre multipoles.
 //!
 //! ```
 //! use pt_spectra::{cosmology::Cosmology, linear::LinearSpectrum};
@@ -27,6 +29,7 @@ pub mod loops;
 pub mod precision;
 pub mod real;
 pub mod resum;
+pub mod rsd;
 
 /// The README's library example, compiled and run as a doctest.
 #[doc = include_str!("../../README.md")]
