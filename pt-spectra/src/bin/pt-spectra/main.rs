@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 mod kernel;
 mod real;
+mod rsd;
 
 /// Perturbation-theory power spectra of matter and haloes (Gil-Marín et al. 2012, arXiv:1209.3771).
 #[derive(Parser)]
@@ -23,6 +24,8 @@ enum Command {
     Kernel(kernel::Args),
     /// Real-space P_δδ, P_δθ, P_θθ (linear, 1-loop SPT, 1-loop RPT with N0 or N1) on a k grid.
     Real(real::Args),
+    /// Redshift-space multipoles P_ℓ(k) (Kaiser or Scoccimarro, Fingers of God, linear bias).
+    Rsd(rsd::Args),
 }
 
 fn main() -> ExitCode {
@@ -30,6 +33,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Kernel(args) => kernel::run(&args),
         Command::Real(args) => real::run(&args),
+        Command::Rsd(args) => rsd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -64,9 +64,9 @@ fn parse_columns(s: &str) -> std::result::Result<Columns, String> {
     Ok(Columns::new(k, p))
 }
 
-/// Arguments of `pt-spectra real`.
+/// The linear spectrum, redshift, k grid and accuracy: the options `real` and `rsd` share.
 #[derive(clap::Args, Debug)]
-pub struct Args {
+pub struct Input {
     /// Linear spectrum table (k [h/Mpc], P [(Mpc/h)^3]; CAMB or CLASS format). Default: the embedded
     /// CAMB spectrum of the Gil-Marín et al. (2012) cosmology.
     #[arg(long, value_name = "FILE", conflicts_with = "eh")]
@@ -94,10 +94,7 @@ pub struct Args {
         default_value_t = 0.0,
         allow_hyphen_values = true
     )]
-    z: f64,
-    /// Model: linear, 1l-spt, 1l-rpt-n0 or 1l-rpt-n1.
-    #[arg(long, value_name = "M", default_value = "1l-spt")]
-    model: String,
+    pub z: f64,
     /// Smallest output k [h/Mpc] (log-spaced grid).
     #[arg(
         long,
@@ -120,12 +117,66 @@ pub struct Args {
     /// Read the output k values [h/Mpc] from the first column of this file instead ('#' comments).
     #[arg(long, value_name = "FILE", conflicts_with_all = ["k_min", "k_max", "nk"])]
     k_file: Option<PathBuf>,
-    /// Also print the separate loop terms, σ_v² and propagators, each with its error estimate.
-    #[arg(long)]
-    terms: bool,
     /// Accuracy of the loop integrals.
     #[arg(long, value_enum, default_value = "default")]
     precision: PrecisionPreset,
+}
+
+impl Input {
+    /// The output k grid [h/Mpc], the linear spectrum at the output redshift (with a warning when the
+    /// grid reaches its extrapolated ends) and the loop-integral settings.
+    pub fn load(&self) -> Result<(Vec<f64>, LinearSpectrum, Precision)> {
+        let precision = match self.precision {
+            PrecisionPreset::Fast => Precision::fast(),
+            PrecisionPreset::Default => Precision::default(),
+            PrecisionPreset::Reference => Precision::reference(),
+        };
+        let k = match &self.k_file {
+            Some(path) => read_k_file(path)?,
+            None => LogGrid::new(self.k_min, self.k_max, self.nk)
+                .context("invalid --k-min/--k-max/--nk")?
+                .points(),
+        };
+        let spectrum = linear_spectrum(self)?;
+        if let Some(ext) = spectrum.extrapolation_in(k[0], k[k.len() - 1]) {
+            eprintln!("warning: output {ext}");
+        }
+        Ok((k, spectrum, precision))
+    }
+
+    /// Header lines naming the input spectrum and the integration settings.
+    pub fn describe(&self, spectrum: &LinearSpectrum, precision: &Precision) -> String {
+        let mut h = format!(
+            "# linear spectrum: {} (z_input = {}; rescaled with the growth of the gm2012 cosmology)\n",
+            spectrum.origin(),
+            if self.linear.is_some() { self.z_input } else { self.z }
+        );
+        h += &format!(
+            "# loop integrals over q in [{:e}, {:e}] h/Mpc, precision {}; the linear table covers [{:e}, \
+             {:e}] h/Mpc and is extended by power laws (slopes {:.3}, {:.3})\n",
+            precision.q_min,
+            precision.q_max,
+            self.precision.name(),
+            spectrum.k_min(),
+            spectrum.k_max(),
+            spectrum.extrapolation_slopes().0,
+            spectrum.extrapolation_slopes().1
+        );
+        h
+    }
+}
+
+/// Arguments of `pt-spectra real`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(flatten)]
+    input: Input,
+    /// Model: linear, 1l-spt, 1l-rpt-n0 or 1l-rpt-n1.
+    #[arg(long, value_name = "M", default_value = "1l-spt")]
+    model: String,
+    /// Also print the separate loop terms, σ_v² and propagators, each with its error estimate.
+    #[arg(long)]
+    terms: bool,
     /// Write the table to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
@@ -134,26 +185,17 @@ pub struct Args {
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<()> {
     let model: RealModel = args.model.parse()?;
-    let precision = match args.precision {
-        PrecisionPreset::Fast => Precision::fast(),
-        PrecisionPreset::Default => Precision::default(),
-        PrecisionPreset::Reference => Precision::reference(),
-    };
-    let k = match &args.k_file {
-        Some(path) => read_k_file(path)?,
-        None => LogGrid::new(args.k_min, args.k_max, args.nk)
-            .context("invalid --k-min/--k-max/--nk")?
-            .points(),
-    };
-    let spectrum = linear_spectrum(args)?;
-    if let Some(ext) = spectrum.extrapolation_in(k[0], k[k.len() - 1]) {
-        eprintln!("warning: output {ext}");
-    }
+    let (k, spectrum, precision) = args.input.load()?;
     let terms = loop_terms(&k, &precision, &spectrum)?;
     let spectra = from_terms(model, &terms);
     let mut text = header(args, model, &spectrum, &precision, &terms);
     text.push_str(&table(&spectra, &terms, args.terms));
-    match &args.out {
+    write_output(args.out.as_ref(), &text)
+}
+
+/// Writes `text` to `out`, or to standard output.
+pub fn write_output(out: Option<&PathBuf>, text: &str) -> Result<()> {
+    match out {
         Some(path) => std::fs::write(path, text)
             .with_context(|| format!("cannot write `{}`", path.display()))?,
         None => std::io::stdout().write_all(text.as_bytes())?,
@@ -162,7 +204,7 @@ pub fn run(args: &Args) -> Result<()> {
 }
 
 /// The input spectrum at the output redshift.
-fn linear_spectrum(args: &Args) -> Result<LinearSpectrum> {
+fn linear_spectrum(args: &Input) -> Result<LinearSpectrum> {
     for (name, z) in [("--z", args.z), ("--z-input", args.z_input)] {
         if !(z.is_finite() && z > -1.0) {
             bail!("{name} {z}: a redshift must be finite and > -1");
@@ -228,7 +270,11 @@ fn read_k_file(path: &PathBuf) -> Result<Vec<f64>> {
 }
 
 /// The loop terms, in chunks behind a progress bar for long grids.
-fn loop_terms(k: &[f64], precision: &Precision, spectrum: &LinearSpectrum) -> Result<OneLoopTerms> {
+pub fn loop_terms(
+    k: &[f64],
+    precision: &Precision,
+    spectrum: &LinearSpectrum,
+) -> Result<OneLoopTerms> {
     if k.len() < PROGRESS_THRESHOLD {
         return Ok(OneLoopPlan::new(k, precision)?.par_evaluate(spectrum));
     }
@@ -275,25 +321,9 @@ fn header(
     let mut h = format!(
         "# pt-spectra {} real: model {model}, z = {}\n",
         env!("CARGO_PKG_VERSION"),
-        args.z
+        args.input.z
     );
-    h +=
-        &format!(
-        "# linear spectrum: {} (z_input = {}; rescaled with the growth of the gm2012 cosmology)\n",
-        spectrum.origin(),
-        if args.linear.is_some() { args.z_input } else { args.z }
-    );
-    h += &format!(
-        "# loop integrals over q in [{:e}, {:e}] h/Mpc, precision {}; the linear table covers [{:e}, {:e}] \
-         h/Mpc and is extended by power laws (slopes {:.3}, {:.3})\n",
-        precision.q_min,
-        precision.q_max,
-        args.precision.name(),
-        spectrum.k_min(),
-        spectrum.k_max(),
-        spectrum.extrapolation_slopes().0,
-        spectrum.extrapolation_slopes().1
-    );
+    h += &args.input.describe(spectrum, precision);
     h += "# conventions: theta = -div v/(aHf); 1-loop correction = P22 + 2 P13; err_X = estimated absolute \
           numerical error of X\n";
     h += &format!(
