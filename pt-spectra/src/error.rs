@@ -111,6 +111,34 @@ pub enum Error {
         right: usize,
     },
 
+    /// A tabulated value (other than k or P) is not acceptable.
+    #[error("{origin}:{line}: {name} = {value}: {reason}")]
+    InvalidValue {
+        /// File path or description of the input.
+        origin: String,
+        /// 1-based line (or row) number.
+        line: usize,
+        /// What the value is, e.g. `b(k)`.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// What the value must satisfy.
+        reason: &'static str,
+    },
+
+    /// A tabulated function was asked for outside its range (it is not extrapolated).
+    #[error("{what} is tabulated for {min} <= k <= {max} h/Mpc, but k = {k} h/Mpc is needed")]
+    OutOfRange {
+        /// The function and where it came from.
+        what: String,
+        /// The requested wavenumber in h/Mpc.
+        k: f64,
+        /// Lower end of the table in h/Mpc.
+        min: f64,
+        /// Upper end of the table in h/Mpc.
+        max: f64,
+    },
+
     /// A numeric argument or parameter is outside its allowed range.
     #[error("invalid {name} = {value}: {reason}")]
     InvalidParameter {

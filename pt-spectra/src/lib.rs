@@ -10,7 +10,9 @@
 //! * [`cosmology`]: flat (or curved) ΛCDM [`Cosmology`](cosmology::Cosmology): exact linear growth D(z), f(z),
 //!   and the Eisenstein & Hu (1998) transfer functions with and without BAO wiggles.
 //! * [`loops`], [`resum`], [`real`]: 1-loop SPT terms with error estimates, RPT propagators, real-space models.
-//! * [`rsd`]: Kaiser and Scoccimarro redshift-space models, Fingers of God, Legendre multipoles.
+//! * [`rsd`]: Kaiser, Scoccimarro and TNS redshift-space models, Fingers of God, Legendre multipoles.
+//! * [`halo`]: scale-dependent bias, stochasticity (shot noise) and signal-to-noise of haloes.
+//! * [`table`]: plain-text tables and tabulated functions of k.
 //!
 //! ```
 //! use pt_spectra::{cosmology::Cosmology, linear::LinearSpectrum};
@@ -23,6 +25,7 @@
 
 pub mod cosmology;
 pub mod error;
+pub mod halo;
 pub mod integrate;
 pub mod linear;
 pub mod loops;
@@ -30,6 +33,7 @@ pub mod precision;
 pub mod real;
 pub mod resum;
 pub mod rsd;
+pub mod table;
 
 /// The README's library example, compiled and run as a doctest.
 #[doc = include_str!("../../README.md")]

@@ -236,45 +236,13 @@ impl LinearSpectrum {
                 "must differ from the k column",
             ));
         }
-        let need = columns.k.max(columns.p) + 1;
-        let (mut k, mut p, mut header) = (Vec::new(), Vec::new(), Vec::new());
-        for (index, raw) in text.lines().enumerate() {
-            let line = index + 1;
-            let (data, comment) = raw.split_once('#').unwrap_or((raw, ""));
-            let fields: Vec<&str> = data
-                .split(|c: char| c == ',' || c.is_whitespace())
-                .filter(|s| !s.is_empty())
-                .collect();
-            if fields.is_empty() {
-                if data.trim().is_empty() && raw.trim_start().starts_with('#') {
-                    header.push(comment.trim().to_string());
-                }
-                continue;
-            }
-            if k.is_empty() && fields.iter().all(|f| f.parse::<f64>().is_err()) {
-                header.push(data.trim().to_string());
-                continue;
-            }
-            if fields.len() < need {
-                let column = if fields.len() <= columns.k {
-                    columns.k
-                } else {
-                    columns.p
-                };
-                let found = fields.len();
-                return Err(Error::MissingColumn {
-                    origin: origin.into(),
-                    line,
-                    column,
-                    found,
-                });
-            }
-            let kv = parse_field(fields[columns.k], origin, line, columns.k)?;
-            let pv = parse_field(fields[columns.p], origin, line, columns.p)?;
-            check_row(origin, line, kv, pv, k.last().copied())?;
-            k.push(kv);
-            p.push(pv);
+        let table = crate::table::Table::parse(text, origin, &[columns.k, columns.p])?;
+        let [k, p]: [Vec<f64>; 2] = table.columns.try_into().expect("two columns");
+        for i in 0..k.len() {
+            let previous = i.checked_sub(1).map(|j| k[j]);
+            check_row(origin, table.lines[i], k[i], p[i], previous)?;
         }
+        let header = table.header;
         Self::build(k, p, header, origin.to_string())
     }
 
@@ -497,15 +465,6 @@ pub fn top_hat(x: f64) -> f64 {
     } else {
         3.0 * (x.sin() - x * x.cos()) / (x * x * x)
     }
-}
-
-fn parse_field(field: &str, origin: &str, line: usize, column: usize) -> Result<f64> {
-    field.parse::<f64>().map_err(|_| Error::Parse {
-        origin: origin.into(),
-        line,
-        column,
-        field: field.into(),
-    })
 }
 
 fn check_row(origin: &str, line: usize, k: f64, p: f64, previous: Option<f64>) -> Result<()> {

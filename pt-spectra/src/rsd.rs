@@ -4,6 +4,8 @@
 //! coefficients are built once per k from the real-space spectra, so a new (f, b, σ0) costs no integral:
 //! * Kaiser (eq. kaiser_eq, whose printed (b + f²μ)² is a typo): P^s = (b + fμ²)² P_δδ;
 //! * Scoccimarro (eq. SC): P^s = b² P_δδ + 2bfμ² P_δθ + f²μ⁴ P_θθ;
+//! * TNS (eq. taruya_eq): Scoccimarro + A(k, μ; f, b) + B(k, μ; f, b), the leading-order correction terms of
+//!   Taruya, Nishimichi & Saito (2010) from [`crate::loops::TnsPlan`], A = b³A(f/b), B = b⁴B(f/b);
 //! * Fingers of God (eq. fog_changing): P^s → P^s D²_FoG(kμσ), σ = σ0 D(z) f(z) as the paper writes it
 //!   (eq. lorentzian): D_Lor = 1/(1 + ½ x²), D_Gau = exp(−½ x²), x = kμσ;
 //! * multipoles (eq. real_Ps): P_ℓ = (2ℓ+1)∫_0^1 dμ P^s(k, μ) L_ℓ(μ), ℓ even ≤ [`MAX_ELL`].
@@ -16,7 +18,7 @@
 
 use crate::error::{Error, Result};
 use crate::integrate::legendre_nodes;
-use crate::loops::Estimate;
+use crate::loops::{Estimate, TnsCoefficients};
 use std::fmt;
 use std::str::FromStr;
 
@@ -37,21 +39,30 @@ pub enum RsdModel {
     Kaiser,
     /// b² P_δδ + 2bfμ² P_δθ + f²μ⁴ P_θθ.
     Scoccimarro,
+    /// Scoccimarro + A + B (Taruya, Nishimichi & Saito 2010).
+    Tns,
 }
 
 impl RsdModel {
     /// Every model.
-    pub const ALL: [RsdModel; 2] = [RsdModel::Kaiser, RsdModel::Scoccimarro];
+    pub const ALL: [RsdModel; 3] = [RsdModel::Kaiser, RsdModel::Scoccimarro, RsdModel::Tns];
 
     /// The model's name.
     pub fn name(self) -> &'static str {
         match self {
             RsdModel::Kaiser => "kaiser",
             RsdModel::Scoccimarro => "scoccimarro",
+            RsdModel::Tns => "tns",
         }
     }
 
-    /// The coefficients of μ⁰, μ², μ⁴ at one k, from the real-space spectra and b, f.
+    /// Whether the model needs the TNS coefficients.
+    pub fn needs_tns(self) -> bool {
+        self == RsdModel::Tns
+    }
+
+    /// The coefficients of μ⁰, μ², μ⁴ at one k, from the real-space spectra and b, f (for TNS: its
+    /// Scoccimarro part).
     ///
     /// ```
     /// use pt_spectra::rsd::RsdModel;
@@ -63,8 +74,98 @@ impl RsdModel {
     pub fn coefficients(self, b: f64, f: f64, [p_dd, p_dt, p_tt]: [f64; 3]) -> [f64; 3] {
         match self {
             RsdModel::Kaiser => [b * b * p_dd, 2.0 * b * f * p_dd, f * f * p_dd],
-            RsdModel::Scoccimarro => [b * b * p_dd, 2.0 * b * f * p_dt, f * f * p_tt],
+            RsdModel::Scoccimarro | RsdModel::Tns => {
+                [b * b * p_dd, 2.0 * b * f * p_dt, f * f * p_tt]
+            }
         }
+    }
+
+    /// P^s(k, μ) at one k before damping, by part, from the real-space spectra [P_δδ, P_δθ, P_θθ] (with
+    /// their errors), the bias b, the growth rate f and, for TNS, the coefficients of A and B.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] if the model is TNS and `tns` is `None`.
+    pub fn parts(
+        self,
+        b: f64,
+        f: f64,
+        spectra: [Estimate; 3],
+        tns: Option<&TnsCoefficients>,
+    ) -> Result<Parts> {
+        let value = self.coefficients(b, f, spectra.map(|e| e.value));
+        let error = self.coefficients(b.abs(), f.abs(), spectra.map(|e| e.error));
+        let mut parts = Parts {
+            base: MuPolynomial::from_low(value, error),
+            ..Parts::default()
+        };
+        if self.needs_tns() {
+            let c = tns.ok_or(Error::InvalidParameter {
+                name: "TNS coefficients",
+                value: f64::NAN,
+                reason: "the tns model needs the A and B coefficients (TnsPlan)",
+            })?;
+            let ((av, ae), (bv, be)) = (c.a_polynomial(f, b), c.b_polynomial(f, b));
+            parts.a = MuPolynomial {
+                value: av,
+                error: ae,
+            };
+            parts.b = MuPolynomial {
+                value: bv,
+                error: be,
+            };
+        }
+        Ok(parts)
+    }
+}
+
+/// A polynomial Σ_n c_n μ^{2n} (n ≤ [`MAX_MU_POWER`]) with bounds on the errors of its coefficients.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MuPolynomial {
+    /// c_n, the coefficient of μ^{2n}.
+    pub value: [f64; MAX_MU_POWER + 1],
+    /// Bounds on the errors of c_n (≥ 0).
+    pub error: [f64; MAX_MU_POWER + 1],
+}
+
+impl MuPolynomial {
+    fn from_low(value: [f64; 3], error: [f64; 3]) -> Self {
+        let mut p = Self::default();
+        p.value[..3].copy_from_slice(&value);
+        p.error[..3].copy_from_slice(&error);
+        p
+    }
+
+    /// The sum of two polynomials, errors added.
+    pub fn add(&self, other: &Self) -> Self {
+        Self {
+            value: std::array::from_fn(|n| self.value[n] + other.value[n]),
+            error: std::array::from_fn(|n| self.error[n] + other.error[n]),
+        }
+    }
+
+    /// The value at μ.
+    pub fn at(&self, mu: f64) -> f64 {
+        let m2 = mu * mu;
+        self.value.iter().rev().fold(0.0, |acc, c| acc * m2 + c)
+    }
+}
+
+/// The parts of P^s(k, μ) before damping: the Kaiser or Scoccimarro part, and the TNS A and B terms
+/// (zero for the other models).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Parts {
+    /// Kaiser or Scoccimarro part.
+    pub base: MuPolynomial,
+    /// The TNS A term.
+    pub a: MuPolynomial,
+    /// The TNS B term.
+    pub b: MuPolynomial,
+}
+
+impl Parts {
+    /// base + A + B.
+    pub fn total(&self) -> MuPolynomial {
+        self.base.add(&self.a).add(&self.b)
     }
 }
 
@@ -87,7 +188,7 @@ impl FromStr for RsdModel {
             .find(|m| m.name().eq_ignore_ascii_case(s.trim()))
             .ok_or_else(|| Error::UnknownModel {
                 name: s.to_string(),
-                available: "kaiser, scoccimarro",
+                available: "kaiser, scoccimarro, tns",
             })
     }
 }
@@ -148,6 +249,88 @@ impl FromStr for Fog {
 /// paper writes it (σ0 is the z = 0 value; D(0) = 1).
 pub fn fog_sigma(sigma0: f64, growth_factor: f64, growth_rate: f64) -> f64 {
     sigma0 * growth_factor * growth_rate
+}
+
+/// Which P_θθ enters the theory value of the velocity dispersion (eq. sigmav).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum DispersionInput {
+    /// P_θθ = P_lin.
+    Linear,
+    /// P_θθ of 1-loop SPT up to [`DISPERSION_Q_CUT`], P_lin beyond.
+    OneLoopSpt,
+}
+
+/// Above this q [h/Mpc] the theory dispersion uses P_lin even for 1-loop input: 1-loop SPT P_θθ turns
+/// negative at q ≈ 0.5–1 h/Mpc (z = 0), where it means nothing. The q > 0.3 h/Mpc tail carries 9% of the
+/// linear σ² at z = 0 (σ = 6.078 Mpc/h with linear input, 5.802 with 1-loop input).
+pub const DISPERSION_Q_CUT: f64 = 0.3;
+
+/// The theory value of the FoG dispersion, eq. sigmav of the paper: σ²(z) = (4π/3)∫dq/(2π)³ P_θθ(q, z)
+/// = (1/6π²)∫P_θθ dq [(Mpc/h)²], over the loop range [q_min, q_max] of `precision`, for the linear
+/// `spectrum` at redshift z. Returns σ [Mpc/h] with an error estimate (Simpson against the half-size rule
+/// plus the propagated loop errors). σ0 = σ/D(z) (eq. lorentzian: σ(z) = σ0 D(z)).
+///
+/// # Errors
+/// As [`crate::loops::OneLoopPlan::new`].
+pub fn dispersion_theory(
+    spectrum: &crate::linear::LinearSpectrum,
+    input: DispersionInput,
+    precision: &crate::precision::Precision,
+) -> Result<Estimate> {
+    // Simpson in ln q on [q_min, q_cut] (P_θθ of the input) and [q_cut, q_max] (P_lin), N intervals each.
+    const N: usize = 400;
+    // Composite Simpson with step h, and its error estimate |S_h − S_2h|/15.
+    fn simpson(h: f64, y: &[f64]) -> f64 {
+        let n = y.len() - 1;
+        let inner: f64 = (1..n)
+            .map(|i| if i % 2 == 1 { 4.0 * y[i] } else { 2.0 * y[i] })
+            .sum();
+        (y[0] + inner + y[n]) * h / 3.0
+    }
+    let integrate = |x: &[f64], y: &[f64]| -> (f64, f64) {
+        let h = (x[x.len() - 1].ln() - x[0].ln()) / N as f64;
+        let fine = simpson(h, y);
+        let coarse = simpson(2.0 * h, &y.iter().step_by(2).copied().collect::<Vec<_>>());
+        (fine, (fine - coarse).abs() / 15.0)
+    };
+    let grid = |a: f64, b: f64| -> Vec<f64> {
+        (0..=N)
+            .map(|i| (a.ln() + (b.ln() - a.ln()) * i as f64 / N as f64).exp())
+            .collect()
+    };
+    let cut = DISPERSION_Q_CUT.clamp(precision.q_min, precision.q_max);
+    let low = grid(precision.q_min * (1.0 + 1e-9), cut * (1.0 - 1e-9));
+    let (p_tt, loop_error): (Vec<f64>, f64) = match input {
+        DispersionInput::Linear => (low.iter().map(|&q| spectrum.eval(q)).collect(), 0.0),
+        DispersionInput::OneLoopSpt => {
+            let terms = crate::loops::OneLoopPlan::new(&low, precision)?.evaluate(spectrum);
+            let corrections: Vec<Estimate> = (0..low.len()).map(|i| terms.tt.one_loop(i)).collect();
+            let p = (0..low.len())
+                .map(|i| terms.p_lin[i] + corrections[i].value)
+                .collect();
+            // Σ err · q Δln q bounds the propagated error of the integral.
+            let h = (cut / precision.q_min).ln() / N as f64;
+            let e = corrections
+                .iter()
+                .zip(&low)
+                .map(|(c, q)| c.error * q * h)
+                .sum();
+            (p, e)
+        }
+    };
+    let y: Vec<f64> = low.iter().zip(&p_tt).map(|(q, p)| q * p).collect();
+    let (a, ea) = integrate(&low, &y);
+    let high = grid(cut, precision.q_max);
+    let y: Vec<f64> = high.iter().map(|&q| q * spectrum.eval(q)).collect();
+    let (b, eb) = integrate(&high, &y);
+    let norm = 1.0 / (6.0 * std::f64::consts::PI.powi(2));
+    let sigma2 = (a + b) * norm;
+    let error2 = (ea + eb + loop_error) * norm;
+    let sigma = sigma2.max(0.0).sqrt();
+    Ok(Estimate::new(
+        sigma,
+        0.5 * error2 / sigma.max(f64::MIN_POSITIVE),
+    ))
 }
 
 /// Coefficients of L_ℓ(μ) in powers of μ: `legendre_coefficients(ℓ)[j]` multiplies μ^j.
@@ -314,6 +497,24 @@ impl MultipoleRule {
     }
 }
 
+impl MultipoleRule {
+    /// The multipoles of D²(kμσ) · `poly`, with the coefficient errors propagated: |L_ℓ| ≤ 1 and
+    /// 0 ≤ μ^{2n} D² ≤ 1 on [0, 1], so an error δc_n moves P_ℓ by at most (2ℓ+1) δc_n.
+    pub fn evaluate_polynomial(
+        &self,
+        poly: &MuPolynomial,
+        fog: Fog,
+        k_sigma: f64,
+    ) -> Vec<Estimate> {
+        let spread: f64 = poly.error.iter().sum();
+        let mut p = self.evaluate(&poly.value, fog, k_sigma);
+        for (e, &l) in p.iter_mut().zip(&self.ells) {
+            e.error += (2 * l + 1) as f64 * spread;
+        }
+        p
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -370,6 +571,27 @@ mod tests {
                 assert!((d.value - u.value).abs() < 1e-11, "{fog:?}");
             }
         }
+    }
+
+    #[test]
+    fn linear_theory_dispersion_is_sigma_v() {
+        use crate::linear::LinearSpectrum;
+        use crate::precision::Precision;
+        let p = LinearSpectrum::gm2012(0.0).unwrap();
+        let precision = Precision::fast();
+        let lin = dispersion_theory(&p, DispersionInput::Linear, &precision).unwrap();
+        // σ_v² of the FAST-PT header over the same range [1e-5, 1e3] h/Mpc: 36.9474495 (Mpc/h)².
+        assert!(
+            (lin.value.powi(2) / 36.947_449_5 - 1.0).abs() < 1e-6,
+            "{lin:?}"
+        );
+        assert!(lin.error < 1e-6 * lin.value);
+        let one = dispersion_theory(&p, DispersionInput::OneLoopSpt, &precision).unwrap();
+        // The 1-loop correction to P_θθ is negative on average at z = 0 and of order 10% of σ².
+        assert!(
+            one.value < lin.value && one.value > 0.8 * lin.value,
+            "{one:?}"
+        );
     }
 
     #[test]

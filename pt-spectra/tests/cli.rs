@@ -19,6 +19,61 @@ fn rows(text: &str) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// A fresh scratch directory under the target directory.
+fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Writes `text` to `dir/name` and returns the path as a string.
+fn write(dir: &std::path::Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.display().to_string()
+}
+
+#[test]
+fn tns_parts_add_up_and_bias_and_noise_tables_are_used() {
+    let dir = scratch("tns_parts");
+    // Constant tables, so that the run must agree with the constant options.
+    let bias = write(&dir, "b.dat", "# k b\n0.001 2.5\n1.0 2.5\n");
+    let noise = write(&dir, "n.dat", "0.001 3e4\n1.0 3e4\n");
+    let grid = [
+        "--nk",
+        "6",
+        "--k-min",
+        "0.02",
+        "--k-max",
+        "0.25",
+        "--precision",
+        "fast",
+    ];
+    let mut with_files = vec!["rsd", "--rsd", "tns", "--terms", "--bias-file", &bias];
+    with_files.extend(["--noise-file", &noise, "--amplitude", "1.2"]);
+    with_files.extend(grid);
+    let (ok, out, err) = run(&with_files);
+    assert!(ok, "{err}");
+    let mut constant = vec!["rsd", "--rsd", "tns", "--bias", "3", "--shot-noise", "3e4"];
+    constant.extend(grid);
+    let (ok, same, err) = run(&constant);
+    assert!(ok, "{err}");
+    let header = out.lines().find(|l| l.starts_with("# k ")).unwrap();
+    assert!(header.contains("P0_sc P2_sc P4_sc P0_A P2_A P4_A P0_B P2_B P4_B P_eps SN"));
+    assert!(out.contains("# signal-to-noise SN = P0/P_eps falls to 1 at k ="));
+    for (r, s) in rows(&out).iter().zip(rows(&same)) {
+        for l in 0..3 {
+            // total = Scoccimarro part + A + B, and A_b · b(k) = 1.2 · 2.5 equals b = 3.
+            let parts = r[4 + l] + r[7 + l] + r[10 + l];
+            assert!((r[1 + l] - parts).abs() <= 1e-8 * r[1 + l].abs().max(r[4 + l].abs()));
+            assert!((r[1 + l] / s[1 + l] - 1.0).abs() < 1e-8, "{r:?} {s:?}");
+        }
+        // P_eps and SN = P0/P_eps.
+        assert_eq!(r[13], 3e4);
+        assert!((r[14] - r[1] / 3e4).abs() < 1e-8 * r[14]);
+    }
+}
+
 #[test]
 fn linear_kaiser_multipoles_follow_the_closed_form() {
     let (b, f) = (1.7, 0.6);
@@ -50,6 +105,9 @@ fn linear_kaiser_multipoles_follow_the_closed_form() {
 
 #[test]
 fn bad_input_exits_non_zero_naming_the_problem() {
+    let dir = scratch("bad_input");
+    let bias_short = write(&dir, "b.dat", "0.001 2.0\n0.2 2.5\n");
+    let noise_nan = write(&dir, "n.dat", "0.001 1e4\n0.1 nan\n1.0 1e4\n");
     for (args, needle) in [
         (vec!["rsd", "--fog", "cauchy"], "cauchy"),
         (vec!["rsd", "--ells", "0,3"], "ell = 3"),
@@ -62,6 +120,17 @@ fn bad_input_exits_non_zero_naming_the_problem() {
         ),
         (vec!["real", "--k-min", "0.5", "--k-max", "0.1"], "k_max"),
         (vec!["kernel", "F"], "no argument vector"),
+        (
+            vec!["rsd", "--bias-file", "/nonexistent/b.dat"],
+            "/nonexistent/b.dat",
+        ),
+        (vec!["rsd", "--number-density", "0"], "number density"),
+        (vec!["rsd", "--shot-noise", "nan"], "shot noise"),
+        (
+            vec!["rsd", "--bias-file", &bias_short, "--k-max", "0.5"],
+            "b(k)",
+        ),
+        (vec!["rsd", "--noise-file", &noise_nan], "P_eps(k) = NaN"),
         (vec!["kernel", "F", "--q", "1,0", "--q", "0,1,0"], "1,0"),
     ] {
         let (ok, _, err) = run(&args);

@@ -39,10 +39,12 @@ mod lattice;
 mod one_loop;
 mod p13;
 mod p22;
+mod tns;
 
 pub use one_loop::OneLoopPlan;
 pub use p13::p13_kernels;
 pub use p22::f2_g2;
+pub use tns::{tns, TnsCoefficients, TnsPlan, TnsTerms};
 
 use crate::error::Result;
 use crate::linear::LinearSpectrum;

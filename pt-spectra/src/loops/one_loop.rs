@@ -11,7 +11,7 @@ use crate::precision::Precision;
 use rayon::prelude::*;
 
 /// The half-resolution rule of the error estimates lowers every P22 Gauss–Legendre order by this.
-const COARSE_ORDER_DROP: usize = 2;
+pub(crate) const COARSE_ORDER_DROP: usize = 2;
 
 /// P_lin, then [P13_F/P, P13_G/P, P22_δδ, P22_δθ, P22_θθ] with the fine and the half-resolution rule.
 type Row = (f64, [f64; 5], [f64; 5]);
@@ -46,23 +46,14 @@ impl Rule {
     fn new(ks: &[f64], lattice: Lattice, precision: &Precision, drop: usize) -> Self {
         let (nodes, weights) = legendre_nodes(precision.p13_cell_order);
         let rule = (nodes.as_slice(), weights.as_slice());
-        let lower = |n: usize| n.saturating_sub(drop).max(1);
-        let layout = Layout {
-            order: lower(precision.p22_order),
-            narrow_order: precision.p22_narrow_order.saturating_sub(drop / 2).max(1),
-            narrow_width: precision.p22_narrow_width,
-            ln_width: precision.p22_ln_width,
-            tail_growth: precision.p22_tail_growth,
-            linear_width: precision.p22_linear_width,
-            band_end: precision.p22_band_end,
-        };
+        let layout = Layout::new(precision, drop);
         Self {
             sigma_v2: sigma_v2_weights(&lattice, rule),
             p13: ks
                 .par_iter()
                 .map(|&k| p13_weights(&lattice, k, rule))
                 .collect(),
-            p22: P22Nodes::new(ks, &lattice, &layout),
+            p22: P22Nodes::p22(ks, &lattice, &layout),
             lattice,
         }
     }
@@ -87,6 +78,29 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     }
     let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
     (s[0] + s[1]) + (s[2] + s[3]) + tail
+}
+
+/// Checks `precision` and that `k` is a non-empty list of finite wavenumbers inside (q_min, q_max).
+pub(crate) fn validate_grid(k: &[f64], precision: &Precision) -> Result<()> {
+    precision.validate()?;
+    if k.is_empty() {
+        return Err(Error::InvalidParameter {
+            name: "number of k values",
+            value: 0.0,
+            reason: "must be at least 1",
+        });
+    }
+    if let Some(&bad) = k
+        .iter()
+        .find(|&&v| !(v.is_finite() && v > precision.q_min && v < precision.q_max))
+    {
+        return Err(Error::InvalidParameter {
+            name: "k [h/Mpc]",
+            value: bad,
+            reason: "must be finite and inside the integration range (q_min, q_max)",
+        });
+    }
+    Ok(())
 }
 
 /// A plan for the 1-loop terms on a fixed k grid: all quadrature weights, built once, independent of the
@@ -118,24 +132,7 @@ impl OneLoopPlan {
     /// [`Error::InvalidParameter`] for invalid `precision` (see [`Precision::validate`]), an empty grid, or
     /// a k that is not finite or not inside (q_min, q_max).
     pub fn new(k: &[f64], precision: &Precision) -> Result<Self> {
-        precision.validate()?;
-        if k.is_empty() {
-            return Err(Error::InvalidParameter {
-                name: "number of k values",
-                value: 0.0,
-                reason: "must be at least 1",
-            });
-        }
-        if let Some(&bad) = k
-            .iter()
-            .find(|&&v| !(v.is_finite() && v > precision.q_min && v < precision.q_max))
-        {
-            return Err(Error::InvalidParameter {
-                name: "k [h/Mpc]",
-                value: bad,
-                reason: "must be finite and inside the integration range (q_min, q_max)",
-            });
-        }
+        validate_grid(k, precision)?;
         let lattice = Lattice::new(precision.q_min, precision.q_max, precision.lattice_step);
         Ok(Self {
             k: k.to_vec(),

@@ -50,6 +50,21 @@ pub(crate) struct Layout {
 }
 
 impl Layout {
+    /// The layout of `precision`, with every Gauss–Legendre order lowered by `drop` (the half-resolution
+    /// rule of the error estimates: `drop` for the full order, `drop / 2` for the narrow-range order,
+    /// whose integrand is a polynomial of degree ~5 that a 3-point rule still integrates well).
+    pub fn new(precision: &crate::precision::Precision, drop: usize) -> Self {
+        Self {
+            order: precision.p22_order.saturating_sub(drop).max(1),
+            narrow_order: precision.p22_narrow_order.saturating_sub(drop / 2).max(1),
+            narrow_width: precision.p22_narrow_width,
+            ln_width: precision.p22_ln_width,
+            tail_growth: precision.p22_tail_growth,
+            linear_width: precision.p22_linear_width,
+            band_end: precision.p22_band_end,
+        }
+    }
+
     /// Largest inner panel width in p at `p` [h/Mpc].
     fn width(&self, p: f64) -> f64 {
         let log = self.ln_width * p;
@@ -74,13 +89,13 @@ impl Layout {
     }
 }
 
-/// Nodes of all k of a plan, flattened.
+/// Nodes of all k of a plan, flattened, each with `M` weights.
 ///
 /// Inner nodes store their interpolation stencil (first lattice point and the four Lagrange weights) and
-/// the three kernel weights in `f32`: their rounding (relative 6e-8, unbiased) is far below the
-/// quadrature errors, and halving the memory traffic speeds up [`P22Nodes::evaluate`].
-#[derive(Debug, Clone, Default)]
-pub(crate) struct P22Nodes {
+/// the `M` kernel weights in `f32`: their rounding (relative 6e-8, unbiased) is far below the
+/// quadrature errors, and halving the memory traffic speeds up the sums ([`P22Nodes::evaluate`]).
+#[derive(Debug, Clone)]
+pub(crate) struct PairNodes<const M: usize> {
     /// Per k: the range of outer nodes.
     pub k_start: Vec<u32>,
     /// Per outer node: lattice position of q.
@@ -91,26 +106,62 @@ pub(crate) struct P22Nodes {
     pub inner_b: Vec<u32>,
     /// Per inner node: the Lagrange weights of the four stencil points.
     pub inner_l: Vec<[f32; 4]>,
-    /// Per inner node: weights of F₂², F₂G₂, G₂².
-    pub inner_w: Vec<[f32; 3]>,
+    /// Per inner node: the kernel weights.
+    pub inner_w: Vec<[f32; M]>,
+}
+
+/// The P22 nodes: weights of F₂², F₂G₂, G₂².
+pub(crate) type P22Nodes = PairNodes<3>;
+
+impl<const M: usize> Default for PairNodes<M> {
+    fn default() -> Self {
+        Self {
+            k_start: Vec::new(),
+            outer_u: Vec::new(),
+            outer_end: Vec::new(),
+            inner_b: Vec::new(),
+            inner_l: Vec::new(),
+            inner_w: Vec::new(),
+        }
+    }
 }
 
 /// The rules of one plan.
-struct Rules<'a> {
+struct Rules<'a, K> {
     lattice: &'a Lattice,
     layout: &'a Layout,
     full: GaussLegendre,
     narrow: GaussLegendre,
+    kernel: &'a K,
 }
 
 impl P22Nodes {
-    /// The nodes for every k of `ks` (built in parallel over k; the result does not depend on threads).
-    pub fn new(ks: &[f64], lattice: &Lattice, layout: &Layout) -> Self {
+    /// The P22 nodes for every k of `ks` (see the module documentation).
+    pub fn p22(ks: &[f64], lattice: &Lattice, layout: &Layout) -> Self {
+        // The half p ≥ q of d³q/(2π)³ = q²p dln q dp/(4π²k) counts twice, and P22 = 2∫…
+        Self::new(ks, lattice, layout, &|k, q, p, measure| {
+            let [f, g] = f2_g2(k * k, q * q, p * p);
+            let c = measure / (PI * PI);
+            [c * f * f, c * f * g, c * g * g]
+        })
+    }
+}
+
+impl<const M: usize> PairNodes<M> {
+    /// The nodes for every k of `ks` on the half p ≥ q of the (q, p = |k − q|) plane (built in parallel
+    /// over k; the result does not depend on threads). `kernel(k, q, p, measure)` gives the M weights of
+    /// a node, where `measure` = w q² p / k is the quadrature weight of d³q/(2π)³ times 4π², so that
+    /// ∫_{p ≥ q} d³q/(2π)³ g = Σ measure · ⟨g⟩_φ/(4π²), ⟨g⟩_φ the average over the azimuth of q about k.
+    pub fn new<K>(ks: &[f64], lattice: &Lattice, layout: &Layout, kernel: &K) -> Self
+    where
+        K: Fn(f64, f64, f64, f64) -> [f64; M] + Sync,
+    {
         let rules = Rules {
             lattice,
             layout,
             full: GaussLegendre::new(layout.order),
             narrow: GaussLegendre::new(layout.narrow_order.min(layout.order)),
+            kernel,
         };
         let parts: Vec<Self> = ks.par_iter().map(|&k| Self::for_k(k, &rules)).collect();
         let mut nodes = Self::default();
@@ -130,7 +181,10 @@ impl P22Nodes {
     }
 
     /// The nodes of one k (without `k_start`).
-    fn for_k(k: f64, rules: &Rules) -> Self {
+    fn for_k<K>(k: f64, rules: &Rules<K>) -> Self
+    where
+        K: Fn(f64, f64, f64, f64) -> [f64; M],
+    {
         let (lattice, layout) = (rules.lattice, rules.layout);
         let (x_min, x_max) = (lattice.x0, lattice.x_end());
         let q_max = x_max.exp();
@@ -155,26 +209,26 @@ impl P22Nodes {
     }
 
     /// The inner nodes of outer node (ln q = x, weight w) at wavenumber k.
-    fn push_outer(&mut self, k: f64, x: f64, w: f64, rules: &Rules) {
+    fn push_outer<K>(&mut self, k: f64, x: f64, w: f64, rules: &Rules<K>)
+    where
+        K: Fn(f64, f64, f64, f64) -> [f64; M],
+    {
         let (lattice, layout) = (rules.lattice, rules.layout);
         let q = x.exp();
         let (lo, hi) = (q.max((k - q).abs()), (k + q).min(lattice.x_end().exp()));
         if hi <= lo {
             return;
         }
-        let (k2, q2) = (k * k, q * q);
-        let factor = w * q2 / (PI * PI * k);
+        let factor = w * q * q / k;
         let narrow = hi - lo < 0.5 * layout.width(lo) && (hi / lo).ln() < layout.narrow_width;
         let rule = if narrow { &rules.narrow } else { &rules.full };
         for e in panel_edges(lo, hi, |p| layout.width(p)).windows(2) {
             for (p, v) in rule.on(e[0], e[1]) {
-                let [f, g] = f2_g2(k2, q2, p * p);
-                let c = factor * v * p;
+                let weights = (rules.kernel)(k, q, p, factor * v * p);
                 let (b, t) = lattice.stencil(lattice.position(p));
                 self.inner_b.push(b as u32);
                 self.inner_l.push(lagrange4(t).map(|l| l as f32));
-                self.inner_w
-                    .push([c * f * f, c * f * g, c * g * g].map(|v| v as f32));
+                self.inner_w.push(weights.map(|v| v as f32));
             }
         }
         self.outer_u.push(lattice.position(q));
@@ -186,16 +240,24 @@ impl P22Nodes {
         self.inner_b.len()
     }
 
-    /// [P22_δδ, P22_δθ, P22_θθ] at k index `i` from the lattice `samples`.
-    pub fn evaluate(&self, i: usize, lattice: &Lattice, samples: &[f64]) -> [f64; 3] {
+    /// The range of inner nodes of k index `i`, and the range of its outer nodes.
+    pub fn ranges(&self, i: usize) -> (usize, std::ops::Range<usize>) {
         let (o0, o1) = (self.k_start[i] as usize, self.k_start[i + 1] as usize);
-        let mut start = if o0 == 0 {
+        let start = if o0 == 0 {
             0
         } else {
             self.outer_end[o0 - 1] as usize
         };
+        (start, o0..o1)
+    }
+}
+
+impl P22Nodes {
+    /// [P22_δδ, P22_δθ, P22_θθ] at k index `i` from the lattice `samples`.
+    pub fn evaluate(&self, i: usize, lattice: &Lattice, samples: &[f64]) -> [f64; 3] {
+        let (mut start, outer) = self.ranges(i);
         let mut total = [0.0; 3];
-        for o in o0..o1 {
+        for o in outer {
             let end = self.outer_end[o] as usize;
             let mut acc = [0.0; 3];
             let nodes = self.inner_b[start..end]
@@ -260,7 +322,7 @@ mod tests {
             linear_width: 0.05,
             band_end: 1.0,
         };
-        let nodes = P22Nodes::new(&[0.1, 0.2], &lattice, &layout);
+        let nodes = P22Nodes::p22(&[0.1, 0.2], &lattice, &layout);
         assert_eq!(nodes.k_start.len(), 3);
         assert_eq!(*nodes.outer_end.last().unwrap() as usize, nodes.len());
         // Every inner stencil lies inside the lattice.

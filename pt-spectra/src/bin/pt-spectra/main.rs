@@ -24,8 +24,8 @@ enum Command {
     Kernel(kernel::Args),
     /// Real-space P_δδ, P_δθ, P_θθ (linear, 1-loop SPT, 1-loop RPT with N0 or N1) on a k grid.
     Real(real::Args),
-    /// Redshift-space multipoles P_ℓ(k) (Kaiser or Scoccimarro, Fingers of God, linear bias).
-    Rsd(rsd::Args),
+    /// Redshift-space multipoles P_ℓ(k) (Kaiser, Scoccimarro or TNS; Fingers of God; halo bias and noise).
+    Rsd(Box<rsd::Args>),
 }
 
 fn main() -> ExitCode {

@@ -3,9 +3,17 @@
 use crate::real::{loop_terms, write_output, Input};
 use anyhow::{bail, Context, Result};
 use pt_spectra::cosmology::Cosmology;
+use pt_spectra::halo::{crossings, Bias, Noise};
+use pt_spectra::loops::TnsPlan;
 use pt_spectra::real::{from_terms, RealModel};
-use pt_spectra::rsd::{fog_sigma, Fog, MultipoleRule, RsdModel};
+use pt_spectra::rsd::{
+    dispersion_theory, fog_sigma, DispersionInput, Fog, MultipoleRule, RsdModel,
+};
+use pt_spectra::table::Tabulated;
 use std::path::PathBuf;
+
+/// Signal-to-noise levels whose crossings are reported (the paper's table_noise).
+const SN_LEVELS: [f64; 3] = [1.0, 0.5, 0.1];
 
 /// Arguments of `pt-spectra rsd`.
 #[derive(clap::Args, Debug)]
@@ -15,8 +23,9 @@ pub struct Args {
     /// Real-space model for P_δδ, P_δθ, P_θθ: linear, 1l-spt, 1l-rpt-n0 or 1l-rpt-n1.
     #[arg(long = "real", value_name = "M", default_value = "1l-rpt-n1")]
     real_model: String,
-    /// Redshift-space model: kaiser or scoccimarro.
-    #[arg(long, value_name = "MODEL", default_value = "scoccimarro")]
+    /// Redshift-space model: kaiser, scoccimarro or tns (Scoccimarro + the A and B terms of Taruya,
+    /// Nishimichi & Saito 2010 at leading order).
+    #[arg(long, value_name = "MODEL", default_value = "tns")]
     rsd: String,
     /// Growth rate f. Default: f(z) of the gm2012 cosmology.
     #[arg(long, value_name = "F", allow_hyphen_values = true)]
@@ -24,25 +33,57 @@ pub struct Args {
     /// Fingers-of-God damping: none, lorentzian or gaussian (P^s → P^s D², D of kμσ0 D(z) f).
     #[arg(long, value_name = "KIND", default_value = "none")]
     fog: String,
-    /// σ0 of the damping [Mpc/h] (its z = 0 value; scaled by D(z) f).
+    /// σ0 of the damping [Mpc/h] (its z = 0 value; scaled by D(z) f), or its theory value σ(z)/D(z) from
+    /// eq. sigmav, σ² = (1/6π²)∫P_θθ dq, with linear (`lin`) or 1-loop SPT (`1l-spt`) P_θθ.
     #[arg(
         long,
         value_name = "S",
-        default_value_t = 0.0,
+        default_value = "0",
         allow_hyphen_values = true
     )]
-    sigma0: f64,
+    sigma0: String,
     /// Constant linear bias b.
     #[arg(
         long,
         value_name = "B",
         default_value_t = 1.0,
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        conflicts_with = "bias_file"
     )]
     bias: f64,
+    /// Scale-dependent bias b(k) from a table (columns k [h/Mpc], b; interpolated in ln k, not
+    /// extrapolated).
+    #[arg(long, value_name = "FILE")]
+    bias_file: Option<PathBuf>,
+    /// Bias amplitude A_b: b(k) → A_b b(k).
+    #[arg(
+        long,
+        value_name = "A",
+        default_value_t = 1.0,
+        allow_hyphen_values = true
+    )]
+    amplitude: f64,
+    /// Constant stochasticity P_εε [(Mpc/h)^3]: adds the columns P_eps and SN = P0/P_eps and the k where
+    /// SN crosses 1, 0.5 and 0.1. The multipoles are noise-subtracted (P_εε changes only the monopole).
+    #[arg(long, value_name = "P", allow_hyphen_values = true, conflicts_with_all = ["number_density", "noise_file"])]
+    shot_noise: Option<f64>,
+    /// Poisson stochasticity P_εε = 1/n_h for the halo number density n_h [(h/Mpc)^3].
+    #[arg(
+        long,
+        value_name = "N",
+        allow_hyphen_values = true,
+        conflicts_with = "noise_file"
+    )]
+    number_density: Option<f64>,
+    /// P_εε(k) from a table (columns k [h/Mpc], P_εε [(Mpc/h)^3]).
+    #[arg(long, value_name = "FILE")]
+    noise_file: Option<PathBuf>,
     /// Multipoles to print, even ℓ ≤ 8, comma separated.
     #[arg(long, value_name = "L,L,…", default_value = "0,2,4")]
     ells: String,
+    /// Add the multipoles of the parts: P<l>_sc (Kaiser or Scoccimarro part), P<l>_A, P<l>_B (TNS terms).
+    #[arg(long)]
+    terms: bool,
     /// Write the table to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
@@ -58,6 +99,30 @@ fn parse_ells(s: &str) -> Result<Vec<usize>> {
         .collect()
 }
 
+impl Args {
+    fn bias(&self) -> Result<Bias> {
+        Ok(match &self.bias_file {
+            Some(path) => {
+                Bias::Table(Tabulated::read(path, "b(k)", (0, 1), true).context("--bias-file")?)
+            }
+            None => Bias::Constant(self.bias),
+        })
+    }
+
+    fn noise(&self) -> Result<Noise> {
+        Ok(
+            match (&self.noise_file, self.shot_noise, self.number_density) {
+                (Some(path), _, _) => Noise::Table(
+                    Tabulated::read(path, "P_eps(k)", (0, 1), true).context("--noise-file")?,
+                ),
+                (None, Some(p), _) => Noise::Constant(p),
+                (None, None, Some(n)) => Noise::poisson(n).context("--number-density")?,
+                (None, None, None) => Noise::None,
+            },
+        )
+    }
+}
+
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<()> {
     let real: RealModel = args.real_model.parse()?;
@@ -65,53 +130,111 @@ pub fn run(args: &Args) -> Result<()> {
     let fog: Fog = args.fog.parse()?;
     let ells = parse_ells(&args.ells)?;
     let rule = MultipoleRule::new(&ells)?;
+    let monopole = MultipoleRule::new(&[0])?;
+    let (bias, noise) = (args.bias()?, args.noise()?);
     let (k, spectrum, precision) = args.input.load()?;
     let cosmology = Cosmology::gm2012();
     let z = args.input.z;
     let f = args.f.unwrap_or_else(|| cosmology.growth_rate(z));
-    for (name, v) in [("--f", f), ("--bias", args.bias)] {
-        if !v.is_finite() {
-            bail!("{name} {v}: must be finite");
+    if !f.is_finite() {
+        bail!("--f {f}: must be finite");
+    }
+    let b = bias.values(&k, args.amplitude)?;
+    let p_eps = noise.values(&k)?;
+    let growth = cosmology.growth_factor(z);
+    let sigma0 = match args.sigma0.trim() {
+        "lin" => dispersion_theory(&spectrum, DispersionInput::Linear, &precision)?.value / growth,
+        "1l-spt" => {
+            dispersion_theory(&spectrum, DispersionInput::OneLoopSpt, &precision)?.value / growth
         }
-    }
-    if !(args.sigma0.is_finite() && args.sigma0 >= 0.0) {
-        bail!("--sigma0 {}: must be finite and non-negative", args.sigma0);
-    }
-    let sigma = fog_sigma(args.sigma0, cosmology.growth_factor(z), f);
+        s => match s.parse::<f64>() {
+            Ok(v) if v.is_finite() && v >= 0.0 => v,
+            _ => bail!(
+                "--sigma0 {s}: must be a finite non-negative number [Mpc/h], `lin` or `1l-spt`"
+            ),
+        },
+    };
+    let sigma = fog_sigma(sigma0, growth, f);
     let spectra = from_terms(real, &loop_terms(&k, &precision, &spectrum)?);
+    let tns = if rsd.needs_tns() {
+        Some(TnsPlan::new(&k, &precision)?.par_evaluate(&spectrum))
+    } else {
+        None
+    };
 
+    let bias_text = match &args.bias_file {
+        Some(p) => format!("b(k) from {}", p.display()),
+        None => format!("b = {}", args.bias),
+    };
     let mut text = format!(
-        "# pt-spectra {} rsd: {rsd} with real-space {real}, z = {z}, f = {f}, b = {}, FoG {fog:?} with \
-         sigma0 = {} Mpc/h (sigma = sigma0 D(z) f = {sigma:.6} Mpc/h)\n",
+        "# pt-spectra {} rsd: {rsd} with real-space {real}, z = {z}, f = {f}, {bias_text} times A_b = {}, \
+         FoG {fog:?} with sigma0 = {} Mpc/h (sigma = sigma0 D(z) f = {sigma:.6} Mpc/h)\n",
         env!("CARGO_PKG_VERSION"),
-        args.bias,
-        args.sigma0
+        args.amplitude,
+        sigma0
     );
     text += &args.input.describe(&spectrum, &precision);
-    text += "# P_l = (2l+1) int_0^1 dmu P^s(k,mu) L_l(mu); err_P_l bounds the numerical error (loop integrals \
-             and mu quadrature); k [h/Mpc], P [(Mpc/h)^3]\n# k";
+    if rsd.needs_tns() {
+        text += "# TNS A and B at leading order (linear P, tree-level bispectrum), A = b^3 A(f/b), B = b^4 B(f/b)\n";
+    }
+    text += "# P_l = (2l+1) int_0^1 dmu P^s(k,mu) L_l(mu), noise-subtracted; err_P_l bounds the numerical \
+             error (loop integrals and mu quadrature); k [h/Mpc], P [(Mpc/h)^3]\n";
+
+    let mut rows = Vec::with_capacity(k.len());
+    let mut signal_to_noise = Vec::with_capacity(k.len());
+    for (i, &ki) in k.iter().enumerate() {
+        let s = [0, 1, 2].map(|j| spectra.spectra[j][i]);
+        let parts = rsd.parts(b[i], f, s, tns.as_ref().map(|t| &t.coefficients[i]))?;
+        let total = rule.evaluate_polynomial(&parts.total(), fog, ki * sigma);
+        let mut row = vec![ki];
+        row.extend(total.iter().map(|e| e.value));
+        if args.terms {
+            for part in [parts.base, parts.a, parts.b] {
+                let p = rule.evaluate_polynomial(&part, fog, ki * sigma);
+                row.extend(p.iter().map(|e| e.value));
+            }
+        }
+        if let Some(p_eps) = &p_eps {
+            let p0 = monopole.evaluate_polynomial(&parts.total(), fog, ki * sigma)[0].value;
+            row.extend([p_eps[i], p0 / p_eps[i]]);
+            signal_to_noise.push(p0 / p_eps[i]);
+        }
+        row.extend(total.iter().map(|e| e.error));
+        rows.push(row);
+    }
+    if p_eps.is_some() {
+        text += "# signal-to-noise SN = P0/P_eps falls to";
+        for (level, c) in SN_LEVELS
+            .iter()
+            .zip(crossings(&k, &signal_to_noise, &SN_LEVELS))
+        {
+            match c {
+                Some(kc) => text += &format!(" {level} at k = {kc:.4}"),
+                None => text += &format!(" {level} at k = - (not on this grid)"),
+            }
+            text.push(';');
+        }
+        text.push('\n');
+    }
+    text += "# k";
     for l in &ells {
         text += &format!(" P{l}");
+    }
+    if args.terms {
+        for part in ["sc", "A", "B"] {
+            for l in &ells {
+                text += &format!(" P{l}_{part}");
+            }
+        }
+    }
+    if p_eps.is_some() {
+        text += " P_eps SN";
     }
     for l in &ells {
         text += &format!(" err_P{l}");
     }
     text.push('\n');
-    for (i, &ki) in k.iter().enumerate() {
-        let values = |j: usize| spectra.spectra[j][i].value;
-        let errors = |j: usize| spectra.spectra[j][i].error;
-        let c = rsd.coefficients(args.bias, f, [values(0), values(1), values(2)]);
-        let dc = rsd.coefficients(args.bias.abs(), f.abs(), [errors(0), errors(1), errors(2)]);
-        let p = rule.evaluate(&c, fog, ki * sigma);
-        let mut row = vec![ki];
-        row.extend(p.iter().map(|e| e.value));
-        // |L_l| ≤ 1 and 0 < mu^2n D² ≤ 1 on [0, 1], so an error δc_n moves P_l by at most (2l+1) Σ|δc_n|.
-        let spread: f64 = dc.iter().sum();
-        row.extend(
-            p.iter()
-                .zip(&ells)
-                .map(|(e, &l)| e.error + (2 * l + 1) as f64 * spread),
-        );
+    for row in rows {
         let line: Vec<String> = row.iter().map(|v| format!("{v:.9e}")).collect();
         text += &line.join(" ");
         text.push('\n');

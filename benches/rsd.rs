@@ -1,0 +1,81 @@
+//! Redshift space, for the embedded gm2012 z = 0 spectrum on 50 log-spaced k in [0.01, 0.3] h/Mpc:
+//!
+//! * `tns/evaluate`: the TNS A and B coefficients of μ^{2n} f^m ([`TnsPlan::evaluate`], one core);
+//! * `tns/plan`: building the cosmology-independent TNS plan (rayon's pool);
+//! * `multipoles/…`: P_0, P_2, P_4 of the TNS model at one (f, σ0, b) from the precomputed real-space
+//!   spectra and TNS coefficients: what a fit pays per step, undamped (exact) and with Lorentzian FoG
+//!   (32-point Gauss–Legendre plus the 16-point error estimate).
+//!
+//! Run with `cargo bench --bench rsd`.
+
+// `criterion_group!` defines an undocumented function.
+#![allow(missing_docs)]
+
+use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
+use pt_spectra::linear::{LinearSpectrum, LogGrid};
+use pt_spectra::loops::{TnsPlan, TnsTerms};
+use pt_spectra::precision::Precision;
+use pt_spectra::real::{real_space, RealModel, RealSpectra};
+use pt_spectra::rsd::{Fog, MultipoleRule, RsdModel};
+use std::time::Duration;
+
+fn grid() -> Vec<f64> {
+    LogGrid::new(0.01, 0.3, 50).expect("valid grid").points()
+}
+
+fn tns(c: &mut Criterion) {
+    let p = LinearSpectrum::gm2012(0.0).expect("embedded spectrum");
+    let k = grid();
+    let mut group = c.benchmark_group("tns");
+    group.measurement_time(Duration::from_secs(5));
+    let plan = TnsPlan::new(&k, &Precision::default()).expect("valid plan");
+    group.bench_function(BenchmarkId::new("evaluate (1 core)", 50), |b| {
+        b.iter(|| plan.evaluate(black_box(&p)))
+    });
+    group.sample_size(10);
+    group.bench_function(BenchmarkId::new("plan (rayon)", 50), |b| {
+        b.iter(|| TnsPlan::new(black_box(&k), &Precision::default()).expect("valid plan"))
+    });
+    group.finish();
+}
+
+/// P_0, P_2, P_4 at (f, σ, b) for every k: the sum a fit evaluates per step.
+fn multipoles(
+    rule: &MultipoleRule,
+    real: &RealSpectra,
+    tns: &TnsTerms,
+    (f, k_sigma, b): (f64, f64, f64),
+    fog: Fog,
+) -> f64 {
+    let mut sum = 0.0;
+    for (i, &k) in real.k.iter().enumerate() {
+        let s = [0, 1, 2].map(|j| real.spectra[j][i]);
+        let parts = RsdModel::Tns
+            .parts(b, f, s, Some(&tns.coefficients[i]))
+            .expect("TNS coefficients given");
+        let p = rule.evaluate_polynomial(&parts.total(), fog, k * k_sigma);
+        sum += p[0].value + p[1].value + p[2].value;
+    }
+    sum
+}
+
+fn rsd_multipoles(c: &mut Criterion) {
+    let p = LinearSpectrum::gm2012(0.0).expect("embedded spectrum");
+    let k = grid();
+    let (real, _) =
+        real_space(RealModel::OneLoopRptN1, &p, &k, &Precision::default()).expect("k valid");
+    let tns = TnsPlan::new(&k, &Precision::default())
+        .expect("valid plan")
+        .evaluate(&p);
+    let rule = MultipoleRule::new(&[0, 2, 4]).expect("valid ells");
+    let mut group = c.benchmark_group("multipoles (50 k, l = 0, 2, 4)");
+    for (name, fog) in [("undamped", Fog::None), ("lorentzian", Fog::Lorentzian)] {
+        group.bench_function(name, |b| {
+            b.iter(|| multipoles(&rule, &real, &tns, black_box((0.483, 3.5, 1.0)), fog))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, tns, rsd_multipoles);
+criterion_main!(benches);

@@ -1,0 +1,254 @@
+//! Plain-text tables: column selection with line-numbered errors, and functions of k tabulated in files
+//! (scale-dependent bias, noise spectra), interpolated in ln k without extrapolation.
+//!
+//! Format (as for linear spectra): lines starting with `#` (after optional blanks) are header lines;
+//! text after a `#` on a data line is ignored; blank lines are skipped; fields are separated by commas
+//! and/or whitespace; a single row of column names with no number in it before the first data row is
+//! taken as a header line.
+
+use crate::error::{Error, Result};
+use std::path::Path;
+
+/// The selected columns of a table's data rows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    /// File path or description, for messages.
+    pub origin: String,
+    /// Header lines (without the `#`).
+    pub header: Vec<String>,
+    /// 1-based line number of each data row.
+    pub lines: Vec<usize>,
+    /// `columns[j][i]`: the value of the j-th requested column on data row i.
+    pub columns: Vec<Vec<f64>>,
+}
+
+impl Table {
+    /// Reads the 0-based `columns` of the file at `path`.
+    ///
+    /// # Errors
+    /// [`Error::Io`], and as [`parse`](Self::parse).
+    pub fn read(path: impl AsRef<Path>, columns: &[usize]) -> Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(&text, &path.display().to_string(), columns)
+    }
+
+    /// Parses the 0-based `columns` of `text`; `origin` names it in messages. Values may be any f64
+    /// (NaN and infinities included: callers check what they need, e.g. with [`Tabulated::new`]).
+    ///
+    /// # Errors
+    /// [`Error::Parse`] for a field that is not a number, [`Error::MissingColumn`] for a short row.
+    pub fn parse(text: &str, origin: &str, columns: &[usize]) -> Result<Self> {
+        let need = columns.iter().max().map_or(0, |c| c + 1);
+        let mut table = Self {
+            origin: origin.to_string(),
+            header: Vec::new(),
+            lines: Vec::new(),
+            columns: vec![Vec::new(); columns.len()],
+        };
+        for (index, raw) in text.lines().enumerate() {
+            let line = index + 1;
+            let (data, comment) = raw.split_once('#').unwrap_or((raw, ""));
+            let fields: Vec<&str> = data
+                .split(|c: char| c == ',' || c.is_whitespace())
+                .filter(|s| !s.is_empty())
+                .collect();
+            if fields.is_empty() {
+                if data.trim().is_empty() && raw.trim_start().starts_with('#') {
+                    table.header.push(comment.trim().to_string());
+                }
+                continue;
+            }
+            if table.lines.is_empty() && fields.iter().all(|f| f.parse::<f64>().is_err()) {
+                table.header.push(data.trim().to_string());
+                continue;
+            }
+            if fields.len() < need {
+                let column = columns
+                    .iter()
+                    .copied()
+                    .find(|&c| c >= fields.len())
+                    .unwrap_or(need - 1);
+                return Err(Error::MissingColumn {
+                    origin: origin.into(),
+                    line,
+                    column,
+                    found: fields.len(),
+                });
+            }
+            for (values, &c) in table.columns.iter_mut().zip(columns) {
+                let field = fields[c];
+                values.push(field.parse::<f64>().map_err(|_| Error::Parse {
+                    origin: origin.into(),
+                    line,
+                    column: c,
+                    field: field.into(),
+                })?);
+            }
+            table.lines.push(line);
+        }
+        Ok(table)
+    }
+}
+
+/// A function of k [h/Mpc] given at strictly increasing k and interpolated linearly in ln k. It is not
+/// extrapolated: asking outside its range is an error.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tabulated {
+    name: &'static str,
+    origin: String,
+    k: Vec<f64>,
+    values: Vec<f64>,
+}
+
+impl Tabulated {
+    /// The function `name` (e.g. `b(k)`), checked: at least 2 rows, k finite, positive and strictly
+    /// increasing, values finite and, if `positive`, > 0. `lines` gives each row's line number for
+    /// messages (row numbers if empty).
+    ///
+    /// # Errors
+    /// [`Error::TooFewPoints`], [`Error::InvalidK`], [`Error::NonIncreasingK`], [`Error::InvalidValue`].
+    pub fn new(
+        name: &'static str,
+        origin: &str,
+        k: Vec<f64>,
+        values: Vec<f64>,
+        positive: bool,
+        lines: &[usize],
+    ) -> Result<Self> {
+        if k.len() != values.len() {
+            return Err(Error::LengthMismatch {
+                what: "k and values",
+                left: k.len(),
+                right: values.len(),
+            });
+        }
+        if k.len() < 2 {
+            return Err(Error::TooFewPoints {
+                origin: origin.into(),
+                found: k.len(),
+                min: 2,
+            });
+        }
+        let line = |i: usize| lines.get(i).copied().unwrap_or(i + 1);
+        for i in 0..k.len() {
+            if !(k[i].is_finite() && k[i] > 0.0) {
+                return Err(Error::InvalidK {
+                    origin: origin.into(),
+                    line: line(i),
+                    k: k[i],
+                });
+            }
+            if i > 0 && k[i] <= k[i - 1] {
+                return Err(Error::NonIncreasingK {
+                    origin: origin.into(),
+                    line: line(i),
+                    k: k[i],
+                    previous: k[i - 1],
+                });
+            }
+            if !(values[i].is_finite() && (!positive || values[i] > 0.0)) {
+                return Err(Error::InvalidValue {
+                    origin: origin.into(),
+                    line: line(i),
+                    name,
+                    value: values[i],
+                    reason: if positive {
+                        "must be finite and positive"
+                    } else {
+                        "must be finite"
+                    },
+                });
+            }
+        }
+        Ok(Self {
+            name,
+            origin: origin.to_string(),
+            k,
+            values,
+        })
+    }
+
+    /// Reads `name` from columns (k, value) of a file (0-based).
+    ///
+    /// # Errors
+    /// As [`Table::read`] and [`new`](Self::new).
+    pub fn read(
+        path: impl AsRef<Path>,
+        name: &'static str,
+        (k_column, value_column): (usize, usize),
+        positive: bool,
+    ) -> Result<Self> {
+        let table = Table::read(path, &[k_column, value_column])?;
+        let [k, v]: [Vec<f64>; 2] = table.columns.try_into().expect("two columns");
+        Self::new(name, &table.origin, k, v, positive, &table.lines)
+    }
+
+    /// The k range [h/Mpc].
+    pub fn range(&self) -> (f64, f64) {
+        (self.k[0], self.k[self.k.len() - 1])
+    }
+
+    /// The value at `k` [h/Mpc].
+    ///
+    /// # Errors
+    /// [`Error::OutOfRange`] outside the tabulated range.
+    pub fn eval(&self, k: f64) -> Result<f64> {
+        let (lo, hi) = self.range();
+        if !(k >= lo * (1.0 - 1e-12) && k <= hi * (1.0 + 1e-12)) {
+            return Err(Error::OutOfRange {
+                what: format!("{} from {}", self.name, self.origin),
+                k,
+                min: lo,
+                max: hi,
+            });
+        }
+        let j = self
+            .k
+            .partition_point(|&x| x <= k)
+            .clamp(1, self.k.len() - 1);
+        let (k0, k1) = (self.k[j - 1], self.k[j]);
+        let t = (k.ln() - k0.ln()) / (k1.ln() - k0.ln());
+        Ok(self.values[j - 1] + t * (self.values[j] - self.values[j - 1]))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn columns_are_selected_and_bad_rows_named() {
+        let text = "# bias\nk,b,x\n0.01 1.5 9\n0.02, 1.7, 9 # note\n\n0.04 2.1 9\n";
+        let t = Table::parse(text, "b.dat", &[0, 1]).unwrap();
+        assert_eq!(t.columns[1], vec![1.5, 1.7, 2.1]);
+        assert_eq!(t.lines, vec![3, 4, 6]);
+        let e = Table::parse("0.1 2\n0.2\n", "b.dat", &[0, 1]).unwrap_err();
+        assert!(e.to_string().starts_with("b.dat:2:"), "{e}");
+        let e = Table::parse("0.1 x\n", "b.dat", &[0, 1]).unwrap_err();
+        assert!(e.to_string().contains("`x`"), "{e}");
+    }
+
+    #[test]
+    fn interpolation_is_linear_in_ln_k_and_does_not_extrapolate() {
+        let f = Tabulated::new("b(k)", "mem", vec![0.01, 0.1], vec![1.0, 2.0], true, &[]).unwrap();
+        assert!((f.eval(0.01f64.sqrt() * 0.1f64.sqrt()).unwrap() - 1.5).abs() < 1e-14);
+        assert_eq!(f.eval(0.1).unwrap(), 2.0);
+        let e = f.eval(0.2).unwrap_err().to_string();
+        assert!(e.contains("b(k)") && e.contains("0.2"), "{e}");
+        let nan = Tabulated::new(
+            "b(k)",
+            "mem",
+            vec![0.01, 0.1],
+            vec![1.0, f64::NAN],
+            true,
+            &[],
+        );
+        assert!(nan.unwrap_err().to_string().contains("NaN"));
+        let down = Tabulated::new("b(k)", "mem", vec![0.1, 0.01], vec![1.0, 1.0], true, &[]);
+        assert!(down.is_err());
+    }
+}
