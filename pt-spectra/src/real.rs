@@ -7,6 +7,7 @@
 //! | `1l-spt`    | P_lin + P22_XY + 2 P13_XY (1-loop SPT)                |
 //! | `1l-rpt-n0` | [P_lin + P22_XY] N0², N0 = exp(−k²σ_v²/2)             |
 //! | `1l-rpt-n1` | [P_lin + P22_XY] N_X N_Y, N_δ,θ = exp(P13_δδ,θθ/P_lin) |
+//! | `1l-rpt-n2` | [P_lin + P22_XY] N_X N_Y, N from P13 and P15 (eq. theory_N2) |
 //!
 //! Every value carries an error estimate propagated from the loop integrals ([`crate::loops`]).
 
@@ -30,18 +31,21 @@ pub enum RealModel {
     OneLoopRptN0,
     /// 1-loop RPT with the propagator N1.
     OneLoopRptN1,
+    /// 1-loop RPT with the 2-loop propagator N2.
+    OneLoopRptN2,
 }
 
 /// The accepted model names, for messages.
-const MODEL_NAMES: &str = "linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1";
+const MODEL_NAMES: &str = "linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1, 1l-rpt-n2";
 
 impl RealModel {
     /// Every model.
-    pub const ALL: [RealModel; 4] = [
+    pub const ALL: [RealModel; 5] = [
         RealModel::Linear,
         RealModel::OneLoopSpt,
         RealModel::OneLoopRptN0,
         RealModel::OneLoopRptN1,
+        RealModel::OneLoopRptN2,
     ];
 
     /// The model's name (`linear`, `1l-spt`, `1l-rpt-n0`, `1l-rpt-n1`).
@@ -51,6 +55,7 @@ impl RealModel {
             RealModel::OneLoopSpt => "1l-spt",
             RealModel::OneLoopRptN0 => "1l-rpt-n0",
             RealModel::OneLoopRptN1 => "1l-rpt-n1",
+            RealModel::OneLoopRptN2 => "1l-rpt-n2",
         }
     }
 
@@ -59,8 +64,14 @@ impl RealModel {
         match self {
             RealModel::OneLoopRptN0 => Some(Propagator::N0),
             RealModel::OneLoopRptN1 => Some(Propagator::N1),
+            RealModel::OneLoopRptN2 => Some(Propagator::N2),
             _ => None,
         }
+    }
+
+    /// Whether the model needs the 2-loop propagator term P15 ([`crate::loops::add_p15`]).
+    pub fn needs_p15(self) -> bool {
+        self.propagator() == Some(Propagator::N2)
     }
 }
 
@@ -118,8 +129,18 @@ fn pair_index(pair: Pair) -> usize {
     }
 }
 
-/// The spectra of `model` from precomputed 1-loop `terms`.
-pub fn from_terms(model: RealModel, terms: &OneLoopTerms) -> RealSpectra {
+/// The spectra of `model` from precomputed loop `terms`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] if the model needs P15 and `terms` have none.
+pub fn from_terms(model: RealModel, terms: &OneLoopTerms) -> Result<RealSpectra> {
+    if model.needs_p15() && terms.dd.p15.len() != terms.k.len() {
+        return Err(Error::InvalidParameter {
+            name: "number of P15 values",
+            value: terms.dd.p15.len() as f64,
+            reason: "the model needs P15 at every k (loops::add_p15)",
+        });
+    }
     let n = terms.k.len();
     let mut spectra: [Vec<Estimate>; 3] = Default::default();
     let mut factors = None;
@@ -157,17 +178,18 @@ pub fn from_terms(model: RealModel, terms: &OneLoopTerms) -> RealSpectra {
             factors = Some(f);
         }
     }
-    RealSpectra {
+    Ok(RealSpectra {
         model,
         k: terms.k.clone(),
         p_lin: terms.p_lin.clone(),
         spectra,
         factors,
-    }
+    })
 }
 
-/// The spectra of `model` for `spectrum` at wavenumbers `k` [h/Mpc], with the 1-loop terms they were
-/// built from (computed in parallel over k; also for `linear`, so that they can be reported).
+/// The spectra of `model` for `spectrum` at wavenumbers `k` [h/Mpc], with the loop terms they were
+/// built from (computed in parallel over k; also for `linear`, so that they can be reported). Models
+/// with N2 also compute P15 (building the angular table on first use, see [`crate::loops::P15Table`]).
 ///
 /// # Errors
 /// As [`OneLoopPlan::new`].
@@ -188,8 +210,11 @@ pub fn real_space(
     k: &[f64],
     precision: &Precision,
 ) -> Result<(RealSpectra, OneLoopTerms)> {
-    let terms = OneLoopPlan::new(k, precision)?.par_evaluate(spectrum);
-    Ok((from_terms(model, &terms), terms))
+    let mut terms = OneLoopPlan::new(k, precision)?.par_evaluate(spectrum);
+    if model.needs_p15() {
+        crate::loops::add_p15(&mut terms, spectrum, precision, &|_, _| {});
+    }
+    Ok((from_terms(model, &terms)?, terms))
 }
 
 #[cfg(test)]
@@ -205,8 +230,8 @@ mod tests {
             "1L-SPT".parse::<RealModel>().unwrap(),
             RealModel::OneLoopSpt
         );
-        let e = "2l-spt".parse::<RealModel>().unwrap_err().to_string();
-        assert!(e.contains("2l-spt") && e.contains("1l-rpt-n1"), "{e}");
+        let e = "3l-spt".parse::<RealModel>().unwrap_err().to_string();
+        assert!(e.contains("3l-spt") && e.contains("1l-rpt-n2"), "{e}");
     }
 
     #[test]
@@ -214,8 +239,9 @@ mod tests {
         let p = LinearSpectrum::gm2012(1.0).unwrap();
         let k = [0.02, 0.05];
         let (lin, terms) = real_space(RealModel::Linear, &p, &k, &Precision::fast()).unwrap();
-        let spt = from_terms(RealModel::OneLoopSpt, &terms);
-        let n1 = from_terms(RealModel::OneLoopRptN1, &terms);
+        let spt = from_terms(RealModel::OneLoopSpt, &terms).unwrap();
+        let n1 = from_terms(RealModel::OneLoopRptN1, &terms).unwrap();
+        assert!(from_terms(RealModel::OneLoopRptN2, &terms).is_err());
         for (i, &ki) in k.iter().enumerate() {
             assert_eq!(lin.spectra[0][i].value, terms.p_lin[i]);
             for j in 0..3 {

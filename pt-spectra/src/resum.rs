@@ -4,14 +4,21 @@
 //! here at one loop. The propagators (the paper's N_i, Crocce & Scoccimarro 2006, astro-ph/0509418):
 //! * N0 = exp(−k²σ_v²/2), the same for δ and θ;
 //! * N1 = exp(P13/P_lin), with P13 = P13_δδ for δ and P13_θθ for θ (paper normalisation, the 1-loop
-//!   correction being P22 + 2P13), so that N1² = 1 + 2P13/P_lin + … reproduces 1-loop SPT.
+//!   correction being P22 + 2P13), so that N1² = 1 + 2P13/P_lin + … reproduces 1-loop SPT;
+//! * N2 (eq. theory_N2) = cosh√s + a sinh(√s)/√s with a = P13/P_lin, s = 2P15/P_lin; for P15 < 0 the
+//!   same entire function of s is cos√−s + a sin(√−s)/√−s. Its expansion 1 + a + s/2 + … reproduces the
+//!   propagator to two loops, and it equals N1 when s = a² (2P15 = (P13/P)² P, factorised kernels);
+//! * N3 (eq. N3) = Σ_j [t^j/(3j)! + a t^j/(3j+1)! + s t^j/(3j+2)!] with t = 6P17/P_lin, the paper's
+//!   (1/3)[A(x) + (a/x)C(x) + (s/x²)B(x)] with x = ∛t (the real cube root when P17 < 0); N3 = N1 when
+//!   s = a², t = a³. **Typo in the paper:** eq. N3 pairs B with P13 and C with P15, which breaks both
+//!   limits; B and C must be interchanged.
 //!
 //! δθ uses N_δ N_θ. Errors are propagated linearly from the loop terms' estimates:
 //! δN0 = N0 k² δσ_v²/2, δN1 = N1 δP13/P_lin, and δ(A·M) = |M| δA + |A| δM.
 
 use crate::loops::{Estimate, OneLoopTerms, Pair};
 
-/// Which 1-loop propagator.
+/// Which resummed propagator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum Propagator {
@@ -19,6 +26,8 @@ pub enum Propagator {
     N0,
     /// N1 = exp(P13/P_lin).
     N1,
+    /// N2 from P13 and P15 (eq. theory_N2).
+    N2,
 }
 
 /// N0(k) = exp(−k²σ_v²/2) with its error, k in h/Mpc, σ_v² in (Mpc/h)².
@@ -46,9 +55,120 @@ pub fn n1(p13: Estimate, p_lin: f64) -> Estimate {
     Estimate::new(value, value * p13.error / p_lin)
 }
 
+/// C(s) = cosh√s (cos√−s for s < 0) and S(s) = sinh(√s)/√s (sin(√−s)/√−s), with their derivatives
+/// C′ = S/2 and S′ = (C − S)/(2s) (series near s = 0).
+fn cosh_sinh(s: f64) -> [f64; 4] {
+    if s.abs() < 1e-3 {
+        let c = 1.0 + s / 2.0 + s * s / 24.0 + s * s * s / 720.0;
+        let sh = 1.0 + s / 6.0 + s * s / 120.0 + s * s * s / 5040.0;
+        return [c, sh, sh / 2.0, 1.0 / 6.0 + s / 60.0 + s * s / 1680.0];
+    }
+    let (c, sh) = if s > 0.0 {
+        let r = s.sqrt();
+        (r.cosh(), r.sinh() / r)
+    } else {
+        let r = (-s).sqrt();
+        (r.cos(), r.sin() / r)
+    };
+    [c, sh, sh / 2.0, (c - sh) / (2.0 * s)]
+}
+
+/// N2 = C(s) + a S(s) with a = P13/P_lin, s = 2P15/P_lin (both branches), with its error
+/// |S| δa + |C′ + a S′| δs.
+///
+/// ```
+/// use pt_spectra::{loops::Estimate, resum::{n1, n2}};
+/// // Factorised kernels, 2P15 = (P13/P)² P: N2 = N1 = e^a.
+/// let (p, p13) = (1000.0, Estimate::new(-300.0, 0.0));
+/// let p15 = Estimate::new(0.5 * 0.09 * p, 0.0);
+/// assert!((n2(p13, p15, p).value - n1(p13, p).value).abs() < 1e-15);
+/// ```
+pub fn n2(p13: Estimate, p15: Estimate, p_lin: f64) -> Estimate {
+    let (a, s) = (p13.value / p_lin, 2.0 * p15.value / p_lin);
+    let [c, sh, dc, dsh] = cosh_sinh(s);
+    let value = c + a * sh;
+    let error = sh.abs() * p13.error / p_lin + (dc + a * dsh).abs() * 2.0 * p15.error / p_lin;
+    Estimate::new(value, error)
+}
+
+/// The three series Σ_j t^j/(3j + m)!, m = 0, 1, 2, of N3; closed forms through x = ∛t (real root) for
+/// |t| > 1: A(x)/3, C(x)/(3x), B(x)/(3x²) with the paper's A, B, C. (The paper pairs B with P13 and C
+/// with P15; as printed N3 then does not expand to 1 + a + s/2 + t/6 nor reduce to e^a for factorised
+/// kernels: B and C are interchanged there.)
+fn triple_series(t: f64) -> [f64; 3] {
+    if t.abs() <= 1.0 {
+        let mut out = [0.0; 3];
+        let mut term = [1.0, 1.0, 0.5]; // t^j/(3j+m)! at j = 0
+        for j in 0..30 {
+            for m in 0..3 {
+                out[m] += term[m];
+                let n = (3 * j + m) as f64;
+                term[m] *= t / ((n + 1.0) * (n + 2.0) * (n + 3.0));
+            }
+        }
+        return out;
+    }
+    let x = t.cbrt();
+    let (e, h) = (x.exp(), (-0.5 * x).exp());
+    let (c, sn) = ((0.75f64.sqrt() * x).cos(), (0.75f64.sqrt() * x).sin());
+    let r3 = 3f64.sqrt();
+    [
+        (e + 2.0 * h * c) / 3.0,
+        (e - h * (c - r3 * sn)) / (3.0 * x),
+        (e - h * (c + r3 * sn)) / (3.0 * x * x),
+    ]
+}
+
+/// N3 = A₃(t) + a B₃(t) + s C₃(t) with a = P13/P_lin, s = 2P15/P_lin, t = 6P17/P_lin (eq. N3), with its
+/// error |B₃| δa + |C₃| δs + |∂N3/∂t| δt (the t-derivative by a central difference).
+///
+/// ```
+/// use pt_spectra::{loops::Estimate, resum::{n1, n3}};
+/// // Factorised kernels (2P15 = a²P, 6P17 = a³P): N3 = e^a, on both branches of the cube root.
+/// for a in [-0.3f64, -2.5, 1.7] {
+///     let p = 1000.0;
+///     let n = n3(Estimate::new(a * p, 0.0), Estimate::new(0.5 * a * a * p, 0.0), Estimate::new(a.powi(3) * p / 6.0, 0.0), p);
+///     assert!((n.value / a.exp() - 1.0).abs() < 1e-12, "{a}");
+/// }
+/// ```
+pub fn n3(p13: Estimate, p15: Estimate, p17: Estimate, p_lin: f64) -> Estimate {
+    let (a, s, t) = (
+        p13.value / p_lin,
+        2.0 * p15.value / p_lin,
+        6.0 * p17.value / p_lin,
+    );
+    let f = |t: f64| {
+        let [x, y, z] = triple_series(t);
+        x + a * y + s * z
+    };
+    let [_, y, z] = triple_series(t);
+    let h = 1e-4 * t.abs().max(1e-2);
+    let dt = (f(t + h) - f(t - h)) / (2.0 * h);
+    let error = y.abs() * p13.error / p_lin
+        + z.abs() * 2.0 * p15.error / p_lin
+        + dt.abs() * 6.0 * p17.error / p_lin;
+    Estimate::new(f(t), error)
+}
+
 /// The propagators (N_δ, N_θ) at every k of `terms`.
+///
+/// # Panics
+/// For [`Propagator::N2`] if `terms` has no P15 (see [`crate::loops::add_p15`]).
 pub fn propagators(kind: Propagator, terms: &OneLoopTerms) -> (Vec<Estimate>, Vec<Estimate>) {
     match kind {
+        Propagator::N2 => {
+            let of = |pair: &crate::loops::PairTerms| -> Vec<Estimate> {
+                assert_eq!(
+                    pair.p15.len(),
+                    terms.k.len(),
+                    "N2 needs P15 (loops::add_p15)"
+                );
+                (0..terms.k.len())
+                    .map(|i| n2(pair.p13[i], pair.p15[i], terms.p_lin[i]))
+                    .collect()
+            };
+            (of(&terms.dd), of(&terms.tt))
+        }
         Propagator::N0 => {
             let n: Vec<Estimate> = terms.k.iter().map(|&k| n0(k, terms.sigma_v2)).collect();
             (n.clone(), n)
@@ -95,6 +215,57 @@ pub fn one_loop_rpt(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn n2_branches_and_series_agree_with_the_closed_forms() {
+        let p = 1.0;
+        for (a, s) in [
+            (-0.4, 0.3),
+            (-0.4, -0.3),
+            (0.2, 2e-4),
+            (0.2, -2e-4),
+            (-3.0, 5.0),
+            (-3.0, -5.0),
+        ] {
+            let n = n2(Estimate::new(a, 0.0), Estimate::new(0.5 * s, 0.0), p).value;
+            let f64_sqrt = f64::sqrt;
+            let expected = if s > 0.0 {
+                f64_sqrt(s).cosh() + a * f64_sqrt(s).sinh() / f64_sqrt(s)
+            } else {
+                f64_sqrt(-s).cos() + a * f64_sqrt(-s).sin() / f64_sqrt(-s)
+            };
+            assert!((n - expected).abs() < 1e-12, "a={a} s={s}: {n} {expected}");
+        }
+        // Continuity across s = 0 and the derivative used for the error: δN2/δs = C′ + aS′.
+        let [_, _, dc, ds] = cosh_sinh(0.0);
+        assert_eq!((dc, ds), (0.5, 1.0 / 6.0));
+        let e = n2(Estimate::new(-0.4, 0.0), Estimate::new(0.15, 1e-3), 1.0).error;
+        let num = (n2(Estimate::new(-0.4, 0.0), Estimate::new(0.151, 0.0), 1.0).value
+            - n2(Estimate::new(-0.4, 0.0), Estimate::new(0.149, 0.0), 1.0).value)
+            / 2.0;
+        assert!((e - num.abs()).abs() < 1e-9, "{e} {num}");
+    }
+
+    #[test]
+    fn n3_series_and_closed_form_join() {
+        for t in [-1.0, 1.0] {
+            let series = triple_series(t);
+            let closed = triple_series(t * (1.0 + 1e-12) + t.signum() * 1e-15);
+            for m in 0..3 {
+                assert!((series[m] - closed[m]).abs() < 1e-9, "t={t} m={m}");
+            }
+        }
+        // N3 expands to 1 + a + s/2 + t/6 + … (the propagator to three loops).
+        let (a, s, t) = (1e-3, 2e-3, 3e-3);
+        let n = n3(
+            Estimate::new(a, 0.0),
+            Estimate::new(0.5 * s, 0.0),
+            Estimate::new(t / 6.0, 0.0),
+            1.0,
+        );
+        // Next terms: a t/24 + s t/120 + t²/720 ≈ 2e-7.
+        assert!((n.value - (1.0 + a + s / 2.0 + t / 6.0)).abs() < 3e-7);
+    }
 
     #[test]
     fn errors_propagate_linearly() {

@@ -38,11 +38,13 @@
 mod lattice;
 mod one_loop;
 mod p13;
+mod p15;
 mod p22;
 mod tns;
 
 pub use one_loop::OneLoopPlan;
 pub use p13::p13_kernels;
+pub use p15::{cache_path, p15_angular_kernel, P15Table};
 pub use p22::f2_g2;
 pub use tns::{tns, TnsCoefficients, TnsPlan, TnsTerms};
 
@@ -107,6 +109,9 @@ pub struct PairTerms {
     pub p22: Vec<Estimate>,
     /// P13 at each k, in the paper's normalisation (the correction is P22 + 2 P13).
     pub p13: Vec<Estimate>,
+    /// P15 at each k (2-loop propagator term, the correction containing 2 P15), or empty if not computed
+    /// (see [`add_p15`]).
+    pub p15: Vec<Estimate>,
 }
 
 impl PairTerms {
@@ -114,6 +119,7 @@ impl PairTerms {
         Self {
             p22: Vec::with_capacity(n),
             p13: Vec::with_capacity(n),
+            p15: Vec::new(),
         }
     }
 
@@ -149,6 +155,30 @@ impl OneLoopTerms {
             Pair::DeltaTheta => &self.dt,
             Pair::ThetaTheta => &self.tt,
         }
+    }
+}
+
+/// Adds P15 of δδ, δθ, θθ to `terms` (computed for `spectrum`, which must be the one `terms` were made
+/// from) from the angular table ([`P15Table::get`], built or read from the cache on first use; `progress`
+/// is called while it is built), over the q range and lattice step of `precision`.
+pub fn add_p15(
+    terms: &mut OneLoopTerms,
+    spectrum: &LinearSpectrum,
+    precision: &Precision,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) {
+    let table = P15Table::get(progress);
+    let p15 = table.evaluate(
+        &terms.k,
+        spectrum,
+        (precision.q_min, precision.q_max),
+        precision.lattice_step,
+    );
+    for (j, pair) in [&mut terms.dd, &mut terms.dt, &mut terms.tt]
+        .into_iter()
+        .enumerate()
+    {
+        pair.p15 = p15.iter().map(|row| row[j]).collect();
     }
 }
 

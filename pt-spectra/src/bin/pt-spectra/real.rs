@@ -171,7 +171,7 @@ impl Input {
 pub struct Args {
     #[command(flatten)]
     input: Input,
-    /// Model: linear, 1l-spt, 1l-rpt-n0 or 1l-rpt-n1.
+    /// Model: linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1 or 1l-rpt-n2.
     #[arg(long, value_name = "M", default_value = "1l-spt")]
     model: String,
     /// Also print the separate loop terms, σ_v² and propagators, each with its error estimate.
@@ -186,8 +186,8 @@ pub struct Args {
 pub fn run(args: &Args) -> Result<()> {
     let model: RealModel = args.model.parse()?;
     let (k, spectrum, precision) = args.input.load()?;
-    let terms = loop_terms(&k, &precision, &spectrum)?;
-    let spectra = from_terms(model, &terms);
+    let terms = loop_terms(&k, &precision, &spectrum, model)?;
+    let spectra = from_terms(model, &terms)?;
     let mut text = header(args, model, &spectrum, &precision, &terms);
     text.push_str(&table(&spectra, &terms, args.terms));
     write_output(args.out.as_ref(), &text)
@@ -269,8 +269,37 @@ fn read_k_file(path: &PathBuf) -> Result<Vec<f64>> {
     Ok(k)
 }
 
-/// The loop terms, in chunks behind a progress bar for long grids.
+/// The loop terms `model` needs: the 1-loop terms (in chunks behind a progress bar for long grids) and,
+/// for N2, P15 (behind a progress bar while its angular table is built on first use).
 pub fn loop_terms(
+    k: &[f64],
+    precision: &Precision,
+    spectrum: &LinearSpectrum,
+    model: RealModel,
+) -> Result<OneLoopTerms> {
+    let mut terms = one_loop_terms(k, precision, spectrum)?;
+    if model.needs_p15() {
+        let bar = ProgressBar::hidden();
+        bar.set_style(
+            ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} nodes ({eta})")
+                .map_err(|e| anyhow::anyhow!("progress bar: {e}"))?,
+        );
+        bar.set_message("P15 angular table (once; cached)");
+        let progress = |done: usize, total: usize| {
+            if bar.is_hidden() {
+                bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+                bar.set_length(total as u64);
+            }
+            bar.set_position(done as u64);
+        };
+        pt_spectra::loops::add_p15(&mut terms, spectrum, precision, &progress);
+        bar.finish_and_clear();
+    }
+    Ok(terms)
+}
+
+/// The 1-loop terms, in chunks behind a progress bar for long grids.
+fn one_loop_terms(
     k: &[f64],
     precision: &Precision,
     spectrum: &LinearSpectrum,
@@ -304,9 +333,10 @@ fn append(all: &mut OneLoopTerms, part: OneLoopTerms) {
         (&mut all.dt, part.dt),
         (&mut all.tt, part.tt),
     ] {
-        let PairTerms { p22, p13 } = b;
+        let PairTerms { p22, p13, p15 } = b;
         a.p22.extend(p22);
         a.p13.extend(p13);
+        a.p15.extend(p15);
     }
 }
 
@@ -370,6 +400,11 @@ fn column_names(model: RealModel, terms: bool) -> Vec<(String, &'static str)> {
         with_err(&mut c, format!("P22_{s}"), POWER);
         with_err(&mut c, format!("P13_{s}"), POWER);
     }
+    if model.needs_p15() {
+        for pair in Pair::ALL {
+            with_err(&mut c, format!("P15_{}", pair.suffix()), POWER);
+        }
+    }
     with_err(&mut c, "sigma_v2".into(), "(Mpc/h)^2");
     if model.propagator().is_some() {
         for s in ["dd", "dt", "tt"] {
@@ -391,6 +426,11 @@ fn table(spectra: &RealSpectra, terms: &OneLoopTerms, with_terms: bool) -> Strin
                 let t = terms.pair(pair);
                 push(&mut row, t.p22[i]);
                 push(&mut row, t.p13[i]);
+            }
+            if spectra.model.needs_p15() {
+                for pair in Pair::ALL {
+                    push(&mut row, terms.pair(pair).p15[i]);
+                }
             }
             push(&mut row, terms.sigma_v2);
             if let Some(f) = &spectra.factors {
@@ -455,7 +495,10 @@ mod tests {
         for model in RealModel::ALL {
             for with_terms in [false, true] {
                 let names = column_names(model, with_terms).len();
-                let text = table(&from_terms(model, &terms), &terms, with_terms);
+                let Ok(spectra) = from_terms(model, &terms) else {
+                    continue;
+                };
+                let text = table(&spectra, &terms, with_terms);
                 for line in text.lines() {
                     assert_eq!(
                         line.split_whitespace().count(),

@@ -20,7 +20,7 @@ const SN_LEVELS: [f64; 3] = [1.0, 0.5, 0.1];
 pub struct Args {
     #[command(flatten)]
     input: Input,
-    /// Real-space model for P_δδ, P_δθ, P_θθ: linear, 1l-spt, 1l-rpt-n0 or 1l-rpt-n1.
+    /// Real-space model for P_δδ, P_δθ, P_θθ: linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1 or 1l-rpt-n2.
     #[arg(long = "real", value_name = "M", default_value = "1l-rpt-n1")]
     real_model: String,
     /// Redshift-space model: kaiser, scoccimarro or tns (Scoccimarro + the A and B terms of Taruya,
@@ -155,7 +155,7 @@ pub fn run(args: &Args) -> Result<()> {
         },
     };
     let sigma = fog_sigma(sigma0, growth, f);
-    let spectra = from_terms(real, &loop_terms(&k, &precision, &spectrum)?);
+    let spectra = from_terms(real, &loop_terms(&k, &precision, &spectrum, real)?)?;
     let tns = if rsd.needs_tns() {
         Some(TnsPlan::new(&k, &precision)?.par_evaluate(&spectrum))
     } else {

@@ -1,0 +1,47 @@
+//! The 2-loop propagator term P15 of δδ, δθ, θθ (with error estimates) from the angular table, for the
+//! embedded gm2012 z = 0 spectrum, and the N2 propagator built from it:
+//!
+//! * `p15/evaluate/100`: P15 on 100 log-spaced k in [0.005, 0.4] h/Mpc (rayon's pool);
+//! * `n2/1l-rpt-n2/100`: the whole 1L-RPT-N2 model on the same grid: 1-loop plan and terms, P15, N2.
+//!
+//! The angular table is read from its cache (or built once, outside the timing). Run with
+//! `cargo bench --bench two_loop`.
+
+// `criterion_group!` defines an undocumented function.
+#![allow(missing_docs)]
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use pt_spectra::linear::{LinearSpectrum, LogGrid};
+use pt_spectra::loops::P15Table;
+use pt_spectra::precision::Precision;
+use pt_spectra::real::{real_space, RealModel};
+
+fn p15(c: &mut Criterion) {
+    let p = LinearSpectrum::gm2012(0.0).expect("embedded spectrum");
+    let k = LogGrid::new(0.005, 0.4, 100).expect("valid grid").points();
+    let precision = Precision::default();
+    let table = P15Table::get(&|_, _| {});
+    let mut group = c.benchmark_group("p15");
+    group.bench_function("evaluate/100", |b| {
+        b.iter(|| {
+            table.evaluate(
+                black_box(&k),
+                &p,
+                (precision.q_min, precision.q_max),
+                precision.lattice_step,
+            )
+        })
+    });
+    group.finish();
+    let mut group = c.benchmark_group("n2");
+    group.sample_size(20);
+    group.bench_function("1l-rpt-n2/100", |b| {
+        b.iter(|| {
+            real_space(RealModel::OneLoopRptN2, black_box(&p), &k, &precision).expect("valid")
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, p15);
+criterion_main!(benches);
