@@ -2,7 +2,9 @@
 //! embedded gm2012 z = 0 spectrum, and the N2 propagator built from it:
 //!
 //! * `p15/evaluate/100`: P15 on 100 log-spaced k in [0.005, 0.4] h/Mpc (rayon's pool);
-//! * `n2/1l-rpt-n2/100`: the whole 1L-RPT-N2 model on the same grid: 1-loop plan and terms, P15, N2.
+//! * `n2/1l-rpt-n2/100`: the whole 1L-RPT-N2 model on the same grid: 1-loop plan and terms, P15, N2;
+//! * `two_loop/set/40`: every 2-loop term (P15, P24, P33, the total) of δδ, δθ, θθ with errors on 40
+//!   log-spaced k in [0.005, 0.4] at the default precision (after the 1-loop terms).
 //!
 //! The angular table is read from its cache (or built once, outside the timing). Run with
 //! `cargo bench --bench two_loop`.
@@ -12,7 +14,7 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use pt_spectra::linear::{LinearSpectrum, LogGrid};
-use pt_spectra::loops::P15Table;
+use pt_spectra::loops::{add_two_loop, OneLoopPlan, P15Table};
 use pt_spectra::precision::Precision;
 use pt_spectra::real::{real_space, RealModel};
 
@@ -43,5 +45,25 @@ fn p15(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, p15);
+fn two_loop(c: &mut Criterion) {
+    let p = LinearSpectrum::gm2012(0.0).expect("embedded spectrum");
+    let k = LogGrid::new(0.005, 0.4, 40).expect("valid grid").points();
+    let precision = Precision::default();
+    let one = OneLoopPlan::new(&k, &precision)
+        .expect("valid")
+        .par_evaluate(&p);
+    P15Table::get(&|_, _| {});
+    let mut group = c.benchmark_group("two_loop");
+    group.sample_size(10);
+    group.bench_function("set/40", |b| {
+        b.iter(|| {
+            let mut terms = one.clone();
+            add_two_loop(&mut terms, black_box(&p), &precision, &|_, _| {});
+            terms
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, p15, two_loop);
 criterion_main!(benches);

@@ -59,6 +59,12 @@ pub struct Precision {
     /// estimate can fall below the actual error there; the floor covers that. Default 3e-6, from the
     /// convergence study in the tests (default against reference settings on the CAMB tables).
     pub p22_error_floor: f64,
+    /// Sobol points per random shift and per k of the 2-loop mode-coupling integral (P24 + P33irr, see
+    /// [`crate::loops::two_loop`]; each point is evaluated at its four images q_i → ±q_i). Default 2^14;
+    /// its error falls roughly as 1/√points.
+    pub two_loop_points: usize,
+    /// Random shifts of the 2-loop integral (its error is their standard error). Default 8.
+    pub two_loop_replicas: usize,
 }
 
 impl Default for Precision {
@@ -76,6 +82,8 @@ impl Default for Precision {
             p22_linear_width: 0.05,
             p22_band_end: 1.0,
             p22_error_floor: 3e-6,
+            two_loop_points: 1 << 14,
+            two_loop_replicas: 8,
         }
     }
 }
@@ -91,6 +99,7 @@ impl Precision {
             p22_tail_growth: 0.5,
             p22_linear_width: 0.08,
             p22_error_floor: 3e-5,
+            two_loop_points: 1 << 12,
             ..Self::default()
         }
     }
@@ -108,6 +117,7 @@ impl Precision {
             p22_linear_width: d.p22_linear_width / 2.0,
             p22_band_end: 2.0 * d.p22_band_end,
             p22_error_floor: d.p22_error_floor / 10.0,
+            two_loop_points: 4 * d.two_loop_points,
             ..d
         }
     }
@@ -161,10 +171,18 @@ impl Precision {
             ("p13_cell_order", self.p13_cell_order),
             ("p22_order", self.p22_order),
             ("p22_narrow_order", self.p22_narrow_order),
+            ("two_loop_points", self.two_loop_points),
         ] {
             if v == 0 {
                 return bad(name, 0.0, "must be at least 1");
             }
+        }
+        if self.two_loop_replicas < 2 {
+            return bad(
+                "two_loop_replicas",
+                self.two_loop_replicas as f64,
+                "must be at least 2 (the error is their spread)",
+            );
         }
         Ok(())
     }

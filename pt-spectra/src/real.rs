@@ -8,6 +8,8 @@
 //! | `1l-rpt-n0` | [P_lin + P22_XY] N0², N0 = exp(−k²σ_v²/2)             |
 //! | `1l-rpt-n1` | [P_lin + P22_XY] N_X N_Y, N_δ,θ = exp(P13_δδ,θθ/P_lin) |
 //! | `1l-rpt-n2` | [P_lin + P22_XY] N_X N_Y, N from P13 and P15 (eq. theory_N2) |
+//! | `2l-spt`    | P_lin + P22 + 2P13 + (2P15 + 2P24 + P33) (2-loop SPT)  |
+//! | `2l-rpt-n0`, `2l-rpt-n1`, `2l-rpt-n2` | [P_lin + P22_XY + P33^{2L}_XY] N_X N_Y |
 //!
 //! Every value carries an error estimate propagated from the loop integrals ([`crate::loops`]).
 
@@ -33,19 +35,32 @@ pub enum RealModel {
     OneLoopRptN1,
     /// 1-loop RPT with the 2-loop propagator N2.
     OneLoopRptN2,
+    /// 2-loop standard perturbation theory.
+    TwoLoopSpt,
+    /// 2-loop RPT with N0.
+    TwoLoopRptN0,
+    /// 2-loop RPT with N1.
+    TwoLoopRptN1,
+    /// 2-loop RPT with N2 (the paper's best model).
+    TwoLoopRptN2,
 }
 
 /// The accepted model names, for messages.
-const MODEL_NAMES: &str = "linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1, 1l-rpt-n2";
+const MODEL_NAMES: &str =
+    "linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1, 1l-rpt-n2, 2l-spt, 2l-rpt-n0, 2l-rpt-n1, 2l-rpt-n2";
 
 impl RealModel {
     /// Every model.
-    pub const ALL: [RealModel; 5] = [
+    pub const ALL: [RealModel; 9] = [
         RealModel::Linear,
         RealModel::OneLoopSpt,
         RealModel::OneLoopRptN0,
         RealModel::OneLoopRptN1,
         RealModel::OneLoopRptN2,
+        RealModel::TwoLoopSpt,
+        RealModel::TwoLoopRptN0,
+        RealModel::TwoLoopRptN1,
+        RealModel::TwoLoopRptN2,
     ];
 
     /// The model's name (`linear`, `1l-spt`, `1l-rpt-n0`, `1l-rpt-n1`).
@@ -56,6 +71,10 @@ impl RealModel {
             RealModel::OneLoopRptN0 => "1l-rpt-n0",
             RealModel::OneLoopRptN1 => "1l-rpt-n1",
             RealModel::OneLoopRptN2 => "1l-rpt-n2",
+            RealModel::TwoLoopSpt => "2l-spt",
+            RealModel::TwoLoopRptN0 => "2l-rpt-n0",
+            RealModel::TwoLoopRptN1 => "2l-rpt-n1",
+            RealModel::TwoLoopRptN2 => "2l-rpt-n2",
         }
     }
 
@@ -64,14 +83,27 @@ impl RealModel {
         match self {
             RealModel::OneLoopRptN0 => Some(Propagator::N0),
             RealModel::OneLoopRptN1 => Some(Propagator::N1),
-            RealModel::OneLoopRptN2 => Some(Propagator::N2),
-            _ => None,
+            RealModel::OneLoopRptN2 | RealModel::TwoLoopRptN2 => Some(Propagator::N2),
+            RealModel::TwoLoopRptN0 => Some(Propagator::N0),
+            RealModel::TwoLoopRptN1 => Some(Propagator::N1),
+            RealModel::Linear | RealModel::OneLoopSpt | RealModel::TwoLoopSpt => None,
         }
     }
 
     /// Whether the model needs the 2-loop propagator term P15 ([`crate::loops::add_p15`]).
     pub fn needs_p15(self) -> bool {
-        self.propagator() == Some(Propagator::N2)
+        self.propagator() == Some(Propagator::N2) || self.needs_two_loop()
+    }
+
+    /// Whether the model needs the 2-loop terms ([`crate::loops::add_two_loop`]).
+    pub fn needs_two_loop(self) -> bool {
+        matches!(
+            self,
+            RealModel::TwoLoopSpt
+                | RealModel::TwoLoopRptN0
+                | RealModel::TwoLoopRptN1
+                | RealModel::TwoLoopRptN2
+        )
     }
 }
 
@@ -141,6 +173,13 @@ pub fn from_terms(model: RealModel, terms: &OneLoopTerms) -> Result<RealSpectra>
             reason: "the model needs P15 at every k (loops::add_p15)",
         });
     }
+    if model.needs_two_loop() && terms.dd.two_loop.len() != terms.k.len() {
+        return Err(Error::InvalidParameter {
+            name: "number of 2-loop values",
+            value: terms.dd.two_loop.len() as f64,
+            reason: "the model needs the 2-loop terms at every k (loops::add_two_loop)",
+        });
+    }
     let n = terms.k.len();
     let mut spectra: [Vec<Estimate>; 3] = Default::default();
     let mut factors = None;
@@ -153,6 +192,10 @@ pub fn from_terms(model: RealModel, terms: &OneLoopTerms) -> Result<RealSpectra>
                         let lin = terms.p_lin[i];
                         match model {
                             RealModel::Linear => Estimate::new(lin, 0.0),
+                            RealModel::TwoLoopSpt => {
+                                let (l, m) = (t.one_loop(i), t.two_loop[i]);
+                                Estimate::new(lin + l.value + m.value, l.error + m.error)
+                            }
                             _ => {
                                 let l = t.one_loop(i);
                                 Estimate::new(lin + l.value, l.error)
@@ -172,7 +215,7 @@ pub fn from_terms(model: RealModel, terms: &OneLoopTerms) -> Result<RealSpectra>
             }
             for (j, pair) in Pair::ALL.into_iter().enumerate() {
                 spectra[j] = (0..n)
-                    .map(|i| resum::one_loop_rpt(terms, &props, pair, i))
+                    .map(|i| resum::rpt(terms, &props, pair, i, model.needs_two_loop()))
                     .collect();
             }
             factors = Some(f);
@@ -211,7 +254,9 @@ pub fn real_space(
     precision: &Precision,
 ) -> Result<(RealSpectra, OneLoopTerms)> {
     let mut terms = OneLoopPlan::new(k, precision)?.par_evaluate(spectrum);
-    if model.needs_p15() {
+    if model.needs_two_loop() {
+        crate::loops::add_two_loop(&mut terms, spectrum, precision, &|_, _| {});
+    } else if model.needs_p15() {
         crate::loops::add_p15(&mut terms, spectrum, precision, &|_, _| {});
     }
     Ok((from_terms(model, &terms)?, terms))

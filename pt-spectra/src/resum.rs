@@ -1,7 +1,7 @@
 //! Renormalised-perturbation-theory (RPT) propagators and the resummed spectra built from them.
 //!
-//! Gil-Marín et al. (2012, arXiv:1209.3771), eq. RPT: P_XY = [P_lin + P22_XY + …] N_X(k) N_Y(k), truncated
-//! here at one loop. The propagators (the paper's N_i, Crocce & Scoccimarro 2006, astro-ph/0509418):
+//! Gil-Marín et al. (2012, arXiv:1209.3771), eq. RPT: P_XY = [P_lin + P22_XY + P33^{2L}_XY + …] N_X(k) N_Y(k),
+//! truncated at one loop (P_lin + P22) or two (+ P33^{2L}). The propagators (the paper's N_i, Crocce & Scoccimarro 2006, astro-ph/0509418):
 //! * N0 = exp(−k²σ_v²/2), the same for δ and θ;
 //! * N1 = exp(P13/P_lin), with P13 = P13_δδ for δ and P13_θθ for θ (paper normalisation, the 1-loop
 //!   correction being P22 + 2P13), so that N1² = 1 + 2P13/P_lin + … reproduces 1-loop SPT;
@@ -199,15 +199,24 @@ pub fn factors(n: &(Vec<Estimate>, Vec<Estimate>), i: usize) -> [Estimate; 3] {
     [product(d, d), product(d, t), product(t, t)]
 }
 
-/// The 1-loop RPT spectrum of `pair` at k index `i`: [P_lin + P22] N_X N_Y.
-pub fn one_loop_rpt(
+/// The RPT spectrum of `pair` at k index `i`: [P_lin + P22] N_X N_Y at one loop, and
+/// [P_lin + P22 + P33^{2L}] N_X N_Y at two loops (`two_loops`; needs the 2-loop terms).
+pub fn rpt(
     terms: &OneLoopTerms,
     n: &(Vec<Estimate>, Vec<Estimate>),
     pair: Pair,
     i: usize,
+    two_loops: bool,
 ) -> Estimate {
-    let p22 = terms.pair(pair).p22[i];
-    let base = Estimate::new(terms.p_lin[i] + p22.value, p22.error);
+    let t = terms.pair(pair);
+    let p22 = t.p22[i];
+    let mut base = Estimate::new(terms.p_lin[i] + p22.value, p22.error);
+    if two_loops {
+        base = Estimate::new(
+            base.value + t.p33_2l[i].value,
+            base.error + t.p33_2l[i].error,
+        );
+    }
     let index = Pair::ALL.iter().position(|&p| p == pair).unwrap_or(0);
     product(base, factors(n, i)[index])
 }

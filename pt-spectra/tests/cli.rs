@@ -75,6 +75,52 @@ fn tns_parts_add_up_and_bias_and_noise_tables_are_used() {
 }
 
 #[test]
+fn model_all_has_every_model_and_agrees_with_single_runs() {
+    let grid = [
+        "--nk",
+        "4",
+        "--k-min",
+        "0.02",
+        "--k-max",
+        "0.2",
+        "--precision",
+        "fast",
+        "--z",
+        "0.5",
+    ];
+    let mut all = vec!["real", "--model", "all"];
+    all.extend(grid);
+    let (ok, out, err) = run(&all);
+    assert!(ok, "{err}");
+    let names: Vec<&str> = out
+        .lines()
+        .find(|l| l.starts_with("# k "))
+        .unwrap()
+        .split_whitespace()
+        .skip(1)
+        .collect();
+    assert_eq!(names[..3], ["k", "P_nw", "linear"]);
+    assert!(names.contains(&"2l-rpt-n2") && names.contains(&"err_2l-spt"));
+    let col = |n: &str| names.iter().position(|&x| x == n).unwrap();
+    for model in ["linear", "2l-spt", "1l-rpt-n2"] {
+        let mut one = vec!["real", "--model", model];
+        one.extend(grid);
+        let (ok, single, err) = run(&one);
+        assert!(ok, "{err}");
+        for (a, b) in rows(&out).iter().zip(rows(&single)) {
+            // P_dd/P_nw × P_nw = P_dd of the single run (same points, same seed).
+            let p = a[col(model)] * a[1];
+            assert!(
+                (p / b[2] - 1.0).abs() < 1e-8,
+                "{model} k={}: {p} vs {}",
+                a[0],
+                b[2]
+            );
+        }
+    }
+}
+
+#[test]
 fn linear_kaiser_multipoles_follow_the_closed_form() {
     let (b, f) = (1.7, 0.6);
     let (ok, out, err) = run(&[

@@ -41,12 +41,14 @@ mod p13;
 mod p15;
 mod p22;
 mod tns;
+mod two_loop;
 
 pub use one_loop::OneLoopPlan;
 pub use p13::p13_kernels;
 pub use p15::{cache_path, p15_angular_kernel, P15Table};
 pub use p22::f2_g2;
 pub use tns::{tns, TnsCoefficients, TnsPlan, TnsTerms};
+pub use two_loop::{two_loop, TwoLoopPair, TwoLoopSettings, TwoLoopTerms};
 
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
@@ -112,6 +114,12 @@ pub struct PairTerms {
     /// P15 at each k (2-loop propagator term, the correction containing 2 P15), or empty if not computed
     /// (see [`add_p15`]).
     pub p15: Vec<Estimate>,
+    /// P24 at each k (the correction contains 2 P24), or empty if not computed (see [`add_two_loop`]).
+    pub p24: Vec<Estimate>,
+    /// P33^{2L} = P33irr, the mode-coupling part of P33, or empty (see [`add_two_loop`]).
+    pub p33_2l: Vec<Estimate>,
+    /// The whole 2-loop SPT correction 2P15 + 2P24 + P33, or empty (see [`add_two_loop`]).
+    pub two_loop: Vec<Estimate>,
 }
 
 impl PairTerms {
@@ -120,6 +128,9 @@ impl PairTerms {
             p22: Vec::with_capacity(n),
             p13: Vec::with_capacity(n),
             p15: Vec::new(),
+            p24: Vec::new(),
+            p33_2l: Vec::new(),
+            two_loop: Vec::new(),
         }
     }
 
@@ -179,6 +190,80 @@ pub fn add_p15(
         .enumerate()
     {
         pair.p15 = p15.iter().map(|row| row[j]).collect();
+    }
+}
+
+impl OneLoopTerms {
+    /// P33red_XY = P13_X P13_Y / P_lin at k index `i` (first term of eq. P33; P13_X = P13_δδ or P13_θθ).
+    pub fn p33_reducible(&self, pair: Pair, i: usize) -> Estimate {
+        let (a, b) = match pair {
+            Pair::DeltaDelta => (self.dd.p13[i], self.dd.p13[i]),
+            Pair::DeltaTheta => (self.dd.p13[i], self.tt.p13[i]),
+            Pair::ThetaTheta => (self.tt.p13[i], self.tt.p13[i]),
+        };
+        let p = self.p_lin[i];
+        Estimate::new(
+            a.value * b.value / p,
+            (a.value.abs() * b.error + b.value.abs() * a.error) / p,
+        )
+    }
+}
+
+/// Adds the 2-loop terms to `terms` (made from `spectrum` with `precision`): P15 (if missing, from the
+/// angular table), P24 and P33^{2L} from the quasi-Monte-Carlo integral ([`two_loop`]), and the whole
+/// correction 2P15 + 2P24 + P33, either as the IR-safe integrand integrated as one (better where the
+/// propagator and mode-coupling pieces cancel, k ≳ 0.15 h/Mpc at z = 0) or as the exact propagator pieces
+/// (2P15 from the table, P33red = P13²/P) plus the mode-coupling integral (better at low k, where the
+/// propagator part dominates): whichever has the smaller error estimate at each k.
+pub fn add_two_loop(
+    terms: &mut OneLoopTerms,
+    spectrum: &LinearSpectrum,
+    precision: &Precision,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) {
+    if terms.dd.p15.len() != terms.k.len() {
+        add_p15(terms, spectrum, precision, progress);
+    }
+    let settings = TwoLoopSettings {
+        points: precision.two_loop_points,
+        replicas: precision.two_loop_replicas,
+        ..TwoLoopSettings::default()
+    };
+    let mc = two_loop(
+        &terms.k,
+        spectrum,
+        (precision.q_min, precision.q_max),
+        precision.lattice_step,
+        &settings,
+    );
+    for (j, pair) in Pair::ALL.into_iter().enumerate() {
+        let total: Vec<Estimate> = (0..terms.k.len())
+            .map(|i| {
+                let (p15, red, m) = (
+                    terms.pair(pair).p15[i],
+                    terms.p33_reducible(pair, i),
+                    mc.pairs[j].mode_coupling[i],
+                );
+                let split = Estimate::new(
+                    2.0 * p15.value + red.value + m.value,
+                    2.0 * p15.error + red.error + m.error,
+                );
+                let whole = mc.pairs[j].total[i];
+                if whole.error < split.error {
+                    whole
+                } else {
+                    split
+                }
+            })
+            .collect();
+        let t = match pair {
+            Pair::DeltaDelta => &mut terms.dd,
+            Pair::DeltaTheta => &mut terms.dt,
+            Pair::ThetaTheta => &mut terms.tt,
+        };
+        t.p24 = mc.pairs[j].p24.clone();
+        t.p33_2l = mc.pairs[j].p33_2l.clone();
+        t.two_loop = total;
     }
 }
 

@@ -171,7 +171,8 @@ impl Input {
 pub struct Args {
     #[command(flatten)]
     input: Input,
-    /// Model: linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1 or 1l-rpt-n2.
+    /// Model: linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1, 1l-rpt-n2, 2l-spt, 2l-rpt-n0, 2l-rpt-n1 or 2l-rpt-n2;
+    /// or `all`: P_dd/P_nowiggle of every model, one column each (the paper's real-space comparison).
     #[arg(long, value_name = "M", default_value = "1l-spt")]
     model: String,
     /// Also print the separate loop terms, σ_v² and propagators, each with its error estimate.
@@ -184,12 +185,55 @@ pub struct Args {
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<()> {
+    if args.model.trim().eq_ignore_ascii_case("all") {
+        return run_all(args);
+    }
     let model: RealModel = args.model.parse()?;
     let (k, spectrum, precision) = args.input.load()?;
     let terms = loop_terms(&k, &precision, &spectrum, model)?;
     let spectra = from_terms(model, &terms)?;
     let mut text = header(args, model, &spectrum, &precision, &terms);
     text.push_str(&table(&spectra, &terms, args.terms));
+    write_output(args.out.as_ref(), &text)
+}
+
+/// `--model all`: P_dd of every model over the no-wiggle spectrum, with errors.
+fn run_all(args: &Args) -> Result<()> {
+    let (k, spectrum, precision) = args.input.load()?;
+    // Every model's terms are a subset of 2l-rpt-n2's.
+    let terms = loop_terms(&k, &precision, &spectrum, RealModel::TwoLoopRptN2)?;
+    let cosmology = Cosmology::gm2012();
+    let eh = cosmology.eisenstein_hu_spectrum(TransferKind::NoWiggle, 0.0, &LogGrid::default())?;
+    let no_wiggle = eh.scaled((spectrum.sigma8() / eh.sigma8()).powi(2))?;
+    let mut text = format!(
+        "# pt-spectra {} real --model all: P_dd of each model over the no-wiggle spectrum, z = {}\n",
+        env!("CARGO_PKG_VERSION"),
+        args.input.z
+    );
+    text += &args.input.describe(&spectrum, &precision);
+    text += "# P_nw: Eisenstein & Hu (1998) no-wiggle fit of the gm2012 cosmology, scaled to the sigma8 of the \
+             linear input; columns <model> = P_dd(model)/P_nw, err_<model> its estimated numerical error; k [h/Mpc], \
+             P_nw [(Mpc/h)^3]\n# k P_nw";
+    let models: Vec<_> = RealModel::ALL
+        .iter()
+        .map(|&m| from_terms(m, &terms))
+        .collect::<Result<_, _>>()?;
+    for m in &models {
+        text += &format!(" {}", m.model);
+    }
+    for m in &models {
+        text += &format!(" err_{}", m.model);
+    }
+    text.push('\n');
+    for (i, &ki) in k.iter().enumerate() {
+        let nw = no_wiggle.eval(ki);
+        let mut row = vec![ki, nw];
+        row.extend(models.iter().map(|m| m.spectra[0][i].value / nw));
+        row.extend(models.iter().map(|m| m.spectra[0][i].error / nw));
+        let line: Vec<String> = row.iter().map(|v| format!("{v:.9e}")).collect();
+        text += &line.join(" ");
+        text.push('\n');
+    }
     write_output(args.out.as_ref(), &text)
 }
 
@@ -295,6 +339,16 @@ pub fn loop_terms(
         pt_spectra::loops::add_p15(&mut terms, spectrum, precision, &progress);
         bar.finish_and_clear();
     }
+    if model.needs_two_loop() {
+        let bar = ProgressBar::new_spinner().with_message(format!(
+            "2-loop terms: {} k x {} quasi-Monte-Carlo points",
+            k.len(),
+            precision.two_loop_points * precision.two_loop_replicas
+        ));
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
+        pt_spectra::loops::add_two_loop(&mut terms, spectrum, precision, &|_, _| {});
+        bar.finish_and_clear();
+    }
     Ok(terms)
 }
 
@@ -333,10 +387,10 @@ fn append(all: &mut OneLoopTerms, part: OneLoopTerms) {
         (&mut all.dt, part.dt),
         (&mut all.tt, part.tt),
     ] {
-        let PairTerms { p22, p13, p15 } = b;
+        // Chunks carry only the 1-loop terms; the 2-loop ones are added to the whole grid afterwards.
+        let PairTerms { p22, p13, .. } = b;
         a.p22.extend(p22);
         a.p13.extend(p13);
-        a.p15.extend(p15);
     }
 }
 
@@ -405,6 +459,14 @@ fn column_names(model: RealModel, terms: bool) -> Vec<(String, &'static str)> {
             with_err(&mut c, format!("P15_{}", pair.suffix()), POWER);
         }
     }
+    if model.needs_two_loop() {
+        for pair in Pair::ALL {
+            let s = pair.suffix();
+            for name in ["P24", "P33", "P33_2L", "P2loop"] {
+                with_err(&mut c, format!("{name}_{s}"), POWER);
+            }
+        }
+    }
     with_err(&mut c, "sigma_v2".into(), "(Mpc/h)^2");
     if model.propagator().is_some() {
         for s in ["dd", "dt", "tt"] {
@@ -430,6 +492,19 @@ fn table(spectra: &RealSpectra, terms: &OneLoopTerms, with_terms: bool) -> Strin
             if spectra.model.needs_p15() {
                 for pair in Pair::ALL {
                     push(&mut row, terms.pair(pair).p15[i]);
+                }
+            }
+            if spectra.model.needs_two_loop() {
+                for pair in Pair::ALL {
+                    let t = terms.pair(pair);
+                    let (red, irr) = (terms.p33_reducible(pair, i), t.p33_2l[i]);
+                    push(&mut row, t.p24[i]);
+                    push(
+                        &mut row,
+                        Estimate::new(red.value + irr.value, red.error + irr.error),
+                    );
+                    push(&mut row, irr);
+                    push(&mut row, t.two_loop[i]);
                 }
             }
             push(&mut row, terms.sigma_v2);

@@ -20,7 +20,7 @@ const SN_LEVELS: [f64; 3] = [1.0, 0.5, 0.1];
 pub struct Args {
     #[command(flatten)]
     input: Input,
-    /// Real-space model for P_δδ, P_δθ, P_θθ: linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1 or 1l-rpt-n2.
+    /// Real-space model for P_δδ, P_δθ, P_θθ: linear, 1l-spt, 2l-spt, 1l-rpt-n0..n2 or 2l-rpt-n0..n2.
     #[arg(long = "real", value_name = "M", default_value = "1l-rpt-n1")]
     real_model: String,
     /// Redshift-space model: kaiser, scoccimarro or tns (Scoccimarro + the A and B terms of Taruya,

@@ -1,0 +1,286 @@
+//! The 2-loop SPT correction from one IR-safe integrand, by randomised quasi-Monte Carlo.
+//!
+//! P^(2)_XY = 2P15_XY + 2P24_XY + P33_XY (eqs. P15, P24, P33 of the paper), with
+//! * 2P15_XY = 15 P(k) ∫∫ (X_5 + Y_5)(k, q₁, −q₁, q₂, −q₂) P₁P₂,
+//! * P33red_XY = 9 P(k) ∫X_3(k, q₁, −q₁)P₁ ∫Y_3(k, q₂, −q₂)P₂ = P13_X P13_Y / P(k) (first term of eq. P33),
+//! * 2P24_XY = 12 ∫∫ (X_2 Y_4 + Y_2 X_4) P(q₁) P(|k − q₁|) P(q₂), X_2 = X_2^s(q₁, k − q₁),
+//!   X_4 = X_4^s(q₁, k − q₁, q₂, −q₂),
+//! * P33irr_XY = P33^{2L}_XY = 6 ∫∫ X_3 Y_3 P(q₁)P(q₂)P(q₃), X_3 = X_3^s(q₁, q₂, q₃), q₃ = k − q₁ − q₂,
+//!
+//! ∫ ≡ ∫d³q/(2π)³. Each term alone has large infrared pieces (∝ k²σ_v² times 1-loop terms) that cancel in
+//! the sum. Following Carrasco, Foreman, Green & Senatore (2014) and Blas, Garny & Konstandin (2013), the
+//! integrands are mapped so that every infrared singularity sits at q₁ → 0 or q₂ → 0: P24 is restricted
+//! to |k − q₁| > q₁ (×2, the q₁ ↔ k − q₁ symmetry), P33irr to q₃ > q₁, q₂ (×3, its permutation symmetry),
+//! and the sum is symmetrised in q₁ ↔ q₂. The leading 1/q² singularities then cancel point by point, and
+//! the total is integrated as one function.
+//!
+//! Integration: (ln q₁, ln q₂) uniform on [ln q_min, ln q_max]², q̂₁ = (s₁, 0, x₁) and
+//! q̂₂ = (s₂ cos φ, s₂ sin φ, x₂) about k̂ with x₁, x₂ ∈ [−1, 1], φ ∈ [0, π] (reflection symmetry), by a
+//! Sobol sequence (Joe–Kuo direction numbers, the `sobol` crate) in R independent Cranley–Patterson
+//! random shifts, each point taken with its four images q_i → ±q_i (antithetic: odd parts of the integrand
+//! cancel exactly), and the radial variables drawn with density ∝ 1/(w² + ln²(q/k)) around q ~ k. The
+//! value is the mean over the shifts and the error is their standard error. Every k uses the same
+//! points, so results are reproducible and smooth in k.
+//!
+//! Accuracy (default settings, 8 × 2^14 points × 4 images per k; the README has the measured table): the
+//! error of the 2-loop correction is ≲ 1e-4 of it for k ≤ 0.05 h/Mpc, ~0.1% at 0.1, ~0.3% at 0.18 and
+//! ~0.6% at 0.29, where it is a small difference of terms ten times larger. 2L-SPT δδ agrees with RegPT
+//! to ≤ 0.3% for k ≤ 0.3 h/Mpc.
+//!
+//! The same points also give 2P24 and P33irr separately (needed by 2-loop RPT, whose mode-coupling term is
+//! P33^{2L}); those carry larger errors, since their infrared pieces do not cancel.
+
+use super::lattice::Lattice;
+use super::Estimate;
+use crate::linear::LinearSpectrum;
+use rayon::prelude::*;
+use sobol::params::JoeKuoD6;
+use sobol::Sobol;
+use std::f64::consts::PI;
+
+/// Settings of the 2-loop integration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TwoLoopSettings {
+    /// Sobol points per random shift and per k.
+    pub points: usize,
+    /// Number of independent random shifts (the error is their standard error).
+    pub replicas: usize,
+    /// Seed of the random shifts.
+    pub seed: u64,
+    /// Width w in ln q of the radial sampling density ∝ 1/(w² + ln²(q/k)).
+    pub radial_width: f64,
+}
+
+impl Default for TwoLoopSettings {
+    fn default() -> Self {
+        Self {
+            points: 1 << 14,
+            replicas: 8,
+            seed: 2,
+            radial_width: 2.0,
+        }
+    }
+}
+
+/// The 2-loop terms of one pair at each k [(Mpc/h)^3].
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TwoLoopPair {
+    /// The whole 2-loop SPT correction 2P15 + 2P24 + P33, from the IR-safe integrand.
+    pub total: Vec<Estimate>,
+    /// P24 (the correction contains 2 P24).
+    pub p24: Vec<Estimate>,
+    /// P33irr = P33^{2L}, the mode-coupling part of P33.
+    pub p33_2l: Vec<Estimate>,
+    /// 2P24 + P33irr from one integrand.
+    pub mode_coupling: Vec<Estimate>,
+}
+
+/// The 2-loop terms of δδ, δθ, θθ on a k grid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TwoLoopTerms {
+    /// Wavenumbers [h/Mpc].
+    pub k: Vec<f64>,
+    /// δδ, δθ, θθ.
+    pub pairs: [TwoLoopPair; 3],
+}
+
+/// Number of accumulated quantities per point: [total, 2P24, P33irr] × [δδ, δθ, θθ].
+const VALUES: usize = 12;
+
+/// The spectrum on the lattice, zero outside [q_min, q_max].
+struct Sampled<'a> {
+    lattice: &'a Lattice,
+    samples: &'a [f64],
+}
+
+impl Sampled<'_> {
+    #[inline]
+    fn at(&self, q: f64) -> f64 {
+        let u = self.lattice.position(q);
+        if !(0.0..=(self.lattice.len - 1) as f64).contains(&u) {
+            return 0.0;
+        }
+        self.lattice.interpolate(self.samples, u)
+    }
+}
+
+/// Pair index j: (X, Y) = (F, F), (F, G), (G, G) → kernel indices.
+const PAIRS: [(usize, usize); 3] = [(0, 0), (0, 1), (1, 1)];
+
+/// g(q₁, q₂) of the module docs for the three pairs, from the Gram matrix [kk, kq₁, kq₂, q₁q₁, q₁q₂, q₂q₂]
+/// (the P33irr part, symmetric, is added by the caller once).
+#[inline]
+fn half_integrand(g: &[f64; 6], p: &Sampled, p_k: f64, p1: f64, p2: f64) -> [[f64; 2]; 3] {
+    let [kk, kq1, _, q1q1, _, _] = *g;
+    let p5 = pt_kernels::propagator_5(g);
+    let a3 = pt_kernels::propagator_3(&[kk, kq1, q1q1]);
+    let b3 = pt_kernels::propagator_3(&[kk, g[2], g[5]]);
+    // The smooth partition w = p⁴/(q⁴ + p⁴), p = |k − q₁|, of the q₁ ↔ k − q₁ symmetry (×2 below).
+    let p1m2 = (kk - 2.0 * kq1 + q1q1).max(0.0);
+    let w = p1m2 * p1m2 / (q1q1 * q1q1 + p1m2 * p1m2);
+    let (m2, m4, p_k1) = if w > 1e-12 {
+        (
+            pt_kernels::mode_coupling_2(&[kk, kq1, q1q1]),
+            pt_kernels::mode_coupling_4(g),
+            w * p.at(p1m2.sqrt()),
+        )
+    } else {
+        ([0.0; 2], [0.0; 2], 0.0)
+    };
+    let mut out = [[0.0; 2]; 3];
+    for (j, &(x, y)) in PAIRS.iter().enumerate() {
+        let prop = 15.0 * p_k * (p5[x] + p5[y]) + 9.0 * p_k * 0.5 * (a3[x] * b3[y] + a3[y] * b3[x]);
+        let mc = 24.0 * (m2[x] * m4[y] + m2[y] * m4[x]) * p_k1;
+        out[j] = [prop * p1 * p2, mc * p1 * p2];
+    }
+    out
+}
+
+/// The integrand at one point: [total, 2P24, P33irr] for δδ, δθ, θθ (times the measure).
+#[inline]
+fn integrand(
+    k: f64,
+    q: [f64; 2],
+    x: [f64; 2],
+    cos_phi: f64,
+    p: &Sampled,
+    p_k: f64,
+) -> [f64; VALUES] {
+    let (s1, s2) = (
+        (1.0 - x[0] * x[0]).max(0.0).sqrt(),
+        (1.0 - x[1] * x[1]).max(0.0).sqrt(),
+    );
+    let q1q2 = q[0] * q[1] * (x[0] * x[1] + s1 * s2 * cos_phi);
+    let (kk, kq1, kq2, q11, q22) = (
+        k * k,
+        k * q[0] * x[0],
+        k * q[1] * x[1],
+        q[0] * q[0],
+        q[1] * q[1],
+    );
+    let (p1, p2) = (p.at(q[0]), p.at(q[1]));
+    if p1 == 0.0 || p2 == 0.0 {
+        return [0.0; VALUES];
+    }
+    let a = half_integrand(&[kk, kq1, kq2, q11, q1q2, q22], p, p_k, p1, p2);
+    let b = half_integrand(&[kk, kq2, kq1, q22, q1q2, q11], p, p_k, p2, p1);
+    let q33 = (kk + q11 + q22 - 2.0 * kq1 - 2.0 * kq2 + 2.0 * q1q2).max(0.0);
+    // The smooth partition w = q₃⁴/(q₁⁴ + q₂⁴ + q₃⁴) of the permutation symmetry (×3 below).
+    let w3 = q33 * q33 / (q11 * q11 + q22 * q22 + q33 * q33);
+    let m3 = if w3 > 1e-12 {
+        let p3 = p.at(q33.sqrt());
+        pt_kernels::mode_coupling_3(&[kk, kq1, kq2, q11, q1q2, q22])
+            .map(|v| v * (18.0 * w3 * p1 * p2 * p3).sqrt())
+    } else {
+        [0.0; 2]
+    };
+    // d³q₁d³q₂/(2π)⁶ = q₁³q₂³ dln q₁ dln q₂ · 2π dx₁ · 2 dx₂ dφ (φ ∈ [0, π]) / (2π)⁶.
+    let measure = (q[0] * q[1]).powi(3) * 4.0 * PI / (2.0 * PI).powi(6);
+    let mut out = [0.0; VALUES];
+    for (j, &(x, y)) in PAIRS.iter().enumerate() {
+        let p33 = m3[x] * m3[y];
+        let mc = 0.5 * (a[j][1] + b[j][1]);
+        let prop = 0.5 * (a[j][0] + b[j][0]);
+        out[j] = measure * (prop + mc + p33);
+        out[3 + j] = measure * mc;
+        out[6 + j] = measure * p33;
+        out[9 + j] = measure * (mc + p33);
+    }
+    out
+}
+
+/// The 2-loop terms of `spectrum` at `k` [h/Mpc], over q ∈ `q_range` (P̃ on a lattice of step
+/// `lattice_step` in ln q), in parallel over k.
+pub fn two_loop(
+    k: &[f64],
+    spectrum: &LinearSpectrum,
+    q_range: (f64, f64),
+    lattice_step: f64,
+    settings: &TwoLoopSettings,
+) -> TwoLoopTerms {
+    let lattice = Lattice::new(q_range.0, q_range.1, lattice_step);
+    let samples = lattice.sample(spectrum);
+    let sampled = Sampled {
+        lattice: &lattice,
+        samples: &samples,
+    };
+    let params = JoeKuoD6::standard();
+    let points: Vec<Vec<f64>> = Sobol::<f64>::new(5, &params)
+        .skip(1)
+        .take(settings.points)
+        .collect();
+    let shifts: Vec<[f64; 5]> = {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(settings.seed);
+        (0..settings.replicas)
+            .map(|_| std::array::from_fn(|_| rng.gen::<f64>()))
+            .collect()
+    };
+    let (lo, hi) = (q_range.0.ln(), q_range.1.ln());
+    let width = settings.radial_width;
+    let rows: Vec<[Estimate; VALUES]> = k
+        .par_iter()
+        .map(|&k| {
+            let p_k = sampled.at(k);
+            // ln q = ln k + w tan θ with θ uniform on [θ_lo, θ_hi]: points concentrate within a few w of
+            // ln k; the Jacobian dln q/dt = (θ_hi − θ_lo) w / cos²θ.
+            let (t_lo, t_hi) = (
+                ((lo - k.ln()) / width).atan(),
+                ((hi - k.ln()) / width).atan(),
+            );
+            let radial = |t: f64| -> (f64, f64) {
+                let theta = t_lo + (t_hi - t_lo) * t;
+                let c = theta.cos();
+                (
+                    (k.ln() + width * theta.tan()).exp(),
+                    (t_hi - t_lo) * width / (c * c),
+                )
+            };
+            let means: Vec<[f64; VALUES]> = shifts
+                .iter()
+                .map(|shift| {
+                    let mut acc = [0.0; VALUES];
+                    for point in &points {
+                        let t: [f64; 5] = std::array::from_fn(|d| (point[d] + shift[d]).fract());
+                        let ((q1, j1), (q2, j2)) = (radial(t[0]), radial(t[1]));
+                        let (x1, x2, c) = (2.0 * t[2] - 1.0, 2.0 * t[3] - 1.0, (PI * t[4]).cos());
+                        // The four images q_i → ±q_i (antithetic points): odd parts cancel exactly.
+                        for (x, c) in [
+                            ([x1, x2], c),
+                            ([-x1, -x2], c),
+                            ([-x1, x2], -c),
+                            ([x1, -x2], -c),
+                        ] {
+                            let v = integrand(k, [q1, q2], x, c, &sampled, p_k);
+                            for (a, b) in acc.iter_mut().zip(v) {
+                                *a += 0.25 * j1 * j2 * b;
+                            }
+                        }
+                    }
+                    // Volume of (x₁, x₂, φ): 2 · 2 · π (the radial Jacobians are in acc).
+                    acc.map(|a| a * 4.0 * PI / points.len() as f64)
+                })
+                .collect();
+            std::array::from_fn(|v| {
+                let r = means.len() as f64;
+                let mean = means.iter().map(|m| m[v]).sum::<f64>() / r;
+                let var =
+                    means.iter().map(|m| (m[v] - mean).powi(2)).sum::<f64>() / (r - 1.0).max(1.0);
+                Estimate::new(mean, (var / r).sqrt())
+            })
+        })
+        .collect();
+    let pair = |j: usize| TwoLoopPair {
+        total: rows.iter().map(|r| r[j]).collect(),
+        p24: rows
+            .iter()
+            .map(|r| Estimate::new(0.5 * r[3 + j].value, 0.5 * r[3 + j].error))
+            .collect(),
+        p33_2l: rows.iter().map(|r| r[6 + j]).collect(),
+        mode_coupling: rows.iter().map(|r| r[9 + j]).collect(),
+    };
+    TwoLoopTerms {
+        k: k.to_vec(),
+        pairs: [pair(0), pair(1), pair(2)],
+    }
+}
