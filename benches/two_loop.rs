@@ -3,6 +3,7 @@
 //!
 //! * `p15/evaluate/100`: P15 on 100 log-spaced k in [0.005, 0.4] h/Mpc (rayon's pool);
 //! * `n2/1l-rpt-n2/100`: the whole 1L-RPT-N2 model on the same grid: 1-loop plan and terms, P15, N2;
+//! * `p17/evaluate/40`: P17 (for N3) on 40 log-spaced k in [0.005, 0.4] from its angular table;
 //! * `two_loop/set/40`: every 2-loop term (P15, P24, P33, the total) of δδ, δθ, θθ with errors on 40
 //!   log-spaced k in [0.005, 0.4] at the default precision (after the 1-loop terms).
 //!
@@ -14,7 +15,7 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use pt_spectra::linear::{LinearSpectrum, LogGrid};
-use pt_spectra::loops::{add_two_loop, OneLoopPlan, P15Table};
+use pt_spectra::loops::{add_two_loop, OneLoopPlan, P15Table, P17Table};
 use pt_spectra::precision::Precision;
 use pt_spectra::real::{real_space, RealModel};
 
@@ -28,6 +29,21 @@ fn p15(c: &mut Criterion) {
         b.iter(|| {
             table.evaluate(
                 black_box(&k),
+                &p,
+                (precision.q_min, precision.q_max),
+                precision.lattice_step,
+            )
+        })
+    });
+    group.finish();
+    let table17 = P17Table::get(&|_, _| {});
+    let k40 = LogGrid::new(0.005, 0.4, 40).expect("valid grid").points();
+    let mut group = c.benchmark_group("p17");
+    group.sample_size(20);
+    group.bench_function("evaluate/40", |b| {
+        b.iter(|| {
+            table17.evaluate(
+                black_box(&k40),
                 &p,
                 (precision.q_min, precision.q_max),
                 precision.lattice_step,

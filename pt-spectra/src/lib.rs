@@ -9,7 +9,8 @@
 //!   embedded gm2012 CAMB spectra, log-log spline interpolation, power-law extrapolation, σ(R), σ_v².
 //! * [`cosmology`]: flat (or curved) ΛCDM [`Cosmology`](cosmology::Cosmology): exact linear growth D(z), f(z),
 //!   and the Eisenstein & Hu (1998) transfer functions with and without BAO wiggles.
-//! * [`loops`], [`resum`], [`real`]: 1-loop SPT terms with error estimates, RPT propagators, real-space models.
+//! * [`loops`], [`resum`], [`real`]: 1- and 2-loop SPT terms, the propagator terms P13, P15, P17 (angular
+//!   tables), and TNS terms, all with error estimates; RPT propagators N0..N3; real-space models.
 //! * [`rsd`]: Kaiser, Scoccimarro and TNS redshift-space models, Fingers of God, Legendre multipoles.
 //! * [`halo`]: scale-dependent bias, stochasticity (shot noise) and signal-to-noise of haloes.
 //! * [`table`]: plain-text tables and tabulated functions of k.

@@ -10,6 +10,7 @@
 //! | `1l-rpt-n2` | [P_lin + P22_XY] N_X N_Y, N from P13 and P15 (eq. theory_N2) |
 //! | `2l-spt`    | P_lin + P22 + 2P13 + (2P15 + 2P24 + P33) (2-loop SPT)  |
 //! | `2l-rpt-n0`, `2l-rpt-n1`, `2l-rpt-n2` | [P_lin + P22_XY + P33^{2L}_XY] N_X N_Y |
+//! | `1l-rpt-n3`, `2l-rpt-n3` | as the N2 models, with N3 from P13, P15 and P17 (eq. N3) |
 //!
 //! Every value carries an error estimate propagated from the loop integrals ([`crate::loops`]).
 
@@ -43,15 +44,19 @@ pub enum RealModel {
     TwoLoopRptN1,
     /// 2-loop RPT with N2 (the paper's best model).
     TwoLoopRptN2,
+    /// 1-loop RPT with the 3-loop propagator N3.
+    OneLoopRptN3,
+    /// 2-loop RPT with N3.
+    TwoLoopRptN3,
 }
 
 /// The accepted model names, for messages.
-const MODEL_NAMES: &str =
-    "linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1, 1l-rpt-n2, 2l-spt, 2l-rpt-n0, 2l-rpt-n1, 2l-rpt-n2";
+const MODEL_NAMES: &str = "linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1, 1l-rpt-n2, 1l-rpt-n3, 2l-spt, \
+                           2l-rpt-n0, 2l-rpt-n1, 2l-rpt-n2, 2l-rpt-n3";
 
 impl RealModel {
     /// Every model.
-    pub const ALL: [RealModel; 9] = [
+    pub const ALL: [RealModel; 11] = [
         RealModel::Linear,
         RealModel::OneLoopSpt,
         RealModel::OneLoopRptN0,
@@ -61,6 +66,8 @@ impl RealModel {
         RealModel::TwoLoopRptN0,
         RealModel::TwoLoopRptN1,
         RealModel::TwoLoopRptN2,
+        RealModel::OneLoopRptN3,
+        RealModel::TwoLoopRptN3,
     ];
 
     /// The model's name (`linear`, `1l-spt`, `1l-rpt-n0`, `1l-rpt-n1`).
@@ -75,6 +82,8 @@ impl RealModel {
             RealModel::TwoLoopRptN0 => "2l-rpt-n0",
             RealModel::TwoLoopRptN1 => "2l-rpt-n1",
             RealModel::TwoLoopRptN2 => "2l-rpt-n2",
+            RealModel::OneLoopRptN3 => "1l-rpt-n3",
+            RealModel::TwoLoopRptN3 => "2l-rpt-n3",
         }
     }
 
@@ -86,13 +95,19 @@ impl RealModel {
             RealModel::OneLoopRptN2 | RealModel::TwoLoopRptN2 => Some(Propagator::N2),
             RealModel::TwoLoopRptN0 => Some(Propagator::N0),
             RealModel::TwoLoopRptN1 => Some(Propagator::N1),
+            RealModel::OneLoopRptN3 | RealModel::TwoLoopRptN3 => Some(Propagator::N3),
             RealModel::Linear | RealModel::OneLoopSpt | RealModel::TwoLoopSpt => None,
         }
     }
 
     /// Whether the model needs the 2-loop propagator term P15 ([`crate::loops::add_p15`]).
     pub fn needs_p15(self) -> bool {
-        self.propagator() == Some(Propagator::N2) || self.needs_two_loop()
+        matches!(self.propagator(), Some(Propagator::N2 | Propagator::N3)) || self.needs_two_loop()
+    }
+
+    /// Whether the model needs the 3-loop propagator term P17 ([`crate::loops::add_p17`]).
+    pub fn needs_p17(self) -> bool {
+        self.propagator() == Some(Propagator::N3)
     }
 
     /// Whether the model needs the 2-loop terms ([`crate::loops::add_two_loop`]).
@@ -103,6 +118,7 @@ impl RealModel {
                 | RealModel::TwoLoopRptN0
                 | RealModel::TwoLoopRptN1
                 | RealModel::TwoLoopRptN2
+                | RealModel::TwoLoopRptN3
         )
     }
 }
@@ -171,6 +187,13 @@ pub fn from_terms(model: RealModel, terms: &OneLoopTerms) -> Result<RealSpectra>
             name: "number of P15 values",
             value: terms.dd.p15.len() as f64,
             reason: "the model needs P15 at every k (loops::add_p15)",
+        });
+    }
+    if model.needs_p17() && terms.dd.p17.len() != terms.k.len() {
+        return Err(Error::InvalidParameter {
+            name: "number of P17 values",
+            value: terms.dd.p17.len() as f64,
+            reason: "the model needs P17 at every k (loops::add_p17)",
         });
     }
     if model.needs_two_loop() && terms.dd.two_loop.len() != terms.k.len() {
@@ -258,6 +281,9 @@ pub fn real_space(
         crate::loops::add_two_loop(&mut terms, spectrum, precision, &|_, _| {});
     } else if model.needs_p15() {
         crate::loops::add_p15(&mut terms, spectrum, precision, &|_, _| {});
+    }
+    if model.needs_p17() {
+        crate::loops::add_p17(&mut terms, spectrum, precision, &|_, _| {});
     }
     Ok((from_terms(model, &terms)?, terms))
 }

@@ -28,6 +28,8 @@ pub enum Propagator {
     N1,
     /// N2 from P13 and P15 (eq. theory_N2).
     N2,
+    /// N3 from P13, P15 and P17 (eq. N3).
+    N3,
 }
 
 /// N0(k) = exp(−k²σ_v²/2) with its error, k in h/Mpc, σ_v² in (Mpc/h)².
@@ -153,9 +155,23 @@ pub fn n3(p13: Estimate, p15: Estimate, p17: Estimate, p_lin: f64) -> Estimate {
 /// The propagators (N_δ, N_θ) at every k of `terms`.
 ///
 /// # Panics
-/// For [`Propagator::N2`] if `terms` has no P15 (see [`crate::loops::add_p15`]).
+/// For [`Propagator::N2`] and [`Propagator::N3`] if `terms` has no P15 (see [`crate::loops::add_p15`]),
+/// and for N3 if it has no P17 ([`crate::loops::add_p17`]).
 pub fn propagators(kind: Propagator, terms: &OneLoopTerms) -> (Vec<Estimate>, Vec<Estimate>) {
     match kind {
+        Propagator::N3 => {
+            let of = |pair: &crate::loops::PairTerms| -> Vec<Estimate> {
+                assert_eq!(
+                    pair.p17.len(),
+                    terms.k.len(),
+                    "N3 needs P17 (loops::add_p17)"
+                );
+                (0..terms.k.len())
+                    .map(|i| n3(pair.p13[i], pair.p15[i], pair.p17[i], terms.p_lin[i]))
+                    .collect()
+            };
+            (of(&terms.dd), of(&terms.tt))
+        }
         Propagator::N2 => {
             let of = |pair: &crate::loops::PairTerms| -> Vec<Estimate> {
                 assert_eq!(

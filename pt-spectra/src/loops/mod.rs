@@ -39,6 +39,7 @@ mod lattice;
 mod one_loop;
 mod p13;
 mod p15;
+mod p17;
 mod p22;
 mod tns;
 mod two_loop;
@@ -46,6 +47,7 @@ mod two_loop;
 pub use one_loop::OneLoopPlan;
 pub use p13::p13_kernels;
 pub use p15::{cache_path, p15_angular_kernel, P15Table};
+pub use p17::{p17_angular_kernel, P17Table};
 pub use p22::f2_g2;
 pub use tns::{tns, TnsCoefficients, TnsPlan, TnsTerms};
 pub use two_loop::{two_loop, TwoLoopPair, TwoLoopSettings, TwoLoopTerms};
@@ -114,6 +116,8 @@ pub struct PairTerms {
     /// P15 at each k (2-loop propagator term, the correction containing 2 P15), or empty if not computed
     /// (see [`add_p15`]).
     pub p15: Vec<Estimate>,
+    /// P17 at each k (3-loop propagator term), or empty if not computed (see [`add_p17`]).
+    pub p17: Vec<Estimate>,
     /// P24 at each k (the correction contains 2 P24), or empty if not computed (see [`add_two_loop`]).
     pub p24: Vec<Estimate>,
     /// P33^{2L} = P33irr, the mode-coupling part of P33, or empty (see [`add_two_loop`]).
@@ -128,6 +132,7 @@ impl PairTerms {
             p22: Vec::with_capacity(n),
             p13: Vec::with_capacity(n),
             p15: Vec::new(),
+            p17: Vec::new(),
             p24: Vec::new(),
             p33_2l: Vec::new(),
             two_loop: Vec::new(),
@@ -156,6 +161,29 @@ pub struct OneLoopTerms {
     pub dt: PairTerms,
     /// θθ terms.
     pub tt: PairTerms,
+}
+
+/// Adds P17 of δδ, δθ, θθ to `terms` (made from `spectrum`) from the P17 angular table
+/// ([`P17Table::get`], built or read from the cache on first use; `progress` is called while it is built).
+pub fn add_p17(
+    terms: &mut OneLoopTerms,
+    spectrum: &LinearSpectrum,
+    precision: &Precision,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) {
+    let table = P17Table::get(progress);
+    let p17 = table.evaluate(
+        &terms.k,
+        spectrum,
+        (precision.q_min, precision.q_max),
+        precision.lattice_step,
+    );
+    for (j, pair) in [&mut terms.dd, &mut terms.dt, &mut terms.tt]
+        .into_iter()
+        .enumerate()
+    {
+        pair.p17 = p17.iter().map(|row| row[j]).collect();
+    }
 }
 
 impl OneLoopTerms {

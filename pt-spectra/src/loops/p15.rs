@@ -117,8 +117,13 @@ fn width(u: f64) -> f64 {
     (0.15 * (1.0 + 0.5 * (u.abs() - 1.5).max(0.0))).min(1.0)
 }
 
-/// Panel edges of [a, b] with the given break points inserted.
-fn edges(a: f64, b: f64, breaks: &[f64]) -> Vec<f64> {
+/// Panel edges of [a, b] with the given break points inserted, panels at most `width(u)` wide.
+pub(crate) fn edges_with(
+    a: f64,
+    b: f64,
+    breaks: &[f64],
+    width: impl Fn(f64) -> f64 + Copy,
+) -> Vec<f64> {
     let mut cuts = vec![a];
     cuts.extend(
         breaks
@@ -133,6 +138,11 @@ fn edges(a: f64, b: f64, breaks: &[f64]) -> Vec<f64> {
         out.extend(panel_edges(w[0], w[1], width).into_iter().skip(1));
     }
     out
+}
+
+/// Panel edges of [a, b] with the given break points inserted.
+fn edges(a: f64, b: f64, breaks: &[f64]) -> Vec<f64> {
+    edges_with(a, b, breaks, width)
 }
 
 /// The radial rule of Gauss–Legendre order `order` on the triangle, grouped by outer node.
@@ -179,13 +189,37 @@ pub struct P15Table {
 /// Where the table is cached: `$PT_SPECTRA_CACHE/`, else `$XDG_CACHE_HOME/pt-spectra/`, else
 /// `$HOME/.cache/pt-spectra/`, file `p15-v<version>-<orders>.bin` (little-endian f64). Delete it to rebuild.
 pub fn cache_path() -> Option<PathBuf> {
-    let dir = std::env::var_os("PT_SPECTRA_CACHE")
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("XDG_CACHE_HOME").map(|d| PathBuf::from(d).join("pt-spectra")))
-        .or_else(|| std::env::var_os("HOME").map(|d| PathBuf::from(d).join(".cache/pt-spectra")))?;
-    Some(dir.join(format!(
+    Some(cache_dir()?.join(format!(
         "p15-v{TABLE_VERSION}-a{ANGULAR_ORDER}-{ANGULAR_ORDER_COARSE}-r{RADIAL_ORDER}.bin"
     )))
+}
+
+/// The cache directory of the angular tables: `$PT_SPECTRA_CACHE`, else `$XDG_CACHE_HOME/pt-spectra`,
+/// else `$HOME/.cache/pt-spectra`.
+pub(crate) fn cache_dir() -> Option<PathBuf> {
+    std::env::var_os("PT_SPECTRA_CACHE")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("XDG_CACHE_HOME").map(|d| PathBuf::from(d).join("pt-spectra")))
+        .or_else(|| std::env::var_os("HOME").map(|d| PathBuf::from(d).join(".cache/pt-spectra")))
+}
+
+/// Writes little-endian f64 `values` to `path` atomically (a failed write only costs a rebuild).
+pub(crate) fn write_f64s(path: &std::path::Path, values: impl IntoIterator<Item = f64>) {
+    let bytes: Vec<u8> = values.into_iter().flat_map(f64::to_le_bytes).collect();
+    let _ = std::fs::create_dir_all(path.parent().unwrap_or(path))
+        .and_then(|()| std::fs::write(path.with_extension("tmp"), &bytes))
+        .and_then(|()| std::fs::rename(path.with_extension("tmp"), path));
+}
+
+/// Reads little-endian f64 values from `path`.
+pub(crate) fn read_f64s(path: &std::path::Path) -> Option<Vec<f64>> {
+    let bytes = std::fs::read(path).ok()?;
+    Some(
+        bytes
+            .chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
+            .collect(),
+    )
 }
 
 impl P15Table {
@@ -264,31 +298,16 @@ impl P15Table {
     }
 
     fn write(&self, path: &std::path::Path) {
-        let mut bytes = Vec::new();
-        let mut put = |v: f64| bytes.extend_from_slice(&v.to_le_bytes());
-        put(self.fine.len() as f64);
-        put(self.coarse.len() as f64);
+        let mut values = vec![self.fine.len() as f64, self.coarse.len() as f64];
         for i in 0..self.fine.len() {
-            self.fine_k[i]
-                .into_iter()
-                .chain(self.fine_k_coarse[i])
-                .for_each(&mut put);
+            values.extend(self.fine_k[i].into_iter().chain(self.fine_k_coarse[i]));
         }
-        for k in &self.coarse_k {
-            k.iter().copied().for_each(&mut put);
-        }
-        // A failed cache write only costs a rebuild next time.
-        let _ = std::fs::create_dir_all(path.parent().unwrap_or(path))
-            .and_then(|()| std::fs::write(path.with_extension("tmp"), &bytes))
-            .and_then(|()| std::fs::rename(path.with_extension("tmp"), path));
+        values.extend(self.coarse_k.iter().flatten());
+        write_f64s(path, values);
     }
 
     fn read(path: &std::path::Path) -> Option<Self> {
-        let bytes = std::fs::read(path).ok()?;
-        let values: Vec<f64> = bytes
-            .chunks_exact(8)
-            .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
-            .collect();
+        let values = read_f64s(path)?;
         let (fine, coarse) = (radial_rule(RADIAL_ORDER), radial_rule(RADIAL_ORDER - 2));
         if values.len() != 2 + 4 * fine.len() + 2 * coarse.len()
             || values[0] != fine.len() as f64

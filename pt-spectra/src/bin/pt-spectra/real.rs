@@ -171,7 +171,7 @@ impl Input {
 pub struct Args {
     #[command(flatten)]
     input: Input,
-    /// Model: linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1, 1l-rpt-n2, 2l-spt, 2l-rpt-n0, 2l-rpt-n1 or 2l-rpt-n2;
+    /// Model: linear, 1l-spt, 2l-spt, 1l-rpt-n0..n3 or 2l-rpt-n0..n3 (N3 builds the P17 table once);
     /// or `all`: P_dd/P_nowiggle of every model, one column each (the paper's real-space comparison).
     #[arg(long, value_name = "M", default_value = "1l-spt")]
     model: String,
@@ -200,8 +200,8 @@ pub fn run(args: &Args) -> Result<()> {
 /// `--model all`: P_dd of every model over the no-wiggle spectrum, with errors.
 fn run_all(args: &Args) -> Result<()> {
     let (k, spectrum, precision) = args.input.load()?;
-    // Every model's terms are a subset of 2l-rpt-n2's.
-    let terms = loop_terms(&k, &precision, &spectrum, RealModel::TwoLoopRptN2)?;
+    // Every model's terms are a subset of 2l-rpt-n3's.
+    let terms = loop_terms(&k, &precision, &spectrum, RealModel::TwoLoopRptN3)?;
     let cosmology = Cosmology::gm2012();
     let eh = cosmology.eisenstein_hu_spectrum(TransferKind::NoWiggle, 0.0, &LogGrid::default())?;
     let no_wiggle = eh.scaled((spectrum.sigma8() / eh.sigma8()).powi(2))?;
@@ -323,21 +323,15 @@ pub fn loop_terms(
 ) -> Result<OneLoopTerms> {
     let mut terms = one_loop_terms(k, precision, spectrum)?;
     if model.needs_p15() {
-        let bar = ProgressBar::hidden();
-        bar.set_style(
-            ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} nodes ({eta})")
-                .map_err(|e| anyhow::anyhow!("progress bar: {e}"))?,
-        );
-        bar.set_message("P15 angular table (once; cached)");
-        let progress = |done: usize, total: usize| {
-            if bar.is_hidden() {
-                bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
-                bar.set_length(total as u64);
-            }
-            bar.set_position(done as u64);
-        };
-        pt_spectra::loops::add_p15(&mut terms, spectrum, precision, &progress);
-        bar.finish_and_clear();
+        with_table_progress("P15 angular table (once; cached)", |progress| {
+            pt_spectra::loops::add_p15(&mut terms, spectrum, precision, progress)
+        })?;
+    }
+    if model.needs_p17() {
+        with_table_progress(
+            "P17 angular table (once, a few minutes; cached)",
+            |progress| pt_spectra::loops::add_p17(&mut terms, spectrum, precision, progress),
+        )?;
     }
     if model.needs_two_loop() {
         let bar = ProgressBar::new_spinner().with_message(format!(
@@ -350,6 +344,29 @@ pub fn loop_terms(
         bar.finish_and_clear();
     }
     Ok(terms)
+}
+
+/// Runs `work` with a progress bar on standard error that appears only if a table is being built.
+fn with_table_progress(
+    message: &'static str,
+    work: impl FnOnce(&(dyn Fn(usize, usize) + Sync)),
+) -> Result<()> {
+    let bar = ProgressBar::hidden();
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} nodes ({eta})")
+            .map_err(|e| anyhow::anyhow!("progress bar: {e}"))?,
+    );
+    bar.set_message(message);
+    let progress = |done: usize, total: usize| {
+        if bar.is_hidden() {
+            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            bar.set_length(total as u64);
+        }
+        bar.set_position(done as u64);
+    };
+    work(&progress);
+    bar.finish_and_clear();
+    Ok(())
 }
 
 /// The 1-loop terms, in chunks behind a progress bar for long grids.
@@ -459,6 +476,11 @@ fn column_names(model: RealModel, terms: bool) -> Vec<(String, &'static str)> {
             with_err(&mut c, format!("P15_{}", pair.suffix()), POWER);
         }
     }
+    if model.needs_p17() {
+        for pair in Pair::ALL {
+            with_err(&mut c, format!("P17_{}", pair.suffix()), POWER);
+        }
+    }
     if model.needs_two_loop() {
         for pair in Pair::ALL {
             let s = pair.suffix();
@@ -492,6 +514,11 @@ fn table(spectra: &RealSpectra, terms: &OneLoopTerms, with_terms: bool) -> Strin
             if spectra.model.needs_p15() {
                 for pair in Pair::ALL {
                     push(&mut row, terms.pair(pair).p15[i]);
+                }
+            }
+            if spectra.model.needs_p17() {
+                for pair in Pair::ALL {
+                    push(&mut row, terms.pair(pair).p17[i]);
                 }
             }
             if spectra.model.needs_two_loop() {
