@@ -12,6 +12,7 @@
 //! * [`loops`], [`resum`], [`real`]: 1- and 2-loop SPT terms, the propagator terms P13, P15, P17 (angular
 //!   tables), and TNS terms, all with error estimates; RPT propagators N0..N3; real-space models.
 //! * [`rsd`]: Kaiser, Scoccimarro and TNS redshift-space models, Fingers of God, Legendre multipoles.
+//! * [`fit`]: χ² fits of f, σ0 and A_b to measured multipoles, with Δχ² contour errors, versus k_max.
 //! * [`halo`]: scale-dependent bias, stochasticity (shot noise) and signal-to-noise of haloes.
 //! * [`table`]: plain-text tables and tabulated functions of k.
 //!
@@ -26,6 +27,7 @@
 
 pub mod cosmology;
 pub mod error;
+pub mod fit;
 pub mod halo;
 pub mod integrate;
 pub mod linear;

@@ -498,6 +498,33 @@ impl MultipoleRule {
 }
 
 impl MultipoleRule {
+    /// The values only of [`evaluate`](Self::evaluate) (no error estimate, no allocation), written to
+    /// `out[i]` for the i-th ℓ of the rule: the fast path of fits.
+    ///
+    /// # Panics
+    /// If `coeffs` has more than [`MAX_MU_POWER`] + 1 entries or `out` is shorter than the ℓ list.
+    pub fn evaluate_values(&self, coeffs: &[f64], fog: Fog, k_sigma: f64, out: &mut [f64]) {
+        assert!(coeffs.len() <= MAX_MU_POWER + 1, "at most μ^8 is supported");
+        if fog == Fog::None || k_sigma == 0.0 {
+            for (o, e) in out.iter_mut().zip(&self.exact) {
+                *o = coeffs.iter().zip(e).map(|(c, m)| c * m).sum();
+            }
+            return;
+        }
+        let q = &self.fine;
+        let mut damping = [0.0; FOG_NODES];
+        for (d, &m) in damping.iter_mut().zip(&q.mu) {
+            *d = fog.damping_squared(k_sigma * m);
+        }
+        for (o, w) in out.iter_mut().zip(&q.weights) {
+            *o = coeffs
+                .iter()
+                .zip(w)
+                .map(|(c, wn)| c * wn.iter().zip(&damping).map(|(x, d)| x * d).sum::<f64>())
+                .sum();
+        }
+    }
+
     /// The multipoles of D²(kμσ) · `poly`, with the coefficient errors propagated: |L_ℓ| ≤ 1 and
     /// 0 ≤ μ^{2n} D² ≤ 1 on [0, 1], so an error δc_n moves P_ℓ by at most (2ℓ+1) δc_n.
     pub fn evaluate_polynomial(

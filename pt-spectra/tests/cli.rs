@@ -121,6 +121,89 @@ fn model_all_has_every_model_and_agrees_with_single_runs() {
 }
 
 #[test]
+fn fit_recovers_the_parameters_of_a_model_made_by_rsd() {
+    let dir = scratch("fit");
+    let grid = [
+        "--nk",
+        "25",
+        "--k-min",
+        "0.01",
+        "--k-max",
+        "0.25",
+        "--precision",
+        "fast",
+    ];
+    let mut mock = vec![
+        "rsd",
+        "--rsd",
+        "tns",
+        "--real",
+        "1l-spt",
+        "--fog",
+        "lorentzian",
+    ];
+    mock.extend(["--sigma0", "4", "--f", "0.5", "--bias", "1.5"]);
+    mock.extend(grid);
+    let (ok, out, err) = run(&mock);
+    assert!(ok, "{err}");
+    let mut text = String::new();
+    for r in rows(&out) {
+        let s = 0.002 * r[1];
+        text += &format!("{} {} {s} {} {s} {} {s}\n", r[0], r[1], r[2], r[3]);
+    }
+    let data = write(&dir, "mock.dat", &text);
+    let mut f = vec![
+        "fit", "--data", &data, "--rsd", "tns", "--real", "1l-spt", "--bias", "1.5",
+    ];
+    f.extend([
+        "--free",
+        "f,sigma0",
+        "--ells",
+        "0,2,4",
+        "--k-max",
+        "0.1:0.2:0.1",
+        "--precision",
+        "fast",
+    ]);
+    let (ok, out, err) = run(&f);
+    assert!(ok, "{err}");
+    let header = out.lines().find(|l| l.starts_with("# k_max")).unwrap();
+    assert_eq!(
+        header,
+        "# k_max points f f_lo f_hi sigma0 sigma0_lo sigma0_hi chi2 dof chi2_dof"
+    );
+    let r = rows(&out);
+    assert_eq!(r.len(), 2);
+    for row in r {
+        assert!(
+            (row[2] - 0.5).abs() < 1e-5 && row[3] < row[2] && row[2] < row[4],
+            "{row:?}"
+        );
+        assert!((row[5] - 4.0).abs() < 1e-3, "{row:?}");
+    }
+    for (args, needle) in [
+        (
+            vec!["fit", "--data", "/nonexistent/d.dat"],
+            "/nonexistent/d.dat",
+        ),
+        (vec!["fit", "--data", &data, "--free", "f,beta"], "beta"),
+        (vec!["fit", "--data", &data, "--ells", "6"], "multipole 6"),
+        (
+            vec!["fit", "--data", &data, "--k-max", "0.3:0.1:0.01"],
+            "--k-max",
+        ),
+        (
+            vec!["fit", "--data", &data, "--data-columns", "1,2,3"],
+            "--data-columns",
+        ),
+    ] {
+        let (ok, _, err) = run(&args);
+        assert!(!ok, "{args:?} should fail");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+}
+
+#[test]
 fn linear_kaiser_multipoles_follow_the_closed_form() {
     let (b, f) = (1.7, 0.6);
     let (ok, out, err) = run(&[

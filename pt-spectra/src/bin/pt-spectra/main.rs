@@ -6,6 +6,7 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+mod fit;
 mod kernel;
 mod real;
 mod rsd;
@@ -26,6 +27,8 @@ enum Command {
     Real(real::Args),
     /// Redshift-space multipoles P_ℓ(k) (Kaiser, Scoccimarro or TNS; Fingers of God; halo bias and noise).
     Rsd(Box<rsd::Args>),
+    /// Fit f, σ0 and the bias amplitude to measured multipoles, with Δχ² errors, versus k_max.
+    Fit(Box<fit::Args>),
 }
 
 fn main() -> ExitCode {
@@ -34,6 +37,7 @@ fn main() -> ExitCode {
         Command::Kernel(args) => kernel::run(&args),
         Command::Real(args) => real::run(&args),
         Command::Rsd(args) => rsd::run(&args),
+        Command::Fit(args) => fit::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -64,9 +64,9 @@ fn parse_columns(s: &str) -> std::result::Result<Columns, String> {
     Ok(Columns::new(k, p))
 }
 
-/// The linear spectrum, redshift, k grid and accuracy: the options `real` and `rsd` share.
+/// The linear spectrum, redshift and accuracy: the options `real`, `rsd` and `fit` share.
 #[derive(clap::Args, Debug)]
-pub struct Input {
+pub struct SpectrumInput {
     /// Linear spectrum table (k [h/Mpc], P [(Mpc/h)^3]; CAMB or CLASS format). Default: the embedded
     /// CAMB spectrum of the Gil-Marín et al. (2012) cosmology.
     #[arg(long, value_name = "FILE", conflicts_with = "eh")]
@@ -95,6 +95,16 @@ pub struct Input {
         allow_hyphen_values = true
     )]
     pub z: f64,
+    /// Accuracy of the loop integrals.
+    #[arg(long, value_enum, default_value = "default")]
+    precision: PrecisionPreset,
+}
+
+/// The linear spectrum and the output k grid: the options `real` and `rsd` share.
+#[derive(clap::Args, Debug)]
+pub struct Input {
+    #[command(flatten)]
+    pub spectrum: SpectrumInput,
     /// Smallest output k [h/Mpc] (log-spaced grid).
     #[arg(
         long,
@@ -117,31 +127,17 @@ pub struct Input {
     /// Read the output k values [h/Mpc] from the first column of this file instead ('#' comments).
     #[arg(long, value_name = "FILE", conflicts_with_all = ["k_min", "k_max", "nk"])]
     k_file: Option<PathBuf>,
-    /// Accuracy of the loop integrals.
-    #[arg(long, value_enum, default_value = "default")]
-    precision: PrecisionPreset,
 }
 
-impl Input {
-    /// The output k grid [h/Mpc], the linear spectrum at the output redshift (with a warning when the
-    /// grid reaches its extrapolated ends) and the loop-integral settings.
-    pub fn load(&self) -> Result<(Vec<f64>, LinearSpectrum, Precision)> {
+impl SpectrumInput {
+    /// The linear spectrum at the output redshift and the loop-integral settings.
+    pub fn load(&self) -> Result<(LinearSpectrum, Precision)> {
         let precision = match self.precision {
             PrecisionPreset::Fast => Precision::fast(),
             PrecisionPreset::Default => Precision::default(),
             PrecisionPreset::Reference => Precision::reference(),
         };
-        let k = match &self.k_file {
-            Some(path) => read_k_file(path)?,
-            None => LogGrid::new(self.k_min, self.k_max, self.nk)
-                .context("invalid --k-min/--k-max/--nk")?
-                .points(),
-        };
-        let spectrum = linear_spectrum(self)?;
-        if let Some(ext) = spectrum.extrapolation_in(k[0], k[k.len() - 1]) {
-            eprintln!("warning: output {ext}");
-        }
-        Ok((k, spectrum, precision))
+        Ok((linear_spectrum(self)?, precision))
     }
 
     /// Header lines naming the input spectrum and the integration settings.
@@ -163,6 +159,34 @@ impl Input {
             spectrum.extrapolation_slopes().1
         );
         h
+    }
+}
+
+impl Input {
+    /// The output k grid [h/Mpc], the linear spectrum at the output redshift (with a warning when the
+    /// grid reaches its extrapolated ends) and the loop-integral settings.
+    pub fn load(&self) -> Result<(Vec<f64>, LinearSpectrum, Precision)> {
+        let k = match &self.k_file {
+            Some(path) => read_k_file(path)?,
+            None => LogGrid::new(self.k_min, self.k_max, self.nk)
+                .context("invalid --k-min/--k-max/--nk")?
+                .points(),
+        };
+        let (spectrum, precision) = self.spectrum.load()?;
+        if let Some(ext) = spectrum.extrapolation_in(k[0], k[k.len() - 1]) {
+            eprintln!("warning: output {ext}");
+        }
+        Ok((k, spectrum, precision))
+    }
+
+    /// Header lines naming the input spectrum and the integration settings.
+    pub fn describe(&self, spectrum: &LinearSpectrum, precision: &Precision) -> String {
+        self.spectrum.describe(spectrum, precision)
+    }
+
+    /// The output redshift.
+    pub fn z(&self) -> f64 {
+        self.spectrum.z
     }
 }
 
@@ -208,7 +232,7 @@ fn run_all(args: &Args) -> Result<()> {
     let mut text = format!(
         "# pt-spectra {} real --model all: P_dd of each model over the no-wiggle spectrum, z = {}\n",
         env!("CARGO_PKG_VERSION"),
-        args.input.z
+        args.input.z()
     );
     text += &args.input.describe(&spectrum, &precision);
     text += "# P_nw: Eisenstein & Hu (1998) no-wiggle fit of the gm2012 cosmology, scaled to the sigma8 of the \
@@ -248,7 +272,7 @@ pub fn write_output(out: Option<&PathBuf>, text: &str) -> Result<()> {
 }
 
 /// The input spectrum at the output redshift.
-fn linear_spectrum(args: &Input) -> Result<LinearSpectrum> {
+fn linear_spectrum(args: &SpectrumInput) -> Result<LinearSpectrum> {
     for (name, z) in [("--z", args.z), ("--z-input", args.z_input)] {
         if !(z.is_finite() && z > -1.0) {
             bail!("{name} {z}: a redshift must be finite and > -1");
@@ -422,7 +446,7 @@ fn header(
     let mut h = format!(
         "# pt-spectra {} real: model {model}, z = {}\n",
         env!("CARGO_PKG_VERSION"),
-        args.input.z
+        args.input.z()
     );
     h += &args.input.describe(spectrum, precision);
     h += "# conventions: theta = -div v/(aHf); 1-loop correction = P22 + 2 P13; err_X = estimated absolute \

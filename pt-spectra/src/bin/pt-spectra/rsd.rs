@@ -134,7 +134,7 @@ pub fn run(args: &Args) -> Result<()> {
     let (bias, noise) = (args.bias()?, args.noise()?);
     let (k, spectrum, precision) = args.input.load()?;
     let cosmology = Cosmology::gm2012();
-    let z = args.input.z;
+    let z = args.input.z();
     let f = args.f.unwrap_or_else(|| cosmology.growth_rate(z));
     if !f.is_finite() {
         bail!("--f {f}: must be finite");

@@ -1,0 +1,237 @@
+//! `pt-spectra fit`: best-fit f, σ0, A_b with Δχ² errors against measured multipoles, versus k_max.
+
+use crate::real::{loop_terms, write_output, SpectrumInput};
+use anyhow::{bail, Context, Result};
+use pt_spectra::cosmology::Cosmology;
+use pt_spectra::fit::{
+    delta_chi2, fit, FitSettings, MultipoleData, MultipoleModel, Parameter, Params,
+};
+use pt_spectra::halo::Bias;
+use pt_spectra::loops::TnsPlan;
+use pt_spectra::real::{from_terms, RealModel};
+use pt_spectra::rsd::{Fog, RsdModel};
+use pt_spectra::table::{Table, Tabulated};
+use std::path::PathBuf;
+
+/// Arguments of `pt-spectra fit`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(flatten)]
+    spectrum: SpectrumInput,
+    /// Measured multipoles: a table with k [h/Mpc] and, per multipole, P_l and its 1σ error [(Mpc/h)^3].
+    #[arg(long, value_name = "FILE")]
+    data: PathBuf,
+    /// 1-based columns of the data: k, then P_l and σ_l for each of --data-ells.
+    #[arg(long, value_name = "K,P,S,…", default_value = "1,2,3,4,5,6,7")]
+    data_columns: String,
+    /// The multipoles in the data file, in column order.
+    #[arg(long, value_name = "L,L,…", default_value = "0,2,4")]
+    data_ells: String,
+    /// The multipoles to fit (jointly), a subset of --data-ells.
+    #[arg(long, value_name = "L,L,…", default_value = "0")]
+    ells: String,
+    /// Optional full covariance of the fitted data vector (ℓ-major over --ells, all k of the file): a
+    /// whitespace square matrix. Default: diagonal σ².
+    #[arg(long, value_name = "FILE")]
+    covariance: Option<PathBuf>,
+    /// Real-space model: linear, 1l-spt, 2l-spt, 1l-rpt-n0..n3, 2l-rpt-n0..n3.
+    #[arg(long = "real", value_name = "M", default_value = "1l-spt")]
+    real_model: String,
+    /// Redshift-space model: kaiser, scoccimarro or tns.
+    #[arg(long, value_name = "MODEL", default_value = "tns")]
+    rsd: String,
+    /// Fingers of God: none, lorentzian or gaussian.
+    #[arg(long, value_name = "KIND", default_value = "lorentzian")]
+    fog: String,
+    /// Free parameters, comma separated: f, sigma0, ab.
+    #[arg(long, value_name = "P,P", default_value = "f,sigma0")]
+    free: String,
+    /// Growth rate: start value if free, value if fixed. Default: f(z) of the gm2012 cosmology.
+    #[arg(long, value_name = "F", allow_hyphen_values = true)]
+    f: Option<f64>,
+    /// σ0 [Mpc/h]: start value if free, value if fixed.
+    #[arg(
+        long,
+        value_name = "S",
+        default_value_t = 3.0,
+        allow_hyphen_values = true
+    )]
+    sigma0: f64,
+    /// Bias amplitude A_b: start value if free, value if fixed.
+    #[arg(
+        long,
+        value_name = "A",
+        default_value_t = 1.0,
+        allow_hyphen_values = true
+    )]
+    amplitude: f64,
+    /// Constant linear bias b (before A_b).
+    #[arg(
+        long,
+        value_name = "B",
+        default_value_t = 1.0,
+        allow_hyphen_values = true,
+        conflicts_with = "bias_file"
+    )]
+    bias: f64,
+    /// Scale-dependent bias b(k) from a table (k [h/Mpc], b), before A_b.
+    #[arg(long, value_name = "FILE")]
+    bias_file: Option<PathBuf>,
+    /// Smallest k used [h/Mpc].
+    #[arg(long, value_name = "K", default_value_t = 0.0)]
+    k_min: f64,
+    /// k_max [h/Mpc]: one value, a list `a,b,c`, or a scan `start:end:step`.
+    #[arg(long, value_name = "K", default_value = "0.05:0.25:0.01")]
+    k_max: String,
+    /// Write the table to this file instead of standard output.
+    #[arg(long, value_name = "FILE")]
+    out: Option<PathBuf>,
+}
+
+fn list<T: std::str::FromStr>(s: &str, what: &str) -> Result<Vec<T>> {
+    s.split(',')
+        .map(|x| {
+            x.trim()
+                .parse::<T>()
+                .map_err(|_| anyhow::anyhow!("{what}: `{x}` is not valid"))
+        })
+        .collect()
+}
+
+/// `a:b:step` (inclusive, to rounding), a list, or one value.
+fn k_max_values(s: &str) -> Result<Vec<f64>> {
+    let parts: Vec<&str> = s.split(':').collect();
+    let v = match parts[..] {
+        [a, b, step] => {
+            let (a, b, step): (f64, f64, f64) =
+                (a.trim().parse()?, b.trim().parse()?, step.trim().parse()?);
+            if !(a.is_finite() && b >= a && step > 0.0) {
+                bail!("--k-max {s}: needs start <= end and step > 0");
+            }
+            let n = ((b - a) / step + 1e-9).floor() as usize;
+            (0..=n).map(|i| a + step * i as f64).collect()
+        }
+        [_] => list(s, "--k-max")?,
+        _ => bail!("--k-max {s}: expected K, a list K,K,… or start:end:step"),
+    };
+    if let Some(bad) = v.iter().find(|k| !(k.is_finite() && **k > 0.0)) {
+        bail!("--k-max: {bad} is not a positive wavenumber");
+    }
+    Ok(v)
+}
+
+/// Runs the subcommand.
+pub fn run(args: &Args) -> Result<()> {
+    let real: RealModel = args.real_model.parse()?;
+    let rsd: RsdModel = args.rsd.parse()?;
+    let fog: Fog = args.fog.parse()?;
+    let free: Vec<Parameter> = args
+        .free
+        .split(',')
+        .map(str::parse)
+        .collect::<Result<_, _>>()?;
+    let data_ells: Vec<usize> = list(&args.data_ells, "--data-ells")?;
+    let ells: Vec<usize> = list(&args.ells, "--ells")?;
+    let cols: Vec<usize> = list(&args.data_columns, "--data-columns")?;
+    if cols.len() != 1 + 2 * data_ells.len() || cols.contains(&0) {
+        bail!(
+            "--data-columns {}: expected {} 1-based columns (k, then P_l, sigma_l for each of --data-ells {})",
+            args.data_columns,
+            1 + 2 * data_ells.len(),
+            args.data_ells
+        );
+    }
+    let mut spec = Vec::new();
+    for &l in &ells {
+        let Some(j) = data_ells.iter().position(|&d| d == l) else {
+            bail!(
+                "--ells: multipole {l} is not among --data-ells {}",
+                args.data_ells
+            );
+        };
+        spec.push((l, cols[1 + 2 * j] - 1, cols[2 + 2 * j] - 1));
+    }
+    let mut data = MultipoleData::read(&args.data, cols[0] - 1, &spec)?;
+    if let Some(path) = &args.covariance {
+        let n = ells.len() * data.k.len();
+        let table = Table::read(path, &(0..n).collect::<Vec<_>>()).context("--covariance")?;
+        let rows: Vec<Vec<f64>> = (0..table.lines.len())
+            .map(|i| table.columns.iter().map(|c| c[i]).collect())
+            .collect();
+        data = data.with_covariance(rows).context("--covariance")?;
+    }
+    let k_max = k_max_values(&args.k_max)?;
+    let (spectrum, precision) = args.spectrum.load()?;
+    let cosmology = Cosmology::gm2012();
+    let z = args.spectrum.z;
+    let f0 = args.f.unwrap_or_else(|| cosmology.growth_rate(z));
+    for (name, v) in [
+        ("--f", f0),
+        ("--sigma0", args.sigma0),
+        ("--amplitude", args.amplitude),
+    ] {
+        if !v.is_finite() {
+            bail!("{name} {v}: must be finite");
+        }
+    }
+    let bias = match &args.bias_file {
+        Some(p) => Bias::Table(Tabulated::read(p, "b(k)", (0, 1), true).context("--bias-file")?),
+        None => Bias::Constant(args.bias),
+    };
+    let b = bias.values(&data.k, 1.0)?;
+    let spectra = from_terms(real, &loop_terms(&data.k, &precision, &spectrum, real)?)?;
+    let tns = if rsd.needs_tns() {
+        Some(TnsPlan::new(&data.k, &precision)?.par_evaluate(&spectrum))
+    } else {
+        None
+    };
+    let model = MultipoleModel::new(
+        &spectra,
+        tns.as_ref(),
+        rsd,
+        fog,
+        cosmology.growth_factor(z),
+        b,
+        &ells,
+    )?;
+    let settings = FitSettings {
+        free: free.clone(),
+        start: Params {
+            f: f0,
+            sigma0: args.sigma0,
+            amplitude: args.amplitude,
+        },
+        k_min: args.k_min,
+    };
+    let results = fit(&model, &data, &settings, &k_max)?;
+
+    let mut text = format!(
+        "# pt-spectra {} fit: {rsd} with real-space {real}, FoG {fog:?}, z = {z}, ells {}, free {}; data {}\n",
+        env!("CARGO_PKG_VERSION"),
+        args.ells,
+        args.free,
+        args.data.display()
+    );
+    text += &args.spectrum.describe(&spectrum, &precision);
+    text += &format!(
+        "# chi2 = {} ; errors: where the profile chi2 reaches chi2_min + {} ({} free); fixed: f = {f0}, sigma0 = {}, ab = {}\n",
+        if data.covariance.is_some() { "(d-m)^T C^-1 (d-m)" } else { "sum ((d-m)/sigma)^2" },
+        delta_chi2(free.len()),
+        free.len(),
+        args.sigma0,
+        args.amplitude
+    );
+    text += "# k_max points";
+    for p in &free {
+        text += &format!(" {p} {p}_lo {p}_hi");
+    }
+    text += " chi2 dof chi2_dof\n";
+    for r in &results {
+        text += &format!("{:.6} {}", r.k_max, r.points);
+        for (p, lo, hi) in &r.intervals {
+            text += &format!(" {:.9e} {lo:.9e} {hi:.9e}", r.best.get(*p));
+        }
+        text += &format!(" {:.6e} {} {:.6e}\n", r.chi2, r.dof, r.chi2 / r.dof as f64);
+    }
+    write_output(args.out.as_ref(), &text)
+}

@@ -1,0 +1,245 @@
+//! End-to-end fits: mock multipoles made by an independent route (closed-form linear Kaiser with a known
+//! f plus Gaussian noise) are fitted back, and a mock from a model the fit does not use shows a bias.
+
+use pt_spectra::fit::{
+    delta_chi2, fit, FitSettings, MultipoleData, MultipoleModel, Parameter, Params,
+};
+use pt_spectra::linear::{LinearSpectrum, LogGrid};
+use pt_spectra::loops::TnsPlan;
+use pt_spectra::precision::Precision;
+use pt_spectra::real::{real_space, RealModel};
+use pt_spectra::rsd::{Fog, RsdModel};
+use rand::{Rng, SeedableRng};
+
+const F_TRUE: f64 = 0.483135;
+
+/// Standard normal deviates (Box–Muller).
+fn normal(rng: &mut rand_chacha::ChaCha8Rng) -> f64 {
+    let (u, v): (f64, f64) = (rng.gen::<f64>().max(1e-300), rng.gen());
+    (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+}
+
+/// Linear Kaiser multipoles from the closed forms (science.md), 1% errors of P0 on every ℓ, noise.
+fn kaiser_mock(k: &[f64], b: f64, seed: u64) -> MultipoleData {
+    let p = LinearSpectrum::gm2012(0.0).unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let f = F_TRUE;
+    let exact: Vec<[f64; 3]> = k
+        .iter()
+        .map(|&k| {
+            let pl = p.eval(k);
+            [
+                pl * (b * b + 2.0 * b * f / 3.0 + f * f / 5.0),
+                pl * (4.0 * b * f / 3.0 + 4.0 * f * f / 7.0),
+                pl * 8.0 * f * f / 35.0,
+            ]
+        })
+        .collect();
+    let sigma: Vec<f64> = exact.iter().map(|e| 0.01 * e[0]).collect();
+    let mut text = String::from("# k P0 s0 P2 s2 P4 s4\n");
+    for (i, &ki) in k.iter().enumerate() {
+        text += &format!("{ki}");
+        for e in exact[i] {
+            text += &format!(" {} {}", e + sigma[i] * normal(&mut rng), sigma[i]);
+        }
+        text.push('\n');
+    }
+    MultipoleData::parse(&text, "mock", 0, &[(0, 1, 2), (2, 3, 4), (4, 5, 6)]).unwrap()
+}
+
+fn linear_kaiser_model(k: &[f64], b: f64) -> MultipoleModel {
+    let p = LinearSpectrum::gm2012(0.0).unwrap();
+    let (real, _) = real_space(RealModel::Linear, &p, k, &Precision::fast()).unwrap();
+    MultipoleModel::new(
+        &real,
+        None,
+        RsdModel::Kaiser,
+        Fog::None,
+        1.0,
+        vec![b; k.len()],
+        &[0, 2, 4],
+    )
+    .unwrap()
+}
+
+#[test]
+fn fit_recovers_f_from_an_independent_kaiser_mock() {
+    let k = LogGrid::new(0.01, 0.3, 40).unwrap().points();
+    let model = linear_kaiser_model(&k, 1.0);
+    let mut inside = 0;
+    for seed in 0..6 {
+        let data = kaiser_mock(&k, 1.0, seed);
+        let settings = FitSettings {
+            free: vec![Parameter::F],
+            start: Params {
+                f: 0.6,
+                sigma0: 0.0,
+                amplitude: 1.0,
+            },
+            k_min: 0.0,
+        };
+        let r = &fit(&model, &data, &settings, &[0.2, 0.3]).unwrap()[1];
+        let (_, lo, hi) = r.intervals[0];
+        assert!(lo < r.best.f && r.best.f < hi, "{r:?}");
+        let sigma = 0.5 * (hi - lo);
+        // The fit is right: within 3σ every time, within 1σ about 68% of the time, χ²/dof ≈ 1.
+        assert!(
+            (r.best.f - F_TRUE).abs() < 3.0 * sigma,
+            "seed {seed}: {r:?}"
+        );
+        assert!(sigma < 0.01, "{sigma}");
+        let reduced = r.chi2 / r.dof as f64;
+        assert!(
+            (0.5..1.7).contains(&reduced),
+            "seed {seed}: χ²/dof = {reduced}"
+        );
+        inside += usize::from((r.best.f - F_TRUE).abs() < sigma);
+    }
+    assert!(inside >= 2, "{inside} of 6 within 1σ");
+}
+
+#[test]
+fn two_parameter_errors_lie_on_the_delta_chi2_contour() {
+    // f and A_b with b = 2: the profile at the interval ends is χ²_min + 2.3, found by bisection.
+    let k = LogGrid::new(0.01, 0.25, 30).unwrap().points();
+    let model = linear_kaiser_model(&k, 2.0);
+    let data = kaiser_mock(&k, 2.0, 42);
+    let settings = FitSettings {
+        free: vec![Parameter::F, Parameter::Amplitude],
+        start: Params {
+            f: 0.4,
+            sigma0: 0.0,
+            amplitude: 1.1,
+        },
+        k_min: 0.0,
+    };
+    let r = &fit(&model, &data, &settings, &[0.25]).unwrap()[0];
+    assert!(
+        (r.best.f - F_TRUE).abs() < 3.0 * 0.5 * (r.intervals[0].2 - r.intervals[0].1),
+        "{r:?}"
+    );
+    assert!(
+        (r.best.amplitude - 1.0).abs() < 3.0 * 0.5 * (r.intervals[1].2 - r.intervals[1].1),
+        "{r:?}"
+    );
+    // Cross-check one end independently: scan A_b on a fine grid at f = upper end; the minimum over
+    // A_b of χ² must be χ²_min + Δχ² there.
+    let (_, _, f_hi) = r.intervals[0];
+    let chi2 = |f: f64, a: f64| -> f64 {
+        let m = model.multipoles(&Params {
+            f,
+            sigma0: 0.0,
+            amplitude: a,
+        });
+        (0..3)
+            .map(|j| {
+                (0..k.len())
+                    .map(|i| ((data.values[j][i] - m[j][i]) / data.sigma[j][i]).powi(2))
+                    .sum::<f64>()
+            })
+            .sum()
+    };
+    let best_a = (0..4001)
+        .map(|i| 0.9 + 0.2 * i as f64 / 4000.0)
+        .map(|a| chi2(f_hi, a))
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        (best_a - r.chi2 - delta_chi2(2)).abs() < 0.02,
+        "{best_a} vs {} + 2.3",
+        r.chi2
+    );
+}
+
+#[test]
+fn a_wrong_model_shows_a_bias() {
+    // Mock: TNS with 1-loop SPT spectra and Lorentzian FoG (σ0 = 4 Mpc/h), fitted with linear Kaiser.
+    let p = LinearSpectrum::gm2012(0.0).unwrap();
+    let k = LogGrid::new(0.01, 0.2, 30).unwrap().points();
+    let (real, _) = real_space(RealModel::OneLoopSpt, &p, &k, &Precision::fast()).unwrap();
+    let tns = TnsPlan::new(&k, &Precision::fast()).unwrap().evaluate(&p);
+    let truth = MultipoleModel::new(
+        &real,
+        Some(&tns),
+        RsdModel::Tns,
+        Fog::Lorentzian,
+        1.0,
+        vec![1.0; k.len()],
+        &[0, 2, 4],
+    )
+    .unwrap();
+    let m = truth.multipoles(&Params {
+        f: F_TRUE,
+        sigma0: 4.0,
+        amplitude: 1.0,
+    });
+    let mut text = String::new();
+    for (i, &ki) in k.iter().enumerate() {
+        // 0.2% of P0: errors as small as the paper's 160 simulation boxes.
+        let s = 0.002 * m[0][i];
+        text += &format!("{ki} {} {s} {} {s} {} {s}\n", m[0][i], m[1][i], m[2][i]);
+    }
+    let data =
+        MultipoleData::parse(&text, "tns mock", 0, &[(0, 1, 2), (2, 3, 4), (4, 5, 6)]).unwrap();
+    let settings = FitSettings {
+        free: vec![Parameter::F],
+        start: Params {
+            f: 0.5,
+            sigma0: 0.0,
+            amplitude: 1.0,
+        },
+        k_min: 0.0,
+    };
+    // The quadrupole alone, as the paper fits each multipole: FoG damping pulls f low.
+    let quadrupole = MultipoleData::parse(&text, "tns mock", 0, &[(2, 3, 4)]).unwrap();
+    let (lin, _) = real_space(RealModel::Linear, &p, &k, &Precision::fast()).unwrap();
+    let kaiser = MultipoleModel::new(
+        &lin,
+        None,
+        RsdModel::Kaiser,
+        Fog::None,
+        1.0,
+        vec![1.0; k.len()],
+        &[2],
+    )
+    .unwrap();
+    let wrong = &fit(&kaiser, &quadrupole, &settings, &[0.2]).unwrap()[0];
+    let sigma = 0.5 * (wrong.intervals[0].2 - wrong.intervals[0].1);
+    println!("wrong model, quadrupole: {wrong:?}");
+    assert!(
+        (wrong.best.f - F_TRUE).abs() > 5.0 * sigma,
+        "no bias: {wrong:?}"
+    );
+    assert!(wrong.chi2 / wrong.dof as f64 > 5.0, "{wrong:?}");
+    // All three multipoles: χ² rejects the model.
+    let joint = &fit(&linear_kaiser_model(&k, 1.0), &data, &settings, &[0.2]).unwrap()[0];
+    assert!(joint.chi2 / joint.dof as f64 > 5.0, "{joint:?}");
+    // The right model with f and σ0 free recovers both.
+    let settings = FitSettings {
+        free: vec![Parameter::F, Parameter::Sigma0],
+        start: Params {
+            f: 0.55,
+            sigma0: 3.0,
+            amplitude: 1.0,
+        },
+        k_min: 0.0,
+    };
+    let right = &fit(&truth, &data, &settings, &[0.2]).unwrap()[0];
+    assert!((right.best.f - F_TRUE).abs() < 1e-4, "{right:?}");
+    assert!((right.best.sigma0 - 4.0).abs() < 1e-2, "{right:?}");
+}
+
+#[test]
+fn bad_data_are_refused_with_the_line() {
+    let cols = [(0, 1, 2)];
+    for (text, needle) in [
+        ("0.1 100 1\n0.2 90 0\n", "sigma_l"),
+        ("0.1 100 1\n0.2 nan 1\n", "P_l"),
+        ("0.1 100 1\n0.05 90 1\n", "increasing"),
+        ("0.1 100\n", "column 2"),
+    ] {
+        let e = MultipoleData::parse(text, "d.dat", 0, &cols)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("d.dat:") && e.contains(needle), "{e}");
+    }
+}
