@@ -204,6 +204,56 @@ fn fit_recovers_the_parameters_of_a_model_made_by_rsd() {
 }
 
 #[test]
+fn plot_writes_png_and_svg_and_refuses_bad_input() {
+    let dir = scratch("plot");
+    let table = dir.join("models.dat").display().to_string();
+    let mut all = vec!["real", "--model", "all", "--out", &table];
+    all.extend([
+        "--nk",
+        "6",
+        "--k-min",
+        "0.02",
+        "--k-max",
+        "0.2",
+        "--precision",
+        "fast",
+    ]);
+    let (ok, _, err) = run(&all);
+    assert!(ok, "{err}");
+    for ext in ["png", "svg"] {
+        let out = dir.join(format!("models.{ext}")).display().to_string();
+        let (ok, _, err) = run(&["plot", "models", &table, "--out", &out]);
+        assert!(ok, "{err}");
+        let bytes = std::fs::read(&out).unwrap();
+        assert!(bytes.len() > 10_000, "{ext}: {} bytes", bytes.len());
+        let magic: &[u8] = if ext == "png" { b"\x89PNG" } else { b"<svg" };
+        assert!(
+            bytes.windows(magic.len()).take(200).any(|w| w == magic),
+            "{ext}"
+        );
+    }
+    let gif = dir.join("m.gif").display().to_string();
+    for (args, needle) in [
+        (
+            vec!["plot", "models", &table, "--out", &gif],
+            ".png or .svg",
+        ),
+        (
+            vec!["plot", "propagators", &table, "--out", "x.png"],
+            "N_dd",
+        ),
+        (
+            vec!["plot", "fit", "/nonexistent/f.dat", "--out", "x.png"],
+            "/nonexistent/f.dat",
+        ),
+    ] {
+        let (ok, _, err) = run(&args);
+        assert!(!ok, "{args:?} should fail");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+}
+
+#[test]
 fn linear_kaiser_multipoles_follow_the_closed_form() {
     let (b, f) = (1.7, 0.6);
     let (ok, out, err) = run(&[

@@ -6,7 +6,7 @@ use pt_spectra::cosmology::Cosmology;
 use pt_spectra::fit::{
     delta_chi2, fit, FitSettings, MultipoleData, MultipoleModel, Parameter, Params,
 };
-use pt_spectra::halo::Bias;
+use pt_spectra::halo::{Bias, Noise};
 use pt_spectra::loops::TnsPlan;
 use pt_spectra::real::{from_terms, RealModel};
 use pt_spectra::rsd::{Fog, RsdModel};
@@ -77,6 +77,17 @@ pub struct Args {
     /// Scale-dependent bias b(k) from a table (k [h/Mpc], b), before A_b.
     #[arg(long, value_name = "FILE")]
     bias_file: Option<PathBuf>,
+    /// Stochasticity P_εε [(Mpc/h)^3] subtracted from the measured monopole (P^s_hh = ⟨δ_h δ_h⟩ − P_εε).
+    #[arg(
+        long,
+        value_name = "P",
+        allow_hyphen_values = true,
+        conflicts_with = "noise_file"
+    )]
+    shot_noise: Option<f64>,
+    /// P_εε(k) from a table (k [h/Mpc], P_εε), subtracted from the measured monopole.
+    #[arg(long, value_name = "FILE")]
+    noise_file: Option<PathBuf>,
     /// Smallest k used [h/Mpc].
     #[arg(long, value_name = "K", default_value_t = 0.0)]
     k_min: f64,
@@ -152,6 +163,18 @@ pub fn run(args: &Args) -> Result<()> {
         spec.push((l, cols[1 + 2 * j] - 1, cols[2 + 2 * j] - 1));
     }
     let mut data = MultipoleData::read(&args.data, cols[0] - 1, &spec)?;
+    let noise = match (&args.noise_file, args.shot_noise) {
+        (Some(p), _) => {
+            Noise::Table(Tabulated::read(p, "P_eps(k)", (0, 1), true).context("--noise-file")?)
+        }
+        (None, Some(p)) => Noise::Constant(p),
+        (None, None) => Noise::None,
+    };
+    if let (Some(p_eps), Some(j)) = (noise.values(&data.k)?, ells.iter().position(|&l| l == 0)) {
+        for (v, e) in data.values[j].iter_mut().zip(p_eps) {
+            *v -= e;
+        }
+    }
     if let Some(path) = &args.covariance {
         let n = ells.len() * data.k.len();
         let table = Table::read(path, &(0..n).collect::<Vec<_>>()).context("--covariance")?;

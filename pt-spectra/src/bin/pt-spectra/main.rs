@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 mod fit;
 mod kernel;
+mod plot;
 mod real;
 mod rsd;
 
@@ -29,6 +30,8 @@ enum Command {
     Rsd(Box<rsd::Args>),
     /// Fit f, σ0 and the bias amplitude to measured multipoles, with Δχ² errors, versus k_max.
     Fit(Box<fit::Args>),
+    /// Draw the paper's kinds of figure (PNG or SVG) from the tables of the other subcommands.
+    Plot(plot::Args),
 }
 
 fn main() -> ExitCode {
@@ -38,6 +41,7 @@ fn main() -> ExitCode {
         Command::Real(args) => real::run(&args),
         Command::Rsd(args) => rsd::run(&args),
         Command::Fit(args) => fit::run(&args),
+        Command::Plot(args) => plot::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -210,7 +210,10 @@ pub fn run(args: &Args) -> Result<()> {
         {
             match c {
                 Some(kc) => text += &format!(" {level} at k = {kc:.4}"),
-                None => text += &format!(" {level} at k = - (not on this grid)"),
+                None if signal_to_noise[0] < *level => {
+                    text += &format!(" {level}: below it at every k")
+                }
+                None => text += &format!(" {level}: not within the k range"),
             }
             text.push(';');
         }
