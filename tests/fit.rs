@@ -243,3 +243,71 @@ fn bad_data_are_refused_with_the_line() {
         assert!(e.contains("d.dat:") && e.contains(needle), "{e}");
     }
 }
+
+#[test]
+fn full_covariance_generalises_the_diagonal_chi2() {
+    let k = LogGrid::new(0.01, 0.2, 20).unwrap().points();
+    let model = linear_kaiser_model(&k, 1.0);
+    let data = kaiser_mock(&k, 1.0, 7);
+    let settings = FitSettings {
+        free: vec![Parameter::F],
+        start: Params {
+            f: 0.5,
+            sigma0: 0.0,
+            amplitude: 1.0,
+        },
+        k_min: 0.0,
+    };
+    let diagonal = &fit(&model, &data, &settings, &[0.2]).unwrap()[0];
+    // The same errors as a diagonal covariance: the same fit.
+    let sigma: Vec<f64> = data.sigma.iter().flatten().copied().collect();
+    let n = sigma.len();
+    let diag: Vec<Vec<f64>> = (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| if i == j { sigma[i] * sigma[i] } else { 0.0 })
+                .collect()
+        })
+        .collect();
+    let same = &fit(
+        &model,
+        &data.clone().with_covariance(diag).unwrap(),
+        &settings,
+        &[0.2],
+    )
+    .unwrap()[0];
+    assert!(
+        (same.chi2 - diagonal.chi2).abs() < 1e-9 * diagonal.chi2,
+        "{same:?} {diagonal:?}"
+    );
+    assert!((same.best.f - diagonal.best.f).abs() < 1e-9);
+    // Fully correlated errors between P0 and P2 at each k (ρ = 0.9) change χ² and the interval.
+    let mut corr = vec![vec![0.0; n]; n];
+    let nk = k.len();
+    for i in 0..n {
+        corr[i][i] = sigma[i] * sigma[i];
+    }
+    for i in 0..nk {
+        let (a, b) = (i, nk + i);
+        corr[a][b] = 0.9 * sigma[a] * sigma[b];
+        corr[b][a] = corr[a][b];
+    }
+    let correlated = &fit(
+        &model,
+        &data.clone().with_covariance(corr).unwrap(),
+        &settings,
+        &[0.2],
+    )
+    .unwrap()[0];
+    assert!(
+        (correlated.chi2 - diagonal.chi2).abs() > 1e-3 * diagonal.chi2,
+        "{correlated:?}"
+    );
+    let width = |r: &pt_spectra::fit::FitResult| r.intervals[0].2 - r.intervals[0].1;
+    assert!(
+        (width(correlated) / width(diagonal) - 1.0).abs() > 0.01,
+        "{correlated:?} {diagonal:?}"
+    );
+    // An asymmetric or wrongly sized matrix is refused.
+    assert!(data.clone().with_covariance(vec![vec![1.0; 3]; 3]).is_err());
+}

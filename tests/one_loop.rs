@@ -12,6 +12,9 @@ use pt_spectra::loops::{Estimate, OneLoopPlan, OneLoopTerms, Pair};
 use pt_spectra::precision::Precision;
 use std::f64::consts::PI;
 
+mod support;
+use support::*;
+
 /// Required agreement with FAST-PT per term, 0.01 ≤ k ≤ 0.5 h/Mpc (the target).
 const FASTPT_TOL: f64 = 1e-4;
 /// Measured agreement is ≲ 1e-5 (the reference's own accuracy); a regression beyond this is a bug.
@@ -22,18 +25,6 @@ const SIGMA_V2_TOL: f64 = 1e-6;
 const LIMIT_TOL: f64 = 1e-4;
 /// Growth against CAMB (which includes radiation and neutrinos in the background).
 const GROWTH_TOL: f64 = 1e-3;
-
-fn data(name: &str) -> String {
-    let path = format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"));
-    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
-}
-
-fn rows(text: &str) -> Vec<Vec<f64>> {
-    text.lines()
-        .filter(|l| !l.trim_start().starts_with('#') && !l.trim().is_empty())
-        .map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect())
-        .collect()
-}
 
 /// The value after `key` (e.g. `growth_rate_f(z)=`) in a header.
 fn header_value(text: &str, key: &str) -> f64 {

@@ -3,19 +3,16 @@
 //!
 //! The first test to run builds the P17 table (about 2.5 minutes on 2 cores) and caches it.
 
-use pt_spectra::integrate::GaussLegendre;
-use pt_spectra::linear::{LinearSpectrum, LogGrid};
-use pt_spectra::loops::{p13_kernels, p17_angular_kernel, P17Table};
+use pt_spectra::linear::LinearSpectrum;
+use pt_spectra::loops::{p17_angular_kernel, P17Table};
 use rand::{Rng, SeedableRng};
 use std::f64::consts::PI;
 
+mod support;
+use support::*;
+
 fn table() -> &'static P17Table {
     P17Table::get(&|_, _| {})
-}
-
-/// K₁(r) = 3⟨F_3^s(k, q, −q)⟩ [F, G].
-fn k1(r: f64) -> [f64; 2] {
-    p13_kernels(r).map(|f| f / (1008.0 * r * r))
 }
 
 #[test]
@@ -36,14 +33,7 @@ fn angular_kernel_has_the_factorised_ir_limit() {
 #[test]
 fn large_k_limit_is_the_gaussian_damping() {
     // All power at q ≪ k: P17/P → (−k²σ_v²/2)³/6.
-    let q0 = 1e-3;
-    let grid = LogGrid::new(1e-6, 1e2, 2000).unwrap();
-    let shape = |q: f64| 1e6 * (q / q0) / (1.0 + (q / q0).powi(8));
-    let spectrum = LinearSpectrum::from_fn(&grid, shape).unwrap();
-    let rule = GaussLegendre::new(10);
-    let edges: Vec<f64> = (0..=400).map(|i| -13.8 + 18.4 * i as f64 / 400.0).collect();
-    let (sigma, _) = rule.integrate_panels(|x| x.exp() * shape(x.exp()), &edges);
-    let sigma_v2 = sigma / (6.0 * PI * PI);
+    let (spectrum, sigma_v2) = infrared_spectrum();
     let k = [0.3];
     let p17 = table().evaluate(&k, &spectrum, (1e-6, 1e2), 0.01);
     let p = spectrum.eval(k[0]);

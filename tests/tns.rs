@@ -10,23 +10,14 @@ use pt_spectra::loops::{TnsPlan, TnsTerms};
 use pt_spectra::precision::Precision;
 use std::f64::consts::PI;
 
+mod support;
+use support::*;
+
 /// The target: every coefficient within 1e-3 of P_lin.
 const FASTPT_TOL: f64 = 1e-3;
 /// B agrees to ≤ 1.7e-5 of P_lin (≤ 5e-6 relative, oscillating in k for k > 0.25: FAST-PT's FFTLog; ours
 /// moves by ≤ 5e-7 at reference precision); a regression beyond this is a bug.
 const B_MEASURED: f64 = 3e-5;
-
-fn data(name: &str) -> String {
-    let path = format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"));
-    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
-}
-
-fn rows(text: &str) -> Vec<Vec<f64>> {
-    text.lines()
-        .filter(|l| !l.trim_start().starts_with('#') && !l.trim().is_empty())
-        .map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect())
-        .collect()
-}
 
 /// (n, m, 0-based column) of a coefficient of μ^{2n} f^m in the reference files.
 type Column = (usize, usize, usize);

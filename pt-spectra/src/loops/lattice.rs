@@ -78,6 +78,18 @@ impl Lattice {
             .collect()
     }
 
+    /// The interpolant P̃ at ln q = `x` from `samples`, and 0 outside [q_min, q_max] (the loop integrals'
+    /// convention: no power outside the integration range).
+    #[inline]
+    pub fn at_ln_or_zero(&self, samples: &[f64], x: f64) -> f64 {
+        let u = (x - self.x0) / self.step;
+        if (0.0..=(self.len - 1) as f64).contains(&u) {
+            self.interpolate(samples, u)
+        } else {
+            0.0
+        }
+    }
+
     /// The interpolant P̃ at fractional index u from `samples` (u in [0, N−1]).
     #[inline(always)]
     pub fn interpolate(&self, samples: &[f64], u: f64) -> f64 {

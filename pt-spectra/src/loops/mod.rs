@@ -163,29 +163,6 @@ pub struct OneLoopTerms {
     pub tt: PairTerms,
 }
 
-/// Adds P17 of δδ, δθ, θθ to `terms` (made from `spectrum`) from the P17 angular table
-/// ([`P17Table::get`], built or read from the cache on first use; `progress` is called while it is built).
-pub fn add_p17(
-    terms: &mut OneLoopTerms,
-    spectrum: &LinearSpectrum,
-    precision: &Precision,
-    progress: &(dyn Fn(usize, usize) + Sync),
-) {
-    let table = P17Table::get(progress);
-    let p17 = table.evaluate(
-        &terms.k,
-        spectrum,
-        (precision.q_min, precision.q_max),
-        precision.lattice_step,
-    );
-    for (j, pair) in [&mut terms.dd, &mut terms.dt, &mut terms.tt]
-        .into_iter()
-        .enumerate()
-    {
-        pair.p17 = p17.iter().map(|row| row[j]).collect();
-    }
-}
-
 impl OneLoopTerms {
     /// The terms of `pair`.
     pub fn pair(&self, pair: Pair) -> &PairTerms {
@@ -206,22 +183,46 @@ pub fn add_p15(
     precision: &Precision,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) {
-    let table = P15Table::get(progress);
-    let p15 = table.evaluate(
+    let rows = P15Table::get(progress).evaluate(
         &terms.k,
         spectrum,
         (precision.q_min, precision.q_max),
         precision.lattice_step,
     );
-    for (j, pair) in [&mut terms.dd, &mut terms.dt, &mut terms.tt]
-        .into_iter()
-        .enumerate()
-    {
-        pair.p15 = p15.iter().map(|row| row[j]).collect();
-    }
+    terms.set_rows(&rows, |pair| &mut pair.p15);
+}
+
+/// Adds P17 of δδ, δθ, θθ to `terms`, as [`add_p15`] from the P17 angular table ([`P17Table::get`]).
+pub fn add_p17(
+    terms: &mut OneLoopTerms,
+    spectrum: &LinearSpectrum,
+    precision: &Precision,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) {
+    let rows = P17Table::get(progress).evaluate(
+        &terms.k,
+        spectrum,
+        (precision.q_min, precision.q_max),
+        precision.lattice_step,
+    );
+    terms.set_rows(&rows, |pair| &mut pair.p17);
 }
 
 impl OneLoopTerms {
+    /// Sets one term of δδ, δθ, θθ from rows [δδ, δθ, θθ] per k.
+    fn set_rows(
+        &mut self,
+        rows: &[[Estimate; 3]],
+        field: impl Fn(&mut PairTerms) -> &mut Vec<Estimate>,
+    ) {
+        for (j, pair) in [&mut self.dd, &mut self.dt, &mut self.tt]
+            .into_iter()
+            .enumerate()
+        {
+            *field(pair) = rows.iter().map(|row| row[j]).collect();
+        }
+    }
+
     /// P33red_XY = P13_X P13_Y / P_lin at k index `i` (first term of eq. P33; P13_X = P13_δδ or P13_θθ).
     pub fn p33_reducible(&self, pair: Pair, i: usize) -> Estimate {
         let (a, b) = match pair {

@@ -349,14 +349,7 @@ impl P15Table {
     ) -> Vec<[Estimate; 3]> {
         let lattice = Lattice::new(q_range.0, q_range.1, lattice_step);
         let samples = lattice.sample(spectrum);
-        let (x_lo, x_hi) = (lattice.x0, lattice.x_end());
-        let p_at = |x: f64| -> f64 {
-            if x < x_lo || x > x_hi {
-                0.0
-            } else {
-                lattice.interpolate(&samples, (x - x_lo) / lattice.step)
-            }
-        };
+        let p_at = |x: f64| lattice.at_ln_or_zero(&samples, x);
         k.par_iter()
             .map(|&k| {
                 let ln_k = k.ln();

@@ -242,14 +242,7 @@ impl P17Table {
     ) -> Vec<[Estimate; 3]> {
         let lattice = Lattice::new(q_range.0, q_range.1, lattice_step);
         let samples = lattice.sample(spectrum);
-        let p_at = |x: f64| -> f64 {
-            let u = (x - lattice.x0) / lattice.step;
-            if (0.0..=(lattice.len - 1) as f64).contains(&u) {
-                lattice.interpolate(&samples, u)
-            } else {
-                0.0
-            }
-        };
+        let p_at = |x: f64| lattice.at_ln_or_zero(&samples, x);
         k.par_iter()
             .map(|&k| {
                 let ln_k = k.ln();

@@ -22,10 +22,10 @@
 //! value is the mean over the shifts and the error is their standard error. Every k uses the same
 //! points, so results are reproducible and smooth in k.
 //!
-//! Accuracy (default settings, 8 × 2^14 points × 4 images per k; the README has the measured table): the
-//! error of the 2-loop correction is ≲ 1e-4 of it for k ≤ 0.05 h/Mpc, ~0.1% at 0.1, ~0.3% at 0.18 and
-//! ~0.6% at 0.29, where it is a small difference of terms ten times larger. 2L-SPT δδ agrees with RegPT
-//! to ≤ 0.3% for k ≤ 0.3 h/Mpc.
+//! Accuracy (default settings: 8 shifts × 2^14 points at k = 0.1, scaled with k from ¼ to 4 times, × 4
+//! images; the README has the measured table): the error of the 2-loop correction is ≤ 5e-4 of it for
+//! k ≤ 0.07 h/Mpc, ~0.2–0.3% at 0.1–0.3 (where it is a small difference of terms twenty times larger)
+//! and ~1% at 0.4 (where it nearly vanishes). 2L-SPT δδ agrees with RegPT to ≤ 0.6% for k ≤ 0.3 h/Mpc.
 //!
 //! The same points also give 2P24 and P33irr separately (needed by 2-loop RPT, whose mode-coupling term is
 //! P33^{2L}); those carry larger errors, since their infrared pieces do not cancel.
@@ -41,7 +41,7 @@ use std::f64::consts::PI;
 /// Settings of the 2-loop integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TwoLoopSettings {
-    /// Sobol points per random shift and per k.
+    /// Sobol points per random shift at k = 0.1 h/Mpc (scaled with k, see `points_at`).
     pub points: usize,
     /// Number of independent random shifts (the error is their standard error).
     pub replicas: usize,
@@ -84,6 +84,22 @@ pub struct TwoLoopTerms {
     pub pairs: [TwoLoopPair; 3],
 }
 
+/// Largest factor by which [`points_at`] raises the number of points.
+const MAX_POINT_FACTOR: usize = 4;
+
+/// The Sobol points used at k: `points` × 2^round(log2(k/0.1)), between ¼ and 4 times `points`. The
+/// 2-loop correction is a cancellation of ever larger terms as k grows, while at k ≲ 0.05 h/Mpc a quarter
+/// of the points already gives ~1e-4 relative errors; on log-spaced grids over [0.005, 0.4] the total
+/// cost is that of `points` at every k.
+fn points_at(k: f64, points: usize) -> usize {
+    let power = (k / 0.1).log2().round().clamp(-2.0, 2.0) as i32;
+    if power >= 0 {
+        points << power
+    } else {
+        (points >> (-power)).max(1)
+    }
+}
+
 /// Number of accumulated quantities per point: [total, 2P24, P33irr] × [δδ, δθ, θθ].
 const VALUES: usize = 12;
 
@@ -96,11 +112,7 @@ struct Sampled<'a> {
 impl Sampled<'_> {
     #[inline]
     fn at(&self, q: f64) -> f64 {
-        let u = self.lattice.position(q);
-        if !(0.0..=(self.lattice.len - 1) as f64).contains(&u) {
-            return 0.0;
-        }
-        self.lattice.interpolate(self.samples, u)
+        self.lattice.at_ln_or_zero(self.samples, q.ln())
     }
 }
 
@@ -207,7 +219,7 @@ pub fn two_loop(
     let params = JoeKuoD6::standard();
     let points: Vec<Vec<f64>> = Sobol::<f64>::new(5, &params)
         .skip(1)
-        .take(settings.points)
+        .take(MAX_POINT_FACTOR * settings.points)
         .collect();
     let shifts: Vec<[f64; 5]> = {
         use rand::{Rng, SeedableRng};
@@ -240,7 +252,8 @@ pub fn two_loop(
                 .iter()
                 .map(|shift| {
                     let mut acc = [0.0; VALUES];
-                    for point in &points {
+                    let points = &points[..points_at(k, settings.points)];
+                    for point in points {
                         let t: [f64; 5] = std::array::from_fn(|d| (point[d] + shift[d]).fract());
                         let ((q1, j1), (q2, j2)) = (radial(t[0]), radial(t[1]));
                         let (x1, x2, c) = (2.0 * t[2] - 1.0, 2.0 * t[3] - 1.0, (PI * t[4]).cos());

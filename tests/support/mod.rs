@@ -1,0 +1,39 @@
+//! Helpers shared by the loop-integral tests: reference tables, and a spectrum with all power at q ≪ k.
+#![allow(dead_code)]
+
+use pt_spectra::integrate::GaussLegendre;
+use pt_spectra::linear::{LinearSpectrum, LogGrid};
+use pt_spectra::loops::p13_kernels;
+use std::f64::consts::PI;
+
+/// The text of `tests/data/<name>`.
+pub fn data(name: &str) -> String {
+    let path = format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"));
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+/// The numeric rows of a table (`#` lines and blank lines skipped).
+pub fn rows(text: &str) -> Vec<Vec<f64>> {
+    text.lines()
+        .filter(|l| !l.trim_start().starts_with('#') && !l.trim().is_empty())
+        .map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect())
+        .collect()
+}
+
+/// K₁(r) = 3⟨X_3^s(k, q, −q)⟩ for X = F, G from the closed form of the P13 kernel (f_X/(1008 r²)).
+pub fn k1(r: f64) -> [f64; 2] {
+    p13_kernels(r).map(|f| f / (1008.0 * r * r))
+}
+
+/// A spectrum with all its power at q ~ 1e-3 h/Mpc (P ∝ q/(1 + (q/q0)⁸)), tabulated on [1e-6, 1e2], and
+/// its σ_v² = (1/6π²)∫P dq by an independent quadrature of the same shape.
+pub fn infrared_spectrum() -> (LinearSpectrum, f64) {
+    let q0 = 1e-3;
+    let grid = LogGrid::new(1e-6, 1e2, 2000).unwrap();
+    let shape = |q: f64| 1e6 * (q / q0) / (1.0 + (q / q0).powi(8));
+    let spectrum = LinearSpectrum::from_fn(&grid, shape).unwrap();
+    let rule = GaussLegendre::new(10);
+    let edges: Vec<f64> = (0..=400).map(|i| -13.8 + 18.4 * i as f64 / 400.0).collect();
+    let (sigma, _) = rule.integrate_panels(|x| x.exp() * shape(x.exp()), &edges);
+    (spectrum, sigma / (6.0 * PI * PI))
+}
