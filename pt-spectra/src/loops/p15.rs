@@ -203,6 +203,57 @@ pub(crate) fn cache_dir() -> Option<PathBuf> {
         .or_else(|| std::env::var_os("HOME").map(|d| PathBuf::from(d).join(".cache/pt-spectra")))
 }
 
+/// A lock older than this is taken to be left by a process that died while building a table.
+const LOCK_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(20 * 60);
+
+/// The cached table at `path`, or a new one from `build`, written there. A process that finds another
+/// building the same table (a fresh `.lock` file beside it) waits for that table instead of building
+/// its own, so that parallel jobs on a fresh machine build each table once.
+pub(crate) fn cached<T>(
+    path: Option<PathBuf>,
+    read: impl Fn(&std::path::Path) -> Option<T>,
+    build: impl FnOnce() -> T,
+    write: impl Fn(&T, &std::path::Path),
+) -> T {
+    let Some(path) = path else {
+        return build();
+    };
+    if let Some(t) = read(&path) {
+        return t;
+    }
+    let lock = path.with_extension("lock");
+    let _ = std::fs::create_dir_all(path.parent().unwrap_or(&path));
+    let fresh = |lock: &std::path::Path| {
+        std::fs::metadata(lock)
+            .and_then(|m| m.modified())
+            .ok()
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|age| age < LOCK_TIMEOUT)
+    };
+    let mine = std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&lock)
+        .is_ok();
+    if !mine {
+        while fresh(&lock) {
+            std::thread::sleep(std::time::Duration::from_millis(500));
+            if let Some(t) = read(&path) {
+                return t;
+            }
+        }
+        if let Some(t) = read(&path) {
+            return t;
+        }
+    }
+    let t = build();
+    write(&t, &path);
+    if mine {
+        let _ = std::fs::remove_file(&lock);
+    }
+    t
+}
+
 /// Writes little-endian f64 `values` to `path` atomically (a failed write only costs a rebuild).
 pub(crate) fn write_f64s(path: &std::path::Path, values: impl IntoIterator<Item = f64>) {
     let bytes: Vec<u8> = values.into_iter().flat_map(f64::to_le_bytes).collect();
@@ -234,19 +285,17 @@ impl P15Table {
     }
 
     /// The table of this process: read from the cache file if it is there and valid, otherwise built (in
-    /// parallel, calling `progress(done, total)` now and then) and written to the cache (if possible).
+    /// parallel, calling `progress(done, total)` now and then; or by another process, which this one then
+    /// waits for) and written to the cache (if possible).
     pub fn get(progress: &(dyn Fn(usize, usize) + Sync)) -> &'static P15Table {
         static TABLE: OnceLock<P15Table> = OnceLock::new();
         TABLE.get_or_init(|| {
-            let path = cache_path();
-            if let Some(table) = path.as_ref().and_then(|p| Self::read(p)) {
-                return table;
-            }
-            let table = Self::build(progress);
-            if let Some(p) = &path {
-                table.write(p);
-            }
-            table
+            cached(
+                cache_path(),
+                Self::read,
+                || Self::build(progress),
+                Self::write,
+            )
         })
     }
 

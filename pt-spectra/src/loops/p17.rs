@@ -18,7 +18,7 @@
 //! factorised kernels.
 
 use super::lattice::Lattice;
-use super::p15::{cache_dir, edges_with, read_f64s, write_f64s};
+use super::p15::{cache_dir, cached, edges_with, read_f64s, write_f64s};
 use super::Estimate;
 use crate::integrate::GaussLegendre;
 use crate::linear::LinearSpectrum;
@@ -175,20 +175,14 @@ impl P17Table {
     pub fn get(progress: &(dyn Fn(usize, usize) + Sync)) -> &'static P17Table {
         static TABLE: OnceLock<P17Table> = OnceLock::new();
         TABLE.get_or_init(|| {
-            let path = cache_path();
-            if let Some(t) = path.as_ref().and_then(|p| Self::read(p)) {
-                return t;
-            }
-            let t = Self::build(progress);
-            if let Some(p) = &path {
-                write_f64s(
-                    p,
-                    t.kernels
-                        .iter()
-                        .flat_map(|k| [k[0].value, k[0].error, k[1].value, k[1].error]),
-                );
-            }
-            t
+            let write = |t: &Self, p: &std::path::Path| {
+                let values = t
+                    .kernels
+                    .iter()
+                    .flat_map(|k| [k[0].value, k[0].error, k[1].value, k[1].error]);
+                write_f64s(p, values);
+            };
+            cached(cache_path(), Self::read, || Self::build(progress), write)
         })
     }
 
