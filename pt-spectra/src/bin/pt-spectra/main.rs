@@ -24,7 +24,7 @@ struct Cli {
 enum Command {
     /// Evaluate the symmetrised SPT kernel F_n^s or G_n^s (n = number of --q, 1..=7).
     Kernel(kernel::Args),
-    /// Real-space P_δδ, P_δθ, P_θθ (linear, 1-loop SPT, 1-loop RPT with N0 or N1) on a k grid.
+    /// Real-space P_δδ, P_δθ, P_θθ (linear, 1- and 2-loop SPT, 1- and 2-loop RPT with N0..N3) on a k grid.
     Real(real::Args),
     /// Redshift-space multipoles P_ℓ(k) (Kaiser, Scoccimarro or TNS; Fingers of God; halo bias and noise).
     Rsd(Box<rsd::Args>),
