@@ -311,3 +311,53 @@ fn full_covariance_generalises_the_diagonal_chi2() {
     // An asymmetric or wrongly sized matrix is refused.
     assert!(data.clone().with_covariance(vec![vec![1.0; 3]; 3]).is_err());
 }
+
+#[test]
+fn three_free_parameters_are_recovered_with_bracketing_intervals() {
+    // Noiseless TNS + 1L-SPT + Lorentzian mock with b = 1.5: f, σ0 and A_b free (Δχ² = 3.53).
+    let p = LinearSpectrum::gm2012(0.0).unwrap();
+    let k = LogGrid::new(0.02, 0.2, 20).unwrap().points();
+    let (real, _) = real_space(RealModel::OneLoopSpt, &p, &k, &Precision::fast()).unwrap();
+    let tns = TnsPlan::new(&k, &Precision::fast()).unwrap().evaluate(&p);
+    let model = MultipoleModel::new(
+        &real,
+        Some(&tns),
+        RsdModel::Tns,
+        Fog::Lorentzian,
+        1.0,
+        vec![1.5; k.len()],
+        &[0, 2, 4],
+    )
+    .unwrap();
+    let truth = Params {
+        f: F_TRUE,
+        sigma0: 4.0,
+        amplitude: 1.0,
+    };
+    let m = model.multipoles(&truth);
+    let mut text = String::new();
+    for (i, &ki) in k.iter().enumerate() {
+        let s = 0.005 * m[0][i];
+        text += &format!("{ki} {} {s} {} {s} {} {s}\n", m[0][i], m[1][i], m[2][i]);
+    }
+    let data = MultipoleData::parse(&text, "mock", 0, &[(0, 1, 2), (2, 3, 4), (4, 5, 6)]).unwrap();
+    let settings = FitSettings {
+        free: vec![Parameter::F, Parameter::Sigma0, Parameter::Amplitude],
+        start: Params {
+            f: 0.55,
+            sigma0: 3.0,
+            amplitude: 0.95,
+        },
+        k_min: 0.0,
+    };
+    let r = &fit(&model, &data, &settings, &[0.2]).unwrap()[0];
+    assert!(r.chi2 < 1e-6, "{r:?}");
+    for &(param, lo, hi) in &r.intervals {
+        let (best, want) = (r.best.get(param), truth.get(param));
+        assert!(
+            (best - want).abs() < 1e-3 * want,
+            "{param}: {best} vs {want}"
+        );
+        assert!(lo < best && best < hi, "{param}: [{lo}, {hi}]");
+    }
+}

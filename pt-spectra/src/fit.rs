@@ -39,6 +39,15 @@ pub struct MultipoleData {
     pub covariance: Option<Vec<Vec<f64>>>,
 }
 
+/// The table columns of k and, per (ℓ, value, error), the value and error columns.
+fn wanted(k_column: usize, columns: &[(usize, usize, usize)]) -> Vec<usize> {
+    let mut wanted = vec![k_column];
+    for &(_, v, s) in columns {
+        wanted.extend([v, s]);
+    }
+    wanted
+}
+
 impl MultipoleData {
     /// Reads a table: k in the 0-based column `k_column`, and for each (ℓ, value column, error column).
     ///
@@ -51,12 +60,7 @@ impl MultipoleData {
         k_column: usize,
         columns: &[(usize, usize, usize)],
     ) -> Result<Self> {
-        let mut wanted = vec![k_column];
-        for &(_, v, s) in columns {
-            wanted.extend([v, s]);
-        }
-        let table = Table::read(path, &wanted)?;
-        Self::from_table(&table, columns)
+        Self::from_table(&Table::read(path, &wanted(k_column, columns))?, columns)
     }
 
     /// As [`read`](Self::read), from text (`origin` names it in messages).
@@ -69,11 +73,10 @@ impl MultipoleData {
         k_column: usize,
         columns: &[(usize, usize, usize)],
     ) -> Result<Self> {
-        let mut wanted = vec![k_column];
-        for &(_, v, s) in columns {
-            wanted.extend([v, s]);
-        }
-        Self::from_table(&Table::parse(text, origin, &wanted)?, columns)
+        Self::from_table(
+            &Table::parse(text, origin, &wanted(k_column, columns))?,
+            columns,
+        )
     }
 
     fn from_table(table: &Table, columns: &[(usize, usize, usize)]) -> Result<Self> {
@@ -412,16 +415,41 @@ pub fn delta_chi2(n: usize) -> f64 {
     }
 }
 
-/// The χ² of one fit window.
-struct Window<'a> {
+/// The data of one fit window (k ≤ k_max) and its χ².
+struct Residuals<'a> {
     model: &'a MultipoleModel,
-    data: &'a MultipoleData,
     /// Data indices of the model k (the model is built on the data grid).
     range: std::ops::Range<usize>,
-    /// The residual weights: 1/σ (diagonal) or the Cholesky factor L⁻¹ of the covariance window.
+    /// L⁻¹ of the Cholesky factor of the covariance window, or `None` for the diagonal σ.
     inverse_factor: Option<Vec<Vec<f64>>>,
     data_vector: Vec<f64>,
     sigma_vector: Vec<f64>,
+}
+
+impl Residuals<'_> {
+    fn chi2(&self, p: &Params) -> f64 {
+        let mut r = vec![0.0; self.data_vector.len()];
+        self.model.multipoles_into(p, self.range.clone(), &mut r);
+        for (r, d) in r.iter_mut().zip(&self.data_vector) {
+            *r = d - *r;
+        }
+        match &self.inverse_factor {
+            None => r
+                .iter()
+                .zip(&self.sigma_vector)
+                .map(|(r, s)| (r / s).powi(2))
+                .sum(),
+            Some(l) => l
+                .iter()
+                .map(|row| row.iter().zip(&r).map(|(a, b)| a * b).sum::<f64>().powi(2))
+                .sum(),
+        }
+    }
+}
+
+/// χ² as a function of the free parameters, the others at `base`.
+struct Window<'a> {
+    residuals: &'a Residuals<'a>,
     base: Params,
     free: Vec<Parameter>,
 }
@@ -436,25 +464,7 @@ impl Window<'_> {
     }
 
     fn chi2(&self, p: &Params) -> f64 {
-        let mut m = vec![0.0; self.data_vector.len()];
-        self.model.multipoles_into(p, self.range.clone(), &mut m);
-        let r: Vec<f64> = self
-            .data_vector
-            .iter()
-            .zip(&m)
-            .map(|(d, m)| d - m)
-            .collect();
-        match &self.inverse_factor {
-            None => r
-                .iter()
-                .zip(&self.sigma_vector)
-                .map(|(r, s)| (r / s).powi(2))
-                .sum(),
-            Some(l) => l
-                .iter()
-                .map(|row| row.iter().zip(&r).map(|(a, b)| a * b).sum::<f64>().powi(2))
-                .sum(),
-        }
+        self.residuals.chi2(p)
     }
 }
 
@@ -497,12 +507,7 @@ impl Profile<'_> {
             }
             _ => {
                 let sub = Window {
-                    model: self.window.model,
-                    data: self.window.data,
-                    range: self.window.range.clone(),
-                    inverse_factor: self.window.inverse_factor.clone(),
-                    data_vector: self.window.data_vector.clone(),
-                    sigma_vector: self.window.sigma_vector.clone(),
+                    residuals: self.window.residuals,
                     base: p,
                     free: others.iter().map(|o| o.1).collect(),
                 };
@@ -675,13 +680,15 @@ pub fn fit(
                 Some(invert_lower(&l))
             }
         };
-        let window = Window {
+        let residuals = Residuals {
             model,
-            data,
             range: start..end,
             inverse_factor,
             data_vector,
             sigma_vector,
+        };
+        let window = Window {
+            residuals: &residuals,
             base: settings.start,
             free: free.clone(),
         };

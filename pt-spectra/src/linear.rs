@@ -210,10 +210,7 @@ impl LinearSpectrum {
     /// [`Error::Io`] if the file cannot be read, otherwise as [`parse`](Self::parse).
     pub fn from_file_with_columns(path: impl AsRef<Path>, columns: Columns) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = crate::table::read_text(path)?;
         Self::parse(&text, &path.display().to_string(), columns)
     }
 

@@ -9,6 +9,17 @@
 use crate::error::{Error, Result};
 use std::path::Path;
 
+/// The text of the file at `path`.
+///
+/// # Errors
+/// [`Error::Io`] naming the file.
+pub(crate) fn read_text(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
 /// The selected columns of a table's data rows.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Table {
@@ -29,11 +40,7 @@ impl Table {
     /// [`Error::Io`], and as [`parse`](Self::parse).
     pub fn read(path: impl AsRef<Path>, columns: &[usize]) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        Self::parse(&text, &path.display().to_string(), columns)
+        Self::parse(&read_text(path)?, &path.display().to_string(), columns)
     }
 
     /// Parses the 0-based `columns` of `text`; `origin` names it in messages. Values may be any f64

@@ -71,6 +71,12 @@ impl Estimate {
         Self { value, error }
     }
 
+    /// The mean of two estimates, errors averaged: the δθ propagator terms are the means of the δδ and
+    /// θθ ones (P1n_δθ = (P1n_δδ + P1n_θθ)/2).
+    pub fn mean(a: Self, b: Self) -> Self {
+        Self::new(0.5 * (a.value + b.value), 0.5 * (a.error + b.error))
+    }
+
     /// The error relative to |value| (∞ if the value is 0 and the error is not).
     pub fn relative_error(&self) -> f64 {
         if self.error == 0.0 {

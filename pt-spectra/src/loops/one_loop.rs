@@ -215,10 +215,7 @@ impl OneLoopPlan {
             out.p_lin.push(p);
             out.dd.p13.push(f13);
             out.tt.p13.push(g13);
-            out.dt.p13.push(Estimate::new(
-                0.5 * (f13.value + g13.value),
-                0.5 * (f13.error + g13.error),
-            ));
+            out.dt.p13.push(Estimate::mean(f13, g13));
             out.dd.p22.push(e(2, 1.0));
             out.dt.p22.push(e(3, 1.0));
             out.tt.p22.push(e(4, 1.0));

@@ -429,8 +429,7 @@ impl P15Table {
                     )
                 };
                 let (dd, tt) = (e(0), e(1));
-                let dt = Estimate::new(0.5 * (dd.value + tt.value), 0.5 * (dd.error + tt.error));
-                [dd, dt, tt]
+                [dd, Estimate::mean(dd, tt), tt]
             })
             .collect()
     }

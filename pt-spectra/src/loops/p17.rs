@@ -251,8 +251,7 @@ impl P17Table {
                 let norm = k.powi(9) / (8.0 * PI.powi(6)) * spectrum.eval(k);
                 let e = |x: usize| Estimate::new(norm * value[x], norm.abs() * error[x]);
                 let (dd, tt) = (e(0), e(1));
-                let dt = Estimate::new(0.5 * (dd.value + tt.value), 0.5 * (dd.error + tt.error));
-                [dd, dt, tt]
+                [dd, Estimate::mean(dd, tt), tt]
             })
             .collect()
     }

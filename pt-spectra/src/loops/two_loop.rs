@@ -119,33 +119,34 @@ impl Sampled<'_> {
 /// Pair index j: (X, Y) = (F, F), (F, G), (G, G) → kernel indices.
 const PAIRS: [(usize, usize); 3] = [(0, 0), (0, 1), (1, 1)];
 
-/// g(q₁, q₂) of the module docs for the three pairs, from the Gram matrix [kk, kq₁, kq₂, q₁q₁, q₁q₂, q₂q₂]
-/// (the P33irr part, symmetric, is added by the caller once).
+/// The propagator pieces 2P15 + P33red of the integrand for the three pairs, from the Gram matrix
+/// [kk, kq₁, kq₂, q₁q₁, q₁q₂, q₂q₂] (without P₁P₂). Symmetric in q₁ ↔ q₂, so evaluated once per point.
 #[inline]
-fn half_integrand(g: &[f64; 6], p: &Sampled, p_k: f64, p1: f64, p2: f64) -> [[f64; 2]; 3] {
-    let [kk, kq1, _, q1q1, _, _] = *g;
+fn propagator_part(g: &[f64; 6], p_k: f64) -> [f64; 3] {
+    let [kk, kq1, kq2, q1q1, _, q2q2] = *g;
     let p5 = pt_kernels::propagator_5(g);
     let a3 = pt_kernels::propagator_3(&[kk, kq1, q1q1]);
-    let b3 = pt_kernels::propagator_3(&[kk, g[2], g[5]]);
+    let b3 = pt_kernels::propagator_3(&[kk, kq2, q2q2]);
+    PAIRS.map(|(x, y)| {
+        15.0 * p_k * (p5[x] + p5[y]) + 9.0 * p_k * 0.5 * (a3[x] * b3[y] + a3[y] * b3[x])
+    })
+}
+
+/// The 2P24 piece of g(q₁, q₂) (module docs) for the three pairs, without P₁P₂, from the Gram matrix
+/// [kk, kq₁, kq₂, q₁q₁, q₁q₂, q₂q₂]; the caller adds it with q₁ ↔ q₂.
+#[inline]
+fn p24_half(g: &[f64; 6], p: &Sampled) -> [f64; 3] {
+    let [kk, kq1, _, q1q1, _, _] = *g;
     // The smooth partition w = p⁴/(q⁴ + p⁴), p = |k − q₁|, of the q₁ ↔ k − q₁ symmetry (×2 below).
     let p1m2 = (kk - 2.0 * kq1 + q1q1).max(0.0);
     let w = p1m2 * p1m2 / (q1q1 * q1q1 + p1m2 * p1m2);
-    let (m2, m4, p_k1) = if w > 1e-12 {
-        (
-            pt_kernels::mode_coupling_2(&[kk, kq1, q1q1]),
-            pt_kernels::mode_coupling_4(g),
-            w * p.at(p1m2.sqrt()),
-        )
-    } else {
-        ([0.0; 2], [0.0; 2], 0.0)
-    };
-    let mut out = [[0.0; 2]; 3];
-    for (j, &(x, y)) in PAIRS.iter().enumerate() {
-        let prop = 15.0 * p_k * (p5[x] + p5[y]) + 9.0 * p_k * 0.5 * (a3[x] * b3[y] + a3[y] * b3[x]);
-        let mc = 24.0 * (m2[x] * m4[y] + m2[y] * m4[x]) * p_k1;
-        out[j] = [prop * p1 * p2, mc * p1 * p2];
+    if w <= 1e-12 {
+        return [0.0; 3];
     }
-    out
+    let m2 = pt_kernels::mode_coupling_2(&[kk, kq1, q1q1]);
+    let m4 = pt_kernels::mode_coupling_4(g);
+    let p_k1 = w * p.at(p1m2.sqrt());
+    PAIRS.map(|(x, y)| 24.0 * (m2[x] * m4[y] + m2[y] * m4[x]) * p_k1)
 }
 
 /// The integrand at one point: [total, 2P24, P33irr] for δδ, δθ, θθ (times the measure).
@@ -174,8 +175,10 @@ fn integrand(
     if p1 == 0.0 || p2 == 0.0 {
         return [0.0; VALUES];
     }
-    let a = half_integrand(&[kk, kq1, kq2, q11, q1q2, q22], p, p_k, p1, p2);
-    let b = half_integrand(&[kk, kq2, kq1, q22, q1q2, q11], p, p_k, p2, p1);
+    let g = [kk, kq1, kq2, q11, q1q2, q22];
+    let prop = propagator_part(&g, p_k);
+    let a = p24_half(&g, p);
+    let b = p24_half(&[kk, kq2, kq1, q22, q1q2, q11], p);
     let q33 = (kk + q11 + q22 - 2.0 * kq1 - 2.0 * kq2 + 2.0 * q1q2).max(0.0);
     // The smooth partition w = q₃⁴/(q₁⁴ + q₂⁴ + q₃⁴) of the permutation symmetry (×3 below).
     let w3 = q33 * q33 / (q11 * q11 + q22 * q22 + q33 * q33);
@@ -191,8 +194,8 @@ fn integrand(
     let mut out = [0.0; VALUES];
     for (j, &(x, y)) in PAIRS.iter().enumerate() {
         let p33 = m3[x] * m3[y];
-        let mc = 0.5 * (a[j][1] + b[j][1]);
-        let prop = 0.5 * (a[j][0] + b[j][0]);
+        let mc = 0.5 * (a[j] + b[j]) * p1 * p2;
+        let prop = prop[j] * p1 * p2;
         out[j] = measure * (prop + mc + p33);
         out[3 + j] = measure * mc;
         out[6 + j] = measure * p33;

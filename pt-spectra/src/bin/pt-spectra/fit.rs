@@ -1,16 +1,16 @@
 //! `pt-spectra fit`: best-fit f, σ0, A_b with Δχ² errors against measured multipoles, versus k_max.
 
+use crate::common::{list, BiasArgs, NoiseArgs};
 use crate::real::{loop_terms, write_output, SpectrumInput};
 use anyhow::{bail, Context, Result};
 use pt_spectra::cosmology::Cosmology;
 use pt_spectra::fit::{
     delta_chi2, fit, FitSettings, MultipoleData, MultipoleModel, Parameter, Params,
 };
-use pt_spectra::halo::{Bias, Noise};
 use pt_spectra::loops::TnsPlan;
 use pt_spectra::real::{from_terms, RealModel};
 use pt_spectra::rsd::{Fog, RsdModel};
-use pt_spectra::table::{Table, Tabulated};
+use pt_spectra::table::Table;
 use std::path::PathBuf;
 
 /// Arguments of `pt-spectra fit`.
@@ -65,29 +65,10 @@ pub struct Args {
         allow_hyphen_values = true
     )]
     amplitude: f64,
-    /// Constant linear bias b (before A_b).
-    #[arg(
-        long,
-        value_name = "B",
-        default_value_t = 1.0,
-        allow_hyphen_values = true,
-        conflicts_with = "bias_file"
-    )]
-    bias: f64,
-    /// Scale-dependent bias b(k) from a table (k [h/Mpc], b), before A_b.
-    #[arg(long, value_name = "FILE")]
-    bias_file: Option<PathBuf>,
-    /// Stochasticity P_εε [(Mpc/h)^3] subtracted from the measured monopole (P^s_hh = ⟨δ_h δ_h⟩ − P_εε).
-    #[arg(
-        long,
-        value_name = "P",
-        allow_hyphen_values = true,
-        conflicts_with = "noise_file"
-    )]
-    shot_noise: Option<f64>,
-    /// P_εε(k) from a table (k [h/Mpc], P_εε), subtracted from the measured monopole.
-    #[arg(long, value_name = "FILE")]
-    noise_file: Option<PathBuf>,
+    #[command(flatten)]
+    bias: BiasArgs,
+    #[command(flatten)]
+    noise: NoiseArgs,
     /// Smallest k used [h/Mpc].
     #[arg(long, value_name = "K", default_value_t = 0.0)]
     k_min: f64,
@@ -97,16 +78,6 @@ pub struct Args {
     /// Write the table to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
-}
-
-fn list<T: std::str::FromStr>(s: &str, what: &str) -> Result<Vec<T>> {
-    s.split(',')
-        .map(|x| {
-            x.trim()
-                .parse::<T>()
-                .map_err(|_| anyhow::anyhow!("{what}: `{x}` is not valid"))
-        })
-        .collect()
 }
 
 /// `a:b:step` (inclusive, to rounding), a list, or one value.
@@ -163,13 +134,7 @@ pub fn run(args: &Args) -> Result<()> {
         spec.push((l, cols[1 + 2 * j] - 1, cols[2 + 2 * j] - 1));
     }
     let mut data = MultipoleData::read(&args.data, cols[0] - 1, &spec)?;
-    let noise = match (&args.noise_file, args.shot_noise) {
-        (Some(p), _) => {
-            Noise::Table(Tabulated::read(p, "P_eps(k)", (0, 1), true).context("--noise-file")?)
-        }
-        (None, Some(p)) => Noise::Constant(p),
-        (None, None) => Noise::None,
-    };
+    let noise = args.noise.noise()?;
     if let (Some(p_eps), Some(j)) = (noise.values(&data.k)?, ells.iter().position(|&l| l == 0)) {
         for (v, e) in data.values[j].iter_mut().zip(p_eps) {
             *v -= e;
@@ -197,11 +162,7 @@ pub fn run(args: &Args) -> Result<()> {
             bail!("{name} {v}: must be finite");
         }
     }
-    let bias = match &args.bias_file {
-        Some(p) => Bias::Table(Tabulated::read(p, "b(k)", (0, 1), true).context("--bias-file")?),
-        None => Bias::Constant(args.bias),
-    };
-    let b = bias.values(&data.k, 1.0)?;
+    let b = args.bias.bias()?.values(&data.k, 1.0)?;
     let spectra = from_terms(real, &loop_terms(&data.k, &precision, &spectrum, real)?)?;
     let tns = if rsd.needs_tns() {
         Some(TnsPlan::new(&data.k, &precision)?.par_evaluate(&spectrum))

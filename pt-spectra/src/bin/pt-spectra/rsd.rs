@@ -1,15 +1,15 @@
 //! `pt-spectra rsd`: redshift-space multipoles P_ℓ(k) of a real-space model through an RSD model.
 
+use crate::common::{list, BiasArgs, NoiseArgs};
 use crate::real::{loop_terms, write_output, Input};
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use pt_spectra::cosmology::Cosmology;
-use pt_spectra::halo::{crossings, Bias, Noise};
+use pt_spectra::halo::crossings;
 use pt_spectra::loops::TnsPlan;
 use pt_spectra::real::{from_terms, RealModel};
 use pt_spectra::rsd::{
     dispersion_theory, fog_sigma, DispersionInput, Fog, MultipoleRule, RsdModel,
 };
-use pt_spectra::table::Tabulated;
 use std::path::PathBuf;
 
 /// Signal-to-noise levels whose crossings are reported (the paper's table_noise).
@@ -42,19 +42,8 @@ pub struct Args {
         allow_hyphen_values = true
     )]
     sigma0: String,
-    /// Constant linear bias b.
-    #[arg(
-        long,
-        value_name = "B",
-        default_value_t = 1.0,
-        allow_hyphen_values = true,
-        conflicts_with = "bias_file"
-    )]
-    bias: f64,
-    /// Scale-dependent bias b(k) from a table (columns k [h/Mpc], b; interpolated in ln k, not
-    /// extrapolated).
-    #[arg(long, value_name = "FILE")]
-    bias_file: Option<PathBuf>,
+    #[command(flatten)]
+    bias: BiasArgs,
     /// Bias amplitude A_b: b(k) → A_b b(k).
     #[arg(
         long,
@@ -63,21 +52,8 @@ pub struct Args {
         allow_hyphen_values = true
     )]
     amplitude: f64,
-    /// Constant stochasticity P_εε [(Mpc/h)^3]: adds the columns P_eps and SN = P0/P_eps and the k where
-    /// SN crosses 1, 0.5 and 0.1. The multipoles are noise-subtracted (P_εε changes only the monopole).
-    #[arg(long, value_name = "P", allow_hyphen_values = true, conflicts_with_all = ["number_density", "noise_file"])]
-    shot_noise: Option<f64>,
-    /// Poisson stochasticity P_εε = 1/n_h for the halo number density n_h [(h/Mpc)^3].
-    #[arg(
-        long,
-        value_name = "N",
-        allow_hyphen_values = true,
-        conflicts_with = "noise_file"
-    )]
-    number_density: Option<f64>,
-    /// P_εε(k) from a table (columns k [h/Mpc], P_εε [(Mpc/h)^3]).
-    #[arg(long, value_name = "FILE")]
-    noise_file: Option<PathBuf>,
+    #[command(flatten)]
+    noise: NoiseArgs,
     /// Multipoles to print, even ℓ ≤ 8, comma separated.
     #[arg(long, value_name = "L,L,…", default_value = "0,2,4")]
     ells: String,
@@ -89,49 +65,15 @@ pub struct Args {
     out: Option<PathBuf>,
 }
 
-fn parse_ells(s: &str) -> Result<Vec<usize>> {
-    s.split(',')
-        .map(|x| {
-            x.trim()
-                .parse::<usize>()
-                .with_context(|| format!("--ells: `{x}` is not a multipole order"))
-        })
-        .collect()
-}
-
-impl Args {
-    fn bias(&self) -> Result<Bias> {
-        Ok(match &self.bias_file {
-            Some(path) => {
-                Bias::Table(Tabulated::read(path, "b(k)", (0, 1), true).context("--bias-file")?)
-            }
-            None => Bias::Constant(self.bias),
-        })
-    }
-
-    fn noise(&self) -> Result<Noise> {
-        Ok(
-            match (&self.noise_file, self.shot_noise, self.number_density) {
-                (Some(path), _, _) => Noise::Table(
-                    Tabulated::read(path, "P_eps(k)", (0, 1), true).context("--noise-file")?,
-                ),
-                (None, Some(p), _) => Noise::Constant(p),
-                (None, None, Some(n)) => Noise::poisson(n).context("--number-density")?,
-                (None, None, None) => Noise::None,
-            },
-        )
-    }
-}
-
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<()> {
     let real: RealModel = args.real_model.parse()?;
     let rsd: RsdModel = args.rsd.parse()?;
     let fog: Fog = args.fog.parse()?;
-    let ells = parse_ells(&args.ells)?;
+    let ells: Vec<usize> = list(&args.ells, "--ells")?;
     let rule = MultipoleRule::new(&ells)?;
     let monopole = MultipoleRule::new(&[0])?;
-    let (bias, noise) = (args.bias()?, args.noise()?);
+    let (bias, noise) = (args.bias.bias()?, args.noise.noise()?);
     let (k, spectrum, precision) = args.input.load()?;
     let cosmology = Cosmology::gm2012();
     let z = args.input.z();
@@ -162,10 +104,7 @@ pub fn run(args: &Args) -> Result<()> {
         None
     };
 
-    let bias_text = match &args.bias_file {
-        Some(p) => format!("b(k) from {}", p.display()),
-        None => format!("b = {}", args.bias),
-    };
+    let bias_text = args.bias.describe();
     let mut text = format!(
         "# pt-spectra {} rsd: {rsd} with real-space {real}, z = {z}, f = {f}, {bias_text} times A_b = {}, \
          FoG {fog:?} with sigma0 = {} Mpc/h (sigma = sigma0 D(z) f = {sigma:.6} Mpc/h)\n",

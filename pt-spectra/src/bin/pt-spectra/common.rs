@@ -1,0 +1,92 @@
+//! Option groups and parsers shared by the subcommands.
+
+use anyhow::{Context, Result};
+use pt_spectra::halo::{Bias, Noise};
+use pt_spectra::table::Tabulated;
+use std::path::PathBuf;
+
+/// The halo bias b(k) before the amplitude A_b.
+#[derive(clap::Args, Debug)]
+pub struct BiasArgs {
+    /// Constant linear bias b.
+    #[arg(
+        long,
+        value_name = "B",
+        default_value_t = 1.0,
+        allow_hyphen_values = true,
+        conflicts_with = "bias_file"
+    )]
+    bias: f64,
+    /// Scale-dependent bias b(k) from a table (columns k [h/Mpc], b; interpolated in ln k, not
+    /// extrapolated).
+    #[arg(long, value_name = "FILE")]
+    bias_file: Option<PathBuf>,
+}
+
+impl BiasArgs {
+    /// The bias the options give.
+    pub fn bias(&self) -> Result<Bias> {
+        Ok(match &self.bias_file {
+            Some(path) => {
+                Bias::Table(Tabulated::read(path, "b(k)", (0, 1), true).context("--bias-file")?)
+            }
+            None => Bias::Constant(self.bias),
+        })
+    }
+
+    /// A description for table headers.
+    pub fn describe(&self) -> String {
+        match &self.bias_file {
+            Some(p) => format!("b(k) from {}", p.display()),
+            None => format!("b = {}", self.bias),
+        }
+    }
+}
+
+/// The stochasticity P_εε.
+#[derive(clap::Args, Debug)]
+pub struct NoiseArgs {
+    /// Constant stochasticity P_εε [(Mpc/h)^3]. `rsd` adds the columns P_eps and SN = P0/P_eps and the k
+    /// where SN crosses 1, 0.5 and 0.1 and subtracts it from the model monopole; `fit` subtracts it from
+    /// the measured monopole (P_εε changes only the monopole).
+    #[arg(long, value_name = "P", allow_hyphen_values = true, conflicts_with_all = ["number_density", "noise_file"])]
+    shot_noise: Option<f64>,
+    /// Poisson stochasticity P_εε = 1/n_h for the halo number density n_h [(h/Mpc)^3].
+    #[arg(
+        long,
+        value_name = "N",
+        allow_hyphen_values = true,
+        conflicts_with = "noise_file"
+    )]
+    number_density: Option<f64>,
+    /// P_εε(k) from a table (columns k [h/Mpc], P_εε [(Mpc/h)^3]).
+    #[arg(long, value_name = "FILE")]
+    noise_file: Option<PathBuf>,
+}
+
+impl NoiseArgs {
+    /// The noise the options give.
+    pub fn noise(&self) -> Result<Noise> {
+        Ok(
+            match (&self.noise_file, self.shot_noise, self.number_density) {
+                (Some(path), _, _) => Noise::Table(
+                    Tabulated::read(path, "P_eps(k)", (0, 1), true).context("--noise-file")?,
+                ),
+                (None, Some(p), _) => Noise::Constant(p),
+                (None, None, Some(n)) => Noise::poisson(n).context("--number-density")?,
+                (None, None, None) => Noise::None,
+            },
+        )
+    }
+}
+
+/// A comma-separated list; `what` names the option in messages.
+pub fn list<T: std::str::FromStr>(s: &str, what: &str) -> Result<Vec<T>> {
+    s.split(',')
+        .map(|x| {
+            x.trim()
+                .parse::<T>()
+                .map_err(|_| anyhow::anyhow!("{what}: `{x}` is not valid"))
+        })
+        .collect()
+}
