@@ -246,10 +246,10 @@ impl OneLoopTerms {
 
 /// Adds the 2-loop terms to `terms` (made from `spectrum` with `precision`): P15 (if missing, from the
 /// angular table), P24 and P33^{2L} from the quasi-Monte-Carlo integral ([`two_loop`]), and the whole
-/// correction 2P15 + 2P24 + P33, either as the IR-safe integrand integrated as one (better where the
-/// propagator and mode-coupling pieces cancel, k ≳ 0.15 h/Mpc at z = 0) or as the exact propagator pieces
-/// (2P15 from the table, P33red = P13²/P) plus the mode-coupling integral (better at low k, where the
-/// propagator part dominates): whichever has the smaller error estimate at each k.
+/// correction 2P15 + 2P24 + P33 as the sum of two infrared-safe parts: the propagator part 2P15 − P33red
+/// (P15 from the table, P33red = P13²/P) and the mode-coupling part 2P24 + P33irr + 2P33red, integrated
+/// as one function (see the `two_loop` module), or at low k, if it has the smaller error, as
+/// 2P15 + P33red + (2P24 + P33irr).
 pub fn add_two_loop(
     terms: &mut OneLoopTerms,
     spectrum: &LinearSpectrum,
@@ -274,20 +274,26 @@ pub fn add_two_loop(
     for (j, pair) in Pair::ALL.into_iter().enumerate() {
         let total: Vec<Estimate> = (0..terms.k.len())
             .map(|i| {
-                let (p15, red, m) = (
+                let (p15, red, ir_safe) = (
                     terms.pair(pair).p15[i],
                     terms.p33_reducible(pair, i),
-                    mc.pairs[j].mode_coupling[i],
+                    mc.pairs[j].ir_safe[i],
                 );
+                let ir_safe = Estimate::new(
+                    2.0 * p15.value - red.value + ir_safe.value,
+                    2.0 * p15.error + red.error + ir_safe.error,
+                );
+                // At k ≲ 0.03 h/Mpc, where the infrared pieces are small, the plain mode coupling can
+                // be the more precise: take whichever estimate has the smaller error.
+                let m = mc.pairs[j].mode_coupling[i];
                 let split = Estimate::new(
                     2.0 * p15.value + red.value + m.value,
                     2.0 * p15.error + red.error + m.error,
                 );
-                let whole = mc.pairs[j].total[i];
-                if whole.error < split.error {
-                    whole
-                } else {
+                if split.error < ir_safe.error {
                     split
+                } else {
+                    ir_safe
                 }
             })
             .collect();

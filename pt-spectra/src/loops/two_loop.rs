@@ -1,4 +1,4 @@
-//! The 2-loop SPT correction from one IR-safe integrand, by randomised quasi-Monte Carlo.
+//! The 2-loop SPT correction in two infrared-safe parts; mode coupling by randomised quasi-Monte Carlo.
 //!
 //! P^(2)_XY = 2P15_XY + 2P24_XY + P33_XY (eqs. P15, P24, P33 of the paper), with
 //! * 2P15_XY = 15 P(k) ∫∫ (X_5 + Y_5)(k, q₁, −q₁, q₂, −q₂) P₁P₂,
@@ -7,25 +7,38 @@
 //!   X_4 = X_4^s(q₁, k − q₁, q₂, −q₂),
 //! * P33irr_XY = P33^{2L}_XY = 6 ∫∫ X_3 Y_3 P(q₁)P(q₂)P(q₃), X_3 = X_3^s(q₁, q₂, q₃), q₃ = k − q₁ − q₂,
 //!
-//! ∫ ≡ ∫d³q/(2π)³. Each term alone has large infrared pieces (∝ k²σ_v² times 1-loop terms) that cancel in
-//! the sum. Following Carrasco, Foreman, Green & Senatore (2014) and Blas, Garny & Konstandin (2013), the
-//! integrands are mapped so that every infrared singularity sits at q₁ → 0 or q₂ → 0: P24 is restricted
-//! to |k − q₁| > q₁ (×2, the q₁ ↔ k − q₁ symmetry), P33irr to q₃ > q₁, q₂ (×3, its permutation symmetry),
-//! and the sum is symmetrised in q₁ ↔ q₂. The leading 1/q² singularities then cancel point by point, and
-//! the total is integrated as one function.
+//! ∫ ≡ ∫d³q/(2π)³. Each term alone has large infrared pieces (∝ k²σ_v² times 1-loop terms, and
+//! (k²σ_v²)² P(k)) that cancel in the sum. The sum is regrouped into two infrared-safe parts:
 //!
-//! Integration: (ln q₁, ln q₂) uniform on [ln q_min, ln q_max]², q̂₁ = (s₁, 0, x₁) and
+//! P^(2) = [2P15 − P33red] + [2P24 + P33irr + 2 P33red].
+//!
+//! As q₁ → 0 (or q₂ → 0, or both), 15(X_5 + Y_5) and 9(X_3 Y_3 + Y_3 X_3)/2 have the same limit,
+//! since F_n^s(…, q, −q) → −(k·q)²/q⁴ F_{n−2}^s(…)/(n(n − 1)): so 2P15 and P33red have the same infrared
+//! pieces and so have, with the opposite sign, 2P24 + P33irr. The propagator part 2P15 − P33red comes
+//! from the P15 angular table and the 1-loop P13 (deterministic, ≲ 1e-5); the mode-coupling part is
+//! integrated here as one function, 2P24 + P33irr + 2·[9P(k)X_3(k, q₁, −q₁)Y_3(k, q₂, −q₂)P₁P₂],
+//! in which the leading singularities cancel point by point. This needs no 5th-order kernel per point.
+//!
+//! Following Carrasco, Foreman, Green & Senatore (2014) and Blas, Garny & Konstandin (2013), the
+//! mode-coupling integrands are mapped so that every infrared singularity sits at q₁ → 0 or q₂ → 0:
+//! P24 is restricted to |k − q₁| > q₁ (×2, the q₁ ↔ k − q₁ symmetry), P33irr to q₃ > q₁, q₂ (×3, its
+//! permutation symmetry), with smooth partitions of unity, and the sum is symmetrised in q₁ ↔ q₂.
+//!
+//! Integration: (ln q₁, ln q₂) on [ln q_min, ln q_max]², q̂₁ = (s₁, 0, x₁) and
 //! q̂₂ = (s₂ cos φ, s₂ sin φ, x₂) about k̂ with x₁, x₂ ∈ [−1, 1], φ ∈ [0, π] (reflection symmetry), by a
 //! Sobol sequence (Joe–Kuo direction numbers, the `sobol` crate) in R independent Cranley–Patterson
 //! random shifts, each point taken with its four images q_i → ±q_i (antithetic: odd parts of the integrand
-//! cancel exactly), and the radial variables drawn with density ∝ 1/(w² + ln²(q/k)) around q ~ k. The
-//! value is the mean over the shifts and the error is their standard error. Every k uses the same
-//! points, so results are reproducible and smooth in k.
+//! cancel exactly). The radial variables are drawn with density ∝ 1/(w² + ln²(q/k)) around q ~ k, and the
+//! cosines x_i with a density that rises towards |x| = 1 (half uniform, half arcsine), where the
+//! residual of the infrared cancellation is largest (q₁ ∥ q₂ ∥ k, q ~ k/3). The value is the mean over the
+//! shifts and the error is their standard error. Every k uses the same points, so results are
+//! reproducible and smooth in k.
 //!
-//! Accuracy (default settings: 8 shifts × 2^14 points at k = 0.1, scaled with k from ¼ to 4 times, × 4
-//! images; the README has the measured table): the error of the 2-loop correction is ≤ 5e-4 of it for
-//! k ≤ 0.07 h/Mpc, ~0.2–0.3% at 0.1–0.3 (where it is a small difference of terms twenty times larger)
-//! and ~1% at 0.4 (where it nearly vanishes). 2L-SPT δδ agrees with RegPT to ≤ 0.6% for k ≤ 0.3 h/Mpc.
+//! Accuracy (default settings: 8 shifts × 2^14 points at k = 0.1, scaled ∝ k^1.5 from ½ to 8 times, × 4
+//! images; z = 0; the README has the table): the error of the 2-loop correction is ≤ 2e-4 of it for
+//! k ≤ 0.05 h/Mpc and ≤ 1e-3 for k ≤ 0.17 (δδ) and k ≤ 0.23 (δθ, θθ); above, 1–4e-3 for δδ up to
+//! k = 0.3 and ~1% at 0.4, where the δδ correction (−115 (Mpc/h)³) is a cancellation of terms
+//! of ±1.7e4; 1.1–1.4e-3 for δθ and θθ. Against 4× the points the differences are within 3σ.
 //!
 //! The same points also give 2P24 and P33irr separately (needed by 2-loop RPT, whose mode-coupling term is
 //! P33^{2L}); those carry larger errors, since their infrared pieces do not cancel.
@@ -62,11 +75,12 @@ impl Default for TwoLoopSettings {
     }
 }
 
-/// The 2-loop terms of one pair at each k [(Mpc/h)^3].
+/// The 2-loop mode-coupling terms of one pair at each k [(Mpc/h)^3].
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TwoLoopPair {
-    /// The whole 2-loop SPT correction 2P15 + 2P24 + P33, from the IR-safe integrand.
-    pub total: Vec<Estimate>,
+    /// The infrared-safe mode-coupling part 2P24 + P33irr + 2P33red (module docs): the 2-loop SPT
+    /// correction is 2P15 − P33red plus this.
+    pub ir_safe: Vec<Estimate>,
     /// P24 (the correction contains 2 P24).
     pub p24: Vec<Estimate>,
     /// P33irr = P33^{2L}, the mode-coupling part of P33.
@@ -85,14 +99,14 @@ pub struct TwoLoopTerms {
 }
 
 /// Largest factor by which [`points_at`] raises the number of points.
-const MAX_POINT_FACTOR: usize = 4;
+const MAX_POINT_FACTOR: usize = 8;
 
-/// The Sobol points used at k: `points` × 2^round(log2(k/0.1)), between ¼ and 4 times `points`. The
-/// 2-loop correction is a cancellation of ever larger terms as k grows, while at k ≲ 0.05 h/Mpc a quarter
-/// of the points already gives ~1e-4 relative errors; on log-spaced grids over [0.005, 0.4] the total
-/// cost is that of `points` at every k.
+/// The Sobol points used at k: `points` × 2^round(1.5 log2(k/0.1)) (∝ k^1.5), between ½ and 8 times
+/// `points`. The 2-loop correction is a cancellation of terms that grow relative to it with k, while at
+/// k ≲ 0.05 h/Mpc half of the points already give ≲ 5e-4 relative errors; on 40 log-spaced k over
+/// [0.005, 0.4] the total cost is that of 1.6 × `points` at every k.
 fn points_at(k: f64, points: usize) -> usize {
-    let power = (k / 0.1).log2().round().clamp(-2.0, 2.0) as i32;
+    let power = (1.5 * (k / 0.1).log2()).round().clamp(-1.0, 3.0) as i32;
     if power >= 0 {
         points << power
     } else {
@@ -100,8 +114,23 @@ fn points_at(k: f64, points: usize) -> usize {
     }
 }
 
-/// Number of accumulated quantities per point: [total, 2P24, P33irr] × [δδ, δθ, θθ].
+/// Number of accumulated quantities per point: [IR-safe part, 2P24, P33irr, 2P24 + P33irr] × [δδ, δθ, θθ].
 const VALUES: usize = 12;
+
+/// Weight of the arcsine part of the cosine sampling density (the rest is uniform).
+const ARCSINE_WEIGHT: f64 = 0.5;
+
+/// The cosine x ∈ [−1, 1] at u ∈ [0, 1] and the Jacobian dx/du relative to the uniform map (2):
+/// x = (1 − a)(2u − 1) + a sin(π(u − ½)), a = [`ARCSINE_WEIGHT`]. Monotonic, and denser towards |x| = 1.
+#[inline]
+fn cosine(u: f64) -> (f64, f64) {
+    let s = PI * (u - 0.5);
+    let a = ARCSINE_WEIGHT;
+    (
+        (1.0 - a) * (2.0 * u - 1.0) + a * s.sin(),
+        (2.0 * (1.0 - a) + a * PI * s.cos()) / 2.0,
+    )
+}
 
 /// The spectrum on the lattice, zero outside [q_min, q_max].
 struct Sampled<'a> {
@@ -119,17 +148,14 @@ impl Sampled<'_> {
 /// Pair index j: (X, Y) = (F, F), (F, G), (G, G) → kernel indices.
 const PAIRS: [(usize, usize); 3] = [(0, 0), (0, 1), (1, 1)];
 
-/// The propagator pieces 2P15 + P33red of the integrand for the three pairs, from the Gram matrix
-/// [kk, kq₁, kq₂, q₁q₁, q₁q₂, q₂q₂] (without P₁P₂). Symmetric in q₁ ↔ q₂, so evaluated once per point.
+/// The pointwise P33red = 9P(k)X_3(k, q₁, −q₁)Y_3(k, q₂, −q₂) (without P₁P₂, symmetrised in X ↔ Y) for
+/// the three pairs, from the Gram matrix [kk, kq₁, kq₂, q₁q₁, q₁q₂, q₂q₂]. Its integral is P13_X P13_Y/P.
 #[inline]
-fn propagator_part(g: &[f64; 6], p_k: f64) -> [f64; 3] {
+fn reducible_part(g: &[f64; 6], p_k: f64) -> [f64; 3] {
     let [kk, kq1, kq2, q1q1, _, q2q2] = *g;
-    let p5 = pt_kernels::propagator_5(g);
     let a3 = pt_kernels::propagator_3(&[kk, kq1, q1q1]);
     let b3 = pt_kernels::propagator_3(&[kk, kq2, q2q2]);
-    PAIRS.map(|(x, y)| {
-        15.0 * p_k * (p5[x] + p5[y]) + 9.0 * p_k * 0.5 * (a3[x] * b3[y] + a3[y] * b3[x])
-    })
+    PAIRS.map(|(x, y)| 9.0 * p_k * 0.5 * (a3[x] * b3[y] + a3[y] * b3[x]))
 }
 
 /// The 2P24 piece of g(q₁, q₂) (module docs) for the three pairs, without P₁P₂, from the Gram matrix
@@ -149,7 +175,8 @@ fn p24_half(g: &[f64; 6], p: &Sampled) -> [f64; 3] {
     PAIRS.map(|(x, y)| 24.0 * (m2[x] * m4[y] + m2[y] * m4[x]) * p_k1)
 }
 
-/// The integrand at one point: [total, 2P24, P33irr] for δδ, δθ, θθ (times the measure).
+/// The integrand at one point: [IR-safe part, 2P24, P33irr, 2P24 + P33irr] for δδ, δθ, θθ (times the
+/// measure).
 #[inline]
 fn integrand(
     k: f64,
@@ -176,7 +203,7 @@ fn integrand(
         return [0.0; VALUES];
     }
     let g = [kk, kq1, kq2, q11, q1q2, q22];
-    let prop = propagator_part(&g, p_k);
+    let red = reducible_part(&g, p_k);
     let a = p24_half(&g, p);
     let b = p24_half(&[kk, kq2, kq1, q22, q1q2, q11], p);
     let q33 = (kk + q11 + q22 - 2.0 * kq1 - 2.0 * kq2 + 2.0 * q1q2).max(0.0);
@@ -195,8 +222,8 @@ fn integrand(
     for (j, &(x, y)) in PAIRS.iter().enumerate() {
         let p33 = m3[x] * m3[y];
         let mc = 0.5 * (a[j] + b[j]) * p1 * p2;
-        let prop = prop[j] * p1 * p2;
-        out[j] = measure * (prop + mc + p33);
+        let red = red[j] * p1 * p2;
+        out[j] = measure * (mc + p33 + 2.0 * red);
         out[3 + j] = measure * mc;
         out[6 + j] = measure * p33;
         out[9 + j] = measure * (mc + p33);
@@ -259,7 +286,9 @@ pub fn two_loop(
                     for point in points {
                         let t: [f64; 5] = std::array::from_fn(|d| (point[d] + shift[d]).fract());
                         let ((q1, j1), (q2, j2)) = (radial(t[0]), radial(t[1]));
-                        let (x1, x2, c) = (2.0 * t[2] - 1.0, 2.0 * t[3] - 1.0, (PI * t[4]).cos());
+                        let ((x1, h1), (x2, h2)) = (cosine(t[2]), cosine(t[3]));
+                        let (j1, j2) = (j1 * h1, j2 * h2);
+                        let c = (PI * t[4]).cos();
                         // The four images q_i → ±q_i (antithetic points): odd parts cancel exactly.
                         for (x, c) in [
                             ([x1, x2], c),
@@ -287,7 +316,7 @@ pub fn two_loop(
         })
         .collect();
     let pair = |j: usize| TwoLoopPair {
-        total: rows.iter().map(|r| r[j]).collect(),
+        ir_safe: rows.iter().map(|r| r[j]).collect(),
         p24: rows
             .iter()
             .map(|r| Estimate::new(0.5 * r[3 + j].value, 0.5 * r[3 + j].error))
