@@ -38,7 +38,7 @@
 //! images; z = 0; the README has the table): the error of the 2-loop correction is ≤ 2e-4 of it for
 //! k ≤ 0.05 h/Mpc and ≤ 1e-3 for k ≤ 0.17 (δδ) and k ≤ 0.23 (δθ, θθ); above, 1–4e-3 for δδ up to
 //! k = 0.3 and ~1% at 0.4, where the δδ correction (−115 (Mpc/h)³) is a cancellation of terms
-//! of ±1.7e4; 1.1–1.4e-3 for δθ and θθ. Against 4× the points the differences are within 3σ.
+//! of ±1.7e4; 1.1–1.4e-3 for δθ and θθ. Two independent randomisations differ by 1.1σ rms (≤ 2.4σ).
 //!
 //! The same points also give 2P24 and P33irr separately (needed by 2-loop RPT, whose mode-coupling term is
 //! P33^{2L}); those carry larger errors, since their infrared pieces do not cancel.
