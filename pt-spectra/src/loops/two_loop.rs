@@ -28,17 +28,18 @@
 //! q̂₂ = (s₂ cos φ, s₂ sin φ, x₂) about k̂ with x₁, x₂ ∈ [−1, 1], φ ∈ [0, π] (reflection symmetry), by a
 //! Sobol sequence (Joe–Kuo direction numbers, the `sobol` crate) in R independent Cranley–Patterson
 //! random shifts, each point taken with its four images q_i → ±q_i (antithetic: odd parts of the integrand
-//! cancel exactly). The radial variables are drawn with density ∝ 1/(w² + ln²(q/k)) around q ~ k, and the
-//! cosines x_i with a density that rises towards |x| = 1 (half uniform, half arcsine), where the
-//! residual of the infrared cancellation is largest (q₁ ∥ q₂ ∥ k, q ~ k/3). The value is the mean over the
+//! cancel exactly). The radial variables are drawn with density ∝ 1/(w² + (ln q − c)²), centred on q = k
+//! at low k and on q ≈ k/2.7 at k ≥ 0.2 (`radial_density`), and the cosines x_i with a density that rises
+//! towards |x| = 1 (half uniform, half arcsine): at high k the variance comes from q₁, q₂ ~ k/3 nearly
+//! parallel to k, where P24 and P33irr are large and cancel in part. The value is the mean over the
 //! shifts and the error is their standard error. Every k uses the same points, so results are
 //! reproducible and smooth in k.
 //!
-//! Accuracy (default settings: 8 shifts × 2^14 points at k = 0.1, scaled ∝ k^1.5 from ½ to 8 times, × 4
-//! images; z = 0; the README has the table): the error of the 2-loop correction is ≤ 2e-4 of it for
-//! k ≤ 0.05 h/Mpc and ≤ 1e-3 for k ≤ 0.17 (δδ) and k ≤ 0.23 (δθ, θθ); above, 1–4e-3 for δδ up to
-//! k = 0.3 and ~1% at 0.4, where the δδ correction (−115 (Mpc/h)³) is a cancellation of terms
-//! of ±1.7e4; 1.1–1.4e-3 for δθ and θθ. Two independent randomisations differ by 1.1σ rms (≤ 2.4σ).
+//! Accuracy (default settings: 8 shifts × 2^14 points at k = 0.155 h/Mpc, scaled ∝ k³ from ½ to 16
+//! times, × 4 images; z = 0; the README has the table): the error of the 2-loop correction is ≤ 2e-4 of
+//! it for k ≤ 0.05 h/Mpc, ≤ 6e-4 for k ≤ 0.12 and ≤ 1e-3 up to k = 0.36 for δδ, and up to 0.4 for δθ
+//! and θθ; 1.2e-3 for δδ at k = 0.4, where its correction (−115 (Mpc/h)³) is a 0.7% remainder of terms
+//! of ±1.7e4. Independent randomisations differ by 0.9–1.2σ rms (≤ 3σ over 120 values).
 //!
 //! The same points also give 2P24 and P33irr separately (needed by 2-loop RPT, whose mode-coupling term is
 //! P33^{2L}); those carry larger errors, since their infrared pieces do not cancel.
@@ -54,13 +55,14 @@ use std::f64::consts::PI;
 /// Settings of the 2-loop integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TwoLoopSettings {
-    /// Sobol points per random shift at k = 0.1 h/Mpc (scaled with k, see `points_at`).
+    /// Sobol points per random shift at k = 0.155 h/Mpc (scaled with k, see `points_at`).
     pub points: usize,
     /// Number of independent random shifts (the error is their standard error).
     pub replicas: usize,
     /// Seed of the random shifts.
     pub seed: u64,
-    /// Width w in ln q of the radial sampling density ∝ 1/(w² + ln²(q/k)).
+    /// Width w in ln q of the radial sampling density ∝ 1/(w² + ln²(q/k)) at k ≤ 0.05 h/Mpc (it narrows
+    /// and moves to q < k at higher k, see `radial_density`). Default 2.
     pub radial_width: f64,
 }
 
@@ -99,14 +101,15 @@ pub struct TwoLoopTerms {
 }
 
 /// Largest factor by which [`points_at`] raises the number of points.
-const MAX_POINT_FACTOR: usize = 8;
+const MAX_POINT_FACTOR: usize = 16;
 
-/// The Sobol points used at k: `points` × 2^round(1.5 log2(k/0.1)) (∝ k^1.5), between ½ and 8 times
-/// `points`. The 2-loop correction is a cancellation of terms that grow relative to it with k, while at
-/// k ≲ 0.05 h/Mpc half of the points already give ≲ 5e-4 relative errors; on 40 log-spaced k over
-/// [0.005, 0.4] the total cost is that of 1.6 × `points` at every k.
+/// The Sobol points used at k: `points` × 2^round(3 log2(k/0.155)) (∝ k³), between ½ and 16 times
+/// `points` (½ for k < 0.138, 16 at k ≥ 0.348 h/Mpc). The relative error of the correction at fixed
+/// points grows steeply with k (at k = 0.4 the δδ correction is a 0.7% remainder of its terms); at
+/// k ≲ 0.12 h/Mpc half of the points already give ≲ 6e-4. On 40 log-spaced k over [0.005, 0.4] the
+/// total cost is that of 1.9 × `points` at every k.
 fn points_at(k: f64, points: usize) -> usize {
-    let power = (1.5 * (k / 0.1).log2()).round().clamp(-1.0, 3.0) as i32;
+    let power = (3.0 * (k / 0.155).log2()).round().clamp(-1.0, 4.0) as i32;
     if power >= 0 {
         points << power
     } else {
@@ -116,6 +119,30 @@ fn points_at(k: f64, points: usize) -> usize {
 
 /// Number of accumulated quantities per point: [IR-safe part, 2P24, P33irr, 2P24 + P33irr] × [δδ, δθ, θθ].
 const VALUES: usize = 12;
+
+/// Anchors (k [h/Mpc], centre shift c − ln k, width w) of the radial sampling density at higher k.
+const RADIAL_ANCHORS: [(f64, f64, f64); 2] = [(0.1, -0.8, 0.75), (0.2, -1.0, 0.6)];
+
+/// Centre c and width w in ln q of the radial sampling density ∝ 1/(w² + (ln q − c)²) at k: c = ln k
+/// and w = `width` for k ≤ 0.05 h/Mpc, then linear in ln k through [`RADIAL_ANCHORS`] to
+/// c = ln k − 1 (q ≈ k/2.7) and w = 0.6 at k ≥ 0.2. At high k the variance of the mode coupling comes
+/// from q₁, q₂ ~ k/3 (three modes of similar size adding up to k, where P(q) is several times P(k));
+/// the narrower density there cuts the errors at k ≥ 0.1 h/Mpc by 2.5–4 for the same points. At low k
+/// the broad density is better.
+fn radial_density(k: f64, width: f64) -> (f64, f64) {
+    let mut from = (0.05, 0.0, width);
+    for to in RADIAL_ANCHORS {
+        if k < to.0 {
+            let s = ((k / from.0).ln() / (to.0 / from.0).ln()).max(0.0);
+            return (
+                k.ln() + from.1 + s * (to.1 - from.1),
+                from.2 + s * (to.2 - from.2),
+            );
+        }
+        from = to;
+    }
+    (k.ln() + from.1, from.2)
+}
 
 /// Weight of the arcsine part of the cosine sampling density (the rest is uniform).
 const ARCSINE_WEIGHT: f64 = 0.5;
@@ -158,34 +185,45 @@ fn reducible_part(g: &[f64; 6], p_k: f64) -> [f64; 3] {
     PAIRS.map(|(x, y)| 9.0 * p_k * 0.5 * (a3[x] * b3[y] + a3[y] * b3[x]))
 }
 
-/// The 2P24 piece of g(q₁, q₂) (module docs) for the three pairs, without P₁P₂, from the Gram matrix
-/// [kk, kq₁, kq₂, q₁q₁, q₁q₂, q₂q₂]; the caller adds it with q₁ ↔ q₂.
+/// What the 2P24 piece needs of one momentum q_i with k·q_i = σ kq_i (σ = ±1): the smooth partition
+/// w = p⁴/(q⁴ + p⁴), p = |k − q_i|, of the q_i ↔ k − q_i symmetry (×2 below) times P(p), and
+/// X_2^s(q_i, k − q_i) for X = F, G. Zero where w is negligible.
 #[inline]
-fn p24_half(g: &[f64; 6], p: &Sampled) -> [f64; 3] {
-    let [kk, kq1, _, q1q1, _, _] = *g;
-    // The smooth partition w = p⁴/(q⁴ + p⁴), p = |k − q₁|, of the q₁ ↔ k − q₁ symmetry (×2 below).
-    let p1m2 = (kk - 2.0 * kq1 + q1q1).max(0.0);
-    let w = p1m2 * p1m2 / (q1q1 * q1q1 + p1m2 * p1m2);
+fn pair_leg(kk: f64, kq: f64, qq: f64, p: &Sampled) -> (f64, [f64; 2]) {
+    let pp = (kk - 2.0 * kq + qq).max(0.0);
+    let w = pp * pp / (qq * qq + pp * pp);
     if w <= 1e-12 {
-        return [0.0; 3];
+        return (0.0, [0.0; 2]);
     }
-    let m2 = pt_kernels::mode_coupling_2(&[kk, kq1, q1q1]);
-    let m4 = pt_kernels::mode_coupling_4(g);
-    let p_k1 = w * p.at(p1m2.sqrt());
-    PAIRS.map(|(x, y)| 24.0 * (m2[x] * m4[y] + m2[y] * m4[x]) * p_k1)
+    (
+        w * p.at(pp.sqrt()),
+        pt_kernels::mode_coupling_2(&[kk, kq, qq]),
+    )
 }
 
-/// The integrand at one point: [IR-safe part, 2P24, P33irr, 2P24 + P33irr] for δδ, δθ, θθ (times the
-/// measure).
+/// The 2P24 piece of g(q₁, q₂) (module docs) for the three pairs, without P₁P₂, from the Gram matrix
+/// [kk, kq₁, kq₂, q₁q₁, q₁q₂, q₂q₂] and the leg of q₁ ([`pair_leg`]); the caller adds it with q₁ ↔ q₂.
 #[inline]
-fn integrand(
-    k: f64,
-    q: [f64; 2],
-    x: [f64; 2],
-    cos_phi: f64,
-    p: &Sampled,
-    p_k: f64,
-) -> [f64; VALUES] {
+fn p24_half(g: &[f64; 6], (weight, m2): (f64, [f64; 2])) -> [f64; 3] {
+    if weight == 0.0 {
+        return [0.0; 3];
+    }
+    let m4 = pt_kernels::mode_coupling_4(g);
+    PAIRS.map(|(x, y)| 24.0 * (m2[x] * m4[y] + m2[y] * m4[x]) * weight)
+}
+
+/// The integrand at one point, averaged over its four images q_i → ±q_i (antithetic: odd parts cancel
+/// exactly): [IR-safe part, 2P24, P33irr, 2P24 + P33irr] for δδ, δθ, θθ (times the measure).
+///
+/// The images are (x₁, x₂, cos φ) → (x₁, x₂, c), (−x₁, −x₂, c), (−x₁, x₂, −c), (x₁, −x₂, −c): they
+/// share |q_i| (so P(q_i) and the reducible part, even in each q_i), the legs |k ∓ q_i| come in two
+/// kinds each, and q₁·q₂ keeps or flips its sign.
+#[inline]
+fn images(k: f64, q: [f64; 2], x: [f64; 2], cos_phi: f64, p: &Sampled, p_k: f64) -> [f64; VALUES] {
+    let (p1, p2) = (p.at(q[0]), p.at(q[1]));
+    if p1 == 0.0 || p2 == 0.0 {
+        return [0.0; VALUES];
+    }
     let (s1, s2) = (
         (1.0 - x[0] * x[0]).max(0.0).sqrt(),
         (1.0 - x[1] * x[1]).max(0.0).sqrt(),
@@ -198,35 +236,40 @@ fn integrand(
         q[0] * q[0],
         q[1] * q[1],
     );
-    let (p1, p2) = (p.at(q[0]), p.at(q[1]));
-    if p1 == 0.0 || p2 == 0.0 {
-        return [0.0; VALUES];
-    }
-    let g = [kk, kq1, kq2, q11, q1q2, q22];
-    let red = reducible_part(&g, p_k);
-    let a = p24_half(&g, p);
-    let b = p24_half(&[kk, kq2, kq1, q22, q1q2, q11], p);
-    let q33 = (kk + q11 + q22 - 2.0 * kq1 - 2.0 * kq2 + 2.0 * q1q2).max(0.0);
-    // The smooth partition w = q₃⁴/(q₁⁴ + q₂⁴ + q₃⁴) of the permutation symmetry (×3 below).
-    let w3 = q33 * q33 / (q11 * q11 + q22 * q22 + q33 * q33);
-    let m3 = if w3 > 1e-12 {
-        let p3 = p.at(q33.sqrt());
-        pt_kernels::mode_coupling_3(&[kk, kq1, kq2, q11, q1q2, q22])
-            .map(|v| v * (18.0 * w3 * p1 * p2 * p3).sqrt())
-    } else {
-        [0.0; 2]
-    };
-    // d³q₁d³q₂/(2π)⁶ = q₁³q₂³ dln q₁ dln q₂ · 2π dx₁ · 2 dx₂ dφ (φ ∈ [0, π]) / (2π)⁶.
-    let measure = (q[0] * q[1]).powi(3) * 4.0 * PI / (2.0 * PI).powi(6);
+    let red = reducible_part(&[kk, kq1, kq2, q11, q1q2, q22], p_k);
+    let legs1 = [pair_leg(kk, kq1, q11, p), pair_leg(kk, -kq1, q11, p)];
+    let legs2 = [pair_leg(kk, kq2, q22, p), pair_leg(kk, -kq2, q22, p)];
+    // d³q₁d³q₂/(2π)⁶ = q₁³q₂³ dln q₁ dln q₂ · 2π dx₁ · 2 dx₂ dφ (φ ∈ [0, π]) / (2π)⁶; ¼ for the images.
+    let measure = 0.25 * (q[0] * q[1]).powi(3) * 4.0 * PI / (2.0 * PI).powi(6);
     let mut out = [0.0; VALUES];
-    for (j, &(x, y)) in PAIRS.iter().enumerate() {
-        let p33 = m3[x] * m3[y];
-        let mc = 0.5 * (a[j] + b[j]) * p1 * p2;
-        let red = red[j] * p1 * p2;
-        out[j] = measure * (mc + p33 + 2.0 * red);
-        out[3 + j] = measure * mc;
-        out[6 + j] = measure * p33;
-        out[9 + j] = measure * (mc + p33);
+    // (sign of k·q₁, sign of k·q₂, sign of q₁·q₂) of the four images.
+    for (i1, i2, flip) in [(0, 0, false), (1, 1, false), (1, 0, true), (0, 1, true)] {
+        let (a1, a2) = (
+            if i1 == 0 { kq1 } else { -kq1 },
+            if i2 == 0 { kq2 } else { -kq2 },
+        );
+        let q12 = if flip { -q1q2 } else { q1q2 };
+        let a = p24_half(&[kk, a1, a2, q11, q12, q22], legs1[i1]);
+        let b = p24_half(&[kk, a2, a1, q22, q12, q11], legs2[i2]);
+        let q33 = (kk + q11 + q22 - 2.0 * a1 - 2.0 * a2 + 2.0 * q12).max(0.0);
+        // The smooth partition w = q₃⁴/(q₁⁴ + q₂⁴ + q₃⁴) of the permutation symmetry (×3 below).
+        let w3 = q33 * q33 / (q11 * q11 + q22 * q22 + q33 * q33);
+        let m3 = if w3 > 1e-12 {
+            let p3 = p.at(q33.sqrt());
+            pt_kernels::mode_coupling_3(&[kk, a1, a2, q11, q12, q22])
+                .map(|v| v * (18.0 * w3 * p1 * p2 * p3).sqrt())
+        } else {
+            [0.0; 2]
+        };
+        for (j, &(x, y)) in PAIRS.iter().enumerate() {
+            let p33 = m3[x] * m3[y];
+            let mc = 0.5 * (a[j] + b[j]) * p1 * p2;
+            let red = red[j] * p1 * p2;
+            out[j] += measure * (mc + p33 + 2.0 * red);
+            out[3 + j] += measure * mc;
+            out[6 + j] += measure * p33;
+            out[9 + j] += measure * (mc + p33);
+        }
     }
     out
 }
@@ -259,22 +302,22 @@ pub fn two_loop(
             .collect()
     };
     let (lo, hi) = (q_range.0.ln(), q_range.1.ln());
-    let width = settings.radial_width;
     let rows: Vec<[Estimate; VALUES]> = k
         .par_iter()
         .map(|&k| {
             let p_k = sampled.at(k);
-            // ln q = ln k + w tan θ with θ uniform on [θ_lo, θ_hi]: points concentrate within a few w of
-            // ln k; the Jacobian dln q/dt = (θ_hi − θ_lo) w / cos²θ.
+            // ln q = c + w tan θ with θ uniform on [θ_lo, θ_hi]: points concentrate within a few w of
+            // the centre c; the Jacobian dln q/dt = (θ_hi − θ_lo) w / cos²θ.
+            let (centre, width) = radial_density(k, settings.radial_width);
             let (t_lo, t_hi) = (
-                ((lo - k.ln()) / width).atan(),
-                ((hi - k.ln()) / width).atan(),
+                ((lo - centre) / width).atan(),
+                ((hi - centre) / width).atan(),
             );
             let radial = |t: f64| -> (f64, f64) {
                 let theta = t_lo + (t_hi - t_lo) * t;
                 let c = theta.cos();
                 (
-                    (k.ln() + width * theta.tan()).exp(),
+                    (centre + width * theta.tan()).exp(),
                     (t_hi - t_lo) * width / (c * c),
                 )
             };
@@ -289,17 +332,9 @@ pub fn two_loop(
                         let ((x1, h1), (x2, h2)) = (cosine(t[2]), cosine(t[3]));
                         let (j1, j2) = (j1 * h1, j2 * h2);
                         let c = (PI * t[4]).cos();
-                        // The four images q_i → ±q_i (antithetic points): odd parts cancel exactly.
-                        for (x, c) in [
-                            ([x1, x2], c),
-                            ([-x1, -x2], c),
-                            ([-x1, x2], -c),
-                            ([x1, -x2], -c),
-                        ] {
-                            let v = integrand(k, [q1, q2], x, c, &sampled, p_k);
-                            for (a, b) in acc.iter_mut().zip(v) {
-                                *a += 0.25 * j1 * j2 * b;
-                            }
+                        let v = images(k, [q1, q2], [x1, x2], c, &sampled, p_k);
+                        for (a, b) in acc.iter_mut().zip(v) {
+                            *a += j1 * j2 * b;
                         }
                     }
                     // Volume of (x₁, x₂, φ): 2 · 2 · π (the radial Jacobians are in acc).
