@@ -59,9 +59,9 @@ pub struct Precision {
     /// estimate can fall below the actual error there; the floor covers that. Default 3e-6, from the
     /// convergence study in the tests (default against reference settings on the CAMB tables).
     pub p22_error_floor: f64,
-    /// Sobol points per random shift of the 2-loop mode-coupling integral at k = 0.155 h/Mpc (P24 +
-    /// P33irr and its infrared-safe combination, see [`crate::loops::two_loop`]; scaled ∝ k³ between ½
-    /// and 16 times; each point is evaluated at its four images q_i → ±q_i). Default 2^14; the error
+    /// Sobol points per random shift of the 2-loop mode-coupling integral at k = 0.16 h/Mpc (P24 +
+    /// P33irr and its infrared-safe combination, see [`crate::loops::two_loop`]; scaled ∝ k^3.5 between
+    /// ½ and 32 times; each point is evaluated at its four images q_i → ±q_i). Default 2^14; the error
     /// falls as points^−0.6 to points^−1.
     pub two_loop_points: usize,
     /// Random shifts of the 2-loop integral (its error is their standard error). Default 8.

@@ -35,11 +35,11 @@
 //! shifts and the error is their standard error. Every k uses the same points, so results are
 //! reproducible and smooth in k.
 //!
-//! Accuracy (default settings: 8 shifts × 2^14 points at k = 0.155 h/Mpc, scaled ∝ k³ from ½ to 16
+//! Accuracy (default settings: 8 shifts × 2^14 points at k = 0.16 h/Mpc, scaled ∝ k^3.5 from ½ to 32
 //! times, × 4 images; z = 0; the README has the table): the error of the 2-loop correction is ≤ 2e-4 of
 //! it for k ≤ 0.05 h/Mpc, ≤ 6e-4 for k ≤ 0.12 and ≤ 1e-3 up to k = 0.36 for δδ, and up to 0.4 for δθ
-//! and θθ; 1.2e-3 for δδ at k = 0.4, where its correction (−115 (Mpc/h)³) is a 0.7% remainder of terms
-//! of ±1.7e4. Independent randomisations differ by 0.9–1.2σ rms (≤ 3σ over 120 values).
+//! and θθ; 1.4e-3 for δδ at k = 0.4 (9.5e-4 rms over 8 seeds), where its correction (−115 (Mpc/h)³) is
+//! a 0.7% remainder of terms of ±1.7e4. Independent randomisations differ by 0.9–1.2σ rms (≤ 3σ over 120 values).
 //!
 //! The same points also give 2P24 and P33irr separately (needed by 2-loop RPT, whose mode-coupling term is
 //! P33^{2L}); those carry larger errors, since their infrared pieces do not cancel.
@@ -55,7 +55,7 @@ use std::f64::consts::PI;
 /// Settings of the 2-loop integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TwoLoopSettings {
-    /// Sobol points per random shift at k = 0.155 h/Mpc (scaled with k, see `points_at`).
+    /// Sobol points per random shift at k = 0.16 h/Mpc (scaled with k, see `points_at`).
     pub points: usize,
     /// Number of independent random shifts (the error is their standard error).
     pub replicas: usize,
@@ -101,15 +101,15 @@ pub struct TwoLoopTerms {
 }
 
 /// Largest factor by which [`points_at`] raises the number of points.
-const MAX_POINT_FACTOR: usize = 16;
+const MAX_POINT_FACTOR: usize = 32;
 
-/// The Sobol points used at k: `points` × 2^round(3 log2(k/0.155)) (∝ k³), between ½ and 16 times
-/// `points` (½ for k < 0.138, 16 at k ≥ 0.348 h/Mpc). The relative error of the correction at fixed
-/// points grows steeply with k (at k = 0.4 the δδ correction is a 0.7% remainder of its terms); at
-/// k ≲ 0.12 h/Mpc half of the points already give ≲ 6e-4. On 40 log-spaced k over [0.005, 0.4] the
-/// total cost is that of 1.9 × `points` at every k.
+/// The Sobol points used at k: `points` × 2^round(3.5 log2(k/0.16)) (∝ k^3.5), between ½ and 32 times
+/// `points` (½ for k < 0.145, 16 at k ≥ 0.32, 32 at k ≥ 0.39 h/Mpc). The relative error of the
+/// correction at fixed points grows steeply with k (at k = 0.4 the δδ correction is a 0.7% remainder of
+/// its terms); at k ≲ 0.14 h/Mpc half of the points already give ≲ 6e-4. On 40 log-spaced k over
+/// [0.005, 0.4] the total cost is that of 2.3 × `points` at every k.
 fn points_at(k: f64, points: usize) -> usize {
-    let power = (3.0 * (k / 0.155).log2()).round().clamp(-1.0, 4.0) as i32;
+    let power = (3.5 * (k / 0.16).log2()).round().clamp(-1.0, 5.0) as i32;
     if power >= 0 {
         points << power
     } else {
@@ -275,7 +275,7 @@ fn images(k: f64, q: [f64; 2], x: [f64; 2], cos_phi: f64, p: &Sampled, p_k: f64)
 }
 
 /// The 2-loop terms of `spectrum` at `k` [h/Mpc], over q ∈ `q_range` (P̃ on a lattice of step
-/// `lattice_step` in ln q), in parallel over k.
+/// `lattice_step` in ln q), in parallel over k and random shifts.
 pub fn two_loop(
     k: &[f64],
     spectrum: &LinearSpectrum,
@@ -290,9 +290,10 @@ pub fn two_loop(
         samples: &samples,
     };
     let params = JoeKuoD6::standard();
-    let points: Vec<Vec<f64>> = Sobol::<f64>::new(5, &params)
+    let points: Vec<[f64; 5]> = Sobol::<f64>::new(5, &params)
         .skip(1)
         .take(MAX_POINT_FACTOR * settings.points)
+        .map(|p| std::array::from_fn(|d| p[d]))
         .collect();
     let shifts: Vec<[f64; 5]> = {
         use rand::{Rng, SeedableRng};
@@ -302,45 +303,50 @@ pub fn two_loop(
             .collect()
     };
     let (lo, hi) = (q_range.0.ln(), q_range.1.ln());
-    let rows: Vec<[Estimate; VALUES]> = k
-        .par_iter()
-        .map(|&k| {
-            let p_k = sampled.at(k);
-            // ln q = c + w tan θ with θ uniform on [θ_lo, θ_hi]: points concentrate within a few w of
-            // the centre c; the Jacobian dln q/dt = (θ_hi − θ_lo) w / cos²θ.
-            let (centre, width) = radial_density(k, settings.radial_width);
-            let (t_lo, t_hi) = (
-                ((lo - centre) / width).atan(),
-                ((hi - centre) / width).atan(),
-            );
-            let radial = |t: f64| -> (f64, f64) {
-                let theta = t_lo + (t_hi - t_lo) * t;
-                let c = theta.cos();
-                (
-                    (centre + width * theta.tan()).exp(),
-                    (t_hi - t_lo) * width / (c * c),
-                )
-            };
-            let means: Vec<[f64; VALUES]> = shifts
-                .iter()
-                .map(|shift| {
-                    let mut acc = [0.0; VALUES];
-                    let points = &points[..points_at(k, settings.points)];
-                    for point in points {
-                        let t: [f64; 5] = std::array::from_fn(|d| (point[d] + shift[d]).fract());
-                        let ((q1, j1), (q2, j2)) = (radial(t[0]), radial(t[1]));
-                        let ((x1, h1), (x2, h2)) = (cosine(t[2]), cosine(t[3]));
-                        let (j1, j2) = (j1 * h1, j2 * h2);
-                        let c = (PI * t[4]).cos();
-                        let v = images(k, [q1, q2], [x1, x2], c, &sampled, p_k);
-                        for (a, b) in acc.iter_mut().zip(v) {
-                            *a += j1 * j2 * b;
-                        }
-                    }
-                    // Volume of (x₁, x₂, φ): 2 · 2 · π (the radial Jacobians are in acc).
-                    acc.map(|a| a * 4.0 * PI / points.len() as f64)
-                })
-                .collect();
+    // The mean of the integrand over the points of one random shift at k.
+    let replica_mean = |k: f64, shift: &[f64; 5]| -> [f64; VALUES] {
+        let p_k = sampled.at(k);
+        // ln q = c + w tan θ with θ uniform on [θ_lo, θ_hi]: points concentrate within a few w of the
+        // centre c; the Jacobian dln q/dt = (θ_hi − θ_lo) w / cos²θ.
+        let (centre, width) = radial_density(k, settings.radial_width);
+        let (t_lo, t_hi) = (
+            ((lo - centre) / width).atan(),
+            ((hi - centre) / width).atan(),
+        );
+        let radial = |t: f64| -> (f64, f64) {
+            let theta = t_lo + (t_hi - t_lo) * t;
+            let c = theta.cos();
+            (
+                (centre + width * theta.tan()).exp(),
+                (t_hi - t_lo) * width / (c * c),
+            )
+        };
+        let mut acc = [0.0; VALUES];
+        let points = &points[..points_at(k, settings.points)];
+        for point in points {
+            let t: [f64; 5] = std::array::from_fn(|d| (point[d] + shift[d]).fract());
+            let ((q1, j1), (q2, j2)) = (radial(t[0]), radial(t[1]));
+            let ((x1, h1), (x2, h2)) = (cosine(t[2]), cosine(t[3]));
+            let (j1, j2) = (j1 * h1, j2 * h2);
+            let c = (PI * t[4]).cos();
+            let v = images(k, [q1, q2], [x1, x2], c, &sampled, p_k);
+            for (a, b) in acc.iter_mut().zip(v) {
+                *a += j1 * j2 * b;
+            }
+        }
+        // Volume of (x₁, x₂, φ): 2 · 2 · π (the radial Jacobians are in acc).
+        acc.map(|a| a * 4.0 * PI / points.len() as f64)
+    };
+    // One parallel job per (k, shift): the points per k differ by up to 32 times, so jobs per k alone
+    // would leave cores idle at the end.
+    let replicas = shifts.len();
+    let means: Vec<[f64; VALUES]> = (0..k.len() * replicas)
+        .into_par_iter()
+        .map(|job| replica_mean(k[job / replicas], &shifts[job % replicas]))
+        .collect();
+    let rows: Vec<[Estimate; VALUES]> = means
+        .chunks(replicas)
+        .map(|means| {
             std::array::from_fn(|v| {
                 let r = means.len() as f64;
                 let mean = means.iter().map(|m| m[v]).sum::<f64>() / r;
