@@ -74,7 +74,13 @@ fn two_loop(c: &mut Criterion) {
     group.bench_function("set/40", |b| {
         b.iter(|| {
             let mut terms = one.clone();
-            add_two_loop(&mut terms, black_box(&p), &precision, &|_, _| {});
+            add_two_loop(
+                &mut terms,
+                black_box(&p),
+                &precision,
+                &|_, _| {},
+                &|_, _| {},
+            );
             terms
         })
     });

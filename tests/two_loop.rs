@@ -238,7 +238,7 @@ fn regpt_two_loop(k_max: f64) -> (Vec<Vec<f64>>, pt_spectra::loops::OneLoopTerms
     let mut terms = OneLoopPlan::new(&k, &precision)
         .unwrap()
         .par_evaluate(&spectrum);
-    pt_spectra::loops::add_two_loop(&mut terms, &spectrum, &precision, &|_, _| {});
+    pt_spectra::loops::add_two_loop(&mut terms, &spectrum, &precision, &|_, _| {}, &|_, _| {});
     (rows, terms)
 }
 
@@ -353,4 +353,32 @@ fn both_parts_of_the_two_loop_correction_are_infrared_safe() {
         );
         println!("k={ki}: 2P15 shift {shift:.1}, propagator part {propagator:.3}, QMC part {moved:.3} ± {noise:.3}");
     }
+}
+
+#[test]
+fn two_loop_progress_reaches_its_total_and_changes_nothing() {
+    let spectrum = LinearSpectrum::gm2012(0.0).unwrap();
+    let k = [0.05, 0.3];
+    let settings = TwoLoopSettings {
+        points: 1 << 10,
+        replicas: 4,
+        ..TwoLoopSettings::default()
+    };
+    let calls = std::sync::Mutex::new(Vec::new());
+    let with = pt_spectra::loops::two_loop_with_progress(
+        &k,
+        &spectrum,
+        (1e-4, 50.0),
+        0.01,
+        &settings,
+        &|done, total| calls.lock().unwrap().push((done, total)),
+    );
+    let without = pt_spectra::loops::two_loop(&k, &spectrum, (1e-4, 50.0), 0.01, &settings);
+    assert_eq!(with, without);
+    let calls = calls.into_inner().unwrap();
+    // One call per (k, shift); the points done grow to the total, which is the same in every call.
+    assert_eq!(calls.len(), k.len() * settings.replicas);
+    let total = calls[0].1;
+    assert!(calls.iter().all(|&(d, t)| t == total && d <= total));
+    assert_eq!(calls.iter().map(|c| c.0).max(), Some(total));
 }

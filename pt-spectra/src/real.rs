@@ -278,7 +278,7 @@ pub fn real_space(
 ) -> Result<(RealSpectra, OneLoopTerms)> {
     let mut terms = OneLoopPlan::new(k, precision)?.par_evaluate(spectrum);
     if model.needs_two_loop() {
-        crate::loops::add_two_loop(&mut terms, spectrum, precision, &|_, _| {});
+        crate::loops::add_two_loop(&mut terms, spectrum, precision, &|_, _| {}, &|_, _| {});
     } else if model.needs_p15() {
         crate::loops::add_p15(&mut terms, spectrum, precision, &|_, _| {});
     }

@@ -50,7 +50,7 @@ pub use p15::{cache_path, p15_angular_kernel, P15Table};
 pub use p17::{p17_angular_kernel, P17Table};
 pub use p22::f2_g2;
 pub use tns::{tns, TnsCoefficients, TnsPlan, TnsTerms};
-pub use two_loop::{two_loop, TwoLoopPair, TwoLoopSettings, TwoLoopTerms};
+pub use two_loop::{two_loop, two_loop_with_progress, TwoLoopPair, TwoLoopSettings, TwoLoopTerms};
 
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
@@ -249,27 +249,30 @@ impl OneLoopTerms {
 /// correction 2P15 + 2P24 + P33 as the sum of two infrared-safe parts: the propagator part 2P15 − P33red
 /// (P15 from the table, P33red = P13²/P) and the mode-coupling part 2P24 + P33irr + 2P33red, integrated
 /// as one function (see the `two_loop` module), or at low k, if it has the smaller error, as
-/// 2P15 + P33red + (2P24 + P33irr).
+/// 2P15 + P33red + (2P24 + P33irr). `table_progress` reports the P15 table build (if P15 is missing and
+/// the table is not cached), `points_progress` the quasi-Monte-Carlo points done.
 pub fn add_two_loop(
     terms: &mut OneLoopTerms,
     spectrum: &LinearSpectrum,
     precision: &Precision,
-    progress: &(dyn Fn(usize, usize) + Sync),
+    table_progress: &(dyn Fn(usize, usize) + Sync),
+    points_progress: &(dyn Fn(usize, usize) + Sync),
 ) {
     if terms.dd.p15.len() != terms.k.len() {
-        add_p15(terms, spectrum, precision, progress);
+        add_p15(terms, spectrum, precision, table_progress);
     }
     let settings = TwoLoopSettings {
         points: precision.two_loop_points,
         replicas: precision.two_loop_replicas,
         ..TwoLoopSettings::default()
     };
-    let mc = two_loop(
+    let mc = two_loop_with_progress(
         &terms.k,
         spectrum,
         (precision.q_min, precision.q_max),
         precision.lattice_step,
         &settings,
+        points_progress,
     );
     for (j, pair) in Pair::ALL.into_iter().enumerate() {
         let total: Vec<Estimate> = (0..terms.k.len())

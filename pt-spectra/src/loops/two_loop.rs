@@ -51,6 +51,7 @@ use rayon::prelude::*;
 use sobol::params::JoeKuoD6;
 use sobol::Sobol;
 use std::f64::consts::PI;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Settings of the 2-loop integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -283,6 +284,18 @@ pub fn two_loop(
     lattice_step: f64,
     settings: &TwoLoopSettings,
 ) -> TwoLoopTerms {
+    two_loop_with_progress(k, spectrum, q_range, lattice_step, settings, &|_, _| {})
+}
+
+/// [`two_loop`], calling `progress(done, total)` with the points integrated so far (all k and shifts).
+pub fn two_loop_with_progress(
+    k: &[f64],
+    spectrum: &LinearSpectrum,
+    q_range: (f64, f64),
+    lattice_step: f64,
+    settings: &TwoLoopSettings,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> TwoLoopTerms {
     let lattice = Lattice::new(q_range.0, q_range.1, lattice_step);
     let samples = lattice.sample(spectrum);
     let sampled = Sampled {
@@ -340,9 +353,20 @@ pub fn two_loop(
     // One parallel job per (k, shift): the points per k differ by up to 32 times, so jobs per k alone
     // would leave cores idle at the end.
     let replicas = shifts.len();
+    let total: usize = k
+        .iter()
+        .map(|&k| replicas * points_at(k, settings.points))
+        .sum();
+    let done = AtomicUsize::new(0);
     let means: Vec<[f64; VALUES]> = (0..k.len() * replicas)
         .into_par_iter()
-        .map(|job| replica_mean(k[job / replicas], &shifts[job % replicas]))
+        .map(|job| {
+            let k = k[job / replicas];
+            let mean = replica_mean(k, &shifts[job % replicas]);
+            let n = points_at(k, settings.points);
+            progress(done.fetch_add(n, Ordering::Relaxed) + n, total);
+            mean
+        })
         .collect();
     let rows: Vec<[Estimate; VALUES]> = means
         .chunks(replicas)

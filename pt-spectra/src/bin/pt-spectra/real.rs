@@ -358,13 +358,16 @@ pub fn loop_terms(
         )?;
     }
     if model.needs_two_loop() {
-        let bar = ProgressBar::new_spinner().with_message(format!(
-            "2-loop terms: {} k x {} quasi-Monte-Carlo points",
-            k.len(),
-            precision.two_loop_points * precision.two_loop_replicas
-        ));
-        bar.enable_steady_tick(std::time::Duration::from_millis(200));
-        pt_spectra::loops::add_two_loop(&mut terms, spectrum, precision, &|_, _| {});
+        let bar = ProgressBar::new(1).with_style(
+            ProgressStyle::with_template("{msg} [{bar:40}] {percent}% ({eta})")
+                .map_err(|e| anyhow::anyhow!("progress bar: {e}"))?,
+        );
+        bar.set_message(format!("2-loop mode coupling, {} k", k.len()));
+        let progress = |done: usize, total: usize| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        };
+        pt_spectra::loops::add_two_loop(&mut terms, spectrum, precision, &|_, _| {}, &progress);
         bar.finish_and_clear();
     }
     Ok(terms)
