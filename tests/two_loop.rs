@@ -247,7 +247,7 @@ fn two_loop_spt_matches_regpt() {
     // Conventions matched: q ∈ [1e-4, 50] h/Mpc as the reference; RegPT's P15 = 2·ours, P24 = 2·ours,
     // P33red and P33irr as ours; P_SPT_2loop = P_lin + P22 + 2P13 + 2P15 + 2P24 + P33.
     let (rows, terms) = regpt_two_loop(0.3);
-    let mut worst: f64 = 0.0;
+    let (mut worst, mut worst_low): (f64, f64) = (0.0, 0.0);
     for (i, r) in rows.iter().enumerate() {
         for (pair, t, c) in [(0, &terms.dd, 14), (1, &terms.dt, 26), (2, &terms.tt, 38)] {
             let one = t.one_loop(i).value;
@@ -257,6 +257,9 @@ fn two_loop_spt_matches_regpt() {
             let rel = ours / spt2 - 1.0;
             if pair == 0 {
                 worst = worst.max(rel.abs());
+                if r[0] <= 0.1 {
+                    worst_low = worst_low.max(rel.abs());
+                }
                 // The target: 2L-SPT δδ within 1% for k ≤ 0.3 h/Mpc.
                 assert!(rel.abs() < 0.01, "k={} δδ: {ours} vs {spt2}", r[0]);
             }
@@ -275,7 +278,7 @@ fn two_loop_spt_matches_regpt() {
             );
         }
     }
-    println!("2L-SPT δδ against RegPT, k ≤ 0.3: largest relative difference {worst:.2e}");
+    println!("2L-SPT δδ against RegPT: largest relative difference {worst:.2e} (k ≤ 0.3), {worst_low:.2e} (k ≤ 0.1)");
 }
 
 #[test]
