@@ -171,6 +171,12 @@ impl Sampled<'_> {
     fn at(&self, q: f64) -> f64 {
         self.lattice.at_ln_or_zero(self.samples, q.ln())
     }
+
+    /// P̃ at q = √`q2` (no square root: ln q = ½ ln q²).
+    #[inline]
+    fn at_squared(&self, q2: f64) -> f64 {
+        self.lattice.at_ln_or_zero(self.samples, 0.5 * q2.ln())
+    }
 }
 
 /// Pair index j: (X, Y) = (F, F), (F, G), (G, G) → kernel indices.
@@ -197,7 +203,7 @@ fn pair_leg(kk: f64, kq: f64, qq: f64, p: &Sampled) -> (f64, [f64; 2]) {
         return (0.0, [0.0; 2]);
     }
     (
-        w * p.at(pp.sqrt()),
+        w * p.at_squared(pp),
         pt_kernels::mode_coupling_2(&[kk, kq, qq]),
     )
 }
@@ -242,6 +248,17 @@ fn images(k: f64, q: [f64; 2], x: [f64; 2], cos_phi: f64, p: &Sampled, p_k: f64)
     let legs2 = [pair_leg(kk, kq2, q22, p), pair_leg(kk, -kq2, q22, p)];
     // d³q₁d³q₂/(2π)⁶ = q₁³q₂³ dln q₁ dln q₂ · 2π dx₁ · 2 dx₂ dφ (φ ∈ [0, π]) / (2π)⁶; ¼ for the images.
     let measure = 0.25 * (q[0] * q[1]).powi(3) * 4.0 * PI / (2.0 * PI).powi(6);
+    // X_4^s(q₁, k − q₁, q₂, −q₂) is even in q₂ and the leg depends on q₁ only, so the P24 half of q₁
+    // takes two values over the images, set by the sign of k·q₁ (images 1, 4 and 2, 3); likewise the
+    // half of q₂ (images 1, 3 and 2, 4).
+    let halves1 = [
+        p24_half(&[kk, kq1, kq2, q11, q1q2, q22], legs1[0]),
+        p24_half(&[kk, -kq1, -kq2, q11, q1q2, q22], legs1[1]),
+    ];
+    let halves2 = [
+        p24_half(&[kk, kq2, kq1, q22, q1q2, q11], legs2[0]),
+        p24_half(&[kk, -kq2, -kq1, q22, q1q2, q11], legs2[1]),
+    ];
     let mut out = [0.0; VALUES];
     // (sign of k·q₁, sign of k·q₂, sign of q₁·q₂) of the four images.
     for (i1, i2, flip) in [(0, 0, false), (1, 1, false), (1, 0, true), (0, 1, true)] {
@@ -250,20 +267,20 @@ fn images(k: f64, q: [f64; 2], x: [f64; 2], cos_phi: f64, p: &Sampled, p_k: f64)
             if i2 == 0 { kq2 } else { -kq2 },
         );
         let q12 = if flip { -q1q2 } else { q1q2 };
-        let a = p24_half(&[kk, a1, a2, q11, q12, q22], legs1[i1]);
-        let b = p24_half(&[kk, a2, a1, q22, q12, q11], legs2[i2]);
+        let (a, b) = (halves1[i1], halves2[i2]);
         let q33 = (kk + q11 + q22 - 2.0 * a1 - 2.0 * a2 + 2.0 * q12).max(0.0);
         // The smooth partition w = q₃⁴/(q₁⁴ + q₂⁴ + q₃⁴) of the permutation symmetry (×3 below).
         let w3 = q33 * q33 / (q11 * q11 + q22 * q22 + q33 * q33);
-        let m3 = if w3 > 1e-12 {
-            let p3 = p.at(q33.sqrt());
-            pt_kernels::mode_coupling_3(&[kk, a1, a2, q11, q12, q22])
-                .map(|v| v * (18.0 * w3 * p1 * p2 * p3).sqrt())
+        let (m3, spectra3) = if w3 > 1e-12 {
+            (
+                pt_kernels::mode_coupling_3(&[kk, a1, a2, q11, q12, q22]),
+                18.0 * w3 * p1 * p2 * p.at_squared(q33),
+            )
         } else {
-            [0.0; 2]
+            ([0.0; 2], 0.0)
         };
         for (j, &(x, y)) in PAIRS.iter().enumerate() {
-            let p33 = m3[x] * m3[y];
+            let p33 = m3[x] * m3[y] * spectra3;
             let mc = 0.5 * (a[j] + b[j]) * p1 * p2;
             let red = red[j] * p1 * p2;
             out[j] += measure * (mc + p33 + 2.0 * red);
