@@ -324,18 +324,24 @@ fn both_parts_of_the_two_loop_correction_are_infrared_safe() {
     let settings = TwoLoopSettings::default();
     let parts = |p: &LinearSpectrum| {
         let p15 = table().evaluate(&k, p, range, precision.lattice_step);
+        let part = table().propagator_part(&k, p, range, precision.lattice_step);
         let one = OneLoopPlan::new(&k, &precision).unwrap().evaluate(p);
         let mc = pt_spectra::loops::two_loop(&k, p, range, precision.lattice_step, &settings);
         (0..k.len())
             .map(|i| {
                 let red = one.dd.p13[i].value.powi(2) / one.p_lin[i];
-                (2.0 * p15[i][0].value, red, mc.pairs[0].ir_safe[i])
+                (
+                    2.0 * p15[i][0].value,
+                    red,
+                    part[i][0].value,
+                    mc.pairs[0].ir_safe[i],
+                )
             })
             .collect::<Vec<_>>()
     };
     let (a, b) = (parts(&plain), parts(&bumped));
     for (i, &ki) in k.iter().enumerate() {
-        let ((p15_a, red_a, mc_a), (p15_b, red_b, mc_b)) = (a[i], b[i]);
+        let ((p15_a, red_a, part_a, mc_a), (p15_b, _, part_b, mc_b)) = (a[i], b[i]);
         // The size of the infrared shift of a single term: 2P15 moves by ≈ −k²σ_b² × (its 1-loop
         // propagator part), thousands of (Mpc/h)³ here.
         let shift = (p15_b - p15_a).abs();
@@ -343,7 +349,7 @@ fn both_parts_of_the_two_loop_correction_are_infrared_safe() {
             shift > 0.5 * ki * ki * sigma_b2 * red_a.abs().sqrt() * plain.eval(ki).sqrt(),
             "k={ki}: the bump should move 2P15 a lot ({shift})"
         );
-        let propagator = (p15_b - red_b) - (p15_a - red_a);
+        let propagator = part_b - part_a;
         assert!(
             propagator.abs() < 1e-3 * shift,
             "k={ki}: 2P15 − P33red moved by {propagator} (2P15 by {shift})"
@@ -384,4 +390,51 @@ fn two_loop_progress_reaches_its_total_and_changes_nothing() {
     let total = calls[0].1;
     assert!(calls.iter().all(|&(d, t)| t == total && d <= total));
     assert_eq!(calls.iter().map(|c| c.0).max(), Some(total));
+}
+
+#[test]
+fn propagator_part_is_2p15_minus_p33_reducible_in_one_integral() {
+    // 2P15 − P13_X P13_Y/P from one integral of 2K − K₁K₁ against the two separate results (P15 from the
+    // table, P13 from the 1-loop plan's own quadrature), within their errors; and 0 for δδ and θθ with
+    // the factorised kernel ½K₁K₁, for which 2P15 = P33red (δθ is then ½∫(K₁F − K₁G)², not 0: 2P15_δθ
+    // is the mean of δδ and θθ by definition).
+    let spectrum = LinearSpectrum::gm2012(0.0).unwrap();
+    let precision = Precision::default();
+    let range = (precision.q_min, precision.q_max);
+    let k = [0.01, 0.1, 0.25, 0.4];
+    let one = OneLoopPlan::new(&k, &precision)
+        .unwrap()
+        .evaluate(&spectrum);
+    let p15 = table().evaluate(&k, &spectrum, range, precision.lattice_step);
+    let part = table().propagator_part(&k, &spectrum, range, precision.lattice_step);
+    for i in 0..k.len() {
+        let p = one.p_lin[i];
+        let p13 = [one.dd.p13[i], one.tt.p13[i]];
+        for (j, (a, b)) in [(0, 0), (0, 1), (1, 1)].into_iter().enumerate() {
+            let separate = 2.0 * p15[i][j].value - p13[a].value * p13[b].value / p;
+            let allowed = 2.0 * p15[i][j].error + part[i][j].error + 1e-6 * separate.abs();
+            assert!(
+                (part[i][j].value - separate).abs() < allowed,
+                "k={} pair {j}: {:?} vs {separate}",
+                k[i],
+                part[i][j]
+            );
+        }
+    }
+    let factorised = P15Table::with_kernel(&|_, _| {}, |r1, r2, _| {
+        let (a, b) = (k1(r1), k1(r2));
+        [0.5 * a[0] * b[0], 0.5 * a[1] * b[1]]
+    });
+    let sizes = factorised.evaluate(&k, &spectrum, range, precision.lattice_step);
+    let parts = factorised.propagator_part(&k, &spectrum, range, precision.lattice_step);
+    for (row, size) in parts.iter().zip(&sizes) {
+        for j in [0, 2] {
+            assert!(
+                row[j].value.abs() <= 1e-12 * size[j].value.abs(),
+                "pair {j}: {:?} (P15 {:?})",
+                row[j],
+                size[j]
+            );
+        }
+    }
 }

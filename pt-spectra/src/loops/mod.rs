@@ -246,9 +246,9 @@ impl OneLoopTerms {
 
 /// Adds the 2-loop terms to `terms` (made from `spectrum` with `precision`): P15 (if missing, from the
 /// angular table), P24 and P33^{2L} from the quasi-Monte-Carlo integral ([`two_loop`]), and the whole
-/// correction 2P15 + 2P24 + P33 as the sum of two infrared-safe parts: the propagator part 2P15 − P33red
-/// (P15 from the table, P33red = P13²/P) and the mode-coupling part 2P24 + P33irr + 2P33red, integrated
-/// as one function (see the `two_loop` module), or at low k, if it has the smaller error, as
+/// correction 2P15 + 2P24 + P33 as the sum of two infrared-safe parts, each one integral: the
+/// propagator part 2P15 − P33red ([`P15Table::propagator_part`]) and the mode-coupling part
+/// 2P24 + P33irr + 2P33red (see the `two_loop` module); or at low k, if it has the smaller error, as
 /// 2P15 + P33red + (2P24 + P33irr). `table_progress` reports the P15 table build (if P15 is missing and
 /// the table is not cached), `points_progress` the quasi-Monte-Carlo points done.
 pub fn add_two_loop(
@@ -266,6 +266,12 @@ pub fn add_two_loop(
         replicas: precision.two_loop_replicas,
         ..TwoLoopSettings::default()
     };
+    let propagator = P15Table::get(table_progress).propagator_part(
+        &terms.k,
+        spectrum,
+        (precision.q_min, precision.q_max),
+        precision.lattice_step,
+    );
     let mc = two_loop_with_progress(
         &terms.k,
         spectrum,
@@ -277,14 +283,15 @@ pub fn add_two_loop(
     for (j, pair) in Pair::ALL.into_iter().enumerate() {
         let total: Vec<Estimate> = (0..terms.k.len())
             .map(|i| {
-                let (p15, red, ir_safe) = (
+                let (p15, red, propagator, ir_safe) = (
                     terms.pair(pair).p15[i],
                     terms.p33_reducible(pair, i),
+                    propagator[i][j],
                     mc.pairs[j].ir_safe[i],
                 );
                 let ir_safe = Estimate::new(
-                    2.0 * p15.value - red.value + ir_safe.value,
-                    2.0 * p15.error + red.error + ir_safe.error,
+                    propagator.value + ir_safe.value,
+                    propagator.error + ir_safe.error,
                 );
                 // At k ≲ 0.03 h/Mpc, where the infrared pieces are small, the plain mode coupling can
                 // be the more precise: take whichever estimate has the smaller error.

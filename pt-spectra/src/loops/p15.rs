@@ -396,21 +396,77 @@ impl P15Table {
         q_range: (f64, f64),
         lattice_step: f64,
     ) -> Vec<[Estimate; 3]> {
+        self.integrate(k, spectrum, q_range, lattice_step, |_, kernel| *kernel)
+            .into_iter()
+            .map(|[dd, tt]| [dd, Estimate::mean(dd, tt), tt])
+            .collect()
+    }
+
+    /// The infrared-safe propagator part 2P15_XY − P13_X P13_Y/P of the 2-loop correction for
+    /// [δδ, δθ, θθ] at each k [(Mpc/h)^3], as one integral of the kernel 2K_XY − K₁X(r₁)K₁Y(r₂)
+    /// (symmetrised), K₁ = 3⟨X_3^s(k, q, −q)⟩ from the closed form of [`super::p13_kernels`]: its
+    /// 1/r² infrared pieces cancel at each node, so no large terms are subtracted afterwards. Integrated
+    /// and with errors as [`Self::evaluate`].
+    pub fn propagator_part(
+        &self,
+        k: &[f64],
+        spectrum: &LinearSpectrum,
+        q_range: (f64, f64),
+        lattice_step: f64,
+    ) -> Vec<[Estimate; 3]> {
+        let k1 = |u: f64| {
+            let r = u.exp();
+            super::p13_kernels(r).map(|f| f / (1008.0 * r * r))
+        };
+        self.integrate(k, spectrum, q_range, lattice_step, |node, [kf, kg]| {
+            let (a, b) = (k1(node.u1), k1(node.u2));
+            [
+                2.0 * kf - a[0] * b[0],
+                kf + kg - 0.5 * (a[0] * b[1] + a[1] * b[0]),
+                2.0 * kg - a[1] * b[1],
+            ]
+        })
+    }
+
+    /// Σ over the radial rule of w P(k r₁) P(k r₂) `pair_kernel`(node, [K_F, K_G]) at each k, normalised
+    /// to (Mpc/h)^3, with the error |fine − coarse radial rule| + Σ|w ΔK_angle| P P (ΔK_angle: the
+    /// pair kernel at the fine minus the coarse angular order).
+    fn integrate<const M: usize>(
+        &self,
+        k: &[f64],
+        spectrum: &LinearSpectrum,
+        q_range: (f64, f64),
+        lattice_step: f64,
+        pair_kernel: impl Fn(&RadialNode, &[f64; 2]) -> [f64; M] + Sync,
+    ) -> Vec<[Estimate; M]> {
         let lattice = Lattice::new(q_range.0, q_range.1, lattice_step);
         let samples = lattice.sample(spectrum);
         let p_at = |x: f64| lattice.at_ln_or_zero(&samples, x);
+        // The pair kernels do not depend on k: evaluate them once per node.
+        let on = |nodes: &[RadialNode], kernels: &[[f64; 2]]| -> Vec<[f64; M]> {
+            nodes
+                .iter()
+                .zip(kernels)
+                .map(|(n, kernel)| pair_kernel(n, kernel))
+                .collect()
+        };
+        let (fine_k, fine_k_coarse, coarse_k) = (
+            on(&self.fine, &self.fine_k),
+            on(&self.fine, &self.fine_k_coarse),
+            on(&self.coarse, &self.coarse_k),
+        );
         k.par_iter()
             .map(|&k| {
                 let ln_k = k.ln();
-                let sum = |nodes: &[RadialNode], kernels: &[[f64; 2]], alt: Option<&[[f64; 2]]>| {
-                    let (mut total, mut angular) = ([0.0; 2], [0.0; 2]);
+                let sum = |nodes: &[RadialNode], kernels: &[[f64; M]], alt: Option<&[[f64; M]]>| {
+                    let (mut total, mut angular) = ([0.0; M], [0.0; M]);
                     let (mut u1, mut p1) = (f64::NAN, 0.0);
                     for (i, n) in nodes.iter().enumerate() {
                         if n.u1 != u1 {
                             (u1, p1) = (n.u1, p_at(ln_k + n.u1));
                         }
                         let pp = n.w * p1 * p_at(ln_k + n.u2);
-                        for x in 0..2 {
+                        for x in 0..M {
                             total[x] += pp * kernels[i][x];
                             if let Some(alt) = alt {
                                 angular[x] += (pp * (kernels[i][x] - alt[i][x])).abs();
@@ -419,17 +475,15 @@ impl P15Table {
                     }
                     (total, angular)
                 };
-                let (fine, angular) = sum(&self.fine, &self.fine_k, Some(&self.fine_k_coarse));
-                let (coarse, _) = sum(&self.coarse, &self.coarse_k, None);
+                let (fine, angular) = sum(&self.fine, &fine_k, Some(&fine_k_coarse));
+                let (coarse, _) = sum(&self.coarse, &coarse_k, None);
                 let norm = k.powi(6) / (4.0 * PI.powi(4)) * spectrum.eval(k);
-                let e = |x: usize| {
+                std::array::from_fn(|x| {
                     Estimate::new(
                         norm * fine[x],
                         norm.abs() * ((fine[x] - coarse[x]).abs() + angular[x]),
                     )
-                };
-                let (dd, tt) = (e(0), e(1));
-                [dd, Estimate::mean(dd, tt), tt]
+                })
             })
             .collect()
     }

@@ -14,8 +14,9 @@
 //!
 //! As q₁ → 0 (or q₂ → 0, or both), 15(X_5 + Y_5) and 9(X_3 Y_3 + Y_3 X_3)/2 have the same limit,
 //! since F_n^s(…, q, −q) → −(k·q)²/q⁴ F_{n−2}^s(…)/(n(n − 1)): so 2P15 and P33red have the same infrared
-//! pieces and so have, with the opposite sign, 2P24 + P33irr. The propagator part 2P15 − P33red comes
-//! from the P15 angular table and the 1-loop P13 (deterministic, ≲ 1e-5); the mode-coupling part is
+//! pieces and so have, with the opposite sign, 2P24 + P33irr. The propagator part 2P15 − P33red is one
+//! deterministic integral of 2K − K₁(r₁)K₁(r₂) on the P15 angular table (`P15Table::propagator_part`;
+//! its 1/r² pieces cancel at each node); the mode-coupling part is
 //! integrated here as one function, 2P24 + P33irr + 2·[9P(k)X_3(k, q₁, −q₁)Y_3(k, q₂, −q₂)P₁P₂],
 //! in which the leading singularities cancel point by point. This needs no 5th-order kernel per point.
 //!
@@ -38,7 +39,7 @@
 //! Accuracy (default settings: 8 shifts × 2^14 points at k = 0.16 h/Mpc, scaled ∝ k^3.5 from ½ to 32
 //! times, × 4 images; z = 0; the README has the table): the error of the 2-loop correction is ≤ 2e-4 of
 //! it for k ≤ 0.05 h/Mpc, ≤ 6e-4 for k ≤ 0.12 and ≤ 1e-3 up to k = 0.36 for δδ, and up to 0.4 for δθ
-//! and θθ; 1.4e-3 for δδ at k = 0.4 (9.5e-4 rms over 8 seeds), where its correction (−115 (Mpc/h)³) is
+//! and θθ; 1.1e-3 for δδ at k = 0.4 (7.0e-4 rms over 8 seeds, whose values scatter by 8.9e-4), where its correction (−114 (Mpc/h)³) is
 //! a 0.7% remainder of terms of ±1.7e4. Independent randomisations differ by 0.9–1.2σ rms (≤ 3σ over 120 values).
 //!
 //! The same points also give 2P24 and P33irr separately (needed by 2-loop RPT, whose mode-coupling term is
