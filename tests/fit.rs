@@ -47,7 +47,8 @@ fn kaiser_mock(k: &[f64], b: f64, seed: u64) -> MultipoleData {
     MultipoleData::parse(&text, "mock", 0, &[(0, 1, 2), (2, 3, 4), (4, 5, 6)]).unwrap()
 }
 
-fn linear_kaiser_model(k: &[f64], b: f64) -> MultipoleModel {
+/// Linear Kaiser, no FoG, bias `b`, for the multipoles `ells`.
+fn linear_kaiser_model(k: &[f64], b: f64, ells: &[usize]) -> MultipoleModel {
     let p = LinearSpectrum::gm2012(0.0).unwrap();
     let (real, _) = real_space(RealModel::Linear, &p, k, &Precision::fast()).unwrap();
     MultipoleModel::new(
@@ -55,6 +56,23 @@ fn linear_kaiser_model(k: &[f64], b: f64) -> MultipoleModel {
         None,
         RsdModel::Kaiser,
         Fog::None,
+        1.0,
+        vec![b; k.len()],
+        ells,
+    )
+    .unwrap()
+}
+
+/// TNS with 1-loop SPT spectra and Lorentzian FoG, bias `b`, for ℓ = 0, 2, 4.
+fn tns_model(k: &[f64], b: f64) -> MultipoleModel {
+    let p = LinearSpectrum::gm2012(0.0).unwrap();
+    let (real, _) = real_space(RealModel::OneLoopSpt, &p, k, &Precision::fast()).unwrap();
+    let tns = TnsPlan::new(k, &Precision::fast()).unwrap().evaluate(&p);
+    MultipoleModel::new(
+        &real,
+        Some(&tns),
+        RsdModel::Tns,
+        Fog::Lorentzian,
         1.0,
         vec![b; k.len()],
         &[0, 2, 4],
@@ -65,7 +83,7 @@ fn linear_kaiser_model(k: &[f64], b: f64) -> MultipoleModel {
 #[test]
 fn fit_recovers_f_from_an_independent_kaiser_mock() {
     let k = LogGrid::new(0.01, 0.3, 40).unwrap().points();
-    let model = linear_kaiser_model(&k, 1.0);
+    let model = linear_kaiser_model(&k, 1.0, &[0, 2, 4]);
     let mut inside = 0;
     for seed in 0..6 {
         let data = kaiser_mock(&k, 1.0, seed);
@@ -102,7 +120,7 @@ fn fit_recovers_f_from_an_independent_kaiser_mock() {
 fn two_parameter_errors_lie_on_the_delta_chi2_contour() {
     // f and A_b with b = 2: the profile at the interval ends is χ²_min + 2.3, found by bisection.
     let k = LogGrid::new(0.01, 0.25, 30).unwrap().points();
-    let model = linear_kaiser_model(&k, 2.0);
+    let model = linear_kaiser_model(&k, 2.0, &[0, 2, 4]);
     let data = kaiser_mock(&k, 2.0, 42);
     let settings = FitSettings {
         free: vec![Parameter::F, Parameter::Amplitude],
@@ -153,20 +171,8 @@ fn two_parameter_errors_lie_on_the_delta_chi2_contour() {
 #[test]
 fn a_wrong_model_shows_a_bias() {
     // Mock: TNS with 1-loop SPT spectra and Lorentzian FoG (σ0 = 4 Mpc/h), fitted with linear Kaiser.
-    let p = LinearSpectrum::gm2012(0.0).unwrap();
     let k = LogGrid::new(0.01, 0.2, 30).unwrap().points();
-    let (real, _) = real_space(RealModel::OneLoopSpt, &p, &k, &Precision::fast()).unwrap();
-    let tns = TnsPlan::new(&k, &Precision::fast()).unwrap().evaluate(&p);
-    let truth = MultipoleModel::new(
-        &real,
-        Some(&tns),
-        RsdModel::Tns,
-        Fog::Lorentzian,
-        1.0,
-        vec![1.0; k.len()],
-        &[0, 2, 4],
-    )
-    .unwrap();
+    let truth = tns_model(&k, 1.0);
     let m = truth.multipoles(&Params {
         f: F_TRUE,
         sigma0: 4.0,
@@ -191,17 +197,7 @@ fn a_wrong_model_shows_a_bias() {
     };
     // The quadrupole alone, as the paper fits each multipole: FoG damping pulls f low.
     let quadrupole = MultipoleData::parse(&text, "tns mock", 0, &[(2, 3, 4)]).unwrap();
-    let (lin, _) = real_space(RealModel::Linear, &p, &k, &Precision::fast()).unwrap();
-    let kaiser = MultipoleModel::new(
-        &lin,
-        None,
-        RsdModel::Kaiser,
-        Fog::None,
-        1.0,
-        vec![1.0; k.len()],
-        &[2],
-    )
-    .unwrap();
+    let kaiser = linear_kaiser_model(&k, 1.0, &[2]);
     let wrong = &fit(&kaiser, &quadrupole, &settings, &[0.2]).unwrap()[0];
     let sigma = 0.5 * (wrong.intervals[0].2 - wrong.intervals[0].1);
     println!("wrong model, quadrupole: {wrong:?}");
@@ -211,7 +207,13 @@ fn a_wrong_model_shows_a_bias() {
     );
     assert!(wrong.chi2 / wrong.dof as f64 > 5.0, "{wrong:?}");
     // All three multipoles: χ² rejects the model.
-    let joint = &fit(&linear_kaiser_model(&k, 1.0), &data, &settings, &[0.2]).unwrap()[0];
+    let joint = &fit(
+        &linear_kaiser_model(&k, 1.0, &[0, 2, 4]),
+        &data,
+        &settings,
+        &[0.2],
+    )
+    .unwrap()[0];
     assert!(joint.chi2 / joint.dof as f64 > 5.0, "{joint:?}");
     // The right model with f and σ0 free recovers both.
     let settings = FitSettings {
@@ -247,7 +249,7 @@ fn bad_data_are_refused_with_the_line() {
 #[test]
 fn full_covariance_generalises_the_diagonal_chi2() {
     let k = LogGrid::new(0.01, 0.2, 20).unwrap().points();
-    let model = linear_kaiser_model(&k, 1.0);
+    let model = linear_kaiser_model(&k, 1.0, &[0, 2, 4]);
     let data = kaiser_mock(&k, 1.0, 7);
     let settings = FitSettings {
         free: vec![Parameter::F],
@@ -315,20 +317,8 @@ fn full_covariance_generalises_the_diagonal_chi2() {
 #[test]
 fn three_free_parameters_are_recovered_with_bracketing_intervals() {
     // Noiseless TNS + 1L-SPT + Lorentzian mock with b = 1.5: f, σ0 and A_b free (Δχ² = 3.53).
-    let p = LinearSpectrum::gm2012(0.0).unwrap();
     let k = LogGrid::new(0.02, 0.2, 20).unwrap().points();
-    let (real, _) = real_space(RealModel::OneLoopSpt, &p, &k, &Precision::fast()).unwrap();
-    let tns = TnsPlan::new(&k, &Precision::fast()).unwrap().evaluate(&p);
-    let model = MultipoleModel::new(
-        &real,
-        Some(&tns),
-        RsdModel::Tns,
-        Fog::Lorentzian,
-        1.0,
-        vec![1.5; k.len()],
-        &[0, 2, 4],
-    )
-    .unwrap();
+    let model = tns_model(&k, 1.5);
     let truth = Params {
         f: F_TRUE,
         sigma0: 4.0,

@@ -6,7 +6,7 @@
 //! `pt_spectra::loops::cache_path`).
 
 use pt_spectra::linear::LinearSpectrum;
-use pt_spectra::loops::{p15_angular_kernel, OneLoopPlan, P15Table, TwoLoopSettings};
+use pt_spectra::loops::{k1_kernels, p15_angular_kernel, OneLoopPlan, P15Table, TwoLoopSettings};
 use pt_spectra::precision::Precision;
 use pt_spectra::resum::{n1, n2};
 use rand::{Rng, SeedableRng};
@@ -38,7 +38,7 @@ fn angular_kernel_has_the_factorised_ir_limit_and_converges() {
     // r₁, r₂ ≪ 1: K → ½K₁(r₁)K₁(r₂), for F and for G; corrections O(r²).
     for (r1, r2) in [(1e-3, 2e-3), (3e-4, 1e-3)] {
         let k = p15_angular_kernel(r1, r2, 20);
-        let (a, b) = (k1(r1), k1(r2));
+        let (a, b) = (k1_kernels(r1), k1_kernels(r2));
         for x in 0..2 {
             let limit = 0.5 * a[x] * b[x];
             assert!(
@@ -79,7 +79,7 @@ fn factorised_kernel_gives_n2_equal_to_n1() {
     // With K = ½K₁K₁ the radial rule must give 2P15 = (P13/P)² P, P13 from the 1-loop plan's independent
     // quadrature; then N2 = N1.
     let factorised = P15Table::with_kernel(&|_, _| {}, |r1, r2, _| {
-        let (a, b) = (k1(r1), k1(r2));
+        let (a, b) = (k1_kernels(r1), k1_kernels(r2));
         [0.5 * a[0] * b[0], 0.5 * a[1] * b[1]]
     });
     let spectrum = LinearSpectrum::gm2012(0.0).unwrap();
@@ -422,7 +422,7 @@ fn propagator_part_is_2p15_minus_p33_reducible_in_one_integral() {
         }
     }
     let factorised = P15Table::with_kernel(&|_, _| {}, |r1, r2, _| {
-        let (a, b) = (k1(r1), k1(r2));
+        let (a, b) = (k1_kernels(r1), k1_kernels(r2));
         [0.5 * a[0] * b[0], 0.5 * a[1] * b[1]]
     });
     let sizes = factorised.evaluate(&k, &spectrum, range, precision.lattice_step);

@@ -12,6 +12,15 @@ fn run(args: &[&str]) -> (bool, String, String) {
 }
 
 /// The numeric rows of a table.
+/// Each command fails (non-zero exit) with a message containing its needle.
+fn fails_naming(cases: &[(Vec<&str>, &str)]) {
+    for (args, needle) in cases {
+        let (ok, _, err) = run(args);
+        assert!(!ok, "{args:?} should fail");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+}
+
 fn rows(text: &str) -> Vec<Vec<f64>> {
     text.lines()
         .filter(|l| !l.starts_with('#'))
@@ -181,7 +190,7 @@ fn fit_recovers_the_parameters_of_a_model_made_by_rsd() {
         );
         assert!((row[5] - 4.0).abs() < 1e-3, "{row:?}");
     }
-    for (args, needle) in [
+    fails_naming(&[
         (
             vec!["fit", "--data", "/nonexistent/d.dat"],
             "/nonexistent/d.dat",
@@ -196,11 +205,7 @@ fn fit_recovers_the_parameters_of_a_model_made_by_rsd() {
             vec!["fit", "--data", &data, "--data-columns", "1,2,3"],
             "--data-columns",
         ),
-    ] {
-        let (ok, _, err) = run(&args);
-        assert!(!ok, "{args:?} should fail");
-        assert!(err.contains(needle), "{args:?}: {err}");
-    }
+    ]);
 }
 
 #[test]
@@ -233,7 +238,7 @@ fn plot_writes_png_and_svg_and_refuses_bad_input() {
         );
     }
     let gif = dir.join("m.gif").display().to_string();
-    for (args, needle) in [
+    fails_naming(&[
         (
             vec!["plot", "models", &table, "--out", &gif],
             ".png or .svg",
@@ -246,11 +251,7 @@ fn plot_writes_png_and_svg_and_refuses_bad_input() {
             vec!["plot", "fit", "/nonexistent/f.dat", "--out", "x.png"],
             "/nonexistent/f.dat",
         ),
-    ] {
-        let (ok, _, err) = run(&args);
-        assert!(!ok, "{args:?} should fail");
-        assert!(err.contains(needle), "{args:?}: {err}");
-    }
+    ]);
 }
 
 #[test]
@@ -287,7 +288,7 @@ fn bad_input_exits_non_zero_naming_the_problem() {
     let dir = scratch("bad_input");
     let bias_short = write(&dir, "b.dat", "0.001 2.0\n0.2 2.5\n");
     let noise_nan = write(&dir, "n.dat", "0.001 1e4\n0.1 nan\n1.0 1e4\n");
-    for (args, needle) in [
+    fails_naming(&[
         (vec!["rsd", "--fog", "cauchy"], "cauchy"),
         (vec!["rsd", "--ells", "0,3"], "ell = 3"),
         (vec!["rsd", "--rsd", "tns-x"], "tns-x"),
@@ -311,9 +312,5 @@ fn bad_input_exits_non_zero_naming_the_problem() {
         ),
         (vec!["rsd", "--noise-file", &noise_nan], "P_eps(k) = NaN"),
         (vec!["kernel", "F", "--q", "1,0", "--q", "0,1,0"], "1,0"),
-    ] {
-        let (ok, _, err) = run(&args);
-        assert!(!ok, "{args:?} should fail");
-        assert!(err.contains(needle), "{args:?}: {err}");
-    }
+    ]);
 }

@@ -3,7 +3,6 @@
 
 use pt_spectra::integrate::GaussLegendre;
 use pt_spectra::linear::{LinearSpectrum, LogGrid};
-use pt_spectra::loops::p13_kernels;
 use std::f64::consts::PI;
 
 /// The text of `tests/data/<name>`.
@@ -18,11 +17,6 @@ pub fn rows(text: &str) -> Vec<Vec<f64>> {
         .filter(|l| !l.trim_start().starts_with('#') && !l.trim().is_empty())
         .map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect())
         .collect()
-}
-
-/// K₁(r) = 3⟨X_3^s(k, q, −q)⟩ for X = F, G from the closed form of the P13 kernel (f_X/(1008 r²)).
-pub fn k1(r: f64) -> [f64; 2] {
-    p13_kernels(r).map(|f| f / (1008.0 * r * r))
 }
 
 /// A spectrum with all its power at q ~ 1e-3 h/Mpc (P ∝ q/(1 + (q/q0)⁸)), tabulated on [1e-6, 1e2], and

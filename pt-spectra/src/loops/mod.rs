@@ -45,7 +45,7 @@ mod tns;
 mod two_loop;
 
 pub use one_loop::OneLoopPlan;
-pub use p13::p13_kernels;
+pub use p13::{k1_kernels, p13_kernels};
 pub use p15::{cache_path, p15_angular_kernel, P15Table};
 pub use p17::{p17_angular_kernel, P17Table};
 pub use p22::f2_g2;
@@ -178,6 +178,14 @@ impl OneLoopTerms {
             Pair::ThetaTheta => &self.tt,
         }
     }
+
+    fn pair_mut(&mut self, pair: Pair) -> &mut PairTerms {
+        match pair {
+            Pair::DeltaDelta => &mut self.dd,
+            Pair::DeltaTheta => &mut self.dt,
+            Pair::ThetaTheta => &mut self.tt,
+        }
+    }
 }
 
 /// Adds P15 of δδ, δθ, θθ to `terms` (computed for `spectrum`, which must be the one `terms` were made
@@ -307,11 +315,7 @@ pub fn add_two_loop(
                 }
             })
             .collect();
-        let t = match pair {
-            Pair::DeltaDelta => &mut terms.dd,
-            Pair::DeltaTheta => &mut terms.dt,
-            Pair::ThetaTheta => &mut terms.tt,
-        };
+        let t = terms.pair_mut(pair);
         t.p24 = mc.pairs[j].p24.clone();
         t.p33_2l = mc.pairs[j].p33_2l.clone();
         t.two_loop = total;

@@ -104,6 +104,13 @@ pub fn p13_kernels(r: f64) -> [f64; 2] {
     }
 }
 
+/// K₁(r) = 3⟨X_3^s(k, q, −q)⟩ averaged over the directions of q, r = q/k, for X = F, G: f_X(r)/(1008 r²)
+/// ([`p13_kernels`]). P13_X = P(k) ∫d³q/(2π)³ K₁X(q/k) P(q); the infrared limit of the P15 kernel is
+/// ½K₁(r₁)K₁(r₂).
+pub fn k1_kernels(r: f64) -> [f64; 2] {
+    p13_kernels(r).map(|f| f / (1008.0 * r * r))
+}
+
 /// Lattice weights of one k: Σ_j w_j P_j = P13_X(k)/P(k) for X = F, G, with P the lattice samples.
 #[derive(Debug, Clone)]
 pub(crate) struct P13Weights {
@@ -163,7 +170,7 @@ mod tests {
         assert!((near[0] + 88.0).abs() < 1e-6 && (near[1] + 216.0).abs() < 1e-6);
     }
 
-    /// The closed forms against Gauss–Legendre angular integration of the generated kernels.
+    /// The closed forms (and K₁) against Gauss–Legendre angular integration of the generated kernels.
     #[test]
     fn closed_forms_match_angular_integrals_of_generated_kernels() {
         use crate::integrate::GaussLegendre;
@@ -181,6 +188,9 @@ mod tests {
                     (got / expected - 1.0).abs() < 1e-10,
                     "r={r} kernel {which}: {got} vs {expected}"
                 );
+                // K₁ = 3⟨X_3^s⟩ = (3/2)∫dμ X_3^s.
+                let k1 = k1_kernels(r)[which];
+                assert!((k1 / (1.5 * got) - 1.0).abs() < 1e-10, "r={r} K₁ {which}");
             }
         }
     }

@@ -172,18 +172,25 @@ fn radial_rule(order: usize) -> Vec<RadialNode> {
     nodes
 }
 
-/// The table: every node of the fine radial rule with K at the fine and the coarse angular order, and
-/// every node of the coarse radial rule with K at the fine angular order.
+/// M kernel values at every node of the fine radial rule at the fine and the coarse angular order, and
+/// at every node of the coarse radial rule at the fine angular order.
+#[derive(Debug, Clone, PartialEq)]
+struct NodeKernels<const M: usize> {
+    fine: Vec<[f64; M]>,
+    fine_coarse_angle: Vec<[f64; M]>,
+    coarse: Vec<[f64; M]>,
+}
+
+/// The table: the fine and the coarse radial rule with [K_F, K_G] at their nodes, and the kernels of
+/// the propagator part derived from them (cosmology-independent, so made once with the table).
 #[derive(Debug, Clone, PartialEq)]
 pub struct P15Table {
     fine: Vec<RadialNode>,
-    /// [K_F, K_G] at the fine nodes, fine angular order.
-    fine_k: Vec<[f64; 2]>,
-    /// [K_F, K_G] at the fine nodes, coarse angular order.
-    fine_k_coarse: Vec<[f64; 2]>,
     coarse: Vec<RadialNode>,
-    /// [K_F, K_G] at the coarse radial nodes, fine angular order.
-    coarse_k: Vec<[f64; 2]>,
+    /// [K_F, K_G].
+    p15: NodeKernels<2>,
+    /// 2K − K₁(r₁)K₁(r₂) for δδ, δθ, θθ (see [`P15Table::propagator_part`]).
+    propagator: NodeKernels<3>,
 }
 
 /// Where the table is cached: `$PT_SPECTRA_CACHE/`, else `$XDG_CACHE_HOME/pt-spectra/`, else
@@ -337,21 +344,55 @@ impl P15Table {
         };
         let f = kernels(&fine, true);
         let c = kernels(&coarse, false);
+        let p15 = NodeKernels {
+            fine: f.iter().map(|k| k[0]).collect(),
+            fine_coarse_angle: f.iter().map(|k| k[1]).collect(),
+            coarse: c.iter().map(|k| k[0]).collect(),
+        };
+        Self::from_parts(fine, coarse, p15)
+    }
+
+    /// The table of the rules and the P15 kernels, with the propagator-part kernels
+    /// 2K_XY − K₁X(r₁)K₁Y(r₂) (symmetrised), K₁ = 3⟨X_3^s(k, q, −q)⟩ from the closed form
+    /// ([`super::k1_kernels`]). 2P15_δθ is the mean of δδ and θθ, P33red_δθ = P13_δ P13_θ/P.
+    fn from_parts(fine: Vec<RadialNode>, coarse: Vec<RadialNode>, p15: NodeKernels<2>) -> Self {
+        let propagator = |nodes: &[RadialNode], kernels: &[[f64; 2]]| -> Vec<[f64; 3]> {
+            nodes
+                .par_iter()
+                .zip(kernels)
+                .map(|(n, &[kf, kg])| {
+                    let (a, b) = (super::k1_kernels(n.u1.exp()), super::k1_kernels(n.u2.exp()));
+                    [
+                        2.0 * kf - a[0] * b[0],
+                        kf + kg - 0.5 * (a[0] * b[1] + a[1] * b[0]),
+                        2.0 * kg - a[1] * b[1],
+                    ]
+                })
+                .collect()
+        };
+        let propagator = NodeKernels {
+            fine: propagator(&fine, &p15.fine),
+            fine_coarse_angle: propagator(&fine, &p15.fine_coarse_angle),
+            coarse: propagator(&coarse, &p15.coarse),
+        };
         Self {
-            fine_k: f.iter().map(|k| k[0]).collect(),
-            fine_k_coarse: f.iter().map(|k| k[1]).collect(),
-            coarse_k: c.iter().map(|k| k[0]).collect(),
             fine,
             coarse,
+            p15,
+            propagator,
         }
     }
 
     fn write(&self, path: &std::path::Path) {
         let mut values = vec![self.fine.len() as f64, self.coarse.len() as f64];
         for i in 0..self.fine.len() {
-            values.extend(self.fine_k[i].into_iter().chain(self.fine_k_coarse[i]));
+            values.extend(
+                self.p15.fine[i]
+                    .into_iter()
+                    .chain(self.p15.fine_coarse_angle[i]),
+            );
         }
-        values.extend(self.coarse_k.iter().flatten());
+        values.extend(self.p15.coarse.iter().flatten());
         write_f64s(path, values);
     }
 
@@ -377,13 +418,12 @@ impl P15Table {
                 return None;
             }
         }
-        Some(Self {
-            fine_k: f.chunks_exact(4).map(|v| [v[0], v[1]]).collect(),
-            fine_k_coarse: f.chunks_exact(4).map(|v| [v[2], v[3]]).collect(),
-            coarse_k: c.chunks_exact(2).map(|v| [v[0], v[1]]).collect(),
-            fine,
-            coarse,
-        })
+        let p15 = NodeKernels {
+            fine: f.chunks_exact(4).map(|v| [v[0], v[1]]).collect(),
+            fine_coarse_angle: f.chunks_exact(4).map(|v| [v[2], v[3]]).collect(),
+            coarse: c.chunks_exact(2).map(|v| [v[0], v[1]]).collect(),
+        };
+        Some(Self::from_parts(fine, coarse, p15))
     }
 
     /// [P15_δδ, P15_δθ, P15_θθ] at each k [(Mpc/h)^3] for the linear `spectrum`, integrated over
@@ -396,7 +436,7 @@ impl P15Table {
         q_range: (f64, f64),
         lattice_step: f64,
     ) -> Vec<[Estimate; 3]> {
-        self.integrate(k, spectrum, q_range, lattice_step, |_, kernel| *kernel)
+        self.integrate(&self.p15, k, spectrum, q_range, lattice_step)
             .into_iter()
             .map(|[dd, tt]| [dd, Estimate::mean(dd, tt), tt])
             .collect()
@@ -404,7 +444,7 @@ impl P15Table {
 
     /// The infrared-safe propagator part 2P15_XY − P13_X P13_Y/P of the 2-loop correction for
     /// [δδ, δθ, θθ] at each k [(Mpc/h)^3], as one integral of the kernel 2K_XY − K₁X(r₁)K₁Y(r₂)
-    /// (symmetrised), K₁ = 3⟨X_3^s(k, q, −q)⟩ from the closed form of [`super::p13_kernels`]: its
+    /// (symmetrised), K₁ = 3⟨X_3^s(k, q, −q)⟩ from the closed form ([`super::k1_kernels`]): its
     /// 1/r² infrared pieces cancel at each node, so no large terms are subtracted afterwards. Integrated
     /// and with errors as [`Self::evaluate`].
     pub fn propagator_part(
@@ -414,47 +454,23 @@ impl P15Table {
         q_range: (f64, f64),
         lattice_step: f64,
     ) -> Vec<[Estimate; 3]> {
-        let k1 = |u: f64| {
-            let r = u.exp();
-            super::p13_kernels(r).map(|f| f / (1008.0 * r * r))
-        };
-        self.integrate(k, spectrum, q_range, lattice_step, |node, [kf, kg]| {
-            let (a, b) = (k1(node.u1), k1(node.u2));
-            [
-                2.0 * kf - a[0] * b[0],
-                kf + kg - 0.5 * (a[0] * b[1] + a[1] * b[0]),
-                2.0 * kg - a[1] * b[1],
-            ]
-        })
+        self.integrate(&self.propagator, k, spectrum, q_range, lattice_step)
     }
 
-    /// Σ over the radial rule of w P(k r₁) P(k r₂) `pair_kernel`(node, [K_F, K_G]) at each k, normalised
-    /// to (Mpc/h)^3, with the error |fine − coarse radial rule| + Σ|w ΔK_angle| P P (ΔK_angle: the
-    /// pair kernel at the fine minus the coarse angular order).
+    /// Σ over the radial rule of w P(k r₁) P(k r₂) × `kernels` at each k, normalised to (Mpc/h)^3, with
+    /// the error |fine − coarse radial rule| + Σ|w ΔK_angle| P P (ΔK_angle: the kernels at the fine
+    /// minus the coarse angular order).
     fn integrate<const M: usize>(
         &self,
+        kernels: &NodeKernels<M>,
         k: &[f64],
         spectrum: &LinearSpectrum,
         q_range: (f64, f64),
         lattice_step: f64,
-        pair_kernel: impl Fn(&RadialNode, &[f64; 2]) -> [f64; M] + Sync,
     ) -> Vec<[Estimate; M]> {
         let lattice = Lattice::new(q_range.0, q_range.1, lattice_step);
         let samples = lattice.sample(spectrum);
         let p_at = |x: f64| lattice.at_ln_or_zero(&samples, x);
-        // The pair kernels do not depend on k: evaluate them once per node.
-        let on = |nodes: &[RadialNode], kernels: &[[f64; 2]]| -> Vec<[f64; M]> {
-            nodes
-                .iter()
-                .zip(kernels)
-                .map(|(n, kernel)| pair_kernel(n, kernel))
-                .collect()
-        };
-        let (fine_k, fine_k_coarse, coarse_k) = (
-            on(&self.fine, &self.fine_k),
-            on(&self.fine, &self.fine_k_coarse),
-            on(&self.coarse, &self.coarse_k),
-        );
         k.par_iter()
             .map(|&k| {
                 let ln_k = k.ln();
@@ -475,8 +491,9 @@ impl P15Table {
                     }
                     (total, angular)
                 };
-                let (fine, angular) = sum(&self.fine, &fine_k, Some(&fine_k_coarse));
-                let (coarse, _) = sum(&self.coarse, &coarse_k, None);
+                let (fine, angular) =
+                    sum(&self.fine, &kernels.fine, Some(&kernels.fine_coarse_angle));
+                let (coarse, _) = sum(&self.coarse, &kernels.coarse, None);
                 let norm = k.powi(6) / (4.0 * PI.powi(4)) * spectrum.eval(k);
                 std::array::from_fn(|x| {
                     Estimate::new(

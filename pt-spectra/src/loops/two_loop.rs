@@ -102,9 +102,6 @@ pub struct TwoLoopTerms {
     pub pairs: [TwoLoopPair; 3],
 }
 
-/// Largest factor by which [`points_at`] raises the number of points.
-const MAX_POINT_FACTOR: usize = 32;
-
 /// The Sobol points used at k: `points` × 2^round(3.5 log2(k/0.16)) (∝ k^3.5), between ½ and 32 times
 /// `points` (½ for k < 0.145, 16 at k ≥ 0.32, 32 at k ≥ 0.39 h/Mpc). The relative error of the
 /// correction at fixed points grows steeply with k (at k = 0.4 the δδ correction is a 0.7% remainder of
@@ -321,9 +318,15 @@ pub fn two_loop_with_progress(
         samples: &samples,
     };
     let params = JoeKuoD6::standard();
+    // Every k takes a prefix of the same sequence.
+    let longest = k
+        .iter()
+        .map(|&k| points_at(k, settings.points))
+        .max()
+        .unwrap_or(0);
     let points: Vec<[f64; 5]> = Sobol::<f64>::new(5, &params)
         .skip(1)
-        .take(MAX_POINT_FACTOR * settings.points)
+        .take(longest)
         .map(|p| std::array::from_fn(|d| p[d]))
         .collect();
     let shifts: Vec<[f64; 5]> = {

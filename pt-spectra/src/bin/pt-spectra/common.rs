@@ -5,7 +5,7 @@ use pt_spectra::halo::{Bias, Noise};
 use pt_spectra::table::Tabulated;
 use std::path::PathBuf;
 
-/// The halo bias b(k) before the amplitude A_b.
+/// The halo bias b(k) and its amplitude A_b.
 #[derive(clap::Args, Debug)]
 pub struct BiasArgs {
     /// Constant linear bias b.
@@ -21,6 +21,14 @@ pub struct BiasArgs {
     /// extrapolated).
     #[arg(long, value_name = "FILE")]
     bias_file: Option<PathBuf>,
+    /// Bias amplitude A_b: b(k) → A_b b(k) (in `fit`: its start value if free, its value if fixed).
+    #[arg(
+        long,
+        value_name = "A",
+        default_value_t = 1.0,
+        allow_hyphen_values = true
+    )]
+    pub amplitude: f64,
 }
 
 impl BiasArgs {

@@ -57,14 +57,6 @@ pub struct Args {
         allow_hyphen_values = true
     )]
     sigma0: f64,
-    /// Bias amplitude A_b: start value if free, value if fixed.
-    #[arg(
-        long,
-        value_name = "A",
-        default_value_t = 1.0,
-        allow_hyphen_values = true
-    )]
-    amplitude: f64,
     #[command(flatten)]
     bias: BiasArgs,
     #[command(flatten)]
@@ -156,7 +148,7 @@ pub fn run(args: &Args) -> Result<()> {
     for (name, v) in [
         ("--f", f0),
         ("--sigma0", args.sigma0),
-        ("--amplitude", args.amplitude),
+        ("--amplitude", args.bias.amplitude),
     ] {
         if !v.is_finite() {
             bail!("{name} {v}: must be finite");
@@ -183,7 +175,7 @@ pub fn run(args: &Args) -> Result<()> {
         start: Params {
             f: f0,
             sigma0: args.sigma0,
-            amplitude: args.amplitude,
+            amplitude: args.bias.amplitude,
         },
         k_min: args.k_min,
     };
@@ -203,7 +195,7 @@ pub fn run(args: &Args) -> Result<()> {
         delta_chi2(free.len()),
         free.len(),
         args.sigma0,
-        args.amplitude
+        args.bias.amplitude
     );
     text += "# k_max points";
     for p in &free {

@@ -359,11 +359,7 @@ fn models(args: &Args) -> Result<Figure> {
         });
     }
     Ok(Figure {
-        title: if args.title.is_empty() {
-            t.title
-        } else {
-            args.title.clone()
-        },
+        title: t.title,
         x_label: "k [h/Mpc]".into(),
         log_x: true,
         panels: vec![
@@ -415,11 +411,7 @@ fn propagators(args: &Args) -> Result<Figure> {
         });
     }
     Ok(Figure {
-        title: if args.title.is_empty() {
-            "RPT damping N_dd and effective sigma_v^2".into()
-        } else {
-            args.title.clone()
-        },
+        title: "RPT damping N_dd and effective sigma_v^2".into(),
         x_label: "k [h/Mpc]".into(),
         log_x: true,
         panels: vec![
@@ -513,11 +505,7 @@ fn multipoles(args: &Args) -> Result<Figure> {
         });
     }
     Ok(Figure {
-        title: if args.title.is_empty() {
-            "Redshift-space multipoles".into()
-        } else {
-            args.title.clone()
-        },
+        title: "Redshift-space multipoles".into(),
         x_label: "k [h/Mpc]".into(),
         log_x: false,
         panels,
@@ -590,11 +578,7 @@ fn fits(args: &Args) -> Result<Figure> {
         panels.push(s_panel);
     }
     Ok(Figure {
-        title: if args.title.is_empty() {
-            "Best fit versus k_max".into()
-        } else {
-            args.title.clone()
-        },
+        title: "Best fit versus k_max".into(),
         x_label: "k_max [h/Mpc]".into(),
         log_x: false,
         panels,
@@ -606,12 +590,16 @@ pub fn run(args: &Args) -> Result<()> {
     // Registering the same font twice is harmless; failure means the embedded file is broken.
     plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
         .map_err(|_| anyhow::anyhow!("embedded font"))?;
-    let figure = match args.kind {
+    let mut figure = match args.kind {
         Kind::Models => models(args)?,
         Kind::Propagators => propagators(args)?,
         Kind::Multipoles => multipoles(args)?,
         Kind::Fit => fits(args)?,
     };
+    // Each kind has its own default title; --title replaces it.
+    if !args.title.is_empty() {
+        figure.title.clone_from(&args.title);
+    }
     let size = (1000, 800);
     match args
         .out

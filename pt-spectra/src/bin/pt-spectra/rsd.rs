@@ -44,14 +44,6 @@ pub struct Args {
     sigma0: String,
     #[command(flatten)]
     bias: BiasArgs,
-    /// Bias amplitude A_b: b(k) → A_b b(k).
-    #[arg(
-        long,
-        value_name = "A",
-        default_value_t = 1.0,
-        allow_hyphen_values = true
-    )]
-    amplitude: f64,
     #[command(flatten)]
     noise: NoiseArgs,
     /// Multipoles to print, even ℓ ≤ 8, comma separated.
@@ -81,7 +73,7 @@ pub fn run(args: &Args) -> Result<()> {
     if !f.is_finite() {
         bail!("--f {f}: must be finite");
     }
-    let b = bias.values(&k, args.amplitude)?;
+    let b = bias.values(&k, args.bias.amplitude)?;
     let p_eps = noise.values(&k)?;
     let growth = cosmology.growth_factor(z);
     let sigma0 = match args.sigma0.trim() {
@@ -109,7 +101,7 @@ pub fn run(args: &Args) -> Result<()> {
         "# pt-spectra {} rsd: {rsd} with real-space {real}, z = {z}, f = {f}, {bias_text} times A_b = {}, \
          FoG {fog:?} with sigma0 = {} Mpc/h (sigma = sigma0 D(z) f = {sigma:.6} Mpc/h)\n",
         env!("CARGO_PKG_VERSION"),
-        args.amplitude,
+        args.bias.amplitude,
         sigma0
     );
     text += &args.input.describe(&spectrum, &precision);
