@@ -438,3 +438,85 @@ fn propagator_part_is_2p15_minus_p33_reducible_in_one_integral() {
         }
     }
 }
+
+#[test]
+fn refinement_adds_points_until_the_tolerance_is_met() {
+    // At fixed points the 2-loop correction (propagator part from the P15 table plus the IR-safe part)
+    // at k = 0.1 has some relative error e (1.6% with 512 points), larger than at k = 0.3 (0.7% with
+    // 16 times the points); asked for 0.6 e, the integrator continues the Sobol sequence at k = 0.1
+    // only, until its error estimate is below the tolerance, within REFINE_LIMIT times the points; the
+    // refined value agrees with the fixed one.
+    let spectrum = LinearSpectrum::gm2012(0.0).unwrap();
+    let k = [0.1, 0.3];
+    let fixed_settings = TwoLoopSettings {
+        points: 1 << 10,
+        replicas: 4,
+        ..TwoLoopSettings::default()
+    };
+    let propagator = P15Table::get(&|_, _| {}).propagator_part(&k, &spectrum, (1e-4, 50.0), 0.01);
+    let offsets: Vec<[f64; 3]> = propagator.iter().map(|r| r.map(|e| e.value)).collect();
+    let run = |settings: &TwoLoopSettings, progress: &(dyn Fn(usize, usize) + Sync)| {
+        pt_spectra::loops::two_loop_refined(
+            &k,
+            &spectrum,
+            (1e-4, 50.0),
+            0.01,
+            settings,
+            &offsets,
+            progress,
+        )
+    };
+    let fixed = run(&fixed_settings, &|_, _| {});
+    let relative = |t: &pt_spectra::loops::TwoLoopTerms, i: usize| {
+        (0..3)
+            .map(|j| {
+                let e = t.pairs[j].ir_safe[i];
+                e.error / (offsets[i][j] + e.value).abs()
+            })
+            .fold(0.0, f64::max)
+    };
+    let tolerance = 0.6 * relative(&fixed, 0);
+    assert!(
+        relative(&fixed, 1) < tolerance,
+        "k = 0.3 needs no refinement"
+    );
+    let refined_settings = TwoLoopSettings {
+        tolerance,
+        ..fixed_settings
+    };
+    let last = std::sync::Mutex::new((0, 0));
+    let refined = run(&refined_settings, &|done, total| {
+        let mut last = last.lock().unwrap();
+        *last = (last.0.max(done), total);
+    });
+    assert_eq!(refined.points[1], fixed.points[1]);
+    assert!(refined.points[0] > fixed.points[0]);
+    assert!(refined.points[0] <= pt_spectra::loops::REFINE_LIMIT * fixed.points[0]);
+    assert!(
+        relative(&refined, 0) <= tolerance,
+        "{} > {tolerance}",
+        relative(&refined, 0)
+    );
+    let (done, total) = last.into_inner().unwrap();
+    assert_eq!(done, total);
+    assert_eq!(
+        total,
+        refined_settings.replicas * (refined.points[0] + refined.points[1])
+    );
+    for j in 0..3 {
+        // k = 0.3 is untouched; at k = 0.1 the two estimates agree within 4σ.
+        assert_eq!(refined.pairs[j].ir_safe[1], fixed.pairs[j].ir_safe[1]);
+        let (a, b) = (refined.pairs[j].ir_safe[0], fixed.pairs[j].ir_safe[0]);
+        assert!(
+            (a.value - b.value).abs() < 4.0 * (a.error.powi(2) + b.error.powi(2)).sqrt(),
+            "pair {j}: {a:?} vs {b:?}"
+        );
+    }
+    println!(
+        "k = 0.1: {} → {} points per shift, relative error {:.2e} → {:.2e} (tolerance {tolerance:.2e})",
+        fixed.points[0],
+        refined.points[0],
+        relative(&fixed, 0),
+        relative(&refined, 0)
+    );
+}

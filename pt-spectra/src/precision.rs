@@ -66,6 +66,11 @@ pub struct Precision {
     pub two_loop_points: usize,
     /// Random shifts of the 2-loop integral (its error is their standard error). Default 8.
     pub two_loop_replicas: usize,
+    /// Target relative error of the 2-loop SPT correction 2P15 + 2P24 + P33 of each pair and k: where
+    /// the error estimate after [`two_loop_points`](Self::two_loop_points) exceeds it, points are added
+    /// (up to [`REFINE_LIMIT`](crate::loops::REFINE_LIMIT) times as many) until it does not. Default
+    /// 1e-3; 0 keeps the points fixed (the `fast` and `reference` presets).
+    pub two_loop_tolerance: f64,
 }
 
 impl Default for Precision {
@@ -85,6 +90,7 @@ impl Default for Precision {
             p22_error_floor: 3e-6,
             two_loop_points: 1 << 14,
             two_loop_replicas: 8,
+            two_loop_tolerance: 1e-3,
         }
     }
 }
@@ -101,6 +107,7 @@ impl Precision {
             p22_linear_width: 0.08,
             p22_error_floor: 3e-5,
             two_loop_points: 1 << 12,
+            two_loop_tolerance: 0.0,
             ..Self::default()
         }
     }
@@ -119,6 +126,7 @@ impl Precision {
             p22_band_end: 2.0 * d.p22_band_end,
             p22_error_floor: d.p22_error_floor / 10.0,
             two_loop_points: 4 * d.two_loop_points,
+            two_loop_tolerance: 0.0,
             ..d
         }
     }
@@ -153,6 +161,7 @@ impl Precision {
         for (name, v) in [
             ("p22_tail_growth", self.p22_tail_growth),
             ("p22_error_floor", self.p22_error_floor),
+            ("two_loop_tolerance", self.two_loop_tolerance),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(name, v, "must be finite and non-negative");

@@ -50,7 +50,10 @@ pub use p15::{cache_path, p15_angular_kernel, P15Table};
 pub use p17::{p17_angular_kernel, P17Table};
 pub use p22::f2_g2;
 pub use tns::{tns, TnsCoefficients, TnsPlan, TnsTerms};
-pub use two_loop::{two_loop, two_loop_with_progress, TwoLoopPair, TwoLoopSettings, TwoLoopTerms};
+pub use two_loop::{
+    two_loop, two_loop_refined, two_loop_with_progress, TwoLoopPair, TwoLoopSettings, TwoLoopTerms,
+    REFINE_LIMIT,
+};
 
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
@@ -256,8 +259,9 @@ impl OneLoopTerms {
 /// angular table), P24 and P33^{2L} from the quasi-Monte-Carlo integral ([`two_loop`]), and the whole
 /// correction 2P15 + 2P24 + P33 as the sum of two infrared-safe parts, each one integral: the
 /// propagator part 2P15 − P33red ([`P15Table::propagator_part`]) and the mode-coupling part
-/// 2P24 + P33irr + 2P33red (see the `two_loop` module); or at low k, if it has the smaller error, as
-/// 2P15 + P33red + (2P24 + P33irr). `table_progress` reports the P15 table build (if P15 is missing and
+/// 2P24 + P33irr + 2P33red (see the `two_loop` module), with points added where the correction's error
+/// exceeds [`Precision::two_loop_tolerance`] of it ([`two_loop_refined`]); or at low k, if it has the
+/// smaller error, as 2P15 + P33red + (2P24 + P33irr). `table_progress` reports the P15 table build (if P15 is missing and
 /// the table is not cached), `points_progress` the quasi-Monte-Carlo points done.
 pub fn add_two_loop(
     terms: &mut OneLoopTerms,
@@ -272,6 +276,7 @@ pub fn add_two_loop(
     let settings = TwoLoopSettings {
         points: precision.two_loop_points,
         replicas: precision.two_loop_replicas,
+        tolerance: precision.two_loop_tolerance,
         ..TwoLoopSettings::default()
     };
     let propagator = P15Table::get(table_progress).propagator_part(
@@ -280,12 +285,14 @@ pub fn add_two_loop(
         (precision.q_min, precision.q_max),
         precision.lattice_step,
     );
-    let mc = two_loop_with_progress(
+    let offsets: Vec<[f64; 3]> = propagator.iter().map(|row| row.map(|e| e.value)).collect();
+    let mc = two_loop_refined(
         &terms.k,
         spectrum,
         (precision.q_min, precision.q_max),
         precision.lattice_step,
         &settings,
+        &offsets,
         points_progress,
     );
     for (j, pair) in Pair::ALL.into_iter().enumerate() {

@@ -66,6 +66,10 @@ pub struct TwoLoopSettings {
     /// Width w in ln q of the radial sampling density ∝ 1/(w² + ln²(q/k)) at k ≤ 0.05 h/Mpc (it narrows
     /// and moves to q < k at higher k, see `radial_density`). Default 2.
     pub radial_width: f64,
+    /// Target relative error of the 2-loop correction of each pair, reached by adding points where it is
+    /// missed ([`two_loop_refined`]); 0 (the default here) keeps the points fixed. `add_two_loop` sets
+    /// it from [`Precision::two_loop_tolerance`](crate::precision::Precision::two_loop_tolerance).
+    pub tolerance: f64,
 }
 
 impl Default for TwoLoopSettings {
@@ -75,6 +79,7 @@ impl Default for TwoLoopSettings {
             replicas: 8,
             seed: 2,
             radial_width: 2.0,
+            tolerance: 0.0,
         }
     }
 }
@@ -100,6 +105,8 @@ pub struct TwoLoopTerms {
     pub k: Vec<f64>,
     /// δδ, δθ, θθ.
     pub pairs: [TwoLoopPair; 3],
+    /// Sobol points per random shift used at each k (after any refinement).
+    pub points: Vec<usize>,
 }
 
 /// The Sobol points used at k: `points` × 2^round(3.5 log2(k/0.16)) (∝ k^3.5), between ½ and 32 times
@@ -206,14 +213,13 @@ fn pair_leg(kk: f64, kq: f64, qq: f64, p: &Sampled) -> (f64, [f64; 2]) {
     )
 }
 
-/// The 2P24 piece of g(q₁, q₂) (module docs) for the three pairs, without P₁P₂, from the Gram matrix
-/// [kk, kq₁, kq₂, q₁q₁, q₁q₂, q₂q₂] and the leg of q₁ ([`pair_leg`]); the caller adds it with q₁ ↔ q₂.
+/// The 2P24 piece of g(q₁, q₂) (module docs) for the three pairs, without P₁P₂, from the leg of q₁
+/// ([`pair_leg`]) and m4 = X_4^s(q₁, k − q₁, q₂, −q₂); the caller adds it with q₁ ↔ q₂.
 #[inline]
-fn p24_half(g: &[f64; 6], (weight, m2): (f64, [f64; 2])) -> [f64; 3] {
+fn p24_half((weight, m2): (f64, [f64; 2]), m4: [f64; 2]) -> [f64; 3] {
     if weight == 0.0 {
         return [0.0; 3];
     }
-    let m4 = pt_kernels::mode_coupling_4(g);
     PAIRS.map(|(x, y)| 24.0 * (m2[x] * m4[y] + m2[y] * m4[x]) * weight)
 }
 
@@ -249,31 +255,37 @@ fn images(k: f64, q: [f64; 2], x: [f64; 2], cos_phi: f64, p: &Sampled, p_k: f64)
     // X_4^s(q₁, k − q₁, q₂, −q₂) is even in q₂ and the leg depends on q₁ only, so the P24 half of q₁
     // takes two values over the images, set by the sign of k·q₁ (images 1, 4 and 2, 3); likewise the
     // half of q₂ (images 1, 3 and 2, 4).
-    let halves1 = [
-        p24_half(&[kk, kq1, kq2, q11, q1q2, q22], legs1[0]),
-        p24_half(&[kk, -kq1, -kq2, q11, q1q2, q22], legs1[1]),
-    ];
-    let halves2 = [
-        p24_half(&[kk, kq2, kq1, q22, q1q2, q11], legs2[0]),
-        p24_half(&[kk, -kq2, -kq1, q22, q1q2, q11], legs2[1]),
-    ];
-    let mut out = [0.0; VALUES];
+    // The four X_4 are evaluated together (four lanes), as are the four X_3 below.
+    let m4 = pt_kernels::mode_coupling_4_x4(&[
+        [kk, kq1, kq2, q11, q1q2, q22],
+        [kk, -kq1, -kq2, q11, q1q2, q22],
+        [kk, kq2, kq1, q22, q1q2, q11],
+        [kk, -kq2, -kq1, q22, q1q2, q11],
+    ]);
+    let halves1 = [p24_half(legs1[0], m4[0]), p24_half(legs1[1], m4[1])];
+    let halves2 = [p24_half(legs2[0], m4[2]), p24_half(legs2[1], m4[3])];
     // (sign of k·q₁, sign of k·q₂, sign of q₁·q₂) of the four images.
-    for (i1, i2, flip) in [(0, 0, false), (1, 1, false), (1, 0, true), (0, 1, true)] {
-        let (a1, a2) = (
+    let signs = [(0, 0, false), (1, 1, false), (1, 0, true), (0, 1, true)];
+    let grams = signs.map(|(i1, i2, flip)| {
+        [
+            kk,
             if i1 == 0 { kq1 } else { -kq1 },
             if i2 == 0 { kq2 } else { -kq2 },
-        );
-        let q12 = if flip { -q1q2 } else { q1q2 };
+            q11,
+            if flip { -q1q2 } else { q1q2 },
+            q22,
+        ]
+    });
+    let m3 = pt_kernels::mode_coupling_3_x4(&grams);
+    let mut out = [0.0; VALUES];
+    for (image, &(i1, i2, _)) in signs.iter().enumerate() {
+        let [_, a1, a2, _, q12, _] = grams[image];
         let (a, b) = (halves1[i1], halves2[i2]);
         let q33 = (kk + q11 + q22 - 2.0 * a1 - 2.0 * a2 + 2.0 * q12).max(0.0);
         // The smooth partition w = q₃⁴/(q₁⁴ + q₂⁴ + q₃⁴) of the permutation symmetry (×3 below).
         let w3 = q33 * q33 / (q11 * q11 + q22 * q22 + q33 * q33);
         let (m3, spectra3) = if w3 > 1e-12 {
-            (
-                pt_kernels::mode_coupling_3(&[kk, a1, a2, q11, q12, q22]),
-                18.0 * w3 * p1 * p2 * p.at_squared(q33),
-            )
+            (m3[image], 18.0 * w3 * p1 * p2 * p.at_squared(q33))
         } else {
             ([0.0; 2], 0.0)
         };
@@ -311,6 +323,52 @@ pub fn two_loop_with_progress(
     settings: &TwoLoopSettings,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> TwoLoopTerms {
+    let offsets = vec![[0.0; 3]; k.len()];
+    two_loop_refined(
+        k,
+        spectrum,
+        q_range,
+        lattice_step,
+        settings,
+        &offsets,
+        progress,
+    )
+}
+
+/// Refinement stops at this many times the initial points of a k ([`points_at`]).
+pub const REFINE_LIMIT: usize = 4;
+
+/// Assumed convergence rate of the error, ∝ points^−α, when refinement predicts the points needed
+/// (measured: α = 0.6–1).
+const RATE: f64 = 0.75;
+
+/// The points per shift at which the error `ratio` × tolerance is predicted to fall to 0.9 × the
+/// tolerance from `points` (error ∝ points^−[`RATE`]): between 1.25 and 4 times as many, a multiple of
+/// min(2^12, points/4), at most `limit`.
+fn refined_points(points: usize, ratio: f64, limit: usize) -> usize {
+    let factor = (ratio / 0.9).powf(1.0 / RATE).clamp(1.25, 4.0);
+    let chunk = (points / 4).clamp(1, 1 << 12);
+    ((points as f64 * factor / chunk as f64).ceil() as usize * chunk).min(limit)
+}
+
+/// [`two_loop_with_progress`], refined to `settings.tolerance`: the whole 2-loop correction of pair j
+/// at k_i is taken to be `offsets[i][j]` (the propagator part 2P15 − P33red, computed elsewhere) plus
+/// the infrared-safe part integrated here. While its error exceeds `settings.tolerance` × |correction|
+/// for some pair, the points of that k are increased (as [`refined_points`] predicts, the Sobol sequence
+/// continued, so earlier points are kept) up to [`REFINE_LIMIT`] times their initial number; beyond it
+/// the error stays as estimated (e.g. where the correction crosses zero). A tolerance of 0 keeps the
+/// points of [`points_at`]. `progress(done, total)` reports the points so far; `total` grows with each
+/// refinement.
+pub fn two_loop_refined(
+    k: &[f64],
+    spectrum: &LinearSpectrum,
+    q_range: (f64, f64),
+    lattice_step: f64,
+    settings: &TwoLoopSettings,
+    offsets: &[[f64; 3]],
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> TwoLoopTerms {
+    assert_eq!(offsets.len(), k.len(), "one offset row per k");
     let lattice = Lattice::new(q_range.0, q_range.1, lattice_step);
     let samples = lattice.sample(spectrum);
     let sampled = Sampled {
@@ -318,17 +376,9 @@ pub fn two_loop_with_progress(
         samples: &samples,
     };
     let params = JoeKuoD6::standard();
-    // Every k takes a prefix of the same sequence.
-    let longest = k
-        .iter()
-        .map(|&k| points_at(k, settings.points))
-        .max()
-        .unwrap_or(0);
-    let points: Vec<[f64; 5]> = Sobol::<f64>::new(5, &params)
-        .skip(1)
-        .take(longest)
-        .map(|p| std::array::from_fn(|d| p[d]))
-        .collect();
+    // Every k takes a prefix of the same sequence, continued as refinement needs.
+    let mut sequence = Sobol::<f64>::new(5, &params).skip(1);
+    let mut points: Vec<[f64; 5]> = Vec::new();
     let shifts: Vec<[f64; 5]> = {
         use rand::{Rng, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(settings.seed);
@@ -337,8 +387,8 @@ pub fn two_loop_with_progress(
             .collect()
     };
     let (lo, hi) = (q_range.0.ln(), q_range.1.ln());
-    // The mean of the integrand over the points of one random shift at k.
-    let replica_mean = |k: f64, shift: &[f64; 5]| -> [f64; VALUES] {
+    // The sum of the integrand over `points` with one random shift at k.
+    let replica_sum = |k: f64, shift: &[f64; 5], points: &[[f64; 5]]| -> [f64; VALUES] {
         let p_k = sampled.at(k);
         // ln q = c + w tan θ with θ uniform on [θ_lo, θ_hi]: points concentrate within a few w of the
         // centre c; the Jacobian dln q/dt = (θ_hi − θ_lo) w / cos²θ.
@@ -348,15 +398,13 @@ pub fn two_loop_with_progress(
             ((hi - centre) / width).atan(),
         );
         let radial = |t: f64| -> (f64, f64) {
-            let theta = t_lo + (t_hi - t_lo) * t;
-            let c = theta.cos();
+            let (sin, cos) = (t_lo + (t_hi - t_lo) * t).sin_cos();
             (
-                (centre + width * theta.tan()).exp(),
-                (t_hi - t_lo) * width / (c * c),
+                (centre + width * sin / cos).exp(),
+                (t_hi - t_lo) * width / (cos * cos),
             )
         };
         let mut acc = [0.0; VALUES];
-        let points = &points[..points_at(k, settings.points)];
         for point in points {
             let t: [f64; 5] = std::array::from_fn(|d| (point[d] + shift[d]).fract());
             let ((q1, j1), (q2, j2)) = (radial(t[0]), radial(t[1]));
@@ -368,38 +416,73 @@ pub fn two_loop_with_progress(
                 *a += j1 * j2 * b;
             }
         }
-        // Volume of (x₁, x₂, φ): 2 · 2 · π (the radial Jacobians are in acc).
-        acc.map(|a| a * 4.0 * PI / points.len() as f64)
+        acc
     };
-    // One parallel job per (k, shift): the points per k differ by up to 32 times, so jobs per k alone
-    // would leave cores idle at the end.
     let replicas = shifts.len();
-    let total: usize = k
-        .iter()
-        .map(|&k| replicas * points_at(k, settings.points))
-        .sum();
+    let mut target: Vec<usize> = k.iter().map(|&k| points_at(k, settings.points)).collect();
+    let limit: Vec<usize> = target.iter().map(|&n| REFINE_LIMIT * n).collect();
+    let mut done_points = vec![0; k.len()];
+    let mut sums = vec![[0.0; VALUES]; k.len() * replicas];
+    let mut total = 0;
     let done = AtomicUsize::new(0);
-    let means: Vec<[f64; VALUES]> = (0..k.len() * replicas)
-        .into_par_iter()
-        .map(|job| {
-            let k = k[job / replicas];
-            let mean = replica_mean(k, &shifts[job % replicas]);
-            let n = points_at(k, settings.points);
-            progress(done.fetch_add(n, Ordering::Relaxed) + n, total);
-            mean
-        })
-        .collect();
-    let rows: Vec<[Estimate; VALUES]> = means
-        .chunks(replicas)
-        .map(|means| {
-            std::array::from_fn(|v| {
-                let r = means.len() as f64;
-                let mean = means.iter().map(|m| m[v]).sum::<f64>() / r;
-                let var =
-                    means.iter().map(|m| (m[v] - mean).powi(2)).sum::<f64>() / (r - 1.0).max(1.0);
-                Estimate::new(mean, (var / r).sqrt())
+    loop {
+        // Continue the sequence to the longest target, then integrate the new points of every
+        // (k, shift) that needs them: one parallel job each, since the points per k differ by up to
+        // 32 times and jobs per k alone would leave cores idle at the end.
+        let longest = target.iter().copied().max().unwrap_or(0);
+        if longest > points.len() {
+            let more = longest - points.len();
+            points.extend(
+                sequence
+                    .by_ref()
+                    .take(more)
+                    .map(|p| std::array::from_fn(|d| p[d])),
+            );
+        }
+        let jobs: Vec<usize> = (0..k.len() * replicas)
+            .filter(|&job| target[job / replicas] > done_points[job / replicas])
+            .collect();
+        if jobs.is_empty() {
+            break;
+        }
+        total += jobs
+            .iter()
+            .map(|&job| target[job / replicas] - done_points[job / replicas])
+            .sum::<usize>();
+        let new: Vec<[f64; VALUES]> = jobs
+            .par_iter()
+            .map(|&job| {
+                let i = job / replicas;
+                let range = done_points[i]..target[i];
+                let n = range.len();
+                let sum = replica_sum(k[i], &shifts[job % replicas], &points[range]);
+                progress(done.fetch_add(n, Ordering::Relaxed) + n, total);
+                sum
             })
-        })
+            .collect();
+        for (&job, sum) in jobs.iter().zip(new) {
+            for (a, b) in sums[job].iter_mut().zip(sum) {
+                *a += b;
+            }
+        }
+        done_points.clone_from(&target);
+        if settings.tolerance <= 0.0 {
+            break;
+        }
+        for (i, points) in target.iter_mut().enumerate() {
+            let row = estimates(&sums[i * replicas..(i + 1) * replicas], *points);
+            let ratio = (0..3)
+                .map(|j| row[j].error / (settings.tolerance * (offsets[i][j] + row[j].value).abs()))
+                .fold(0.0, f64::max);
+            if ratio > 1.0 {
+                *points = refined_points(*points, ratio, limit[i]);
+            }
+        }
+    }
+    let rows: Vec<[Estimate; VALUES]> = sums
+        .chunks(replicas)
+        .zip(&done_points)
+        .map(|(sums, &n)| estimates(sums, n))
         .collect();
     let pair = |j: usize| TwoLoopPair {
         ir_safe: rows.iter().map(|r| r[j]).collect(),
@@ -413,5 +496,23 @@ pub fn two_loop_with_progress(
     TwoLoopTerms {
         k: k.to_vec(),
         pairs: [pair(0), pair(1), pair(2)],
+        points: done_points,
     }
+}
+
+/// The mean over the shifts of their integrals, each the sum of `points` integrand values times the
+/// volume of (x₁, x₂, φ) over the points (the radial Jacobians are in the sums), and its standard error.
+fn estimates(sums: &[[f64; VALUES]], points: usize) -> [Estimate; VALUES] {
+    // Volume of (x₁, x₂, φ): 2 · 2 · π.
+    let scale = 4.0 * PI / points as f64;
+    let r = sums.len() as f64;
+    std::array::from_fn(|v| {
+        let mean = sums.iter().map(|m| m[v] * scale).sum::<f64>() / r;
+        let var = sums
+            .iter()
+            .map(|m| (m[v] * scale - mean).powi(2))
+            .sum::<f64>()
+            / (r - 1.0).max(1.0);
+        Estimate::new(mean, (var / r).sqrt())
+    })
 }
