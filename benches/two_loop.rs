@@ -3,6 +3,8 @@
 //!
 //! * `p15/evaluate/100`: P15 on 100 log-spaced k in [0.005, 0.4] h/Mpc (rayon's pool);
 //! * `n2/1l-rpt-n2/100`: the whole 1L-RPT-N2 model on the same grid: 1-loop plan and terms, P15, N2;
+//! * `n2/evaluate/100`: the same for a new spectrum once the cosmology-independent work is done (the
+//!   1-loop plan built and the angular table read): 1-loop terms, P15, N2, as in a fit or an MCMC step;
 //! * `p17/evaluate/40`: P17 (for N3) on 40 log-spaced k in [0.005, 0.4] from its angular table;
 //! * `two_loop/set/40`: every 2-loop term (P15, P24, P33, the total) of δδ, δθ, θθ with errors on 40
 //!   log-spaced k in [0.005, 0.4] at the default precision (after the 1-loop terms).
@@ -15,9 +17,9 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use pt_spectra::linear::{LinearSpectrum, LogGrid};
-use pt_spectra::loops::{add_two_loop, OneLoopPlan, P15Table, P17Table};
+use pt_spectra::loops::{add_p15, add_two_loop, OneLoopPlan, P15Table, P17Table};
 use pt_spectra::precision::Precision;
-use pt_spectra::real::{real_space, RealModel};
+use pt_spectra::real::{from_terms, real_space, RealModel};
 
 fn p15(c: &mut Criterion) {
     let p = LinearSpectrum::gm2012(0.0).expect("embedded spectrum");
@@ -56,6 +58,14 @@ fn p15(c: &mut Criterion) {
     group.bench_function("1l-rpt-n2/100", |b| {
         b.iter(|| {
             real_space(RealModel::OneLoopRptN2, black_box(&p), &k, &precision).expect("valid")
+        })
+    });
+    let plan = OneLoopPlan::new(&k, &precision).expect("valid");
+    group.bench_function("evaluate/100", |b| {
+        b.iter(|| {
+            let mut terms = plan.par_evaluate(black_box(&p));
+            add_p15(&mut terms, &p, &precision, &|_, _| {});
+            from_terms(RealModel::OneLoopRptN2, &terms).expect("valid")
         })
     });
     group.finish();

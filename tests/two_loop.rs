@@ -453,8 +453,7 @@ fn refinement_adds_points_until_the_tolerance_is_met() {
         replicas: 4,
         ..TwoLoopSettings::default()
     };
-    let propagator = P15Table::get(&|_, _| {}).propagator_part(&k, &spectrum, (1e-4, 50.0), 0.01);
-    let offsets: Vec<[f64; 3]> = propagator.iter().map(|r| r.map(|e| e.value)).collect();
+    let offsets = P15Table::get(&|_, _| {}).propagator_part(&k, &spectrum, (1e-4, 50.0), 0.01);
     let run = |settings: &TwoLoopSettings, progress: &(dyn Fn(usize, usize) + Sync)| {
         pt_spectra::loops::two_loop_refined(
             &k,
@@ -470,8 +469,8 @@ fn refinement_adds_points_until_the_tolerance_is_met() {
     let relative = |t: &pt_spectra::loops::TwoLoopTerms, i: usize| {
         (0..3)
             .map(|j| {
-                let e = t.pairs[j].ir_safe[i];
-                e.error / (offsets[i][j] + e.value).abs()
+                let (offset, e) = (offsets[i][j], t.pairs[j].ir_safe[i]);
+                (offset.error + e.error) / (offset.value + e.value).abs()
             })
             .fold(0.0, f64::max)
     };

@@ -71,6 +71,9 @@ pub struct Precision {
     /// (up to [`REFINE_LIMIT`](crate::loops::REFINE_LIMIT) times as many) until it does not. Default
     /// 1e-3; 0 keeps the points fixed (the `fast` and `reference` presets).
     pub two_loop_tolerance: f64,
+    /// Seed of the 2-loop integral's random shifts; another seed gives an independent estimate.
+    /// Default 2.
+    pub two_loop_seed: u64,
 }
 
 impl Default for Precision {
@@ -91,6 +94,7 @@ impl Default for Precision {
             two_loop_points: 1 << 14,
             two_loop_replicas: 8,
             two_loop_tolerance: 1e-3,
+            two_loop_seed: 2,
         }
     }
 }

@@ -277,6 +277,7 @@ pub fn add_two_loop(
         points: precision.two_loop_points,
         replicas: precision.two_loop_replicas,
         tolerance: precision.two_loop_tolerance,
+        seed: precision.two_loop_seed,
         ..TwoLoopSettings::default()
     };
     let propagator = P15Table::get(table_progress).propagator_part(
@@ -285,14 +286,13 @@ pub fn add_two_loop(
         (precision.q_min, precision.q_max),
         precision.lattice_step,
     );
-    let offsets: Vec<[f64; 3]> = propagator.iter().map(|row| row.map(|e| e.value)).collect();
     let mc = two_loop_refined(
         &terms.k,
         spectrum,
         (precision.q_min, precision.q_max),
         precision.lattice_step,
         &settings,
-        &offsets,
+        &propagator,
         points_progress,
     );
     for (j, pair) in Pair::ALL.into_iter().enumerate() {

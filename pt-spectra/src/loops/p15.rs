@@ -474,6 +474,7 @@ impl P15Table {
         k.par_iter()
             .map(|&k| {
                 let ln_k = k.ln();
+                // Nodes come in runs of equal u₁; a run where P(k r₁) = 0 (outside the q range) is skipped.
                 let sum = |nodes: &[RadialNode], kernels: &[[f64; M]], alt: Option<&[[f64; M]]>| {
                     let (mut total, mut angular) = ([0.0; M], [0.0; M]);
                     let (mut u1, mut p1) = (f64::NAN, 0.0);
@@ -481,11 +482,18 @@ impl P15Table {
                         if n.u1 != u1 {
                             (u1, p1) = (n.u1, p_at(ln_k + n.u1));
                         }
+                        if p1 == 0.0 {
+                            continue;
+                        }
                         let pp = n.w * p1 * p_at(ln_k + n.u2);
+                        let kernel = &kernels[i];
                         for x in 0..M {
-                            total[x] += pp * kernels[i][x];
-                            if let Some(alt) = alt {
-                                angular[x] += (pp * (kernels[i][x] - alt[i][x])).abs();
+                            total[x] += pp * kernel[x];
+                        }
+                        if let Some(alt) = alt {
+                            let alt = &alt[i];
+                            for x in 0..M {
+                                angular[x] += (pp * (kernel[x] - alt[x])).abs();
                             }
                         }
                     }

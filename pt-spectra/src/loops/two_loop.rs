@@ -177,6 +177,12 @@ impl Sampled<'_> {
         self.lattice.at_ln_or_zero(self.samples, q.ln())
     }
 
+    /// P̃ at q = e^`ln_q`.
+    #[inline]
+    fn at_ln(&self, ln_q: f64) -> f64 {
+        self.lattice.at_ln_or_zero(self.samples, ln_q)
+    }
+
     /// P̃ at q = √`q2` (no square root: ln q = ½ ln q²).
     #[inline]
     fn at_squared(&self, q2: f64) -> f64 {
@@ -223,15 +229,22 @@ fn p24_half((weight, m2): (f64, [f64; 2]), m4: [f64; 2]) -> [f64; 3] {
     PAIRS.map(|(x, y)| 24.0 * (m2[x] * m4[y] + m2[y] * m4[x]) * weight)
 }
 
-/// The integrand at one point, averaged over its four images q_i → ±q_i (antithetic: odd parts cancel
-/// exactly): [IR-safe part, 2P24, P33irr, 2P24 + P33irr] for δδ, δθ, θθ (times the measure).
+/// The integrand at one point (q_i and ln q_i, cosines x_i about k̂, cos φ), averaged over its four
+/// images q_i → ±q_i (antithetic: odd parts cancel exactly): [IR-safe part, 2P24, P33irr, 2P24 + P33irr] for δδ, δθ, θθ (times the measure).
 ///
 /// The images are (x₁, x₂, cos φ) → (x₁, x₂, c), (−x₁, −x₂, c), (−x₁, x₂, −c), (x₁, −x₂, −c): they
 /// share |q_i| (so P(q_i) and the reducible part, even in each q_i), the legs |k ∓ q_i| come in two
 /// kinds each, and q₁·q₂ keeps or flips its sign.
 #[inline]
-fn images(k: f64, q: [f64; 2], x: [f64; 2], cos_phi: f64, p: &Sampled, p_k: f64) -> [f64; VALUES] {
-    let (p1, p2) = (p.at(q[0]), p.at(q[1]));
+fn images(
+    k: f64,
+    (q, ln_q): ([f64; 2], [f64; 2]),
+    x: [f64; 2],
+    cos_phi: f64,
+    p: &Sampled,
+    p_k: f64,
+) -> [f64; VALUES] {
+    let (p1, p2) = (p.at_ln(ln_q[0]), p.at_ln(ln_q[1]));
     if p1 == 0.0 || p2 == 0.0 {
         return [0.0; VALUES];
     }
@@ -323,7 +336,7 @@ pub fn two_loop_with_progress(
     settings: &TwoLoopSettings,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> TwoLoopTerms {
-    let offsets = vec![[0.0; 3]; k.len()];
+    let offsets = vec![[Estimate::default(); 3]; k.len()];
     two_loop_refined(
         k,
         spectrum,
@@ -353,7 +366,8 @@ fn refined_points(points: usize, ratio: f64, limit: usize) -> usize {
 
 /// [`two_loop_with_progress`], refined to `settings.tolerance`: the whole 2-loop correction of pair j
 /// at k_i is taken to be `offsets[i][j]` (the propagator part 2P15 − P33red, computed elsewhere) plus
-/// the infrared-safe part integrated here. While its error exceeds `settings.tolerance` × |correction|
+/// the infrared-safe part integrated here, errors added. While its error exceeds
+/// `settings.tolerance` × |correction|
 /// for some pair, the points of that k are increased (as [`refined_points`] predicts, the Sobol sequence
 /// continued, so earlier points are kept) up to [`REFINE_LIMIT`] times their initial number; beyond it
 /// the error stays as estimated (e.g. where the correction crosses zero). A tolerance of 0 keeps the
@@ -365,7 +379,7 @@ pub fn two_loop_refined(
     q_range: (f64, f64),
     lattice_step: f64,
     settings: &TwoLoopSettings,
-    offsets: &[[f64; 3]],
+    offsets: &[[Estimate; 3]],
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> TwoLoopTerms {
     assert_eq!(offsets.len(), k.len(), "one offset row per k");
@@ -397,21 +411,23 @@ pub fn two_loop_refined(
             ((lo - centre) / width).atan(),
             ((hi - centre) / width).atan(),
         );
+        // (ln q, dln q/dt) at t.
         let radial = |t: f64| -> (f64, f64) {
             let (sin, cos) = (t_lo + (t_hi - t_lo) * t).sin_cos();
             (
-                (centre + width * sin / cos).exp(),
+                centre + width * sin / cos,
                 (t_hi - t_lo) * width / (cos * cos),
             )
         };
         let mut acc = [0.0; VALUES];
         for point in points {
             let t: [f64; 5] = std::array::from_fn(|d| (point[d] + shift[d]).fract());
-            let ((q1, j1), (q2, j2)) = (radial(t[0]), radial(t[1]));
+            let ((l1, j1), (l2, j2)) = (radial(t[0]), radial(t[1]));
             let ((x1, h1), (x2, h2)) = (cosine(t[2]), cosine(t[3]));
             let (j1, j2) = (j1 * h1, j2 * h2);
             let c = (PI * t[4]).cos();
-            let v = images(k, [q1, q2], [x1, x2], c, &sampled, p_k);
+            let q = ([l1.exp(), l2.exp()], [l1, l2]);
+            let v = images(k, q, [x1, x2], c, &sampled, p_k);
             for (a, b) in acc.iter_mut().zip(v) {
                 *a += j1 * j2 * b;
             }
@@ -472,7 +488,11 @@ pub fn two_loop_refined(
         for (i, points) in target.iter_mut().enumerate() {
             let row = estimates(&sums[i * replicas..(i + 1) * replicas], *points);
             let ratio = (0..3)
-                .map(|j| row[j].error / (settings.tolerance * (offsets[i][j] + row[j].value).abs()))
+                .map(|j| {
+                    let (offset, part) = (offsets[i][j], row[j]);
+                    (offset.error + part.error)
+                        / (settings.tolerance * (offset.value + part.value).abs())
+                })
                 .fold(0.0, f64::max);
             if ratio > 1.0 {
                 *points = refined_points(*points, ratio, limit[i]);
