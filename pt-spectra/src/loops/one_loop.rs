@@ -134,11 +134,16 @@ impl OneLoopPlan {
     pub fn new(k: &[f64], precision: &Precision) -> Result<Self> {
         validate_grid(k, precision)?;
         let lattice = Lattice::new(precision.q_min, precision.q_max, precision.lattice_step);
+        let coarse_lattice = lattice.coarse();
+        let (coarse, fine) = rayon::join(
+            || Rule::new(k, coarse_lattice, precision, COARSE_ORDER_DROP),
+            || Rule::new(k, lattice, precision, 0),
+        );
         Ok(Self {
             k: k.to_vec(),
             precision: precision.clone(),
-            coarse: Rule::new(k, lattice.coarse(), precision, COARSE_ORDER_DROP),
-            fine: Rule::new(k, lattice, precision, 0),
+            coarse,
+            fine,
         })
     }
 

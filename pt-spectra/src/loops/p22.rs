@@ -164,7 +164,16 @@ impl<const M: usize> PairNodes<M> {
             kernel,
         };
         let parts: Vec<Self> = ks.par_iter().map(|&k| Self::for_k(k, &rules)).collect();
+        let (outer_total, inner_total) = parts.iter().fold((0, 0), |(o, i), part| {
+            (o + part.outer_u.len(), i + part.inner_b.len())
+        });
         let mut nodes = Self::default();
+        nodes.k_start.reserve(parts.len() + 1);
+        nodes.outer_u.reserve(outer_total);
+        nodes.outer_end.reserve(outer_total);
+        nodes.inner_b.reserve(inner_total);
+        nodes.inner_l.reserve(inner_total);
+        nodes.inner_w.reserve(inner_total);
         for part in parts {
             let (outer, inner) = (nodes.outer_u.len() as u32, nodes.inner_b.len() as u32);
             nodes.k_start.push(outer);
