@@ -1,5 +1,6 @@
-//! Time per evaluation of the generated kernels (F and G together, f64), and of the brute-force
-//! n!-permutation reference for comparison. Fixed inputs; one core.
+//! Time per evaluation of the generated kernels (F and G together, f64; and four configurations at once
+//! in `F64x4` lanes), and of the brute-force n!-permutation reference for comparison. Fixed inputs; one
+//! core.
 
 // `criterion_group!` defines an undocumented function.
 #![allow(missing_docs)]
@@ -7,7 +8,8 @@
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
 use pt_kernels::{general_from_gram, gram, reference};
 use pt_kernels::{
-    mode_coupling_2, mode_coupling_3, mode_coupling_4, propagator_3, propagator_5, propagator_7,
+    mode_coupling_2, mode_coupling_3, mode_coupling_3_x4, mode_coupling_4, mode_coupling_4_x4,
+    propagator_3, propagator_5, propagator_7,
 };
 use std::time::Duration;
 
@@ -56,6 +58,19 @@ fn specialised(c: &mut Criterion) {
     });
     group.bench_function("mode_coupling_4 (P24)", |b| {
         b.iter(|| mode_coupling_4(black_box(&g3)))
+    });
+    group.finish();
+    // Four configurations per call in F64x4 lanes (the 2-loop integrand's four images).
+    let g3x4: [[f64; 6]; 4] = std::array::from_fn(|l| {
+        let w: Vec<[f64; 3]> = v[l..l + 3].to_vec();
+        gram(&w).try_into().unwrap()
+    });
+    let mut group = c.benchmark_group("four lanes");
+    group.bench_function("mode_coupling_3_x4 (4 × P33)", |b| {
+        b.iter(|| mode_coupling_3_x4(black_box(&g3x4)))
+    });
+    group.bench_function("mode_coupling_4_x4 (4 × P24)", |b| {
+        b.iter(|| mode_coupling_4_x4(black_box(&g3x4)))
     });
     group.finish();
 }

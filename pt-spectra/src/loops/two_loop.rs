@@ -39,8 +39,13 @@
 //! Accuracy (default settings: 8 shifts × 2^14 points at k = 0.16 h/Mpc, scaled ∝ k^3.5 from ½ to 32
 //! times, × 4 images; z = 0; the README has the table): the error of the 2-loop correction is ≤ 2e-4 of
 //! it for k ≤ 0.05 h/Mpc, ≤ 6e-4 for k ≤ 0.12 and ≤ 1e-3 up to k = 0.36 for δδ, and up to 0.4 for δθ
-//! and θθ; 1.1e-3 for δδ at k = 0.4 (7.0e-4 rms over 8 seeds, whose values scatter by 8.9e-4), where its correction (−114 (Mpc/h)³) is
-//! a 0.7% remainder of terms of ±1.7e4. Independent randomisations differ by 0.9–1.2σ rms (≤ 3σ over 120 values).
+//! and θθ. With a tolerance ([`two_loop_refined`], 1e-3 through `add_two_loop`) the points of any k
+//! whose correction misses it are increased until it does: on 40 log-spaced k in [0.005, 0.4] only δδ
+//! at k = 0.4 (1.1e-3 → 6.6e-4 with 1.3× its points), whose correction (−114 (Mpc/h)³) is a 0.7% remainder of terms of ±1.7e4. Independent
+//! randomisations differ by 0.9–1.2σ rms (≤ 3σ over 120 values).
+//!
+//! The kernels of the four images are evaluated together in four SIMD lanes
+//! ([`pt_kernels::mode_coupling_3_x4`], [`pt_kernels::mode_coupling_4_x4`]).
 //!
 //! The same points also give 2P24 and P33irr separately (needed by 2-loop RPT, whose mode-coupling term is
 //! P33^{2L}); those carry larger errors, since their infrared pieces do not cancel.
@@ -57,7 +62,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// Settings of the 2-loop integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TwoLoopSettings {
-    /// Sobol points per random shift at k = 0.16 h/Mpc (scaled with k, see `points_at`).
+    /// Sobol points per random shift at k = 0.16 h/Mpc, scaled ∝ k^3.5: `points` × 2^round(3.5 log2(k/0.16))
+    /// between ½ and 32 times `points` (before any refinement, see [`two_loop_refined`]).
     pub points: usize,
     /// Number of independent random shifts (the error is their standard error).
     pub replicas: usize,
@@ -348,7 +354,8 @@ pub fn two_loop_with_progress(
     )
 }
 
-/// Refinement stops at this many times the initial points of a k ([`points_at`]).
+/// Refinement stops at this many times the initial points of a k (`points` × 2^round(3.5 log2(k/0.16)),
+/// between ½ and 32 times `points`, see [`TwoLoopSettings::points`]).
 pub const REFINE_LIMIT: usize = 4;
 
 /// Assumed convergence rate of the error, ∝ points^−α, when refinement predicts the points needed
@@ -367,12 +374,12 @@ fn refined_points(points: usize, ratio: f64, limit: usize) -> usize {
 /// [`two_loop_with_progress`], refined to `settings.tolerance`: the whole 2-loop correction of pair j
 /// at k_i is taken to be `offsets[i][j]` (the propagator part 2P15 − P33red, computed elsewhere) plus
 /// the infrared-safe part integrated here, errors added. While its error exceeds
-/// `settings.tolerance` × |correction|
-/// for some pair, the points of that k are increased (as [`refined_points`] predicts, the Sobol sequence
-/// continued, so earlier points are kept) up to [`REFINE_LIMIT`] times their initial number; beyond it
-/// the error stays as estimated (e.g. where the correction crosses zero). A tolerance of 0 keeps the
-/// points of [`points_at`]. `progress(done, total)` reports the points so far; `total` grows with each
-/// refinement.
+/// `settings.tolerance` × |correction| for some pair, the points of that k are increased (to where
+/// error ∝ points^−0.75 predicts 0.9 × the tolerance, by 1.25 to 4 times per round; the Sobol sequence
+/// is continued, so earlier points are kept) up to [`REFINE_LIMIT`] times their initial number; beyond
+/// it the error stays as estimated (e.g. where the correction crosses zero). A tolerance of 0 keeps
+/// the initial points. `progress(done, total)` reports the points so far; `total` grows with each
+/// refinement. [`TwoLoopTerms::points`] gives the points used.
 pub fn two_loop_refined(
     k: &[f64],
     spectrum: &LinearSpectrum,
