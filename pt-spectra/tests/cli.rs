@@ -130,6 +130,59 @@ fn model_all_has_every_model_and_agrees_with_single_runs() {
 }
 
 #[test]
+fn two_loop_tolerance_adds_points_until_the_errors_meet_it() {
+    // `fast` keeps the 2-loop points fixed; asked for half of its largest relative error, the run
+    // refines until every 2-loop correction's error is below that, and says so in the header.
+    let grid = [
+        "--model",
+        "2l-spt",
+        "--terms",
+        "--precision",
+        "fast",
+        "--nk",
+        "2",
+        "--k-min",
+        "0.2",
+        "--k-max",
+        "0.3",
+    ];
+    let worst = |out: &str| {
+        let names: Vec<&str> = out
+            .lines()
+            .find(|l| l.starts_with("# k "))
+            .unwrap()
+            .split_whitespace()
+            .skip(1)
+            .collect();
+        let col = |n: &str| names.iter().position(|&x| x == n).unwrap();
+        rows(out)
+            .iter()
+            .flat_map(|r| {
+                ["dd", "dt", "tt"].map(|x| {
+                    r[col(&format!("err_P2loop_{x}"))] / r[col(&format!("P2loop_{x}"))].abs()
+                })
+            })
+            .fold(0.0, f64::max)
+    };
+    let mut fixed = vec!["real"];
+    fixed.extend(grid);
+    let (ok, out, err) = run(&fixed);
+    assert!(ok, "{err}");
+    assert!(out.contains("fixed points"), "{out}");
+    let tolerance = format!("{:e}", 0.5 * worst(&out));
+    let mut refined = fixed.clone();
+    refined.extend(["--two-loop-tolerance", &tolerance]);
+    let (ok, out, err) = run(&refined);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains(&format!("exceeds {tolerance} of the correction")),
+        "{out}"
+    );
+    let tolerance: f64 = tolerance.parse().unwrap();
+    assert!(worst(&out) <= tolerance, "{} > {tolerance}", worst(&out));
+}
+
+#[test]
 fn fit_recovers_the_parameters_of_a_model_made_by_rsd() {
     let dir = scratch("fit");
     let grid = [
@@ -294,6 +347,14 @@ fn bad_input_exits_non_zero_naming_the_problem() {
         (vec!["rsd", "--rsd", "tns-x"], "tns-x"),
         (vec!["rsd", "--sigma0", "-1"], "--sigma0"),
         (vec!["real", "--model", "3l-spt"], "3l-spt"),
+        (
+            vec!["real", "--model", "2l-spt", "--two-loop-tolerance", "-1"],
+            "--two-loop-tolerance",
+        ),
+        (
+            vec!["real", "--model", "2l-spt", "--two-loop-tolerance", "nan"],
+            "--two-loop-tolerance",
+        ),
         (
             vec!["real", "--linear", "/nonexistent/pk.dat"],
             "/nonexistent/pk.dat",
