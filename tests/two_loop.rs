@@ -519,3 +519,39 @@ fn refinement_adds_points_until_the_tolerance_is_met() {
         relative(&refined, 0)
     );
 }
+
+#[test]
+fn refinement_stops_at_its_limit_when_the_tolerance_cannot_be_met() {
+    // A tolerance no number of points reaches (as where a correction crosses zero): the points stop at
+    // REFINE_LIMIT times the initial ones and the error is still reported, larger than the tolerance.
+    let spectrum = LinearSpectrum::gm2012(0.0).unwrap();
+    let k = [0.2];
+    let settings = TwoLoopSettings {
+        points: 1 << 8,
+        replicas: 2,
+        tolerance: 1e-12,
+        ..TwoLoopSettings::default()
+    };
+    let fixed = pt_spectra::loops::two_loop(
+        &k,
+        &spectrum,
+        (1e-4, 50.0),
+        0.01,
+        &TwoLoopSettings {
+            tolerance: 0.0,
+            ..settings
+        },
+    );
+    let refined = pt_spectra::loops::two_loop(&k, &spectrum, (1e-4, 50.0), 0.01, &settings);
+    assert_eq!(
+        refined.points[0],
+        pt_spectra::loops::REFINE_LIMIT * fixed.points[0]
+    );
+    for pair in &refined.pairs {
+        let e = pair.ir_safe[0];
+        assert!(
+            e.error.is_finite() && e.error > 1e-12 * e.value.abs(),
+            "{e:?}"
+        );
+    }
+}

@@ -28,6 +28,16 @@ fn rows(text: &str) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// The column names of a table's `# k …` header line.
+fn column_names(text: &str) -> Vec<&str> {
+    text.lines()
+        .find(|l| l.starts_with("# k "))
+        .expect("a `# k …` header line")
+        .split_whitespace()
+        .skip(1)
+        .collect()
+}
+
 /// A fresh scratch directory under the target directory.
 fn scratch(name: &str) -> std::path::PathBuf {
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
@@ -67,8 +77,9 @@ fn tns_parts_add_up_and_bias_and_noise_tables_are_used() {
     constant.extend(grid);
     let (ok, same, err) = run(&constant);
     assert!(ok, "{err}");
-    let header = out.lines().find(|l| l.starts_with("# k ")).unwrap();
-    assert!(header.contains("P0_sc P2_sc P4_sc P0_A P2_A P4_A P0_B P2_B P4_B P_eps SN"));
+    assert!(column_names(&out)
+        .join(" ")
+        .contains("P0_sc P2_sc P4_sc P0_A P2_A P4_A P0_B P2_B P4_B P_eps SN"));
     assert!(out.contains("# signal-to-noise SN = P0/P_eps falls to 1 at k ="));
     for (r, s) in rows(&out).iter().zip(rows(&same)) {
         for l in 0..3 {
@@ -101,13 +112,7 @@ fn model_all_has_every_model_and_agrees_with_single_runs() {
     all.extend(grid);
     let (ok, out, err) = run(&all);
     assert!(ok, "{err}");
-    let names: Vec<&str> = out
-        .lines()
-        .find(|l| l.starts_with("# k "))
-        .unwrap()
-        .split_whitespace()
-        .skip(1)
-        .collect();
+    let names = column_names(&out);
     assert_eq!(names[..3], ["k", "P_nw", "linear"]);
     assert!(names.contains(&"2l-rpt-n2") && names.contains(&"err_2l-spt"));
     let col = |n: &str| names.iter().position(|&x| x == n).unwrap();
@@ -147,13 +152,7 @@ fn two_loop_tolerance_adds_points_until_the_errors_meet_it() {
         "0.3",
     ];
     let worst = |out: &str| {
-        let names: Vec<&str> = out
-            .lines()
-            .find(|l| l.starts_with("# k "))
-            .unwrap()
-            .split_whitespace()
-            .skip(1)
-            .collect();
+        let names = column_names(out);
         let col = |n: &str| names.iter().position(|&x| x == n).unwrap();
         rows(out)
             .iter()
