@@ -87,6 +87,8 @@ four_at_once! {
     mode_coupling_3_x4 = mode_coupling_3: 6;
     /// [`crate::mode_coupling_4`] at four configurations.
     mode_coupling_4_x4 = mode_coupling_4: 6;
+    /// [`crate::propagator_7`] at four configurations.
+    propagator_7_x4 = propagator_7: 10;
 }
 
 #[cfg(test)]
@@ -102,9 +104,23 @@ mod tests {
             [1.0, 1.0, 0.0, 1.0, 0.0, 1e-4],
         ];
         let (m3, m4) = (mode_coupling_3_x4(&g), mode_coupling_4_x4(&g));
+        // Gram matrices of (k, q1, q2, q3) for the P17 kernel.
+        let g7: [[f64; 10]; 4] = std::array::from_fn(|l| {
+            let a = l as f64;
+            let v = [
+                [0.0, 0.0, 1.0],
+                [0.3 + 0.1 * a, -0.2, 0.5],
+                [-0.4, 0.7 * a, 0.1],
+                [0.2, 0.1, -0.9 + a],
+            ];
+            let g = crate::gram(&v);
+            g.try_into().unwrap()
+        });
+        let p7 = propagator_7_x4(&g7);
         for l in 0..4 {
             assert_eq!(m3[l], crate::mode_coupling_3(&g[l]), "lane {l}");
             assert_eq!(m4[l], crate::mode_coupling_4(&g[l]), "lane {l}");
+            assert_eq!(p7[l], crate::propagator_7(&g7[l]), "lane {l}");
         }
     }
 }

@@ -34,7 +34,7 @@ pub mod reference;
 mod scalar;
 
 pub use instances::Evaluate;
-pub use lanes::{mode_coupling_3_x4, mode_coupling_4_x4, F64x4};
+pub use lanes::{mode_coupling_3_x4, mode_coupling_4_x4, propagator_7_x4, F64x4};
 
 pub use scalar::{dot, one, zero, Scalar};
 
