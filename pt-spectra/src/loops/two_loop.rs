@@ -377,8 +377,10 @@ fn refined_points(points: usize, ratio: f64, limit: usize) -> usize {
 /// `settings.tolerance` × |correction| for some pair, the points of that k are increased (to where
 /// error ∝ points^−0.75 predicts 0.9 × the tolerance, by 1.25 to 4 times per round; the Sobol sequence
 /// is continued, so earlier points are kept) up to [`REFINE_LIMIT`] times their initial number; beyond
-/// it the error stays as estimated (e.g. where the correction crosses zero). A tolerance of 0 keeps
-/// the initial points. `progress(done, total)` reports the points so far; `total` grows with each
+/// it the error stays as estimated (e.g. where the correction crosses zero). After a refinement the
+/// error reported is at least the previous round's error scaled by (points before/after)^0.75, so
+/// that stopping at the first estimate below the tolerance does not favour estimates that came out low.
+/// A tolerance of 0 keeps the initial points. `progress(done, total)` reports the points so far; `total` grows with each
 /// refinement. [`TwoLoopTerms::points`] gives the points used.
 pub fn two_loop_refined(
     k: &[f64],
@@ -446,6 +448,7 @@ pub fn two_loop_refined(
     let limit: Vec<usize> = target.iter().map(|&n| REFINE_LIMIT * n).collect();
     let mut done_points = vec![0; k.len()];
     let mut sums = vec![[0.0; VALUES]; k.len() * replicas];
+    let mut rows = vec![[Estimate::default(); VALUES]; k.len()];
     let mut total = 0;
     let done = AtomicUsize::new(0);
     loop {
@@ -488,12 +491,28 @@ pub fn two_loop_refined(
                 *a += b;
             }
         }
+        for (i, row) in rows.iter_mut().enumerate() {
+            if target[i] == done_points[i] {
+                continue;
+            }
+            let mut new = estimates(&sums[i * replicas..(i + 1) * replicas], target[i]);
+            // After a refinement the error is at least what the previous round's predicts for the
+            // new points: stopping as soon as the estimate dips below the tolerance would otherwise
+            // favour estimates that came out low.
+            if done_points[i] > 0 {
+                let scale = (done_points[i] as f64 / target[i] as f64).powf(RATE);
+                for (e, previous) in new.iter_mut().zip(row.iter()) {
+                    e.error = e.error.max(previous.error * scale);
+                }
+            }
+            *row = new;
+        }
         done_points.clone_from(&target);
         if settings.tolerance <= 0.0 {
             break;
         }
         for (i, points) in target.iter_mut().enumerate() {
-            let row = estimates(&sums[i * replicas..(i + 1) * replicas], *points);
+            let row = &rows[i];
             let ratio = (0..3)
                 .map(|j| {
                     let (offset, part) = (offsets[i][j], row[j]);
@@ -506,11 +525,6 @@ pub fn two_loop_refined(
             }
         }
     }
-    let rows: Vec<[Estimate; VALUES]> = sums
-        .chunks(replicas)
-        .zip(&done_points)
-        .map(|(sums, &n)| estimates(sums, n))
-        .collect();
     let pair = |j: usize| TwoLoopPair {
         ir_safe: rows.iter().map(|r| r[j]).collect(),
         p24: rows
