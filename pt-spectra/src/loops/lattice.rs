@@ -19,6 +19,8 @@ pub(crate) struct Lattice {
     pub x0: f64,
     /// Step h in ln q.
     pub step: f64,
+    /// 1/h (lookups multiply rather than divide).
+    inv_step: f64,
     /// Number of points N (odd, ≥ 5).
     pub len: usize,
 }
@@ -30,9 +32,11 @@ impl Lattice {
         let intervals = ((span / max_step).ceil() as usize)
             .max(4)
             .next_multiple_of(2);
+        let step = span / intervals as f64;
         Self {
             x0: q_min.ln(),
-            step: span / intervals as f64,
+            step,
+            inv_step: 1.0 / step,
             len: intervals + 1,
         }
     }
@@ -42,6 +46,7 @@ impl Lattice {
         Self {
             x0: self.x0,
             step: 2.0 * self.step,
+            inv_step: 0.5 * self.inv_step,
             len: self.len.div_ceil(2),
         }
     }
@@ -82,7 +87,7 @@ impl Lattice {
     /// convention: no power outside the integration range).
     #[inline]
     pub fn at_ln_or_zero(&self, samples: &[f64], x: f64) -> f64 {
-        let u = (x - self.x0) / self.step;
+        let u = (x - self.x0) * self.inv_step;
         if (0.0..=(self.len - 1) as f64).contains(&u) {
             self.interpolate(samples, u)
         } else {
