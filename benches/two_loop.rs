@@ -2,9 +2,10 @@
 //! embedded gm2012 z = 0 spectrum, and the N2 propagator built from it:
 //!
 //! * `p15/evaluate/100`: P15 on 100 log-spaced k in [0.005, 0.4] h/Mpc (rayon's pool);
-//! * `n2/1l-rpt-n2/100`: the whole 1L-RPT-N2 model on the same grid: 1-loop plan and terms, P15, N2;
-//! * `n2/evaluate/100`: the same for a new spectrum once the cosmology-independent work is done (the
-//!   1-loop plan built and the angular table read): 1-loop terms, P15, N2, as in a fit or an MCMC step;
+//! * `n2/1l-rpt-n2/100`: the whole 1L-RPT-N2 model on the same grid through `real_space`, as a fit or an
+//!   MCMC step calls it (the 1-loop plan of the previous call reused, the angular table read): 1-loop
+//!   terms, P15, N2;
+//! * `n2/with-plan/100`: the same on a new grid, building the 1-loop plan as well;
 //! * `p17/evaluate/40`: P17 (for N3) on 40 log-spaced k in [0.005, 0.4] from its angular table;
 //! * `two_loop/set/40`: every 2-loop term (P15, P24, P33, the total) of δδ, δθ, θθ with errors on 40
 //!   log-spaced k in [0.005, 0.4] at the default precision (after the 1-loop terms).
@@ -55,15 +56,17 @@ fn p15(c: &mut Criterion) {
     group.finish();
     let mut group = c.benchmark_group("n2");
     group.sample_size(20);
+    // As a fit or an MCMC loop calls it: `real_space` reuses the plan of its previous call.
     group.bench_function("1l-rpt-n2/100", |b| {
         b.iter(|| {
             real_space(RealModel::OneLoopRptN2, black_box(&p), &k, &precision).expect("valid")
         })
     });
-    let plan = OneLoopPlan::new(&k, &precision).expect("valid");
-    group.bench_function("evaluate/100", |b| {
+    // A first call on a new grid: the 1-loop plan is built too.
+    group.bench_function("with-plan/100", |b| {
         b.iter(|| {
-            let mut terms = plan.par_evaluate(black_box(&p));
+            let plan = OneLoopPlan::new(black_box(&k), &precision).expect("valid");
+            let mut terms = plan.par_evaluate(&p);
             add_p15(&mut terms, &p, &precision, &|_, _| {});
             from_terms(RealModel::OneLoopRptN2, &terms).expect("valid")
         })

@@ -21,6 +21,7 @@ use crate::precision::Precision;
 use crate::resum::{self, Propagator};
 use std::fmt;
 use std::str::FromStr;
+use std::sync::{Arc, Mutex};
 
 /// A real-space model, named as on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -253,9 +254,29 @@ pub fn from_terms(model: RealModel, terms: &OneLoopTerms) -> Result<RealSpectra>
     })
 }
 
+/// The 1-loop plan for `k` and `precision`: the one of the previous call if they are the same.
+fn plan_for(k: &[f64], precision: &Precision) -> Result<Arc<OneLoopPlan>> {
+    static LAST: Mutex<Option<Arc<OneLoopPlan>>> = Mutex::new(None);
+    let same = |plan: &OneLoopPlan| plan.k() == k && plan.precision() == precision;
+    if let Some(plan) = LAST.lock().ok().and_then(|last| last.clone()) {
+        if same(&plan) {
+            return Ok(plan);
+        }
+    }
+    let plan = Arc::new(OneLoopPlan::new(k, precision)?);
+    if let Ok(mut last) = LAST.lock() {
+        *last = Some(Arc::clone(&plan));
+    }
+    Ok(plan)
+}
+
 /// The spectra of `model` for `spectrum` at wavenumbers `k` [h/Mpc], with the loop terms they were
 /// built from (computed in parallel over k; also for `linear`, so that they can be reported). Models
 /// with N2 also compute P15 (building the angular table on first use, see [`crate::loops::P15Table`]).
+///
+/// The 1-loop plan (the cosmology-independent quadrature weights, [`OneLoopPlan`]) of the previous call
+/// is kept and reused when `k` and `precision` are the same, so a loop over spectra on one grid (a fit,
+/// an MCMC chain) builds it once.
 ///
 /// # Errors
 /// As [`OneLoopPlan::new`].
@@ -276,7 +297,7 @@ pub fn real_space(
     k: &[f64],
     precision: &Precision,
 ) -> Result<(RealSpectra, OneLoopTerms)> {
-    let mut terms = OneLoopPlan::new(k, precision)?.par_evaluate(spectrum);
+    let mut terms = plan_for(k, precision)?.par_evaluate(spectrum);
     if model.needs_two_loop() {
         crate::loops::add_two_loop(&mut terms, spectrum, precision, &|_, _| {}, &|_, _| {});
     } else if model.needs_p15() {
@@ -303,6 +324,24 @@ mod tests {
         );
         let e = "3l-spt".parse::<RealModel>().unwrap_err().to_string();
         assert!(e.contains("3l-spt") && e.contains("1l-rpt-n2"), "{e}");
+    }
+
+    #[test]
+    fn the_reused_plan_is_the_plan_of_the_grid_and_precision_asked_for() {
+        let p = LinearSpectrum::gm2012(0.0).unwrap();
+        let fresh =
+            |k: &[f64], precision: &Precision| OneLoopPlan::new(k, precision).unwrap().evaluate(&p);
+        let (a, b) = ([0.05, 0.1], [0.05, 0.2]);
+        for (k, precision) in [
+            (&a[..], Precision::fast()),
+            (&a[..], Precision::fast()),
+            (&b[..], Precision::fast()),
+            (&b[..], Precision::default()),
+            (&a[..], Precision::default()),
+        ] {
+            let (_, terms) = real_space(RealModel::OneLoopSpt, &p, k, &precision).unwrap();
+            assert_eq!(terms, fresh(k, &precision), "{k:?}");
+        }
     }
 
     #[test]
