@@ -382,6 +382,9 @@ fn refined_points(points: usize, ratio: f64, limit: usize) -> usize {
 /// that stopping at the first estimate below the tolerance does not favour estimates that came out low.
 /// A tolerance of 0 keeps the initial points. `progress(done, total)` reports the points so far; `total` grows with each
 /// refinement. [`TwoLoopTerms::points`] gives the points used.
+///
+/// # Panics
+/// If `offsets` does not have one row per k.
 pub fn two_loop_refined(
     k: &[f64],
     spectrum: &LinearSpectrum,
@@ -409,39 +412,9 @@ pub fn two_loop_refined(
             .map(|_| std::array::from_fn(|_| rng.gen::<f64>()))
             .collect()
     };
-    let (lo, hi) = (q_range.0.ln(), q_range.1.ln());
-    // The sum of the integrand over `points` with one random shift at k.
-    let replica_sum = |k: f64, shift: &[f64; 5], points: &[[f64; 5]]| -> [f64; VALUES] {
-        let p_k = sampled.at(k);
-        // ln q = c + w tan θ with θ uniform on [θ_lo, θ_hi]: points concentrate within a few w of the
-        // centre c; the Jacobian dln q/dt = (θ_hi − θ_lo) w / cos²θ.
-        let (centre, width) = radial_density(k, settings.radial_width);
-        let (t_lo, t_hi) = (
-            ((lo - centre) / width).atan(),
-            ((hi - centre) / width).atan(),
-        );
-        // (ln q, dln q/dt) at t.
-        let radial = |t: f64| -> (f64, f64) {
-            let (sin, cos) = (t_lo + (t_hi - t_lo) * t).sin_cos();
-            (
-                centre + width * sin / cos,
-                (t_hi - t_lo) * width / (cos * cos),
-            )
-        };
-        let mut acc = [0.0; VALUES];
-        for point in points {
-            let t: [f64; 5] = std::array::from_fn(|d| (point[d] + shift[d]).fract());
-            let ((l1, j1), (l2, j2)) = (radial(t[0]), radial(t[1]));
-            let ((x1, h1), (x2, h2)) = (cosine(t[2]), cosine(t[3]));
-            let (j1, j2) = (j1 * h1, j2 * h2);
-            let c = (PI * t[4]).cos();
-            let q = ([l1.exp(), l2.exp()], [l1, l2]);
-            let v = images(k, q, [x1, x2], c, &sampled, p_k);
-            for (a, b) in acc.iter_mut().zip(v) {
-                *a += j1 * j2 * b;
-            }
-        }
-        acc
+    let ln_range = (q_range.0.ln(), q_range.1.ln());
+    let replica_sum = |k: f64, shift: &[f64; 5], points: &[[f64; 5]]| {
+        shifted_sum(k, shift, points, &sampled, ln_range, settings.radial_width)
     };
     let replicas = shifts.len();
     let mut target: Vec<usize> = k.iter().map(|&k| points_at(k, settings.points)).collect();
@@ -512,14 +485,7 @@ pub fn two_loop_refined(
             break;
         }
         for (i, points) in target.iter_mut().enumerate() {
-            let row = &rows[i];
-            let ratio = (0..3)
-                .map(|j| {
-                    let (offset, part) = (offsets[i][j], row[j]);
-                    (offset.error + part.error)
-                        / (settings.tolerance * (offset.value + part.value).abs())
-                })
-                .fold(0.0, f64::max);
+            let ratio = worst_ratio(&rows[i], &offsets[i], settings.tolerance);
             if ratio > 1.0 {
                 *points = refined_points(*points, ratio, limit[i]);
             }
@@ -539,6 +505,59 @@ pub fn two_loop_refined(
         pairs: [pair(0), pair(1), pair(2)],
         points: done_points,
     }
+}
+
+/// The sum of the integrand (times the radial and cosine Jacobians) at k over `points` moved by one
+/// random `shift` (Cranley–Patterson, mod 1), on ln q ∈ `ln_range`.
+fn shifted_sum(
+    k: f64,
+    shift: &[f64; 5],
+    points: &[[f64; 5]],
+    sampled: &Sampled,
+    (lo, hi): (f64, f64),
+    radial_width: f64,
+) -> [f64; VALUES] {
+    let p_k = sampled.at(k);
+    // ln q = c + w tan θ with θ uniform on [θ_lo, θ_hi]: points concentrate within a few w of the
+    // centre c; the Jacobian dln q/dt = (θ_hi − θ_lo) w / cos²θ.
+    let (centre, width) = radial_density(k, radial_width);
+    let (t_lo, t_hi) = (
+        ((lo - centre) / width).atan(),
+        ((hi - centre) / width).atan(),
+    );
+    // (ln q, dln q/dt) at t.
+    let radial = |t: f64| -> (f64, f64) {
+        let (sin, cos) = (t_lo + (t_hi - t_lo) * t).sin_cos();
+        (
+            centre + width * sin / cos,
+            (t_hi - t_lo) * width / (cos * cos),
+        )
+    };
+    let mut acc = [0.0; VALUES];
+    for point in points {
+        let t: [f64; 5] = std::array::from_fn(|d| (point[d] + shift[d]).fract());
+        let ((l1, j1), (l2, j2)) = (radial(t[0]), radial(t[1]));
+        let ((x1, h1), (x2, h2)) = (cosine(t[2]), cosine(t[3]));
+        let (j1, j2) = (j1 * h1, j2 * h2);
+        let c = (PI * t[4]).cos();
+        let q = ([l1.exp(), l2.exp()], [l1, l2]);
+        let v = images(k, q, [x1, x2], c, sampled, p_k);
+        for (a, b) in acc.iter_mut().zip(v) {
+            *a += j1 * j2 * b;
+        }
+    }
+    acc
+}
+
+/// The largest error of the three pairs' corrections (offset + `row`, errors added) in units of
+/// `tolerance` × |correction|: above 1, the k needs more points.
+fn worst_ratio(row: &[Estimate; VALUES], offsets: &[Estimate; 3], tolerance: f64) -> f64 {
+    (0..3)
+        .map(|j| {
+            let (offset, part) = (offsets[j], row[j]);
+            (offset.error + part.error) / (tolerance * (offset.value + part.value).abs())
+        })
+        .fold(0.0, f64::max)
 }
 
 /// The mean over the shifts of their integrals, each the sum of `points` integrand values times the
