@@ -9,7 +9,7 @@ use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criteri
 use pt_kernels::{general_from_gram, gram, reference};
 use pt_kernels::{
     mode_coupling_2, mode_coupling_3, mode_coupling_3_x4, mode_coupling_4, mode_coupling_4_x4,
-    propagator_3, propagator_5, propagator_7, propagator_7_x4,
+    propagator_3, propagator_5, propagator_5_x4, propagator_7, propagator_7_x4,
 };
 use std::time::Duration;
 
@@ -75,6 +75,9 @@ fn specialised(c: &mut Criterion) {
     let g4x4: [[f64; 10]; 4] = std::array::from_fn(|l| {
         let w: Vec<[f64; 3]> = v[l..l + 4].to_vec();
         gram(&w).try_into().unwrap()
+    });
+    group.bench_function("propagator_5_x4 (4 × P15)", |b| {
+        b.iter(|| propagator_5_x4(black_box(&g3x4)))
     });
     group.bench_function("propagator_7_x4 (4 × P17)", |b| {
         b.iter(|| propagator_7_x4(black_box(&g4x4)))

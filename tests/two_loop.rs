@@ -2,7 +2,7 @@
 //! angular kernel, the factorised-kernel limit N2 → N1, the large-k limit, a direct 5-D Monte Carlo, and
 //! the RegPT reference (`tests/data/regpt_2loop_gm2012_z0.0.dat`, provenance in `tests/data/README.md`).
 //!
-//! The first test to run builds the angular table (about a minute on 2 cores) and caches it (see
+//! The first test to run builds the angular table (about 35 s on 2 cores) and caches it (see
 //! `pt_spectra::loops::cache_path`).
 
 use pt_spectra::linear::LinearSpectrum;

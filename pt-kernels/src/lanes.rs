@@ -87,6 +87,8 @@ four_at_once! {
     mode_coupling_3_x4 = mode_coupling_3: 6;
     /// [`crate::mode_coupling_4`] at four configurations.
     mode_coupling_4_x4 = mode_coupling_4: 6;
+    /// [`crate::propagator_5`] at four configurations.
+    propagator_5_x4 = propagator_5: 6;
     /// [`crate::propagator_7`] at four configurations.
     propagator_7_x4 = propagator_7: 10;
 }
@@ -116,10 +118,11 @@ mod tests {
             let g = crate::gram(&v);
             g.try_into().unwrap()
         });
-        let p7 = propagator_7_x4(&g7);
+        let (p5, p7) = (propagator_5_x4(&g), propagator_7_x4(&g7));
         for l in 0..4 {
             assert_eq!(m3[l], crate::mode_coupling_3(&g[l]), "lane {l}");
             assert_eq!(m4[l], crate::mode_coupling_4(&g[l]), "lane {l}");
+            assert_eq!(p5[l], crate::propagator_5(&g[l]), "lane {l}");
             assert_eq!(p7[l], crate::propagator_7(&g7[l]), "lane {l}");
         }
     }

@@ -10,7 +10,8 @@
 //! * [`propagator_3`], [`propagator_5`], [`propagator_7`] (P13, P15, P17: F_{2x+1}^s(k, q1, −q1, …)) and
 //!   [`mode_coupling_2`], [`mode_coupling_3`], [`mode_coupling_4`] (P22, P33, P24): the specialised kernels
 //!   of the loop integrals, taking the scalar invariants k², k·q_i, q_i·q_j an integrator has;
-//!   [`mode_coupling_3_x4`], [`mode_coupling_4_x4`] evaluate four configurations at once ([`F64x4`] lanes);
+//!   [`mode_coupling_3_x4`], [`mode_coupling_4_x4`], [`propagator_5_x4`], [`propagator_7_x4`] evaluate four
+//!   configurations at once ([`F64x4`] lanes);
 //! * [`generated`]: the raw generic functions behind all of these. Prefer the wrappers above: they call
 //!   instances compiled once in this crate for `f64` and `BigRational` ([`Evaluate`]), whereas a direct
 //!   call instantiates a kernel of up to ~9,000 statements anew in the calling crate;
@@ -34,7 +35,7 @@ pub mod reference;
 mod scalar;
 
 pub use instances::Evaluate;
-pub use lanes::{mode_coupling_3_x4, mode_coupling_4_x4, propagator_7_x4, F64x4};
+pub use lanes::{mode_coupling_3_x4, mode_coupling_4_x4, propagator_5_x4, propagator_7_x4, F64x4};
 
 pub use scalar::{dot, one, zero, Scalar};
 

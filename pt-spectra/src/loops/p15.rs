@@ -71,13 +71,27 @@ pub fn p15_angular_kernel(r1: f64, r2: f64, order: usize) -> [f64; 2] {
             let x2 = ((1.0 + r2 * r2 - p2 * p2) / (2.0 * r2)).clamp(-1.0, 1.0);
             let s2 = (1.0 - x2 * x2).sqrt();
             let j = j1 * w2 * p2 / r2;
-            let mut inner = [0.0; 2];
-            for (c, w) in cos_phi.iter().zip(&w_phi) {
+            let gram = |c: f64| {
                 let q12 = r1 * r2 * (x1 * x2 + s1 * s2 * c);
-                let [f, g] =
-                    pt_kernels::propagator_5(&[1.0, r1 * x1, r2 * x2, r1 * r1, q12, r2 * r2]);
+                [1.0, r1 * x1, r2 * x2, r1 * r1, q12, r2 * r2]
+            };
+            // Four φ nodes per call in the kernel's four lanes, the rest one by one; summed in node
+            // order either way.
+            let mut inner = [0.0; 2];
+            let mut add = |w: f64, [f, g]: [f64; 2]| {
                 inner[0] += w * f;
                 inner[1] += w * g;
+            };
+            let (c4, w4) = (cos_phi.chunks_exact(4), w_phi.chunks_exact(4));
+            let (c_rest, w_rest) = (c4.remainder(), w4.remainder());
+            for (c, w) in c4.zip(w4) {
+                let kernels = pt_kernels::propagator_5_x4(&std::array::from_fn(|l| gram(c[l])));
+                for (&w, kernel) in w.iter().zip(kernels) {
+                    add(w, kernel);
+                }
+            }
+            for (&c, &w) in c_rest.iter().zip(w_rest) {
+                add(w, pt_kernels::propagator_5(&gram(c)));
             }
             acc[0] += j * inner[0];
             acc[1] += j * inner[1];
