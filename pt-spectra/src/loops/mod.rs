@@ -261,8 +261,9 @@ impl OneLoopTerms {
 /// propagator part 2P15 − P33red ([`P15Table::propagator_part`]) and the mode-coupling part
 /// 2P24 + P33irr + 2P33red (see the `two_loop` module), with points added where the correction's error
 /// exceeds [`Precision::two_loop_tolerance`] of it ([`two_loop_refined`]); or at low k, if it has the
-/// smaller error, as 2P15 + P33red + (2P24 + P33irr). `table_progress` reports the P15 table build (if P15 is missing and
-/// the table is not cached), `points_progress` the quasi-Monte-Carlo points done.
+/// smaller error, as 2P15 + P33red + (2P24 + P33irr). `table_progress` reports the P15 table build
+/// (if P15 is missing and the table is not cached), `points_progress` the quasi-Monte-Carlo points
+/// done.
 pub fn add_two_loop(
     terms: &mut OneLoopTerms,
     spectrum: &LinearSpectrum,

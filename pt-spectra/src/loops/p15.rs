@@ -488,7 +488,8 @@ impl P15Table {
         k.par_iter()
             .map(|&k| {
                 let ln_k = k.ln();
-                // Nodes come in runs of equal u₁; a run where P(k r₁) = 0 (outside the q range) is skipped.
+                // Nodes come in runs of equal u₁; a run where P(k r₁) = 0 (outside the q range) is
+                // skipped.
                 let sum = |nodes: &[RadialNode], kernels: &[[f64; M]], alt: Option<&[[f64; M]]>| {
                     let (mut total, mut angular) = ([0.0; M], [0.0; M]);
                     let (mut u1, mut p1) = (f64::NAN, 0.0);

@@ -41,8 +41,9 @@
 //! it for k ≤ 0.05 h/Mpc, ≤ 6e-4 for k ≤ 0.12 and ≤ 1e-3 up to k = 0.36 for δδ, and up to 0.4 for δθ
 //! and θθ. With a tolerance ([`two_loop_refined`], 1e-3 through `add_two_loop`) the points of any k
 //! whose correction misses it are increased until it does: on 40 log-spaced k in [0.005, 0.4] only δδ
-//! at k = 0.4 (1.1e-3 → 6.6e-4 with 1.3× its points), whose correction (−114 (Mpc/h)³) is a 0.7% remainder of terms of ±1.7e4. Independent
-//! randomisations differ by 0.9–1.2σ rms (≤ 3σ over 120 values).
+//! at k = 0.4 (1.1e-3 → 6.6e-4 with 1.3× its points), whose correction (−114 (Mpc/h)³) is a 0.7%
+//! remainder of terms of ±1.7e4. Independent randomisations differ by 0.9–1.2σ rms (≤ 3σ over 120
+//! values).
 //!
 //! The kernels of the four images are evaluated together in four SIMD lanes
 //! ([`pt_kernels::mode_coupling_3_x4`], [`pt_kernels::mode_coupling_4_x4`]).
@@ -62,8 +63,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// Settings of the 2-loop integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TwoLoopSettings {
-    /// Sobol points per random shift at k = 0.16 h/Mpc, scaled ∝ k^3.5: `points` × 2^round(3.5 log2(k/0.16))
-    /// between ½ and 32 times `points` (before any refinement, see [`two_loop_refined`]).
+    /// Sobol points per random shift at k = 0.16 h/Mpc, scaled ∝ k^3.5:
+    /// `points` × 2^round(3.5 log2(k/0.16)), between ½ and 32 times `points` (before any refinement,
+    /// see [`two_loop_refined`]).
     pub points: usize,
     /// Number of independent random shifts (the error is their standard error).
     pub replicas: usize,
@@ -236,7 +238,8 @@ fn p24_half((weight, m2): (f64, [f64; 2]), m4: [f64; 2]) -> [f64; 3] {
 }
 
 /// The integrand at one point (q_i and ln q_i, cosines x_i about k̂, cos φ), averaged over its four
-/// images q_i → ±q_i (antithetic: odd parts cancel exactly): [IR-safe part, 2P24, P33irr, 2P24 + P33irr] for δδ, δθ, θθ (times the measure).
+/// images q_i → ±q_i (antithetic: odd parts cancel exactly): [IR-safe part, 2P24, P33irr,
+/// 2P24 + P33irr] for δδ, δθ, θθ (times the measure).
 ///
 /// The images are (x₁, x₂, cos φ) → (x₁, x₂, c), (−x₁, −x₂, c), (−x₁, x₂, −c), (x₁, −x₂, −c): they
 /// share |q_i| (so P(q_i) and the reducible part, even in each q_i), the legs |k ∓ q_i| come in two
@@ -380,8 +383,8 @@ fn refined_points(points: usize, ratio: f64, limit: usize) -> usize {
 /// it the error stays as estimated (e.g. where the correction crosses zero). After a refinement the
 /// error reported is at least the previous round's error scaled by (points before/after)^0.75, so
 /// that stopping at the first estimate below the tolerance does not favour estimates that came out low.
-/// A tolerance of 0 keeps the initial points. `progress(done, total)` reports the points so far; `total` grows with each
-/// refinement. [`TwoLoopTerms::points`] gives the points used.
+/// A tolerance of 0 keeps the initial points. `progress(done, total)` reports the points so far;
+/// `total` grows with each refinement. [`TwoLoopTerms::points`] gives the points used.
 ///
 /// # Panics
 /// If `offsets` does not have one row per k.
@@ -575,4 +578,40 @@ fn estimates(sums: &[[f64; VALUES]], points: usize) -> [Estimate; VALUES] {
             / (r - 1.0).max(1.0);
         Estimate::new(mean, (var / r).sqrt())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refined_points_follow_the_assumed_rate_within_their_bounds() {
+        let n = 1 << 16;
+        // Error 0.9 · 2^0.75 × the tolerance: error ∝ N^−0.75 reaches 0.9 × the tolerance at 2N
+        // (up to one rounding chunk of 2^12).
+        let twice = refined_points(n, 0.9 * 2f64.powf(RATE), usize::MAX);
+        assert!((2 * n..=2 * n + (1 << 12)).contains(&twice), "{twice}");
+        // Just above the tolerance: at least 1.25 times; far above: at most 4 times, and the limit.
+        assert_eq!(refined_points(n, 0.901, usize::MAX), n + n / 4);
+        assert_eq!(refined_points(n, 100.0, usize::MAX), 4 * n);
+        assert_eq!(refined_points(n, 100.0, 3 * n), 3 * n);
+        // Small counts round to a quarter of the points.
+        assert_eq!(refined_points(512, 0.901, usize::MAX), 640);
+    }
+
+    #[test]
+    fn worst_ratio_is_the_largest_error_of_the_whole_corrections_over_the_tolerance() {
+        let mut row = [Estimate::default(); VALUES];
+        row[0] = Estimate::new(10.0, 0.01);
+        row[1] = Estimate::new(-4.0, 0.002);
+        row[2] = Estimate::new(1.0, 0.001);
+        let offsets = [
+            Estimate::new(90.0, 0.0),
+            Estimate::new(-6.0, 0.008),
+            Estimate::new(1.0, 0.0),
+        ];
+        // Relative errors 0.01/100, 0.01/10, 0.001/2: the δθ pair sets it, 1e-3 / 1e-3.
+        let r = worst_ratio(&row, &offsets, 1e-3);
+        assert!((r - 1.0).abs() < 1e-12, "{r}");
+    }
 }
