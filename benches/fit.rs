@@ -17,12 +17,19 @@ use pt_spectra::loops::TnsPlan;
 use pt_spectra::precision::Precision;
 use pt_spectra::real::{real_space, RealModel};
 use pt_spectra::rsd::{Fog, RsdModel};
+use pt_spectra::store::TableStore;
 
 fn setup() -> (MultipoleModel, MultipoleData) {
     let p = LinearSpectrum::gm2012(0.0).expect("embedded spectrum");
     let k = LogGrid::new(0.01, 0.3, 50).expect("valid grid").points();
-    let (real, _) =
-        real_space(RealModel::OneLoopSpt, &p, &k, &Precision::default()).expect("valid");
+    let real = real_space(
+        RealModel::OneLoopSpt,
+        &p,
+        &k,
+        &Precision::default(),
+        &TableStore::in_memory(),
+    )
+    .expect("valid");
     let tns = TnsPlan::new(&k, &Precision::default())
         .expect("valid")
         .evaluate(&p);

@@ -17,6 +17,7 @@ use pt_spectra::loops::{TnsPlan, TnsTerms};
 use pt_spectra::precision::Precision;
 use pt_spectra::real::{real_space, RealModel, RealSpectra};
 use pt_spectra::rsd::{Fog, MultipoleRule, RsdModel};
+use pt_spectra::store::TableStore;
 use std::time::Duration;
 
 fn grid() -> Vec<f64> {
@@ -49,7 +50,7 @@ fn multipoles(
 ) -> f64 {
     let mut sum = 0.0;
     for (i, &k) in real.k.iter().enumerate() {
-        let s = [0, 1, 2].map(|j| real.spectra[j][i]);
+        let s = [real.spectra.dd[i], real.spectra.dt[i], real.spectra.tt[i]];
         let parts = RsdModel::Tns
             .parts(b, f, s, Some(&tns.coefficients[i]))
             .expect("TNS coefficients given");
@@ -62,8 +63,15 @@ fn multipoles(
 fn rsd_multipoles(c: &mut Criterion) {
     let p = LinearSpectrum::gm2012(0.0).expect("embedded spectrum");
     let k = grid();
-    let (real, _) =
-        real_space(RealModel::OneLoopRptN1, &p, &k, &Precision::default()).expect("k valid");
+    let store = TableStore::in_memory();
+    let real = real_space(
+        RealModel::OneLoopRptN1,
+        &p,
+        &k,
+        &Precision::default(),
+        &store,
+    )
+    .expect("k valid");
     let tns = TnsPlan::new(&k, &Precision::default())
         .expect("valid plan")
         .evaluate(&p);

@@ -2,10 +2,10 @@
 //! embedded gm2012 z = 0 spectrum, and the N2 propagator built from it:
 //!
 //! * `p15/evaluate/100`: P15 on 100 log-spaced k in [0.005, 0.4] h/Mpc (rayon's pool);
-//! * `n2/1l-rpt-n2/100`: the whole 1L-RPT-N2 model on the same grid through `real_space`, as a fit or an
-//!   MCMC step calls it (the 1-loop plan of the previous call reused, the angular table read): 1-loop
-//!   terms, P15, N2;
-//! * `n2/with-plan/100`: the same on a new grid, building the 1-loop plan as well;
+//! * `n2/1l-rpt-n2/100`: the whole 1L-RPT-N2 model on the same grid through `RealPlan::evaluate`, as a
+//!   fit or an MCMC step calls it (the plan built once): 1-loop terms, P15, N2;
+//! * `n2/with-plan/100`: the same on a new grid, building the plan as well (the angular table already
+//!   loaded in the store);
 //! * `p17/evaluate/40`: P17 (for N3) on 40 log-spaced k in [0.005, 0.4] from its angular table;
 //! * `two_loop/set/40`: every 2-loop term (P15, P24, P33, the total) of δδ, δθ, θθ with errors on 40
 //!   log-spaced k in [0.005, 0.4] at the default precision (after the 1-loop terms).
@@ -18,15 +18,18 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use pt_spectra::linear::{LinearSpectrum, LogGrid};
-use pt_spectra::loops::{add_p15, add_two_loop, OneLoopPlan, P15Table, P17Table};
+use pt_spectra::loops::{p15_terms, two_loop_correction, OneLoopPlan};
 use pt_spectra::precision::Precision;
-use pt_spectra::real::{from_terms, real_space, RealModel};
+use pt_spectra::progress::Silent;
+use pt_spectra::real::{RealModel, RealPlan};
+use pt_spectra::store::TableStore;
 
 fn p15(c: &mut Criterion) {
     let p = LinearSpectrum::gm2012(0.0).expect("embedded spectrum");
     let k = LogGrid::new(0.005, 0.4, 100).expect("valid grid").points();
     let precision = Precision::default();
-    let table = P15Table::get(&|_, _| {});
+    let store = TableStore::from_env();
+    let table = store.p15(&Silent).expect("table");
     let mut group = c.benchmark_group("p15");
     group.bench_function("evaluate/100", |b| {
         b.iter(|| {
@@ -39,7 +42,7 @@ fn p15(c: &mut Criterion) {
         })
     });
     group.finish();
-    let table17 = P17Table::get(&|_, _| {});
+    let table17 = store.p17(&Silent).expect("table");
     let k40 = LogGrid::new(0.005, 0.4, 40).expect("valid grid").points();
     let mut group = c.benchmark_group("p17");
     group.sample_size(20);
@@ -56,19 +59,18 @@ fn p15(c: &mut Criterion) {
     group.finish();
     let mut group = c.benchmark_group("n2");
     group.sample_size(20);
-    // As a fit or an MCMC loop calls it: `real_space` reuses the plan of its previous call.
+    // As a fit or an MCMC loop calls it: the plan is built once.
+    let model = RealModel::OneLoopRptN2;
+    let plan = RealPlan::new(&k, model, &precision, &store, &Silent).expect("valid");
     group.bench_function("1l-rpt-n2/100", |b| {
-        b.iter(|| {
-            real_space(RealModel::OneLoopRptN2, black_box(&p), &k, &precision).expect("valid")
-        })
+        b.iter(|| plan.evaluate(black_box(&p), &Silent).expect("valid"))
     });
-    // A first call on a new grid: the 1-loop plan is built too.
+    // A first call on a new grid: the plan is built too.
     group.bench_function("with-plan/100", |b| {
         b.iter(|| {
-            let plan = OneLoopPlan::new(black_box(&k), &precision).expect("valid");
-            let mut terms = plan.par_evaluate(&p);
-            add_p15(&mut terms, &p, &precision, &|_, _| {});
-            from_terms(RealModel::OneLoopRptN2, &terms).expect("valid")
+            let plan =
+                RealPlan::new(black_box(&k), model, &precision, &store, &Silent).expect("valid");
+            plan.evaluate(&p, &Silent).expect("valid")
         })
     });
     group.finish();
@@ -81,20 +83,13 @@ fn two_loop(c: &mut Criterion) {
     let one = OneLoopPlan::new(&k, &precision)
         .expect("valid")
         .par_evaluate(&p);
-    P15Table::get(&|_, _| {});
+    let table = TableStore::from_env().p15(&Silent).expect("table");
     let mut group = c.benchmark_group("two_loop");
     group.sample_size(10);
     group.bench_function("set/40", |b| {
         b.iter(|| {
-            let mut terms = one.clone();
-            add_two_loop(
-                &mut terms,
-                black_box(&p),
-                &precision,
-                &|_, _| {},
-                &|_, _| {},
-            );
-            terms
+            let p15 = p15_terms(&table, &k, black_box(&p), &precision);
+            two_loop_correction(&one, &p15, &table, &p, &precision, &|_, _| {})
         })
     });
     group.finish();

@@ -9,6 +9,7 @@ use pt_spectra::loops::TnsPlan;
 use pt_spectra::precision::Precision;
 use pt_spectra::real::{real_space, RealModel};
 use pt_spectra::rsd::{Fog, RsdModel};
+use pt_spectra::store::TableStore;
 use rand::{Rng, SeedableRng};
 
 const F_TRUE: f64 = 0.483135;
@@ -50,7 +51,14 @@ fn kaiser_mock(k: &[f64], b: f64, seed: u64) -> MultipoleData {
 /// Linear Kaiser, no FoG, bias `b`, for the multipoles `ells`.
 fn linear_kaiser_model(k: &[f64], b: f64, ells: &[usize]) -> MultipoleModel {
     let p = LinearSpectrum::gm2012(0.0).unwrap();
-    let (real, _) = real_space(RealModel::Linear, &p, k, &Precision::fast()).unwrap();
+    let real = real_space(
+        RealModel::Linear,
+        &p,
+        k,
+        &Precision::fast(),
+        &TableStore::in_memory(),
+    )
+    .unwrap();
     MultipoleModel::new(
         &real,
         None,
@@ -66,7 +74,14 @@ fn linear_kaiser_model(k: &[f64], b: f64, ells: &[usize]) -> MultipoleModel {
 /// TNS with 1-loop SPT spectra and Lorentzian FoG, bias `b`, for ℓ = 0, 2, 4.
 fn tns_model(k: &[f64], b: f64) -> MultipoleModel {
     let p = LinearSpectrum::gm2012(0.0).unwrap();
-    let (real, _) = real_space(RealModel::OneLoopSpt, &p, k, &Precision::fast()).unwrap();
+    let real = real_space(
+        RealModel::OneLoopSpt,
+        &p,
+        k,
+        &Precision::fast(),
+        &TableStore::in_memory(),
+    )
+    .unwrap();
     let tns = TnsPlan::new(k, &Precision::fast()).unwrap().evaluate(&p);
     MultipoleModel::new(
         &real,

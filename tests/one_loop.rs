@@ -71,9 +71,11 @@ fn reference(z: &str, k_range: (f64, f64)) -> Reference {
 }
 
 fn ours(terms: &OneLoopTerms, pair: Pair, i: usize) -> [Estimate; 2] {
-    let t = terms.pair(pair);
-    let p13 = t.p13[i];
-    [t.p22[i], Estimate::new(2.0 * p13.value, 2.0 * p13.error)]
+    let p13 = terms.p13[pair][i];
+    [
+        terms.p22[pair][i],
+        Estimate::new(2.0 * p13.value, 2.0 * p13.error),
+    ]
 }
 
 #[test]
@@ -135,7 +137,7 @@ fn infrared_limit_two_p13_is_minus_k2_sigma_v2_p() {
     let sv = terms.sigma_v2.value;
     for (i, &ki) in k.iter().enumerate() {
         for pair in Pair::ALL {
-            let ratio = 2.0 * terms.pair(pair).p13[i].value / (terms.p_lin[i] * ki * ki * sv);
+            let ratio = 2.0 * terms.p13[pair][i].value / (terms.p_lin[i] * ki * ki * sv);
             assert!((ratio + 1.0).abs() < LIMIT_TOL, "k={ki} {pair:?}: {ratio}");
         }
     }
@@ -167,13 +169,12 @@ fn ultraviolet_limits_of_p13_and_p22() {
     let p22_limit = [9.0 / 98.0, 19.0 / 294.0, 61.0 / 490.0];
     for (i, &ki) in k.iter().enumerate() {
         for (j, pair) in Pair::ALL.into_iter().enumerate() {
-            let t = terms.pair(pair);
-            let ratio = 2.0 * t.p13[i].value / (terms.p_lin[i] * ki * ki * sv);
+            let ratio = 2.0 * terms.p13[pair][i].value / (terms.p_lin[i] * ki * ki * sv);
             assert!(
                 (ratio + p13_limit[j]).abs() < LIMIT_TOL,
                 "k={ki} {pair:?} P13: {ratio}"
             );
-            let c = t.p22[i].value / (ki.powi(4) * i4);
+            let c = terms.p22[pair][i].value / (ki.powi(4) * i4);
             assert!(
                 (c / p22_limit[j] - 1.0).abs() < LIMIT_TOL,
                 "k={ki} {pair:?} P22: {c}"
@@ -226,7 +227,7 @@ fn p22_matches_independent_brute_force_quadrature() {
     for (i, &ki) in k.iter().enumerate() {
         let brute = brute_force_p22(&p, ki);
         for (j, pair) in Pair::ALL.into_iter().enumerate() {
-            let ours = terms.pair(pair).p22[i].value;
+            let ours = terms.p22[pair][i].value;
             let rel = (ours / brute[j] - 1.0).abs();
             println!(
                 "k={ki} {pair:?}: ours/brute − 1 = {:.1e}",
@@ -262,9 +263,16 @@ fn doubling_the_resolution_changes_results_by_less_than_the_reported_error() {
         check(a.sigma_v2, b.sigma_v2, "sigma_v2");
         for (i, ki) in k.iter().enumerate() {
             for pair in Pair::ALL {
-                let (ta, tb) = (a.pair(pair), b.pair(pair));
-                check(ta.p22[i], tb.p22[i], &format!("P22 {pair:?} k={ki}"));
-                check(ta.p13[i], tb.p13[i], &format!("P13 {pair:?} k={ki}"));
+                check(
+                    a.p22[pair][i],
+                    b.p22[pair][i],
+                    &format!("P22 {pair:?} k={ki}"),
+                );
+                check(
+                    a.p13[pair][i],
+                    b.p13[pair][i],
+                    &format!("P13 {pair:?} k={ki}"),
+                );
             }
         }
     }
@@ -308,9 +316,8 @@ fn loop_terms_scale_as_the_growth_factor() {
     let (a, b) = (plan.evaluate(&p0), plan.evaluate(&p1));
     for i in 0..k.len() {
         for pair in Pair::ALL {
-            let (ta, tb) = (a.pair(pair), b.pair(pair));
-            assert!((tb.p22[i].value / ta.p22[i].value - 0.0625).abs() < 1e-12);
-            assert!((tb.p13[i].value / ta.p13[i].value - 0.0625).abs() < 1e-12);
+            assert!((b.p22[pair][i].value / a.p22[pair][i].value - 0.0625).abs() < 1e-12);
+            assert!((b.p13[pair][i].value / a.p13[pair][i].value - 0.0625).abs() < 1e-12);
         }
     }
 }

@@ -11,8 +11,8 @@ use std::f64::consts::PI;
 mod support;
 use support::*;
 
-fn table() -> &'static P17Table {
-    P17Table::get(&|_, _| {})
+fn table() -> std::sync::Arc<P17Table> {
+    store().p17(&pt_spectra::progress::Silent).unwrap()
 }
 
 #[test]

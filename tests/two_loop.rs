@@ -3,10 +3,12 @@
 //! the RegPT reference (`tests/data/regpt_2loop_gm2012_z0.0.dat`, provenance in `tests/data/README.md`).
 //!
 //! The first test to run builds the angular table (about 35 s on 2 cores) and caches it (see
-//! `pt_spectra::loops::cache_path`).
+//! `pt_spectra::store::TableStore`).
 
 use pt_spectra::linear::LinearSpectrum;
-use pt_spectra::loops::{k1_kernels, p15_angular_kernel, OneLoopPlan, P15Table, TwoLoopSettings};
+use pt_spectra::loops::{
+    k1_kernels, p15_angular_kernel, OneLoopPlan, P15Table, Pair, TwoLoopSettings,
+};
 use pt_spectra::precision::Precision;
 use pt_spectra::resum::{n1, n2};
 use rand::{Rng, SeedableRng};
@@ -15,8 +17,8 @@ use std::f64::consts::PI;
 mod support;
 use support::*;
 
-fn table() -> &'static P15Table {
-    P15Table::get(&|_, _| {})
+fn table() -> std::sync::Arc<P15Table> {
+    store().p15(&pt_spectra::progress::Silent).unwrap()
 }
 
 #[test]
@@ -96,7 +98,7 @@ fn factorised_kernel_gives_n2_equal_to_n1() {
         .evaluate(&spectrum);
     for i in 0..k.len() {
         let p = one.p_lin[i];
-        for (x, p13) in [(0, one.dd.p13[i]), (2, one.tt.p13[i])] {
+        for (x, p13) in [(0, one.p13.dd[i]), (2, one.p13.tt[i])] {
             let want = (p13.value / p).powi(2) * p / 2.0;
             let got = p15[i][x];
             assert!(
@@ -226,20 +228,23 @@ fn table_p15_agrees_with_regpt() {
 }
 
 /// The RegPT grid up to k_max with the reference's q range, and our 2L-SPT terms there.
-fn regpt_two_loop(k_max: f64) -> (Vec<Vec<f64>>, pt_spectra::loops::OneLoopTerms) {
+fn regpt_two_loop(k_max: f64) -> (Vec<Vec<f64>>, pt_spectra::loops::LoopTerms) {
     let rows: Vec<Vec<f64>> = rows(&data("regpt_2loop_gm2012_z0.0.dat"))
         .into_iter()
         .filter(|r| r[0] <= k_max)
         .collect();
     let k: Vec<f64> = rows.iter().map(|r| r[0]).collect();
     let spectrum = LinearSpectrum::gm2012(0.0).unwrap();
-    let mut precision = Precision::default();
-    (precision.q_min, precision.q_max) = (1e-4, 50.0);
-    let mut terms = OneLoopPlan::new(&k, &precision)
-        .unwrap()
-        .par_evaluate(&spectrum);
-    pt_spectra::loops::add_two_loop(&mut terms, &spectrum, &precision, &|_, _| {}, &|_, _| {});
-    (rows, terms)
+    let precision = Precision::default().with_q_range(1e-4, 50.0).unwrap();
+    let plan = pt_spectra::real::RealPlan::new(
+        &k,
+        pt_spectra::real::RealModel::TwoLoopSpt,
+        &precision,
+        store(),
+        &pt_spectra::progress::Silent,
+    )
+    .unwrap();
+    (rows, plan.terms(&spectrum, &pt_spectra::progress::Silent))
 }
 
 #[test]
@@ -249,10 +254,11 @@ fn two_loop_spt_matches_regpt() {
     let (rows, terms) = regpt_two_loop(0.3);
     let (mut worst, mut worst_low): (f64, f64) = (0.0, 0.0);
     for (i, r) in rows.iter().enumerate() {
-        for (pair, t, c) in [(0, &terms.dd, 14), (1, &terms.dt, 26), (2, &terms.tt, 38)] {
-            let one = t.one_loop(i).value;
-            let two = t.two_loop[i];
-            let ours = terms.p_lin[i] + one + two.value;
+        for (pair, c) in [(0, 14), (1, 26), (2, 38)] {
+            let p = Pair::ALL[pair];
+            let one = terms.one_loop.one_loop(p, i).value;
+            let two = terms.two_loop.as_ref().unwrap().pairs[p].total[i];
+            let ours = terms.one_loop.p_lin[i] + one + two.value;
             let (spt2, spt1) = (r[c + 1], r[c]);
             let rel = ours / spt2 - 1.0;
             if pair == 0 {
@@ -329,7 +335,7 @@ fn both_parts_of_the_two_loop_correction_are_infrared_safe() {
         let mc = pt_spectra::loops::two_loop(&k, p, range, precision.lattice_step, &settings);
         (0..k.len())
             .map(|i| {
-                let red = one.dd.p13[i].value.powi(2) / one.p_lin[i];
+                let red = one.p13.dd[i].value.powi(2) / one.p_lin[i];
                 (
                     2.0 * p15[i][0].value,
                     red,
@@ -409,7 +415,7 @@ fn propagator_part_is_2p15_minus_p33_reducible_in_one_integral() {
     let part = table().propagator_part(&k, &spectrum, range, precision.lattice_step);
     for i in 0..k.len() {
         let p = one.p_lin[i];
-        let p13 = [one.dd.p13[i], one.tt.p13[i]];
+        let p13 = [one.p13.dd[i], one.p13.tt[i]];
         for (j, (a, b)) in [(0, 0), (0, 1), (1, 1)].into_iter().enumerate() {
             let separate = 2.0 * p15[i][j].value - p13[a].value * p13[b].value / p;
             let allowed = 2.0 * p15[i][j].error + part[i][j].error + 1e-6 * separate.abs();
@@ -453,7 +459,7 @@ fn refinement_adds_points_until_the_tolerance_is_met() {
         replicas: 4,
         ..TwoLoopSettings::default()
     };
-    let offsets = P15Table::get(&|_, _| {}).propagator_part(&k, &spectrum, (1e-4, 50.0), 0.01);
+    let offsets = table().propagator_part(&k, &spectrum, (1e-4, 50.0), 0.01);
     let run = |settings: &TwoLoopSettings, progress: &(dyn Fn(usize, usize) + Sync)| {
         pt_spectra::loops::two_loop_refined(
             &k,

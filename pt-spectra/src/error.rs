@@ -21,6 +21,40 @@ pub enum Error {
         source: std::io::Error,
     },
 
+    /// The table cache failed: a directory, lock or table file could not be created or written.
+    #[error("table cache: cannot {what} `{}`: {source}", path.display())]
+    Cache {
+        /// The file or directory.
+        path: PathBuf,
+        /// What was being done, e.g. `write the table`.
+        what: &'static str,
+        /// The operating-system error.
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// A result was asked for a term that was not computed.
+    #[error("{needed_by} needs {term}, which was not computed{hint}")]
+    MissingTerm {
+        /// The term, e.g. `P15`.
+        term: &'static str,
+        /// What needs it, e.g. `model 1l-rpt-n2`.
+        needed_by: String,
+        /// How to compute it (may be empty).
+        hint: &'static str,
+    },
+
+    /// Two inputs that must share a k grid do not.
+    #[error("{what}: {found} does not match the {expected} it must match")]
+    GridMismatch {
+        /// Which inputs, e.g. `TNS terms and real-space spectra`.
+        what: &'static str,
+        /// The grid that was expected, described (e.g. `40 k in [0.005, 0.4] h/Mpc`).
+        expected: String,
+        /// The grid that was found, described.
+        found: String,
+    },
+
     /// A field of a data row is not a number.
     #[error("{origin}:{line}: cannot parse `{field}` (column {column}, 0-based) as a number")]
     Parse {
@@ -159,9 +193,11 @@ pub enum Error {
         available: &'static str,
     },
 
-    /// A model name that is not known.
-    #[error("unknown model `{name}`; available models: {available}")]
-    UnknownModel {
+    /// A name (of a model, a FoG kind, a parameter, a preset) that is not known.
+    #[error("unknown {what} `{name}`; available: {available}")]
+    UnknownName {
+        /// What kind of name, e.g. `real-space model`.
+        what: &'static str,
         /// The name that was given.
         name: String,
         /// The names that are accepted.

@@ -201,6 +201,14 @@ pub enum Parameter {
 }
 
 impl Parameter {
+    /// The unit of the parameter's values.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Parameter::Sigma0 => "Mpc/h",
+            Parameter::F | Parameter::Amplitude => "1",
+        }
+    }
+
     /// The name, as on the command line: `f`, `sigma0`, `ab`.
     pub fn name(self) -> &'static str {
         match self {
@@ -225,7 +233,8 @@ impl FromStr for Parameter {
             "f" => Ok(Parameter::F),
             "sigma0" | "s0" => Ok(Parameter::Sigma0),
             "ab" | "a_b" | "amplitude" => Ok(Parameter::Amplitude),
-            _ => Err(Error::UnknownModel {
+            _ => Err(Error::UnknownName {
+                what: "fit parameter",
                 name: s.to_string(),
                 available: "f, sigma0, ab",
             }),
@@ -302,10 +311,10 @@ impl MultipoleModel {
         }
         let tns = match (rsd.needs_tns(), tns) {
             (true, None) => {
-                return Err(Error::InvalidParameter {
-                    name: "TNS coefficients",
-                    value: f64::NAN,
-                    reason: "the tns model needs the A and B coefficients (TnsPlan)",
+                return Err(Error::MissingTerm {
+                    term: "the TNS A and B coefficients",
+                    needed_by: "the tns model".into(),
+                    hint: " (TnsPlan, or an RsdPlan)",
                 })
             }
             (true, Some(t)) if t.coefficients.len() != n => {
@@ -325,7 +334,7 @@ impl MultipoleModel {
             growth_factor,
             bias,
             spectra: (0..n)
-                .map(|i| [0, 1, 2].map(|j| real.spectra[j][i]))
+                .map(|i| [real.spectra.dd[i], real.spectra.dt[i], real.spectra.tt[i]])
                 .collect(),
             tns,
             rule: MultipoleRule::new(ells)?,

@@ -27,15 +27,20 @@
 
 pub mod cosmology;
 pub mod error;
+pub mod estimate;
 pub mod fit;
 pub mod halo;
 pub mod integrate;
 pub mod linear;
 pub mod loops;
+pub mod output;
 pub mod precision;
+pub mod progress;
 pub mod real;
 pub mod resum;
 pub mod rsd;
+pub mod setup;
+pub mod store;
 pub mod table;
 
 /// The README's library example, compiled and run as a doctest.

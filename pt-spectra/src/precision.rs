@@ -19,6 +19,8 @@ use crate::error::{Error, Result};
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct Precision {
+    /// The preset these settings started from (`fast`, `default`, `reference`), for table headers.
+    pub preset: &'static str,
     /// Lower limit of every loop integral over q [h/Mpc]; P = 0 below. Default 1e-5, as FAST-PT's
     /// `low_extrap = −5` with which the reference tables were made; below the linear table the
     /// spectrum's power-law extrapolation is used.
@@ -79,6 +81,7 @@ pub struct Precision {
 impl Default for Precision {
     fn default() -> Self {
         Self {
+            preset: "default",
             q_min: 1e-5,
             q_max: 1e3,
             lattice_step: 0.01,
@@ -104,6 +107,7 @@ impl Precision {
     /// and wider P22 panels.
     pub fn fast() -> Self {
         Self {
+            preset: "fast",
             lattice_step: 0.02,
             p13_cell_order: 3,
             p22_ln_width: 0.5,
@@ -120,6 +124,7 @@ impl Precision {
     pub fn reference() -> Self {
         let d = Self::default();
         Self {
+            preset: "reference",
             lattice_step: d.lattice_step / 2.0,
             p13_cell_order: 2 * d.p13_cell_order,
             p22_order: 2 * d.p22_order,
@@ -133,6 +138,36 @@ impl Precision {
             two_loop_tolerance: 0.0,
             ..d
         }
+    }
+
+    /// The names of the presets.
+    pub const PRESETS: [&'static str; 3] = ["fast", "default", "reference"];
+
+    /// The preset called `name` (`fast`, `default` or `reference`, ASCII case ignored).
+    ///
+    /// # Errors
+    /// [`Error::UnknownName`] listing the presets.
+    pub fn preset(name: &str) -> Result<Self> {
+        match name.trim().to_ascii_lowercase().as_str() {
+            "fast" => Ok(Self::fast()),
+            "default" => Ok(Self::default()),
+            "reference" => Ok(Self::reference()),
+            _ => Err(Error::UnknownName {
+                what: "precision preset",
+                name: name.to_string(),
+                available: "fast, default, reference",
+            }),
+        }
+    }
+
+    /// These settings with the loop integrals over q ∈ [`q_min`, `q_max`] h/Mpc.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] unless 0 < q_min < q_max < ∞ with room for the lattice.
+    pub fn with_q_range(mut self, q_min: f64, q_max: f64) -> Result<Self> {
+        (self.q_min, self.q_max) = (q_min, q_max);
+        self.validate()?;
+        Ok(self)
     }
 
     /// Checks the settings.
@@ -225,5 +260,16 @@ mod tests {
             ..Precision::default()
         };
         assert!(p.validate().unwrap_err().to_string().contains("p22_order"));
+        for name in Precision::PRESETS {
+            assert_eq!(Precision::preset(name).unwrap().preset, name);
+        }
+        assert!(Precision::preset("best")
+            .unwrap_err()
+            .to_string()
+            .contains("fast, default"));
+        let p = Precision::fast().with_q_range(1e-4, 10.0).unwrap();
+        assert_eq!((p.q_min, p.q_max, p.preset), (1e-4, 10.0, "fast"));
+        assert!(Precision::fast().with_q_range(1.0, 0.5).is_err());
+        assert!(Precision::fast().with_q_range(f64::NAN, 0.5).is_err());
     }
 }

@@ -16,12 +16,17 @@
 
 use crate::error::{Error, Result};
 use crate::linear::LinearSpectrum;
-use crate::loops::{Estimate, OneLoopPlan, OneLoopTerms, Pair};
+use crate::loops::{
+    self, ByPair, Estimate, LoopTerms, OneLoopPlan, OneLoopTerms, P15Table, P17Table, Pair,
+};
+use crate::output::{Table, POWER, WAVENUMBER};
 use crate::precision::Precision;
+use crate::progress::{stage_callback, Progress, Silent, Stage};
 use crate::resum::{self, Propagator};
+use crate::store::TableStore;
 use std::fmt;
 use std::str::FromStr;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// A real-space model, named as on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -101,17 +106,17 @@ impl RealModel {
         }
     }
 
-    /// Whether the model needs the 2-loop propagator term P15 ([`crate::loops::add_p15`]).
+    /// Whether the model needs the 2-loop propagator term P15 ([`crate::loops::p15_terms`]).
     pub fn needs_p15(self) -> bool {
         matches!(self.propagator(), Some(Propagator::N2 | Propagator::N3)) || self.needs_two_loop()
     }
 
-    /// Whether the model needs the 3-loop propagator term P17 ([`crate::loops::add_p17`]).
+    /// Whether the model needs the 3-loop propagator term P17 ([`crate::loops::p17_terms`]).
     pub fn needs_p17(self) -> bool {
         self.propagator() == Some(Propagator::N3)
     }
 
-    /// Whether the model needs the 2-loop terms ([`crate::loops::add_two_loop`]).
+    /// Whether the model needs the 2-loop terms ([`crate::loops::two_loop_correction`]).
     pub fn needs_two_loop(self) -> bool {
         matches!(
             self,
@@ -136,19 +141,20 @@ impl FromStr for RealModel {
     /// Parses a model name, ignoring ASCII case.
     ///
     /// # Errors
-    /// [`Error::UnknownModel`] naming the accepted models.
+    /// [`Error::UnknownName`] naming the accepted models.
     fn from_str(s: &str) -> Result<Self> {
         RealModel::ALL
             .into_iter()
             .find(|m| m.name().eq_ignore_ascii_case(s.trim()))
-            .ok_or_else(|| Error::UnknownModel {
+            .ok_or_else(|| Error::UnknownName {
+                what: "real-space model",
                 name: s.to_string(),
                 available: MODEL_NAMES,
             })
     }
 }
 
-/// Real-space spectra of one model on a k grid, in (Mpc/h)^3.
+/// Real-space spectra of one model on a k grid, in (Mpc/h)^3, with the loop terms they were made of.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RealSpectra {
     /// The model.
@@ -157,137 +163,301 @@ pub struct RealSpectra {
     pub k: Vec<f64>,
     /// The linear spectrum.
     pub p_lin: Vec<f64>,
-    /// P_δδ, P_δθ, P_θθ at each k, in that order.
-    pub spectra: [Vec<Estimate>; 3],
-    /// For RPT models, the factors N_X N_Y multiplying [P_lin + P22] for δδ, δθ, θθ.
-    pub factors: Option<[Vec<Estimate>; 3]>,
+    /// P_δδ, P_δθ, P_θθ at each k.
+    pub spectra: ByPair<Vec<Estimate>>,
+    /// For RPT models, the factors N_X N_Y multiplying [P_lin + P22 (+ P33^{2L})].
+    pub factors: Option<ByPair<Vec<Estimate>>>,
+    /// The loop terms (every term the model needs is there; others may be too).
+    pub terms: LoopTerms,
 }
 
 impl RealSpectra {
     /// The spectrum of `pair`.
     pub fn pair(&self, pair: Pair) -> &[Estimate] {
-        &self.spectra[pair_index(pair)]
+        &self.spectra[pair]
     }
-}
 
-fn pair_index(pair: Pair) -> usize {
-    match pair {
-        Pair::DeltaDelta => 0,
-        Pair::DeltaTheta => 1,
-        Pair::ThetaTheta => 2,
-    }
-}
-
-/// The spectra of `model` from precomputed loop `terms`.
-///
-/// # Errors
-/// [`Error::InvalidParameter`] if the model needs P15 and `terms` have none.
-pub fn from_terms(model: RealModel, terms: &OneLoopTerms) -> Result<RealSpectra> {
-    if model.needs_p15() && terms.dd.p15.len() != terms.k.len() {
-        return Err(Error::InvalidParameter {
-            name: "number of P15 values",
-            value: terms.dd.p15.len() as f64,
-            reason: "the model needs P15 at every k (loops::add_p15)",
-        });
-    }
-    if model.needs_p17() && terms.dd.p17.len() != terms.k.len() {
-        return Err(Error::InvalidParameter {
-            name: "number of P17 values",
-            value: terms.dd.p17.len() as f64,
-            reason: "the model needs P17 at every k (loops::add_p17)",
-        });
-    }
-    if model.needs_two_loop() && terms.dd.two_loop.len() != terms.k.len() {
-        return Err(Error::InvalidParameter {
-            name: "number of 2-loop values",
-            value: terms.dd.two_loop.len() as f64,
-            reason: "the model needs the 2-loop terms at every k (loops::add_two_loop)",
-        });
-    }
-    let n = terms.k.len();
-    let mut spectra: [Vec<Estimate>; 3] = Default::default();
-    let mut factors = None;
-    match model.propagator() {
-        None => {
-            for (j, pair) in Pair::ALL.into_iter().enumerate() {
-                let t = terms.pair(pair);
-                spectra[j] = (0..n)
-                    .map(|i| {
-                        let lin = terms.p_lin[i];
-                        match model {
-                            RealModel::Linear => Estimate::new(lin, 0.0),
-                            RealModel::TwoLoopSpt => {
-                                let (l, m) = (t.one_loop(i), t.two_loop[i]);
-                                Estimate::new(lin + l.value + m.value, l.error + m.error)
+    /// The spectra of `model` from precomputed loop `terms`.
+    ///
+    /// # Errors
+    /// [`Error::MissingTerm`] if the model needs a term that `terms` do not have.
+    pub fn from_terms(model: RealModel, terms: LoopTerms) -> Result<Self> {
+        let t = &terms.one_loop;
+        let n = t.k.len();
+        let two_loop = if model.needs_two_loop() {
+            Some(terms.two_loop(&format_args!("model {model}"))?)
+        } else {
+            None
+        };
+        let (spectra, factors) = match model.propagator() {
+            None => {
+                let spectra = ByPair::from_fn(|pair| {
+                    (0..n)
+                        .map(|i| {
+                            let lin = Estimate::exact(t.p_lin[i]);
+                            match (model, two_loop) {
+                                (RealModel::Linear, _) => lin,
+                                (_, Some(two)) => {
+                                    lin + t.one_loop(pair, i) + two.pairs[pair].total[i]
+                                }
+                                (_, None) => lin + t.one_loop(pair, i),
                             }
-                            _ => {
-                                let l = t.one_loop(i);
-                                Estimate::new(lin + l.value, l.error)
-                            }
-                        }
-                    })
-                    .collect();
+                        })
+                        .collect()
+                });
+                (spectra, None)
             }
+            Some(kind) => {
+                let props = resum::propagators(kind, &terms, &format_args!("model {model}"))?;
+                let factors = ByPair::from_fn(|pair| {
+                    (0..n).map(|i| resum::factors(&props, i)[pair]).collect()
+                });
+                let spectra = ByPair::from_fn(|pair| {
+                    (0..n)
+                        .map(|i| resum::rpt(t, two_loop, &props, pair, i))
+                        .collect()
+                });
+                (spectra, Some(factors))
+            }
+        };
+        Ok(Self {
+            model,
+            k: t.k.clone(),
+            p_lin: t.p_lin.clone(),
+            spectra,
+            factors,
+            terms,
+        })
+    }
+}
+
+impl RealSpectra {
+    /// The spectra as a table with `header` lines: `k P_lin P_dd P_dt P_tt`, and with `terms` also
+    /// their errors, every loop term the model uses with its error (`P22_xx`, `P13_xx`, then `P15_xx`,
+    /// `P17_xx`, `P24_xx P33_xx P33_2L_xx P2loop_xx` as the model needs them), σ_v² and, for RPT, the
+    /// factors `N_xx` (xx = dd, dt, tt).
+    pub fn table(&self, header: Vec<String>, terms: bool) -> Table {
+        let mut t = Table::new(header);
+        t.push("k", WAVENUMBER, self.k.clone());
+        t.push("P_lin", POWER, self.p_lin.clone());
+        for (pair, s) in self.spectra.iter() {
+            t.push(format!("P_{}", pair.suffix()), POWER, values(s));
         }
-        Some(kind) => {
-            let props = resum::propagators(kind, terms);
-            let mut f: [Vec<Estimate>; 3] = Default::default();
-            for i in 0..n {
-                for (j, fi) in resum::factors(&props, i).into_iter().enumerate() {
-                    f[j].push(fi);
+        if !terms {
+            return t;
+        }
+        for (pair, s) in self.spectra.iter() {
+            t.push(format!("err_P_{}", pair.suffix()), POWER, errors(s));
+        }
+        let one = &self.terms.one_loop;
+        for pair in Pair::ALL {
+            t.push_estimates(&format!("P22_{}", pair.suffix()), POWER, &one.p22[pair]);
+            t.push_estimates(&format!("P13_{}", pair.suffix()), POWER, &one.p13[pair]);
+        }
+        let model = self.model;
+        for (name, term, needed) in [
+            ("P15", &self.terms.p15, model.needs_p15()),
+            ("P17", &self.terms.p17, model.needs_p17()),
+        ] {
+            if let (Some(term), true) = (term, needed) {
+                for (pair, v) in term.iter() {
+                    t.push_estimates(&format!("{name}_{}", pair.suffix()), POWER, v);
                 }
             }
-            for (j, pair) in Pair::ALL.into_iter().enumerate() {
-                spectra[j] = (0..n)
-                    .map(|i| resum::rpt(terms, &props, pair, i, model.needs_two_loop()))
+        }
+        if let (Some(two), true) = (&self.terms.two_loop, model.needs_two_loop()) {
+            for (pair, p) in two.pairs.iter() {
+                let s = pair.suffix();
+                let p33: Vec<Estimate> = (0..self.k.len())
+                    .map(|i| one.p33_reducible(pair, i) + p.p33_2l[i])
                     .collect();
+                t.push_estimates(&format!("P24_{s}"), POWER, &p.p24);
+                t.push_estimates(&format!("P33_{s}"), POWER, &p33);
+                t.push_estimates(&format!("P33_2L_{s}"), POWER, &p.p33_2l);
+                t.push_estimates(&format!("P2loop_{s}"), POWER, &p.total);
             }
-            factors = Some(f);
         }
+        t.push_estimates("sigma_v2", "(Mpc/h)^2", &vec![one.sigma_v2; self.k.len()]);
+        if let Some(factors) = &self.factors {
+            for (pair, f) in factors.iter() {
+                t.push_estimates(&format!("N_{}", pair.suffix()), "1", f);
+            }
+        }
+        t
     }
-    Ok(RealSpectra {
-        model,
-        k: terms.k.clone(),
-        p_lin: terms.p_lin.clone(),
-        spectra,
-        factors,
-    })
 }
 
-/// The 1-loop plan for `k` and `precision`: the one of the previous call if they are the same.
-fn plan_for(k: &[f64], precision: &Precision) -> Result<Arc<OneLoopPlan>> {
-    static LAST: Mutex<Option<Arc<OneLoopPlan>>> = Mutex::new(None);
-    let same = |plan: &OneLoopPlan| plan.k() == k && plan.precision() == precision;
-    if let Some(plan) = LAST.lock().ok().and_then(|last| last.clone()) {
-        if same(&plan) {
-            return Ok(plan);
-        }
-    }
-    let plan = Arc::new(OneLoopPlan::new(k, precision)?);
-    if let Ok(mut last) = LAST.lock() {
-        *last = Some(Arc::clone(&plan));
-    }
-    Ok(plan)
+fn values(e: &[Estimate]) -> Vec<f64> {
+    e.iter().map(|e| e.value).collect()
 }
 
-/// The spectra of `model` for `spectrum` at wavenumbers `k` [h/Mpc], with the loop terms they were
-/// built from (computed in parallel over k; also for `linear`, so that they can be reported). Models
-/// with N2 also compute P15 (building the angular table on first use, see [`crate::loops::P15Table`]).
-///
-/// The 1-loop plan (the cosmology-independent quadrature weights, [`OneLoopPlan`]) of the previous call
-/// is kept and reused when `k` and `precision` are the same, so a loop over spectra on one grid (a fit,
-/// an MCMC chain) builds it once.
-///
-/// # Errors
-/// As [`OneLoopPlan::new`].
+fn errors(e: &[Estimate]) -> Vec<f64> {
+    e.iter().map(|e| e.error).collect()
+}
+
+/// Above this many k values the 1-loop plan is built and evaluated in chunks, reporting
+/// [`Stage::OneLoop`] progress after each.
+const CHUNKED_GRID: usize = 2048;
+/// k values per chunk.
+const CHUNK: usize = 512;
+
+/// A real-space model prepared for one k grid: the 1-loop quadrature weights and the angular tables the
+/// model needs, all independent of the cosmology. [`evaluate`](Self::evaluate) then computes the
+/// spectra of any linear spectrum, as often as needed (a fit, a chain, a batch of cosmologies).
 ///
 /// ```
-/// use pt_spectra::{linear::LinearSpectrum, precision::Precision, real::{real_space, RealModel}};
-/// let p = LinearSpectrum::gm2012(0.0)?;
-/// let (spt, _) = real_space("1l-spt".parse()?, &p, &[0.1], &Precision::fast())?;
-/// let (n1, _) = real_space(RealModel::OneLoopRptN1, &p, &[0.1], &Precision::fast())?;
+/// use pt_spectra::{linear::LinearSpectrum, loops::Pair, precision::Precision, progress::Silent};
+/// use pt_spectra::{real::{RealModel, RealPlan}, store::TableStore};
+/// let store = TableStore::in_memory();
+/// let plan = RealPlan::new(&[0.05, 0.1], RealModel::OneLoopSpt, &Precision::fast(), &store, &Silent)?;
+/// for z in [0.0, 1.0] {
+///     let s = plan.evaluate(&LinearSpectrum::gm2012(z)?, &Silent)?;
+///     // At k = 0.1 h/Mpc the 1-loop P_δδ exceeds P_lin by a few per cent.
+///     let ratio = s.pair(Pair::DeltaDelta)[1].value / s.p_lin[1];
+///     assert!(ratio > 1.0 && ratio < 1.1, "{ratio}");
+/// }
+/// # Ok::<(), pt_spectra::error::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct RealPlan {
+    k: Vec<f64>,
+    model: RealModel,
+    precision: Precision,
+    one_loop: Vec<OneLoopPlan>,
+    p15: Option<Arc<P15Table>>,
+    p17: Option<Arc<P17Table>>,
+}
+
+impl RealPlan {
+    /// The plan of `model` on the wavenumbers `k` [h/Mpc] with `precision`; the angular tables the
+    /// model needs (P15 for N2, N3 and 2-loop models, P17 for N3) come from `store`, built there on
+    /// first use (reported to `progress`).
+    ///
+    /// # Errors
+    /// As [`OneLoopPlan::new`] and [`TableStore::p15`].
+    pub fn new(
+        k: &[f64],
+        model: RealModel,
+        precision: &Precision,
+        store: &TableStore,
+        progress: &dyn Progress,
+    ) -> Result<Self> {
+        precision.validate()?;
+        let one_loop = if k.len() < CHUNKED_GRID {
+            vec![OneLoopPlan::new(k, precision)?]
+        } else {
+            let mut plans = Vec::new();
+            for (i, chunk) in k.chunks(CHUNK).enumerate() {
+                plans.push(OneLoopPlan::new(chunk, precision)?);
+                progress.update(Stage::OneLoop, ((i + 1) * CHUNK).min(k.len()), 2 * k.len());
+            }
+            plans
+        };
+        let p15 = if model.needs_p15() {
+            Some(store.p15(progress)?)
+        } else {
+            None
+        };
+        let p17 = if model.needs_p17() {
+            Some(store.p17(progress)?)
+        } else {
+            None
+        };
+        Ok(Self {
+            k: k.to_vec(),
+            model,
+            precision: precision.clone(),
+            one_loop,
+            p15,
+            p17,
+        })
+    }
+
+    /// The wavenumbers [h/Mpc].
+    pub fn k(&self) -> &[f64] {
+        &self.k
+    }
+
+    /// The model.
+    pub fn model(&self) -> RealModel {
+        self.model
+    }
+
+    /// The settings of the loop integrals.
+    pub fn precision(&self) -> &Precision {
+        &self.precision
+    }
+
+    /// Every loop term the model needs, for the linear `spectrum` (at the output redshift), in
+    /// parallel over k; the 2-loop points are reported to `progress` ([`Stage::TwoLoopPoints`]).
+    pub fn terms(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> LoopTerms {
+        let mut one_loop: Option<OneLoopTerms> = None;
+        for (i, plan) in self.one_loop.iter().enumerate() {
+            let part = plan.par_evaluate(spectrum);
+            match one_loop.as_mut() {
+                None => one_loop = Some(part),
+                Some(all) => all.append(part),
+            }
+            if self.one_loop.len() > 1 {
+                let done = self.k.len() + ((i + 1) * CHUNK).min(self.k.len());
+                progress.update(Stage::OneLoop, done, 2 * self.k.len());
+            }
+        }
+        let one_loop = one_loop.expect("a plan has at least one chunk");
+        let (k, precision) = (&self.k, &self.precision);
+        let p15 = self
+            .p15
+            .as_ref()
+            .map(|table| loops::p15_terms(table, k, spectrum, precision));
+        let p17 = self
+            .p17
+            .as_ref()
+            .map(|table| loops::p17_terms(table, k, spectrum, precision));
+        let two_loop = match (&self.p15, &p15) {
+            (Some(table), Some(p15)) if self.model.needs_two_loop() => {
+                let points = stage_callback(progress, Stage::TwoLoopPoints);
+                Some(loops::two_loop_correction(
+                    &one_loop, p15, table, spectrum, precision, &points,
+                ))
+            }
+            _ => None,
+        };
+        LoopTerms {
+            one_loop,
+            p15,
+            p17,
+            two_loop,
+        }
+    }
+
+    /// The model's spectra for the linear `spectrum` (at the output redshift).
+    ///
+    /// # Errors
+    /// None in practice: the plan computes every term its model needs (a [`Error::MissingTerm`]
+    /// would be a bug).
+    pub fn evaluate(
+        &self,
+        spectrum: &LinearSpectrum,
+        progress: &dyn Progress,
+    ) -> Result<RealSpectra> {
+        RealSpectra::from_terms(self.model, self.terms(spectrum, progress))
+    }
+}
+
+/// The spectra of `model` for `spectrum` at wavenumbers `k` [h/Mpc]: a [`RealPlan`] built and
+/// evaluated once. Build the plan yourself to evaluate several spectra on one grid.
+///
+/// # Errors
+/// As [`RealPlan::new`].
+///
+/// ```
+/// use pt_spectra::{linear::LinearSpectrum, loops::Pair, precision::Precision, store::TableStore};
+/// use pt_spectra::real::{real_space, RealModel};
+/// let (p, store) = (LinearSpectrum::gm2012(0.0)?, TableStore::in_memory());
+/// let spt = real_space("1l-spt".parse()?, &p, &[0.1], &Precision::fast(), &store)?;
+/// let n1 = real_space(RealModel::OneLoopRptN1, &p, &[0.1], &Precision::fast(), &store)?;
 /// // At k = 0.1 h/Mpc, z = 0 the two agree to a few per cent and exceed P_lin.
-/// let (a, b) = (spt.spectra[0][0].value, n1.spectra[0][0].value);
+/// let (a, b) = (spt.pair(Pair::DeltaDelta)[0].value, n1.pair(Pair::DeltaDelta)[0].value);
 /// assert!(a > spt.p_lin[0] && (a / b - 1.0).abs() < 0.05);
 /// # Ok::<(), pt_spectra::error::Error>(())
 /// ```
@@ -296,17 +466,9 @@ pub fn real_space(
     spectrum: &LinearSpectrum,
     k: &[f64],
     precision: &Precision,
-) -> Result<(RealSpectra, OneLoopTerms)> {
-    let mut terms = plan_for(k, precision)?.par_evaluate(spectrum);
-    if model.needs_two_loop() {
-        crate::loops::add_two_loop(&mut terms, spectrum, precision, &|_, _| {}, &|_, _| {});
-    } else if model.needs_p15() {
-        crate::loops::add_p15(&mut terms, spectrum, precision, &|_, _| {});
-    }
-    if model.needs_p17() {
-        crate::loops::add_p17(&mut terms, spectrum, precision, &|_, _| {});
-    }
-    Ok((from_terms(model, &terms)?, terms))
+    store: &TableStore,
+) -> Result<RealSpectra> {
+    RealPlan::new(k, model, precision, store, &Silent)?.evaluate(spectrum, &Silent)
 }
 
 #[cfg(test)]
@@ -327,20 +489,21 @@ mod tests {
     }
 
     #[test]
-    fn the_reused_plan_is_the_plan_of_the_grid_and_precision_asked_for() {
+    fn a_plan_gives_the_terms_of_a_fresh_1_loop_plan_and_chunks_change_nothing() {
         let p = LinearSpectrum::gm2012(0.0).unwrap();
-        let fresh =
-            |k: &[f64], precision: &Precision| OneLoopPlan::new(k, precision).unwrap().evaluate(&p);
-        let (a, b) = ([0.05, 0.1], [0.05, 0.2]);
-        for (k, precision) in [
-            (&a[..], Precision::fast()),
-            (&a[..], Precision::fast()),
-            (&b[..], Precision::fast()),
-            (&b[..], Precision::default()),
-            (&a[..], Precision::default()),
-        ] {
-            let (_, terms) = real_space(RealModel::OneLoopSpt, &p, k, &precision).unwrap();
-            assert_eq!(terms, fresh(k, &precision), "{k:?}");
+        let store = TableStore::in_memory();
+        let k: Vec<f64> = (0..CHUNKED_GRID + 100)
+            .map(|i| 1e-3 * (1.0 + i as f64 * 1e-3))
+            .collect();
+        for (k, precision) in [(&k[..3], Precision::fast()), (&k[..], Precision::fast())] {
+            let plan =
+                RealPlan::new(k, RealModel::OneLoopSpt, &precision, &store, &Silent).unwrap();
+            let terms = plan.terms(&p, &Silent);
+            assert_eq!(
+                terms.one_loop,
+                OneLoopPlan::new(k, &precision).unwrap().evaluate(&p)
+            );
+            assert!(terms.p15.is_none() && terms.two_loop.is_none());
         }
     }
 
@@ -348,23 +511,26 @@ mod tests {
     fn rpt_n1_expands_to_spt_and_linear_is_p_lin() {
         let p = LinearSpectrum::gm2012(1.0).unwrap();
         let k = [0.02, 0.05];
-        let (lin, terms) = real_space(RealModel::Linear, &p, &k, &Precision::fast()).unwrap();
-        let spt = from_terms(RealModel::OneLoopSpt, &terms).unwrap();
-        let n1 = from_terms(RealModel::OneLoopRptN1, &terms).unwrap();
-        assert!(from_terms(RealModel::OneLoopRptN2, &terms).is_err());
+        let store = TableStore::in_memory();
+        let lin = real_space(RealModel::Linear, &p, &k, &Precision::fast(), &store).unwrap();
+        let terms = lin.terms.clone();
+        let spt = RealSpectra::from_terms(RealModel::OneLoopSpt, terms.clone()).unwrap();
+        let n1 = RealSpectra::from_terms(RealModel::OneLoopRptN1, terms.clone()).unwrap();
+        let e = RealSpectra::from_terms(RealModel::OneLoopRptN2, terms.clone()).unwrap_err();
+        assert!(e.to_string().contains("model 1l-rpt-n2 needs P15"), "{e}");
+        let t = &terms.one_loop;
         for (i, &ki) in k.iter().enumerate() {
-            assert_eq!(lin.spectra[0][i].value, terms.p_lin[i]);
-            for j in 0..3 {
+            assert_eq!(lin.spectra.dd[i].value, t.p_lin[i]);
+            for pair in Pair::ALL {
                 // N1² = 1 + 2x + 2x² + O(x³), x = P13/P: the models differ by 2P13(P13 + P22)/P
                 // at second order, with third-order terms of size ~ 2x²(|P13| + |P22|).
-                let (a, b) = (spt.spectra[j][i].value, n1.spectra[j][i].value);
-                let t = terms.pair(Pair::ALL[j]);
-                let (p22, p13, lin) = (t.p22[i].value, t.p13[i].value, terms.p_lin[i]);
+                let (a, b) = (spt.spectra[pair][i].value, n1.spectra[pair][i].value);
+                let (p22, p13, lin) = (t.p22[pair][i].value, t.p13[pair][i].value, t.p_lin[i]);
                 let second = 2.0 * p13 * (p13 + p22) / lin;
                 let third = 2.0 * (p13 / lin).powi(2) * (p13.abs() + p22.abs());
                 assert!(
                     (b - a - second).abs() < third,
-                    "k={ki} j={j}: {a} {b} {second}"
+                    "k={ki} {pair:?}: {a} {b} {second}"
                 );
             }
         }

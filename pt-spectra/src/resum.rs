@@ -16,7 +16,10 @@
 //! δθ uses N_δ N_θ. Errors are propagated linearly from the loop terms' estimates:
 //! δN0 = N0 k² δσ_v²/2, δN1 = N1 δP13/P_lin, and δ(A·M) = |M| δA + |A| δM.
 
-use crate::loops::{Estimate, OneLoopTerms, Pair};
+#[cfg(doc)]
+use crate::error::Error;
+use crate::error::Result;
+use crate::loops::{ByPair, Estimate, LoopTerms, OneLoopTerms, Pair, TwoLoopCorrection};
 
 /// Which resummed propagator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -154,87 +157,78 @@ pub fn n3(p13: Estimate, p15: Estimate, p17: Estimate, p_lin: f64) -> Estimate {
 
 /// The propagators (N_δ, N_θ) at every k of `terms`.
 ///
-/// # Panics
-/// For [`Propagator::N2`] and [`Propagator::N3`] if `terms` has no P15 (see [`crate::loops::add_p15`]),
-/// and for N3 if it has no P17 ([`crate::loops::add_p17`]).
-pub fn propagators(kind: Propagator, terms: &OneLoopTerms) -> (Vec<Estimate>, Vec<Estimate>) {
-    match kind {
+/// # Errors
+/// [`Error::MissingTerm`] (naming `needed_by`) for [`Propagator::N2`] and [`Propagator::N3`] if
+/// `terms` have no P15, and for N3 if they have no P17.
+pub fn propagators(
+    kind: Propagator,
+    terms: &LoopTerms,
+    needed_by: &dyn std::fmt::Display,
+) -> Result<(Vec<Estimate>, Vec<Estimate>)> {
+    let t = &terms.one_loop;
+    let n = t.k.len();
+    let (p13, p_lin) = (&t.p13, &t.p_lin);
+    Ok(match kind {
         Propagator::N3 => {
-            let of = |pair: &crate::loops::PairTerms| -> Vec<Estimate> {
-                assert_eq!(
-                    pair.p17.len(),
-                    terms.k.len(),
-                    "N3 needs P17 (loops::add_p17)"
-                );
-                (0..terms.k.len())
-                    .map(|i| n3(pair.p13[i], pair.p15[i], pair.p17[i], terms.p_lin[i]))
+            let (p15, p17) = (terms.p15(needed_by)?, terms.p17(needed_by)?);
+            let of = |pair: Pair| -> Vec<Estimate> {
+                (0..n)
+                    .map(|i| n3(p13[pair][i], p15[pair][i], p17[pair][i], p_lin[i]))
                     .collect()
             };
-            (of(&terms.dd), of(&terms.tt))
+            (of(Pair::DeltaDelta), of(Pair::ThetaTheta))
         }
         Propagator::N2 => {
-            let of = |pair: &crate::loops::PairTerms| -> Vec<Estimate> {
-                assert_eq!(
-                    pair.p15.len(),
-                    terms.k.len(),
-                    "N2 needs P15 (loops::add_p15)"
-                );
-                (0..terms.k.len())
-                    .map(|i| n2(pair.p13[i], pair.p15[i], terms.p_lin[i]))
+            let p15 = terms.p15(needed_by)?;
+            let of = |pair: Pair| -> Vec<Estimate> {
+                (0..n)
+                    .map(|i| n2(p13[pair][i], p15[pair][i], p_lin[i]))
                     .collect()
             };
-            (of(&terms.dd), of(&terms.tt))
+            (of(Pair::DeltaDelta), of(Pair::ThetaTheta))
         }
         Propagator::N0 => {
-            let n: Vec<Estimate> = terms.k.iter().map(|&k| n0(k, terms.sigma_v2)).collect();
+            let n: Vec<Estimate> = t.k.iter().map(|&k| n0(k, t.sigma_v2)).collect();
             (n.clone(), n)
         }
         Propagator::N1 => {
             let of = |p13: &[Estimate]| -> Vec<Estimate> {
-                p13.iter()
-                    .zip(&terms.p_lin)
-                    .map(|(&p, &lin)| n1(p, lin))
-                    .collect()
+                p13.iter().zip(p_lin).map(|(&p, &lin)| n1(p, lin)).collect()
             };
-            (of(&terms.dd.p13), of(&terms.tt.p13))
+            (of(&p13.dd), of(&p13.tt))
         }
-    }
+    })
 }
 
-/// Product of two estimates, errors propagated linearly.
+/// Product of two estimates, errors propagated linearly (as `a * b`).
 pub fn product(a: Estimate, b: Estimate) -> Estimate {
-    Estimate::new(
-        a.value * b.value,
-        a.value.abs() * b.error + b.value.abs() * a.error,
-    )
+    a * b
 }
 
 /// The damping factors N_X N_Y of δδ, δθ and θθ at k index `i`, from (N_δ, N_θ).
-pub fn factors(n: &(Vec<Estimate>, Vec<Estimate>), i: usize) -> [Estimate; 3] {
+pub fn factors(n: &(Vec<Estimate>, Vec<Estimate>), i: usize) -> ByPair<Estimate> {
     let (d, t) = (n.0[i], n.1[i]);
-    [product(d, d), product(d, t), product(t, t)]
+    ByPair {
+        dd: d * d,
+        dt: d * t,
+        tt: t * t,
+    }
 }
 
 /// The RPT spectrum of `pair` at k index `i`: [P_lin + P22] N_X N_Y at one loop, and
-/// [P_lin + P22 + P33^{2L}] N_X N_Y at two loops (`two_loops`; needs the 2-loop terms).
+/// [P_lin + P22 + P33^{2L}] N_X N_Y at two loops (`two_loop`: the 2-loop terms).
 pub fn rpt(
     terms: &OneLoopTerms,
+    two_loop: Option<&TwoLoopCorrection>,
     n: &(Vec<Estimate>, Vec<Estimate>),
     pair: Pair,
     i: usize,
-    two_loops: bool,
 ) -> Estimate {
-    let t = terms.pair(pair);
-    let p22 = t.p22[i];
-    let mut base = Estimate::new(terms.p_lin[i] + p22.value, p22.error);
-    if two_loops {
-        base = Estimate::new(
-            base.value + t.p33_2l[i].value,
-            base.error + t.p33_2l[i].error,
-        );
+    let mut base = terms.p22[pair][i] + terms.p_lin[i];
+    if let Some(t) = two_loop {
+        base += t.pairs[pair].p33_2l[i];
     }
-    let index = Pair::ALL.iter().position(|&p| p == pair).unwrap_or(0);
-    product(base, factors(n, i)[index])
+    base * factors(n, i)[pair]
 }
 
 #[cfg(test)]

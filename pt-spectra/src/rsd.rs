@@ -18,9 +18,12 @@
 
 use crate::error::{Error, Result};
 use crate::integrate::legendre_nodes;
-use crate::loops::{Estimate, TnsCoefficients};
+use crate::loops::{Estimate, Pair, TnsCoefficients};
 use std::fmt;
 use std::str::FromStr;
+
+mod multipoles;
+pub use multipoles::{multipoles, RsdMultipoles, RsdPlan, RsdSettings, Sigma0};
 
 /// Largest multipole order ℓ supported.
 pub const MAX_ELL: usize = 8;
@@ -84,7 +87,7 @@ impl RsdModel {
     /// their errors), the bias b, the growth rate f and, for TNS, the coefficients of A and B.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] if the model is TNS and `tns` is `None`.
+    /// [`Error::MissingTerm`] if the model is TNS and `tns` is `None`.
     pub fn parts(
         self,
         b: f64,
@@ -99,10 +102,10 @@ impl RsdModel {
             ..Parts::default()
         };
         if self.needs_tns() {
-            let c = tns.ok_or(Error::InvalidParameter {
-                name: "TNS coefficients",
-                value: f64::NAN,
-                reason: "the tns model needs the A and B coefficients (TnsPlan)",
+            let c = tns.ok_or(Error::MissingTerm {
+                term: "the TNS A and B coefficients",
+                needed_by: "the tns model".into(),
+                hint: " (TnsPlan, or an RsdPlan)",
             })?;
             let ((av, ae), (bv, be)) = (c.a_polynomial(f, b), c.b_polynomial(f, b));
             parts.a = MuPolynomial {
@@ -181,12 +184,13 @@ impl FromStr for RsdModel {
     /// Parses a model name, ignoring ASCII case.
     ///
     /// # Errors
-    /// [`Error::UnknownModel`] naming the accepted models.
+    /// [`Error::UnknownName`] naming the accepted models.
     fn from_str(s: &str) -> Result<Self> {
         RsdModel::ALL
             .into_iter()
             .find(|m| m.name().eq_ignore_ascii_case(s.trim()))
-            .ok_or_else(|| Error::UnknownModel {
+            .ok_or_else(|| Error::UnknownName {
+                what: "RSD model",
                 name: s.to_string(),
                 available: "kaiser, scoccimarro, tns",
             })
@@ -231,13 +235,14 @@ impl FromStr for Fog {
     /// `none`, `lorentzian` or `gaussian` (ASCII case ignored).
     ///
     /// # Errors
-    /// [`Error::UnknownModel`] naming the accepted choices.
+    /// [`Error::UnknownName`] naming the accepted choices.
     fn from_str(s: &str) -> Result<Self> {
         match s.trim().to_ascii_lowercase().as_str() {
             "none" => Ok(Fog::None),
             "lorentzian" => Ok(Fog::Lorentzian),
             "gaussian" => Ok(Fog::Gaussian),
-            _ => Err(Error::UnknownModel {
+            _ => Err(Error::UnknownName {
+                what: "Fingers-of-God damping",
                 name: s.to_string(),
                 available: "none, lorentzian, gaussian",
             }),
@@ -304,7 +309,9 @@ pub fn dispersion_theory(
         DispersionInput::Linear => (low.iter().map(|&q| spectrum.eval(q)).collect(), 0.0),
         DispersionInput::OneLoopSpt => {
             let terms = crate::loops::OneLoopPlan::new(&low, precision)?.evaluate(spectrum);
-            let corrections: Vec<Estimate> = (0..low.len()).map(|i| terms.tt.one_loop(i)).collect();
+            let corrections: Vec<Estimate> = (0..low.len())
+                .map(|i| terms.one_loop(Pair::ThetaTheta, i))
+                .collect();
             let p = (0..low.len())
                 .map(|i| terms.p_lin[i] + corrections[i].value)
                 .collect();

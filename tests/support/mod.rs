@@ -3,7 +3,16 @@
 
 use pt_spectra::integrate::GaussLegendre;
 use pt_spectra::linear::{LinearSpectrum, LogGrid};
+use pt_spectra::store::TableStore;
 use std::f64::consts::PI;
+use std::sync::OnceLock;
+
+/// The angular-table store of the test process: the cache directory of the environment
+/// (`PT_SPECTRA_CACHE` in CI), so each table is built once per machine.
+pub fn store() -> &'static TableStore {
+    static STORE: OnceLock<TableStore> = OnceLock::new();
+    STORE.get_or_init(TableStore::from_env)
+}
 
 /// The text of `tests/data/<name>`.
 pub fn data(name: &str) -> String {

@@ -46,7 +46,7 @@ mod two_loop;
 
 pub use one_loop::OneLoopPlan;
 pub use p13::{k1_kernels, p13_kernels};
-pub use p15::{cache_path, p15_angular_kernel, P15Table};
+pub use p15::{p15_angular_kernel, P15Table};
 pub use p17::{p17_angular_kernel, P17Table};
 pub use p22::f2_g2;
 pub use tns::{tns, TnsCoefficients, TnsPlan, TnsTerms};
@@ -55,40 +55,11 @@ pub use two_loop::{
     REFINE_LIMIT,
 };
 
-use crate::error::Result;
+use crate::error::{Error, Result};
+pub use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
-
-/// A computed value with an estimate of its numerical error (same units).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Estimate {
-    /// The value.
-    pub value: f64,
-    /// The estimated absolute numerical error (≥ 0).
-    pub error: f64,
-}
-
-impl Estimate {
-    /// A value with its error estimate.
-    pub const fn new(value: f64, error: f64) -> Self {
-        Self { value, error }
-    }
-
-    /// The mean of two estimates, errors averaged: the δθ propagator terms are the means of the δδ and
-    /// θθ ones (P1n_δθ = (P1n_δδ + P1n_θθ)/2).
-    pub fn mean(a: Self, b: Self) -> Self {
-        Self::new(0.5 * (a.value + b.value), 0.5 * (a.error + b.error))
-    }
-
-    /// The error relative to |value| (∞ if the value is 0 and the error is not).
-    pub fn relative_error(&self) -> f64 {
-        if self.error == 0.0 {
-            0.0
-        } else {
-            self.error / self.value.abs()
-        }
-    }
-}
+use std::ops::{Index, IndexMut};
 
 /// Which pair of fields a spectrum correlates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -115,74 +86,76 @@ impl Pair {
     }
 }
 
-/// The 1-loop terms of one pair on the plan's k grid [(Mpc/h)^3].
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct PairTerms {
-    /// P22 at each k.
-    pub p22: Vec<Estimate>,
-    /// P13 at each k, in the paper's normalisation (the correction is P22 + 2 P13).
-    pub p13: Vec<Estimate>,
-    /// P15 at each k (2-loop propagator term, the correction containing 2 P15), or empty if not computed
-    /// (see [`add_p15`]).
-    pub p15: Vec<Estimate>,
-    /// P17 at each k (3-loop propagator term), or empty if not computed (see [`add_p17`]).
-    pub p17: Vec<Estimate>,
-    /// P24 at each k (the correction contains 2 P24), or empty if not computed (see [`add_two_loop`]).
-    pub p24: Vec<Estimate>,
-    /// P33^{2L} = P33irr, the mode-coupling part of P33, or empty (see [`add_two_loop`]).
-    pub p33_2l: Vec<Estimate>,
-    /// The whole 2-loop SPT correction 2P15 + 2P24 + P33, or empty (see [`add_two_loop`]).
-    pub two_loop: Vec<Estimate>,
+/// One value per [`Pair`] (δδ, δθ, θθ), indexed by the pair: `terms.p22[Pair::DeltaTheta]` or
+/// `terms.p22.dt`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ByPair<T> {
+    /// δδ.
+    pub dd: T,
+    /// δθ.
+    pub dt: T,
+    /// θθ.
+    pub tt: T,
 }
 
-impl PairTerms {
-    fn with_capacity(n: usize) -> Self {
+impl<T> ByPair<T> {
+    /// The values `f(pair)` of the three pairs.
+    pub fn from_fn(mut f: impl FnMut(Pair) -> T) -> Self {
         Self {
-            p22: Vec::with_capacity(n),
-            p13: Vec::with_capacity(n),
-            p15: Vec::new(),
-            p17: Vec::new(),
-            p24: Vec::new(),
-            p33_2l: Vec::new(),
-            two_loop: Vec::new(),
+            dd: f(Pair::DeltaDelta),
+            dt: f(Pair::DeltaTheta),
+            tt: f(Pair::ThetaTheta),
         }
     }
 
-    /// The 1-loop correction P22 + 2 P13 at k index `i`, errors added linearly.
-    pub fn one_loop(&self, i: usize) -> Estimate {
-        let (a, b) = (self.p22[i], self.p13[i]);
-        Estimate::new(a.value + 2.0 * b.value, a.error + 2.0 * b.error)
+    /// δδ, δθ, θθ from an array in that order.
+    pub fn from_array([dd, dt, tt]: [T; 3]) -> Self {
+        Self { dd, dt, tt }
+    }
+
+    /// Each value mapped by `f`.
+    pub fn map<U>(self, mut f: impl FnMut(T) -> U) -> ByPair<U> {
+        ByPair {
+            dd: f(self.dd),
+            dt: f(self.dt),
+            tt: f(self.tt),
+        }
+    }
+
+    /// The pairs and their values, in the order δδ, δθ, θθ.
+    pub fn iter(&self) -> impl Iterator<Item = (Pair, &T)> {
+        [
+            (Pair::DeltaDelta, &self.dd),
+            (Pair::DeltaTheta, &self.dt),
+            (Pair::ThetaTheta, &self.tt),
+        ]
+        .into_iter()
     }
 }
 
-/// All 1-loop SPT terms on a k grid.
-#[derive(Debug, Clone, PartialEq)]
-pub struct OneLoopTerms {
-    /// Wavenumbers [h/Mpc].
-    pub k: Vec<f64>,
-    /// The linear spectrum at k [(Mpc/h)^3].
-    pub p_lin: Vec<f64>,
-    /// σ_v² = (1/6π²)∫P dq over [q_min, q_max] [(Mpc/h)²].
-    pub sigma_v2: Estimate,
-    /// δδ terms.
-    pub dd: PairTerms,
-    /// δθ terms.
-    pub dt: PairTerms,
-    /// θθ terms.
-    pub tt: PairTerms,
+impl<T> ByPair<Vec<T>> {
+    /// Per-pair rows `[δδ, δθ, θθ]` (one per k) regrouped into one vector per pair.
+    pub fn from_rows(rows: &[[T; 3]]) -> Self
+    where
+        T: Copy,
+    {
+        Self::from_fn(|pair| rows.iter().map(|row| row[pair as usize]).collect())
+    }
 }
 
-impl OneLoopTerms {
-    /// The terms of `pair`.
-    pub fn pair(&self, pair: Pair) -> &PairTerms {
+impl<T> Index<Pair> for ByPair<T> {
+    type Output = T;
+    fn index(&self, pair: Pair) -> &T {
         match pair {
             Pair::DeltaDelta => &self.dd,
             Pair::DeltaTheta => &self.dt,
             Pair::ThetaTheta => &self.tt,
         }
     }
+}
 
-    fn pair_mut(&mut self, pair: Pair) -> &mut PairTerms {
+impl<T> IndexMut<Pair> for ByPair<T> {
+    fn index_mut(&mut self, pair: Pair) -> &mut T {
         match pair {
             Pair::DeltaDelta => &mut self.dd,
             Pair::DeltaTheta => &mut self.dt,
@@ -191,89 +164,175 @@ impl OneLoopTerms {
     }
 }
 
-/// Adds P15 of δδ, δθ, θθ to `terms` (computed for `spectrum`, which must be the one `terms` were made
-/// from) from the angular table ([`P15Table::get`], built or read from the cache on first use; `progress`
-/// is called while it is built), over the q range and lattice step of `precision`.
-pub fn add_p15(
-    terms: &mut OneLoopTerms,
-    spectrum: &LinearSpectrum,
-    precision: &Precision,
-    progress: &(dyn Fn(usize, usize) + Sync),
-) {
-    let rows = P15Table::get(progress).evaluate(
-        &terms.k,
-        spectrum,
-        (precision.q_min, precision.q_max),
-        precision.lattice_step,
-    );
-    terms.set_rows(&rows, |pair| &mut pair.p15);
-}
-
-/// Adds P17 of δδ, δθ, θθ to `terms`, as [`add_p15`] from the P17 angular table ([`P17Table::get`]).
-pub fn add_p17(
-    terms: &mut OneLoopTerms,
-    spectrum: &LinearSpectrum,
-    precision: &Precision,
-    progress: &(dyn Fn(usize, usize) + Sync),
-) {
-    let rows = P17Table::get(progress).evaluate(
-        &terms.k,
-        spectrum,
-        (precision.q_min, precision.q_max),
-        precision.lattice_step,
-    );
-    terms.set_rows(&rows, |pair| &mut pair.p17);
+/// All 1-loop SPT terms on a k grid [(Mpc/h)^3].
+#[derive(Debug, Clone, PartialEq)]
+pub struct OneLoopTerms {
+    /// Wavenumbers [h/Mpc].
+    pub k: Vec<f64>,
+    /// The linear spectrum at k [(Mpc/h)^3].
+    pub p_lin: Vec<f64>,
+    /// σ_v² = (1/6π²)∫P dq over [q_min, q_max] [(Mpc/h)²].
+    pub sigma_v2: Estimate,
+    /// P22 of each pair at each k.
+    pub p22: ByPair<Vec<Estimate>>,
+    /// P13 of each pair at each k, in the paper's normalisation (the correction is P22 + 2 P13).
+    pub p13: ByPair<Vec<Estimate>>,
 }
 
 impl OneLoopTerms {
-    /// Sets one term of δδ, δθ, θθ from rows [δδ, δθ, θθ] per k.
-    fn set_rows(
-        &mut self,
-        rows: &[[Estimate; 3]],
-        field: impl Fn(&mut PairTerms) -> &mut Vec<Estimate>,
-    ) {
-        for (j, pair) in [&mut self.dd, &mut self.dt, &mut self.tt]
-            .into_iter()
-            .enumerate()
-        {
-            *field(pair) = rows.iter().map(|row| row[j]).collect();
-        }
+    /// The 1-loop correction P22 + 2 P13 of `pair` at k index `i`.
+    pub fn one_loop(&self, pair: Pair, i: usize) -> Estimate {
+        self.p22[pair][i] + 2.0 * self.p13[pair][i]
     }
 
     /// P33red_XY = P13_X P13_Y / P_lin at k index `i` (first term of eq. P33; P13_X = P13_δδ or P13_θθ).
     pub fn p33_reducible(&self, pair: Pair, i: usize) -> Estimate {
         let (a, b) = match pair {
-            Pair::DeltaDelta => (self.dd.p13[i], self.dd.p13[i]),
-            Pair::DeltaTheta => (self.dd.p13[i], self.tt.p13[i]),
-            Pair::ThetaTheta => (self.tt.p13[i], self.tt.p13[i]),
+            Pair::DeltaDelta => (self.p13.dd[i], self.p13.dd[i]),
+            Pair::DeltaTheta => (self.p13.dd[i], self.p13.tt[i]),
+            Pair::ThetaTheta => (self.p13.tt[i], self.p13.tt[i]),
         };
-        let p = self.p_lin[i];
-        Estimate::new(
-            a.value * b.value / p,
-            (a.value.abs() * b.error + b.value.abs() * a.error) / p,
-        )
+        a * b / self.p_lin[i]
+    }
+
+    /// Appends the terms of `other` (the next k of the grid, for computing a long grid in chunks).
+    pub fn append(&mut self, other: Self) {
+        self.k.extend(other.k);
+        self.p_lin.extend(other.p_lin);
+        for pair in Pair::ALL {
+            self.p22[pair].extend(&other.p22[pair]);
+            self.p13[pair].extend(&other.p13[pair]);
+        }
     }
 }
 
-/// Adds the 2-loop terms to `terms` (made from `spectrum` with `precision`): P15 (if missing, from the
-/// angular table), P24 and P33^{2L} from the quasi-Monte-Carlo integral ([`two_loop`]), and the whole
-/// correction 2P15 + 2P24 + P33 as the sum of two infrared-safe parts, each one integral: the
-/// propagator part 2P15 − P33red ([`P15Table::propagator_part`]) and the mode-coupling part
-/// 2P24 + P33irr + 2P33red (see the `two_loop` module), with points added where the correction's error
-/// exceeds [`Precision::two_loop_tolerance`] of it ([`two_loop_refined`]); or at low k, if it has the
-/// smaller error, as 2P15 + P33red + (2P24 + P33irr). `table_progress` reports the P15 table build
-/// (if P15 is missing and the table is not cached), `points_progress` the quasi-Monte-Carlo points
-/// done.
-pub fn add_two_loop(
-    terms: &mut OneLoopTerms,
+/// The 2-loop SPT terms of one pair at each k [(Mpc/h)^3].
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TwoLoopPairTerms {
+    /// P24 (the correction contains 2 P24).
+    pub p24: Vec<Estimate>,
+    /// P33^{2L} = P33irr, the mode-coupling part of P33 (P33 = P33red + P33irr).
+    pub p33_2l: Vec<Estimate>,
+    /// The whole 2-loop SPT correction 2P15 + 2P24 + P33.
+    pub total: Vec<Estimate>,
+}
+
+/// The 2-loop terms of δδ, δθ, θθ.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TwoLoopCorrection {
+    /// The terms of each pair.
+    pub pairs: ByPair<TwoLoopPairTerms>,
+    /// Sobol points per random shift used at each k (after any refinement).
+    pub points: Vec<usize>,
+}
+
+/// Every loop term a real-space model may use, on one k grid: the 1-loop terms always, the others if
+/// they were computed. A model's spectra ([`crate::real::RealSpectra`]) are built from the terms it
+/// needs, and building them fails with [`Error::MissingTerm`] if one is `None`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoopTerms {
+    /// P22, P13 and σ_v².
+    pub one_loop: OneLoopTerms,
+    /// The 2-loop propagator term P15 ([`p15_terms`]).
+    pub p15: Option<ByPair<Vec<Estimate>>>,
+    /// The 3-loop propagator term P17 ([`p17_terms`]).
+    pub p17: Option<ByPair<Vec<Estimate>>>,
+    /// The 2-loop SPT terms ([`two_loop_correction`]).
+    pub two_loop: Option<TwoLoopCorrection>,
+}
+
+impl LoopTerms {
+    /// The 1-loop terms alone.
+    pub fn new(one_loop: OneLoopTerms) -> Self {
+        Self {
+            one_loop,
+            p15: None,
+            p17: None,
+            two_loop: None,
+        }
+    }
+
+    /// Wavenumbers [h/Mpc].
+    pub fn k(&self) -> &[f64] {
+        &self.one_loop.k
+    }
+
+    /// P15, or [`Error::MissingTerm`] naming `needed_by`.
+    pub fn p15(&self, needed_by: &dyn std::fmt::Display) -> Result<&ByPair<Vec<Estimate>>> {
+        self.p15.as_ref().ok_or_else(|| missing("P15", needed_by))
+    }
+
+    /// P17, or [`Error::MissingTerm`] naming `needed_by`.
+    pub fn p17(&self, needed_by: &dyn std::fmt::Display) -> Result<&ByPair<Vec<Estimate>>> {
+        self.p17.as_ref().ok_or_else(|| missing("P17", needed_by))
+    }
+
+    /// The 2-loop terms, or [`Error::MissingTerm`] naming `needed_by`.
+    pub fn two_loop(&self, needed_by: &dyn std::fmt::Display) -> Result<&TwoLoopCorrection> {
+        self.two_loop
+            .as_ref()
+            .ok_or_else(|| missing("the 2-loop terms", needed_by))
+    }
+}
+
+fn missing(term: &'static str, needed_by: &dyn std::fmt::Display) -> Error {
+    Error::MissingTerm {
+        term,
+        needed_by: needed_by.to_string(),
+        hint: " (compute the terms with a RealPlan for that model)",
+    }
+}
+
+/// P15 of δδ, δθ, θθ at wavenumbers `k` for `spectrum` from the angular `table`, over the q range and
+/// lattice step of `precision`.
+pub fn p15_terms(
+    table: &P15Table,
+    k: &[f64],
     spectrum: &LinearSpectrum,
     precision: &Precision,
-    table_progress: &(dyn Fn(usize, usize) + Sync),
+) -> ByPair<Vec<Estimate>> {
+    let rows = table.evaluate(
+        k,
+        spectrum,
+        (precision.q_min, precision.q_max),
+        precision.lattice_step,
+    );
+    ByPair::from_rows(&rows)
+}
+
+/// P17 of δδ, δθ, θθ, as [`p15_terms`] from the P17 angular table.
+pub fn p17_terms(
+    table: &P17Table,
+    k: &[f64],
+    spectrum: &LinearSpectrum,
+    precision: &Precision,
+) -> ByPair<Vec<Estimate>> {
+    let rows = table.evaluate(
+        k,
+        spectrum,
+        (precision.q_min, precision.q_max),
+        precision.lattice_step,
+    );
+    ByPair::from_rows(&rows)
+}
+
+/// The 2-loop terms for `spectrum` (from which `one_loop` and `p15` were computed with `precision`):
+/// P24 and P33^{2L} from the quasi-Monte-Carlo integral ([`two_loop`]), and the whole correction
+/// 2P15 + 2P24 + P33 as the sum of two infrared-safe parts, each one integral: the propagator part
+/// 2P15 − P33red ([`P15Table::propagator_part`]) and the mode-coupling part 2P24 + P33irr + 2P33red
+/// (see the `two_loop` module), with points added where the correction's error exceeds
+/// [`Precision::two_loop_tolerance`] of it ([`two_loop_refined`]); or at low k, if it has the smaller
+/// error, as 2P15 + P33red + (2P24 + P33irr). `points_progress` reports the quasi-Monte-Carlo points
+/// done.
+pub fn two_loop_correction(
+    one_loop: &OneLoopTerms,
+    p15: &ByPair<Vec<Estimate>>,
+    table: &P15Table,
+    spectrum: &LinearSpectrum,
+    precision: &Precision,
     points_progress: &(dyn Fn(usize, usize) + Sync),
-) {
-    if terms.dd.p15.len() != terms.k.len() {
-        add_p15(terms, spectrum, precision, table_progress);
-    }
+) -> TwoLoopCorrection {
+    let k = &one_loop.k;
     let settings = TwoLoopSettings {
         points: precision.two_loop_points,
         replicas: precision.two_loop_replicas,
@@ -281,52 +340,39 @@ pub fn add_two_loop(
         seed: precision.two_loop_seed,
         ..TwoLoopSettings::default()
     };
-    let propagator = P15Table::get(table_progress).propagator_part(
-        &terms.k,
-        spectrum,
-        (precision.q_min, precision.q_max),
-        precision.lattice_step,
-    );
+    let q_range = (precision.q_min, precision.q_max);
+    let propagator = table.propagator_part(k, spectrum, q_range, precision.lattice_step);
     let mc = two_loop_refined(
-        &terms.k,
+        k,
         spectrum,
-        (precision.q_min, precision.q_max),
+        q_range,
         precision.lattice_step,
         &settings,
         &propagator,
         points_progress,
     );
-    for (j, pair) in Pair::ALL.into_iter().enumerate() {
-        let total: Vec<Estimate> = (0..terms.k.len())
+    let pairs = ByPair::from_fn(|pair| {
+        let j = pair as usize;
+        let total = (0..k.len())
             .map(|i| {
-                let (p15, red, propagator, ir_safe) = (
-                    terms.pair(pair).p15[i],
-                    terms.p33_reducible(pair, i),
-                    propagator[i][j],
-                    mc.pairs[j].ir_safe[i],
-                );
-                let ir_safe = Estimate::new(
-                    propagator.value + ir_safe.value,
-                    propagator.error + ir_safe.error,
-                );
+                let ir_safe = propagator[i][j] + mc.pairs[j].ir_safe[i];
                 // At k ≲ 0.03 h/Mpc, where the infrared pieces are small, the plain mode coupling can
                 // be the more precise: take whichever estimate has the smaller error.
-                let m = mc.pairs[j].mode_coupling[i];
-                let split = Estimate::new(
-                    2.0 * p15.value + red.value + m.value,
-                    2.0 * p15.error + red.error + m.error,
-                );
-                if split.error < ir_safe.error {
-                    split
-                } else {
-                    ir_safe
-                }
+                let split = 2.0 * p15[pair][i]
+                    + one_loop.p33_reducible(pair, i)
+                    + mc.pairs[j].mode_coupling[i];
+                ir_safe.more_precise(split)
             })
             .collect();
-        let t = terms.pair_mut(pair);
-        t.p24 = mc.pairs[j].p24.clone();
-        t.p33_2l = mc.pairs[j].p33_2l.clone();
-        t.two_loop = total;
+        TwoLoopPairTerms {
+            p24: mc.pairs[j].p24.clone(),
+            p33_2l: mc.pairs[j].p33_2l.clone(),
+            total,
+        }
+    });
+    TwoLoopCorrection {
+        pairs,
+        points: mc.points,
     }
 }
 

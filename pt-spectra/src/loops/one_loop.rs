@@ -3,7 +3,7 @@
 use super::lattice::Lattice;
 use super::p13::{p13_weights, sigma_v2_weights, P13Weights};
 use super::p22::{Layout, P22Nodes};
-use super::{Estimate, OneLoopTerms, PairTerms};
+use super::{ByPair, Estimate, OneLoopTerms};
 use crate::error::{Error, Result};
 use crate::integrate::legendre_nodes;
 use crate::linear::LinearSpectrum;
@@ -107,14 +107,14 @@ pub(crate) fn validate_grid(k: &[f64], precision: &Precision) -> Result<()> {
 /// linear spectrum. [`evaluate`](Self::evaluate) then costs one lattice sampling of P plus dot products.
 ///
 /// ```
-/// use pt_spectra::{linear::LinearSpectrum, loops::OneLoopPlan, precision::Precision};
+/// use pt_spectra::{linear::LinearSpectrum, loops::{OneLoopPlan, Pair}, precision::Precision};
 /// let p = LinearSpectrum::gm2012(0.0)?;
 /// let plan = OneLoopPlan::new(&[0.05, 0.1, 0.2], &Precision::fast())?;
 /// let t = plan.evaluate(&p);
 /// // 1-loop δδ correction at k = 0.1 h/Mpc, z = 0: P22 + 2 P13 ≈ 1854 − 1501, about 7% of P_lin.
-/// let one_loop = t.dd.one_loop(1).value;
+/// let one_loop = t.one_loop(Pair::DeltaDelta, 1).value;
 /// assert!((one_loop / t.p_lin[1] - 0.066).abs() < 0.005);
-/// assert!(t.dd.p22[1].relative_error() < 1e-4);
+/// assert!(t.p22.dd[1].relative_error() < 1e-4);
 /// # Ok::<(), pt_spectra::error::Error>(())
 /// ```
 #[derive(Debug, Clone)]
@@ -203,9 +203,8 @@ impl OneLoopPlan {
             k: self.k.clone(),
             p_lin: Vec::with_capacity(n),
             sigma_v2: Estimate::new(sv, (sv - sv_coarse).abs()),
-            dd: PairTerms::with_capacity(n),
-            dt: PairTerms::with_capacity(n),
-            tt: PairTerms::with_capacity(n),
+            p22: ByPair::from_fn(|_| Vec::with_capacity(n)),
+            p13: ByPair::from_fn(|_| Vec::with_capacity(n)),
         };
         for (p, fine, coarse) in rows {
             let floor = self.precision.p22_error_floor;
@@ -218,12 +217,12 @@ impl OneLoopPlan {
             };
             let (f13, g13) = (e(0, p), e(1, p));
             out.p_lin.push(p);
-            out.dd.p13.push(f13);
-            out.tt.p13.push(g13);
-            out.dt.p13.push(Estimate::mean(f13, g13));
-            out.dd.p22.push(e(2, 1.0));
-            out.dt.p22.push(e(3, 1.0));
-            out.tt.p22.push(e(4, 1.0));
+            out.p13.dd.push(f13);
+            out.p13.tt.push(g13);
+            out.p13.dt.push(Estimate::mean(f13, g13));
+            out.p22.dd.push(e(2, 1.0));
+            out.p22.dt.push(e(3, 1.0));
+            out.p22.tt.push(e(4, 1.0));
         }
         out
     }

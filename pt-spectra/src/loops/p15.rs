@@ -15,7 +15,7 @@
 //! u_i = ln r_i ∈ [ln [`R_MIN`], ln [`R_END`]], on Gauss–Legendre panels whose edges follow the lines
 //! where K is not smooth (r_i = 1, r₁ ± r₂ = 1). The table stores K at every node of that rule and of a
 //! lower-order rule on the same panels (the radial error estimate). It does not depend on k or on the
-//! spectrum: it is built once per process (about 20 s on 2 cores) and cached on disk (see [`cache_path`]).
+//! spectrum: it is built once (about 35 s on 2 cores) and cached on disk by a [`TableStore`](crate::store::TableStore).
 //!
 //! Limits (tests): K_F → ½K₁(r₁)K₁(r₂) when r₁, r₂ ≪ 1 (K₁ = 3⟨F_3^s(k, q, −q)⟩); K_F → −β/(r₁² + r₂²)·…
 //! in the UV with β = 22382/429975 at r₁ = r₂ ≫ 1 and 120424/3009825 for 1 ≪ r₂ ≪ r₁ (Bernardeau, Taruya &
@@ -33,8 +33,6 @@ use crate::integrate::{panel_edges, GaussLegendre};
 use crate::linear::LinearSpectrum;
 use rayon::prelude::*;
 use std::f64::consts::PI;
-use std::path::PathBuf;
-use std::sync::OnceLock;
 
 /// Smallest r = q/k of the radial rule.
 pub const R_MIN: f64 = 1e-5;
@@ -207,91 +205,12 @@ pub struct P15Table {
     propagator: NodeKernels<3>,
 }
 
-/// Where the table is cached: `$PT_SPECTRA_CACHE/`, else `$XDG_CACHE_HOME/pt-spectra/`, else
-/// `$HOME/.cache/pt-spectra/`, file `p15-v<version>-<orders>.bin` (little-endian f64). Delete it to rebuild.
-pub fn cache_path() -> Option<PathBuf> {
-    Some(cache_dir()?.join(format!(
-        "p15-v{TABLE_VERSION}-a{ANGULAR_ORDER}-{ANGULAR_ORDER_COARSE}-r{RADIAL_ORDER}.bin"
-    )))
-}
-
-/// The cache directory of the angular tables: `$PT_SPECTRA_CACHE`, else `$XDG_CACHE_HOME/pt-spectra`,
-/// else `$HOME/.cache/pt-spectra`.
-pub(crate) fn cache_dir() -> Option<PathBuf> {
-    std::env::var_os("PT_SPECTRA_CACHE")
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("XDG_CACHE_HOME").map(|d| PathBuf::from(d).join("pt-spectra")))
-        .or_else(|| std::env::var_os("HOME").map(|d| PathBuf::from(d).join(".cache/pt-spectra")))
-}
-
-/// A lock older than this is taken to be left by a process that died while building a table.
-const LOCK_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(20 * 60);
-
-/// The cached table at `path`, or a new one from `build`, written there. A process that finds another
-/// building the same table (a fresh `.lock` file beside it) waits for that table instead of building
-/// its own, so that parallel jobs on a fresh machine build each table once.
-pub(crate) fn cached<T>(
-    path: Option<PathBuf>,
-    read: impl Fn(&std::path::Path) -> Option<T>,
-    build: impl FnOnce() -> T,
-    write: impl Fn(&T, &std::path::Path),
-) -> T {
-    let Some(path) = path else {
-        return build();
-    };
-    if let Some(t) = read(&path) {
-        return t;
+impl P15Table {
+    /// The table's file name in a [`TableStore`](crate::store::TableStore) directory:
+    /// `p15-v<version>-<orders>.bin` (little-endian f64). Delete the file to rebuild the table.
+    pub fn file_name() -> String {
+        format!("p15-v{TABLE_VERSION}-a{ANGULAR_ORDER}-{ANGULAR_ORDER_COARSE}-r{RADIAL_ORDER}.bin")
     }
-    let lock = path.with_extension("lock");
-    let _ = std::fs::create_dir_all(path.parent().unwrap_or(&path));
-    let fresh = |lock: &std::path::Path| {
-        std::fs::metadata(lock)
-            .and_then(|m| m.modified())
-            .ok()
-            .and_then(|t| t.elapsed().ok())
-            .is_some_and(|age| age < LOCK_TIMEOUT)
-    };
-    let mine = std::fs::OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(&lock)
-        .is_ok();
-    if !mine {
-        while fresh(&lock) {
-            std::thread::sleep(std::time::Duration::from_millis(500));
-            if let Some(t) = read(&path) {
-                return t;
-            }
-        }
-        if let Some(t) = read(&path) {
-            return t;
-        }
-    }
-    let t = build();
-    write(&t, &path);
-    if mine {
-        let _ = std::fs::remove_file(&lock);
-    }
-    t
-}
-
-/// Writes little-endian f64 `values` to `path` atomically (a failed write only costs a rebuild).
-pub(crate) fn write_f64s(path: &std::path::Path, values: impl IntoIterator<Item = f64>) {
-    let bytes: Vec<u8> = values.into_iter().flat_map(f64::to_le_bytes).collect();
-    let _ = std::fs::create_dir_all(path.parent().unwrap_or(path))
-        .and_then(|()| std::fs::write(path.with_extension("tmp"), &bytes))
-        .and_then(|()| std::fs::rename(path.with_extension("tmp"), path));
-}
-
-/// Reads little-endian f64 values from `path`.
-pub(crate) fn read_f64s(path: &std::path::Path) -> Option<Vec<f64>> {
-    let bytes = std::fs::read(path).ok()?;
-    Some(
-        bytes
-            .chunks_exact(8)
-            .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
-            .collect(),
-    )
 }
 
 impl P15Table {
@@ -303,21 +222,6 @@ impl P15Table {
     /// Whether the table is empty (never, for a built table).
     pub fn is_empty(&self) -> bool {
         self.fine.is_empty()
-    }
-
-    /// The table of this process: read from the cache file if it is there and valid, otherwise built (in
-    /// parallel, calling `progress(done, total)` now and then; or by another process, which this one then
-    /// waits for) and written to the cache (if possible).
-    pub fn get(progress: &(dyn Fn(usize, usize) + Sync)) -> &'static P15Table {
-        static TABLE: OnceLock<P15Table> = OnceLock::new();
-        TABLE.get_or_init(|| {
-            cached(
-                cache_path(),
-                Self::read,
-                || Self::build(progress),
-                Self::write,
-            )
-        })
     }
 
     /// Builds the table (in parallel over nodes).
@@ -397,7 +301,8 @@ impl P15Table {
         }
     }
 
-    fn write(&self, path: &std::path::Path) {
+    /// The table as the values of its file (see [`TableStore`](crate::store::TableStore)).
+    pub(crate) fn to_f64s(&self) -> Vec<f64> {
         let mut values = vec![self.fine.len() as f64, self.coarse.len() as f64];
         for i in 0..self.fine.len() {
             values.extend(
@@ -407,11 +312,12 @@ impl P15Table {
             );
         }
         values.extend(self.p15.coarse.iter().flatten());
-        write_f64s(path, values);
+        values
     }
 
-    fn read(path: &std::path::Path) -> Option<Self> {
-        let values = read_f64s(path)?;
+    /// The table from the values of its file, or `None` if they do not fit the rules or a few
+    /// recomputed entries differ (a stale or corrupted file).
+    pub(crate) fn from_f64s(values: &[f64]) -> Option<Self> {
         let (fine, coarse) = (radial_rule(RADIAL_ORDER), radial_rule(RADIAL_ORDER - 2));
         if values.len() != 2 + 4 * fine.len() + 2 * coarse.len()
             || values[0] != fine.len() as f64

@@ -12,14 +12,14 @@
 //! ln [`R_MAX`]] with Gauss–Legendre panels split at r = 1. The table holds K at every node; it is built
 //! once (under 2 minutes on 2 cores, with progress; the four shifts of each point run in the four
 //! lanes of [`pt_kernels::propagator_7_x4`]) and cached like the P15 table
-//! ([`cache_path`]). The UV beyond R_MAX·k is dropped (P17 matters only where N3 differs from N2,
+//! ([`TableStore`](crate::store::TableStore)). The UV beyond R_MAX·k is dropped (P17 matters only where N3 differs from N2,
 //! k ≳ 0.05 h/Mpc, for which q > 50 h/Mpc carries no power).
 //!
 //! Limits (tests): K_F → K₁(r₁)K₁(r₂)K₁(r₃)/6 for r_i ≪ 1, so that 6P17/P → (P13/P)³ and N3 → N1 for
 //! factorised kernels.
 
 use super::lattice::Lattice;
-use super::p15::{cache_dir, cached, edges_with, read_f64s, write_f64s};
+use super::p15::edges_with;
 use super::Estimate;
 use crate::integrate::GaussLegendre;
 use crate::linear::LinearSpectrum;
@@ -27,7 +27,6 @@ use rayon::prelude::*;
 use sobol::params::JoeKuoD6;
 use sobol::Sobol;
 use std::f64::consts::PI;
-use std::path::PathBuf;
 use std::sync::OnceLock;
 
 /// Smallest r = q/k of the radial rule.
@@ -158,11 +157,11 @@ pub struct P17Table {
     kernels: Vec<[Estimate; 2]>,
 }
 
-/// The cache file of the P17 table (in the directory of [`super::cache_path`]).
-pub fn cache_path() -> Option<PathBuf> {
-    Some(cache_dir()?.join(format!(
-        "p17-v{TABLE_VERSION}-a{ANGULAR_POINTS}-r{RADIAL_ORDER}.bin"
-    )))
+impl P17Table {
+    /// The table's file name in a [`TableStore`](crate::store::TableStore) directory.
+    pub fn file_name() -> String {
+        format!("p17-v{TABLE_VERSION}-a{ANGULAR_POINTS}-r{RADIAL_ORDER}.bin")
+    }
 }
 
 impl P17Table {
@@ -176,20 +175,12 @@ impl P17Table {
         self.nodes.is_empty()
     }
 
-    /// The table of this process: from the cache if valid, else built (calling `progress(done, total)`)
-    /// and cached.
-    pub fn get(progress: &(dyn Fn(usize, usize) + Sync)) -> &'static P17Table {
-        static TABLE: OnceLock<P17Table> = OnceLock::new();
-        TABLE.get_or_init(|| {
-            let write = |t: &Self, p: &std::path::Path| {
-                let values = t
-                    .kernels
-                    .iter()
-                    .flat_map(|k| [k[0].value, k[0].error, k[1].value, k[1].error]);
-                write_f64s(p, values);
-            };
-            cached(cache_path(), Self::read, || Self::build(progress), write)
-        })
+    /// The table as the values of its file (see [`TableStore`](crate::store::TableStore)).
+    pub(crate) fn to_f64s(&self) -> Vec<f64> {
+        self.kernels
+            .iter()
+            .flat_map(|k| [k[0].value, k[0].error, k[1].value, k[1].error])
+            .collect()
     }
 
     /// Builds the table (in parallel).
@@ -211,8 +202,9 @@ impl P17Table {
         Self { nodes, kernels }
     }
 
-    fn read(path: &std::path::Path) -> Option<Self> {
-        let values = read_f64s(path)?;
+    /// The table from the values of its file, or `None` if they do not fit the rule or a few
+    /// recomputed entries differ (a stale or corrupted file).
+    pub(crate) fn from_f64s(values: &[f64]) -> Option<Self> {
         let nodes = radial_rule();
         if values.len() != 4 * nodes.len() || values.iter().any(|v| !v.is_finite()) {
             return None;

@@ -1,15 +1,16 @@
 //! `pt-spectra fit`: best-fit f, σ0, A_b with Δχ² errors against measured multipoles, versus k_max.
 
 use crate::common::{list, BiasArgs, NoiseArgs};
-use crate::real::{loop_terms, write_output, SpectrumInput};
+use crate::input::SpectrumInput;
+use crate::progress::Bars;
+use crate::real::write_output;
+use crate::rsd::parsed;
 use anyhow::{bail, Context, Result};
-use pt_spectra::cosmology::Cosmology;
 use pt_spectra::fit::{
     delta_chi2, fit, FitSettings, MultipoleData, MultipoleModel, Parameter, Params,
 };
-use pt_spectra::loops::TnsPlan;
-use pt_spectra::real::{from_terms, RealModel};
-use pt_spectra::rsd::{Fog, RsdModel};
+use pt_spectra::real::RealModel;
+use pt_spectra::rsd::{Fog, RsdModel, RsdPlan};
 use pt_spectra::table::Table;
 use std::path::PathBuf;
 
@@ -35,18 +36,18 @@ pub struct Args {
     #[arg(long, value_name = "FILE")]
     covariance: Option<PathBuf>,
     /// Real-space model: linear, 1l-spt, 2l-spt, 1l-rpt-n0..n3, 2l-rpt-n0..n3.
-    #[arg(long = "real", value_name = "M", default_value = "1l-spt")]
-    real_model: String,
+    #[arg(long = "real", value_name = "M", default_value = "1l-spt", value_parser = parsed::<RealModel>)]
+    real_model: RealModel,
     /// Redshift-space model: kaiser, scoccimarro or tns.
-    #[arg(long, value_name = "MODEL", default_value = "tns")]
-    rsd: String,
+    #[arg(long, value_name = "MODEL", default_value = "tns", value_parser = parsed::<RsdModel>)]
+    rsd: RsdModel,
     /// Fingers of God: none, lorentzian or gaussian.
-    #[arg(long, value_name = "KIND", default_value = "lorentzian")]
-    fog: String,
+    #[arg(long, value_name = "KIND", default_value = "lorentzian", value_parser = parsed::<Fog>)]
+    fog: Fog,
     /// Free parameters, comma separated: f, sigma0, ab.
     #[arg(long, value_name = "P,P", default_value = "f,sigma0")]
     free: String,
-    /// Growth rate: start value if free, value if fixed. Default: f(z) of the gm2012 cosmology.
+    /// Growth rate: start value if free, value if fixed. Default: f(z) of the cosmology.
     #[arg(long, value_name = "F", allow_hyphen_values = true)]
     f: Option<f64>,
     /// σ0 [Mpc/h]: start value if free, value if fixed.
@@ -96,9 +97,7 @@ fn k_max_values(s: &str) -> Result<Vec<f64>> {
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<()> {
-    let real: RealModel = args.real_model.parse()?;
-    let rsd: RsdModel = args.rsd.parse()?;
-    let fog: Fog = args.fog.parse()?;
+    let (real, rsd, fog) = (args.real_model, args.rsd, args.fog);
     let free: Vec<Parameter> = args
         .free
         .split(',')
@@ -141,10 +140,10 @@ pub fn run(args: &Args) -> Result<()> {
         data = data.with_covariance(rows).context("--covariance")?;
     }
     let k_max = k_max_values(&args.k_max)?;
-    let (spectrum, precision) = args.spectrum.load()?;
-    let cosmology = Cosmology::gm2012();
+    let loaded = args.spectrum.load()?;
+    let (prepared, precision) = (&loaded.prepared, &loaded.precision);
     let z = args.spectrum.z;
-    let f0 = args.f.unwrap_or_else(|| cosmology.growth_rate(z));
+    let f0 = args.f.unwrap_or(prepared.growth_rate);
     for (name, v) in [
         ("--f", f0),
         ("--sigma0", args.sigma0),
@@ -155,18 +154,15 @@ pub fn run(args: &Args) -> Result<()> {
         }
     }
     let b = args.bias.bias()?.values(&data.k, 1.0)?;
-    let spectra = from_terms(real, &loop_terms(&data.k, &precision, &spectrum, real)?)?;
-    let tns = if rsd.needs_tns() {
-        Some(TnsPlan::new(&data.k, &precision)?.par_evaluate(&spectrum))
-    } else {
-        None
-    };
+    let bars = Bars::default();
+    let plan = RsdPlan::new(&data.k, real, rsd, precision, &loaded.store, &bars)?;
+    let (spectra, tns) = plan.evaluate(&prepared.spectrum, &bars)?;
     let model = MultipoleModel::new(
         &spectra,
         tns.as_ref(),
         rsd,
         fog,
-        cosmology.growth_factor(z),
+        prepared.growth_factor,
         b,
         &ells,
     )?;
@@ -181,33 +177,22 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let results = fit(&model, &data, &settings, &k_max)?;
 
-    let mut text = format!(
-        "# pt-spectra {} fit: {rsd} with real-space {real}, FoG {fog:?}, z = {z}, ells {}, free {}; data {}\n",
+    let mut header = vec![format!(
+        "pt-spectra {} fit: {rsd} with real-space {real}, FoG {fog:?}, z = {z}, ells {}, free {}; data {}",
         env!("CARGO_PKG_VERSION"),
         args.ells,
         args.free,
         args.data.display()
-    );
-    text += &args.spectrum.describe(&spectrum, &precision);
-    text += &format!(
-        "# chi2 = {} ; errors: where the profile chi2 reaches chi2_min + {} ({} free); fixed: f = {f0}, sigma0 = {}, ab = {}\n",
+    )];
+    header.extend(loaded.describe());
+    header.push(format!(
+        "chi2 = {} ; errors: where the profile chi2 reaches chi2_min + {} ({} free); fixed: f = {f0}, sigma0 = {}, ab = {}",
         if data.covariance.is_some() { "(d-m)^T C^-1 (d-m)" } else { "sum ((d-m)/sigma)^2" },
         delta_chi2(free.len()),
         free.len(),
         args.sigma0,
         args.bias.amplitude
-    );
-    text += "# k_max points";
-    for p in &free {
-        text += &format!(" {p} {p}_lo {p}_hi");
-    }
-    text += " chi2 dof chi2_dof\n";
-    for r in &results {
-        text += &format!("{:.6} {}", r.k_max, r.points);
-        for (p, lo, hi) in &r.intervals {
-            text += &format!(" {:.9e} {lo:.9e} {hi:.9e}", r.best.get(*p));
-        }
-        text += &format!(" {:.6e} {} {:.6e}\n", r.chi2, r.dof, r.chi2 / r.dof as f64);
-    }
-    write_output(args.out.as_ref(), &text)
+    ));
+    let table = pt_spectra::output::fit_table(&results, header);
+    write_output(args.out.as_ref(), &table.to_text())
 }

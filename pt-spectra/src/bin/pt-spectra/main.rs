@@ -8,8 +8,10 @@ use std::process::ExitCode;
 
 mod common;
 mod fit;
+mod input;
 mod kernel;
 mod plot;
+mod progress;
 mod real;
 mod rsd;
 
@@ -26,7 +28,7 @@ enum Command {
     /// Evaluate the symmetrised SPT kernel F_n^s or G_n^s (n = number of --q, 1..=7).
     Kernel(kernel::Args),
     /// Real-space P_δδ, P_δθ, P_θθ (linear, 1- and 2-loop SPT, 1- and 2-loop RPT with N0..N3) on a k grid.
-    Real(real::Args),
+    Real(Box<real::Args>),
     /// Redshift-space multipoles P_ℓ(k) (Kaiser, Scoccimarro or TNS; Fingers of God; halo bias and noise).
     Rsd(Box<rsd::Args>),
     /// Fit f, σ0 and the bias amplitude to measured multipoles, with Δχ² errors, versus k_max.

@@ -1,0 +1,337 @@
+//! The options that say what to compute from: cosmology, linear spectrum, redshifts, loop-integral
+//! settings, table cache and k grid; parsed here, turned into library inputs by the library.
+
+use anyhow::{bail, Context, Result};
+use pt_spectra::cosmology::TransferKind;
+use pt_spectra::linear::{Columns, LinearSpectrum, LogGrid};
+use pt_spectra::precision::Precision;
+use pt_spectra::setup::{self, LinearSource, NamedCosmology, Prepared, Request};
+use pt_spectra::store::TableStore;
+use std::path::PathBuf;
+
+/// `K,P` (1-based column numbers) as 0-based [`Columns`].
+pub fn parse_columns(s: &str) -> std::result::Result<Columns, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let [k, p] = parts[..] else {
+        return Err(format!(
+            "`{s}`: expected two column numbers K,P (1-based), e.g. 1,2"
+        ));
+    };
+    let one = |x: &str| match x.parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n - 1),
+        _ => Err(format!("`{x}` is not a column number (1, 2, …)")),
+    };
+    let (k, p) = (one(k)?, one(p)?);
+    if k == p {
+        return Err(format!("`{s}`: k and P must be different columns"));
+    }
+    Ok(Columns::new(k, p))
+}
+
+/// `QMIN,QMAX` [h/Mpc]: 0 < QMIN < QMAX, both finite.
+pub fn parse_q_range(s: &str) -> std::result::Result<(f64, f64), String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let [a, b] = parts[..] else {
+        return Err(format!("`{s}`: expected QMIN,QMAX in h/Mpc, e.g. 1e-5,1e3"));
+    };
+    let number = |x: &str| {
+        x.parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .ok_or_else(|| format!("`{x}` is not a finite positive wavenumber"))
+    };
+    let (lo, hi) = (number(a)?, number(b)?);
+    if lo >= hi {
+        return Err(format!("`{s}`: QMIN must be below QMAX"));
+    }
+    Ok((lo, hi))
+}
+
+/// A precision preset by name.
+pub fn parse_precision(s: &str) -> std::result::Result<Precision, String> {
+    Precision::preset(s).map_err(|e| e.to_string())
+}
+
+/// Eisenstein & Hu (1998) transfer function choice.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum EhKind {
+    /// Full fit with baryon acoustic oscillations.
+    Wiggle,
+    /// Smooth no-wiggle fit.
+    NoWiggle,
+}
+
+/// The cosmology, linear spectrum, redshift and accuracy: the options `real`, `rsd` and `fit` share.
+#[derive(clap::Args, Debug)]
+pub struct SpectrumInput {
+    /// Cosmology: a preset (`gm2012`, the default, or `planck2018`) or a CLASS/CAMB `.ini` parameter
+    /// file. It sets the growth D(z) and f(z) (rescaling from --z-input to --z, default f, FoG scale)
+    /// and the no-wiggle reference; without --linear, a cosmology other than gm2012 uses its
+    /// Eisenstein & Hu spectrum.
+    #[arg(long, value_name = "NAME|FILE")]
+    cosmology: Option<String>,
+    /// Linear spectrum table (k [h/Mpc], P [(Mpc/h)^3]; CAMB or CLASS format). Default: the embedded
+    /// CAMB spectrum of the Gil-Marín et al. (2012) cosmology.
+    #[arg(long, value_name = "FILE", conflicts_with = "eh")]
+    linear: Option<PathBuf>,
+    /// Columns of k and P in the --linear table, 1-based, e.g. `1,3` for a CLASS file with several
+    /// spectra. Default `1,2`.
+    #[arg(long, value_name = "K,P", value_parser = parse_columns, requires = "linear")]
+    columns: Option<Columns>,
+    /// Use the Eisenstein & Hu (1998) linear spectrum of the cosmology instead of a table: `wiggle`
+    /// (with BAO) or `no-wiggle` (the smooth fit); gm2012 is normalised to σ8 = 0.8.
+    #[arg(long, value_name = "KIND", value_enum)]
+    eh: Option<EhKind>,
+    /// Redshift of the --linear table.
+    #[arg(
+        long,
+        value_name = "Z",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    z_input: f64,
+    /// Redshift of the output; the input is rescaled by [D(z)/D(z_input)]² of the cosmology.
+    #[arg(
+        long,
+        value_name = "Z",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    pub z: f64,
+    /// Accuracy of the loop integrals: fast, default or reference.
+    #[arg(long, value_name = "PRESET", default_value = "default", value_parser = parse_precision)]
+    precision: Precision,
+    /// Range of every loop integral over q [h/Mpc], QMIN,QMAX (default 1e-5,1e3). The 2-loop and
+    /// propagator terms P15, P17 depend on QMAX (UV sensitivity); the header states the range.
+    #[arg(long, value_name = "QMIN,QMAX", value_parser = parse_q_range)]
+    q_range: Option<(f64, f64)>,
+    /// Directory of the cached angular tables (P15, P17). Default: $PT_SPECTRA_CACHE, else
+    /// $XDG_CACHE_HOME/pt-spectra, else ~/.cache/pt-spectra.
+    #[arg(long, value_name = "DIR")]
+    cache_dir: Option<PathBuf>,
+}
+
+/// What the input options give: the prepared spectrum and growth, the loop settings, the table store.
+pub struct Loaded {
+    /// The linear spectrum at the output redshift, with the cosmology's growth.
+    pub prepared: Prepared,
+    /// The loop-integral settings.
+    pub precision: Precision,
+    /// The angular-table cache.
+    pub store: TableStore,
+}
+
+impl SpectrumInput {
+    /// Parses the cosmology and reads the spectrum; warnings go to standard error.
+    pub fn load(&self) -> Result<Loaded> {
+        for (name, z) in [("--z", self.z), ("--z-input", self.z_input)] {
+            if !(z.is_finite() && z > -1.0) {
+                bail!("{name} {z}: a redshift must be finite and > -1");
+            }
+        }
+        let cosmology = match &self.cosmology {
+            None => None,
+            Some(s) => {
+                let (named, ignored) =
+                    NamedCosmology::parse(s).map_err(|e| anyhow::anyhow!("--cosmology: {e}"))?;
+                if !ignored.is_empty() {
+                    eprintln!(
+                        "note: --cosmology {s}: keys ignored (they do not set the background or growth): {}",
+                        ignored.join(", ")
+                    );
+                }
+                Some(named)
+            }
+        };
+        let source = match (&self.linear, self.eh) {
+            (Some(path), _) => LinearSource::Table {
+                // The library error already names the file and the OS error; keep the message single.
+                spectrum: Box::new(
+                    LinearSpectrum::from_file_with_columns(path, self.columns.unwrap_or_default())
+                        .map_err(|e| anyhow::anyhow!("{e}"))?,
+                ),
+                z_input: self.z_input,
+            },
+            (None, Some(EhKind::Wiggle)) => LinearSource::EisensteinHu(TransferKind::Wiggle),
+            (None, Some(EhKind::NoWiggle)) => LinearSource::EisensteinHu(TransferKind::NoWiggle),
+            (None, None) => LinearSource::Embedded,
+        };
+        let prepared = setup::prepare(Request {
+            source,
+            cosmology,
+            z: self.z,
+        })?;
+        for w in &prepared.warnings {
+            eprintln!("warning: {w}");
+        }
+        let mut precision = self.precision.clone();
+        if let Some((lo, hi)) = self.q_range {
+            precision = precision
+                .with_q_range(lo, hi)
+                .context("invalid --q-range")?;
+        }
+        let store = match &self.cache_dir {
+            Some(dir) => TableStore::new(dir),
+            None => TableStore::from_env(),
+        };
+        Ok(Loaded {
+            prepared,
+            precision,
+            store,
+        })
+    }
+}
+
+impl Loaded {
+    /// Header lines naming the cosmology, the input spectrum and the integration settings.
+    pub fn describe(&self) -> Vec<String> {
+        let (spectrum, precision) = (&self.prepared.spectrum, &self.precision);
+        let mut h = self.prepared.description.clone();
+        h.push(format!(
+            "loop integrals over q in [{:e}, {:e}] h/Mpc, precision {}; the linear table covers [{:e}, \
+             {:e}] h/Mpc and is extended by power laws (slopes {:.3}, {:.3})",
+            precision.q_min,
+            precision.q_max,
+            precision.preset,
+            spectrum.k_min(),
+            spectrum.k_max(),
+            spectrum.extrapolation_slopes().0,
+            spectrum.extrapolation_slopes().1
+        ));
+        h
+    }
+}
+
+/// The linear spectrum and the output k grid: the options `real` and `rsd` share.
+#[derive(clap::Args, Debug)]
+pub struct Input {
+    #[command(flatten)]
+    pub spectrum: SpectrumInput,
+    /// Smallest output k [h/Mpc] (log-spaced grid).
+    #[arg(
+        long,
+        value_name = "K",
+        default_value_t = 1e-3,
+        allow_hyphen_values = true
+    )]
+    k_min: f64,
+    /// Largest output k [h/Mpc].
+    #[arg(
+        long,
+        value_name = "K",
+        default_value_t = 1.0,
+        allow_hyphen_values = true
+    )]
+    k_max: f64,
+    /// Number of log-spaced k values.
+    #[arg(long, value_name = "N", default_value_t = 100)]
+    nk: usize,
+    /// Read the output k values [h/Mpc] from the first column of this file instead ('#' comments).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["k_min", "k_max", "nk"])]
+    k_file: Option<PathBuf>,
+}
+
+impl Input {
+    /// The output k grid [h/Mpc] and the loaded input (with a warning when the grid reaches the
+    /// extrapolated ends of the linear table).
+    pub fn load(&self) -> Result<(Vec<f64>, Loaded)> {
+        let k = match &self.k_file {
+            Some(path) => read_k_file(path)?,
+            None => LogGrid::new(self.k_min, self.k_max, self.nk)
+                .context("invalid --k-min/--k-max/--nk")?
+                .points(),
+        };
+        let loaded = self.spectrum.load()?;
+        if let Some(ext) = loaded
+            .prepared
+            .spectrum
+            .extrapolation_in(k[0], k[k.len() - 1])
+        {
+            eprintln!("warning: output {ext}");
+        }
+        Ok((k, loaded))
+    }
+
+    /// The output redshift.
+    pub fn z(&self) -> f64 {
+        self.spectrum.z
+    }
+}
+
+/// k values from the first column of a file: finite, positive, strictly increasing.
+pub fn read_k_file(path: &PathBuf) -> Result<Vec<f64>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read --k-file `{}`", path.display()))?;
+    let mut k: Vec<f64> = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let data = line.split('#').next().unwrap_or("");
+        let Some(field) = data
+            .split(|c: char| c == ',' || c.is_whitespace())
+            .find(|s| !s.is_empty())
+        else {
+            continue;
+        };
+        let where_ = format!("{}:{}", path.display(), i + 1);
+        let v: f64 = field
+            .parse()
+            .with_context(|| format!("{where_}: cannot parse `{field}` as k"))?;
+        if !(v.is_finite() && v > 0.0) {
+            bail!("{where_}: k = {v} h/Mpc is not a finite positive number");
+        }
+        if let Some(&prev) = k.last().filter(|&&prev| v <= prev) {
+            bail!(
+                "{where_}: k = {v} h/Mpc does not exceed the previous k = {prev} (k must increase)"
+            );
+        }
+        k.push(v);
+    }
+    if k.is_empty() {
+        bail!("--k-file `{}` contains no k values", path.display());
+    }
+    Ok(k)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(name: &str, text: &str) -> PathBuf {
+        let path =
+            std::env::temp_dir().join(format!("pt-spectra-real-{}-{name}", std::process::id()));
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    #[test]
+    fn k_files_are_validated_with_line_numbers() {
+        let ok = write("ok", "# k\n0.01 1\n\n0.1, 2 # comment\n");
+        assert_eq!(read_k_file(&ok).unwrap(), vec![0.01, 0.1]);
+        for (name, text, needle) in [
+            ("dec", "0.1\n0.05\n", ":2: k = 0.05"),
+            ("nan", "0.1\nNaN\n", ":2: k = NaN"),
+            ("neg", "-1\n", ":1: k = -1"),
+            ("txt", "0.1\nabc\n", ":2: cannot parse `abc`"),
+            ("empty", "# nothing\n", "no k values"),
+        ] {
+            let e = format!("{:#}", read_k_file(&write(name, text)).unwrap_err());
+            assert!(e.contains(needle), "{name}: {e}");
+        }
+        let missing = format!(
+            "{:#}",
+            read_k_file(&PathBuf::from("/nonexistent/k")).unwrap_err()
+        );
+        assert!(missing.contains("/nonexistent/k"), "{missing}");
+    }
+
+    #[test]
+    fn column_choices_and_q_ranges_are_checked() {
+        assert_eq!(parse_columns("1,3").unwrap(), Columns::new(0, 2));
+        for bad in ["0,1", "1", "1,1", "a,2", "1,2,3"] {
+            assert!(parse_columns(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_q_range("1e-4, 10").unwrap(), (1e-4, 10.0));
+        for bad in ["1", "10,1", "0,1", "nan,1", "1,inf", "a,b"] {
+            assert!(parse_q_range(bad).is_err(), "{bad}");
+        }
+    }
+}

@@ -1,0 +1,136 @@
+//! Output tables: each column declared once (name, unit, values), written as text by the command line
+//! and handed to Python as arrays under the same names.
+//!
+//! Text format: `#` header lines, then `# column i: name [unit]` for every column, then `# ` and the
+//! names, then one row per k with every value as `{:.9e}`, separated by single spaces.
+//!
+//! ```
+//! use pt_spectra::{estimate::Estimate, output::Table};
+//! let mut t = Table::new(vec!["an example".into()]);
+//! t.push("k", "h/Mpc", vec![0.1, 0.2]);
+//! t.push_estimates("P", "(Mpc/h)^3", &[Estimate::new(1.0, 0.01), Estimate::new(2.0, 0.02)]);
+//! assert_eq!(t.names(), ["k", "P", "err_P"]);
+//! assert!(t.to_text().ends_with("2.000000000e-1 2.000000000e0 2.000000000e-2\n"));
+//! ```
+
+use crate::estimate::Estimate;
+
+/// The unit of spectra.
+pub const POWER: &str = "(Mpc/h)^3";
+/// The unit of wavenumbers.
+pub const WAVENUMBER: &str = "h/Mpc";
+
+/// One column: its name, unit and a value per row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Column {
+    /// The name, e.g. `P22_dd` or `err_P22_dd`.
+    pub name: String,
+    /// The unit, e.g. `(Mpc/h)^3`, or `1` for a ratio.
+    pub unit: &'static str,
+    /// The values.
+    pub values: Vec<f64>,
+}
+
+/// A table: header lines (without the `#`) and columns of equal length.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Table {
+    /// Lines saying what was computed, how and from what.
+    pub header: Vec<String>,
+    /// The columns, in order.
+    pub columns: Vec<Column>,
+}
+
+impl Table {
+    /// An empty table with `header` lines.
+    pub fn new(header: Vec<String>) -> Self {
+        Self {
+            header,
+            columns: Vec::new(),
+        }
+    }
+
+    /// Appends a column.
+    pub fn push(&mut self, name: impl Into<String>, unit: &'static str, values: Vec<f64>) {
+        self.columns.push(Column {
+            name: name.into(),
+            unit,
+            values,
+        });
+    }
+
+    /// Appends the values of `estimates` as `name` and their errors as `err_<name>`.
+    pub fn push_estimates(&mut self, name: &str, unit: &'static str, estimates: &[Estimate]) {
+        self.push(name, unit, estimates.iter().map(|e| e.value).collect());
+        self.push(
+            format!("err_{name}"),
+            unit,
+            estimates.iter().map(|e| e.error).collect(),
+        );
+    }
+
+    /// The column names.
+    pub fn names(&self) -> Vec<&str> {
+        self.columns.iter().map(|c| c.name.as_str()).collect()
+    }
+
+    /// The values of the column `name`.
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.columns
+            .iter()
+            .find(|c| c.name == name)
+            .map(|c| c.values.as_slice())
+    }
+
+    /// The number of rows.
+    pub fn rows(&self) -> usize {
+        self.columns.first().map_or(0, |c| c.values.len())
+    }
+
+    /// The table as text (see the module docs).
+    pub fn to_text(&self) -> String {
+        let n = self.rows();
+        let mut out = String::with_capacity(64 * self.columns.len() * (n + 2));
+        for line in &self.header {
+            out += "# ";
+            out += line;
+            out.push('\n');
+        }
+        for (i, c) in self.columns.iter().enumerate() {
+            out += &format!("# column {}: {} [{}]\n", i + 1, c.name, c.unit);
+        }
+        out += "# ";
+        out += &self.names().join(" ");
+        out.push('\n');
+        for i in 0..n {
+            let row: Vec<String> = self
+                .columns
+                .iter()
+                .map(|c| format!("{:.9e}", c.values[i]))
+                .collect();
+            out += &row.join(" ");
+            out.push('\n');
+        }
+        out
+    }
+}
+
+/// The results of a fit versus k_max as a table with `header` lines: `k_max points`, for each free
+/// parameter `p p_lo p_hi` (best fit and 1σ interval), then `chi2 dof chi2_dof`.
+pub fn fit_table(results: &[crate::fit::FitResult], header: Vec<String>) -> Table {
+    let mut t = Table::new(header);
+    let column = |f: &dyn Fn(&crate::fit::FitResult) -> f64| results.iter().map(f).collect();
+    t.push("k_max", WAVENUMBER, column(&|r| r.k_max));
+    t.push("points", "1", column(&|r| r.points as f64));
+    if let Some(first) = results.first() {
+        for (j, (p, _, _)) in first.intervals.iter().enumerate() {
+            let unit = p.unit();
+            t.push(p.name(), unit, column(&|r| r.best.get(r.intervals[j].0)));
+            t.push(format!("{p}_lo"), unit, column(&|r| r.intervals[j].1));
+            t.push(format!("{p}_hi"), unit, column(&|r| r.intervals[j].2));
+        }
+    }
+    t.push("chi2", "1", column(&|r| r.chi2));
+    t.push("dof", "1", column(&|r| r.dof as f64));
+    t.push("chi2_dof", "1", column(&|r| r.chi2 / r.dof as f64));
+    t
+}

@@ -1,0 +1,361 @@
+//! The library's redshift-space entry point: multipoles from real-space spectra, an RSD model, f,
+//! bias, Fingers of God and noise ([`multipoles`]), and the plan that computes the loop terms they
+//! need once per k grid ([`RsdPlan`]).
+
+use super::{dispersion_theory, DispersionInput, Fog, MultipoleRule, RsdModel};
+use crate::error::{Error, Result};
+use crate::estimate::Estimate;
+use crate::linear::LinearSpectrum;
+use crate::loops::{Pair, TnsPlan, TnsTerms};
+use crate::output::{Table, POWER, WAVENUMBER};
+use crate::precision::Precision;
+use crate::progress::Progress;
+use crate::real::{RealModel, RealPlan, RealSpectra};
+use crate::store::TableStore;
+
+/// What turns real-space spectra into redshift-space multipoles.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RsdSettings {
+    /// Kaiser, Scoccimarro or TNS.
+    pub model: RsdModel,
+    /// The growth rate f.
+    pub f: f64,
+    /// The bias b(k) at each k, amplitude A_b included.
+    pub bias: Vec<f64>,
+    /// The Fingers-of-God damping.
+    pub fog: Fog,
+    /// Its scale σ = σ0 D(z) f [Mpc/h] ([`super::fog_sigma`]).
+    pub sigma: f64,
+    /// The stochasticity P_εε [(Mpc/h)^3] at each k, if any: subtracted from the monopole
+    /// (P^s_hh = ⟨δ_h δ_h⟩ − P_εε) and reported with the signal-to-noise.
+    pub noise: Option<Vec<f64>>,
+    /// The multipoles ℓ (even, ≤ 8).
+    pub ells: Vec<usize>,
+    /// Whether to also compute the multipoles of each part (Kaiser/Scoccimarro, A, B).
+    pub parts: bool,
+}
+
+/// Redshift-space multipoles on a k grid [(Mpc/h)^3].
+#[derive(Debug, Clone, PartialEq)]
+pub struct RsdMultipoles {
+    /// Wavenumbers [h/Mpc].
+    pub k: Vec<f64>,
+    /// The multipole orders.
+    pub ells: Vec<usize>,
+    /// P_ℓ(k): `total[j][i]` for the j-th ℓ at the i-th k, with its error (loop integrals and μ
+    /// quadrature).
+    pub total: Vec<Vec<Estimate>>,
+    /// With [`RsdSettings::parts`]: the multipoles of the Kaiser/Scoccimarro part, of the TNS A term
+    /// and of the TNS B term, each indexed as `total`.
+    pub parts: Option<[Vec<Vec<Estimate>>; 3]>,
+    /// P_εε at each k, if a noise was given.
+    pub noise: Option<Vec<f64>>,
+    /// P0/P_εε at each k, if a noise was given.
+    pub signal_to_noise: Option<Vec<f64>>,
+}
+
+/// The multipoles of `settings.model` applied to the real-space spectra `real` (with `tns`, the TNS
+/// A and B coefficients on the same grid, for [`RsdModel::Tns`]).
+///
+/// # Errors
+/// [`Error::GridMismatch`] if the bias, noise or TNS terms are not on the grid of `real`;
+/// [`Error::MissingTerm`] for TNS without `tns`; [`Error::InvalidParameter`] for a non-finite f or
+/// σ < 0, or a bad ℓ.
+///
+/// ```
+/// use pt_spectra::{linear::LinearSpectrum, precision::Precision, store::TableStore};
+/// use pt_spectra::real::{real_space, RealModel};
+/// use pt_spectra::rsd::{multipoles, Fog, RsdModel, RsdSettings};
+/// let p = LinearSpectrum::gm2012(0.0)?;
+/// let real = real_space(RealModel::Linear, &p, &[0.05], &Precision::fast(), &TableStore::in_memory())?;
+/// let settings = RsdSettings {
+///     model: RsdModel::Kaiser, f: 0.5, bias: vec![2.0], fog: Fog::None, sigma: 0.0, noise: None,
+///     ells: vec![0, 2], parts: false,
+/// };
+/// let m = multipoles(&real, None, &settings)?;
+/// // Linear Kaiser: P0 = (b² + 2bf/3 + f²/5) P_lin.
+/// let expected = (4.0 + 2.0 / 3.0 + 0.05) * real.p_lin[0];
+/// assert!((m.total[0][0].value / expected - 1.0).abs() < 1e-14);
+/// # Ok::<(), pt_spectra::error::Error>(())
+/// ```
+pub fn multipoles(
+    real: &RealSpectra,
+    tns: Option<&TnsTerms>,
+    settings: &RsdSettings,
+) -> Result<RsdMultipoles> {
+    let k = &real.k;
+    check_grid("bias and real-space spectra", k, settings.bias.len())?;
+    if let Some(noise) = &settings.noise {
+        check_grid("noise and real-space spectra", k, noise.len())?;
+    }
+    let tns = match (settings.model.needs_tns(), tns) {
+        (false, _) => None,
+        (true, None) => {
+            return Err(Error::MissingTerm {
+                term: "the TNS A and B coefficients",
+                needed_by: "the tns model".into(),
+                hint: " (TnsPlan, or an RsdPlan)",
+            })
+        }
+        (true, Some(t)) if t.k != *k => {
+            return Err(Error::GridMismatch {
+                what: "TNS terms and real-space spectra",
+                expected: describe_grid(k),
+                found: describe_grid(&t.k),
+            })
+        }
+        (true, Some(t)) => Some(t),
+    };
+    if !settings.f.is_finite() {
+        return Err(invalid("f", settings.f, "must be finite"));
+    }
+    if !(settings.sigma.is_finite() && settings.sigma >= 0.0) {
+        let reason = "must be finite and non-negative";
+        return Err(invalid("FoG sigma [Mpc/h]", settings.sigma, reason));
+    }
+    let rule = MultipoleRule::new(&settings.ells)?;
+    let monopole = MultipoleRule::new(&[0])?;
+    let n_ell = settings.ells.len();
+    let empty = || vec![Vec::with_capacity(k.len()); n_ell];
+    let mut total = empty();
+    let mut parts = settings.parts.then(|| [empty(), empty(), empty()]);
+    let mut signal_to_noise = settings.noise.as_ref().map(|_| Vec::with_capacity(k.len()));
+    for (i, &ki) in k.iter().enumerate() {
+        let s = [Pair::DeltaDelta, Pair::DeltaTheta, Pair::ThetaTheta].map(|p| real.spectra[p][i]);
+        let coefficients = tns.map(|t| &t.coefficients[i]);
+        let p = settings
+            .model
+            .parts(settings.bias[i], settings.f, s, coefficients)?;
+        let x = ki * settings.sigma;
+        let sum = p.total();
+        push(&mut total, rule.evaluate_polynomial(&sum, settings.fog, x));
+        if let Some(parts) = parts.as_mut() {
+            for (out, part) in parts.iter_mut().zip([p.base, p.a, p.b]) {
+                push(out, rule.evaluate_polynomial(&part, settings.fog, x));
+            }
+        }
+        if let (Some(sn), Some(noise)) = (signal_to_noise.as_mut(), &settings.noise) {
+            let p0 = monopole.evaluate_polynomial(&sum, settings.fog, x)[0].value;
+            sn.push(p0 / noise[i]);
+        }
+    }
+    Ok(RsdMultipoles {
+        k: k.clone(),
+        ells: settings.ells.clone(),
+        total,
+        parts,
+        noise: settings.noise.clone(),
+        signal_to_noise,
+    })
+}
+
+impl RsdMultipoles {
+    /// The multipoles as a table with `header` lines: `k P<l>…`, with the parts `P<l>_sc P<l>_A
+    /// P<l>_B` if computed, `P_eps SN` with a noise, and the errors `err_P<l>`.
+    pub fn table(&self, header: Vec<String>) -> Table {
+        let mut t = Table::new(header);
+        t.push("k", WAVENUMBER, self.k.clone());
+        let values = |e: &Vec<Estimate>| e.iter().map(|e| e.value).collect::<Vec<f64>>();
+        for (l, p) in self.ells.iter().zip(&self.total) {
+            t.push(format!("P{l}"), POWER, values(p));
+        }
+        if let Some(parts) = &self.parts {
+            for (name, part) in ["sc", "A", "B"].into_iter().zip(parts) {
+                for (l, p) in self.ells.iter().zip(part) {
+                    t.push(format!("P{l}_{name}"), POWER, values(p));
+                }
+            }
+        }
+        if let (Some(noise), Some(sn)) = (&self.noise, &self.signal_to_noise) {
+            t.push("P_eps", POWER, noise.clone());
+            t.push("SN", "1", sn.clone());
+        }
+        for (l, p) in self.ells.iter().zip(&self.total) {
+            t.push(
+                format!("err_P{l}"),
+                POWER,
+                p.iter().map(|e| e.error).collect(),
+            );
+        }
+        t
+    }
+}
+
+fn push(out: &mut [Vec<Estimate>], values: Vec<Estimate>) {
+    for (o, v) in out.iter_mut().zip(values) {
+        o.push(v);
+    }
+}
+
+fn invalid(name: &'static str, value: f64, reason: &'static str) -> Error {
+    Error::InvalidParameter {
+        name,
+        value,
+        reason,
+    }
+}
+
+/// `n` values must sit on the grid `k`.
+fn check_grid(what: &'static str, k: &[f64], n: usize) -> Result<()> {
+    if n == k.len() {
+        return Ok(());
+    }
+    Err(Error::GridMismatch {
+        what,
+        expected: describe_grid(k),
+        found: format!("{n} values"),
+    })
+}
+
+/// `n k in [a, b] h/Mpc`.
+pub(crate) fn describe_grid(k: &[f64]) -> String {
+    match (k.first(), k.last()) {
+        (Some(a), Some(b)) => format!("{} k in [{a}, {b}] h/Mpc", k.len()),
+        _ => "an empty k grid".into(),
+    }
+}
+
+/// The σ0 of the Fingers-of-God damping [Mpc/h]: a number, or the theory value σ(z)/D(z) of eq.
+/// sigmav (σ² = (1/6π²)∫P_θθ dq) with linear or 1-loop SPT P_θθ ([`dispersion_theory`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Sigma0 {
+    /// A value [Mpc/h] (finite, ≥ 0).
+    Value(f64),
+    /// The theory value with the P_θθ of `DispersionInput`.
+    Theory(DispersionInput),
+}
+
+impl std::str::FromStr for Sigma0 {
+    type Err = Error;
+
+    /// A number [Mpc/h], `lin` or `1l-spt`.
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim() {
+            "lin" => Ok(Sigma0::Theory(DispersionInput::Linear)),
+            "1l-spt" => Ok(Sigma0::Theory(DispersionInput::OneLoopSpt)),
+            t => match t.parse::<f64>() {
+                Ok(v) if v.is_finite() && v >= 0.0 => Ok(Sigma0::Value(v)),
+                _ => Err(Error::UnknownName {
+                    what: "sigma0",
+                    name: s.to_string(),
+                    available: "a finite non-negative number [Mpc/h], lin, 1l-spt",
+                }),
+            },
+        }
+    }
+}
+
+impl Sigma0 {
+    /// σ0 [Mpc/h]: the value, or the theory value for the linear `spectrum` at a redshift where the
+    /// growth factor is `growth_factor`, integrated with `precision`.
+    ///
+    /// # Errors
+    /// As [`dispersion_theory`].
+    pub fn resolve(
+        self,
+        spectrum: &LinearSpectrum,
+        growth_factor: f64,
+        precision: &Precision,
+    ) -> Result<f64> {
+        match self {
+            Sigma0::Value(v) => Ok(v),
+            Sigma0::Theory(input) => {
+                Ok(dispersion_theory(spectrum, input, precision)?.value / growth_factor)
+            }
+        }
+    }
+}
+
+/// The loop terms a redshift-space model needs on one k grid, planned once: the real-space plan and,
+/// for TNS, the plan of the A and B terms.
+#[derive(Debug, Clone)]
+pub struct RsdPlan {
+    real: RealPlan,
+    tns: Option<TnsPlan>,
+}
+
+impl RsdPlan {
+    /// The plan of real-space `real_model` with RSD model `rsd` on wavenumbers `k` [h/Mpc].
+    ///
+    /// # Errors
+    /// As [`RealPlan::new`] and [`TnsPlan::new`].
+    pub fn new(
+        k: &[f64],
+        real_model: RealModel,
+        rsd: RsdModel,
+        precision: &Precision,
+        store: &TableStore,
+        progress: &dyn Progress,
+    ) -> Result<Self> {
+        let real = RealPlan::new(k, real_model, precision, store, progress)?;
+        let tns = if rsd.needs_tns() {
+            Some(TnsPlan::new(k, precision)?)
+        } else {
+            None
+        };
+        Ok(Self { real, tns })
+    }
+
+    /// The real-space plan.
+    pub fn real(&self) -> &RealPlan {
+        &self.real
+    }
+
+    /// The real-space spectra and (for TNS) the A and B coefficients of the linear `spectrum`.
+    ///
+    /// # Errors
+    /// As [`RealPlan::evaluate`].
+    pub fn evaluate(
+        &self,
+        spectrum: &LinearSpectrum,
+        progress: &dyn Progress,
+    ) -> Result<(RealSpectra, Option<TnsTerms>)> {
+        let real = self.real.evaluate(spectrum, progress)?;
+        let tns = self.tns.as_ref().map(|plan| plan.par_evaluate(spectrum));
+        Ok((real, tns))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grids_that_do_not_match_are_errors_naming_them() {
+        let p = LinearSpectrum::gm2012(0.0).unwrap();
+        let store = TableStore::in_memory();
+        let real = crate::real::real_space(
+            RealModel::Linear,
+            &p,
+            &[0.05, 0.1],
+            &Precision::fast(),
+            &store,
+        )
+        .unwrap();
+        let mut settings = RsdSettings {
+            model: RsdModel::Tns,
+            f: 0.5,
+            bias: vec![1.0; 3],
+            fog: Fog::None,
+            sigma: 0.0,
+            noise: None,
+            ells: vec![0],
+            parts: false,
+        };
+        let e = multipoles(&real, None, &settings).unwrap_err().to_string();
+        assert!(
+            e.contains("bias") && e.contains("3 values") && e.contains("2 k in"),
+            "{e}"
+        );
+        settings.bias = vec![1.0; 2];
+        let e = multipoles(&real, None, &settings).unwrap_err().to_string();
+        assert!(e.contains("TNS A and B"), "{e}");
+        let other = TnsPlan::new(&[0.05, 0.2], &Precision::fast())
+            .unwrap()
+            .evaluate(&p);
+        let e = multipoles(&real, Some(&other), &settings)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("TNS terms") && e.contains("0.2]"), "{e}");
+    }
+}

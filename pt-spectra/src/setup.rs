@@ -1,0 +1,236 @@
+//! From what a user gives (a cosmology, a linear spectrum at some redshift, the output redshift) to what
+//! the computations need: the linear spectrum at the output redshift, D(z) and f(z) of the cosmology,
+//! the warnings a user must see, and header lines saying what was used.
+//!
+//! The cosmology sets the growth: the rescaling of a spectrum from `z_input` to `z` by
+//! [D(z)/D(z_input)]², the default growth rate f(z) of redshift-space models, the Fingers-of-God scale
+//! σ = σ0 D(z) f and the no-wiggle reference spectrum. Its default is the gm2012 cosmology of the
+//! embedded spectra; a spectrum of another cosmology with the default growth is warned about.
+//!
+//! ```
+//! use pt_spectra::setup::{prepare, LinearSource, NamedCosmology, Request};
+//! let request = Request {
+//!     source: LinearSource::Embedded,
+//!     cosmology: Some(NamedCosmology::parse("gm2012")?.0),
+//!     z: 1.0,
+//! };
+//! let p = prepare(request)?;
+//! assert!((p.growth_rate - 0.852).abs() < 1e-3 && p.warnings.is_empty());
+//! # Ok::<(), pt_spectra::error::Error>(())
+//! ```
+
+use crate::cosmology::{Cosmology, TransferKind};
+use crate::error::{Error, Result};
+use crate::linear::{LinearSpectrum, LogGrid, GM2012_REDSHIFTS};
+
+/// A cosmology with the name it was given by (a preset name or a parameter file).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedCosmology {
+    /// `gm2012`, `planck2018`, or the path of the parameter file.
+    pub name: String,
+    /// The parameters.
+    pub cosmology: Cosmology,
+}
+
+impl NamedCosmology {
+    /// The gm2012 cosmology of the embedded spectra (the default).
+    pub fn gm2012() -> Self {
+        Self {
+            name: "gm2012".into(),
+            cosmology: Cosmology::gm2012(),
+        }
+    }
+
+    /// A preset name (`gm2012`, `planck2018`) or the path of a CLASS or CAMB parameter file, with the
+    /// keys of the file that were ignored.
+    ///
+    /// # Errors
+    /// As `Cosmology::from_name_or_file`.
+    pub fn parse(name_or_file: &str) -> Result<(Self, Vec<String>)> {
+        // MERGE-SHIM: replaced by Cosmology::from_name_or_file once the cosmology branch lands.
+        if name_or_file.trim() != "gm2012" {
+            return Err(Error::UnknownName {
+                what: "cosmology",
+                name: name_or_file.into(),
+                available: "gm2012",
+            });
+        }
+        Ok((Self::gm2012(), Vec::new()))
+    }
+
+    /// Whether this is the gm2012 cosmology of the embedded spectra.
+    pub fn is_gm2012(&self) -> bool {
+        self.cosmology == Cosmology::gm2012()
+    }
+}
+
+/// Where the linear spectrum comes from.
+#[derive(Debug, Clone)]
+pub enum LinearSource {
+    /// The embedded CAMB spectra of the gm2012 cosmology (z = 0, 0.5, 1, 1.5; other redshifts rescaled
+    /// from z = 0). With another cosmology, its Eisenstein & Hu spectrum with BAO, with a warning.
+    Embedded,
+    /// A tabulated spectrum (a file or arrays) at redshift `z_input`.
+    Table {
+        /// The spectrum.
+        spectrum: Box<LinearSpectrum>,
+        /// Its redshift.
+        z_input: f64,
+    },
+    /// The Eisenstein & Hu (1998) fit of the cosmology, with or without BAO.
+    EisensteinHu(TransferKind),
+}
+
+/// What the user asked for.
+#[derive(Debug, Clone)]
+pub struct Request {
+    /// The linear spectrum.
+    pub source: LinearSource,
+    /// The cosmology; `None` is the gm2012 default.
+    pub cosmology: Option<NamedCosmology>,
+    /// The output redshift.
+    pub z: f64,
+}
+
+/// The linear spectrum at the output redshift, with the growth of its cosmology.
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    /// The linear spectrum at `z`.
+    pub spectrum: LinearSpectrum,
+    /// The cosmology.
+    pub cosmology: NamedCosmology,
+    /// The output redshift.
+    pub z: f64,
+    /// D(z), normalised to D(0) = 1.
+    pub growth_factor: f64,
+    /// f(z) = d ln D/d ln a.
+    pub growth_rate: f64,
+    /// Things the user must be told (e.g. a default that may not fit the input); also in the header.
+    pub warnings: Vec<String>,
+    /// Header lines: the cosmology and its growth, the linear spectrum and how it was rescaled.
+    pub description: Vec<String>,
+}
+
+/// Checks a redshift.
+fn check_z(name: &'static str, z: f64) -> Result<()> {
+    if z.is_finite() && z > -1.0 {
+        return Ok(());
+    }
+    Err(Error::InvalidParameter {
+        name,
+        value: z,
+        reason: "a redshift must be finite and > -1",
+    })
+}
+
+/// The linear spectrum at the output redshift and the growth of the cosmology (see the module docs).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a redshift that is not finite and > −1; as
+/// [`Cosmology::eisenstein_hu_spectrum`] and [`LinearSpectrum::scaled`].
+pub fn prepare(request: Request) -> Result<Prepared> {
+    check_z("z", request.z)?;
+    let z = request.z;
+    let defaulted = request.cosmology.is_none();
+    let named = request.cosmology.unwrap_or_else(NamedCosmology::gm2012);
+    let c = named.cosmology;
+    let (d, f) = (c.growth_factor(z), c.growth_rate(z));
+    let mut warnings = Vec::new();
+    let mut description = vec![format!(
+        "cosmology: {}{} ({}); D(z)/D(0) = {d:.6}, f(z) = {f:.6} at z = {z}",
+        named.name,
+        if defaulted { " (the default)" } else { "" },
+        format!("{c:?}") // MERGE-SHIM
+    )];
+    let eh = |kind: TransferKind| c.eisenstein_hu_spectrum(kind, z, &LogGrid::default());
+    let spectrum = match request.source {
+        LinearSource::Embedded if named.is_gm2012() => {
+            let embedded = GM2012_REDSHIFTS.iter().any(|&zi| (zi - z).abs() < 1e-6);
+            let (spectrum, how) = if embedded {
+                (LinearSpectrum::gm2012(z)?, String::new())
+            } else {
+                let ratio = d / c.growth_factor(0.0);
+                let s = LinearSpectrum::gm2012(0.0)?.scaled(ratio * ratio)?;
+                (
+                    s,
+                    format!(", rescaled by [D(z)/D(0)]^2 = {:.6}", ratio * ratio),
+                )
+            };
+            description.push(format!(
+                "linear spectrum: {} (embedded CAMB spectrum of gm2012{how})",
+                spectrum.origin()
+            ));
+            spectrum
+        }
+        LinearSource::Embedded => {
+            warnings.push(format!(
+                "no linear spectrum was given for cosmology {}: using its Eisenstein & Hu (1998) fit with \
+                 BAO, good to a few per cent; give a Boltzmann-code spectrum (--linear) for precise work",
+                named.name
+            ));
+            description.push(format!(
+                "linear spectrum: Eisenstein & Hu (1998) with BAO of cosmology {} at z = {z}",
+                named.name
+            ));
+            eh(TransferKind::Wiggle)?
+        }
+        LinearSource::EisensteinHu(kind) => {
+            let what = match kind {
+                TransferKind::Wiggle => "with BAO",
+                TransferKind::NoWiggle => "no-wiggle",
+            };
+            description.push(format!(
+                "linear spectrum: Eisenstein & Hu (1998) {what} of cosmology {} at z = {z}",
+                named.name
+            ));
+            eh(kind)?
+        }
+        LinearSource::Table { spectrum, z_input } => {
+            check_z("z_input", z_input)?;
+            let ratio = d / c.growth_factor(z_input);
+            if defaulted {
+                warnings.push(format!(
+                    "no cosmology was given for the linear spectrum `{}`: the growth of the gm2012 \
+                     cosmology is used (f = {f:.4}, D(z)/D(z_input) = {ratio:.6}); give --cosmology",
+                    spectrum.origin()
+                ));
+            }
+            description.push(format!(
+                "linear spectrum: {} at z_input = {z_input}, rescaled to z = {z} by [D(z)/D(z_input)]^2 = \
+                 {:.6}",
+                spectrum.origin(),
+                ratio * ratio
+            ));
+            if z_input == z {
+                *spectrum
+            } else {
+                spectrum.scaled(ratio * ratio)?
+            }
+        }
+    };
+    for w in &warnings {
+        description.push(format!("warning: {w}"));
+    }
+    Ok(Prepared {
+        spectrum,
+        cosmology: named,
+        z,
+        growth_factor: d,
+        growth_rate: f,
+        warnings,
+        description,
+    })
+}
+
+impl Prepared {
+    /// The Eisenstein & Hu (1998) no-wiggle spectrum of the cosmology at the output redshift, scaled to
+    /// the σ8 of the linear spectrum: the smooth reference by which BAO are divided out.
+    ///
+    /// # Errors
+    /// As [`Cosmology::eisenstein_hu_spectrum`].
+    pub fn no_wiggle(&self) -> Result<LinearSpectrum> {
+        let c = &self.cosmology.cosmology;
+        let eh = c.eisenstein_hu_spectrum(TransferKind::NoWiggle, 0.0, &LogGrid::default())?;
+        eh.scaled((self.spectrum.sigma8() / eh.sigma8()).powi(2))
+    }
+}

@@ -1,0 +1,369 @@
+//! [`TableStore`]: the cosmology-independent angular tables (P15, P17), built once and cached in a
+//! directory the caller chooses.
+//!
+//! A table is read from its file if the file is there and passes its checks (size, finite values, a few
+//! entries recomputed); otherwise it is built and written atomically (a temporary file renamed into
+//! place), so a reader never sees half a table, and a corrupted or stale file is rebuilt. While a
+//! process builds a table it holds an operating-system lock on `<table>.lock` beside it
+//! ([`std::fs::File::lock`]): another process that needs the same table waits for it (and says so
+//! through [`Progress::note`]) instead of building it twice, and a process that dies while building
+//! releases the lock with its death, so an interrupted build never blocks later runs.
+//!
+//! ```no_run
+//! use pt_spectra::{progress::Silent, store::TableStore};
+//! let store = TableStore::new("/tmp/pt-spectra-cache");
+//! let p15 = store.p15(&Silent)?; // built on first use (~35 s on 2 cores), then read from the file
+//! # Ok::<(), pt_spectra::error::Error>(())
+//! ```
+
+use crate::error::{Error, Result};
+use crate::loops::{P15Table, P17Table};
+use crate::progress::{Progress, Stage};
+use std::fs::{File, OpenOptions, TryLockError};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+/// Where the angular tables live, and the tables this store has already loaded.
+#[derive(Debug, Default)]
+pub struct TableStore {
+    dir: Option<PathBuf>,
+    p15: Mutex<Option<Arc<P15Table>>>,
+    p17: Mutex<Option<Arc<P17Table>>>,
+}
+
+impl TableStore {
+    /// A store caching its tables in `dir` (created when first needed).
+    pub fn new(dir: impl Into<PathBuf>) -> Self {
+        Self {
+            dir: Some(dir.into()),
+            ..Self::default()
+        }
+    }
+
+    /// A store without a directory: tables are built in memory by each store that needs them.
+    pub fn in_memory() -> Self {
+        Self::default()
+    }
+
+    /// The conventional cache directory: `$PT_SPECTRA_CACHE`, else `$XDG_CACHE_HOME/pt-spectra`, else
+    /// `$HOME/.cache/pt-spectra`; in memory if none of them is set.
+    pub fn from_env() -> Self {
+        let dir = std::env::var_os("PT_SPECTRA_CACHE")
+            .map(PathBuf::from)
+            .or_else(|| {
+                std::env::var_os("XDG_CACHE_HOME").map(|d| PathBuf::from(d).join("pt-spectra"))
+            })
+            .or_else(|| {
+                std::env::var_os("HOME").map(|d| PathBuf::from(d).join(".cache/pt-spectra"))
+            });
+        Self {
+            dir,
+            ..Self::default()
+        }
+    }
+
+    /// The cache directory, if any.
+    pub fn dir(&self) -> Option<&Path> {
+        self.dir.as_deref()
+    }
+
+    /// The file a table of this store lives in (`file_name` as the table names it).
+    fn path(&self, file_name: &str) -> Option<PathBuf> {
+        self.dir.as_ref().map(|d| d.join(file_name))
+    }
+
+    /// The P15 angular table ([`P15Table`]): loaded by this store already, read from its file, or built
+    /// (reporting [`Stage::P15Table`]) and written.
+    ///
+    /// # Errors
+    /// [`Error::Cache`] if the directory cannot be created or the table cannot be written or locked.
+    pub fn p15(&self, progress: &dyn Progress) -> Result<Arc<P15Table>> {
+        load(
+            &self.p15,
+            self.path(&P15Table::file_name()),
+            "P15",
+            P15Table::from_f64s,
+            || P15Table::build(&|d, t| progress.update(Stage::P15Table, d, t)),
+            P15Table::to_f64s,
+            progress,
+        )
+    }
+
+    /// The P17 angular table ([`P17Table`]), as [`p15`](Self::p15).
+    ///
+    /// # Errors
+    /// As [`p15`](Self::p15).
+    pub fn p17(&self, progress: &dyn Progress) -> Result<Arc<P17Table>> {
+        load(
+            &self.p17,
+            self.path(&P17Table::file_name()),
+            "P17",
+            P17Table::from_f64s,
+            || P17Table::build(&|d, t| progress.update(Stage::P17Table, d, t)),
+            P17Table::to_f64s,
+            progress,
+        )
+    }
+}
+
+/// The table in `slot`, else from [`cached`], kept in `slot`.
+fn load<T>(
+    slot: &Mutex<Option<Arc<T>>>,
+    path: Option<PathBuf>,
+    name: &str,
+    read: impl Fn(&[f64]) -> Option<T>,
+    build: impl FnOnce() -> T,
+    write: impl Fn(&T) -> Vec<f64>,
+    progress: &dyn Progress,
+) -> Result<Arc<T>> {
+    // Holding the slot while loading makes threads of one process share one build.
+    let mut slot = slot
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    if let Some(t) = slot.as_ref() {
+        return Ok(Arc::clone(t));
+    }
+    let t = Arc::new(match path {
+        None => build(),
+        Some(path) => cached(&path, name, read, build, write, progress)?,
+    });
+    *slot = Some(Arc::clone(&t));
+    Ok(t)
+}
+
+/// The table at `path` if it is there and valid, otherwise built under an exclusive lock on
+/// `<path>.lock` (after waiting for any other process holding it, which may have built it meanwhile)
+/// and written atomically.
+///
+/// # Errors
+/// [`Error::Cache`] naming the file when the directory, the lock or the table file fails.
+pub(crate) fn cached<T>(
+    path: &Path,
+    name: &str,
+    read: impl Fn(&[f64]) -> Option<T>,
+    build: impl FnOnce() -> T,
+    write: impl Fn(&T) -> Vec<f64>,
+    progress: &dyn Progress,
+) -> Result<T> {
+    let read_file = || read_f64s(path).and_then(|v| read(&v));
+    if let Some(t) = read_file() {
+        return Ok(t);
+    }
+    let fail = |path: &Path, what: &'static str| {
+        let path = path.to_path_buf();
+        move |source| Error::Cache { path, what, source }
+    };
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(fail(dir, "create the cache directory"))?;
+    }
+    let lock_path = path.with_extension("lock");
+    let lock = OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&lock_path)
+        .map_err(fail(&lock_path, "open the lock file"))?;
+    acquire(&lock, &lock_path, name, progress)?;
+    // Another process may have finished the table while this one waited.
+    if let Some(t) = read_file() {
+        return Ok(t);
+    }
+    let t = build();
+    write_f64s(path, &write(&t)).map_err(fail(path, "write the table"))?;
+    // The lock is released when `lock` is dropped (or the process dies); the file stays, empty.
+    drop(lock);
+    Ok(t)
+}
+
+/// Takes the exclusive lock on `lock`, telling `progress` when it has to wait for another process.
+fn acquire(lock: &File, lock_path: &Path, name: &str, progress: &dyn Progress) -> Result<()> {
+    let fail = |source| Error::Cache {
+        path: lock_path.to_path_buf(),
+        what: "lock the table",
+        source,
+    };
+    match lock.try_lock() {
+        Ok(()) => Ok(()),
+        Err(TryLockError::WouldBlock) => {
+            progress.note(&format!(
+                "waiting for another process that is building the {name} angular table (it holds \
+                 the lock `{}`)",
+                lock_path.display()
+            ));
+            lock.lock().map_err(fail)
+        }
+        Err(TryLockError::Error(e)) => Err(fail(e)),
+    }
+}
+
+/// Writes little-endian f64 `values` to `path` atomically: to a temporary file of this process, then
+/// renamed into place.
+fn write_f64s(path: &Path, values: &[f64]) -> std::io::Result<()> {
+    let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
+    std::fs::write(&tmp, &bytes)?;
+    std::fs::rename(&tmp, path)
+}
+
+/// Reads little-endian f64 values from `path`; `None` if it is missing, unreadable or not a whole
+/// number of values.
+fn read_f64s(path: &Path) -> Option<Vec<f64>> {
+    let bytes = std::fs::read(path).ok()?;
+    if !bytes.len().is_multiple_of(8) {
+        return None;
+    }
+    let values = bytes
+        .chunks_exact(8)
+        .map(|c| {
+            let mut b = [0u8; 8];
+            b.copy_from_slice(c);
+            f64::from_le_bytes(b)
+        })
+        .collect();
+    Some(values)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::Silent;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("pt-spectra-store-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        dir
+    }
+
+    fn table(path: &Path, builds: &AtomicUsize, value: f64) -> Result<Vec<f64>> {
+        cached(
+            path,
+            "test",
+            |v: &[f64]| (v.len() == 3).then(|| v.to_vec()),
+            || {
+                builds.fetch_add(1, Ordering::Relaxed);
+                vec![value; 3]
+            },
+            Clone::clone,
+            &Silent,
+        )
+    }
+
+    #[test]
+    fn a_table_is_built_once_then_read_and_a_corrupt_file_is_rebuilt() {
+        let dir = scratch("once");
+        let path = dir.join("t.bin");
+        let builds = AtomicUsize::new(0);
+        assert_eq!(table(&path, &builds, 1.5).unwrap(), vec![1.5; 3]);
+        assert_eq!(table(&path, &builds, 2.5).unwrap(), vec![1.5; 3]);
+        assert_eq!(builds.load(Ordering::Relaxed), 1);
+        std::fs::write(&path, [0u8; 13]).unwrap();
+        assert_eq!(table(&path, &builds, 2.5).unwrap(), vec![2.5; 3]);
+        assert_eq!(builds.load(Ordering::Relaxed), 2);
+    }
+
+    /// Notes received, for the test below.
+    struct Notes(Mutex<Vec<String>>);
+    impl Progress for Notes {
+        fn note(&self, message: &str) {
+            self.0.lock().unwrap().push(message.to_string());
+        }
+    }
+
+    /// Run by [`a_killed_build_releases_its_lock`] in a child process: starts building a table that
+    /// takes a minute, holding its lock, and is killed meanwhile.
+    #[test]
+    #[ignore = "a child process of a_killed_build_releases_its_lock"]
+    fn child_builds_slowly() {
+        let Some(dir) = std::env::var_os("PT_SPECTRA_STORE_CHILD") else {
+            return;
+        };
+        let path = PathBuf::from(dir).join("t.bin");
+        let _ = cached(
+            &path,
+            "test",
+            |_: &[f64]| None::<Vec<f64>>,
+            || {
+                std::thread::sleep(std::time::Duration::from_secs(60));
+                vec![0.0]
+            },
+            Clone::clone,
+            &Silent,
+        );
+    }
+
+    #[test]
+    fn a_killed_build_releases_its_lock() {
+        let dir = scratch("killed");
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut child = std::process::Command::new(std::env::current_exe().unwrap())
+            .args(["store::tests::child_builds_slowly", "--exact", "--ignored"])
+            .env("PT_SPECTRA_STORE_CHILD", &dir)
+            .stdout(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        // Wait until the child holds the lock.
+        let lock_path = dir.join("t.lock");
+        let start = std::time::Instant::now();
+        loop {
+            let held = File::open(&lock_path)
+                .map(|f| matches!(f.try_lock(), Err(TryLockError::WouldBlock)))
+                .unwrap_or(false);
+            if held {
+                break;
+            }
+            assert!(
+                start.elapsed().as_secs() < 30,
+                "the child never took the lock"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        // This process now waits for the child, says so, and builds the table as soon as the child
+        // is killed (the operating system releases its lock).
+        let killer = std::thread::spawn(move || {
+            std::thread::sleep(std::time::Duration::from_millis(500));
+            child.kill().unwrap();
+            child.wait().unwrap();
+        });
+        let notes = Notes(Mutex::new(Vec::new()));
+        let builds = AtomicUsize::new(0);
+        let waited = std::time::Instant::now();
+        let t = cached(
+            &dir.join("t.bin"),
+            "test",
+            |v: &[f64]| (v.len() == 3).then(|| v.to_vec()),
+            || {
+                builds.fetch_add(1, Ordering::Relaxed);
+                vec![7.0; 3]
+            },
+            Clone::clone,
+            &notes,
+        )
+        .unwrap();
+        killer.join().unwrap();
+        assert_eq!(t, vec![7.0; 3]);
+        assert_eq!(builds.load(Ordering::Relaxed), 1);
+        assert!(waited.elapsed().as_secs() < 20, "{:?}", waited.elapsed());
+        let notes = notes.0.into_inner().unwrap();
+        assert!(
+            notes.len() == 1 && notes[0].contains("waiting") && notes[0].contains("t.lock"),
+            "{notes:?}"
+        );
+    }
+
+    #[test]
+    fn an_unwritable_directory_is_an_error_naming_it() {
+        let dir = scratch("unwritable");
+        std::fs::create_dir_all(&dir).unwrap();
+        // A file where the cache directory should be.
+        let blocker = dir.join("file");
+        std::fs::write(&blocker, "x").unwrap();
+        let e = table(&blocker.join("t.bin"), &AtomicUsize::new(0), 1.0).unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.contains("file") && text.contains("cache directory"),
+            "{text}"
+        );
+    }
+}
