@@ -31,6 +31,7 @@ pub mod estimate;
 pub mod fit;
 pub mod halo;
 pub mod integrate;
+pub mod jobs;
 pub mod linear;
 pub mod loops;
 pub mod output;

@@ -154,6 +154,38 @@ impl FromStr for RealModel {
     }
 }
 
+/// What `real` computes: one model, or P_dd of every model over the no-wiggle spectrum (`all`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RealSelection {
+    /// One model.
+    One(RealModel),
+    /// Every model (the paper's real-space comparison).
+    All,
+}
+
+impl RealSelection {
+    /// The model whose plan computes what the selection needs (`all`: 2l-rpt-n3, whose terms include
+    /// every model's).
+    pub fn plan_model(self) -> RealModel {
+        match self {
+            RealSelection::One(m) => m,
+            RealSelection::All => RealModel::TwoLoopRptN3,
+        }
+    }
+}
+
+impl FromStr for RealSelection {
+    type Err = Error;
+
+    /// A model name or `all`.
+    fn from_str(s: &str) -> Result<Self> {
+        if s.trim().eq_ignore_ascii_case("all") {
+            return Ok(RealSelection::All);
+        }
+        s.parse().map(RealSelection::One)
+    }
+}
+
 /// Real-space spectra of one model on a k grid, in (Mpc/h)^3, with the loop terms they were made of.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RealSpectra {
@@ -504,6 +536,37 @@ mod tests {
                 OneLoopPlan::new(k, &precision).unwrap().evaluate(&p)
             );
             assert!(terms.p15.is_none() && terms.two_loop.is_none());
+        }
+    }
+
+    #[test]
+    fn every_row_has_one_value_per_named_column() {
+        let p = LinearSpectrum::gm2012(0.0).unwrap();
+        let store = TableStore::in_memory();
+        let plan = RealPlan::new(
+            &[0.05, 0.1],
+            RealModel::OneLoopRptN1,
+            &Precision::fast(),
+            &store,
+            &Silent,
+        )
+        .unwrap();
+        let terms = plan.evaluate(&p, &Silent).unwrap().terms;
+        for model in RealModel::ALL {
+            for with_terms in [false, true] {
+                let Ok(spectra) = RealSpectra::from_terms(model, terms.clone()) else {
+                    continue;
+                };
+                let t = spectra.table(vec![], with_terms);
+                assert!(t.columns.iter().all(|c| c.values.len() == 2), "{model}");
+                let text = t.to_text();
+                let names = text.lines().find(|l| l.starts_with("# k")).unwrap();
+                let n = names.split_whitespace().count() - 1;
+                assert_eq!(n, t.columns.len());
+                for line in text.lines().filter(|l| !l.starts_with('#')) {
+                    assert_eq!(line.split_whitespace().count(), n, "{model} {with_terms}");
+                }
+            }
         }
     }
 

@@ -112,6 +112,11 @@ pub struct Tabulated {
 }
 
 impl Tabulated {
+    /// Where the table came from (a file path or a description).
+    pub fn origin(&self) -> &str {
+        &self.origin
+    }
+
     /// The function `name` (e.g. `b(k)`), checked: at least 2 rows, k finite, positive and strictly
     /// increasing, values finite and, if `positive`, > 0. `lines` gives each row's line number for
     /// messages (row numbers if empty).

@@ -41,14 +41,6 @@ impl BiasArgs {
             None => Bias::Constant(self.bias),
         })
     }
-
-    /// A description for table headers.
-    pub fn describe(&self) -> String {
-        match &self.bias_file {
-            Some(p) => format!("b(k) from {}", p.display()),
-            None => format!("b = {}", self.bias),
-        }
-    }
 }
 
 /// The stochasticity P_εε.

@@ -6,11 +6,10 @@ use crate::progress::Bars;
 use crate::real::write_output;
 use crate::rsd::parsed;
 use anyhow::{bail, Context, Result};
-use pt_spectra::fit::{
-    delta_chi2, fit, FitSettings, MultipoleData, MultipoleModel, Parameter, Params,
-};
+use pt_spectra::fit::{MultipoleData, Parameter};
+use pt_spectra::jobs::{fit_table, FitRequest, RsdRequest};
 use pt_spectra::real::RealModel;
-use pt_spectra::rsd::{Fog, RsdModel, RsdPlan};
+use pt_spectra::rsd::{Fog, RsdModel, RsdPlan, Sigma0};
 use pt_spectra::table::Table;
 use std::path::PathBuf;
 
@@ -97,7 +96,6 @@ fn k_max_values(s: &str) -> Result<Vec<f64>> {
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<()> {
-    let (real, rsd, fog) = (args.real_model, args.rsd, args.fog);
     let free: Vec<Parameter> = args
         .free
         .split(',')
@@ -125,12 +123,6 @@ pub fn run(args: &Args) -> Result<()> {
         spec.push((l, cols[1 + 2 * j] - 1, cols[2 + 2 * j] - 1));
     }
     let mut data = MultipoleData::read(&args.data, cols[0] - 1, &spec)?;
-    let noise = args.noise.noise()?;
-    if let (Some(p_eps), Some(j)) = (noise.values(&data.k)?, ells.iter().position(|&l| l == 0)) {
-        for (v, e) in data.values[j].iter_mut().zip(p_eps) {
-            *v -= e;
-        }
-    }
     if let Some(path) = &args.covariance {
         let n = ells.len() * data.k.len();
         let table = Table::read(path, &(0..n).collect::<Vec<_>>()).context("--covariance")?;
@@ -139,60 +131,38 @@ pub fn run(args: &Args) -> Result<()> {
             .collect();
         data = data.with_covariance(rows).context("--covariance")?;
     }
-    let k_max = k_max_values(&args.k_max)?;
-    let loaded = args.spectrum.load()?;
-    let (prepared, precision) = (&loaded.prepared, &loaded.precision);
-    let z = args.spectrum.z;
-    let f0 = args.f.unwrap_or(prepared.growth_rate);
+    let request = FitRequest {
+        model: RsdRequest {
+            rsd: args.rsd,
+            f: args.f,
+            bias: args.bias.bias()?,
+            amplitude: args.bias.amplitude,
+            fog: args.fog,
+            sigma0: Sigma0::Value(args.sigma0),
+            noise: args.noise.noise()?,
+            ells,
+            terms: false,
+        },
+        free,
+        k_min: args.k_min,
+        k_max: k_max_values(&args.k_max)?,
+        data_name: args.data.display().to_string(),
+    };
     for (name, v) in [
-        ("--f", f0),
         ("--sigma0", args.sigma0),
         ("--amplitude", args.bias.amplitude),
-    ] {
+    ]
+    .into_iter()
+    .chain(args.f.map(|f| ("--f", f)))
+    {
         if !v.is_finite() {
             bail!("{name} {v}: must be finite");
         }
     }
-    let b = args.bias.bias()?.values(&data.k, 1.0)?;
+    let loaded = args.spectrum.load()?;
     let bars = Bars::default();
-    let plan = RsdPlan::new(&data.k, real, rsd, precision, &loaded.store, &bars)?;
-    let (spectra, tns) = plan.evaluate(&prepared.spectrum, &bars)?;
-    let model = MultipoleModel::new(
-        &spectra,
-        tns.as_ref(),
-        rsd,
-        fog,
-        prepared.growth_factor,
-        b,
-        &ells,
-    )?;
-    let settings = FitSettings {
-        free: free.clone(),
-        start: Params {
-            f: f0,
-            sigma0: args.sigma0,
-            amplitude: args.bias.amplitude,
-        },
-        k_min: args.k_min,
-    };
-    let results = fit(&model, &data, &settings, &k_max)?;
-
-    let mut header = vec![format!(
-        "pt-spectra {} fit: {rsd} with real-space {real}, FoG {fog:?}, z = {z}, ells {}, free {}; data {}",
-        env!("CARGO_PKG_VERSION"),
-        args.ells,
-        args.free,
-        args.data.display()
-    )];
-    header.extend(loaded.describe());
-    header.push(format!(
-        "chi2 = {} ; errors: where the profile chi2 reaches chi2_min + {} ({} free); fixed: f = {f0}, sigma0 = {}, ab = {}",
-        if data.covariance.is_some() { "(d-m)^T C^-1 (d-m)" } else { "sum ((d-m)/sigma)^2" },
-        delta_chi2(free.len()),
-        free.len(),
-        args.sigma0,
-        args.bias.amplitude
-    ));
-    let table = pt_spectra::output::fit_table(&results, header);
+    let (precision, store) = (&loaded.precision, &loaded.store);
+    let plan = RsdPlan::new(&data.k, args.real_model, args.rsd, precision, store, &bars)?;
+    let table = fit_table(&plan, data, &request, &loaded.prepared, &bars)?;
     write_output(args.out.as_ref(), &table.to_text())
 }

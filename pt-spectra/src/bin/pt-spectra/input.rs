@@ -97,7 +97,7 @@ pub struct SpectrumInput {
         default_value_t = 0.0,
         allow_hyphen_values = true
     )]
-    pub z: f64,
+    z: f64,
     /// Accuracy of the loop integrals: fast, default or reference.
     #[arg(long, value_name = "PRESET", default_value = "default", value_parser = parse_precision)]
     precision: Precision,
@@ -182,26 +182,6 @@ impl SpectrumInput {
     }
 }
 
-impl Loaded {
-    /// Header lines naming the cosmology, the input spectrum and the integration settings.
-    pub fn describe(&self) -> Vec<String> {
-        let (spectrum, precision) = (&self.prepared.spectrum, &self.precision);
-        let mut h = self.prepared.description.clone();
-        h.push(format!(
-            "loop integrals over q in [{:e}, {:e}] h/Mpc, precision {}; the linear table covers [{:e}, \
-             {:e}] h/Mpc and is extended by power laws (slopes {:.3}, {:.3})",
-            precision.q_min,
-            precision.q_max,
-            precision.preset,
-            spectrum.k_min(),
-            spectrum.k_max(),
-            spectrum.extrapolation_slopes().0,
-            spectrum.extrapolation_slopes().1
-        ));
-        h
-    }
-}
-
 /// The linear spectrum and the output k grid: the options `real` and `rsd` share.
 #[derive(clap::Args, Debug)]
 pub struct Input {
@@ -250,11 +230,6 @@ impl Input {
             eprintln!("warning: output {ext}");
         }
         Ok((k, loaded))
-    }
-
-    /// The output redshift.
-    pub fn z(&self) -> f64 {
-        self.spectrum.z
     }
 }
 

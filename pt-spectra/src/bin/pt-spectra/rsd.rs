@@ -4,14 +4,11 @@ use crate::common::{list, BiasArgs, NoiseArgs};
 use crate::input::Input;
 use crate::progress::Bars;
 use crate::real::write_output;
-use anyhow::{bail, Result};
-use pt_spectra::halo::crossings;
+use anyhow::Result;
+use pt_spectra::jobs::{rsd_table, RsdRequest};
 use pt_spectra::real::RealModel;
-use pt_spectra::rsd::{fog_sigma, multipoles, Fog, RsdModel, RsdPlan, RsdSettings, Sigma0};
+use pt_spectra::rsd::{Fog, RsdModel, RsdPlan, Sigma0};
 use std::path::PathBuf;
-
-/// Signal-to-noise levels whose crossings are reported (the paper's table_noise).
-const SN_LEVELS: [f64; 3] = [1.0, 0.5, 0.1];
 
 /// A name through the library's `FromStr`, for clap.
 pub fn parsed<T: std::str::FromStr<Err = pt_spectra::error::Error>>(
@@ -64,75 +61,32 @@ pub struct Args {
     out: Option<PathBuf>,
 }
 
-/// Runs the subcommand.
-pub fn run(args: &Args) -> Result<()> {
-    let (real, rsd, fog) = (args.real_model, args.rsd, args.fog);
-    let ells: Vec<usize> = list(&args.ells, "--ells")?;
-    pt_spectra::rsd::MultipoleRule::new(&ells)?;
-    let (bias, noise) = (args.bias.bias()?, args.noise.noise()?);
-    let (k, loaded) = args.input.load()?;
-    let (prepared, precision) = (&loaded.prepared, &loaded.precision);
-    let z = args.input.z();
-    let f = args.f.unwrap_or(prepared.growth_rate);
-    if !f.is_finite() {
-        bail!("--f {f}: must be finite");
+impl Args {
+    /// The redshift-space settings of the options.
+    fn request(&self) -> Result<RsdRequest> {
+        let ells: Vec<usize> = list(&self.ells, "--ells")?;
+        pt_spectra::rsd::MultipoleRule::new(&ells)?;
+        Ok(RsdRequest {
+            rsd: self.rsd,
+            f: self.f,
+            bias: self.bias.bias()?,
+            amplitude: self.bias.amplitude,
+            fog: self.fog,
+            sigma0: self.sigma0,
+            noise: self.noise.noise()?,
+            ells,
+            terms: self.terms,
+        })
     }
-    let b = bias.values(&k, args.bias.amplitude)?;
-    let p_eps = noise.values(&k)?;
-    let growth = prepared.growth_factor;
-    let sigma0 = args.sigma0.resolve(&prepared.spectrum, growth, precision)?;
-    let sigma = fog_sigma(sigma0, growth, f);
-    let bars = Bars::default();
-    let plan = RsdPlan::new(&k, real, rsd, precision, &loaded.store, &bars)?;
-    let (spectra, tns) = plan.evaluate(&prepared.spectrum, &bars)?;
-    let settings = RsdSettings {
-        model: rsd,
-        f,
-        bias: b,
-        fog,
-        sigma,
-        noise: p_eps,
-        ells,
-        parts: args.terms,
-    };
-    let m = multipoles(&spectra, tns.as_ref(), &settings)?;
-
-    let mut header = vec![format!(
-        "pt-spectra {} rsd: {rsd} with real-space {real}, z = {z}, f = {f}, {} times A_b = {}, \
-         FoG {fog:?} with sigma0 = {} Mpc/h (sigma = sigma0 D(z) f = {sigma:.6} Mpc/h)",
-        env!("CARGO_PKG_VERSION"),
-        args.bias.describe(),
-        args.bias.amplitude,
-        sigma0
-    )];
-    header.extend(loaded.describe());
-    if rsd.needs_tns() {
-        header.push(
-            "TNS A and B at leading order (linear P, tree-level bispectrum), A = b^3 A(f/b), B = b^4 B(f/b)"
-                .into(),
-        );
-    }
-    header.push(
-        "P_l = (2l+1) int_0^1 dmu P^s(k,mu) L_l(mu), noise-subtracted; err_P_l bounds the numerical \
-         error (loop integrals and mu quadrature)"
-            .into(),
-    );
-    if let Some(sn) = &m.signal_to_noise {
-        header.push(crossing_line(&k, sn));
-    }
-    write_output(args.out.as_ref(), &m.table(header).to_text())
 }
 
-/// Where the signal-to-noise falls to each of [`SN_LEVELS`].
-fn crossing_line(k: &[f64], sn: &[f64]) -> String {
-    let mut text = "signal-to-noise SN = P0/P_eps falls to".to_string();
-    for (level, c) in SN_LEVELS.iter().zip(crossings(k, sn, &SN_LEVELS)) {
-        match c {
-            Some(kc) => text += &format!(" {level} at k = {kc:.4}"),
-            None if sn[0] < *level => text += &format!(" {level}: below it at every k"),
-            None => text += &format!(" {level}: not within the k range"),
-        }
-        text.push(';');
-    }
-    text
+/// Runs the subcommand.
+pub fn run(args: &Args) -> Result<()> {
+    let request = args.request()?;
+    let (k, loaded) = args.input.load()?;
+    let bars = Bars::default();
+    let (precision, store) = (&loaded.precision, &loaded.store);
+    let plan = RsdPlan::new(&k, args.real_model, args.rsd, precision, store, &bars)?;
+    let table = rsd_table(&plan, &request, &loaded.prepared, &bars)?;
+    write_output(args.out.as_ref(), &table.to_text())
 }
