@@ -1,10 +1,21 @@
-//! ΛCDM background, exact linear growth, and Eisenstein & Hu (1998) linear spectra.
+//! Background cosmology (matter, curvature, w0–wa dark energy), linear growth, and Eisenstein & Hu (1998)
+//! linear spectra.
 //!
-//! * Growth (radiation neglected, matter + curvature + Λ): the growing mode is Heath's (1977) integral
-//!   D(a) ∝ E(a) ∫_0^a da′ / (a′E(a′))³, E = H/H0 = (Ω_m a⁻³ + Ω_k a⁻² + Ω_Λ)^½, normalised to D(z=0) = 1,
-//!   and f = d ln D/d ln a = −(3Ω_m a⁻³ + 2Ω_k a⁻²)/(2E²) + 1/(a²E³ I(a)) with I the integral. The integral
+//! * Expansion (radiation and massive neutrinos neglected): E(a) = H/H0 with
+//!   E² = Ω_m a⁻³ + Ω_k a⁻² + Ω_DE a^{−3(1+w0+wa)} exp(−3 wa (1−a)), the dark energy of equation of state
+//!   w(a) = w0 + wa (1 − a) (Chevallier & Polarski 2001, Linder 2003), and Ω_k = 1 − Ω_m − Ω_DE.
+//! * Growth, for a cosmological constant (w0 = −1, wa = 0; flat or curved): the growing mode is Heath's
+//!   (1977) integral D(a) ∝ E(a) ∫_0^a da′ / (a′E(a′))³, normalised to D(z=0) = 1, and
+//!   f = d ln D/d ln a = −(3Ω_m a⁻³ + 2Ω_k a⁻²)/(2E²) + 1/(a²E³ I(a)) with I the integral. The integral
 //!   is done in u = √a, where the integrand 2u⁴/(Ω_m + Ω_k u² + Ω_Λ u⁶)^{3/2} is smooth, by Simpson's rule
 //!   (relative error < 1e-12). Not a fitting formula.
+//! * Growth, for any other w0, wa: the linear growth equation in ln a (e.g. Linder & Jenkins 2003),
+//!   D″ + (2 + d ln E/d ln a) D′ − (3/2) Ω_m a⁻³/E² D = 0, for the growing mode started deep in matter
+//!   domination (D = D′ = a at a = 1e-8), integrated by an adaptive Dormand–Prince 5(4) Runge–Kutta method
+//!   to ~1e-11 relative; D is normalised to D(z=0) = 1 and f = D′/D. The tests check the ODE against
+//!   Heath's integral (flat and curved), Einstein–de Sitter, the flat-ΛCDM hypergeometric closed form and
+//!   w = −1/3 (which dilutes like curvature) to ≤ 1e-8. Scale-independent: dark energy is taken to be
+//!   smooth (no perturbations), as in the CAMB "fluid"/PPF models on sub-horizon scales.
 //! * Transfer functions: Eisenstein & Hu (1998, ApJ 496, 605; astro-ph/9709112), the full fit with baryon
 //!   acoustic oscillations (their §3, eqs. 2–24) and the smooth "no-wiggle" fit (§4.2, eqs. 26–31), with
 //!   T_CMB = [`T_CMB_K`]. [`Cosmology::eisenstein_hu_spectrum`] turns them into P(k) = A k^{n_s} T²(k)
@@ -23,16 +34,17 @@ mod growth;
 
 pub use eisenstein_hu::{EisensteinHu, TransferKind};
 
-/// Cosmological parameters of a ΛCDM model (massless neutrinos, radiation neglected in the growth).
+/// Cosmological parameters: matter, curvature and w0–wa dark energy (massless neutrinos, radiation
+/// neglected in the growth).
 ///
-/// Ω_k = 1 − Ω_m − Ω_Λ; the paper's models are flat. After changing fields, call
+/// Ω_k = 1 − Ω_m − Ω_DE; the paper's models are flat ΛCDM. After changing fields, call
 /// [`validate`](Self::validate).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct Cosmology {
     /// Total matter density today Ω_m (CDM + baryons).
     pub omega_m: f64,
-    /// Cosmological-constant density today Ω_Λ.
+    /// Dark-energy density today Ω_DE: the cosmological constant Ω_Λ when w0 = −1 and wa = 0.
     pub omega_lambda: f64,
     /// Dimensionless Hubble constant h = H0 / (100 km/s/Mpc).
     pub h: f64,
@@ -42,6 +54,10 @@ pub struct Cosmology {
     pub n_s: f64,
     /// RMS linear density fluctuation in spheres of 8 Mpc/h at z = 0.
     pub sigma8: f64,
+    /// Dark-energy equation of state today, w0 (−1 for a cosmological constant).
+    pub w0: f64,
+    /// Dark-energy equation-of-state slope wa, w(a) = w0 + wa (1 − a) (0 for a cosmological constant).
+    pub wa: f64,
 }
 
 impl Default for Cosmology {
@@ -62,10 +78,13 @@ impl Cosmology {
             omega_b_h2: 0.023,
             n_s: 0.95,
             sigma8: 0.8,
+            w0: -1.0,
+            wa: 0.0,
         }
     }
 
-    /// A validated cosmology.
+    /// A validated cosmology with a cosmological constant Ω_Λ (w0 = −1, wa = 0); see
+    /// [`with_dark_energy`](Self::with_dark_energy) for other dark energy.
     ///
     /// # Errors
     /// As [`validate`](Self::validate).
@@ -84,6 +103,8 @@ impl Cosmology {
             omega_b_h2,
             n_s,
             sigma8,
+            w0: -1.0,
+            wa: 0.0,
         };
         c.validate()?;
         Ok(c)
@@ -97,11 +118,24 @@ impl Cosmology {
         Self::new(omega_m, 1.0 - omega_m, h, omega_b_h2, n_s, sigma8)
     }
 
+    /// The same cosmology with dark energy of equation of state w(a) = w0 + wa (1 − a) and the same
+    /// density today Ω_DE (= `omega_lambda`), so the same Ω_k.
+    ///
+    /// # Errors
+    /// As [`validate`](Self::validate), e.g. unless w0 + wa < 0.
+    pub fn with_dark_energy(self, w0: f64, wa: f64) -> Result<Self> {
+        let c = Self { w0, wa, ..self };
+        c.validate()?;
+        Ok(c)
+    }
+
     /// Checks the parameters.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] unless all are finite, Ω_m > 0, Ω_Λ ≥ 0, h > 0,
-    /// 0 < Ω_b h² < Ω_m h², σ8 > 0, and E²(a) > 0 for all 0 < a ≤ 1 (no bounce).
+    /// [`Error::InvalidParameter`] unless all are finite, Ω_m > 0, Ω_DE ≥ 0, h > 0,
+    /// 0 < Ω_b h² < Ω_m h², σ8 > 0, w0 + wa < 0 (so that w(a → 0) < 0 and dark energy is subdominant at
+    /// early times, as the growth's start in matter domination needs), and E²(a) > 0 for all 0 < a ≤ 1
+    /// (no bounce).
     pub fn validate(&self) -> Result<()> {
         let bad = |name, value, reason| {
             Err(Error::InvalidParameter {
@@ -122,7 +156,7 @@ impl Cosmology {
         }
         if !(self.omega_lambda.is_finite() && self.omega_lambda >= 0.0) {
             return bad(
-                "Omega_Lambda",
+                "Omega_DE",
                 self.omega_lambda,
                 "must be finite and non-negative",
             );
@@ -134,8 +168,18 @@ impl Cosmology {
                 "must be positive and below Omega_m h^2",
             );
         }
-        if !self.n_s.is_finite() {
-            return bad("n_s", self.n_s, "must be finite");
+        for (name, v) in [("n_s", self.n_s), ("w0", self.w0), ("wa", self.wa)] {
+            if !v.is_finite() {
+                return bad(name, v, "must be finite");
+            }
+        }
+        if self.w0 + self.wa >= 0.0 {
+            return bad(
+                "w0 + wa",
+                self.w0 + self.wa,
+                "must be negative: w(a -> 0) = w0 + wa >= 0 makes dark energy as important as matter \
+                 at early times, where the growth starts in matter domination",
+            );
         }
         if (1..=1000).any(|i| self.a2e2(f64::from(i) / 1000.0) <= 0.0) {
             return bad(
@@ -147,7 +191,7 @@ impl Cosmology {
         Ok(())
     }
 
-    /// Curvature density Ω_k = 1 − Ω_m − Ω_Λ.
+    /// Curvature density Ω_k = 1 − Ω_m − Ω_DE.
     pub fn omega_k(&self) -> f64 {
         1.0 - self.omega_m - self.omega_lambda
     }
@@ -231,6 +275,16 @@ mod tests {
         assert!(Cosmology::new(0.1, 3.0, 0.7, 0.002, 0.96, 0.8).is_err()); // bounce
         let e = Cosmology::flat(0.3, 0.7, 0.02, 0.96, -0.8).unwrap_err();
         assert!(e.to_string().contains("sigma8 = -0.8"), "{e}");
+        let flat = Cosmology::flat(0.3, 0.7, 0.02, 0.96, 0.8).unwrap();
+        assert!(flat.with_dark_energy(-0.9, 0.3).is_ok());
+        let e = flat.with_dark_energy(-0.5, 0.75).unwrap_err();
+        assert!(e.to_string().contains("w0 + wa = 0.25"), "{e}");
+        assert!(flat.with_dark_energy(f64::INFINITY, -2.0).is_err());
+        // Closed: with Λ, a²E² = 0.3/a − 0.8 + 1.5a² > 0.16; with phantom w = −2 dark energy,
+        // a²E² = 0.3/a − 0.8 + 1.5a⁵ < 0 near a = 0.5.
+        let closed = Cosmology::new(0.3, 1.5, 0.7, 0.02, 0.96, 0.8).unwrap();
+        let e = closed.with_dark_energy(-2.0, 0.0).unwrap_err();
+        assert!(e.to_string().contains("bouncing"), "{e}");
     }
 
     fn ratios(kind: TransferKind) -> (LinearSpectrum, LinearSpectrum) {
