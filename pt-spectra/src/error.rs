@@ -167,6 +167,18 @@ pub enum Error {
         /// The names that are accepted.
         available: &'static str,
     },
+
+    /// A cosmology name that is not a preset.
+    #[error(
+        "unknown cosmology `{name}`: the presets are {available} (or give the path of a CLASS or CAMB \
+         .ini parameter file where a file is accepted)"
+    )]
+    UnknownCosmology {
+        /// The name that was given.
+        name: String,
+        /// The preset names, comma-separated.
+        available: String,
+    },
 }
 
 /// `Result` with the crate's [`Error`].

@@ -138,7 +138,6 @@ impl Cosmology {
     }
 
     /// The growing mode normalised to D_md = a deep in matter domination, at a.
-    #[cfg_attr(not(test), expect(dead_code, reason = "the A_s normalisation will use it"))]
     pub(super) fn growth_md(&self, a: f64, method: Method) -> f64 {
         match method {
             Method::Heath => self.heath_d_md(a),

@@ -18,21 +18,60 @@
 //!   smooth (no perturbations), as in the CAMB "fluid"/PPF models on sub-horizon scales.
 //! * Transfer functions: Eisenstein & Hu (1998, ApJ 496, 605; astro-ph/9709112), the full fit with baryon
 //!   acoustic oscillations (their §3, eqs. 2–24) and the smooth "no-wiggle" fit (§4.2, eqs. 26–31), with
-//!   T_CMB = [`T_CMB_K`]. [`Cosmology::eisenstein_hu_spectrum`] turns them into P(k) = A k^{n_s} T²(k)
-//!   normalised to σ8, as a [`LinearSpectrum`].
+//!   T_CMB = [`T_CMB_K`]. [`Cosmology::eisenstein_hu_spectrum`] turns them into a [`LinearSpectrum`]
+//!   normalised by the cosmology's [`Amplitude`]: P(k) = A k^{n_s} T²(k) with A fixed by σ8, or from the
+//!   primordial amplitude A_s, P(k) = 2π²/k³ · (4/25) A_s (k/k_pivot)^{n_s−1} (k c/H0)⁴ T²(k) (D_md(1)/Ω_m)²
+//!   with D_md the growing mode normalised to a deep in matter domination: on super-horizon scales in
+//!   matter domination Φ = (3/5)ζ, and the Poisson equation k²Φ = (3/2) Ω_m H0² δ/a gives
+//!   δ = (2/5) ζ (k/H0)² D_md/Ω_m, times T(k) on smaller scales.
+//! * Presets: [`PRESETS`], [`Cosmology::preset`].
 //!
 //! Units: k in h/Mpc, P in (Mpc/h)^3, lengths in Mpc/h unless stated otherwise.
 
 use crate::error::{Error, Result};
 use crate::linear::{LinearSpectrum, LogGrid};
+use std::f64::consts::PI;
 
 /// CMB temperature in K used by the Eisenstein & Hu transfer functions (the CAMB default).
 pub const T_CMB_K: f64 = 2.7255;
+
+/// The Hubble distance c/H0 in Mpc/h (c = 299792.458 km/s, H0 = 100 h km/s/Mpc).
+pub const HUBBLE_DISTANCE_MPC_H: f64 = 2997.92458;
+
+/// Names accepted by [`Cosmology::preset`].
+pub const PRESETS: [&str; 2] = ["gm2012", "planck2018"];
 
 mod eisenstein_hu;
 mod growth;
 
 pub use eisenstein_hu::{EisensteinHu, TransferKind};
+
+/// How the amplitude of the linear spectrum is fixed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Amplitude {
+    /// σ8: the RMS linear density fluctuation in spheres of 8 Mpc/h at z = 0.
+    Sigma8(f64),
+    /// The primordial curvature power spectrum Δ²_ζ(k) = A_s (k/k_pivot)^{n_s−1}.
+    As {
+        /// Amplitude A_s at the pivot.
+        a_s: f64,
+        /// Pivot wavenumber in 1/Mpc (not h/Mpc), [`Amplitude::DEFAULT_K_PIVOT`] in CAMB and CLASS.
+        k_pivot: f64,
+    },
+}
+
+impl Amplitude {
+    /// The CAMB and CLASS default pivot, 0.05/Mpc.
+    pub const DEFAULT_K_PIVOT: f64 = 0.05;
+
+    /// A_s at the default pivot [`DEFAULT_K_PIVOT`](Self::DEFAULT_K_PIVOT).
+    pub const fn a_s(a_s: f64) -> Self {
+        Self::As {
+            a_s,
+            k_pivot: Self::DEFAULT_K_PIVOT,
+        }
+    }
+}
 
 /// Cosmological parameters: matter, curvature and w0–wa dark energy (massless neutrinos, radiation
 /// neglected in the growth).
@@ -52,8 +91,8 @@ pub struct Cosmology {
     pub omega_b_h2: f64,
     /// Primordial spectral index n_s.
     pub n_s: f64,
-    /// RMS linear density fluctuation in spheres of 8 Mpc/h at z = 0.
-    pub sigma8: f64,
+    /// Amplitude of the linear spectrum: σ8 or the primordial A_s.
+    pub amplitude: Amplitude,
     /// Dark-energy equation of state today, w0 (−1 for a cosmological constant).
     pub w0: f64,
     /// Dark-energy equation-of-state slope wa, w(a) = w0 + wa (1 − a) (0 for a cosmological constant).
@@ -77,9 +116,44 @@ impl Cosmology {
             h: 0.7,
             omega_b_h2: 0.023,
             n_s: 0.95,
-            sigma8: 0.8,
+            amplitude: Amplitude::Sigma8(0.8),
             w0: -1.0,
             wa: 0.0,
+        }
+    }
+
+    /// Planck 2018 best fit as in the CAMB reference tables of the tests (`tests/data/make_planck2018.py`):
+    /// h = 0.6766, Ω_b h² = 0.02242, Ω_c h² = 0.11933, n_s = 0.9665, A_s = 2.105209e-9 at k_pivot = 0.05/Mpc,
+    /// flat, Λ. Ω_m = (Ω_b h² + Ω_c h²)/h² = 0.309641: neutrinos are massless (their radiation is
+    /// neglected in the growth, as is the photons').
+    pub const fn planck2018() -> Self {
+        let h = 0.6766;
+        let (omega_b_h2, omega_c_h2) = (0.02242, 0.11933);
+        let omega_m = (omega_b_h2 + omega_c_h2) / (h * h);
+        Self {
+            omega_m,
+            omega_lambda: 1.0 - omega_m,
+            h,
+            omega_b_h2,
+            n_s: 0.9665,
+            amplitude: Amplitude::a_s(2.105209e-9),
+            w0: -1.0,
+            wa: 0.0,
+        }
+    }
+
+    /// The preset called `name`, one of [`PRESETS`].
+    ///
+    /// # Errors
+    /// [`Error::UnknownCosmology`] (listing the presets) for any other name.
+    pub fn preset(name: &str) -> Result<Self> {
+        match name {
+            "gm2012" => Ok(Self::gm2012()),
+            "planck2018" => Ok(Self::planck2018()),
+            _ => Err(Error::UnknownCosmology {
+                name: name.to_string(),
+                available: PRESETS.join(", "),
+            }),
         }
     }
 
@@ -102,7 +176,7 @@ impl Cosmology {
             h,
             omega_b_h2,
             n_s,
-            sigma8,
+            amplitude: Amplitude::Sigma8(sigma8),
             w0: -1.0,
             wa: 0.0,
         };
@@ -129,11 +203,21 @@ impl Cosmology {
         Ok(c)
     }
 
+    /// The same cosmology normalised by `amplitude` instead.
+    ///
+    /// # Errors
+    /// As [`validate`](Self::validate).
+    pub fn with_amplitude(self, amplitude: Amplitude) -> Result<Self> {
+        let c = Self { amplitude, ..self };
+        c.validate()?;
+        Ok(c)
+    }
+
     /// Checks the parameters.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] unless all are finite, Ω_m > 0, Ω_DE ≥ 0, h > 0,
-    /// 0 < Ω_b h² < Ω_m h², σ8 > 0, w0 + wa < 0 (so that w(a → 0) < 0 and dark energy is subdominant at
+    /// 0 < Ω_b h² < Ω_m h², σ8 > 0 or A_s > 0 and k_pivot > 0, w0 + wa < 0 (so that w(a → 0) < 0 and dark energy is subdominant at
     /// early times, as the growth's start in matter domination needs), and E²(a) > 0 for all 0 < a ≤ 1
     /// (no bounce).
     pub fn validate(&self) -> Result<()> {
@@ -145,11 +229,14 @@ impl Cosmology {
             })
         };
         let positive = "must be finite and positive";
-        for (name, v) in [
-            ("Omega_m", self.omega_m),
-            ("h", self.h),
-            ("sigma8", self.sigma8),
-        ] {
+        let amplitude = match self.amplitude {
+            Amplitude::Sigma8(s) => [("sigma8", s), ("sigma8", s)],
+            Amplitude::As { a_s, k_pivot } => [("A_s", a_s), ("k_pivot [1/Mpc]", k_pivot)],
+        };
+        for (name, v) in [("Omega_m", self.omega_m), ("h", self.h)]
+            .into_iter()
+            .chain(amplitude)
+        {
             if !(v.is_finite() && v > 0.0) {
                 return bad(name, v, positive);
             }
@@ -214,11 +301,14 @@ impl Cosmology {
         spectrum.scaled((self.growth_factor(z) / self.growth_factor(z_in)).powi(2))
     }
 
-    /// Eisenstein & Hu (1998) linear spectrum P(k, z) = A k^{n_s} T²(k) D²(z) on `grid`, with A set so that
-    /// σ(8 Mpc/h) = `self.sigma8` at z = 0 (top hat, [`LinearSpectrum::sigma_r`]).
+    /// Eisenstein & Hu (1998) linear spectrum P(k, z) on `grid`, normalised by [`amplitude`](Self::amplitude):
+    /// for σ8, P = A k^{n_s} T²(k) D²(z) with A set so that σ(8 Mpc/h) = σ8 at z = 0 (top hat,
+    /// [`LinearSpectrum::sigma_r`]); for A_s, P(k, z = 0) = 2π²/k³ · (4/25) A_s (k/k_pivot)^{n_s−1}
+    /// (k c/H0)⁴ T²(k) (D_md(1)/Ω_m)² (module docs), then × D²(z).
     ///
     /// [`TransferKind::NoWiggle`] gives the smooth spectrum by which BAO features are divided out
-    /// (P_lin/P_nw); with the same σ8 it matches the broadband of the [`TransferKind::Wiggle`] one.
+    /// (P_lin/P_nw); with the same σ8 it matches the broadband of the [`TransferKind::Wiggle`] one. With
+    /// A_s both share the large-scale amplitude, and their σ8 differ by the wiggles' share (~0.5%).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for an invalid cosmology or redshift.
@@ -227,6 +317,9 @@ impl Cosmology {
     /// use pt_spectra::{cosmology::{Cosmology, TransferKind}, linear::LogGrid};
     /// let p = Cosmology::gm2012().eisenstein_hu_spectrum(TransferKind::NoWiggle, 0.0, &LogGrid::default())?;
     /// assert!((p.sigma8() - 0.8).abs() < 1e-9);
+    /// // Planck 2018 is normalised by A_s: σ8 follows (CAMB: 0.8217; EH is a fit).
+    /// let p = Cosmology::planck2018().eisenstein_hu_spectrum(TransferKind::Wiggle, 0.0, &LogGrid::default())?;
+    /// assert!((p.sigma8() / 0.8217 - 1.0).abs() < 0.03);
     /// # Ok::<(), pt_spectra::error::Error>(())
     /// ```
     pub fn eisenstein_hu_spectrum(
@@ -236,77 +329,88 @@ impl Cosmology {
         grid: &LogGrid,
     ) -> Result<LinearSpectrum> {
         let eh = EisensteinHu::new(self)?;
-        let shape =
-            LinearSpectrum::from_fn(grid, |k| k.powf(self.n_s) * eh.transfer(kind, k).powi(2))?;
-        let sigma = shape.sigma_r(8.0)?.0;
-        let normalised = shape.scaled((self.sigma8 / sigma).powi(2))?;
-        self.rescale(&normalised, 0.0, z)
+        let t2 = |k: f64| eh.transfer(kind, k).powi(2);
+        let today = match self.amplitude {
+            Amplitude::Sigma8(sigma8) => {
+                let shape = LinearSpectrum::from_fn(grid, |k| k.powf(self.n_s) * t2(k))?;
+                let sigma = shape.sigma_r(8.0)?.0;
+                shape.scaled((sigma8 / sigma).powi(2))?
+            }
+            Amplitude::As { a_s, k_pivot } => {
+                let k_pivot_h = k_pivot / self.h;
+                let growth = self.growth_md(1.0, self.method()) / self.omega_m;
+                LinearSpectrum::from_fn(grid, |k| {
+                    let primordial = a_s * (k / k_pivot_h).powf(self.n_s - 1.0);
+                    2.0 * PI * PI / k.powi(3)
+                        * 0.16
+                        * primordial
+                        * (k * HUBBLE_DISTANCE_MPC_H).powi(4)
+                        * t2(k)
+                        * growth
+                        * growth
+                })?
+            }
+        };
+        self.rescale(&today, 0.0, z)
     }
+
+    /// One line describing the cosmology, for output headers, e.g. `Omega_m = 0.309641, Omega_DE =
+    /// 0.690359, Omega_k = 0, h = 0.6766, omega_b = 0.02242, n_s = 0.9665, A_s = 2.105209e-09, w0 = -1,
+    /// wa = 0`.
+    ///
+    /// Input values are printed exactly (shortest form that reads back to the same number), the derived
+    /// densities to 6 significant digits; |Ω_k| < 1e-12 (rounding of 1 − Ω_m − Ω_DE) prints as 0. The
+    /// pivot is shown when it is not the default 0.05/Mpc.
+    pub fn describe(&self) -> String {
+        let amplitude = match self.amplitude {
+            Amplitude::Sigma8(s) => format!("sigma8 = {}", number(s)),
+            Amplitude::As { a_s, k_pivot } if k_pivot == Amplitude::DEFAULT_K_PIVOT => {
+                format!("A_s = {}", number(a_s))
+            }
+            Amplitude::As { a_s, k_pivot } => {
+                format!("A_s = {}, k_pivot = {}/Mpc", number(a_s), number(k_pivot))
+            }
+        };
+        let omega_k = self.omega_k();
+        let omega_k = if omega_k.abs() < 1e-12 { 0.0 } else { omega_k };
+        format!(
+            "Omega_m = {}, Omega_DE = {}, Omega_k = {}, h = {}, omega_b = {}, n_s = {}, {amplitude}, \
+             w0 = {}, wa = {}",
+            significant(self.omega_m),
+            significant(self.omega_lambda),
+            significant(omega_k),
+            number(self.h),
+            number(self.omega_b_h2),
+            number(self.n_s),
+            number(self.w0),
+            number(self.wa),
+        )
+    }
+}
+
+/// `x` in its shortest exact form, in exponent notation with a two-digit exponent (`2.105209e-09`, as
+/// C's `%e`) outside 1e-4 ≤ |x| < 1e6.
+fn number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e6).contains(&x.abs()) {
+        return format!("{x}");
+    }
+    let text = format!("{x:e}");
+    match text.split_once('e') {
+        Some((mantissa, exponent)) => {
+            let (sign, digits) = match exponent.strip_prefix('-') {
+                Some(digits) => ("-", digits),
+                None => ("+", exponent),
+            };
+            format!("{mantissa}e{sign}{digits:0>2}")
+        }
+        None => text,
+    }
+}
+
+/// `x` rounded to 6 significant digits, printed by [`number`].
+fn significant(x: f64) -> String {
+    number(format!("{x:.5e}").parse().unwrap_or(x))
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// CAMB includes radiation and scale-dependent baryon effects that the ΛCDM growth integral neglects.
-    const CAMB_GROWTH_TOL: f64 = 1e-3;
-
-    #[test]
-    fn rescaling_follows_growth_squared() {
-        let c = Cosmology::gm2012();
-        let p0 = LinearSpectrum::gm2012_z0();
-        let p1 = c.rescale(&p0, 0.0, 1.0).unwrap();
-        let camb1 = LinearSpectrum::gm2012(1.0).unwrap();
-        for k in [1e-3, 0.05, 0.2] {
-            assert!(
-                (p1.eval(k) / camb1.eval(k) - 1.0).abs() < 2.0 * CAMB_GROWTH_TOL,
-                "k {k}"
-            );
-        }
-        assert!(c.rescale(&p0, -1.0, 0.0).is_err());
-    }
-
-    #[test]
-    fn invalid_cosmologies_are_rejected() {
-        assert!(Cosmology::gm2012().validate().is_ok());
-        assert!(Cosmology::flat(-0.1, 0.7, 0.02, 0.96, 0.8).is_err());
-        assert!(Cosmology::flat(0.3, 0.7, 0.5, 0.96, 0.8).is_err());
-        assert!(Cosmology::flat(0.3, f64::NAN, 0.02, 0.96, 0.8).is_err());
-        assert!(Cosmology::new(0.1, 3.0, 0.7, 0.002, 0.96, 0.8).is_err()); // bounce
-        let e = Cosmology::flat(0.3, 0.7, 0.02, 0.96, -0.8).unwrap_err();
-        assert!(e.to_string().contains("sigma8 = -0.8"), "{e}");
-        let flat = Cosmology::flat(0.3, 0.7, 0.02, 0.96, 0.8).unwrap();
-        assert!(flat.with_dark_energy(-0.9, 0.3).is_ok());
-        let e = flat.with_dark_energy(-0.5, 0.75).unwrap_err();
-        assert!(e.to_string().contains("w0 + wa = 0.25"), "{e}");
-        assert!(flat.with_dark_energy(f64::INFINITY, -2.0).is_err());
-        // Closed: with Λ, a²E² = 0.3/a − 0.8 + 1.5a² > 0.16; with phantom w = −2 dark energy,
-        // a²E² = 0.3/a − 0.8 + 1.5a⁵ < 0 near a = 0.5.
-        let closed = Cosmology::new(0.3, 1.5, 0.7, 0.02, 0.96, 0.8).unwrap();
-        let e = closed.with_dark_energy(-2.0, 0.0).unwrap_err();
-        assert!(e.to_string().contains("bouncing"), "{e}");
-    }
-
-    fn ratios(kind: TransferKind) -> (LinearSpectrum, LinearSpectrum) {
-        let c = Cosmology::gm2012();
-        let eh = c
-            .eisenstein_hu_spectrum(kind, 0.0, &LogGrid::default())
-            .unwrap();
-        (eh, LinearSpectrum::gm2012_z0())
-    }
-
-    #[test]
-    fn eisenstein_hu_broadband_matches_camb() {
-        let (nw, camb) = ratios(TransferKind::NoWiggle);
-        let (w, _) = ratios(TransferKind::Wiggle);
-        assert!((nw.sigma8() - 0.8).abs() < 1e-9 && (w.sigma8() - 0.8).abs() < 1e-9);
-        let (mut worst_nw, mut worst_w) = (0.0_f64, 0.0_f64);
-        for k in LogGrid::new(0.01, 0.3, 100).unwrap().points() {
-            worst_nw = worst_nw.max((nw.eval(k) / camb.eval(k) - 1.0).abs());
-            worst_w = worst_w.max((w.eval(k) / camb.eval(k) - 1.0).abs());
-        }
-        println!("max |P_EH/P_CAMB - 1| on 0.01-0.3: no-wiggle {worst_nw:.4}, wiggle {worst_w:.4}");
-        assert!(worst_nw < 0.08, "{worst_nw}");
-        assert!(worst_w < 0.05, "{worst_w}");
-    }
-}
+mod tests;

@@ -271,7 +271,7 @@ fn dynamical_dark_energy_growth_is_consistent() {
 
 #[test]
 fn growth_evaluation_is_cheap() {
-    let heath = Cosmology::flat(0.3096, 0.6766, 0.02242, 0.9665, 0.81).unwrap();
+    let heath = Cosmology::planck2018();
     let c = heath.with_dark_energy(-0.9, -0.2).unwrap();
     let n = 200;
     let start = std::time::Instant::now();
