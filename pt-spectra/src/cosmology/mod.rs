@@ -24,7 +24,8 @@
 //!   with D_md the growing mode normalised to a deep in matter domination: on super-horizon scales in
 //!   matter domination Φ = (3/5)ζ, and the Poisson equation k²Φ = (3/2) Ω_m H0² δ/a gives
 //!   δ = (2/5) ζ (k/H0)² D_md/Ω_m, times T(k) on smaller scales.
-//! * Presets: [`PRESETS`], [`Cosmology::preset`].
+//! * Presets [`PRESETS`] ([`Cosmology::preset`]), and CLASS or CAMB parameter files ([`ini`]:
+//!   [`Cosmology::from_ini_file`], [`Cosmology::from_name_or_file`]).
 //!
 //! Units: k in h/Mpc, P in (Mpc/h)^3, lengths in Mpc/h unless stated otherwise.
 
@@ -43,8 +44,10 @@ pub const PRESETS: [&str; 2] = ["gm2012", "planck2018"];
 
 mod eisenstein_hu;
 mod growth;
+pub mod ini;
 
 pub use eisenstein_hu::{EisensteinHu, TransferKind};
+pub use ini::ParsedCosmology;
 
 /// How the amplitude of the linear spectrum is fixed.
 #[derive(Debug, Clone, Copy, PartialEq)]
