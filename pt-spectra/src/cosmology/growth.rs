@@ -5,8 +5,8 @@
 //! * Otherwise: the growth ODE in x = ln a for g = D/a, integrated by an adaptive Dormand–Prince 5(4)
 //!   Runge–Kutta method from a = [`A_START`] (g = 1, g′ = 0, i.e. D = D′ = a, plus first-order
 //!   corrections, see `ode_start`) with a local error tolerance of [`ODE_TOL`] per step: 200–300 steps
-//!   and ~30 µs per call, as for Heath's integral. The tests check it against Heath's integral to
-//!   ≤ 1e-8 (measured ~1e-11).
+//!   and a few tens of µs per call, about as for Heath's integral. The tests check it against Heath's
+//!   integral to ≤ 1e-8 (measured ~1e-11).
 
 use super::Cosmology;
 

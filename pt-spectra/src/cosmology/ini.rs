@@ -229,6 +229,8 @@ impl Cosmology {
 
     /// A cosmology from key–value pairs with the keys and values of a parameter file (e.g. a Python
     /// dict's items); `origin` names them in error messages, where "line" is the 1-based index of the pair.
+    /// Takes pairs by value (`Vec<(String, String)>`, a `HashMap` or `&HashMap`, an array of `(&str, &str)`);
+    /// for a slice `s` of pairs pass `s.iter().map(|(k, v)| (k, v))`.
     ///
     /// # Errors
     /// * [`Error::IniSyntax`] for an empty key;

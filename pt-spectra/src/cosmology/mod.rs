@@ -9,10 +9,10 @@
 //!   f = d ln D/d ln a = −(3Ω_m a⁻³ + 2Ω_k a⁻²)/(2E²) + 1/(a²E³ I(a)) with I the integral. The integral
 //!   is done in u = √a, where the integrand 2u⁴/(Ω_m + Ω_k u² + Ω_Λ u⁶)^{3/2} is smooth, by Simpson's rule
 //!   (relative error < 1e-12). Not a fitting formula.
-//! * Growth, for any other w0, wa: the linear growth equation in ln a (e.g. Linder & Jenkins 2003),
+//! * Growth, for any other w0, wa: the linear growth equation in ln a (′ = d/d ln a),
 //!   D″ + (2 + d ln E/d ln a) D′ − (3/2) Ω_m a⁻³/E² D = 0, for the growing mode started deep in matter
-//!   domination (D = D′ = a at a = 1e-8), integrated by an adaptive Dormand–Prince 5(4) Runge–Kutta method
-//!   to ~1e-11 relative; D is normalised to D(z=0) = 1 and f = D′/D. The tests check the ODE against
+//!   domination (D = D′ = a at a = 1e-8, with the first-order corrections for curvature and dark energy),
+//!   integrated by an adaptive Dormand–Prince 5(4) Runge–Kutta method to ~1e-11 relative; D is normalised to D(z=0) = 1 and f = D′/D. The tests check the ODE against
 //!   Heath's integral (flat and curved), Einstein–de Sitter, the flat-ΛCDM hypergeometric closed form and
 //!   w = −1/3 (which dilutes like curvature) to ≤ 1e-8. Scale-independent: dark energy is taken to be
 //!   smooth (no perturbations), as in the CAMB "fluid"/PPF models on sub-horizon scales.

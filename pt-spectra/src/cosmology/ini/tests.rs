@@ -116,6 +116,9 @@ fn class_and_camb_files_give_the_planck2018_preset() {
         .iter()
         .map(|(k, v)| (k.to_string(), v.to_string()))
         .collect();
+    let slice: &[(String, String)] = &owned;
+    let from_slice = Cosmology::from_keys(slice.iter().map(|(k, v)| (k, v)), "dict").unwrap();
+    assert_eq!(from_slice, dict);
     assert_eq!(Cosmology::from_keys(owned, "dict").unwrap(), dict);
 }
 
