@@ -203,6 +203,93 @@ pub enum Error {
         /// The names that are accepted.
         available: &'static str,
     },
+
+    /// A cosmology name that is not a preset.
+    #[error(
+        "unknown cosmology `{name}`: the presets are {available} (or give the path of a CLASS or CAMB \
+         .ini parameter file where a file is accepted)"
+    )]
+    UnknownCosmology {
+        /// The name that was given.
+        name: String,
+        /// The preset names, comma-separated.
+        available: String,
+    },
+
+    /// A line of a parameter file that is not `key = value` (or, for key–value pairs, an empty key).
+    #[error("{origin}:{line}: `{text}` is not a `key = value` line")]
+    IniSyntax {
+        /// File path or description of the input.
+        origin: String,
+        /// 1-based line number (1-based index for key–value pairs).
+        line: usize,
+        /// The line, trimmed (and cut after 80 characters).
+        text: String,
+    },
+
+    /// The value of a parameter that is read is not a finite number.
+    #[error("{origin}:{line}: the value `{value}` of `{key}` is not a finite number")]
+    IniValue {
+        /// File path or description of the input.
+        origin: String,
+        /// 1-based line number (1-based index for key–value pairs).
+        line: usize,
+        /// The key.
+        key: String,
+        /// The value as written.
+        value: String,
+    },
+
+    /// A parameter that a cosmology needs is not given.
+    #[error("{origin}: {quantity} is not given; set one of {keys}")]
+    MissingKey {
+        /// File path or description of the input.
+        origin: String,
+        /// The missing quantity, e.g. `the Hubble constant`.
+        quantity: &'static str,
+        /// The keys that would set it.
+        keys: &'static str,
+    },
+
+    /// Two parameters set the same quantity to values that disagree (or set σ8 and A_s both).
+    #[error("{origin}:{line}: `{second}` conflicts with `{first}` (line {first_line}): both set {quantity}")]
+    ConflictingKeys {
+        /// File path or description of the input.
+        origin: String,
+        /// The quantity both set.
+        quantity: &'static str,
+        /// The earlier `key = value`.
+        first: String,
+        /// Line (or pair index) of the earlier one.
+        first_line: usize,
+        /// The later `key = value`.
+        second: String,
+        /// Line (or pair index) of the later one.
+        line: usize,
+    },
+
+    /// The same parameter is given twice.
+    #[error("{origin}:{line}: `{key}` is given twice (first on line {first_line})")]
+    DuplicateKey {
+        /// File path or description of the input.
+        origin: String,
+        /// The key.
+        key: String,
+        /// Line (or pair index) of the first occurrence.
+        first_line: usize,
+        /// Line (or pair index) of the second.
+        line: usize,
+    },
+
+    /// Parameters that were read do not make a valid cosmology.
+    #[error("{origin}: the parameters do not give a valid cosmology: {source}")]
+    InvalidCosmology {
+        /// File path or description of the input.
+        origin: String,
+        /// What [`Cosmology::validate`](crate::cosmology::Cosmology::validate) found.
+        #[source]
+        source: Box<Error>,
+    },
 }
 
 /// `Result` with the crate's [`Error`].

@@ -7,8 +7,9 @@
 //! * [`error`]: the crate's [`Error`](error::Error) and [`Result`](error::Result).
 //! * [`linear`]: the linear spectrum [`LinearSpectrum`](linear::LinearSpectrum): CAMB/CLASS tables, the
 //!   embedded gm2012 CAMB spectra, log-log spline interpolation, power-law extrapolation, σ(R), σ_v².
-//! * [`cosmology`]: flat (or curved) ΛCDM [`Cosmology`](cosmology::Cosmology): exact linear growth D(z), f(z),
-//!   and the Eisenstein & Hu (1998) transfer functions with and without BAO wiggles.
+//! * [`cosmology`]: [`Cosmology`](cosmology::Cosmology), flat or curved with w0–wa dark energy, normalised by
+//!   σ8 or A_s: linear growth D(z), f(z) (exact for Λ, an ODE otherwise), the Eisenstein & Hu (1998)
+//!   transfer functions with and without BAO wiggles, presets and CLASS/CAMB parameter files.
 //! * [`loops`], [`resum`], [`real`]: 1- and 2-loop SPT terms, the propagator terms P13, P15, P17 (angular
 //!   tables), and TNS terms, all with error estimates; RPT propagators N0..N3; real-space models.
 //! * [`rsd`]: Kaiser, Scoccimarro and TNS redshift-space models, Fingers of God, Legendre multipoles.
