@@ -372,5 +372,116 @@ fn bad_input_exits_non_zero_naming_the_problem() {
         ),
         (vec!["rsd", "--noise-file", &noise_nan], "P_eps(k) = NaN"),
         (vec!["kernel", "F", "--q", "1,0", "--q", "0,1,0"], "1,0"),
+        (vec!["real", "--cosmology", "planck2013"], "planck2013"),
+        (vec!["real", "--q-range", "10,1"], "--q-range"),
+        (
+            vec!["real", "--precision", "best"],
+            "fast, default, reference",
+        ),
     ]);
+}
+
+/// A reference table of the workspace's `tests/data`.
+fn data(name: &str) -> String {
+    format!("{}/../tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The value after `key = ` in a header line.
+fn header_number(text: &str, key: &str) -> f64 {
+    let at = text
+        .find(key)
+        .unwrap_or_else(|| panic!("no `{key}` in {text}"))
+        + key.len();
+    let rest = &text[at..];
+    let end = rest
+        .find(|c: char| c == ',' || c.is_whitespace())
+        .unwrap_or(rest.len());
+    rest[..end].parse().unwrap()
+}
+
+#[test]
+fn the_cosmology_sets_f_and_the_rescaling() {
+    // Linear Kaiser monopole of CAMB's Planck 2018 z = 0 table rescaled to z = 1: with --cosmology it
+    // must be CAMB's own z = 1 table times 1 + 2f/3 + f²/5 with CAMB's f(1) (2e-3, the acceptance of
+    // the growth); without, the gm2012 growth is used and warned about.
+    let dir = scratch("cosmology");
+    let ini = write(
+        &dir,
+        "planck.ini",
+        "# CLASS-style\nh = 0.6766\nomega_b = 0.02242\nomega_cdm = 0.11933\nn_s = 0.9665\n\
+         A_s = 2.105209e-9\noutput = mPk\n",
+    );
+    let z0 = data("linear_pk_planck2018_z0.0.dat");
+    let camb1 = std::fs::read_to_string(data("linear_pk_planck2018_z1.0.dat")).unwrap();
+    let f_camb = header_number(&camb1, "f(z) = fsigma8/sigma8 = ");
+    // Output k at nodes of CAMB's tables, so that its z = 1 values are compared without interpolation.
+    let nodes: Vec<Vec<f64>> = rows(&camb1)
+        .into_iter()
+        .filter(|r| (0.01..=0.3).contains(&r[0]))
+        .step_by(60)
+        .collect();
+    let k_text: String = nodes.iter().map(|r| format!("{:e}\n", r[0])).collect();
+    let k_file = write(&dir, "k.dat", &k_text);
+    let kaiser = |cosmology: Option<&str>| {
+        let mut args = vec![
+            "rsd", "--rsd", "kaiser", "--real", "linear", "--linear", &z0,
+        ];
+        args.extend(["--k-file", &k_file, "--z", "1"]);
+        if let Some(c) = cosmology {
+            args.extend(["--cosmology", c]);
+        }
+        let (ok, out, err) = run(&args);
+        assert!(ok, "{err}");
+        (out, err)
+    };
+    for cosmology in ["planck2018", ini.as_str()] {
+        let (out, err) = kaiser(Some(cosmology));
+        assert!(!err.contains("warning"), "{err}");
+        if cosmology == ini {
+            assert!(err.contains("ignored") && err.contains("output"), "{err}");
+        }
+        let f = header_number(&out, " f = ");
+        assert!((f / f_camb - 1.0).abs() < 2e-3, "f = {f} vs CAMB {f_camb}");
+        assert_eq!(rows(&out).len(), nodes.len());
+        for (r, node) in rows(&out).iter().zip(&nodes) {
+            let want = node[1] * (1.0 + 2.0 * f_camb / 3.0 + f_camb * f_camb / 5.0);
+            assert!(
+                (r[1] / want - 1.0).abs() < 2e-3,
+                "k = {}: {} vs {want}",
+                r[0],
+                r[1]
+            );
+        }
+    }
+    let (out, err) = kaiser(None);
+    assert!(err.contains("warning") && err.contains("gm2012"), "{err}");
+    let f = header_number(&out, " f = ");
+    assert!((f - 0.8524).abs() < 1e-3, "gm2012 f(1) = {f}");
+}
+
+#[test]
+fn the_q_range_is_the_users_and_the_header_states_it() {
+    let grid = [
+        "real",
+        "--model",
+        "1l-spt",
+        "--nk",
+        "2",
+        "--precision",
+        "fast",
+    ];
+    let (ok, full, err) = run(&grid);
+    assert!(ok, "{err}");
+    let mut cut = grid.to_vec();
+    cut.extend(["--q-range", "1e-4,10"]);
+    let (ok, out, err) = run(&cut);
+    assert!(ok, "{err}");
+    assert!(full.contains("q in [1e-5, 1e3] h/Mpc"), "{full}");
+    assert!(out.contains("q in [1e-4, 1e1] h/Mpc"), "{out}");
+    // σ_v² = (1/6π²)∫P dq loses the power above 10 h/Mpc and below 1e-4 h/Mpc: a little, not nothing.
+    let (a, b) = (
+        header_number(&full, "sigma_v2 = "),
+        header_number(&out, "sigma_v2 = "),
+    );
+    assert!(b < a && a / b - 1.0 < 1e-3, "{a} {b}");
 }
