@@ -79,6 +79,55 @@ impl MultipoleData {
         )
     }
 
+    /// Measured multipoles from arrays: `k` and, for each ℓ of `ells`, the values and 1σ errors on that
+    /// grid (`origin` names them in messages; rows are numbered from 1).
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] for arrays of different lengths, otherwise as [`read`](Self::read).
+    pub fn from_arrays(
+        k: Vec<f64>,
+        ells: &[usize],
+        values: Vec<Vec<f64>>,
+        sigma: Vec<Vec<f64>>,
+        origin: &str,
+    ) -> Result<Self> {
+        for (what, n) in [
+            ("values and ells", values.len()),
+            ("errors and ells", sigma.len()),
+        ] {
+            if n != ells.len() {
+                return Err(Error::LengthMismatch {
+                    what,
+                    left: n,
+                    right: ells.len(),
+                });
+            }
+        }
+        let mut columns = vec![k];
+        for (v, s) in values.into_iter().zip(sigma) {
+            columns.extend([v, s]);
+        }
+        if let Some(bad) = columns.iter().find(|c| c.len() != columns[0].len()) {
+            return Err(Error::LengthMismatch {
+                what: "multipole arrays and k",
+                left: bad.len(),
+                right: columns[0].len(),
+            });
+        }
+        let table = Table {
+            origin: origin.to_string(),
+            header: Vec::new(),
+            lines: (1..=columns[0].len()).collect(),
+            columns,
+        };
+        let spec: Vec<(usize, usize, usize)> = ells
+            .iter()
+            .enumerate()
+            .map(|(j, &l)| (l, 1 + 2 * j, 2 + 2 * j))
+            .collect();
+        Self::from_table(&table, &spec)
+    }
+
     fn from_table(table: &Table, columns: &[(usize, usize, usize)]) -> Result<Self> {
         let k = table.columns[0].clone();
         let origin = &table.origin;

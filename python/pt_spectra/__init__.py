@@ -1,0 +1,175 @@
+"""pt-spectra: perturbation-theory power spectra of matter and haloes, with error estimates.
+
+The Python face of the Rust library: the same entry points, names and columns as the command line
+``pt-spectra``. Units: k in h/Mpc, P in (Mpc/h)^3.
+
+>>> import numpy as np, pt_spectra as pt
+>>> t = pt.real(model="1l-spt", k=np.geomspace(0.01, 0.3, 20), terms=True, precision="fast")
+>>> t["P_dd"][0] > t["P_lin"][0] * 0.99
+True
+
+Every function returns a :class:`Table`: ``t.columns`` (the command line's column names), ``t[name]``
+(numpy arrays), ``t.units``, ``t.header``, ``t.meta`` (z, f, D, cosmology, precision, q range, model)
+and ``t.to_text()``. Bad input raises ``ValueError`` with the library's message; defaults that may not
+fit the input (e.g. the gm2012 growth for a spectrum given without a cosmology) raise a
+:class:`PtSpectraWarning`.
+
+Computations release the GIL and run on rayon's thread pool: its size is ``RAYON_NUM_THREADS`` or
+:func:`set_num_threads` (before the first computation).
+"""
+
+from __future__ import annotations
+
+import warnings as _warnings
+
+from . import _core
+from ._core import Table, eisenstein_hu, growth, log_grid, num_threads, set_num_threads
+
+__all__ = [
+    "PtSpectraWarning",
+    "RealPlan",
+    "RsdPlan",
+    "Table",
+    "eisenstein_hu",
+    "fit",
+    "growth",
+    "kernel",
+    "log_grid",
+    "num_threads",
+    "real",
+    "rsd",
+    "set_num_threads",
+]
+
+__version__ = _core.__version__
+
+
+class PtSpectraWarning(UserWarning):
+    """A default or an input that may not be what you meant (also stated in the table header)."""
+
+
+def _warn(table: Table) -> Table:
+    for message in table.warnings:
+        _warnings.warn(message, PtSpectraWarning, stacklevel=3)
+    return table
+
+
+def _grid(k, k_min, k_max, nk):
+    return log_grid(k_min, k_max, nk) if k is None else k
+
+
+class RealPlan:
+    """A real-space model prepared for one k grid: build once, call for every linear spectrum.
+
+    ``RealPlan(k, model="1l-spt", precision="default", q_range=None, two_loop_tolerance=None,
+    cache_dir=None)``; models ``linear, 1l-spt, 2l-spt, 1l-rpt-n0..n3, 2l-rpt-n0..n3`` or ``all``.
+    ``plan(linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False, eh=None)`` returns a
+    :class:`Table` with no set-up cost beyond the computation itself.
+    """
+
+    def __init__(self, k, model="1l-spt", precision="default", q_range=None,
+                 two_loop_tolerance=None, cache_dir=None):
+        self._plan = _core.RealPlan(k, model, precision, q_range, two_loop_tolerance, cache_dir)
+        self.model = model
+
+    @property
+    def k(self):
+        """The k grid [h/Mpc]."""
+        return self._plan.k
+
+    def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False, eh=None):
+        return _warn(self._plan(linear, z, z_input, cosmology, terms, eh))
+
+
+class RsdPlan:
+    """The loop terms of a redshift-space model prepared for one k grid.
+
+    ``RsdPlan(k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None, cache_dir=None)``;
+    calling it takes the arguments of :func:`rsd` after ``k`` (linear, z, cosmology, f, bias, fog,
+    sigma0, noise, ells, terms) and returns the multipoles.
+    """
+
+    def __init__(self, k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None,
+                 cache_dir=None):
+        self._plan = _core.RsdPlan(k, real, rsd, precision, q_range, cache_dir)
+
+    def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=1.0,
+                 amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None, number_density=None,
+                 noise_table=None, ells=(0, 2, 4), terms=False, eh=None):
+        return _warn(self._plan(linear, z, z_input, cosmology, f, bias, amplitude, fog, sigma0,
+                                shot_noise, number_density, noise_table, list(ells), terms, eh))
+
+
+def real(model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False,
+         precision="default", q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None,
+         k_min=1e-3, k_max=1.0, nk=100) -> Table:
+    """Real-space P_dd, P_dt, P_tt of a model (``pt-spectra real``).
+
+    model: ``linear``, ``1l-spt``, ``2l-spt``, ``1l-rpt-n0`` … ``1l-rpt-n3``, ``2l-rpt-n0`` …
+    ``2l-rpt-n3``, or ``all`` (P_dd/P_nw of every model).
+    k: wavenumbers [h/Mpc] (default ``nk`` log-spaced in [k_min, k_max]).
+    linear: ``None`` (the embedded gm2012 CAMB spectra), a file path, or ``(k_lin, p_lin)`` arrays at
+    ``z_input``; rescaled to ``z`` with D(z) of ``cosmology``.
+    cosmology: ``None`` (gm2012), a preset (``gm2012``, ``planck2018``), a CLASS/CAMB ini path, or a
+    dict of ini keys (e.g. ``{"h": 0.68, "omega_b": 0.0224, "omega_cdm": 0.12, "n_s": 0.96,
+    "A_s": 2.1e-9}``).
+    terms: add every loop term with its error (``P22_dd``, ``err_P22_dd``, …).
+    precision: ``fast``, ``default`` or ``reference``; q_range: (QMIN, QMAX) of the loop integrals.
+    eh: ``"wiggle"`` or ``"no-wiggle"`` for the Eisenstein & Hu spectrum of the cosmology.
+    """
+    plan = RealPlan(_grid(k, k_min, k_max, nk), model, precision, q_range, two_loop_tolerance,
+                    cache_dir)
+    return plan(linear, z, z_input, cosmology, terms, eh)
+
+
+def rsd(rsd="tns", real="1l-rpt-n1", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None,
+        f=None, bias=1.0, amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None,
+        number_density=None, noise_table=None, ells=(0, 2, 4), terms=False, precision="default",
+        q_range=None, cache_dir=None, eh=None, k_min=1e-3, k_max=1.0, nk=100) -> Table:
+    """Redshift-space multipoles (``pt-spectra rsd``): columns ``k P0 P2 P4 … err_P0 …``.
+
+    rsd: ``kaiser``, ``scoccimarro`` or ``tns``; real: the real-space model (as :func:`real`).
+    f: growth rate (default f(z) of the cosmology). bias: a number, a path or ``(k, b)`` arrays;
+    amplitude: A_b. fog: ``none``, ``lorentzian`` or ``gaussian``; sigma0 [Mpc/h] (z = 0 value) or
+    ``"lin"`` / ``"1l-spt"`` (the theory value). Noise: one of shot_noise [(Mpc/h)^3],
+    number_density [(h/Mpc)^3] (Poisson) or noise_table (path or ``(k, P_eps)``); it is subtracted
+    from the monopole and adds ``P_eps SN``. ells: even multipoles up to 8. terms: add the parts
+    ``P<l>_sc P<l>_A P<l>_B``. The other arguments are those of :func:`real`.
+    """
+    plan = RsdPlan(_grid(k, k_min, k_max, nk), real, rsd, precision, q_range, cache_dir)
+    return plan(linear, z, z_input, cosmology, f, bias, amplitude, fog, sigma0, shot_noise,
+                number_density, noise_table, ells, terms, eh)
+
+
+def fit(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_columns=None,
+        covariance=None, rsd="tns", real="1l-spt", fog="lorentzian", f=None, sigma0=3.0, bias=1.0,
+        amplitude=1.0, shot_noise=None, number_density=None, noise_table=None, k_min=0.0,
+        linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default", q_range=None,
+        cache_dir=None, eh=None) -> Table:
+    """Fits of f, sigma0 and A_b (``free``) to measured multipoles (``pt-spectra fit``).
+
+    data: a file (columns ``k P0 s0 P2 s2 P4 s4``, or ``data_columns`` 1-based for ``data_ells``) or a
+    dict ``{"k": …, "P0": …, "s0": …, …}`` with the multipoles of ``ells``. k_max: a list of k_max
+    [h/Mpc], one fit (one row) each. covariance: the full covariance of the fitted data vector
+    (ell-major), default diagonal. f, sigma0, amplitude: start values if free, values if fixed.
+    Returns ``k_max points <p> <p>_lo <p>_hi … chi2 dof chi2_dof``.
+    """
+    if isinstance(k_max, (int, float)):
+        k_max = [k_max]
+    return _warn(_core.fit(data, list(k_max), list(free), list(ells), list(data_ells),
+                           None if data_columns is None else list(data_columns), covariance, rsd,
+                           real, fog, f, sigma0, bias, amplitude, shot_noise, number_density,
+                           noise_table, k_min, linear, z, z_input, cosmology, precision, q_range,
+                           cache_dir, eh))
+
+
+def kernel(which, vectors, exact=False):
+    """The symmetrised kernel F_n^s or G_n^s (``which`` = "F" or "G") at the vectors [x, y, z].
+
+    With ``exact=True`` the components may be ints, ``fractions.Fraction`` or "p/q" strings and the
+    result is the reduced fraction as a string; otherwise a float.
+
+    >>> kernel("F", [[1, 0, 0], [0, 1, 0]])
+    0.7142857142857143
+    """
+    return _core.kernel(which, [list(v) for v in vectors], exact)

@@ -1,0 +1,134 @@
+//! `pt_spectra.kernel`: the symmetrised kernels F_n^s, G_n^s at given vectors.
+
+use num_bigint::BigInt;
+use num_rational::BigRational;
+use num_traits::{One, Zero};
+use pt_kernels::kernels;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyFloat, PyInt};
+use std::str::FromStr;
+
+/// One component as an exact rational: an int, a `fractions.Fraction`, a string `p/q` or integer, or
+/// a float (its exact binary value).
+fn rational(c: &Bound<'_, PyAny>) -> PyResult<BigRational> {
+    let bad = || PyValueError::new_err(format!("kernel: component {c} is not a number"));
+    let int = |o: &Bound<'_, PyAny>| -> PyResult<BigInt> {
+        BigInt::from_str(&o.str()?.to_string()).map_err(|_| bad())
+    };
+    if c.is_instance_of::<PyInt>() {
+        return Ok(BigRational::from_integer(int(c)?));
+    }
+    if !c.is_instance_of::<PyFloat>() && c.hasattr("numerator")? && c.hasattr("denominator")? {
+        let (n, d) = (
+            int(&c.getattr("numerator")?)?,
+            int(&c.getattr("denominator")?)?,
+        );
+        if d.is_zero() {
+            return Err(bad());
+        }
+        return Ok(BigRational::new(n, d));
+    }
+    if let Ok(s) = c.extract::<String>() {
+        let (p, q) = s.split_once('/').unwrap_or((&s, "1"));
+        let p = BigInt::from_str(p.trim()).map_err(|_| bad())?;
+        let q = BigInt::from_str(q.trim()).map_err(|_| bad())?;
+        if q.is_zero() {
+            return Err(bad());
+        }
+        return Ok(BigRational::new(p, q));
+    }
+    let v: f64 = c.extract().map_err(|_| bad())?;
+    BigRational::from_float(v).ok_or_else(bad)
+}
+
+/// The three components of one vector.
+fn components<'py>(v: &Bound<'py, PyAny>) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let c: Vec<Bound<'py, PyAny>> = v.extract()?;
+    if c.len() != 3 {
+        return Err(PyValueError::new_err(format!(
+            "kernel: vector {v} must have three components"
+        )));
+    }
+    Ok(c)
+}
+
+/// `p/q` in lowest terms, or an integer.
+fn format_rational(r: &BigRational) -> String {
+    if r.denom().is_one() {
+        r.numer().to_string()
+    } else {
+        format!("{}/{}", r.numer(), r.denom())
+    }
+}
+
+/// F_n^s or G_n^s (`which` = "F" or "G") at the n = len(vectors) vectors (1 ≤ n ≤ 7), each [x, y, z]
+/// in h/Mpc. With `exact`, in rational arithmetic (components as ints, Fractions, "p/q" strings or
+/// floats taken exactly), returned as the string of the reduced fraction; otherwise a float.
+#[pyfunction]
+#[pyo3(signature = (which, vectors, exact=false))]
+pub fn kernel(which: &str, vectors: Vec<Bound<'_, PyAny>>, exact: bool) -> PyResult<Py<PyAny>> {
+    let py = match vectors.first() {
+        Some(v) => v.py(),
+        None => {
+            return Err(PyValueError::new_err(format!(
+                "kernel: no vector given (1 to {})",
+                pt_kernels::MAX_ORDER
+            )))
+        }
+    };
+    let index = match which {
+        "F" | "f" => 0,
+        "G" | "g" => 1,
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "kernel: unknown kernel `{which}`; available: F, G"
+            )))
+        }
+    };
+    if vectors.len() > pt_kernels::MAX_ORDER {
+        return Err(PyValueError::new_err(format!(
+            "kernel: order n = {} is not supported: at most {} vectors",
+            vectors.len(),
+            pt_kernels::MAX_ORDER
+        )));
+    }
+    if exact {
+        let q: Vec<[BigRational; 3]> = vectors
+            .iter()
+            .map(|v| {
+                let c = components(v)?;
+                Ok([rational(&c[0])?, rational(&c[1])?, rational(&c[2])?])
+            })
+            .collect::<PyResult<_>>()?;
+        let value = kernels(&q).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        return Ok(format_rational(&value[index])
+            .into_pyobject(py)?
+            .into_any()
+            .unbind());
+    }
+    let q: Vec<[f64; 3]> = vectors
+        .iter()
+        .map(|v| {
+            let c = components(v)?;
+            let x = |i: usize| -> PyResult<f64> {
+                let v: f64 = c[i].extract()?;
+                if v.is_finite() {
+                    Ok(v)
+                } else {
+                    Err(PyValueError::new_err(format!(
+                        "kernel: component {v} is not finite"
+                    )))
+                }
+            };
+            Ok([x(0)?, x(1)?, x(2)?])
+        })
+        .collect::<PyResult<_>>()?;
+    let value = kernels(&q).map_err(|e| PyValueError::new_err(e.to_string()))?[index];
+    if !value.is_finite() {
+        return Err(PyValueError::new_err(format!(
+            "kernel: the value overflows double precision ({value}); use exact=True"
+        )));
+    }
+    Ok(value.into_pyobject(py)?.into_any().unbind())
+}

@@ -1,0 +1,714 @@
+//! `pt_spectra._core`: the Python face of the pt-spectra library entry points.
+//!
+//! Each function converts its arguments at the edge (numpy arrays, paths, names, dicts), calls the same
+//! library function as the command line (`pt_spectra::jobs`), with the GIL released, and returns a
+//! [`Table`] whose columns have the names the command line prints. Errors of the library become
+//! `ValueError` with its message. The pure-Python package `pt_spectra` wraps these (warnings, docs).
+
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
+use pt_spectra::cosmology::{Cosmology, TransferKind};
+use pt_spectra::fit::{MultipoleData, Parameter};
+use pt_spectra::halo::{Bias, Noise};
+use pt_spectra::jobs::{self, FitRequest, RsdRequest};
+use pt_spectra::linear::{LinearSpectrum, LogGrid};
+use pt_spectra::precision::Precision;
+use pt_spectra::progress::Silent;
+use pt_spectra::real::{RealPlan as LibRealPlan, RealSelection};
+use pt_spectra::rsd::{Fog, RsdModel, RsdPlan as LibRsdPlan, Sigma0};
+use pt_spectra::setup::{self, LinearSource, NamedCosmology, Prepared, Request};
+use pt_spectra::store::TableStore;
+use pt_spectra::table::Tabulated;
+use pyo3::exceptions::{PyKeyError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+mod kernel;
+mod tables;
+
+pub use tables::Table;
+
+/// A library error as a Python `ValueError` with the library's message.
+fn value_error(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+/// The table store of calls without `cache_dir`: the conventional cache directory
+/// ($PT_SPECTRA_CACHE, $XDG_CACHE_HOME/pt-spectra or ~/.cache/pt-spectra), loaded tables kept for the
+/// life of the process.
+fn default_store() -> &'static TableStore {
+    static STORE: OnceLock<TableStore> = OnceLock::new();
+    STORE.get_or_init(TableStore::from_env)
+}
+
+/// The store of `cache_dir`, or the default one.
+enum Store {
+    Default,
+    Own(TableStore),
+}
+
+impl Store {
+    fn new(cache_dir: Option<PathBuf>) -> Self {
+        match cache_dir {
+            Some(dir) => Store::Own(TableStore::new(dir)),
+            None => Store::Default,
+        }
+    }
+
+    fn get(&self) -> &TableStore {
+        match self {
+            Store::Default => default_store(),
+            Store::Own(s) => s,
+        }
+    }
+}
+
+/// A float array from a numpy array or any sequence of numbers.
+fn floats(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+    if let Ok(a) = obj.extract::<PyReadonlyArray1<'_, f64>>() {
+        return Ok(a.as_array().to_vec());
+    }
+    obj.extract::<Vec<f64>>().map_err(|_| {
+        PyValueError::new_err(format!(
+            "{what}: expected a 1-D array or sequence of numbers"
+        ))
+    })
+}
+
+/// The precision preset `name`, with the q range and 2-loop tolerance if given.
+fn precision(
+    name: &str,
+    q_range: Option<(f64, f64)>,
+    two_loop_tolerance: Option<f64>,
+) -> PyResult<Precision> {
+    let mut p = Precision::preset(name).map_err(value_error)?;
+    if let Some((lo, hi)) = q_range {
+        p = p.with_q_range(lo, hi).map_err(value_error)?;
+    }
+    if let Some(t) = two_loop_tolerance {
+        p.two_loop_tolerance = t;
+        p.validate().map_err(value_error)?;
+    }
+    Ok(p)
+}
+
+/// The cosmology: `None` (gm2012), a preset name or ini path, or a dict of ini keys.
+fn cosmology(obj: Option<&Bound<'_, PyAny>>) -> PyResult<(Option<NamedCosmology>, Vec<String>)> {
+    let Some(obj) = obj else {
+        return Ok((None, Vec::new()));
+    };
+    if let Ok(dict) = obj.cast::<PyDict>() {
+        let mut pairs = Vec::new();
+        for (key, value) in dict.iter() {
+            pairs.push((key.str()?.to_string(), value.str()?.to_string()))
+        }
+        let parsed = Cosmology::from_keys(pairs, "cosmology dict").map_err(value_error)?;
+        let named = NamedCosmology {
+            name: "dict".into(),
+            cosmology: parsed.cosmology,
+        };
+        return Ok((Some(named), parsed.ignored));
+    }
+    let name: PathBuf = obj.extract().map_err(|_| {
+        PyValueError::new_err(
+            "cosmology: expected a preset name, an ini path or a dict of ini keys",
+        )
+    })?;
+    let (named, ignored) = NamedCosmology::parse(&name.to_string_lossy()).map_err(value_error)?;
+    Ok((Some(named), ignored))
+}
+
+/// Where the linear spectrum comes from: `None` (embedded or EH with `eh`), a path, or (k, P).
+fn linear_source(
+    linear: Option<&Bound<'_, PyAny>>,
+    z_input: f64,
+    eh: Option<&str>,
+) -> PyResult<LinearSource> {
+    let eh_kind = match eh {
+        None => None,
+        Some("wiggle") => Some(TransferKind::Wiggle),
+        Some("no-wiggle") => Some(TransferKind::NoWiggle),
+        Some(other) => {
+            return Err(PyValueError::new_err(format!(
+                "unknown eh `{other}`; available: wiggle, no-wiggle"
+            )))
+        }
+    };
+    let spectrum = match linear {
+        None => return Ok(eh_kind.map_or(LinearSource::Embedded, LinearSource::EisensteinHu)),
+        Some(_) if eh_kind.is_some() => {
+            return Err(PyValueError::new_err("give either linear or eh, not both"))
+        }
+        Some(obj) if obj.is_instance_of::<PyString>() || obj.extract::<PathBuf>().is_ok() => {
+            let path: PathBuf = obj.extract()?;
+            LinearSpectrum::from_file(&path).map_err(value_error)?
+        }
+        Some(obj) => {
+            let (k, p): (Bound<'_, PyAny>, Bound<'_, PyAny>) = obj.extract().map_err(|_| {
+                PyValueError::new_err(
+                    "linear: expected a path or a pair (k [h/Mpc], P [(Mpc/h)^3])",
+                )
+            })?;
+            LinearSpectrum::from_nodes(floats(&k, "linear k")?, floats(&p, "linear P")?)
+                .map_err(value_error)?
+        }
+    };
+    Ok(LinearSource::Table {
+        spectrum: Box::new(spectrum),
+        z_input,
+    })
+}
+
+/// The linear spectrum at `z` with the growth of the cosmology, and the warnings (ignored ini keys
+/// included).
+fn prepare(
+    linear: Option<&Bound<'_, PyAny>>,
+    z: f64,
+    z_input: f64,
+    cosmology_arg: Option<&Bound<'_, PyAny>>,
+    eh: Option<&str>,
+) -> PyResult<Prepared> {
+    let source = linear_source(linear, z_input, eh)?;
+    let (cosmology, ignored) = cosmology(cosmology_arg)?;
+    let mut prepared = setup::prepare(Request {
+        source,
+        cosmology,
+        z,
+    })
+    .map_err(value_error)?;
+    if !ignored.is_empty() {
+        prepared.warnings.push(format!(
+            "cosmology: keys ignored (they do not set the background or growth): {}",
+            ignored.join(", ")
+        ));
+    }
+    Ok(prepared)
+}
+
+/// The output k grid: `k` if given, else `nk` log-spaced values in [k_min, k_max].
+fn k_grid(k: Option<&Bound<'_, PyAny>>, k_min: f64, k_max: f64, nk: usize) -> PyResult<Vec<f64>> {
+    match k {
+        Some(k) => {
+            let k = floats(k, "k")?;
+            if k.is_empty() {
+                return Err(PyValueError::new_err("k: the grid is empty"));
+            }
+            Ok(k)
+        }
+        None => Ok(LogGrid::new(k_min, k_max, nk)
+            .map_err(value_error)?
+            .points()),
+    }
+}
+
+/// A warning when the output grid reaches the extrapolated ends of the linear table.
+fn extrapolation_warning(prepared: &mut Prepared, k: &[f64]) {
+    let (lo, hi) = (
+        k.iter().copied().fold(f64::MAX, f64::min),
+        k.iter().copied().fold(0.0, f64::max),
+    );
+    if let Some(ext) = prepared.spectrum.extrapolation_in(lo, hi) {
+        prepared.warnings.push(format!("output {ext}"));
+    }
+}
+
+/// Runs `f` with the GIL released.
+fn detached<T: Send>(
+    py: Python<'_>,
+    f: impl FnOnce() -> pt_spectra::error::Result<T> + Send,
+) -> PyResult<T> {
+    py.detach(f).map_err(value_error)
+}
+
+/// A real-space model prepared for one k grid (cosmology-independent work done once); calling it
+/// evaluates any linear spectrum.
+#[pyclass(module = "pt_spectra._core", frozen)]
+struct RealPlan {
+    plan: LibRealPlan,
+    selection: RealSelection,
+    store: Store,
+}
+
+#[pymethods]
+impl RealPlan {
+    #[new]
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (k, model="1l-spt", precision="default", q_range=None, two_loop_tolerance=None, cache_dir=None))]
+    fn new(
+        py: Python<'_>,
+        k: &Bound<'_, PyAny>,
+        model: &str,
+        precision: &str,
+        q_range: Option<(f64, f64)>,
+        two_loop_tolerance: Option<f64>,
+        cache_dir: Option<PathBuf>,
+    ) -> PyResult<Self> {
+        let k = floats(k, "k")?;
+        let selection: RealSelection = model.parse().map_err(value_error)?;
+        let precision = self::precision(precision, q_range, two_loop_tolerance)?;
+        let store = Store::new(cache_dir);
+        let plan = detached(py, || {
+            LibRealPlan::new(&k, selection.plan_model(), &precision, store.get(), &Silent)
+        })?;
+        Ok(Self {
+            plan,
+            selection,
+            store,
+        })
+    }
+
+    /// The k grid [h/Mpc].
+    #[getter]
+    fn k<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.plan.k().to_vec().into_pyarray(py)
+    }
+
+    /// The spectra of `linear` (None: the embedded gm2012 spectrum; a path; or (k, P)) at z.
+    #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false, eh=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn __call__(
+        &self,
+        py: Python<'_>,
+        linear: Option<&Bound<'_, PyAny>>,
+        z: f64,
+        z_input: f64,
+        cosmology: Option<&Bound<'_, PyAny>>,
+        terms: bool,
+        eh: Option<&str>,
+    ) -> PyResult<Table> {
+        let _ = &self.store;
+        let mut prepared = prepare(linear, z, z_input, cosmology, eh)?;
+        extrapolation_warning(&mut prepared, self.plan.k());
+        let table = detached(py, || {
+            jobs::real_table(&self.plan, self.selection, &prepared, terms, &Silent)
+        })?;
+        Table::new(
+            py,
+            table,
+            &prepared,
+            self.plan.precision(),
+            &self.selection.plan_model().to_string(),
+        )
+    }
+}
+
+/// `pt-spectra real` as a function: see the Python wrapper's docstring.
+#[pyfunction]
+#[pyo3(signature = (model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false,
+    precision="default", q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None, k_min=1e-3,
+    k_max=1.0, nk=100))]
+#[allow(clippy::too_many_arguments)]
+fn real(
+    py: Python<'_>,
+    model: &str,
+    k: Option<&Bound<'_, PyAny>>,
+    linear: Option<&Bound<'_, PyAny>>,
+    z: f64,
+    z_input: f64,
+    cosmology: Option<&Bound<'_, PyAny>>,
+    terms: bool,
+    precision: &str,
+    q_range: Option<(f64, f64)>,
+    two_loop_tolerance: Option<f64>,
+    cache_dir: Option<PathBuf>,
+    eh: Option<&str>,
+    k_min: f64,
+    k_max: f64,
+    nk: usize,
+) -> PyResult<Table> {
+    let k = k_grid(k, k_min, k_max, nk)?;
+    let plan = RealPlan::new(
+        py,
+        &k.clone().into_pyarray(py).into_any(),
+        model,
+        precision,
+        q_range,
+        two_loop_tolerance,
+        cache_dir,
+    )?;
+    plan.__call__(py, linear, z, z_input, cosmology, terms, eh)
+}
+
+/// b(k) or P_εε(k) from a constant, a path or (k, values).
+fn tabulated(obj: &Bound<'_, PyAny>, name: &'static str) -> PyResult<Tabulated> {
+    if let Ok(path) = obj.extract::<PathBuf>() {
+        return Tabulated::read(&path, name, (0, 1), true).map_err(value_error);
+    }
+    let (k, v): (Bound<'_, PyAny>, Bound<'_, PyAny>) = obj.extract().map_err(|_| {
+        PyValueError::new_err(format!(
+            "{name}: expected a path or a pair (k [h/Mpc], values)"
+        ))
+    })?;
+    Tabulated::new(
+        name,
+        "array",
+        floats(&k, name)?,
+        floats(&v, name)?,
+        true,
+        &[],
+    )
+    .map_err(value_error)
+}
+
+/// The bias and noise of the keyword arguments.
+fn bias_and_noise(
+    bias: &Bound<'_, PyAny>,
+    shot_noise: Option<f64>,
+    number_density: Option<f64>,
+    noise_table: Option<&Bound<'_, PyAny>>,
+) -> PyResult<(Bias, Noise)> {
+    let bias = match bias.extract::<f64>() {
+        Ok(b) => Bias::Constant(b),
+        Err(_) => Bias::Table(tabulated(bias, "b(k)")?),
+    };
+    let noise = match (noise_table, shot_noise, number_density) {
+        (Some(t), None, None) => Noise::Table(tabulated(t, "P_eps(k)")?),
+        (None, Some(p), None) => Noise::Constant(p),
+        (None, None, Some(n)) => Noise::poisson(n).map_err(value_error)?,
+        (None, None, None) => Noise::None,
+        _ => {
+            return Err(PyValueError::new_err(
+                "give at most one of shot_noise, number_density, noise_table",
+            ))
+        }
+    };
+    Ok((bias, noise))
+}
+
+/// σ0 as a number or `lin` / `1l-spt`.
+fn sigma0(obj: &Bound<'_, PyAny>) -> PyResult<Sigma0> {
+    match obj.extract::<f64>() {
+        Ok(v) => format!("{v}").parse().map_err(value_error),
+        Err(_) => obj.extract::<String>()?.parse().map_err(value_error),
+    }
+}
+
+/// Redshift-space loop terms planned once for one k grid.
+#[pyclass(module = "pt_spectra._core", frozen)]
+struct RsdPlan {
+    plan: LibRsdPlan,
+    rsd: RsdModel,
+    store: Store,
+}
+
+#[pymethods]
+impl RsdPlan {
+    #[new]
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None, cache_dir=None))]
+    fn new(
+        py: Python<'_>,
+        k: &Bound<'_, PyAny>,
+        real: &str,
+        rsd: &str,
+        precision: &str,
+        q_range: Option<(f64, f64)>,
+        cache_dir: Option<PathBuf>,
+    ) -> PyResult<Self> {
+        let k = floats(k, "k")?;
+        let real = real.parse().map_err(value_error)?;
+        let rsd: RsdModel = rsd.parse().map_err(value_error)?;
+        let precision = self::precision(precision, q_range, None)?;
+        let store = Store::new(cache_dir);
+        let plan = detached(py, || {
+            LibRsdPlan::new(&k, real, rsd, &precision, store.get(), &Silent)
+        })?;
+        Ok(Self { plan, rsd, store })
+    }
+
+    /// The multipoles of the prepared spectrum: see the Python wrapper `pt_spectra.rsd`.
+    #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=None, amplitude=1.0,
+        fog="none", sigma0=None, shot_noise=None, number_density=None, noise_table=None, ells=vec![0, 2, 4],
+        terms=false, eh=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn __call__(
+        &self,
+        py: Python<'_>,
+        linear: Option<&Bound<'_, PyAny>>,
+        z: f64,
+        z_input: f64,
+        cosmology: Option<&Bound<'_, PyAny>>,
+        f: Option<f64>,
+        bias: Option<&Bound<'_, PyAny>>,
+        amplitude: f64,
+        fog: &str,
+        sigma0: Option<&Bound<'_, PyAny>>,
+        shot_noise: Option<f64>,
+        number_density: Option<f64>,
+        noise_table: Option<&Bound<'_, PyAny>>,
+        ells: Vec<usize>,
+        terms: bool,
+        eh: Option<&str>,
+    ) -> PyResult<Table> {
+        let _ = &self.store;
+        let one = 1.0f64.into_pyobject(py)?.into_any();
+        let zero = 0.0f64.into_pyobject(py)?.into_any();
+        let (bias, noise) = bias_and_noise(
+            bias.unwrap_or(&one),
+            shot_noise,
+            number_density,
+            noise_table,
+        )?;
+        let request = RsdRequest {
+            rsd: self.rsd,
+            f,
+            bias,
+            amplitude,
+            fog: fog.parse::<Fog>().map_err(value_error)?,
+            sigma0: self::sigma0(sigma0.unwrap_or(&zero))?,
+            noise,
+            ells,
+            terms,
+        };
+        let mut prepared = prepare(linear, z, z_input, cosmology, eh)?;
+        extrapolation_warning(&mut prepared, self.plan.real().k());
+        let table = detached(py, || {
+            jobs::rsd_table(&self.plan, &request, &prepared, &Silent)
+        })?;
+        let model = format!("{} + {}", self.rsd, self.plan.real().model());
+        Table::new(py, table, &prepared, self.plan.real().precision(), &model)
+    }
+}
+
+/// Measured multipoles from a path (with columns) or a dict {"k", "P0", "s0", "P2", "s2", …}.
+fn data(
+    data: &Bound<'_, PyAny>,
+    data_columns: Option<Vec<usize>>,
+    data_ells: &[usize],
+    ells: &[usize],
+) -> PyResult<(MultipoleData, String)> {
+    if let Ok(dict) = data.cast::<PyDict>() {
+        let get = |name: &str| -> PyResult<Vec<f64>> {
+            let v = dict
+                .get_item(name)?
+                .ok_or_else(|| PyKeyError::new_err(format!("data: no `{name}`")))?;
+            floats(&v, name)
+        };
+        let k = get("k")?;
+        let values = ells
+            .iter()
+            .map(|l| get(&format!("P{l}")))
+            .collect::<PyResult<_>>()?;
+        let sigma = ells
+            .iter()
+            .map(|l| get(&format!("s{l}")))
+            .collect::<PyResult<_>>()?;
+        let d =
+            MultipoleData::from_arrays(k, ells, values, sigma, "data dict").map_err(value_error)?;
+        return Ok((d, "dict".into()));
+    }
+    let path: PathBuf = data
+        .extract()
+        .map_err(|_| PyValueError::new_err("data: expected a path or a dict of arrays"))?;
+    let columns = data_columns.unwrap_or_else(|| (1..=1 + 2 * data_ells.len()).collect());
+    if columns.len() != 1 + 2 * data_ells.len() || columns.contains(&0) {
+        return Err(PyValueError::new_err(format!(
+            "data_columns: expected {} 1-based columns (k, then P_l, sigma_l for each of data_ells)",
+            1 + 2 * data_ells.len()
+        )));
+    }
+    let mut spec = Vec::new();
+    for &l in ells {
+        let j = data_ells.iter().position(|&d| d == l).ok_or_else(|| {
+            PyValueError::new_err(format!("ells: multipole {l} is not among data_ells"))
+        })?;
+        spec.push((l, columns[1 + 2 * j] - 1, columns[2 + 2 * j] - 1));
+    }
+    let d = MultipoleData::read(&path, columns[0] - 1, &spec).map_err(value_error)?;
+    Ok((d, path.display().to_string()))
+}
+
+/// `pt-spectra fit` as a function: see the Python wrapper's docstring.
+#[pyfunction]
+#[pyo3(signature = (data, k_max, free=vec!["f".to_string(), "sigma0".to_string()], ells=vec![0],
+    data_ells=vec![0, 2, 4], data_columns=None, covariance=None, rsd="tns", real="1l-spt", fog="lorentzian",
+    f=None, sigma0=3.0, bias=None, amplitude=1.0, shot_noise=None, number_density=None, noise_table=None,
+    k_min=0.0, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default", q_range=None,
+    cache_dir=None, eh=None))]
+#[allow(clippy::too_many_arguments)]
+fn fit(
+    py: Python<'_>,
+    data: &Bound<'_, PyAny>,
+    k_max: Vec<f64>,
+    free: Vec<String>,
+    ells: Vec<usize>,
+    data_ells: Vec<usize>,
+    data_columns: Option<Vec<usize>>,
+    covariance: Option<&Bound<'_, PyAny>>,
+    rsd: &str,
+    real: &str,
+    fog: &str,
+    f: Option<f64>,
+    sigma0: f64,
+    bias: Option<&Bound<'_, PyAny>>,
+    amplitude: f64,
+    shot_noise: Option<f64>,
+    number_density: Option<f64>,
+    noise_table: Option<&Bound<'_, PyAny>>,
+    k_min: f64,
+    linear: Option<&Bound<'_, PyAny>>,
+    z: f64,
+    z_input: f64,
+    cosmology: Option<&Bound<'_, PyAny>>,
+    precision: &str,
+    q_range: Option<(f64, f64)>,
+    cache_dir: Option<PathBuf>,
+    eh: Option<&str>,
+) -> PyResult<Table> {
+    let (mut data, data_name) = self::data(data, data_columns, &data_ells, &ells)?;
+    if let Some(c) = covariance {
+        let rows: Vec<Vec<f64>> = match c.extract::<numpy::PyReadonlyArray2<'_, f64>>() {
+            Ok(a) => a
+                .as_array()
+                .rows()
+                .into_iter()
+                .map(|r| r.to_vec())
+                .collect(),
+            Err(_) => c
+                .extract()
+                .map_err(|_| PyValueError::new_err("covariance: expected a square 2-D array"))?,
+        };
+        data = data.with_covariance(rows).map_err(value_error)?;
+    }
+    let one = 1.0f64.into_pyobject(py)?.into_any();
+    let (bias, noise) = bias_and_noise(
+        bias.unwrap_or(&one),
+        shot_noise,
+        number_density,
+        noise_table,
+    )?;
+    let rsd_model: RsdModel = rsd.parse().map_err(value_error)?;
+    let free = free
+        .iter()
+        .map(|p| p.parse::<Parameter>())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(value_error)?;
+    let request = FitRequest {
+        model: RsdRequest {
+            rsd: rsd_model,
+            f,
+            bias,
+            amplitude,
+            fog: fog.parse().map_err(value_error)?,
+            sigma0: Sigma0::Value(sigma0),
+            noise,
+            ells,
+            terms: false,
+        },
+        free,
+        k_min,
+        k_max,
+        data_name,
+    };
+    let precision = self::precision(precision, q_range, None)?;
+    let store = Store::new(cache_dir);
+    let real = real.parse().map_err(value_error)?;
+    let prepared = prepare(linear, z, z_input, cosmology, eh)?;
+    let k = data.k.clone();
+    let table = detached(py, || {
+        let plan = LibRsdPlan::new(&k, real, rsd_model, &precision, store.get(), &Silent)?;
+        jobs::fit_table(&plan, data, &request, &prepared, &Silent)
+    })?;
+    Table::new(
+        py,
+        table,
+        &prepared,
+        &precision,
+        &format!("{rsd_model} + {real}"),
+    )
+}
+
+/// The linear growth factor D(z) (D(0) = 1) and rate f(z) of a cosmology.
+#[pyfunction]
+#[pyo3(signature = (z, cosmology=None))]
+fn growth(z: f64, cosmology: Option<&Bound<'_, PyAny>>) -> PyResult<(f64, f64)> {
+    let (named, _) = self::cosmology(cosmology)?;
+    let c = named.map_or(Cosmology::gm2012(), |n| n.cosmology);
+    if !(z.is_finite() && z > -1.0) {
+        return Err(PyValueError::new_err(format!(
+            "z = {z}: a redshift must be finite and > -1"
+        )));
+    }
+    Ok((c.growth_factor(z), c.growth_rate(z)))
+}
+
+/// The Eisenstein & Hu (1998) linear spectrum of a cosmology at `k` [h/Mpc] and z.
+#[pyfunction]
+#[pyo3(signature = (k, z=0.0, cosmology=None, wiggle=true))]
+fn eisenstein_hu<'py>(
+    py: Python<'py>,
+    k: &Bound<'py, PyAny>,
+    z: f64,
+    cosmology: Option<&Bound<'py, PyAny>>,
+    wiggle: bool,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let k = floats(k, "k")?;
+    let (named, _) = self::cosmology(cosmology)?;
+    let c = named.map_or(Cosmology::gm2012(), |n| n.cosmology);
+    let kind = if wiggle {
+        TransferKind::Wiggle
+    } else {
+        TransferKind::NoWiggle
+    };
+    let lo = k.iter().copied().fold(1e-4, f64::min) * 0.5;
+    let hi = k.iter().copied().fold(50.0, f64::max) * 2.0;
+    let grid = LogGrid::new(lo, hi, 2000).map_err(value_error)?;
+    let p = c
+        .eisenstein_hu_spectrum(kind, z, &grid)
+        .map_err(value_error)?;
+    Ok(k.iter()
+        .map(|&k| p.eval(k))
+        .collect::<Vec<f64>>()
+        .into_pyarray(py))
+}
+
+/// Sets the number of threads of the computations (rayon's global pool); call it before any
+/// computation. The environment variable RAYON_NUM_THREADS does the same.
+#[pyfunction]
+fn set_num_threads(n: usize) -> PyResult<()> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build_global()
+        .map_err(|e| {
+            PyRuntimeError::new_err(format!(
+                "cannot set the number of threads to {n}: {e} (call set_num_threads before any computation)"
+            ))
+        })
+}
+
+/// The number of threads the computations use.
+#[pyfunction]
+fn num_threads() -> usize {
+    rayon::current_num_threads()
+}
+
+/// `nk` log-spaced wavenumbers in [k_min, k_max] [h/Mpc], the grid of the command line's
+/// `--k-min --k-max --nk`.
+#[pyfunction]
+fn log_grid<'py>(
+    py: Python<'py>,
+    k_min: f64,
+    k_max: f64,
+    nk: usize,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    Ok(k_grid(None, k_min, k_max, nk)?.into_pyarray(py))
+}
+
+/// The `pt_spectra._core` module.
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<Table>()?;
+    m.add_class::<RealPlan>()?;
+    m.add_class::<RsdPlan>()?;
+    m.add_function(wrap_pyfunction!(real, m)?)?;
+    m.add_function(wrap_pyfunction!(fit, m)?)?;
+    m.add_function(wrap_pyfunction!(growth, m)?)?;
+    m.add_function(wrap_pyfunction!(eisenstein_hu, m)?)?;
+    m.add_function(wrap_pyfunction!(kernel::kernel, m)?)?;
+    m.add_function(wrap_pyfunction!(set_num_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(num_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(log_grid, m)?)?;
+    Ok(())
+}
