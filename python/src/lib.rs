@@ -6,26 +6,28 @@
 //! `ValueError` with its message. The pure-Python package `pt_spectra` wraps these (warnings, docs).
 
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
-use pt_spectra::cosmology::{Cosmology, TransferKind};
+use pt_spectra::cosmology::TransferKind;
 use pt_spectra::fit::{MultipoleData, Parameter};
 use pt_spectra::halo::{Bias, Noise};
 use pt_spectra::jobs::{self, FitRequest, RsdRequest};
-use pt_spectra::linear::{LinearSpectrum, LogGrid};
+use pt_spectra::linear::LogGrid;
 use pt_spectra::precision::Precision;
 use pt_spectra::progress::Silent;
 use pt_spectra::real::{RealPlan as LibRealPlan, RealSelection};
 use pt_spectra::rsd::{Fog, RsdModel, RsdPlan as LibRsdPlan, Sigma0};
-use pt_spectra::setup::{self, LinearSource, NamedCosmology, Prepared, Request};
 use pt_spectra::store::TableStore;
 use pt_spectra::table::Tabulated;
 use pyo3::exceptions::{PyKeyError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::PyDict;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
+mod inputs;
 mod kernel;
 mod tables;
+
+use inputs::Inputs;
 
 pub use tables::Table;
 
@@ -93,99 +95,6 @@ fn precision(
     Ok(p)
 }
 
-/// The cosmology: `None` (gm2012), a preset name or ini path, or a dict of ini keys.
-fn cosmology(obj: Option<&Bound<'_, PyAny>>) -> PyResult<(Option<NamedCosmology>, Vec<String>)> {
-    let Some(obj) = obj else {
-        return Ok((None, Vec::new()));
-    };
-    if let Ok(dict) = obj.cast::<PyDict>() {
-        let mut pairs = Vec::new();
-        for (key, value) in dict.iter() {
-            pairs.push((key.str()?.to_string(), value.str()?.to_string()))
-        }
-        let parsed = Cosmology::from_keys(pairs, "cosmology dict").map_err(value_error)?;
-        let named = NamedCosmology {
-            name: "dict".into(),
-            cosmology: parsed.cosmology,
-        };
-        return Ok((Some(named), parsed.ignored));
-    }
-    let name: PathBuf = obj.extract().map_err(|_| {
-        PyValueError::new_err(
-            "cosmology: expected a preset name, an ini path or a dict of ini keys",
-        )
-    })?;
-    let (named, ignored) = NamedCosmology::parse(&name.to_string_lossy()).map_err(value_error)?;
-    Ok((Some(named), ignored))
-}
-
-/// Where the linear spectrum comes from: `None` (embedded or EH with `eh`), a path, or (k, P).
-fn linear_source(
-    linear: Option<&Bound<'_, PyAny>>,
-    z_input: f64,
-    eh: Option<&str>,
-) -> PyResult<LinearSource> {
-    let eh_kind = match eh {
-        None => None,
-        Some("wiggle") => Some(TransferKind::Wiggle),
-        Some("no-wiggle") => Some(TransferKind::NoWiggle),
-        Some(other) => {
-            return Err(PyValueError::new_err(format!(
-                "unknown eh `{other}`; available: wiggle, no-wiggle"
-            )))
-        }
-    };
-    let spectrum = match linear {
-        None => return Ok(eh_kind.map_or(LinearSource::Embedded, LinearSource::EisensteinHu)),
-        Some(_) if eh_kind.is_some() => {
-            return Err(PyValueError::new_err("give either linear or eh, not both"))
-        }
-        Some(obj) if obj.is_instance_of::<PyString>() || obj.extract::<PathBuf>().is_ok() => {
-            let path: PathBuf = obj.extract()?;
-            LinearSpectrum::from_file(&path).map_err(value_error)?
-        }
-        Some(obj) => {
-            let (k, p): (Bound<'_, PyAny>, Bound<'_, PyAny>) = obj.extract().map_err(|_| {
-                PyValueError::new_err(
-                    "linear: expected a path or a pair (k [h/Mpc], P [(Mpc/h)^3])",
-                )
-            })?;
-            LinearSpectrum::from_nodes(floats(&k, "linear k")?, floats(&p, "linear P")?)
-                .map_err(value_error)?
-        }
-    };
-    Ok(LinearSource::Table {
-        spectrum: Box::new(spectrum),
-        z_input,
-    })
-}
-
-/// The linear spectrum at `z` with the growth of the cosmology, and the warnings (ignored ini keys
-/// included).
-fn prepare(
-    linear: Option<&Bound<'_, PyAny>>,
-    z: f64,
-    z_input: f64,
-    cosmology_arg: Option<&Bound<'_, PyAny>>,
-    eh: Option<&str>,
-) -> PyResult<Prepared> {
-    let source = linear_source(linear, z_input, eh)?;
-    let (cosmology, ignored) = cosmology(cosmology_arg)?;
-    let mut prepared = setup::prepare(Request {
-        source,
-        cosmology,
-        z,
-    })
-    .map_err(value_error)?;
-    if !ignored.is_empty() {
-        prepared.warnings.push(format!(
-            "cosmology: keys ignored (they do not set the background or growth): {}",
-            ignored.join(", ")
-        ));
-    }
-    Ok(prepared)
-}
-
 /// The output k grid: `k` if given, else `nk` log-spaced values in [k_min, k_max].
 fn k_grid(k: Option<&Bound<'_, PyAny>>, k_min: f64, k_max: f64, nk: usize) -> PyResult<Vec<f64>> {
     match k {
@@ -202,23 +111,17 @@ fn k_grid(k: Option<&Bound<'_, PyAny>>, k_min: f64, k_max: f64, nk: usize) -> Py
     }
 }
 
-/// A warning when the output grid reaches the extrapolated ends of the linear table.
-fn extrapolation_warning(prepared: &mut Prepared, k: &[f64]) {
-    let (lo, hi) = (
-        k.iter().copied().fold(f64::MAX, f64::min),
-        k.iter().copied().fold(0.0, f64::max),
-    );
-    if let Some(ext) = prepared.spectrum.extrapolation_in(lo, hi) {
-        prepared.warnings.push(format!("output {ext}"));
-    }
-}
-
 /// Runs `f` with the GIL released.
 fn detached<T: Send>(
     py: Python<'_>,
     f: impl FnOnce() -> pt_spectra::error::Result<T> + Send,
-) -> PyResult<T> {
-    py.detach(f).map_err(value_error)
+) -> PyResult<(T, f64)> {
+    let (result, seconds) = py.detach(|| {
+        let start = std::time::Instant::now();
+        let result = f();
+        (result, start.elapsed().as_secs_f64())
+    });
+    Ok((result.map_err(value_error)?, seconds))
 }
 
 /// A real-space model prepared for one k grid (cosmology-independent work done once); calling it
@@ -248,7 +151,7 @@ impl RealPlan {
         let selection: RealSelection = model.parse().map_err(value_error)?;
         let precision = self::precision(precision, q_range, two_loop_tolerance)?;
         let store = Store::new(cache_dir);
-        let plan = detached(py, || {
+        let (plan, _) = detached(py, || {
             LibRealPlan::new(&k, selection.plan_model(), &precision, store.get(), &Silent)
         })?;
         Ok(Self {
@@ -278,10 +181,11 @@ impl RealPlan {
         eh: Option<&str>,
     ) -> PyResult<Table> {
         let _ = &self.store;
-        let mut prepared = prepare(linear, z, z_input, cosmology, eh)?;
-        extrapolation_warning(&mut prepared, self.plan.k());
-        let table = detached(py, || {
-            jobs::real_table(&self.plan, self.selection, &prepared, terms, &Silent)
+        let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
+        let ((table, prepared), seconds) = detached(py, || {
+            let prepared = inputs.prepare(self.plan.k())?;
+            let table = jobs::real_table(&self.plan, self.selection, &prepared, terms, &Silent)?;
+            Ok((table, prepared))
         })?;
         Table::new(
             py,
@@ -289,6 +193,7 @@ impl RealPlan {
             &prepared,
             self.plan.precision(),
             &self.selection.plan_model().to_string(),
+            seconds,
         )
     }
 }
@@ -411,7 +316,7 @@ impl RsdPlan {
         let rsd: RsdModel = rsd.parse().map_err(value_error)?;
         let precision = self::precision(precision, q_range, None)?;
         let store = Store::new(cache_dir);
-        let plan = detached(py, || {
+        let (plan, _) = detached(py, || {
             LibRsdPlan::new(&k, real, rsd, &precision, store.get(), &Silent)
         })?;
         Ok(Self { plan, rsd, store })
@@ -461,13 +366,21 @@ impl RsdPlan {
             ells,
             terms,
         };
-        let mut prepared = prepare(linear, z, z_input, cosmology, eh)?;
-        extrapolation_warning(&mut prepared, self.plan.real().k());
-        let table = detached(py, || {
-            jobs::rsd_table(&self.plan, &request, &prepared, &Silent)
+        let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
+        let ((table, prepared), seconds) = detached(py, || {
+            let prepared = inputs.prepare(self.plan.real().k())?;
+            let table = jobs::rsd_table(&self.plan, &request, &prepared, &Silent)?;
+            Ok((table, prepared))
         })?;
         let model = format!("{} + {}", self.rsd, self.plan.real().model());
-        Table::new(py, table, &prepared, self.plan.real().precision(), &model)
+        Table::new(
+            py,
+            table,
+            &prepared,
+            self.plan.real().precision(),
+            &model,
+            seconds,
+        )
     }
 }
 
@@ -604,11 +517,13 @@ fn fit(
     let precision = self::precision(precision, q_range, None)?;
     let store = Store::new(cache_dir);
     let real = real.parse().map_err(value_error)?;
-    let prepared = prepare(linear, z, z_input, cosmology, eh)?;
+    let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
     let k = data.k.clone();
-    let table = detached(py, || {
+    let ((table, prepared), seconds) = detached(py, || {
+        let prepared = inputs.prepare(&k)?;
         let plan = LibRsdPlan::new(&k, real, rsd_model, &precision, store.get(), &Silent)?;
-        jobs::fit_table(&plan, data, &request, &prepared, &Silent)
+        let table = jobs::fit_table(&plan, data, &request, &prepared, &Silent)?;
+        Ok((table, prepared))
     })?;
     Table::new(
         py,
@@ -616,6 +531,7 @@ fn fit(
         &prepared,
         &precision,
         &format!("{rsd_model} + {real}"),
+        seconds,
     )
 }
 
@@ -623,8 +539,7 @@ fn fit(
 #[pyfunction]
 #[pyo3(signature = (z, cosmology=None))]
 fn growth(z: f64, cosmology: Option<&Bound<'_, PyAny>>) -> PyResult<(f64, f64)> {
-    let (named, _) = self::cosmology(cosmology)?;
-    let c = named.map_or(Cosmology::gm2012(), |n| n.cosmology);
+    let c = inputs::cosmology_of(cosmology)?;
     if !(z.is_finite() && z > -1.0) {
         return Err(PyValueError::new_err(format!(
             "z = {z}: a redshift must be finite and > -1"
@@ -644,8 +559,7 @@ fn eisenstein_hu<'py>(
     wiggle: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let k = floats(k, "k")?;
-    let (named, _) = self::cosmology(cosmology)?;
-    let c = named.map_or(Cosmology::gm2012(), |n| n.cosmology);
+    let c = inputs::cosmology_of(cosmology)?;
     let kind = if wiggle {
         TransferKind::Wiggle
     } else {

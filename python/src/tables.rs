@@ -27,6 +27,7 @@ impl Table {
         prepared: &Prepared,
         precision: &Precision,
         model: &str,
+        seconds: f64,
     ) -> PyResult<Self> {
         let meta = PyDict::new(py);
         meta.set_item("z", prepared.z)?;
@@ -41,6 +42,8 @@ impl Table {
         meta.set_item("q_range", (precision.q_min, precision.q_max))?;
         meta.set_item("model", model)?;
         meta.set_item("linear", prepared.spectrum.origin())?;
+        // The wall time of the library call alone (GIL released), to measure the Python overhead.
+        meta.set_item("seconds", seconds)?;
         Ok(Self {
             table,
             meta: meta.unbind(),
@@ -78,7 +81,7 @@ impl Table {
         self.table.header.clone()
     }
 
-    /// z, f, D, cosmology, precision, q range, model, linear spectrum.
+    /// z, f, D, cosmology, precision, q range, model, linear spectrum, seconds (of the library call).
     #[getter]
     fn meta<'py>(&self, py: Python<'py>) -> Bound<'py, PyDict> {
         self.meta.bind(py).clone()

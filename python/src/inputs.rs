@@ -1,0 +1,167 @@
+//! The inputs every computation shares (linear spectrum, redshifts, cosmology), taken from Python
+//! arguments into plain Rust values while the GIL is held, then turned into the library's inputs
+//! ([`Inputs::prepare`]) with the GIL released, as part of the library call.
+
+use crate::value_error;
+use pt_spectra::cosmology::{Cosmology, TransferKind};
+use pt_spectra::linear::LinearSpectrum;
+use pt_spectra::setup::{self, LinearSource, NamedCosmology, Prepared, Request};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use std::path::PathBuf;
+
+/// The linear spectrum as given.
+enum Linear {
+    /// The embedded gm2012 spectra, or Eisenstein & Hu.
+    Default(Option<TransferKind>),
+    /// A table file.
+    File(PathBuf),
+    /// Arrays k [h/Mpc], P [(Mpc/h)^3].
+    Arrays(Vec<f64>, Vec<f64>),
+}
+
+/// The cosmology as given.
+enum CosmologyArg {
+    Default,
+    NameOrFile(String),
+    Keys(Vec<(String, String)>),
+}
+
+/// The shared inputs of a call.
+pub struct Inputs {
+    linear: Linear,
+    cosmology: CosmologyArg,
+    z: f64,
+    z_input: f64,
+}
+
+impl Inputs {
+    /// Reads the Python arguments: `linear` (None, a path or (k, P)), `cosmology` (None, a name or
+    /// path, or a dict of ini keys), `eh` (None, "wiggle" or "no-wiggle").
+    pub fn extract(
+        linear: Option<&Bound<'_, PyAny>>,
+        z: f64,
+        z_input: f64,
+        cosmology: Option<&Bound<'_, PyAny>>,
+        eh: Option<&str>,
+    ) -> PyResult<Self> {
+        let eh = match eh {
+            None => None,
+            Some("wiggle") => Some(TransferKind::Wiggle),
+            Some("no-wiggle") => Some(TransferKind::NoWiggle),
+            Some(other) => {
+                return Err(PyValueError::new_err(format!(
+                    "unknown eh `{other}`; available: wiggle, no-wiggle"
+                )))
+            }
+        };
+        let linear = match linear {
+            None => Linear::Default(eh),
+            Some(_) if eh.is_some() => {
+                return Err(PyValueError::new_err("give either linear or eh, not both"))
+            }
+            Some(obj) if obj.is_instance_of::<PyString>() || obj.extract::<PathBuf>().is_ok() => {
+                Linear::File(obj.extract()?)
+            }
+            Some(obj) => {
+                let (k, p): (Bound<'_, PyAny>, Bound<'_, PyAny>) = obj.extract().map_err(|_| {
+                    PyValueError::new_err(
+                        "linear: expected a path or a pair (k [h/Mpc], P [(Mpc/h)^3])",
+                    )
+                })?;
+                Linear::Arrays(
+                    crate::floats(&k, "linear k")?,
+                    crate::floats(&p, "linear P")?,
+                )
+            }
+        };
+        let cosmology = match cosmology {
+            None => CosmologyArg::Default,
+            Some(obj) => match obj.cast::<PyDict>() {
+                Ok(dict) => {
+                    let mut pairs = Vec::new();
+                    for (key, value) in dict.iter() {
+                        pairs.push((key.str()?.to_string(), value.str()?.to_string()))
+                    }
+                    CosmologyArg::Keys(pairs)
+                }
+                Err(_) => {
+                    let name: PathBuf = obj.extract().map_err(|_| {
+                        PyValueError::new_err(
+                            "cosmology: expected a preset name, an ini path or a dict of ini keys",
+                        )
+                    })?;
+                    CosmologyArg::NameOrFile(name.to_string_lossy().into_owned())
+                }
+            },
+        };
+        Ok(Self {
+            linear,
+            cosmology,
+            z,
+            z_input,
+        })
+    }
+
+    /// The cosmology and the keys of its ini file or dict that were ignored.
+    pub fn cosmology(&self) -> pt_spectra::error::Result<(Option<NamedCosmology>, Vec<String>)> {
+        Ok(match &self.cosmology {
+            CosmologyArg::Default => (None, Vec::new()),
+            CosmologyArg::NameOrFile(s) => {
+                let (named, ignored) = NamedCosmology::parse(s)?;
+                (Some(named), ignored)
+            }
+            CosmologyArg::Keys(pairs) => {
+                let parsed = Cosmology::from_keys(pairs.iter().cloned(), "cosmology dict")?;
+                let named = NamedCosmology {
+                    name: "dict".into(),
+                    cosmology: parsed.cosmology,
+                };
+                (Some(named), parsed.ignored)
+            }
+        })
+    }
+
+    /// The linear spectrum at z with the growth of the cosmology, the warnings (ignored keys and
+    /// output k beyond the linear table included).
+    pub fn prepare(&self, k: &[f64]) -> pt_spectra::error::Result<Prepared> {
+        let source = match &self.linear {
+            Linear::Default(None) => LinearSource::Embedded,
+            Linear::Default(Some(kind)) => LinearSource::EisensteinHu(*kind),
+            Linear::File(path) => LinearSource::Table {
+                spectrum: Box::new(LinearSpectrum::from_file(path)?),
+                z_input: self.z_input,
+            },
+            Linear::Arrays(k, p) => LinearSource::Table {
+                spectrum: Box::new(LinearSpectrum::from_nodes(k.clone(), p.clone())?),
+                z_input: self.z_input,
+            },
+        };
+        let (cosmology, ignored) = self.cosmology()?;
+        let mut prepared = setup::prepare(Request {
+            source,
+            cosmology,
+            z: self.z,
+        })?;
+        if !ignored.is_empty() {
+            prepared.warnings.push(format!(
+                "cosmology: keys ignored (they do not set the background or growth): {}",
+                ignored.join(", ")
+            ));
+        }
+        let lo = k.iter().copied().fold(f64::MAX, f64::min);
+        let hi = k.iter().copied().fold(0.0, f64::max);
+        if let Some(ext) = prepared.spectrum.extrapolation_in(lo, hi) {
+            prepared.warnings.push(format!("output {ext}"));
+        }
+        Ok(prepared)
+    }
+}
+
+/// The cosmology of a Python argument (for the small helpers), gm2012 by default.
+pub fn cosmology_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Cosmology> {
+    let inputs = Inputs::extract(None, 0.0, 0.0, obj, None)?;
+    let (named, _) = inputs.cosmology().map_err(value_error)?;
+    Ok(named.map_or(Cosmology::gm2012(), |n| n.cosmology))
+}

@@ -1,0 +1,176 @@
+"""The pt_spectra module against the command line, the FAST-PT reference tables and its own contracts.
+
+Run from the repository: ``pytest python/tests`` after ``pip install ./python`` and
+``cargo build --release -p pt-spectra`` (the CLI comparisons run ``target/release/pt-spectra``, or
+``$PT_SPECTRA_BIN``).
+"""
+
+import os
+import subprocess
+import threading
+import time
+import warnings
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pt_spectra as pt
+
+ROOT = Path(__file__).resolve().parents[2]
+DATA = ROOT / "tests" / "data"
+CLI = Path(os.environ.get("PT_SPECTRA_BIN", ROOT / "target" / "release" / "pt-spectra"))
+
+
+def cli(*args):
+    """The command line's standard output."""
+    if not CLI.exists():
+        pytest.fail(f"the pt-spectra binary is not at {CLI}: cargo build --release -p pt-spectra")
+    out = subprocess.run([str(CLI), *args], capture_output=True, text=True, check=True)
+    return out.stdout
+
+
+def planck(z):
+    d = np.loadtxt(DATA / f"linear_pk_planck2018_z{z:.1f}.dat")
+    return d[:, 0], d[:, 1]
+
+
+def test_python_tables_equal_the_command_line_text():
+    # The same library job writes both: header, names and every value, to the last printed digit.
+    args = ["--nk", "12", "--k-min", "0.01", "--k-max", "0.4", "--precision", "fast", "--z", "0.5"]
+    t = pt.real(model="1l-rpt-n1", terms=True, precision="fast", z=0.5, k_min=0.01, k_max=0.4, nk=12)
+    assert t.to_text() == cli("real", "--model", "1l-rpt-n1", "--terms", *args)
+    m = pt.rsd(rsd="tns", real="1l-spt", fog="lorentzian", sigma0=3.5, bias=2.0, shot_noise=2e3,
+               terms=True, precision="fast", z=0.5, k_min=0.01, k_max=0.4, nk=12)
+    text = cli("rsd", "--rsd", "tns", "--real", "1l-spt", "--fog", "lorentzian", "--sigma0", "3.5",
+               "--bias", "2", "--shot-noise", "2e3", "--terms", *args)
+    assert m.to_text() == text
+    # Columns and values as parsed from the text.
+    rows = np.loadtxt([line for line in text.splitlines() if not line.startswith("#")])
+    names = [line for line in text.splitlines() if line.startswith("# k ")][0].split()[1:]
+    assert m.columns == names
+    for j, name in enumerate(names):
+        np.testing.assert_allclose(m[name], rows[:, j], rtol=1e-9)
+    path = str(DATA / "linear_pk_planck2018_z0.0.dat")
+    t = pt.real(model="1l-spt", linear=path, cosmology="planck2018", z=1.0, precision="fast",
+                k_min=0.01, k_max=0.3, nk=5)
+    assert t.to_text() == cli("real", "--linear", path, "--cosmology", "planck2018", "--z", "1",
+                              "--precision", "fast", "--k-min", "0.01", "--k-max", "0.3", "--nk", "5")
+
+
+def test_one_loop_terms_match_fastpt():
+    # tests/data/README.md: columns 8 and 9 are FAST-PT 4.1.1's P22 and 2 P13 of delta-delta, good to
+    # ~1e-5 (brute force); ours agree to <= 9e-6 (P22) and 1.5e-6 (2 P13) in the Rust tests.
+    ref = np.loadtxt(DATA / "fastpt_1loop_gm2012_z0.0.dat")
+    ref = ref[(ref[:, 0] >= 0.01) & (ref[:, 0] <= 0.5)]
+    t = pt.real(model="1l-spt", k=ref[:, 0], terms=True)
+    np.testing.assert_allclose(t["P_lin"], ref[:, 1], rtol=1e-6)
+    np.testing.assert_allclose(t["P22_dd"], ref[:, 7], rtol=2e-5)
+    np.testing.assert_allclose(2 * t["P13_dd"], ref[:, 8], rtol=2e-5)
+    # The reported errors are honest bounds at this level.
+    assert np.all(t["err_P22_dd"] < 2e-4 * np.abs(t["P22_dd"]))
+    assert t.units["P22_dd"] == "(Mpc/h)^3" and t.units["k"] == "h/Mpc"
+    assert t.meta["cosmology"] == "gm2012" and t.meta["q_range"] == (1e-5, 1e3)
+
+
+def test_a_plan_is_reused_across_spectra():
+    k = np.geomspace(0.01, 0.3, 15)
+    plan = pt.RealPlan(k, model="1l-spt", precision="fast")
+    np.testing.assert_array_equal(plan.k, k)
+    kl, pl = planck(0.0)
+    for z in (0.0, 1.0):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            a = plan(linear=(kl, pl), z=z, cosmology="planck2018")
+        b = pt.real(model="1l-spt", k=k, linear=(kl, pl), z=z, cosmology="planck2018",
+                    precision="fast")
+        for name in a.columns:
+            np.testing.assert_array_equal(a[name], b[name])
+    # P22 scales as D^4 between the two redshifts (the same linear shape).
+    a0 = plan(linear=(kl, pl), z=0.0, cosmology="planck2018")
+    a1 = plan(linear=(kl, pl), z=1.0, cosmology="planck2018", terms=True)
+    d = a1.meta["D"]
+    np.testing.assert_allclose(a1["P_lin"], d**2 * a0["P_lin"], rtol=1e-12)
+    assert abs(a1.meta["f"] / 0.873875 - 1) < 2e-3
+
+
+def test_bad_input_raises_value_error_naming_the_problem():
+    k = [0.05, 0.1]
+    cases = [
+        (lambda: pt.real(model="3l-spt", k=k), "3l-spt"),
+        (lambda: pt.real(k=[0.1, -0.2]), "k"),
+        (lambda: pt.real(k=k, linear=([0.1, 0.2], [1.0])), "k and P"),
+        (lambda: pt.real(k=k, linear="/nonexistent/pk.dat"), "/nonexistent/pk.dat"),
+        (lambda: pt.real(k=k, cosmology="planck2013"), "planck2013"),
+        (lambda: pt.real(k=k, cosmology={"h": 0.7, "H0": 68, "omega_b": 0.022, "omega_cdm": 0.12,
+                                         "n_s": 0.96, "A_s": 2e-9}), "H0"),
+        (lambda: pt.real(k=k, precision="best"), "best"),
+        (lambda: pt.real(k=k, q_range=(10.0, 1.0)), "q_max"),
+        (lambda: pt.real(k=k, z=-2.0), "z = -2"),
+        (lambda: pt.rsd(k=k, fog="cauchy"), "cauchy"),
+        (lambda: pt.rsd(k=k, ells=(0, 3)), "ell"),
+        (lambda: pt.rsd(k=k, sigma0="maybe"), "maybe"),
+        (lambda: pt.rsd(k=k, bias=([0.01, 0.02], [2.0, 2.0])), "b(k)"),
+        (lambda: pt.kernel("F", [[1e200, 0, 0], [-1e200, 1e-200, 0], [0, 1e200, 0]]), "overflow"),
+        (lambda: pt.kernel("H", [[1, 0, 0]]), "H"),
+        (lambda: pt.kernel("F", [[1, 0]]), "three components"),
+    ]
+    for call, needle in cases:
+        with pytest.raises(ValueError, match=None) as e:
+            call()
+        assert needle in str(e.value), (needle, str(e.value))
+
+
+def test_kernels_exact_and_float():
+    assert pt.kernel("F", [[1, 0, 0], [0, 1, 0]]) == pytest.approx(5 / 7, rel=1e-15)
+    assert pt.kernel("G", [[1, 2, 3], [0, 1, 0], [0, -1, 0]], exact=True) == "-20452/30723"
+    # F_2(q1, q2) = 5/7 + (1/2) mu (q1/q2 + q2/q1) + (2/7) mu^2, exactly.
+    q1, q2 = [Fraction(1, 2), 0, 0], [Fraction(1, 3), Fraction(1, 4), 0]
+    n1, n2 = Fraction(1, 4), Fraction(1, 9) + Fraction(1, 16)
+    dot = Fraction(1, 6)
+    f2 = Fraction(5, 7) + dot / 2 * (1 / n1 + 1 / n2) + Fraction(2, 7) * dot**2 / (n1 * n2)
+    assert pt.kernel("F", [q1, q2], exact=True) == f"{f2.numerator}/{f2.denominator}"
+
+
+def test_warnings_for_defaults_that_may_not_fit():
+    kl, pl = planck(0.0)
+    with pytest.warns(pt.PtSpectraWarning, match="gm2012"):
+        t = pt.real(k=[0.1], linear=(kl, pl), z=1.0, precision="fast")
+    assert any("gm2012" in line for line in t.header)
+    with pytest.warns(pt.PtSpectraWarning, match="Eisenstein"):
+        pt.real(k=[0.1], cosmology="planck2018", precision="fast")
+
+
+def test_the_gil_is_released_during_a_computation():
+    # A long computation in a thread; the main thread keeps running Python meanwhile. With the GIL
+    # held, no Python line could run between the start and the end of the computation.
+    k = np.geomspace(0.001, 1.0, 4000)
+    stamps, done = [], {}
+
+    def work():
+        done["start"] = time.perf_counter()
+        pt.real(model="1l-spt", k=k, precision="default")
+        done["end"] = time.perf_counter()
+
+    thread = threading.Thread(target=work)
+    thread.start()
+    while thread.is_alive():
+        stamps.append(time.perf_counter())
+    thread.join()
+    inside = [s for s in stamps if done["start"] + 0.05 < s < done["end"] - 0.05]
+    assert done["end"] - done["start"] > 0.2, "the computation is too short to tell"
+    assert len(inside) > 1000, len(inside)
+
+
+def test_fit_from_arrays_recovers_f():
+    # A linear Kaiser mock (exact, 1% errors, no noise): the fit of f must return its true value.
+    k = np.geomspace(0.02, 0.2, 15)
+    mock = pt.rsd(rsd="kaiser", real="linear", k=k, f=0.6, bias=1.5, ells=(0, 2))
+    data = {"k": k, "P0": mock["P0"], "s0": 0.01 * mock["P0"], "P2": mock["P2"],
+            "s2": 0.01 * mock["P2"]}
+    r = pt.fit(data, k_max=[0.1, 0.2], free=("f",), ells=(0, 2), rsd="kaiser", real="linear",
+               fog="none", bias=1.5, f=0.5)
+    assert r.columns[:5] == ["k_max", "points", "f", "f_lo", "f_hi"]
+    np.testing.assert_allclose(r["f"], 0.6, rtol=1e-5)
+    assert np.all(r["chi2"] < 1e-6)
