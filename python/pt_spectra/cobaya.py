@@ -1,0 +1,261 @@
+"""A cobaya theory: redshift-space multipoles of pt-spectra from the linear spectrum of CAMB or CLASS.
+
+``pt_spectra.cobaya.PTMultipoles`` takes the linear matter spectrum, H0, fσ8 and σ8 from the
+Boltzmann code of the run and provides ``pt_pk_ell``: the multipoles P_ℓ(k) [(Mpc/h)^3] at each
+redshift of ``zs`` on its k grid [h/Mpc]. Its loop terms are planned once (``pt.RsdPlan``) in
+``initialize``; each evaluation only integrates the new linear spectrum.
+
+Options (yaml or class attributes):
+
+- ``zs``: the redshifts (required).
+- ``k``: the output k [h/Mpc], or ``k_min, k_max, nk`` (log-spaced); if none is given, the union of
+  the k requested by the likelihoods (``pt_pk_ell: {k: [...]}``) is used.
+- ``ells`` ([0, 2, 4]), ``rsd`` ("tns"), ``real`` ("1l-spt"), ``fog`` ("lorentzian"),
+  ``precision`` ("default"; "fast" is ~3× cheaper for 2-loop models), ``q_range`` (QMIN, QMAX
+  [h/Mpc]), ``cache_dir`` (the angular tables; default $PT_SPECTRA_CACHE or ~/.cache/pt-spectra).
+- ``k_max_linear`` (10): the k_max [1/Mpc] asked of the Boltzmann code; as h < 1 this covers k up to
+  ``k_max_linear`` h/Mpc. The library extends the spectrum beyond both ends by power laws.
+- ``var_pair`` (["delta_tot", "delta_tot"]): the Boltzmann spectrum; ["delta_nonu", "delta_nonu"]
+  for the CDM + baryon spectrum with massive neutrinos.
+- ``prefix`` (""): prefix of the nuisance parameter names, to run two tracers side by side.
+
+Nuisance parameters, one set per redshift ``zs[i]`` (declare them in ``params``, fixed or sampled):
+
+- ``b_i`` (required): the linear bias, constant in k.
+- ``sigma0_i`` [Mpc/h] (required unless ``fog: none``): the z = 0 velocity dispersion of the
+  Fingers-of-God damping, whose scale is σ = σ0 D(z) f(z) with D = σ8(z)/σ8(0) of the Boltzmann code.
+- ``A_b_i`` (optional, default 1): the bias amplitude A_b; with a constant bias it multiplies b
+  and so is degenerate with it: sample one of them.
+- ``P_shot_i`` [(Mpc/h)^3] (optional, default 0): a constant residual shot noise added to the
+  monopole. (The library's multipoles are noise-subtracted, as a measured P0 is after removing 1/n.)
+
+The linear spectrum is the Boltzmann code's own ``Pk_grid`` at exactly each z (k [1/Mpc] and P
+[Mpc^3] converted to h/Mpc and (Mpc/h)^3 with its H0), rather than ``Pk_interpolator``: no second
+interpolation, and no need for the ≥ 4 redshifts that the interpolator requires. The growth rate is
+f = fσ8/σ8 of the Boltzmann code (for massive neutrinos an effective, scale-independent f).
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+try:
+    from cobaya.theory import Theory
+except ImportError as e:  # pragma: no cover - depends on the environment
+    raise ImportError(
+        "pt_spectra.cobaya needs cobaya (and a Boltzmann code): pip install cobaya camb"
+    ) from e
+
+import pt_spectra as pt
+
+__all__ = ["PTMultipoles", "NUISANCE"]
+
+#: The nuisance parameters of one redshift: name -> (required, default, unit).
+NUISANCE = {
+    "b": (True, None, ""),
+    "sigma0": (True, None, "Mpc/h"),
+    "A_b": (False, 1.0, ""),
+    "P_shot": (False, 0.0, "(Mpc/h)^3"),
+}
+
+# The library warns that without a cosmology the growth of its gm2012 cosmology is used. It does not
+# apply here: z_input = z (the spectrum is used as given, rescaling factor 1), f is passed, and the
+# only other use of D(z), the FoG scale σ0 D(z) f, is corrected by passing σ0 D_boltzmann / D_gm2012.
+_NO_COSMOLOGY = "no cosmology was given for the linear spectrum"
+
+
+def _close_index(values, x, what):
+    """The index of x in values (relative tolerance 1e-8), or a ValueError naming `what`."""
+    values = np.asarray(values, dtype=float)
+    hits = np.flatnonzero(np.isclose(values, x, rtol=1e-8, atol=1e-12))
+    if hits.size == 0:
+        raise ValueError(f"{what} = {x} is not among {list(values)}")
+    return int(hits[0])
+
+
+class PTMultipoles(Theory):
+    """Redshift-space multipoles P_ℓ(k) [(Mpc/h)^3], k [h/Mpc], of pt-spectra: see the module docs."""
+
+    zs: list | None = None
+    k: list | None = None
+    k_min: float | None = None
+    k_max: float | None = None
+    nk: int | None = None
+    ells: list = [0, 2, 4]
+    rsd: str = "tns"
+    real: str = "1l-spt"
+    fog: str = "lorentzian"
+    precision: str = "default"
+    q_range: list | None = None
+    cache_dir: str | None = None
+    k_max_linear: float = 10.0
+    var_pair: list = ["delta_tot", "delta_tot"]
+    prefix: str = ""
+
+    # ---- set-up ------------------------------------------------------------------------------
+    def initialize(self):
+        if self.zs is None:
+            raise ValueError("PTMultipoles: option `zs` (the list of redshifts) is required")
+        self.zs = [float(z) for z in np.atleast_1d(self.zs)]
+        if any(not np.isfinite(z) or z < 0 for z in self.zs) or len(set(self.zs)) != len(self.zs):
+            raise ValueError(f"PTMultipoles: `zs` must be distinct redshifts >= 0, got {self.zs}")
+        self.ells = [int(l) for l in np.atleast_1d(self.ells)]
+        if not self.ells or any(l < 0 or l % 2 or l > 8 for l in self.ells):
+            raise ValueError(f"PTMultipoles: `ells` must be even multipoles <= 8, got {self.ells}")
+        if self.fog not in ("none", "lorentzian", "gaussian"):
+            raise ValueError(f"PTMultipoles: unknown `fog` {self.fog!r}; "
+                             "available: none, lorentzian, gaussian")
+        if not self.k_max_linear > 0:
+            raise ValueError(f"PTMultipoles: `k_max_linear` must be > 0, got {self.k_max_linear}")
+        if len(self.var_pair) != 2:
+            raise ValueError(f"PTMultipoles: `var_pair` must be two names, got {self.var_pair}")
+        self._k = self._option_grid()
+        self._requested_k: list[float] = []
+        self._plan = None
+        self._planned_k = None
+        # D_gm2012(z): what the library multiplies σ0 by when no cosmology is given (see above).
+        self._d_library = [pt.growth(z)[0] for z in self.zs]
+        if self._k is not None:
+            self._make_plan(self._k)
+
+    def _option_grid(self):
+        given = [self.k_min is not None, self.k_max is not None, self.nk is not None]
+        if self.k is not None:
+            if any(given):
+                raise ValueError("PTMultipoles: give either `k` or `k_min, k_max, nk`, not both")
+            k = np.asarray(self.k, dtype=float).ravel()
+            if k.size == 0 or np.any(~np.isfinite(k)) or np.any(k <= 0) or np.any(np.diff(k) <= 0):
+                raise ValueError("PTMultipoles: `k` must be increasing positive wavenumbers [h/Mpc]")
+            return k
+        if any(given) and not all(given):
+            raise ValueError("PTMultipoles: `k_min`, `k_max` and `nk` go together")
+        return pt.log_grid(float(self.k_min), float(self.k_max), int(self.nk)) if all(given) else None
+
+    def _make_plan(self, k):
+        self._plan = pt.RsdPlan(k, real=self.real, rsd=self.rsd, precision=self.precision,
+                                q_range=None if self.q_range is None else tuple(self.q_range),
+                                cache_dir=self.cache_dir)
+        self._planned_k = np.asarray(k, dtype=float)
+
+    def param_name(self, name, i):
+        """The name of nuisance parameter `name` (b, sigma0, A_b, P_shot) of redshift zs[i]."""
+        return f"{self.prefix}{name}_{i}"
+
+    def get_can_support_params(self):
+        return [self.param_name(n, i) for i in range(len(self.zs)) for n in NUISANCE]
+
+    def initialize_with_params(self):
+        given = set(self.input_params)
+        missing, defaulted = [], []
+        for i in range(len(self.zs)):
+            for name, (required, default, _) in NUISANCE.items():
+                p = self.param_name(name, i)
+                if p in given:
+                    continue
+                if name == "sigma0" and self.fog == "none":
+                    continue
+                (missing if required else defaulted).append(p if required else f"{p} = {default}")
+        if missing:
+            raise ValueError(
+                f"PTMultipoles: parameters {', '.join(missing)} are required (fixed or sampled in "
+                "`params`); see pt_spectra.cobaya for their meaning")
+        if defaulted:
+            self.log.info("Nuisance parameters not given, fixed at: %s", ", ".join(defaulted))
+
+    def get_requirements(self):
+        zs = self.zs
+        return {
+            "Pk_grid": {"z": zs, "k_max": float(self.k_max_linear), "nonlinear": False,
+                        "vars_pairs": [list(self.var_pair)]},
+            "fsigma8": {"z": zs},
+            "sigma8_z": {"z": sorted(set([0.0] + zs))},
+            "H0": None,
+        }
+
+    def must_provide(self, **requirements):
+        super().must_provide(**requirements)
+        options = requirements.get("pt_pk_ell") or {}
+        for z in np.atleast_1d(options.get("z", [])):
+            _close_index(self.zs, float(z), "requested pt_pk_ell z")
+        for l in options.get("ells") or []:
+            if int(l) not in self.ells:
+                raise ValueError(f"PTMultipoles: multipole {l} is requested but `ells` = {self.ells}")
+        k = np.atleast_1d(options.get("k", [])).astype(float)
+        if k.size and self._k is not None:
+            for ki in k:
+                _close_index(self._k, ki, "requested pt_pk_ell k [h/Mpc]")
+        elif k.size:
+            self._requested_k = sorted(set(self._requested_k) | set(k.tolist()))
+        return None
+
+    def initialize_with_provider(self, provider):
+        super().initialize_with_provider(provider)
+        k = self._k if self._k is not None else np.asarray(self._requested_k)
+        if k.size == 0:
+            raise ValueError("PTMultipoles: no k grid: give `k` (or `k_min, k_max, nk`), or require "
+                             "pt_pk_ell with a `k` list from the likelihood")
+        if self._planned_k is None or not np.array_equal(k, self._planned_k):
+            self._make_plan(k)
+
+    # ---- computation -------------------------------------------------------------------------
+    def _nuisance(self, params, i):
+        values = {}
+        for name, (_, default, _) in NUISANCE.items():
+            values[name] = float(params.get(self.param_name(name, i), default or 0.0))
+        return values
+
+    def calculate(self, state, want_derived=True, **params_values_dict):
+        h = self.provider.get_param("H0") / 100.0
+        k_mpc, z_grid, pk = self.provider.get_Pk_grid(var_pair=tuple(self.var_pair),
+                                                      nonlinear=False)
+        k_lin = np.asarray(k_mpc) / h
+        fs8 = np.atleast_1d(self.provider.get_fsigma8(self.zs))
+        s8 = np.atleast_1d(self.provider.get_sigma8_z(self.zs))
+        s8_0 = float(np.atleast_1d(self.provider.get_sigma8_z([0.0]))[0])
+        spectra, errors, growth = {}, {}, {}
+        for i, z in enumerate(self.zs):
+            p_lin = np.asarray(pk[_close_index(z_grid, z, "z of the Boltzmann P(k) grid")]) * h**3
+            f, d = fs8[i] / s8[i], s8[i] / s8_0
+            nu = self._nuisance(params_values_dict, i)
+            with warnings.catch_warnings():
+                warnings.filterwarnings("ignore", message=_NO_COSMOLOGY,
+                                        category=pt.PtSpectraWarning)
+                t = self._plan(linear=(k_lin, p_lin), z=z, z_input=z, f=f, bias=nu["b"],
+                               amplitude=nu["A_b"], fog=self.fog,
+                               sigma0=nu["sigma0"] * d / self._d_library[i], ells=self.ells)
+            p = np.array([t[f"P{l}"] for l in self.ells])
+            if 0 in self.ells:
+                p[self.ells.index(0)] += nu["P_shot"]
+            spectra[z] = p
+            errors[z] = np.array([t[f"err_P{l}"] for l in self.ells])
+            growth[z] = (f, d)
+        state["pt_pk_ell"] = spectra
+        state["pt_pk_ell_err"] = errors
+        state["pt_growth"] = growth
+
+    # ---- products ----------------------------------------------------------------------------
+    def _at(self, name, z):
+        values = self.current_state[name]
+        return values if z is None else values[self.zs[_close_index(self.zs, z, "z")]]
+
+    def get_pt_pk_ell(self, z=None):
+        """{z: array [len(ells), len(k)]} of P_ℓ(k) [(Mpc/h)^3], or the array of one z."""
+        return self._at("pt_pk_ell", z)
+
+    def get_pt_pk_ell_err(self, z=None):
+        """The numerical error bounds of :meth:`get_pt_pk_ell` (loop integrals, μ quadrature)."""
+        return self._at("pt_pk_ell_err", z)
+
+    def get_pt_growth(self, z=None):
+        """{z: (f, D)} with f = fσ8/σ8 and D = σ8(z)/σ8(0) of the Boltzmann code."""
+        return self._at("pt_growth", z)
+
+    def get_pt_k(self):
+        """The k grid [h/Mpc] of the multipoles."""
+        return self._planned_k.copy()
+
+    def get_pt_ells(self):
+        """The multipoles ℓ, in the order of the rows of :meth:`get_pt_pk_ell`."""
+        return list(self.ells)

@@ -1,0 +1,123 @@
+"""The cobaya theory PTMultipoles and likelihood MultipoleGaussian on the example's mock data.
+
+Runs CAMB a few times (k_max 10/Mpc, ~2 s each on 2 cores); the PT part is 1-loop SPT + TNS with
+the fast precision on 20 k.
+"""
+
+import copy
+import importlib.util
+import pathlib
+
+import numpy as np
+import pytest
+
+cobaya = pytest.importorskip("cobaya", reason="cobaya is not installed (pip install cobaya camb)")
+pytest.importorskip("camb", reason="camb is not installed (pip install camb)")
+
+import pt_spectra as pt  # noqa: E402
+from cobaya.model import get_model  # noqa: E402
+from cobaya.yaml import yaml_load_file  # noqa: E402
+from pt_spectra.likelihoods import read_multipoles  # noqa: E402
+
+EXAMPLES = pathlib.Path(__file__).resolve().parents[1] / "examples"
+Z = 0.5
+
+
+def _make_mock_module():
+    spec = importlib.util.spec_from_file_location("make_mock", EXAMPLES / "make_mock.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def setup(tmp_path_factory):
+    """The example's input with the mock written to a temporary file, and its fiducial point."""
+    info = yaml_load_file(str(EXAMPLES / "cobaya_mock.yaml"))
+    info["theory"]["pt"].update(real="1l-spt", precision="fast", stop_at_error=True)
+    path = str(tmp_path_factory.mktemp("mock") / "mock.npz")
+    info["likelihood"]["mock"].update(data_file=path, stop_at_error=True)
+    make_mock = _make_mock_module()
+    np.savez(path, **make_mock.make_mock(info)[path])
+    return info, make_mock.fiducial_point(info)
+
+
+@pytest.fixture(scope="module")
+def model(setup):
+    info, _ = setup
+    m = get_model(copy.deepcopy({k: v for k, v in info.items() if k != "sampler"}))
+    m.add_requirements({"CAMBdata": None, "pt_pk_ell": None, "pt_growth": None, "pt_k": None})
+    return m
+
+
+def test_evaluate_sampler_at_the_fiducial_point_gives_chi2_zero(setup):
+    info, _ = setup
+    _, sampler = cobaya.run(copy.deepcopy(info))
+    sample = sampler.products()["sample"]
+    assert abs(float(sample["chi2__mock"][0])) < 1e-12
+
+
+def test_chi2_zero_at_fiducial_and_large_when_b_moves_by_5_percent(setup, model):
+    _, point = setup
+    assert model.loglikes(point, as_dict=True)[0]["mock"] == pytest.approx(0.0, abs=1e-12)
+    moved = dict(point, b_0=point["b_0"] * 1.05)
+    chi2 = -2 * model.loglikes(moved, as_dict=True)[0]["mock"]
+    assert chi2 > 100, chi2
+
+
+def test_multipoles_equal_a_direct_rsd_plan_call_with_camb_spectrum_and_f(setup, model):
+    _, point = setup
+    point = dict(point, b_0=1.7, sigma0_0=5.0, P_shot_0=300.0)
+    model.logposterior(point)
+    got = np.asarray(model.provider.get_pt_pk_ell(z=Z))
+    # CAMB's own h units and growth, independent of the theory's conversions
+    results = model.provider.get_CAMBdata()
+    kh, zs, pk = results.get_linear_matter_power_spectrum(hubble_units=True, k_hunit=True)
+    z_tr = np.array(results.transfer_redshifts)
+    iz, i0 = np.argmin(abs(z_tr - Z)), np.argmin(abs(z_tr))
+    fs8, s8 = results.get_fsigma8(), results.get_sigma8()
+    f, d = fs8[iz] / s8[iz], s8[iz] / s8[i0]
+    plan = pt.RsdPlan(model.provider.get_pt_k(), real="1l-spt", rsd="tns", precision="fast")
+    # z = z_input = 0: no rescaling and D_library = 1, so the FoG scale is (sigma0 D) f
+    with pytest.warns(pt.PtSpectraWarning, match="no cosmology"):
+        t = plan(linear=(kh, pk[np.argmin(abs(zs - Z))]), z=0.0, z_input=0.0, f=f, bias=1.7,
+                 fog="lorentzian", sigma0=5.0 * d, ells=(0, 2, 4))
+    want = np.array([t["P0"] + 300.0, t["P2"], t["P4"]])
+    np.testing.assert_allclose(got, want, rtol=1e-10, atol=0)
+    got_f, got_d = model.provider.get_pt_growth(z=Z)
+    assert got_f == pytest.approx(f, rel=1e-12) and got_d == pytest.approx(d, rel=1e-12)
+
+
+def test_no_other_library_warning_is_raised(setup, model, recwarn):
+    _, point = setup
+    model.logposterior(dict(point, logA=3.0))
+    assert not [w for w in recwarn if issubclass(w.category, pt.PtSpectraWarning)]
+
+
+def test_a_missing_nuisance_parameter_is_named(setup):
+    info, _ = setup
+    info = copy.deepcopy(info)
+    del info["params"]["sigma0_0"]
+    with pytest.raises(Exception, match="sigma0_0"):
+        get_model({k: v for k, v in info.items() if k != "sampler"})
+
+
+def test_bad_options_are_named(setup):
+    info, _ = setup
+    for option, value, message in [("fog", "cauchy", "fog"), ("ells", [0, 3], "ells"),
+                                   ("zs", None, "zs")]:
+        bad = copy.deepcopy(info)
+        bad["theory"]["pt"][option] = value
+        with pytest.raises(Exception, match=message):
+            get_model({k: v for k, v in bad.items() if k != "sampler"})
+
+
+def test_text_data_files_are_read_like_npz(setup, tmp_path):
+    info, _ = setup
+    k, values, sigma = read_multipoles(info["likelihood"]["mock"]["data_file"])
+    columns = [k] + [a for l in (0, 2, 4) for a in (values[l], sigma[l])]
+    np.savetxt(tmp_path / "mock.txt", np.column_stack(columns), fmt="%.17g")
+    k2, values2, sigma2 = read_multipoles(tmp_path / "mock.txt")
+    assert np.array_equal(k, k2) and all(np.array_equal(values[l], values2[l]) for l in values)
+    with pytest.raises(ValueError, match="columns"):
+        read_multipoles(tmp_path / "mock.txt", data_ells=(0, 2))
