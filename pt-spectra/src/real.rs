@@ -54,15 +54,18 @@ pub enum RealModel {
     OneLoopRptN3,
     /// 2-loop RPT with N3.
     TwoLoopRptN3,
+    /// 1-loop RegPT (Taruya, Bernardeau, Nishimichi & Codis 2012): regularised propagators with
+    /// σ_d² at the running cut-off k/2 ([`crate::resum::regpt_one_loop`]).
+    OneLoopRegPt,
 }
 
 /// The accepted model names, for messages.
 const MODEL_NAMES: &str = "linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1, 1l-rpt-n2, 1l-rpt-n3, 2l-spt, \
-                           2l-rpt-n0, 2l-rpt-n1, 2l-rpt-n2, 2l-rpt-n3";
+                           2l-rpt-n0, 2l-rpt-n1, 2l-rpt-n2, 2l-rpt-n3, 1l-regpt";
 
 impl RealModel {
     /// Every model.
-    pub const ALL: [RealModel; 11] = [
+    pub const ALL: [RealModel; 12] = [
         RealModel::Linear,
         RealModel::OneLoopSpt,
         RealModel::OneLoopRptN0,
@@ -74,6 +77,7 @@ impl RealModel {
         RealModel::TwoLoopRptN2,
         RealModel::OneLoopRptN3,
         RealModel::TwoLoopRptN3,
+        RealModel::OneLoopRegPt,
     ];
 
     /// The model's name (`linear`, `1l-spt`, `1l-rpt-n0`, `1l-rpt-n1`).
@@ -90,6 +94,7 @@ impl RealModel {
             RealModel::TwoLoopRptN2 => "2l-rpt-n2",
             RealModel::OneLoopRptN3 => "1l-rpt-n3",
             RealModel::TwoLoopRptN3 => "2l-rpt-n3",
+            RealModel::OneLoopRegPt => "1l-regpt",
         }
     }
 
@@ -102,7 +107,10 @@ impl RealModel {
             RealModel::TwoLoopRptN0 => Some(Propagator::N0),
             RealModel::TwoLoopRptN1 => Some(Propagator::N1),
             RealModel::OneLoopRptN3 | RealModel::TwoLoopRptN3 => Some(Propagator::N3),
-            RealModel::Linear | RealModel::OneLoopSpt | RealModel::TwoLoopSpt => None,
+            RealModel::Linear
+            | RealModel::OneLoopSpt
+            | RealModel::TwoLoopSpt
+            | RealModel::OneLoopRegPt => None,
         }
     }
 
@@ -222,6 +230,19 @@ impl RealSpectra {
             None
         };
         let (spectra, factors) = match model.propagator() {
+            None if model == RealModel::OneLoopRegPt => {
+                let sigma_d2 = terms.sigma_d2.as_ref().ok_or_else(|| Error::MissingTerm {
+                    term: "sigma_d^2",
+                    needed_by: format!("model {model}"),
+                    hint: " (compute the terms with a RealPlan)",
+                })?;
+                let spectra = ByPair::from_fn(|pair| {
+                    (0..n)
+                        .map(|i| resum::regpt_one_loop(t, pair, i, sigma_d2[i]))
+                        .collect()
+                });
+                (spectra, None)
+            }
             None => {
                 let spectra = ByPair::from_fn(|pair| {
                     (0..n)
@@ -310,6 +331,9 @@ impl RealSpectra {
             }
         }
         t.push_estimates("sigma_v2", "(Mpc/h)^2", &vec![one.sigma_v2; self.k.len()]);
+        if let (Some(sigma_d2), RealModel::OneLoopRegPt) = (&self.terms.sigma_d2, model) {
+            t.push_estimates("sigma_d2", "(Mpc/h)^2", sigma_d2);
+        }
         if let Some(factors) = &self.factors {
             for (pair, f) in factors.iter() {
                 t.push_estimates(&format!("N_{}", pair.suffix()), "1", f);
@@ -454,11 +478,13 @@ impl RealPlan {
             }
             _ => None,
         };
+        let sigma_d2 = Some(resum::sigma_d2(spectrum, k, precision));
         LoopTerms {
             one_loop,
             p15,
             p17,
             two_loop,
+            sigma_d2,
         }
     }
 

@@ -135,7 +135,7 @@ def camb_linear(cosmology, zs, k_max=20.0):
     import camb
 
     c = cosmology
-    pars = camb.CAMBparams()
+    pars = camb.CAMBparams(WantCls=False, Want_CMB=False, WantTransfer=True)
     pars.set_cosmology(H0=100 * c["h"], ombh2=c["omega_b"], omch2=c["omega_cdm"],
                        omk=c.get("Omega_k", 0.0), mnu=0.0, num_massive_neutrinos=0)
     pars.InitPower.set_params(ns=c["n_s"], As=c.get("A_s", 2e-9),
@@ -157,11 +157,21 @@ def _threads(n, size):
         except RuntimeError as e:
             if pt.num_threads() != int(n):
                 warnings.warn(f"run.threads = {n} not applied: {e}", pt.PtSpectraWarning)
-    elif size > 1 and "RAYON_NUM_THREADS" not in os.environ:
-        warnings.warn(f"{size} ranks each use {pt.num_threads()} threads (all cores): set "
+    elif size * pt.num_threads() > (os.cpu_count() or 1):
+        warnings.warn(f"{size} ranks x {pt.num_threads()} threads > {os.cpu_count()} cores: set "
                       "run.threads or RAYON_NUM_THREADS so that ranks x threads <= cores",
                       pt.PtSpectraWarning)
     return pt.num_threads()
+
+
+def _point_tables(plan, config, cosmology):
+    """The tables of one cosmology at each z."""
+    if config["linear"] == "camb":
+        spectra = camb_linear(cosmology, config["z"], config["camb_k_max"])
+        return [plan(p, z=z, z_input=z, cosmology=cosmology, terms=True)
+                for p, z in zip(spectra, config["z"])]
+    eh = "wiggle" if config["linear"] == "eh" else "no-wiggle"
+    return [plan(z=z, cosmology=cosmology, terms=True, eh=eh) for z in config["z"]]
 
 
 def _rank_arrays(config, indices):
@@ -172,14 +182,11 @@ def _rank_arrays(config, indices):
     nz = len(config["z"])
     for row, i in enumerate(indices):
         cosmology = config["points"][i]
-        spectra = camb_linear(cosmology, config["z"], config["camb_k_max"]) \
-            if config["linear"] == "camb" else [None] * nz
-        for j, z in enumerate(config["z"]):
-            if config["linear"] == "camb":
-                t = plan(spectra[j], z=z, z_input=z, cosmology=cosmology, terms=True)
-            else:
-                eh = "wiggle" if config["linear"] == "eh" else "no-wiggle"
-                t = plan(z=z, cosmology=cosmology, terms=True, eh=eh)
+        try:
+            tables = _point_tables(plan, config, cosmology)
+        except ValueError as e:
+            raise ValueError(f"point {i} {cosmology}: {e}") from e
+        for j, t in enumerate(tables):
             shape = (len(indices), nz, len(config["k"]))
             for c in t.columns:
                 if c != "k" and (config["terms"] or c in BASIC):
@@ -187,7 +194,7 @@ def _rank_arrays(config, indices):
             for name in ("f", "D", "seconds"):
                 out.setdefault(name, np.full(shape[:2], np.nan))[row, j] = t.meta.get(name, np.nan)
             meta = t.meta
-    for key in sorted({k for i in indices for k in config["points"][i]}):
+    for key in sorted({k for p in config["points"] for k in p}):  # the same keys on every rank
         out[f"param_{key}"] = np.array([config["points"][i].get(key, np.nan) for i in indices])
     out["z"], out["k"] = np.asarray(config["z"]), np.asarray(config["k"])
     return out, meta

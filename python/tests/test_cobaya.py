@@ -121,3 +121,15 @@ def test_text_data_files_are_read_like_npz(setup, tmp_path):
     assert np.array_equal(k, k2) and all(np.array_equal(values[l], values2[l]) for l in values)
     with pytest.raises(ValueError, match="columns"):
         read_multipoles(tmp_path / "mock.txt", data_ells=(0, 2))
+
+
+def test_k_from_the_likelihood_and_a_second_redshift(setup):
+    info, point = setup
+    info = copy.deepcopy({k: v for k, v in info.items() if k != "sampler"})
+    for option in ("k_min", "k_max", "nk"):
+        del info["theory"]["pt"][option]
+    info["theory"]["pt"]["zs"] = [0.5, 1.0]
+    info["params"].update(b_1=2.5, sigma0_1=3.0)
+    model = get_model(info)
+    assert model.loglikes(point, as_dict=True)[0]["mock"] == pytest.approx(0.0, abs=1e-12)
+    assert set(model.provider.get_pt_pk_ell()) == {0.5, 1.0}

@@ -239,6 +239,9 @@ pub struct LoopTerms {
     pub p17: Option<ByPair<Vec<Estimate>>>,
     /// The 2-loop SPT terms ([`two_loop_correction`]).
     pub two_loop: Option<TwoLoopCorrection>,
+    /// RegPT's σ_d²(k) = (1/6π²)∫_{q_min}^{k/2} P dq at each k [(Mpc/h)²]
+    /// ([`crate::resum::sigma_d2`]).
+    pub sigma_d2: Option<Vec<Estimate>>,
 }
 
 impl LoopTerms {
@@ -249,6 +252,7 @@ impl LoopTerms {
             p15: None,
             p17: None,
             two_loop: None,
+            sigma_d2: None,
         }
     }
 
