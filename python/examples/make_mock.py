@@ -64,9 +64,9 @@ def make_mock(info, rel_error=0.02, point=None):
         p = np.asarray(model.provider.get_pt_pk_ell(z=float(options["z"])))
         floor = rel_error * 0.1 * np.abs(p[ells.index(0)]) if 0 in ells else 0.0
         data = {"k": k}
-        for row, l in zip(p, ells):
-            data[f"P{l}"] = row
-            data[f"s{l}"] = np.maximum(rel_error * np.abs(row), floor)
+        for row, ell in zip(p, ells):
+            data[f"P{ell}"] = row
+            data[f"s{ell}"] = np.maximum(rel_error * np.abs(row), floor)
         mocks[options["data_file"]] = data
     return mocks
 

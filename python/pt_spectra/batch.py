@@ -1,4 +1,4 @@
-"""Real-space spectra of many cosmologies, spread over MPI ranks: ``python -m pt_spectra.batch grid.toml``.
+"""Real-space spectra of many cosmologies over MPI ranks: ``python -m pt_spectra.batch grid.toml``.
 
 The toml (see ``python/examples/grid.toml``)::
 
@@ -30,9 +30,9 @@ Parallelism: point i goes to rank i % size (rank striping). Each rank builds ONE
 ``index`` [n], ``z`` [nz], ``k`` [nk], every column (``P_dd``, ``err_P_dd``, …) as [n, nz, nk]
 (k in h/Mpc, P in (Mpc/h)^3), ``f``, ``D`` [n, nz] and ``param_<key>`` [n]. Then rank 0 writes
 ``index.json`` (point → rank file and row, parameters, z, model, precision, q range, version) and
-``all.npz`` (the same arrays for all points, in point order). Without mpi4py, under a single process,
-or with ``--no-mpi`` the same files come from one serial run. Results do not depend on the number of
-ranks or threads (the library is deterministic).
+``all.npz`` (the same arrays for all points, in point order). Without mpi4py, under a single
+process, or with ``--no-mpi`` the same files come from one serial run. Results do not depend on the
+number of ranks or threads (the library is deterministic).
 
 Ranks × threads: each rank runs its computations on a rayon pool of ``threads`` (or
 RAYON_NUM_THREADS, or :func:`pt_spectra.set_num_threads`) threads. Keep ranks × threads ≤ cores,
@@ -48,8 +48,15 @@ import json
 import os
 import sys
 import time
-import tomllib
 import warnings
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python < 3.11
+    try:
+        import tomli as tomllib
+    except ModuleNotFoundError:
+        tomllib = None
 
 import numpy as np
 
@@ -96,6 +103,8 @@ def _cosmology(point, where):
 def load_config(path):
     """The validated run options of a grid toml: a dict with ``points`` (a list of cosmology dicts),
     ``z``, ``k`` [h/Mpc] and the [run] options."""
+    if tomllib is None:
+        raise ImportError("pt_spectra.batch reads toml: use Python >= 3.11 or pip install tomli")
     with open(path, "rb") as fh:
         raw = tomllib.load(fh)
     unknown = sorted(set(raw) - {"run", "cosmology", "grid", "points"})
@@ -131,7 +140,7 @@ def load_config(path):
 
 
 def camb_linear(cosmology, zs, k_max=20.0):
-    """[(k [h/Mpc], P [(Mpc/h)^3])] of CAMB at each z for a cosmology dict of :func:`load_config`."""
+    """[(k [h/Mpc], P [(Mpc/h)^3])] of CAMB at each z, for a cosmology of :func:`load_config`."""
     import camb
 
     c = cosmology
@@ -156,11 +165,12 @@ def _threads(n, size):
             pt.set_num_threads(int(n))
         except RuntimeError as e:
             if pt.num_threads() != int(n):
-                warnings.warn(f"run.threads = {n} not applied: {e}", pt.PtSpectraWarning)
+                warnings.warn(f"run.threads = {n} not applied: {e}", pt.PtSpectraWarning,
+                              stacklevel=3)
     elif size * pt.num_threads() > (os.cpu_count() or 1):
         warnings.warn(f"{size} ranks x {pt.num_threads()} threads > {os.cpu_count()} cores: set "
                       "run.threads or RAYON_NUM_THREADS so that ranks x threads <= cores",
-                      pt.PtSpectraWarning)
+                      pt.PtSpectraWarning, stacklevel=3)
     return pt.num_threads()
 
 
@@ -284,7 +294,8 @@ def main(argv=None):
                                                  "(MPI ranks x rayon threads); see the module docs")
     parser.add_argument("toml", help="the grid (see python/examples/grid.toml)")
     parser.add_argument("--output", help="output directory (default: run.output of the toml)")
-    parser.add_argument("--no-mpi", action="store_true", help="run serially without importing mpi4py")
+    parser.add_argument("--no-mpi", action="store_true",
+                        help="run serially without importing mpi4py")
     args = parser.parse_args(argv)
     comm = _communicator(not args.no_mpi)
     try:

@@ -1,4 +1,4 @@
-"""A cobaya theory: redshift-space multipoles of pt-spectra from the linear spectrum of CAMB or CLASS.
+"""A cobaya theory: redshift-space multipoles of pt-spectra from a CAMB or CLASS linear spectrum.
 
 ``pt_spectra.cobaya.PTMultipoles`` takes the linear matter spectrum, H0, fσ8 and σ8 from the
 Boltzmann code of the run and provides ``pt_pk_ell``: the multipoles P_ℓ(k) [(Mpc/h)^3] at each
@@ -23,7 +23,8 @@ Nuisance parameters, one set per redshift ``zs[i]`` (declare them in ``params``,
 
 - ``b_i`` (required): the linear bias, constant in k.
 - ``sigma0_i`` [Mpc/h] (required unless ``fog: none``): the z = 0 velocity dispersion of the
-  Fingers-of-God damping, whose scale is σ = σ0 D(z) f(z) with D = σ8(z)/σ8(0) of the Boltzmann code.
+  Fingers-of-God damping, whose scale is σ = σ0 D(z) f(z) with D = σ8(z)/σ8(0) of the Boltzmann
+  code.
 - ``A_b_i`` (optional, default 1): the bias amplitude A_b; with a constant bias it multiplies b
   and so is degenerate with it: sample one of them.
 - ``P_shot_i`` [(Mpc/h)^3] (optional, default 0): a constant residual shot noise added to the
@@ -60,9 +61,10 @@ NUISANCE = {
     "P_shot": (False, 0.0, "(Mpc/h)^3"),
 }
 
-# The library warns that without a cosmology the growth of its gm2012 cosmology is used. It does not
-# apply here: z_input = z (the spectrum is used as given, rescaling factor 1), f is passed, and the
-# only other use of D(z), the FoG scale σ0 D(z) f, is corrected by passing σ0 D_boltzmann / D_gm2012.
+# The library warns that without a cosmology the growth of its gm2012 cosmology is used. It does
+# not apply here: z_input = z (the spectrum is used as given, rescaling factor 1), f is passed, and
+# the only other use of D(z), the FoG scale σ0 D(z) f, is corrected by passing
+# σ0 D_boltzmann(z) / D_gm2012(z) as σ0.
 _NO_COSMOLOGY = "no cosmology was given for the linear spectrum"
 
 
@@ -76,7 +78,7 @@ def _close_index(values, x, what):
 
 
 class PTMultipoles(Theory):
-    """Redshift-space multipoles P_ℓ(k) [(Mpc/h)^3], k [h/Mpc], of pt-spectra: see the module docs."""
+    """Redshift-space multipoles P_ℓ(k) [(Mpc/h)^3], k [h/Mpc], of pt-spectra (see the module)."""
 
     zs: list | None = None
     k: list | None = None
@@ -101,8 +103,8 @@ class PTMultipoles(Theory):
         self.zs = [float(z) for z in np.atleast_1d(self.zs)]
         if any(not np.isfinite(z) or z < 0 for z in self.zs) or len(set(self.zs)) != len(self.zs):
             raise ValueError(f"PTMultipoles: `zs` must be distinct redshifts >= 0, got {self.zs}")
-        self.ells = [int(l) for l in np.atleast_1d(self.ells)]
-        if not self.ells or any(l < 0 or l % 2 or l > 8 for l in self.ells):
+        self.ells = [int(ell) for ell in np.atleast_1d(self.ells)]
+        if not self.ells or any(ell < 0 or ell % 2 or ell > 8 for ell in self.ells):
             raise ValueError(f"PTMultipoles: `ells` must be even multipoles <= 8, got {self.ells}")
         if self.fog not in ("none", "lorentzian", "gaussian"):
             raise ValueError(f"PTMultipoles: unknown `fog` {self.fog!r}; "
@@ -127,11 +129,14 @@ class PTMultipoles(Theory):
                 raise ValueError("PTMultipoles: give either `k` or `k_min, k_max, nk`, not both")
             k = np.asarray(self.k, dtype=float).ravel()
             if k.size == 0 or np.any(~np.isfinite(k)) or np.any(k <= 0) or np.any(np.diff(k) <= 0):
-                raise ValueError("PTMultipoles: `k` must be increasing positive wavenumbers [h/Mpc]")
+                raise ValueError("PTMultipoles: `k` must be increasing positive wavenumbers "
+                                 "[h/Mpc]")
             return k
         if any(given) and not all(given):
             raise ValueError("PTMultipoles: `k_min`, `k_max` and `nk` go together")
-        return pt.log_grid(float(self.k_min), float(self.k_max), int(self.nk)) if all(given) else None
+        if not all(given):
+            return None
+        return pt.log_grid(float(self.k_min), float(self.k_max), int(self.nk))
 
     def _make_plan(self, k):
         self._plan = pt.RsdPlan(k, real=self.real, rsd=self.rsd, precision=self.precision,
@@ -179,9 +184,10 @@ class PTMultipoles(Theory):
         options = requirements.get("pt_pk_ell") or {}
         for z in np.atleast_1d(options.get("z", [])):
             _close_index(self.zs, float(z), "requested pt_pk_ell z")
-        for l in options.get("ells") or []:
-            if int(l) not in self.ells:
-                raise ValueError(f"PTMultipoles: multipole {l} is requested but `ells` = {self.ells}")
+        for ell in options.get("ells") or []:
+            if int(ell) not in self.ells:
+                raise ValueError(f"PTMultipoles: multipole {ell} is requested but "
+                                 f"`ells` = {self.ells}")
         k = np.atleast_1d(options.get("k", [])).astype(float)
         if k.size and self._k is not None:
             for ki in k:
@@ -194,8 +200,8 @@ class PTMultipoles(Theory):
         super().initialize_with_provider(provider)
         k = self._k if self._k is not None else np.asarray(self._requested_k)
         if k.size == 0:
-            raise ValueError("PTMultipoles: no k grid: give `k` (or `k_min, k_max, nk`), or require "
-                             "pt_pk_ell with a `k` list from the likelihood")
+            raise ValueError("PTMultipoles: no k grid: give `k` (or `k_min, k_max, nk`), or "
+                             "require pt_pk_ell with a `k` list from the likelihood")
         if self._planned_k is None or not np.array_equal(k, self._planned_k):
             self._make_plan(k)
 
@@ -225,11 +231,11 @@ class PTMultipoles(Theory):
                 t = self._plan(linear=(k_lin, p_lin), z=z, z_input=z, f=f, bias=nu["b"],
                                amplitude=nu["A_b"], fog=self.fog,
                                sigma0=nu["sigma0"] * d / self._d_library[i], ells=self.ells)
-            p = np.array([t[f"P{l}"] for l in self.ells])
+            p = np.array([t[f"P{ell}"] for ell in self.ells])
             if 0 in self.ells:
                 p[self.ells.index(0)] += nu["P_shot"]
             spectra[z] = p
-            errors[z] = np.array([t[f"err_P{l}"] for l in self.ells])
+            errors[z] = np.array([t[f"err_P{ell}"] for ell in self.ells])
             growth[z] = (f, d)
         state["pt_pk_ell"] = spectra
         state["pt_pk_ell_err"] = errors

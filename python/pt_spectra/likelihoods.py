@@ -32,8 +32,8 @@ __all__ = ["MultipoleGaussian", "read_multipoles"]
 
 
 def read_multipoles(path, data_ells=(0, 2, 4)):
-    """``(k, {ℓ: P_ℓ}, {ℓ: σ_ℓ})`` from an npz (``k``, ``P<ℓ>``, ``s<ℓ>``) or a text file with columns
-    ``k P_ℓ σ_ℓ …`` for the multipoles ``data_ells``. k in h/Mpc, P and σ in (Mpc/h)^3."""
+    """``(k, {ℓ: P_ℓ}, {ℓ: σ_ℓ})`` from an npz (``k``, ``P<ℓ>``, ``s<ℓ>``) or a text file with
+    columns ``k P_ℓ σ_ℓ …`` for the multipoles ``data_ells``. k in h/Mpc, P and σ in (Mpc/h)^3."""
     path = os.fspath(path)
     if not os.path.isfile(path):
         raise ValueError(f"data_file: no file {path!r}")
@@ -42,13 +42,13 @@ def read_multipoles(path, data_ells=(0, 2, 4)):
             if "k" not in d:
                 raise ValueError(f"data_file {path!r}: no array `k`")
             ells = sorted(int(n[1:]) for n in d.files if n[:1] == "P" and n[1:].isdigit())
-            missing = [f"s{l}" for l in ells if f"s{l}" not in d]
+            missing = [f"s{ell}" for ell in ells if f"s{ell}" not in d]
             if not ells or missing:
                 raise ValueError(f"data_file {path!r}: needs P<l> and s<l> arrays for each "
                                  f"multipole (found {d.files}; missing {missing})")
             k = np.asarray(d["k"], dtype=float)
-            values = {l: np.asarray(d[f"P{l}"], dtype=float) for l in ells}
-            sigma = {l: np.asarray(d[f"s{l}"], dtype=float) for l in ells}
+            values = {ell: np.asarray(d[f"P{ell}"], dtype=float) for ell in ells}
+            sigma = {ell: np.asarray(d[f"s{ell}"], dtype=float) for ell in ells}
     else:
         table = np.atleast_2d(np.loadtxt(path))
         if table.shape[1] != 1 + 2 * len(data_ells):
@@ -56,13 +56,13 @@ def read_multipoles(path, data_ells=(0, 2, 4)):
                              f"{1 + 2 * len(data_ells)} (k, then P_l, sigma_l for data_ells = "
                              f"{list(data_ells)})")
         k = table[:, 0]
-        values = {int(l): table[:, 1 + 2 * j] for j, l in enumerate(data_ells)}
-        sigma = {int(l): table[:, 2 + 2 * j] for j, l in enumerate(data_ells)}
-    for l in values:
-        if values[l].shape != k.shape or sigma[l].shape != k.shape:
-            raise ValueError(f"data_file {path!r}: P{l} or s{l} has not the length of k")
-        if np.any(~(sigma[l] > 0)):
-            raise ValueError(f"data_file {path!r}: the errors s{l} must be > 0")
+        values = {int(ell): table[:, 1 + 2 * j] for j, ell in enumerate(data_ells)}
+        sigma = {int(ell): table[:, 2 + 2 * j] for j, ell in enumerate(data_ells)}
+    for ell in values:
+        if values[ell].shape != k.shape or sigma[ell].shape != k.shape:
+            raise ValueError(f"data_file {path!r}: P{ell} or s{ell} has not the length of k")
+        if np.any(~(sigma[ell] > 0)):
+            raise ValueError(f"data_file {path!r}: the errors s{ell} must be > 0")
     return k, values, sigma
 
 
@@ -82,9 +82,9 @@ class MultipoleGaussian(Likelihood):
         if self.z is None:
             raise ValueError("MultipoleGaussian: option `z` (the redshift of the data) is required")
         self.z = float(self.z)
-        k, values, sigma = read_multipoles(self.data_file, [int(l) for l in self.data_ells])
-        ells = sorted(values) if self.ells is None else [int(l) for l in self.ells]
-        absent = [l for l in ells if l not in values]
+        k, values, sigma = read_multipoles(self.data_file, [int(ell) for ell in self.data_ells])
+        ells = sorted(values) if self.ells is None else [int(ell) for ell in self.ells]
+        absent = [ell for ell in ells if ell not in values]
         if absent:
             raise ValueError(f"MultipoleGaussian: `ells` {absent} are not in {self.data_file}")
         keep = (k >= float(self.k_min)) & (k <= float(self.k_max))
@@ -93,8 +93,8 @@ class MultipoleGaussian(Likelihood):
                              f"[{self.k_min}, {self.k_max}] h/Mpc")
         self.ells = ells
         self.k_data = k[keep]
-        self.data = np.array([values[l][keep] for l in ells])
-        self.inv_sigma = 1.0 / np.array([sigma[l][keep] for l in ells])
+        self.data = np.array([values[ell][keep] for ell in ells])
+        self.inv_sigma = 1.0 / np.array([sigma[ell][keep] for ell in ells])
         self._rows = self._cols = None
         self.log.info("%d multipoles x %d k in [%g, %g] h/Mpc at z = %g", len(ells),
                       self.k_data.size, self.k_data[0], self.k_data[-1], self.z)
@@ -110,9 +110,10 @@ class MultipoleGaussian(Likelihood):
         for kd in self.k_data:
             hit = np.flatnonzero(np.isclose(theory_k, kd, rtol=1e-8, atol=0.0))
             if hit.size == 0:
-                raise ValueError(f"MultipoleGaussian: data k = {kd} h/Mpc is not on the theory grid")
+                raise ValueError(f"MultipoleGaussian: data k = {kd} h/Mpc is not on the "
+                                 "theory's k grid")
             cols.append(int(hit[0]))
-        self._rows = [theory_ells.index(l) for l in self.ells]
+        self._rows = [theory_ells.index(ell) for ell in self.ells]
         self._cols = np.array(cols)
 
     def model(self):

@@ -130,7 +130,6 @@ fn detached<T: Send>(
 struct RealPlan {
     plan: LibRealPlan,
     selection: RealSelection,
-    store: Store,
 }
 
 #[pymethods]
@@ -154,11 +153,7 @@ impl RealPlan {
         let (plan, _) = detached(py, || {
             LibRealPlan::new(&k, selection.plan_model(), &precision, store.get(), &Silent)
         })?;
-        Ok(Self {
-            plan,
-            selection,
-            store,
-        })
+        Ok(Self { plan, selection })
     }
 
     /// The k grid [h/Mpc].
@@ -180,7 +175,6 @@ impl RealPlan {
         terms: bool,
         eh: Option<&str>,
     ) -> PyResult<Table> {
-        let _ = &self.store;
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
         let ((table, prepared), seconds) = detached(py, || {
             let prepared = inputs.prepare(self.plan.k())?;
@@ -294,7 +288,6 @@ fn sigma0(obj: &Bound<'_, PyAny>) -> PyResult<Sigma0> {
 struct RsdPlan {
     plan: LibRsdPlan,
     rsd: RsdModel,
-    store: Store,
 }
 
 #[pymethods]
@@ -319,7 +312,7 @@ impl RsdPlan {
         let (plan, _) = detached(py, || {
             LibRsdPlan::new(&k, real, rsd, &precision, store.get(), &Silent)
         })?;
-        Ok(Self { plan, rsd, store })
+        Ok(Self { plan, rsd })
     }
 
     /// The multipoles of the prepared spectrum: see the Python wrapper `pt_spectra.rsd`.
@@ -346,7 +339,6 @@ impl RsdPlan {
         terms: bool,
         eh: Option<&str>,
     ) -> PyResult<Table> {
-        let _ = &self.store;
         let one = 1.0f64.into_pyobject(py)?.into_any();
         let zero = 0.0f64.into_pyobject(py)?.into_any();
         let (bias, noise) = bias_and_noise(
