@@ -12,6 +12,7 @@ The toml (see ``python/examples/grid.toml``)::
     k = {min = 0.02, max = 0.3, n = 20}   # log-spaced [h/Mpc], or a list
     terms = false              # true: keep every loop term, not only P_lin, P_dd/dt/tt and errors
     threads = 1                # rayon threads per rank (default: RAYON_NUM_THREADS, else all cores)
+    # also: two_loop_tolerance, cache_dir (angular tables), camb_k_max (h/Mpc, default 20)
     [cosmology]                # the keys every point shares
     h = 0.7
     [grid]                     # varied keys: Cartesian product; a list or {min, max, n} (linear)

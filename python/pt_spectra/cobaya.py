@@ -157,9 +157,11 @@ class PTMultipoles(Theory):
         for i in range(len(self.zs)):
             for name, (required, default, _) in NUISANCE.items():
                 p = self.param_name(name, i)
-                if p in given:
-                    continue
                 if name == "sigma0" and self.fog == "none":
+                    if p in given:
+                        self.log.warning("%s has no effect with fog: none", p)
+                    continue
+                if p in given:
                     continue
                 (missing if required else defaulted).append(p if required else f"{p} = {default}")
         if missing:
@@ -207,10 +209,10 @@ class PTMultipoles(Theory):
 
     # ---- computation -------------------------------------------------------------------------
     def _nuisance(self, params, i):
-        values = {}
-        for name, (_, default, _) in NUISANCE.items():
-            values[name] = float(params.get(self.param_name(name, i), default or 0.0))
-        return values
+        # the required ones are in `params` (checked in initialize_with_params), except sigma0
+        # with fog: none, where it has no effect
+        return {name: float(params.get(self.param_name(name, i), 0.0 if d is None else d))
+                for name, (_, d, _) in NUISANCE.items()}
 
     def calculate(self, state, want_derived=True, **params_values_dict):
         h = self.provider.get_param("H0") / 100.0
