@@ -224,8 +224,30 @@ pub fn rsd_table(
     prepared: &Prepared,
     progress: &dyn Progress,
 ) -> Result<Table> {
-    let (real, precision) = (plan.real(), plan.real().precision());
-    let k = real.k();
+    let (spectra, tns) = plan.evaluate(&prepared.spectrum, progress)?;
+    rsd_table_from_terms(
+        &spectra,
+        tns.as_ref(),
+        plan.real().precision(),
+        request,
+        prepared,
+    )
+}
+
+/// [`rsd_table`] from loop terms computed before (`spectra` and, for TNS, `tns` of the prepared
+/// spectrum, with `precision`): the cheap step of a chain in which only f, the bias, σ0 or the noise
+/// change.
+///
+/// # Errors
+/// As [`rsd_table`].
+pub fn rsd_table_from_terms(
+    spectra: &RealSpectra,
+    tns: Option<&crate::loops::TnsTerms>,
+    precision: &Precision,
+    request: &RsdRequest,
+    prepared: &Prepared,
+) -> Result<Table> {
+    let k = &spectra.k;
     let f = request.f.unwrap_or(prepared.growth_rate);
     if !f.is_finite() {
         return Err(Error::InvalidParameter {
@@ -249,13 +271,12 @@ pub fn rsd_table(
         ells: request.ells.clone(),
         parts: request.terms,
     };
-    let (spectra, tns) = plan.evaluate(&prepared.spectrum, progress)?;
-    let m = multipoles(&spectra, tns.as_ref(), &settings)?;
+    let m = multipoles(spectra, tns, &settings)?;
     let (rsd, fog) = (request.rsd, request.fog);
     let mut header = vec![format!(
         "pt-spectra {VERSION} rsd: {rsd} with real-space {}, z = {}, f = {f}, {} times A_b = {}, \
          FoG {fog:?} with sigma0 = {sigma0} Mpc/h (sigma = sigma0 D(z) f = {sigma:.6} Mpc/h)",
-        real.model(),
+        spectra.model,
         prepared.z,
         request.describe_bias(),
         request.amplitude,

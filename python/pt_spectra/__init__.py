@@ -29,6 +29,7 @@ __all__ = [
     "PtSpectraWarning",
     "RealPlan",
     "RsdPlan",
+    "RsdTerms",
     "Table",
     "eisenstein_hu",
     "fit",
@@ -95,9 +96,35 @@ class RsdPlan:
 
     def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=1.0,
                  amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None, number_density=None,
-                 noise_table=None, ells=(0, 2, 4), terms=False, eh=None):
+                 noise_table=None, ells=(0, 2, 4), terms=False, eh=None, growth_factor=None):
         return _warn(self._plan(linear, z, z_input, cosmology, f, bias, amplitude, fog, sigma0,
-                                shot_noise, number_density, noise_table, list(ells), terms, eh))
+                                shot_noise, number_density, noise_table, list(ells), terms, eh,
+                                growth_factor))
+
+    def terms(self, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None):
+        """The loop terms of one linear spectrum (the expensive part), as :class:`RsdTerms`."""
+        return RsdTerms(self._plan.terms(linear, z, z_input, cosmology, eh))
+
+
+class RsdTerms:
+    """The loop terms of one linear spectrum on an :class:`RsdPlan`'s grid.
+
+    ``terms.multipoles(f=None, bias=1.0, amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None,
+    number_density=None, noise_table=None, ells=(0, 2, 4), terms=False, growth_factor=None)`` costs
+    microseconds: the step of a chain in which only f, the bias, sigma0 or the noise change.
+    ``growth_factor`` replaces D(z) of the cosmology in the FoG scale sigma0 D(z) f (e.g. with a
+    Boltzmann code's sigma8(z)/sigma8(0)).
+    """
+
+    def __init__(self, core):
+        self._terms = core
+
+    def multipoles(self, f=None, bias=1.0, amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None,
+                   number_density=None, noise_table=None, ells=(0, 2, 4), terms=False,
+                   growth_factor=None):
+        return _warn(self._terms.multipoles(f, bias, amplitude, fog, sigma0, shot_noise,
+                                            number_density, noise_table, list(ells), terms,
+                                            growth_factor))
 
 
 def real(model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False,
@@ -132,8 +159,9 @@ def rsd(rsd="tns", real="1l-rpt-n1", k=None, linear=None, z=0.0, z_input=0.0, co
     f: growth rate (default f(z) of the cosmology). bias: a number, a path or ``(k, b)`` arrays;
     amplitude: A_b. fog: ``none``, ``lorentzian`` or ``gaussian``; sigma0 [Mpc/h] (z = 0 value) or
     ``"lin"`` / ``"1l-spt"`` (the theory value). Noise: one of shot_noise [(Mpc/h)^3],
-    number_density [(h/Mpc)^3] (Poisson) or noise_table (path or ``(k, P_eps)``); it is subtracted
-    from the monopole and adds ``P_eps SN``. ells: even multipoles up to 8. terms: add the parts
+    number_density [(h/Mpc)^3] (Poisson) or noise_table (path or ``(k, P_eps)``): the multipoles are
+    those of the noise-subtracted spectrum P_hh - P_eps, so the noise does not change them; it adds
+    the columns ``P_eps SN``. ells: even multipoles up to 8. terms: add the parts
     ``P<l>_sc P<l>_A P<l>_B``. The other arguments are those of :func:`real`.
     """
     plan = RsdPlan(_grid(k, k_min, k_max, nk), real, rsd, precision, q_range, cache_dir)

@@ -38,6 +38,7 @@ f = fσ8/σ8 of the Boltzmann code (for massive neutrinos an effective, scale-in
 
 from __future__ import annotations
 
+import hashlib
 import warnings
 
 import numpy as np
@@ -63,8 +64,7 @@ NUISANCE = {
 
 # The library warns that without a cosmology the growth of its gm2012 cosmology is used. It does
 # not apply here: z_input = z (the spectrum is used as given, rescaling factor 1), f is passed, and
-# the only other use of D(z), the FoG scale σ0 D(z) f, is corrected by passing
-# σ0 D_boltzmann(z) / D_gm2012(z) as σ0.
+# the only other use of D(z), the FoG scale σ0 D(z) f, gets D_boltzmann(z) as `growth_factor`.
 _NO_COSMOLOGY = "no cosmology was given for the linear spectrum"
 
 
@@ -117,8 +117,9 @@ class PTMultipoles(Theory):
         self._requested_k: list[float] = []
         self._plan = None
         self._planned_k = None
-        # D_gm2012(z): what the library multiplies σ0 by when no cosmology is given (see above).
-        self._d_library = [pt.growth(z)[0] for z in self.zs]
+        # Loop terms per redshift, kept while the linear spectrum is unchanged: a step that moves only
+        # the nuisance parameters costs a multipole evaluation (microseconds), not the loops.
+        self._terms = {}
         if self._k is not None:
             self._make_plan(self._k)
 
@@ -227,12 +228,18 @@ class PTMultipoles(Theory):
             p_lin = np.asarray(pk[_close_index(z_grid, z, "z of the Boltzmann P(k) grid")]) * h**3
             f, d = fs8[i] / s8[i], s8[i] / s8_0
             nu = self._nuisance(params_values_dict, i)
+            digest = hashlib.sha1(k_lin.tobytes() + p_lin.tobytes()).digest()
             with warnings.catch_warnings():
+                # The spectrum is given at z (no rescaling), f and D come from the Boltzmann code:
+                # the default-cosmology growth the warning is about is not used.
                 warnings.filterwarnings("ignore", message=_NO_COSMOLOGY,
                                         category=pt.PtSpectraWarning)
-                t = self._plan(linear=(k_lin, p_lin), z=z, z_input=z, f=f, bias=nu["b"],
-                               amplitude=nu["A_b"], fog=self.fog,
-                               sigma0=nu["sigma0"] * d / self._d_library[i], ells=self.ells)
+                cached = self._terms.get(i)
+                if cached is None or cached[0] != digest:
+                    cached = (digest, self._plan.terms(linear=(k_lin, p_lin), z=z, z_input=z))
+                    self._terms[i] = cached
+                t = cached[1].multipoles(f=f, bias=nu["b"], amplitude=nu["A_b"], fog=self.fog,
+                                         sigma0=nu["sigma0"], ells=self.ells, growth_factor=d)
             p = np.array([t[f"P{ell}"] for ell in self.ells])
             if 0 in self.ells:
                 p[self.ells.index(0)] += nu["P_shot"]

@@ -8,15 +8,13 @@
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pt_spectra::cosmology::TransferKind;
 use pt_spectra::fit::{MultipoleData, Parameter};
-use pt_spectra::halo::{Bias, Noise};
 use pt_spectra::jobs::{self, FitRequest, RsdRequest};
 use pt_spectra::linear::LogGrid;
 use pt_spectra::precision::Precision;
 use pt_spectra::progress::Silent;
 use pt_spectra::real::{RealPlan as LibRealPlan, RealSelection};
-use pt_spectra::rsd::{Fog, RsdModel, RsdPlan as LibRsdPlan, Sigma0};
+use pt_spectra::rsd::{RsdModel, RsdPlan as LibRsdPlan, Sigma0};
 use pt_spectra::store::TableStore;
-use pt_spectra::table::Tabulated;
 use pyo3::exceptions::{PyKeyError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -25,6 +23,7 @@ use std::sync::OnceLock;
 
 mod inputs;
 mod kernel;
+mod redshift;
 mod tables;
 
 use inputs::Inputs;
@@ -32,7 +31,7 @@ use inputs::Inputs;
 pub use tables::Table;
 
 /// A library error as a Python `ValueError` with the library's message.
-fn value_error(e: impl std::fmt::Display) -> PyErr {
+pub(crate) fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
@@ -45,20 +44,20 @@ fn default_store() -> &'static TableStore {
 }
 
 /// The store of `cache_dir`, or the default one.
-enum Store {
+pub(crate) enum Store {
     Default,
     Own(TableStore),
 }
 
 impl Store {
-    fn new(cache_dir: Option<PathBuf>) -> Self {
+    pub(crate) fn new(cache_dir: Option<PathBuf>) -> Self {
         match cache_dir {
             Some(dir) => Store::Own(TableStore::new(dir)),
             None => Store::Default,
         }
     }
 
-    fn get(&self) -> &TableStore {
+    pub(crate) fn get(&self) -> &TableStore {
         match self {
             Store::Default => default_store(),
             Store::Own(s) => s,
@@ -67,7 +66,7 @@ impl Store {
 }
 
 /// A float array from a numpy array or any sequence of numbers.
-fn floats(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+pub(crate) fn floats(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
     if let Ok(a) = obj.extract::<PyReadonlyArray1<'_, f64>>() {
         return Ok(a.as_array().to_vec());
     }
@@ -79,7 +78,7 @@ fn floats(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
 }
 
 /// The precision preset `name`, with the q range and 2-loop tolerance if given.
-fn precision(
+pub(crate) fn precision(
     name: &str,
     q_range: Option<(f64, f64)>,
     two_loop_tolerance: Option<f64>,
@@ -112,7 +111,7 @@ fn k_grid(k: Option<&Bound<'_, PyAny>>, k_min: f64, k_max: f64, nk: usize) -> Py
 }
 
 /// Runs `f` with the GIL released.
-fn detached<T: Send>(
+pub(crate) fn detached<T: Send>(
     py: Python<'_>,
     f: impl FnOnce() -> pt_spectra::error::Result<T> + Send,
 ) -> PyResult<(T, f64)> {
@@ -229,153 +228,6 @@ fn real(
     plan.__call__(py, linear, z, z_input, cosmology, terms, eh)
 }
 
-/// b(k) or P_εε(k) from a constant, a path or (k, values).
-fn tabulated(obj: &Bound<'_, PyAny>, name: &'static str) -> PyResult<Tabulated> {
-    if let Ok(path) = obj.extract::<PathBuf>() {
-        return Tabulated::read(&path, name, (0, 1), true).map_err(value_error);
-    }
-    let (k, v): (Bound<'_, PyAny>, Bound<'_, PyAny>) = obj.extract().map_err(|_| {
-        PyValueError::new_err(format!(
-            "{name}: expected a path or a pair (k [h/Mpc], values)"
-        ))
-    })?;
-    Tabulated::new(
-        name,
-        "array",
-        floats(&k, name)?,
-        floats(&v, name)?,
-        true,
-        &[],
-    )
-    .map_err(value_error)
-}
-
-/// The bias and noise of the keyword arguments.
-fn bias_and_noise(
-    bias: &Bound<'_, PyAny>,
-    shot_noise: Option<f64>,
-    number_density: Option<f64>,
-    noise_table: Option<&Bound<'_, PyAny>>,
-) -> PyResult<(Bias, Noise)> {
-    let bias = match bias.extract::<f64>() {
-        Ok(b) => Bias::Constant(b),
-        Err(_) => Bias::Table(tabulated(bias, "b(k)")?),
-    };
-    let noise = match (noise_table, shot_noise, number_density) {
-        (Some(t), None, None) => Noise::Table(tabulated(t, "P_eps(k)")?),
-        (None, Some(p), None) => Noise::Constant(p),
-        (None, None, Some(n)) => Noise::poisson(n).map_err(value_error)?,
-        (None, None, None) => Noise::None,
-        _ => {
-            return Err(PyValueError::new_err(
-                "give at most one of shot_noise, number_density, noise_table",
-            ))
-        }
-    };
-    Ok((bias, noise))
-}
-
-/// σ0 as a number or `lin` / `1l-spt`.
-fn sigma0(obj: &Bound<'_, PyAny>) -> PyResult<Sigma0> {
-    match obj.extract::<f64>() {
-        Ok(v) => format!("{v}").parse().map_err(value_error),
-        Err(_) => obj.extract::<String>()?.parse().map_err(value_error),
-    }
-}
-
-/// Redshift-space loop terms planned once for one k grid.
-#[pyclass(module = "pt_spectra._core", frozen)]
-struct RsdPlan {
-    plan: LibRsdPlan,
-    rsd: RsdModel,
-}
-
-#[pymethods]
-impl RsdPlan {
-    #[new]
-    #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None, cache_dir=None))]
-    fn new(
-        py: Python<'_>,
-        k: &Bound<'_, PyAny>,
-        real: &str,
-        rsd: &str,
-        precision: &str,
-        q_range: Option<(f64, f64)>,
-        cache_dir: Option<PathBuf>,
-    ) -> PyResult<Self> {
-        let k = floats(k, "k")?;
-        let real = real.parse().map_err(value_error)?;
-        let rsd: RsdModel = rsd.parse().map_err(value_error)?;
-        let precision = self::precision(precision, q_range, None)?;
-        let store = Store::new(cache_dir);
-        let (plan, _) = detached(py, || {
-            LibRsdPlan::new(&k, real, rsd, &precision, store.get(), &Silent)
-        })?;
-        Ok(Self { plan, rsd })
-    }
-
-    /// The multipoles of the prepared spectrum: see the Python wrapper `pt_spectra.rsd`.
-    #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=None, amplitude=1.0,
-        fog="none", sigma0=None, shot_noise=None, number_density=None, noise_table=None, ells=vec![0, 2, 4],
-        terms=false, eh=None))]
-    #[allow(clippy::too_many_arguments)]
-    fn __call__(
-        &self,
-        py: Python<'_>,
-        linear: Option<&Bound<'_, PyAny>>,
-        z: f64,
-        z_input: f64,
-        cosmology: Option<&Bound<'_, PyAny>>,
-        f: Option<f64>,
-        bias: Option<&Bound<'_, PyAny>>,
-        amplitude: f64,
-        fog: &str,
-        sigma0: Option<&Bound<'_, PyAny>>,
-        shot_noise: Option<f64>,
-        number_density: Option<f64>,
-        noise_table: Option<&Bound<'_, PyAny>>,
-        ells: Vec<usize>,
-        terms: bool,
-        eh: Option<&str>,
-    ) -> PyResult<Table> {
-        let one = 1.0f64.into_pyobject(py)?.into_any();
-        let zero = 0.0f64.into_pyobject(py)?.into_any();
-        let (bias, noise) = bias_and_noise(
-            bias.unwrap_or(&one),
-            shot_noise,
-            number_density,
-            noise_table,
-        )?;
-        let request = RsdRequest {
-            rsd: self.rsd,
-            f,
-            bias,
-            amplitude,
-            fog: fog.parse::<Fog>().map_err(value_error)?,
-            sigma0: self::sigma0(sigma0.unwrap_or(&zero))?,
-            noise,
-            ells,
-            terms,
-        };
-        let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
-        let ((table, prepared), seconds) = detached(py, || {
-            let prepared = inputs.prepare(self.plan.real().k())?;
-            let table = jobs::rsd_table(&self.plan, &request, &prepared, &Silent)?;
-            Ok((table, prepared))
-        })?;
-        let model = format!("{} + {}", self.rsd, self.plan.real().model());
-        Table::new(
-            py,
-            table,
-            &prepared,
-            self.plan.real().precision(),
-            &model,
-            seconds,
-        )
-    }
-}
-
 /// Measured multipoles from a path (with columns) or a dict {"k", "P0", "s0", "P2", "s2", …}.
 fn data(
     data: &Bound<'_, PyAny>,
@@ -477,7 +329,7 @@ fn fit(
         data = data.with_covariance(rows).map_err(value_error)?;
     }
     let one = 1.0f64.into_pyobject(py)?.into_any();
-    let (bias, noise) = bias_and_noise(
+    let (bias, noise) = redshift::bias_and_noise(
         bias.unwrap_or(&one),
         shot_noise,
         number_density,
@@ -607,7 +459,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<Table>()?;
     m.add_class::<RealPlan>()?;
-    m.add_class::<RsdPlan>()?;
+    m.add_class::<redshift::RsdPlan>()?;
+    m.add_class::<redshift::RsdTerms>()?;
     m.add_function(wrap_pyfunction!(real, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(growth, m)?)?;

@@ -174,3 +174,23 @@ def test_fit_from_arrays_recovers_f():
     assert r.columns[:5] == ["k_max", "points", "f", "f_lo", "f_hi"]
     np.testing.assert_allclose(r["f"], 0.6, rtol=1e-5)
     assert np.all(r["chi2"] < 1e-6)
+
+
+def test_rsd_terms_give_the_multipoles_of_a_full_call_at_any_nuisance_point():
+    k = np.geomspace(0.02, 0.25, 10)
+    kl, pl = planck(0.0)
+    plan = pt.RsdPlan(k, real="1l-spt", rsd="tns", precision="fast")
+    terms = plan.terms(linear=(kl, pl), z=0.5, cosmology="planck2018")
+    for b, s0, d in [(1.5, 2.0, None), (2.3, 4.0, 0.7)]:
+        full = plan(linear=(kl, pl), z=0.5, cosmology="planck2018", bias=b, fog="lorentzian",
+                    sigma0=s0, growth_factor=d)
+        fast = terms.multipoles(bias=b, fog="lorentzian", sigma0=s0, growth_factor=d)
+        for name in full.columns:
+            np.testing.assert_array_equal(full[name], fast[name])
+    # A growth factor given by the caller enters sigma = sigma0 D f (stated in the header).
+    a = terms.multipoles(fog="gaussian", sigma0=4.0, growth_factor=0.5)
+    b = terms.multipoles(fog="gaussian", sigma0=2.0, growth_factor=1.0)
+    np.testing.assert_allclose(a["P0"], b["P0"], rtol=1e-13)
+    assert any("growth factor D(z) = 0.5" in line for line in a.header)
+    with pytest.raises(ValueError, match="growth_factor"):
+        terms.multipoles(growth_factor=-1.0)

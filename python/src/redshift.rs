@@ -1,0 +1,280 @@
+//! Redshift space from Python: `RsdPlan` (loop terms planned once per k grid), `RsdTerms` (the
+//! terms of one linear spectrum, for cheap multipoles at other f, bias, σ0, noise) and the argument
+//! conversions they share with `fit`.
+
+use crate::inputs::Inputs;
+use crate::tables::Table;
+use crate::{detached, floats, value_error, Store};
+use pt_spectra::halo::{Bias, Noise};
+use pt_spectra::jobs::{self, RsdRequest};
+use pt_spectra::progress::Silent;
+use pt_spectra::rsd::{Fog, RsdModel, RsdPlan as LibRsdPlan, Sigma0};
+use pt_spectra::setup::Prepared;
+use pt_spectra::table::Tabulated;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use std::path::PathBuf;
+
+/// b(k) or P_εε(k) from a constant, a path or (k, values).
+fn tabulated(obj: &Bound<'_, PyAny>, name: &'static str) -> PyResult<Tabulated> {
+    if let Ok(path) = obj.extract::<PathBuf>() {
+        return Tabulated::read(&path, name, (0, 1), true).map_err(value_error);
+    }
+    let (k, v): (Bound<'_, PyAny>, Bound<'_, PyAny>) = obj.extract().map_err(|_| {
+        PyValueError::new_err(format!(
+            "{name}: expected a path or a pair (k [h/Mpc], values)"
+        ))
+    })?;
+    Tabulated::new(
+        name,
+        "array",
+        floats(&k, name)?,
+        floats(&v, name)?,
+        true,
+        &[],
+    )
+    .map_err(value_error)
+}
+
+/// The bias and noise of the keyword arguments.
+pub(crate) fn bias_and_noise(
+    bias: &Bound<'_, PyAny>,
+    shot_noise: Option<f64>,
+    number_density: Option<f64>,
+    noise_table: Option<&Bound<'_, PyAny>>,
+) -> PyResult<(Bias, Noise)> {
+    let bias = match bias.extract::<f64>() {
+        Ok(b) => Bias::Constant(b),
+        Err(_) => Bias::Table(tabulated(bias, "b(k)")?),
+    };
+    let noise = match (noise_table, shot_noise, number_density) {
+        (Some(t), None, None) => Noise::Table(tabulated(t, "P_eps(k)")?),
+        (None, Some(p), None) => Noise::Constant(p),
+        (None, None, Some(n)) => Noise::poisson(n).map_err(value_error)?,
+        (None, None, None) => Noise::None,
+        _ => {
+            return Err(PyValueError::new_err(
+                "give at most one of shot_noise, number_density, noise_table",
+            ))
+        }
+    };
+    Ok((bias, noise))
+}
+
+/// σ0 as a number or `lin` / `1l-spt`.
+fn sigma0(obj: &Bound<'_, PyAny>) -> PyResult<Sigma0> {
+    match obj.extract::<f64>() {
+        Ok(v) => format!("{v}").parse().map_err(value_error),
+        Err(_) => obj.extract::<String>()?.parse().map_err(value_error),
+    }
+}
+
+/// Redshift-space loop terms planned once for one k grid.
+#[pyclass(module = "pt_spectra._core", frozen)]
+pub(crate) struct RsdPlan {
+    plan: LibRsdPlan,
+    rsd: RsdModel,
+}
+
+#[pymethods]
+impl RsdPlan {
+    #[new]
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None, cache_dir=None))]
+    fn new(
+        py: Python<'_>,
+        k: &Bound<'_, PyAny>,
+        real: &str,
+        rsd: &str,
+        precision: &str,
+        q_range: Option<(f64, f64)>,
+        cache_dir: Option<PathBuf>,
+    ) -> PyResult<Self> {
+        let k = floats(k, "k")?;
+        let real = real.parse().map_err(value_error)?;
+        let rsd: RsdModel = rsd.parse().map_err(value_error)?;
+        let precision = crate::precision(precision, q_range, None)?;
+        let store = Store::new(cache_dir);
+        let (plan, _) = detached(py, || {
+            LibRsdPlan::new(&k, real, rsd, &precision, store.get(), &Silent)
+        })?;
+        Ok(Self { plan, rsd })
+    }
+
+    /// The multipoles of the prepared spectrum: see the Python wrapper `pt_spectra.rsd`.
+    #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=None, amplitude=1.0,
+        fog="none", sigma0=None, shot_noise=None, number_density=None, noise_table=None, ells=vec![0, 2, 4],
+        terms=false, eh=None, growth_factor=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn __call__(
+        &self,
+        py: Python<'_>,
+        linear: Option<&Bound<'_, PyAny>>,
+        z: f64,
+        z_input: f64,
+        cosmology: Option<&Bound<'_, PyAny>>,
+        f: Option<f64>,
+        bias: Option<&Bound<'_, PyAny>>,
+        amplitude: f64,
+        fog: &str,
+        sigma0: Option<&Bound<'_, PyAny>>,
+        shot_noise: Option<f64>,
+        number_density: Option<f64>,
+        noise_table: Option<&Bound<'_, PyAny>>,
+        ells: Vec<usize>,
+        terms: bool,
+        eh: Option<&str>,
+        growth_factor: Option<f64>,
+    ) -> PyResult<Table> {
+        let settings = (f, amplitude, fog, shot_noise, number_density, ells, terms);
+        let request = rsd_request(py, self.rsd, bias, sigma0, noise_table, settings)?;
+        let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
+        let ((table, prepared), seconds) = detached(py, || {
+            let prepared = with_growth(inputs.prepare(self.plan.real().k())?, growth_factor)?;
+            let table = jobs::rsd_table(&self.plan, &request, &prepared, &Silent)?;
+            Ok((table, prepared))
+        })?;
+        let model = format!("{} + {}", self.rsd, self.plan.real().model());
+        let precision = self.plan.real().precision();
+        Table::new(py, table, &prepared, precision, &model, seconds)
+    }
+
+    /// The loop terms of a linear spectrum, for many cheap multipole evaluations
+    /// ([`RsdTerms::multipoles`]) at other f, bias, σ0 and noise.
+    #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None))]
+    fn terms(
+        &self,
+        py: Python<'_>,
+        linear: Option<&Bound<'_, PyAny>>,
+        z: f64,
+        z_input: f64,
+        cosmology: Option<&Bound<'_, PyAny>>,
+        eh: Option<&str>,
+    ) -> PyResult<RsdTerms> {
+        let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
+        let ((spectra, tns, prepared), _) = detached(py, || {
+            let prepared = inputs.prepare(self.plan.real().k())?;
+            let (spectra, tns) = self.plan.evaluate(&prepared.spectrum, &Silent)?;
+            Ok((spectra, tns, prepared))
+        })?;
+        Ok(RsdTerms {
+            spectra,
+            tns,
+            prepared,
+            precision: self.plan.real().precision().clone(),
+            rsd: self.rsd,
+        })
+    }
+}
+
+/// (f, A_b, FoG, shot noise, number density, ells, parts) of an RSD call.
+type RsdSettingsArgs<'a> = (
+    Option<f64>,
+    f64,
+    &'a str,
+    Option<f64>,
+    Option<f64>,
+    Vec<usize>,
+    bool,
+);
+
+/// The redshift-space request of the keyword arguments.
+fn rsd_request(
+    py: Python<'_>,
+    rsd: RsdModel,
+    bias: Option<&Bound<'_, PyAny>>,
+    sigma0: Option<&Bound<'_, PyAny>>,
+    noise_table: Option<&Bound<'_, PyAny>>,
+    (f, amplitude, fog, shot_noise, number_density, ells, terms): RsdSettingsArgs<'_>,
+) -> PyResult<RsdRequest> {
+    let one = 1.0f64.into_pyobject(py)?.into_any();
+    let zero = 0.0f64.into_pyobject(py)?.into_any();
+    let (bias, noise) = bias_and_noise(
+        bias.unwrap_or(&one),
+        shot_noise,
+        number_density,
+        noise_table,
+    )?;
+    Ok(RsdRequest {
+        rsd,
+        f,
+        bias,
+        amplitude,
+        fog: fog.parse::<Fog>().map_err(value_error)?,
+        sigma0: self::sigma0(sigma0.unwrap_or(&zero))?,
+        noise,
+        ells,
+        terms,
+    })
+}
+
+/// `prepared` with its growth factor D(z) replaced (e.g. by a Boltzmann code's σ8(z)/σ8(0)).
+fn with_growth(
+    mut prepared: Prepared,
+    growth_factor: Option<f64>,
+) -> pt_spectra::error::Result<Prepared> {
+    if let Some(d) = growth_factor {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(pt_spectra::error::Error::InvalidParameter {
+                name: "growth_factor",
+                value: d,
+                reason: "must be finite and positive",
+            });
+        }
+        prepared.growth_factor = d;
+        prepared
+            .description
+            .push(format!("growth factor D(z) = {d} given by the caller"));
+    }
+    Ok(prepared)
+}
+
+/// The loop terms of one linear spectrum on an [`RsdPlan`]'s grid; [`multipoles`](Self::multipoles)
+/// then costs microseconds per call (the fast nuisance parameters of a chain).
+#[pyclass(module = "pt_spectra._core", frozen)]
+pub(crate) struct RsdTerms {
+    spectra: pt_spectra::real::RealSpectra,
+    tns: Option<pt_spectra::loops::TnsTerms>,
+    prepared: Prepared,
+    precision: pt_spectra::precision::Precision,
+    rsd: RsdModel,
+}
+
+#[pymethods]
+impl RsdTerms {
+    /// The multipoles at f, bias, A_b, FoG, σ0 and noise: see the Python wrapper.
+    #[pyo3(signature = (f=None, bias=None, amplitude=1.0, fog="none", sigma0=None, shot_noise=None,
+        number_density=None, noise_table=None, ells=vec![0, 2, 4], terms=false, growth_factor=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn multipoles(
+        &self,
+        py: Python<'_>,
+        f: Option<f64>,
+        bias: Option<&Bound<'_, PyAny>>,
+        amplitude: f64,
+        fog: &str,
+        sigma0: Option<&Bound<'_, PyAny>>,
+        shot_noise: Option<f64>,
+        number_density: Option<f64>,
+        noise_table: Option<&Bound<'_, PyAny>>,
+        ells: Vec<usize>,
+        terms: bool,
+        growth_factor: Option<f64>,
+    ) -> PyResult<Table> {
+        let settings = (f, amplitude, fog, shot_noise, number_density, ells, terms);
+        let request = rsd_request(py, self.rsd, bias, sigma0, noise_table, settings)?;
+        let ((table, prepared), seconds) = detached(py, || {
+            let prepared = with_growth(self.prepared.clone(), growth_factor)?;
+            let table = jobs::rsd_table_from_terms(
+                &self.spectra,
+                self.tns.as_ref(),
+                &self.precision,
+                &request,
+                &prepared,
+            )?;
+            Ok((table, prepared))
+        })?;
+        let model = format!("{} + {}", self.rsd, self.spectra.model);
+        Table::new(py, table, &prepared, &self.precision, &model, seconds)
+    }
+}
