@@ -11,7 +11,6 @@ use pt_spectra::fit::{
 };
 use pt_spectra::real::RealModel;
 use pt_spectra::rsd::{Fog, RsdModel, RsdPlan};
-use pt_spectra::table::Table;
 use std::path::PathBuf;
 
 /// Arguments of `pt-spectra fit`.
@@ -132,12 +131,7 @@ pub fn run(args: &Args) -> Result<()> {
         }
     }
     if let Some(path) = &args.covariance {
-        let n = ells.len() * data.k.len();
-        let table = Table::read(path, &(0..n).collect::<Vec<_>>()).context("--covariance")?;
-        let rows: Vec<Vec<f64>> = (0..table.lines.len())
-            .map(|i| table.columns.iter().map(|c| c[i]).collect())
-            .collect();
-        data = data.with_covariance(rows).context("--covariance")?;
+        data = data.read_covariance(path).context("--covariance")?;
     }
     let k_max = k_max_values(&args.k_max)?;
     let loaded = args.spectrum.load()?;
