@@ -84,7 +84,7 @@ pub enum Error {
     },
 
     /// A wavenumber is zero, negative, infinite or NaN.
-    #[error("{origin}:{line}: k = {k} h/Mpc is not a finite positive number")]
+    #[error("{origin}:{line}: k = {} h/Mpc is not a finite positive number", number(.k))]
     InvalidK {
         /// File path or description of the input.
         origin: String,
@@ -96,8 +96,10 @@ pub enum Error {
 
     /// The wavenumbers are not strictly increasing.
     #[error(
-        "{origin}:{line}: k = {k} h/Mpc does not exceed the previous k = {previous} h/Mpc \
-         (k must be strictly increasing)"
+        "{origin}:{line}: k = {} h/Mpc does not exceed the previous k = {} h/Mpc \
+         (k must be strictly increasing)",
+        number(.k),
+        number(.previous)
     )]
     NonIncreasingK {
         /// File path or description of the input.
@@ -111,7 +113,11 @@ pub enum Error {
     },
 
     /// A power value is zero, negative, infinite or NaN.
-    #[error("{origin}:{line}: P = {p} (Mpc/h)^3 at k = {k} h/Mpc is not a finite positive number")]
+    #[error(
+        "{origin}:{line}: P = {} (Mpc/h)^3 at k = {} h/Mpc is not a finite positive number",
+        number(.p),
+        number(.k)
+    )]
     InvalidPower {
         /// File path or description of the input.
         origin: String,
@@ -145,8 +151,9 @@ pub enum Error {
         right: usize,
     },
 
-    /// A tabulated value (other than k or P) is not acceptable.
-    #[error("{origin}:{line}: {name} = {value}: {reason}")]
+    /// A tabulated value is not acceptable for a reason the variants above do not state (a value other
+    /// than k or P, a k too close to the previous one, a P that overflows the interpolation).
+    #[error("{origin}:{line}: {name} = {}: {reason}", number(.value))]
     InvalidValue {
         /// File path or description of the input.
         origin: String,
@@ -161,7 +168,12 @@ pub enum Error {
     },
 
     /// A tabulated function was asked for outside its range (it is not extrapolated).
-    #[error("{what} is tabulated for {min} <= k <= {max} h/Mpc, but k = {k} h/Mpc is needed")]
+    #[error(
+        "{what} is tabulated for {} <= k <= {} h/Mpc, but k = {} h/Mpc is needed",
+        number(.min),
+        number(.max),
+        number(.k)
+    )]
     OutOfRange {
         /// The function and where it came from.
         what: String,
@@ -174,7 +186,7 @@ pub enum Error {
     },
 
     /// A numeric argument or parameter is outside its allowed range.
-    #[error("invalid {name} = {value}: {reason}")]
+    #[error("invalid {name} = {}: {reason}", number(.value))]
     InvalidParameter {
         /// Name of the parameter, with its unit where it has one.
         name: &'static str,
@@ -290,6 +302,28 @@ pub enum Error {
         #[source]
         source: Box<Error>,
     },
+    /// A row of a table does not fit the table's shape or consistency: a matrix row with the wrong number
+    /// of columns, a row too many, an element that differs from its mirror image across the diagonal.
+    #[error("{origin}:{line}: {problem}")]
+    BadRow {
+        /// File path or description of the input.
+        origin: String,
+        /// 1-based line (or row) number.
+        line: usize,
+        /// What is wrong, with the values involved.
+        problem: String,
+    },
+}
+
+/// `v` as messages show it: as Rust prints it (shortest exact decimal), but in scientific notation when
+/// that would be a long run of zeros (|v| < 1e-4 or ≥ 1e16), e.g. `1e-320` rather than 320 digits.
+pub fn number(v: &f64) -> String {
+    let size = v.abs();
+    if size != 0.0 && size.is_finite() && !(1e-4..1e16).contains(&size) {
+        format!("{v:e}")
+    } else {
+        v.to_string()
+    }
 }
 
 /// `Result` with the crate's [`Error`].
@@ -298,6 +332,28 @@ pub type Result<T> = std::result::Result<T, Error>;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_in_messages_stay_short() {
+        assert_eq!(number(&0.05), "0.05");
+        assert_eq!(number(&-3.0), "-3");
+        assert_eq!(number(&1e-4), "0.0001");
+        assert_eq!(number(&1e308), "1e308");
+        assert_eq!(number(&-2.5e-320), "-2.5e-320");
+        assert_eq!(number(&f64::NAN), "NaN");
+        assert_eq!(number(&f64::NEG_INFINITY), "-inf");
+        let e = Error::NonIncreasingK {
+            origin: "k.dat".into(),
+            line: 3,
+            k: 1e-300,
+            previous: 1e300,
+        };
+        assert_eq!(
+            e.to_string(),
+            "k.dat:3: k = 1e-300 h/Mpc does not exceed the previous k = 1e300 h/Mpc \
+             (k must be strictly increasing)"
+        );
+    }
 
     #[test]
     fn messages_name_the_bad_value() {

@@ -12,7 +12,7 @@
 //!   contour by bracketing and bisection, never from a quadratic approximation.
 //! * σ0 enters only through σ0², so it is fitted as is and reported as |σ0|.
 
-use crate::error::{Error, Result};
+use crate::error::{number, Error, Result};
 use crate::loops::{Estimate, TnsCoefficients, TnsTerms};
 use crate::real::RealSpectra;
 use crate::rsd::{Fog, MultipoleRule, RsdModel};
@@ -195,9 +195,10 @@ impl MultipoleData {
     /// Attaches a full covariance matrix of the data vector (ℓ-major, n_ℓ·n_k square, symmetric).
     ///
     /// # Errors
-    /// [`Error::LengthMismatch`] for a wrong size, [`Error::InvalidParameter`] for a non-finite or
-    /// asymmetric matrix or a non-positive diagonal.
-    pub fn with_covariance(mut self, c: Vec<Vec<f64>>) -> Result<Self> {
+    /// [`Error::LengthMismatch`] for a wrong size; [`Error::InvalidValue`] for a diagonal element that is
+    /// not finite and positive, [`Error::BadRow`] for a non-finite or asymmetric element (row numbers
+    /// 1-based, origin `covariance matrix`).
+    pub fn with_covariance(self, c: Vec<Vec<f64>>) -> Result<Self> {
         let n = self.ells.len() * self.k.len();
         if c.len() != n || c.iter().any(|r| r.len() != n) {
             return Err(Error::LengthMismatch {
@@ -206,22 +207,108 @@ impl MultipoleData {
                 right: n,
             });
         }
-        for i in 0..n {
-            if !(c[i][i].is_finite() && c[i][i] > 0.0) {
-                return Err(Error::InvalidParameter {
+        self.checked_covariance(c, "covariance matrix", &[])
+    }
+
+    /// Reads the covariance of the data vector (ℓ-major, n_ℓ·n_k square, symmetric) from a table file:
+    /// one matrix row per data row, n_ℓ·n_k columns each.
+    ///
+    /// # Errors
+    /// [`Error::Io`], and as [`parse_covariance`](Self::parse_covariance).
+    pub fn read_covariance(self, path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = crate::table::read_text(path)?;
+        self.parse_covariance(&text, &path.display().to_string())
+    }
+
+    /// As [`read_covariance`](Self::read_covariance), from text (`origin` names it in messages).
+    ///
+    /// # Errors
+    /// Each naming `origin` and the line: [`Error::Parse`], [`Error::MissingColumn`] and
+    /// [`Error::BadRow`] for a row that is not n_ℓ·n_k numbers, [`Error::BadRow`] for a row too many or a
+    /// non-finite or asymmetric element, [`Error::InvalidValue`] for a diagonal element that is not finite
+    /// and positive; [`Error::TooFewPoints`] for too few rows.
+    pub fn parse_covariance(self, text: &str, origin: &str) -> Result<Self> {
+        let n = self.ells.len() * self.k.len();
+        let table = Table::parse_exact(text, origin, n)?;
+        let rows = table.lines.len();
+        if rows < n {
+            return Err(Error::TooFewPoints {
+                origin: origin.into(),
+                found: rows,
+                min: n,
+            });
+        }
+        if rows > n {
+            return Err(Error::BadRow {
+                origin: origin.into(),
+                line: table.lines[n],
+                problem: format!(
+                    "row {} of the covariance is one too many: the data vector has {} values \
+                     ({} multipole(s) × {} k)",
+                    n + 1,
+                    n,
+                    self.ells.len(),
+                    self.k.len()
+                ),
+            });
+        }
+        let c = (0..n)
+            .map(|i| table.columns.iter().map(|column| column[i]).collect())
+            .collect();
+        self.checked_covariance(c, origin, &table.lines)
+    }
+
+    /// Attaches the n×n matrix `c` after checking it; `lines` numbers its rows for messages (row numbers if
+    /// empty).
+    fn checked_covariance(
+        mut self,
+        c: Vec<Vec<f64>>,
+        origin: &str,
+        lines: &[usize],
+    ) -> Result<Self> {
+        let line = |i: usize| lines.get(i).copied().unwrap_or(i + 1);
+        for (i, row) in c.iter().enumerate() {
+            if let Some(j) = row.iter().position(|v| !v.is_finite()) {
+                return Err(Error::BadRow {
+                    origin: origin.into(),
+                    line: line(i),
+                    problem: format!(
+                        "covariance element ({}, {}) = {} is not finite (row, column 1-based)",
+                        i + 1,
+                        j + 1,
+                        number(&row[j])
+                    ),
+                });
+            }
+            // (Finite: checked above.)
+            if row[i] <= 0.0 {
+                return Err(Error::InvalidValue {
+                    origin: origin.into(),
+                    line: line(i),
                     name: "covariance diagonal",
-                    value: c[i][i],
+                    value: row[i],
                     reason: "must be finite and positive",
                 });
             }
             for j in 0..i {
-                if !c[i][j].is_finite()
-                    || (c[i][j] - c[j][i]).abs() > 1e-9 * (c[i][i] * c[j][j]).sqrt()
-                {
-                    return Err(Error::InvalidParameter {
-                        name: "covariance element",
-                        value: c[i][j],
-                        reason: "must be finite and symmetric",
+                // sqrt before the product: c_ii c_jj may overflow, and then any asymmetry would pass.
+                let tolerance = 1e-9 * c[i][i].sqrt() * c[j][j].sqrt();
+                // Both finite: the difference is finite or infinite, never NaN.
+                if (row[j] - c[j][i]).abs() > tolerance {
+                    return Err(Error::BadRow {
+                        origin: origin.into(),
+                        line: line(i),
+                        problem: format!(
+                            "covariance element ({}, {}) = {} differs from element ({}, {}) = {}: \
+                             the matrix must be symmetric (row, column 1-based)",
+                            i + 1,
+                            j + 1,
+                            number(&row[j]),
+                            j + 1,
+                            i + 1,
+                            number(&c[j][i])
+                        ),
                     });
                 }
             }
@@ -639,7 +726,8 @@ fn cholesky(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
             let s: f64 = (0..j).map(|m| l[i][m] * l[j][m]).sum();
             if i == j {
                 let d = a[i][i] - s;
-                if d <= 0.0 {
+                // Also refuse NaN and infinity: huge elements overflow the sums.
+                if !(d > 0.0 && d.is_finite()) {
                     return None;
                 }
                 l[i][i] = d.sqrt();

@@ -7,8 +7,9 @@
 //!   [`Columns`] picks the k and P columns of wider tables. The spectra of Gil-Marín et al. (2012,
 //!   arXiv:1209.3771) computed with CAMB are embedded ([`LinearSpectrum::gm2012`]), so nothing has to be
 //!   read from disk.
-//! * **Validation.** k finite, positive and strictly increasing; P finite and positive; at least
-//!   [`MIN_POINTS`] rows. Every failure is an [`Error`] naming the line and value.
+//! * **Validation.** k finite, positive and strictly increasing (ln k too); P finite and positive, and its
+//!   interpolation below [`MAX_POWER`]; at least [`MIN_POINTS`] rows. Every failure is an [`Error`] naming
+//!   the line and value.
 //! * **Interpolation.** A not-a-knot cubic spline in (ln k, ln P). On the CAMB tables (Δln k = 0.011) it
 //!   reproduces nodes dropped from a table decimated by 2 to < 1e-4 over 0.01–0.5 h/Mpc, BAO wiggles
 //!   included (see the tests).
@@ -31,6 +32,14 @@ pub const MIN_POINTS: usize = 20;
 
 /// Number of end nodes to which each extrapolating power law is fitted.
 pub const EXTRAPOLATION_POINTS: usize = 5;
+
+/// Largest P(k) [(Mpc/h)^3] a table may have, also between its nodes: bounds of the log-log spline must
+/// stay below it so that P, its power-law tails and sums of it stay finite in f64.
+pub const MAX_POWER: f64 = 1e300;
+
+/// Why a table whose log-log spline overshoots [`MAX_POWER`] is refused.
+const SPLINE_OVERFLOW: &str = "the log-log spline next to this row exceeds 1e300: P changes too \
+                               abruptly here, or the k are too unevenly spaced";
 
 /// Redshifts of the embedded Gil-Marín et al. (2012) linear spectra, see [`LinearSpectrum::gm2012`].
 pub const GM2012_REDSHIFTS: [f64; 4] = [0.0, 0.5, 1.0, 1.5];
@@ -223,8 +232,9 @@ impl LinearSpectrum {
     ///
     /// # Errors
     /// [`Error::Parse`], [`Error::MissingColumn`], [`Error::InvalidK`], [`Error::NonIncreasingK`],
-    /// [`Error::InvalidPower`] (each with the line number), [`Error::TooFewPoints`], and
-    /// [`Error::InvalidParameter`] if `columns.k == columns.p`.
+    /// [`Error::InvalidPower`], [`Error::InvalidValue`] (a k so close to the previous one that ln k does not
+    /// increase, or a P whose log-log spline may exceed [`MAX_POWER`]; each with the line number),
+    /// [`Error::TooFewPoints`], and [`Error::InvalidParameter`] if `columns.k == columns.p`.
     pub fn parse(text: &str, origin: &str, columns: Columns) -> Result<Self> {
         if columns.k == columns.p {
             return Err(invalid(
@@ -239,8 +249,7 @@ impl LinearSpectrum {
             let previous = i.checked_sub(1).map(|j| k[j]);
             check_row(origin, table.lines[i], k[i], p[i], previous)?;
         }
-        let header = table.header;
-        Self::build(k, p, header, origin.to_string())
+        Self::build(k, p, table.header, origin.to_string(), &table.lines)
     }
 
     /// A spectrum from nodes k [h/Mpc] and P [(Mpc/h)^3], validated as a table would be (row numbers are
@@ -248,7 +257,7 @@ impl LinearSpectrum {
     ///
     /// # Errors
     /// [`Error::LengthMismatch`], [`Error::InvalidK`], [`Error::NonIncreasingK`], [`Error::InvalidPower`],
-    /// [`Error::TooFewPoints`].
+    /// [`Error::InvalidValue`], [`Error::TooFewPoints`].
     pub fn from_nodes(k: Vec<f64>, p: Vec<f64>) -> Result<Self> {
         if k.len() != p.len() {
             return Err(Error::LengthMismatch {
@@ -261,7 +270,7 @@ impl LinearSpectrum {
         for i in 0..k.len() {
             check_row(origin, i + 1, k[i], p[i], i.checked_sub(1).map(|j| k[j]))?;
         }
-        Self::build(k, p, Vec::new(), origin.to_string())
+        Self::build(k, p, Vec::new(), origin.to_string(), &[])
     }
 
     /// Tabulates `p_of_k` [(Mpc/h)^3] on `grid` and interpolates it.
@@ -297,7 +306,14 @@ impl LinearSpectrum {
         Self::gm2012(0.0).expect("the embedded z = 0 table is valid")
     }
 
-    fn build(k: Vec<f64>, p: Vec<f64>, header: Vec<String>, origin: String) -> Result<Self> {
+    /// The spectrum through validated rows; `lines` numbers them for messages (row numbers if empty).
+    fn build(
+        k: Vec<f64>,
+        p: Vec<f64>,
+        header: Vec<String>,
+        origin: String,
+        lines: &[usize],
+    ) -> Result<Self> {
         if k.len() < MIN_POINTS {
             return Err(Error::TooFewPoints {
                 origin,
@@ -312,6 +328,21 @@ impl LinearSpectrum {
         let low = PowerLaw::fit(&x[..m], &y[..m], 0);
         let high = PowerLaw::fit(&x[n - m..], &y[n - m..], m - 1);
         let spline = LogSpline::new(x, y);
+        // Rows spaced very unevenly, or P changing abruptly, can make the spline exceed f64 between the
+        // nodes. The overshoot spreads along the spline: blame the row where it is worst.
+        if spline
+            .upper_bounds()
+            .any(|bound| bound.is_nan() || bound >= MAX_POWER.ln())
+        {
+            let j = spline.worst_node();
+            return Err(Error::InvalidValue {
+                origin,
+                line: lines.get(j).copied().unwrap_or(j + 1),
+                name: "P [(Mpc/h)^3]",
+                value: p[j],
+                reason: SPLINE_OVERFLOW,
+            });
+        }
         Ok(Self {
             k,
             p,
@@ -394,9 +425,19 @@ impl LinearSpectrum {
     /// The spectrum multiplied by a constant `factor` (e.g. a growth ratio D²(z)/D²(z_in)).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] unless `factor` is finite and positive.
+    /// [`Error::InvalidParameter`] unless `factor` is finite and positive and keeps P below
+    /// [`MAX_POWER`].
     pub fn scaled(&self, factor: f64) -> Result<Self> {
         check_positive("scale factor", factor)?;
+        let peak = self.spline.upper_bounds().fold(f64::NEG_INFINITY, f64::max);
+        // The bounds are finite (checked when built) and so is ln(factor).
+        if peak + factor.ln() >= MAX_POWER.ln() {
+            return Err(invalid(
+                "scale factor",
+                factor,
+                "would raise P(k) above 1e300 (Mpc/h)^3",
+            ));
+        }
         let mut out = self.clone();
         out.p.iter_mut().for_each(|v| *v *= factor);
         out.spline.shift(factor.ln());
@@ -480,12 +521,30 @@ fn check_row(origin: &str, line: usize, k: f64, p: f64, previous: Option<f64>) -
             previous,
         });
     }
+    if previous.is_some_and(|prev| k.ln() <= prev.ln()) {
+        return Err(Error::InvalidValue {
+            origin: origin.into(),
+            line,
+            name: "k [h/Mpc]",
+            value: k,
+            reason: crate::table::K_TOO_CLOSE,
+        });
+    }
     if !(p.is_finite() && p > 0.0) {
         return Err(Error::InvalidPower {
             origin: origin.into(),
             line,
             k,
             p,
+        });
+    }
+    if p >= MAX_POWER {
+        return Err(Error::InvalidValue {
+            origin: origin.into(),
+            line,
+            name: "P [(Mpc/h)^3]",
+            value: p,
+            reason: "exceeds 1e300: too close to the largest f64 to interpolate and integrate",
         });
     }
     Ok(())

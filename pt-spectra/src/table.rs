@@ -4,21 +4,74 @@
 //! Format (as for linear spectra): lines starting with `#` (after optional blanks) are header lines;
 //! text after a `#` on a data line is ignored; blank lines are skipped; fields are separated by commas
 //! and/or whitespace; a single row of column names with no number in it before the first data row is
-//! taken as a header line.
+//! taken as a header line. Lines end with `\n`, `\r\n` or a lone `\r`; a leading byte-order mark is
+//! ignored.
 
 use crate::error::{Error, Result};
 use std::path::Path;
 
-/// The text of the file at `path`.
+/// The text of the file at `path`. Bytes that are not UTF-8 (a Latin-1 `µ` in a comment, a binary file)
+/// become U+FFFD, so that a table reports the line they are on rather than refusing the whole file.
 ///
 /// # Errors
 /// [`Error::Io`] naming the file.
 pub(crate) fn read_text(path: &Path) -> Result<String> {
-    std::fs::read_to_string(path).map_err(|source| Error::Io {
+    let bytes = std::fs::read(path).map_err(|source| Error::Io {
         path: path.to_path_buf(),
         source,
+    })?;
+    Ok(match String::from_utf8(bytes) {
+        Ok(text) => text,
+        Err(e) => String::from_utf8_lossy(e.as_bytes()).into_owned(),
     })
 }
+
+/// The lines of `text` numbered from 1, without their ends: `\n`, `\r\n` and a lone `\r` (classic Mac
+/// OS) each end a line, as a text editor counts them; a leading UTF-8 byte-order mark is dropped.
+fn numbered_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    let mut rest = Some(text.strip_prefix('\u{feff}').unwrap_or(text));
+    let lines = std::iter::from_fn(move || {
+        let s = rest?;
+        match s.find(['\n', '\r']) {
+            None => {
+                rest = None;
+                (!s.is_empty()).then_some(s)
+            }
+            Some(i) => {
+                let end = if s[i..].starts_with("\r\n") { 2 } else { 1 };
+                rest = Some(&s[i + end..]);
+                Some(&s[..i])
+            }
+        }
+    });
+    (1..).zip(lines)
+}
+
+/// A field as shown in a message: control characters escaped, at most 40 characters (then `…`), so that
+/// a binary or one-line file gives a short readable message.
+fn shown(field: &str) -> String {
+    const MAX: usize = 40;
+    let mut out: String = field
+        .chars()
+        .take(MAX)
+        .map(|c| {
+            if c.is_control() || c == '\u{feff}' {
+                c.escape_debug().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect();
+    if field.chars().nth(MAX).is_some() {
+        out.push('…');
+    }
+    out
+}
+
+/// What a row of k needs beyond k > previous k: ln k must increase too, or the interpolation in ln k
+/// divides by zero (two k a few units in the last place apart).
+pub(crate) const K_TOO_CLOSE: &str =
+    "too close to the previous k: ln k does not increase (remove one of the two rows)";
 
 /// The selected columns of a table's data rows.
 #[derive(Debug, Clone, PartialEq)]
@@ -49,15 +102,32 @@ impl Table {
     /// # Errors
     /// [`Error::Parse`] for a field that is not a number, [`Error::MissingColumn`] for a short row.
     pub fn parse(text: &str, origin: &str, columns: &[usize]) -> Result<Self> {
-        let need = columns.iter().max().map_or(0, |c| c + 1);
+        Self::parse_rows(text, origin, columns, None)
+    }
+
+    /// Parses a table whose every data row has exactly `width` columns (e.g. a matrix), all kept.
+    ///
+    /// # Errors
+    /// As [`parse`](Self::parse), and [`Error::BadRow`] for a row with more than `width` columns.
+    pub fn parse_exact(text: &str, origin: &str, width: usize) -> Result<Self> {
+        Self::parse_rows(text, origin, &(0..width).collect::<Vec<_>>(), Some(width))
+    }
+
+    fn parse_rows(
+        text: &str,
+        origin: &str,
+        columns: &[usize],
+        width: Option<usize>,
+    ) -> Result<Self> {
+        let need = columns.iter().max().map_or(0, |c| c.saturating_add(1));
         let mut table = Self {
             origin: origin.to_string(),
             header: Vec::new(),
             lines: Vec::new(),
             columns: vec![Vec::new(); columns.len()],
         };
-        for (index, raw) in text.lines().enumerate() {
-            let line = index + 1;
+        let mut named_columns = false;
+        for (line, raw) in numbered_lines(text) {
             let (data, comment) = raw.split_once('#').unwrap_or((raw, ""));
             let fields: Vec<&str> = data
                 .split(|c: char| c == ',' || c.is_whitespace())
@@ -69,7 +139,13 @@ impl Table {
                 }
                 continue;
             }
-            if table.lines.is_empty() && fields.iter().all(|f| f.parse::<f64>().is_err()) {
+            // One row of column names (no number in it) may precede the data; a second such row is
+            // reported as a parse error on its line.
+            if table.lines.is_empty()
+                && !named_columns
+                && fields.iter().all(|f| f.parse::<f64>().is_err())
+            {
+                named_columns = true;
                 table.header.push(data.trim().to_string());
                 continue;
             }
@@ -86,13 +162,20 @@ impl Table {
                     found: fields.len(),
                 });
             }
+            if let Some(width) = width.filter(|&w| fields.len() > w) {
+                return Err(Error::BadRow {
+                    origin: origin.into(),
+                    line,
+                    problem: format!("the row has {} columns, {width} expected", fields.len()),
+                });
+            }
             for (values, &c) in table.columns.iter_mut().zip(columns) {
                 let field = fields[c];
                 values.push(field.parse::<f64>().map_err(|_| Error::Parse {
                     origin: origin.into(),
                     line,
                     column: c,
-                    field: field.into(),
+                    field: shown(field),
                 })?);
             }
             table.lines.push(line);
@@ -118,11 +201,12 @@ impl Tabulated {
     }
 
     /// The function `name` (e.g. `b(k)`), checked: at least 2 rows, k finite, positive and strictly
-    /// increasing, values finite and, if `positive`, > 0. `lines` gives each row's line number for
-    /// messages (row numbers if empty).
+    /// increasing (in ln k too), values finite and, if `positive`, > 0. `lines` gives each row's line
+    /// number for messages (row numbers if empty).
     ///
     /// # Errors
-    /// [`Error::TooFewPoints`], [`Error::InvalidK`], [`Error::NonIncreasingK`], [`Error::InvalidValue`].
+    /// [`Error::TooFewPoints`], [`Error::InvalidK`], [`Error::NonIncreasingK`], [`Error::InvalidValue`]
+    /// (also for a k so close to the previous one that ln k does not increase).
     pub fn new(
         name: &'static str,
         origin: &str,
@@ -160,6 +244,15 @@ impl Tabulated {
                     line: line(i),
                     k: k[i],
                     previous: k[i - 1],
+                });
+            }
+            if i > 0 && k[i].ln() <= k[i - 1].ln() {
+                return Err(Error::InvalidValue {
+                    origin: origin.into(),
+                    line: line(i),
+                    name: "k [h/Mpc]",
+                    value: k[i],
+                    reason: K_TOO_CLOSE,
                 });
             }
             if !(values[i].is_finite() && (!positive || values[i] > 0.0)) {
@@ -224,7 +317,14 @@ impl Tabulated {
             .clamp(1, self.k.len() - 1);
         let (k0, k1) = (self.k[j - 1], self.k[j]);
         let t = (k.ln() - k0.ln()) / (k1.ln() - k0.ln());
-        Ok(self.values[j - 1] + t * (self.values[j] - self.values[j - 1]))
+        let (v0, v1) = (self.values[j - 1], self.values[j]);
+        let step = v1 - v0;
+        // Values of opposite sign near f64::MAX: the difference overflows, the weighted mean does not.
+        Ok(if step.is_finite() {
+            v0 + t * step
+        } else {
+            (1.0 - t) * v0 + t * v1
+        })
     }
 }
 

@@ -485,3 +485,72 @@ fn the_q_range_is_the_users_and_the_header_states_it() {
     );
     assert!(b < a && a / b - 1.0 < 1e-3, "{a} {b}");
 }
+
+#[test]
+fn bad_files_and_overflowing_kernels_are_errors_naming_file_and_line() {
+    let dir = scratch("bad_files");
+    let k_file = write(&dir, "k.dat", "# k\r\n0.01\r\n0.02\r\n1e400\r\n");
+    let k_names = write(&dir, "k2.dat", "k\nkh\n0.1\n");
+    let linear: String = (0..30)
+        .map(|i| {
+            let k = 1e-3 * 1.3f64.powi(i);
+            let p = if i == 17 { 1e308 } else { 1e4 * k };
+            format!("{k:e} {p:e}\n")
+        })
+        .collect();
+    let linear = write(&dir, "pk.dat", &linear);
+    let data = write(&dir, "data.dat", "0.05 1e4 100\n0.1 8e3 80\n");
+    let covariance = write(&dir, "cov.dat", "1e4 0\n0 6400 0\n");
+    let fit_args = vec![
+        "fit",
+        "--data",
+        &data,
+        "--data-columns",
+        "1,2,3",
+        "--data-ells",
+        "0",
+        "--ells",
+        "0",
+        "--free",
+        "f",
+        "--covariance",
+        &covariance,
+    ];
+    fails_naming(&[
+        (
+            vec!["real", "--k-file", &k_file],
+            &format!("{k_file}:4: k = inf h/Mpc"),
+        ),
+        (
+            vec!["real", "--k-file", &k_names],
+            &format!("{k_names}:2: cannot parse `kh`"),
+        ),
+        (
+            vec!["real", "--linear", &linear],
+            &format!("{linear}:18: P [(Mpc/h)^3] = 1e308"),
+        ),
+        (
+            fit_args,
+            &format!("{covariance}:2: the row has 3 columns, 2 expected"),
+        ),
+        (
+            vec!["kernel", "F", "--q", "1e200,0,0", "--q", "-1e200,1e-200,0"],
+            "F_2 at --q 1e200,0,0 --q -1e200,1e-200,0 is NaN",
+        ),
+        (
+            vec!["kernel", "G", "--q", "1e999999999,0,0", "--exact"],
+            "too large for exact arithmetic",
+        ),
+    ]);
+    // Exact arithmetic does not overflow.
+    let (ok, out, err) = run(&[
+        "kernel",
+        "F",
+        "--q",
+        "1e200,0,0",
+        "--q",
+        "-1e200,1e-200,0",
+        "--exact",
+    ]);
+    assert!(ok && out.starts_with("3/14"), "{out}{err}");
+}

@@ -274,7 +274,7 @@ fn describe_gives_one_line_of_parameters() {
 fn invalid_amplitudes_are_rejected() {
     let c = Cosmology::gm2012();
     for (amplitude, name) in [
-        (Amplitude::a_s(-2e-9), "A_s = -0.000000002"),
+        (Amplitude::a_s(-2e-9), "A_s = -2e-9"),
         (Amplitude::a_s(f64::NAN), "A_s = NaN"),
         (
             Amplitude::As {

@@ -22,6 +22,37 @@ impl LogSpline {
         Self { x, y, m, inv_dx }
     }
 
+    /// For each interval [x_i, x_{i+1}], an upper bound of y there (NaN if the spline is not finite):
+    /// max(y_i, y_{i+1}) plus the largest cubic term, |a³ − a| ≤ 2/(3√3) for a ∈ [0, 1].
+    pub(super) fn upper_bounds(&self) -> impl Iterator<Item = f64> + '_ {
+        let cubic = 2.0 / (3.0 * 3f64.sqrt()) / 6.0;
+        self.x.windows(2).enumerate().map(move |(i, x)| {
+            let h = x[1] - x[0];
+            let bend = (self.m[i].abs() + self.m[i + 1].abs()) * h * h * cubic;
+            // `+` keeps a NaN of m; f64::max would drop it.
+            if self.y[i] > self.y[i + 1] {
+                self.y[i] + bend
+            } else {
+                self.y[i + 1] + bend
+            }
+        })
+    }
+
+    /// The node to blame for the largest overshoot: of the two ends of the interval with the largest
+    /// [`upper_bounds`](Self::upper_bounds), the one where |y''| is larger (NaN counts as largest).
+    pub(super) fn worst_node(&self) -> usize {
+        let i = self
+            .upper_bounds()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(0, |(i, _)| i);
+        if self.m[i + 1].abs().total_cmp(&self.m[i].abs()).is_gt() {
+            i + 1
+        } else {
+            i
+        }
+    }
+
     /// Adds a constant to y (multiplies P by e^c when y = ln P).
     pub(super) fn shift(&mut self, c: f64) {
         self.y.iter_mut().for_each(|v| *v += c);

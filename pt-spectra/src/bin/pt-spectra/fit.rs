@@ -10,7 +10,6 @@ use pt_spectra::fit::{MultipoleData, Parameter};
 use pt_spectra::jobs::{fit_table, FitRequest, RsdRequest};
 use pt_spectra::real::RealModel;
 use pt_spectra::rsd::{Fog, RsdModel, RsdPlan, Sigma0};
-use pt_spectra::table::Table;
 use std::path::PathBuf;
 
 /// Arguments of `pt-spectra fit`.
@@ -124,12 +123,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let mut data = MultipoleData::read(&args.data, cols[0] - 1, &spec)?;
     if let Some(path) = &args.covariance {
-        let n = ells.len() * data.k.len();
-        let table = Table::read(path, &(0..n).collect::<Vec<_>>()).context("--covariance")?;
-        let rows: Vec<Vec<f64>> = (0..table.lines.len())
-            .map(|i| table.columns.iter().map(|c| c[i]).collect())
-            .collect();
-        data = data.with_covariance(rows).context("--covariance")?;
+        data = data.read_covariance(path).context("--covariance")?;
     }
     let request = FitRequest {
         model: RsdRequest {

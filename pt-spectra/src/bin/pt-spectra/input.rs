@@ -3,10 +3,12 @@
 
 use anyhow::{bail, Context, Result};
 use pt_spectra::cosmology::TransferKind;
+use pt_spectra::error::Error;
 use pt_spectra::linear::{Columns, LinearSpectrum, LogGrid};
 use pt_spectra::precision::Precision;
 use pt_spectra::setup::{self, LinearSource, NamedCosmology, Prepared, Request};
 use pt_spectra::store::TableStore;
+use pt_spectra::table::Table;
 use std::path::PathBuf;
 
 /// `K,P` (1-based column numbers) as 0-based [`Columns`].
@@ -233,35 +235,28 @@ impl Input {
     }
 }
 
-/// k values from the first column of a file: finite, positive, strictly increasing.
+/// k values from the first column of a file: finite, positive, strictly increasing. The file is read as
+/// any table (`#` comments, one optional row of column names, comma or blank separated, any line ends);
+/// every error names the file and the line.
 pub fn read_k_file(path: &PathBuf) -> Result<Vec<f64>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read --k-file `{}`", path.display()))?;
-    let mut k: Vec<f64> = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let data = line.split('#').next().unwrap_or("");
-        let Some(field) = data
-            .split(|c: char| c == ',' || c.is_whitespace())
-            .find(|s| !s.is_empty())
-        else {
-            continue;
-        };
-        let where_ = format!("{}:{}", path.display(), i + 1);
-        let v: f64 = field
-            .parse()
-            .with_context(|| format!("{where_}: cannot parse `{field}` as k"))?;
-        if !(v.is_finite() && v > 0.0) {
-            bail!("{where_}: k = {v} h/Mpc is not a finite positive number");
-        }
-        if let Some(&prev) = k.last().filter(|&&prev| v <= prev) {
-            bail!(
-                "{where_}: k = {v} h/Mpc does not exceed the previous k = {prev} (k must increase)"
-            );
-        }
-        k.push(v);
-    }
-    if k.is_empty() {
+    let table = Table::read(path, &[0]).context("--k-file")?;
+    let Some(k) = table.columns.into_iter().next().filter(|k| !k.is_empty()) else {
         bail!("--k-file `{}` contains no k values", path.display());
+    };
+    for (i, (&v, &line)) in k.iter().zip(&table.lines).enumerate() {
+        let origin = table.origin.clone();
+        if !(v.is_finite() && v > 0.0) {
+            return Err(Error::InvalidK { origin, line, k: v }).context("--k-file");
+        }
+        if let Some(&previous) = i.checked_sub(1).map(|j| &k[j]).filter(|&&p| v <= p) {
+            return Err(Error::NonIncreasingK {
+                origin,
+                line,
+                k: v,
+                previous,
+            })
+            .context("--k-file");
+        }
     }
     Ok(k)
 }
@@ -296,6 +291,48 @@ mod tests {
             read_k_file(&PathBuf::from("/nonexistent/k")).unwrap_err()
         );
         assert!(missing.contains("/nonexistent/k"), "{missing}");
+    }
+
+    #[test]
+    fn k_files_of_any_origin_are_read_or_refused_at_a_line() {
+        let windows = write("crlf", "\u{feff}# k\r\n0.01\r\n0.02, x\r\n");
+        assert_eq!(read_k_file(&windows).unwrap(), vec![0.01, 0.02]);
+        let mac = write("cr", "k\r0.01\r0.02\r0.03");
+        assert_eq!(read_k_file(&mac).unwrap(), vec![0.01, 0.02, 0.03]);
+        let cases: [(&str, &[u8], &str); 9] = [
+            (
+                "dup",
+                b"0.1\n0.1\n",
+                ":2: k = 0.1 h/Mpc does not exceed the previous k = 0.1",
+            ),
+            ("huge", b"0.1\n1e400\n", ":2: k = inf h/Mpc"),
+            (
+                "tiny",
+                b"1e-320\n1e-321\n",
+                ":2: k = 1e-321 h/Mpc does not exceed",
+            ),
+            (
+                "zero",
+                b"# k\n\n-0\n",
+                ":3: k = -0 h/Mpc is not a finite positive number",
+            ),
+            ("names", b"k\nkh\n0.1\n", ":2: cannot parse `kh`"),
+            (
+                "bytes",
+                b"\x7fELF\x02\x01\n\xff\xfe\n",
+                ":2: cannot parse `\u{fffd}\u{fffd}`",
+            ),
+            ("cut", b"0.1\n0.2\n0.", ":3: k = 0 h/Mpc"),
+            ("esc", b"0.1\n\x1b[31m\n", ":2: cannot parse `\\u{1b}[31m`"),
+            ("blank", b"\n \t\n# only comments\n", "no k values"),
+        ];
+        for (name, bytes, needle) in cases {
+            let path = write(name, "");
+            std::fs::write(&path, bytes).unwrap();
+            let e = format!("{:#}", read_k_file(&path).unwrap_err());
+            assert!(e.contains(needle), "{name}: {e}");
+            assert!(e.contains(&path.display().to_string()), "{name}: {e}");
+        }
     }
 
     #[test]

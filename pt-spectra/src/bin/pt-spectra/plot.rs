@@ -512,7 +512,12 @@ fn multipoles(args: &Args) -> Result<Figure> {
     })
 }
 
+/// y(at), linear between the points (x increasing); a table of one row is constant, of none NaN.
 fn interpolate(x: &[f64], y: &[f64], at: f64) -> f64 {
+    if x.len() < 2 {
+        // `clamp(1, x.len() - 1)` below would panic.
+        return y.first().copied().unwrap_or(f64::NAN);
+    }
     let j = x.partition_point(|&v| v <= at).clamp(1, x.len() - 1);
     let t = (at - x[j - 1]) / (x[j] - x[j - 1]);
     y[j - 1] + t * (y[j] - y[j - 1])
@@ -622,4 +627,16 @@ pub fn run(args: &Args) -> Result<()> {
         ),
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn model_tables_of_one_row_interpolate_without_panic() {
+        assert_eq!(interpolate(&[0.1], &[5.0], 0.3), 5.0);
+        assert!(interpolate(&[], &[], 0.3).is_nan());
+        assert_eq!(interpolate(&[0.1, 0.3], &[1.0, 3.0], 0.2), 2.0);
+    }
 }
