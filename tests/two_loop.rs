@@ -244,7 +244,11 @@ fn regpt_two_loop(k_max: f64) -> (Vec<Vec<f64>>, pt_spectra::loops::LoopTerms) {
         &pt_spectra::progress::Silent,
     )
     .unwrap();
-    (rows, plan.terms(&spectrum, &pt_spectra::progress::Silent))
+    (
+        rows,
+        plan.terms(&spectrum, &pt_spectra::progress::Silent)
+            .unwrap(),
+    )
 }
 
 #[test]

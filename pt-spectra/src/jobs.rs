@@ -11,8 +11,8 @@
 //! use pt_spectra::setup::{prepare, LinearSource, Request};
 //! let prepared = prepare(Request { source: LinearSource::Embedded, cosmology: None, z: 0.0 })?;
 //! let selection: RealSelection = "1l-spt".parse()?;
-//! let plan = RealPlan::new(&[0.05, 0.1], selection.plan_model(), &Precision::fast(),
-//!                          &TableStore::in_memory(), &Silent)?;
+//! let plan = RealPlan::for_selection(&[0.05, 0.1], selection, &Precision::fast(),
+//!                                    &TableStore::in_memory(), &Silent)?;
 //! let t = jobs::real_table(&plan, selection, &prepared, true, &Silent)?;
 //! assert_eq!(t.names()[..5], ["k", "P_lin", "P_dd", "P_dt", "P_tt"]);
 //! assert!(t.column("P22_dd").is_some() && t.header[0].contains("1l-spt"));
@@ -74,7 +74,7 @@ pub fn two_loop_line(precision: &Precision) -> String {
 /// prepared linear spectrum, with the loop terms if `terms`.
 ///
 /// # Errors
-/// [`Error::GridMismatch`] if the plan is not for the selection's model; as [`RealPlan::evaluate`]
+/// [`Error::GridMismatch`] if the plan does not cover the selection ([`RealPlan::for_selection`]); as [`RealPlan::evaluate`]
 /// and [`Prepared::no_wiggle`].
 pub fn real_table(
     plan: &RealPlan,
@@ -83,7 +83,7 @@ pub fn real_table(
     terms: bool,
     progress: &dyn Progress,
 ) -> Result<Table> {
-    if plan.model() != selection.plan_model() {
+    if !plan.covers(selection) {
         return Err(Error::GridMismatch {
             what: "real-space plan and model",
             expected: format!("a plan for {}", selection.plan_model()),

@@ -32,6 +32,7 @@ pub mod estimate;
 pub mod fit;
 pub mod halo;
 pub mod integrate;
+pub mod ir;
 pub mod jobs;
 pub mod linear;
 pub mod loops;

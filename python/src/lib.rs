@@ -150,7 +150,7 @@ impl RealPlan {
         let precision = self::precision(precision, q_range, two_loop_tolerance)?;
         let store = Store::new(cache_dir);
         let (plan, _) = detached(py, || {
-            LibRealPlan::new(&k, selection.plan_model(), &precision, store.get(), &Silent)
+            LibRealPlan::for_selection(&k, selection, &precision, store.get(), &Silent)
         })?;
         Ok(Self { plan, selection })
     }

@@ -242,6 +242,17 @@ pub struct LoopTerms {
     /// RegPT's σ_d²(k) = (1/6π²)∫_{q_min}^{k/2} P dq at each k [(Mpc/h)²]
     /// ([`crate::resum::sigma_d2`]).
     pub sigma_d2: Option<Vec<Estimate>>,
+    /// The no-wiggle terms of the IR-resummed models ([`crate::ir`]).
+    pub ir: Option<Box<IrTerms>>,
+}
+
+/// What the IR-resummed models add to the loop terms of the linear spectrum.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IrTerms {
+    /// The BAO damping Σ² [(Mpc/h)²] ([`crate::ir::sigma2_bao`]).
+    pub sigma2: Estimate,
+    /// The loop terms of the no-wiggle spectrum (its `p_lin` is P_nw).
+    pub no_wiggle: LoopTerms,
 }
 
 impl LoopTerms {
@@ -253,6 +264,7 @@ impl LoopTerms {
             p17: None,
             two_loop: None,
             sigma_d2: None,
+            ir: None,
         }
     }
 

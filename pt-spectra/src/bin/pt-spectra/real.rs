@@ -42,8 +42,7 @@ pub fn run(args: &Args) -> Result<()> {
             .context("invalid --two-loop-tolerance")?;
     }
     let bars = Bars::default();
-    let model = args.model.plan_model();
-    let plan = RealPlan::new(&k, model, &loaded.precision, &loaded.store, &bars)?;
+    let plan = RealPlan::for_selection(&k, args.model, &loaded.precision, &loaded.store, &bars)?;
     let table = real_table(&plan, args.model, &loaded.prepared, args.terms, &bars)?;
     write_output(args.out.as_ref(), &table.to_text())
 }

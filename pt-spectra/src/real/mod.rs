@@ -15,18 +15,14 @@
 //! Every value carries an error estimate propagated from the loop integrals ([`crate::loops`]).
 
 use crate::error::{Error, Result};
-use crate::linear::LinearSpectrum;
-use crate::loops::{
-    self, ByPair, Estimate, LoopTerms, OneLoopPlan, OneLoopTerms, P15Table, P17Table, Pair,
-};
+use crate::loops::{ByPair, Estimate, LoopTerms, Pair};
 use crate::output::{Table, POWER, WAVENUMBER};
-use crate::precision::Precision;
-use crate::progress::{stage_callback, Progress, Silent, Stage};
 use crate::resum::{self, Propagator};
-use crate::store::TableStore;
 use std::fmt;
 use std::str::FromStr;
-use std::sync::Arc;
+
+mod plan;
+pub use plan::{real_space, RealPlan};
 
 /// A real-space model, named as on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -57,15 +53,19 @@ pub enum RealModel {
     /// 1-loop RegPT (Taruya, Bernardeau, Nishimichi & Codis 2012): regularised propagators with
     /// σ_d² at the running cut-off k/2 ([`crate::resum::regpt_one_loop`]).
     OneLoopRegPt,
+    /// 1-loop SPT with the BAO wiggles IR-resummed ([`crate::ir`]).
+    OneLoopSptIr,
+    /// 2-loop SPT with the BAO wiggles IR-resummed ([`crate::ir`]).
+    TwoLoopSptIr,
 }
 
 /// The accepted model names, for messages.
 const MODEL_NAMES: &str = "linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1, 1l-rpt-n2, 1l-rpt-n3, 2l-spt, \
-                           2l-rpt-n0, 2l-rpt-n1, 2l-rpt-n2, 2l-rpt-n3, 1l-regpt";
+                           2l-rpt-n0, 2l-rpt-n1, 2l-rpt-n2, 2l-rpt-n3, 1l-regpt, 1l-spt-ir, 2l-spt-ir";
 
 impl RealModel {
     /// Every model.
-    pub const ALL: [RealModel; 12] = [
+    pub const ALL: [RealModel; 14] = [
         RealModel::Linear,
         RealModel::OneLoopSpt,
         RealModel::OneLoopRptN0,
@@ -78,6 +78,8 @@ impl RealModel {
         RealModel::OneLoopRptN3,
         RealModel::TwoLoopRptN3,
         RealModel::OneLoopRegPt,
+        RealModel::OneLoopSptIr,
+        RealModel::TwoLoopSptIr,
     ];
 
     /// The model's name (`linear`, `1l-spt`, `1l-rpt-n0`, `1l-rpt-n1`).
@@ -95,6 +97,8 @@ impl RealModel {
             RealModel::OneLoopRptN3 => "1l-rpt-n3",
             RealModel::TwoLoopRptN3 => "2l-rpt-n3",
             RealModel::OneLoopRegPt => "1l-regpt",
+            RealModel::OneLoopSptIr => "1l-spt-ir",
+            RealModel::TwoLoopSptIr => "2l-spt-ir",
         }
     }
 
@@ -110,7 +114,9 @@ impl RealModel {
             RealModel::Linear
             | RealModel::OneLoopSpt
             | RealModel::TwoLoopSpt
-            | RealModel::OneLoopRegPt => None,
+            | RealModel::OneLoopRegPt
+            | RealModel::OneLoopSptIr
+            | RealModel::TwoLoopSptIr => None,
         }
     }
 
@@ -133,7 +139,14 @@ impl RealModel {
                 | RealModel::TwoLoopRptN1
                 | RealModel::TwoLoopRptN2
                 | RealModel::TwoLoopRptN3
+                | RealModel::TwoLoopSptIr
         )
+    }
+
+    /// Whether the model resums the BAO ([`crate::ir`]): its terms include those of the no-wiggle
+    /// spectrum.
+    pub fn needs_ir(self) -> bool {
+        matches!(self, RealModel::OneLoopSptIr | RealModel::TwoLoopSptIr)
     }
 }
 
@@ -230,6 +243,27 @@ impl RealSpectra {
             None
         };
         let (spectra, factors) = match model.propagator() {
+            None if model.needs_ir() => {
+                let ir = terms.ir.as_deref().ok_or_else(|| Error::MissingTerm {
+                    term: "the no-wiggle loop terms",
+                    needed_by: format!("model {model}"),
+                    hint: " (compute the terms with a RealPlan)",
+                })?;
+                let two = if model.needs_two_loop() {
+                    Some((
+                        two_loop.expect("checked above"),
+                        ir.no_wiggle.two_loop(&model)?,
+                    ))
+                } else {
+                    None
+                };
+                let spectra = ByPair::from_fn(|pair| {
+                    (0..n)
+                        .map(|i| crate::ir::resummed(t, ir, two, pair, i))
+                        .collect()
+                });
+                (spectra, None)
+            }
             None if model == RealModel::OneLoopRegPt => {
                 let sigma_d2 = terms.sigma_d2.as_ref().ok_or_else(|| Error::MissingTerm {
                     term: "sigma_d^2",
@@ -334,6 +368,10 @@ impl RealSpectra {
         if let (Some(sigma_d2), RealModel::OneLoopRegPt) = (&self.terms.sigma_d2, model) {
             t.push_estimates("sigma_d2", "(Mpc/h)^2", sigma_d2);
         }
+        if let (Some(ir), true) = (&self.terms.ir, model.needs_ir()) {
+            t.push("P_nw", POWER, ir.no_wiggle.one_loop.p_lin.clone());
+            t.push_estimates("Sigma2_bao", "(Mpc/h)^2", &vec![ir.sigma2; self.k.len()]);
+        }
         if let Some(factors) = &self.factors {
             for (pair, f) in factors.iter() {
                 t.push_estimates(&format!("N_{}", pair.suffix()), "1", f);
@@ -351,187 +389,15 @@ fn errors(e: &[Estimate]) -> Vec<f64> {
     e.iter().map(|e| e.error).collect()
 }
 
-/// Above this many k values the 1-loop plan is built and evaluated in chunks, reporting
-/// [`Stage::OneLoop`] progress after each.
-const CHUNKED_GRID: usize = 2048;
-/// k values per chunk.
-const CHUNK: usize = 512;
-
-/// A real-space model prepared for one k grid: the 1-loop quadrature weights and the angular tables the
-/// model needs, all independent of the cosmology. [`evaluate`](Self::evaluate) then computes the
-/// spectra of any linear spectrum, as often as needed (a fit, a chain, a batch of cosmologies).
-///
-/// ```
-/// use pt_spectra::{linear::LinearSpectrum, loops::Pair, precision::Precision, progress::Silent};
-/// use pt_spectra::{real::{RealModel, RealPlan}, store::TableStore};
-/// let store = TableStore::in_memory();
-/// let plan = RealPlan::new(&[0.05, 0.1], RealModel::OneLoopSpt, &Precision::fast(), &store, &Silent)?;
-/// for z in [0.0, 1.0] {
-///     let s = plan.evaluate(&LinearSpectrum::gm2012(z)?, &Silent)?;
-///     // At k = 0.1 h/Mpc the 1-loop P_δδ exceeds P_lin by a few per cent.
-///     let ratio = s.pair(Pair::DeltaDelta)[1].value / s.p_lin[1];
-///     assert!(ratio > 1.0 && ratio < 1.1, "{ratio}");
-/// }
-/// # Ok::<(), pt_spectra::error::Error>(())
-/// ```
-#[derive(Debug, Clone)]
-pub struct RealPlan {
-    k: Vec<f64>,
-    model: RealModel,
-    precision: Precision,
-    one_loop: Vec<OneLoopPlan>,
-    p15: Option<Arc<P15Table>>,
-    p17: Option<Arc<P17Table>>,
-}
-
-impl RealPlan {
-    /// The plan of `model` on the wavenumbers `k` [h/Mpc] with `precision`; the angular tables the
-    /// model needs (P15 for N2, N3 and 2-loop models, P17 for N3) come from `store`, built there on
-    /// first use (reported to `progress`).
-    ///
-    /// # Errors
-    /// As [`OneLoopPlan::new`] and [`TableStore::p15`].
-    pub fn new(
-        k: &[f64],
-        model: RealModel,
-        precision: &Precision,
-        store: &TableStore,
-        progress: &dyn Progress,
-    ) -> Result<Self> {
-        precision.validate()?;
-        let one_loop = if k.len() < CHUNKED_GRID {
-            vec![OneLoopPlan::new(k, precision)?]
-        } else {
-            let mut plans = Vec::new();
-            for (i, chunk) in k.chunks(CHUNK).enumerate() {
-                plans.push(OneLoopPlan::new(chunk, precision)?);
-                progress.update(Stage::OneLoop, ((i + 1) * CHUNK).min(k.len()), 2 * k.len());
-            }
-            plans
-        };
-        let p15 = if model.needs_p15() {
-            Some(store.p15(progress)?)
-        } else {
-            None
-        };
-        let p17 = if model.needs_p17() {
-            Some(store.p17(progress)?)
-        } else {
-            None
-        };
-        Ok(Self {
-            k: k.to_vec(),
-            model,
-            precision: precision.clone(),
-            one_loop,
-            p15,
-            p17,
-        })
-    }
-
-    /// The wavenumbers [h/Mpc].
-    pub fn k(&self) -> &[f64] {
-        &self.k
-    }
-
-    /// The model.
-    pub fn model(&self) -> RealModel {
-        self.model
-    }
-
-    /// The settings of the loop integrals.
-    pub fn precision(&self) -> &Precision {
-        &self.precision
-    }
-
-    /// Every loop term the model needs, for the linear `spectrum` (at the output redshift), in
-    /// parallel over k; the 2-loop points are reported to `progress` ([`Stage::TwoLoopPoints`]).
-    pub fn terms(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> LoopTerms {
-        let mut one_loop: Option<OneLoopTerms> = None;
-        for (i, plan) in self.one_loop.iter().enumerate() {
-            let part = plan.par_evaluate(spectrum);
-            match one_loop.as_mut() {
-                None => one_loop = Some(part),
-                Some(all) => all.append(part),
-            }
-            if self.one_loop.len() > 1 {
-                let done = self.k.len() + ((i + 1) * CHUNK).min(self.k.len());
-                progress.update(Stage::OneLoop, done, 2 * self.k.len());
-            }
-        }
-        let one_loop = one_loop.expect("a plan has at least one chunk");
-        let (k, precision) = (&self.k, &self.precision);
-        let p15 = self
-            .p15
-            .as_ref()
-            .map(|table| loops::p15_terms(table, k, spectrum, precision));
-        let p17 = self
-            .p17
-            .as_ref()
-            .map(|table| loops::p17_terms(table, k, spectrum, precision));
-        let two_loop = match (&self.p15, &p15) {
-            (Some(table), Some(p15)) if self.model.needs_two_loop() => {
-                let points = stage_callback(progress, Stage::TwoLoopPoints);
-                Some(loops::two_loop_correction(
-                    &one_loop, p15, table, spectrum, precision, &points,
-                ))
-            }
-            _ => None,
-        };
-        let sigma_d2 = Some(resum::sigma_d2(spectrum, k, precision));
-        LoopTerms {
-            one_loop,
-            p15,
-            p17,
-            two_loop,
-            sigma_d2,
-        }
-    }
-
-    /// The model's spectra for the linear `spectrum` (at the output redshift).
-    ///
-    /// # Errors
-    /// None in practice: the plan computes every term its model needs (a [`Error::MissingTerm`]
-    /// would be a bug).
-    pub fn evaluate(
-        &self,
-        spectrum: &LinearSpectrum,
-        progress: &dyn Progress,
-    ) -> Result<RealSpectra> {
-        RealSpectra::from_terms(self.model, self.terms(spectrum, progress))
-    }
-}
-
-/// The spectra of `model` for `spectrum` at wavenumbers `k` [h/Mpc]: a [`RealPlan`] built and
-/// evaluated once. Build the plan yourself to evaluate several spectra on one grid.
-///
-/// # Errors
-/// As [`RealPlan::new`].
-///
-/// ```
-/// use pt_spectra::{linear::LinearSpectrum, loops::Pair, precision::Precision, store::TableStore};
-/// use pt_spectra::real::{real_space, RealModel};
-/// let (p, store) = (LinearSpectrum::gm2012(0.0)?, TableStore::in_memory());
-/// let spt = real_space("1l-spt".parse()?, &p, &[0.1], &Precision::fast(), &store)?;
-/// let n1 = real_space(RealModel::OneLoopRptN1, &p, &[0.1], &Precision::fast(), &store)?;
-/// // At k = 0.1 h/Mpc, z = 0 the two agree to a few per cent and exceed P_lin.
-/// let (a, b) = (spt.pair(Pair::DeltaDelta)[0].value, n1.pair(Pair::DeltaDelta)[0].value);
-/// assert!(a > spt.p_lin[0] && (a / b - 1.0).abs() < 0.05);
-/// # Ok::<(), pt_spectra::error::Error>(())
-/// ```
-pub fn real_space(
-    model: RealModel,
-    spectrum: &LinearSpectrum,
-    k: &[f64],
-    precision: &Precision,
-    store: &TableStore,
-) -> Result<RealSpectra> {
-    RealPlan::new(k, model, precision, store, &Silent)?.evaluate(spectrum, &Silent)
-}
-
 #[cfg(test)]
 mod tests {
+    use super::plan::CHUNKED_GRID;
     use super::*;
+    use crate::linear::LinearSpectrum;
+    use crate::loops::OneLoopPlan;
+    use crate::precision::Precision;
+    use crate::progress::Silent;
+    use crate::store::TableStore;
 
     #[test]
     fn model_names_round_trip_and_unknown_names_are_listed() {
@@ -556,7 +422,7 @@ mod tests {
         for (k, precision) in [(&k[..3], Precision::fast()), (&k[..], Precision::fast())] {
             let plan =
                 RealPlan::new(k, RealModel::OneLoopSpt, &precision, &store, &Silent).unwrap();
-            let terms = plan.terms(&p, &Silent);
+            let terms = plan.terms(&p, &Silent).unwrap();
             assert_eq!(
                 terms.one_loop,
                 OneLoopPlan::new(k, &precision).unwrap().evaluate(&p)

@@ -1,0 +1,231 @@
+//! [`RealPlan`]: a real-space model prepared for one k grid, evaluated for any linear spectrum.
+
+use super::{RealModel, RealSelection, RealSpectra};
+use crate::error::Result;
+use crate::linear::LinearSpectrum;
+use crate::loops::{self, LoopTerms, OneLoopPlan, OneLoopTerms, P15Table, P17Table};
+use crate::precision::Precision;
+use crate::progress::{stage_callback, Progress, Silent, Stage};
+use crate::resum;
+use crate::store::TableStore;
+use std::sync::Arc;
+
+/// Above this many k values the 1-loop plan is built and evaluated in chunks, reporting
+/// [`Stage::OneLoop`] progress after each.
+pub(super) const CHUNKED_GRID: usize = 2048;
+/// k values per chunk.
+const CHUNK: usize = 512;
+
+/// A real-space model prepared for one k grid: the 1-loop quadrature weights and the angular tables the
+/// model needs, all independent of the cosmology. [`evaluate`](Self::evaluate) then computes the
+/// spectra of any linear spectrum, as often as needed (a fit, a chain, a batch of cosmologies).
+///
+/// ```
+/// use pt_spectra::{linear::LinearSpectrum, loops::Pair, precision::Precision, progress::Silent};
+/// use pt_spectra::{real::{RealModel, RealPlan}, store::TableStore};
+/// let store = TableStore::in_memory();
+/// let plan = RealPlan::new(&[0.05, 0.1], RealModel::OneLoopSpt, &Precision::fast(), &store, &Silent)?;
+/// for z in [0.0, 1.0] {
+///     let s = plan.evaluate(&LinearSpectrum::gm2012(z)?, &Silent)?;
+///     // At k = 0.1 h/Mpc the 1-loop P_δδ exceeds P_lin by a few per cent.
+///     let ratio = s.pair(Pair::DeltaDelta)[1].value / s.p_lin[1];
+///     assert!(ratio > 1.0 && ratio < 1.1, "{ratio}");
+/// }
+/// # Ok::<(), pt_spectra::error::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct RealPlan {
+    k: Vec<f64>,
+    model: RealModel,
+    precision: Precision,
+    one_loop: Vec<OneLoopPlan>,
+    p15: Option<Arc<P15Table>>,
+    p17: Option<Arc<P17Table>>,
+    /// Whether [`terms`](Self::terms) also computes the no-wiggle terms of the IR-resummed models.
+    ir: bool,
+}
+
+impl RealPlan {
+    /// The plan of what `selection` needs: its model's, and for `all` every model's terms (the IR
+    /// resummation included).
+    ///
+    /// # Errors
+    /// As [`new`](Self::new).
+    pub fn for_selection(
+        k: &[f64],
+        selection: RealSelection,
+        precision: &Precision,
+        store: &TableStore,
+        progress: &dyn Progress,
+    ) -> Result<Self> {
+        let mut plan = Self::new(k, selection.plan_model(), precision, store, progress)?;
+        plan.ir |= selection == RealSelection::All;
+        Ok(plan)
+    }
+
+    /// Whether the plan computes every model's terms (those of `real --model all`).
+    pub fn covers(&self, selection: RealSelection) -> bool {
+        self.model == selection.plan_model() && (self.ir || selection != RealSelection::All)
+    }
+
+    /// The plan of `model` on the wavenumbers `k` [h/Mpc] with `precision`; the angular tables the
+    /// model needs (P15 for N2, N3 and 2-loop models, P17 for N3) come from `store`, built there on
+    /// first use (reported to `progress`).
+    ///
+    /// # Errors
+    /// As [`OneLoopPlan::new`] and [`TableStore::p15`].
+    pub fn new(
+        k: &[f64],
+        model: RealModel,
+        precision: &Precision,
+        store: &TableStore,
+        progress: &dyn Progress,
+    ) -> Result<Self> {
+        precision.validate()?;
+        let one_loop = if k.len() < CHUNKED_GRID {
+            vec![OneLoopPlan::new(k, precision)?]
+        } else {
+            let mut plans = Vec::new();
+            for (i, chunk) in k.chunks(CHUNK).enumerate() {
+                plans.push(OneLoopPlan::new(chunk, precision)?);
+                progress.update(Stage::OneLoop, ((i + 1) * CHUNK).min(k.len()), 2 * k.len());
+            }
+            plans
+        };
+        let p15 = if model.needs_p15() {
+            Some(store.p15(progress)?)
+        } else {
+            None
+        };
+        let p17 = if model.needs_p17() {
+            Some(store.p17(progress)?)
+        } else {
+            None
+        };
+        Ok(Self {
+            k: k.to_vec(),
+            model,
+            precision: precision.clone(),
+            one_loop,
+            p15,
+            p17,
+            ir: model.needs_ir(),
+        })
+    }
+
+    /// The wavenumbers [h/Mpc].
+    pub fn k(&self) -> &[f64] {
+        &self.k
+    }
+
+    /// The model.
+    pub fn model(&self) -> RealModel {
+        self.model
+    }
+
+    /// The settings of the loop integrals.
+    pub fn precision(&self) -> &Precision {
+        &self.precision
+    }
+
+    /// Every loop term the model needs, for the linear `spectrum` (at the output redshift), in
+    /// parallel over k; the 2-loop points are reported to `progress` ([`Stage::TwoLoopPoints`]).
+    /// IR-resummed models also get the terms of the no-wiggle spectrum ([`crate::ir`]).
+    ///
+    /// # Errors
+    /// As [`crate::ir::no_wiggle`].
+    pub fn terms(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> Result<LoopTerms> {
+        let mut terms = self.loop_terms(spectrum, progress);
+        if self.ir {
+            let nw = crate::ir::no_wiggle(spectrum)?;
+            terms.ir = Some(Box::new(loops::IrTerms {
+                sigma2: crate::ir::sigma2_bao(&nw, self.precision.q_min),
+                no_wiggle: self.loop_terms(&nw, progress),
+            }));
+        }
+        Ok(terms)
+    }
+
+    fn loop_terms(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> LoopTerms {
+        let mut one_loop: Option<OneLoopTerms> = None;
+        for (i, plan) in self.one_loop.iter().enumerate() {
+            let part = plan.par_evaluate(spectrum);
+            match one_loop.as_mut() {
+                None => one_loop = Some(part),
+                Some(all) => all.append(part),
+            }
+            if self.one_loop.len() > 1 {
+                let done = self.k.len() + ((i + 1) * CHUNK).min(self.k.len());
+                progress.update(Stage::OneLoop, done, 2 * self.k.len());
+            }
+        }
+        let one_loop = one_loop.expect("a plan has at least one chunk");
+        let (k, precision) = (&self.k, &self.precision);
+        let p15 = self
+            .p15
+            .as_ref()
+            .map(|table| loops::p15_terms(table, k, spectrum, precision));
+        let p17 = self
+            .p17
+            .as_ref()
+            .map(|table| loops::p17_terms(table, k, spectrum, precision));
+        let two_loop = match (&self.p15, &p15) {
+            (Some(table), Some(p15)) if self.model.needs_two_loop() => {
+                let points = stage_callback(progress, Stage::TwoLoopPoints);
+                Some(loops::two_loop_correction(
+                    &one_loop, p15, table, spectrum, precision, &points,
+                ))
+            }
+            _ => None,
+        };
+        let sigma_d2 = Some(resum::sigma_d2(spectrum, k, precision));
+        LoopTerms {
+            one_loop,
+            p15,
+            p17,
+            two_loop,
+            sigma_d2,
+            ir: None,
+        }
+    }
+
+    /// The model's spectra for the linear `spectrum` (at the output redshift).
+    ///
+    /// # Errors
+    /// None in practice: the plan computes every term its model needs (a [`Error::MissingTerm`]
+    /// would be a bug).
+    pub fn evaluate(
+        &self,
+        spectrum: &LinearSpectrum,
+        progress: &dyn Progress,
+    ) -> Result<RealSpectra> {
+        RealSpectra::from_terms(self.model, self.terms(spectrum, progress)?)
+    }
+}
+
+/// The spectra of `model` for `spectrum` at wavenumbers `k` [h/Mpc]: a [`RealPlan`] built and
+/// evaluated once. Build the plan yourself to evaluate several spectra on one grid.
+///
+/// # Errors
+/// As [`RealPlan::new`].
+///
+/// ```
+/// use pt_spectra::{linear::LinearSpectrum, loops::Pair, precision::Precision, store::TableStore};
+/// use pt_spectra::real::{real_space, RealModel};
+/// let (p, store) = (LinearSpectrum::gm2012(0.0)?, TableStore::in_memory());
+/// let spt = real_space("1l-spt".parse()?, &p, &[0.1], &Precision::fast(), &store)?;
+/// let n1 = real_space(RealModel::OneLoopRptN1, &p, &[0.1], &Precision::fast(), &store)?;
+/// // At k = 0.1 h/Mpc, z = 0 the two agree to a few per cent and exceed P_lin.
+/// let (a, b) = (spt.pair(Pair::DeltaDelta)[0].value, n1.pair(Pair::DeltaDelta)[0].value);
+/// assert!(a > spt.p_lin[0] && (a / b - 1.0).abs() < 0.05);
+/// # Ok::<(), pt_spectra::error::Error>(())
+/// ```
+pub fn real_space(
+    model: RealModel,
+    spectrum: &LinearSpectrum,
+    k: &[f64],
+    precision: &Precision,
+    store: &TableStore,
+) -> Result<RealSpectra> {
+    RealPlan::new(k, model, precision, store, &Silent)?.evaluate(spectrum, &Silent)
+}
