@@ -1,0 +1,219 @@
+//! Measured multipoles: reading them from tables or arrays, with checks that name the bad row.
+
+use crate::error::{Error, Result};
+use crate::table::Table;
+use std::path::Path;
+
+/// Measured multipoles P_ℓ(k) with their 1σ errors.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MultipoleData {
+    /// Wavenumbers [h/Mpc], strictly increasing.
+    pub k: Vec<f64>,
+    /// The multipole orders.
+    pub ells: Vec<usize>,
+    /// `values[j][i]`: P_ℓj at k_i [(Mpc/h)^3].
+    pub values: Vec<Vec<f64>>,
+    /// `sigma[j][i]`: the 1σ error of `values[j][i]`, > 0.
+    pub sigma: Vec<Vec<f64>>,
+    /// Optional full covariance of the data vector (ℓ-major), replacing the diagonal σ².
+    pub covariance: Option<Vec<Vec<f64>>>,
+}
+
+/// The table columns of k and, per (ℓ, value, error), the value and error columns.
+fn wanted(k_column: usize, columns: &[(usize, usize, usize)]) -> Vec<usize> {
+    let mut wanted = vec![k_column];
+    for &(_, v, s) in columns {
+        wanted.extend([v, s]);
+    }
+    wanted
+}
+
+impl MultipoleData {
+    /// Reads a table: k in the 0-based column `k_column`, and for each (ℓ, value column, error column).
+    ///
+    /// # Errors
+    /// [`Error::Io`], [`Error::Parse`], [`Error::MissingColumn`]; [`Error::InvalidK`],
+    /// [`Error::NonIncreasingK`]; [`Error::InvalidValue`] for a NaN or infinite value or an error that is
+    /// not finite and positive.
+    pub fn read(
+        path: impl AsRef<Path>,
+        k_column: usize,
+        columns: &[(usize, usize, usize)],
+    ) -> Result<Self> {
+        Self::from_table(&Table::read(path, &wanted(k_column, columns))?, columns)
+    }
+
+    /// As [`read`](Self::read), from text (`origin` names it in messages).
+    ///
+    /// # Errors
+    /// As [`read`](Self::read).
+    pub fn parse(
+        text: &str,
+        origin: &str,
+        k_column: usize,
+        columns: &[(usize, usize, usize)],
+    ) -> Result<Self> {
+        Self::from_table(
+            &Table::parse(text, origin, &wanted(k_column, columns))?,
+            columns,
+        )
+    }
+
+    /// Measured multipoles from arrays: `k` and, for each ℓ of `ells`, the values and 1σ errors on that
+    /// grid (`origin` names them in messages; rows are numbered from 1).
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] for arrays of different lengths, otherwise as [`read`](Self::read).
+    pub fn from_arrays(
+        k: Vec<f64>,
+        ells: &[usize],
+        values: Vec<Vec<f64>>,
+        sigma: Vec<Vec<f64>>,
+        origin: &str,
+    ) -> Result<Self> {
+        for (what, n) in [
+            ("values and ells", values.len()),
+            ("errors and ells", sigma.len()),
+        ] {
+            if n != ells.len() {
+                return Err(Error::LengthMismatch {
+                    what,
+                    left: n,
+                    right: ells.len(),
+                });
+            }
+        }
+        let mut columns = vec![k];
+        for (v, s) in values.into_iter().zip(sigma) {
+            columns.extend([v, s]);
+        }
+        if let Some(bad) = columns.iter().find(|c| c.len() != columns[0].len()) {
+            return Err(Error::LengthMismatch {
+                what: "multipole arrays and k",
+                left: bad.len(),
+                right: columns[0].len(),
+            });
+        }
+        let table = Table {
+            origin: origin.to_string(),
+            header: Vec::new(),
+            lines: (1..=columns[0].len()).collect(),
+            columns,
+        };
+        let spec: Vec<(usize, usize, usize)> = ells
+            .iter()
+            .enumerate()
+            .map(|(j, &l)| (l, 1 + 2 * j, 2 + 2 * j))
+            .collect();
+        Self::from_table(&table, &spec)
+    }
+
+    fn from_table(table: &Table, columns: &[(usize, usize, usize)]) -> Result<Self> {
+        let k = table.columns[0].clone();
+        let origin = &table.origin;
+        if k.is_empty() {
+            return Err(Error::TooFewPoints {
+                origin: origin.clone(),
+                found: 0,
+                min: 1,
+            });
+        }
+        for i in 0..k.len() {
+            let line = table.lines[i];
+            if !(k[i].is_finite() && k[i] > 0.0) {
+                return Err(Error::InvalidK {
+                    origin: origin.clone(),
+                    line,
+                    k: k[i],
+                });
+            }
+            if i > 0 && k[i] <= k[i - 1] {
+                return Err(Error::NonIncreasingK {
+                    origin: origin.clone(),
+                    line,
+                    k: k[i],
+                    previous: k[i - 1],
+                });
+            }
+        }
+        let (mut values, mut sigma) = (Vec::new(), Vec::new());
+        for (j, _) in columns.iter().enumerate() {
+            let (v, s) = (&table.columns[1 + 2 * j], &table.columns[2 + 2 * j]);
+            for i in 0..k.len() {
+                let line = table.lines[i];
+                if !v[i].is_finite() {
+                    return Err(Error::InvalidValue {
+                        origin: origin.clone(),
+                        line,
+                        name: "P_l",
+                        value: v[i],
+                        reason: "must be finite",
+                    });
+                }
+                if !(s[i].is_finite() && s[i] > 0.0) {
+                    return Err(Error::InvalidValue {
+                        origin: origin.clone(),
+                        line,
+                        name: "sigma_l",
+                        value: s[i],
+                        reason: "must be finite and positive",
+                    });
+                }
+            }
+            values.push(v.clone());
+            sigma.push(s.clone());
+        }
+        Ok(Self {
+            k,
+            ells: columns.iter().map(|c| c.0).collect(),
+            values,
+            sigma,
+            covariance: None,
+        })
+    }
+
+    /// Attaches a full covariance matrix of the data vector (ℓ-major, n_ℓ·n_k square, symmetric).
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] for a wrong size, [`Error::InvalidParameter`] for a non-finite or
+    /// asymmetric matrix or a non-positive diagonal.
+    pub fn with_covariance(mut self, c: Vec<Vec<f64>>) -> Result<Self> {
+        let n = self.ells.len() * self.k.len();
+        if c.len() != n || c.iter().any(|r| r.len() != n) {
+            return Err(Error::LengthMismatch {
+                what: "covariance rows and data vector",
+                left: c.len(),
+                right: n,
+            });
+        }
+        for i in 0..n {
+            if !(c[i][i].is_finite() && c[i][i] > 0.0) {
+                return Err(Error::InvalidParameter {
+                    name: "covariance diagonal",
+                    value: c[i][i],
+                    reason: "must be finite and positive",
+                });
+            }
+            for j in 0..i {
+                if !c[i][j].is_finite()
+                    || (c[i][j] - c[j][i]).abs() > 1e-9 * (c[i][i] * c[j][j]).sqrt()
+                {
+                    return Err(Error::InvalidParameter {
+                        name: "covariance element",
+                        value: c[i][j],
+                        reason: "must be finite and symmetric",
+                    });
+                }
+            }
+        }
+        self.covariance = Some(c);
+        Ok(self)
+    }
+
+    /// Number of k ≤ `k_max` (with k ≥ `k_min`) and the first index.
+    pub(super) fn range(&self, k_min: f64, k_max: f64) -> (usize, usize) {
+        let start = self.k.partition_point(|&k| k < k_min);
+        let end = self.k.partition_point(|&k| k <= k_max);
+        (start, end.max(start))
+    }
+}
