@@ -235,10 +235,11 @@ fn real(
     plan.__call__(py, linear, z, z_input, cosmology, terms, eh)
 }
 
-/// b(k) or P_εε(k) from a constant, a path or (k, values).
-fn tabulated(obj: &Bound<'_, PyAny>, name: &'static str) -> PyResult<Tabulated> {
+/// A function of k from a path (k in column 1, the value in the column named `column` on a `# k …`
+/// line, else column 2) or a pair of arrays.
+fn tabulated(obj: &Bound<'_, PyAny>, name: &'static str, column: &str) -> PyResult<Tabulated> {
     if let Ok(path) = obj.extract::<PathBuf>() {
-        return Tabulated::read(&path, name, (0, 1), true).map_err(value_error);
+        return Tabulated::read_column(&path, name, column, true).map_err(value_error);
     }
     let (k, v): (Bound<'_, PyAny>, Bound<'_, PyAny>) = obj.extract().map_err(|_| {
         PyValueError::new_err(format!(
@@ -265,10 +266,10 @@ fn bias_and_noise(
 ) -> PyResult<(Bias, Noise)> {
     let bias = match bias.extract::<f64>() {
         Ok(b) => Bias::Constant(b),
-        Err(_) => Bias::Table(tabulated(bias, "b(k)")?),
+        Err(_) => Bias::Table(tabulated(bias, "b(k)", "b")?),
     };
     let noise = match (noise_table, shot_noise, number_density) {
-        (Some(t), None, None) => Noise::Table(tabulated(t, "P_eps(k)")?),
+        (Some(t), None, None) => Noise::Table(tabulated(t, "P_eps(k)", "P_eps")?),
         (None, Some(p), None) => Noise::Constant(p),
         (None, None, Some(n)) => Noise::poisson(n).map_err(value_error)?,
         (None, None, None) => Noise::None,
@@ -325,7 +326,7 @@ impl RsdPlan {
     /// The multipoles of the prepared spectrum: see the Python wrapper `pt_spectra.rsd`.
     #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=None, amplitude=1.0,
         fog="none", sigma0=None, shot_noise=None, number_density=None, noise_table=None, ells=vec![0, 2, 4],
-        terms=false, eh=None))]
+        terms=false, eh=None, no_wiggle=false))]
     #[allow(clippy::too_many_arguments)]
     fn __call__(
         &self,
@@ -345,6 +346,7 @@ impl RsdPlan {
         ells: Vec<usize>,
         terms: bool,
         eh: Option<&str>,
+        no_wiggle: bool,
     ) -> PyResult<Table> {
         let _ = &self.store;
         let one = 1.0f64.into_pyobject(py)?.into_any();
@@ -365,6 +367,7 @@ impl RsdPlan {
             noise,
             ells,
             terms,
+            no_wiggle,
         };
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
         let ((table, prepared), seconds) = detached(py, || {
@@ -436,7 +439,7 @@ fn data(
 #[pyfunction]
 #[pyo3(signature = (data, k_max, free=vec!["f".to_string(), "sigma0".to_string()], ells=vec![0],
     data_ells=vec![0, 2, 4], data_columns=None, covariance=None, rsd="tns", real="1l-spt", fog="lorentzian",
-    f=None, sigma0=3.0, bias=None, amplitude=1.0, shot_noise=None, number_density=None, noise_table=None,
+    f=None, sigma0=None, bias=None, amplitude=1.0, shot_noise=None, number_density=None, noise_table=None,
     k_min=0.0, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default", q_range=None,
     cache_dir=None, eh=None))]
 #[allow(clippy::too_many_arguments)]
@@ -453,7 +456,7 @@ fn fit(
     real: &str,
     fog: &str,
     f: Option<f64>,
-    sigma0: f64,
+    sigma0: Option<&Bound<'_, PyAny>>,
     bias: Option<&Bound<'_, PyAny>>,
     amplitude: f64,
     shot_noise: Option<f64>,
@@ -504,10 +507,14 @@ fn fit(
             bias,
             amplitude,
             fog: fog.parse().map_err(value_error)?,
-            sigma0: Sigma0::Value(sigma0),
+            sigma0: match sigma0 {
+                Some(s) => self::sigma0(s)?,
+                None => Sigma0::Value(3.0),
+            },
             noise,
             ells,
             terms: false,
+            no_wiggle: false,
         },
         free,
         k_min,
