@@ -1,11 +1,13 @@
 //! The `pt-spectra` binary end to end: outputs against closed forms, bad input against clear errors.
-//! The modules hold the tests of the paper's halo analysis: `halo` (bias and noise from measured
-//! spectra, S/N) and `fit` (model multipoles, Δχ² surfaces, theory σ0).
+//! The modules hold the tests of the paper's halo and figure analysis: `halo` (bias and noise from
+//! measured spectra, S/N), `fit` (model multipoles, Δχ² surfaces, theory σ0) and `plot` (every kind of
+//! figure from the fixture tables).
 
 use std::process::Command;
 
 mod fit;
 mod halo;
+mod plot;
 
 fn run(args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_pt-spectra"))
