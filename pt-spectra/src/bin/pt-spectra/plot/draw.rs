@@ -85,6 +85,8 @@ pub struct Panel {
     pub weight: u32,
     /// Limits of the y axis: values outside are left out (ratios near a zero crossing).
     pub clamp: Option<(f64, f64)>,
+    /// Where the legend goes, if the panel has one (curves with labels).
+    pub legend: Option<SeriesLabelPosition>,
 }
 
 impl Panel {
@@ -99,6 +101,7 @@ impl Panel {
             log_y: false,
             weight: 1,
             clamp: None,
+            legend: Some(SeriesLabelPosition::LowerLeft),
         }
     }
 
@@ -272,8 +275,11 @@ where
             .map_err(e)?;
         let none = |_: &f64| String::new();
         let mut mesh = chart.configure_mesh();
+        // Few labels and no minor lines on short panels, which they would fill.
         mesh.y_desc(panel.y_label.as_str())
-            .label_style(("sans-serif", 14));
+            .label_style(("sans-serif", 14))
+            .y_labels(if panel.weight >= 2 { 10 } else { 5 })
+            .max_light_lines(if panel.weight >= 2 { 4 } else { 1 });
         if panel.log_y {
             mesh.y_label_formatter(&log_label);
         }
@@ -354,15 +360,17 @@ where
                     .map_err(e)?;
             }
         }
-        if panel.curves.iter().any(|c| !c.label.is_empty()) {
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 13))
-                .position(SeriesLabelPosition::LowerLeft)
-                .draw()
-                .map_err(e)?;
+        if let Some(position) = panel.legend.clone() {
+            if panel.curves.iter().any(|c| !c.label.is_empty()) {
+                chart
+                    .configure_series_labels()
+                    .background_style(WHITE.mix(0.85))
+                    .border_style(BLACK)
+                    .label_font(("sans-serif", 13))
+                    .position(position)
+                    .draw()
+                    .map_err(e)?;
+            }
         }
     }
     Ok(())

@@ -44,14 +44,16 @@ pub fn fits(args: &Args) -> Result<Figure> {
             "scoccimarro" => Style::Dashed,
             _ => Style::Solid,
         };
-        for (name, panel) in panels.iter_mut() {
+        for (p, (name, panel)) in panels.iter_mut().enumerate() {
             let Some(v) = t.column(name) else { continue };
             let (lo, hi) = (
                 t.need(&format!("{name}_lo"))?,
                 t.need(&format!("{name}_hi"))?,
             );
+            // The fits are named in the first panel's legend only; the σ0 panel names its theory lines.
+            let label = if p == 0 { label.clone() } else { String::new() };
             panel.curves.push(
-                Curve::new(label.clone(), k.clone(), v)
+                Curve::new(label, k.clone(), v)
                     .styled(style)
                     .colored(c)
                     .with_bars(lo.into_iter().zip(hi).collect()),

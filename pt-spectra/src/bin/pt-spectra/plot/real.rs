@@ -63,6 +63,8 @@ pub fn models(args: &Args) -> Result<Figure> {
     }
     let bands = args.bands(&[1.0])?;
     let mut upper = Panel::new("P_dd / P_nowiggle");
+    // The paper's range; models that have broken down (N2, N3 at high k) leave it.
+    upper.clamp = Some((0.7, 1.3));
     let mut lower = Panel::new("");
     lower.lines.push((1.0, Style::Solid));
     lower.bands = bands.iter().map(|b| (1.0 - b, 1.0 + b)).collect();

@@ -7,6 +7,7 @@ use super::real::rsd_color;
 use super::table::{interpolate, Measured, Named};
 use super::Args;
 use anyhow::{bail, Result};
+use plotters::chart::SeriesLabelPosition;
 use plotters::style::RGBColor;
 use pt_spectra::halo::crossings;
 use pt_spectra::jobs::SN_LEVELS;
@@ -101,6 +102,8 @@ pub fn multipoles(args: &Args) -> Result<Figure> {
         ratio.clamp = Some((0.5, 1.5));
         value.vlines.clone_from(&sn_lines);
         ratio.vlines.clone_from(&sn_lines);
+        // One legend, in the first panel, above the curves that start near 1 at low k.
+        value.legend = panels.is_empty().then_some(SeriesLabelPosition::UpperLeft);
         let reference = tables
             .iter()
             .find_map(|t| Some((t.column("k")?, t.column(&nw_name)?)));
@@ -117,9 +120,9 @@ pub fn multipoles(args: &Args) -> Result<Figure> {
             let rsd = what.split_whitespace().next().unwrap_or("").to_string();
             let real = what.rsplit(' ').next().unwrap_or("").to_string();
             let c = rsd_color(&real);
-            let mut label = args.label(i, || what.clone())?;
+            let mut label = args.label(i, || format!("{rsd} + {real}"))?;
             if let Some(km) = k_max {
-                label += &format!(", k_max = {km}");
+                label += &format!(" (k_max {km})");
             }
             let y: Vec<f64> = match t.column(&nw_name) {
                 Some(nw) => p.iter().zip(&nw).map(|(p, n)| p / n).collect(),
