@@ -1,6 +1,11 @@
 //! Δχ² surfaces in the plane of two free parameters (the paper's f–σ0 and f–A_b planes): χ² on a grid
 //! around the best fit, with the other free parameter re-minimised at each grid point, so that the
 //! Δχ² = 2.30 contour is the two-parameter 1σ region of the paper (sections 4.3 and 4.5).
+//!
+//! The grid follows the principal axes of the Δχ² ellipse at the best fit (the Hessian of the profile χ²
+//! by central differences, in units of the 1σ half-widths): in a degenerate plane such as f–A_b of the
+//! halo monopole (correlation ≈ −0.999) the contour is a thin tilted ellipse that a grid along the
+//! parameters resolves only with hundreds of points per axis.
 
 use super::minimise::{steps, Residuals, Window};
 use super::{check, FitResult, FitSettings, MultipoleData, MultipoleModel, Parameter, Params};
@@ -14,14 +19,15 @@ pub const CONTOUR_LEVELS: [f64; 2] = [2.30, 6.17];
 /// The grid of a Δχ² surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContourGrid {
-    /// The parameter along the first axis.
+    /// The first parameter.
     pub x: Parameter,
-    /// The parameter along the second axis.
+    /// The second parameter.
     pub y: Parameter,
     /// Grid points per axis (3 to 401), spaced evenly.
     pub points: usize,
-    /// Half-width of each axis in units of the half-width of the parameter's 1σ interval of the fit
-    /// (2.5 holds the Δχ² = 6.17 contour of a Gaussian surface, 1.64 times the 2.30 one).
+    /// Half-width of each axis in units of the Δχ² = 2.30 semi-axis along it (2.5 holds the 6.17
+    /// contour of a Gaussian surface, 1.64 times the 2.30 one); for a grid along the parameters, in
+    /// units of their 1σ half-widths.
     pub span: f64,
 }
 
@@ -36,52 +42,82 @@ impl Default for ContourGrid {
     }
 }
 
-/// Δχ² on a grid of two parameters at one k_max.
+/// Δχ² on a grid of two parameters at one k_max. Grid point (i, j) is `centre + u_i axes[0] + u_j
+/// axes[1]`, u evenly spaced over [−span, span].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Contour {
     /// k_max [h/Mpc] of the fit window.
     pub k_max: f64,
-    /// The parameter along `xs`.
+    /// The first parameter.
     pub x: Parameter,
-    /// The parameter along `ys`.
+    /// The second parameter.
     pub y: Parameter,
     /// χ² at the best fit (the [`FitResult`]'s).
     pub chi2_min: f64,
-    /// Grid values of `x`.
-    pub xs: Vec<f64>,
-    /// Grid values of `y`.
-    pub ys: Vec<f64>,
-    /// `chi2[i][j]`: the profile χ² at (`xs[i]`, `ys[j]`), the other free parameters re-minimised.
+    /// The best fit (x, y), the centre of the grid.
+    pub centre: (f64, f64),
+    /// The two step directions (Δx, Δy) of the grid per unit of u: the principal semi-axes of the
+    /// Δχ² = 2.30 ellipse, or the 1σ half-widths along x and y if the Hessian is not positive definite.
+    pub axes: [(f64, f64); 2],
+    /// Whether `axes` are the ellipse's (else along x and y).
+    pub principal: bool,
+    /// `points[i][j]`: (x, y) of grid point (i, j).
+    pub points: Vec<Vec<(f64, f64)>>,
+    /// `chi2[i][j]`: the profile χ² at `points[i][j]`, the other free parameters re-minimised.
     pub chi2: Vec<Vec<f64>>,
     /// `at[i][j]`: the parameters where that minimum is reached.
     pub at: Vec<Vec<Params>>,
 }
 
-/// The axis of `p`: `points` values over best ± span × the half-width of its 1σ interval (5% of the
-/// value, at least 0.005, if the interval is not finite), cut at 0 for σ0 (χ² is even in σ0).
-fn axis(p: Parameter, result: &FitResult, grid: &ContourGrid) -> Vec<f64> {
-    let centre = result.best.get(p);
-    let half = result
+/// The half-width of the 1σ interval of `p` in `result` (5% of its value, at least 0.005, if the
+/// interval is not finite).
+fn half_width(p: Parameter, result: &FitResult) -> f64 {
+    result
         .intervals
         .iter()
         .find(|i| i.0 == p)
         .map(|&(_, lo, hi)| 0.5 * (hi - lo))
         .filter(|h| h.is_finite() && *h > 0.0)
-        .unwrap_or(0.05 * centre.abs().max(0.1));
-    let (mut lo, hi) = (centre - grid.span * half, centre + grid.span * half);
-    if p == Parameter::Sigma0 {
-        lo = lo.max(0.0);
+        .unwrap_or(0.05 * result.best.get(p).abs().max(0.1))
+}
+
+/// The principal semi-axes of the Δχ² = 2.30 ellipse of `profile` (χ² of (x, y) around `centre`), in
+/// (Δx, Δy), from its Hessian by central differences with steps of half the 1σ half-widths `w`;
+/// `None` if that Hessian is not positive definite.
+fn principal_axes(
+    profile: &dyn Fn(f64, f64) -> f64,
+    centre: (f64, f64),
+    w: (f64, f64),
+) -> Option<[(f64, f64); 2]> {
+    // In units of w: X = Δx/w_x, Y = Δy/w_y, steps h = 1/2.
+    let h = 0.5;
+    let at = |a: f64, b: f64| profile(centre.0 + a * w.0, centre.1 + b * w.1);
+    let f0 = at(0.0, 0.0);
+    let hxx = (at(h, 0.0) - 2.0 * f0 + at(-h, 0.0)) / (h * h);
+    let hyy = (at(0.0, h) - 2.0 * f0 + at(0.0, -h)) / (h * h);
+    let hxy = (at(h, h) - at(h, -h) - at(-h, h) + at(-h, -h)) / (4.0 * h * h);
+    let (mean, diff) = (0.5 * (hxx + hyy), 0.5 * (hxx - hyy));
+    let root = (diff * diff + hxy * hxy).sqrt();
+    let (l1, l2) = (mean + root, mean - root);
+    if !(l1.is_finite() && l2.is_finite() && l2 > 0.0) {
+        return None;
     }
-    let n = grid.points;
-    (0..n)
-        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
-        .collect()
+    // Unit eigenvectors of [[hxx, hxy], [hxy, hyy]]: angle θ with tan 2θ = 2 hxy/(hxx − hyy).
+    let theta = 0.5 * (2.0 * hxy).atan2(hxx - hyy);
+    let (c, s) = (theta.cos(), theta.sin());
+    // Δχ² = ½ λ r² = 2.30 along an eigenvector at r = √(4.6/λ).
+    let r = |l: f64| (2.0 * CONTOUR_LEVELS[0] / l).sqrt();
+    let (r1, r2) = (r(l1), r(l2));
+    Some([(c * r1 * w.0, s * r1 * w.1), (-s * r2 * w.0, c * r2 * w.1)])
 }
 
 /// The Δχ² surface of `grid.x` and `grid.y` around the best fit `result` of `settings` (as returned by
 /// [`super::fit`] for the same model and data): at each grid point the two parameters are held and the
 /// other free parameter, if any, is re-minimised (1-D Brent within 20 starting steps of its best-fit
-/// value, as for the intervals of [`super::fit`]).
+/// value, as for the intervals of [`super::fit`]). The grid runs along the principal axes of the
+/// Δχ² ellipse over ±`span` times its 2.30 semi-axes (module docs), or along x and y over ±`span`
+/// times their 1σ half-widths where the Hessian is not positive definite. χ² is even in σ0, so grid
+/// points with σ0 < 0 mirror those at |σ0|.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] if x = y, either is not free, the grid has fewer than 3 or more than 401
@@ -124,14 +160,31 @@ pub fn contour(
     };
     let x0: Vec<f64> = free.iter().map(|&p| settings.start.get(p)).collect();
     let steps = steps(&x0);
-    let (xs, ys) = (axis(grid.x, result, grid), axis(grid.y, result, grid));
-    let mut chi2 = Vec::with_capacity(xs.len());
-    let mut at = Vec::with_capacity(xs.len());
-    for &x in &xs {
-        let (c, p): (Vec<f64>, Vec<Params>) = ys
+    let profile =
+        |x: f64, y: f64| window.profile(&[(grid.x, x), (grid.y, y)], &result.best, &steps);
+    let centre = (result.best.get(grid.x), result.best.get(grid.y));
+    let w = (half_width(grid.x, result), half_width(grid.y, result));
+    let (axes, principal) = match principal_axes(&|x, y| profile(x, y).0, centre, w) {
+        Some(axes) => (axes, true),
+        None => ([(w.0, 0.0), (0.0, w.1)], false),
+    };
+    let n = grid.points;
+    let u: Vec<f64> = (0..n)
+        .map(|i| grid.span * (2.0 * i as f64 / (n - 1) as f64 - 1.0))
+        .collect();
+    let (mut points, mut chi2, mut at) = (Vec::new(), Vec::new(), Vec::new());
+    for &a in &u {
+        let row: Vec<(f64, f64)> = u
             .iter()
-            .map(|&y| window.profile(&[(grid.x, x), (grid.y, y)], &result.best, &steps))
-            .unzip();
+            .map(|&b| {
+                (
+                    centre.0 + a * axes[0].0 + b * axes[1].0,
+                    centre.1 + a * axes[0].1 + b * axes[1].1,
+                )
+            })
+            .collect();
+        let (c, p): (Vec<f64>, Vec<Params>) = row.iter().map(|&(x, y)| profile(x, y)).unzip();
+        points.push(row);
         chi2.push(c);
         at.push(p);
     }
@@ -140,15 +193,17 @@ pub fn contour(
         x: grid.x,
         y: grid.y,
         chi2_min: result.chi2,
-        xs,
-        ys,
+        centre,
+        axes,
+        principal,
+        points,
         chi2,
         at,
     })
 }
 
-/// Δχ² surfaces as one table with `header` lines, a row per grid point (x outer, y inner, k_max
-/// outermost): `k_max <x> <y> chi2 delta_chi2`, then the re-minimised value of each other free
+/// Δχ² surfaces as one table with `header` lines, a row per grid point (i outer, j inner, k_max
+/// outermost): `k_max i j <x> <y> chi2 delta_chi2`, then the re-minimised value of each other free
 /// parameter of `free`.
 pub fn contour_table(contours: &[Contour], free: &[Parameter], header: Vec<String>) -> Table {
     let mut t = Table::new(header);
@@ -159,15 +214,17 @@ pub fn contour_table(contours: &[Contour], free: &[Parameter], header: Vec<Strin
     let others: Vec<Parameter> = free.iter().copied().filter(|&p| p != x && p != y).collect();
     let rows = || {
         contours.iter().flat_map(|c| {
-            (0..c.xs.len()).flat_map(move |i| (0..c.ys.len()).map(move |j| (c, i, j)))
+            (0..c.points.len()).flat_map(move |i| (0..c.points[i].len()).map(move |j| (c, i, j)))
         })
     };
     let column = |f: &dyn Fn(&Contour, usize, usize) -> f64| -> Vec<f64> {
         rows().map(|(c, i, j)| f(c, i, j)).collect()
     };
     t.push("k_max", WAVENUMBER, column(&|c, _, _| c.k_max));
-    t.push(x.name(), x.unit(), column(&|c, i, _| c.xs[i]));
-    t.push(y.name(), y.unit(), column(&|c, _, j| c.ys[j]));
+    t.push("i", "1", column(&|_, i, _| i as f64));
+    t.push("j", "1", column(&|_, _, j| j as f64));
+    t.push(x.name(), x.unit(), column(&|c, i, j| c.points[i][j].0));
+    t.push(y.name(), y.unit(), column(&|c, i, j| c.points[i][j].1));
     t.push("chi2", "1", column(&|c, i, j| c.chi2[i][j]));
     t.push(
         "delta_chi2",
@@ -269,9 +326,10 @@ mod tests {
             span: 2.0,
         };
         let c = contour(&model, &data, &settings, r, &grid).unwrap();
+        assert!(c.principal);
         // No other free parameter: every grid value is χ² at that point, summed independently.
-        for (i, &x) in c.xs.iter().enumerate() {
-            for (j, &y) in c.ys.iter().enumerate() {
+        for (i, row) in c.points.iter().enumerate() {
+            for (j, &(x, y)) in row.iter().enumerate() {
                 let p = Params {
                     f: x,
                     amplitude: y,
@@ -286,36 +344,43 @@ mod tests {
                 assert_eq!(chi2(&model, &data, &p, 0.0, 0.15).unwrap(), c.chi2[i][j]);
             }
         }
-        // The Δχ² = 2.30 region projected on each axis is the fit's 1σ interval (found by bisection on
-        // the profile): the crossings of min_y Δχ², a parabola near its minimum, interpolated between
-        // grid columns of width 4/60 of the interval, agree to ~1e-3 of its width.
-        let profile_x: Vec<f64> = c
-            .chi2
-            .iter()
-            .map(|col| col.iter().copied().fold(f64::INFINITY, f64::min) - c.chi2_min)
-            .collect();
-        let (_, lo, hi) = r.intervals[0];
-        let ends = crossings_of(&c.xs, &profile_x, CONTOUR_LEVELS[0]);
-        assert_eq!(ends.len(), 2, "{ends:?}");
-        let width = hi - lo;
+        // The Δχ² = 2.30 contour (crossings on the grid's edges, linearly interpolated) reaches exactly
+        // the fit's 1σ interval of f, found by bisection on the profile, at its two ends.
+        let (lo, hi) = x_extent(&c, CONTOUR_LEVELS[0]);
+        let (_, f_lo, f_hi) = r.intervals[0];
+        let width = f_hi - f_lo;
         assert!(
-            (ends[0] - lo).abs() < 0.01 * width,
-            "{ends:?} vs [{lo}, {hi}]"
+            (lo - f_lo).abs() < 0.01 * width,
+            "[{lo}, {hi}] vs [{f_lo}, {f_hi}]"
         );
         assert!(
-            (ends[1] - hi).abs() < 0.01 * width,
-            "{ends:?} vs [{lo}, {hi}]"
+            (hi - f_hi).abs() < 0.01 * width,
+            "[{lo}, {hi}] vs [{f_lo}, {f_hi}]"
         );
-        // The grid holds the 6.17 contour: its edges are above it.
-        assert!(profile_x[0] > CONTOUR_LEVELS[1] && profile_x[60] > CONTOUR_LEVELS[1]);
+        // The grid holds the 6.17 contour: its border is above it, its centre at the minimum.
+        let n = c.points.len() - 1;
+        let border = (0..=n).flat_map(|i| [c.chi2[i][0], c.chi2[i][n], c.chi2[0][i], c.chi2[n][i]]);
+        assert!(border.fold(f64::INFINITY, f64::min) - c.chi2_min > CONTOUR_LEVELS[1]);
+        assert!((c.chi2[n / 2][n / 2] - c.chi2_min).abs() < 1e-6);
     }
 
-    /// Where `y` crosses `level` along `x`, linearly interpolated.
-    fn crossings_of(x: &[f64], y: &[f64], level: f64) -> Vec<f64> {
-        (1..x.len())
-            .filter(|&i| (y[i - 1] - level) * (y[i] - level) < 0.0)
-            .map(|i| x[i - 1] + (level - y[i - 1]) / (y[i] - y[i - 1]) * (x[i] - x[i - 1]))
-            .collect()
+    /// The least and largest x where Δχ² crosses `level` on an edge of the grid, linearly interpolated.
+    fn x_extent(c: &Contour, level: f64) -> (f64, f64) {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let n = c.points.len();
+        let d = |i: usize, j: usize| c.chi2[i][j] - c.chi2_min - level;
+        for i in 0..n {
+            for j in 0..n {
+                for (i2, j2) in [(i + 1, j), (i, j + 1)] {
+                    if i2 < n && j2 < n && d(i, j) * d(i2, j2) < 0.0 {
+                        let t = d(i, j) / (d(i, j) - d(i2, j2));
+                        let x = c.points[i][j].0 + t * (c.points[i2][j2].0 - c.points[i][j].0);
+                        (lo, hi) = (lo.min(x), hi.max(x));
+                    }
+                }
+            }
+        }
+        (lo, hi)
     }
 
     #[test]
@@ -341,8 +406,8 @@ mod tests {
             span: 2.5,
         };
         let c = contour(&model, &data, &settings, r, &grid).unwrap();
-        for (i, &x) in c.xs.iter().enumerate() {
-            for (j, &y) in c.ys.iter().enumerate() {
+        for (i, row) in c.points.iter().enumerate() {
+            for (j, &(x, y)) in row.iter().enumerate() {
                 // σ0 on a fine scan of [0, 10] Mpc/h (χ² is even in σ0), then a finer one around the
                 // best node: its minimum can only be above the true one, by ~1e-6 here.
                 let at = |s: f64| {
@@ -419,7 +484,10 @@ mod tests {
             &settings.free,
             vec![],
         );
-        assert_eq!(t.names(), ["k_max", "f", "ab", "chi2", "delta_chi2"]);
+        assert_eq!(
+            t.names(),
+            ["k_max", "i", "j", "f", "ab", "chi2", "delta_chi2"]
+        );
         assert_eq!(t.rows(), 9);
     }
 }

@@ -48,7 +48,7 @@ pub struct FitTables {
     /// `P<l>_nw` (at the start f and A_b), and the best-fit model `P<l>_kmax<K>` of each k_max over the
     /// whole data grid.
     pub model: Option<Table>,
-    /// `k_max <x> <y> chi2 delta_chi2 <other>`: the Δχ² surface, a row per grid point.
+    /// `k_max i j <x> <y> chi2 delta_chi2 <other>`: the Δχ² surface, a row per grid point (i, j).
     pub contour: Option<Table>,
 }
 
@@ -203,9 +203,11 @@ pub fn fit_tables(
                 .collect::<Result<Vec<_>>>()?;
             let mut h = header;
             h.push(format!(
-                "delta_chi2 = chi2 - chi2_min on a {0} x {0} grid of ({1}, {2}) over the best fit +- {3} \
-                 times the 1-sigma half-width, the other free parameters re-minimised at each point; \
-                 levels {4} and {5} bound the 68.3% and 95.4% regions of two parameters",
+                "delta_chi2 = chi2 - chi2_min on a {0} x {0} grid (i, j) of ({1}, {2}) along the principal \
+                 axes of the delta_chi2 = {4} ellipse at the best fit, over +- {3} times its semi-axes (or \
+                 along {1} and {2} over +- {3} times their 1-sigma half-widths where the ellipse is not \
+                 defined), the other free parameters re-minimised at each point; levels {4} and {5} \
+                 bound the 68.3% and 95.4% regions of two parameters; chi2 is even in sigma0",
                 grid.points, grid.x, grid.y, grid.span, CONTOUR_LEVELS[0], CONTOUR_LEVELS[1]
             ));
             Some(contour_table(&surfaces, &request.free, h))

@@ -86,19 +86,30 @@ fn fit_writes_model_multipoles_and_contours_that_match_direct_chi2() {
     let contour = std::fs::read_to_string(&contour_out).unwrap();
     assert_eq!(
         column_names_of(&contour, "# k_max"),
-        ["k_max", "f", "ab", "chi2", "delta_chi2"]
+        ["k_max", "i", "j", "f", "ab", "chi2", "delta_chi2"]
     );
     let grid = rows(&contour);
     assert_eq!(grid.len(), 2 * 11 * 11);
     // The inputs pass through 10 printed digits and the 1% errors amplify them 100 times: ~1e-7 of a
     // data point's share of χ², ~1e-6 of χ² in all.
     for r in &grid {
-        let want = chi2(r[1], r[2], r[0]);
-        assert!((r[3] / want - 1.0).abs() < 1e-5, "{r:?} vs {want}");
+        let want = chi2(r[3], r[4], r[0]);
+        assert!((r[5] / want - 1.0).abs() < 1e-5, "{r:?} vs {want}");
         let fit = fits.iter().find(|x| x[0] == r[0]).unwrap();
         assert!(
-            (r[4] - (want - fit[8])).abs() < 1e-5 * want.max(1.0),
+            (r[6] - (want - fit[8])).abs() < 1e-5 * want.max(1.0),
             "{r:?} {fit:?}"
+        );
+    }
+    // The grid centre (i, j) = (5, 5) is the best fit, where Δχ² = 0.
+    for fit in &fits {
+        let centre = grid
+            .iter()
+            .find(|r| r[0] == fit[0] && r[1] == 5.0 && r[2] == 5.0)
+            .unwrap();
+        assert!(
+            (centre[3] / fit[2] - 1.0).abs() < 1e-8 && centre[6].abs() < 1e-6,
+            "{centre:?}"
         );
     }
     // The best fit at each k_max, and the model table at it.

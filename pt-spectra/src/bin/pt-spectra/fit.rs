@@ -82,13 +82,15 @@ pub struct Args {
     /// Δχ² = 2.3 and 6.17 contours).
     #[arg(long, value_name = "P1,P2", requires = "contour_out")]
     contour: Option<String>,
-    /// The file of the --contour surface: `k_max <P1> <P2> chi2 delta_chi2 <other free>`.
+    /// The file of the --contour surface: `k_max i j <P1> <P2> chi2 delta_chi2 <other free>`, a row per
+    /// grid point (i, j).
     #[arg(long, value_name = "FILE", requires = "contour")]
     contour_out: Option<PathBuf>,
     /// Grid points per axis of the --contour surface (3 to 401).
     #[arg(long, value_name = "N", default_value_t = 41)]
     contour_points: usize,
-    /// Half-width of each --contour axis in units of the parameter's 1σ half-width from the fit.
+    /// Half-width of each --contour axis in units of the Δχ² = 2.3 ellipse's semi-axis along it (the grid
+    /// follows the ellipse's principal axes, which resolves degenerate planes such as f–A_b).
     #[arg(long, value_name = "S", default_value_t = 2.5)]
     contour_span: f64,
 }

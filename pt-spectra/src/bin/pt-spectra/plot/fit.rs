@@ -111,22 +111,25 @@ pub fn fits(args: &Args) -> Result<Figure> {
     ))
 }
 
-/// The segments where the grid `v[i][j]` (at `xs[i]`, `ys[j]`) crosses `level`, by marching squares,
-/// as one polyline with NaN between segments.
-fn level_lines(xs: &[f64], ys: &[f64], v: &[Vec<f64>], level: f64) -> (Vec<f64>, Vec<f64>) {
+/// The segments where Δχ² on the structured grid (`x[i][j]`, `y[i][j]`, `v[i][j]`) crosses `level`, by
+/// marching squares (crossings linearly interpolated on the cell edges), as one polyline with NaN
+/// between segments.
+fn level_lines(x: &[Vec<f64>], y: &[Vec<f64>], v: &[Vec<f64>], level: f64) -> (Vec<f64>, Vec<f64>) {
     let (mut px, mut py) = (Vec::new(), Vec::new());
-    let cross = |a: (f64, f64, f64), b: (f64, f64, f64)| -> Option<(f64, f64)> {
-        let (da, db) = (a.2 - level, b.2 - level);
+    let n = v.len();
+    let m = v.first().map_or(0, Vec::len);
+    let cross = |a: (usize, usize), b: (usize, usize)| -> Option<(f64, f64)> {
+        let (da, db) = (v[a.0][a.1] - level, v[b.0][b.1] - level);
         if !(da.is_finite() && db.is_finite()) || (da < 0.0) == (db < 0.0) {
             return None;
         }
         let t = da / (da - db);
-        Some((a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1)))
+        let lerp = |g: &[Vec<f64>]| g[a.0][a.1] + t * (g[b.0][b.1] - g[a.0][a.1]);
+        Some((lerp(x), lerp(y)))
     };
-    for i in 0..xs.len().saturating_sub(1) {
-        for j in 0..ys.len().saturating_sub(1) {
-            let corner = |di: usize, dj: usize| (xs[i + di], ys[j + dj], v[i + di][j + dj]);
-            let (c00, c10, c11, c01) = (corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1));
+    for i in 0..n.saturating_sub(1) {
+        for j in 0..m.saturating_sub(1) {
+            let (c00, c10, c11, c01) = ((i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1));
             let points: Vec<(f64, f64)> = [(c00, c10), (c10, c11), (c11, c01), (c01, c00)]
                 .into_iter()
                 .filter_map(|(a, b)| cross(a, b))
@@ -144,20 +147,17 @@ fn level_lines(xs: &[f64], ys: &[f64], v: &[Vec<f64>], level: f64) -> (Vec<f64>,
 /// k_max, and the grid point of least χ².
 pub fn contour(args: &Args) -> Result<Figure> {
     let t = Named::read(args.one_input()?)?;
-    if t.names.len() < 5 || t.names[0] != "k_max" || t.names[4] != "delta_chi2" {
+    let n = &t.names;
+    if n.len() < 7 || n[0] != "k_max" || n[1] != "i" || n[2] != "j" || n[6] != "delta_chi2" {
         bail!(
-            "`{}`: expected `k_max <P1> <P2> chi2 delta_chi2 …` (fit --contour-out), found {}",
+            "`{}`: expected `k_max i j <P1> <P2> chi2 delta_chi2 …` (fit --contour-out), found {}",
             t.path,
-            t.names.join(" ")
+            n.join(" ")
         );
     }
-    let (xn, yn) = (t.names[1].clone(), t.names[2].clone());
-    let (k, x, y, d) = (
-        t.need("k_max")?,
-        t.need(&xn)?,
-        t.need(&yn)?,
-        t.need("delta_chi2")?,
-    );
+    let (xn, yn) = (n[3].clone(), n[4].clone());
+    let (k, gi, gj) = (t.need("k_max")?, t.need("i")?, t.need("j")?);
+    let (x, y, d) = (t.need(&xn)?, t.need(&yn)?, t.need("delta_chi2")?);
     let chosen = match args.k_max {
         Some(want) => k
             .iter()
@@ -166,32 +166,40 @@ pub fn contour(args: &Args) -> Result<Figure> {
         None => k.iter().copied().max_by(f64::total_cmp),
     }
     .unwrap_or(f64::NAN);
-    let rows: Vec<usize> = (0..k.len()).filter(|&i| k[i] == chosen).collect();
-    let mut xs: Vec<f64> = Vec::new();
-    let mut ys: Vec<f64> = Vec::new();
-    for &r in &rows {
-        if !xs.contains(&x[r]) {
-            xs.push(x[r]);
-        }
-        if !ys.contains(&y[r]) {
-            ys.push(y[r]);
-        }
-    }
-    if xs.len() < 2 || ys.len() < 2 || xs.len() * ys.len() != rows.len() {
+    let rows: Vec<usize> = (0..k.len()).filter(|&r| k[r] == chosen).collect();
+    let index = |v: f64| (v >= 0.0 && v.fract() == 0.0).then_some(v as usize);
+    let size = |g: &[f64]| {
+        rows.iter()
+            .filter_map(|&r| index(g[r]))
+            .max()
+            .map_or(0, |m| m + 1)
+    };
+    let (ni, nj) = (size(&gi), size(&gj));
+    if ni < 2 || nj < 2 || ni * nj != rows.len() {
         bail!(
-            "`{}`: the rows of k_max = {chosen} are not a grid of {xn} and {yn}",
+            "`{}`: the rows of k_max = {chosen} are not a grid (i, j) of {xn} and {yn}",
             t.path
         );
     }
-    let mut grid = vec![vec![f64::NAN; ys.len()]; xs.len()];
+    let (mut gx, mut gy, mut gd) = (
+        vec![vec![f64::NAN; nj]; ni],
+        vec![vec![f64::NAN; nj]; ni],
+        vec![vec![f64::NAN; nj]; ni],
+    );
     for &r in &rows {
-        let i = xs.iter().position(|&v| v == x[r]).unwrap_or(0);
-        let j = ys.iter().position(|&v| v == y[r]).unwrap_or(0);
-        grid[i][j] = d[r];
+        let (Some(i), Some(j)) = (index(gi[r]), index(gj[r])) else {
+            bail!(
+                "`{}`: row with i = {}, j = {} is not on the grid",
+                t.path,
+                gi[r],
+                gj[r]
+            );
+        };
+        (gx[i][j], gy[i][j], gd[i][j]) = (x[r], y[r], d[r]);
     }
     let mut panel = Panel::new(yn.clone());
     for (level, style) in CONTOUR_LEVELS.iter().zip([Style::Solid, Style::Dashed]) {
-        let (px, py) = level_lines(&xs, &ys, &grid, *level);
+        let (px, py) = level_lines(&gx, &gy, &gd, *level);
         panel.curves.push(
             Curve::new(format!("Delta chi2 = {level}"), px, py)
                 .styled(style)
