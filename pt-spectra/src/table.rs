@@ -184,6 +184,26 @@ impl Table {
     }
 }
 
+/// The 0-based index of the column `name` on the last `# k …` names line of `text` before its first
+/// data row, if there is such a line and it has that name (not as its first column).
+pub fn named_column(text: &str, name: &str) -> Option<usize> {
+    let mut found = None;
+    for line in text.lines() {
+        let t = line.trim_start();
+        let Some(rest) = t.strip_prefix('#') else {
+            if !t.is_empty() {
+                break;
+            }
+            continue;
+        };
+        let names: Vec<&str> = rest.split_whitespace().collect();
+        if names.first() == Some(&"k") {
+            found = names.iter().skip(1).position(|&n| n == name).map(|j| j + 1);
+        }
+    }
+    found
+}
+
 /// A function of k [h/Mpc] given at strictly increasing k and interpolated linearly in ln k. It is not
 /// extrapolated: asking outside its range is an error.
 #[derive(Debug, Clone, PartialEq)]
@@ -292,6 +312,37 @@ impl Tabulated {
         Self::new(name, &table.origin, k, v, positive, &table.lines)
     }
 
+    /// Reads `name` from a file whose first column is k and whose value column is the one named
+    /// `column` on a `# k …` names line (as every table of pt-spectra has: `halo` output feeds
+    /// `--bias-file` by its column `b` and `--noise-file` by `P_eps`), else the second column.
+    ///
+    /// ```
+    /// use pt_spectra::table::Tabulated;
+    /// let path = std::env::temp_dir().join(format!("pt-named-{}.dat", std::process::id()));
+    /// std::fs::write(&path, "# column 1: k [h/Mpc]\n# k b P_eps\n0.01 2.5 3e4\n0.1 2.6 2.9e4\n")?;
+    /// let noise = Tabulated::read_column(&path, "P_eps(k)", "P_eps", true)?;
+    /// assert_eq!(noise.eval(0.1)?, 2.9e4);
+    /// let bias = Tabulated::read_column(&path, "b(k)", "bias", true)?; // no such name: column 2
+    /// assert_eq!(bias.eval(0.01)?, 2.5);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`read`](Self::read).
+    pub fn read_column(
+        path: impl AsRef<Path>,
+        name: &'static str,
+        column: &str,
+        positive: bool,
+    ) -> Result<Self> {
+        let path = path.as_ref();
+        let text = read_text(path)?;
+        let value_column = named_column(&text, column).unwrap_or(1);
+        let table = Table::parse(&text, &path.display().to_string(), &[0, value_column])?;
+        let [k, v]: [Vec<f64>; 2] = table.columns.try_into().expect("two columns");
+        Self::new(name, &table.origin, k, v, positive, &table.lines)
+    }
+
     /// The k range [h/Mpc].
     pub fn range(&self) -> (f64, f64) {
         (self.k[0], self.k[self.k.len() - 1])
@@ -362,5 +413,17 @@ mod tests {
         assert!(nan.unwrap_err().to_string().contains("NaN"));
         let down = Tabulated::new("b(k)", "mem", vec![0.1, 0.01], vec![1.0, 1.0], true, &[]);
         assert!(down.is_err());
+    }
+
+    #[test]
+    fn named_columns_are_found_on_the_k_line_only() {
+        let text = "# halo\n# column 1: k [h/Mpc]\n# k b P_eps\n0.1 2 3\n";
+        assert_eq!(named_column(text, "P_eps"), Some(2));
+        assert_eq!(named_column(text, "b"), Some(1));
+        assert_eq!(named_column(text, "k"), None);
+        assert_eq!(named_column(text, "SN"), None);
+        // Only header lines before the data count; a names row without `#` is not a `# k` line.
+        assert_eq!(named_column("0.1 2\n# k b\n", "b"), None);
+        assert_eq!(named_column("k b\n0.1 2\n", "b"), None);
     }
 }

@@ -96,10 +96,11 @@ class RsdPlan:
 
     def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=1.0,
                  amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None, number_density=None,
-                 noise_table=None, ells=(0, 2, 4), terms=False, eh=None, growth_factor=None):
+                 noise_table=None, ells=(0, 2, 4), terms=False, eh=None, growth_factor=None,
+                 no_wiggle=False):
         return _warn(self._plan(linear, z, z_input, cosmology, f, bias, amplitude, fog, sigma0,
                                 shot_noise, number_density, noise_table, list(ells), terms, eh,
-                                growth_factor))
+                                growth_factor, no_wiggle))
 
     def terms(self, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None):
         """The loop terms of one linear spectrum (the expensive part), as :class:`RsdTerms`."""
@@ -121,10 +122,10 @@ class RsdTerms:
 
     def multipoles(self, f=None, bias=1.0, amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None,
                    number_density=None, noise_table=None, ells=(0, 2, 4), terms=False,
-                   growth_factor=None):
+                   growth_factor=None, no_wiggle=False):
         return _warn(self._terms.multipoles(f, bias, amplitude, fog, sigma0, shot_noise,
                                             number_density, noise_table, list(ells), terms,
-                                            growth_factor))
+                                            growth_factor, no_wiggle))
 
 
 def real(model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False,
@@ -152,21 +153,25 @@ def real(model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None
 def rsd(rsd="tns", real="1l-rpt-n1", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None,
         f=None, bias=1.0, amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None,
         number_density=None, noise_table=None, ells=(0, 2, 4), terms=False, precision="default",
-        q_range=None, cache_dir=None, eh=None, k_min=1e-3, k_max=1.0, nk=100) -> Table:
+        q_range=None, cache_dir=None, eh=None, k_min=1e-3, k_max=1.0, nk=100,
+        no_wiggle=False) -> Table:
     """Redshift-space multipoles (``pt-spectra rsd``): columns ``k P0 P2 P4 … err_P0 …``.
 
     rsd: ``kaiser``, ``scoccimarro`` or ``tns``; real: the real-space model (as :func:`real`).
     f: growth rate (default f(z) of the cosmology). bias: a number, a path or ``(k, b)`` arrays;
     amplitude: A_b. fog: ``none``, ``lorentzian`` or ``gaussian``; sigma0 [Mpc/h] (z = 0 value) or
     ``"lin"`` / ``"1l-spt"`` (the theory value). Noise: one of shot_noise [(Mpc/h)^3],
-    number_density [(h/Mpc)^3] (Poisson) or noise_table (path or ``(k, P_eps)``): the multipoles are
-    those of the noise-subtracted spectrum P_hh - P_eps, so the noise does not change them; it adds
-    the columns ``P_eps SN``. ells: even multipoles up to 8. terms: add the parts
-    ``P<l>_sc P<l>_A P<l>_B``. The other arguments are those of :func:`real`.
+    number_density [(h/Mpc)^3] (Poisson) or noise_table (path or ``(k, P_eps)``; a path is read by
+    the column names ``b`` and ``P_eps`` of a ``pt-spectra halo`` table, else column 2). The models
+    are of the noise-subtracted spectrum, so the noise changes no P_l: it adds ``P_eps SN SN_s``, SN =
+    b^2 P_dd/P_eps (real space, the paper's signal-to-noise) and SN_s = P0/P_eps. ells: even
+    multipoles up to 8. terms: add the parts ``P<l>_sc P<l>_A P<l>_B``. no_wiggle: add ``P<l>_nw``,
+    the linear Kaiser multipoles of the no-wiggle spectrum. The other arguments are those of
+    :func:`real`.
     """
     plan = RsdPlan(_grid(k, k_min, k_max, nk), real, rsd, precision, q_range, cache_dir)
     return plan(linear, z, z_input, cosmology, f, bias, amplitude, fog, sigma0, shot_noise,
-                number_density, noise_table, ells, terms, eh)
+                number_density, noise_table, ells, terms, eh, no_wiggle=no_wiggle)
 
 
 def fit(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_columns=None,
@@ -179,7 +184,9 @@ def fit(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_
     data: a file (columns ``k P0 s0 P2 s2 P4 s4``, or ``data_columns`` 1-based for ``data_ells``) or a
     dict ``{"k": …, "P0": …, "s0": …, …}`` with the multipoles of ``ells``. k_max: a list of k_max
     [h/Mpc], one fit (one row) each. covariance: the full covariance of the fitted data vector
-    (ell-major), default diagonal. f, sigma0, amplitude: start values if free, values if fixed.
+    (ell-major), default diagonal. f, sigma0, amplitude: start values if free, values if fixed;
+    sigma0 may be ``"lin"`` or ``"1l-spt"`` (the theory value, as in :func:`rsd`). With a fog, the
+    columns ``sigma0_lin sigma0_1l`` give the theory sigma0.
     Returns ``k_max points <p> <p>_lo <p>_hi … chi2 dof chi2_dof``.
     """
     if isinstance(k_max, (int, float)):

@@ -280,7 +280,7 @@ fn data(
 #[pyfunction]
 #[pyo3(signature = (data, k_max, free=vec!["f".to_string(), "sigma0".to_string()], ells=vec![0],
     data_ells=vec![0, 2, 4], data_columns=None, covariance=None, rsd="tns", real="1l-spt", fog="lorentzian",
-    f=None, sigma0=3.0, bias=None, amplitude=1.0, shot_noise=None, number_density=None, noise_table=None,
+    f=None, sigma0=None, bias=None, amplitude=1.0, shot_noise=None, number_density=None, noise_table=None,
     k_min=0.0, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default", q_range=None,
     cache_dir=None, eh=None))]
 #[allow(clippy::too_many_arguments)]
@@ -297,7 +297,7 @@ fn fit(
     real: &str,
     fog: &str,
     f: Option<f64>,
-    sigma0: f64,
+    sigma0: Option<&Bound<'_, PyAny>>,
     bias: Option<&Bound<'_, PyAny>>,
     amplitude: f64,
     shot_noise: Option<f64>,
@@ -348,10 +348,14 @@ fn fit(
             bias,
             amplitude,
             fog: fog.parse().map_err(value_error)?,
-            sigma0: Sigma0::Value(sigma0),
+            sigma0: match sigma0 {
+                Some(s) => redshift::sigma0(s)?,
+                None => Sigma0::Value(3.0),
+            },
             noise,
             ells,
             terms: false,
+            no_wiggle: false,
         },
         free,
         k_min,

@@ -15,10 +15,11 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
-/// b(k) or P_εε(k) from a constant, a path or (k, values).
-fn tabulated(obj: &Bound<'_, PyAny>, name: &'static str) -> PyResult<Tabulated> {
+/// A function of k from a path (k in column 1, the value in the column named `column` on a `# k …`
+/// line, else column 2) or a pair of arrays.
+fn tabulated(obj: &Bound<'_, PyAny>, name: &'static str, column: &str) -> PyResult<Tabulated> {
     if let Ok(path) = obj.extract::<PathBuf>() {
-        return Tabulated::read(&path, name, (0, 1), true).map_err(value_error);
+        return Tabulated::read_column(&path, name, column, true).map_err(value_error);
     }
     let (k, v): (Bound<'_, PyAny>, Bound<'_, PyAny>) = obj.extract().map_err(|_| {
         PyValueError::new_err(format!(
@@ -45,10 +46,10 @@ pub(crate) fn bias_and_noise(
 ) -> PyResult<(Bias, Noise)> {
     let bias = match bias.extract::<f64>() {
         Ok(b) => Bias::Constant(b),
-        Err(_) => Bias::Table(tabulated(bias, "b(k)")?),
+        Err(_) => Bias::Table(tabulated(bias, "b(k)", "b")?),
     };
     let noise = match (noise_table, shot_noise, number_density) {
-        (Some(t), None, None) => Noise::Table(tabulated(t, "P_eps(k)")?),
+        (Some(t), None, None) => Noise::Table(tabulated(t, "P_eps(k)", "P_eps")?),
         (None, Some(p), None) => Noise::Constant(p),
         (None, None, Some(n)) => Noise::poisson(n).map_err(value_error)?,
         (None, None, None) => Noise::None,
@@ -62,7 +63,7 @@ pub(crate) fn bias_and_noise(
 }
 
 /// σ0 as a number or `lin` / `1l-spt`.
-fn sigma0(obj: &Bound<'_, PyAny>) -> PyResult<Sigma0> {
+pub(crate) fn sigma0(obj: &Bound<'_, PyAny>) -> PyResult<Sigma0> {
     match obj.extract::<f64>() {
         Ok(v) => format!("{v}").parse().map_err(value_error),
         Err(_) => obj.extract::<String>()?.parse().map_err(value_error),
@@ -104,7 +105,7 @@ impl RsdPlan {
     /// The multipoles of the prepared spectrum: see the Python wrapper `pt_spectra.rsd`.
     #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=None, amplitude=1.0,
         fog="none", sigma0=None, shot_noise=None, number_density=None, noise_table=None, ells=vec![0, 2, 4],
-        terms=false, eh=None, growth_factor=None))]
+        terms=false, eh=None, growth_factor=None, no_wiggle=false))]
     #[allow(clippy::too_many_arguments)]
     fn __call__(
         &self,
@@ -125,8 +126,18 @@ impl RsdPlan {
         terms: bool,
         eh: Option<&str>,
         growth_factor: Option<f64>,
+        no_wiggle: bool,
     ) -> PyResult<Table> {
-        let settings = (f, amplitude, fog, shot_noise, number_density, ells, terms);
+        let settings = (
+            f,
+            amplitude,
+            fog,
+            shot_noise,
+            number_density,
+            ells,
+            terms,
+            no_wiggle,
+        );
         let request = rsd_request(py, self.rsd, bias, sigma0, noise_table, settings)?;
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
         let ((table, prepared), seconds) = detached(py, || {
@@ -167,7 +178,7 @@ impl RsdPlan {
     }
 }
 
-/// (f, A_b, FoG, shot noise, number density, ells, parts) of an RSD call.
+/// (f, A_b, FoG, shot noise, number density, ells, parts, no-wiggle multipoles) of an RSD call.
 type RsdSettingsArgs<'a> = (
     Option<f64>,
     f64,
@@ -175,6 +186,7 @@ type RsdSettingsArgs<'a> = (
     Option<f64>,
     Option<f64>,
     Vec<usize>,
+    bool,
     bool,
 );
 
@@ -185,7 +197,7 @@ fn rsd_request(
     bias: Option<&Bound<'_, PyAny>>,
     sigma0: Option<&Bound<'_, PyAny>>,
     noise_table: Option<&Bound<'_, PyAny>>,
-    (f, amplitude, fog, shot_noise, number_density, ells, terms): RsdSettingsArgs<'_>,
+    (f, amplitude, fog, shot_noise, number_density, ells, terms, no_wiggle): RsdSettingsArgs<'_>,
 ) -> PyResult<RsdRequest> {
     let one = 1.0f64.into_pyobject(py)?.into_any();
     let zero = 0.0f64.into_pyobject(py)?.into_any();
@@ -205,6 +217,7 @@ fn rsd_request(
         noise,
         ells,
         terms,
+        no_wiggle,
     })
 }
 
@@ -244,7 +257,8 @@ pub(crate) struct RsdTerms {
 impl RsdTerms {
     /// The multipoles at f, bias, A_b, FoG, σ0 and noise: see the Python wrapper.
     #[pyo3(signature = (f=None, bias=None, amplitude=1.0, fog="none", sigma0=None, shot_noise=None,
-        number_density=None, noise_table=None, ells=vec![0, 2, 4], terms=false, growth_factor=None))]
+        number_density=None, noise_table=None, ells=vec![0, 2, 4], terms=false, growth_factor=None,
+        no_wiggle=false))]
     #[allow(clippy::too_many_arguments)]
     fn multipoles(
         &self,
@@ -260,8 +274,18 @@ impl RsdTerms {
         ells: Vec<usize>,
         terms: bool,
         growth_factor: Option<f64>,
+        no_wiggle: bool,
     ) -> PyResult<Table> {
-        let settings = (f, amplitude, fog, shot_noise, number_density, ells, terms);
+        let settings = (
+            f,
+            amplitude,
+            fog,
+            shot_noise,
+            number_density,
+            ells,
+            terms,
+            no_wiggle,
+        );
         let request = rsd_request(py, self.rsd, bias, sigma0, noise_table, settings)?;
         let ((table, prepared), seconds) = detached(py, || {
             let prepared = with_growth(self.prepared.clone(), growth_factor)?;

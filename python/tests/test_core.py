@@ -194,3 +194,25 @@ def test_rsd_terms_give_the_multipoles_of_a_full_call_at_any_nuisance_point():
     assert any("growth factor D(z) = 0.5" in line for line in a.header)
     with pytest.raises(ValueError, match="growth_factor"):
         terms.multipoles(growth_factor=-1.0)
+
+
+def test_signal_to_noise_halo_tables_and_theory_sigma0(tmp_path):
+    # SN = b^2 P_lin/P_eps (real space), SN_s = P0/P_eps; a noise or bias path is read by the column
+    # names of a `pt-spectra halo` table; fit takes sigma0 = "lin" as rsd does.
+    k = np.geomspace(0.02, 0.2, 6)
+    b, f = 2.6, 0.48
+    m = pt.rsd(rsd="kaiser", real="linear", k=k, f=f, bias=b, shot_noise=3e4, no_wiggle=True)
+    lin = pt.real(model="linear", k=k)
+    np.testing.assert_allclose(m["SN"], b * b * lin["P_lin"] / 3e4, rtol=1e-12)
+    np.testing.assert_allclose(m["SN_s"], m["P0"] / 3e4, rtol=1e-12)
+    assert {"P0_nw", "P2_nw", "P4_nw"} <= set(m.columns)
+    halo = tmp_path / "halo.dat"
+    halo.write_text("# k b P_eps P_eps_n\n0.01 2.0 4e4 0.7\n0.5 2.0 4e4 0.7\n")
+    h = pt.rsd(rsd="kaiser", real="linear", k=k, f=f, bias=str(halo), noise_table=str(halo))
+    np.testing.assert_allclose(h["P_eps"], 4e4, rtol=1e-12)
+    np.testing.assert_allclose(h["SN"], 4.0 * lin["P_lin"] / 4e4, rtol=1e-12)
+    mock = pt.rsd(rsd="kaiser", real="linear", k=k, f=f, fog="lorentzian", sigma0="lin")
+    data = {"k": k, "P0": mock["P0"], "s0": 0.01 * mock["P0"]}
+    r = pt.fit(data, k_max=[0.2], free=("f",), rsd="kaiser", real="linear", sigma0="lin", f=0.4)
+    np.testing.assert_allclose(r["f"], f, rtol=1e-5)
+    assert r["sigma0_1l"][0] < r["sigma0_lin"][0]

@@ -26,8 +26,9 @@ pub struct RsdSettings {
     pub fog: Fog,
     /// Its scale σ = σ0 D(z) f [Mpc/h] ([`super::fog_sigma`]).
     pub sigma: f64,
-    /// The stochasticity P_εε [(Mpc/h)^3] at each k, if any: subtracted from the monopole
-    /// (P^s_hh = ⟨δ_h δ_h⟩ − P_εε) and reported with the signal-to-noise.
+    /// The stochasticity P_εε [(Mpc/h)^3] at each k, if any. The models are of the noise-subtracted
+    /// spectrum P^s_hh = ⟨δ_h δ_h⟩ − P_εε (which P_εε, μ-independent, changes only in the monopole), so
+    /// P_εε is neither added to nor subtracted from them: it is reported with the signal-to-noise.
     pub noise: Option<Vec<f64>>,
     /// The multipoles ℓ (even, ≤ 8).
     pub ells: Vec<usize>,
@@ -50,8 +51,11 @@ pub struct RsdMultipoles {
     pub parts: Option<[Vec<Vec<Estimate>>; 3]>,
     /// P_εε at each k, if a noise was given.
     pub noise: Option<Vec<f64>>,
-    /// P0/P_εε at each k, if a noise was given.
+    /// The paper's signal-to-noise P_hh/P_εε in real space at each k, P_hh = b² P_δδ (b with its
+    /// amplitude, P_δδ of the real-space model), if a noise was given.
     pub signal_to_noise: Option<Vec<f64>>,
+    /// The redshift-space ratio P0/P_εε at each k, if a noise was given.
+    pub signal_to_noise_s: Option<Vec<f64>>,
 }
 
 /// The multipoles of `settings.model` applied to the real-space spectra `real` (with `tns`, the TNS
@@ -120,6 +124,7 @@ pub fn multipoles(
     let mut total = empty();
     let mut parts = settings.parts.then(|| [empty(), empty(), empty()]);
     let mut signal_to_noise = settings.noise.as_ref().map(|_| Vec::with_capacity(k.len()));
+    let mut signal_to_noise_s = signal_to_noise.clone();
     for (i, &ki) in k.iter().enumerate() {
         let s = [Pair::DeltaDelta, Pair::DeltaTheta, Pair::ThetaTheta].map(|p| real.spectra[p][i]);
         let coefficients = tns.map(|t| &t.coefficients[i]);
@@ -134,9 +139,15 @@ pub fn multipoles(
                 push(out, rule.evaluate_polynomial(&part, settings.fog, x));
             }
         }
-        if let (Some(sn), Some(noise)) = (signal_to_noise.as_mut(), &settings.noise) {
+        if let (Some(sn), Some(sn_s), Some(noise)) = (
+            signal_to_noise.as_mut(),
+            signal_to_noise_s.as_mut(),
+            &settings.noise,
+        ) {
+            let b = settings.bias[i];
+            sn.push(b * b * s[0].value / noise[i]);
             let p0 = monopole.evaluate_polynomial(&sum, settings.fog, x)[0].value;
-            sn.push(p0 / noise[i]);
+            sn_s.push(p0 / noise[i]);
         }
     }
     Ok(RsdMultipoles {
@@ -146,12 +157,14 @@ pub fn multipoles(
         parts,
         noise: settings.noise.clone(),
         signal_to_noise,
+        signal_to_noise_s,
     })
 }
 
 impl RsdMultipoles {
     /// The multipoles as a table with `header` lines: `k P<l>…`, with the parts `P<l>_sc P<l>_A
-    /// P<l>_B` if computed, `P_eps SN` with a noise, and the errors `err_P<l>`.
+    /// P<l>_B` if computed, `P_eps SN SN_s` with a noise (SN = b² P_δδ/P_εε, SN_s = P0/P_εε), and the
+    /// errors `err_P<l>`.
     pub fn table(&self, header: Vec<String>) -> Table {
         let mut t = Table::new(header);
         t.push("k", WAVENUMBER, self.k.clone());
@@ -166,9 +179,12 @@ impl RsdMultipoles {
                 }
             }
         }
-        if let (Some(noise), Some(sn)) = (&self.noise, &self.signal_to_noise) {
+        if let (Some(noise), Some(sn), Some(sn_s)) =
+            (&self.noise, &self.signal_to_noise, &self.signal_to_noise_s)
+        {
             t.push("P_eps", POWER, noise.clone());
             t.push("SN", "1", sn.clone());
+            t.push("SN_s", "1", sn_s.clone());
         }
         for (l, p) in self.ells.iter().zip(&self.total) {
             t.push(
@@ -357,5 +373,48 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("TNS terms") && e.contains("0.2]"), "{e}");
+    }
+
+    #[test]
+    fn signal_to_noise_is_the_real_space_halo_spectrum_over_the_noise() {
+        // Linear input: SN = b² P_lin/P_εε exactly, and the redshift-space ratio SN_s = P0/P_εε is
+        // larger by (b² + 2bf/3 + f²/5)/b² (13% for b = 2.6, f = 0.48).
+        let p = LinearSpectrum::gm2012(0.0).unwrap();
+        let k = [0.02, 0.1, 0.2];
+        let real = crate::real::real_space(
+            RealModel::Linear,
+            &p,
+            &k,
+            &Precision::fast(),
+            &TableStore::in_memory(),
+        )
+        .unwrap();
+        let (b, f) = (2.6, 0.48);
+        let noise = vec![3.0e4, 2.5e4, 2.0e4];
+        let settings = RsdSettings {
+            model: RsdModel::Kaiser,
+            f,
+            bias: vec![b; 3],
+            fog: Fog::None,
+            sigma: 0.0,
+            noise: Some(noise.clone()),
+            ells: vec![0, 2],
+            parts: false,
+        };
+        let m = multipoles(&real, None, &settings).unwrap();
+        let (sn, sn_s) = (
+            m.signal_to_noise.clone().unwrap(),
+            m.signal_to_noise_s.clone().unwrap(),
+        );
+        for i in 0..3 {
+            let want = b * b * p.eval(k[i]) / noise[i];
+            assert!((sn[i] / want - 1.0).abs() < 1e-12, "{} {want}", sn[i]);
+            let kaiser = (b * b + 2.0 * b * f / 3.0 + f * f / 5.0) / (b * b);
+            assert!((sn_s[i] / sn[i] / kaiser - 1.0).abs() < 1e-12);
+        }
+        assert!(m
+            .table(vec![])
+            .names()
+            .ends_with(&["P_eps", "SN", "SN_s", "err_P0", "err_P2"]));
     }
 }

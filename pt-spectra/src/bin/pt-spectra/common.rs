@@ -17,8 +17,8 @@ pub struct BiasArgs {
         conflicts_with = "bias_file"
     )]
     bias: f64,
-    /// Scale-dependent bias b(k) from a table (columns k [h/Mpc], b; interpolated in ln k, not
-    /// extrapolated).
+    /// Scale-dependent bias b(k) from a table: k [h/Mpc] in column 1 and b in the column named `b` on
+    /// a `# k …` names line (as `halo` writes), else column 2; interpolated in ln k, not extrapolated.
     #[arg(long, value_name = "FILE")]
     bias_file: Option<PathBuf>,
     /// Bias amplitude A_b: b(k) → A_b b(k) (in `fit`: its start value if free, its value if fixed).
@@ -36,7 +36,7 @@ impl BiasArgs {
     pub fn bias(&self) -> Result<Bias> {
         Ok(match &self.bias_file {
             Some(path) => {
-                Bias::Table(Tabulated::read(path, "b(k)", (0, 1), true).context("--bias-file")?)
+                Bias::Table(Tabulated::read_column(path, "b(k)", "b", true).context("--bias-file")?)
             }
             None => Bias::Constant(self.bias),
         })
@@ -46,9 +46,11 @@ impl BiasArgs {
 /// The stochasticity P_εε.
 #[derive(clap::Args, Debug)]
 pub struct NoiseArgs {
-    /// Constant stochasticity P_εε [(Mpc/h)^3]. `rsd` adds the columns P_eps and SN = P0/P_eps and the k
-    /// where SN crosses 1, 0.5 and 0.1 and subtracts it from the model monopole; `fit` subtracts it from
-    /// the measured monopole (P_εε changes only the monopole).
+    /// Constant stochasticity P_εε [(Mpc/h)^3]. `rsd`: its models are of the noise-subtracted spectrum
+    /// P^s_hh = ⟨δ_h δ_h⟩ − P_εε, so P_εε is not added to or subtracted from them; it adds the columns
+    /// P_eps, SN = P_hh/P_εε = b² P_δδ/P_εε (real space, the paper's signal-to-noise) and SN_s = P0/P_εε
+    /// and the k where each falls to 1, 0.5 and 0.1. `fit`: subtracted from the measured monopole
+    /// (P_εε changes only the monopole).
     #[arg(long, value_name = "P", allow_hyphen_values = true, conflicts_with_all = ["number_density", "noise_file"])]
     shot_noise: Option<f64>,
     /// Poisson stochasticity P_εε = 1/n_h for the halo number density n_h [(h/Mpc)^3].
@@ -59,7 +61,8 @@ pub struct NoiseArgs {
         conflicts_with = "noise_file"
     )]
     number_density: Option<f64>,
-    /// P_εε(k) from a table (columns k [h/Mpc], P_εε [(Mpc/h)^3]).
+    /// P_εε(k) from a table: k [h/Mpc] in column 1 and P_εε [(Mpc/h)^3] in the column named `P_eps`
+    /// on a `# k …` names line (as `halo` writes), else column 2.
     #[arg(long, value_name = "FILE")]
     noise_file: Option<PathBuf>,
 }
@@ -70,7 +73,8 @@ impl NoiseArgs {
         Ok(
             match (&self.noise_file, self.shot_noise, self.number_density) {
                 (Some(path), _, _) => Noise::Table(
-                    Tabulated::read(path, "P_eps(k)", (0, 1), true).context("--noise-file")?,
+                    Tabulated::read_column(path, "P_eps(k)", "P_eps", true)
+                        .context("--noise-file")?,
                 ),
                 (None, Some(p), _) => Noise::Constant(p),
                 (None, None, Some(n)) => Noise::poisson(n).context("--number-density")?,

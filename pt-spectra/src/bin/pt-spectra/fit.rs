@@ -6,8 +6,8 @@ use crate::progress::Bars;
 use crate::real::write_output;
 use crate::rsd::parsed;
 use anyhow::{bail, Context, Result};
-use pt_spectra::fit::{MultipoleData, Parameter};
-use pt_spectra::jobs::{fit_table, FitRequest, RsdRequest};
+use pt_spectra::fit::{ContourGrid, MultipoleData, Parameter};
+use pt_spectra::jobs::{fit_tables, FitOutputs, FitRequest, RsdRequest};
 use pt_spectra::real::RealModel;
 use pt_spectra::rsd::{Fog, RsdModel, RsdPlan, Sigma0};
 use std::path::PathBuf;
@@ -48,14 +48,16 @@ pub struct Args {
     /// Growth rate: start value if free, value if fixed. Default: f(z) of the cosmology.
     #[arg(long, value_name = "F", allow_hyphen_values = true)]
     f: Option<f64>,
-    /// σ0 [Mpc/h]: start value if free, value if fixed.
+    /// σ0 [Mpc/h]: start value if free, value if fixed; a number, or the theory value of eq. sigmav as
+    /// in `rsd`: `lin` (P_lin) or `1l-spt` (1-loop SPT P_θθ for q ≤ 0.3 h/Mpc, P_lin above).
     #[arg(
         long,
         value_name = "S",
-        default_value_t = 3.0,
-        allow_hyphen_values = true
+        default_value = "3",
+        allow_hyphen_values = true,
+        value_parser = parsed::<Sigma0>
     )]
-    sigma0: f64,
+    sigma0: Sigma0,
     #[command(flatten)]
     bias: BiasArgs,
     #[command(flatten)]
@@ -69,6 +71,27 @@ pub struct Args {
     /// Write the table to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
+    /// Write the best-fit model multipoles of every k_max to this file: `k`, the fitted data
+    /// `P<l>_data err_P<l>_data`, the no-wiggle reference `P<l>_nw` and `P<l>_kmax<K>` (the model
+    /// curves of the paper's figures; `plot multipoles` draws them).
+    #[arg(long, value_name = "FILE")]
+    model_out: Option<PathBuf>,
+    /// Two free parameters, e.g. `f,sigma0` or `f,ab`: write their Δχ² surface at every k_max to
+    /// --contour-out, the other free parameters re-minimised at each point (`plot contour` draws the
+    /// Δχ² = 2.3 and 6.17 contours).
+    #[arg(long, value_name = "P1,P2", requires = "contour_out")]
+    contour: Option<String>,
+    /// The file of the --contour surface: `k_max i j <P1> <P2> chi2 delta_chi2 <other free>`, a row per
+    /// grid point (i, j).
+    #[arg(long, value_name = "FILE", requires = "contour")]
+    contour_out: Option<PathBuf>,
+    /// Grid points per axis of the --contour surface (3 to 401).
+    #[arg(long, value_name = "N", default_value_t = 41)]
+    contour_points: usize,
+    /// Half-width of each --contour axis in units of the Δχ² = 2.3 ellipse's semi-axis along it (the grid
+    /// follows the ellipse's principal axes, which resolves degenerate planes such as f–A_b).
+    #[arg(long, value_name = "S", default_value_t = 2.5)]
+    contour_span: f64,
 }
 
 /// `a:b:step` (inclusive, to rounding), a list, or one value.
@@ -132,22 +155,20 @@ pub fn run(args: &Args) -> Result<()> {
             bias: args.bias.bias()?,
             amplitude: args.bias.amplitude,
             fog: args.fog,
-            sigma0: Sigma0::Value(args.sigma0),
+            sigma0: args.sigma0,
             noise: args.noise.noise()?,
             ells,
             terms: false,
+            no_wiggle: false,
         },
         free,
         k_min: args.k_min,
         k_max: k_max_values(&args.k_max)?,
         data_name: args.data.display().to_string(),
     };
-    for (name, v) in [
-        ("--sigma0", args.sigma0),
-        ("--amplitude", args.bias.amplitude),
-    ]
-    .into_iter()
-    .chain(args.f.map(|f| ("--f", f)))
+    for (name, v) in [("--amplitude", args.bias.amplitude)]
+        .into_iter()
+        .chain(args.f.map(|f| ("--f", f)))
     {
         if !v.is_finite() {
             bail!("{name} {v}: must be finite");
@@ -156,7 +177,58 @@ pub fn run(args: &Args) -> Result<()> {
     let loaded = args.spectrum.load()?;
     let bars = Bars::default();
     let (precision, store) = (&loaded.precision, &loaded.store);
+    let outputs = FitOutputs {
+        model: args.model_out.is_some(),
+        contour: match &args.contour {
+            None => None,
+            Some(text) => Some(contour_grid(text, args, &request.free)?),
+        },
+    };
     let plan = RsdPlan::new(&data.k, args.real_model, args.rsd, precision, store, &bars)?;
-    let table = fit_table(&plan, data, &request, &loaded.prepared, &bars)?;
-    write_output(args.out.as_ref(), &table.to_text())
+    let tables = fit_tables(&plan, data, &request, outputs, &loaded.prepared, &bars)?;
+    for (path, table) in [
+        (args.model_out.as_ref(), tables.model.as_ref()),
+        (args.contour_out.as_ref(), tables.contour.as_ref()),
+    ] {
+        if let (Some(path), Some(table)) = (path, table) {
+            write_output(Some(path), &table.to_text())?;
+        }
+    }
+    write_output(args.out.as_ref(), &tables.fit.to_text())
+}
+
+/// The grid of `--contour P1,P2`: two different parameters among the free ones.
+fn contour_grid(text: &str, args: &Args, free: &[Parameter]) -> Result<ContourGrid> {
+    let pair: Vec<Parameter> = text
+        .split(',')
+        .map(str::parse)
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("--contour {text}"))?;
+    let [x, y] = pair[..] else {
+        bail!("--contour {text}: expected two parameters P1,P2, e.g. f,sigma0");
+    };
+    if x == y || !free.contains(&x) || !free.contains(&y) {
+        bail!(
+            "--contour {text}: expected two different parameters of --free {}",
+            args.free
+        );
+    }
+    if !(3..=401).contains(&args.contour_points) {
+        bail!(
+            "--contour-points {}: must be between 3 and 401",
+            args.contour_points
+        );
+    }
+    if !(args.contour_span.is_finite() && args.contour_span > 0.0) {
+        bail!(
+            "--contour-span {}: must be finite and positive",
+            args.contour_span
+        );
+    }
+    Ok(ContourGrid {
+        x,
+        y,
+        points: args.contour_points,
+        span: args.contour_span,
+    })
 }

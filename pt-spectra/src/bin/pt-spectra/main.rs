@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 mod common;
 mod fit;
+mod halo;
 mod input;
 mod kernel;
 mod plot;
@@ -33,6 +34,8 @@ enum Command {
     Rsd(Box<rsd::Args>),
     /// Fit f, σ0 and the bias amplitude to measured multipoles, with Δχ² errors, versus k_max.
     Fit(Box<fit::Args>),
+    /// Halo bias b(k) = P_mh/P_mm and stochasticity P_εε = P_hh − P_mh²/P_mm from measured spectra.
+    Halo(halo::Args),
     /// Draw the paper's kinds of figure (PNG or SVG) from the tables of the other subcommands.
     Plot(plot::Args),
 }
@@ -44,6 +47,7 @@ fn main() -> ExitCode {
         Command::Real(args) => real::run(&args),
         Command::Rsd(args) => rsd::run(&args),
         Command::Fit(args) => fit::run(&args),
+        Command::Halo(args) => halo::run(&args),
         Command::Plot(args) => plot::run(&args),
     };
     match result {

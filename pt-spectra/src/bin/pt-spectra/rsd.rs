@@ -37,7 +37,9 @@ pub struct Args {
     #[arg(long, value_name = "KIND", default_value = "none", value_parser = parsed::<Fog>)]
     fog: Fog,
     /// σ0 of the damping [Mpc/h] (its z = 0 value; scaled by D(z) f), or its theory value σ(z)/D(z) from
-    /// eq. sigmav, σ² = (1/6π²)∫P_θθ dq, with linear (`lin`) or 1-loop SPT (`1l-spt`) P_θθ.
+    /// eq. sigmav, σ² = (1/6π²)∫P_θθ dq, with linear (`lin`) or 1-loop SPT (`1l-spt`) P_θθ; `1l-spt`
+    /// uses the 1-loop P_θθ for q ≤ 0.3 h/Mpc and P_lin above (1-loop P_θθ turns negative at
+    /// q ≈ 0.5–1 h/Mpc).
     #[arg(
         long,
         value_name = "S",
@@ -56,6 +58,10 @@ pub struct Args {
     /// Add the multipoles of the parts: P<l>_sc (Kaiser or Scoccimarro part), P<l>_A, P<l>_B (TNS terms).
     #[arg(long)]
     terms: bool,
+    /// Add the no-wiggle reference P<l>_nw: the linear Kaiser multipoles (same b(k) and f, no FoG) of the
+    /// Eisenstein & Hu no-wiggle spectrum, by which `plot multipoles` divides as the paper does.
+    #[arg(long)]
+    no_wiggle: bool,
     /// Write the table to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
@@ -76,6 +82,7 @@ impl Args {
             noise: self.noise.noise()?,
             ells,
             terms: self.terms,
+            no_wiggle: self.no_wiggle,
         })
     }
 }

@@ -1,6 +1,13 @@
 //! The `pt-spectra` binary end to end: outputs against closed forms, bad input against clear errors.
+//! The modules hold the tests of the paper's halo and figure analysis: `halo` (bias and noise from
+//! measured spectra, S/N), `fit` (model multipoles, Δχ² surfaces, theory σ0) and `plot` (every kind of
+//! figure from the fixture tables).
 
 use std::process::Command;
+
+mod fit;
+mod halo;
+mod plot;
 
 fn run(args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_pt-spectra"))
@@ -11,7 +18,6 @@ fn run(args: &[&str]) -> (bool, String, String) {
     (out.status.success(), text(out.stdout), text(out.stderr))
 }
 
-/// The numeric rows of a table.
 /// Each command fails (non-zero exit) with a message containing its needle.
 fn fails_naming(cases: &[(Vec<&str>, &str)]) {
     for (args, needle) in cases {
@@ -21,6 +27,7 @@ fn fails_naming(cases: &[(Vec<&str>, &str)]) {
     }
 }
 
+/// The numeric rows of a table.
 fn rows(text: &str) -> Vec<Vec<f64>> {
     text.lines()
         .filter(|l| !l.starts_with('#'))
@@ -30,9 +37,14 @@ fn rows(text: &str) -> Vec<Vec<f64>> {
 
 /// The column names of a table's `# k …` header line.
 fn column_names(text: &str) -> Vec<&str> {
+    column_names_of(text, "# k ")
+}
+
+/// The column names of a table's names line, the `#` line starting with `start`.
+fn column_names_of<'a>(text: &'a str, start: &str) -> Vec<&'a str> {
     text.lines()
-        .find(|l| l.starts_with("# k "))
-        .expect("a `# k …` header line")
+        .rfind(|l| l.starts_with(start))
+        .expect("a names line")
         .split_whitespace()
         .skip(1)
         .collect()
@@ -79,18 +91,28 @@ fn tns_parts_add_up_and_bias_and_noise_tables_are_used() {
     assert!(ok, "{err}");
     assert!(column_names(&out)
         .join(" ")
-        .contains("P0_sc P2_sc P4_sc P0_A P2_A P4_A P0_B P2_B P4_B P_eps SN"));
-    assert!(out.contains("# signal-to-noise SN = P0/P_eps falls to 1 at k ="));
-    for (r, s) in rows(&out).iter().zip(rows(&same)) {
+        .contains("P0_sc P2_sc P4_sc P0_A P2_A P4_A P0_B P2_B P4_B P_eps SN SN_s"));
+    assert!(out.contains("# signal-to-noise SN = P_hh/P_eps = b^2 P_dd/P_eps (real space, as the paper) falls to 1 at k ="));
+    assert!(out.contains("# redshift-space ratio SN_s = P0/P_eps falls to 1 at k ="));
+    // The real-space P_dd of the default model on the same grid, for SN = b² P_dd/P_eps.
+    let mut real = vec!["real", "--model", "1l-rpt-n1"];
+    real.extend(grid);
+    let (ok, p_dd, err) = run(&real);
+    assert!(ok, "{err}");
+    for ((r, s), p) in rows(&out).iter().zip(rows(&same)).zip(rows(&p_dd)) {
         for l in 0..3 {
             // total = Scoccimarro part + A + B, and A_b · b(k) = 1.2 · 2.5 equals b = 3.
             let parts = r[4 + l] + r[7 + l] + r[10 + l];
             assert!((r[1 + l] - parts).abs() <= 1e-8 * r[1 + l].abs().max(r[4 + l].abs()));
             assert!((r[1 + l] / s[1 + l] - 1.0).abs() < 1e-8, "{r:?} {s:?}");
         }
-        // P_eps and SN = P0/P_eps.
+        // P_eps, SN = (A_b b)² P_dd/P_eps in real space and SN_s = P0/P_eps.
         assert_eq!(r[13], 3e4);
-        assert!((r[14] - r[1] / 3e4).abs() < 1e-8 * r[14]);
+        assert!(
+            (r[14] - 9.0 * p[2] / 3e4).abs() < 1e-8 * r[14],
+            "{r:?} {p:?}"
+        );
+        assert!((r[15] - r[1] / 3e4).abs() < 1e-8 * r[15]);
     }
 }
 
@@ -231,7 +253,8 @@ fn fit_recovers_the_parameters_of_a_model_made_by_rsd() {
     let header = out.lines().find(|l| l.starts_with("# k_max")).unwrap();
     assert_eq!(
         header,
-        "# k_max points f f_lo f_hi sigma0 sigma0_lo sigma0_hi chi2 dof chi2_dof"
+        "# k_max points f f_lo f_hi sigma0 sigma0_lo sigma0_hi chi2 dof chi2_dof sigma0_lin \
+         sigma0_1l"
     );
     let r = rows(&out);
     assert_eq!(r.len(), 2);
@@ -256,52 +279,6 @@ fn fit_recovers_the_parameters_of_a_model_made_by_rsd() {
         (
             vec!["fit", "--data", &data, "--data-columns", "1,2,3"],
             "--data-columns",
-        ),
-    ]);
-}
-
-#[test]
-fn plot_writes_png_and_svg_and_refuses_bad_input() {
-    let dir = scratch("plot");
-    let table = dir.join("models.dat").display().to_string();
-    let mut all = vec!["real", "--model", "all", "--out", &table];
-    all.extend([
-        "--nk",
-        "6",
-        "--k-min",
-        "0.02",
-        "--k-max",
-        "0.2",
-        "--precision",
-        "fast",
-    ]);
-    let (ok, _, err) = run(&all);
-    assert!(ok, "{err}");
-    for ext in ["png", "svg"] {
-        let out = dir.join(format!("models.{ext}")).display().to_string();
-        let (ok, _, err) = run(&["plot", "models", &table, "--out", &out]);
-        assert!(ok, "{err}");
-        let bytes = std::fs::read(&out).unwrap();
-        assert!(bytes.len() > 10_000, "{ext}: {} bytes", bytes.len());
-        let magic: &[u8] = if ext == "png" { b"\x89PNG" } else { b"<svg" };
-        assert!(
-            bytes.windows(magic.len()).take(200).any(|w| w == magic),
-            "{ext}"
-        );
-    }
-    let gif = dir.join("m.gif").display().to_string();
-    fails_naming(&[
-        (
-            vec!["plot", "models", &table, "--out", &gif],
-            ".png or .svg",
-        ),
-        (
-            vec!["plot", "propagators", &table, "--out", "x.png"],
-            "N_dd",
-        ),
-        (
-            vec!["plot", "fit", "/nonexistent/f.dat", "--out", "x.png"],
-            "/nonexistent/f.dat",
         ),
     ]);
 }

@@ -1,0 +1,306 @@
+//! Measured multipoles: reading them from tables or arrays, with checks that name the bad row.
+
+use crate::error::{number, Error, Result};
+use crate::table::Table;
+use std::path::Path;
+
+/// Measured multipoles P_ℓ(k) with their 1σ errors.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MultipoleData {
+    /// Wavenumbers [h/Mpc], strictly increasing.
+    pub k: Vec<f64>,
+    /// The multipole orders.
+    pub ells: Vec<usize>,
+    /// `values[j][i]`: P_ℓj at k_i [(Mpc/h)^3].
+    pub values: Vec<Vec<f64>>,
+    /// `sigma[j][i]`: the 1σ error of `values[j][i]`, > 0.
+    pub sigma: Vec<Vec<f64>>,
+    /// Optional full covariance of the data vector (ℓ-major), replacing the diagonal σ².
+    pub covariance: Option<Vec<Vec<f64>>>,
+}
+
+/// The table columns of k and, per (ℓ, value, error), the value and error columns.
+fn wanted(k_column: usize, columns: &[(usize, usize, usize)]) -> Vec<usize> {
+    let mut wanted = vec![k_column];
+    for &(_, v, s) in columns {
+        wanted.extend([v, s]);
+    }
+    wanted
+}
+
+impl MultipoleData {
+    /// Reads a table: k in the 0-based column `k_column`, and for each (ℓ, value column, error column).
+    ///
+    /// # Errors
+    /// [`Error::Io`], [`Error::Parse`], [`Error::MissingColumn`]; [`Error::InvalidK`],
+    /// [`Error::NonIncreasingK`]; [`Error::InvalidValue`] for a NaN or infinite value or an error that is
+    /// not finite and positive.
+    pub fn read(
+        path: impl AsRef<Path>,
+        k_column: usize,
+        columns: &[(usize, usize, usize)],
+    ) -> Result<Self> {
+        Self::from_table(&Table::read(path, &wanted(k_column, columns))?, columns)
+    }
+
+    /// As [`read`](Self::read), from text (`origin` names it in messages).
+    ///
+    /// # Errors
+    /// As [`read`](Self::read).
+    pub fn parse(
+        text: &str,
+        origin: &str,
+        k_column: usize,
+        columns: &[(usize, usize, usize)],
+    ) -> Result<Self> {
+        Self::from_table(
+            &Table::parse(text, origin, &wanted(k_column, columns))?,
+            columns,
+        )
+    }
+
+    /// Measured multipoles from arrays: `k` and, for each ℓ of `ells`, the values and 1σ errors on that
+    /// grid (`origin` names them in messages; rows are numbered from 1).
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] for arrays of different lengths, otherwise as [`read`](Self::read).
+    pub fn from_arrays(
+        k: Vec<f64>,
+        ells: &[usize],
+        values: Vec<Vec<f64>>,
+        sigma: Vec<Vec<f64>>,
+        origin: &str,
+    ) -> Result<Self> {
+        for (what, n) in [
+            ("values and ells", values.len()),
+            ("errors and ells", sigma.len()),
+        ] {
+            if n != ells.len() {
+                return Err(Error::LengthMismatch {
+                    what,
+                    left: n,
+                    right: ells.len(),
+                });
+            }
+        }
+        let mut columns = vec![k];
+        for (v, s) in values.into_iter().zip(sigma) {
+            columns.extend([v, s]);
+        }
+        if let Some(bad) = columns.iter().find(|c| c.len() != columns[0].len()) {
+            return Err(Error::LengthMismatch {
+                what: "multipole arrays and k",
+                left: bad.len(),
+                right: columns[0].len(),
+            });
+        }
+        let table = Table {
+            origin: origin.to_string(),
+            header: Vec::new(),
+            lines: (1..=columns[0].len()).collect(),
+            columns,
+        };
+        let spec: Vec<(usize, usize, usize)> = ells
+            .iter()
+            .enumerate()
+            .map(|(j, &l)| (l, 1 + 2 * j, 2 + 2 * j))
+            .collect();
+        Self::from_table(&table, &spec)
+    }
+
+    fn from_table(table: &Table, columns: &[(usize, usize, usize)]) -> Result<Self> {
+        let k = table.columns[0].clone();
+        let origin = &table.origin;
+        if k.is_empty() {
+            return Err(Error::TooFewPoints {
+                origin: origin.clone(),
+                found: 0,
+                min: 1,
+            });
+        }
+        for i in 0..k.len() {
+            let line = table.lines[i];
+            if !(k[i].is_finite() && k[i] > 0.0) {
+                return Err(Error::InvalidK {
+                    origin: origin.clone(),
+                    line,
+                    k: k[i],
+                });
+            }
+            if i > 0 && k[i] <= k[i - 1] {
+                return Err(Error::NonIncreasingK {
+                    origin: origin.clone(),
+                    line,
+                    k: k[i],
+                    previous: k[i - 1],
+                });
+            }
+        }
+        let (mut values, mut sigma) = (Vec::new(), Vec::new());
+        for (j, _) in columns.iter().enumerate() {
+            let (v, s) = (&table.columns[1 + 2 * j], &table.columns[2 + 2 * j]);
+            for i in 0..k.len() {
+                let line = table.lines[i];
+                if !v[i].is_finite() {
+                    return Err(Error::InvalidValue {
+                        origin: origin.clone(),
+                        line,
+                        name: "P_l",
+                        value: v[i],
+                        reason: "must be finite",
+                    });
+                }
+                if !(s[i].is_finite() && s[i] > 0.0) {
+                    return Err(Error::InvalidValue {
+                        origin: origin.clone(),
+                        line,
+                        name: "sigma_l",
+                        value: s[i],
+                        reason: "must be finite and positive",
+                    });
+                }
+            }
+            values.push(v.clone());
+            sigma.push(s.clone());
+        }
+        Ok(Self {
+            k,
+            ells: columns.iter().map(|c| c.0).collect(),
+            values,
+            sigma,
+            covariance: None,
+        })
+    }
+
+    /// Attaches a full covariance matrix of the data vector (ℓ-major, n_ℓ·n_k square, symmetric).
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] for a wrong size; [`Error::InvalidValue`] for a diagonal element that is
+    /// not finite and positive, [`Error::BadRow`] for a non-finite or asymmetric element (row numbers
+    /// 1-based, origin `covariance matrix`).
+    pub fn with_covariance(self, c: Vec<Vec<f64>>) -> Result<Self> {
+        let n = self.ells.len() * self.k.len();
+        if c.len() != n || c.iter().any(|r| r.len() != n) {
+            return Err(Error::LengthMismatch {
+                what: "covariance rows and data vector",
+                left: c.len(),
+                right: n,
+            });
+        }
+        self.checked_covariance(c, "covariance matrix", &[])
+    }
+
+    /// Reads the covariance of the data vector (ℓ-major, n_ℓ·n_k square, symmetric) from a table file:
+    /// one matrix row per data row, n_ℓ·n_k columns each.
+    ///
+    /// # Errors
+    /// [`Error::Io`], and as [`parse_covariance`](Self::parse_covariance).
+    pub fn read_covariance(self, path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = crate::table::read_text(path)?;
+        self.parse_covariance(&text, &path.display().to_string())
+    }
+
+    /// As [`read_covariance`](Self::read_covariance), from text (`origin` names it in messages).
+    ///
+    /// # Errors
+    /// Each naming `origin` and the line: [`Error::Parse`], [`Error::MissingColumn`] and
+    /// [`Error::BadRow`] for a row that is not n_ℓ·n_k numbers, [`Error::BadRow`] for a row too many or a
+    /// non-finite or asymmetric element, [`Error::InvalidValue`] for a diagonal element that is not finite
+    /// and positive; [`Error::TooFewPoints`] for too few rows.
+    pub fn parse_covariance(self, text: &str, origin: &str) -> Result<Self> {
+        let n = self.ells.len() * self.k.len();
+        let table = Table::parse_exact(text, origin, n)?;
+        let rows = table.lines.len();
+        if rows < n {
+            return Err(Error::TooFewPoints {
+                origin: origin.into(),
+                found: rows,
+                min: n,
+            });
+        }
+        if rows > n {
+            return Err(Error::BadRow {
+                origin: origin.into(),
+                line: table.lines[n],
+                problem: format!(
+                    "row {} of the covariance is one too many: the data vector has {} values \
+                     ({} multipole(s) × {} k)",
+                    n + 1,
+                    n,
+                    self.ells.len(),
+                    self.k.len()
+                ),
+            });
+        }
+        let c = (0..n)
+            .map(|i| table.columns.iter().map(|column| column[i]).collect())
+            .collect();
+        self.checked_covariance(c, origin, &table.lines)
+    }
+
+    /// Attaches the n×n matrix `c` after checking it; `lines` numbers its rows for messages (row numbers if
+    /// empty).
+    fn checked_covariance(
+        mut self,
+        c: Vec<Vec<f64>>,
+        origin: &str,
+        lines: &[usize],
+    ) -> Result<Self> {
+        let line = |i: usize| lines.get(i).copied().unwrap_or(i + 1);
+        for (i, row) in c.iter().enumerate() {
+            if let Some(j) = row.iter().position(|v| !v.is_finite()) {
+                return Err(Error::BadRow {
+                    origin: origin.into(),
+                    line: line(i),
+                    problem: format!(
+                        "covariance element ({}, {}) = {} is not finite (row, column 1-based)",
+                        i + 1,
+                        j + 1,
+                        number(&row[j])
+                    ),
+                });
+            }
+            // (Finite: checked above.)
+            if row[i] <= 0.0 {
+                return Err(Error::InvalidValue {
+                    origin: origin.into(),
+                    line: line(i),
+                    name: "covariance diagonal",
+                    value: row[i],
+                    reason: "must be finite and positive",
+                });
+            }
+            for j in 0..i {
+                // sqrt before the product: c_ii c_jj may overflow, and then any asymmetry would pass.
+                let tolerance = 1e-9 * c[i][i].sqrt() * c[j][j].sqrt();
+                // Both finite: the difference is finite or infinite, never NaN.
+                if (row[j] - c[j][i]).abs() > tolerance {
+                    return Err(Error::BadRow {
+                        origin: origin.into(),
+                        line: line(i),
+                        problem: format!(
+                            "covariance element ({}, {}) = {} differs from element ({}, {}) = {}: \
+                             the matrix must be symmetric (row, column 1-based)",
+                            i + 1,
+                            j + 1,
+                            number(&row[j]),
+                            j + 1,
+                            i + 1,
+                            number(&c[j][i])
+                        ),
+                    });
+                }
+            }
+        }
+        self.covariance = Some(c);
+        Ok(self)
+    }
+
+    /// Number of k ≤ `k_max` (with k ≥ `k_min`) and the first index.
+    pub(super) fn range(&self, k_min: f64, k_max: f64) -> (usize, usize) {
+        let start = self.k.partition_point(|&k| k < k_min);
+        let end = self.k.partition_point(|&k| k <= k_max);
+        (start, end.max(start))
+    }
+}

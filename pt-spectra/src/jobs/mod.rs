@@ -1,0 +1,184 @@
+//! One function per job of the command line and of the Python module, each returning the [`Table`]
+//! both write: `real` ([`real_table`]), `rsd` ([`rsd_table`]), `fit` ([`fit_table`]; with the model
+//! multipoles and Δχ² surfaces, [`fit_tables`]) and `halo` ([`halo_table`]). The caller
+//! parses its input into the typed requests here, builds the plan once per k grid ([`RealPlan`],
+//! [`RsdPlan`]) and prepares the linear spectrum of each cosmology ([`crate::setup::prepare`]); the
+//! job does the rest, with the header saying what was computed, with which cosmology, q range and
+//! precision.
+//!
+//! ```
+//! use pt_spectra::{jobs, precision::Precision, progress::Silent, store::TableStore};
+//! use pt_spectra::real::{RealPlan, RealSelection};
+//! use pt_spectra::setup::{prepare, LinearSource, Request};
+//! let prepared = prepare(Request { source: LinearSource::Embedded, cosmology: None, z: 0.0 })?;
+//! let selection: RealSelection = "1l-spt".parse()?;
+//! let plan = RealPlan::for_selection(&[0.05, 0.1], selection, &Precision::fast(),
+//!                                    &TableStore::in_memory(), &Silent)?;
+//! let t = jobs::real_table(&plan, selection, &prepared, true, &Silent)?;
+//! assert_eq!(t.names()[..5], ["k", "P_lin", "P_dd", "P_dt", "P_tt"]);
+//! assert!(t.column("P22_dd").is_some() && t.header[0].contains("1l-spt"));
+//! # Ok::<(), pt_spectra::error::Error>(())
+//! ```
+
+use crate::error::{Error, Result};
+use crate::loops::Pair;
+use crate::output::{Table, POWER, WAVENUMBER};
+use crate::precision::Precision;
+use crate::progress::Progress;
+use crate::real::{RealModel, RealPlan, RealSelection, RealSpectra};
+use crate::setup::Prepared;
+
+mod fit;
+mod halo;
+mod rsd;
+pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
+pub use halo::{halo_table, HaloRequest};
+pub use rsd::{
+    describe_sigma0, no_wiggle_multipoles, rsd_table, rsd_table_from_terms, RsdRequest, SN_LEVELS,
+};
+
+/// The version of pt-spectra, for table headers.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// Header lines naming the cosmology, the input spectrum and the integration settings.
+pub fn describe_inputs(prepared: &Prepared, precision: &Precision) -> Vec<String> {
+    let spectrum = &prepared.spectrum;
+    let (low, high) = spectrum.extrapolation_slopes();
+    let mut h = prepared.description.clone();
+    h.push(format!(
+        "loop integrals over q in [{:e}, {:e}] h/Mpc, precision {}; the linear table covers [{:e}, \
+         {:e}] h/Mpc and is extended by power laws (slopes {low:.3}, {high:.3})",
+        precision.q_min,
+        precision.q_max,
+        precision.preset,
+        spectrum.k_min(),
+        spectrum.k_max(),
+    ));
+    h
+}
+
+/// The header line describing the 2-loop mode-coupling integration.
+pub fn two_loop_line(precision: &Precision) -> String {
+    let target = if precision.two_loop_tolerance > 0.0 {
+        format!(
+            "points added where the error exceeds {:e} of the correction",
+            precision.two_loop_tolerance
+        )
+    } else {
+        "fixed points".to_string()
+    };
+    format!(
+        "2-loop mode coupling: randomised quasi-Monte Carlo, {} shifts x {} Sobol points at k = 0.16 \
+         (scaled as k^3.5), seed {}; {target}",
+        precision.two_loop_replicas, precision.two_loop_points, precision.two_loop_seed
+    )
+}
+
+/// `pt-spectra real`: the spectra of the selected model (or P_dd/P_nw of every model) for the
+/// prepared linear spectrum, with the loop terms if `terms`.
+///
+/// # Errors
+/// [`Error::GridMismatch`] if the plan does not cover the selection ([`RealPlan::for_selection`]); as [`RealPlan::evaluate`]
+/// and [`Prepared::no_wiggle`].
+pub fn real_table(
+    plan: &RealPlan,
+    selection: RealSelection,
+    prepared: &Prepared,
+    terms: bool,
+    progress: &dyn Progress,
+) -> Result<Table> {
+    if !plan.covers(selection) {
+        return Err(Error::GridMismatch {
+            what: "real-space plan and model",
+            expected: format!("a plan for {}", selection.plan_model()),
+            found: format!("a plan for {}", plan.model()),
+        });
+    }
+    let precision = plan.precision();
+    let spectra = plan.evaluate(&prepared.spectrum, progress)?;
+    let mut header = vec![format!(
+        "pt-spectra {VERSION} real: model {}, z = {}",
+        match selection {
+            RealSelection::One(m) => m.name(),
+            RealSelection::All => "all (P_dd of each model over the no-wiggle spectrum)",
+        },
+        prepared.z
+    )];
+    header.extend(describe_inputs(prepared, precision));
+    match selection {
+        RealSelection::One(model) => {
+            header.extend(model_header(model, &spectra, precision, terms));
+            Ok(spectra.table(header, terms))
+        }
+        RealSelection::All => {
+            header.push(two_loop_line(precision));
+            header.push(
+                "P_nw: Eisenstein & Hu (1998) no-wiggle fit of the cosmology, scaled to the sigma8 of \
+                 the linear input; columns <model> = P_dd(model)/P_nw, err_<model> its estimated \
+                 numerical error"
+                    .into(),
+            );
+            all_models(header, &spectra, &prepared.no_wiggle()?)
+        }
+    }
+}
+
+/// The header lines of one model: conventions, σ_v², the 2-loop settings and the RPT factors.
+fn model_header(
+    model: RealModel,
+    spectra: &RealSpectra,
+    precision: &Precision,
+    terms: bool,
+) -> Vec<String> {
+    let sigma_v2 = spectra.terms.one_loop.sigma_v2;
+    let mut h = vec![
+        "conventions: theta = -div v/(aHf); 1-loop correction = P22 + 2 P13; err_X = estimated \
+         absolute numerical error of X"
+            .to_string(),
+        format!(
+            "sigma_v2 = {:.8e} +- {:.1e} (Mpc/h)^2",
+            sigma_v2.value, sigma_v2.error
+        ),
+    ];
+    if model.needs_two_loop() {
+        h.push(two_loop_line(precision));
+    }
+    if terms && model.propagator().is_some() {
+        h.push(
+            "N_dd = N_delta^2, N_dt = N_delta N_theta, N_tt = N_theta^2: the factors multiplying \
+             P_lin + P22 in the RPT model"
+                .into(),
+        );
+    }
+    h
+}
+
+/// `k P_nw`, then P_dd/P_nw of every model and their errors.
+fn all_models(
+    header: Vec<String>,
+    spectra: &RealSpectra,
+    p_nw: &crate::linear::LinearSpectrum,
+) -> Result<Table> {
+    let nw: Vec<f64> = spectra.k.iter().map(|&k| p_nw.eval(k)).collect();
+    let models = RealModel::ALL
+        .iter()
+        .map(|&m| RealSpectra::from_terms(m, spectra.terms.clone()))
+        .collect::<Result<Vec<_>>>()?;
+    let mut t = Table::new(header);
+    t.push("k", WAVENUMBER, spectra.k.clone());
+    t.push("P_nw", POWER, nw.clone());
+    let ratio = |m: &RealSpectra, error: bool| -> Vec<f64> {
+        let dd = m.pair(Pair::DeltaDelta);
+        dd.iter()
+            .zip(&nw)
+            .map(|(e, n)| if error { e.error / n } else { e.value / n })
+            .collect()
+    };
+    for m in &models {
+        t.push(m.model.name(), "1", ratio(m, false));
+    }
+    for m in &models {
+        t.push(format!("err_{}", m.model), "1", ratio(m, true));
+    }
+    Ok(t)
+}

@@ -1,0 +1,232 @@
+//! `pt-spectra rsd`: redshift-space multipoles, with the halo signal-to-noise and the no-wiggle
+//! reference of the paper's figures.
+
+use super::{describe_inputs, VERSION};
+use crate::error::{Error, Result};
+use crate::halo::{crossings, Bias, Noise};
+use crate::linear::LinearSpectrum;
+use crate::loops::TnsTerms;
+use crate::output::{Table, POWER};
+use crate::precision::Precision;
+use crate::progress::Progress;
+use crate::real::RealSpectra;
+use crate::rsd::{
+    fog_sigma, multipoles, DispersionInput, Fog, MultipoleRule, RsdModel, RsdPlan, RsdSettings,
+    Sigma0, DISPERSION_Q_CUT,
+};
+use crate::setup::Prepared;
+
+/// Signal-to-noise levels whose crossings are reported (the paper's table_noise).
+pub const SN_LEVELS: [f64; 3] = [1.0, 0.5, 0.1];
+
+/// The redshift-space settings of `rsd` and `fit` that are not plans or data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RsdRequest {
+    /// The RSD model.
+    pub rsd: RsdModel,
+    /// The growth rate; `None` for f(z) of the cosmology.
+    pub f: Option<f64>,
+    /// The bias b(k) before the amplitude.
+    pub bias: Bias,
+    /// The bias amplitude A_b.
+    pub amplitude: f64,
+    /// The Fingers-of-God damping.
+    pub fog: Fog,
+    /// Its σ0 [Mpc/h] (z = 0 value), or a theory value.
+    pub sigma0: Sigma0,
+    /// The stochasticity P_εε.
+    pub noise: Noise,
+    /// The multipoles.
+    pub ells: Vec<usize>,
+    /// Whether to add the multipoles of the parts.
+    pub terms: bool,
+    /// Whether to add the no-wiggle reference `P<l>_nw` ([`no_wiggle_multipoles`]).
+    pub no_wiggle: bool,
+}
+
+impl RsdRequest {
+    /// A description of the bias for headers.
+    pub fn describe_bias(&self) -> String {
+        match &self.bias {
+            Bias::Constant(b) => format!("b = {b}"),
+            Bias::Table(t) => format!("b(k) from {}", t.origin()),
+        }
+    }
+}
+
+/// How a σ0 was obtained, for headers: empty for a number, else the equation and its input.
+pub fn describe_sigma0(sigma0: Sigma0) -> String {
+    match sigma0 {
+        Sigma0::Value(_) => String::new(),
+        Sigma0::Theory(DispersionInput::Linear) => {
+            " (theory: eq. sigmav, sigma^2 = (1/6pi^2) int P_lin dq, sigma0 = sigma(z)/D(z))".into()
+        }
+        Sigma0::Theory(DispersionInput::OneLoopSpt) => format!(
+            " (theory: eq. sigmav, sigma^2 = (1/6pi^2) int P_tt dq with 1-loop SPT P_tt for q <= \
+             {DISPERSION_Q_CUT} h/Mpc and P_lin above, where 1-loop P_tt turns negative; sigma0 = \
+             sigma(z)/D(z))"
+        ),
+    }
+}
+
+/// The linear Kaiser multipoles of the no-wiggle spectrum `p_nw` with bias `bias` (amplitude included)
+/// and growth rate f, without FoG: `P<l>_nw`, the smooth reference by which the paper divides
+/// multipoles (its "non-wiggle linear prediction"), P_0,nw = (b² + 2bf/3 + f²/5) P_nw, P_2,nw =
+/// (4bf/3 + 4f²/7) P_nw, P_4,nw = 8f²/35 P_nw. `result[j][i]` for the j-th ℓ at k_i.
+///
+/// # Errors
+/// [`Error::LengthMismatch`] for a bias not on `k`; [`Error::InvalidParameter`] for a bad ℓ.
+pub fn no_wiggle_multipoles(
+    k: &[f64],
+    bias: &[f64],
+    f: f64,
+    ells: &[usize],
+    p_nw: &LinearSpectrum,
+) -> Result<Vec<Vec<f64>>> {
+    if bias.len() != k.len() {
+        return Err(Error::LengthMismatch {
+            what: "bias and k",
+            left: bias.len(),
+            right: k.len(),
+        });
+    }
+    let rule = MultipoleRule::new(ells)?;
+    let mut out = vec![Vec::with_capacity(k.len()); ells.len()];
+    for (&ki, &b) in k.iter().zip(bias) {
+        let c = RsdModel::Kaiser.coefficients(b, f, [p_nw.eval(ki); 3]);
+        for (o, p) in out.iter_mut().zip(rule.evaluate(&c, Fog::None, 0.0)) {
+            o.push(p.value);
+        }
+    }
+    Ok(out)
+}
+
+/// `pt-spectra rsd`: the multipoles of `request` for the prepared linear spectrum, from the loop
+/// terms of `plan`. With a noise: the columns `P_eps SN SN_s`, SN = P_hh/P_εε = (A_b b)² P_δδ/P_εε in
+/// real space (the paper's signal-to-noise, P_δδ of the real-space model) and SN_s = P0/P_εε, and the
+/// k where each falls to [`SN_LEVELS`] in the header.
+///
+/// # Errors
+/// As [`RsdPlan::evaluate`], [`multipoles`], [`Bias::values`], [`Noise::values`],
+/// [`Sigma0::resolve`] and (with `no_wiggle`) [`Prepared::no_wiggle`]; [`Error::InvalidParameter`] for
+/// a non-finite f.
+pub fn rsd_table(
+    plan: &RsdPlan,
+    request: &RsdRequest,
+    prepared: &Prepared,
+    progress: &dyn Progress,
+) -> Result<Table> {
+    let (spectra, tns) = plan.evaluate(&prepared.spectrum, progress)?;
+    rsd_table_from_terms(
+        &spectra,
+        tns.as_ref(),
+        plan.real().precision(),
+        request,
+        prepared,
+    )
+}
+
+/// [`rsd_table`] from loop terms computed before (`spectra` and, for TNS, `tns` of the prepared
+/// spectrum, with `precision`): the cheap step of a chain in which only f, the bias, σ0 or the noise
+/// change.
+///
+/// # Errors
+/// As [`rsd_table`].
+pub fn rsd_table_from_terms(
+    spectra: &RealSpectra,
+    tns: Option<&TnsTerms>,
+    precision: &Precision,
+    request: &RsdRequest,
+    prepared: &Prepared,
+) -> Result<Table> {
+    let k = &spectra.k;
+    let f = request.f.unwrap_or(prepared.growth_rate);
+    if !f.is_finite() {
+        return Err(Error::InvalidParameter {
+            name: "f",
+            value: f,
+            reason: "must be finite",
+        });
+    }
+    let growth = prepared.growth_factor;
+    let sigma0 = request
+        .sigma0
+        .resolve(&prepared.spectrum, growth, precision)?;
+    let sigma = fog_sigma(sigma0, growth, f);
+    let bias = request.bias.values(k, request.amplitude)?;
+    let settings = RsdSettings {
+        model: request.rsd,
+        f,
+        bias: bias.clone(),
+        fog: request.fog,
+        sigma,
+        noise: request.noise.values(k)?,
+        ells: request.ells.clone(),
+        parts: request.terms,
+    };
+    let m = multipoles(spectra, tns, &settings)?;
+    let (rsd, fog) = (request.rsd, request.fog);
+    let mut header = vec![format!(
+        "pt-spectra {VERSION} rsd: {rsd} with real-space {}, z = {}, f = {f}, {} times A_b = {}, \
+         FoG {fog:?} with sigma0 = {sigma0} Mpc/h{} (sigma = sigma0 D(z) f = {sigma:.6} Mpc/h)",
+        spectra.model,
+        prepared.z,
+        request.describe_bias(),
+        request.amplitude,
+        describe_sigma0(request.sigma0),
+    )];
+    header.extend(describe_inputs(prepared, precision));
+    if rsd.needs_tns() {
+        header.push(
+            "TNS A and B at leading order (linear P, tree-level bispectrum), A = b^3 A(f/b), \
+             B = b^4 B(f/b)"
+                .into(),
+        );
+    }
+    header.push(
+        "P_l = (2l+1) int_0^1 dmu P^s(k,mu) L_l(mu) of the noise-free model (the paper's P^s_hh = \
+         <d_h d_h> - P_eps); err_P_l bounds the numerical error (loop integrals and mu quadrature)"
+            .into(),
+    );
+    if let (Some(sn), Some(sn_s)) = (&m.signal_to_noise, &m.signal_to_noise_s) {
+        header.push(crossing_line(
+            "signal-to-noise SN = P_hh/P_eps = b^2 P_dd/P_eps (real space, as the paper)",
+            k,
+            sn,
+        ));
+        header.push(crossing_line(
+            "redshift-space ratio SN_s = P0/P_eps",
+            k,
+            sn_s,
+        ));
+    }
+    if request.no_wiggle {
+        header.push(
+            "P<l>_nw: linear Kaiser multipoles of the Eisenstein & Hu no-wiggle spectrum (same b(k) \
+             and f, no FoG), the reference the paper divides multipoles by"
+                .into(),
+        );
+    }
+    let mut t = m.table(header);
+    if request.no_wiggle {
+        let nw = no_wiggle_multipoles(k, &bias, f, &request.ells, &prepared.no_wiggle()?)?;
+        for (l, p) in request.ells.iter().zip(nw) {
+            t.push(format!("P{l}_nw"), POWER, p);
+        }
+    }
+    Ok(t)
+}
+
+/// Where `sn` falls to each of [`SN_LEVELS`]: `<what> falls to 1 at k = …; …`.
+fn crossing_line(what: &str, k: &[f64], sn: &[f64]) -> String {
+    let mut text = format!("{what} falls to");
+    for (level, c) in SN_LEVELS.iter().zip(crossings(k, sn, &SN_LEVELS)) {
+        match c {
+            Some(kc) => text += &format!(" {level} at k = {kc:.4}"),
+            None if sn[0] < *level => text += &format!(" {level}: below it at every k"),
+            None => text += &format!(" {level}: not within the k range"),
+        }
+        text.push(';');
+    }
+    text
+}
