@@ -84,28 +84,15 @@ pub fn no_wiggle(spectrum: &LinearSpectrum) -> Result<LinearSpectrum> {
 /// k_s = [`SIGMA_CUTOFF`]: Simpson in ln q (2048 intervals), error against the half rule.
 pub fn sigma2_bao(no_wiggle: &LinearSpectrum, q_min: f64) -> Estimate {
     const INTERVALS: usize = 2048;
-    let (a, b) = (q_min.ln(), SIGMA_CUTOFF.ln());
-    if b <= a {
-        return Estimate::exact(0.0);
-    }
-    let h = (b - a) / INTERVALS as f64;
-    let y: Vec<f64> = (0..=INTERVALS)
-        .map(|i| {
-            let q = (a + h * i as f64).exp();
-            let x = q * BAO_SCALE;
-            q * no_wiggle.eval(q) * (1.0 - j0(x) + 2.0 * j2(x))
-        })
-        .collect();
-    let simpson = |stride: usize| {
-        let n = INTERVALS / stride;
-        let inner: f64 = (1..n)
-            .map(|i| y[i * stride] * if i % 2 == 1 { 4.0 } else { 2.0 })
-            .sum();
-        (y[0] + inner + y[INTERVALS]) * h * stride as f64 / 3.0
+    let integrand = |ln_q: f64| {
+        let q = ln_q.exp();
+        let x = q * BAO_SCALE;
+        q * no_wiggle.eval(q) * (1.0 - j0(x) + 2.0 * j2(x))
     };
+    let (value, error) =
+        crate::integrate::simpson_ln(integrand, q_min.ln(), SIGMA_CUTOFF.ln(), INTERVALS);
     let norm = 1.0 / (6.0 * PI * PI);
-    let (fine, coarse) = (simpson(1), simpson(2));
-    Estimate::new(norm * fine, norm * (fine - coarse).abs())
+    Estimate::new(norm * value, norm * error)
 }
 
 /// Spherical Bessel j0(x) = sin x / x.

@@ -213,25 +213,12 @@ pub fn sigma_d2(
     k.iter()
         .map(|&k| {
             let (a, b) = (precision.q_min.ln(), (0.5 * k).min(precision.q_max).ln());
-            if b <= a {
-                return Estimate::exact(0.0);
-            }
-            let h = (b - a) / INTERVALS as f64;
-            let y: Vec<f64> = (0..=INTERVALS)
-                .map(|i| {
-                    let q = (a + h * i as f64).exp();
-                    q * spectrum.eval(q)
-                })
-                .collect();
-            let simpson = |step: usize| {
-                let n = INTERVALS / step;
-                let inner: f64 = (1..n)
-                    .map(|i| y[i * step] * if i % 2 == 1 { 4.0 } else { 2.0 })
-                    .sum();
-                (y[0] + inner + y[INTERVALS]) * h * step as f64 / 3.0
+            let integrand = |ln_q: f64| {
+                let q = ln_q.exp();
+                q * spectrum.eval(q)
             };
-            let (fine, coarse) = (simpson(1), simpson(2));
-            Estimate::new(norm * fine, norm * (fine - coarse).abs())
+            let (value, error) = crate::integrate::simpson_ln(integrand, a, b, INTERVALS);
+            Estimate::new(norm * value, norm * error)
         })
         .collect()
 }
