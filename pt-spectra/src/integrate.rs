@@ -278,9 +278,12 @@ mod tests {
     #[test]
     fn simpson_in_ln_q_integrates_and_bounds_its_error() {
         // ∫ q dq from 1e-3 to 1 is ∫ e^{2u} du over u = ln q: (1 − 1e-6)/2.
-        let (v, e) = simpson_ln(|u| (2.0 * u).exp(), 1e-3f64.ln(), 0.0, 64);
+        // The error estimate |S_h − S_2h| is ~15 times the actual error of S_h (both O(h⁴)).
         let exact = 0.5 * (1.0 - 1e-6);
-        assert!((v - exact).abs() <= e && e < 1e-5, "{v} {e}");
+        for (n, bound) in [(64, 1e-4), (256, 1e-6)] {
+            let (v, e) = simpson_ln(|u| (2.0 * u).exp(), 1e-3f64.ln(), 0.0, n);
+            assert!((v - exact).abs() <= e && e < bound, "{n}: {v} {e}");
+        }
         assert_eq!(simpson_ln(|u| u, 1.0, 0.5, 8), (0.0, 0.0));
     }
 }
