@@ -36,16 +36,45 @@ pub const SIGMA_CUTOFF: f64 = 0.2;
 /// Nodes per unit ln k of the split's grid.
 const NODES_PER_E_FOLD: f64 = 100.0;
 
-/// The no-wiggle part of `spectrum` on its own k range (see the module docs).
+/// The no-wiggle part of `spectrum` on its own k range (see the module docs): [`WiggleSplit`] built
+/// and applied once. A plan that splits many spectra keeps its [`WiggleSplit`].
 ///
 /// # Errors
-/// As [`LinearSpectrum::from_nodes`].
+/// As [`WiggleSplit::new`] and [`WiggleSplit::no_wiggle`].
 pub fn no_wiggle(spectrum: &LinearSpectrum) -> Result<LinearSpectrum> {
-    let reference = Cosmology::gm2012().eisenstein_hu_spectrum(
-        TransferKind::NoWiggle,
-        0.0,
-        &LogGrid::new(1e-6, 1e4, 4000)?,
-    )?;
+    WiggleSplit::new()?.no_wiggle(spectrum)
+}
+
+/// The smooth reference P_ref of the split (cosmology independent: built once per plan).
+#[derive(Debug, Clone)]
+pub struct WiggleSplit {
+    reference: LinearSpectrum,
+}
+
+impl WiggleSplit {
+    /// The split with P_ref the Eisenstein & Hu no-wiggle spectrum of gm2012.
+    ///
+    /// # Errors
+    /// As [`Cosmology::eisenstein_hu_spectrum`].
+    pub fn new() -> Result<Self> {
+        let reference = Cosmology::gm2012().eisenstein_hu_spectrum(
+            TransferKind::NoWiggle,
+            0.0,
+            &LogGrid::new(1e-6, 1e4, 4000)?,
+        )?;
+        Ok(Self { reference })
+    }
+
+    /// The no-wiggle part of `spectrum` on its own k range (see the module docs).
+    ///
+    /// # Errors
+    /// As [`LinearSpectrum::from_nodes`].
+    pub fn no_wiggle(&self, spectrum: &LinearSpectrum) -> Result<LinearSpectrum> {
+        split(spectrum, &self.reference)
+    }
+}
+
+fn split(spectrum: &LinearSpectrum, reference: &LinearSpectrum) -> Result<LinearSpectrum> {
     let (lo, hi) = (spectrum.k_min().ln(), spectrum.k_max().ln());
     let n = ((hi - lo) * NODES_PER_E_FOLD).ceil() as usize + 1;
     let step = (hi - lo) / (n - 1) as f64;

@@ -216,3 +216,13 @@ def test_signal_to_noise_halo_tables_and_theory_sigma0(tmp_path):
     r = pt.fit(data, k_max=[0.2], free=("f",), rsd="kaiser", real="linear", sigma0="lin", f=0.4)
     np.testing.assert_allclose(r["f"], f, rtol=1e-5)
     assert r["sigma0_1l"][0] < r["sigma0_lin"][0]
+
+
+def test_growth_matches_camb_for_planck2018():
+    # CAMB 2.0.5 headers of tests/data/linear_pk_planck2018_z*.dat: sigma8(z) and f(z).
+    d, f = pt.growth(1.0, "planck2018")
+    assert abs(f / 0.873875 - 1) < 2e-3
+    assert abs(d / (0.500091 / 0.821734) - 1) < 2e-3
+    assert pt.growth(0.0, "planck2018")[0] == 1.0
+    with pytest.raises(ValueError, match="redshift"):
+        pt.growth(-1.0)

@@ -41,8 +41,9 @@ pub struct RealPlan {
     one_loop: Vec<OneLoopPlan>,
     p15: Option<Arc<P15Table>>,
     p17: Option<Arc<P17Table>>,
-    /// Whether [`terms`](Self::terms) also computes the no-wiggle terms of the IR-resummed models.
-    ir: bool,
+    /// The wiggle split if [`terms`](Self::terms) also computes the no-wiggle terms of the
+    /// IR-resummed models (its reference spectrum built once, here).
+    ir: Option<crate::ir::WiggleSplit>,
 }
 
 impl RealPlan {
@@ -59,13 +60,16 @@ impl RealPlan {
         progress: &dyn Progress,
     ) -> Result<Self> {
         let mut plan = Self::new(k, selection.plan_model(), precision, store, progress)?;
-        plan.ir |= selection == RealSelection::All;
+        if selection == RealSelection::All && plan.ir.is_none() {
+            plan.ir = Some(crate::ir::WiggleSplit::new()?);
+        }
         Ok(plan)
     }
 
     /// Whether the plan computes every model's terms (those of `real --model all`).
     pub fn covers(&self, selection: RealSelection) -> bool {
-        self.model == selection.plan_model() && (self.ir || selection != RealSelection::All)
+        self.model == selection.plan_model()
+            && (self.ir.is_some() || selection != RealSelection::All)
     }
 
     /// The plan of `model` on the wavenumbers `k` [h/Mpc] with `precision`; the angular tables the
@@ -109,7 +113,11 @@ impl RealPlan {
             one_loop,
             p15,
             p17,
-            ir: model.needs_ir(),
+            ir: if model.needs_ir() {
+                Some(crate::ir::WiggleSplit::new()?)
+            } else {
+                None
+            },
         })
     }
 
@@ -136,8 +144,8 @@ impl RealPlan {
     /// As [`crate::ir::no_wiggle`].
     pub fn terms(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> Result<LoopTerms> {
         let mut terms = self.loop_terms(spectrum, progress);
-        if self.ir {
-            let nw = crate::ir::no_wiggle(spectrum)?;
+        if let Some(split) = &self.ir {
+            let nw = split.no_wiggle(spectrum)?;
             terms.ir = Some(Box::new(loops::IrTerms {
                 sigma2: crate::ir::sigma2_bao(&nw, self.precision.q_min),
                 no_wiggle: self.loop_terms(&nw, progress),
