@@ -29,6 +29,8 @@ pub enum Stage {
     P17Table,
     /// The quasi-Monte-Carlo points of the 2-loop mode coupling.
     TwoLoopPoints,
+    /// The cosmology-independent weights of RegPT's vertex Γ2 (once per plan).
+    Gamma2Weights,
 }
 
 impl fmt::Display for Stage {
@@ -38,6 +40,7 @@ impl fmt::Display for Stage {
             Stage::P15Table => "P15 angular table (once; cached)",
             Stage::P17Table => "P17 angular table (once, a few minutes; cached)",
             Stage::TwoLoopPoints => "2-loop mode coupling",
+            Stage::Gamma2Weights => "RegPT vertex weights (once per k grid)",
         })
     }
 }

@@ -244,6 +244,54 @@ pub fn regpt_one_loop(terms: &OneLoopTerms, pair: Pair, i: usize, sigma_d2: Esti
     damping * ((1.0 + x + gx) * (1.0 + x + gy) * p + terms.p22[pair][i])
 }
 
+/// What the 2-loop RegPT spectrum is made of, on one k grid.
+#[derive(Debug, Clone, Copy)]
+pub struct RegPtTwoLoop<'a> {
+    /// P_lin, P22, P13.
+    pub one_loop: &'a OneLoopTerms,
+    /// σ_d²(k) ([`sigma_d2`]).
+    pub sigma_d2: &'a [Estimate],
+    /// P15 (the 2-loop propagator).
+    pub p15: &'a ByPair<Vec<Estimate>>,
+    /// The 2-loop SPT terms, for P33irr.
+    pub two_loop: &'a TwoLoopCorrection,
+    /// P24 and PΓ2 from the 1-loop vertex.
+    pub gamma2: &'a crate::loops::Gamma2Terms,
+}
+
+impl RegPtTwoLoop<'_> {
+    /// The 2-loop RegPT spectrum of `pair` at k index `i` (Taruya et al. 2012, arXiv:1208.1191, eqs.
+    /// 23–24, as pyregpt writes it): with x = k²σ_d²/2, Γ1_X = P13_XX/P_lin and Γ2_X = P15_XX/P_lin
+    /// (the 1- and 2-loop propagator corrections; X = δ, θ),
+    /// P_XY = e^{−2x} {A_X A_Y P_lin + P22_XY (1 + x)² + P24_XY (1 + x) + PΓ2_XY + P33irr_XY},
+    /// A_X = 1 + x + x²/2 + Γ1_X (1 + x) + Γ2_X, with RegPT's P24 = 2P24 of the paper and PΓ2
+    /// ([`crate::loops::Gamma2Terms`]).
+    pub fn spectrum(&self, pair: Pair, i: usize) -> Estimate {
+        let t = self.one_loop;
+        let (k, p) = (t.k[i], t.p_lin[i]);
+        let x = 0.5 * k * k * self.sigma_d2[i];
+        let propagator = |x_pair: Pair| {
+            1.0 + x + x * x * 0.5 + t.p13[x_pair][i] / p * (1.0 + x) + self.p15[x_pair][i] / p
+        };
+        let (a, b) = match pair {
+            Pair::DeltaDelta => (Pair::DeltaDelta, Pair::DeltaDelta),
+            Pair::DeltaTheta => (Pair::DeltaDelta, Pair::ThetaTheta),
+            Pair::ThetaTheta => (Pair::ThetaTheta, Pair::ThetaTheta),
+        };
+        let damping = {
+            let e = (-2.0 * x.value).exp();
+            Estimate::new(e, 2.0 * e * x.error)
+        };
+        let one_plus = 1.0 + x;
+        damping
+            * (propagator(a) * propagator(b) * p
+                + t.p22[pair][i] * one_plus * one_plus
+                + self.gamma2.p24[pair][i] * one_plus
+                + self.gamma2.p_gamma2[pair][i]
+                + self.two_loop.pairs[pair].p33_2l[i])
+    }
+}
+
 /// Product of two estimates, errors propagated linearly (as `a * b`).
 pub fn product(a: Estimate, b: Estimate) -> Estimate {
     a * b

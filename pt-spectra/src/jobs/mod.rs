@@ -143,6 +143,22 @@ fn model_header(
     if model.needs_two_loop() {
         h.push(two_loop_line(precision));
     }
+    if matches!(model, RealModel::OneLoopRegPt | RealModel::TwoLoopRegPt) {
+        h.push(
+            "RegPT (Taruya et al. 2012): x = k^2 sigma_d2/2, sigma_d2 = (1/6pi^2) int_qmin^(k/2) P dq; \
+             1-loop: e^-2x [(1+x+G1_X)(1+x+G1_Y) P_lin + P22], G1_X = P13_XX/P_lin"
+                .into(),
+        );
+    }
+    if model.needs_gamma2() {
+        h.push(
+            "2-loop RegPT: e^-2x [A_X A_Y P_lin + P22 (1+x)^2 + P24_Gamma2 (1+x) + PGamma2 + P33_2L], \
+             A_X = 1+x+x^2/2+G1_X(1+x)+P15_XX/P_lin; P24_Gamma2 = 2 int [X2 Gamma2_Y + Gamma2_X Y2] P P \
+             (= 2 P24), PGamma2 = 2 int Gamma2_X Gamma2_Y P P, Gamma2 = 6 int F4(k1,k2,p,-p) P(p): \
+             Gauss-Legendre quadrature, error = difference from a coarser layout"
+                .into(),
+        );
+    }
     if terms && model.propagator().is_some() {
         h.push(
             "N_dd = N_delta^2, N_dt = N_delta N_theta, N_tt = N_theta^2: the factors multiplying \

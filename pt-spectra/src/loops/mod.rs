@@ -35,6 +35,7 @@
 //! [`Precision::lattice_step`]: crate::precision::Precision::lattice_step
 //! [`Precision::p22_error_floor`]: crate::precision::Precision::p22_error_floor
 
+mod gamma2;
 mod lattice;
 mod one_loop;
 mod p13;
@@ -44,6 +45,7 @@ mod p22;
 mod tns;
 mod two_loop;
 
+pub use gamma2::{Gamma2Plan, Gamma2Terms};
 pub use one_loop::OneLoopPlan;
 pub use p13::{k1_kernels, p13_kernels};
 pub use p15::{p15_angular_kernel, P15Table};
@@ -244,6 +246,8 @@ pub struct LoopTerms {
     pub sigma_d2: Option<Vec<Estimate>>,
     /// The no-wiggle terms of the IR-resummed models ([`crate::ir`]).
     pub ir: Option<Box<IrTerms>>,
+    /// RegPT's vertex terms P24 and PΓ2 ([`Gamma2Plan`]).
+    pub gamma2: Option<Gamma2Terms>,
 }
 
 /// What the IR-resummed models add to the loop terms of the linear spectrum.
@@ -265,6 +269,7 @@ impl LoopTerms {
             two_loop: None,
             sigma_d2: None,
             ir: None,
+            gamma2: None,
         }
     }
 
@@ -281,6 +286,20 @@ impl LoopTerms {
     /// P17, or [`Error::MissingTerm`] naming `needed_by`.
     pub fn p17(&self, needed_by: &dyn std::fmt::Display) -> Result<&ByPair<Vec<Estimate>>> {
         self.p17.as_ref().ok_or_else(|| missing("P17", needed_by))
+    }
+
+    /// RegPT's Γ2 terms, or [`Error::MissingTerm`] naming `needed_by`.
+    pub fn gamma2(&self, needed_by: &dyn std::fmt::Display) -> Result<&Gamma2Terms> {
+        self.gamma2
+            .as_ref()
+            .ok_or_else(|| missing("the Gamma2 terms P24, PGamma2", needed_by))
+    }
+
+    /// σ_d², or [`Error::MissingTerm`] naming `needed_by`.
+    pub fn sigma_d2(&self, needed_by: &dyn std::fmt::Display) -> Result<&[Estimate]> {
+        self.sigma_d2
+            .as_deref()
+            .ok_or_else(|| missing("sigma_d^2", needed_by))
     }
 
     /// The 2-loop terms, or [`Error::MissingTerm`] naming `needed_by`.

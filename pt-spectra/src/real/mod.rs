@@ -11,6 +11,8 @@
 //! | `2l-spt`    | P_lin + P22 + 2P13 + (2P15 + 2P24 + P33) (2-loop SPT)  |
 //! | `2l-rpt-n0`, `2l-rpt-n1`, `2l-rpt-n2` | [P_lin + P22_XY + P33^{2L}_XY] N_X N_Y |
 //! | `1l-rpt-n3`, `2l-rpt-n3` | as the N2 models, with N3 from P13, P15 and P17 (eq. N3) |
+//! | `1l-regpt`, `2l-regpt` | RegPT (Taruya et al. 2012), [`crate::resum::regpt_one_loop`], [`crate::resum::regpt_two_loop`] |
+//! | `1l-spt-ir`, `2l-spt-ir` | SPT with IR-resummed BAO ([`crate::ir`]) |
 //!
 //! Every value carries an error estimate propagated from the loop integrals ([`crate::loops`]).
 
@@ -53,6 +55,9 @@ pub enum RealModel {
     /// 1-loop RegPT (Taruya, Bernardeau, Nishimichi & Codis 2012): regularised propagators with
     /// σ_d² at the running cut-off k/2 ([`crate::resum::regpt_one_loop`]).
     OneLoopRegPt,
+    /// 2-loop RegPT: regularised propagators to two loops, P24 and PΓ2 from the 1-loop vertex Γ2
+    /// ([`crate::resum::regpt_two_loop`]).
+    TwoLoopRegPt,
     /// 1-loop SPT with the BAO wiggles IR-resummed ([`crate::ir`]).
     OneLoopSptIr,
     /// 2-loop SPT with the BAO wiggles IR-resummed ([`crate::ir`]).
@@ -61,11 +66,12 @@ pub enum RealModel {
 
 /// The accepted model names, for messages.
 const MODEL_NAMES: &str = "linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1, 1l-rpt-n2, 1l-rpt-n3, 2l-spt, \
-                           2l-rpt-n0, 2l-rpt-n1, 2l-rpt-n2, 2l-rpt-n3, 1l-regpt, 1l-spt-ir, 2l-spt-ir";
+                           2l-rpt-n0, 2l-rpt-n1, 2l-rpt-n2, 2l-rpt-n3, 1l-regpt, 2l-regpt, 1l-spt-ir, \
+                           2l-spt-ir";
 
 impl RealModel {
     /// Every model.
-    pub const ALL: [RealModel; 14] = [
+    pub const ALL: [RealModel; 15] = [
         RealModel::Linear,
         RealModel::OneLoopSpt,
         RealModel::OneLoopRptN0,
@@ -78,6 +84,7 @@ impl RealModel {
         RealModel::OneLoopRptN3,
         RealModel::TwoLoopRptN3,
         RealModel::OneLoopRegPt,
+        RealModel::TwoLoopRegPt,
         RealModel::OneLoopSptIr,
         RealModel::TwoLoopSptIr,
     ];
@@ -97,6 +104,7 @@ impl RealModel {
             RealModel::OneLoopRptN3 => "1l-rpt-n3",
             RealModel::TwoLoopRptN3 => "2l-rpt-n3",
             RealModel::OneLoopRegPt => "1l-regpt",
+            RealModel::TwoLoopRegPt => "2l-regpt",
             RealModel::OneLoopSptIr => "1l-spt-ir",
             RealModel::TwoLoopSptIr => "2l-spt-ir",
         }
@@ -115,6 +123,7 @@ impl RealModel {
             | RealModel::OneLoopSpt
             | RealModel::TwoLoopSpt
             | RealModel::OneLoopRegPt
+            | RealModel::TwoLoopRegPt
             | RealModel::OneLoopSptIr
             | RealModel::TwoLoopSptIr => None,
         }
@@ -140,7 +149,13 @@ impl RealModel {
                 | RealModel::TwoLoopRptN2
                 | RealModel::TwoLoopRptN3
                 | RealModel::TwoLoopSptIr
+                | RealModel::TwoLoopRegPt
         )
+    }
+
+    /// Whether the model needs RegPT's vertex terms P24 and PΓ2 ([`crate::loops::Gamma2Plan`]).
+    pub fn needs_gamma2(self) -> bool {
+        self == RealModel::TwoLoopRegPt
     }
 
     /// Whether the model resums the BAO ([`crate::ir`]): its terms include those of the no-wiggle
@@ -265,16 +280,25 @@ impl RealSpectra {
                 (spectra, None)
             }
             None if model == RealModel::OneLoopRegPt => {
-                let sigma_d2 = terms.sigma_d2.as_ref().ok_or_else(|| Error::MissingTerm {
-                    term: "sigma_d^2",
-                    needed_by: format!("model {model}"),
-                    hint: " (compute the terms with a RealPlan)",
-                })?;
+                let sigma_d2 = terms.sigma_d2(&format_args!("model {model}"))?;
                 let spectra = ByPair::from_fn(|pair| {
                     (0..n)
                         .map(|i| resum::regpt_one_loop(t, pair, i, sigma_d2[i]))
                         .collect()
                 });
+                (spectra, None)
+            }
+            None if model == RealModel::TwoLoopRegPt => {
+                let needed_by = format_args!("model {model}");
+                let regpt = resum::RegPtTwoLoop {
+                    one_loop: t,
+                    sigma_d2: terms.sigma_d2(&needed_by)?,
+                    p15: terms.p15(&needed_by)?,
+                    two_loop: two_loop.expect("checked above"),
+                    gamma2: terms.gamma2(&needed_by)?,
+                };
+                let spectra =
+                    ByPair::from_fn(|pair| (0..n).map(|i| regpt.spectrum(pair, i)).collect());
                 (spectra, None)
             }
             None => {
@@ -365,8 +389,18 @@ impl RealSpectra {
             }
         }
         t.push_estimates("sigma_v2", "(Mpc/h)^2", &vec![one.sigma_v2; self.k.len()]);
-        if let (Some(sigma_d2), RealModel::OneLoopRegPt) = (&self.terms.sigma_d2, model) {
+        if let (Some(sigma_d2), RealModel::OneLoopRegPt | RealModel::TwoLoopRegPt) =
+            (&self.terms.sigma_d2, model)
+        {
             t.push_estimates("sigma_d2", "(Mpc/h)^2", sigma_d2);
+        }
+        if let (Some(g), true) = (&self.terms.gamma2, model.needs_gamma2()) {
+            for (pair, v) in g.p24.iter() {
+                t.push_estimates(&format!("P24_Gamma2_{}", pair.suffix()), POWER, v);
+            }
+            for (pair, v) in g.p_gamma2.iter() {
+                t.push_estimates(&format!("PGamma2_{}", pair.suffix()), POWER, v);
+            }
         }
         if let (Some(ir), true) = (&self.terms.ir, model.needs_ir()) {
             t.push("P_nw", POWER, ir.no_wiggle.one_loop.p_lin.clone());

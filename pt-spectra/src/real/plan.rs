@@ -3,7 +3,7 @@
 use super::{RealModel, RealSelection, RealSpectra};
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
-use crate::loops::{self, LoopTerms, OneLoopPlan, OneLoopTerms, P15Table, P17Table};
+use crate::loops::{self, Gamma2Plan, LoopTerms, OneLoopPlan, OneLoopTerms, P15Table, P17Table};
 use crate::precision::Precision;
 use crate::progress::{stage_callback, Progress, Silent, Stage};
 use crate::resum;
@@ -44,6 +44,8 @@ pub struct RealPlan {
     /// The wiggle split if [`terms`](Self::terms) also computes the no-wiggle terms of the
     /// IR-resummed models (its reference spectrum built once, here).
     ir: Option<crate::ir::WiggleSplit>,
+    /// RegPT's vertex weights (2-loop RegPT, and `all`).
+    gamma2: Option<Gamma2Plan>,
 }
 
 impl RealPlan {
@@ -60,8 +62,13 @@ impl RealPlan {
         progress: &dyn Progress,
     ) -> Result<Self> {
         let mut plan = Self::new(k, selection.plan_model(), precision, store, progress)?;
-        if selection == RealSelection::All && plan.ir.is_none() {
-            plan.ir = Some(crate::ir::WiggleSplit::new()?);
+        if selection == RealSelection::All {
+            if plan.ir.is_none() {
+                plan.ir = Some(crate::ir::WiggleSplit::new()?);
+            }
+            if plan.gamma2.is_none() {
+                plan.gamma2 = Some(gamma2_plan(k, precision, progress));
+            }
         }
         Ok(plan)
     }
@@ -69,7 +76,7 @@ impl RealPlan {
     /// Whether the plan computes every model's terms (those of `real --model all`).
     pub fn covers(&self, selection: RealSelection) -> bool {
         self.model == selection.plan_model()
-            && (self.ir.is_some() || selection != RealSelection::All)
+            && ((self.ir.is_some() && self.gamma2.is_some()) || selection != RealSelection::All)
     }
 
     /// The plan of `model` on the wavenumbers `k` [h/Mpc] with `precision`; the angular tables the
@@ -118,6 +125,9 @@ impl RealPlan {
             } else {
                 None
             },
+            gamma2: model
+                .needs_gamma2()
+                .then(|| gamma2_plan(k, precision, progress)),
         })
     }
 
@@ -187,6 +197,7 @@ impl RealPlan {
             _ => None,
         };
         let sigma_d2 = Some(resum::sigma_d2(spectrum, k, precision));
+        let gamma2 = self.gamma2.as_ref().map(|plan| plan.evaluate(spectrum));
         LoopTerms {
             one_loop,
             p15,
@@ -194,6 +205,7 @@ impl RealPlan {
             two_loop,
             sigma_d2,
             ir: None,
+            gamma2,
         }
     }
 
@@ -209,6 +221,16 @@ impl RealPlan {
     ) -> Result<RealSpectra> {
         RealSpectra::from_terms(self.model, self.terms(spectrum, progress)?)
     }
+}
+
+/// RegPT's vertex weights on `k` (seconds on long grids: reported as [`Stage::Gamma2Weights`]).
+fn gamma2_plan(k: &[f64], precision: &Precision, progress: &dyn Progress) -> Gamma2Plan {
+    Gamma2Plan::with_progress(
+        k,
+        (precision.q_min, precision.q_max),
+        precision.lattice_step,
+        &stage_callback(progress, Stage::Gamma2Weights),
+    )
 }
 
 /// The spectra of `model` for `spectrum` at wavenumbers `k` [h/Mpc]: a [`RealPlan`] built and

@@ -138,7 +138,7 @@ fn model_all_has_every_model_and_agrees_with_single_runs() {
     assert_eq!(names[..3], ["k", "P_nw", "linear"]);
     assert!(names.contains(&"2l-rpt-n2") && names.contains(&"err_2l-spt"));
     let col = |n: &str| names.iter().position(|&x| x == n).unwrap();
-    for model in ["linear", "2l-spt", "1l-rpt-n2"] {
+    for model in ["linear", "2l-spt", "1l-rpt-n2", "2l-regpt"] {
         let mut one = vec!["real", "--model", model];
         one.extend(grid);
         let (ok, single, err) = run(&one);

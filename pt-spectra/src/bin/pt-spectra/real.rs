@@ -14,7 +14,8 @@ use std::path::PathBuf;
 pub struct Args {
     #[command(flatten)]
     input: Input,
-    /// Model: linear, 1l-spt, 2l-spt, 1l-rpt-n0..n3 or 2l-rpt-n0..n3 (N3 builds the P17 table once);
+    /// Model: linear, 1l-spt, 2l-spt, 1l-rpt-n0..n3, 2l-rpt-n0..n3 (N3 builds the P17 table once),
+    /// 1l-regpt, 2l-regpt (RegPT), 1l-spt-ir, 2l-spt-ir (IR-resummed BAO);
     /// or `all`: P_dd/P_nowiggle of every model, one column each (the paper's real-space comparison).
     #[arg(long, value_name = "M", default_value = "1l-spt", value_parser = parsed::<RealSelection>)]
     model: RealSelection,
