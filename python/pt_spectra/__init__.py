@@ -34,6 +34,7 @@ __all__ = [
     "eisenstein_hu",
     "fit",
     "growth",
+    "halo",
     "kernel",
     "log_grid",
     "num_threads",
@@ -196,6 +197,18 @@ def fit(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_
                            real, fog, f, sigma0, bias, amplitude, shot_noise, number_density,
                            noise_table, k_min, linear, z, z_input, cosmology, precision, q_range,
                            cache_dir, eh))
+
+
+def halo(pmm, pmh, phh, number_density=None) -> Table:
+    """Scale-dependent bias and stochasticity from measured spectra (``pt-spectra halo``).
+
+    pmm, pmh, phh: tuples ``(k, P)`` or ``(k, P, sigma)`` of arrays on one k grid [h/Mpc,
+    (Mpc/h)^3]: the matter, matter-halo and halo spectra (P_hh with its noise). Returns ``k b P_eps``
+    with b = P_mh/P_mm and P_eps = P_hh - P_mh^2/P_mm, ``P_eps_n`` = P_eps n_h for a
+    ``number_density`` n_h [(h/Mpc)^3], and the propagated errors ``err_b err_P_eps`` where sigmas
+    are given. The table's ``to_text()`` feeds ``bias``/``noise_table`` of :func:`rsd` and :func:`fit`.
+    """
+    return _core.halo(tuple(pmm), tuple(pmh), tuple(phh), number_density)
 
 
 def kernel(which, vectors, exact=False):

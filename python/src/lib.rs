@@ -21,6 +21,7 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
+mod halo;
 mod inputs;
 mod kernel;
 mod redshift;
@@ -470,6 +471,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(growth, m)?)?;
     m.add_function(wrap_pyfunction!(eisenstein_hu, m)?)?;
     m.add_function(wrap_pyfunction!(kernel::kernel, m)?)?;
+    m.add_function(wrap_pyfunction!(halo::halo, m)?)?;
     m.add_function(wrap_pyfunction!(set_num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(log_grid, m)?)?;

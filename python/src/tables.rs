@@ -50,6 +50,23 @@ impl Table {
             warnings: prepared.warnings.clone(),
         })
     }
+
+    /// A table of a job without a cosmology (`halo`): `meta` has the model and the seconds.
+    pub fn plain(
+        py: Python<'_>,
+        table: output::Table,
+        model: &str,
+        seconds: f64,
+    ) -> PyResult<Self> {
+        let meta = PyDict::new(py);
+        meta.set_item("model", model)?;
+        meta.set_item("seconds", seconds)?;
+        Ok(Self {
+            table,
+            meta: meta.unbind(),
+            warnings: Vec::new(),
+        })
+    }
 }
 
 #[pymethods]

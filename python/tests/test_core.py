@@ -226,3 +226,27 @@ def test_growth_matches_camb_for_planck2018():
     assert pt.growth(0.0, "planck2018")[0] == 1.0
     with pytest.raises(ValueError, match="redshift"):
         pt.growth(-1.0)
+
+
+def test_halo_recovers_bias_and_noise_and_feeds_rsd(tmp_path):
+    # Synthetic spectra with a known b(k) and P_eps: P_mh = b P_mm, P_hh = b^2 P_mm + P_eps.
+    k = np.geomspace(0.02, 0.2, 8)
+    pmm = pt.real(model="linear", k=k)["P_lin"]
+    b = 2.0 + 3.0 * k**2
+    p_eps = np.full_like(k, 2.5e3)
+    sigma = 0.01 * pmm
+    t = pt.halo((k, pmm, sigma), (k, b * pmm), (k, b * b * pmm + p_eps), number_density=2e-4)
+    assert t.columns == ["k", "b", "P_eps", "P_eps_n", "err_b", "err_P_eps", "err_P_eps_n"]
+    np.testing.assert_allclose(t["b"], b, rtol=1e-13)
+    np.testing.assert_allclose(t["P_eps"], p_eps, rtol=1e-9)
+    np.testing.assert_allclose(t["P_eps_n"], p_eps * 2e-4, rtol=1e-9)
+    # err_b = b s_mm/P_mm with only P_mm's error given (first-order propagation).
+    np.testing.assert_allclose(t["err_b"], b * 0.01, rtol=1e-12)
+    path = tmp_path / "halo.dat"
+    path.write_text(t.to_text())
+    m = pt.rsd(rsd="kaiser", real="linear", k=k, f=0.5, bias=str(path), noise_table=str(path))
+    np.testing.assert_allclose(m["P_eps"], p_eps, rtol=1e-6)
+    with pytest.raises(ValueError, match="P_mh"):
+        pt.halo((k, pmm), (k[:-1], pmm[:-1]), (k, pmm))
+    with pytest.raises(ValueError, match="P_hh"):
+        pt.halo((k, pmm), (k, pmm), (k,))
