@@ -44,6 +44,6 @@ pub(crate) fn halo(
         phh: measured("P_hh", phh)?,
         number_density,
     };
-    let (table, seconds) = detached(py, || Ok(halo_table(&request)?))?;
+    let (table, seconds) = detached(py, || halo_table(&request))?;
     Table::plain(py, table, "halo", seconds)
 }
