@@ -13,6 +13,9 @@
 //! | `1l-rpt-n3`, `2l-rpt-n3` | as the N2 models, with N3 from P13, P15 and P17 (eq. N3) |
 //!
 //! Every value carries an error estimate propagated from the loop integrals ([`crate::loops`]).
+//! Any model takes the EFT counterterm −(2, 4, 6) c_s² k² P_lin of δδ, δθ, θθ
+//! ([`RealSpectra::with_counterterm`], module [`counterterm`](mod@counterterm): the pair factors
+//! and their assumptions).
 
 use crate::error::{Error, Result};
 use crate::loops::{ByPair, Estimate, LoopTerms, Pair};
@@ -21,7 +24,9 @@ use crate::resum::{self, Propagator};
 use std::fmt;
 use std::str::FromStr;
 
+pub mod counterterm;
 mod plan;
+pub use counterterm::{check_cs2, counterterm, counterterm_factor};
 pub use plan::{real_space, RealPlan};
 
 /// A real-space model, named as on the command line.
@@ -222,6 +227,9 @@ pub struct RealSpectra {
     pub factors: Option<ByPair<Vec<Estimate>>>,
     /// The loop terms (every term the model needs is there; others may be too).
     pub terms: LoopTerms,
+    /// The EFT counterterm c_s² [(Mpc/h)²] included in `spectra` (0: none;
+    /// [`with_counterterm`](Self::with_counterterm)).
+    pub cs2: f64,
 }
 
 impl RealSpectra {
@@ -314,6 +322,7 @@ impl RealSpectra {
             spectra,
             factors,
             terms,
+            cs2: 0.0,
         })
     }
 }
