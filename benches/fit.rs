@@ -47,6 +47,7 @@ fn setup() -> (MultipoleModel, MultipoleData) {
         f: 0.483,
         sigma0: 4.0,
         amplitude: 1.0,
+        cs2: 0.0,
     });
     let mut text = String::new();
     for (i, &ki) in k.iter().enumerate() {
@@ -72,6 +73,7 @@ fn benches(c: &mut Criterion) {
                     f,
                     sigma0: 4.0,
                     amplitude: 1.0,
+                    cs2: 0.0,
                 }),
                 0..n,
                 &mut out,
@@ -86,6 +88,7 @@ fn benches(c: &mut Criterion) {
             f: 0.55,
             sigma0: 3.0,
             amplitude: 1.0,
+            cs2: 0.0,
         },
         k_min: 0.0,
     };

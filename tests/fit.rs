@@ -108,6 +108,7 @@ fn fit_recovers_f_from_an_independent_kaiser_mock() {
                 f: 0.6,
                 sigma0: 0.0,
                 amplitude: 1.0,
+                cs2: 0.0,
             },
             k_min: 0.0,
         };
@@ -143,6 +144,7 @@ fn two_parameter_errors_lie_on_the_delta_chi2_contour() {
             f: 0.4,
             sigma0: 0.0,
             amplitude: 1.1,
+            cs2: 0.0,
         },
         k_min: 0.0,
     };
@@ -163,6 +165,7 @@ fn two_parameter_errors_lie_on_the_delta_chi2_contour() {
             f,
             sigma0: 0.0,
             amplitude: a,
+            cs2: 0.0,
         });
         (0..3)
             .map(|j| {
@@ -192,6 +195,7 @@ fn a_wrong_model_shows_a_bias() {
         f: F_TRUE,
         sigma0: 4.0,
         amplitude: 1.0,
+        cs2: 0.0,
     });
     let mut text = String::new();
     for (i, &ki) in k.iter().enumerate() {
@@ -207,6 +211,7 @@ fn a_wrong_model_shows_a_bias() {
             f: 0.5,
             sigma0: 0.0,
             amplitude: 1.0,
+            cs2: 0.0,
         },
         k_min: 0.0,
     };
@@ -237,6 +242,7 @@ fn a_wrong_model_shows_a_bias() {
             f: 0.55,
             sigma0: 3.0,
             amplitude: 1.0,
+            cs2: 0.0,
         },
         k_min: 0.0,
     };
@@ -272,6 +278,7 @@ fn full_covariance_generalises_the_diagonal_chi2() {
             f: 0.5,
             sigma0: 0.0,
             amplitude: 1.0,
+            cs2: 0.0,
         },
         k_min: 0.0,
     };
@@ -338,6 +345,7 @@ fn three_free_parameters_are_recovered_with_bracketing_intervals() {
         f: F_TRUE,
         sigma0: 4.0,
         amplitude: 1.0,
+        cs2: 0.0,
     };
     let m = model.multipoles(&truth);
     let mut text = String::new();
@@ -352,6 +360,7 @@ fn three_free_parameters_are_recovered_with_bracketing_intervals() {
             f: 0.55,
             sigma0: 3.0,
             amplitude: 0.95,
+            cs2: 0.0,
         },
         k_min: 0.0,
     };

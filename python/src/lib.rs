@@ -286,7 +286,7 @@ fn data(
     data_ells=vec![0, 2, 4], data_columns=None, covariance=None, rsd="tns", real="1l-spt", fog="lorentzian",
     f=None, sigma0=None, bias=None, amplitude=1.0, shot_noise=None, number_density=None, noise_table=None,
     k_min=0.0, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default", q_range=None,
-    cache_dir=None, eh=None))]
+    cache_dir=None, eh=None, cs2=0.0))]
 #[allow(clippy::too_many_arguments)]
 fn fit(
     py: Python<'_>,
@@ -316,6 +316,7 @@ fn fit(
     q_range: Option<(f64, f64)>,
     cache_dir: Option<PathBuf>,
     eh: Option<&str>,
+    cs2: f64,
 ) -> PyResult<Table> {
     let (mut data, data_name) = self::data(data, data_columns, &data_ells, &ells)?;
     if let Some(c) = covariance {
@@ -360,6 +361,7 @@ fn fit(
             ells,
             terms: false,
             no_wiggle: false,
+            cs2,
         },
         free,
         k_min,
