@@ -458,8 +458,9 @@ fn fit_recovers_an_injected_counterterm_with_f_and_the_amplitude() {
             k_min: 0.0,
         };
         let at = &fit(&model, &data, &held, &[0.25]).unwrap()[0];
+        // Measured: 3.53002 and 3.53001.
         assert!(
-            (at.chi2 - r.chi2 - delta_chi2(3)).abs() < 0.02,
+            (at.chi2 - r.chi2 - delta_chi2(3)).abs() < 1e-3,
             "c_s² = {end}: χ² = {} vs {} + 3.53",
             at.chi2,
             r.chi2
