@@ -1,5 +1,5 @@
 //! Fits of the growth rate f, the FoG dispersion σ0, the bias amplitude A_b and the EFT counterterm c_s²
-//! to measured multipoles (Gil-Marín et al. 2012, sections 4.2–4.5; c_s²: [`crate::real::counterterm`]).
+//! to measured multipoles (Gil-Marín et al. 2012, sections 4.2–4.5; c_s²: [`crate::real::counterterm`](mod@crate::real::counterterm)).
 //!
 //! * χ² = Σ_ℓ Σ_{k ≤ k_max} [(P_ℓ,data − P_ℓ,model)/σ_ℓ]² (diagonal, as the paper), or
 //!   (d − m)ᵀ C⁻¹ (d − m) with a full covariance of the data vector (ℓ-major: all k of the first ℓ, …).
@@ -39,7 +39,7 @@ pub enum Parameter {
     Sigma0,
     /// The bias amplitude A_b (b → A_b b).
     Amplitude,
-    /// The EFT counterterm c_s² [(Mpc/h)²] ([`crate::real::counterterm`]).
+    /// The EFT counterterm c_s² [(Mpc/h)²] ([`crate::real::counterterm`](mod@crate::real::counterterm)).
     Cs2,
 }
 

@@ -81,7 +81,7 @@ pub fn two_loop_line(precision: &Precision) -> String {
 
 /// `pt-spectra real`: the spectra of the selected model (or P_dd/P_nw of every model) for the
 /// prepared linear spectrum, with the loop terms if `terms`, and the EFT counterterm of c_s² = `cs2`
-/// [(Mpc/h)²] added to every model (0: none; [`crate::real::counterterm`]). With a counterterm the
+/// [(Mpc/h)²] added to every model (0: none; [`crate::real::counterterm`](mod@crate::real::counterterm)). With a counterterm the
 /// header states c_s² and, with `terms`, the columns `P_ct_dd P_ct_dt P_ct_tt` give it.
 ///
 /// # Errors

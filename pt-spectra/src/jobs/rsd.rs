@@ -42,7 +42,7 @@ pub struct RsdRequest {
     pub terms: bool,
     /// Whether to add the no-wiggle reference `P<l>_nw` ([`no_wiggle_multipoles`]).
     pub no_wiggle: bool,
-    /// The EFT counterterm c_s² [(Mpc/h)²] added to the real-space spectra ([`crate::real::counterterm`];
+    /// The EFT counterterm c_s² [(Mpc/h)²] added to the real-space spectra ([`crate::real::counterterm`](mod@crate::real::counterterm);
     /// 0: none); in `fit` its start value if free, else its value.
     pub cs2: f64,
 }

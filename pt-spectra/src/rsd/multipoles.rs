@@ -35,7 +35,7 @@ pub struct RsdSettings {
     /// Whether to also compute the multipoles of each part (Kaiser/Scoccimarro, A, B).
     pub parts: bool,
     /// The EFT counterterm c_s² [(Mpc/h)²] added to the real-space P_δδ, P_δθ, P_θθ before the RSD
-    /// model (−2, −4, −6 c_s² k² P_lin, [`crate::real::counterterm`]; on top of any the spectra
+    /// model (−2, −4, −6 c_s² k² P_lin, [`crate::real::counterterm`](mod@crate::real::counterterm); on top of any the spectra
     /// include); 0 for none.
     pub cs2: f64,
 }
