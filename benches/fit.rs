@@ -1,7 +1,8 @@
 //! Fits on one core, for the embedded gm2012 z = 0 spectrum on 50 log-spaced k in [0.01, 0.3] h/Mpc
 //! with TNS + 1L-SPT and Lorentzian FoG (all loop terms computed once, outside the timing):
 //!
-//! * `model/evaluate`: P_0, P_2, P_4 at a new (f, σ0, A_b) — one χ² step;
+//! * `model/evaluate`: P_0, P_2, P_4 at a new (f, σ0, A_b) — one χ² step; `model/evaluate-cs2` the
+//!   same with the EFT counterterm c_s² ≠ 0;
 //! * `fit/scan-20`: a 20-point k_max scan (0.06 … 0.3) of a 2-parameter (f, σ0) fit on the three
 //!   multipoles, with the Δχ² = 2.3 errors of both parameters.
 //!
@@ -47,6 +48,7 @@ fn setup() -> (MultipoleModel, MultipoleData) {
         f: 0.483,
         sigma0: 4.0,
         amplitude: 1.0,
+        cs2: 0.0,
     });
     let mut text = String::new();
     for (i, &ki) in k.iter().enumerate() {
@@ -72,6 +74,25 @@ fn benches(c: &mut Criterion) {
                     f,
                     sigma0: 4.0,
                     amplitude: 1.0,
+                    cs2: 0.0,
+                }),
+                0..n,
+                &mut out,
+            );
+            out[0]
+        })
+    });
+    // The same with the EFT counterterm: three more multiply-adds per k.
+    group.bench_function("evaluate-cs2", |b| {
+        let mut f = 0.45;
+        b.iter(|| {
+            f += 1e-9;
+            model.multipoles_into(
+                black_box(&Params {
+                    f,
+                    sigma0: 4.0,
+                    amplitude: 1.0,
+                    cs2: 1.0,
                 }),
                 0..n,
                 &mut out,
@@ -86,6 +107,7 @@ fn benches(c: &mut Criterion) {
             f: 0.55,
             sigma0: 3.0,
             amplitude: 1.0,
+            cs2: 0.0,
         },
         k_min: 0.0,
     };

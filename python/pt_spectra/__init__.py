@@ -65,8 +65,9 @@ class RealPlan:
 
     ``RealPlan(k, model="1l-spt", precision="default", q_range=None, two_loop_tolerance=None,
     cache_dir=None)``; models ``linear, 1l-spt, 2l-spt, 1l-rpt-n0..n3, 2l-rpt-n0..n3`` or ``all``.
-    ``plan(linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False, eh=None)`` returns a
-    :class:`Table` with no set-up cost beyond the computation itself.
+    ``plan(linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False, eh=None, cs2=0.0)`` returns a
+    :class:`Table` with no set-up cost beyond the computation itself (``cs2``: the EFT counterterm, as
+    in :func:`real`).
     """
 
     def __init__(self, k, model="1l-spt", precision="default", q_range=None,
@@ -79,8 +80,9 @@ class RealPlan:
         """The k grid [h/Mpc]."""
         return self._plan.k
 
-    def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False, eh=None):
-        return _warn(self._plan(linear, z, z_input, cosmology, terms, eh))
+    def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False, eh=None,
+                 cs2=0.0):
+        return _warn(self._plan(linear, z, z_input, cosmology, terms, eh, cs2))
 
 
 class RsdPlan:
@@ -88,7 +90,7 @@ class RsdPlan:
 
     ``RsdPlan(k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None, cache_dir=None)``;
     calling it takes the arguments of :func:`rsd` after ``k`` (linear, z, cosmology, f, bias, fog,
-    sigma0, noise, ells, terms) and returns the multipoles.
+    sigma0, noise, ells, terms, cs2) and returns the multipoles.
     """
 
     def __init__(self, k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None,
@@ -98,10 +100,10 @@ class RsdPlan:
     def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=1.0,
                  amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None, number_density=None,
                  noise_table=None, ells=(0, 2, 4), terms=False, eh=None, growth_factor=None,
-                 no_wiggle=False):
+                 no_wiggle=False, cs2=0.0):
         return _warn(self._plan(linear, z, z_input, cosmology, f, bias, amplitude, fog, sigma0,
                                 shot_noise, number_density, noise_table, list(ells), terms, eh,
-                                growth_factor, no_wiggle))
+                                growth_factor, no_wiggle, cs2))
 
     def terms(self, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None):
         """The loop terms of one linear spectrum (the expensive part), as :class:`RsdTerms`."""
@@ -112,8 +114,9 @@ class RsdTerms:
     """The loop terms of one linear spectrum on an :class:`RsdPlan`'s grid.
 
     ``terms.multipoles(f=None, bias=1.0, amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None,
-    number_density=None, noise_table=None, ells=(0, 2, 4), terms=False, growth_factor=None)`` costs
-    microseconds: the step of a chain in which only f, the bias, sigma0 or the noise change.
+    number_density=None, noise_table=None, ells=(0, 2, 4), terms=False, growth_factor=None,
+    no_wiggle=False, cs2=0.0)`` costs microseconds: the step of a chain in which only f, the bias,
+    sigma0, the noise or the EFT counterterm ``cs2`` change.
     ``growth_factor`` replaces D(z) of the cosmology in the FoG scale sigma0 D(z) f (e.g. with a
     Boltzmann code's sigma8(z)/sigma8(0)).
     """
@@ -123,15 +126,15 @@ class RsdTerms:
 
     def multipoles(self, f=None, bias=1.0, amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None,
                    number_density=None, noise_table=None, ells=(0, 2, 4), terms=False,
-                   growth_factor=None, no_wiggle=False):
+                   growth_factor=None, no_wiggle=False, cs2=0.0):
         return _warn(self._terms.multipoles(f, bias, amplitude, fog, sigma0, shot_noise,
                                             number_density, noise_table, list(ells), terms,
-                                            growth_factor, no_wiggle))
+                                            growth_factor, no_wiggle, cs2))
 
 
 def real(model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False,
          precision="default", q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None,
-         k_min=1e-3, k_max=1.0, nk=100) -> Table:
+         k_min=1e-3, k_max=1.0, nk=100, cs2=0.0) -> Table:
     """Real-space P_dd, P_dt, P_tt of a model (``pt-spectra real``).
 
     model: ``linear``, ``1l-spt``, ``2l-spt``, ``1l-rpt-n0`` … ``1l-rpt-n3``, ``2l-rpt-n0`` …
@@ -145,17 +148,21 @@ def real(model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None
     terms: add every loop term with its error (``P22_dd``, ``err_P22_dd``, …).
     precision: ``fast``, ``default`` or ``reference``; q_range: (QMIN, QMAX) of the loop integrals.
     eh: ``"wiggle"`` or ``"no-wiggle"`` for the Eisenstein & Hu spectrum of the cosmology.
+    cs2: the EFT counterterm c_s^2 [(Mpc/h)^2] added to the model: P_dd - 2 cs2 k^2 P_lin,
+    P_dt - 4 cs2 k^2 P_lin, P_tt - 6 cs2 k^2 P_lin (delta_ct grows as D^3 and theta_ct = 3 delta_ct by
+    mass conservation); exact; stated in the header, and with ``terms`` the columns ``P_ct_dd P_ct_dt
+    P_ct_tt``.
     """
     plan = RealPlan(_grid(k, k_min, k_max, nk), model, precision, q_range, two_loop_tolerance,
                     cache_dir)
-    return plan(linear, z, z_input, cosmology, terms, eh)
+    return plan(linear, z, z_input, cosmology, terms, eh, cs2)
 
 
 def rsd(rsd="tns", real="1l-rpt-n1", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None,
         f=None, bias=1.0, amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None,
         number_density=None, noise_table=None, ells=(0, 2, 4), terms=False, precision="default",
         q_range=None, cache_dir=None, eh=None, k_min=1e-3, k_max=1.0, nk=100,
-        no_wiggle=False) -> Table:
+        no_wiggle=False, cs2=0.0) -> Table:
     """Redshift-space multipoles (``pt-spectra rsd``): columns ``k P0 P2 P4 … err_P0 …``.
 
     rsd: ``kaiser``, ``scoccimarro`` or ``tns``; real: the real-space model (as :func:`real`).
@@ -167,25 +174,28 @@ def rsd(rsd="tns", real="1l-rpt-n1", k=None, linear=None, z=0.0, z_input=0.0, co
     are of the noise-subtracted spectrum, so the noise changes no P_l: it adds ``P_eps SN SN_s``, SN =
     b^2 P_dd/P_eps (real space, the paper's signal-to-noise) and SN_s = P0/P_eps. ells: even
     multipoles up to 8. terms: add the parts ``P<l>_sc P<l>_A P<l>_B``. no_wiggle: add ``P<l>_nw``,
-    the linear Kaiser multipoles of the no-wiggle spectrum. The other arguments are those of
+    the linear Kaiser multipoles of the no-wiggle spectrum. cs2: the EFT counterterm added to the
+    real-space spectra before the RSD model (as in :func:`real`). The other arguments are those of
     :func:`real`.
     """
     plan = RsdPlan(_grid(k, k_min, k_max, nk), real, rsd, precision, q_range, cache_dir)
     return plan(linear, z, z_input, cosmology, f, bias, amplitude, fog, sigma0, shot_noise,
-                number_density, noise_table, ells, terms, eh, no_wiggle=no_wiggle)
+                number_density, noise_table, ells, terms, eh, no_wiggle=no_wiggle, cs2=cs2)
 
 
 def fit(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_columns=None,
         covariance=None, rsd="tns", real="1l-spt", fog="lorentzian", f=None, sigma0=3.0, bias=1.0,
         amplitude=1.0, shot_noise=None, number_density=None, noise_table=None, k_min=0.0,
         linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default", q_range=None,
-        cache_dir=None, eh=None) -> Table:
-    """Fits of f, sigma0 and A_b (``free``) to measured multipoles (``pt-spectra fit``).
+        cache_dir=None, eh=None, cs2=0.0) -> Table:
+    """Fits of f, sigma0, A_b and the EFT counterterm c_s^2 (``free``, of ``"f"``, ``"sigma0"``,
+    ``"ab"``, ``"cs2"``) to measured multipoles (``pt-spectra fit``).
 
     data: a file (columns ``k P0 s0 P2 s2 P4 s4``, or ``data_columns`` 1-based for ``data_ells``) or a
     dict ``{"k": …, "P0": …, "s0": …, …}`` with the multipoles of ``ells``. k_max: a list of k_max
     [h/Mpc], one fit (one row) each. covariance: the full covariance of the fitted data vector
-    (ell-major), default diagonal. f, sigma0, amplitude: start values if free, values if fixed;
+    (ell-major), default diagonal. f, sigma0, amplitude, cs2 [(Mpc/h)^2, as in :func:`real`]: start
+    values if free, values if fixed;
     sigma0 may be ``"lin"`` or ``"1l-spt"`` (the theory value, as in :func:`rsd`). With a fog, the
     columns ``sigma0_lin sigma0_1l`` give the theory sigma0.
     Returns ``k_max points <p> <p>_lo <p>_hi … chi2 dof chi2_dof``.
@@ -196,7 +206,7 @@ def fit(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_
                            None if data_columns is None else list(data_columns), covariance, rsd,
                            real, fog, f, sigma0, bias, amplitude, shot_noise, number_density,
                            noise_table, k_min, linear, z, z_input, cosmology, precision, q_range,
-                           cache_dir, eh))
+                           cache_dir, eh, cs2))
 
 
 def halo(pmm, pmh, phh, number_density=None) -> Table:

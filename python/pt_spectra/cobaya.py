@@ -29,6 +29,9 @@ Nuisance parameters, one set per redshift ``zs[i]`` (declare them in ``params``,
   and so is degenerate with it: sample one of them.
 - ``P_shot_i`` [(Mpc/h)^3] (optional, default 0): a constant residual shot noise added to the
   monopole. (The library's multipoles are noise-subtracted, as a measured P0 is after removing 1/n.)
+- ``cs2_i`` [(Mpc/h)^2] (optional, default 0): the EFT counterterm c_s^2 at zs[i], added to the
+  real-space P_dd, P_dt, P_tt as -2, -4, -6 c_s^2 k^2 P_lin before the RSD model (``pt.rsd``'s
+  ``cs2``); a fast parameter like the others.
 
 The linear spectrum is the Boltzmann code's own ``Pk_grid`` at exactly each z (k [1/Mpc] and P
 [Mpc^3] converted to h/Mpc and (Mpc/h)^3 with its H0), rather than ``Pk_interpolator``: no second
@@ -60,6 +63,7 @@ NUISANCE = {
     "sigma0": (True, None, "Mpc/h"),
     "A_b": (False, 1.0, ""),
     "P_shot": (False, 0.0, "(Mpc/h)^3"),
+    "cs2": (False, 0.0, "(Mpc/h)^2"),
 }
 
 # The library warns that without a cosmology the growth of its gm2012 cosmology is used. It does
@@ -146,7 +150,7 @@ class PTMultipoles(Theory):
         self._planned_k = np.asarray(k, dtype=float)
 
     def param_name(self, name, i):
-        """The name of nuisance parameter `name` (b, sigma0, A_b, P_shot) of redshift zs[i]."""
+        """The name of nuisance parameter `name` (b, sigma0, A_b, P_shot, cs2) of redshift zs[i]."""
         return f"{self.prefix}{name}_{i}"
 
     def get_can_support_params(self):
@@ -239,7 +243,8 @@ class PTMultipoles(Theory):
                     cached = (digest, self._plan.terms(linear=(k_lin, p_lin), z=z, z_input=z))
                     self._terms[i] = cached
                 t = cached[1].multipoles(f=f, bias=nu["b"], amplitude=nu["A_b"], fog=self.fog,
-                                         sigma0=nu["sigma0"], ells=self.ells, growth_factor=d)
+                                         sigma0=nu["sigma0"], ells=self.ells, growth_factor=d,
+                                         cs2=nu["cs2"])
             p = np.array([t[f"P{ell}"] for ell in self.ells])
             if 0 in self.ells:
                 p[self.ells.index(0)] += nu["P_shot"]

@@ -162,8 +162,9 @@ impl RealPlan {
         self.plan.k().to_vec().into_pyarray(py)
     }
 
-    /// The spectra of `linear` (None: the embedded gm2012 spectrum; a path; or (k, P)) at z.
-    #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false, eh=None))]
+    /// The spectra of `linear` (None: the embedded gm2012 spectrum; a path; or (k, P)) at z, with the
+    /// EFT counterterm c_s² = `cs2` [(Mpc/h)²].
+    #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false, eh=None, cs2=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn __call__(
         &self,
@@ -174,11 +175,13 @@ impl RealPlan {
         cosmology: Option<&Bound<'_, PyAny>>,
         terms: bool,
         eh: Option<&str>,
+        cs2: f64,
     ) -> PyResult<Table> {
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
         let ((table, prepared), seconds) = detached(py, || {
             let prepared = inputs.prepare(self.plan.k())?;
-            let table = jobs::real_table(&self.plan, self.selection, &prepared, terms, &Silent)?;
+            let table =
+                jobs::real_table(&self.plan, self.selection, &prepared, terms, cs2, &Silent)?;
             Ok((table, prepared))
         })?;
         Table::new(
@@ -196,7 +199,7 @@ impl RealPlan {
 #[pyfunction]
 #[pyo3(signature = (model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false,
     precision="default", q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None, k_min=1e-3,
-    k_max=1.0, nk=100))]
+    k_max=1.0, nk=100, cs2=0.0))]
 #[allow(clippy::too_many_arguments)]
 fn real(
     py: Python<'_>,
@@ -215,6 +218,7 @@ fn real(
     k_min: f64,
     k_max: f64,
     nk: usize,
+    cs2: f64,
 ) -> PyResult<Table> {
     let k = k_grid(k, k_min, k_max, nk)?;
     let plan = RealPlan::new(
@@ -226,7 +230,7 @@ fn real(
         two_loop_tolerance,
         cache_dir,
     )?;
-    plan.__call__(py, linear, z, z_input, cosmology, terms, eh)
+    plan.__call__(py, linear, z, z_input, cosmology, terms, eh, cs2)
 }
 
 /// Measured multipoles from a path (with columns) or a dict {"k", "P0", "s0", "P2", "s2", …}.
@@ -283,7 +287,7 @@ fn data(
     data_ells=vec![0, 2, 4], data_columns=None, covariance=None, rsd="tns", real="1l-spt", fog="lorentzian",
     f=None, sigma0=None, bias=None, amplitude=1.0, shot_noise=None, number_density=None, noise_table=None,
     k_min=0.0, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default", q_range=None,
-    cache_dir=None, eh=None))]
+    cache_dir=None, eh=None, cs2=0.0))]
 #[allow(clippy::too_many_arguments)]
 fn fit(
     py: Python<'_>,
@@ -313,6 +317,7 @@ fn fit(
     q_range: Option<(f64, f64)>,
     cache_dir: Option<PathBuf>,
     eh: Option<&str>,
+    cs2: f64,
 ) -> PyResult<Table> {
     let (mut data, data_name) = self::data(data, data_columns, &data_ells, &ells)?;
     if let Some(c) = covariance {
@@ -357,6 +362,7 @@ fn fit(
             ells,
             terms: false,
             no_wiggle: false,
+            cs2,
         },
         free,
         k_min,

@@ -105,7 +105,7 @@ impl RsdPlan {
     /// The multipoles of the prepared spectrum: see the Python wrapper `pt_spectra.rsd`.
     #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=None, amplitude=1.0,
         fog="none", sigma0=None, shot_noise=None, number_density=None, noise_table=None, ells=vec![0, 2, 4],
-        terms=false, eh=None, growth_factor=None, no_wiggle=false))]
+        terms=false, eh=None, growth_factor=None, no_wiggle=false, cs2=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn __call__(
         &self,
@@ -127,6 +127,7 @@ impl RsdPlan {
         eh: Option<&str>,
         growth_factor: Option<f64>,
         no_wiggle: bool,
+        cs2: f64,
     ) -> PyResult<Table> {
         let settings = (
             f,
@@ -137,6 +138,7 @@ impl RsdPlan {
             ells,
             terms,
             no_wiggle,
+            cs2,
         );
         let request = rsd_request(py, self.rsd, bias, sigma0, noise_table, settings)?;
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
@@ -178,7 +180,7 @@ impl RsdPlan {
     }
 }
 
-/// (f, A_b, FoG, shot noise, number density, ells, parts, no-wiggle multipoles) of an RSD call.
+/// (f, A_b, FoG, shot noise, number density, ells, parts, no-wiggle multipoles, c_s²) of an RSD call.
 type RsdSettingsArgs<'a> = (
     Option<f64>,
     f64,
@@ -188,6 +190,7 @@ type RsdSettingsArgs<'a> = (
     Vec<usize>,
     bool,
     bool,
+    f64,
 );
 
 /// The redshift-space request of the keyword arguments.
@@ -197,7 +200,9 @@ fn rsd_request(
     bias: Option<&Bound<'_, PyAny>>,
     sigma0: Option<&Bound<'_, PyAny>>,
     noise_table: Option<&Bound<'_, PyAny>>,
-    (f, amplitude, fog, shot_noise, number_density, ells, terms, no_wiggle): RsdSettingsArgs<'_>,
+    (f, amplitude, fog, shot_noise, number_density, ells, terms, no_wiggle, cs2): RsdSettingsArgs<
+        '_,
+    >,
 ) -> PyResult<RsdRequest> {
     let one = 1.0f64.into_pyobject(py)?.into_any();
     let zero = 0.0f64.into_pyobject(py)?.into_any();
@@ -218,6 +223,7 @@ fn rsd_request(
         ells,
         terms,
         no_wiggle,
+        cs2,
     })
 }
 
@@ -258,7 +264,7 @@ impl RsdTerms {
     /// The multipoles at f, bias, A_b, FoG, σ0 and noise: see the Python wrapper.
     #[pyo3(signature = (f=None, bias=None, amplitude=1.0, fog="none", sigma0=None, shot_noise=None,
         number_density=None, noise_table=None, ells=vec![0, 2, 4], terms=false, growth_factor=None,
-        no_wiggle=false))]
+        no_wiggle=false, cs2=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn multipoles(
         &self,
@@ -275,6 +281,7 @@ impl RsdTerms {
         terms: bool,
         growth_factor: Option<f64>,
         no_wiggle: bool,
+        cs2: f64,
     ) -> PyResult<Table> {
         let settings = (
             f,
@@ -285,6 +292,7 @@ impl RsdTerms {
             ells,
             terms,
             no_wiggle,
+            cs2,
         );
         let request = rsd_request(py, self.rsd, bias, sigma0, noise_table, settings)?;
         let ((table, prepared), seconds) = detached(py, || {

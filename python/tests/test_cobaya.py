@@ -88,6 +88,31 @@ def test_multipoles_equal_a_direct_rsd_plan_call_with_camb_spectrum_and_f(setup,
     assert got_f == pytest.approx(f, rel=1e-12) and got_d == pytest.approx(d, rel=1e-12)
 
 
+def test_a_counterterm_parameter_reaches_the_multipoles(setup, model):
+    # cs2_0 declared (fixed) in `params`: the theory's multipoles are those of its RsdTerms at that
+    # c_s^2, and differ from the run without it by the counterterm alone.
+    info, point = setup
+    info = copy.deepcopy({k: v for k, v in info.items() if k != "sampler"})
+    info["params"]["cs2_0"] = 1.5
+    with_ct = get_model(info)
+    with_ct.add_requirements({"pt_pk_ell": None, "pt_growth": None})
+    with_ct.logposterior(point)
+    got = np.asarray(with_ct.provider.get_pt_pk_ell(z=Z))
+    model.logposterior(point)
+    base = np.asarray(model.provider.get_pt_pk_ell(z=Z))
+    theory = with_ct.theory["pt"]
+    terms = theory._terms[0][1]
+    f, d = with_ct.provider.get_pt_growth(z=Z)
+    nu = theory._nuisance(point, 0)
+    with pytest.warns(pt.PtSpectraWarning, match="no cosmology"):  # as the theory, which filters it
+        t = terms.multipoles(f=f, bias=nu["b"], amplitude=nu["A_b"], fog=theory.fog,
+                             sigma0=nu["sigma0"], ells=theory.ells, growth_factor=d, cs2=1.5)
+    want = np.array([t[f"P{ell}"] for ell in theory.ells])
+    want[theory.ells.index(0)] += nu["P_shot"]
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=0)
+    assert np.all(np.abs(got - base) > 0)
+
+
 def test_no_other_library_warning_is_raised(setup, model, recwarn):
     _, point = setup
     model.logposterior(dict(point, logA=3.0))

@@ -159,7 +159,7 @@ pub fn contour(
         free: free.clone(),
     };
     let x0: Vec<f64> = free.iter().map(|&p| settings.start.get(p)).collect();
-    let steps = steps(&x0);
+    let steps = steps(free, &x0);
     let profile =
         |x: f64, y: f64| window.profile(&[(grid.x, x), (grid.y, y)], &result.best, &steps);
     let centre = (result.best.get(grid.x), result.best.get(grid.y));
@@ -273,6 +273,7 @@ mod tests {
             f: 0.48,
             sigma0: 4.0,
             amplitude: 1.0,
+            cs2: 0.0,
         };
         let m = model.multipoles(&truth);
         let sigma: Vec<f64> = m[0].iter().map(|p| 0.01 * p).collect();
@@ -315,6 +316,7 @@ mod tests {
                 f: 0.5,
                 sigma0: 0.0,
                 amplitude: 1.05,
+                cs2: 0.0,
             },
             k_min: 0.0,
         };
@@ -333,6 +335,7 @@ mod tests {
                 let p = Params {
                     f: x,
                     amplitude: y,
+                    cs2: 0.0,
                     ..settings.start
                 };
                 let want = direct_chi2(&model, &data, &p, 0.15);
@@ -395,6 +398,7 @@ mod tests {
                 f: 0.5,
                 sigma0: 3.5,
                 amplitude: 1.05,
+                cs2: 0.0,
             },
             k_min: 0.0,
         };
@@ -415,6 +419,7 @@ mod tests {
                         f: x,
                         sigma0: s,
                         amplitude: y,
+                        cs2: 0.0,
                     };
                     direct_chi2(&model, &data, &p, 0.25)
                 };
@@ -451,6 +456,7 @@ mod tests {
                 f: 0.5,
                 sigma0: 0.0,
                 amplitude: 1.0,
+                cs2: 0.0,
             },
             k_min: 0.0,
         };

@@ -236,10 +236,17 @@ impl CostFunction for &Window<'_> {
     }
 }
 
-/// The starting simplex steps of the free parameters at their start values `x0`: 5% of each, at least
-/// 0.005.
-pub(super) fn steps(x0: &[f64]) -> Vec<f64> {
-    x0.iter().map(|v| 0.05 * v.abs().max(0.1)).collect()
+/// The starting simplex steps of the free parameters `free` at their start values `x0`: 5% of each, at
+/// least 0.005 (f, σ0, A_b) or 0.05 (Mpc/h)² (c_s², whose start is usually 0 and whose values are of
+/// order 1 (Mpc/h)²: the interval search then reaches ±40 (Mpc/h)² in its 12 doublings).
+pub(super) fn steps(free: &[Parameter], x0: &[f64]) -> Vec<f64> {
+    free.iter()
+        .zip(x0)
+        .map(|(&p, v)| {
+            let floor = if p == Parameter::Cs2 { 1.0 } else { 0.1 };
+            0.05 * v.abs().max(floor)
+        })
+        .collect()
 }
 
 /// Lower-triangular Cholesky factor of a symmetric positive-definite matrix, or `None`.

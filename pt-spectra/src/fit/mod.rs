@@ -1,14 +1,15 @@
-//! Fits of the growth rate f, the FoG dispersion σ0 and the bias amplitude A_b to measured multipoles
-//! (Gil-Marín et al. 2012, sections 4.2–4.5).
+//! Fits of the growth rate f, the FoG dispersion σ0, the bias amplitude A_b and the EFT counterterm c_s²
+//! to measured multipoles (Gil-Marín et al. 2012, sections 4.2–4.5; c_s²: [`crate::real::counterterm`](mod@crate::real::counterterm)).
 //!
 //! * χ² = Σ_ℓ Σ_{k ≤ k_max} [(P_ℓ,data − P_ℓ,model)/σ_ℓ]² (diagonal, as the paper), or
 //!   (d − m)ᵀ C⁻¹ (d − m) with a full covariance of the data vector (ℓ-major: all k of the first ℓ, …).
-//! * The model ([`MultipoleModel`]) holds everything that does not depend on (f, σ0, A_b): the real-space
-//!   spectra and the TNS coefficients per k. A new parameter point costs one polynomial per k and a
-//!   32-point μ quadrature with FoG: no loop integral is ever recomputed.
+//! * The model ([`MultipoleModel`]) holds everything that does not depend on (f, σ0, A_b, c_s²): the
+//!   real-space spectra, P_lin and the TNS coefficients per k. A new parameter point costs one polynomial
+//!   per k (the counterterm, linear in c_s² and P_lin, is added to the three real-space spectra there) and
+//!   a 32-point μ quadrature with FoG: no loop integral is ever recomputed.
 //! * The best fit minimises χ² over the free parameters with Nelder–Mead (the `argmin` crate). The 1σ
 //!   interval of each free parameter is where its profile χ² (minimised over the other free parameters,
-//!   1-D Brent) crosses χ²_min + Δχ², Δχ² = 1, 2.3, 3.53 for 1, 2, 3 free parameters: found on the
+//!   1-D Brent) crosses χ²_min + Δχ², Δχ² = 1, 2.3, 3.53, 4.72 for 1 to 4 free parameters: found on the
 //!   contour by bracketing and bisection, never from a quadratic approximation.
 //! * σ0 enters only through σ0², so it is fitted as is and reported as |σ0|.
 //! * [`contour`]: Δχ² = χ² − χ²_min on a grid of two free parameters around the best fit, the other free
@@ -16,8 +17,8 @@
 //!   paper's two-parameter errors ([`CONTOUR_LEVELS`]).
 
 use crate::error::{Error, Result};
-use crate::loops::{Estimate, TnsCoefficients, TnsTerms};
-use crate::real::RealSpectra;
+use crate::loops::{Estimate, Pair, TnsCoefficients, TnsTerms};
+use crate::real::{counterterm, RealSpectra};
 use crate::rsd::{Fog, MultipoleRule, RsdModel};
 use minimise::{Residuals, Window};
 use std::fmt;
@@ -38,6 +39,8 @@ pub enum Parameter {
     Sigma0,
     /// The bias amplitude A_b (b → A_b b).
     Amplitude,
+    /// The EFT counterterm c_s² [(Mpc/h)²] ([`crate::real::counterterm`](mod@crate::real::counterterm)).
+    Cs2,
 }
 
 impl Parameter {
@@ -45,16 +48,18 @@ impl Parameter {
     pub fn unit(self) -> &'static str {
         match self {
             Parameter::Sigma0 => "Mpc/h",
+            Parameter::Cs2 => "(Mpc/h)^2",
             Parameter::F | Parameter::Amplitude => "1",
         }
     }
 
-    /// The name, as on the command line: `f`, `sigma0`, `ab`.
+    /// The name, as on the command line: `f`, `sigma0`, `ab`, `cs2`.
     pub fn name(self) -> &'static str {
         match self {
             Parameter::F => "f",
             Parameter::Sigma0 => "sigma0",
             Parameter::Amplitude => "ab",
+            Parameter::Cs2 => "cs2",
         }
     }
 }
@@ -73,10 +78,11 @@ impl FromStr for Parameter {
             "f" => Ok(Parameter::F),
             "sigma0" | "s0" => Ok(Parameter::Sigma0),
             "ab" | "a_b" | "amplitude" => Ok(Parameter::Amplitude),
+            "cs2" | "c_s2" => Ok(Parameter::Cs2),
             _ => Err(Error::UnknownName {
                 what: "fit parameter",
                 name: s.to_string(),
-                available: "f, sigma0, ab",
+                available: "f, sigma0, ab, cs2",
             }),
         }
     }
@@ -91,6 +97,8 @@ pub struct Params {
     pub sigma0: f64,
     /// Bias amplitude A_b.
     pub amplitude: f64,
+    /// EFT counterterm c_s² [(Mpc/h)²], added to the model's real-space spectra (0: none).
+    pub cs2: f64,
 }
 
 impl Params {
@@ -100,6 +108,7 @@ impl Params {
             Parameter::F => self.f,
             Parameter::Sigma0 => self.sigma0,
             Parameter::Amplitude => self.amplitude,
+            Parameter::Cs2 => self.cs2,
         }
     }
 
@@ -108,14 +117,16 @@ impl Params {
             Parameter::F => self.f = v,
             Parameter::Sigma0 => self.sigma0 = v,
             Parameter::Amplitude => self.amplitude = v,
+            Parameter::Cs2 => self.cs2 = v,
         }
     }
 }
 
-/// The multipoles of one RSD model as a function of (f, σ0, A_b) on a fixed k grid.
+/// The multipoles of one RSD model as a function of (f, σ0, A_b, c_s²) on a fixed k grid.
 #[derive(Debug, Clone)]
 pub struct MultipoleModel {
     k: Vec<f64>,
+    p_lin: Vec<f64>,
     rsd: RsdModel,
     fog: Fog,
     growth_factor: f64,
@@ -128,6 +139,7 @@ pub struct MultipoleModel {
 impl MultipoleModel {
     /// The model at the k of `real` (and `tns`, needed for [`RsdModel::Tns`]), with b(k) before A_b in
     /// `bias`, FoG `fog`, the growth factor D(z) of the damping scale σ = σ0 D f, and multipoles `ells`.
+    /// The counterterm of [`Params::cs2`] is added to the spectra of `real` (on top of any they hold).
     ///
     /// # Errors
     /// [`Error::LengthMismatch`] if the grids differ, [`Error::InvalidParameter`] for TNS without `tns`
@@ -169,6 +181,7 @@ impl MultipoleModel {
         };
         Ok(Self {
             k: real.k.clone(),
+            p_lin: real.p_lin.clone(),
             rsd,
             fog,
             growth_factor,
@@ -198,14 +211,15 @@ impl MultipoleModel {
         let sigma = params.sigma0 * self.growth_factor * params.f;
         for (c, i) in range.enumerate() {
             let b = params.amplitude * self.bias[i];
+            let mut spectra = self.spectra[i];
+            if params.cs2 != 0.0 {
+                for (e, pair) in spectra.iter_mut().zip(Pair::ALL) {
+                    e.value += counterterm(pair, params.cs2, self.k[i], self.p_lin[i]);
+                }
+            }
             let parts = self
                 .rsd
-                .parts(
-                    b,
-                    params.f,
-                    self.spectra[i],
-                    self.tns.as_ref().map(|t| &t[i]),
-                )
+                .parts(b, params.f, spectra, self.tns.as_ref().map(|t| &t[i]))
                 .expect("TNS coefficients are present when needed");
             let poly = parts.total();
             let ells = self.rule.ells().len();
@@ -229,7 +243,7 @@ impl MultipoleModel {
 /// What to fit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitSettings {
-    /// The free parameters (1 to 3, no repeats).
+    /// The free parameters (1 to 4, no repeats).
     pub free: Vec<Parameter>,
     /// Starting values of the free parameters and the values of the fixed ones.
     pub start: Params,
@@ -255,23 +269,25 @@ pub struct FitResult {
     pub intervals: Vec<(Parameter, f64, f64)>,
 }
 
-/// Δχ² of the 1σ region for n free parameters.
+/// Δχ² of the 1σ (68.3%) region for n free parameters (the χ² quantiles of Press et al., Numerical
+/// Recipes, §15.6).
 pub fn delta_chi2(n: usize) -> f64 {
     match n {
         1 => 1.0,
         2 => 2.30,
-        _ => 3.53,
+        3 => 3.53,
+        _ => 4.72,
     }
 }
 
-/// Checks that `free` names 1 to 3 distinct parameters and that `model` is on the grid and ells of
+/// Checks that `free` names 1 to 4 distinct parameters and that `model` is on the grid and ells of
 /// `data`.
 fn check(model: &MultipoleModel, data: &MultipoleData, free: &[Parameter]) -> Result<()> {
-    if free.is_empty() || free.len() > 3 || (1..free.len()).any(|i| free[..i].contains(&free[i])) {
+    if free.is_empty() || free.len() > 4 || (1..free.len()).any(|i| free[..i].contains(&free[i])) {
         return Err(Error::InvalidParameter {
             name: "number of distinct free parameters",
             value: free.len() as f64,
-            reason: "must be 1, 2 or 3 distinct of f, sigma0, ab",
+            reason: "must be 1 to 4 distinct of f, sigma0, ab, cs2",
         });
     }
     if model.k() != data.k.as_slice() {
@@ -331,7 +347,7 @@ pub fn fit(
             free: free.clone(),
         };
         let x0: Vec<f64> = free.iter().map(|&p| settings.start.get(p)).collect();
-        let steps = minimise::steps(&x0);
+        let steps = minimise::steps(free, &x0);
         let (x, _) = minimise::minimise(&window, &x0, &steps);
         // Restart once from the optimum: Nelder–Mead can stall on a ridge.
         let (x, chi2) = minimise::minimise(&window, &x, &steps);

@@ -2,7 +2,7 @@
 //! paper's figures show.
 
 use super::rsd::{describe_sigma0, no_wiggle_multipoles, RsdRequest};
-use super::{describe_inputs, VERSION};
+use super::{counterterm_line, describe_inputs, VERSION};
 use crate::error::{Error, Result};
 use crate::fit::{
     contour, contour_table, delta_chi2, fit, ContourGrid, FitResult, FitSettings, MultipoleData,
@@ -95,7 +95,13 @@ pub fn fit_tables(
     let growth = prepared.growth_factor;
     let sigma0 = m.sigma0.resolve(&prepared.spectrum, growth, precision)?;
     let f0 = m.f.unwrap_or(prepared.growth_rate);
-    for (name, v) in [("f", f0), ("sigma0", sigma0), ("A_b", m.amplitude)] {
+    let fields = [
+        ("f", f0),
+        ("sigma0", sigma0),
+        ("A_b", m.amplitude),
+        ("cs2", m.cs2),
+    ];
+    for (name, v) in fields {
         if !v.is_finite() {
             let reason = "must be finite";
             return Err(Error::InvalidParameter {
@@ -130,6 +136,7 @@ pub fn fit_tables(
             f: f0,
             sigma0,
             amplitude: m.amplitude,
+            cs2: m.cs2,
         },
         k_min: request.k_min,
     };
@@ -148,9 +155,10 @@ pub fn fit_tables(
         request.data_name
     )];
     header.extend(describe_inputs(prepared, precision));
+    let with_cs2 = m.cs2 != 0.0 || request.free.contains(&Parameter::Cs2);
     header.push(format!(
         "chi2 = {} ; errors: where the profile chi2 reaches chi2_min + {} ({} free); fixed: f = {f0}, \
-         sigma0 = {sigma0}{}, ab = {}",
+         sigma0 = {sigma0}{}, ab = {}{}",
         if data.covariance.is_some() {
             "(d-m)^T C^-1 (d-m)"
         } else {
@@ -159,8 +167,16 @@ pub fn fit_tables(
         delta_chi2(request.free.len()),
         request.free.len(),
         describe_sigma0(m.sigma0),
-        m.amplitude
+        m.amplitude,
+        if with_cs2 {
+            format!(", cs2 = {} (Mpc/h)^2", m.cs2)
+        } else {
+            String::new()
+        }
     ));
+    if with_cs2 {
+        header.push(counterterm_line(m.cs2).replacen("cs2 = ", "cs2 (fixed or start) = ", 1));
+    }
     let theory = if m.fog == Fog::None {
         None
     } else {

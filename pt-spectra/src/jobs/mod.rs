@@ -14,9 +14,14 @@
 //! let selection: RealSelection = "1l-spt".parse()?;
 //! let plan = RealPlan::for_selection(&[0.05, 0.1], selection, &Precision::fast(),
 //!                                    &TableStore::in_memory(), &Silent)?;
-//! let t = jobs::real_table(&plan, selection, &prepared, true, &Silent)?;
+//! let t = jobs::real_table(&plan, selection, &prepared, true, 0.0, &Silent)?;
 //! assert_eq!(t.names()[..5], ["k", "P_lin", "P_dd", "P_dt", "P_tt"]);
 //! assert!(t.column("P22_dd").is_some() && t.header[0].contains("1l-spt"));
+//! // With the EFT counterterm c_s² = 1 (Mpc/h)²: P_dd − 2 k² P_lin, stated in the header.
+//! let c = jobs::real_table(&plan, selection, &prepared, true, 1.0, &Silent)?;
+//! let (p, q, p_lin) = (t.column("P_dd").unwrap(), c.column("P_dd").unwrap(), t.column("P_lin").unwrap());
+//! assert!((q[1] - p[1] + 2.0 * 0.1 * 0.1 * p_lin[1]).abs() < 1e-9 * p[1]);
+//! assert!(c.header.iter().any(|h| h.contains("cs2 = 1")) && c.column("P_ct_tt").is_some());
 //! # Ok::<(), pt_spectra::error::Error>(())
 //! ```
 
@@ -75,16 +80,19 @@ pub fn two_loop_line(precision: &Precision) -> String {
 }
 
 /// `pt-spectra real`: the spectra of the selected model (or P_dd/P_nw of every model) for the
-/// prepared linear spectrum, with the loop terms if `terms`.
+/// prepared linear spectrum, with the loop terms if `terms`, and the EFT counterterm of c_s² = `cs2`
+/// [(Mpc/h)²] added to every model (0: none; [`crate::real::counterterm`](mod@crate::real::counterterm)). With a counterterm the
+/// header states c_s² and, with `terms`, the columns `P_ct_dd P_ct_dt P_ct_tt` give it.
 ///
 /// # Errors
-/// [`Error::GridMismatch`] if the plan does not cover the selection ([`RealPlan::for_selection`]); as [`RealPlan::evaluate`]
-/// and [`Prepared::no_wiggle`].
+/// [`Error::GridMismatch`] if the plan does not cover the selection ([`RealPlan::for_selection`]); as [`RealPlan::evaluate`],
+/// [`RealSpectra::with_counterterm`] and [`Prepared::no_wiggle`].
 pub fn real_table(
     plan: &RealPlan,
     selection: RealSelection,
     prepared: &Prepared,
     terms: bool,
+    cs2: f64,
     progress: &dyn Progress,
 ) -> Result<Table> {
     if !plan.covers(selection) {
@@ -94,6 +102,7 @@ pub fn real_table(
             found: format!("a plan for {}", plan.model()),
         });
     }
+    crate::real::check_cs2(cs2)?;
     let precision = plan.precision();
     let spectra = plan.evaluate(&prepared.spectrum, progress)?;
     let mut header = vec![format!(
@@ -105,10 +114,21 @@ pub fn real_table(
         prepared.z
     )];
     header.extend(describe_inputs(prepared, precision));
+    if cs2 != 0.0 {
+        header.push(counterterm_line(cs2));
+    }
     match selection {
         RealSelection::One(model) => {
             header.extend(model_header(model, &spectra, precision, terms));
-            Ok(spectra.table(header, terms))
+            let spectra = spectra.with_counterterm(cs2)?;
+            let mut t = spectra.table(header, terms);
+            if terms && cs2 != 0.0 {
+                for pair in Pair::ALL {
+                    let name = format!("P_ct_{}", pair.suffix());
+                    t.push(name, POWER, spectra.counterterm(pair));
+                }
+            }
+            Ok(t)
         }
         RealSelection::All => {
             header.push(two_loop_line(precision));
@@ -118,9 +138,18 @@ pub fn real_table(
                  numerical error"
                     .into(),
             );
-            all_models(header, &spectra, &prepared.no_wiggle()?)
+            all_models(header, &spectra, cs2, &prepared.no_wiggle()?)
         }
     }
+}
+
+/// The header line of an EFT counterterm c_s² = `cs2` ≠ 0 [(Mpc/h)²].
+pub fn counterterm_line(cs2: f64) -> String {
+    format!(
+        "EFT counterterm cs2 = {cs2} (Mpc/h)^2 added to P_dd, P_dt, P_tt: -2, -4, -6 cs2 k^2 P_lin \
+         (delta_ct = -cs2 k^2 delta_lin growing as D^3, theta_ct = 3 delta_ct by mass conservation; \
+         exact, no error added)"
+    )
 }
 
 /// The header lines of one model: conventions, σ_v², the 2-loop settings and the RPT factors.
@@ -173,12 +202,13 @@ fn model_header(
 fn all_models(
     header: Vec<String>,
     spectra: &RealSpectra,
+    cs2: f64,
     p_nw: &crate::linear::LinearSpectrum,
 ) -> Result<Table> {
     let nw: Vec<f64> = spectra.k.iter().map(|&k| p_nw.eval(k)).collect();
     let models = RealModel::ALL
         .iter()
-        .map(|&m| RealSpectra::from_terms(m, spectra.terms.clone()))
+        .map(|&m| RealSpectra::from_terms(m, spectra.terms.clone())?.with_counterterm(cs2))
         .collect::<Result<Vec<_>>>()?;
     let mut t = Table::new(header);
     t.push("k", WAVENUMBER, spectra.k.clone());

@@ -1,7 +1,7 @@
 //! `pt-spectra rsd`: redshift-space multipoles, with the halo signal-to-noise and the no-wiggle
 //! reference of the paper's figures.
 
-use super::{describe_inputs, VERSION};
+use super::{counterterm_line, describe_inputs, VERSION};
 use crate::error::{Error, Result};
 use crate::halo::{crossings, Bias, Noise};
 use crate::linear::LinearSpectrum;
@@ -42,6 +42,9 @@ pub struct RsdRequest {
     pub terms: bool,
     /// Whether to add the no-wiggle reference `P<l>_nw` ([`no_wiggle_multipoles`]).
     pub no_wiggle: bool,
+    /// The EFT counterterm c_s² [(Mpc/h)²] added to the real-space spectra ([`crate::real::counterterm`](mod@crate::real::counterterm);
+    /// 0: none); in `fit` its start value if free, else its value.
+    pub cs2: f64,
 }
 
 impl RsdRequest {
@@ -109,7 +112,7 @@ pub fn no_wiggle_multipoles(
 /// # Errors
 /// As [`RsdPlan::evaluate`], [`multipoles`], [`Bias::values`], [`Noise::values`],
 /// [`Sigma0::resolve`] and (with `no_wiggle`) [`Prepared::no_wiggle`]; [`Error::InvalidParameter`] for
-/// a non-finite f.
+/// a non-finite f or c_s².
 pub fn rsd_table(
     plan: &RsdPlan,
     request: &RsdRequest,
@@ -163,6 +166,7 @@ pub fn rsd_table_from_terms(
         noise: request.noise.values(k)?,
         ells: request.ells.clone(),
         parts: request.terms,
+        cs2: request.cs2,
     };
     let m = multipoles(spectra, tns, &settings)?;
     let (rsd, fog) = (request.rsd, request.fog);
@@ -176,6 +180,9 @@ pub fn rsd_table_from_terms(
         describe_sigma0(request.sigma0),
     )];
     header.extend(describe_inputs(prepared, precision));
+    if request.cs2 != 0.0 {
+        header.push(counterterm_line(request.cs2));
+    }
     if rsd.needs_tns() {
         header.push(
             "TNS A and B at leading order (linear P, tree-level bispectrum), A = b^3 A(f/b), \

@@ -15,6 +15,9 @@
 //! | `1l-spt-ir`, `2l-spt-ir` | SPT with IR-resummed BAO ([`crate::ir`]) |
 //!
 //! Every value carries an error estimate propagated from the loop integrals ([`crate::loops`]).
+//! Any model takes the EFT counterterm −(2, 4, 6) c_s² k² P_lin of δδ, δθ, θθ
+//! ([`RealSpectra::with_counterterm`], module [`counterterm`](mod@counterterm): the pair factors
+//! and their assumptions).
 
 use crate::error::{Error, Result};
 use crate::loops::{ByPair, Estimate, LoopTerms, Pair};
@@ -23,7 +26,9 @@ use crate::resum::{self, Propagator};
 use std::fmt;
 use std::str::FromStr;
 
+pub mod counterterm;
 mod plan;
+pub use counterterm::{check_cs2, counterterm, counterterm_factor};
 pub use plan::{real_space, RealPlan};
 
 /// A real-space model, named as on the command line.
@@ -237,6 +242,9 @@ pub struct RealSpectra {
     pub factors: Option<ByPair<Vec<Estimate>>>,
     /// The loop terms (every term the model needs is there; others may be too).
     pub terms: LoopTerms,
+    /// The EFT counterterm c_s² [(Mpc/h)²] included in `spectra` (0: none;
+    /// [`with_counterterm`](Self::with_counterterm)).
+    pub cs2: f64,
 }
 
 impl RealSpectra {
@@ -338,6 +346,7 @@ impl RealSpectra {
             spectra,
             factors,
             terms,
+            cs2: 0.0,
         })
     }
 }

@@ -10,7 +10,7 @@ use crate::loops::{Pair, TnsPlan, TnsTerms};
 use crate::output::{Table, POWER, WAVENUMBER};
 use crate::precision::Precision;
 use crate::progress::Progress;
-use crate::real::{RealModel, RealPlan, RealSpectra};
+use crate::real::{counterterm, RealModel, RealPlan, RealSpectra};
 use crate::store::TableStore;
 
 /// What turns real-space spectra into redshift-space multipoles.
@@ -34,6 +34,10 @@ pub struct RsdSettings {
     pub ells: Vec<usize>,
     /// Whether to also compute the multipoles of each part (Kaiser/Scoccimarro, A, B).
     pub parts: bool,
+    /// The EFT counterterm c_s² [(Mpc/h)²] added to the real-space P_δδ, P_δθ, P_θθ before the RSD
+    /// model (−2, −4, −6 c_s² k² P_lin, [`crate::real::counterterm`](mod@crate::real::counterterm); on top of any the spectra
+    /// include); 0 for none.
+    pub cs2: f64,
 }
 
 /// Redshift-space multipoles on a k grid [(Mpc/h)^3].
@@ -64,7 +68,7 @@ pub struct RsdMultipoles {
 /// # Errors
 /// [`Error::GridMismatch`] if the bias, noise or TNS terms are not on the grid of `real`;
 /// [`Error::MissingTerm`] for TNS without `tns`; [`Error::InvalidParameter`] for a non-finite f or
-/// σ < 0, or a bad ℓ.
+/// c_s², σ < 0, or a bad ℓ.
 ///
 /// ```
 /// use pt_spectra::{linear::LinearSpectrum, precision::Precision, store::TableStore};
@@ -74,7 +78,7 @@ pub struct RsdMultipoles {
 /// let real = real_space(RealModel::Linear, &p, &[0.05], &Precision::fast(), &TableStore::in_memory())?;
 /// let settings = RsdSettings {
 ///     model: RsdModel::Kaiser, f: 0.5, bias: vec![2.0], fog: Fog::None, sigma: 0.0, noise: None,
-///     ells: vec![0, 2], parts: false,
+///     ells: vec![0, 2], parts: false, cs2: 0.0,
 /// };
 /// let m = multipoles(&real, None, &settings)?;
 /// // Linear Kaiser: P0 = (b² + 2bf/3 + f²/5) P_lin.
@@ -113,6 +117,7 @@ pub fn multipoles(
     if !settings.f.is_finite() {
         return Err(invalid("f", settings.f, "must be finite"));
     }
+    crate::real::check_cs2(settings.cs2)?;
     if !(settings.sigma.is_finite() && settings.sigma >= 0.0) {
         let reason = "must be finite and non-negative";
         return Err(invalid("FoG sigma [Mpc/h]", settings.sigma, reason));
@@ -126,7 +131,12 @@ pub fn multipoles(
     let mut signal_to_noise = settings.noise.as_ref().map(|_| Vec::with_capacity(k.len()));
     let mut signal_to_noise_s = signal_to_noise.clone();
     for (i, &ki) in k.iter().enumerate() {
-        let s = [Pair::DeltaDelta, Pair::DeltaTheta, Pair::ThetaTheta].map(|p| real.spectra[p][i]);
+        let mut s = Pair::ALL.map(|p| real.spectra[p][i]);
+        if settings.cs2 != 0.0 {
+            for (e, pair) in s.iter_mut().zip(Pair::ALL) {
+                e.value += counterterm(pair, settings.cs2, ki, real.p_lin[i]);
+            }
+        }
         let coefficients = tns.map(|t| &t.coefficients[i]);
         let p = settings
             .model
@@ -357,6 +367,7 @@ mod tests {
             noise: None,
             ells: vec![0],
             parts: false,
+            cs2: 0.0,
         };
         let e = multipoles(&real, None, &settings).unwrap_err().to_string();
         assert!(
@@ -400,6 +411,7 @@ mod tests {
             noise: Some(noise.clone()),
             ells: vec![0, 2],
             parts: false,
+            cs2: 0.0,
         };
         let m = multipoles(&real, None, &settings).unwrap();
         let (sn, sn_s) = (

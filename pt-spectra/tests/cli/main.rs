@@ -5,6 +5,7 @@
 
 use std::process::Command;
 
+mod counterterm;
 mod fit;
 mod halo;
 mod plot;

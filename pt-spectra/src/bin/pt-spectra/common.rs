@@ -84,6 +84,16 @@ impl NoiseArgs {
     }
 }
 
+/// The EFT counterterm c_s² [(Mpc/h)²] of `--cs2`: a finite number.
+pub fn parse_cs2(s: &str) -> std::result::Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number (c_s^2 in (Mpc/h)^2)"))?;
+    pt_spectra::real::check_cs2(v).map_err(|e| e.to_string())?;
+    Ok(v)
+}
+
 /// A comma-separated list; `what` names the option in messages.
 pub fn list<T: std::str::FromStr>(s: &str, what: &str) -> Result<Vec<T>> {
     s.split(',')

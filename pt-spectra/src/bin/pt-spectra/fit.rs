@@ -1,6 +1,6 @@
 //! `pt-spectra fit`: best-fit f, σ0, A_b with Δχ² errors against measured multipoles, versus k_max.
 
-use crate::common::{list, BiasArgs, NoiseArgs};
+use crate::common::{list, parse_cs2, BiasArgs, NoiseArgs};
 use crate::input::SpectrumInput;
 use crate::progress::Bars;
 use crate::real::write_output;
@@ -42,7 +42,7 @@ pub struct Args {
     /// Fingers of God: none, lorentzian or gaussian.
     #[arg(long, value_name = "KIND", default_value = "lorentzian", value_parser = parsed::<Fog>)]
     fog: Fog,
-    /// Free parameters, comma separated: f, sigma0, ab.
+    /// Free parameters, comma separated: f, sigma0, ab, cs2 (the EFT counterterm of --cs2).
     #[arg(long, value_name = "P,P", default_value = "f,sigma0")]
     free: String,
     /// Growth rate: start value if free, value if fixed. Default: f(z) of the cosmology.
@@ -58,6 +58,9 @@ pub struct Args {
         value_parser = parsed::<Sigma0>
     )]
     sigma0: Sigma0,
+    /// EFT counterterm c_s² [(Mpc/h)²] (as `real --cs2`): start value if free, value if fixed.
+    #[arg(long, value_name = "CS2", default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_cs2)]
+    cs2: f64,
     #[command(flatten)]
     bias: BiasArgs,
     #[command(flatten)]
@@ -76,7 +79,7 @@ pub struct Args {
     /// curves of the paper's figures; `plot multipoles` draws them).
     #[arg(long, value_name = "FILE")]
     model_out: Option<PathBuf>,
-    /// Two free parameters, e.g. `f,sigma0` or `f,ab`: write their Δχ² surface at every k_max to
+    /// Two free parameters, e.g. `f,sigma0`, `f,ab` or `f,cs2`: write their Δχ² surface at every k_max to
     /// --contour-out, the other free parameters re-minimised at each point (`plot contour` draws the
     /// Δχ² = 2.3 and 6.17 contours).
     #[arg(long, value_name = "P1,P2", requires = "contour_out")]
@@ -160,6 +163,7 @@ pub fn run(args: &Args) -> Result<()> {
             ells,
             terms: false,
             no_wiggle: false,
+            cs2: args.cs2,
         },
         free,
         k_min: args.k_min,

@@ -1,5 +1,6 @@
 //! `pt-spectra real`: real-space P_δδ, P_δθ, P_θθ of a model on a k grid, as a whitespace table.
 
+use crate::common::parse_cs2;
 use crate::input::Input;
 use crate::progress::Bars;
 use crate::rsd::parsed;
@@ -19,9 +20,14 @@ pub struct Args {
     /// or `all`: P_dd/P_nowiggle of every model, one column each (the paper's real-space comparison).
     #[arg(long, value_name = "M", default_value = "1l-spt", value_parser = parsed::<RealSelection>)]
     model: RealSelection,
-    /// Also print the separate loop terms, σ_v² and propagators, each with its error estimate.
+    /// Also print the separate loop terms, σ_v² and propagators, each with its error estimate (and,
+    /// with --cs2, the counterterms P_ct_dd P_ct_dt P_ct_tt).
     #[arg(long)]
     terms: bool,
+    /// EFT counterterm c_s² [(Mpc/h)²] added to the model: P_dd − 2 c_s² k² P_lin, P_dt − 4 c_s² k²
+    /// P_lin, P_tt − 6 c_s² k² P_lin (δ_ct ∝ D³, θ_ct = 3 δ_ct by mass conservation); exact.
+    #[arg(long, value_name = "CS2", default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_cs2)]
+    cs2: f64,
     /// Write the table to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
@@ -44,7 +50,14 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let bars = Bars::default();
     let plan = RealPlan::for_selection(&k, args.model, &loaded.precision, &loaded.store, &bars)?;
-    let table = real_table(&plan, args.model, &loaded.prepared, args.terms, &bars)?;
+    let table = real_table(
+        &plan,
+        args.model,
+        &loaded.prepared,
+        args.terms,
+        args.cs2,
+        &bars,
+    )?;
     write_output(args.out.as_ref(), &table.to_text())
 }
 

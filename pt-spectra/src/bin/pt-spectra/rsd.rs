@@ -1,6 +1,6 @@
 //! `pt-spectra rsd`: redshift-space multipoles P_ℓ(k) of a real-space model through an RSD model.
 
-use crate::common::{list, BiasArgs, NoiseArgs};
+use crate::common::{list, parse_cs2, BiasArgs, NoiseArgs};
 use crate::input::Input;
 use crate::progress::Bars;
 use crate::real::write_output;
@@ -52,6 +52,10 @@ pub struct Args {
     bias: BiasArgs,
     #[command(flatten)]
     noise: NoiseArgs,
+    /// EFT counterterm c_s² [(Mpc/h)²] added to the real-space spectra before the RSD model: P_dd −
+    /// 2 c_s² k² P_lin, P_dt − 4 c_s² k² P_lin, P_tt − 6 c_s² k² P_lin (as `real --cs2`).
+    #[arg(long, value_name = "CS2", default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_cs2)]
+    cs2: f64,
     /// Multipoles to print, even ℓ ≤ 8, comma separated.
     #[arg(long, value_name = "L,L,…", default_value = "0,2,4")]
     ells: String,
@@ -83,6 +87,7 @@ impl Args {
             ells,
             terms: self.terms,
             no_wiggle: self.no_wiggle,
+            cs2: self.cs2,
         })
     }
 }
