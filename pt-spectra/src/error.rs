@@ -205,6 +205,15 @@ pub enum Error {
         available: &'static str,
     },
 
+    /// A combination of settings that does not make sense, e.g. a Δχ² surface of a fixed parameter.
+    #[error("{what}: {reason}")]
+    InvalidChoice {
+        /// The setting, as the user wrote it where possible.
+        what: String,
+        /// What is wrong and what is expected.
+        reason: String,
+    },
+
     /// A name (of a model, a FoG kind, a parameter, a preset) that is not known.
     #[error("unknown {what} `{name}`; available: {available}")]
     UnknownName {

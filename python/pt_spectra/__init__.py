@@ -33,6 +33,7 @@ __all__ = [
     "Table",
     "eisenstein_hu",
     "fit",
+    "fit_tables",
     "growth",
     "halo",
     "kernel",
@@ -200,13 +201,36 @@ def fit(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_
     columns ``sigma0_lin sigma0_1l`` give the theory sigma0.
     Returns ``k_max points <p> <p>_lo <p>_hi … chi2 dof chi2_dof``.
     """
+    return fit_tables(data, k_max, free, ells, data_ells, data_columns, covariance, rsd, real, fog, f,
+                      sigma0, bias, amplitude, shot_noise, number_density, noise_table, k_min, linear,
+                      z, z_input, cosmology, precision, q_range, cache_dir, eh, cs2)["fit"]
+
+
+def fit_tables(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_columns=None,
+               covariance=None, rsd="tns", real="1l-spt", fog="lorentzian", f=None, sigma0=3.0,
+               bias=1.0, amplitude=1.0, shot_noise=None, number_density=None, noise_table=None,
+               k_min=0.0, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default",
+               q_range=None, cache_dir=None, eh=None, cs2=0.0, model=False, contour=None,
+               contour_points=41, contour_span=2.5) -> dict:
+    """:func:`fit` with the command line's ``--model-out`` and ``--contour`` tables.
+
+    Returns ``{"fit": Table, "model": Table or None, "contour": Table or None}``. model=True adds
+    ``k P<l>_data err_P<l>_data P<l>_nw P<l>_kmax<K>``: the fitted data, the no-wiggle reference and the
+    best-fit multipoles of each k_max over the whole data grid. contour=("f", "sigma0") (two free
+    parameters) adds the Delta chi^2 surface ``k_max i j <p1> <p2> chi2 delta_chi2 <other free>`` on a
+    ``contour_points`` x ``contour_points`` grid along the axes of the Delta chi^2 = 2.3 ellipse,
+    ``contour_span`` semi-axes each way, the other free parameters re-minimised at each point.
+    """
     if isinstance(k_max, (int, float)):
         k_max = [k_max]
-    return _warn(_core.fit(data, list(k_max), list(free), list(ells), list(data_ells),
-                           None if data_columns is None else list(data_columns), covariance, rsd,
-                           real, fog, f, sigma0, bias, amplitude, shot_noise, number_density,
-                           noise_table, k_min, linear, z, z_input, cosmology, precision, q_range,
-                           cache_dir, eh, cs2))
+    tables = _core.fit(data, list(k_max), list(free), list(ells), list(data_ells),
+                       None if data_columns is None else list(data_columns), covariance, rsd, real,
+                       fog, f, sigma0, bias, amplitude, shot_noise, number_density, noise_table,
+                       k_min, linear, z, z_input, cosmology, precision, q_range, cache_dir, eh, cs2,
+                       bool(model), None if contour is None else list(contour), contour_points,
+                       contour_span)
+    return {name: None if t is None else _warn(t)
+            for name, t in zip(("fit", "model", "contour"), tables)}
 
 
 def halo(pmm, pmh, phh, number_density=None) -> Table:

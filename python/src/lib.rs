@@ -7,7 +7,7 @@
 
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pt_spectra::cosmology::TransferKind;
-use pt_spectra::fit::{MultipoleData, Parameter};
+use pt_spectra::fit::{ContourGrid, MultipoleData, Parameter};
 use pt_spectra::jobs::{self, FitRequest, RsdRequest};
 use pt_spectra::linear::LogGrid;
 use pt_spectra::precision::Precision;
@@ -287,7 +287,7 @@ fn data(
     data_ells=vec![0, 2, 4], data_columns=None, covariance=None, rsd="tns", real="1l-spt", fog="lorentzian",
     f=None, sigma0=None, bias=None, amplitude=1.0, shot_noise=None, number_density=None, noise_table=None,
     k_min=0.0, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default", q_range=None,
-    cache_dir=None, eh=None, cs2=0.0))]
+    cache_dir=None, eh=None, cs2=0.0, model_out=false, contour=None, contour_points=41, contour_span=2.5))]
 #[allow(clippy::too_many_arguments)]
 fn fit(
     py: Python<'_>,
@@ -318,7 +318,11 @@ fn fit(
     cache_dir: Option<PathBuf>,
     eh: Option<&str>,
     cs2: f64,
-) -> PyResult<Table> {
+    model_out: bool,
+    contour: Option<Vec<String>>,
+    contour_points: usize,
+    contour_span: f64,
+) -> PyResult<(Table, Option<Table>, Option<Table>)> {
     let (mut data, data_name) = self::data(data, data_columns, &data_ells, &ells)?;
     if let Some(c) = covariance {
         let rows: Vec<Vec<f64>> = match c.extract::<numpy::PyReadonlyArray2<'_, f64>>() {
@@ -374,20 +378,39 @@ fn fit(
     let real = real.parse().map_err(value_error)?;
     let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
     let k = data.k.clone();
-    let ((table, prepared), seconds) = detached(py, || {
+    let outputs = jobs::FitOutputs {
+        model: model_out,
+        contour: match contour {
+            None => None,
+            Some(pair) => {
+                let [x, y] = &pair[..] else {
+                    return Err(PyValueError::new_err(format!(
+                        "contour: expected two parameter names, got {pair:?}"
+                    )));
+                };
+                let (x, y) = (
+                    x.parse().map_err(value_error)?,
+                    y.parse().map_err(value_error)?,
+                );
+                let grid = ContourGrid::new(x, y, contour_points, contour_span, &request.free);
+                Some(grid.map_err(value_error)?)
+            }
+        },
+    };
+    let ((tables, prepared), seconds) = detached(py, || {
         let prepared = inputs.prepare(&k)?;
         let plan = LibRsdPlan::new(&k, real, rsd_model, &precision, store.get(), &Silent)?;
-        let table = jobs::fit_table(&plan, data, &request, &prepared, &Silent)?;
-        Ok((table, prepared))
+        let tables = jobs::fit_tables(&plan, data, &request, outputs, &prepared, &Silent)?;
+        Ok((tables, prepared))
     })?;
-    Table::new(
-        py,
-        table,
-        &prepared,
-        &precision,
-        &format!("{rsd_model} + {real}"),
-        seconds,
-    )
+    let model = format!("{rsd_model} + {real}");
+    let table =
+        |t: pt_spectra::output::Table| Table::new(py, t, &prepared, &precision, &model, seconds);
+    Ok((
+        table(tables.fit)?,
+        tables.model.map(table).transpose()?,
+        tables.contour.map(table).transpose()?,
+    ))
 }
 
 /// The linear growth factor D(z) (D(0) = 1) and rate f(z) of a cosmology.

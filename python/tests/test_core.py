@@ -250,3 +250,36 @@ def test_halo_recovers_bias_and_noise_and_feeds_rsd(tmp_path):
         pt.halo((k, pmm), (k[:-1], pmm[:-1]), (k, pmm))
     with pytest.raises(ValueError, match="P_hh"):
         pt.halo((k, pmm), (k, pmm), (k,))
+
+
+def test_fit_tables_give_the_model_and_a_contour_that_is_the_chi2_of_direct_calls():
+    # A linear Kaiser mock, f and A_b free: the model table reproduces the data at the best fit, and the
+    # chi2 column of the contour equals the chi2 of the multipoles of pt.rsd at the grid point.
+    k = np.geomspace(0.02, 0.2, 15)
+    mock = pt.rsd(rsd="kaiser", real="linear", k=k, f=0.6, bias=1.5, ells=(0, 2))
+    data = {"k": k, "P0": mock["P0"], "s0": 0.02 * mock["P0"], "P2": mock["P2"],
+            "s2": 0.02 * mock["P2"]}
+    kw = dict(free=("f", "ab"), ells=(0, 2), rsd="kaiser", real="linear", fog="none", bias=1.5,
+              f=0.5)
+    t = pt.fit_tables(data, k_max=0.15, model=True, contour=("f", "ab"), contour_points=5, **kw)
+    assert set(t) == {"fit", "model", "contour"}
+    np.testing.assert_allclose(t["fit"]["f"], 0.6, rtol=1e-5)
+    m = t["model"]
+    assert "P0_data" in m.columns and "P0_nw" in m.columns
+    model_p0 = [c for c in m.columns if c.startswith("P0_kmax")]
+    assert len(model_p0) == 1
+    np.testing.assert_allclose(m[model_p0[0]], mock["P0"], rtol=1e-5)
+    c = t["contour"]
+    assert c.columns[:7] == ["k_max", "i", "j", "f", "ab", "chi2", "delta_chi2"]
+    assert len(c) == 25 and min(c["delta_chi2"]) < 1e-8
+    used = k <= 0.15
+    for row in (0, 7, 24):
+        f, ab = c["f"][row], c["ab"][row]
+        p = pt.rsd(rsd="kaiser", real="linear", k=k, f=f, bias=1.5, amplitude=ab, ells=(0, 2))
+        chi2 = sum(np.sum(((p[f"P{l}"] - data[f"P{l}"]) / data[f"s{l}"])[used] ** 2) for l in (0, 2))
+        np.testing.assert_allclose(c["chi2"][row], chi2, rtol=1e-7)
+    with pytest.raises(ValueError, match="contour"):
+        pt.fit_tables(data, k_max=0.15, contour=("f", "sigma0"), **kw)
+    with pytest.raises(ValueError, match="contour points"):
+        pt.fit_tables(data, k_max=0.15, contour=("f", "ab"), contour_points=2, **kw)
+    assert pt.fit_tables(data, k_max=0.15, **kw)["model"] is None

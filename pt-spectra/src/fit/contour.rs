@@ -31,6 +31,48 @@ pub struct ContourGrid {
     pub span: f64,
 }
 
+impl ContourGrid {
+    /// The grid of the parameters `x`, `y` (two different ones of `free`), `points` per axis (3 to
+    /// 401) and half-width `span` (finite, > 0).
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] for parameters that are equal or not free, [`Error::InvalidParameter`]
+    /// for `points` or `span` out of range.
+    pub fn new(
+        x: Parameter,
+        y: Parameter,
+        points: usize,
+        span: f64,
+        free: &[Parameter],
+    ) -> Result<Self> {
+        if x == y || !free.contains(&x) || !free.contains(&y) {
+            let names: Vec<&str> = free.iter().map(|p| p.name()).collect();
+            return Err(Error::InvalidChoice {
+                what: format!("contour {x},{y}"),
+                reason: format!(
+                    "expected two different free parameters, of {}",
+                    names.join(",")
+                ),
+            });
+        }
+        if !(3..=401).contains(&points) {
+            return Err(Error::InvalidParameter {
+                name: "contour points per axis",
+                value: points as f64,
+                reason: "must be between 3 and 401",
+            });
+        }
+        if !(span.is_finite() && span > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "contour span",
+                value: span,
+                reason: "must be finite and positive",
+            });
+        }
+        Ok(Self { x, y, points, span })
+    }
+}
+
 impl Default for ContourGrid {
     fn default() -> Self {
         Self {

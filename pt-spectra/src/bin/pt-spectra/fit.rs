@@ -211,28 +211,11 @@ fn contour_grid(text: &str, args: &Args, free: &[Parameter]) -> Result<ContourGr
     let [x, y] = pair[..] else {
         bail!("--contour {text}: expected two parameters P1,P2, e.g. f,sigma0");
     };
-    if x == y || !free.contains(&x) || !free.contains(&y) {
-        bail!(
-            "--contour {text}: expected two different parameters of --free {}",
-            args.free
-        );
-    }
-    if !(3..=401).contains(&args.contour_points) {
-        bail!(
-            "--contour-points {}: must be between 3 and 401",
-            args.contour_points
-        );
-    }
-    if !(args.contour_span.is_finite() && args.contour_span > 0.0) {
-        bail!(
-            "--contour-span {}: must be finite and positive",
-            args.contour_span
-        );
-    }
-    Ok(ContourGrid {
-        x,
-        y,
-        points: args.contour_points,
-        span: args.contour_span,
+    let (points, span) = (args.contour_points, args.contour_span);
+    ContourGrid::new(x, y, points, span, free).map_err(|e| match e {
+        // "contour P1,P2: …" names the option's value already.
+        pt_spectra::error::Error::InvalidChoice { .. } => anyhow::anyhow!("--{e}"),
+        e => anyhow::Error::new(e)
+            .context(format!("--contour-points {points} --contour-span {span}")),
     })
 }
