@@ -8,7 +8,9 @@
 //!   loaded in the store);
 //! * `p17/evaluate/40`: P17 (for N3) on 40 log-spaced k in [0.005, 0.4] from its angular table;
 //! * `two_loop/set/40`: every 2-loop term (P15, P24, P33, the total) of δδ, δθ, θθ with errors on 40
-//!   log-spaced k in [0.005, 0.4] at the default precision (after the 1-loop terms).
+//!   log-spaced k in [0.005, 0.4] at the default precision (after the 1-loop terms);
+//! * `gamma2/plan/40`, `gamma2/evaluate/40`: RegPT's vertex terms P24 and PΓ2 on the same grid: the
+//!   cosmology-independent weights (once per grid), and a spectrum on them (per cosmology).
 //!
 //! The angular table is read from its cache (or built once, outside the timing). Run with
 //! `cargo bench --bench two_loop`.
@@ -18,7 +20,7 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use pt_spectra::linear::{LinearSpectrum, LogGrid};
-use pt_spectra::loops::{p15_terms, two_loop_correction, OneLoopPlan};
+use pt_spectra::loops::{p15_terms, two_loop_correction, Gamma2Plan, OneLoopPlan};
 use pt_spectra::precision::Precision;
 use pt_spectra::progress::Silent;
 use pt_spectra::real::{RealModel, RealPlan};
@@ -92,6 +94,15 @@ fn two_loop(c: &mut Criterion) {
             two_loop_correction(&one, &p15, &table, &p, &precision, &|_, _| {})
         })
     });
+    group.finish();
+    let range = (precision.q_min, precision.q_max);
+    let mut group = c.benchmark_group("gamma2");
+    group.sample_size(10);
+    group.bench_function("plan/40", |b| {
+        b.iter(|| Gamma2Plan::new(black_box(&k), range, precision.lattice_step))
+    });
+    let plan = Gamma2Plan::new(&k, range, precision.lattice_step);
+    group.bench_function("evaluate/40", |b| b.iter(|| plan.evaluate(black_box(&p))));
     group.finish();
 }
 
