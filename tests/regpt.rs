@@ -19,15 +19,22 @@ const REGPT_1LOOP: [(Pair, usize); 3] = [
     (Pair::ThetaTheta, 40),
 ];
 
-#[test]
-fn one_loop_regpt_matches_pyregpt() {
+/// The reference rows with k ≤ 0.3 h/Mpc, their k, the linear spectrum the reference used (gm2012,
+/// z = 0) and the reference's q range [1e-4, 50] h/Mpc.
+fn reference() -> (Vec<Vec<f64>>, Vec<f64>, LinearSpectrum, Precision) {
     let rows: Vec<Vec<f64>> = rows(&data("regpt_2loop_gm2012_z0.0.dat"))
         .into_iter()
         .filter(|r| r[0] <= 0.3)
         .collect();
-    let k: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+    let k = rows.iter().map(|r| r[0]).collect();
     let spectrum = LinearSpectrum::gm2012(0.0).unwrap();
     let precision = Precision::default().with_q_range(1e-4, 50.0).unwrap();
+    (rows, k, spectrum, precision)
+}
+
+#[test]
+fn one_loop_regpt_matches_pyregpt() {
+    let (rows, k, spectrum, precision) = reference();
     let store = TableStore::in_memory();
     let plan = RealPlan::new(&k, RealModel::OneLoopRegPt, &precision, &store, &Silent).unwrap();
     let s = plan.evaluate(&spectrum, &Silent).unwrap();
@@ -75,13 +82,7 @@ const REGPT_2LOOP: [(Pair, usize, usize, usize); 3] = [
 
 #[test]
 fn two_loop_regpt_and_its_vertex_terms_match_pyregpt() {
-    let rows: Vec<Vec<f64>> = rows(&data("regpt_2loop_gm2012_z0.0.dat"))
-        .into_iter()
-        .filter(|r| r[0] <= 0.3)
-        .collect();
-    let k: Vec<f64> = rows.iter().map(|r| r[0]).collect();
-    let spectrum = LinearSpectrum::gm2012(0.0).unwrap();
-    let precision = Precision::default().with_q_range(1e-4, 50.0).unwrap();
+    let (rows, k, spectrum, precision) = reference();
     let plan = RealPlan::new(&k, RealModel::TwoLoopRegPt, &precision, store(), &Silent).unwrap();
     let s = plan.evaluate(&spectrum, &Silent).unwrap();
     let g = s.terms.gamma2.as_ref().unwrap();
