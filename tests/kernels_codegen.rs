@@ -128,7 +128,7 @@ fn expansion_of_f2_reads_like_the_recursion() {
     assert_eq!(text.matches("safe_recip()").count(), 2, "{text}");
     assert!(text.contains("T::from_ratio("), "{text}");
     assert!(
-        text.contains("pub fn general_2<T: Scalar>(g: &[T; 3usize]) -> [T; 2]"),
+        text.contains("pub fn general_2<T: Scalar + Copy>(g: &[T; 3usize]) -> [T; 2]"),
         "{text}"
     );
     // inputs are the Gram entries q1.q1, q1.q2, q2.q2 and nothing else

@@ -1,6 +1,6 @@
 //! The one place the kernel generator runs.
 //!
-//! Every function here is `name<T: Scalar>(g: &[T; N]) -> [T; 2]`: it takes the Gram matrix of its basis
+//! Every function here is `name<T: Scalar + Copy>(g: &[T; N]) -> [T; 2]`: it takes the Gram matrix of its basis
 //! vectors (upper triangle, row-major; the order is in `NAME_INFO.inputs` and in each function's docs)
 //! and returns `[F^s, G^s]`. Nothing here is hand-written: the bodies are flattened straight-line code
 //! emitted by `kernelgen` from the symmetrised subset recursion, with exact rational coefficients.

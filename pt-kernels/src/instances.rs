@@ -2,11 +2,13 @@
 //!
 //! The functions in [`crate::generated`] are generic, and in an optimised build Rust compiles a generic
 //! function anew in every crate that calls it. For kernels of up to ~9,000 straight-line statements that
-//! costs minutes per crate, and for `BigRational`, whose arithmetic LLVM inlines into every statement,
-//! ten minutes and ~10 GB each. [`Evaluate`] fixes both: its impls for `f64` and `BigRational` are
-//! ordinary functions of this crate, so every kernel is compiled exactly once, and exact arithmetic runs
-//! through `Exact`, a `Copy` handle to a `BigRational` on a per-thread tape whose operations are
-//! outlined calls (same values; big-integer arithmetic dwarfs a call), a body LLVM optimises quickly.
+//! costs seconds to a minute per crate and kernel, and for `BigRational`, whose arithmetic LLVM inlines
+//! into every statement, ten minutes and ~10 GB each. [`Evaluate`] fixes both: its impls for `f64` and
+//! `BigRational` are ordinary functions of this crate, so every kernel is compiled exactly once, and exact
+//! arithmetic runs through `Exact`, a `Copy` handle to a `BigRational` on a per-thread tape whose
+//! operations are outlined calls (same values; big-integer arithmetic dwarfs a call), a body LLVM
+//! optimises quickly. (The generated functions require `T: Copy`, which `Exact` is and `BigRational` is
+//! not: see `kernelgen_core::emit` for why.)
 
 use crate::generated;
 use crate::{KernelError, Scalar};
@@ -38,8 +40,8 @@ pub trait Evaluate: Scalar {
 }
 
 /// Calls the generated general kernel of order n with a slice of the right length.
-fn general_dispatch<T: Scalar>(n: usize, g: &[T]) -> Result<[T; 2], KernelError> {
-    fn call<T: Scalar, const N: usize>(g: &[T], f: fn(&[T; N]) -> [T; 2]) -> [T; 2] {
+fn general_dispatch<T: Scalar + Copy>(n: usize, g: &[T]) -> Result<[T; 2], KernelError> {
+    fn call<T: Scalar + Copy, const N: usize>(g: &[T], f: fn(&[T; N]) -> [T; 2]) -> [T; 2] {
         f(g.try_into().expect("length checked by the caller"))
     }
     if g.len() != n * (n + 1) / 2 {

@@ -3,8 +3,9 @@
 //! The density and velocity-divergence kernels of SPT (Goroff et al. 1986; Gil-Marín et al. 2012,
 //! arXiv:1209.3771, appendix A) are produced by the `kernelgen` macro as flattened straight-line code whose
 //! rational coefficients were folded in exactly at generation time; the n! symmetrisation never runs at run
-//! time. Every generated function is generic over [`Scalar`], so it runs in `f64` (fast) and in exact
-//! [`num_rational::BigRational`] (verification) alike.
+//! time. Every generated function is generic over a `Copy` [`Scalar`], so it runs in `f64` (fast), in
+//! [`F64x4`] lanes and in exact [`num_rational::BigRational`] arithmetic (verification; through a `Copy`
+//! handle, see [`Evaluate`]) alike.
 //!
 //! * [`kernels`]: `[F_n^s, G_n^s](q_1, …, q_n)` of free 3-vectors, n = 1..=7, any scalar type;
 //! * [`propagator_3`], [`propagator_5`], [`propagator_7`] (P13, P15, P17: F_{2x+1}^s(k, q1, −q1, …)) and

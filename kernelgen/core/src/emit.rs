@@ -4,8 +4,15 @@
 //! and returns `[F^s, G^s]`. Each live graph node becomes one `let`; each rational coefficient becomes a
 //! visible `let cJ = T::from_ratio(p, q);` (exact in f64 since |p|, q < 2^53, checked here); sums are
 //! emitted as balanced trees (shorter dependency chains, smaller rounding error). The scalar trait must
-//! provide `from_ratio(i64, i64) -> Self`, `safe_recip(&self) -> Self` (1/x, and 0 at an exact 0), `Clone`
-//! and the four arithmetic operators.
+//! provide `from_ratio(i64, i64) -> Self`, `safe_recip(&self) -> Self` (1/x, and 0 at an exact 0) and the
+//! four arithmetic operators; the function also requires `T: Copy`.
+//!
+//! `Copy` is what keeps these functions quick to compile: every node is used by value, never borrowed,
+//! so rustc hands LLVM each `let` as an SSA value. Written with `.clone()`, every node is borrowed and
+//! becomes a stack slot that LLVM's scalar replacement of aggregates (SROA) has to promote again, at a cost
+//! superlinear in the function's size: optimising `general_7` for `f64` took 50 s that way, 5 s this way,
+//! for the same machine code. Exact arithmetic runs through a `Copy` handle to a `BigRational`
+//! (`pt_kernels`' `Exact`), so one function still runs in f64 and in exact rationals.
 
 use crate::dag::{as_i64_pair, exact_in_f64, NodeId, Op, Value, Q};
 use crate::program::Program;
@@ -50,7 +57,7 @@ impl Emitter {
             (negative, x)
         } else {
             let c = self.constant(&mag);
-            (negative, quote!(#c.clone() * #x))
+            (negative, quote!(#c * #x))
         }
     }
 
@@ -58,11 +65,11 @@ impl Emitter {
         let (neg, t) = match v.node {
             None => {
                 let c = self.constant(&v.coef.abs());
-                (v.coef.is_negative(), quote!(#c.clone()))
+                (v.coef.is_negative(), quote!(#c))
             }
             Some(id) => {
                 let x = Self::node(id);
-                self.scaled(&v.coef, quote!(#x.clone()))
+                self.scaled(&v.coef, quote!(#x))
             }
         };
         if neg {
@@ -80,7 +87,7 @@ impl Emitter {
                 .iter()
                 .map(|&(neg, id)| {
                     let x = Self::node(id);
-                    (neg, quote!(#x.clone()))
+                    (neg, quote!(#x))
                 })
                 .collect();
             if mag.is_one() {
@@ -88,12 +95,12 @@ impl Emitter {
             } else {
                 let (neg, sum) = balanced_sum(signed);
                 let c = self.constant(&mag);
-                parts.push((neg, quote!(#c.clone() * #sum)));
+                parts.push((neg, quote!(#c * #sum)));
             }
         }
         if !c0.is_zero() {
             let c = self.constant(&c0.abs());
-            parts.push((c0.is_negative(), quote!(#c.clone())));
+            parts.push((c0.is_negative(), quote!(#c)));
         }
         balanced_sum(parts)
     }
@@ -101,10 +108,10 @@ impl Emitter {
     fn statement(&mut self, id: NodeId, op: &Op) -> TokenStream {
         let x = Self::node(id);
         let rhs = match op {
-            Op::Input(i) => quote!(g[#i].clone()),
+            Op::Input(i) => quote!(g[#i]),
             Op::Mul(a, b) => {
                 let (a, b) = (Self::node(*a), Self::node(*b));
-                quote!(#a.clone() * #b.clone())
+                quote!(#a * #b)
             }
             Op::Recip(a) => {
                 let a = Self::node(*a);
@@ -208,7 +215,7 @@ pub fn emit(program: &Program, paths: &Paths, docs: &[syn::Attribute]) -> syn::R
         #[doc = ""]
         #[doc = #header]
         #[inline(never)]
-        pub fn #name<T: #scalar>(g: &[T; #n_inputs]) -> [T; 2] {
+        pub fn #name<T: #scalar + Copy>(g: &[T; #n_inputs]) -> [T; 2] {
             #(#consts)*
             #(#body)*
             [#f, #g]
