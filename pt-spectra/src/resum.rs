@@ -231,17 +231,24 @@ pub fn regpt_one_loop(terms: &OneLoopTerms, pair: Pair, i: usize, sigma_d2: Esti
     let k = terms.k[i];
     let x = 0.5 * k * k * sigma_d2;
     let p = terms.p_lin[i];
-    let gamma = |p13: Estimate| p13 / p;
-    let (gx, gy) = match pair {
-        Pair::DeltaDelta => (gamma(terms.p13.dd[i]), gamma(terms.p13.dd[i])),
-        Pair::DeltaTheta => (gamma(terms.p13.dd[i]), gamma(terms.p13.tt[i])),
-        Pair::ThetaTheta => (gamma(terms.p13.tt[i]), gamma(terms.p13.tt[i])),
-    };
-    let damping = {
-        let e = (-2.0 * x.value).exp();
-        Estimate::new(e, 2.0 * e * x.error)
-    };
-    damping * ((1.0 + x + gx) * (1.0 + x + gy) * p + terms.p22[pair][i])
+    let (a, b) = legs(pair);
+    let gamma = |leg: Pair| terms.p13[leg][i] / p;
+    regpt_damping(x) * ((1.0 + x + gamma(a)) * (1.0 + x + gamma(b)) * p + terms.p22[pair][i])
+}
+
+/// The auto pairs (XX, YY) of the fields X, Y of `pair`: the propagators of δθ are those of δ and θ.
+fn legs(pair: Pair) -> (Pair, Pair) {
+    match pair {
+        Pair::DeltaDelta => (Pair::DeltaDelta, Pair::DeltaDelta),
+        Pair::DeltaTheta => (Pair::DeltaDelta, Pair::ThetaTheta),
+        Pair::ThetaTheta => (Pair::ThetaTheta, Pair::ThetaTheta),
+    }
+}
+
+/// RegPT's damping e^{−2x} with its error 2e^{−2x}δx.
+fn regpt_damping(x: Estimate) -> Estimate {
+    let e = (-2.0 * x.value).exp();
+    Estimate::new(e, 2.0 * e * x.error)
 }
 
 /// What the 2-loop RegPT spectrum is made of, on one k grid.
@@ -273,17 +280,9 @@ impl RegPtTwoLoop<'_> {
         let propagator = |x_pair: Pair| {
             1.0 + x + x * x * 0.5 + t.p13[x_pair][i] / p * (1.0 + x) + self.p15[x_pair][i] / p
         };
-        let (a, b) = match pair {
-            Pair::DeltaDelta => (Pair::DeltaDelta, Pair::DeltaDelta),
-            Pair::DeltaTheta => (Pair::DeltaDelta, Pair::ThetaTheta),
-            Pair::ThetaTheta => (Pair::ThetaTheta, Pair::ThetaTheta),
-        };
-        let damping = {
-            let e = (-2.0 * x.value).exp();
-            Estimate::new(e, 2.0 * e * x.error)
-        };
+        let (a, b) = legs(pair);
         let one_plus = 1.0 + x;
-        damping
+        regpt_damping(x)
             * (propagator(a) * propagator(b) * p
                 + t.p22[pair][i] * one_plus * one_plus
                 + self.gamma2.p24[pair][i] * one_plus

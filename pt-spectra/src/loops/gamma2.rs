@@ -128,8 +128,8 @@ struct Outer {
 /// The nodes of one layout for every k.
 #[derive(Debug, Clone)]
 struct Nodes {
-    /// Lattice positions of the radial nodes r_j of Γ2.
-    radial: Vec<f64>,
+    /// The radial nodes of Γ2: (ln r_j, weight in ln r).
+    radial: Vec<(f64, f64)>,
     /// Per k: the range of its outer nodes.
     k_start: Vec<usize>,
     outer: Vec<Outer>,
@@ -137,34 +137,37 @@ struct Nodes {
     weights: Vec<[f32; 2]>,
 }
 
-/// Γ2's inner weights at one outer node (k, q, p = |k − q|) over the radial nodes `(ln r, w)`.
+/// The angular nodes (x₂, s₂ cos φ, weight) of the `n` × `n` Gauss–Legendre rule on [0, 1] × [0, π].
+fn directions(n: usize) -> Vec<(f64, f64, f64)> {
+    let rule = GaussLegendre::new(n);
+    let mut out = Vec::with_capacity(n * n);
+    for (x2, wx) in rule.on(0.0, 1.0) {
+        let s2 = (1.0 - x2 * x2).max(0.0).sqrt();
+        for (phi, wp) in rule.on(0.0, PI) {
+            out.push((x2, s2 * phi.cos(), wx * wp));
+        }
+    }
+    out
+}
+
+/// Γ2's inner weights at one outer node (k, q, p = |k − q|) over the radial nodes `(ln r, w)`, with the
+/// angular nodes `near` for r ≥ min(q, p, k)/[`NEAR`] and `far` below ([`directions`]).
 fn inner_weights(
     k: f64,
     q: f64,
     p: f64,
     radial: &[(f64, f64)],
-    angular: [&GaussLegendre; 2],
+    [near, far]: [&[(f64, f64, f64)]; 2],
 ) -> Vec<[f32; 2]> {
     let x1 = ((k * k + q * q - p * p) / (2.0 * k * q)).clamp(-1.0, 1.0);
     let s1 = (1.0 - x1 * x1).max(0.0).sqrt();
-    // The angular nodes (x₂, s₂ cos φ, weight) on [0, 1] × [0, π], near the scales and far from them.
-    let [near, far] = angular.map(|rule| {
-        let mut directions = Vec::with_capacity(rule.len() * rule.len());
-        for (x2, wx) in rule.on(0.0, 1.0) {
-            let s2 = (1.0 - x2 * x2).max(0.0).sqrt();
-            for (phi, wp) in rule.on(0.0, PI) {
-                directions.push((x2, s2 * phi.cos(), wx * wp));
-            }
-        }
-        directions
-    });
-    let (lo, hi) = (q.min(p).min(k) / NEAR, f64::INFINITY);
+    let lo = q.min(p).min(k) / NEAR;
     let norm = 24.0 / (2.0 * PI).powi(3);
     radial
         .iter()
         .map(|&(ln_r, w)| {
             let r = ln_r.exp();
-            let directions = if (lo..=hi).contains(&r) { &near } else { &far };
+            let directions = if r >= lo { near } else { far };
             let mut sum = [0.0; 2];
             for chunk in directions.chunks(4) {
                 let grams: [[f64; 6]; 4] = std::array::from_fn(|i| {
@@ -233,10 +236,7 @@ impl Nodes {
             k_start.push(outer.len());
         }
         Self {
-            radial: radial
-                .iter()
-                .map(|&(x, _)| (x - lo) / lattice.step)
-                .collect(),
+            radial,
             k_start,
             outer,
             weights: Vec::new(),
@@ -252,11 +252,7 @@ impl Nodes {
         layout: Layout,
         report: &(dyn Fn(usize) + Sync),
     ) -> Self {
-        let radial = radial_nodes(lattice.x0, lattice.x_end(), layout);
-        let angular = [
-            GaussLegendre::new(layout.angular),
-            GaussLegendre::new(layout.angular_far),
-        ];
+        let (near, far) = (directions(layout.angular), directions(layout.angular_far));
         let mut ks = Vec::with_capacity(self.outer.len());
         for (i, &k) in k.iter().enumerate() {
             ks.extend(std::iter::repeat_n(
@@ -278,7 +274,7 @@ impl Nodes {
                             (lattice.x0 + o.u_q * lattice.step).exp(),
                             (lattice.x0 + o.u_p * lattice.step).exp(),
                         );
-                        inner_weights(k, q, p, &radial, [&angular[0], &angular[1]])
+                        inner_weights(k, q, p, &self.radial, [&near, &far])
                     })
                     .collect();
                 report(outer.len());
@@ -286,6 +282,14 @@ impl Nodes {
             })
             .collect();
         self
+    }
+
+    /// P̃ at the radial nodes, from the lattice `samples`.
+    fn radial_spectrum(&self, lattice: &Lattice, samples: &[f64]) -> Vec<f64> {
+        self.radial
+            .iter()
+            .map(|&(ln_r, _)| lattice.interpolate(samples, (ln_r - lattice.x0) / lattice.step))
+            .collect()
     }
 
     /// [P24, PΓ2] of the three pairs at k index `i`, from the lattice `samples` and P at the radial nodes.
@@ -379,14 +383,10 @@ impl Gamma2Plan {
     /// P24 and PΓ2 of `spectrum` at the plan's k, each with the error |fine − coarse|.
     pub fn evaluate(&self, spectrum: &LinearSpectrum) -> Gamma2Terms {
         let samples = self.lattice.sample(spectrum);
-        let at = |nodes: &Nodes| -> Vec<f64> {
-            nodes
-                .radial
-                .iter()
-                .map(|&u| self.lattice.interpolate(&samples, u))
-                .collect()
-        };
-        let (p_fine, p_coarse) = (at(&self.fine), at(&self.coarse));
+        let (p_fine, p_coarse) = (
+            self.fine.radial_spectrum(&self.lattice, &samples),
+            self.coarse.radial_spectrum(&self.lattice, &samples),
+        );
         let rows: Vec<[[Estimate; 3]; 2]> = (0..self.len())
             .into_par_iter()
             .map(|i| {
@@ -433,11 +433,7 @@ mod tests {
             let start = std::time::Instant::now();
             let nodes =
                 Nodes::layout(&k, &lattice, layout).with_weights(&k, &lattice, layout, &|_| {});
-            let p_r: Vec<f64> = nodes
-                .radial
-                .iter()
-                .map(|&u| lattice.interpolate(&samples, u))
-                .collect();
+            let p_r = nodes.radial_spectrum(&lattice, &samples);
             println!(
                 "{layout:?}: {} outer, {} radial nodes, {:?}",
                 nodes.outer.len(),
