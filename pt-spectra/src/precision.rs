@@ -76,6 +76,60 @@ pub struct Precision {
     /// Seed of the 2-loop integral's random shifts; another seed gives an independent estimate.
     /// Default 2.
     pub two_loop_seed: u64,
+    /// How the 2-loop terms (P15 and the 2-loop correction) of a spectrum are computed: from basis
+    /// tensors or by direct integration ([`TwoLoopMethod`]). Default [`TwoLoopMethod::Auto`].
+    pub two_loop: TwoLoopMethod,
+}
+
+/// How a [`RealPlan`](crate::real::RealPlan) computes the 2-loop terms of a spectrum.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TwoLoopMethod {
+    /// From the basis tensors ([`crate::loops::basis`]) if they are already cached for the k grid and
+    /// these settings, else [`Direct`](Self::Direct): a one-off run never waits for a tensor build.
+    #[default]
+    Auto,
+    /// From the basis tensors, built and cached on first use for the k grid (minutes; then ~ms per
+    /// spectrum): for fits and chains over cosmologies. A spectrum that the basis does not represent
+    /// well enough is computed directly, with a warning.
+    Basis,
+    /// Direct integration for every spectrum (seconds for 40 k).
+    Direct,
+}
+
+impl TwoLoopMethod {
+    /// The names accepted by [`FromStr`](std::str::FromStr): `auto`, `basis`, `direct`.
+    pub const NAMES: [&'static str; 3] = ["auto", "basis", "direct"];
+
+    /// The method's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::Basis => "basis",
+            Self::Direct => "direct",
+        }
+    }
+}
+
+impl std::fmt::Display for TwoLoopMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for TwoLoopMethod {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "auto" => Ok(Self::Auto),
+            "basis" => Ok(Self::Basis),
+            "direct" => Ok(Self::Direct),
+            _ => Err(Error::UnknownName {
+                what: "2-loop method",
+                name: s.to_string(),
+                available: "auto, basis, direct",
+            }),
+        }
+    }
 }
 
 impl Default for Precision {
@@ -98,6 +152,7 @@ impl Default for Precision {
             two_loop_replicas: 8,
             two_loop_tolerance: 1e-3,
             two_loop_seed: 2,
+            two_loop: TwoLoopMethod::Auto,
         }
     }
 }

@@ -31,6 +31,8 @@ pub enum Stage {
     TwoLoopPoints,
     /// The cosmology-independent weights of RegPT's vertex Γ2 (once per plan).
     Gamma2Weights,
+    /// The 2-loop basis tensors of a k grid (once; cached).
+    TwoLoopBasis,
 }
 
 impl fmt::Display for Stage {
@@ -41,6 +43,7 @@ impl fmt::Display for Stage {
             Stage::P17Table => "P17 angular table (once, a few minutes; cached)",
             Stage::TwoLoopPoints => "2-loop mode coupling",
             Stage::Gamma2Weights => "RegPT vertex weights (once per k grid)",
+            Stage::TwoLoopBasis => "2-loop basis tensors (once per k grid, minutes; cached)",
         })
     }
 }

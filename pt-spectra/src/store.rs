@@ -17,7 +17,9 @@
 //! ```
 
 use crate::error::{Error, Result};
+use crate::loops::basis::TwoLoopBasis;
 use crate::loops::{P15Table, P17Table};
+use crate::precision::Precision;
 use crate::progress::{Progress, Stage};
 use std::fs::{File, OpenOptions, TryLockError};
 use std::path::{Path, PathBuf};
@@ -106,6 +108,52 @@ impl TableStore {
     }
 }
 
+impl TableStore {
+    /// The 2-loop basis tensors ([`TwoLoopBasis`]) for the wavenumbers `k` and `precision`: read
+    /// from their file, or built with the P15 `table` (reporting [`Stage::TwoLoopBasis`]; minutes)
+    /// and written. Without a directory they are built each time.
+    ///
+    /// # Errors
+    /// [`Error::Cache`] if the directory cannot be created or the file cannot be written or locked.
+    pub fn two_loop_basis(
+        &self,
+        k: &[f64],
+        precision: &Precision,
+        table: &P15Table,
+        progress: &dyn Progress,
+    ) -> Result<Arc<TwoLoopBasis>> {
+        let build = || {
+            TwoLoopBasis::build(k, precision, table, &|d, t| {
+                progress.update(Stage::TwoLoopBasis, d, t)
+            })
+        };
+        let tensors = match self.path(&TwoLoopBasis::file_name(k, precision)) {
+            None => build(),
+            Some(path) => cached(
+                &path,
+                "2-loop basis",
+                |v| TwoLoopBasis::from_f64s(v, k, precision),
+                build,
+                TwoLoopBasis::to_f64s,
+                progress,
+            )?,
+        };
+        Ok(Arc::new(tensors))
+    }
+
+    /// The 2-loop basis tensors for `k` and `precision` if their file is in the directory (never
+    /// builds them).
+    pub fn cached_two_loop_basis(
+        &self,
+        k: &[f64],
+        precision: &Precision,
+    ) -> Option<Arc<TwoLoopBasis>> {
+        let path = self.path(&TwoLoopBasis::file_name(k, precision))?;
+        let values = read_f64s(&path)?;
+        TwoLoopBasis::from_f64s(&values, k, precision).map(Arc::new)
+    }
+}
+
 /// The table in `slot`, else from [`cached`], kept in `slot`.
 fn load<T>(
     slot: &Mutex<Option<Arc<T>>>,
@@ -186,8 +234,8 @@ fn acquire(lock: &File, lock_path: &Path, name: &str, progress: &dyn Progress) -
         Ok(()) => Ok(()),
         Err(TryLockError::WouldBlock) => {
             progress.note(&format!(
-                "waiting for another process that is building the {name} angular table (it holds \
-                 the lock `{}`)",
+                "waiting for another process that is building the {name} table (it holds the lock \
+                 `{}`)",
                 lock_path.display()
             ));
             lock.lock().map_err(fail)

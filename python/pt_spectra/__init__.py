@@ -65,15 +65,21 @@ class RealPlan:
     """A real-space model prepared for one k grid: build once, call for every linear spectrum.
 
     ``RealPlan(k, model="1l-spt", precision="default", q_range=None, two_loop_tolerance=None,
-    cache_dir=None)``; models ``linear, 1l-spt, 2l-spt, 1l-rpt-n0..n3, 2l-rpt-n0..n3`` or ``all``.
+    cache_dir=None, two_loop="auto")``; models ``linear, 1l-spt, 2l-spt, 1l-rpt-n0..n3,
+    2l-rpt-n0..n3`` or ``all``. ``two_loop``: ``"basis"`` computes the 2-loop terms of every spectrum
+    from precomputed tensors on a basis of CAMB spectra (built and cached once per k grid, minutes;
+    then milliseconds per spectrum: the choice for chains), ``"direct"`` integrates them for every
+    spectrum (seconds), ``"auto"`` uses the tensors if they are already cached. A spectrum the basis
+    does not represent (e.g. Eisenstein & Hu) is integrated directly, with a warning.
     ``plan(linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False, eh=None, cs2=0.0)`` returns a
     :class:`Table` with no set-up cost beyond the computation itself (``cs2``: the EFT counterterm, as
     in :func:`real`).
     """
 
     def __init__(self, k, model="1l-spt", precision="default", q_range=None,
-                 two_loop_tolerance=None, cache_dir=None):
-        self._plan = _core.RealPlan(k, model, precision, q_range, two_loop_tolerance, cache_dir)
+                 two_loop_tolerance=None, cache_dir=None, two_loop="auto"):
+        self._plan = _core.RealPlan(k, model, precision, q_range, two_loop_tolerance, cache_dir,
+                                    two_loop)
         self.model = model
 
     @property
@@ -89,14 +95,15 @@ class RealPlan:
 class RsdPlan:
     """The loop terms of a redshift-space model prepared for one k grid.
 
-    ``RsdPlan(k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None, cache_dir=None)``;
-    calling it takes the arguments of :func:`rsd` after ``k`` (linear, z, cosmology, f, bias, fog,
-    sigma0, noise, ells, terms, cs2) and returns the multipoles.
+    ``RsdPlan(k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None, cache_dir=None,
+    two_loop="auto")``; calling it takes the arguments of :func:`rsd` after ``k`` (linear, z,
+    cosmology, f, bias, fog, sigma0, noise, ells, terms, cs2) and returns the multipoles.
+    ``two_loop`` as in :class:`RealPlan`.
     """
 
     def __init__(self, k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None,
-                 cache_dir=None):
-        self._plan = _core.RsdPlan(k, real, rsd, precision, q_range, cache_dir)
+                 cache_dir=None, two_loop="auto"):
+        self._plan = _core.RsdPlan(k, real, rsd, precision, q_range, cache_dir, two_loop)
 
     def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=1.0,
                  amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None, number_density=None,
@@ -135,7 +142,7 @@ class RsdTerms:
 
 def real(model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False,
          precision="default", q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None,
-         k_min=1e-3, k_max=1.0, nk=100, cs2=0.0) -> Table:
+         k_min=1e-3, k_max=1.0, nk=100, cs2=0.0, two_loop="auto") -> Table:
     """Real-space P_dd, P_dt, P_tt of a model (``pt-spectra real``).
 
     model: ``linear``, ``1l-spt``, ``2l-spt``, ``1l-rpt-n0`` … ``1l-rpt-n3``, ``2l-rpt-n0`` …
@@ -148,6 +155,7 @@ def real(model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None
     "A_s": 2.1e-9}``).
     terms: add every loop term with its error (``P22_dd``, ``err_P22_dd``, …).
     precision: ``fast``, ``default`` or ``reference``; q_range: (QMIN, QMAX) of the loop integrals.
+    two_loop: ``"auto"``, ``"basis"`` or ``"direct"`` (see :class:`RealPlan`).
     eh: ``"wiggle"`` or ``"no-wiggle"`` for the Eisenstein & Hu spectrum of the cosmology.
     cs2: the EFT counterterm c_s^2 [(Mpc/h)^2] added to the model: P_dd - 2 cs2 k^2 P_lin,
     P_dt - 4 cs2 k^2 P_lin, P_tt - 6 cs2 k^2 P_lin (delta_ct grows as D^3 and theta_ct = 3 delta_ct by
@@ -155,7 +163,7 @@ def real(model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None
     P_ct_tt``.
     """
     plan = RealPlan(_grid(k, k_min, k_max, nk), model, precision, q_range, two_loop_tolerance,
-                    cache_dir)
+                    cache_dir, two_loop)
     return plan(linear, z, z_input, cosmology, terms, eh, cs2)
 
 

@@ -13,8 +13,14 @@ Options (yaml or class attributes):
 - ``ells`` ([0, 2, 4]), ``rsd`` ("tns"), ``real`` ("1l-spt"), ``fog`` ("lorentzian"),
   ``precision`` ("default"; "fast" is ~3× cheaper for 2-loop models), ``q_range`` (QMIN, QMAX
   [h/Mpc]), ``cache_dir`` (the angular tables; default $PT_SPECTRA_CACHE or ~/.cache/pt-spectra).
+- ``two_loop`` ("basis"): for 2-loop real-space models, the 2-loop terms of each step come from basis
+  tensors (built once per k grid and cached, minutes; then milliseconds per step), or ``"direct"``
+  (seconds per step). The basis is made of CAMB spectra to k = 50 h/Mpc, so with it the Boltzmann
+  code is asked for k up to at least 60/Mpc (see ``k_max_linear``); a step whose spectrum the basis
+  does not represent is integrated directly, with a warning.
 - ``k_max_linear`` (10): the k_max [1/Mpc] asked of the Boltzmann code; as h < 1 this covers k up to
-  ``k_max_linear`` h/Mpc. The library extends the spectrum beyond both ends by power laws.
+  ``k_max_linear`` h/Mpc. The library extends the spectrum beyond both ends by power laws. Raised to
+  60 for 2-loop models with ``two_loop: basis``.
 - ``var_pair`` (["delta_tot", "delta_tot"]): the Boltzmann spectrum; ["delta_nonu", "delta_nonu"]
   for the CDM + baryon spectrum with massive neutrinos.
 - ``prefix`` (""): prefix of the nuisance parameter names, to run two tracers side by side.
@@ -97,6 +103,7 @@ class PTMultipoles(Theory):
     q_range: list | None = None
     cache_dir: str | None = None
     k_max_linear: float = 10.0
+    two_loop: str = "basis"
     var_pair: list = ["delta_tot", "delta_tot"]
     prefix: str = ""
 
@@ -143,10 +150,16 @@ class PTMultipoles(Theory):
             return None
         return pt.log_grid(float(self.k_min), float(self.k_max), int(self.nk))
 
+    def _k_max_linear(self):
+        """k_max [1/Mpc] of the Boltzmann spectrum: 60 at least with the 2-loop basis."""
+        if str(self.real).startswith("2l-") and self.two_loop != "direct":
+            return max(float(self.k_max_linear), 60.0)
+        return float(self.k_max_linear)
+
     def _make_plan(self, k):
         self._plan = pt.RsdPlan(k, real=self.real, rsd=self.rsd, precision=self.precision,
                                 q_range=None if self.q_range is None else tuple(self.q_range),
-                                cache_dir=self.cache_dir)
+                                cache_dir=self.cache_dir, two_loop=self.two_loop)
         self._planned_k = np.asarray(k, dtype=float)
 
     def param_name(self, name, i):
@@ -179,7 +192,7 @@ class PTMultipoles(Theory):
     def get_requirements(self):
         zs = self.zs
         return {
-            "Pk_grid": {"z": zs, "k_max": float(self.k_max_linear), "nonlinear": False,
+            "Pk_grid": {"z": zs, "k_max": self._k_max_linear(), "nonlinear": False,
                         "vars_pairs": [list(self.var_pair)]},
             "fsigma8": {"z": zs},
             "sigma8_z": {"z": sorted(set([0.0] + zs))},

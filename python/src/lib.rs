@@ -78,13 +78,18 @@ pub(crate) fn floats(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
     })
 }
 
-/// The precision preset `name`, with the q range and 2-loop tolerance if given.
+/// The precision preset `name`, with the q range, 2-loop tolerance and 2-loop method
+/// (`auto`, `basis`, `direct`) if given.
 pub(crate) fn precision(
     name: &str,
     q_range: Option<(f64, f64)>,
     two_loop_tolerance: Option<f64>,
+    two_loop: Option<&str>,
 ) -> PyResult<Precision> {
     let mut p = Precision::preset(name).map_err(value_error)?;
+    if let Some(method) = two_loop {
+        p.two_loop = method.parse().map_err(value_error)?;
+    }
     if let Some((lo, hi)) = q_range {
         p = p.with_q_range(lo, hi).map_err(value_error)?;
     }
@@ -136,7 +141,7 @@ struct RealPlan {
 impl RealPlan {
     #[new]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (k, model="1l-spt", precision="default", q_range=None, two_loop_tolerance=None, cache_dir=None))]
+    #[pyo3(signature = (k, model="1l-spt", precision="default", q_range=None, two_loop_tolerance=None, cache_dir=None, two_loop="auto"))]
     fn new(
         py: Python<'_>,
         k: &Bound<'_, PyAny>,
@@ -145,10 +150,11 @@ impl RealPlan {
         q_range: Option<(f64, f64)>,
         two_loop_tolerance: Option<f64>,
         cache_dir: Option<PathBuf>,
+        two_loop: &str,
     ) -> PyResult<Self> {
         let k = floats(k, "k")?;
         let selection: RealSelection = model.parse().map_err(value_error)?;
-        let precision = self::precision(precision, q_range, two_loop_tolerance)?;
+        let precision = self::precision(precision, q_range, two_loop_tolerance, Some(two_loop))?;
         let store = Store::new(cache_dir);
         let (plan, _) = detached(py, || {
             LibRealPlan::for_selection(&k, selection, &precision, store.get(), &Silent)
@@ -199,7 +205,7 @@ impl RealPlan {
 #[pyfunction]
 #[pyo3(signature = (model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false,
     precision="default", q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None, k_min=1e-3,
-    k_max=1.0, nk=100, cs2=0.0))]
+    k_max=1.0, nk=100, cs2=0.0, two_loop="auto"))]
 #[allow(clippy::too_many_arguments)]
 fn real(
     py: Python<'_>,
@@ -219,6 +225,7 @@ fn real(
     k_max: f64,
     nk: usize,
     cs2: f64,
+    two_loop: &str,
 ) -> PyResult<Table> {
     let k = k_grid(k, k_min, k_max, nk)?;
     let plan = RealPlan::new(
@@ -229,6 +236,7 @@ fn real(
         q_range,
         two_loop_tolerance,
         cache_dir,
+        two_loop,
     )?;
     plan.__call__(py, linear, z, z_input, cosmology, terms, eh, cs2)
 }
@@ -373,7 +381,7 @@ fn fit(
         k_max,
         data_name,
     };
-    let precision = self::precision(precision, q_range, None)?;
+    let precision = self::precision(precision, q_range, None, None)?;
     let store = Store::new(cache_dir);
     let real = real.parse().map_err(value_error)?;
     let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;

@@ -81,7 +81,7 @@ pub(crate) struct RsdPlan {
 impl RsdPlan {
     #[new]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None, cache_dir=None))]
+    #[pyo3(signature = (k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None, cache_dir=None, two_loop="auto"))]
     fn new(
         py: Python<'_>,
         k: &Bound<'_, PyAny>,
@@ -90,11 +90,12 @@ impl RsdPlan {
         precision: &str,
         q_range: Option<(f64, f64)>,
         cache_dir: Option<PathBuf>,
+        two_loop: &str,
     ) -> PyResult<Self> {
         let k = floats(k, "k")?;
         let real = real.parse().map_err(value_error)?;
         let rsd: RsdModel = rsd.parse().map_err(value_error)?;
-        let precision = crate::precision(precision, q_range, None)?;
+        let precision = crate::precision(precision, q_range, None, Some(two_loop))?;
         let store = Store::new(cache_dir);
         let (plan, _) = detached(py, || {
             LibRsdPlan::new(&k, real, rsd, &precision, store.get(), &Silent)

@@ -283,3 +283,20 @@ def test_fit_tables_give_the_model_and_a_contour_that_is_the_chi2_of_direct_call
     with pytest.raises(ValueError, match="contour points"):
         pt.fit_tables(data, k_max=0.15, contour=("f", "ab"), contour_points=2, **kw)
     assert pt.fit_tables(data, k_max=0.15, **kw)["model"] is None
+
+
+def test_two_loop_basis_matches_direct_and_bad_methods_raise():
+    # A grid of its own (no other test caches tensors for it); `fast` keeps the build to seconds.
+    k = [0.0402, 0.0707, 0.1102]
+    planck0 = planck(0.0)
+    basis = pt.real(model="2l-spt", k=k, linear=planck0, cosmology="planck2018", precision="fast",
+                    two_loop="basis", terms=True)
+    direct = pt.real(model="2l-spt", k=k, linear=planck0, cosmology="planck2018", precision="fast",
+                     two_loop="direct", terms=True)
+    assert any("basis tensors on 24 functions" in line for line in basis.header)
+    assert any(line == "2-loop terms: direct integration" for line in direct.header)
+    for x in ("dd", "dt", "tt"):
+        b, d, e = basis[f"P2loop_{x}"], direct[f"P2loop_{x}"], basis[f"err_P2loop_{x}"]
+        assert np.all(np.abs(b - d) <= 1e-3 * np.abs(d)) and np.all(np.abs(b - d) <= e)
+    with pytest.raises(ValueError, match="two-loop|2-loop method"):
+        pt.RealPlan(k, "2l-spt", two_loop="sometimes")

@@ -132,6 +132,7 @@ pub fn real_table(
         }
         RealSelection::All => {
             header.push(two_loop_line(precision));
+            header.extend(spectra.terms.two_loop_source.map(|s| s.describe()));
             header.push(
                 "P_nw: Eisenstein & Hu (1998) no-wiggle fit of the cosmology, scaled to the sigma8 of \
                  the linear input; columns <model> = P_dd(model)/P_nw, err_<model> its estimated \
@@ -171,6 +172,7 @@ fn model_header(
     ];
     if model.needs_two_loop() {
         h.push(two_loop_line(precision));
+        h.extend(spectra.terms.two_loop_source.map(|s| s.describe()));
     }
     if matches!(model, RealModel::OneLoopRegPt | RealModel::TwoLoopRegPt) {
         h.push(

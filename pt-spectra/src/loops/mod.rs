@@ -35,8 +35,10 @@
 //! [`Precision::lattice_step`]: crate::precision::Precision::lattice_step
 //! [`Precision::p22_error_floor`]: crate::precision::Precision::p22_error_floor
 
+pub mod basis;
 mod gamma2;
 mod lattice;
+mod mode_coupling;
 mod one_loop;
 mod p13;
 mod p15;
@@ -248,6 +250,61 @@ pub struct LoopTerms {
     pub ir: Option<Box<IrTerms>>,
     /// RegPT's vertex terms P24 and PΓ2 ([`Gamma2Plan`]).
     pub gamma2: Option<Gamma2Terms>,
+    /// How P15 and the 2-loop terms were computed, if they were.
+    pub two_loop_source: Option<TwoLoopSource>,
+}
+
+/// How P15 and the 2-loop terms of a [`LoopTerms`] were computed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TwoLoopSource {
+    /// Direct integration.
+    Direct,
+    /// From the basis tensors ([`basis`]): the spectrum's projection residual ε on `functions` basis
+    /// functions; the errors include the projection error 3ε|T|.
+    Basis {
+        /// Basis functions.
+        functions: usize,
+        /// The projection residual ε ([`basis::Projection::residual`]: smoothed).
+        residual: f64,
+        /// The largest pointwise relative residual ([`basis::Projection::pointwise`]).
+        pointwise: f64,
+    },
+    /// Direct integration because the spectrum's projection residual exceeded the basis's limit.
+    Fallback {
+        /// The projection residual.
+        residual: f64,
+        /// The largest residual the basis accepts.
+        max_residual: f64,
+    },
+}
+
+impl TwoLoopSource {
+    /// One line for table headers.
+    pub fn describe(&self) -> String {
+        match *self {
+            Self::Direct => "2-loop terms: direct integration".into(),
+            Self::Basis {
+                functions,
+                residual,
+                pointwise,
+            } => format!(
+                "2-loop terms (P15, P24, P33, total): basis tensors on {functions} functions (CAMB \
+                 spectra over the EuclidEmulator2 box), the same quasi-Monte-Carlo points as direct; \
+                 projection residual {residual:.1e} (smoothed over {} in ln q; pointwise \
+                 {pointwise:.1e}); errors include the projection error {:.0} x residual x |term|",
+                basis::SMOOTHING,
+                basis::PROJECTION_ERROR_FACTOR
+            ),
+            Self::Fallback {
+                residual,
+                max_residual,
+            } => format!(
+                "2-loop terms: direct integration, since the spectrum's projection residual on the \
+                 2-loop basis, {residual:.1e}, exceeds {max_residual:.1e} (a spectrum outside the \
+                 basis prior)"
+            ),
+        }
+    }
 }
 
 /// What the IR-resummed models add to the loop terms of the linear spectrum.
@@ -270,6 +327,7 @@ impl LoopTerms {
             sigma_d2: None,
             ir: None,
             gamma2: None,
+            two_loop_source: None,
         }
     }
 
@@ -386,6 +444,18 @@ pub fn two_loop_correction(
         &propagator,
         points_progress,
     );
+    assemble_two_loop(one_loop, p15, &propagator, mc)
+}
+
+/// The 2-loop correction from its propagator part 2P15 − P33red and the mode-coupling integrals
+/// ([`two_loop_correction`]).
+pub(crate) fn assemble_two_loop(
+    one_loop: &OneLoopTerms,
+    p15: &ByPair<Vec<Estimate>>,
+    propagator: &[[Estimate; 3]],
+    mc: TwoLoopTerms,
+) -> TwoLoopCorrection {
+    let k = &one_loop.k;
     let pairs = ByPair::from_fn(|pair| {
         let j = pair as usize;
         let total = (0..k.len())

@@ -52,6 +52,7 @@
 //! P33^{2L}); those carry larger errors, since their infrared pieces do not cancel.
 
 use super::lattice::Lattice;
+use super::mode_coupling::{Sampled, Sampler, ACC};
 use super::Estimate;
 use crate::linear::LinearSpectrum;
 use rayon::prelude::*;
@@ -122,7 +123,7 @@ pub struct TwoLoopTerms {
 /// correction at fixed points grows steeply with k (at k = 0.4 the δδ correction is a 0.7% remainder of
 /// its terms); at k ≲ 0.14 h/Mpc half of the points already give ≲ 6e-4. On 40 log-spaced k over
 /// [0.005, 0.4] the total cost is that of 2.3 × `points` at every k.
-fn points_at(k: f64, points: usize) -> usize {
+pub(crate) fn points_at(k: f64, points: usize) -> usize {
     let power = (3.5 * (k / 0.16).log2()).round().clamp(-1.0, 5.0) as i32;
     if power >= 0 {
         points << power
@@ -131,198 +132,9 @@ fn points_at(k: f64, points: usize) -> usize {
     }
 }
 
-/// Number of accumulated quantities per point: [IR-safe part, 2P24, P33irr, 2P24 + P33irr] × [δδ, δθ, θθ].
-const VALUES: usize = 12;
-
-/// Anchors (k [h/Mpc], centre shift c − ln k, width w) of the radial sampling density at higher k.
-const RADIAL_ANCHORS: [(f64, f64, f64); 2] = [(0.1, -0.8, 0.75), (0.2, -1.0, 0.6)];
-
-/// Centre c and width w in ln q of the radial sampling density ∝ 1/(w² + (ln q − c)²) at k: c = ln k
-/// and w = `width` for k ≤ 0.05 h/Mpc, then linear in ln k through [`RADIAL_ANCHORS`] to
-/// c = ln k − 1 (q ≈ k/2.7) and w = 0.6 at k ≥ 0.2. At high k the variance of the mode coupling comes
-/// from q₁, q₂ ~ k/3 (three modes of similar size adding up to k, where P(q) is several times P(k));
-/// the narrower density there cuts the errors at k ≥ 0.1 h/Mpc by 2.5–4 for the same points. At low k
-/// the broad density is better.
-fn radial_density(k: f64, width: f64) -> (f64, f64) {
-    let mut from = (0.05, 0.0, width);
-    for to in RADIAL_ANCHORS {
-        if k < to.0 {
-            let s = ((k / from.0).ln() / (to.0 / from.0).ln()).max(0.0);
-            return (
-                k.ln() + from.1 + s * (to.1 - from.1),
-                from.2 + s * (to.2 - from.2),
-            );
-        }
-        from = to;
-    }
-    (k.ln() + from.1, from.2)
-}
-
-/// Weight of the arcsine part of the cosine sampling density (the rest is uniform).
-const ARCSINE_WEIGHT: f64 = 0.5;
-
-/// The cosine x ∈ [−1, 1] at u ∈ [0, 1] and the Jacobian dx/du relative to the uniform map (2):
-/// x = (1 − a)(2u − 1) + a sin(π(u − ½)), a = [`ARCSINE_WEIGHT`]. Monotonic, and denser towards |x| = 1.
-#[inline]
-fn cosine(u: f64) -> (f64, f64) {
-    let s = PI * (u - 0.5);
-    let a = ARCSINE_WEIGHT;
-    (
-        (1.0 - a) * (2.0 * u - 1.0) + a * s.sin(),
-        (2.0 * (1.0 - a) + a * PI * s.cos()) / 2.0,
-    )
-}
-
-/// The spectrum on the lattice, zero outside [q_min, q_max].
-struct Sampled<'a> {
-    lattice: &'a Lattice,
-    samples: &'a [f64],
-}
-
-impl Sampled<'_> {
-    #[inline]
-    fn at(&self, q: f64) -> f64 {
-        self.lattice.at_ln_or_zero(self.samples, q.ln())
-    }
-
-    /// P̃ at q = e^`ln_q`.
-    #[inline]
-    fn at_ln(&self, ln_q: f64) -> f64 {
-        self.lattice.at_ln_or_zero(self.samples, ln_q)
-    }
-
-    /// P̃ at q = √`q2` (no square root: ln q = ½ ln q²).
-    #[inline]
-    fn at_squared(&self, q2: f64) -> f64 {
-        self.lattice.at_ln_or_zero(self.samples, 0.5 * q2.ln())
-    }
-}
-
-/// Pair index j: (X, Y) = (F, F), (F, G), (G, G) → kernel indices.
-const PAIRS: [(usize, usize); 3] = [(0, 0), (0, 1), (1, 1)];
-
-/// The pointwise P33red = 9P(k)X_3(k, q₁, −q₁)Y_3(k, q₂, −q₂) (without P₁P₂, symmetrised in X ↔ Y) for
-/// the three pairs, from the Gram matrix [kk, kq₁, kq₂, q₁q₁, q₁q₂, q₂q₂]. Its integral is P13_X P13_Y/P.
-#[inline]
-fn reducible_part(g: &[f64; 6], p_k: f64) -> [f64; 3] {
-    let [kk, kq1, kq2, q1q1, _, q2q2] = *g;
-    let a3 = pt_kernels::propagator_3(&[kk, kq1, q1q1]);
-    let b3 = pt_kernels::propagator_3(&[kk, kq2, q2q2]);
-    PAIRS.map(|(x, y)| 9.0 * p_k * 0.5 * (a3[x] * b3[y] + a3[y] * b3[x]))
-}
-
-/// What the 2P24 piece needs of one momentum q_i with k·q_i = σ kq_i (σ = ±1): the smooth partition
-/// w = p⁴/(q⁴ + p⁴), p = |k − q_i|, of the q_i ↔ k − q_i symmetry (×2 below) times P(p), and
-/// X_2^s(q_i, k − q_i) for X = F, G. Zero where w is negligible.
-#[inline]
-fn pair_leg(kk: f64, kq: f64, qq: f64, p: &Sampled) -> (f64, [f64; 2]) {
-    let pp = (kk - 2.0 * kq + qq).max(0.0);
-    let w = pp * pp / (qq * qq + pp * pp);
-    if w <= 1e-12 {
-        return (0.0, [0.0; 2]);
-    }
-    (
-        w * p.at_squared(pp),
-        pt_kernels::mode_coupling_2(&[kk, kq, qq]),
-    )
-}
-
-/// The 2P24 piece of g(q₁, q₂) (module docs) for the three pairs, without P₁P₂, from the leg of q₁
-/// ([`pair_leg`]) and m4 = X_4^s(q₁, k − q₁, q₂, −q₂); the caller adds it with q₁ ↔ q₂.
-#[inline]
-fn p24_half((weight, m2): (f64, [f64; 2]), m4: [f64; 2]) -> [f64; 3] {
-    if weight == 0.0 {
-        return [0.0; 3];
-    }
-    PAIRS.map(|(x, y)| 24.0 * (m2[x] * m4[y] + m2[y] * m4[x]) * weight)
-}
-
-/// The integrand at one point (q_i and ln q_i, cosines x_i about k̂, cos φ), averaged over its four
-/// images q_i → ±q_i (antithetic: odd parts cancel exactly): [IR-safe part, 2P24, P33irr,
-/// 2P24 + P33irr] for δδ, δθ, θθ (times the measure).
-///
-/// The images are (x₁, x₂, cos φ) → (x₁, x₂, c), (−x₁, −x₂, c), (−x₁, x₂, −c), (x₁, −x₂, −c): they
-/// share |q_i| (so P(q_i) and the reducible part, even in each q_i), the legs |k ∓ q_i| come in two
-/// kinds each, and q₁·q₂ keeps or flips its sign.
-#[inline]
-fn images(
-    k: f64,
-    (q, ln_q): ([f64; 2], [f64; 2]),
-    x: [f64; 2],
-    cos_phi: f64,
-    p: &Sampled,
-    p_k: f64,
-) -> [f64; VALUES] {
-    let (p1, p2) = (p.at_ln(ln_q[0]), p.at_ln(ln_q[1]));
-    if p1 == 0.0 || p2 == 0.0 {
-        return [0.0; VALUES];
-    }
-    let (s1, s2) = (
-        (1.0 - x[0] * x[0]).max(0.0).sqrt(),
-        (1.0 - x[1] * x[1]).max(0.0).sqrt(),
-    );
-    let q1q2 = q[0] * q[1] * (x[0] * x[1] + s1 * s2 * cos_phi);
-    let (kk, kq1, kq2, q11, q22) = (
-        k * k,
-        k * q[0] * x[0],
-        k * q[1] * x[1],
-        q[0] * q[0],
-        q[1] * q[1],
-    );
-    let red = reducible_part(&[kk, kq1, kq2, q11, q1q2, q22], p_k);
-    let legs1 = [pair_leg(kk, kq1, q11, p), pair_leg(kk, -kq1, q11, p)];
-    let legs2 = [pair_leg(kk, kq2, q22, p), pair_leg(kk, -kq2, q22, p)];
-    // d³q₁d³q₂/(2π)⁶ = q₁³q₂³ dln q₁ dln q₂ · 2π dx₁ · 2 dx₂ dφ (φ ∈ [0, π]) / (2π)⁶; ¼ for the images.
-    let measure = 0.25 * (q[0] * q[1]).powi(3) * 4.0 * PI / (2.0 * PI).powi(6);
-    // X_4^s(q₁, k − q₁, q₂, −q₂) is even in q₂ and the leg depends on q₁ only, so the P24 half of q₁
-    // takes two values over the images, set by the sign of k·q₁ (images 1, 4 and 2, 3); likewise the
-    // half of q₂ (images 1, 3 and 2, 4).
-    // The four X_4 are evaluated together (four lanes), as are the four X_3 below.
-    let m4 = pt_kernels::mode_coupling_4_x4(&[
-        [kk, kq1, kq2, q11, q1q2, q22],
-        [kk, -kq1, -kq2, q11, q1q2, q22],
-        [kk, kq2, kq1, q22, q1q2, q11],
-        [kk, -kq2, -kq1, q22, q1q2, q11],
-    ]);
-    let halves1 = [p24_half(legs1[0], m4[0]), p24_half(legs1[1], m4[1])];
-    let halves2 = [p24_half(legs2[0], m4[2]), p24_half(legs2[1], m4[3])];
-    // (sign of k·q₁, sign of k·q₂, sign of q₁·q₂) of the four images.
-    let signs = [(0, 0, false), (1, 1, false), (1, 0, true), (0, 1, true)];
-    let grams = signs.map(|(i1, i2, flip)| {
-        [
-            kk,
-            if i1 == 0 { kq1 } else { -kq1 },
-            if i2 == 0 { kq2 } else { -kq2 },
-            q11,
-            if flip { -q1q2 } else { q1q2 },
-            q22,
-        ]
-    });
-    let m3 = pt_kernels::mode_coupling_3_x4(&grams);
-    let mut out = [0.0; VALUES];
-    for (image, &(i1, i2, _)) in signs.iter().enumerate() {
-        let [_, a1, a2, _, q12, _] = grams[image];
-        let (a, b) = (halves1[i1], halves2[i2]);
-        let q33 = (kk + q11 + q22 - 2.0 * a1 - 2.0 * a2 + 2.0 * q12).max(0.0);
-        // The smooth partition w = q₃⁴/(q₁⁴ + q₂⁴ + q₃⁴) of the permutation symmetry (×3 below).
-        let w3 = q33 * q33 / (q11 * q11 + q22 * q22 + q33 * q33);
-        let (m3, spectra3) = if w3 > 1e-12 {
-            (m3[image], 18.0 * w3 * p1 * p2 * p.at_squared(q33))
-        } else {
-            ([0.0; 2], 0.0)
-        };
-        for (j, &(x, y)) in PAIRS.iter().enumerate() {
-            let p33 = m3[x] * m3[y] * spectra3;
-            let mc = 0.5 * (a[j] + b[j]) * p1 * p2;
-            let red = red[j] * p1 * p2;
-            out[j] += measure * (mc + p33 + 2.0 * red);
-            out[3 + j] += measure * mc;
-            out[6 + j] += measure * p33;
-            out[9 + j] += measure * (mc + p33);
-        }
-    }
-    out
-}
+/// Number of quantities per k: [IR-safe part, 2P24, P33irr, 2P24 + P33irr] × [δδ, δθ, θθ] (the
+/// last three from the middle six).
+pub(crate) const VALUES: usize = 12;
 
 /// The 2-loop terms of `spectrum` at `k` [h/Mpc], over q ∈ `q_range` (P̃ on a lattice of step
 /// `lattice_step` in ln q), in parallel over k and random shifts.
@@ -355,6 +167,23 @@ pub fn two_loop_with_progress(
         &offsets,
         progress,
     )
+}
+
+/// The 5-D Sobol sequence (Joe–Kuo direction numbers) whose prefixes every k takes, without its first
+/// point (the origin).
+pub(crate) fn sobol_sequence() -> impl Iterator<Item = [f64; 5]> {
+    Sobol::<f64>::new(5, &JoeKuoD6::standard())
+        .skip(1)
+        .map(|p| std::array::from_fn(|d| p[d]))
+}
+
+/// The Cranley–Patterson random shifts of the replicas (ChaCha8 from `settings.seed`).
+pub(crate) fn random_shifts(settings: &TwoLoopSettings) -> Vec<[f64; 5]> {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(settings.seed);
+    (0..settings.replicas)
+        .map(|_| std::array::from_fn(|_| rng.gen::<f64>()))
+        .collect()
 }
 
 /// Refinement stops at this many times the initial points of a k (`points` × 2^round(3.5 log2(k/0.16)),
@@ -404,17 +233,10 @@ pub fn two_loop_refined(
         lattice: &lattice,
         samples: &samples,
     };
-    let params = JoeKuoD6::standard();
     // Every k takes a prefix of the same sequence, continued as refinement needs.
-    let mut sequence = Sobol::<f64>::new(5, &params).skip(1);
+    let mut sequence = sobol_sequence();
     let mut points: Vec<[f64; 5]> = Vec::new();
-    let shifts: Vec<[f64; 5]> = {
-        use rand::{Rng, SeedableRng};
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(settings.seed);
-        (0..settings.replicas)
-            .map(|_| std::array::from_fn(|_| rng.gen::<f64>()))
-            .collect()
-    };
+    let shifts = random_shifts(settings);
     let ln_range = (q_range.0.ln(), q_range.1.ln());
     let replica_sum = |k: f64, shift: &[f64; 5], points: &[[f64; 5]]| {
         shifted_sum(k, shift, points, &sampled, ln_range, settings.radial_width)
@@ -423,7 +245,7 @@ pub fn two_loop_refined(
     let mut target: Vec<usize> = k.iter().map(|&k| points_at(k, settings.points)).collect();
     let limit: Vec<usize> = target.iter().map(|&n| REFINE_LIMIT * n).collect();
     let mut done_points = vec![0; k.len()];
-    let mut sums = vec![[0.0; VALUES]; k.len() * replicas];
+    let mut sums = vec![[0.0; ACC]; k.len() * replicas];
     let mut rows = vec![[Estimate::default(); VALUES]; k.len()];
     let mut total = 0;
     let done = AtomicUsize::new(0);
@@ -434,12 +256,7 @@ pub fn two_loop_refined(
         let longest = target.iter().copied().max().unwrap_or(0);
         if longest > points.len() {
             let more = longest - points.len();
-            points.extend(
-                sequence
-                    .by_ref()
-                    .take(more)
-                    .map(|p| std::array::from_fn(|d| p[d])),
-            );
+            points.extend(sequence.by_ref().take(more));
         }
         let jobs: Vec<usize> = (0..k.len() * replicas)
             .filter(|&job| target[job / replicas] > done_points[job / replicas])
@@ -451,7 +268,7 @@ pub fn two_loop_refined(
             .iter()
             .map(|&job| target[job / replicas] - done_points[job / replicas])
             .sum::<usize>();
-        let new: Vec<[f64; VALUES]> = jobs
+        let new: Vec<[f64; ACC]> = jobs
             .par_iter()
             .map(|&job| {
                 let i = job / replicas;
@@ -494,19 +311,26 @@ pub fn two_loop_refined(
             }
         }
     }
-    let pair = |j: usize| TwoLoopPair {
-        ir_safe: rows.iter().map(|r| r[j]).collect(),
-        p24: rows
-            .iter()
-            .map(|r| Estimate::new(0.5 * r[3 + j].value, 0.5 * r[3 + j].error))
-            .collect(),
-        p33_2l: rows.iter().map(|r| r[6 + j]).collect(),
-        mode_coupling: rows.iter().map(|r| r[9 + j]).collect(),
-    };
-    TwoLoopTerms {
-        k: k.to_vec(),
-        pairs: [pair(0), pair(1), pair(2)],
-        points: done_points,
+    TwoLoopTerms::from_rows(k, &rows, done_points)
+}
+
+impl TwoLoopTerms {
+    /// The terms from one row of [`VALUES`] estimates per k.
+    pub(crate) fn from_rows(k: &[f64], rows: &[[Estimate; VALUES]], points: Vec<usize>) -> Self {
+        let pair = |j: usize| TwoLoopPair {
+            ir_safe: rows.iter().map(|r| r[j]).collect(),
+            p24: rows
+                .iter()
+                .map(|r| Estimate::new(0.5 * r[3 + j].value, 0.5 * r[3 + j].error))
+                .collect(),
+            p33_2l: rows.iter().map(|r| r[6 + j]).collect(),
+            mode_coupling: rows.iter().map(|r| r[9 + j]).collect(),
+        };
+        Self {
+            k: k.to_vec(),
+            pairs: [pair(0), pair(1), pair(2)],
+            points,
+        }
     }
 }
 
@@ -517,36 +341,16 @@ fn shifted_sum(
     shift: &[f64; 5],
     points: &[[f64; 5]],
     sampled: &Sampled,
-    (lo, hi): (f64, f64),
+    ln_range: (f64, f64),
     radial_width: f64,
-) -> [f64; VALUES] {
-    let p_k = sampled.at(k);
-    // ln q = c + w tan θ with θ uniform on [θ_lo, θ_hi]: points concentrate within a few w of the
-    // centre c; the Jacobian dln q/dt = (θ_hi − θ_lo) w / cos²θ.
-    let (centre, width) = radial_density(k, radial_width);
-    let (t_lo, t_hi) = (
-        ((lo - centre) / width).atan(),
-        ((hi - centre) / width).atan(),
-    );
-    // (ln q, dln q/dt) at t.
-    let radial = |t: f64| -> (f64, f64) {
-        let (sin, cos) = (t_lo + (t_hi - t_lo) * t).sin_cos();
-        (
-            centre + width * sin / cos,
-            (t_hi - t_lo) * width / (cos * cos),
-        )
-    };
-    let mut acc = [0.0; VALUES];
+) -> [f64; ACC] {
+    let sampler = Sampler::new(k, ln_range, radial_width);
+    let mut acc = [0.0; ACC];
     for point in points {
-        let t: [f64; 5] = std::array::from_fn(|d| (point[d] + shift[d]).fract());
-        let ((l1, j1), (l2, j2)) = (radial(t[0]), radial(t[1]));
-        let ((x1, h1), (x2, h2)) = (cosine(t[2]), cosine(t[3]));
-        let (j1, j2) = (j1 * h1, j2 * h2);
-        let c = (PI * t[4]).cos();
-        let q = ([l1.exp(), l2.exp()], [l1, l2]);
-        let v = images(k, q, [x1, x2], c, sampled, p_k);
+        let point = sampler.point(point, shift);
+        let v = sampled.integrand(k, &point);
         for (a, b) in acc.iter_mut().zip(v) {
-            *a += j1 * j2 * b;
+            *a += point.jacobian * b;
         }
     }
     acc
@@ -564,16 +368,37 @@ fn worst_ratio(row: &[Estimate; VALUES], offsets: &[Estimate; 3], tolerance: f64
 }
 
 /// The mean over the shifts of their integrals, each the sum of `points` integrand values times the
-/// volume of (x₁, x₂, φ) over the points (the radial Jacobians are in the sums), and its standard error.
-fn estimates(sums: &[[f64; VALUES]], points: usize) -> [Estimate; VALUES] {
+/// volume of (x₁, x₂, φ) over the points (the radial Jacobians are in the sums), and its standard error;
+/// the [`VALUES`] quantities from the [`ACC`] accumulated ones.
+fn estimates(sums: &[[f64; ACC]], points: usize) -> [Estimate; VALUES] {
     // Volume of (x₁, x₂, φ): 2 · 2 · π.
-    let scale = 4.0 * PI / points as f64;
-    let r = sums.len() as f64;
+    let scale = integral_scale(points);
+    let integrals: Vec<[f64; ACC]> = sums.iter().map(|m| m.map(|v| v * scale)).collect();
+    replica_estimates(&integrals)
+}
+
+/// The factor from a sum over `points` (with the radial Jacobians) to the integral: the volume of
+/// (x₁, x₂, φ), 2 · 2 · π, over the points.
+pub(crate) fn integral_scale(points: usize) -> f64 {
+    4.0 * PI / points as f64
+}
+
+/// The mean over the replicas of their integrals and its standard error, for the [`VALUES`]
+/// quantities from the [`ACC`] accumulated ones.
+pub(crate) fn replica_estimates(integrals: &[[f64; ACC]]) -> [Estimate; VALUES] {
+    let r = integrals.len() as f64;
+    let value = |m: &[f64; ACC], v: usize| {
+        if v < ACC {
+            m[v]
+        } else {
+            m[v - 6] + m[v - 3]
+        }
+    };
     std::array::from_fn(|v| {
-        let mean = sums.iter().map(|m| m[v] * scale).sum::<f64>() / r;
-        let var = sums
+        let mean = integrals.iter().map(|m| value(m, v)).sum::<f64>() / r;
+        let var = integrals
             .iter()
-            .map(|m| (m[v] * scale - mean).powi(2))
+            .map(|m| (value(m, v) - mean).powi(2))
             .sum::<f64>()
             / (r - 1.0).max(1.0);
         Estimate::new(mean, (var / r).sqrt())

@@ -3,8 +3,10 @@
 use super::{RealModel, RealSelection, RealSpectra};
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
-use crate::loops::{self, Gamma2Plan, LoopTerms, OneLoopPlan, OneLoopTerms, P15Table, P17Table};
-use crate::precision::Precision;
+use crate::loops::basis::TwoLoopBasis;
+use crate::loops::{self, ByPair, Estimate, Gamma2Plan, LoopTerms, OneLoopPlan, OneLoopTerms};
+use crate::loops::{P15Table, P17Table, TwoLoopCorrection, TwoLoopSource};
+use crate::precision::{Precision, TwoLoopMethod};
 use crate::progress::{stage_callback, Progress, Silent, Stage};
 use crate::resum;
 use crate::store::TableStore;
@@ -46,6 +48,8 @@ pub struct RealPlan {
     ir: Option<crate::ir::WiggleSplit>,
     /// RegPT's vertex weights (2-loop RegPT, and `all`).
     gamma2: Option<Gamma2Plan>,
+    /// The 2-loop basis tensors, if the 2-loop terms come from them ([`TwoLoopMethod`]).
+    basis: Option<Arc<TwoLoopBasis>>,
 }
 
 impl RealPlan {
@@ -81,7 +85,9 @@ impl RealPlan {
 
     /// The plan of `model` on the wavenumbers `k` [h/Mpc] with `precision`; the angular tables the
     /// model needs (P15 for N2, N3 and 2-loop models, P17 for N3) come from `store`, built there on
-    /// first use (reported to `progress`).
+    /// first use (reported to `progress`). For 2-loop models, `precision.two_loop` says whether the
+    /// 2-loop terms come from basis tensors (read from `store`, or for [`TwoLoopMethod::Basis`]
+    /// built there: minutes, once per grid) or from direct integrals.
     ///
     /// # Errors
     /// As [`OneLoopPlan::new`] and [`TableStore::p15`].
@@ -113,6 +119,14 @@ impl RealPlan {
         } else {
             None
         };
+        let basis = match (&p15, precision.two_loop) {
+            (Some(table), method) if model.needs_two_loop() => match method {
+                TwoLoopMethod::Direct => None,
+                TwoLoopMethod::Auto => store.cached_two_loop_basis(k, precision),
+                TwoLoopMethod::Basis => Some(store.two_loop_basis(k, precision, table, progress)?),
+            },
+            _ => None,
+        };
         Ok(Self {
             k: k.to_vec(),
             model,
@@ -128,6 +142,7 @@ impl RealPlan {
             gamma2: model
                 .needs_gamma2()
                 .then(|| gamma2_plan(k, precision, progress)),
+            basis,
         })
     }
 
@@ -179,23 +194,11 @@ impl RealPlan {
         }
         let one_loop = one_loop.expect("a plan has at least one chunk");
         let (k, precision) = (&self.k, &self.precision);
-        let p15 = self
-            .p15
-            .as_ref()
-            .map(|table| loops::p15_terms(table, k, spectrum, precision));
         let p17 = self
             .p17
             .as_ref()
             .map(|table| loops::p17_terms(table, k, spectrum, precision));
-        let two_loop = match (&self.p15, &p15) {
-            (Some(table), Some(p15)) if self.model.needs_two_loop() => {
-                let points = stage_callback(progress, Stage::TwoLoopPoints);
-                Some(loops::two_loop_correction(
-                    &one_loop, p15, table, spectrum, precision, &points,
-                ))
-            }
-            _ => None,
-        };
+        let (p15, two_loop, two_loop_source) = self.two_loop_terms(spectrum, &one_loop, progress);
         let sigma_d2 = Some(resum::sigma_d2(spectrum, k, precision));
         let gamma2 = self.gamma2.as_ref().map(|plan| plan.evaluate(spectrum));
         LoopTerms {
@@ -206,7 +209,55 @@ impl RealPlan {
             sigma_d2,
             ir: None,
             gamma2,
+            two_loop_source,
         }
+    }
+
+    /// P15 and, for 2-loop models, the 2-loop terms: from the basis tensors if the plan has them and
+    /// the spectrum projects well enough, else directly (with a note to `progress` if the basis was
+    /// passed over).
+    fn two_loop_terms(
+        &self,
+        spectrum: &LinearSpectrum,
+        one_loop: &OneLoopTerms,
+        progress: &dyn Progress,
+    ) -> (
+        Option<ByPair<Vec<Estimate>>>,
+        Option<TwoLoopCorrection>,
+        Option<TwoLoopSource>,
+    ) {
+        let (k, precision) = (&self.k, &self.precision);
+        let Some(table) = &self.p15 else {
+            return (None, None, None);
+        };
+        let mut source = TwoLoopSource::Direct;
+        if let Some(basis) = &self.basis {
+            match basis.evaluate(spectrum, one_loop) {
+                Ok(terms) => {
+                    let source = TwoLoopSource::Basis {
+                        functions: basis.basis().len(),
+                        residual: terms.projection.residual,
+                        pointwise: terms.projection.pointwise,
+                    };
+                    return (Some(terms.p15), Some(terms.correction), Some(source));
+                }
+                Err(projection) => {
+                    source = TwoLoopSource::Fallback {
+                        residual: projection.residual,
+                        max_residual: basis.max_residual(),
+                    };
+                    progress.note(&format!("warning: {}", source.describe()));
+                }
+            }
+        }
+        let p15 = loops::p15_terms(table, k, spectrum, precision);
+        if !self.model.needs_two_loop() {
+            return (Some(p15), None, None);
+        }
+        let points = stage_callback(progress, Stage::TwoLoopPoints);
+        let two_loop =
+            loops::two_loop_correction(one_loop, &p15, table, spectrum, precision, &points);
+        (Some(p15), Some(two_loop), Some(source))
     }
 
     /// The model's spectra for the linear `spectrum` (at the output redshift).

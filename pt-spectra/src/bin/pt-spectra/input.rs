@@ -5,7 +5,7 @@ use anyhow::{bail, Context, Result};
 use pt_spectra::cosmology::TransferKind;
 use pt_spectra::error::Error;
 use pt_spectra::linear::{Columns, LinearSpectrum, LogGrid};
-use pt_spectra::precision::Precision;
+use pt_spectra::precision::{Precision, TwoLoopMethod};
 use pt_spectra::setup::{self, LinearSource, NamedCosmology, Prepared, Request};
 use pt_spectra::store::TableStore;
 use pt_spectra::table::Table;
@@ -47,6 +47,12 @@ pub fn parse_q_range(s: &str) -> std::result::Result<(f64, f64), String> {
         return Err(format!("`{s}`: QMIN must be below QMAX"));
     }
     Ok((lo, hi))
+}
+
+/// A 2-loop method by name.
+fn parse_two_loop(s: &str) -> std::result::Result<TwoLoopMethod, String> {
+    s.parse()
+        .map_err(|e: pt_spectra::error::Error| e.to_string())
 }
 
 /// A precision preset by name.
@@ -107,6 +113,13 @@ pub struct SpectrumInput {
     /// propagator terms P15, P17 depend on QMAX (UV sensitivity); the header states the range.
     #[arg(long, value_name = "QMIN,QMAX", value_parser = parse_q_range)]
     q_range: Option<(f64, f64)>,
+    /// How the 2-loop terms are computed: `basis` (precomputed tensors contracted with the
+    /// spectrum's projection on a basis of linear spectra; built and cached once per k grid, minutes,
+    /// then milliseconds per spectrum; a spectrum the basis does not represent is computed directly,
+    /// with a warning), `direct` (integrals for every spectrum, seconds), or `auto` (basis if the
+    /// tensors of this grid are already cached, else direct). The header says which was used.
+    #[arg(long, value_name = "METHOD", default_value = "auto", value_parser = parse_two_loop)]
+    two_loop: TwoLoopMethod,
     /// Directory of the cached angular tables (P15, P17). Default: $PT_SPECTRA_CACHE, else
     /// $XDG_CACHE_HOME/pt-spectra, else ~/.cache/pt-spectra.
     #[arg(long, value_name = "DIR")]
@@ -167,6 +180,7 @@ impl SpectrumInput {
             eprintln!("warning: {w}");
         }
         let mut precision = self.precision.clone();
+        precision.two_loop = self.two_loop;
         if let Some((lo, hi)) = self.q_range {
             precision = precision
                 .with_q_range(lo, hi)

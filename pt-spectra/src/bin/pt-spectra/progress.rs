@@ -15,7 +15,9 @@ pub struct Bars {
 fn template(stage: Stage) -> &'static str {
     match stage {
         Stage::TwoLoopPoints => "{msg} [{bar:40}] {percent}% ({eta})",
-        Stage::OneLoop | Stage::Gamma2Weights => "{msg} [{bar:40}] {percent}% ({eta})",
+        Stage::OneLoop | Stage::Gamma2Weights | Stage::TwoLoopBasis => {
+            "{msg} [{bar:40}] {percent}% ({eta})"
+        }
         _ => "{msg} [{bar:40}] {pos}/{len} nodes ({eta})",
     }
 }

@@ -1,0 +1,287 @@
+//! A basis for linear spectra on the loop lattice, and the projection of a spectrum on it.
+//!
+//! The functions φ_a are orthonormal in the weighted inner product ⟨f, g⟩ = Σ_j ω_j f_j g_j over the
+//! lattice points q_j, with ω_j = Δln q / P̄(q_j)² (P̄: the mean training spectrum), so that the
+//! projection c_a = ⟨φ_a, P⟩ minimises the relative residual in the least-squares sense over the whole
+//! lattice (tails included: the loop integrals use them), and costs one pass over the lattice.
+//!
+//! The residual that matters for loop integrals is not the pointwise one: CAMB tables carry
+//! uncorrelated kinks of a few 1e-4 from one k to the next (its internal k sampling), which no small
+//! basis follows and which integrals average out. The projection therefore reports the largest
+//! relative residual after smoothing with a Gaussian of width [`SMOOTHING`] in ln q (the residual
+//! the integrals see), and the pointwise one. The basis is built greedily (a reduced basis): from a training set of
+//! spectra, each step adds the (orthonormalised) training spectrum that the basis so far represents
+//! worst, so the first n functions of a basis are the basis of size n, and its worst training residual
+//! falls step by step.
+
+use crate::loops::lattice::Lattice;
+
+/// Width (standard deviation in ln q) of the Gaussian with which the relative residual is smoothed.
+pub const SMOOTHING: f64 = 0.1;
+
+/// The projection of a spectrum on a [`LinearBasis`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Projection {
+    /// The coefficients c_a, P ≈ Σ_a c_a φ_a.
+    pub coefficients: Vec<f64>,
+    /// The projected samples Σ_a c_a φ_a(q_j) on the lattice.
+    pub samples: Vec<f64>,
+    /// The largest relative residual (P̂ − P)/P over the lattice after smoothing with a Gaussian of
+    /// width [`SMOOTHING`] in ln q: the residual the loop integrals see.
+    pub residual: f64,
+    /// The largest pointwise relative residual |P̂ − P|/P over the lattice.
+    pub pointwise: f64,
+}
+
+/// Basis functions sampled on a loop lattice, orthonormal in the weighted inner product.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearBasis {
+    lattice: Lattice,
+    /// ω_j.
+    weights: Vec<f64>,
+    /// φ_a(q_j) at row j: `phi[j * n + a]`.
+    phi: Vec<f64>,
+    n: usize,
+}
+
+impl LinearBasis {
+    /// The greedy basis of at most `n` functions for the `training` spectra (samples on `lattice`,
+    /// positive), stopping early if the training set is represented to round-off.
+    ///
+    /// # Panics
+    /// If the training set is empty or a spectrum's length differs from the lattice.
+    pub(crate) fn greedy(lattice: Lattice, training: &[Vec<f64>], n: usize) -> Self {
+        assert!(!training.is_empty(), "an empty training set");
+        let len = lattice.len;
+        assert!(training.iter().all(|t| t.len() == len), "training length");
+        let weights: Vec<f64> = (0..len)
+            .map(|j| {
+                let mean = training.iter().map(|t| t[j]).sum::<f64>() / training.len() as f64;
+                lattice.step / (mean * mean)
+            })
+            .collect();
+        // Work with y = √ω P, orthonormal in the plain inner product.
+        let root: Vec<f64> = weights.iter().map(|w| w.sqrt()).collect();
+        let mut residuals: Vec<Vec<f64>> = training
+            .iter()
+            .map(|t| t.iter().zip(&root).map(|(p, r)| p * r).collect())
+            .collect();
+        let first_norm = residuals.iter().map(|r| norm2(r)).fold(0.0, f64::max);
+        let mut basis: Vec<Vec<f64>> = Vec::new();
+        while basis.len() < n {
+            let (worst, norm) = residuals
+                .iter()
+                .enumerate()
+                .map(|(m, r)| (m, norm2(r)))
+                .fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a });
+            if norm <= 1e-28 * first_norm {
+                break;
+            }
+            let mut e = residuals[worst].clone();
+            // Orthogonalised twice against the basis (modified Gram–Schmidt) for round-off.
+            for _ in 0..2 {
+                for b in &basis {
+                    let d = dot(&e, b);
+                    e.iter_mut().zip(b).for_each(|(x, y)| *x -= d * y);
+                }
+            }
+            let s = norm2(&e).sqrt();
+            e.iter_mut().for_each(|x| *x /= s);
+            for r in &mut residuals {
+                let d = dot(r, &e);
+                r.iter_mut().zip(&e).for_each(|(x, y)| *x -= d * y);
+            }
+            basis.push(e);
+        }
+        let n = basis.len();
+        let mut phi = vec![0.0; len * n];
+        for (a, e) in basis.iter().enumerate() {
+            for j in 0..len {
+                phi[j * n + a] = e[j] / root[j];
+            }
+        }
+        Self {
+            lattice,
+            weights,
+            phi,
+            n,
+        }
+    }
+
+    /// Number of functions.
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    /// Whether the basis has no functions (never, for a built basis).
+    pub fn is_empty(&self) -> bool {
+        self.n == 0
+    }
+
+    /// The lattice points q_j [h/Mpc] the functions are sampled on.
+    pub fn q(&self) -> Vec<f64> {
+        (0..self.lattice.len)
+            .map(|j| self.lattice.x(j).exp())
+            .collect()
+    }
+
+    /// The lattice the functions are sampled on.
+    pub(crate) fn lattice(&self) -> &Lattice {
+        &self.lattice
+    }
+
+    /// The lattice row j: φ_a(q_j) for every a.
+    pub(crate) fn row(&self, j: usize) -> &[f64] {
+        &self.phi[j * self.n..(j + 1) * self.n]
+    }
+
+    /// The functions' lattice interpolants at ln q = `x` into `out` (length n), zero outside the
+    /// lattice (as the loop integrals take the spectrum).
+    #[inline]
+    pub(crate) fn at_ln(&self, x: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|o| *o = 0.0);
+        let l = &self.lattice;
+        let u = (x - l.x0) / l.step;
+        if !(0.0..=(l.len - 1) as f64).contains(&u) {
+            return;
+        }
+        let (b, t) = l.stencil(u);
+        let w = crate::integrate::lagrange4(t);
+        for (i, wi) in w.iter().enumerate() {
+            for (o, p) in out.iter_mut().zip(self.row(b + i)) {
+                *o += wi * p;
+            }
+        }
+    }
+
+    /// The projection of the lattice `samples` of a spectrum: c_a = ⟨φ_a, P⟩ and the residual.
+    pub fn project(&self, samples: &[f64]) -> Projection {
+        let n = self.n;
+        let mut c = vec![0.0; n];
+        for (j, (&p, &w)) in samples.iter().zip(&self.weights).enumerate() {
+            let wp = w * p;
+            for (ca, phi) in c.iter_mut().zip(self.row(j)) {
+                *ca += wp * phi;
+            }
+        }
+        let projected: Vec<f64> = (0..self.lattice.len)
+            .map(|j| dot(self.row(j), &c))
+            .collect();
+        let relative: Vec<f64> = projected
+            .iter()
+            .zip(samples)
+            .map(|(p, s)| p / s - 1.0)
+            .collect();
+        let finite = |r: f64| if r.is_nan() { f64::INFINITY } else { r };
+        let pointwise = relative.iter().map(|r| r.abs()).fold(0.0, f64::max);
+        let residual = smoothed(&relative, SMOOTHING / self.lattice.step)
+            .iter()
+            .map(|r| r.abs())
+            .fold(0.0, f64::max);
+        Projection {
+            coefficients: c,
+            samples: projected,
+            residual: finite(residual),
+            pointwise: finite(pointwise),
+        }
+    }
+
+    /// The basis as values for a cache file: n, then ω, then φ row by row.
+    pub(crate) fn to_f64s(&self) -> Vec<f64> {
+        let mut v = vec![self.n as f64];
+        v.extend(&self.weights);
+        v.extend(&self.phi);
+        v
+    }
+
+    /// The basis on `lattice` from [`to_f64s`](Self::to_f64s) values (the rest of the slice
+    /// returned), or `None` if they do not fit.
+    pub(crate) fn from_f64s(lattice: Lattice, values: &[f64]) -> Option<(Self, &[f64])> {
+        let n = *values.first()? as usize;
+        let len = lattice.len;
+        let size = 1 + len + len * n;
+        if n == 0 || values.len() < size {
+            return None;
+        }
+        let basis = Self {
+            weights: values[1..1 + len].to_vec(),
+            phi: values[1 + len..size].to_vec(),
+            lattice,
+            n,
+        };
+        Some((basis, &values[size..]))
+    }
+}
+
+/// `values` smoothed with a Gaussian of `width` points (standard deviation), truncated at 3 widths
+/// and renormalised at the ends.
+fn smoothed(values: &[f64], width: f64) -> Vec<f64> {
+    let reach = (3.0 * width).ceil() as usize;
+    let g: Vec<f64> = (0..=reach)
+        .map(|d| (-0.5 * (d as f64 / width).powi(2)).exp())
+        .collect();
+    (0..values.len())
+        .map(|j| {
+            let (lo, hi) = (j.saturating_sub(reach), (j + reach).min(values.len() - 1));
+            let (mut s, mut w) = (0.0, 0.0);
+            for (i, v) in values.iter().enumerate().take(hi + 1).skip(lo) {
+                let gi = g[i.abs_diff(j)];
+                s += gi * v;
+                w += gi;
+            }
+            s / w
+        })
+        .collect()
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn norm2(a: &[f64]) -> f64 {
+    dot(a, a)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Power laws q^n e^{−q}: a 3-parameter family spanned by few functions.
+    fn family(lattice: &Lattice, n: f64, a: f64) -> Vec<f64> {
+        (0..lattice.len)
+            .map(|j| {
+                let q = lattice.x(j).exp();
+                a * q.powf(n) / (1.0 + q * q)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_spectrum_in_the_span_projects_exactly_and_others_nearly() {
+        let lattice = Lattice::new(1e-5, 1e3, 0.05);
+        // Two exponents: the span of two functions holds every amplitude of them exactly.
+        let training: Vec<Vec<f64>> = [(1.0, 1.0), (0.9, 2.0), (1.0, 3.0)]
+            .iter()
+            .map(|&(n, a)| family(&lattice, n, a))
+            .collect();
+        let basis = LinearBasis::greedy(lattice.clone(), &training, 10);
+        assert_eq!(basis.len(), 2, "the training set spans two dimensions");
+        let p = family(&lattice, 0.9, 7.5);
+        let proj = basis.project(&p);
+        assert!(proj.residual < 1e-12, "{}", proj.residual);
+        // Orthonormal in the weighted inner product.
+        let gram = |a: usize, b: usize| -> f64 {
+            (0..lattice.len)
+                .map(|j| basis.weights[j] * basis.row(j)[a] * basis.row(j)[b])
+                .sum()
+        };
+        assert!((gram(0, 0) - 1.0).abs() < 1e-12 && gram(0, 1).abs() < 1e-12);
+        // An exponent between the trained ones is not in the span: a small but non-zero residual.
+        let q = basis.project(&family(&lattice, 0.95, 1.0));
+        assert!(q.residual > 1e-6 && q.residual < 0.1, "{}", q.residual);
+        // Interpolated functions match the samples at lattice points.
+        let mut out = vec![0.0; 2];
+        basis.at_ln(lattice.x(100), &mut out);
+        assert!((out[1] - basis.row(100)[1]).abs() < 1e-15);
+    }
+}

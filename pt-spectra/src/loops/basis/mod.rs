@@ -1,0 +1,431 @@
+//! The 2-loop terms of a new linear spectrum in milliseconds: precomputed tensors on a basis of linear
+//! spectra, contracted with the spectrum's projection on it.
+//!
+//! Every 2-loop term is a trilinear functional of the linear spectrum P (P15 is P(k) times a bilinear
+//! one). With P ≈ P̂ = Σ_a c_a φ_a on a basis of N functions ([`LinearBasis`], built from
+//! Eisenstein–Hu spectra over a prior, [`training`]), each term becomes a contraction of a
+//! cosmology-independent tensor with c ⊗ c ⊗ c (or c ⊗ c). The tensors are made once per k grid and
+//! [`Precision`] with the integrators of the direct path and cached ([`TableStore::two_loop_basis`]):
+//! * P15 and the propagator part 2P15 − P33red: the angular table's radial sums as bilinear forms
+//!   ([`P15Table::basis_forms`]), with their error terms;
+//! * the mode-coupling part 2P24 + P33irr + 2P33red, 2P24 and P33irr: the quasi-Monte-Carlo integral
+//!   of [`super::two_loop`] on the same Sobol points, shifts and points per k as the direct path, each
+//!   point adding the products of basis functions at its momenta ([`tensors`]); one tensor per random
+//!   shift, so the error is the same standard error over the shifts.
+//!
+//! Because the points are the same, the basis result equals the direct result for the projected
+//! spectrum P̂ (to round-off): the only difference from `direct` is the response to the projection
+//! residual P − P̂. That is taken as 3ε|T| for a term T of degree 3, with ε the largest relative
+//! residual smoothed over [`SMOOTHING`] in ln q ([`PROJECTION_ERROR_FACTOR`], [`Projection`]); it is
+//! added to every error.
+//! A spectrum whose residual exceeds [`TwoLoopBasis::max_residual`] is not evaluated on the basis
+//! (the caller falls back to the direct integrals).
+//!
+//! The error of the mode coupling is the spread over the shifts, contracted with the first
+//! [`ERROR_FUNCTIONS`] coefficients only (the tensors of each shift are kept on those; the mean on
+//! all N): an error estimate to ~1e-3 of itself, at a tenth of the memory.
+//!
+//! [`TableStore::two_loop_basis`]: crate::store::TableStore::two_loop_basis
+
+mod linear_basis;
+mod tensors;
+pub mod training;
+
+pub use linear_basis::{LinearBasis, Projection, SMOOTHING};
+
+use super::lattice::Lattice;
+use super::mode_coupling::ACC;
+use super::p15::FORM_KERNELS;
+use super::two_loop::{
+    integral_scale, points_at, random_shifts, replica_estimates, sobol_sequence, VALUES,
+};
+use super::{
+    assemble_two_loop, ByPair, Estimate, OneLoopTerms, P15Table, TwoLoopCorrection,
+    TwoLoopSettings, TwoLoopTerms,
+};
+use crate::linear::LinearSpectrum;
+use crate::precision::Precision;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Basis functions (the study in `examples/basis_study.py`: the largest relative residual of
+/// Eisenstein–Hu spectra over the prior is 1.5e-4 at 24 functions, 2.7e-5 at 32).
+pub const BASIS_SIZE: usize = 24;
+
+/// Basis functions on which the per-shift tensors (the error estimate) are kept.
+pub const ERROR_FUNCTIONS: usize = 12;
+
+/// The projection error of a term T of degree 3 in P is taken as this times ε|T| (ε: the largest
+/// relative projection residual).
+pub const PROJECTION_ERROR_FACTOR: f64 = 3.0;
+
+/// Default largest (smoothed) projection residual for which a spectrum is evaluated on the basis:
+/// its projection error 3ε|T| then stays below the default 2-loop tolerance, 1e-3 of each term.
+/// CAMB tables of the prior project to ~1e-4 on 24 functions (tests/two_loop_basis.rs).
+pub const MAX_RESIDUAL: f64 = 3e-4;
+
+/// Version of the tensor layout and rules, part of the cache file name.
+const VERSION: u32 = 1;
+
+/// Index of the pair a ≤ b in the symmetric storage (pairs with b < n come first).
+#[inline]
+pub(crate) fn pair_index(a: usize, b: usize) -> usize {
+    b * (b + 1) / 2 + a
+}
+
+/// Index of the triple a ≤ b ≤ c in the symmetric storage (triples with c < n come first).
+#[inline]
+pub(crate) fn triple_index(a: usize, b: usize, c: usize) -> usize {
+    c * (c + 1) * (c + 2) / 6 + pair_index(a, b)
+}
+
+fn triples(n: usize) -> usize {
+    n * (n + 1) * (n + 2) / 6
+}
+
+/// The 2-loop terms of a spectrum from the basis tensors.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BasisTwoLoop {
+    /// P15 of δδ, δθ, θθ (errors include the projection error).
+    pub p15: ByPair<Vec<Estimate>>,
+    /// The 2-loop terms and the whole correction (errors include the projection error).
+    pub correction: TwoLoopCorrection,
+    /// The spectrum's projection on the basis.
+    pub projection: Projection,
+}
+
+/// The basis tensors of the 2-loop terms on one k grid for one [`Precision`] (cosmology independent).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TwoLoopBasis {
+    k: Vec<f64>,
+    /// The settings the tensors were built with (their cache key).
+    key: Vec<f64>,
+    basis: LinearBasis,
+    /// Points per shift at each k.
+    points: Vec<usize>,
+    replicas: usize,
+    n_err: usize,
+    /// Per k: [type][kernel][pair] ([`P15Table::basis_forms`]).
+    forms: Vec<Vec<f64>>,
+    /// Per k: the mean over shifts [quantity][triple].
+    mean: Vec<Vec<f64>>,
+    /// Per k: each shift's deviation from the mean, [shift][quantity][triple < triples(n_err)].
+    deviations: Vec<Vec<f64>>,
+    max_residual: f64,
+}
+
+/// The settings that make the tensors: k grid and [`Precision`] fields, as a vector (file header).
+fn key(k: &[f64], precision: &Precision, n: usize) -> Vec<f64> {
+    let radial_width = TwoLoopSettings::default().radial_width;
+    let mut key = vec![
+        f64::from(VERSION),
+        n as f64,
+        ERROR_FUNCTIONS.min(n) as f64,
+        precision.q_min,
+        precision.q_max,
+        precision.lattice_step,
+        precision.two_loop_points as f64,
+        precision.two_loop_replicas as f64,
+        precision.two_loop_seed as f64,
+        radial_width,
+        f64::from(training::VERSION),
+        k.len() as f64,
+    ];
+    key.extend(k);
+    key
+}
+
+impl TwoLoopBasis {
+    /// The cache file name of the tensors for `k` and `precision`: `two-loop-basis-v<version>-<hash>.bin`.
+    pub fn file_name(k: &[f64], precision: &Precision) -> String {
+        // FNV-1a over the key's bits.
+        let hash = key(k, precision, BASIS_SIZE)
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+                (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+            });
+        format!("two-loop-basis-v{VERSION}-n{BASIS_SIZE}-{hash:016x}.bin")
+    }
+
+    /// Builds the tensors on `k` [h/Mpc] for `precision` with the P15 angular `table`, in parallel;
+    /// `progress(done, total)` counts the quasi-Monte-Carlo points.
+    pub fn build(
+        k: &[f64],
+        precision: &Precision,
+        table: &P15Table,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Self {
+        let lattice = lattice_of(precision);
+        let basis = training::camb_basis(lattice, BASIS_SIZE);
+        let n = basis.len();
+        let n_err = ERROR_FUNCTIONS.min(n);
+        let settings = TwoLoopSettings {
+            points: precision.two_loop_points,
+            replicas: precision.two_loop_replicas,
+            seed: precision.two_loop_seed,
+            ..TwoLoopSettings::default()
+        };
+        let points: Vec<usize> = k.iter().map(|&k| points_at(k, settings.points)).collect();
+        let longest = points.iter().copied().max().unwrap_or(0);
+        let sequence: Vec<[f64; 5]> = sobol_sequence().take(longest).collect();
+        let shifts = random_shifts(&settings);
+        let replicas = shifts.len();
+        let ln_range = (precision.q_min.ln(), precision.q_max.ln());
+        let total = replicas * points.iter().sum::<usize>();
+        let done = AtomicUsize::new(0);
+        let tick = |n: usize| progress(done.fetch_add(n, Ordering::Relaxed) + n, total);
+        // Largest jobs first, so that the cores finish together.
+        let mut jobs: Vec<usize> = (0..k.len() * replicas).collect();
+        jobs.sort_by_key(|&j| std::cmp::Reverse(points[j / replicas]));
+        let mut tensors: Vec<(usize, Vec<f64>)> = jobs
+            .par_iter()
+            .map(|&job| {
+                let i = job / replicas;
+                let t = tensors::shifted_tensor(
+                    k[i],
+                    &shifts[job % replicas],
+                    &sequence[..points[i]],
+                    &basis,
+                    ln_range,
+                    settings.radial_width,
+                    &tick,
+                );
+                (job, t)
+            })
+            .collect();
+        tensors.sort_by_key(|t| t.0);
+        let t = triples(n);
+        let t_err = triples(n_err);
+        let (mut mean, mut deviations) = (Vec::new(), Vec::new());
+        for (i, shifts) in tensors.chunks(replicas).enumerate() {
+            let scale = integral_scale(points[i]) / replicas as f64;
+            let mut m = vec![0.0; ACC * t];
+            for (_, s) in shifts {
+                m.iter_mut().zip(s).for_each(|(m, s)| *m += scale * s);
+            }
+            let mut d = Vec::with_capacity(replicas * ACC * t_err);
+            for (_, s) in shifts {
+                for v in 0..ACC {
+                    let range = v * t..v * t + t_err;
+                    d.extend(
+                        s[range.clone()]
+                            .iter()
+                            .zip(&m[range])
+                            .map(|(s, m)| s * scale * replicas as f64 - m),
+                    );
+                }
+            }
+            mean.push(m);
+            deviations.push(d);
+        }
+        let forms = k
+            .par_iter()
+            .map(|&k| table.basis_forms(k, &basis))
+            .collect();
+        Self {
+            k: k.to_vec(),
+            key: key(k, precision, BASIS_SIZE),
+            basis,
+            points,
+            replicas,
+            n_err,
+            forms,
+            mean,
+            deviations,
+            max_residual: MAX_RESIDUAL,
+        }
+    }
+
+    /// The wavenumbers [h/Mpc].
+    pub fn k(&self) -> &[f64] {
+        &self.k
+    }
+
+    /// The basis.
+    pub fn basis(&self) -> &LinearBasis {
+        &self.basis
+    }
+
+    /// The largest projection residual for which [`evaluate`](Self::evaluate) uses the basis.
+    pub fn max_residual(&self) -> f64 {
+        self.max_residual
+    }
+
+    /// The same tensors with another largest projection residual.
+    pub fn with_max_residual(mut self, max_residual: f64) -> Self {
+        self.max_residual = max_residual;
+        self
+    }
+
+    /// Whether the tensors were built for `k` and `precision`.
+    pub fn fits(&self, k: &[f64], precision: &Precision) -> bool {
+        self.key == key(k, precision, BASIS_SIZE)
+    }
+
+    /// The projection of `spectrum` on the basis.
+    pub fn project(&self, spectrum: &LinearSpectrum) -> Projection {
+        self.basis.project(&self.basis.lattice().sample(spectrum))
+    }
+
+    /// P15 and the 2-loop terms of `spectrum` (whose 1-loop terms on the same grid are `one_loop`),
+    /// or, if its projection residual exceeds [`max_residual`](Self::max_residual), `Err` with the
+    /// projection (compute those spectra directly).
+    ///
+    /// # Errors
+    /// The projection, when the spectrum is not represented well enough by the basis.
+    pub fn evaluate(
+        &self,
+        spectrum: &LinearSpectrum,
+        one_loop: &OneLoopTerms,
+    ) -> Result<BasisTwoLoop, Projection> {
+        let projection = self.project(spectrum);
+        // A NaN residual (a spectrum with non-positive values) is refused too.
+        if projection.residual.is_nan() || projection.residual > self.max_residual {
+            return Err(projection);
+        }
+        let c = &projection.coefficients;
+        let n = c.len();
+        let mut s2 = vec![0.0; n * (n + 1) / 2];
+        let mut s3 = vec![0.0; triples(n)];
+        for b in 0..n {
+            for a in 0..=b {
+                s2[pair_index(a, b)] = c[a] * c[b];
+                for (i, cc) in c[b..].iter().enumerate() {
+                    s3[triple_index(a, b, b + i)] = c[a] * c[b] * cc;
+                }
+            }
+        }
+        let eps = PROJECTION_ERROR_FACTOR * projection.residual;
+        let with_projection = |e: Estimate| Estimate::new(e.value, e.error + eps * e.value.abs());
+        let (t, t_err) = (triples(n), triples(self.n_err));
+        let mut p15_rows = Vec::with_capacity(self.k.len());
+        let mut propagator = Vec::with_capacity(self.k.len());
+        let mut rows = Vec::with_capacity(self.k.len());
+        for (i, &k) in self.k.iter().enumerate() {
+            let pairs = s2.len();
+            let form = |kind: usize, m: usize| -> f64 {
+                let f = &self.forms[i][(kind * FORM_KERNELS + m) * pairs..][..pairs];
+                dot(f, &s2)
+            };
+            let norm = k.powi(6) / (4.0 * PI.powi(4)) * spectrum.eval(k);
+            let kernel = |m: usize| {
+                with_projection(Estimate::new(
+                    norm * form(0, m),
+                    norm.abs() * (form(1, m).abs() + form(2, m)),
+                ))
+            };
+            let (dd, tt) = (kernel(0), kernel(1));
+            p15_rows.push([dd, Estimate::mean(dd, tt), tt]);
+            propagator.push([kernel(2), kernel(3), kernel(4)]);
+            let mean: [f64; ACC] =
+                std::array::from_fn(|v| dot(&self.mean[i][v * t..(v + 1) * t], &s3));
+            let integrals: Vec<[f64; ACC]> = self.deviations[i]
+                .chunks_exact(ACC * t_err)
+                .map(|d| {
+                    std::array::from_fn(|v| {
+                        mean[v] + dot(&d[v * t_err..(v + 1) * t_err], &s3[..t_err])
+                    })
+                })
+                .collect();
+            let row: [Estimate; VALUES] = replica_estimates(&integrals);
+            rows.push(row.map(with_projection));
+        }
+        let p15 = ByPair::from_rows(&p15_rows);
+        let mc = TwoLoopTerms::from_rows(&self.k, &rows, self.points.clone());
+        Ok(BasisTwoLoop {
+            correction: assemble_two_loop(one_loop, &p15, &propagator, mc),
+            p15,
+            projection,
+        })
+    }
+
+    /// The tensors as the values of their cache file.
+    pub(crate) fn to_f64s(&self) -> Vec<f64> {
+        let mut v = vec![self.key.len() as f64];
+        v.extend(&self.key);
+        v.extend(self.points.iter().map(|&p| p as f64));
+        v.push(self.replicas as f64);
+        v.extend(self.basis.to_f64s());
+        for i in 0..self.k.len() {
+            v.extend(&self.forms[i]);
+            v.extend(&self.mean[i]);
+            v.extend(&self.deviations[i]);
+        }
+        v
+    }
+
+    /// The tensors for `k` and `precision` from the values of their file, or `None` if the file was
+    /// made for other settings or does not fit them.
+    pub(crate) fn from_f64s(values: &[f64], k: &[f64], precision: &Precision) -> Option<Self> {
+        let expected = key(k, precision, BASIS_SIZE);
+        let len = *values.first()? as usize;
+        if len != expected.len() || values.get(1..1 + len)? != expected.as_slice() {
+            return None;
+        }
+        if values.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let rest = &values[1 + len..];
+        let points: Vec<usize> = rest.get(..k.len())?.iter().map(|&p| p as usize).collect();
+        let replicas = *rest.get(k.len())? as usize;
+        let (basis, mut rest) =
+            LinearBasis::from_f64s(lattice_of(precision), &rest[k.len() + 1..])?;
+        let n = basis.len();
+        let n_err = ERROR_FUNCTIONS.min(n);
+        let sizes = [
+            3 * FORM_KERNELS * n * (n + 1) / 2,
+            ACC * triples(n),
+            replicas * ACC * triples(n_err),
+        ];
+        if rest.len() != k.len() * sizes.iter().sum::<usize>() {
+            return None;
+        }
+        let (mut forms, mut mean, mut deviations) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in k {
+            let (f, r) = rest.split_at(sizes[0]);
+            let (m, r) = r.split_at(sizes[1]);
+            let (d, r) = r.split_at(sizes[2]);
+            forms.push(f.to_vec());
+            mean.push(m.to_vec());
+            deviations.push(d.to_vec());
+            rest = r;
+        }
+        Some(Self {
+            k: k.to_vec(),
+            key: expected,
+            basis,
+            points,
+            replicas,
+            n_err,
+            forms,
+            mean,
+            deviations,
+            max_residual: MAX_RESIDUAL,
+        })
+    }
+}
+
+/// The lattice of the loop integrals of `precision`.
+fn lattice_of(precision: &Precision) -> Lattice {
+    Lattice::new(precision.q_min, precision.q_max, precision.lattice_step)
+}
+
+/// Σ a_i b_i with four partial sums (so that it vectorises).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut s = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in ca.zip(cb) {
+        for i in 0..4 {
+            s[i] += x[i] * y[i];
+        }
+    }
+    (s[0] + s[1]) + (s[2] + s[3]) + tail
+}
