@@ -260,7 +260,7 @@ pub enum TwoLoopSource {
     /// Direct integration.
     Direct,
     /// From the basis tensors ([`basis`]): the spectrum's projection residual ε on `functions` basis
-    /// functions; the errors include the projection error 3ε|T|.
+    /// functions; the errors include the projection error ε Σ|T| over the terms of each result.
     Basis {
         /// Basis functions.
         functions: usize,
@@ -290,10 +290,10 @@ impl TwoLoopSource {
             } => format!(
                 "2-loop terms (P15, P24, P33, total): basis tensors on {functions} functions (CAMB \
                  spectra over the EuclidEmulator2 box), the same quasi-Monte-Carlo points as direct; \
-                 projection residual {residual:.1e} (smoothed over {} in ln q; pointwise \
-                 {pointwise:.1e}); errors include the projection error {:.0} x residual x |term|",
-                basis::SMOOTHING,
-                basis::PROJECTION_ERROR_FACTOR
+                 fixed points (no refinement); projection residual {residual:.1e} (smoothed over {} \
+                 in ln q; pointwise {pointwise:.1e}); errors include the projection error residual x \
+                 the sum of |P15|, |P24|, |P33| terms of each value",
+                basis::SMOOTHING
             ),
             Self::Fallback {
                 residual,

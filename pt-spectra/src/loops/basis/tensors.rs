@@ -73,7 +73,8 @@ pub(super) fn shifted_tensor(
 }
 
 /// acc[i][j] += Σ_{p < used} left[p][i] right[p][j] for the (`rows` × `cols`) matrix `acc`: blocks of
-/// 4 × 8 entries kept in registers across the points (4 + 8 loads per 32 multiply-adds).
+/// 4 × 4 entries kept in (eight SSE2) registers across the points, 4 + 4 loads per 16 multiply-adds
+/// (4 × 8 blocks spill to the stack).
 fn rank_update(
     acc: &mut [f64],
     left: &[f64],
@@ -83,7 +84,7 @@ fn rank_update(
     cols: usize,
 ) {
     const R: usize = 4;
-    const C: usize = 8;
+    const C: usize = 4;
     let (full_rows, full_cols) = (rows - rows % R, cols - cols % C);
     for i0 in (0..full_rows).step_by(R) {
         for j0 in (0..full_cols).step_by(C) {
