@@ -300,8 +300,9 @@ impl TwoLoopSource {
                 max_residual,
             } => format!(
                 "2-loop terms: direct integration, since the spectrum's projection residual on the \
-                 2-loop basis, {residual:.1e}, exceeds {max_residual:.1e} (a spectrum outside the \
-                 basis prior)"
+                 2-loop basis, {residual:.1e}, exceeds {max_residual:.1e} (the basis holds CAMB tables \
+                 to k = 50 h/Mpc over the EuclidEmulator2 box; fits such as Eisenstein-Hu, tables of \
+                 other ranges or with massive neutrinos are computed directly)"
             ),
         }
     }

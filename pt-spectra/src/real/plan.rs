@@ -246,7 +246,7 @@ impl RealPlan {
                         residual: projection.residual,
                         max_residual: basis.max_residual(),
                     };
-                    progress.note(&format!("warning: {}", source.describe()));
+                    progress.note(&source.describe());
                 }
             }
         }
