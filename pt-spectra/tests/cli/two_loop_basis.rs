@@ -56,7 +56,7 @@ fn two_loop_basis_is_built_once_then_used_and_refuses_spectra_outside_its_span()
     // Eisenstein–Hu spectra are outside the span of the CAMB training spectra.
     let (eh, err) = with(&["--eh", "wiggle", "--two-loop", "basis"]);
     assert!(
-        err.contains("warning: 2-loop terms: direct integration"),
+        err.contains("note: 2-loop terms: direct integration, since"),
         "{err}"
     );
     assert!(eh.contains("exceeds 3.0e-4"), "{eh}");
