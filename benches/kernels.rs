@@ -1,6 +1,6 @@
-//! Time per evaluation of the generated kernels (F and G together, f64; and four configurations at once
-//! in `F64x4` lanes), and of the brute-force n!-permutation reference for comparison. Fixed inputs; one
-//! core.
+//! Time per evaluation of the generated kernels (F and G together, f64; and four configurations per call,
+//! two at a time in `F64x2` lanes), and of the brute-force n!-permutation reference for comparison. Fixed
+//! inputs; one core.
 
 // `criterion_group!` defines an undocumented function.
 #![allow(missing_docs)]
@@ -60,7 +60,7 @@ fn specialised(c: &mut Criterion) {
         b.iter(|| mode_coupling_4(black_box(&g3)))
     });
     group.finish();
-    // Four configurations per call in F64x4 lanes (the 2-loop integrand's four images).
+    // Four configurations per call, two F64x2 lanes at a time (the 2-loop integrand's four images).
     let g3x4: [[f64; 6]; 4] = std::array::from_fn(|l| {
         let w: Vec<[f64; 3]> = v[l..l + 3].to_vec();
         gram(&w).try_into().unwrap()

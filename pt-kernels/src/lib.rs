@@ -4,7 +4,7 @@
 //! arXiv:1209.3771, appendix A) are produced by the `kernelgen` macro as flattened straight-line code whose
 //! rational coefficients were folded in exactly at generation time; the n! symmetrisation never runs at run
 //! time. Every generated function is generic over a `Copy` [`Scalar`], so it runs in `f64` (fast), in
-//! [`F64x4`] lanes and in exact [`num_rational::BigRational`] arithmetic (verification; through a `Copy`
+//! [`F64x2`] lanes and in exact [`num_rational::BigRational`] arithmetic (verification; through a `Copy`
 //! handle, see [`Evaluate`]) alike.
 //!
 //! * [`kernels`]: `[F_n^s, G_n^s](q_1, …, q_n)` of free 3-vectors, n = 1..=7, any scalar type;
@@ -12,7 +12,7 @@
 //!   [`mode_coupling_2`], [`mode_coupling_3`], [`mode_coupling_4`] (P22, P33, P24): the specialised kernels
 //!   of the loop integrals, taking the scalar invariants k², k·q_i, q_i·q_j an integrator has;
 //!   [`mode_coupling_3_x4`], [`mode_coupling_4_x4`], [`propagator_5_x4`], [`propagator_7_x4`] evaluate four
-//!   configurations at once ([`F64x4`] lanes);
+//!   configurations at once ([`F64x4`], [`F64x2`] lanes);
 //! * [`generated`]: the raw generic functions behind all of these. Prefer the wrappers above: they call
 //!   instances compiled once in this crate for `f64` and `BigRational` ([`Evaluate`]), whereas a direct
 //!   call instantiates a kernel of up to ~9,000 statements anew in the calling crate;
@@ -36,7 +36,9 @@ pub mod reference;
 mod scalar;
 
 pub use instances::Evaluate;
-pub use lanes::{mode_coupling_3_x4, mode_coupling_4_x4, propagator_5_x4, propagator_7_x4, F64x4};
+pub use lanes::{
+    mode_coupling_3_x4, mode_coupling_4_x4, propagator_5_x4, propagator_7_x4, F64x2, F64x4,
+};
 
 pub use scalar::{dot, one, zero, Scalar};
 

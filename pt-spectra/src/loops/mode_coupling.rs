@@ -207,7 +207,7 @@ pub(crate) fn point_legs(k: f64, point: &Point) -> PointLegs {
     // X_4^s(q₁, k − q₁, q₂, −q₂) is even in q₂ and the leg depends on q₁ only, so the P24 half of q₁
     // takes two values over the images, set by the sign of k·q₁ (images 1, 4 and 2, 3), each twice,
     // with the weight ½ of the q₁ ↔ q₂ symmetrisation; likewise the half of q₂ (images 1, 3 and 2, 4).
-    // The four X_4 are evaluated together (four lanes), as are the four X_3 below.
+    // The four X_4 are evaluated together (in lanes), as are the four X_3 below.
     let m4 = pt_kernels::mode_coupling_4_x4(&[
         [kk, kq1, kq2, q11, q1q2, q22],
         [kk, -kq1, -kq2, q11, q1q2, q22],

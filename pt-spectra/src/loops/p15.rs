@@ -73,7 +73,7 @@ pub fn p15_angular_kernel(r1: f64, r2: f64, order: usize) -> [f64; 2] {
                 let q12 = r1 * r2 * (x1 * x2 + s1 * s2 * c);
                 [1.0, r1 * x1, r2 * x2, r1 * r1, q12, r2 * r2]
             };
-            // Four φ nodes per call in the kernel's four lanes, the rest one by one; summed in node
+            // Four φ nodes per call of the four-configuration kernel, the rest one by one; summed in node
             // order either way.
             let mut inner = [0.0; 2];
             let mut add = |w: f64, [f, g]: [f64; 2]| {
