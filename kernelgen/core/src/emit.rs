@@ -10,8 +10,8 @@
 //! `Copy` is what keeps these functions quick to compile: every node is used by value, never borrowed,
 //! so rustc hands LLVM each `let` as an SSA value. Written with `.clone()`, every node is borrowed and
 //! becomes a stack slot that LLVM's scalar replacement of aggregates (SROA) has to promote again, at a cost
-//! superlinear in the function's size: optimising `general_7` for `f64` took 50 s that way, 5 s this way,
-//! for the same machine code. Exact arithmetic runs through a `Copy` handle to a `BigRational`
+//! superlinear in the function's size: optimising `general_7` for `f64` took ~50 s that way, ~5 s this way,
+//! for essentially the same machine code. Exact arithmetic runs through a `Copy` handle to a `BigRational`
 //! (`pt_kernels`' `Exact`), so one function still runs in f64 and in exact rationals.
 
 use crate::dag::{as_i64_pair, exact_in_f64, NodeId, Op, Value, Q};
