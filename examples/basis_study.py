@@ -12,6 +12,10 @@ others. Prints the largest and the median relative residual over q ∈ [1e-4, 10
 
 Measured (seed 1): N = 12: 2.3e-3 (median 4.3e-4); 16: 8.3e-4 (1.5e-4); 20: 4.2e-4 (5.1e-5);
 24: 1.5e-4 (1.9e-5); 32: 2.7e-5 (5.3e-6); 40: 1.9e-5 (1.7e-6).
+
+This was the first step only: such an Eisenstein-Hu basis leaves 1-3e-2 on CAMB tables, whose shape
+differs from the fit's by percents, so the library's basis (pt_spectra::loops::basis) is built from CAMB
+spectra instead (examples/make_two_loop_training.py; README, "2-loop terms per cosmology").
 """
 import warnings
 
