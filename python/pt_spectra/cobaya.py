@@ -15,12 +15,13 @@ Options (yaml or class attributes):
   [h/Mpc]), ``cache_dir`` (the angular tables; default $PT_SPECTRA_CACHE or ~/.cache/pt-spectra).
 - ``two_loop`` ("basis"): for 2-loop real-space models, the 2-loop terms of each step come from basis
   tensors (built once per k grid and cached, minutes; then milliseconds per step), or ``"direct"``
-  (seconds per step). The basis is made of CAMB spectra to k = 50 h/Mpc, so with it the Boltzmann
-  code is asked for k up to at least 60/Mpc (see ``k_max_linear``); a step whose spectrum the basis
-  does not represent is integrated directly, with a warning.
+  (seconds per step). The basis is made of CAMB tables ending at 50 h/Mpc (it also takes tables ending
+  from 15 to 50 h/Mpc), so with it the Boltzmann code is asked for k up to at least 35/Mpc (48 to
+  57 h/Mpc over the prior's h); a step whose spectrum the basis does not represent is integrated
+  directly, with a warning.
 - ``k_max_linear`` (10): the k_max [1/Mpc] asked of the Boltzmann code; as h < 1 this covers k up to
   ``k_max_linear`` h/Mpc. The library extends the spectrum beyond both ends by power laws. Raised to
-  60 for 2-loop models with ``two_loop: basis``.
+  35 for 2-loop models with ``two_loop: basis``.
 - ``var_pair`` (["delta_tot", "delta_tot"]): the Boltzmann spectrum; ["delta_nonu", "delta_nonu"]
   for the CDM + baryon spectrum with massive neutrinos.
 - ``prefix`` (""): prefix of the nuisance parameter names, to run two tracers side by side.
@@ -151,9 +152,9 @@ class PTMultipoles(Theory):
         return pt.log_grid(float(self.k_min), float(self.k_max), int(self.nk))
 
     def _k_max_linear(self):
-        """k_max [1/Mpc] of the Boltzmann spectrum: 60 at least with the 2-loop basis."""
+        """k_max [1/Mpc] of the Boltzmann spectrum: 35 at least with the 2-loop basis."""
         if str(self.real).startswith("2l-") and self.two_loop != "direct":
-            return max(float(self.k_max_linear), 60.0)
+            return max(float(self.k_max_linear), 35.0)
         return float(self.k_max_linear)
 
     def _make_plan(self, k):

@@ -29,14 +29,14 @@ fn two_loop_basis_is_built_once_then_used_and_refuses_spectra_outside_its_span()
         (out, err)
     };
     let (basis, _) = with(&["--two-loop", "basis"]);
-    assert!(basis.contains("basis tensors on 32 functions"), "{basis}");
+    assert!(basis.contains("basis tensors on 36 functions"), "{basis}");
     let (direct, _) = with(&["--two-loop", "direct"]);
     assert!(
         direct.contains("# 2-loop terms: direct integration\n"),
         "{direct}"
     );
     let (auto, _) = with(&[]);
-    assert!(auto.contains("basis tensors on 32 functions"), "{auto}");
+    assert!(auto.contains("basis tensors on 36 functions"), "{auto}");
     assert_eq!(rows(&auto), rows(&basis), "auto reads the cached tensors");
     let names = column_names(&basis);
     let col = |n: &str| names.iter().position(|&x| x == n).unwrap();

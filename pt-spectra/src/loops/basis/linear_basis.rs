@@ -50,7 +50,23 @@ impl LinearBasis {
     ///
     /// # Panics
     /// If the training set is empty or a spectrum's length differs from the lattice.
+    #[cfg(test)]
     pub(crate) fn greedy(lattice: Lattice, training: &[Vec<f64>], n: usize) -> Self {
+        Self::greedy_after(lattice, &[], training, n)
+    }
+
+    /// The greedy basis of at most `n` functions for the `training` spectra, starting from the `fixed`
+    /// functions (all samples on `lattice`), which the basis then spans whatever the training set;
+    /// it stops early if the training set is represented to round-off.
+    ///
+    /// # Panics
+    /// If the training set is empty or a spectrum's length differs from the lattice.
+    pub(crate) fn greedy_after(
+        lattice: Lattice,
+        fixed: &[Vec<f64>],
+        training: &[Vec<f64>],
+        n: usize,
+    ) -> Self {
         assert!(!training.is_empty(), "an empty training set");
         let len = lattice.len;
         assert!(training.iter().all(|t| t.len() == len), "training length");
@@ -68,16 +84,26 @@ impl LinearBasis {
             .collect();
         let first_norm = residuals.iter().map(|r| norm2(r)).fold(0.0, f64::max);
         let mut basis: Vec<Vec<f64>> = Vec::new();
+        let mut fixed = fixed.iter().map(|f| {
+            f.iter()
+                .zip(&root)
+                .map(|(p, r)| p * r)
+                .collect::<Vec<f64>>()
+        });
         while basis.len() < n {
-            let (worst, norm) = residuals
-                .iter()
-                .enumerate()
-                .map(|(m, r)| (m, norm2(r)))
-                .fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a });
-            if norm <= 1e-28 * first_norm {
-                break;
-            }
-            let mut e = residuals[worst].clone();
+            let mut e = if let Some(f) = fixed.next() {
+                f
+            } else {
+                let (worst, norm) = residuals
+                    .iter()
+                    .enumerate()
+                    .map(|(m, r)| (m, norm2(r)))
+                    .fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a });
+                if norm <= 1e-28 * first_norm {
+                    break;
+                }
+                residuals[worst].clone()
+            };
             // Orthogonalised twice against the basis (modified Gram–Schmidt) for round-off.
             for _ in 0..2 {
                 for b in &basis {

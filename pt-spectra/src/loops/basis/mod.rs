@@ -20,8 +20,8 @@
 //! ([`PROJECTION_ERROR_FACTOR`], [`Projection`]); it is added to every error. At high k the terms
 //! cancel to a small remainder (at k = 0.4, −114 of terms ±1.7e4), so there the projection error
 //! dominates. Measured on 40 k in [0.005, 0.4] (`benches/two_loop.rs`): the correction of six CAMB
-//! tables not in the training set is within 8e-4 of `direct` for k ≤ 0.3; at k = 0.4 (gm2012, δδ)
-//! within 4.2e-3, inside the reported error.
+//! tables not in the training set is within 8.4e-4 of `direct` for k ≤ 0.3; at k = 0.4 (gm2012, δδ)
+//! within 4.8e-3, inside the reported error.
 //! A spectrum whose residual exceeds [`TwoLoopBasis::max_residual`] is not evaluated on the basis
 //! (the caller falls back to the direct integrals).
 //!
@@ -55,10 +55,11 @@ use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Basis functions. CAMB tables of the prior not in the training set project with a smoothed residual
-/// of 3e-5 to 9e-5 on 32 functions (5e-5 to 1.3e-4 on 24), and their 2-loop corrections for k ≤ 0.3
-/// are then within 8e-4 of direct at the same points (1.1e-3 on 24); the contraction costs ~N³.
-pub const BASIS_SIZE: usize = 32;
+/// Basis functions: [`training::TAIL_FUNCTIONS`] tail functions and the rest chosen from the training
+/// spectra. CAMB tables of the prior not in the training set project with a smoothed residual of
+/// 5e-5 to 7e-5, and their 2-loop corrections for k ≤ 0.3 are then within 8.4e-4 of direct at the
+/// same points (24 functions without tails: 1.1e-3); the contraction costs ~N³.
+pub const BASIS_SIZE: usize = 36;
 
 /// Basis functions on which the per-shift tensors (the error estimate) are kept.
 pub const ERROR_FUNCTIONS: usize = 12;
@@ -69,8 +70,8 @@ pub const ERROR_FUNCTIONS: usize = 12;
 pub const PROJECTION_ERROR_FACTOR: f64 = 1.0;
 
 /// Default largest (smoothed) projection residual for which a spectrum is evaluated on the basis.
-/// CAMB tables of the prior project to ≤ 1.3e-4 on 32 functions (tests/two_loop_basis.rs), and
-/// respond by ≤ 8e-4 of the 2-loop correction for k ≤ 0.3; Eisenstein–Hu fits project to ~4e-3.
+/// CAMB tables of the prior project to ≤ 2e-4 (also when they end at 15 h/Mpc), and respond by
+/// ≤ 8.4e-4 of the 2-loop correction for k ≤ 0.3; Eisenstein–Hu fits project to ~4e-3.
 pub const MAX_RESIDUAL: f64 = 3e-4;
 
 /// Version of the tensor layout and rules, part of the cache file name.

@@ -10,6 +10,12 @@
 //! points. Each table becomes a [`LinearSpectrum`] exactly as a user's table does (spline in ln k,
 //! power laws beyond its ends), so the basis represents tables made this way, extrapolation included.
 //!
+//! Tables end anywhere from ~10 to 100 h/Mpc and are extended by power laws beyond, so their tails
+//! differ; the basis therefore starts with [`TAIL_FUNCTIONS`] smooth functions of q ≥ 3 h/Mpc, and
+//! every fourth training table is also taken cut to other ranges. CAMB tables ending between 15 and
+//! 50 h/Mpc then project to ≤ 2e-4; one ending at 100 h/Mpc (CAMB run with a larger kmax, whose own
+//! k sampling differs) to 5e-4, one ending at 5 h/Mpc to ~1e-3: those are computed directly.
+//!
 //! Eisenstein–Hu spectra are not in the span (their shape differs from CAMB's by percents; an
 //! Eisenstein–Hu basis leaves 1–3e-2 on CAMB tables): they, and tables of other codes, ranges or
 //! physics (massive neutrinos), are computed directly when their projection residual is too large.
@@ -19,7 +25,7 @@ use crate::linear::LinearSpectrum;
 use crate::loops::lattice::Lattice;
 
 /// Version of the training set, part of the cache key of the tensors.
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 
 /// Number of training spectra.
 pub const TRAINING_SPECTRA: usize = 100;
@@ -51,8 +57,136 @@ pub fn camb_training() -> Vec<LinearSpectrum> {
         .collect()
 }
 
-/// The greedy basis of `n` functions from [`camb_training`] on `lattice`.
+/// Table ranges [h/Mpc] of the cut variants: a user's table may end at 10–30 h/Mpc or start at
+/// 1e-3 h/Mpc, and is then extended by power laws, whose tails differ from CAMB's by tens of per cent
+/// at q ~ 1e3; every fourth training table is also taken cut to each of these ranges.
+const CUTS: [(f64, f64); 4] = [(1e-4, 10.0), (1e-4, 20.0), (1e-4, 30.0), (1e-3, 50.0)];
+
+/// The training spectra on `lattice`: the tables of [`camb_training`], and every fourth of them cut to
+/// each range of [`CUTS`] (power-law ends beyond, as the library extends any table).
+pub(crate) fn camb_samples(lattice: &Lattice) -> Vec<Vec<f64>> {
+    let tables = camb_training();
+    let mut samples: Vec<Vec<f64>> = tables.iter().map(|p| lattice.sample(p)).collect();
+    for p in tables.iter().step_by(4) {
+        let (k, pk) = p.nodes();
+        for (lo, hi) in CUTS {
+            let keep: Vec<usize> = (0..k.len()).filter(|&i| k[i] >= lo && k[i] <= hi).collect();
+            let cut = LinearSpectrum::from_nodes(
+                keep.iter().map(|&i| k[i]).collect(),
+                keep.iter().map(|&i| pk[i]).collect(),
+            )
+            .expect("a cut of a valid table is valid");
+            samples.push(lattice.sample(&cut));
+        }
+    }
+    samples
+}
+
+/// Where the tail functions start [h/Mpc] ([`tail_functions`]).
+const TAIL_START: f64 = 3.0;
+
+/// Number of tail functions.
+pub const TAIL_FUNCTIONS: usize = 6;
+
+/// Functions that give the basis any smooth tail beyond [`TAIL_START`]: P̄(q) B_i(ln q), P̄ the mean
+/// training spectrum and B_i cubic B-splines on knots spaced (ln q_max − ln 3)/6 from ln 3 (zero
+/// below it, C² at it). Tables end anywhere from 10 to 100 h/Mpc and are extended by power laws
+/// beyond, so their tails differ from one another (and from CAMB's) by up to tens of per cent at
+/// q ~ 1e3, a smooth difference that no set of training spectra spans but these do.
+fn tail_functions(lattice: &Lattice, mean: &[f64]) -> Vec<Vec<f64>> {
+    let (start, end) = (TAIL_START.ln(), lattice.x_end());
+    let h = (end - start) / TAIL_FUNCTIONS as f64;
+    (0..TAIL_FUNCTIONS)
+        .map(|i| {
+            (0..lattice.len)
+                .map(|j| mean[j] * cubic_b_spline((lattice.x(j) - start) / h - i as f64))
+                .collect()
+        })
+        .collect()
+}
+
+/// The uniform cubic B-spline on [0, 4] (zero outside).
+fn cubic_b_spline(t: f64) -> f64 {
+    match t {
+        t if !(0.0..4.0).contains(&t) => 0.0,
+        t if t < 1.0 => t * t * t / 6.0,
+        t if t < 2.0 => (-3.0 * t * t * t + 12.0 * t * t - 12.0 * t + 4.0) / 6.0,
+        t if t < 3.0 => (3.0 * t * t * t - 24.0 * t * t + 60.0 * t - 44.0) / 6.0,
+        t => (4.0 - t).powi(3) / 6.0,
+    }
+}
+
+/// The basis of `n` functions on `lattice`: the [`TAIL_FUNCTIONS`] tail functions, then the greedy
+/// choice from [`camb_samples`].
 pub(crate) fn camb_basis(lattice: Lattice, n: usize) -> LinearBasis {
-    let training: Vec<Vec<f64>> = camb_training().iter().map(|p| lattice.sample(p)).collect();
-    LinearBasis::greedy(lattice, &training, n)
+    let training = camb_samples(&lattice);
+    let mean: Vec<f64> = (0..lattice.len)
+        .map(|j| training.iter().map(|t| t[j]).sum::<f64>() / training.len() as f64)
+        .collect();
+    let tails = tail_functions(&lattice, &mean);
+    LinearBasis::greedy_after(lattice, &tails, &training, n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The table `name` of tests/data cut to k ∈ [lo, hi] (then extended by power laws).
+    fn cut(name: &str, lo: f64, hi: f64) -> LinearSpectrum {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/");
+        let p = LinearSpectrum::from_file(format!("{dir}{name}")).unwrap();
+        let (k, pk) = p.nodes();
+        let keep: Vec<usize> = (0..k.len()).filter(|&i| k[i] >= lo && k[i] <= hi).collect();
+        LinearSpectrum::from_nodes(
+            keep.iter().map(|&i| k[i]).collect(),
+            keep.iter().map(|&i| pk[i]).collect(),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn tables_of_other_ranges_project_and_short_ones_do_not() {
+        // CAMB tables not in the training set, ending at 15 or 50 h/Mpc, starting at 1e-4 or 3e-4:
+        // within the basis's limit (measured 5e-5 to 1.9e-4; without the tail functions, ending at
+        // 15 gave 1e-3).
+        // Ending at 5 h/Mpc, the power law beyond is too far from any CAMB tail: refused.
+        let lattice = Lattice::new(1e-5, 1e3, 0.01);
+        let basis = camb_basis(lattice.clone(), super::super::BASIS_SIZE);
+        assert_eq!(basis.len(), super::super::BASIS_SIZE);
+        for name in [
+            "linear_pk_planck2018_z0.0.dat",
+            "linear_pk_camb_heldout_1.dat",
+        ] {
+            for (lo, hi) in [(1e-4, 50.0), (1e-4, 15.0), (3e-4, 50.0)] {
+                let r = basis.project(&lattice.sample(&cut(name, lo, hi))).residual;
+                assert!(
+                    r < super::super::MAX_RESIDUAL,
+                    "{name} [{lo}, {hi}]: {r:.2e}"
+                );
+            }
+            let r = basis
+                .project(&lattice.sample(&cut(name, 1e-4, 5.0)))
+                .residual;
+            assert!(r > super::super::MAX_RESIDUAL, "{name} to 5 h/Mpc: {r:.2e}");
+        }
+    }
+
+    #[test]
+    fn the_cubic_b_spline_is_a_smooth_partition_of_unity() {
+        // Σ_i B(t − i) = 1 for every t (in the interior of the knots), and B is C² at its knots.
+        for t in [0.3, 1.7, 2.5, 3.99] {
+            let sum: f64 = (-4..=4).map(|i| cubic_b_spline(t + f64::from(i))).sum();
+            assert!((sum - 1.0).abs() < 1e-14, "{t}: {sum}");
+        }
+        let h = 1e-5;
+        for knot in [1.0, 2.0, 3.0] {
+            let d2 = |t: f64| {
+                (cubic_b_spline(t + h) - 2.0 * cubic_b_spline(t) + cubic_b_spline(t - h)) / (h * h)
+            };
+            assert!(
+                (d2(knot - 3.0 * h) - d2(knot + 3.0 * h)).abs() < 1e-3,
+                "{knot}"
+            );
+        }
+    }
 }
