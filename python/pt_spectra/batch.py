@@ -12,7 +12,9 @@ The toml (see ``python/examples/grid.toml``)::
     k = {min = 0.02, max = 0.3, n = 20}   # log-spaced [h/Mpc], or a list
     terms = false              # true: keep every loop term, not only P_lin, P_dd/dt/tt and errors
     threads = 1                # rayon threads per rank (default: RAYON_NUM_THREADS, else all cores)
-    # also: two_loop_tolerance, cache_dir (angular tables), camb_k_max (h/Mpc, default 20)
+    # also: two_loop_tolerance, cache_dir (angular tables), camb_k_max (h/Mpc, default 20),
+    # two_loop ("auto"; "basis": 2-loop terms of every point from tensors built once for the k grid,
+    # for CAMB batches of 2-loop models; Eisenstein & Hu spectra are computed directly anyway)
     [cosmology]                # the keys every point shares
     h = 0.7
     [grid]                     # varied keys: Cartesian product; a list or {min, max, n} (linear)
@@ -69,8 +71,9 @@ COSMOLOGY_KEYS = ("h", "omega_b", "omega_cdm", "Omega_k", "n_s", "A_s", "sigma8"
                   "w0_fld", "wa_fld")
 RUN_KEYS = {"output": None, "model": "2l-rpt-n2", "precision": "default", "q_range": None,
             "two_loop_tolerance": None, "linear": "eh", "z": [0.0], "k": None, "terms": False,
-            "threads": None, "cache_dir": None, "camb_k_max": 20.0}
+            "threads": None, "cache_dir": None, "camb_k_max": 20.0, "two_loop": "auto"}
 LINEAR = ("eh", "eh-no-wiggle", "camb")
+TWO_LOOP = ("auto", "basis", "direct")
 BASIC = ("P_lin", "P_dd", "P_dt", "P_tt", "err_P_dd", "err_P_dt", "err_P_tt")
 
 
@@ -118,6 +121,9 @@ def load_config(path):
     config = {**RUN_KEYS, **run_opts}
     if config["linear"] not in LINEAR:
         raise ValueError(f"run.linear: {config['linear']!r}; expected one of {', '.join(LINEAR)}")
+    if config["two_loop"] not in TWO_LOOP:
+        raise ValueError(f"run.two_loop: {config['two_loop']!r}; "
+                         f"expected one of {', '.join(TWO_LOOP)}")
     config["z"] = [float(z) for z in np.atleast_1d(config["z"])]
     k = config["k"]
     if isinstance(k, dict) and set(k) == {"min", "max", "n"}:
@@ -188,7 +194,7 @@ def _point_tables(plan, config, cosmology):
 def _rank_arrays(config, indices):
     """The arrays of the points `indices` (one plan for all), and the metadata of the last table."""
     plan = pt.RealPlan(config["k"], config["model"], config["precision"], config["q_range"],
-                       config["two_loop_tolerance"], config["cache_dir"])
+                       config["two_loop_tolerance"], config["cache_dir"], config["two_loop"])
     out, meta = {"index": np.asarray(indices, dtype=np.int64)}, {}
     nz = len(config["z"])
     for row, i in enumerate(indices):

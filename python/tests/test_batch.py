@@ -131,6 +131,7 @@ def test_a_failing_point_is_named(grid, tmp_path):
 @pytest.mark.parametrize("text, message", [
     ("[run]\nmodel = '1l-spt'\nk = [0.1]\nlinearr = 'eh'\n", "linearr"),
     ("[run]\nk = [0.1]\nlinear = 'class'\n", "linear"),
+    ("[run]\nk = [0.1]\ntwo_loop = 'sometimes'\n", "two_loop"),
     ("[run]\nk = [0.1]\n[cosmology]\nh = 0.7\nomega_b = 0.02\nomega_cdm = 0.1\nn_s = 1\n",
      "sigma8"),
     ("[run]\nk = [0.1]\n[cosmology]\nh = 0.7\nomega_b = 0.02\nomega_cdm = 0.1\nn_s = 1\n"
