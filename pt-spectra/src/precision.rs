@@ -97,8 +97,8 @@ pub enum TwoLoopMethod {
 }
 
 impl TwoLoopMethod {
-    /// The names accepted by [`FromStr`](std::str::FromStr): `auto`, `basis`, `direct`.
-    pub const NAMES: [&'static str; 3] = ["auto", "basis", "direct"];
+    /// The names accepted by [`FromStr`](std::str::FromStr).
+    pub const NAMES: &'static str = "auto, basis, direct";
 
     /// The method's name.
     pub fn name(self) -> &'static str {
@@ -126,7 +126,7 @@ impl std::str::FromStr for TwoLoopMethod {
             _ => Err(Error::UnknownName {
                 what: "2-loop method",
                 name: s.to_string(),
-                available: "auto, basis, direct",
+                available: Self::NAMES,
             }),
         }
     }

@@ -452,6 +452,8 @@ impl P15Table {
         // Full matrices [type][kernel][a][b], symmetrised at the end.
         let mut full = vec![0.0; 3 * FORM_KERNELS * n * n];
         let (mut phi1, mut phi2) = (vec![0.0; n], vec![0.0; n]);
+        // y[type][kernel][b] = Σ_run w K φ_b(kr₂), reset for each run of equal u₁.
+        let mut y = vec![0.0; 3 * FORM_KERNELS * n];
         let kernels_at =
             |kernels: &NodeKernels<2>, prop: &NodeKernels<3>, i: usize, which: usize| {
                 let (a, b) = match which {
@@ -474,8 +476,7 @@ impl P15Table {
                     i = end;
                     continue;
                 }
-                // y[type][kernel][b] = Σ_run w K φ_b(kr₂).
-                let mut y = vec![0.0; 3 * FORM_KERNELS * n];
+                y.iter_mut().for_each(|v| *v = 0.0);
                 for (node, idx) in nodes[i..end].iter().zip(i..end) {
                     basis.at_ln(ln_k + node.u2, &mut phi2);
                     let add = |y: &mut [f64], t: usize, m: usize, c: f64| {

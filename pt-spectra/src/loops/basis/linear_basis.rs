@@ -45,23 +45,13 @@ pub struct LinearBasis {
 }
 
 impl LinearBasis {
-    /// The greedy basis of at most `n` functions for the `training` spectra (samples on `lattice`,
-    /// positive), stopping early if the training set is represented to round-off.
-    ///
-    /// # Panics
-    /// If the training set is empty or a spectrum's length differs from the lattice.
-    #[cfg(test)]
-    pub(crate) fn greedy(lattice: Lattice, training: &[Vec<f64>], n: usize) -> Self {
-        Self::greedy_after(lattice, &[], training, n)
-    }
-
     /// The greedy basis of at most `n` functions for the `training` spectra, starting from the `fixed`
     /// functions (all samples on `lattice`), which the basis then spans whatever the training set;
     /// it stops early if the training set is represented to round-off.
     ///
     /// # Panics
     /// If the training set is empty or a spectrum's length differs from the lattice.
-    pub(crate) fn greedy_after(
+    pub(crate) fn greedy(
         lattice: Lattice,
         fixed: &[Vec<f64>],
         training: &[Vec<f64>],
@@ -290,7 +280,7 @@ mod tests {
             .iter()
             .map(|&(n, a)| family(&lattice, n, a))
             .collect();
-        let basis = LinearBasis::greedy(lattice.clone(), &training, 10);
+        let basis = LinearBasis::greedy(lattice.clone(), &[], &training, 10);
         assert_eq!(basis.len(), 2, "the training set spans two dimensions");
         let p = family(&lattice, 0.9, 7.5);
         let proj = basis.project(&p);
@@ -309,5 +299,22 @@ mod tests {
         let mut out = vec![0.0; 2];
         basis.at_ln(lattice.x(100), &mut out);
         assert!((out[1] - basis.row(100)[1]).abs() < 1e-15);
+    }
+
+    #[test]
+    fn smoothing_keeps_straight_lines_and_spreads_a_spike_over_its_width() {
+        // A symmetric window keeps a linear function exactly away from the ends.
+        let line: Vec<f64> = (0..200).map(|j| 0.3 - 0.01 * j as f64).collect();
+        let s = smoothed(&line, 10.0);
+        for j in 30..170 {
+            assert!((s[j] - line[j]).abs() < 1e-14, "{j}");
+        }
+        // A unit spike becomes the normalised Gaussian: at the spike 1/Σ_d e^{−d²/2w²} ≈ 1/(w√(2π)),
+        // one width away e^{−1/2} of that.
+        let mut spike = vec![0.0; 200];
+        spike[100] = 1.0;
+        let s = smoothed(&spike, 10.0);
+        assert!((s[100] * 10.0 * (2.0 * std::f64::consts::PI).sqrt() - 1.0).abs() < 3e-3);
+        assert!((s[110] / s[100] - (-0.5f64).exp()).abs() < 1e-14);
     }
 }

@@ -89,6 +89,11 @@ pub(crate) fn triple_index(a: usize, b: usize, c: usize) -> usize {
     c * (c + 1) * (c + 2) / 6 + pair_index(a, b)
 }
 
+/// Basis functions of the per-shift tensors for a basis of `n`.
+fn error_functions(n: usize) -> usize {
+    ERROR_FUNCTIONS.min(n)
+}
+
 fn triples(n: usize) -> usize {
     n * (n + 1) * (n + 2) / 6
 }
@@ -114,7 +119,6 @@ pub struct TwoLoopBasis {
     /// Points per shift at each k.
     points: Vec<usize>,
     replicas: usize,
-    n_err: usize,
     /// Per k: [type][kernel][pair] ([`P15Table::basis_forms`]).
     forms: Vec<Vec<f64>>,
     /// Per k: the mean over shifts [quantity][triple].
@@ -125,12 +129,12 @@ pub struct TwoLoopBasis {
 }
 
 /// The settings that make the tensors: k grid and [`Precision`] fields, as a vector (file header).
-fn key(k: &[f64], precision: &Precision, n: usize) -> Vec<f64> {
+fn key(k: &[f64], precision: &Precision) -> Vec<f64> {
     let radial_width = TwoLoopSettings::default().radial_width;
     let mut key = vec![
         f64::from(VERSION),
-        n as f64,
-        ERROR_FUNCTIONS.min(n) as f64,
+        BASIS_SIZE as f64,
+        ERROR_FUNCTIONS as f64,
         precision.q_min,
         precision.q_max,
         precision.lattice_step,
@@ -149,7 +153,7 @@ impl TwoLoopBasis {
     /// The cache file name of the tensors for `k` and `precision`: `two-loop-basis-v<version>-<hash>.bin`.
     pub fn file_name(k: &[f64], precision: &Precision) -> String {
         // FNV-1a over the key's bits.
-        let hash = key(k, precision, BASIS_SIZE)
+        let hash = key(k, precision)
             .iter()
             .flat_map(|v| v.to_le_bytes())
             .fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
@@ -169,7 +173,6 @@ impl TwoLoopBasis {
         let lattice = lattice_of(precision);
         let basis = training::camb_basis(lattice, BASIS_SIZE);
         let n = basis.len();
-        let n_err = ERROR_FUNCTIONS.min(n);
         let settings = TwoLoopSettings {
             points: precision.two_loop_points,
             replicas: precision.two_loop_replicas,
@@ -206,13 +209,16 @@ impl TwoLoopBasis {
             .collect();
         tensors.sort_by_key(|t| t.0);
         let t = triples(n);
-        let t_err = triples(n_err);
+        let t_err = triples(error_functions(n));
         let (mut mean, mut deviations) = (Vec::new(), Vec::new());
         for (i, shifts) in tensors.chunks(replicas).enumerate() {
-            let scale = integral_scale(points[i]) / replicas as f64;
+            // Each shift's integral is its sum times the scale; the mean is over the shifts.
+            let scale = integral_scale(points[i]);
             let mut m = vec![0.0; ACC * t];
             for (_, s) in shifts {
-                m.iter_mut().zip(s).for_each(|(m, s)| *m += scale * s);
+                m.iter_mut()
+                    .zip(s)
+                    .for_each(|(m, s)| *m += scale * s / replicas as f64);
             }
             let mut d = Vec::with_capacity(replicas * ACC * t_err);
             for (_, s) in shifts {
@@ -222,7 +228,7 @@ impl TwoLoopBasis {
                         s[range.clone()]
                             .iter()
                             .zip(&m[range])
-                            .map(|(s, m)| s * scale * replicas as f64 - m),
+                            .map(|(s, m)| scale * s - m),
                     );
                 }
             }
@@ -235,11 +241,10 @@ impl TwoLoopBasis {
             .collect();
         Self {
             k: k.to_vec(),
-            key: key(k, precision, BASIS_SIZE),
+            key: key(k, precision),
             basis,
             points,
             replicas,
-            n_err,
             forms,
             mean,
             deviations,
@@ -266,11 +271,6 @@ impl TwoLoopBasis {
     pub fn with_max_residual(mut self, max_residual: f64) -> Self {
         self.max_residual = max_residual;
         self
-    }
-
-    /// Whether the tensors were built for `k` and `precision`.
-    pub fn fits(&self, k: &[f64], precision: &Precision) -> bool {
-        self.key == key(k, precision, BASIS_SIZE)
     }
 
     /// The projection of `spectrum` on the basis.
@@ -306,7 +306,7 @@ impl TwoLoopBasis {
                 }
             }
         }
-        let (t, t_err) = (triples(n), triples(self.n_err));
+        let (t, t_err) = (triples(n), triples(error_functions(n)));
         let mut p15_rows = Vec::with_capacity(self.k.len());
         let mut propagator = Vec::with_capacity(self.k.len());
         let mut rows = Vec::with_capacity(self.k.len());
@@ -397,7 +397,7 @@ impl TwoLoopBasis {
     /// The tensors for `k` and `precision` from the values of their file, or `None` if the file was
     /// made for other settings or does not fit them.
     pub(crate) fn from_f64s(values: &[f64], k: &[f64], precision: &Precision) -> Option<Self> {
-        let expected = key(k, precision, BASIS_SIZE);
+        let expected = key(k, precision);
         let len = *values.first()? as usize;
         if len != expected.len() || values.get(1..1 + len)? != expected.as_slice() {
             return None;
@@ -411,11 +411,10 @@ impl TwoLoopBasis {
         let (basis, mut rest) =
             LinearBasis::from_f64s(lattice_of(precision), &rest[k.len() + 1..])?;
         let n = basis.len();
-        let n_err = ERROR_FUNCTIONS.min(n);
         let sizes = [
             3 * FORM_KERNELS * n * (n + 1) / 2,
             ACC * triples(n),
-            replicas * ACC * triples(n_err),
+            replicas * ACC * triples(error_functions(n)),
         ];
         if rest.len() != k.len() * sizes.iter().sum::<usize>() {
             return None;
@@ -436,7 +435,6 @@ impl TwoLoopBasis {
             basis,
             points,
             replicas,
-            n_err,
             forms,
             mean,
             deviations,

@@ -124,7 +124,7 @@ pub(crate) fn camb_basis(lattice: Lattice, n: usize) -> LinearBasis {
         .map(|j| training.iter().map(|t| t[j]).sum::<f64>() / training.len() as f64)
         .collect();
     let tails = tail_functions(&lattice, &mean);
-    LinearBasis::greedy_after(lattice, &tails, &training, n)
+    LinearBasis::greedy(lattice, &tails, &training, n)
 }
 
 #[cfg(test)]
