@@ -3,14 +3,16 @@
 //! Every function here is `name<T: Scalar + Copy>(g: &[T; N]) -> [T; 2]`: it takes the Gram matrix of its basis
 //! vectors (upper triangle, row-major; the order is in `NAME_INFO.inputs` and in each function's docs)
 //! and returns `[F^s, G^s]`. Nothing here is hand-written: the bodies are flattened straight-line code
-//! emitted by `kernelgen` from the symmetrised subset recursion, with exact rational coefficients.
+//! emitted by `kernelgen` from the symmetrised subset recursion, with exact rational coefficients. The
+//! `_paired` functions take the Gram matrix as lane scalars and run in a [`PairScalar`] (see there).
 #![allow(clippy::all, clippy::pedantic, unused_parens, missing_docs)]
 
-use crate::{KernelInfo, Scalar};
+use crate::{KernelInfo, PairScalar, Scalar};
 
 kernelgen::kernels! {
     scalar = Scalar;
     info = KernelInfo;
+    pair = PairScalar;
 
     /// F_1^s = G_1^s = 1.
     general_1 = free(1);
@@ -33,6 +35,9 @@ kernelgen::kernels! {
     propagator_5 = propagator(2);
     /// The P17 propagator kernel F_7^s(k, q1, −q1, q2, −q2, q3, −q3).
     propagator_7 = propagator(3);
+    /// The P17 propagator kernel in lane pairs: one evaluation, lane 1 running the mirror image of lane 0
+    /// under a symmetry of the arguments (`pt_kernels::propagator_7` for `f64` runs it in [`crate::F64x2`]).
+    propagator_7_paired = propagator(3) paired;
 
     /// The P22 mode-coupling kernel F_2^s(q, k − q).
     mode_coupling_2 = basis(k, q) args(q, k - q);

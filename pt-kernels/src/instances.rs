@@ -11,7 +11,7 @@
 //! not: see `kernelgen_core::emit` for why.)
 
 use crate::generated;
-use crate::{KernelError, Scalar};
+use crate::{F64x2, KernelError, Scalar};
 use num_rational::BigRational;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
@@ -70,8 +70,10 @@ impl Evaluate for f64 {
     fn propagator_5(g: &[f64; 6]) -> [f64; 2] {
         generated::propagator_5(g)
     }
+    /// In one call of [`F64x2`] lane pairs, lane 1 running the mirror image (see
+    /// [`generated::propagator_7_paired`]): equal to the direct program to rounding.
     fn propagator_7(g: &[f64; 10]) -> [f64; 2] {
-        generated::propagator_7(g)
+        generated::propagator_7_paired::<F64x2>(g)
     }
     fn mode_coupling_2(g: &[f64; 3]) -> [f64; 2] {
         generated::mode_coupling_2(g)
@@ -230,6 +232,7 @@ impl Scalar for Exact {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use num_traits::ToPrimitive;
 
     #[test]
     fn exact_and_f64_instances_agree_on_f2() {
@@ -241,5 +244,38 @@ mod tests {
         let [ff, gf] = f64::general(2, &[1.0, 1.0, 2.0]).unwrap();
         assert!((ff - 45.0 / 28.0).abs() < 1e-15 && (gf - 41.0 / 28.0).abs() < 1e-15);
         assert_eq!(f64::general(3, &[1.0]), Err(KernelError::Order(3)));
+    }
+
+    #[test]
+    fn paired_p17_is_the_direct_program_exactly() {
+        use crate::Lanes2;
+        // Gram matrices of (k, q1, q2, q3) with small integer components, generic and degenerate
+        // (q2 = q1, and q3 = k, where the mirror image of a sub-kernel can coincide with another one).
+        let vectors: [[[i64; 3]; 4]; 3] = [
+            [[0, 0, 2], [1, -2, 1], [-1, 3, 2], [2, 1, -3]],
+            [[0, 0, 1], [1, 1, 0], [1, 1, 0], [0, 2, 1]],
+            [[1, 0, 1], [0, 3, -1], [2, -1, 1], [1, 0, 1]],
+        ];
+        for v in vectors {
+            let g: Vec<BigRational> =
+                crate::gram(&v.map(|x| x.map(|c| BigRational::from_ratio(c, 1))));
+            let g: [BigRational; 10] = g.try_into().unwrap();
+            let direct = BigRational::propagator_7(&g);
+            let paired = tape::record(|| {
+                generated::propagator_7_paired::<Lanes2<Exact>>(&g.clone().map(Exact::new))
+                    .map(Exact::value)
+            });
+            assert_eq!(paired, direct, "{v:?}");
+            let gf = g.clone().map(|x| x.to_f64().unwrap());
+            let (fast, reference) = (f64::propagator_7(&gf), generated::propagator_7::<f64>(&gf));
+            let d = direct.map(|x| x.to_f64().unwrap());
+            for i in 0..2 {
+                assert!(
+                    (fast[i] - d[i]).abs() <= 1e-12 * d[i].abs().max(1.0),
+                    "{v:?}: {fast:?} vs {d:?}"
+                );
+                assert!((reference[i] - d[i]).abs() <= 1e-12 * d[i].abs().max(1.0));
+            }
+        }
     }
 }

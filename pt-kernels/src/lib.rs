@@ -40,7 +40,7 @@ pub use lanes::{
     mode_coupling_3_x4, mode_coupling_4_x4, propagator_5_x4, propagator_7_x4, F64x2, F64x4,
 };
 
-pub use scalar::{dot, one, zero, Scalar};
+pub use scalar::{dot, one, zero, Lanes2, PairScalar, Scalar};
 
 /// Largest kernel order generated.
 pub const MAX_ORDER: usize = 7;
@@ -110,6 +110,7 @@ pub fn all_info() -> Vec<&'static KernelInfo> {
         &PROPAGATOR_3_INFO,
         &PROPAGATOR_5_INFO,
         &PROPAGATOR_7_INFO,
+        &PROPAGATOR_7_PAIRED_INFO,
         &MODE_COUPLING_2_INFO,
         &MODE_COUPLING_3_INFO,
         &MODE_COUPLING_4_INFO,

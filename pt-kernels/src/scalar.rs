@@ -62,6 +62,69 @@ impl Scalar for BigRational {
     }
 }
 
+/// Two lanes of a scalar type, the type the paired kernels run in (see `kernelgen_core::pairing`): lane 0
+/// evaluates the kernel, lane 1 its mirror image, and each statement runs on both at once.
+pub trait PairScalar: Scalar + Copy {
+    /// The scalar of one lane.
+    type Lane: Scalar + Copy;
+    /// The pair (a, b).
+    fn pair(a: Self::Lane, b: Self::Lane) -> Self;
+    /// (b, a) from (a, b).
+    fn swap(self) -> Self;
+    /// Lane `i` (0 or 1).
+    fn lane(self, i: usize) -> Self::Lane;
+}
+
+/// Two lanes of any scalar, operated on one after the other: the paired kernels in exact arithmetic
+/// (tests), or anywhere a packed type is not wanted.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lanes2<S>(pub [S; 2]);
+
+macro_rules! lanes2_binary {
+    ($($trait:ident $method:ident),*) => {$(
+        impl<S: Scalar + Copy> $trait for Lanes2<S> {
+            type Output = Self;
+            fn $method(self, rhs: Self) -> Self {
+                Lanes2([self.0[0].$method(rhs.0[0]), self.0[1].$method(rhs.0[1])])
+            }
+        }
+    )*};
+}
+lanes2_binary!(Add add, Sub sub, Mul mul, Div div);
+
+impl<S: Scalar + Copy> Neg for Lanes2<S> {
+    type Output = Self;
+    fn neg(self) -> Self {
+        Lanes2(self.0.map(|x| -x))
+    }
+}
+
+impl<S: Scalar + Copy> Scalar for Lanes2<S> {
+    fn from_ratio(num: i64, den: i64) -> Self {
+        let x = S::from_ratio(num, den);
+        Lanes2([x, x])
+    }
+    fn safe_recip(&self) -> Self {
+        Lanes2(self.0.map(|x| x.safe_recip()))
+    }
+    fn is_zero(&self) -> bool {
+        self.0.iter().all(S::is_zero)
+    }
+}
+
+impl<S: Scalar + Copy> PairScalar for Lanes2<S> {
+    type Lane = S;
+    fn pair(a: S, b: S) -> Self {
+        Lanes2([a, b])
+    }
+    fn swap(self) -> Self {
+        Lanes2([self.0[1], self.0[0]])
+    }
+    fn lane(self, i: usize) -> S {
+        self.0[i]
+    }
+}
+
 /// `1` in any scalar type.
 pub fn one<T: Scalar>() -> T {
     T::from_ratio(1, 1)

@@ -1,4 +1,6 @@
-//! Prints the size of every generated kernel program (statements and operation counts).
+//! Prints the size of every generated kernel program (statements and operation counts), and what the
+//! propagators cost in lane pairs under each symmetry of their arguments.
+use kernelgen_core::pairing::{pair, Involution};
 use kernelgen_core::{Program, Spec};
 
 fn main() {
@@ -51,5 +53,26 @@ fn main() {
             p.stats.subkernels,
             p.stats.splits
         );
+    }
+    for x in 2..=3 {
+        let program = Program::build(&Spec::propagator("p", x).unwrap());
+        println!(
+            "\npropagator_{} in lane pairs ({} direct statements):",
+            2 * x + 1,
+            program.op_counts().statements
+        );
+        for inv in Involution::candidates(&program.spec) {
+            if let Some(p) = pair(&program, &inv) {
+                let c = p.counts;
+                println!(
+                    "  {:32} {:>5} statements {:>4} swaps {:>5} mirrored {:>4} merged",
+                    inv.describe(&program.spec),
+                    c.statements,
+                    c.swaps,
+                    c.mirrored,
+                    c.merged
+                );
+            }
+        }
     }
 }

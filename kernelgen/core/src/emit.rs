@@ -15,6 +15,7 @@
 //! (`pt_kernels`' `Exact`), so one function still runs in f64 and in exact rationals.
 
 use crate::dag::{as_i64_pair, exact_in_f64, NodeId, Op, Value, Q};
+use crate::pairing::{Output, PairOp, Paired};
 use crate::program::Program;
 use crate::GENERATOR_VERSION;
 use num_traits::{One, Signed, Zero};
@@ -27,6 +28,8 @@ pub struct Paths {
     pub scalar: syn::Path,
     /// The metadata struct, e.g. `crate::KernelInfo`.
     pub info: syn::Path,
+    /// The lane-pair trait of paired kernels, e.g. `crate::PairScalar` (see [`emit_paired`]).
+    pub pair: Option<syn::Path>,
 }
 
 struct Emitter {
@@ -43,6 +46,22 @@ impl Emitter {
             }
         };
         format_ident!("c{}", i)
+    }
+
+    /// `let cJ = T::from_ratio(p, q);` for every constant used, refusing any that f64 cannot hold exactly.
+    fn constant_lets(&self) -> syn::Result<Vec<TokenStream>> {
+        let mut consts = Vec::new();
+        for (i, c) in self.constants.iter().enumerate() {
+            let Some((n, d)) = as_i64_pair(c).filter(|_| exact_in_f64(c)) else {
+                return Err(syn::Error::new(
+                    Span::call_site(),
+                    format!("coefficient {c} is not exact in f64"),
+                ));
+            };
+            let ci = format_ident!("c{}", i);
+            consts.push(quote!(let #ci = T::from_ratio(#n, #d);));
+        }
+        Ok(consts)
     }
 
     fn node(id: NodeId) -> Ident {
@@ -81,15 +100,23 @@ impl Emitter {
 
     /// Σ c_i x_i + c_0 with the terms grouped by |c_i|: one multiplication per distinct coefficient.
     fn lin(&mut self, terms: &[(Q, NodeId)], c0: &Q) -> (bool, TokenStream) {
+        self.lin_of(terms, c0, |id| {
+            let x = Self::node(id);
+            quote!(#x)
+        })
+    }
+
+    /// [`Self::lin`] with the variables named by `leaf`.
+    fn lin_of(
+        &mut self,
+        terms: &[(Q, usize)],
+        c0: &Q,
+        leaf: impl Fn(usize) -> TokenStream,
+    ) -> (bool, TokenStream) {
         let mut parts: Vec<(bool, TokenStream)> = Vec::new();
         for (mag, group) in group_by_magnitude(terms) {
-            let signed: Vec<(bool, TokenStream)> = group
-                .iter()
-                .map(|&(neg, id)| {
-                    let x = Self::node(id);
-                    (neg, quote!(#x))
-                })
-                .collect();
+            let signed: Vec<(bool, TokenStream)> =
+                group.iter().map(|&(neg, id)| (neg, leaf(id))).collect();
             if mag.is_one() {
                 parts.extend(signed);
             } else {
@@ -175,17 +202,7 @@ pub fn emit(program: &Program, paths: &Paths, docs: &[syn::Attribute]) -> syn::R
     }
     let f = e.value(&program.f);
     let g = e.value(&program.g);
-    let mut consts = Vec::new();
-    for (i, c) in e.constants.iter().enumerate() {
-        let Some((n, d)) = as_i64_pair(c).filter(|_| exact_in_f64(c)) else {
-            return Err(syn::Error::new(
-                Span::call_site(),
-                format!("coefficient {c} is not exact in f64"),
-            ));
-        };
-        let ci = format_ident!("c{}", i);
-        consts.push(quote!(let #ci = T::from_ratio(#n, #d);));
-    }
+    let consts = e.constant_lets()?;
 
     let name = Ident::new(&spec.name, Span::call_site());
     let info_name = format_ident!("{}_INFO", spec.name.to_uppercase());
@@ -216,6 +233,156 @@ pub fn emit(program: &Program, paths: &Paths, docs: &[syn::Attribute]) -> syn::R
         #[doc = #header]
         #[inline(never)]
         pub fn #name<T: #scalar + Copy>(g: &[T; #n_inputs]) -> [T; 2] {
+            #(#consts)*
+            #(#body)*
+            [#f, #g]
+        }
+
+        #[doc = concat!("How `", stringify!(#name), "` was generated.")]
+        pub const #info_name: #info = #info {
+            name: stringify!(#name),
+            order: #order,
+            arguments: &[#(#args),*],
+            inputs: &[#(#inputs),*],
+            statements: #statements,
+            multiplications: #muls,
+            additions: #adds,
+            reciprocals: #recips,
+            subkernels: #subkernels,
+            zero_momentum_subsets: #zero_subsets,
+            splits: #splits,
+            generator: #GENERATOR_VERSION,
+        };
+    })
+}
+
+/// Emits the paired kernel `name<T: Pair>(g: &[T::Lane; N]) -> [T::Lane; 2]` and its `NAME_INFO` constant:
+/// one evaluation in the two lanes of `T`, the second lane running the mirror image (see
+/// [`crate::pairing`]). The pair trait (named by `pair = <path>;` in the macro header) must provide
+/// `type Lane: Scalar + Copy`, `pair(a, b) -> Self`, `swap(self) -> Self` and `lane(self, i) -> Lane`.
+pub fn emit_paired(
+    paired: &Paired,
+    paths: &Paths,
+    docs: &[syn::Attribute],
+) -> syn::Result<TokenStream> {
+    let spec = &paired.spec;
+    let Some(pair) = &paths.pair else {
+        return Err(syn::Error::new(
+            Span::call_site(),
+            format!(
+                "`{}` is paired: name the lane-pair trait with `pair = <path>;` in the header",
+                spec.name
+            ),
+        ));
+    };
+    let mut e = Emitter {
+        constants: Vec::new(),
+    };
+    let y = |v: usize| format_ident!("y{}", v);
+    let leaf = |v: usize| {
+        let x = y(v);
+        quote!(#x)
+    };
+    let mut body = Vec::new();
+    for (i, op) in paired.ops.iter().enumerate() {
+        let rhs = match op {
+            PairOp::Input { i, j, negated } if *negated => quote!(T::pair(g[#i], -g[#j])),
+            PairOp::Input { i, j, .. } => quote!(T::pair(g[#i], g[#j])),
+            PairOp::Mul { a, b, swap_b } => {
+                let (a, b) = (y(*a), y(*b));
+                if *swap_b {
+                    quote!(#a * #b.swap())
+                } else {
+                    quote!(#a * #b)
+                }
+            }
+            PairOp::Recip(a) => {
+                let a = y(*a);
+                quote!(#a.safe_recip())
+            }
+            PairOp::Lin {
+                direct,
+                swapped,
+                c0,
+            } => {
+                let mut parts = Vec::new();
+                if !direct.is_empty() || !c0.is_zero() {
+                    parts.push(e.lin_of(direct, c0, leaf));
+                }
+                if !swapped.is_empty() {
+                    let (neg, t) = e.lin_of(swapped, &Q::zero(), leaf);
+                    parts.push((neg, quote!((#t).swap())));
+                }
+                let (neg, t) = balanced_sum(parts);
+                if neg {
+                    quote!(-(#t))
+                } else {
+                    t
+                }
+            }
+        };
+        let yi = y(i);
+        body.push(quote!(let #yi = #rhs;));
+    }
+    let mut output = |o: &Output| {
+        let (neg, mag) = (o.coef.is_negative(), o.coef.abs());
+        let t = match o.var {
+            None => {
+                let c = e.constant(&mag);
+                quote!(#c.lane(0))
+            }
+            Some((v, lane)) if mag.is_one() => {
+                let x = y(v);
+                quote!(#x.lane(#lane))
+            }
+            Some((v, lane)) => {
+                let (c, x) = (e.constant(&mag), y(v));
+                quote!((#c.lane(0) * #x.lane(#lane)))
+            }
+        };
+        if neg {
+            quote!(-(#t))
+        } else {
+            t
+        }
+    };
+    let (f, g) = (output(&paired.f), output(&paired.g));
+    let consts = e.constant_lets()?;
+    let name = Ident::new(&spec.name, Span::call_site());
+    let info_name = format_ident!("{}_INFO", spec.name.to_uppercase());
+    let info = &paths.info;
+    let n_inputs = spec.n_inputs();
+    let order = spec.order();
+    let counts = paired.op_counts();
+    let (muls, adds, recips, statements) =
+        (counts.muls, counts.adds, counts.recips, counts.statements);
+    let stats = paired.stats;
+    let (subkernels, zero_subsets, splits) =
+        (stats.subkernels, stats.zero_momentum_subsets, stats.splits);
+    let args = spec.arg_names();
+    let inputs = spec.input_names();
+    let c = paired.counts;
+    let header = format!(
+        " Generated by kernelgen {GENERATOR_VERSION}: F_{order}^s and G_{order}^s at ({}), in lane pairs.\n\n \
+         Input `g`: the basis Gram matrix [{}]. Output: `[F, G]`.\n \
+         Lane 1 evaluates the mirror image under {}, so each of the direct program's {} statements is \
+         paired ({}), mirrored ({}, free) or merged with an equal one ({}): {statements} packed statements \
+         with {} lane swaps, {muls} multiplications, {adds} additions, {recips} reciprocals.",
+        args.join(", "),
+        inputs.join(", "),
+        paired.involution.describe(spec),
+        c.direct,
+        c.statements,
+        c.mirrored,
+        c.merged,
+        c.swaps,
+    );
+    Ok(quote! {
+        #(#docs)*
+        #[doc = ""]
+        #[doc = #header]
+        #[inline(never)]
+        pub fn #name<T: #pair + Copy>(g: &[<T as #pair>::Lane; #n_inputs]) -> [<T as #pair>::Lane; 2] {
             #(#consts)*
             #(#body)*
             [#f, #g]

@@ -11,6 +11,8 @@
 
 pub mod dag;
 pub mod emit;
+pub mod modp;
+pub mod pairing;
 pub mod parse;
 pub mod program;
 pub mod recursion;
@@ -31,7 +33,20 @@ pub fn expand(input: TokenStream) -> syn::Result<TokenStream> {
     let mut out = TokenStream::new();
     for item in &input.items {
         let program = Program::build(&item.spec);
-        out.extend(emit::emit(&program, &input.paths, &item.docs)?);
+        if item.paired {
+            let paired = pairing::best_pairing(&program).ok_or_else(|| {
+                syn::Error::new(
+                    proc_macro2::Span::call_site(),
+                    format!(
+                        "`{}` has no symmetry of its arguments to pair under",
+                        item.spec.name
+                    ),
+                )
+            })?;
+            out.extend(emit::emit_paired(&paired, &input.paths, &item.docs)?);
+        } else {
+            out.extend(emit::emit(&program, &input.paths, &item.docs)?);
+        }
     }
     Ok(out)
 }

@@ -7,6 +7,7 @@
 //! general_3 = free(3);                            // F_3^s(q1, q2, q3) of free vectors
 //! propagator_5 = propagator(2);                   // F_5^s(k, q1, −q1, q2, −q2)
 //! mode_coupling_3 = basis(k, q1, q2) args(q1, q2, k - q1 - q2);
+//! propagator_7_paired = propagator(3) paired;     // in lane pairs (needs `pair = <trait>;` after `info`)
 //! ```
 //! Arguments are integer combinations of the basis names: `k - q1`, `-q2`, `2*q1 + q2`.
 
@@ -22,6 +23,8 @@ pub struct KernelItem {
     pub docs: Vec<syn::Attribute>,
     /// The configuration.
     pub spec: Spec,
+    /// Evaluate in lane pairs under the configuration's cheapest symmetry (`… paired;`).
+    pub paired: bool,
 }
 
 /// The whole macro input.
@@ -50,12 +53,17 @@ impl Parse for Input {
     fn parse(input: ParseStream) -> syn::Result<Self> {
         let scalar = keyed_path(input, "scalar")?;
         let info = keyed_path(input, "info")?;
+        let pair = if input.fork().parse::<Ident>().is_ok_and(|k| k == "pair") {
+            Some(keyed_path(input, "pair")?)
+        } else {
+            None
+        };
         let mut items = Vec::new();
         while !input.is_empty() {
             items.push(input.parse()?);
         }
         Ok(Input {
-            paths: Paths { scalar, info },
+            paths: Paths { scalar, info, pair },
             items,
         })
     }
@@ -96,8 +104,15 @@ impl Parse for KernelItem {
                 ))
             }
         };
+        let paired = input.peek(Ident);
+        if paired {
+            let kw: Ident = input.parse()?;
+            if kw != "paired" {
+                return Err(syn::Error::new(kw.span(), "expected `paired` or `;`"));
+            }
+        }
         input.parse::<Token![;]>()?;
-        Ok(KernelItem { docs, spec })
+        Ok(KernelItem { docs, spec, paired })
     }
 }
 
@@ -164,10 +179,13 @@ mod tests {
              a = free(3);
              b = propagator(2);
              c = basis(k, q1, q2) args(q1, q2, k - q1 - q2);
-             d = basis(k, q) args(2*q - k, -(k - q));",
+             d = basis(k, q) args(2*q - k, -(k - q));
+             e = propagator(3) paired;",
         )
         .unwrap();
-        assert_eq!(input.items.len(), 4);
+        assert_eq!(input.items.len(), 5);
+        assert!(input.items[4].paired && !input.items[3].paired);
+        assert!(input.paths.pair.is_none());
         assert_eq!(input.items[0].docs.len(), 1);
         assert_eq!(
             input.items[1].spec.arg_names(),

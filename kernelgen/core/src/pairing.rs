@@ -1,0 +1,598 @@
+//! One evaluation in two SIMD lanes: a kernel and its mirror image under a symmetry of its arguments.
+//!
+//! A kernel whose argument list is mapped onto itself by an involution σ of the basis (a signed permutation
+//! with σ² = 1, e.g. q1 ↔ q2, q3 → −q3 for F_7^s(k, ±q1, ±q2, ±q3)) is unchanged by σ, but its
+//! sub-expressions are not: a node n of the graph and its image n∘σ (n evaluated at the mirrored Gram
+//! matrix σg) are, most of the time, two different nodes of the same graph. Evaluating every node as the
+//! lane pair P(n) = (n(g), n(σg)) therefore computes both in one packed operation:
+//!
+//! - P(x·y) = P(x)·P(y), P(1/x) = 1/P(x), P(Σ cᵢxᵢ) = Σ cᵢP(xᵢ), and P(gᵢ) = (gᵢ, ±g_j) for the inputs;
+//! - if n∘σ = c·m for a node m already paired, then P(n) = c·swap(P(m)) costs nothing;
+//! - a node equal to an earlier one up to a constant costs nothing either (the graph is hash-consed by
+//!   structure; this also merges what is equal by value).
+//!
+//! Each pair is stored in one orientation (P(n) or swap(P(n))), chosen so that operands mostly agree; a
+//! product of operands in opposite orientations costs one swap, a sum one swap per node. Identities are
+//! found by exact evaluation at random points modulo 2^61 − 1 ([`crate::modp`]). For the P17 kernel the
+//! best involution leaves 2,3xx packed operations and ~300 swaps where the direct program has 4,485
+//! statements; the kernel's value is lane 0 of its output pair.
+
+use crate::dag::{NodeId, Op, Q};
+use crate::emit::group_by_magnitude;
+use crate::modp::{evaluate, Fp, Stream};
+use crate::program::{OpCounts, Program};
+use crate::recursion::RecursionStats;
+use crate::spec::Spec;
+use num_traits::{One, Zero};
+use std::collections::HashMap;
+use std::ops::{Add, Mul, Neg};
+
+/// A signed permutation of the basis vectors: e_a ↦ sign[a] · e_perm[a], with σ² = 1.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Involution {
+    /// Image index of each basis vector.
+    pub perm: Vec<usize>,
+    /// Sign of each image (±1).
+    pub sign: Vec<i64>,
+}
+
+impl Involution {
+    /// Where each Gram input goes: (σg)ᵢ = ±g_j as (j, negated).
+    pub fn on_inputs(&self, spec: &Spec) -> Vec<(usize, bool)> {
+        let nb = spec.basis.len();
+        let mut out = vec![(0, false); spec.n_inputs()];
+        for a in 0..nb {
+            for b in a..nb {
+                let j = spec.gram_index(self.perm[a], self.perm[b]);
+                out[spec.gram_index(a, b)] = (j, self.sign[a] * self.sign[b] < 0);
+            }
+        }
+        out
+    }
+
+    /// Every involution of the basis that maps the argument list onto itself (as a multiset) and acts on
+    /// the Gram inputs non-trivially.
+    pub fn candidates(spec: &Spec) -> Vec<Involution> {
+        let nb = spec.basis.len();
+        let mut out = Vec::new();
+        for perm in permutations(nb) {
+            if (0..nb).any(|a| perm[perm[a]] != a) {
+                continue;
+            }
+            for bits in 0..(1u32 << nb) {
+                let sign: Vec<i64> = (0..nb)
+                    .map(|a| if bits & (1 << a) != 0 { -1 } else { 1 })
+                    .collect();
+                if (0..nb).any(|a| sign[a] * sign[perm[a]] != 1) {
+                    continue;
+                }
+                let inv = Involution {
+                    perm: perm.clone(),
+                    sign,
+                };
+                let trivial = inv
+                    .on_inputs(spec)
+                    .iter()
+                    .enumerate()
+                    .all(|(i, &(j, neg))| i == j && !neg);
+                if !trivial && inv.preserves_arguments(spec) {
+                    out.push(inv);
+                }
+            }
+        }
+        out
+    }
+
+    fn image(&self, arg: &[i64]) -> Vec<i64> {
+        let mut v = vec![0; arg.len()];
+        for (a, &c) in arg.iter().enumerate() {
+            v[self.perm[a]] += self.sign[a] * c;
+        }
+        v
+    }
+
+    fn preserves_arguments(&self, spec: &Spec) -> bool {
+        let mut args = spec.args.clone();
+        let mut images: Vec<Vec<i64>> = args.iter().map(|a| self.image(a)).collect();
+        args.sort();
+        images.sort();
+        args == images
+    }
+
+    /// `q1 → q2, q2 → q1, q3 → −q3`: the non-trivial part of the map.
+    pub fn describe(&self, spec: &Spec) -> String {
+        (0..spec.basis.len())
+            .filter(|&a| self.perm[a] != a || self.sign[a] != 1)
+            .map(|a| {
+                let sign = if self.sign[a] < 0 { "−" } else { "" };
+                format!("{} → {sign}{}", spec.basis[a], spec.basis[self.perm[a]])
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+fn permutations(n: usize) -> Vec<Vec<usize>> {
+    if n == 0 {
+        return vec![Vec::new()];
+    }
+    let mut out = Vec::new();
+    for p in permutations(n - 1) {
+        for pos in 0..=p.len() {
+            let mut q = p.clone();
+            q.insert(pos, n - 1);
+            out.push(q);
+        }
+    }
+    out
+}
+
+/// A lane pair of the paired program (an index into [`Paired::ops`]).
+pub type Var = usize;
+
+/// One statement of the paired program; statement i defines the pair `y{i}`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PairOp {
+    /// (g_i, ±g_j).
+    Input {
+        /// Lane 0's input.
+        i: usize,
+        /// Lane 1's input (the mirror of i).
+        j: usize,
+        /// Lane 1 is −g_j.
+        negated: bool,
+    },
+    /// Σ cᵢ yᵢ + Σ dⱼ swap(yⱼ) + c0, the swapped terms summed first and swapped once.
+    Lin {
+        /// Terms taken as they are.
+        direct: Vec<(Q, Var)>,
+        /// Terms taken swapped.
+        swapped: Vec<(Q, Var)>,
+        /// Constant.
+        c0: Q,
+    },
+    /// a · b, or a · swap(b).
+    Mul {
+        /// First factor.
+        a: Var,
+        /// Second factor.
+        b: Var,
+        /// Take b swapped.
+        swap_b: bool,
+    },
+    /// 1/a lane by lane (0 at an exact 0).
+    Recip(Var),
+}
+
+/// A scalar of the paired program: `coef`, times a lane of a pair if `var` is set.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Output {
+    /// Exact multiplier.
+    pub coef: Q,
+    /// The pair and the lane holding the value, if not a constant.
+    pub var: Option<(Var, usize)>,
+}
+
+/// How much the paired program costs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PairCounts {
+    /// Packed statements.
+    pub statements: usize,
+    /// Lane swaps: one per pair used swapped in products (once however often), one per sum with swapped
+    /// terms.
+    pub swaps: usize,
+    /// Nodes of the direct program that cost nothing: mirror images of paired ones.
+    pub mirrored: usize,
+    /// Nodes equal to an earlier node up to a constant (merged).
+    pub merged: usize,
+    /// Statements of the direct program.
+    pub direct: usize,
+}
+
+/// A program evaluated in lane pairs under an involution.
+pub struct Paired {
+    /// The configuration.
+    pub spec: Spec,
+    /// The symmetry used.
+    pub involution: Involution,
+    /// Statements in evaluation order.
+    pub ops: Vec<PairOp>,
+    /// F^s.
+    pub f: Output,
+    /// G^s.
+    pub g: Output,
+    /// Costs.
+    pub counts: PairCounts,
+    /// What the recursion of the direct program did.
+    pub stats: RecursionStats,
+}
+
+impl Paired {
+    /// Operation counts of the emitted code (each packed operation counted once; swaps not included).
+    pub fn op_counts(&self) -> OpCounts {
+        let mut c = OpCounts::default();
+        for op in &self.ops {
+            match op {
+                PairOp::Input { .. } => {}
+                PairOp::Mul { .. } => c.muls += 1,
+                PairOp::Recip(_) => c.recips += 1,
+                PairOp::Lin {
+                    direct,
+                    swapped,
+                    c0,
+                } => {
+                    let leaves = direct.len() + swapped.len() + usize::from(!c0.is_zero());
+                    c.adds += leaves.saturating_sub(1);
+                    c.muls += [direct, swapped]
+                        .into_iter()
+                        .map(|t| {
+                            group_by_magnitude(t)
+                                .iter()
+                                .filter(|(m, _)| !m.is_one())
+                                .count()
+                        })
+                        .sum::<usize>();
+                }
+            }
+            c.statements += 1;
+        }
+        c
+    }
+}
+
+/// P(n) = scale × y (or × swap(y)); `var` None means the constant `scale`.
+#[derive(Clone, Debug)]
+struct Ref {
+    scale: Q,
+    var: Option<Var>,
+    swapped: bool,
+}
+
+impl Ref {
+    fn constant(c: Q) -> Ref {
+        Ref {
+            scale: c,
+            var: None,
+            swapped: false,
+        }
+    }
+}
+
+/// Node values at three random points and at their mirror images, for exact identity tests.
+struct Samples {
+    at: [Vec<Fp>; 3],
+    mirrored: [Vec<Fp>; 3],
+}
+
+impl Samples {
+    fn new(program: &Program, inv: &Involution) -> Samples {
+        let n = program.spec.n_inputs();
+        let map = inv.on_inputs(&program.spec);
+        let mut stream = Stream::new(0x5eed_0f17);
+        let points: [Vec<Fp>; 3] =
+            std::array::from_fn(|_| (0..n).map(|_| stream.next_fp()).collect());
+        let mirror = |p: &Vec<Fp>| -> Vec<Fp> {
+            map.iter()
+                .map(|&(j, neg)| if neg { p[j].neg() } else { p[j] })
+                .collect()
+        };
+        Samples {
+            at: points.clone().map(|p| evaluate(&program.dag, &p)),
+            mirrored: points.map(|p| evaluate(&program.dag, &mirror(&p))),
+        }
+    }
+
+    /// Shape of a value triple up to a constant factor: (v₂/v₁, v₃/v₁), if v₁ ≠ 0.
+    fn shape(v: [Fp; 3]) -> Option<(Fp, Fp)> {
+        (v[0] != Fp::new(0)).then(|| (v[1].mul(v[0].recip()), v[2].mul(v[0].recip())))
+    }
+
+    fn values(&self, id: NodeId) -> [Fp; 3] {
+        std::array::from_fn(|p| self.at[p][id])
+    }
+
+    fn mirrored_values(&self, id: NodeId) -> [Fp; 3] {
+        std::array::from_fn(|p| self.mirrored[p][id])
+    }
+}
+
+/// Pairs `program` under `inv` (see the module docs), checked against the direct program at two fresh
+/// random points; `None` if the check fails (an identity wrongly assumed, which no test has seen).
+pub fn pair(program: &Program, inv: &Involution) -> Option<Paired> {
+    let samples = Samples::new(program, inv);
+    let live = program.live();
+    let inputs = inv.on_inputs(&program.spec);
+    // Shape → first live node with that shape.
+    let mut index: HashMap<(Fp, Fp), NodeId> = HashMap::new();
+    let mut refs: Vec<Option<Ref>> = vec![None; program.dag.ops().len()];
+    let mut b = Builder::default();
+    // The node m with values proportional to `v`, and the factor c with v = c·m, if m is already paired.
+    let find = |index: &HashMap<(Fp, Fp), NodeId>, refs: &[Option<Ref>], v: [Fp; 3]| {
+        let m = *index.get(&Samples::shape(v)?)?;
+        let c = v[0].mul(samples.at[0][m].recip()).to_small_rational()?;
+        refs[m].as_ref().map(|r| (r.clone(), c))
+    };
+    for (id, op) in program.dag.ops().iter().enumerate() {
+        if !live[id] {
+            continue;
+        }
+        let own = samples.values(id);
+        let shape = Samples::shape(own);
+        if let Some((r, c)) = find(&index, &refs, own) {
+            b.counts.merged += 1;
+            refs[id] = Some(Ref {
+                scale: c * r.scale,
+                ..r
+            });
+            continue;
+        }
+        if let Some((r, c)) = find(&index, &refs, samples.mirrored_values(id)) {
+            // n(σg) = c·m(g), so P(n) = c·swap(P(m)).
+            b.counts.mirrored += 1;
+            refs[id] = Some(Ref {
+                scale: c * r.scale,
+                var: r.var,
+                swapped: !r.swapped,
+            });
+        } else {
+            let get = |x: &NodeId| refs[*x].clone().expect("operands come first");
+            refs[id] = Some(match op {
+                Op::Input(i) => {
+                    let (j, negated) = inputs[*i];
+                    b.push_ref(PairOp::Input { i: *i, j, negated }, Q::one(), false)
+                }
+                Op::Mul(x, y) => b.mul(get(x), get(y)),
+                Op::Recip(x) => b.recip(get(x)),
+                Op::Lin(terms, c0) => {
+                    let terms: Vec<(Q, Ref)> =
+                        terms.iter().map(|(c, x)| (c.clone(), get(x))).collect();
+                    b.lin(&terms, c0)
+                }
+            });
+        }
+        if let Some(s) = shape {
+            index.entry(s).or_insert(id);
+        }
+    }
+    let output = |v: &crate::dag::Value| match v.node {
+        None => Output {
+            coef: v.coef.clone(),
+            var: None,
+        },
+        Some(id) => {
+            let r = refs[id].clone().expect("outputs are live");
+            Output {
+                coef: &v.coef * &r.scale,
+                var: r.var.map(|y| (y, usize::from(r.swapped))),
+            }
+        }
+    };
+    let (f, g) = (output(&program.f), output(&program.g));
+    b.counts.statements = b.ops.len();
+    b.counts.direct = program.op_counts().statements;
+    let paired = Paired {
+        spec: program.spec.clone(),
+        involution: inv.clone(),
+        ops: b.ops,
+        f,
+        g,
+        counts: b.counts,
+        stats: program.stats,
+    };
+    let mut stream = Stream::new(0x000c_4ec4);
+    let n = program.spec.n_inputs();
+    (0..2)
+        .map(|_| (0..n).map(|_| stream.next_fp()).collect::<Vec<Fp>>())
+        .all(|g| evaluate_paired(&paired, &g) == evaluate_direct(program, &g))
+        .then_some(paired)
+}
+
+/// (F, G) of the direct program modulo p at `g`.
+pub fn evaluate_direct(program: &Program, g: &[Fp]) -> (Fp, Fp) {
+    let v = evaluate(&program.dag, g);
+    let out = |x: &crate::dag::Value| {
+        let c = Fp::from_q(&x.coef);
+        x.node.map_or(c, |id| c.mul(v[id]))
+    };
+    (out(&program.f), out(&program.g))
+}
+
+/// The cheapest pairing of `program` over every involution of its arguments (fewest statements plus
+/// swaps), if it has any.
+pub fn best_pairing(program: &Program) -> Option<Paired> {
+    Involution::candidates(&program.spec)
+        .iter()
+        .filter_map(|inv| pair(program, inv))
+        .min_by_key(|p| p.counts.statements + p.counts.swaps)
+}
+
+#[derive(Default)]
+struct Builder {
+    ops: Vec<PairOp>,
+    counts: PairCounts,
+    /// Pairs used swapped in a product (the compiler swaps each once, however often it is used).
+    swapped_factors: std::collections::HashSet<Var>,
+}
+
+impl Builder {
+    fn push_ref(&mut self, op: PairOp, scale: Q, swapped: bool) -> Ref {
+        self.ops.push(op);
+        Ref {
+            scale,
+            var: Some(self.ops.len() - 1),
+            swapped,
+        }
+    }
+
+    fn mul(&mut self, x: Ref, y: Ref) -> Ref {
+        let scale = &x.scale * &y.scale;
+        match (x.var, y.var) {
+            (None, _) => Ref { scale, ..y },
+            (_, None) => Ref { scale, ..x },
+            (Some(a), Some(b)) => {
+                let swap_b = x.swapped != y.swapped;
+                if swap_b && self.swapped_factors.insert(b) {
+                    self.counts.swaps += 1;
+                }
+                self.push_ref(PairOp::Mul { a, b, swap_b }, scale, x.swapped)
+            }
+        }
+    }
+
+    fn recip(&mut self, x: Ref) -> Ref {
+        match x.var {
+            None if x.scale.is_zero() => Ref::constant(Q::zero()),
+            None => Ref::constant(x.scale.recip()),
+            Some(a) => self.push_ref(PairOp::Recip(a), x.scale.recip(), x.swapped),
+        }
+    }
+
+    fn lin(&mut self, terms: &[(Q, Ref)], c0: &Q) -> Ref {
+        // Merge like terms (same pair, same orientation) and fold constants.
+        let mut c0 = c0.clone();
+        let mut merged: Vec<(Q, Var, bool)> = Vec::new();
+        for (c, r) in terms {
+            let c = c * &r.scale;
+            match r.var {
+                None => c0 += c,
+                Some(y) => match merged.iter_mut().find(|t| t.1 == y && t.2 == r.swapped) {
+                    Some(t) => t.0 += c,
+                    None => merged.push((c, y, r.swapped)),
+                },
+            }
+        }
+        merged.retain(|t| !t.0.is_zero());
+        if merged.is_empty() {
+            return Ref::constant(c0);
+        }
+        if merged.len() == 1 && c0.is_zero() {
+            let (c, y, swapped) = merged.pop().expect("one term");
+            return Ref {
+                scale: c,
+                var: Some(y),
+                swapped,
+            };
+        }
+        // Orientation of the majority; the lead coefficient factored out as the scale.
+        let n_swapped = merged.iter().filter(|t| t.2).count();
+        let swapped = 2 * n_swapped > merged.len();
+        let lead = merged[0].0.clone();
+        let (mut direct, mut other) = (Vec::new(), Vec::new());
+        for (c, y, s) in merged {
+            let t = (c / &lead, y);
+            if s == swapped {
+                direct.push(t);
+            } else {
+                other.push(t);
+            }
+        }
+        self.counts.swaps += usize::from(!other.is_empty());
+        let op = PairOp::Lin {
+            direct,
+            swapped: other,
+            c0: c0 / &lead,
+        };
+        self.push_ref(op, lead, swapped)
+    }
+}
+
+/// Evaluates the paired program modulo p at `g` (both lanes), for tests: returns (F, G).
+pub fn evaluate_paired(p: &Paired, g: &[Fp]) -> (Fp, Fp) {
+    let mut y: Vec<[Fp; 2]> = Vec::with_capacity(p.ops.len());
+    let swap = |v: [Fp; 2]| [v[1], v[0]];
+    for op in &p.ops {
+        let v = match op {
+            PairOp::Input { i, j, negated } => [g[*i], if *negated { g[*j].neg() } else { g[*j] }],
+            PairOp::Mul { a, b, swap_b } => {
+                let bv = if *swap_b { swap(y[*b]) } else { y[*b] };
+                [y[*a][0].mul(bv[0]), y[*a][1].mul(bv[1])]
+            }
+            PairOp::Recip(a) => y[*a].map(Fp::recip),
+            PairOp::Lin {
+                direct,
+                swapped,
+                c0,
+            } => {
+                let sum = |terms: &[(Q, Var)], lane: usize, swap_it: bool| {
+                    terms.iter().fold(Fp::new(0), |acc, (c, v)| {
+                        let val = if swap_it { swap(y[*v]) } else { y[*v] };
+                        acc.add(Fp::from_q(c).mul(val[lane]))
+                    })
+                };
+                std::array::from_fn(|l| {
+                    Fp::from_q(c0)
+                        .add(sum(direct, l, false))
+                        .add(sum(swapped, l, true))
+                })
+            }
+        };
+        y.push(v);
+    }
+    let out = |o: &Output| {
+        let c = Fp::from_q(&o.coef);
+        match o.var {
+            None => c,
+            Some((v, lane)) => c.mul(y[v][lane]),
+        }
+    };
+    (out(&p.f), out(&p.g))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn propagator_involutions_are_the_signed_pair_permutations() {
+        // k stays (the arguments hold k, not −k). The q's are permuted by the identity or one of three
+        // transpositions, with signs such that σ² = 1: 8 + 3·4 maps, less the identity.
+        let spec = Spec::propagator("p", 3).unwrap();
+        let c = Involution::candidates(&spec);
+        assert_eq!(c.len(), 19);
+        let swap12 = c
+            .iter()
+            .find(|i| i.perm == [0, 2, 1, 3] && i.sign == [1, 1, 1, -1])
+            .unwrap();
+        assert_eq!(swap12.describe(&spec), "q1 → q2, q2 → q1, q3 → −q3");
+        // A configuration without a symmetry has no candidates.
+        let mc = Spec::new(
+            "m",
+            vec!["k".into(), "q1".into(), "q2".into()],
+            vec![vec![0, 1, 0], vec![0, 0, 1], vec![1, -1, -1], vec![1, 1, 0]],
+        )
+        .unwrap();
+        assert!(Involution::candidates(&mc).is_empty());
+    }
+
+    #[test]
+    fn paired_programs_equal_the_direct_ones_at_random_points() {
+        for x in 1..=3 {
+            let program = Program::build(&Spec::propagator("p", x).unwrap());
+            let mut stream = Stream::new(99);
+            for inv in Involution::candidates(&program.spec) {
+                let paired = pair(&program, &inv).expect("checked");
+                for _ in 0..3 {
+                    let g: Vec<Fp> = (0..program.spec.n_inputs())
+                        .map(|_| stream.next_fp())
+                        .collect();
+                    assert_eq!(
+                        evaluate_paired(&paired, &g),
+                        evaluate_direct(&program, &g),
+                        "x = {x}, {}",
+                        inv.describe(&program.spec)
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn pairing_halves_the_p17_program() {
+        let program = Program::build(&Spec::propagator("p17", 3).unwrap());
+        let direct = program.op_counts().statements;
+        let best = best_pairing(&program).unwrap();
+        let cost = best.counts.statements + best.counts.swaps;
+        assert!(2 * cost < 4 * direct / 3, "{:?} vs {direct}", best.counts);
+        assert!(best.counts.mirrored > direct / 3, "{:?}", best.counts);
+    }
+}
