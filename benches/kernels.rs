@@ -1,5 +1,5 @@
-//! Time per evaluation of the generated kernels (F and G together, f64; and four configurations per call,
-//! two at a time in `F64x2` lanes), and of the brute-force n!-permutation reference for comparison. Fixed
+//! Time per evaluation of the generated kernels (F and G together, f64, the P17 kernel in lane pairs and,
+//! for comparison, without; and four configurations per call, two at a time in `F64x2` lanes), and of the brute-force n!-permutation reference for comparison. Fixed
 //! inputs; one core.
 
 // `criterion_group!` defines an undocumented function.
@@ -49,6 +49,10 @@ fn specialised(c: &mut Criterion) {
     });
     group.bench_function("propagator_7 (P17)", |b| {
         b.iter(|| propagator_7(black_box(&g4)))
+    });
+    // The same kernel without the lane pairs (the direct program in plain f64), for comparison.
+    group.bench_function("propagator_7 direct (P17, unpaired)", |b| {
+        b.iter(|| pt_kernels::generated::propagator_7::<f64>(black_box(&g4)))
     });
     group.bench_function("mode_coupling_2 (P22)", |b| {
         b.iter(|| mode_coupling_2(black_box(&g2)))

@@ -5,7 +5,9 @@
 //! of a quasi-Monte-Carlo point, or the four random shifts of an angular rule) evaluates them together:
 //! the straight-line generated code then runs each statement on all lanes at once (packed SSE2 operations
 //! from the `wide` crate, since this crate forbids the `unsafe` of `std::arch`), and the divisions, the
-//! slowest statements, overlap. Each lane gives exactly the `f64` result.
+//! slowest statements, overlap. Each lane gives exactly the result of the direct `f64` program
+//! (`generated::name::<f64>`; for P17 the single `f64` call instead runs the paired program, one evaluation
+//! in two lanes, equal to it to rounding: see `kernelgen_core::pairing`).
 //!
 //! The `_x4` functions take four configurations: the smaller kernels in one call of [`F64x4`], the P17
 //! kernel in two calls of [`F64x2`]. [`F64x2`] is a SIMD vector to rustc, so each statement stays an SSA
