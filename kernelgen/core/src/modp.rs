@@ -5,9 +5,12 @@
 //! below (degree)/p ≈ 1e-16 per point (Schwartz–Zippel), and [`crate::pairing`] asks for agreement at three
 //! points. No rounding is involved, so the test is exact in the sense that matters: a match is an identity
 //! with overwhelming probability, and the generated code is checked against the direct program in exact
-//! rationals by the tests of the crates that use it.
+//! rationals by the tests of the crates that use it. [`evaluate_direct`] and [`evaluate_paired`] run a
+//! program and its lane-pair form this way, to check one against the other.
 
 use crate::dag::{Dag, Op, Q};
+use crate::pairing::{Output, PairOp, Paired, Var};
+use crate::program::Program;
 use num_bigint::BigInt;
 use num_integer::Integer;
 use num_traits::Signed;
@@ -117,6 +120,58 @@ pub fn evaluate(dag: &Dag, inputs: &[Fp]) -> Vec<Fp> {
         v.push(x);
     }
     v
+}
+
+/// (F, G) of the direct program modulo p at `g`.
+pub fn evaluate_direct(program: &Program, g: &[Fp]) -> (Fp, Fp) {
+    let v = evaluate(&program.dag, g);
+    let out = |x: &crate::dag::Value| {
+        let c = Fp::from_q(&x.coef);
+        x.node.map_or(c, |id| c.mul(v[id]))
+    };
+    (out(&program.f), out(&program.g))
+}
+
+/// Evaluates the paired program modulo p at `g` (both lanes), for tests: returns (F, G).
+pub fn evaluate_paired(p: &Paired, g: &[Fp]) -> (Fp, Fp) {
+    let mut y: Vec<[Fp; 2]> = Vec::with_capacity(p.ops.len());
+    let swap = |v: [Fp; 2]| [v[1], v[0]];
+    for op in &p.ops {
+        let v = match op {
+            PairOp::Input { i, j, negated } => [g[*i], if *negated { g[*j].neg() } else { g[*j] }],
+            PairOp::Mul { a, b, swap_b } => {
+                let bv = if *swap_b { swap(y[*b]) } else { y[*b] };
+                [y[*a][0].mul(bv[0]), y[*a][1].mul(bv[1])]
+            }
+            PairOp::Recip(a) => y[*a].map(Fp::recip),
+            PairOp::Lin {
+                direct,
+                swapped,
+                c0,
+            } => {
+                let sum = |terms: &[(Q, Var)], lane: usize, swap_it: bool| {
+                    terms.iter().fold(Fp::new(0), |acc, (c, v)| {
+                        let val = if swap_it { swap(y[*v]) } else { y[*v] };
+                        acc.add(Fp::from_q(c).mul(val[lane]))
+                    })
+                };
+                std::array::from_fn(|l| {
+                    Fp::from_q(c0)
+                        .add(sum(direct, l, false))
+                        .add(sum(swapped, l, true))
+                })
+            }
+        };
+        y.push(v);
+    }
+    let out = |o: &Output| {
+        let c = Fp::from_q(&o.coef);
+        match o.var {
+            None => c,
+            Some((v, lane)) => c.mul(y[v][lane]),
+        }
+    };
+    (out(&p.f), out(&p.g))
 }
 
 /// A deterministic stream of field elements (SplitMix64), so that generated code is reproducible.
