@@ -1,6 +1,6 @@
 //! Kernel timings that survive a drifting machine: the paired and the direct P17 kernel, P15, and P17 four at
 //! a time, timed in interleaved blocks of 1,000 calls, 300 rounds, the fastest block of each kept. Ratios
-//! between kernels measured this way are stable to ~2% on a VM whose speed drifts by 1.6× within minutes,
+//! between kernels measured this way are stable to ~3% on a VM whose speed drifts by 1.6× within minutes,
 //! where separate criterion runs are not. `cargo run --release -p pt-kernels --example interleaved_timing`
 use std::hint::black_box;
 use std::time::Instant;
