@@ -96,3 +96,33 @@ fn basis_two_loop_terms_match_the_direct_integrals() {
     let refused = tensors.evaluate(&eh, &plan.par_evaluate(&eh)).unwrap_err();
     assert!(refused.residual > MAX_RESIDUAL, "{}", refused.residual);
 }
+
+#[test]
+fn auto_says_when_it_integrates_directly_for_want_of_tensors() {
+    use pt_spectra::loops::TwoLoopSource;
+    use pt_spectra::precision::TwoLoopMethod;
+    use pt_spectra::real::{RealModel, RealPlan};
+    // A grid no test builds tensors for, so the cache never holds them.
+    let k = [0.0123, 0.0456];
+    let p = LinearSpectrum::gm2012(0.0).unwrap();
+    let source = |method| {
+        let mut precision = Precision::fast();
+        precision.two_loop = method;
+        let plan = RealPlan::new(&k, RealModel::TwoLoopSpt, &precision, store(), &Silent).unwrap();
+        plan.evaluate(&p, &Silent)
+            .unwrap()
+            .terms
+            .two_loop_source
+            .unwrap()
+    };
+    let auto = source(TwoLoopMethod::Auto);
+    assert_eq!(auto, TwoLoopSource::DirectUncached);
+    assert!(auto
+        .describe()
+        .contains("no basis tensors are cached for this k grid"));
+    assert_eq!(source(TwoLoopMethod::Direct), TwoLoopSource::Direct);
+    assert_eq!(
+        TwoLoopSource::Direct.describe(),
+        "2-loop terms: direct integration"
+    );
+}

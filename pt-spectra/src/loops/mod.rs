@@ -259,6 +259,9 @@ pub struct LoopTerms {
 pub enum TwoLoopSource {
     /// Direct integration.
     Direct,
+    /// Direct integration under [`TwoLoopMethod::Auto`](crate::precision::TwoLoopMethod::Auto): no basis
+    /// tensors were cached for the k grid and precision, and `auto` does not build them.
+    DirectUncached,
     /// From the basis tensors ([`basis`]): the spectrum's projection residual ε on `functions` basis
     /// functions; the errors include the projection error ε Σ|T| over the terms of each result.
     Basis {
@@ -283,6 +286,10 @@ impl TwoLoopSource {
     pub fn describe(&self) -> String {
         match *self {
             Self::Direct => "2-loop terms: direct integration".into(),
+            Self::DirectUncached => "2-loop terms: direct integration (method auto: no basis tensors \
+                 are cached for this k grid and precision; method basis builds them once, minutes on 2 \
+                 cores, then takes milliseconds per spectrum)"
+                .into(),
             Self::Basis {
                 functions,
                 residual,

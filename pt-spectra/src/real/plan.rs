@@ -230,7 +230,10 @@ impl RealPlan {
         let Some(table) = &self.p15 else {
             return (None, None, None);
         };
-        let mut source = TwoLoopSource::Direct;
+        let mut source = match precision.two_loop {
+            TwoLoopMethod::Auto => TwoLoopSource::DirectUncached,
+            _ => TwoLoopSource::Direct,
+        };
         if let Some(basis) = &self.basis {
             match basis.evaluate(spectrum, one_loop) {
                 Ok(terms) => {
