@@ -159,6 +159,14 @@ impl Emitter {
     }
 }
 
+/// Multiplications of a linear combination as emitted: one per distinct |coefficient| other than 1.
+pub fn coefficient_muls(terms: &[(Q, NodeId)]) -> usize {
+    group_by_magnitude(terms)
+        .iter()
+        .filter(|(m, _)| !m.is_one())
+        .count()
+}
+
 /// Terms of a linear combination grouped by the magnitude of their coefficient, each with its sign.
 pub fn group_by_magnitude(terms: &[(Q, NodeId)]) -> Vec<(Q, Vec<(bool, NodeId)>)> {
     let mut groups: Vec<(Q, Vec<(bool, NodeId)>)> = Vec::new();

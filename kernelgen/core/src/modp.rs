@@ -29,11 +29,6 @@ impl Fp {
         Fp(x % P)
     }
 
-    /// The canonical representative in [0, p).
-    pub fn value(self) -> u64 {
-        self.0
-    }
-
     /// 1/a, and 0 for a = 0 (as the generated code's `safe_recip`).
     pub fn recip(self) -> Fp {
         let (mut base, mut e, mut r) = (self, P - 2, Fp(1));

@@ -19,7 +19,7 @@
 //! direct program has 4,485 statements; the kernel's value is lane 0 of its output pair.
 
 use crate::dag::{NodeId, Op, Q};
-use crate::emit::group_by_magnitude;
+use crate::emit::coefficient_muls;
 use crate::modp::{evaluate, evaluate_direct, evaluate_paired, Fp, Stream};
 use crate::program::{OpCounts, Program};
 use crate::recursion::RecursionStats;
@@ -224,15 +224,7 @@ impl Paired {
                 } => {
                     let leaves = direct.len() + swapped.len() + usize::from(!c0.is_zero());
                     c.adds += leaves.saturating_sub(1);
-                    c.muls += [direct, swapped]
-                        .into_iter()
-                        .map(|t| {
-                            group_by_magnitude(t)
-                                .iter()
-                                .filter(|(m, _)| !m.is_one())
-                                .count()
-                        })
-                        .sum::<usize>();
+                    c.muls += coefficient_muls(direct) + coefficient_muls(swapped);
                 }
             }
             c.statements += 1;
@@ -259,28 +251,35 @@ impl Ref {
     }
 }
 
-/// Node values at three random points and at their mirror images, for exact identity tests.
+/// Node values at three random points, and at their mirror images under one involution, for exact
+/// identity tests. The points and the values there do not depend on the involution: made once per program.
 struct Samples {
+    points: [Vec<Fp>; 3],
     at: [Vec<Fp>; 3],
-    mirrored: [Vec<Fp>; 3],
 }
 
+/// The node values at a program's sample points after mirroring them under an involution.
+struct Mirrored([Vec<Fp>; 3]);
+
 impl Samples {
-    fn new(program: &Program, inv: &Involution) -> Samples {
+    fn new(program: &Program) -> Samples {
         let n = program.spec.n_inputs();
-        let map = inv.on_inputs(&program.spec);
         let mut stream = Stream::new(0x5eed_0f17);
         let points: [Vec<Fp>; 3] =
             std::array::from_fn(|_| (0..n).map(|_| stream.next_fp()).collect());
-        let mirror = |p: &Vec<Fp>| -> Vec<Fp> {
-            map.iter()
+        let at = points.clone().map(|p| evaluate(&program.dag, &p));
+        Samples { points, at }
+    }
+
+    fn mirrored(&self, program: &Program, inv: &Involution) -> Mirrored {
+        let map = inv.on_inputs(&program.spec);
+        Mirrored(self.points.clone().map(|p| {
+            let mirror: Vec<Fp> = map
+                .iter()
                 .map(|&(j, neg)| if neg { p[j].neg() } else { p[j] })
-                .collect()
-        };
-        Samples {
-            at: points.clone().map(|p| evaluate(&program.dag, &p)),
-            mirrored: points.map(|p| evaluate(&program.dag, &mirror(&p))),
-        }
+                .collect();
+            evaluate(&program.dag, &mirror)
+        }))
     }
 
     /// Shape of a value triple up to a constant factor: (v₂/v₁, v₃/v₁), if v₁ ≠ 0.
@@ -291,16 +290,22 @@ impl Samples {
     fn values(&self, id: NodeId) -> [Fp; 3] {
         std::array::from_fn(|p| self.at[p][id])
     }
+}
 
-    fn mirrored_values(&self, id: NodeId) -> [Fp; 3] {
-        std::array::from_fn(|p| self.mirrored[p][id])
+impl Mirrored {
+    fn values(&self, id: NodeId) -> [Fp; 3] {
+        std::array::from_fn(|p| self.0[p][id])
     }
 }
 
 /// Pairs `program` under `inv` (see the module docs), checked against the direct program at two fresh
 /// random points; `None` if the check fails (an identity wrongly assumed, which no test has seen).
 pub fn pair(program: &Program, inv: &Involution) -> Option<Paired> {
-    let samples = Samples::new(program, inv);
+    pair_at(program, inv, &Samples::new(program))
+}
+
+fn pair_at(program: &Program, inv: &Involution, samples: &Samples) -> Option<Paired> {
+    let mirrored = samples.mirrored(program, inv);
     let live = program.live();
     let inputs = inv.on_inputs(&program.spec);
     // Shape → first live node with that shape.
@@ -327,7 +332,7 @@ pub fn pair(program: &Program, inv: &Involution) -> Option<Paired> {
             });
             continue;
         }
-        if let Some((r, c)) = find(&index, &refs, samples.mirrored_values(id)) {
+        if let Some((r, c)) = find(&index, &refs, mirrored.values(id)) {
             // n(σg) = c·m(g), so P(n) = c·swap(P(m)).
             b.counts.mirrored += 1;
             refs[id] = Some(Ref {
@@ -392,9 +397,10 @@ pub fn pair(program: &Program, inv: &Involution) -> Option<Paired> {
 /// statements, a swap counted as half of one (a swap is one short register instruction, a statement often
 /// a load or store besides its arithmetic; weighting them equally chose a program 8% slower).
 pub fn best_pairing(program: &Program) -> Option<Paired> {
+    let samples = Samples::new(program);
     Involution::candidates(&program.spec)
         .iter()
-        .filter_map(|inv| pair(program, inv))
+        .filter_map(|inv| pair_at(program, inv, &samples))
         .min_by_key(|p| 2 * p.counts.statements + p.counts.swaps)
 }
 

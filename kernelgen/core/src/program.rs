@@ -5,10 +5,10 @@
 //! a dot product costs two additions of norms already at hand: k_A·k_B = (k_{A∪B}² − k_A² − k_B²)/2.
 
 use crate::dag::{q, Dag, Op, Value, Q};
-use crate::emit::group_by_magnitude;
+use crate::emit::coefficient_muls;
 use crate::recursion::{momentum, Algebra, Mask, Recursion, RecursionStats};
 use crate::spec::Spec;
-use num_traits::{One, Zero};
+use num_traits::Zero;
 use std::collections::HashMap;
 
 /// The recursion's algebra over the expression graph of one configuration.
@@ -178,10 +178,7 @@ impl Program {
                 Op::Input(_) => continue,
                 Op::Lin(terms, c0) => {
                     c.adds += terms.len() - 1 + usize::from(!c0.is_zero());
-                    c.muls += group_by_magnitude(terms)
-                        .iter()
-                        .filter(|(m, _)| !m.is_one())
-                        .count();
+                    c.muls += coefficient_muls(terms);
                 }
                 Op::Mul(..) => c.muls += 1,
                 Op::Recip(_) => c.recips += 1,
