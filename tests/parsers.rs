@@ -613,7 +613,7 @@ fn a_second_row_of_names_is_an_error_on_its_line() {
     let e = Table::parse("k P\nkh pk\n0.1 2\n", ORIGIN, &[0, 1]).unwrap_err();
     assert_eq!(
         message(e),
-        format!("{ORIGIN}:2: cannot parse `kh` (column 0, 0-based) as a number")
+        format!("{ORIGIN}:2: cannot parse `kh` (column 1) as a number")
     );
     // Garbage throughout: the second line is named, not "0 rows".
     let e = Table::parse("\u{7f}ELF\u{2}\u{1}\nxx yy zz\n", ORIGIN, &[0]).unwrap_err();
@@ -783,7 +783,7 @@ fn covariance_shape_errors_name_file_and_line() {
         ("1 0\n0 1 0\n", ":2: the row has 3 columns, 2 expected"),
         (
             "1 0\n0\n",
-            ":2: column 1 (0-based) was requested but the row has only 1",
+            ":2: column 2 was requested but the row has only 1",
         ),
         (
             "1 0\n0 1\n0 0\n",

@@ -37,6 +37,13 @@ pub trait Evaluate: Scalar {
     fn mode_coupling_3(g: &[Self; 6]) -> [Self; 2];
     /// F_4^s(q1, k − q1, q2, −q2) from the 6 Gram entries of (k, q1, q2).
     fn mode_coupling_4(g: &[Self; 6]) -> [Self; 2];
+    /// The vectors as [`kernels`](crate::kernels) evaluates them: the kernels are homogeneous of
+    /// degree 0, so any common factor may be taken out. Exact types keep them; `f64` scales them by
+    /// the power of two that brings the largest component to [1, 2), so that the dot products of tiny
+    /// (1e-170) or huge (1e170) vectors neither underflow nor overflow, and the scaling itself is exact.
+    fn normalised(q: &[[Self; 3]]) -> Vec<[Self; 3]> {
+        q.to_vec()
+    }
 }
 
 /// Calls the generated general kernel of order n with a slice of the right length.
@@ -61,6 +68,18 @@ fn general_dispatch<T: Scalar + Copy>(n: usize, g: &[T]) -> Result<[T; 2], Kerne
 }
 
 impl Evaluate for f64 {
+    fn normalised(q: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        let largest = q.iter().flatten().fold(0.0_f64, |m, c| m.max(c.abs()));
+        if !(largest.is_finite() && largest > 0.0) {
+            return q.to_vec();
+        }
+        // 2^-e with e the binary exponent of the largest component, applied in two exact steps
+        // (2^±1074 is not representable in one factor).
+        let e = largest.log2().floor() as i32;
+        let (a, b) = (e / 2, e - e / 2);
+        let scale = |v: f64| v * 2f64.powi(-a) * 2f64.powi(-b);
+        q.iter().map(|v| v.map(scale)).collect()
+    }
     fn general(n: usize, g: &[f64]) -> Result<[f64; 2], KernelError> {
         general_dispatch(n, g)
     }

@@ -142,6 +142,10 @@ pub fn general_from_gram<T: Evaluate>(n: usize, g: &[T]) -> Result<[T; 2], Kerne
 
 /// `[F_n^s, G_n^s](q_1, …, q_n)` of n = 1..=7 free 3-vectors (k in h/Mpc; the kernels are dimensionless).
 ///
+/// The kernels are homogeneous of degree 0: the vectors are first scaled by one common factor
+/// ([`Evaluate::normalised`]), so that in `f64` vectors of any size in the floating-point range give
+/// the same value as vectors of order one (a component below 2^-1022 times the largest is lost).
+///
 /// # Errors
 /// n outside 1..=7, or a zero vector. Subsets summing exactly to zero momentum are fine.
 pub fn kernels<T: Evaluate>(q: &[[T; 3]]) -> Result<[T; 2], KernelError> {
@@ -151,7 +155,7 @@ pub fn kernels<T: Evaluate>(q: &[[T; 3]]) -> Result<[T; 2], KernelError> {
     if let Some(i) = q.iter().position(|v| v.iter().all(Scalar::is_zero)) {
         return Err(KernelError::ZeroVector(i + 1));
     }
-    general_from_gram(q.len(), &gram(q))
+    general_from_gram(q.len(), &gram(&T::normalised(q)))
 }
 
 macro_rules! specialised {
@@ -178,4 +182,75 @@ specialised! {
     mode_coupling_3: 6;
     /// The P24 mode-coupling kernel F_4^s(q1, k − q1, q2, −q2) from the Gram matrix of (k, q1, q2).
     mode_coupling_4: 6;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// F_2^s(q1, q2) of orthogonal unit vectors is 5/7 and G_2^s 3/7 exactly: the same at any scale of
+    /// the vectors, down to the subnormal range and up to the top of f64.
+    #[test]
+    fn kernels_of_tiny_and_huge_vectors_are_those_of_unit_vectors() {
+        for s in [1e-320, 1e-170, 1e-100, 1.0, 1e100, 1e170, 1e300] {
+            let [f, g] = kernels(&[[s, 0.0, 0.0], [0.0, s, 0.0]]).unwrap();
+            let exact = [5.0 / 7.0, 3.0 / 7.0];
+            assert!(
+                (f - exact[0]).abs() < 1e-15 && (g - exact[1]).abs() < 1e-15,
+                "scale {s}"
+            );
+        }
+        // A general configuration: scaling all vectors by a power of ten changes at most rounding.
+        let q = [[0.3, -0.1, 0.2], [0.05, 0.4, -0.3], [-0.2, 0.1, 0.15]];
+        let reference = kernels(&q).unwrap();
+        for s in [1e-200, 1e-150, 1e150, 1e200] {
+            let scaled: Vec<[f64; 3]> = q.iter().map(|v| v.map(|c| c * s)).collect();
+            let value = kernels(&scaled).unwrap();
+            for (a, b) in value.iter().zip(&reference) {
+                assert!((a - b).abs() <= 1e-13 * b.abs(), "scale {s}: {a} vs {b}");
+            }
+        }
+    }
+}
+
+/// Length ratio of the vectors above which [`cancellation_note`] warns.
+pub const CANCELLATION_RATIO: f64 = 1e3;
+
+/// A warning for `f64` vectors whose lengths differ by more than [`CANCELLATION_RATIO`]: the kernels'
+/// Gram-matrix form then cancels large terms, and the `f64` result loses digits (F_2^s of orthogonal
+/// vectors is 3e-11 off at length ratio 1e3, 2e-9 at 1e4, 3e-8 at 1e5, 35% at 1e9); exact rationals
+/// do not.
+pub fn cancellation_note(q: &[[f64; 3]]) -> Option<String> {
+    let lengths: Vec<f64> = q
+        .iter()
+        .map(|v| v.iter().map(|c| c.abs()).fold(0.0, f64::max))
+        .collect();
+    let (min, max) = lengths
+        .iter()
+        .fold((f64::INFINITY, 0.0_f64), |(a, b), &l| (a.min(l), b.max(l)));
+    let ratio = max / min;
+    (min > 0.0 && ratio > CANCELLATION_RATIO).then(|| {
+        format!(
+            "the vectors' lengths differ by a factor {ratio:.1e}: in f64 the kernel loses digits to \
+             cancellation (F_2 of orthogonal vectors: 2e-9 off at 1e4, 3e-8 at 1e5, 35% at 1e9); exact rational arithmetic (--exact, exact=True) has no such loss"
+        )
+    })
+}
+
+#[cfg(test)]
+mod cancellation_tests {
+    use super::*;
+
+    #[test]
+    fn unequal_lengths_are_noted_and_the_figures_quoted_hold() {
+        assert!(cancellation_note(&[[1.0, 0.0, 0.0], [0.0, 1e-3, 0.0]]).is_none());
+        let note = cancellation_note(&[[1.0, 0.0, 0.0], [0.0, 1e-5, 0.0]]).unwrap();
+        assert!(note.contains("1.0e5"), "{note}");
+        // The errors the note quotes, within a factor of a few.
+        for (ratio, quoted) in [(1e4, 2e-9), (1e5, 3e-8)] {
+            let [f, _] = kernels(&[[1.0 / ratio, 0.0, 0.0], [0.0, 1.0, 0.0]]).unwrap();
+            let error = (f - 5.0 / 7.0).abs() / (5.0 / 7.0);
+            assert!(error < 5.0 * quoted, "ratio {ratio}: {error:e}");
+        }
+    }
 }

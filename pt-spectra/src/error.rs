@@ -56,13 +56,13 @@ pub enum Error {
     },
 
     /// A field of a data row is not a number.
-    #[error("{origin}:{line}: cannot parse `{field}` (column {column}, 0-based) as a number")]
+    #[error("{origin}:{line}: cannot parse `{field}` (column {}) as a number", .column + 1)]
     Parse {
         /// File path or description of the input.
         origin: String,
         /// 1-based line number.
         line: usize,
-        /// 0-based column index of the field.
+        /// 0-based column index of the field (printed 1-based, as `--columns` counts).
         column: usize,
         /// The text that failed to parse.
         field: String,
@@ -70,14 +70,15 @@ pub enum Error {
 
     /// A data row has fewer columns than the requested column choice needs.
     #[error(
-        "{origin}:{line}: column {column} (0-based) was requested but the row has only {found} column(s)"
+        "{origin}:{line}: column {} was requested but the row has only {found} column(s)",
+        .column + 1
     )]
     MissingColumn {
         /// File path or description of the input.
         origin: String,
         /// 1-based line number.
         line: usize,
-        /// The 0-based column index that was requested.
+        /// The 0-based column index that was requested (printed 1-based).
         column: usize,
         /// Number of columns found on the row.
         found: usize,
@@ -311,6 +312,54 @@ pub enum Error {
         #[source]
         source: Box<Error>,
     },
+    /// A parameter-file key whose value is outside the plausible range of its quantity.
+    #[error("{origin}:{line}: `{key}` is outside the plausible range of {name}, {range}{converted}{hint}")]
+    Implausible {
+        /// File path or description of the input.
+        origin: String,
+        /// 1-based line number (1-based index for key–value pairs).
+        line: usize,
+        /// The `key = value` as written.
+        key: String,
+        /// The quantity's value in the units of the range, as ` (h = 0.6766)`, where the key's
+        /// differ (empty where they are the same).
+        converted: String,
+        /// The quantity, e.g. `h`.
+        name: &'static str,
+        /// The range, e.g. `[0.2, 1.5]`.
+        range: String,
+        /// A guess at what was meant (may be empty), e.g. that h was given as H0.
+        hint: &'static str,
+    },
+
+    /// A computed value that is NaN or infinite: never written as a result.
+    #[error(
+        "the result has a non-finite value, {column} = {} at {at}: not written (a bug or an input \
+         outside what the model handles; please report it with the command)",
+        number(.value)
+    )]
+    NonFiniteOutput {
+        /// The column.
+        column: String,
+        /// The row, e.g. `k = 0.05 h/Mpc`.
+        at: String,
+        /// The value.
+        value: f64,
+    },
+
+    /// A plan would need more memory than the limit allows.
+    #[error("{what} needs about {needed} of memory, above {limit} ({origin})")]
+    MemoryLimit {
+        /// What would be built, e.g. `the 1l-spt plan on 10000000 k`.
+        what: String,
+        /// The estimate, e.g. `3.4 TB`.
+        needed: String,
+        /// The limit, e.g. `12 GB`.
+        limit: String,
+        /// Where the limit comes from.
+        origin: String,
+    },
+
     /// A row of a table does not fit the table's shape or consistency: a matrix row with the wrong number
     /// of columns, a row too many, an element that differs from its mirror image across the diagonal.
     #[error("{origin}:{line}: {problem}")]

@@ -16,6 +16,7 @@
 //! * [`fit`]: χ² fits of f, σ0 and A_b to measured multipoles, with Δχ² contour errors, versus k_max.
 //! * [`halo`]: scale-dependent bias, stochasticity (shot noise) and signal-to-noise of haloes.
 //! * [`table`]: plain-text tables and tabulated functions of k.
+//! * [`memory`]: memory estimates of plans, checked against a limit before they allocate.
 //!
 //! ```
 //! use pt_spectra::{cosmology::Cosmology, linear::LinearSpectrum};
@@ -36,6 +37,7 @@ pub mod ir;
 pub mod jobs;
 pub mod linear;
 pub mod loops;
+pub mod memory;
 pub mod output;
 pub mod precision;
 pub mod progress;

@@ -11,8 +11,14 @@
 //! t.push_estimates("P", "(Mpc/h)^3", &[Estimate::new(1.0, 0.01), Estimate::new(2.0, 0.02)]);
 //! assert_eq!(t.names(), ["k", "P", "err_P"]);
 //! assert!(t.to_text().ends_with("2.000000000e-1 2.000000000e0 2.000000000e-2\n"));
+//! assert!(t.checked().is_ok());
+//! t.push("bad", "1", vec![1.0, f64::NAN]);
+//! assert_eq!(t.checked().unwrap_err().to_string(),
+//!            "the result has a non-finite value, bad = NaN at k = 0.2 h/Mpc: not written (a bug or \
+//!             an input outside what the model handles; please report it with the command)");
 //! ```
 
+use crate::error::{number, Error, Result};
 use crate::estimate::Estimate;
 
 /// The unit of spectra.
@@ -29,6 +35,9 @@ pub struct Column {
     pub unit: &'static str,
     /// The values.
     pub values: Vec<f64>,
+    /// `Some(meaning)` if NaN is a documented value of this column (e.g. a 1σ bound that does not
+    /// exist); `None` (every column but such) if every value must be finite.
+    pub undefined: Option<&'static str>,
 }
 
 /// A table: header lines (without the `#`) and columns of equal length.
@@ -55,6 +64,28 @@ impl Table {
             name: name.into(),
             unit,
             values,
+            undefined: None,
+        });
+    }
+
+    /// Appends a column in which NaN is a documented value meaning `meaning` (said in the header
+    /// when it occurs).
+    pub fn push_undefined_as(
+        &mut self,
+        name: impl Into<String>,
+        unit: &'static str,
+        values: Vec<f64>,
+        meaning: &'static str,
+    ) {
+        let name = name.into();
+        if values.iter().any(|v| v.is_nan()) {
+            self.header.push(format!("{name} = NaN: {meaning}"));
+        }
+        self.columns.push(Column {
+            name,
+            unit,
+            values,
+            undefined: Some(meaning),
         });
     }
 
@@ -84,6 +115,38 @@ impl Table {
     /// The number of rows.
     pub fn rows(&self) -> usize {
         self.columns.first().map_or(0, |c| c.values.len())
+    }
+
+    /// The table itself if every value is finite: the check both faces make before they hand a table
+    /// out, so that a NaN or an infinity (from a corrupted input, an overflow, a bug) is never
+    /// printed as a result. The one exception is a column pushed with
+    /// [`push_undefined_as`](Self::push_undefined_as), where NaN has a meaning the header states (a fit's
+    /// 1σ bound that does not exist).
+    ///
+    /// # Errors
+    /// [`Error::NonFiniteOutput`] naming the first non-finite value's column and row (by the first
+    /// column's name and value, e.g. `k = 0.05`).
+    pub fn checked(&self) -> Result<&Self> {
+        for c in &self.columns {
+            let allowed = |v: &f64| v.is_finite() || (v.is_nan() && c.undefined.is_some());
+            if let Some(i) = c.values.iter().position(|v| !allowed(v)) {
+                let at = match self.columns.first() {
+                    Some(first) if first.values[i].is_finite() => {
+                        let unit = if first.unit == "1" { "" } else { first.unit };
+                        format!("{} = {} {unit}", first.name, number(&first.values[i]))
+                            .trim_end()
+                            .to_string()
+                    }
+                    _ => format!("row {}", i + 1),
+                };
+                return Err(Error::NonFiniteOutput {
+                    column: c.name.clone(),
+                    at,
+                    value: c.values[i],
+                });
+            }
+        }
+        Ok(self)
     }
 
     /// The table as text (see the module docs).
@@ -125,8 +188,20 @@ pub fn fit_table(results: &[crate::fit::FitResult], header: Vec<String>) -> Tabl
         for (j, (p, _, _)) in first.intervals.iter().enumerate() {
             let unit = p.unit();
             t.push(p.name(), unit, column(&|r| r.best.get(r.intervals[j].0)));
-            t.push(format!("{p}_lo"), unit, column(&|r| r.intervals[j].1));
-            t.push(format!("{p}_hi"), unit, column(&|r| r.intervals[j].2));
+            let unbounded = "no delta chi2 = 1 crossing found on that side within 2^12 times the \
+                             initial step (the parameter is unconstrained there)";
+            t.push_undefined_as(
+                format!("{p}_lo"),
+                unit,
+                column(&|r| r.intervals[j].1),
+                unbounded,
+            );
+            t.push_undefined_as(
+                format!("{p}_hi"),
+                unit,
+                column(&|r| r.intervals[j].2),
+                unbounded,
+            );
         }
     }
     t.push("chi2", "1", column(&|r| r.chi2));

@@ -79,6 +79,9 @@ pub struct Precision {
     /// How the 2-loop terms (P15 and the 2-loop correction) of a spectrum are computed: from basis
     /// tensors or by direct integration ([`TwoLoopMethod`]). Default [`TwoLoopMethod::Auto`].
     pub two_loop: TwoLoopMethod,
+    /// The most memory [bytes] a plan may take: a plan whose estimate ([`crate::memory`]) exceeds it
+    /// is refused before it allocates. Default `None`: half of the machine's memory.
+    pub max_memory: Option<f64>,
 }
 
 /// How a [`RealPlan`](crate::real::RealPlan) computes the 2-loop terms of a spectrum.
@@ -132,6 +135,9 @@ impl std::str::FromStr for TwoLoopMethod {
     }
 }
 
+/// The range [h/Mpc] in which [`Precision::q_min`] and [`Precision::q_max`] must lie.
+pub const Q_LIMITS: (f64, f64) = (1e-8, 1e6);
+
 impl Default for Precision {
     fn default() -> Self {
         Self {
@@ -153,6 +159,7 @@ impl Default for Precision {
             two_loop_tolerance: 1e-3,
             two_loop_seed: 2,
             two_loop: TwoLoopMethod::Auto,
+            max_memory: None,
         }
     }
 }
@@ -228,8 +235,8 @@ impl Precision {
     /// Checks the settings.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] unless 0 < q_min < q_max < ∞, every width and step is finite and
-    /// positive, the lattice has at least 8 points, and every order is ≥ 1.
+    /// [`Error::InvalidParameter`] unless 0 < q_min < q_max < ∞, both in [`Q_LIMITS`], every width and
+    /// step is finite and positive, the lattice has at least 8 points, and every order is ≥ 1.
     pub fn validate(&self) -> Result<()> {
         let bad = |name, value: f64, reason| {
             Err(Error::InvalidParameter {
@@ -264,6 +271,22 @@ impl Precision {
         if self.q_max <= self.q_min {
             return bad("q_max [h/Mpc]", self.q_max, "must exceed q_min");
         }
+        if !(Q_LIMITS.0..=Q_LIMITS.1).contains(&self.q_min) {
+            return bad(
+                "q_min [h/Mpc]",
+                self.q_min,
+                "must be in [1e-8, 1e6] h/Mpc (below 1e-8 the power of any CDM spectrum is \
+                 negligible; the lattice spans the range in steps of lattice_step in ln q)",
+            );
+        }
+        if !(Q_LIMITS.0..=Q_LIMITS.1).contains(&self.q_max) {
+            return bad(
+                "q_max [h/Mpc]",
+                self.q_max,
+                "must be in [1e-8, 1e6] h/Mpc (beyond 1e6 the loop integrands overflow or \
+                 underflow in f64 for a CDM spectrum extended as a power law)",
+            );
+        }
         if (self.q_max / self.q_min).ln() < 8.0 * self.lattice_step {
             return bad(
                 "lattice_step",
@@ -279,6 +302,11 @@ impl Precision {
         ] {
             if v == 0 {
                 return bad(name, 0.0, "must be at least 1");
+            }
+        }
+        if let Some(m) = self.max_memory {
+            if !(m.is_finite() && m > 0.0) {
+                return bad("max_memory [bytes]", m, positive);
             }
         }
         if self.two_loop_replicas < 2 {

@@ -1,9 +1,14 @@
 //! [`TableStore`]: the cosmology-independent angular tables (P15, P17), built once and cached in a
 //! directory the caller chooses.
 //!
-//! A table is read from its file if the file is there and passes its checks (size, finite values, a few
-//! entries recomputed); otherwise it is built and written atomically (a temporary file renamed into
-//! place), so a reader never sees half a table, and a corrupted or stale file is rebuilt. While a
+//! A table file is a header (the magic `PTSTAB01`, the number of values, and the 64-bit FNV-1a hash of
+//! the payload's bytes) followed by the values as little-endian f64. A table is read from its file if
+//! the file is there, its hash matches and the values pass the table's own checks (size, finite
+//! values, a few entries recomputed); otherwise it is built and written atomically (a temporary file
+//! renamed into place), so a reader never sees half a table, and a corrupted, truncated or stale file
+//! is rebuilt, with a note through [`Progress::note`] that says why. A table that cannot be written
+//! (full disk, read-only directory) is used from memory, with a note, and the temporary file is
+//! removed. While a
 //! process builds a table it holds an operating-system lock on `<table>.lock` beside it
 //! ([`std::fs::File::lock`]): another process that needs the same table waits for it (and says so
 //! through [`Progress::note`]) instead of building it twice, and a process that dies while building
@@ -141,16 +146,34 @@ impl TableStore {
         Ok(Arc::new(tensors))
     }
 
-    /// The 2-loop basis tensors for `k` and `precision` if their file is in the directory (never
-    /// builds them).
+    /// The 2-loop basis tensors for `k` and `precision` if their file is in the directory and valid
+    /// (never builds them; a corrupted file is reported to `progress` and not used).
     pub fn cached_two_loop_basis(
         &self,
         k: &[f64],
         precision: &Precision,
+        progress: &dyn Progress,
     ) -> Option<Arc<TwoLoopBasis>> {
         let path = self.path(&TwoLoopBasis::file_name(k, precision))?;
-        let values = read_f64s(&path)?;
-        TwoLoopBasis::from_f64s(&values, k, precision).map(Arc::new)
+        let tensors = match read_f64s(&path) {
+            Stored::Missing => None,
+            Stored::Invalid(why) => {
+                progress.note(&format!(
+                    "the cached 2-loop basis tensors `{}` {why}: not used (method basis rebuilds them)",
+                    path.display()
+                ));
+                return None;
+            }
+            Stored::Values(v) => TwoLoopBasis::from_f64s(&v, k, precision),
+        };
+        if tensors.is_none() && path.exists() {
+            progress.note(&format!(
+                "the cached 2-loop basis tensors `{}` fail their consistency checks: not used \
+                 (method basis rebuilds them)",
+                path.display()
+            ));
+        }
+        tensors.map(Arc::new)
     }
 }
 
@@ -193,15 +216,32 @@ pub(crate) fn cached<T>(
     write: impl Fn(&T) -> Vec<f64>,
     progress: &dyn Progress,
 ) -> Result<T> {
-    let read_file = || read_f64s(path).and_then(|v| read(&v));
-    if let Some(t) = read_file() {
-        return Ok(t);
-    }
+    // The table if the file holds a valid one; else why not (None: no file, nothing to say).
+    let read_file = || -> std::result::Result<T, Option<String>> {
+        match read_f64s(path) {
+            Stored::Missing => Err(None),
+            Stored::Invalid(why) => Err(Some(why)),
+            Stored::Values(v) => {
+                read(&v).ok_or_else(|| Some("fails the table's consistency checks".to_string()))
+            }
+        }
+    };
+    let first = match read_file() {
+        Ok(t) => return Ok(t),
+        Err(why) => why,
+    };
     let fail = |path: &Path, what: &'static str| {
         let path = path.to_path_buf();
         move |source| Error::Cache { path, what, source }
     };
     if let Some(dir) = path.parent() {
+        if dir.exists() && !dir.is_dir() {
+            return Err(Error::Cache {
+                path: dir.to_path_buf(),
+                what: "use as the cache directory",
+                source: std::io::Error::other("it exists and is not a directory"),
+            });
+        }
         std::fs::create_dir_all(dir).map_err(fail(dir, "create the cache directory"))?;
     }
     let lock_path = path.with_extension("lock");
@@ -213,11 +253,24 @@ pub(crate) fn cached<T>(
         .map_err(fail(&lock_path, "open the lock file"))?;
     acquire(&lock, &lock_path, name, progress)?;
     // Another process may have finished the table while this one waited.
-    if let Some(t) = read_file() {
-        return Ok(t);
+    let why = match read_file() {
+        Ok(t) => return Ok(t),
+        Err(why) => why.or(first),
+    };
+    if let Some(why) = why {
+        progress.note(&format!(
+            "the cached {name} table `{}` {why}: rebuilding it",
+            path.display()
+        ));
     }
     let t = build();
-    write_f64s(path, &write(&t)).map_err(fail(path, "write the table"))?;
+    if let Err(e) = write_f64s(path, &write(&t)) {
+        progress.note(&format!(
+            "cannot write the {name} table to `{}` ({e}): using it from memory; it will be built \
+             again by the next process",
+            path.display()
+        ));
+    }
     // The lock is released when `lock` is dropped (or the process dies); the file stays, empty.
     drop(lock);
     Ok(t)
@@ -244,31 +297,85 @@ fn acquire(lock: &File, lock_path: &Path, name: &str, progress: &dyn Progress) -
     }
 }
 
-/// Writes little-endian f64 `values` to `path` atomically: to a temporary file of this process, then
-/// renamed into place.
-fn write_f64s(path: &Path, values: &[f64]) -> std::io::Result<()> {
-    let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
-    std::fs::write(&tmp, &bytes)?;
-    std::fs::rename(&tmp, path)
+/// The first bytes of every table file (the format's version is its last two characters).
+const MAGIC: &[u8; 8] = b"PTSTAB01";
+/// The header: [`MAGIC`], the number of values (u64) and the [`fnv1a`] hash of the payload (u64).
+const HEADER: usize = 24;
+
+/// The 64-bit FNV-1a hash of `bytes` (Fowler, Noll & Vo): any change of one byte changes it, and a
+/// random change goes unnoticed with probability 2^-64.
+pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
 }
 
-/// Reads little-endian f64 values from `path`; `None` if it is missing, unreadable or not a whole
-/// number of values.
-fn read_f64s(path: &Path) -> Option<Vec<f64>> {
-    let bytes = std::fs::read(path).ok()?;
-    if !bytes.len().is_multiple_of(8) {
-        return None;
+/// Writes `values` to `path` atomically (a temporary file of this process, then renamed into place)
+/// behind the [`HEADER`]; the temporary file is removed if anything fails.
+fn write_f64s(path: &Path, values: &[f64]) -> std::io::Result<()> {
+    let payload: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+    let mut bytes = Vec::with_capacity(HEADER + payload.len());
+    bytes.extend_from_slice(MAGIC);
+    bytes.extend_from_slice(&(values.len() as u64).to_le_bytes());
+    bytes.extend_from_slice(&fnv1a(&payload).to_le_bytes());
+    bytes.extend_from_slice(&payload);
+    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
+    let result = std::fs::write(&tmp, &bytes).and_then(|()| std::fs::rename(&tmp, path));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
     }
-    let values = bytes
-        .chunks_exact(8)
-        .map(|c| {
-            let mut b = [0u8; 8];
-            b.copy_from_slice(c);
-            f64::from_le_bytes(b)
-        })
-        .collect();
-    Some(values)
+    result
+}
+
+/// What a table file holds.
+enum Stored {
+    /// No file (or none that can be read): build the table without comment.
+    Missing,
+    /// A file that is not a whole, intact table: why.
+    Invalid(String),
+    /// The values, their hash verified.
+    Values(Vec<f64>),
+}
+
+/// Reads a table file written by [`write_f64s`], verifying its header, length and hash.
+fn read_f64s(path: &Path) -> Stored {
+    let Ok(bytes) = std::fs::read(path) else {
+        return Stored::Missing;
+    };
+    let word = |i: usize| {
+        let mut b = [0u8; 8];
+        b.copy_from_slice(&bytes[8 * i..8 * i + 8]);
+        u64::from_le_bytes(b)
+    };
+    if bytes.len() < HEADER || &bytes[..8] != MAGIC {
+        return Stored::Invalid(
+            "is not a table file of this version (no PTSTAB01 header)".to_string(),
+        );
+    }
+    let payload = &bytes[HEADER..];
+    let (count, hash) = (word(1), word(2));
+    if payload.len() as u64 != count.saturating_mul(8) {
+        return Stored::Invalid(format!(
+            "is truncated or extended: {} bytes of values where the header says {count} values",
+            payload.len()
+        ));
+    }
+    let actual = fnv1a(payload);
+    if actual != hash {
+        return Stored::Invalid(format!(
+            "is corrupted: its checksum is {actual:016x}, the header says {hash:016x}"
+        ));
+    }
+    Stored::Values(
+        payload
+            .chunks_exact(8)
+            .map(|c| {
+                let mut b = [0u8; 8];
+                b.copy_from_slice(c);
+                f64::from_le_bytes(b)
+            })
+            .collect(),
+    )
 }
 
 #[cfg(test)]
@@ -401,6 +508,119 @@ mod tests {
     }
 
     #[test]
+    fn fnv1a_has_its_published_values() {
+        assert_eq!(fnv1a(b""), 0xcbf2_9ce4_8422_2325);
+        assert_eq!(fnv1a(b"a"), 0xaf63_dc4c_8601_ec8c);
+        assert_eq!(fnv1a(b"foobar"), 0x8594_4171_f739_67e8);
+    }
+
+    /// Builds (or reads) a table of 1000 values at `path`, counting builds and collecting notes.
+    fn long_table(path: &Path, builds: &AtomicUsize, notes: &Notes) -> Vec<f64> {
+        cached(
+            path,
+            "test",
+            |v: &[f64]| (v.len() == 1000).then(|| v.to_vec()),
+            || {
+                builds.fetch_add(1, Ordering::Relaxed);
+                (0..1000).map(f64::from).collect()
+            },
+            Clone::clone,
+            notes,
+        )
+        .unwrap()
+    }
+
+    /// Fault injection: bytes overwritten in the middle, values scaled, the file truncated or of an
+    /// older format; each is noticed, said, and rebuilt, never used.
+    #[test]
+    fn a_corrupted_table_is_rebuilt_with_a_note() {
+        let dir = scratch("corrupt");
+        let path = dir.join("t.bin");
+        let builds = AtomicUsize::new(0);
+        let notes = Notes(Mutex::new(Vec::new()));
+        let good: Vec<f64> = (0..1000).map(f64::from).collect();
+        assert_eq!(long_table(&path, &builds, &notes), good);
+        let intact = std::fs::read(&path).unwrap();
+        let corruptions: [(&str, Box<dyn Fn(&mut Vec<u8>)>, &str); 5] = [
+            (
+                "random bytes",
+                Box::new(|b: &mut Vec<u8>| {
+                    let at = b.len() / 2 + 3;
+                    for (i, x) in b[at..at + 64].iter_mut().enumerate() {
+                        *x ^= 0x5a ^ (i as u8);
+                    }
+                }),
+                "corrupted",
+            ),
+            (
+                "values x 1.5",
+                Box::new(|b: &mut Vec<u8>| {
+                    for i in 500..510 {
+                        let at = HEADER + 8 * i;
+                        let v = f64::from_le_bytes(b[at..at + 8].try_into().unwrap()) * 1.5;
+                        b[at..at + 8].copy_from_slice(&v.to_le_bytes());
+                    }
+                }),
+                "corrupted",
+            ),
+            (
+                "truncated",
+                Box::new(|b: &mut Vec<u8>| b.truncate(b.len() - 8)),
+                "truncated",
+            ),
+            (
+                "older format",
+                Box::new(|b: &mut Vec<u8>| {
+                    b.drain(..HEADER);
+                }),
+                "no PTSTAB01 header",
+            ),
+            (
+                "empty",
+                Box::new(|b: &mut Vec<u8>| b.clear()),
+                "no PTSTAB01",
+            ),
+        ];
+        for (i, (what, corrupt, needle)) in corruptions.iter().enumerate() {
+            let mut bytes = intact.clone();
+            corrupt(&mut bytes);
+            std::fs::write(&path, &bytes).unwrap();
+            assert_eq!(long_table(&path, &builds, &notes), good, "{what}");
+            assert_eq!(builds.load(Ordering::Relaxed), i + 2, "{what}");
+            let last = notes.0.lock().unwrap().last().cloned().unwrap_or_default();
+            assert!(
+                last.contains(needle) && last.contains("rebuilding") && last.contains("t.bin"),
+                "{what}: {last}"
+            );
+            assert_eq!(std::fs::read(&path).unwrap(), intact, "{what}: rewritten");
+        }
+    }
+
+    #[test]
+    fn a_table_that_cannot_be_written_is_used_from_memory() {
+        let dir = scratch("unwritable-table");
+        let path = dir.join("t.bin");
+        // A directory where the table file should be: the rename fails after the build.
+        std::fs::create_dir_all(path.join("inside")).unwrap();
+        let builds = AtomicUsize::new(0);
+        let notes = Notes(Mutex::new(Vec::new()));
+        assert_eq!(long_table(&path, &builds, &notes).len(), 1000);
+        let notes = notes.0.into_inner().unwrap();
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.contains("cannot write") && n.contains("from memory")),
+            "{notes:?}"
+        );
+        let left: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .filter(|n| n.contains(".tmp"))
+            .collect();
+        assert!(left.is_empty(), "temporary files left: {left:?}");
+    }
+
+    #[test]
     fn an_unwritable_directory_is_an_error_naming_it() {
         let dir = scratch("unwritable");
         std::fs::create_dir_all(&dir).unwrap();
@@ -410,7 +630,9 @@ mod tests {
         let e = table(&blocker.join("t.bin"), &AtomicUsize::new(0), 1.0).unwrap_err();
         let text = e.to_string();
         assert!(
-            text.contains("file") && text.contains("cache directory"),
+            text.contains("file")
+                && text.contains("cache directory")
+                && text.contains("not a directory"),
             "{text}"
         );
     }

@@ -124,6 +124,10 @@ pub fn kernel(which: &str, vectors: Vec<Bound<'_, PyAny>>, exact: bool) -> PyRes
             Ok([x(0)?, x(1)?, x(2)?])
         })
         .collect::<PyResult<_>>()?;
+    if let Some(note) = pt_kernels::cancellation_note(&q) {
+        let category = py.get_type::<pyo3::exceptions::PyRuntimeWarning>();
+        PyErr::warn(py, &category, &std::ffi::CString::new(note)?, 1)?;
+    }
     let value = kernels(&q).map_err(|e| PyValueError::new_err(e.to_string()))?[index];
     if !value.is_finite() {
         return Err(PyValueError::new_err(format!(

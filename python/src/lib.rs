@@ -87,6 +87,7 @@ pub(crate) fn precision(
     two_loop: Option<&str>,
 ) -> PyResult<Precision> {
     let mut p = Precision::preset(name).map_err(value_error)?;
+    p.max_memory = pt_spectra::memory::env_max_memory().map_err(value_error)?;
     if let Some(method) = two_loop {
         p.two_loop = method.parse().map_err(value_error)?;
     }

@@ -29,6 +29,7 @@ impl Table {
         model: &str,
         seconds: f64,
     ) -> PyResult<Self> {
+        checked(&table)?;
         let meta = PyDict::new(py);
         meta.set_item("z", prepared.z)?;
         meta.set_item("f", prepared.growth_rate)?;
@@ -58,6 +59,7 @@ impl Table {
         model: &str,
         seconds: f64,
     ) -> PyResult<Self> {
+        checked(&table)?;
         let meta = PyDict::new(py);
         meta.set_item("model", model)?;
         meta.set_item("seconds", seconds)?;
@@ -67,6 +69,15 @@ impl Table {
             warnings: Vec::new(),
         })
     }
+}
+
+/// A `ValueError` if a value of `table` is not finite (the check the command line makes before it
+/// writes a table).
+fn checked(table: &output::Table) -> PyResult<()> {
+    table
+        .checked()
+        .map(|_| ())
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))
 }
 
 #[pymethods]

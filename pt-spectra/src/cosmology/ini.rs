@@ -94,6 +94,22 @@ impl Quantity {
             Self::OmegaK | Self::Pivot | Self::W0 | Self::Wa => "",
         }
     }
+
+    /// The name of the quantity in [`PLAUSIBLE`](super::PLAUSIBLE).
+    fn plausible_name(self) -> &'static str {
+        match self {
+            Self::Hubble => "h",
+            Self::OmegaB => "omega_b",
+            Self::OmegaCdm => "omega_cdm",
+            Self::OmegaK => "Omega_k",
+            Self::SpectralIndex => "n_s",
+            Self::Sigma8 => "sigma8",
+            Self::PrimordialAmplitude => "A_s",
+            Self::Pivot => "k_pivot",
+            Self::W0 => "w0",
+            Self::Wa => "wa",
+        }
+    }
 }
 
 /// How a key's value converts to its quantity.
@@ -449,7 +465,8 @@ impl<'a> Values<'a> {
     /// sets it.
     ///
     /// # Errors
-    /// [`Error::ConflictingKeys`] if two keys for it disagree.
+    /// [`Error::Implausible`] for a value outside the quantity's [`PLAUSIBLE`](super::PLAUSIBLE)
+    /// range; [`Error::ConflictingKeys`] if two keys for it disagree.
     fn get(&self, quantity: Quantity, h2: f64) -> Result<Option<f64>> {
         let mut first: Option<(Entry<'a>, f64)> = None;
         for f in self.found.iter().filter(|f| f.quantity == quantity) {
@@ -459,6 +476,22 @@ impl<'a> Values<'a> {
                 Unit::TimesH2 => f.number * h2,
                 Unit::Ln1e10 => f.number.exp() * 1e-10,
             };
+            if let Some(range) = super::plausible(quantity.plausible_name()) {
+                if !range.contains(value) {
+                    return Err(Error::Implausible {
+                        origin: self.origin.to_string(),
+                        line: f.entry.line,
+                        key: f.entry.text(),
+                        converted: match f.unit {
+                            Unit::Same => String::new(),
+                            _ => format!(" ({} = {})", range.name, crate::error::number(&value)),
+                        },
+                        name: range.name,
+                        range: range.describe(),
+                        hint: range.hint(value),
+                    });
+                }
+            }
             match first {
                 None => first = Some((f.entry, value)),
                 Some((entry, v)) if !agree(v, value) => {

@@ -95,6 +95,7 @@ pub fn fit_tables(
     let growth = prepared.growth_factor;
     let sigma0 = m.sigma0.resolve(&prepared.spectrum, growth, precision)?;
     let f0 = m.f.unwrap_or(prepared.growth_rate);
+    super::rsd::check_growth_rate(f0)?;
     let fields = [
         ("f", f0),
         ("sigma0", sigma0),

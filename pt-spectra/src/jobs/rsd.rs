@@ -144,13 +144,7 @@ pub fn rsd_table_from_terms(
 ) -> Result<Table> {
     let k = &spectra.k;
     let f = request.f.unwrap_or(prepared.growth_rate);
-    if !f.is_finite() {
-        return Err(Error::InvalidParameter {
-            name: "f",
-            value: f,
-            reason: "must be finite",
-        });
-    }
+    check_growth_rate(f)?;
     let growth = prepared.growth_factor;
     let sigma0 = request
         .sigma0
@@ -236,4 +230,20 @@ fn crossing_line(what: &str, k: &[f64], sn: &[f64]) -> String {
         text.push(';');
     }
     text
+}
+
+/// The growth rate `f` if finite and in its [`PLAUSIBLE`](crate::cosmology::PLAUSIBLE) range [0, 2].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming f, its value and the range.
+pub fn check_growth_rate(f: f64) -> Result<()> {
+    let range = crate::cosmology::plausible("f").expect("f has a plausible range");
+    if !(f.is_finite() && range.contains(f)) {
+        return Err(Error::InvalidParameter {
+            name: "f",
+            value: f,
+            reason: range.reason,
+        });
+    }
+    Ok(())
 }

@@ -65,6 +65,14 @@ impl RealPlan {
         store: &TableStore,
         progress: &dyn Progress,
     ) -> Result<Self> {
+        if selection == RealSelection::All {
+            precision.validate()?;
+            crate::memory::check(
+                crate::memory::plan_bytes(k.len(), RealModel::TwoLoopRegPt.plan_parts(), precision),
+                precision,
+                &format!("the plan of every model on {} k", k.len()),
+            )?;
+        }
         let mut plan = Self::new(k, selection.plan_model(), precision, store, progress)?;
         if selection == RealSelection::All {
             if plan.ir.is_none() {
@@ -99,6 +107,11 @@ impl RealPlan {
         progress: &dyn Progress,
     ) -> Result<Self> {
         precision.validate()?;
+        crate::memory::check(
+            crate::memory::plan_bytes(k.len(), model.plan_parts(), precision),
+            precision,
+            &format!("the {} plan on {} k", model.name(), k.len()),
+        )?;
         let one_loop = if k.len() < CHUNKED_GRID {
             vec![OneLoopPlan::new(k, precision)?]
         } else {
@@ -122,7 +135,7 @@ impl RealPlan {
         let basis = match (&p15, precision.two_loop) {
             (Some(table), method) if model.needs_two_loop() => match method {
                 TwoLoopMethod::Direct => None,
-                TwoLoopMethod::Auto => store.cached_two_loop_basis(k, precision),
+                TwoLoopMethod::Auto => store.cached_two_loop_basis(k, precision, progress),
                 TwoLoopMethod::Basis => Some(store.two_loop_basis(k, precision, table, progress)?),
             },
             _ => None,

@@ -313,6 +313,21 @@ impl RsdPlan {
         store: &TableStore,
         progress: &dyn Progress,
     ) -> Result<Self> {
+        if rsd.needs_tns() {
+            precision.validate()?;
+            crate::memory::check(
+                crate::memory::plan_bytes(
+                    k.len(),
+                    crate::memory::PlanParts {
+                        tns: true,
+                        ..real_model.plan_parts()
+                    },
+                    precision,
+                ),
+                precision,
+                &format!("the {} + TNS plan on {} k", real_model.name(), k.len()),
+            )?;
+        }
         let real = RealPlan::new(k, real_model, precision, store, progress)?;
         let tns = if rsd.needs_tns() {
             Some(TnsPlan::new(k, precision)?)

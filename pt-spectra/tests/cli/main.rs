@@ -9,6 +9,7 @@ mod counterterm;
 mod fit;
 mod halo;
 mod plot;
+mod robustness;
 mod two_loop_basis;
 
 fn run(args: &[&str]) -> (bool, String, String) {

@@ -3,7 +3,7 @@
 use anyhow::{Context, Result};
 use pt_spectra::halo::{Bias, Noise};
 use pt_spectra::table::Tabulated;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// The halo bias b(k) and its amplitude A_b.
 #[derive(clap::Args, Debug)]
@@ -32,6 +32,11 @@ pub struct BiasArgs {
 }
 
 impl BiasArgs {
+    /// The file these options read, by option.
+    pub fn files(&self) -> Vec<(&'static str, Option<&Path>)> {
+        vec![("--bias-file", self.bias_file.as_deref())]
+    }
+
     /// The bias the options give.
     pub fn bias(&self) -> Result<Bias> {
         Ok(match &self.bias_file {
@@ -68,6 +73,11 @@ pub struct NoiseArgs {
 }
 
 impl NoiseArgs {
+    /// The file these options read, by option.
+    pub fn files(&self) -> Vec<(&'static str, Option<&Path>)> {
+        vec![("--noise-file", self.noise_file.as_deref())]
+    }
+
     /// The noise the options give.
     pub fn noise(&self) -> Result<Noise> {
         Ok(

@@ -2,8 +2,8 @@
 
 use crate::common::{list, parse_cs2, BiasArgs, NoiseArgs};
 use crate::input::SpectrumInput;
+use crate::output::{check_outputs, write_output};
 use crate::progress::Bars;
-use crate::real::write_output;
 use crate::rsd::parsed;
 use anyhow::{bail, Context, Result};
 use pt_spectra::fit::{ContourGrid, MultipoleData, Parameter};
@@ -121,6 +121,17 @@ fn k_max_values(s: &str) -> Result<Vec<f64>> {
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<()> {
+    let mut inputs = args.spectrum.files();
+    inputs.push(("--data", Some(args.data.as_path())));
+    inputs.push(("--covariance", args.covariance.as_deref()));
+    inputs.extend(args.bias.files());
+    inputs.extend(args.noise.files());
+    let outputs = [
+        ("--out", args.out.as_deref()),
+        ("--model-out", args.model_out.as_deref()),
+        ("--contour-out", args.contour_out.as_deref()),
+    ];
+    check_outputs(&outputs, &inputs)?;
     let free: Vec<Parameter> = args
         .free
         .split(',')
@@ -195,10 +206,10 @@ pub fn run(args: &Args) -> Result<()> {
         (args.contour_out.as_ref(), tables.contour.as_ref()),
     ] {
         if let (Some(path), Some(table)) = (path, table) {
-            write_output(Some(path), &table.to_text())?;
+            write_output(Some(path), table)?;
         }
     }
-    write_output(args.out.as_ref(), &tables.fit.to_text())
+    write_output(args.out.as_ref(), &tables.fit)
 }
 
 /// The grid of `--contour P1,P2`: two different parameters among the free ones.

@@ -1,6 +1,6 @@
 //! `pt-spectra halo`: b(k) = P_mh/P_mm and P_εε = P_hh − P_mh²/P_mm from measured spectra.
 
-use crate::real::write_output;
+use crate::output::{check_outputs, write_output};
 use anyhow::{bail, Context, Result};
 use pt_spectra::halo::MeasuredSpectrum;
 use pt_spectra::jobs::{halo_table, HaloRequest};
@@ -48,6 +48,12 @@ fn columns(s: &str) -> Result<(usize, usize, Option<usize>)> {
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<()> {
+    let inputs = [
+        ("--pmm", Some(args.pmm.as_path())),
+        ("--pmh", Some(args.pmh.as_path())),
+        ("--phh", Some(args.phh.as_path())),
+    ];
+    check_outputs(&[("--out", args.out.as_deref())], &inputs)?;
     let cols = columns(&args.columns)?;
     let read = |path: &PathBuf, name: &'static str, option: &str| {
         MeasuredSpectrum::read(path, name, cols).with_context(|| option.to_string())
@@ -59,5 +65,5 @@ pub fn run(args: &Args) -> Result<()> {
         number_density: args.number_density,
     };
     let table = halo_table(&request)?;
-    write_output(args.out.as_ref(), &table.to_text())
+    write_output(args.out.as_ref(), &table)
 }

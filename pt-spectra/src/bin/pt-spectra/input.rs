@@ -9,7 +9,7 @@ use pt_spectra::precision::{Precision, TwoLoopMethod};
 use pt_spectra::setup::{self, LinearSource, NamedCosmology, Prepared, Request};
 use pt_spectra::store::TableStore;
 use pt_spectra::table::Table;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// `K,P` (1-based column numbers) as 0-based [`Columns`].
 pub fn parse_columns(s: &str) -> std::result::Result<Columns, String> {
@@ -47,6 +47,11 @@ pub fn parse_q_range(s: &str) -> std::result::Result<(f64, f64), String> {
         return Err(format!("`{s}`: QMIN must be below QMAX"));
     }
     Ok((lo, hi))
+}
+
+/// A memory size such as `8G`.
+fn parse_max_memory(s: &str) -> std::result::Result<f64, String> {
+    pt_spectra::memory::parse_size(s).map_err(|e| e.to_string())
 }
 
 /// A 2-loop method by name.
@@ -113,6 +118,11 @@ pub struct SpectrumInput {
     /// propagator terms P15, P17 depend on QMAX (UV sensitivity); the header states the range.
     #[arg(long, value_name = "QMIN,QMAX", value_parser = parse_q_range)]
     q_range: Option<(f64, f64)>,
+    /// The most memory the plans may take, e.g. `8G` or `500M` (decimal units): a k grid whose
+    /// estimated memory exceeds it is refused before anything is allocated, with both figures.
+    /// Default: $PT_SPECTRA_MAX_MEMORY, else half of the machine's memory.
+    #[arg(long, value_name = "SIZE", value_parser = parse_max_memory)]
+    max_memory: Option<f64>,
     /// How the 2-loop terms are computed: `basis` (precomputed tensors contracted with the
     /// spectrum's projection on a basis of linear spectra; built and cached once per k grid, minutes,
     /// then milliseconds per spectrum; a spectrum the basis does not represent is computed directly,
@@ -137,6 +147,19 @@ pub struct Loaded {
 }
 
 impl SpectrumInput {
+    /// The files these options read, by option, for [`crate::output::check_outputs`].
+    pub fn files(&self) -> Vec<(&'static str, Option<&Path>)> {
+        let cosmology = self
+            .cosmology
+            .as_deref()
+            .map(Path::new)
+            .filter(|p| p.is_file());
+        vec![
+            ("--linear", self.linear.as_deref()),
+            ("--cosmology", cosmology),
+        ]
+    }
+
     /// Parses the cosmology and reads the spectrum; warnings go to standard error.
     pub fn load(&self) -> Result<Loaded> {
         for (name, z) in [("--z", self.z), ("--z-input", self.z_input)] {
@@ -181,6 +204,10 @@ impl SpectrumInput {
         }
         let mut precision = self.precision.clone();
         precision.two_loop = self.two_loop;
+        precision.max_memory = match self.max_memory {
+            Some(m) => Some(m),
+            None => pt_spectra::memory::env_max_memory()?,
+        };
         if let Some((lo, hi)) = self.q_range {
             precision = precision
                 .with_q_range(lo, hi)
@@ -228,6 +255,13 @@ pub struct Input {
 }
 
 impl Input {
+    /// The files these options read, by option.
+    pub fn files(&self) -> Vec<(&'static str, Option<&Path>)> {
+        let mut files = self.spectrum.files();
+        files.push(("--k-file", self.k_file.as_deref()));
+        files
+    }
+
     /// The output k grid [h/Mpc] and the loaded input (with a warning when the grid reaches the
     /// extrapolated ends of the linear table).
     pub fn load(&self) -> Result<(Vec<f64>, Loaded)> {

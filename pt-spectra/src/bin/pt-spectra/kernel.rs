@@ -56,6 +56,9 @@ pub fn run(args: &Args) -> Result<()> {
             .iter()
             .map(|s| parse_float_vector(s))
             .collect::<Result<_>>()?;
+        if let Some(note) = pt_kernels::cancellation_note(&v) {
+            eprintln!("warning: {note}");
+        }
         println!(
             "{}",
             finite(args.which, &args.q, pick(args.which, kernels(&v)?))?

@@ -11,6 +11,7 @@ mod fit;
 mod halo;
 mod input;
 mod kernel;
+mod output;
 mod plot;
 mod progress;
 mod real;

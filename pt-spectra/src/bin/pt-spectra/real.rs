@@ -2,12 +2,12 @@
 
 use crate::common::parse_cs2;
 use crate::input::Input;
+use crate::output::{check_outputs, write_output};
 use crate::progress::Bars;
 use crate::rsd::parsed;
 use anyhow::{Context, Result};
 use pt_spectra::jobs::real_table;
 use pt_spectra::real::{RealPlan, RealSelection};
-use std::io::Write;
 use std::path::PathBuf;
 
 /// Arguments of `pt-spectra real`.
@@ -40,6 +40,7 @@ pub struct Args {
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<()> {
+    check_outputs(&[("--out", args.out.as_deref())], &args.input.files())?;
     let (k, mut loaded) = args.input.load()?;
     if let Some(tolerance) = args.two_loop_tolerance {
         loaded.precision.two_loop_tolerance = tolerance;
@@ -58,15 +59,5 @@ pub fn run(args: &Args) -> Result<()> {
         args.cs2,
         &bars,
     )?;
-    write_output(args.out.as_ref(), &table.to_text())
-}
-
-/// Writes `text` to `out`, or to standard output.
-pub fn write_output(out: Option<&PathBuf>, text: &str) -> Result<()> {
-    match out {
-        Some(path) => std::fs::write(path, text)
-            .with_context(|| format!("cannot write `{}`", path.display()))?,
-        None => std::io::stdout().write_all(text.as_bytes())?,
-    }
-    Ok(())
+    write_output(args.out.as_ref(), &table)
 }

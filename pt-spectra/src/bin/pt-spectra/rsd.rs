@@ -2,8 +2,8 @@
 
 use crate::common::{list, parse_cs2, BiasArgs, NoiseArgs};
 use crate::input::Input;
+use crate::output::{check_outputs, write_output};
 use crate::progress::Bars;
-use crate::real::write_output;
 use anyhow::Result;
 use pt_spectra::jobs::{rsd_table, RsdRequest};
 use pt_spectra::real::RealModel;
@@ -94,11 +94,15 @@ impl Args {
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<()> {
+    let mut inputs = args.input.files();
+    inputs.extend(args.bias.files());
+    inputs.extend(args.noise.files());
+    check_outputs(&[("--out", args.out.as_deref())], &inputs)?;
     let request = args.request()?;
     let (k, loaded) = args.input.load()?;
     let bars = Bars::default();
     let (precision, store) = (&loaded.precision, &loaded.store);
     let plan = RsdPlan::new(&k, args.real_model, args.rsd, precision, store, &bars)?;
     let table = rsd_table(&plan, &request, &loaded.prepared, &bars)?;
-    write_output(args.out.as_ref(), &table.to_text())
+    write_output(args.out.as_ref(), &table)
 }

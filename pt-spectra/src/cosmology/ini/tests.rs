@@ -214,7 +214,10 @@ fn each_error_names_the_problem() {
         ),
         (
             format!("{base}sigma8 = 0.8\nOmega_k = -2\n"),
-            &["test.ini:", "valid cosmology", "bouncing"],
+            &[
+                "test.ini:",
+                "`Omega_k = -2` is outside the plausible range of Omega_k, [-1, 1]",
+            ],
         ),
     ];
     for (text, needles) in cases {

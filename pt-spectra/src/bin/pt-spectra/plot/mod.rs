@@ -149,6 +149,13 @@ pub fn run(args: &Args) -> Result<()> {
             args.out.display()
         );
     }
+    let mut inputs: Vec<(&str, Option<&std::path::Path>)> = args
+        .inputs
+        .iter()
+        .map(|p| ("input", Some(p.as_path())))
+        .collect();
+    inputs.push(("--data", args.data.as_deref()));
+    crate::output::check_outputs(&[("--out", Some(args.out.as_path()))], &inputs)?;
     let mut figure = match args.kind {
         Kind::Models => real::models(args)?,
         Kind::Propagators => real::propagators(args)?,

@@ -1,0 +1,222 @@
+//! Memory estimates of plans, checked before they allocate, so that a grid too large for the machine
+//! is an error with the figure rather than a process that grows until the machine runs out.
+//!
+//! The estimate is the measured peak resident memory of the release binary (2 December 2026,
+//! `--precision default`, k up to 1 h/Mpc) per output k, scaled with the node density of the P22-type
+//! rules, plus fixed costs. Measured per k: 1-loop terms 0.32 MB (`fast` 0.125, `reference` 4.7),
+//! TNS A and B another 0.9 MB, RegPT's Γ2 weights 1.1 MB, the 2-loop basis tensors 0.9 MB; the
+//! constants below are those rounded up.
+//!
+//! ```
+//! use pt_spectra::{memory, precision::Precision, real::RealModel};
+//! let e = memory::plan_bytes(100_000, RealModel::OneLoopSpt.plan_parts(), &Precision::default());
+//! assert!(e > 30e9 && e < 60e9); // ~0.4 MB per k
+//! let mut p = Precision::default();
+//! p.max_memory = Some(1e9);
+//! let err = memory::check(e, &p, "1l-spt on 100000 k").unwrap_err().to_string();
+//! assert!(err.contains("1l-spt on 100000 k needs about 40 GB") && err.contains("1 GB"), "{err}");
+//! ```
+
+use crate::error::{Error, Result};
+use crate::precision::{Precision, TwoLoopMethod};
+
+/// The parts of a plan that take memory (a model's are
+/// [`RealModel::plan_parts`](crate::real::RealModel::plan_parts)).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PlanParts {
+    /// The TNS A and B terms.
+    pub tns: bool,
+    /// RegPT's Γ2 weights.
+    pub gamma2: bool,
+    /// 2-loop terms (basis tensors unless integrated directly).
+    pub two_loop: bool,
+    /// The P15 angular table.
+    pub p15: bool,
+    /// The P17 angular table.
+    pub p17: bool,
+}
+
+/// Bytes per output k of the 1-loop plan at the default node density.
+const ONE_LOOP_PER_K: f64 = 0.4e6;
+/// Bytes per output k of the TNS plan at the default node density.
+const TNS_PER_K: f64 = 1.0e6;
+/// Bytes per output k of RegPT's Γ2 weights.
+const GAMMA2_PER_K: f64 = 1.2e6;
+/// Bytes per output k of the 2-loop basis tensors.
+const BASIS_PER_K: f64 = 1.0e6;
+/// Bytes of the process, the P15 and the P17 angular tables.
+const FIXED: (f64, f64, f64) = (20e6, 4e6, 6e6);
+/// The environment variable both faces read for the limit when it is not given (`8G`, `500M`, …).
+pub const ENV: &str = "PT_SPECTRA_MAX_MEMORY";
+
+/// The limit of [`ENV`], if set.
+///
+/// # Errors
+/// As [`parse_size`], naming the variable.
+pub fn env_max_memory() -> Result<Option<f64>> {
+    match std::env::var(ENV) {
+        Ok(text) => parse_size(&text)
+            .map(Some)
+            .map_err(|e| Error::InvalidChoice {
+                what: format!("${ENV}"),
+                reason: e.to_string(),
+            }),
+        Err(_) => Ok(None),
+    }
+}
+
+/// The fraction of the machine's memory a plan may take by default.
+pub const DEFAULT_FRACTION: f64 = 0.5;
+
+/// The estimated peak memory [bytes] of a plan of `parts` on `nk` output wavenumbers (the 1-loop terms
+/// are always part of it).
+pub fn plan_bytes(nk: usize, parts: PlanParts, precision: &Precision) -> f64 {
+    // The P22-type rules have ~(order / panel width)² nodes per k; 20² at the default.
+    let density = (precision.p22_order as f64 / precision.p22_ln_width / 20.0).powi(2);
+    let mut per_k = ONE_LOOP_PER_K * density;
+    if parts.tns {
+        per_k += TNS_PER_K * density;
+    }
+    if parts.gamma2 {
+        per_k += GAMMA2_PER_K;
+    }
+    if parts.two_loop && precision.two_loop != TwoLoopMethod::Direct {
+        per_k += BASIS_PER_K;
+    }
+    let mut fixed = FIXED.0;
+    if parts.p15 {
+        fixed += FIXED.1;
+    }
+    if parts.p17 {
+        fixed += FIXED.2;
+    }
+    fixed + per_k * nk as f64
+}
+
+/// The total memory of this machine [bytes] (`MemTotal` of `/proc/meminfo`), if known.
+pub fn machine_bytes() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024.0)
+}
+
+/// The limit that applies: `precision.max_memory` (which the faces set from `--max-memory` or
+/// [`ENV`]), else [`DEFAULT_FRACTION`] of the machine's memory
+/// (8 GB where it is not known), with a description of where it came from.
+pub fn limit(precision: &Precision) -> (f64, String) {
+    match (precision.max_memory, machine_bytes()) {
+        (Some(limit), _) => (limit, format!("the limit given by --max-memory or ${ENV}")),
+        (None, Some(machine)) => (
+            DEFAULT_FRACTION * machine,
+            format!(
+                "the default limit, half of this machine's {}; --max-memory or ${ENV} \
+                 changes it",
+                size(machine)
+            ),
+        ),
+        (None, None) => (
+            8e9,
+            format!(
+                "the default limit where the machine's memory is unknown; --max-memory or ${ENV} \
+                 changes it"
+            ),
+        ),
+    }
+}
+
+/// `bytes` against the limit of `precision`; `what` says what would be built.
+///
+/// # Errors
+/// [`Error::MemoryLimit`] with both figures if the estimate exceeds the limit.
+pub fn check(bytes: f64, precision: &Precision, what: &str) -> Result<()> {
+    let (limit, source) = limit(precision);
+    if bytes > limit {
+        return Err(Error::MemoryLimit {
+            what: what.to_string(),
+            needed: size(bytes),
+            limit: size(limit),
+            origin: source,
+        });
+    }
+    Ok(())
+}
+
+/// `bytes` as `12 GB`, `340 MB` (decimal units, two significant figures).
+pub fn size(bytes: f64) -> String {
+    let (value, unit) = [(1e12, "TB"), (1e9, "GB"), (1e6, "MB"), (1e3, "kB")]
+        .into_iter()
+        .find(|&(scale, _)| bytes >= scale)
+        .map_or((bytes, "bytes"), |(scale, unit)| (bytes / scale, unit));
+    let digits = if value >= 10.0 { 0 } else { 1 };
+    format!("{value:.digits$} {unit}")
+}
+
+/// A size such as `8G`, `500M`, `2.5GB`, `1e9` (bytes) or `64k`: decimal units.
+///
+/// # Errors
+/// [`Error::InvalidChoice`] if it is not a positive number with an optional k, M, G, T (B) suffix.
+pub fn parse_size(text: &str) -> Result<f64> {
+    let t = text.trim();
+    let t = t.strip_suffix(['B', 'b']).unwrap_or(t);
+    let (number, scale) = match t.char_indices().last() {
+        Some((i, 'k' | 'K')) => (&t[..i], 1e3),
+        Some((i, 'M' | 'm')) => (&t[..i], 1e6),
+        Some((i, 'G' | 'g')) => (&t[..i], 1e9),
+        Some((i, 'T' | 't')) => (&t[..i], 1e12),
+        _ => (t, 1.0),
+    };
+    match number.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v * scale),
+        _ => Err(Error::InvalidChoice {
+            what: format!("memory size `{text}`"),
+            reason: "expected a positive number of bytes, optionally with k, M, G or T (e.g. 8G)"
+                .into(),
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::real::RealModel;
+
+    #[test]
+    fn sizes_are_parsed_and_printed() {
+        assert_eq!(parse_size("8G").unwrap(), 8e9);
+        assert_eq!(parse_size("500MB").unwrap(), 5e8);
+        assert_eq!(parse_size("1e9").unwrap(), 1e9);
+        assert_eq!(parse_size(" 2.5 g").unwrap(), 2.5e9);
+        for bad in ["", "G", "-1G", "0", "nan", "8X", "inf"] {
+            assert!(parse_size(bad).is_err(), "{bad}");
+        }
+        assert_eq!(size(3.4e12), "3.4 TB");
+        assert_eq!(size(714e6), "714 MB");
+        assert_eq!(size(12.0), "12 bytes");
+    }
+
+    /// The estimate is above what was measured, within a factor 2.5 (the measurements in the module docs).
+    #[test]
+    fn estimates_bound_the_measured_memory() {
+        let d = Precision::default();
+        for (nk, model, tns, preset, measured) in [
+            (1000, RealModel::OneLoopSpt, false, "default", 340e6),
+            (200, RealModel::OneLoopSpt, false, "fast", 36e6),
+            (200, RealModel::OneLoopSpt, false, "reference", 962e6),
+            (300, RealModel::OneLoopSpt, true, "default", 356e6),
+            (80, RealModel::TwoLoopRegPt, false, "default", 118e6),
+        ] {
+            let p = Precision::preset(preset).unwrap();
+            let parts = PlanParts {
+                tns,
+                ..model.plan_parts()
+            };
+            let e = plan_bytes(nk, parts, &p);
+            assert!(
+                e >= measured && e < 2.5 * measured,
+                "{model:?} {preset} {nk}: {e:e}"
+            );
+        }
+        assert!(plan_bytes(10_000_000, RealModel::OneLoopSpt.plan_parts(), &d) > 1e12);
+    }
+}
