@@ -258,7 +258,7 @@ fn bad_data_are_refused_with_the_line() {
         ("0.1 100 1\n0.2 90 0\n", "sigma_l"),
         ("0.1 100 1\n0.2 nan 1\n", "P_l"),
         ("0.1 100 1\n0.05 90 1\n", "increasing"),
-        ("0.1 100\n", "column 2"),
+        ("0.1 100\n", "column 3 was requested"),
     ] {
         let e = MultipoleData::parse(text, "d.dat", 0, &cols)
             .unwrap_err()

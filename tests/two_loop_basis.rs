@@ -50,11 +50,11 @@ fn basis_two_loop_terms_match_the_direct_integrals() {
         .unwrap();
     // Read back from the file by a new store: the same tensors.
     let again = TableStore::new(&dir)
-        .cached_two_loop_basis(&k, &precision)
+        .cached_two_loop_basis(&k, &precision, &Silent)
         .unwrap();
     assert!(*again == *tensors, "the cache file reads back the tensors");
     assert!(TableStore::new(&dir)
-        .cached_two_loop_basis(&k[1..], &precision)
+        .cached_two_loop_basis(&k[1..], &precision, &Silent)
         .is_none());
     let plan = OneLoopPlan::new(&k, &precision).unwrap();
     let camb = |name: &str| LinearSpectrum::parse(&data(name), name, Default::default()).unwrap();

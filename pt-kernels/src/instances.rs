@@ -40,7 +40,8 @@ pub trait Evaluate: Scalar {
     /// The vectors as [`kernels`](crate::kernels) evaluates them: the kernels are homogeneous of
     /// degree 0, so any common factor may be taken out. Exact types keep them; `f64` scales them by
     /// the power of two that brings the largest component to [1, 2), so that the dot products of tiny
-    /// (1e-170) or huge (1e170) vectors neither underflow nor overflow, and the scaling itself is exact.
+    /// (1e-170) or huge (1e170) vectors neither underflow nor overflow, and the scaling itself is exact
+    /// (unless it would flush a component below the normal range: then they are kept as they are).
     fn normalised(q: &[[Self; 3]]) -> Vec<[Self; 3]> {
         q.to_vec()
     }
@@ -78,7 +79,20 @@ impl Evaluate for f64 {
         let e = largest.log2().floor() as i32;
         let (a, b) = (e / 2, e - e / 2);
         let scale = |v: f64| v * 2f64.powi(-a) * 2f64.powi(-b);
-        q.iter().map(|v| v.map(scale)).collect()
+        let scaled: Vec<[f64; 3]> = q.iter().map(|v| v.map(scale)).collect();
+        // A component flushed to zero (or to the subnormal range) would change the configuration,
+        // e.g. turn a tiny partial sum of momenta into an exact zero: keep the vectors as they are, so
+        // that the overflow is reported rather than a different configuration evaluated.
+        let flushed = q
+            .iter()
+            .flatten()
+            .zip(scaled.iter().flatten())
+            .any(|(&c, &s)| c != 0.0 && !s.is_normal());
+        if flushed {
+            q.to_vec()
+        } else {
+            scaled
+        }
     }
     fn general(n: usize, g: &[f64]) -> Result<[f64; 2], KernelError> {
         general_dispatch(n, g)

@@ -313,21 +313,21 @@ pub enum Error {
         source: Box<Error>,
     },
     /// A parameter-file key whose value is outside the plausible range of its quantity.
-    #[error("{origin}:{line}: `{key}` is outside the plausible range of {name}, {range}{converted}{hint}")]
+    #[error(
+        "{origin}:{line}: {key} is outside the plausible range of {}, {}{hint}",
+        .range.name,
+        .range.describe()
+    )]
     Implausible {
         /// File path or description of the input.
         origin: String,
         /// 1-based line number (1-based index for key–value pairs).
         line: usize,
-        /// The `key = value` as written.
+        /// The `key = value` as written, quoted, with the quantity's value where the units differ,
+        /// e.g. `` `H0 = 6766` (h = 67.66)``.
         key: String,
-        /// The quantity's value in the units of the range, as ` (h = 0.6766)`, where the key's
-        /// differ (empty where they are the same).
-        converted: String,
-        /// The quantity, e.g. `h`.
-        name: &'static str,
-        /// The range, e.g. `[0.2, 1.5]`.
-        range: String,
+        /// The range.
+        range: &'static crate::cosmology::Plausible,
         /// A guess at what was meant (may be empty), e.g. that h was given as H0.
         hint: &'static str,
     },

@@ -26,6 +26,8 @@ use crate::precision::{Precision, TwoLoopMethod};
 pub struct PlanParts {
     /// The TNS A and B terms.
     pub tns: bool,
+    /// The bias terms ([`crate::loops::bias`]).
+    pub bias: bool,
     /// RegPT's Γ2 weights.
     pub gamma2: bool,
     /// 2-loop terms (basis tensors unless integrated directly).
@@ -40,6 +42,8 @@ pub struct PlanParts {
 const ONE_LOOP_PER_K: f64 = 0.4e6;
 /// Bytes per output k of the TNS plan at the default node density.
 const TNS_PER_K: f64 = 1.0e6;
+/// Bytes per output k of the bias plan at the default node density (7 f32 weights per P22 node).
+const BIAS_PER_K: f64 = 0.6e6;
 /// Bytes per output k of RegPT's Γ2 weights.
 const GAMMA2_PER_K: f64 = 1.2e6;
 /// Bytes per output k of the 2-loop basis tensors.
@@ -76,6 +80,9 @@ pub fn plan_bytes(nk: usize, parts: PlanParts, precision: &Precision) -> f64 {
     let mut per_k = ONE_LOOP_PER_K * density;
     if parts.tns {
         per_k += TNS_PER_K * density;
+    }
+    if parts.bias {
+        per_k += BIAS_PER_K * density;
     }
     if parts.gamma2 {
         per_k += GAMMA2_PER_K;

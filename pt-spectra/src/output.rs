@@ -176,36 +176,3 @@ impl Table {
         out
     }
 }
-
-/// The results of a fit versus k_max as a table with `header` lines: `k_max points`, for each free
-/// parameter `p p_lo p_hi` (best fit and 1σ interval), then `chi2 dof chi2_dof`.
-pub fn fit_table(results: &[crate::fit::FitResult], header: Vec<String>) -> Table {
-    let mut t = Table::new(header);
-    let column = |f: &dyn Fn(&crate::fit::FitResult) -> f64| results.iter().map(f).collect();
-    t.push("k_max", WAVENUMBER, column(&|r| r.k_max));
-    t.push("points", "1", column(&|r| r.points as f64));
-    if let Some(first) = results.first() {
-        for (j, (p, _, _)) in first.intervals.iter().enumerate() {
-            let unit = p.unit();
-            t.push(p.name(), unit, column(&|r| r.best.get(r.intervals[j].0)));
-            let unbounded = "no delta chi2 = 1 crossing found on that side within 2^12 times the \
-                             initial step (the parameter is unconstrained there)";
-            t.push_undefined_as(
-                format!("{p}_lo"),
-                unit,
-                column(&|r| r.intervals[j].1),
-                unbounded,
-            );
-            t.push_undefined_as(
-                format!("{p}_hi"),
-                unit,
-                column(&|r| r.intervals[j].2),
-                unbounded,
-            );
-        }
-    }
-    t.push("chi2", "1", column(&|r| r.chi2));
-    t.push("dof", "1", column(&|r| r.dof as f64));
-    t.push("chi2_dof", "1", column(&|r| r.chi2 / r.dof as f64));
-    t
-}

@@ -541,7 +541,8 @@ mod tests {
         let good: Vec<f64> = (0..1000).map(f64::from).collect();
         assert_eq!(long_table(&path, &builds, &notes), good);
         let intact = std::fs::read(&path).unwrap();
-        let corruptions: [(&str, Box<dyn Fn(&mut Vec<u8>)>, &str); 5] = [
+        type Corruption = Box<dyn Fn(&mut Vec<u8>)>;
+        let corruptions: [(&str, Corruption, &str); 5] = [
             (
                 "random bytes",
                 Box::new(|b: &mut Vec<u8>| {

@@ -124,7 +124,7 @@ def test_in_process_run(grid, tmp_path, expected):
 def test_a_failing_point_is_named(grid, tmp_path):
     config = dict(batch.load_config(grid), threads=None)
     config["points"][1] = dict(config["points"][1], omega_cdm=-0.5)
-    with pytest.raises(RuntimeError, match=r"rank 0: ValueError: point 1 .*Omega_m"):
+    with pytest.raises(RuntimeError, match=r"rank 0: ValueError: point 1 .*omega_cdm"):
         batch.run(config, str(tmp_path / "bad"))
 
 

@@ -481,13 +481,16 @@ impl<'a> Values<'a> {
                     return Err(Error::Implausible {
                         origin: self.origin.to_string(),
                         line: f.entry.line,
-                        key: f.entry.text(),
-                        converted: match f.unit {
-                            Unit::Same => String::new(),
-                            _ => format!(" ({} = {})", range.name, crate::error::number(&value)),
+                        key: match f.unit {
+                            Unit::Same => format!("`{}`", f.entry.text()),
+                            _ => format!(
+                                "`{}` ({} = {})",
+                                f.entry.text(),
+                                range.name,
+                                crate::error::number(&value)
+                            ),
                         },
-                        name: range.name,
-                        range: range.describe(),
+                        range,
                         hint: range.hint(value),
                     });
                 }

@@ -26,6 +26,7 @@
 //! ```
 
 use crate::error::{Error, Result};
+use crate::loops::bias::BiasPlan;
 use crate::loops::Pair;
 use crate::output::{Table, POWER, WAVENUMBER};
 use crate::precision::Precision;
@@ -33,9 +34,11 @@ use crate::progress::Progress;
 use crate::real::{RealModel, RealPlan, RealSelection, RealSpectra};
 use crate::setup::Prepared;
 
+mod bias;
 mod fit;
 mod halo;
 mod rsd;
+pub use bias::BiasOutput;
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use halo::{halo_table, HaloRequest};
 pub use rsd::{
@@ -95,6 +98,37 @@ pub fn real_table(
     cs2: f64,
     progress: &dyn Progress,
 ) -> Result<Table> {
+    real_table_with_bias(
+        plan,
+        None,
+        selection,
+        prepared,
+        terms,
+        cs2,
+        BiasOutput::default(),
+        progress,
+    )
+}
+
+/// [`real_table`] with the galaxy bias expansion of `bias` (its terms from `bias_plan`, on the
+/// plan's k): the bias terms as columns (`Pd1d2 err_Pd1d2 …`), and P_gg, P_gm of the model's P_δδ
+/// ([`crate::loops::bias`]). Without either in `bias`, exactly [`real_table`].
+///
+/// # Errors
+/// As [`real_table`]; [`Error::InvalidChoice`] for bias output with `--model all`;
+/// [`Error::MissingTerm`] without a `bias_plan`, [`Error::GridMismatch`] if it is for other k.
+#[allow(clippy::too_many_arguments)]
+pub fn real_table_with_bias(
+    plan: &RealPlan,
+    bias_plan: Option<&BiasPlan>,
+    selection: RealSelection,
+    prepared: &Prepared,
+    terms: bool,
+    cs2: f64,
+    bias: BiasOutput,
+    progress: &dyn Progress,
+) -> Result<Table> {
+    let bias_terms = bias::terms(plan, bias_plan, selection, prepared, bias)?;
     if !plan.covers(selection) {
         return Err(Error::GridMismatch {
             what: "real-space plan and model",
@@ -127,6 +161,9 @@ pub fn real_table(
                     let name = format!("P_ct_{}", pair.suffix());
                     t.push(name, POWER, spectra.counterterm(pair));
                 }
+            }
+            if let Some(b) = bias_terms {
+                bias::push_columns(&mut t, &spectra, &b, bias);
             }
             Ok(t)
         }

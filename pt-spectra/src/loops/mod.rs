@@ -36,6 +36,7 @@
 //! [`Precision::p22_error_floor`]: crate::precision::Precision::p22_error_floor
 
 pub mod basis;
+pub mod bias;
 mod gamma2;
 mod lattice;
 mod mode_coupling;

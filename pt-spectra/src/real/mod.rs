@@ -138,6 +138,7 @@ impl RealModel {
     pub fn plan_parts(self) -> crate::memory::PlanParts {
         crate::memory::PlanParts {
             tns: false,
+            bias: false,
             gamma2: self.needs_gamma2(),
             two_loop: self.needs_two_loop(),
             p15: self.needs_p15(),

@@ -5,6 +5,7 @@
 
 use std::process::Command;
 
+mod bias;
 mod counterterm;
 mod fit;
 mod halo;

@@ -94,6 +94,14 @@ impl NoiseArgs {
     }
 }
 
+/// A name through the library's `FromStr`, for clap.
+pub fn parsed<T: std::str::FromStr<Err = pt_spectra::error::Error>>(
+    s: &str,
+) -> std::result::Result<T, String> {
+    s.parse()
+        .map_err(|e: pt_spectra::error::Error| e.to_string())
+}
+
 /// The EFT counterterm c_s² [(Mpc/h)²] of `--cs2`: a finite number.
 pub fn parse_cs2(s: &str) -> std::result::Result<f64, String> {
     let v: f64 = s

@@ -1,10 +1,9 @@
 //! `pt-spectra fit`: best-fit f, σ0, A_b with Δχ² errors against measured multipoles, versus k_max.
 
-use crate::common::{list, parse_cs2, BiasArgs, NoiseArgs};
+use crate::common::{list, parse_cs2, parsed, BiasArgs, NoiseArgs};
 use crate::input::SpectrumInput;
 use crate::output::{check_outputs, write_output};
 use crate::progress::Bars;
-use crate::rsd::parsed;
 use anyhow::{bail, Context, Result};
 use pt_spectra::fit::{ContourGrid, MultipoleData, Parameter};
 use pt_spectra::jobs::{fit_tables, FitOutputs, FitRequest, RsdRequest};

@@ -1,12 +1,12 @@
 //! `pt-spectra real`: real-space P_δδ, P_δθ, P_θθ of a model on a k grid, as a whitespace table.
 
-use crate::common::parse_cs2;
+use crate::common::{parse_cs2, parsed};
 use crate::input::Input;
 use crate::output::{check_outputs, write_output};
 use crate::progress::Bars;
-use crate::rsd::parsed;
 use anyhow::{Context, Result};
-use pt_spectra::jobs::real_table;
+use pt_spectra::jobs::{real_table_with_bias, BiasOutput};
+use pt_spectra::loops::bias::{BiasPlan, GalaxyBias};
 use pt_spectra::real::{RealPlan, RealSelection};
 use std::path::PathBuf;
 
@@ -28,6 +28,23 @@ pub struct Args {
     /// P_lin, P_tt − 6 c_s² k² P_lin (δ_ct ∝ D³, θ_ct = 3 δ_ct by mass conservation); exact.
     #[arg(long, value_name = "CS2", default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_cs2)]
     cs2: f64,
+    /// Add the 1-loop bias terms Pd1d2 Pd2d2 Pd1s2 Pd2s2 Ps2s2 (FAST-PT's names and normalisation, no
+    /// constant subtracted), their velocity counterparts Pt1d2 Pt1s2 and sig3nl, each with err_.
+    #[arg(long)]
+    bias_terms: bool,
+    /// Linear galaxy bias b1: adds P_gg and P_gm (with err_) of the bias expansion on the model's P_dd,
+    /// with --b2, --bs, --b3 (default 0).
+    #[arg(long, value_name = "B1", allow_hyphen_values = true)]
+    bias: Option<f64>,
+    /// Second-order local bias b2 (needs --bias).
+    #[arg(long, value_name = "B2", allow_hyphen_values = true, requires = "bias")]
+    b2: Option<f64>,
+    /// Tidal bias b_s² (FAST-PT's bs; needs --bias).
+    #[arg(long, value_name = "BS", allow_hyphen_values = true, requires = "bias")]
+    bs: Option<f64>,
+    /// Non-local cubic bias b3nl (Saito et al. 2014; needs --bias).
+    #[arg(long, value_name = "B3", allow_hyphen_values = true, requires = "bias")]
+    b3: Option<f64>,
     /// Write the table to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
@@ -50,13 +67,30 @@ pub fn run(args: &Args) -> Result<()> {
             .context("invalid --two-loop-tolerance")?;
     }
     let bars = Bars::default();
+    let bias = BiasOutput {
+        terms: args.bias_terms,
+        galaxy: args.bias.map(|b1| GalaxyBias {
+            b1,
+            b2: args.b2.unwrap_or(0.0),
+            bs: args.bs.unwrap_or(0.0),
+            b3nl: args.b3.unwrap_or(0.0),
+        }),
+    };
+    bias.validate(args.model)?;
     let plan = RealPlan::for_selection(&k, args.model, &loaded.precision, &loaded.store, &bars)?;
-    let table = real_table(
+    let bias_plan = if bias.any() {
+        Some(BiasPlan::new(&k, &loaded.precision)?)
+    } else {
+        None
+    };
+    let table = real_table_with_bias(
         &plan,
+        bias_plan.as_ref(),
         args.model,
         &loaded.prepared,
         args.terms,
         args.cs2,
+        bias,
         &bars,
     )?;
     write_output(args.out.as_ref(), &table)

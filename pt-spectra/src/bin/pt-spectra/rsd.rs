@@ -1,6 +1,6 @@
 //! `pt-spectra rsd`: redshift-space multipoles P_ℓ(k) of a real-space model through an RSD model.
 
-use crate::common::{list, parse_cs2, BiasArgs, NoiseArgs};
+use crate::common::{list, parse_cs2, parsed, BiasArgs, NoiseArgs};
 use crate::input::Input;
 use crate::output::{check_outputs, write_output};
 use crate::progress::Bars;
@@ -9,14 +9,6 @@ use pt_spectra::jobs::{rsd_table, RsdRequest};
 use pt_spectra::real::RealModel;
 use pt_spectra::rsd::{Fog, RsdModel, RsdPlan, Sigma0};
 use std::path::PathBuf;
-
-/// A name through the library's `FromStr`, for clap.
-pub fn parsed<T: std::str::FromStr<Err = pt_spectra::error::Error>>(
-    s: &str,
-) -> std::result::Result<T, String> {
-    s.parse()
-        .map_err(|e: pt_spectra::error::Error| e.to_string())
-}
 
 /// Arguments of `pt-spectra rsd`.
 #[derive(clap::Args, Debug)]

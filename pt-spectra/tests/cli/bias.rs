@@ -1,0 +1,92 @@
+//! `real --bias-terms` and `real --bias B1 --b2 … --bs … --b3 …`: the columns, P_gg and P_gm of the bias
+//! expansion, and the refusals.
+
+use super::{column_names, fails_naming, rows, run};
+
+#[test]
+fn bias_columns_and_galaxy_spectra() {
+    let grid = [
+        "--k-min",
+        "0.02",
+        "--k-max",
+        "0.2",
+        "--nk",
+        "4",
+        "--precision",
+        "fast",
+    ];
+    let args = |extra: &[&'static str]| {
+        let mut a = vec!["real", "--model", "1l-spt"];
+        a.extend(grid);
+        a.extend(extra);
+        a
+    };
+    let (ok, plain, err) = run(&args(&[]));
+    assert!(ok, "{err}");
+    let (ok, out, err) = run(&args(&[
+        "--bias-terms",
+        "--bias",
+        "2",
+        "--b2",
+        "0.5",
+        "--bs",
+        "-0.3",
+        "--b3",
+        "0.2",
+    ]));
+    assert!(ok, "{err}");
+    let names = column_names(&out);
+    for name in [
+        "Pd1d2",
+        "err_Pd1d2",
+        "Ps2s2",
+        "Pt1s2",
+        "sig3nl",
+        "err_sig3nl",
+        "P_gg",
+        "err_P_gg",
+        "P_gm",
+    ] {
+        assert!(names.contains(&name), "{name}: {names:?}");
+    }
+    assert!(
+        out.contains("sigma4 = int P^2") && out.contains("b3nl = 0.2"),
+        "{out}"
+    );
+    let (plain, table) = (rows(&plain), rows(&out));
+    let col = |n: &str| names.iter().position(|&c| c == n).unwrap();
+    for (p, r) in plain.iter().zip(&table) {
+        // The matter columns are those of the plain run.
+        assert_eq!(p[..], r[..p.len()]);
+        let (dd, b1, b2, bs, b3) = (r[col("P_dd")], 2.0, 0.5, -0.3, 0.2);
+        let gg = b1 * b1 * dd
+            + b1 * b2 * r[col("Pd1d2")]
+            + 0.25 * b2 * b2 * r[col("Pd2d2")]
+            + b1 * bs * r[col("Pd1s2")]
+            + 0.5 * b2 * bs * r[col("Pd2s2")]
+            + 0.25 * bs * bs * r[col("Ps2s2")]
+            + 2.0 * b1 * b3 * r[col("sig3nl")];
+        let gm = b1 * dd
+            + 0.5 * b2 * r[col("Pd1d2")]
+            + 0.5 * bs * r[col("Pd1s2")]
+            + b3 * r[col("sig3nl")];
+        // The table prints 10 significant digits.
+        assert!(
+            (r[col("P_gg")] - gg).abs() < 1e-8 * gg.abs(),
+            "{} vs {gg}",
+            r[col("P_gg")]
+        );
+        assert!(
+            (r[col("P_gm")] - gm).abs() < 1e-8 * gm.abs(),
+            "{} vs {gm}",
+            r[col("P_gm")]
+        );
+    }
+    fails_naming(&[
+        (args(&["--b2", "1"]), "--bias"),
+        (
+            vec!["real", "--model", "all", "--nk", "3", "--bias", "2"],
+            "choose it with --model",
+        ),
+    ]);
+}
