@@ -148,3 +148,79 @@ fn galaxy_spectra_are_the_bias_expansion() {
     assert!((gm.value - want_gm).abs() < 1e-9 * want_gm.abs());
     assert!(gg.error >= 2.25 * 0.5 && gm.error >= 1.5 * 0.5);
 }
+
+/// TNS with nonlinear bias (Beutler et al. 2017): without FoG the multipoles move from those of the
+/// linear bias by the Kaiser projections of ΔP_gg = P_gg − b1² P_δδ and ΔP_gθ = P_gθ − b1 P_δθ:
+/// ΔP0 = ΔP_gg + (2f/3) ΔP_gθ, ΔP2 = (4f/3) ΔP_gθ, ΔP4 = 0 (A and B depend on b1 only).
+#[test]
+fn tns_with_nonlinear_bias_moves_the_multipoles_by_the_bias_terms() {
+    use pt_spectra::jobs::{rsd_table, NonlinearBias, RsdRequest};
+    use pt_spectra::real::RealModel;
+    use pt_spectra::rsd::{Fog, RsdModel, RsdPlan, Sigma0};
+    use pt_spectra::setup::{prepare, LinearSource, Request};
+    let k = [0.03, 0.08, 0.15];
+    let prepared = prepare(Request {
+        source: LinearSource::Embedded,
+        cosmology: None,
+        z: 0.5,
+    })
+    .unwrap();
+    let precision = Precision::fast();
+    let plan = RsdPlan::new(
+        &k,
+        RealModel::OneLoopSpt,
+        RsdModel::Tns,
+        &precision,
+        store(),
+        &pt_spectra::progress::Silent,
+    )
+    .unwrap()
+    .with_bias_terms()
+    .unwrap();
+    let (b1, f) = (1.8, 0.7);
+    let mut request = RsdRequest {
+        rsd: RsdModel::Tns,
+        f: Some(f),
+        bias: pt_spectra::halo::Bias::Constant(b1),
+        amplitude: 1.0,
+        fog: Fog::None,
+        sigma0: Sigma0::Value(0.0),
+        noise: pt_spectra::halo::Noise::None,
+        ells: vec![0, 2, 4],
+        terms: false,
+        no_wiggle: false,
+        cs2: 0.0,
+        galaxy: None,
+    };
+    let silent = &pt_spectra::progress::Silent;
+    let linear = rsd_table(&plan, &request, &prepared, silent).unwrap();
+    let g = NonlinearBias {
+        b2: 0.6,
+        bs: -0.4,
+        b3nl: 0.25,
+    };
+    request.galaxy = Some(g);
+    let galaxy = rsd_table(&plan, &request, &prepared, silent).unwrap();
+    let t = plan.bias_terms(&prepared.spectrum).unwrap();
+    let v = |name: &str, i: usize| t.pair(name).unwrap()[i].value;
+    for (i, ki) in k.iter().enumerate() {
+        let s3 = t.sig3nl[i].value;
+        let d_gg = b1 * g.b2 * v("Pd1d2", i)
+            + 0.25 * g.b2 * g.b2 * v("Pd2d2", i)
+            + b1 * g.bs * v("Pd1s2", i)
+            + 0.5 * g.b2 * g.bs * v("Pd2s2", i)
+            + 0.25 * g.bs * g.bs * v("Ps2s2", i)
+            + 2.0 * b1 * g.b3nl * s3;
+        let d_gt = 0.5 * g.b2 * v("Pt1d2", i) + 0.5 * g.bs * v("Pt1s2", i) + g.b3nl * s3;
+        let want = [d_gg + 2.0 * f / 3.0 * d_gt, 4.0 * f / 3.0 * d_gt, 0.0];
+        for (l, w) in ["P0", "P2", "P4"].iter().zip(want) {
+            let d = galaxy.column(l).unwrap()[i] - linear.column(l).unwrap()[i];
+            let scale = linear.column("P0").unwrap()[i];
+            assert!((d - w).abs() < 1e-11 * scale, "{l} k = {ki}: {d} vs {w}");
+        }
+    }
+    assert!(galaxy
+        .header
+        .iter()
+        .any(|h| h.contains("Beutler et al. 2017")));
+}

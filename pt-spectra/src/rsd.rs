@@ -23,7 +23,7 @@ use std::fmt;
 use std::str::FromStr;
 
 mod multipoles;
-pub use multipoles::{multipoles, RsdMultipoles, RsdPlan, RsdSettings, Sigma0};
+pub use multipoles::{multipoles, GalaxyTerms, RsdMultipoles, RsdPlan, RsdSettings, Sigma0};
 
 /// Largest multipole order ℓ supported.
 pub const MAX_ELL: usize = 8;
@@ -97,8 +97,43 @@ impl RsdModel {
     ) -> Result<Parts> {
         let value = self.coefficients(b, f, spectra.map(|e| e.value));
         let error = self.coefficients(b.abs(), f.abs(), spectra.map(|e| e.error));
+        self.with_tns(MuPolynomial::from_low(value, error), b, f, tns)
+    }
+
+    /// As [`parts`](Self::parts) for galaxies with nonlinear bias (Beutler et al. 2017): from the
+    /// galaxy spectra [P_gg, P_gθ, P_θθ] ([`crate::loops::bias`]), P^s = P_gg + 2fμ² P_gθ + f²μ⁴ P_θθ
+    /// (+ b1³ A(f/b1) + b1⁴ B(f/b1) for TNS, with b1 = `b`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] for Kaiser (linear by definition); as [`parts`](Self::parts).
+    pub fn galaxy_parts(
+        self,
+        b: f64,
+        f: f64,
+        [gg, gt, tt]: [Estimate; 3],
+        tns: Option<&TnsCoefficients>,
+    ) -> Result<Parts> {
+        if self == RsdModel::Kaiser {
+            return Err(Error::InvalidChoice {
+                what: "nonlinear bias with the kaiser model".into(),
+                reason: "Kaiser is linear in the bias: use scoccimarro or tns".into(),
+            });
+        }
+        let value = [gg.value, 2.0 * f * gt.value, f * f * tt.value];
+        let error = [gg.error, 2.0 * f.abs() * gt.error, f * f * tt.error];
+        self.with_tns(MuPolynomial::from_low(value, error), b, f, tns)
+    }
+
+    /// The parts with `base` and, for TNS, the A and B terms of bias `b`.
+    fn with_tns(
+        self,
+        base: MuPolynomial,
+        b: f64,
+        f: f64,
+        tns: Option<&TnsCoefficients>,
+    ) -> Result<Parts> {
         let mut parts = Parts {
-            base: MuPolynomial::from_low(value, error),
+            base,
             ..Parts::default()
         };
         if self.needs_tns() {

@@ -142,7 +142,8 @@ class RsdTerms:
 
 def real(model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False,
          precision="default", q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None,
-         k_min=1e-3, k_max=1.0, nk=100, cs2=0.0, two_loop="auto") -> Table:
+         k_min=1e-3, k_max=1.0, nk=100, cs2=0.0, two_loop="auto", bias_terms=False, bias=None,
+         b2=0.0, bs=0.0, b3=0.0) -> Table:
     """Real-space P_dd, P_dt, P_tt of a model (``pt-spectra real``).
 
     model: ``linear``, ``1l-spt``, ``2l-spt``, ``1l-rpt-n0`` … ``1l-rpt-n3``, ``2l-rpt-n0`` …
@@ -161,10 +162,14 @@ def real(model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None
     P_dt - 4 cs2 k^2 P_lin, P_tt - 6 cs2 k^2 P_lin (delta_ct grows as D^3 and theta_ct = 3 delta_ct by
     mass conservation); exact; stated in the header, and with ``terms`` the columns ``P_ct_dd P_ct_dt
     P_ct_tt``.
+    bias_terms: add the 1-loop bias terms ``Pd1d2 Pd2d2 Pd1s2 Pd2s2 Ps2s2`` (FAST-PT's names and
+    normalisation, no constant subtracted), ``Pt1d2 Pt1s2`` (their velocity counterparts) and
+    ``sig3nl``, each with ``err_``. bias: b1; with it, ``P_gg`` and ``P_gm`` of the bias expansion
+    (b2, bs = b_s^2, b3 = b3nl; Saito et al. 2014, FAST-PT's convention) on the model's P_dd.
     """
     plan = RealPlan(_grid(k, k_min, k_max, nk), model, precision, q_range, two_loop_tolerance,
                     cache_dir, two_loop)
-    return plan(linear, z, z_input, cosmology, terms, eh, cs2)
+    return plan(linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2, bs, b3)
 
 
 def rsd(rsd="tns", real="1l-rpt-n1", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None,

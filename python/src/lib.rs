@@ -8,8 +8,9 @@
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pt_spectra::cosmology::TransferKind;
 use pt_spectra::fit::{ContourGrid, MultipoleData, Parameter};
-use pt_spectra::jobs::{self, FitRequest, RsdRequest};
+use pt_spectra::jobs::{self, BiasOutput, FitRequest, RsdRequest};
 use pt_spectra::linear::LogGrid;
+use pt_spectra::loops::bias::{BiasPlan, GalaxyBias};
 use pt_spectra::precision::Precision;
 use pt_spectra::progress::Silent;
 use pt_spectra::real::{RealPlan as LibRealPlan, RealSelection};
@@ -136,6 +137,8 @@ pub(crate) fn detached<T: Send>(
 struct RealPlan {
     plan: LibRealPlan,
     selection: RealSelection,
+    /// The bias terms' plan, built at the first call that asks for them.
+    bias_plan: OnceLock<BiasPlan>,
 }
 
 #[pymethods]
@@ -160,7 +163,11 @@ impl RealPlan {
         let (plan, _) = detached(py, || {
             LibRealPlan::for_selection(&k, selection, &precision, store.get(), &Silent)
         })?;
-        Ok(Self { plan, selection })
+        Ok(Self {
+            plan,
+            selection,
+            bias_plan: OnceLock::new(),
+        })
     }
 
     /// The k grid [h/Mpc].
@@ -170,8 +177,9 @@ impl RealPlan {
     }
 
     /// The spectra of `linear` (None: the embedded gm2012 spectrum; a path; or (k, P)) at z, with the
-    /// EFT counterterm c_s² = `cs2` [(Mpc/h)²].
-    #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false, eh=None, cs2=0.0))]
+    /// EFT counterterm c_s² = `cs2` [(Mpc/h)²], and the galaxy bias terms and spectra if asked for.
+    #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false, eh=None, cs2=0.0,
+        bias_terms=false, bias=None, b2=0.0, bs=0.0, b3=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn __call__(
         &self,
@@ -183,12 +191,44 @@ impl RealPlan {
         terms: bool,
         eh: Option<&str>,
         cs2: f64,
+        bias_terms: bool,
+        bias: Option<f64>,
+        b2: f64,
+        bs: f64,
+        b3: f64,
     ) -> PyResult<Table> {
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
+        let output = BiasOutput {
+            terms: bias_terms,
+            galaxy: bias.map(|b1| GalaxyBias {
+                b1,
+                b2,
+                bs,
+                b3nl: b3,
+            }),
+        };
+        if bias.is_none() && (b2 != 0.0 || bs != 0.0 || b3 != 0.0) {
+            return Err(PyValueError::new_err(
+                "b2, bs and b3 need bias (b1): the galaxy spectra are those of the bias expansion",
+            ));
+        }
         let ((table, prepared), seconds) = detached(py, || {
+            output.validate(self.selection)?;
+            if output.any() && self.bias_plan.get().is_none() {
+                let plan = BiasPlan::new(self.plan.k(), self.plan.precision())?;
+                let _ = self.bias_plan.set(plan);
+            }
             let prepared = inputs.prepare(self.plan.k())?;
-            let table =
-                jobs::real_table(&self.plan, self.selection, &prepared, terms, cs2, &Silent)?;
+            let table = jobs::real_table_with_bias(
+                &self.plan,
+                self.bias_plan.get(),
+                self.selection,
+                &prepared,
+                terms,
+                cs2,
+                output,
+                &Silent,
+            )?;
             Ok((table, prepared))
         })?;
         Table::new(
@@ -206,7 +246,7 @@ impl RealPlan {
 #[pyfunction]
 #[pyo3(signature = (model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false,
     precision="default", q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None, k_min=1e-3,
-    k_max=1.0, nk=100, cs2=0.0, two_loop="auto"))]
+    k_max=1.0, nk=100, cs2=0.0, two_loop="auto", bias_terms=false, bias=None, b2=0.0, bs=0.0, b3=0.0))]
 #[allow(clippy::too_many_arguments)]
 fn real(
     py: Python<'_>,
@@ -227,6 +267,11 @@ fn real(
     nk: usize,
     cs2: f64,
     two_loop: &str,
+    bias_terms: bool,
+    bias: Option<f64>,
+    b2: f64,
+    bs: f64,
+    b3: f64,
 ) -> PyResult<Table> {
     let k = k_grid(k, k_min, k_max, nk)?;
     let plan = RealPlan::new(
@@ -239,7 +284,9 @@ fn real(
         cache_dir,
         two_loop,
     )?;
-    plan.__call__(py, linear, z, z_input, cosmology, terms, eh, cs2)
+    plan.__call__(
+        py, linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2, bs, b3,
+    )
 }
 
 /// Measured multipoles from a path (with columns) or a dict {"k", "P0", "s0", "P2", "s2", …}.
@@ -376,6 +423,7 @@ fn fit(
             terms: false,
             no_wiggle: false,
             cs2,
+            galaxy: None,
         },
         free,
         k_min,

@@ -225,6 +225,7 @@ fn rsd_request(
         terms,
         no_wiggle,
         cs2,
+        galaxy: None,
     })
 }
 

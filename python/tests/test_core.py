@@ -122,6 +122,33 @@ def test_bad_input_raises_value_error_naming_the_problem():
         assert needle in str(e.value), (needle, str(e.value))
 
 
+def test_guards_name_the_problem(monkeypatch):
+    """Never a silently wrong number: implausible parameters, a memory limit, tiny kernel vectors."""
+    k = np.geomspace(0.01, 0.3, 5)
+    h_percent = dict(h=67.66, omega_b=0.022, omega_cdm=0.12, n_s=0.96, A_s=2.1e-9)
+    with pytest.raises(ValueError, match="looks like H0"):
+        pt.real(k=k, cosmology=h_percent)
+    with pytest.raises(ValueError, match=r"f = -1: must be in \[0, 2\]"):
+        pt.rsd(k=k, f=-1.0)
+    assert pt.kernel("F", [[1e-170, 0, 0], [0, 1e-170, 0]]) == pytest.approx(5 / 7, rel=1e-15)
+    with pytest.warns(RuntimeWarning, match="lengths differ"):
+        pt.kernel("F", [[1e-6, 0, 0], [0, 1, 0]])
+    monkeypatch.setenv("PT_SPECTRA_MAX_MEMORY", "1M")
+    with pytest.raises(ValueError, match=r"needs about .* of memory, above 1.0 MB"):
+        pt.real(k=k)
+
+
+def test_bias_terms_and_galaxy_spectra_mirror_the_command_line():
+    k = np.geomspace(0.02, 0.2, 4)
+    t = pt.real(model="1l-spt", k=k, precision="fast", bias_terms=True, bias=2.0, b2=0.5)
+    for name in ("Pd1d2", "err_Pd1d2", "Ps2s2", "Pt1d2", "sig3nl", "P_gg", "err_P_gg", "P_gm"):
+        assert name in t.columns, name
+    expected = 4.0 * t["P_dd"] + 2.0 * 0.5 * t["Pd1d2"] + 0.25 * 0.25 * t["Pd2d2"]
+    np.testing.assert_allclose(t["P_gg"], expected, rtol=1e-12)
+    with pytest.raises(ValueError, match="need bias"):
+        pt.real(k=k, b2=1.0)
+
+
 def test_kernels_exact_and_float():
     assert pt.kernel("F", [[1, 0, 0], [0, 1, 0]]) == pytest.approx(5 / 7, rel=1e-15)
     assert pt.kernel("G", [[1, 2, 3], [0, 1, 0], [0, -1, 0]], exact=True) == "-20452/30723"

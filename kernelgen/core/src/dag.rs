@@ -228,6 +228,28 @@ pub fn q(n: i64, d: i64) -> Q {
     Q::new(BigInt::from(n), BigInt::from(d))
 }
 
+/// Multiplications of a linear combination as emitted: one per distinct |coefficient| other than 1.
+pub fn coefficient_muls(terms: &[(Q, NodeId)]) -> usize {
+    group_by_magnitude(terms)
+        .iter()
+        .filter(|(m, _)| !m.is_one())
+        .count()
+}
+
+/// Terms of a linear combination grouped by the magnitude of their coefficient, each with its sign.
+pub fn group_by_magnitude(terms: &[(Q, NodeId)]) -> Vec<(Q, Vec<(bool, NodeId)>)> {
+    let mut groups: Vec<(Q, Vec<(bool, NodeId)>)> = Vec::new();
+    for (c, id) in terms {
+        let mag = c.abs();
+        let entry = (c.is_negative(), *id);
+        match groups.iter_mut().find(|(m, _)| *m == mag) {
+            Some((_, g)) => g.push(entry),
+            None => groups.push((mag, vec![entry])),
+        }
+    }
+    groups
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

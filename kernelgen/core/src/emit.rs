@@ -14,8 +14,8 @@
 //! for essentially the same machine code. Exact arithmetic runs through a `Copy` handle to a `BigRational`
 //! (`pt_kernels`' `Exact`), so one function still runs in f64 and in exact rationals.
 
-use crate::dag::{as_i64_pair, exact_in_f64, NodeId, Op, Value, Q};
-use crate::pairing::{Output, PairOp, Paired};
+use crate::dag::{as_i64_pair, exact_in_f64, group_by_magnitude, NodeId, Op, Value, Q};
+use crate::paired::{Output, PairOp, Paired};
 use crate::program::{OpCounts, Program};
 use crate::recursion::RecursionStats;
 use crate::spec::Spec;
@@ -157,28 +157,6 @@ impl Emitter {
         };
         quote!(let #x = #rhs;)
     }
-}
-
-/// Multiplications of a linear combination as emitted: one per distinct |coefficient| other than 1.
-pub fn coefficient_muls(terms: &[(Q, NodeId)]) -> usize {
-    group_by_magnitude(terms)
-        .iter()
-        .filter(|(m, _)| !m.is_one())
-        .count()
-}
-
-/// Terms of a linear combination grouped by the magnitude of their coefficient, each with its sign.
-pub fn group_by_magnitude(terms: &[(Q, NodeId)]) -> Vec<(Q, Vec<(bool, NodeId)>)> {
-    let mut groups: Vec<(Q, Vec<(bool, NodeId)>)> = Vec::new();
-    for (c, id) in terms {
-        let mag = c.abs();
-        let entry = (c.is_negative(), *id);
-        match groups.iter_mut().find(|(m, _)| *m == mag) {
-            Some((_, g)) => g.push(entry),
-            None => groups.push((mag, vec![entry])),
-        }
-    }
-    groups
 }
 
 /// Sum of signed terms as a balanced tree; returns (negated, expression).

@@ -12,6 +12,7 @@
 pub mod dag;
 pub mod emit;
 pub mod modp;
+pub mod paired;
 pub mod pairing;
 pub mod parse;
 pub mod program;

@@ -9,7 +9,7 @@
 //! program and its lane-pair form this way, to check one against the other.
 
 use crate::dag::{Dag, Op, Q};
-use crate::pairing::{Output, PairOp, Paired, Var};
+use crate::paired::{Output, PairOp, Paired, Var};
 use crate::program::Program;
 use num_bigint::BigInt;
 use num_integer::Integer;

@@ -4,8 +4,7 @@
 //! known exactly here, so forms that coincide are computed once, forms that vanish are constant zeros, and
 //! a dot product costs two additions of norms already at hand: k_A·k_B = (k_{A∪B}² − k_A² − k_B²)/2.
 
-use crate::dag::{q, Dag, Op, Value, Q};
-use crate::emit::coefficient_muls;
+use crate::dag::{coefficient_muls, q, Dag, Op, Value, Q};
 use crate::recursion::{momentum, Algebra, Mask, Recursion, RecursionStats};
 use crate::spec::Spec;
 use num_traits::Zero;

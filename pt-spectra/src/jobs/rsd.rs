@@ -5,14 +5,15 @@ use super::{counterterm_line, describe_inputs, VERSION};
 use crate::error::{Error, Result};
 use crate::halo::{crossings, Bias, Noise};
 use crate::linear::LinearSpectrum;
+use crate::loops::bias::BiasTerms;
 use crate::loops::TnsTerms;
 use crate::output::{Table, POWER};
 use crate::precision::Precision;
 use crate::progress::Progress;
 use crate::real::RealSpectra;
 use crate::rsd::{
-    fog_sigma, multipoles, DispersionInput, Fog, MultipoleRule, RsdModel, RsdPlan, RsdSettings,
-    Sigma0, DISPERSION_Q_CUT,
+    fog_sigma, multipoles, DispersionInput, Fog, GalaxyTerms, MultipoleRule, RsdModel, RsdPlan,
+    RsdSettings, Sigma0, DISPERSION_Q_CUT,
 };
 use crate::setup::Prepared;
 
@@ -45,9 +46,56 @@ pub struct RsdRequest {
     /// The EFT counterterm c_s² [(Mpc/h)²] added to the real-space spectra ([`crate::real::counterterm`](mod@crate::real::counterterm);
     /// 0: none); in `fit` its start value if free, else its value.
     pub cs2: f64,
+    /// The nonlinear galaxy bias b2, bs, b3nl of the Scoccimarro and TNS models (the plan needs
+    /// [`RsdPlan::with_bias_terms`]; b1 is the constant bias); `None`: linear bias.
+    pub galaxy: Option<NonlinearBias>,
+}
+
+/// The nonlinear galaxy bias of an [`RsdRequest`] ([`crate::rsd::GalaxyTerms`] without its terms).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NonlinearBias {
+    /// Second-order local bias b2.
+    pub b2: f64,
+    /// Tidal bias b_s².
+    pub bs: f64,
+    /// Non-local cubic bias b3nl.
+    pub b3nl: f64,
 }
 
 impl RsdRequest {
+    /// Checks the nonlinear bias against the model and the bias before any plan is built.
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] for nonlinear bias with the Kaiser model or a b(k) table;
+    /// [`Error::InvalidParameter`] for a bias that is not finite.
+    pub fn validate_galaxy(&self) -> Result<()> {
+        let Some(g) = self.galaxy else {
+            return Ok(());
+        };
+        if self.rsd == RsdModel::Kaiser {
+            return Err(Error::InvalidChoice {
+                what: "nonlinear bias with the kaiser model".into(),
+                reason: "Kaiser is linear in the bias: use scoccimarro or tns".into(),
+            });
+        }
+        if !matches!(self.bias, Bias::Constant(_)) {
+            return Err(Error::InvalidChoice {
+                what: "nonlinear bias with a b(k) table".into(),
+                reason: "the bias expansion has a constant b1: give it with --bias".into(),
+            });
+        }
+        for (name, v) in [("b2", g.b2), ("bs", g.bs), ("b3nl", g.b3nl)] {
+            if !v.is_finite() {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: v,
+                    reason: "must be finite",
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// A description of the bias for headers.
     pub fn describe_bias(&self) -> String {
         match &self.bias {
@@ -120,9 +168,21 @@ pub fn rsd_table(
     progress: &dyn Progress,
 ) -> Result<Table> {
     let (spectra, tns) = plan.evaluate(&prepared.spectrum, progress)?;
-    rsd_table_from_terms(
+    let bias_terms = match request.galaxy {
+        None => None,
+        Some(_) => Some(
+            plan.bias_terms(&prepared.spectrum)
+                .ok_or(Error::MissingTerm {
+                    term: "the bias terms",
+                    needed_by: "the nonlinear galaxy bias".into(),
+                    hint: " (RsdPlan::with_bias_terms)",
+                })?,
+        ),
+    };
+    rsd_table_with_bias_terms(
         &spectra,
         tns.as_ref(),
+        bias_terms,
         plan.real().precision(),
         request,
         prepared,
@@ -142,6 +202,23 @@ pub fn rsd_table_from_terms(
     request: &RsdRequest,
     prepared: &Prepared,
 ) -> Result<Table> {
+    rsd_table_with_bias_terms(spectra, tns, None, precision, request, prepared)
+}
+
+/// [`rsd_table_from_terms`] with the bias terms of the spectrum, which a request with nonlinear bias
+/// ([`RsdRequest::galaxy`]) needs.
+///
+/// # Errors
+/// As [`rsd_table_from_terms`]; [`Error::MissingTerm`] for nonlinear bias without `bias_terms`,
+/// [`Error::InvalidChoice`] for it with a b(k) table or the Kaiser model.
+pub fn rsd_table_with_bias_terms(
+    spectra: &RealSpectra,
+    tns: Option<&TnsTerms>,
+    bias_terms: Option<BiasTerms>,
+    precision: &Precision,
+    request: &RsdRequest,
+    prepared: &Prepared,
+) -> Result<Table> {
     let k = &spectra.k;
     let f = request.f.unwrap_or(prepared.growth_rate);
     check_growth_rate(f)?;
@@ -151,6 +228,23 @@ pub fn rsd_table_from_terms(
         .resolve(&prepared.spectrum, growth, precision)?;
     let sigma = fog_sigma(sigma0, growth, f);
     let bias = request.bias.values(k, request.amplitude)?;
+    request.validate_galaxy()?;
+    let galaxy = match (request.galaxy, bias_terms) {
+        (None, _) => None,
+        (Some(_), None) => {
+            return Err(Error::MissingTerm {
+                term: "the bias terms",
+                needed_by: "the nonlinear galaxy bias".into(),
+                hint: " (RsdPlan::with_bias_terms)",
+            })
+        }
+        (Some(g), Some(terms)) => Some(GalaxyTerms {
+            b2: g.b2,
+            bs: g.bs,
+            b3nl: g.b3nl,
+            terms,
+        }),
+    };
     let settings = RsdSettings {
         model: request.rsd,
         f,
@@ -161,6 +255,7 @@ pub fn rsd_table_from_terms(
         ells: request.ells.clone(),
         parts: request.terms,
         cs2: request.cs2,
+        galaxy,
     };
     let m = multipoles(spectra, tns, &settings)?;
     let (rsd, fog) = (request.rsd, request.fog);
@@ -183,6 +278,16 @@ pub fn rsd_table_from_terms(
              B = b^4 B(f/b)"
                 .into(),
         );
+    }
+    if let Some(g) = request.galaxy {
+        header.push(format!(
+            "nonlinear galaxy bias (Beutler et al. 2017): b1 = A_b b, b2 = {}, bs = {}, b3nl = {}; \
+             P^s = P_gg + 2 f mu^2 P_gt + f^2 mu^4 P_tt (+ A, B of b1), P_gg = b1^2 P_dd + b1 b2 Pd1d2 \
+             + 1/4 b2^2 Pd2d2 + b1 bs Pd1s2 + 1/2 b2 bs Pd2s2 + 1/4 bs^2 Ps2s2 + 2 b1 b3nl sig3nl, P_gt \
+             = b1 P_dt + 1/2 b2 Pt1d2 + 1/2 bs Pt1s2 + b3nl sig3nl (FAST-PT's bias terms, no constant \
+             subtracted: the k -> 0 constant 1/4 b2^2 Pd2d2 + ... acts as a shot noise)",
+            g.b2, g.bs, g.b3nl
+        ));
     }
     header.push(
         "P_l = (2l+1) int_0^1 dmu P^s(k,mu) L_l(mu) of the noise-free model (the paper's P^s_hh = \

@@ -330,6 +330,13 @@ impl GalaxyBias {
         let gm = p_dd * b1 + d1d2 * (0.5 * b2) + d1s2 * (0.5 * bs) + s3 * b3nl;
         [gg, gm]
     }
+
+    /// P_gθ at k index `i` from the matter P_δθ of any model (Beutler et al. 2017's P_gδ,θ in this
+    /// normalisation): b1 P_δθ + ½ b2 Pt1d2 + ½ bs Pt1s2 + b3nl sig3nl.
+    pub fn velocity(&self, i: usize, p_dt: Estimate, t: &BiasTerms) -> Estimate {
+        let (t1d2, t1s2) = (t.pairs[5][i], t.pairs[6][i]);
+        p_dt * self.b1 + t1d2 * (0.5 * self.b2) + t1s2 * (0.5 * self.bs) + t.sig3nl[i] * self.b3nl
+    }
 }
 
 #[cfg(test)]

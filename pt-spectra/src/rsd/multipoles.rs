@@ -6,6 +6,7 @@ use super::{dispersion_theory, DispersionInput, Fog, MultipoleRule, RsdModel};
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
+use crate::loops::bias::{BiasPlan, BiasTerms, GalaxyBias};
 use crate::loops::{Pair, TnsPlan, TnsTerms};
 use crate::output::{Table, POWER, WAVENUMBER};
 use crate::precision::Precision;
@@ -38,6 +39,24 @@ pub struct RsdSettings {
     /// model (−2, −4, −6 c_s² k² P_lin, [`crate::real::counterterm`](mod@crate::real::counterterm); on top of any the spectra
     /// include); 0 for none.
     pub cs2: f64,
+    /// The nonlinear galaxy bias of the Scoccimarro and TNS models (Beutler et al. 2017), if any:
+    /// P_δδ, P_δθ then enter through P_gg, P_gθ of the bias expansion, with b1 = the bias above.
+    pub galaxy: Option<GalaxyTerms>,
+}
+
+/// The nonlinear bias of galaxies in the Scoccimarro and TNS models (the BOSS DR12 model of Beutler
+/// et al. 2017, arXiv:1607.03150, in FAST-PT's normalisation of the bias terms): b2, bs = b_s², b3nl
+/// and the bias terms of the spectrum on the grid. b1 is [`RsdSettings::bias`] at each k.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GalaxyTerms {
+    /// Second-order local bias b2.
+    pub b2: f64,
+    /// Tidal bias b_s².
+    pub bs: f64,
+    /// Non-local cubic bias b3nl.
+    pub b3nl: f64,
+    /// The bias terms on the grid of the real-space spectra.
+    pub terms: BiasTerms,
 }
 
 /// Redshift-space multipoles on a k grid [(Mpc/h)^3].
@@ -78,7 +97,7 @@ pub struct RsdMultipoles {
 /// let real = real_space(RealModel::Linear, &p, &[0.05], &Precision::fast(), &TableStore::in_memory())?;
 /// let settings = RsdSettings {
 ///     model: RsdModel::Kaiser, f: 0.5, bias: vec![2.0], fog: Fog::None, sigma: 0.0, noise: None,
-///     ells: vec![0, 2], parts: false, cs2: 0.0,
+///     ells: vec![0, 2], parts: false, cs2: 0.0, galaxy: None,
 /// };
 /// let m = multipoles(&real, None, &settings)?;
 /// // Linear Kaiser: P0 = (b² + 2bf/3 + f²/5) P_lin.
@@ -95,6 +114,16 @@ pub fn multipoles(
     check_grid("bias and real-space spectra", k, settings.bias.len())?;
     if let Some(noise) = &settings.noise {
         check_grid("noise and real-space spectra", k, noise.len())?;
+    }
+    if let Some(g) = &settings.galaxy {
+        check_grid("bias terms and real-space spectra", k, g.terms.k.len())?;
+        if g.terms.k != *k {
+            return Err(Error::GridMismatch {
+                what: "bias terms and real-space spectra",
+                expected: describe_grid(k),
+                found: describe_grid(&g.terms.k),
+            });
+        }
     }
     let tns = match (settings.model.needs_tns(), tns) {
         (false, _) => None,
@@ -138,9 +167,30 @@ pub fn multipoles(
             }
         }
         let coefficients = tns.map(|t| &t.coefficients[i]);
-        let p = settings
-            .model
-            .parts(settings.bias[i], settings.f, s, coefficients)?;
+        // The real-space spectrum of the signal-to-noise: b² P_δδ, or P_gg.
+        let mut p_real = settings.bias[i] * settings.bias[i] * s[0].value;
+        let p = match &settings.galaxy {
+            None => settings
+                .model
+                .parts(settings.bias[i], settings.f, s, coefficients)?,
+            Some(g) => {
+                let bias = GalaxyBias {
+                    b1: settings.bias[i],
+                    b2: g.b2,
+                    bs: g.bs,
+                    b3nl: g.b3nl,
+                };
+                let [gg, _] = bias.spectra(i, s[0], &g.terms);
+                let gt = bias.velocity(i, s[1], &g.terms);
+                p_real = gg.value;
+                settings.model.galaxy_parts(
+                    settings.bias[i],
+                    settings.f,
+                    [gg, gt, s[2]],
+                    coefficients,
+                )?
+            }
+        };
         let x = ki * settings.sigma;
         let sum = p.total();
         push(&mut total, rule.evaluate_polynomial(&sum, settings.fog, x));
@@ -154,8 +204,7 @@ pub fn multipoles(
             signal_to_noise_s.as_mut(),
             &settings.noise,
         ) {
-            let b = settings.bias[i];
-            sn.push(b * b * s[0].value / noise[i]);
+            sn.push(p_real / noise[i]);
             let p0 = monopole.evaluate_polynomial(&sum, settings.fog, x)[0].value;
             sn_s.push(p0 / noise[i]);
         }
@@ -298,6 +347,8 @@ impl Sigma0 {
 pub struct RsdPlan {
     real: RealPlan,
     tns: Option<TnsPlan>,
+    /// The bias terms' plan, for nonlinear galaxy bias ([`with_bias_terms`](Self::with_bias_terms)).
+    bias: Option<BiasPlan>,
 }
 
 impl RsdPlan {
@@ -334,7 +385,27 @@ impl RsdPlan {
         } else {
             None
         };
-        Ok(Self { real, tns })
+        Ok(Self {
+            real,
+            tns,
+            bias: None,
+        })
+    }
+
+    /// This plan with the bias terms' plan too (for [`GalaxyTerms`]); a no-op if it has it.
+    ///
+    /// # Errors
+    /// As [`BiasPlan::new`].
+    pub fn with_bias_terms(mut self) -> Result<Self> {
+        if self.bias.is_none() {
+            self.bias = Some(BiasPlan::new(self.real.k(), self.real.precision())?);
+        }
+        Ok(self)
+    }
+
+    /// The bias terms of `spectrum`, if the plan has their plan.
+    pub fn bias_terms(&self, spectrum: &LinearSpectrum) -> Option<BiasTerms> {
+        self.bias.as_ref().map(|plan| plan.evaluate(spectrum))
     }
 
     /// The real-space plan.
@@ -383,6 +454,7 @@ mod tests {
             ells: vec![0],
             parts: false,
             cs2: 0.0,
+            galaxy: None,
         };
         let e = multipoles(&real, None, &settings).unwrap_err().to_string();
         assert!(
@@ -427,6 +499,7 @@ mod tests {
             ells: vec![0, 2],
             parts: false,
             cs2: 0.0,
+            galaxy: None,
         };
         let m = multipoles(&real, None, &settings).unwrap();
         let (sn, sn_s) = (

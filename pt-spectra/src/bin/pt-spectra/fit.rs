@@ -174,6 +174,7 @@ pub fn run(args: &Args) -> Result<()> {
             terms: false,
             no_wiggle: false,
             cs2: args.cs2,
+            galaxy: None,
         },
         free,
         k_min: args.k_min,

@@ -5,7 +5,7 @@ use crate::input::Input;
 use crate::output::{check_outputs, write_output};
 use crate::progress::Bars;
 use anyhow::Result;
-use pt_spectra::jobs::{rsd_table, RsdRequest};
+use pt_spectra::jobs::{rsd_table, NonlinearBias, RsdRequest};
 use pt_spectra::real::RealModel;
 use pt_spectra::rsd::{Fog, RsdModel, RsdPlan, Sigma0};
 use std::path::PathBuf;
@@ -42,6 +42,16 @@ pub struct Args {
     sigma0: Sigma0,
     #[command(flatten)]
     bias: BiasArgs,
+    /// Nonlinear galaxy bias b2 (scoccimarro, tns: the BOSS DR12 model of Beutler et al. 2017, with
+    /// the bias terms of `real --bias-terms`; b1 is --bias, constant).
+    #[arg(long, value_name = "B2", allow_hyphen_values = true)]
+    b2: Option<f64>,
+    /// Tidal bias b_s² of the nonlinear galaxy bias (FAST-PT's bs).
+    #[arg(long, value_name = "BS", allow_hyphen_values = true)]
+    bs: Option<f64>,
+    /// Non-local cubic bias b3nl of the nonlinear galaxy bias.
+    #[arg(long, value_name = "B3", allow_hyphen_values = true)]
+    b3: Option<f64>,
     #[command(flatten)]
     noise: NoiseArgs,
     /// EFT counterterm c_s² [(Mpc/h)²] added to the real-space spectra before the RSD model: P_dd −
@@ -64,6 +74,15 @@ pub struct Args {
 }
 
 impl Args {
+    /// The nonlinear bias of --b2, --bs, --b3, if any is given.
+    fn galaxy(&self) -> Option<NonlinearBias> {
+        (self.b2.is_some() || self.bs.is_some() || self.b3.is_some()).then(|| NonlinearBias {
+            b2: self.b2.unwrap_or(0.0),
+            bs: self.bs.unwrap_or(0.0),
+            b3nl: self.b3.unwrap_or(0.0),
+        })
+    }
+
     /// The redshift-space settings of the options.
     fn request(&self) -> Result<RsdRequest> {
         let ells: Vec<usize> = list(&self.ells, "--ells")?;
@@ -80,6 +99,7 @@ impl Args {
             terms: self.terms,
             no_wiggle: self.no_wiggle,
             cs2: self.cs2,
+            galaxy: self.galaxy(),
         })
     }
 }
@@ -91,10 +111,14 @@ pub fn run(args: &Args) -> Result<()> {
     inputs.extend(args.noise.files());
     check_outputs(&[("--out", args.out.as_deref())], &inputs)?;
     let request = args.request()?;
+    request.validate_galaxy()?;
     let (k, loaded) = args.input.load()?;
     let bars = Bars::default();
     let (precision, store) = (&loaded.precision, &loaded.store);
-    let plan = RsdPlan::new(&k, args.real_model, args.rsd, precision, store, &bars)?;
+    let mut plan = RsdPlan::new(&k, args.real_model, args.rsd, precision, store, &bars)?;
+    if request.galaxy.is_some() {
+        plan = plan.with_bias_terms()?;
+    }
     let table = rsd_table(&plan, &request, &loaded.prepared, &bars)?;
     write_output(args.out.as_ref(), &table)
 }

@@ -7,7 +7,7 @@
 //! cosmology-independent tensor with c ⊗ c ⊗ c (or c ⊗ c). The tensors are made once per k grid and
 //! [`Precision`] with the integrators of the direct path and cached ([`TableStore::two_loop_basis`]):
 //! * P15 and the propagator part 2P15 − P33red: the angular table's radial sums as bilinear forms
-//!   ([`P15Table::basis_forms`]), with their error terms;
+//!   ([`p15_forms`]), with their error terms;
 //! * the mode-coupling part 2P24 + P33irr + 2P33red, 2P24 and P33irr: the quasi-Monte-Carlo integral
 //!   of [`super::two_loop`] on the same Sobol points, shifts and points per k as the direct path, each
 //!   point adding the products of basis functions at its momenta ([`tensors`]); one tensor per random
@@ -34,6 +34,7 @@
 //! [`TableStore::two_loop_basis`]: crate::store::TableStore::two_loop_basis
 
 mod linear_basis;
+mod p15_forms;
 mod tensors;
 pub mod training;
 
@@ -41,7 +42,6 @@ pub use linear_basis::{LinearBasis, Projection, SMOOTHING};
 
 use super::lattice::Lattice;
 use super::mode_coupling::ACC;
-use super::p15::FORM_KERNELS;
 use super::two_loop::{
     integral_scale, points_at, random_shifts, replica_estimates, sobol_sequence,
 };
@@ -51,6 +51,7 @@ use super::{
 };
 use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
+use p15_forms::{p15_forms, FORM_KERNELS};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -119,7 +120,7 @@ pub struct TwoLoopBasis {
     /// Points per shift at each k.
     points: Vec<usize>,
     replicas: usize,
-    /// Per k: [type][kernel][pair] ([`P15Table::basis_forms`]).
+    /// Per k: [type][kernel][pair] ([`p15_forms`]).
     forms: Vec<Vec<f64>>,
     /// Per k: the mean over shifts [quantity][triple].
     mean: Vec<Vec<f64>>,
@@ -235,10 +236,7 @@ impl TwoLoopBasis {
             mean.push(m);
             deviations.push(d);
         }
-        let forms = k
-            .par_iter()
-            .map(|&k| table.basis_forms(k, &basis))
-            .collect();
+        let forms = k.par_iter().map(|&k| p15_forms(table, k, &basis)).collect();
         Self {
             k: k.to_vec(),
             key: key(k, precision),
