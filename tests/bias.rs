@@ -191,6 +191,7 @@ fn tns_with_nonlinear_bias_moves_the_multipoles_by_the_bias_terms() {
         no_wiggle: false,
         cs2: 0.0,
         galaxy: None,
+        ap: None,
     };
     let silent = &pt_spectra::progress::Silent;
     let linear = rsd_table(&plan, &request, &prepared, silent).unwrap();

@@ -22,8 +22,11 @@ use crate::loops::{Estimate, Pair, TnsCoefficients};
 use std::fmt;
 use std::str::FromStr;
 
+pub mod ap;
 mod multipoles;
-pub use multipoles::{multipoles, GalaxyTerms, RsdMultipoles, RsdPlan, RsdSettings, Sigma0};
+pub use multipoles::{
+    multipoles, GalaxyTerms, Observed, RsdMultipoles, RsdPlan, RsdSettings, Sigma0,
+};
 
 /// Largest multipole order ℓ supported.
 pub const MAX_ELL: usize = 8;

@@ -424,6 +424,7 @@ fn fit(
             no_wiggle: false,
             cs2,
             galaxy: None,
+            ap: None,
         },
         free,
         k_min,

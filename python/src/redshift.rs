@@ -226,6 +226,7 @@ fn rsd_request(
         no_wiggle,
         cs2,
         galaxy: None,
+        ap: None,
     })
 }
 

@@ -42,6 +42,7 @@ pub const HUBBLE_DISTANCE_MPC_H: f64 = 2997.92458;
 /// Names accepted by [`Cosmology::preset`].
 pub const PRESETS: [&str; 2] = ["gm2012", "planck2018"];
 
+pub mod distance;
 mod eisenstein_hu;
 mod growth;
 pub mod ini;

@@ -12,8 +12,8 @@ use crate::precision::Precision;
 use crate::progress::Progress;
 use crate::real::RealSpectra;
 use crate::rsd::{
-    fog_sigma, multipoles, DispersionInput, Fog, GalaxyTerms, MultipoleRule, RsdModel, RsdPlan,
-    RsdSettings, Sigma0, DISPERSION_Q_CUT,
+    fog_sigma, multipoles, DispersionInput, Fog, GalaxyTerms, MultipoleRule, Observed, RsdModel,
+    RsdPlan, RsdSettings, Sigma0, DISPERSION_Q_CUT,
 };
 use crate::setup::Prepared;
 
@@ -49,6 +49,9 @@ pub struct RsdRequest {
     /// The nonlinear galaxy bias b2, bs, b3nl of the Scoccimarro and TNS models (the plan needs
     /// [`RsdPlan::with_bias_terms`]; b1 is the constant bias); `None`: linear bias.
     pub galaxy: Option<NonlinearBias>,
+    /// The Alcock–Paczynski projection onto observed k ([`crate::rsd::ap`]): the plan must then be
+    /// on [`Distortion::internal_grid`](crate::rsd::ap::Distortion::internal_grid) of those k.
+    pub ap: Option<Observed>,
 }
 
 /// The nonlinear galaxy bias of an [`RsdRequest`] ([`crate::rsd::GalaxyTerms`] without its terms).
@@ -256,6 +259,7 @@ pub fn rsd_table_with_bias_terms(
         parts: request.terms,
         cs2: request.cs2,
         galaxy,
+        ap: request.ap.clone(),
     };
     let m = multipoles(spectra, tns, &settings)?;
     let (rsd, fog) = (request.rsd, request.fog);
@@ -313,9 +317,29 @@ pub fn rsd_table_with_bias_terms(
                 .into(),
         );
     }
+    if let Some(ap) = &request.ap {
+        let (d, grid) = (ap.distortion, &spectra.k);
+        header.push(format!(
+            "Alcock-Paczynski: apar = {}, aperp = {}; observed P_l(k) = (2l+1) int_0^1 dmu L_l(mu) \
+             P^s(k', mu')/(apar aperp^2), k' = (k/aperp) sqrt(1 + mu^2 (F^-2 - 1)), mu' = mu/(F sqrt(1 + \
+             mu^2 (F^-2 - 1))), F = apar/aperp; the model on {} k in [{:.6e}, {:.6e}] h/Mpc \
+             (interpolated cubically in ln k), {}-point Gauss-Legendre in mu (error from half as many); \
+             wide-angle terms neglected",
+            d.apar,
+            d.aperp,
+            grid.len(),
+            grid[0],
+            grid[grid.len() - 1],
+            crate::rsd::ap::MU_NODES
+        ));
+    }
     let mut t = m.table(header);
     if request.no_wiggle {
-        let nw = no_wiggle_multipoles(k, &bias, f, &request.ells, &prepared.no_wiggle()?)?;
+        let (k, bias) = match &request.ap {
+            None => (k.clone(), bias.clone()),
+            Some(ap) => (ap.k.clone(), request.bias.values(&ap.k, request.amplitude)?),
+        };
+        let nw = no_wiggle_multipoles(&k, &bias, f, &request.ells, &prepared.no_wiggle()?)?;
         for (l, p) in request.ells.iter().zip(nw) {
             t.push(format!("P{l}_nw"), POWER, p);
         }

@@ -2,7 +2,10 @@
 //! bias, Fingers of God and noise ([`multipoles`]), and the plan that computes the loop terms they
 //! need once per k grid ([`RsdPlan`]).
 
-use super::{dispersion_theory, DispersionInput, Fog, MultipoleRule, RsdModel};
+use super::ap::{observed_multipoles, Distortion};
+use super::{
+    dispersion_theory, DispersionInput, Fog, MuPolynomial, MultipoleRule, Parts, RsdModel,
+};
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
@@ -42,6 +45,18 @@ pub struct RsdSettings {
     /// The nonlinear galaxy bias of the Scoccimarro and TNS models (Beutler et al. 2017), if any:
     /// P_δδ, P_δθ then enter through P_gg, P_gθ of the bias expansion, with b1 = the bias above.
     pub galaxy: Option<GalaxyTerms>,
+    /// The Alcock–Paczynski projection, if any: the real-space spectra are then on the internal grid
+    /// of [`Distortion::internal_grid`] and the multipoles on the observed grid of [`Observed`].
+    pub ap: Option<Observed>,
+}
+
+/// Multipoles observed in a fiducial cosmology: the distortion and the observed k [h/Mpc].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Observed {
+    /// α∥ and α⊥.
+    pub distortion: Distortion,
+    /// The observed wavenumbers [h/Mpc].
+    pub k: Vec<f64>,
 }
 
 /// The nonlinear bias of galaxies in the Scoccimarro and TNS models (the BOSS DR12 model of Beutler
@@ -97,7 +112,7 @@ pub struct RsdMultipoles {
 /// let real = real_space(RealModel::Linear, &p, &[0.05], &Precision::fast(), &TableStore::in_memory())?;
 /// let settings = RsdSettings {
 ///     model: RsdModel::Kaiser, f: 0.5, bias: vec![2.0], fog: Fog::None, sigma: 0.0, noise: None,
-///     ells: vec![0, 2], parts: false, cs2: 0.0, galaxy: None,
+///     ells: vec![0, 2], parts: false, cs2: 0.0, galaxy: None, ap: None,
 /// };
 /// let m = multipoles(&real, None, &settings)?;
 /// // Linear Kaiser: P0 = (b² + 2bf/3 + f²/5) P_lin.
@@ -152,6 +167,10 @@ pub fn multipoles(
         return Err(invalid("FoG sigma [Mpc/h]", settings.sigma, reason));
     }
     let rule = MultipoleRule::new(&settings.ells)?;
+    let model = model_parts(real, tns, settings)?;
+    if let Some(ap) = &settings.ap {
+        return observed(real, &model, settings, ap);
+    }
     let monopole = MultipoleRule::new(&[0])?;
     let n_ell = settings.ells.len();
     let empty = || vec![Vec::with_capacity(k.len()); n_ell];
@@ -159,38 +178,7 @@ pub fn multipoles(
     let mut parts = settings.parts.then(|| [empty(), empty(), empty()]);
     let mut signal_to_noise = settings.noise.as_ref().map(|_| Vec::with_capacity(k.len()));
     let mut signal_to_noise_s = signal_to_noise.clone();
-    for (i, &ki) in k.iter().enumerate() {
-        let mut s = Pair::ALL.map(|p| real.spectra[p][i]);
-        if settings.cs2 != 0.0 {
-            for (e, pair) in s.iter_mut().zip(Pair::ALL) {
-                e.value += counterterm(pair, settings.cs2, ki, real.p_lin[i]);
-            }
-        }
-        let coefficients = tns.map(|t| &t.coefficients[i]);
-        // The real-space spectrum of the signal-to-noise: b² P_δδ, or P_gg.
-        let mut p_real = settings.bias[i] * settings.bias[i] * s[0].value;
-        let p = match &settings.galaxy {
-            None => settings
-                .model
-                .parts(settings.bias[i], settings.f, s, coefficients)?,
-            Some(g) => {
-                let bias = GalaxyBias {
-                    b1: settings.bias[i],
-                    b2: g.b2,
-                    bs: g.bs,
-                    b3nl: g.b3nl,
-                };
-                let [gg, _] = bias.spectra(i, s[0], &g.terms);
-                let gt = bias.velocity(i, s[1], &g.terms);
-                p_real = gg.value;
-                settings.model.galaxy_parts(
-                    settings.bias[i],
-                    settings.f,
-                    [gg, gt, s[2]],
-                    coefficients,
-                )?
-            }
-        };
+    for (i, (&ki, (p, p_real))) in k.iter().zip(&model).enumerate() {
         let x = ki * settings.sigma;
         let sum = p.total();
         push(&mut total, rule.evaluate_polynomial(&sum, settings.fog, x));
@@ -217,6 +205,99 @@ pub fn multipoles(
         noise: settings.noise.clone(),
         signal_to_noise,
         signal_to_noise_s,
+    })
+}
+
+/// P^s(k, μ) before damping at every k of `real`, by part, with the real-space spectrum of the
+/// signal-to-noise (b² P_δδ, or P_gg with nonlinear bias). The inputs are checked by [`multipoles`].
+fn model_parts(
+    real: &RealSpectra,
+    tns: Option<&TnsTerms>,
+    settings: &RsdSettings,
+) -> Result<Vec<(Parts, f64)>> {
+    let mut out = Vec::with_capacity(real.k.len());
+    for (i, &ki) in real.k.iter().enumerate() {
+        let mut s = Pair::ALL.map(|p| real.spectra[p][i]);
+        if settings.cs2 != 0.0 {
+            for (e, pair) in s.iter_mut().zip(Pair::ALL) {
+                e.value += counterterm(pair, settings.cs2, ki, real.p_lin[i]);
+            }
+        }
+        let coefficients = tns.map(|t| &t.coefficients[i]);
+        let mut p_real = settings.bias[i] * settings.bias[i] * s[0].value;
+        let p = match &settings.galaxy {
+            None => settings
+                .model
+                .parts(settings.bias[i], settings.f, s, coefficients)?,
+            Some(g) => {
+                let bias = GalaxyBias {
+                    b1: settings.bias[i],
+                    b2: g.b2,
+                    bs: g.bs,
+                    b3nl: g.b3nl,
+                };
+                let [gg, _] = bias.spectra(i, s[0], &g.terms);
+                let gt = bias.velocity(i, s[1], &g.terms);
+                p_real = gg.value;
+                settings.model.galaxy_parts(
+                    settings.bias[i],
+                    settings.f,
+                    [gg, gt, s[2]],
+                    coefficients,
+                )?
+            }
+        };
+        out.push((p, p_real));
+    }
+    Ok(out)
+}
+
+/// The multipoles observed in a fiducial cosmology ([`super::ap`]): `model` on the grid of `real`
+/// projected onto the observed grid of `ap`.
+fn observed(
+    real: &RealSpectra,
+    model: &[(Parts, f64)],
+    settings: &RsdSettings,
+    ap: &Observed,
+) -> Result<RsdMultipoles> {
+    if settings.noise.is_some() {
+        return Err(Error::InvalidChoice {
+            what: "a noise with the Alcock-Paczynski projection".into(),
+            reason: "the signal-to-noise columns are of real space; run without the noise (it \
+                     does not change the multipoles)"
+                .into(),
+        });
+    }
+    let project = |part: &dyn Fn(&Parts) -> MuPolynomial| {
+        let polys: Vec<MuPolynomial> = model.iter().map(|(p, _)| part(p)).collect();
+        observed_multipoles(
+            &real.k,
+            &polys,
+            settings.fog,
+            settings.sigma,
+            &ap.distortion,
+            &settings.ells,
+            &ap.k,
+        )
+    };
+    let total = project(&|p: &Parts| p.total())?;
+    let parts = if settings.parts {
+        Some([
+            project(&|p: &Parts| p.base)?,
+            project(&|p: &Parts| p.a)?,
+            project(&|p: &Parts| p.b)?,
+        ])
+    } else {
+        None
+    };
+    Ok(RsdMultipoles {
+        k: ap.k.clone(),
+        ells: settings.ells.clone(),
+        total,
+        parts,
+        noise: None,
+        signal_to_noise: None,
+        signal_to_noise_s: None,
     })
 }
 
@@ -455,6 +536,7 @@ mod tests {
             parts: false,
             cs2: 0.0,
             galaxy: None,
+            ap: None,
         };
         let e = multipoles(&real, None, &settings).unwrap_err().to_string();
         assert!(
@@ -500,6 +582,7 @@ mod tests {
             parts: false,
             cs2: 0.0,
             galaxy: None,
+            ap: None,
         };
         let m = multipoles(&real, None, &settings).unwrap();
         let (sn, sn_s) = (

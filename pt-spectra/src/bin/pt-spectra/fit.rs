@@ -175,6 +175,7 @@ pub fn run(args: &Args) -> Result<()> {
             no_wiggle: false,
             cs2: args.cs2,
             galaxy: None,
+            ap: None,
         },
         free,
         k_min: args.k_min,

@@ -7,7 +7,9 @@ use crate::progress::Bars;
 use anyhow::Result;
 use pt_spectra::jobs::{rsd_table, NonlinearBias, RsdRequest};
 use pt_spectra::real::RealModel;
-use pt_spectra::rsd::{Fog, RsdModel, RsdPlan, Sigma0};
+use pt_spectra::rsd::ap::Distortion;
+use pt_spectra::rsd::{Fog, Observed, RsdModel, RsdPlan, Sigma0};
+use pt_spectra::setup::NamedCosmology;
 use std::path::PathBuf;
 
 /// Arguments of `pt-spectra rsd`.
@@ -54,6 +56,22 @@ pub struct Args {
     b3: Option<f64>,
     #[command(flatten)]
     noise: NoiseArgs,
+    /// Alcock–Paczynski α∥ = H^fid(z)/H(z) (velocileptors' apar): the multipoles as measured in a
+    /// fiducial cosmology, integrated over the distorted μ with every ℓ ≤ 8 of the model (needs --aperp).
+    #[arg(
+        long,
+        value_name = "A",
+        requires = "aperp",
+        conflicts_with = "fiducial"
+    )]
+    apar: Option<f64>,
+    /// Alcock–Paczynski α⊥ = D_M(z)/D_M^fid(z) (velocileptors' aperp; needs --apar).
+    #[arg(long, value_name = "A", requires = "apar")]
+    aperp: Option<f64>,
+    /// The fiducial cosmology of the measurement (a preset or a CLASS/CAMB .ini): α∥ and α⊥ from
+    /// its H(z) and D_M(z) against --cosmology's (distances in Mpc/h of each).
+    #[arg(long, value_name = "NAME|FILE", conflicts_with = "aperp")]
+    fiducial: Option<String>,
     /// EFT counterterm c_s² [(Mpc/h)²] added to the real-space spectra before the RSD model: P_dd −
     /// 2 c_s² k² P_lin, P_dt − 4 c_s² k² P_lin, P_tt − 6 c_s² k² P_lin (as `real --cs2`).
     #[arg(long, value_name = "CS2", default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_cs2)]
@@ -100,6 +118,7 @@ impl Args {
             no_wiggle: self.no_wiggle,
             cs2: self.cs2,
             galaxy: self.galaxy(),
+            ap: None,
         })
     }
 }
@@ -109,13 +128,46 @@ pub fn run(args: &Args) -> Result<()> {
     let mut inputs = args.input.files();
     inputs.extend(args.bias.files());
     inputs.extend(args.noise.files());
+    let fiducial = args
+        .fiducial
+        .as_deref()
+        .map(std::path::Path::new)
+        .filter(|p| p.is_file());
+    inputs.push(("--fiducial", fiducial));
     check_outputs(&[("--out", args.out.as_deref())], &inputs)?;
     let request = args.request()?;
     request.validate_galaxy()?;
+    let mut request = request;
+    let distortion = match (args.apar, args.aperp) {
+        (Some(apar), Some(aperp)) => Some(Distortion::new(apar, aperp)?),
+        _ => None,
+    };
     let (k, loaded) = args.input.load()?;
+    let distortion = match &args.fiducial {
+        None => distortion,
+        Some(name) => {
+            let fiducial = NamedCosmology::parse(name)
+                .map_err(|e| anyhow::anyhow!("--fiducial: {e}"))?
+                .0;
+            let truth = &loaded.prepared.cosmology.cosmology;
+            Some(Distortion::from_cosmologies(
+                truth,
+                &fiducial.cosmology,
+                loaded.prepared.z,
+            )?)
+        }
+    };
+    let grid = match distortion {
+        Some(distortion) => {
+            let grid = distortion.internal_grid(&k)?;
+            request.ap = Some(Observed { distortion, k });
+            grid
+        }
+        None => k,
+    };
     let bars = Bars::default();
     let (precision, store) = (&loaded.precision, &loaded.store);
-    let mut plan = RsdPlan::new(&k, args.real_model, args.rsd, precision, store, &bars)?;
+    let mut plan = RsdPlan::new(&grid, args.real_model, args.rsd, precision, store, &bars)?;
     if request.galaxy.is_some() {
         plan = plan.with_bias_terms()?;
     }

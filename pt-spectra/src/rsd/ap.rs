@@ -1,0 +1,301 @@
+//! The Alcock–Paczynski effect: multipoles as measured in a fiducial cosmology.
+//!
+//! A survey turns redshifts and angles into distances with a fiducial cosmology; where it differs from
+//! the true one, separations along and across the line of sight are scaled by
+//!   α∥ = H^fid(z)/H(z) = D_H(z)/D_H^fid(z),   α⊥ = D_M(z)/D_M^fid(z)
+//! (velocileptors' `apar`, `aperp`; Ballinger, Peacock & Heavens 1996). The observed spectrum at the
+//! fiducial wavevector (k, μ) is the true one at
+//!   k' = (k/α⊥) [1 + μ²(F⁻² − 1)]^½,   μ' = (μ/F) [1 + μ²(F⁻² − 1)]^−½,   F = α∥/α⊥,
+//! times the volume factor 1/(α∥α⊥²), and its multipoles are
+//!   P̂_ℓ(k) = (2ℓ + 1) ∫_0^1 dμ L_ℓ(μ) P^s(k', μ')/(α∥α⊥²).
+//!
+//! Numerics: the model's P^s(k, μ) (a polynomial in μ² per k, and its Fingers-of-God damping) is
+//! computed on an internal log-uniform grid ([`Distortion::internal_grid`], [`POINTS_PER_DECADE`]
+//! per decade over the k' that the output needs) and interpolated in ln k by four-point Lagrange
+//! polynomials; the μ integral is a [`MU_NODES`]-point Gauss–Legendre rule, its error the difference
+//! from half as many nodes. Every ℓ ≤ 8 of the true spectrum enters (the polynomial is complete), so
+//! the hexadecapole is exact to the interpolation. Wide-angle effects are neglected.
+
+use super::{Fog, MuPolynomial, MAX_ELL};
+use crate::cosmology::Cosmology;
+use crate::error::{Error, Result};
+use crate::estimate::Estimate;
+use crate::integrate::{lagrange4, legendre_nodes};
+
+/// Points per decade of the internal k grid.
+pub const POINTS_PER_DECADE: f64 = 100.0;
+/// Gauss–Legendre nodes of the μ integral on [0, 1] (the error estimate uses half as many).
+pub const MU_NODES: usize = 32;
+/// The accepted range of α∥ and α⊥.
+pub const ALPHA_RANGE: (f64, f64) = (0.5, 2.0);
+
+/// The scaling parameters α∥ (`apar`) and α⊥ (`aperp`) of the fiducial cosmology.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Distortion {
+    /// α∥ = H^fid(z)/H(z).
+    pub apar: f64,
+    /// α⊥ = D_M(z)/D_M^fid(z).
+    pub aperp: f64,
+}
+
+impl Distortion {
+    /// The distortion of `apar`, `aperp`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] unless both are finite and in [`ALPHA_RANGE`].
+    pub fn new(apar: f64, aperp: f64) -> Result<Self> {
+        for (name, v) in [("apar", apar), ("aperp", aperp)] {
+            if !(v.is_finite() && (ALPHA_RANGE.0..=ALPHA_RANGE.1).contains(&v)) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: v,
+                    reason: "must be in [0.5, 2] (the ratio of a true to a fiducial distance)",
+                });
+            }
+        }
+        Ok(Self { apar, aperp })
+    }
+
+    /// The distortion of a measurement in the `fiducial` cosmology of the `truth` at redshift `z`:
+    /// α∥ = H^fid(z)/H(z), α⊥ = D_M(z)/D_M^fid(z), distances in Mpc/h of each cosmology
+    /// ([`crate::cosmology::distance`]; velocileptors' and desilike's convention).
+    ///
+    /// # Errors
+    /// As [`new`](Self::new) for the ratios; [`Error::InvalidParameter`] for z ≤ 0.
+    pub fn from_cosmologies(truth: &Cosmology, fiducial: &Cosmology, z: f64) -> Result<Self> {
+        if !(z.is_finite() && z > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "z",
+                value: z,
+                reason: "must be positive for the Alcock-Paczynski distortion (none at z = 0)",
+            });
+        }
+        Self::new(
+            fiducial.hubble(z) / truth.hubble(z),
+            truth.transverse_comoving_distance(z) / fiducial.transverse_comoving_distance(z),
+        )
+    }
+
+    /// (k', μ') of the true spectrum at the observed (k, μ) (module docs).
+    pub fn true_coordinates(&self, k: f64, mu: f64) -> (f64, f64) {
+        let f = self.apar / self.aperp;
+        let stretch = (1.0 + mu * mu * (1.0 / (f * f) - 1.0)).sqrt();
+        (k / self.aperp * stretch, mu / (f * stretch))
+    }
+
+    /// The volume factor 1/(α∥α⊥²).
+    pub fn volume(&self) -> f64 {
+        1.0 / (self.apar * self.aperp * self.aperp)
+    }
+
+    /// The log-uniform grid [h/Mpc] on which the true spectrum is computed for the observed `k`:
+    /// every k' of every μ, two points beyond each end for the interpolation stencil, at least
+    /// [`POINTS_PER_DECADE`] per decade and 8 points.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for an empty or non-positive `k`.
+    pub fn internal_grid(&self, k: &[f64]) -> Result<Vec<f64>> {
+        let (lo, hi) = k
+            .iter()
+            .fold((f64::INFINITY, 0.0_f64), |(a, b), &v| (a.min(v), b.max(v)));
+        if !(lo > 0.0 && hi.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "k [h/Mpc]",
+                value: lo,
+                reason: "the output grid must be non-empty and positive",
+            });
+        }
+        let scale = [1.0 / self.aperp, 1.0 / self.apar];
+        let k_min = lo * scale[0].min(scale[1]);
+        let k_max = hi * scale[0].max(scale[1]);
+        let decades = (k_max / k_min).log10();
+        let intervals = ((decades * POINTS_PER_DECADE).ceil() as usize).max(4);
+        let step = (k_max / k_min).ln() / intervals as f64;
+        Ok((0..intervals + 5)
+            .map(|i| (k_min.ln() + step * (i as f64 - 2.0)).exp())
+            .collect())
+    }
+}
+
+/// The observed multipoles `ells` at `k_out` of the model whose P^s(k, μ) before damping is `polys`
+/// on the log-uniform `grid` (from [`Distortion::internal_grid`]), with the damping `fog` of scale
+/// `sigma` [Mpc/h]: `out[j][i]` for the j-th ℓ at the i-th k, with its error (the coefficients'
+/// errors, propagated, plus the μ quadrature's).
+///
+/// # Errors
+/// [`Error::LengthMismatch`] if `polys` is not on `grid`; [`Error::OutOfRange`] if an output k needs
+/// the spectrum outside the grid; [`Error::InvalidParameter`] for ℓ > 8 or odd.
+pub fn observed_multipoles(
+    grid: &[f64],
+    polys: &[MuPolynomial],
+    fog: Fog,
+    sigma: f64,
+    ap: &Distortion,
+    ells: &[usize],
+    k_out: &[f64],
+) -> Result<Vec<Vec<Estimate>>> {
+    if grid.len() != polys.len() {
+        return Err(Error::LengthMismatch {
+            what: "model polynomials and their k grid",
+            left: polys.len(),
+            right: grid.len(),
+        });
+    }
+    if grid.len() < 4 {
+        return Err(Error::TooFewPoints {
+            origin: "the internal k grid of the Alcock-Paczynski projection".into(),
+            found: grid.len(),
+            min: 4,
+        });
+    }
+    if let Some(&bad) = ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
+        return Err(Error::InvalidParameter {
+            name: "multipole ell",
+            value: bad as f64,
+            reason: "must be even and at most 8",
+        });
+    }
+    let (x0, step) = (
+        grid[0].ln(),
+        (grid[grid.len() - 1] / grid[0]).ln() / (grid.len() - 1) as f64,
+    );
+    // The polynomial (value and error coefficients) at ln k = x, cubic Lagrange on the grid.
+    let at = |k: f64| -> Result<MuPolynomial> {
+        let u = (k.ln() - x0) / step;
+        let last = (grid.len() - 1) as f64;
+        if !(1.0 - 1e-9..=last - 1.0 + 1e-9).contains(&u) {
+            return Err(Error::OutOfRange {
+                what: "the true spectrum of the Alcock-Paczynski projection".into(),
+                k,
+                min: grid[1],
+                max: grid[grid.len() - 2],
+            });
+        }
+        let b = (u.floor() as usize).saturating_sub(1).min(grid.len() - 4);
+        let w = lagrange4(u - b as f64);
+        let mut p = MuPolynomial::default();
+        for (j, wj) in w.iter().enumerate() {
+            let q = &polys[b + j];
+            for n in 0..p.value.len() {
+                p.value[n] += wj * q.value[n];
+                p.error[n] += wj.abs() * q.error[n];
+            }
+        }
+        Ok(p)
+    };
+    let rules = [MU_NODES, MU_NODES / 2].map(|n| {
+        let (x, w) = legendre_nodes(n);
+        // On [0, 1].
+        let nodes: Vec<(f64, f64)> = x
+            .iter()
+            .zip(&w)
+            .map(|(&x, &w)| (0.5 * (x + 1.0), 0.5 * w))
+            .collect();
+        nodes
+    });
+    let legendre: Vec<Vec<f64>> = ells.iter().map(|&l| legendre_coefficients(l)).collect();
+    let volume = ap.volume();
+    let mut out = vec![Vec::with_capacity(k_out.len()); ells.len()];
+    for &k in k_out {
+        let mut sums = [vec![0.0; ells.len()], vec![0.0; ells.len()]];
+        let mut spread = vec![0.0; ells.len()];
+        for (r, nodes) in rules.iter().enumerate() {
+            for &(mu, w) in nodes {
+                let (kt, mt) = ap.true_coordinates(k, mu);
+                let p = at(kt)?;
+                let damping = fog.damping_squared(kt * mt * sigma);
+                let m2 = mt * mt;
+                let value =
+                    p.value.iter().rev().fold(0.0, |acc, c| acc * m2 + c) * damping * volume;
+                let error =
+                    p.error.iter().rev().fold(0.0, |acc, c| acc * m2 + c) * damping * volume;
+                for (j, l) in ells.iter().enumerate() {
+                    let lj = polynomial(&legendre[j], mu);
+                    sums[r][j] += w * (2 * l + 1) as f64 * lj * value;
+                    if r == 0 {
+                        spread[j] += w * (2 * l + 1) as f64 * lj.abs() * error;
+                    }
+                }
+            }
+        }
+        for j in 0..ells.len() {
+            let quadrature = (sums[0][j] - sums[1][j]).abs();
+            out[j].push(Estimate::new(sums[0][j], spread[j] + quadrature));
+        }
+    }
+    Ok(out)
+}
+
+/// Σ_j c_j μ^j.
+fn polynomial(c: &[f64], mu: f64) -> f64 {
+    c.iter().rev().fold(0.0, |acc, c| acc * mu + c)
+}
+
+/// Coefficients of L_ℓ(μ) in powers of μ (Bonnet's recursion).
+fn legendre_coefficients(ell: usize) -> Vec<f64> {
+    let (mut prev, mut cur) = (vec![1.0], vec![0.0, 1.0]);
+    if ell == 0 {
+        return prev;
+    }
+    for j in 1..ell {
+        // (j+1) L_{j+1} = (2j+1) μ L_j − j L_{j−1}
+        let mut next = vec![0.0; j + 2];
+        for (i, c) in cur.iter().enumerate() {
+            next[i + 1] += (2 * j + 1) as f64 * c / (j + 1) as f64;
+        }
+        for (i, c) in prev.iter().enumerate() {
+            next[i] -= j as f64 * c / (j + 1) as f64;
+        }
+        prev = cur;
+        cur = next;
+    }
+    cur
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coordinates_map_back_and_the_identity_is_the_identity() {
+        let id = Distortion::new(1.0, 1.0).unwrap();
+        assert_eq!(id.true_coordinates(0.1, 0.3), (0.1, 0.3));
+        let d = Distortion::new(1.1, 0.95).unwrap();
+        // Along the line of sight k' = k/α∥, across k' = k/α⊥, and μ' = ±1 at μ = ±1.
+        let (k, m) = d.true_coordinates(0.2, 1.0);
+        assert!((k - 0.2 / 1.1).abs() < 1e-15 && (m - 1.0).abs() < 1e-15);
+        let (k, m) = d.true_coordinates(0.2, 0.0);
+        assert!((k - 0.2 / 0.95).abs() < 1e-15 && m == 0.0);
+        // k'∥ = kμ/α∥ and k'⊥ = k√(1 − μ²)/α⊥.
+        let (k, m) = d.true_coordinates(0.2, 0.6);
+        assert!((k * m - 0.2 * 0.6 / 1.1).abs() < 1e-15);
+        assert!((k * (1.0 - m * m).sqrt() - 0.2 * 0.8 / 0.95).abs() < 1e-15);
+        for bad in [0.0, -1.0, f64::NAN, 3.0] {
+            assert!(Distortion::new(bad, 1.0).is_err() && Distortion::new(1.0, bad).is_err());
+        }
+    }
+
+    /// A μ-independent constant P (Kaiser with b = 1, f = 0 of a flat spectrum): P̂_ℓ = P/(α∥α⊥²) δ_ℓ0.
+    #[test]
+    fn a_constant_isotropic_spectrum_only_changes_volume() {
+        let d = Distortion::new(1.2, 0.9).unwrap();
+        let grid = d.internal_grid(&[0.05, 0.1]).unwrap();
+        let mut c = MuPolynomial::default();
+        c.value[0] = 1000.0;
+        let polys = vec![c; grid.len()];
+        let m = observed_multipoles(&grid, &polys, Fog::None, 0.0, &d, &[0, 2, 4], &[0.05, 0.1])
+            .unwrap();
+        for ((p0, p2), p4) in m[0].iter().zip(&m[1]).zip(&m[2]) {
+            assert!((p0.value - 1000.0 * d.volume()).abs() < 1e-10);
+            assert!(p2.value.abs() < 1e-10 && p4.value.abs() < 1e-10);
+        }
+    }
+
+    #[test]
+    fn legendre_polynomials() {
+        assert_eq!(legendre_coefficients(2), vec![-0.5, 0.0, 1.5]);
+        for l in 0..=8 {
+            assert!((polynomial(&legendre_coefficients(l), 1.0) - 1.0).abs() < 1e-14);
+        }
+    }
+}
