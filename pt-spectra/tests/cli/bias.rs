@@ -90,3 +90,78 @@ fn bias_columns_and_galaxy_spectra() {
         ),
     ]);
 }
+
+/// `rsd --b2 …` (nonlinear bias), `--apar --aperp` and `--fiducial` (Alcock–Paczynski): the header
+/// says so, α = 1 changes the multipoles by the interpolation only, and bad combinations are refused.
+#[test]
+fn nonlinear_bias_and_alcock_paczynski_in_rsd() {
+    let base = [
+        "rsd",
+        "--real",
+        "1l-spt",
+        "--rsd",
+        "tns",
+        "--bias",
+        "2",
+        "--k-min",
+        "0.03",
+        "--k-max",
+        "0.2",
+        "--nk",
+        "3",
+        "--precision",
+        "fast",
+    ];
+    let args = |extra: &[&'static str]| {
+        let mut a = base.to_vec();
+        a.extend(extra);
+        a
+    };
+    let (ok, plain, err) = run(&base);
+    assert!(ok, "{err}");
+    let (ok, b2_zero, err) = run(&args(&["--b2", "0"]));
+    assert!(ok, "{err}");
+    assert_eq!(
+        rows(&plain),
+        rows(&b2_zero),
+        "b2 = bs = b3 = 0 is linear bias"
+    );
+    assert!(b2_zero.contains("Beutler et al. 2017"));
+    let (ok, identity, err) = run(&args(&["--apar", "1", "--aperp", "1"]));
+    assert!(ok, "{err}");
+    assert!(identity.contains("Alcock-Paczynski: apar = 1, aperp = 1"));
+    for (a, b) in rows(&plain).iter().zip(rows(&identity)) {
+        for j in 1..4 {
+            assert!((a[j] - b[j]).abs() < 1e-5 * a[1], "{a:?} vs {b:?}");
+        }
+    }
+    let (ok, fid, err) = run(&args(&[
+        "--z",
+        "0.5",
+        "--cosmology",
+        "planck2018",
+        "--fiducial",
+        "gm2012",
+    ]));
+    assert!(ok, "{err}");
+    assert!(fid.contains("Alcock-Paczynski: apar = 0.9"), "{fid}");
+    fails_naming(&[
+        (
+            args(&["--apar", "0", "--aperp", "1"]),
+            "apar = 0: must be in [0.5, 2]",
+        ),
+        (args(&["--apar", "1.1"]), "--aperp"),
+        (
+            args(&["--fiducial", "gm2012"]),
+            "must be positive for the Alcock-Paczynski",
+        ),
+        (
+            args(&["--apar", "1", "--aperp", "1", "--shot-noise", "100"]),
+            "noise with the Alcock-Paczynski",
+        ),
+        (
+            vec!["rsd", "--rsd", "kaiser", "--nk", "3", "--b2", "1"],
+            "Kaiser is linear in the bias",
+        ),
+    ]);
+}

@@ -195,30 +195,37 @@ fn arguments() -> impl Strategy<Value = Vec<String>> {
             a
         });
     let rsd = (
-        optional(
-            "--real",
-            &[
-                "linear",
-                "1l-spt",
-                "1l-rpt-n1",
-                "1l-regpt",
-                "2l-spt",
-                "bogus",
-            ],
+        (
+            optional(
+                "--real",
+                &[
+                    "linear",
+                    "1l-spt",
+                    "1l-rpt-n1",
+                    "1l-regpt",
+                    "2l-spt",
+                    "bogus",
+                ],
+            ),
+            optional("--rsd", &["kaiser", "scoccimarro", "tns", "bogus"]),
+            optional("--f", numbers),
+            optional("--fog", &["none", "lorentzian", "gaussian", "bogus"]),
+            optional("--sigma0", &["0", "3", "-3", "lin", "1l-spt", "nan", "x"]),
+            optional("--bias", numbers),
         ),
-        optional("--rsd", &["kaiser", "scoccimarro", "tns", "bogus"]),
-        optional("--f", numbers),
-        optional("--fog", &["none", "lorentzian", "gaussian", "bogus"]),
-        optional("--sigma0", &["0", "3", "-3", "lin", "1l-spt", "nan", "x"]),
-        optional("--bias", numbers),
-        optional("--amplitude", numbers),
-        optional("--shot-noise", numbers),
-        optional("--number-density", numbers),
-        optional("--ells", &["0", "0,2,4", "0,2,4,6,8", "1", "10", "", "x"]),
+        (
+            optional("--amplitude", numbers),
+            optional("--shot-noise", numbers),
+            optional("--number-density", numbers),
+            optional("--ells", &["0", "0,2,4", "0,2,4,6,8", "1", "10", "", "x"]),
+            optional("--b2", numbers),
+            optional("--apar", &["0.9", "1", "1.1", "0", "-1", "nan", "x"]),
+        ),
+        optional("--aperp", &["0.95", "1", "3", "x"]),
     )
-        .prop_map(|(a, b, c, d, e, f, g, h, i, j)| {
+        .prop_map(|((a, b, c, d, e, f), (g, h, i, j, l, m), n)| {
             let mut args = vec!["rsd".to_string()];
-            for part in [a, b, c, d, e, f, g, h, i, j] {
+            for part in [a, b, c, d, e, f, g, h, i, j, l, m, n] {
                 args.extend(part);
             }
             args
