@@ -14,7 +14,7 @@
 //! let mut p = Precision::default();
 //! p.max_memory = Some(1e9);
 //! let err = memory::check(e, &p, "1l-spt on 100000 k").unwrap_err().to_string();
-//! assert!(err.contains("1l-spt on 100000 k needs about 40 GB") && err.contains("1 GB"), "{err}");
+//! assert!(err.contains("1l-spt on 100000 k needs about 40 GB") && err.contains("above 1.0 GB"), "{err}");
 //! ```
 
 use crate::error::{Error, Result};
