@@ -71,9 +71,10 @@ class RealPlan:
     then milliseconds per spectrum: the choice for chains), ``"direct"`` integrates them for every
     spectrum (seconds), ``"auto"`` uses the tensors if they are already cached. A spectrum the basis
     does not represent (e.g. Eisenstein & Hu) is integrated directly, with a warning.
-    ``plan(linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False, eh=None, cs2=0.0)`` returns a
-    :class:`Table` with no set-up cost beyond the computation itself (``cs2``: the EFT counterterm, as
-    in :func:`real`).
+    ``plan(linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False, eh=None, cs2=0.0,
+    bias_terms=False, bias=None, b2=0.0, bs=0.0, b3=0.0)`` returns a :class:`Table` with no set-up cost
+    beyond the computation itself (``cs2``: the EFT counterterm; the bias arguments: the galaxy bias
+    terms and spectra; both as in :func:`real`).
     """
 
     def __init__(self, k, model="1l-spt", precision="default", q_range=None,
@@ -88,8 +89,9 @@ class RealPlan:
         return self._plan.k
 
     def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False, eh=None,
-                 cs2=0.0):
-        return _warn(self._plan(linear, z, z_input, cosmology, terms, eh, cs2))
+                 cs2=0.0, bias_terms=False, bias=None, b2=0.0, bs=0.0, b3=0.0):
+        return _warn(self._plan(linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2,
+                                bs, b3))
 
 
 class RsdPlan:
@@ -108,10 +110,10 @@ class RsdPlan:
     def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=1.0,
                  amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None, number_density=None,
                  noise_table=None, ells=(0, 2, 4), terms=False, eh=None, growth_factor=None,
-                 no_wiggle=False, cs2=0.0):
+                 no_wiggle=False, cs2=0.0, b2=None, bs=None, b3=None):
         return _warn(self._plan(linear, z, z_input, cosmology, f, bias, amplitude, fog, sigma0,
                                 shot_noise, number_density, noise_table, list(ells), terms, eh,
-                                growth_factor, no_wiggle, cs2))
+                                growth_factor, no_wiggle, cs2, b2, bs, b3))
 
     def terms(self, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None):
         """The loop terms of one linear spectrum (the expensive part), as :class:`RsdTerms`."""
@@ -176,7 +178,7 @@ def rsd(rsd="tns", real="1l-rpt-n1", k=None, linear=None, z=0.0, z_input=0.0, co
         f=None, bias=1.0, amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None,
         number_density=None, noise_table=None, ells=(0, 2, 4), terms=False, precision="default",
         q_range=None, cache_dir=None, eh=None, k_min=1e-3, k_max=1.0, nk=100,
-        no_wiggle=False, cs2=0.0) -> Table:
+        no_wiggle=False, cs2=0.0, b2=None, bs=None, b3=None) -> Table:
     """Redshift-space multipoles (``pt-spectra rsd``): columns ``k P0 P2 P4 … err_P0 …``.
 
     rsd: ``kaiser``, ``scoccimarro`` or ``tns``; real: the real-space model (as :func:`real`).
@@ -189,12 +191,15 @@ def rsd(rsd="tns", real="1l-rpt-n1", k=None, linear=None, z=0.0, z_input=0.0, co
     b^2 P_dd/P_eps (real space, the paper's signal-to-noise) and SN_s = P0/P_eps. ells: even
     multipoles up to 8. terms: add the parts ``P<l>_sc P<l>_A P<l>_B``. no_wiggle: add ``P<l>_nw``,
     the linear Kaiser multipoles of the no-wiggle spectrum. cs2: the EFT counterterm added to the
-    real-space spectra before the RSD model (as in :func:`real`). The other arguments are those of
-    :func:`real`.
+    real-space spectra before the RSD model (as in :func:`real`). b2, bs, b3: the nonlinear galaxy
+    bias of the ``scoccimarro`` and ``tns`` models (the BOSS DR12 model of Beutler et al. 2017, with
+    the bias terms of :func:`real`'s ``bias_terms``; ``bias`` is b1, a number). The other arguments
+    are those of :func:`real`.
     """
     plan = RsdPlan(_grid(k, k_min, k_max, nk), real, rsd, precision, q_range, cache_dir)
     return plan(linear, z, z_input, cosmology, f, bias, amplitude, fog, sigma0, shot_noise,
-                number_density, noise_table, ells, terms, eh, no_wiggle=no_wiggle, cs2=cs2)
+                number_density, noise_table, ells, terms, eh, no_wiggle=no_wiggle, cs2=cs2, b2=b2,
+                bs=bs, b3=b3)
 
 
 def fit(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_columns=None,

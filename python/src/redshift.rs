@@ -75,6 +75,8 @@ pub(crate) fn sigma0(obj: &Bound<'_, PyAny>) -> PyResult<Sigma0> {
 pub(crate) struct RsdPlan {
     plan: LibRsdPlan,
     rsd: RsdModel,
+    /// The bias terms' plan, built at the first call with nonlinear bias.
+    bias_plan: std::sync::OnceLock<pt_spectra::loops::bias::BiasPlan>,
 }
 
 #[pymethods]
@@ -100,13 +102,17 @@ impl RsdPlan {
         let (plan, _) = detached(py, || {
             LibRsdPlan::new(&k, real, rsd, &precision, store.get(), &Silent)
         })?;
-        Ok(Self { plan, rsd })
+        Ok(Self {
+            plan,
+            rsd,
+            bias_plan: std::sync::OnceLock::new(),
+        })
     }
 
     /// The multipoles of the prepared spectrum: see the Python wrapper `pt_spectra.rsd`.
     #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=None, amplitude=1.0,
         fog="none", sigma0=None, shot_noise=None, number_density=None, noise_table=None, ells=vec![0, 2, 4],
-        terms=false, eh=None, growth_factor=None, no_wiggle=false, cs2=0.0))]
+        terms=false, eh=None, growth_factor=None, no_wiggle=false, cs2=0.0, b2=None, bs=None, b3=None))]
     #[allow(clippy::too_many_arguments)]
     fn __call__(
         &self,
@@ -129,6 +135,9 @@ impl RsdPlan {
         growth_factor: Option<f64>,
         no_wiggle: bool,
         cs2: f64,
+        b2: Option<f64>,
+        bs: Option<f64>,
+        b3: Option<f64>,
     ) -> PyResult<Table> {
         let settings = (
             f,
@@ -141,11 +150,38 @@ impl RsdPlan {
             no_wiggle,
             cs2,
         );
-        let request = rsd_request(py, self.rsd, bias, sigma0, noise_table, settings)?;
+        let mut request = rsd_request(py, self.rsd, bias, sigma0, noise_table, settings)?;
+        if b2.is_some() || bs.is_some() || b3.is_some() {
+            request.galaxy = Some(jobs::NonlinearBias {
+                b2: b2.unwrap_or(0.0),
+                bs: bs.unwrap_or(0.0),
+                b3nl: b3.unwrap_or(0.0),
+            });
+        }
+        request.validate_galaxy().map_err(value_error)?;
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
         let ((table, prepared), seconds) = detached(py, || {
             let prepared = with_growth(inputs.prepare(self.plan.real().k())?, growth_factor)?;
-            let table = jobs::rsd_table(&self.plan, &request, &prepared, &Silent)?;
+            let table = if request.galaxy.is_some() {
+                let real = self.plan.real();
+                if self.bias_plan.get().is_none() {
+                    let plan = pt_spectra::loops::bias::BiasPlan::new(real.k(), real.precision())?;
+                    let _ = self.bias_plan.set(plan);
+                }
+                let (spectra, tns) = self.plan.evaluate(&prepared.spectrum, &Silent)?;
+                let terms = self.bias_plan.get().map(|p| p.evaluate(&prepared.spectrum));
+                let precision = real.precision();
+                jobs::rsd_table_with_bias_terms(
+                    &spectra,
+                    tns.as_ref(),
+                    terms,
+                    precision,
+                    &request,
+                    &prepared,
+                )?
+            } else {
+                jobs::rsd_table(&self.plan, &request, &prepared, &Silent)?
+            };
             Ok((table, prepared))
         })?;
         let model = format!("{} + {}", self.rsd, self.plan.real().model());

@@ -147,6 +147,15 @@ def test_bias_terms_and_galaxy_spectra_mirror_the_command_line():
     np.testing.assert_allclose(t["P_gg"], expected, rtol=1e-12)
     with pytest.raises(ValueError, match="need bias"):
         pt.real(k=k, b2=1.0)
+    # TNS with nonlinear bias: b2 = 0 is linear bias; b2 moves P4 not at all without FoG.
+    common = dict(rsd="tns", real="1l-spt", k=k, precision="fast", bias=2.0, f=0.7)
+    linear = pt.rsd(**common)
+    np.testing.assert_array_equal(pt.rsd(**common, b2=0.0)["P0"], linear["P0"])
+    moved = pt.rsd(**common, b2=0.8)
+    np.testing.assert_allclose(moved["P4"], linear["P4"], rtol=1e-12)
+    assert np.all(np.abs(moved["P0"] - linear["P0"]) > 1e-6 * linear["P0"])
+    with pytest.raises(ValueError, match="Kaiser is linear"):
+        pt.rsd(**dict(common, rsd="kaiser"), b2=1.0)
 
 
 def test_kernels_exact_and_float():
