@@ -380,7 +380,7 @@ pub fn dispersion_theory(
 
 /// Coefficients of L_ℓ(μ) in powers of μ: `legendre_coefficients(ℓ)[j]` multiplies μ^j.
 /// Exact in f64 for ℓ ≤ 8 (dyadic rationals with small numerators).
-fn legendre_coefficients(ell: usize) -> Vec<f64> {
+pub(crate) fn legendre_coefficients(ell: usize) -> Vec<f64> {
     // (j+1) L_{j+1} = (2j+1) μ L_j − j L_{j−1}
     let mut prev = vec![1.0];
     if ell == 0 {

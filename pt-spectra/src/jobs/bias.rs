@@ -34,18 +34,12 @@ impl BiasOutput {
                 reason: "the galaxy spectra need one matter model: choose it with --model".into(),
             });
         }
-        if let Some(b) = self.galaxy {
-            for (name, v) in [("b1", b.b1), ("b2", b.b2), ("bs", b.bs), ("b3nl", b.b3nl)] {
-                if !v.is_finite() {
-                    return Err(Error::InvalidParameter {
-                        name,
-                        value: v,
-                        reason: "must be finite",
-                    });
-                }
+        match self.galaxy {
+            Some(b) => {
+                super::check_finite(&[("b1", b.b1), ("b2", b.b2), ("bs", b.bs), ("b3nl", b.b3nl)])
             }
+            None => Ok(()),
         }
-        Ok(())
     }
 }
 

@@ -49,6 +49,21 @@ pub use rsd::{
 /// The version of pt-spectra, for table headers.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 
+/// Each `(name, value)` finite.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming the first that is not.
+pub(crate) fn check_finite(parameters: &[(&'static str, f64)]) -> Result<()> {
+    match parameters.iter().find(|(_, v)| !v.is_finite()) {
+        Some(&(name, value)) => Err(Error::InvalidParameter {
+            name,
+            value,
+            reason: "must be finite",
+        }),
+        None => Ok(()),
+    }
+}
+
 /// Header lines naming the cosmology, the input spectrum and the integration settings.
 pub fn describe_inputs(prepared: &Prepared, precision: &Precision) -> Vec<String> {
     let spectrum = &prepared.spectrum;

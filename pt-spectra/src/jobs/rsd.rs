@@ -87,16 +87,7 @@ impl RsdRequest {
                 reason: "the bias expansion has a constant b1: give it with --bias".into(),
             });
         }
-        for (name, v) in [("b2", g.b2), ("bs", g.bs), ("b3nl", g.b3nl)] {
-            if !v.is_finite() {
-                return Err(Error::InvalidParameter {
-                    name,
-                    value: v,
-                    reason: "must be finite",
-                });
-            }
-        }
-        Ok(())
+        super::check_finite(&[("b2", g.b2), ("bs", g.bs), ("b3nl", g.b3nl)])
     }
 
     /// A description of the bias for headers.

@@ -16,7 +16,7 @@
 //! from half as many nodes. Every ℓ ≤ 8 of the true spectrum enters (the polynomial is complete), so
 //! the hexadecapole is exact to the interpolation. Wide-angle effects are neglected.
 
-use super::{Fog, MuPolynomial, MAX_ELL};
+use super::{legendre_coefficients, Fog, MuPolynomial, MAX_ELL};
 use crate::cosmology::Cosmology;
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
@@ -231,27 +231,6 @@ fn polynomial(c: &[f64], mu: f64) -> f64 {
     c.iter().rev().fold(0.0, |acc, c| acc * mu + c)
 }
 
-/// Coefficients of L_ℓ(μ) in powers of μ (Bonnet's recursion).
-fn legendre_coefficients(ell: usize) -> Vec<f64> {
-    let (mut prev, mut cur) = (vec![1.0], vec![0.0, 1.0]);
-    if ell == 0 {
-        return prev;
-    }
-    for j in 1..ell {
-        // (j+1) L_{j+1} = (2j+1) μ L_j − j L_{j−1}
-        let mut next = vec![0.0; j + 2];
-        for (i, c) in cur.iter().enumerate() {
-            next[i + 1] += (2 * j + 1) as f64 * c / (j + 1) as f64;
-        }
-        for (i, c) in prev.iter().enumerate() {
-            next[i] -= j as f64 * c / (j + 1) as f64;
-        }
-        prev = cur;
-        cur = next;
-    }
-    cur
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -288,14 +267,6 @@ mod tests {
         for ((p0, p2), p4) in m[0].iter().zip(&m[1]).zip(&m[2]) {
             assert!((p0.value - 1000.0 * d.volume()).abs() < 1e-10);
             assert!(p2.value.abs() < 1e-10 && p4.value.abs() < 1e-10);
-        }
-    }
-
-    #[test]
-    fn legendre_polynomials() {
-        assert_eq!(legendre_coefficients(2), vec![-0.5, 0.0, 1.5]);
-        for l in 0..=8 {
-            assert!((polynomial(&legendre_coefficients(l), 1.0) - 1.0).abs() < 1e-14);
         }
     }
 }
