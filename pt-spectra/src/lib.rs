@@ -15,6 +15,8 @@
 //! * [`rsd`]: Kaiser, Scoccimarro and TNS redshift-space models, Fingers of God, Legendre multipoles.
 //! * [`fit`]: χ² fits of f, σ0 and A_b to measured multipoles, with Δχ² contour errors, versus k_max.
 //! * [`halo`]: scale-dependent bias, stochasticity (shot noise) and signal-to-noise of haloes.
+//! * [`hankel`]: FFTLog Hankel transforms between power-spectrum multipoles P_ℓ(k) and correlation-function
+//!   multipoles ξ_ℓ(s), ℓ ≤ 8.
 //! * [`table`]: plain-text tables and tabulated functions of k.
 //! * [`memory`]: memory estimates of plans, checked against a limit before they allocate.
 //!
@@ -32,6 +34,7 @@ pub mod error;
 pub mod estimate;
 pub mod fit;
 pub mod halo;
+pub mod hankel;
 pub mod integrate;
 pub mod ir;
 pub mod jobs;

@@ -18,7 +18,7 @@
 //!   nodes at that end. [`LinearSpectrum::region`] and [`LinearSpectrum::extrapolation_in`] tell the
 //!   caller when this happens so that it can warn.
 
-mod spline;
+pub(crate) mod spline;
 
 use crate::error::{Error, Result};
 pub(crate) use spline::simpson;

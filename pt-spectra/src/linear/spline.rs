@@ -3,7 +3,7 @@
 
 /// Not-a-knot cubic spline y(x) through at least 4 nodes with strictly increasing x.
 #[derive(Debug, Clone)]
-pub(super) struct LogSpline {
+pub(crate) struct LogSpline {
     x: Vec<f64>,
     y: Vec<f64>,
     /// Second derivatives y'' at the nodes.
@@ -14,7 +14,7 @@ pub(super) struct LogSpline {
 
 impl LogSpline {
     /// The spline through (x_i, y_i); x strictly increasing, at least 4 nodes (checked by the caller).
-    pub(super) fn new(x: Vec<f64>, y: Vec<f64>) -> Self {
+    pub(crate) fn new(x: Vec<f64>, y: Vec<f64>) -> Self {
         let n = x.len();
         debug_assert!(n >= 4 && y.len() == n);
         let m = not_a_knot_second_derivatives(&x, &y);
@@ -71,7 +71,7 @@ impl LogSpline {
     }
 
     /// y(x) for x inside [x_0, x_{n−1}].
-    pub(super) fn eval(&self, x: f64) -> f64 {
+    pub(crate) fn eval(&self, x: f64) -> f64 {
         let i = self.interval(x);
         let h = self.x[i + 1] - self.x[i];
         let a = (self.x[i + 1] - x) / h;
