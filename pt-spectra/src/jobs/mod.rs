@@ -43,7 +43,7 @@ pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use halo::{halo_table, HaloRequest};
 pub use rsd::{
     describe_sigma0, no_wiggle_multipoles, rsd_table, rsd_table_from_terms,
-    rsd_table_with_bias_terms, NonlinearBias, RsdRequest, SN_LEVELS,
+    rsd_table_with_bias_terms, xi_table, NonlinearBias, RsdRequest, SN_LEVELS,
 };
 
 /// The version of pt-spectra, for table headers.

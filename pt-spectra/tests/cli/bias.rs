@@ -165,3 +165,44 @@ fn nonlinear_bias_and_alcock_paczynski_in_rsd() {
         ),
     ]);
 }
+
+/// `rsd --xi`: linear Kaiser ξ_ℓ are the Kaiser factors times the transforms of P_lin (the transform
+/// is linear), ξ2 with the i² = −1 of its definition included in both.
+#[test]
+fn correlation_function_multipoles_of_linear_kaiser() {
+    let grid = ["--k-min", "1e-4", "--k-max", "1", "--nk", "300"];
+    let mut rsd = vec![
+        "rsd", "--real", "linear", "--rsd", "kaiser", "--bias", "2", "--f", "0.5",
+    ];
+    rsd.extend(grid);
+    rsd.extend(["--xi", "--s-min", "20", "--s-max", "150", "--ns", "6"]);
+    let (ok, out, err) = run(&rsd);
+    assert!(ok, "{err}");
+    assert!(out.contains("by FFTLog"), "{out}");
+    let mut real = vec!["real", "--model", "linear"];
+    real.extend(grid);
+    let (ok, lin, err) = run(&real);
+    assert!(ok, "{err}");
+    let lin = rows(&lin);
+    let (k, p): (Vec<f64>, Vec<f64>) = lin.iter().map(|r| (r[0], r[1])).unzip();
+    let table = rows(&out);
+    let s: Vec<f64> = table.iter().map(|r| r[0]).collect();
+    let (b, f) = (2.0, 0.5);
+    let factors = [
+        b * b + 2.0 * b * f / 3.0 + f * f / 5.0,
+        4.0 * b * f / 3.0 + 4.0 * f * f / 7.0,
+        8.0 * f * f / 35.0,
+    ];
+    for (j, (l, factor)) in [0, 2, 4].into_iter().zip(factors).enumerate() {
+        let want = pt_spectra::hankel::xi_from_pk(&k, &p, l, &s).unwrap();
+        let scale = want.iter().fold(0.0_f64, |m, v| m.max(v.abs())) * factor;
+        for (row, w) in table.iter().zip(&want) {
+            assert!(
+                (row[1 + j] - factor * w).abs() < 1e-6 * scale,
+                "l = {l}: {} vs {}",
+                row[1 + j],
+                factor * w
+            );
+        }
+    }
+}

@@ -4,8 +4,9 @@ use crate::common::{list, parse_cs2, parsed, BiasArgs, NoiseArgs};
 use crate::input::Input;
 use crate::output::{check_outputs, write_output};
 use crate::progress::Bars;
-use anyhow::Result;
-use pt_spectra::jobs::{rsd_table, NonlinearBias, RsdRequest};
+use anyhow::{Context, Result};
+use pt_spectra::jobs::{rsd_table, xi_table, NonlinearBias, RsdRequest};
+use pt_spectra::linear::LogGrid;
 use pt_spectra::real::RealModel;
 use pt_spectra::rsd::ap::Distortion;
 use pt_spectra::rsd::{Fog, Observed, RsdModel, RsdPlan, Sigma0};
@@ -86,6 +87,20 @@ pub struct Args {
     /// Eisenstein & Hu no-wiggle spectrum, by which `plot multipoles` divides as the paper does.
     #[arg(long)]
     no_wiggle: bool,
+    /// Print the correlation-function multipoles ξ_ℓ(s) of the model instead (FFTLog of the P_ℓ on the
+    /// k grid: give it a wide range, e.g. --k-min 1e-4 --k-max 1, as P_ℓ is extended by power laws
+    /// beyond it), at --ns log-spaced s in [--s-min, --s-max] Mpc/h.
+    #[arg(long)]
+    xi: bool,
+    /// Smallest s [Mpc/h] of --xi.
+    #[arg(long, value_name = "S", default_value_t = 10.0, requires = "xi")]
+    s_min: f64,
+    /// Largest s [Mpc/h] of --xi.
+    #[arg(long, value_name = "S", default_value_t = 200.0, requires = "xi")]
+    s_max: f64,
+    /// Number of s of --xi.
+    #[arg(long, value_name = "N", default_value_t = 50, requires = "xi")]
+    ns: usize,
     /// Write the table to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
@@ -172,5 +187,12 @@ pub fn run(args: &Args) -> Result<()> {
         plan = plan.with_bias_terms()?;
     }
     let table = rsd_table(&plan, &request, &loaded.prepared, &bars)?;
+    if args.xi {
+        let s = LogGrid::new(args.s_min, args.s_max, args.ns)
+            .context("invalid --s-min/--s-max/--ns")?
+            .points();
+        let xi = xi_table(&table, &request.ells, &s)?;
+        return write_output(args.out.as_ref(), &xi);
+    }
     write_output(args.out.as_ref(), &table)
 }
