@@ -6,6 +6,11 @@
 //!   spectra and TNS coefficients: what a fit pays per step, undamped (exact) and with Lorentzian FoG
 //!   (32-point Gauss–Legendre plus the 16-point error estimate).
 //!
+//! * `bias/evaluate`: the 1-loop bias terms Pd1d2 … sig3nl, Pt1d2, Pt1s2 of a new spectrum
+//!   ([`BiasPlan::evaluate`], rayon's pool; `RAYON_NUM_THREADS=1` for one core);
+//! * `ap/observed`: P_0, P_2, P_4 of TNS with Lorentzian FoG observed with α∥ = 1.03, α⊥ = 0.98
+//!   ([`multipoles`] with the Alcock–Paczynski projection from its internal grid), per step of a fit.
+//!
 //! Run with `cargo bench --bench rsd`.
 
 // `criterion_group!` defines an undocumented function.
@@ -13,10 +18,12 @@
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
 use pt_spectra::linear::{LinearSpectrum, LogGrid};
+use pt_spectra::loops::bias::BiasPlan;
 use pt_spectra::loops::{TnsPlan, TnsTerms};
 use pt_spectra::precision::Precision;
 use pt_spectra::real::{real_space, RealModel, RealSpectra};
-use pt_spectra::rsd::{Fog, MultipoleRule, RsdModel};
+use pt_spectra::rsd::ap::Distortion;
+use pt_spectra::rsd::{Fog, MultipoleRule, Observed, RsdModel, RsdSettings};
 use pt_spectra::store::TableStore;
 use std::time::Duration;
 
@@ -85,5 +92,52 @@ fn rsd_multipoles(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, tns, rsd_multipoles);
+fn bias_and_ap(c: &mut Criterion) {
+    let p = LinearSpectrum::gm2012(0.0).expect("embedded spectrum");
+    let k = grid();
+    let mut group = c.benchmark_group("bias");
+    let plan = BiasPlan::new(&k, &Precision::default()).expect("valid plan");
+    group.bench_function(BenchmarkId::new("evaluate", 50), |b| {
+        b.iter(|| plan.evaluate(black_box(&p)))
+    });
+    group.finish();
+    let distortion = Distortion::new(1.03, 0.98).expect("valid alphas");
+    let internal = distortion.internal_grid(&k).expect("valid grid");
+    let store = TableStore::in_memory();
+    let real = real_space(
+        RealModel::OneLoopSpt,
+        &p,
+        &internal,
+        &Precision::default(),
+        &store,
+    )
+    .expect("k valid");
+    let tns = TnsPlan::new(&internal, &Precision::default())
+        .expect("valid plan")
+        .evaluate(&p);
+    let settings = RsdSettings {
+        model: RsdModel::Tns,
+        f: 0.483,
+        bias: vec![2.0; internal.len()],
+        fog: Fog::Lorentzian,
+        sigma: 3.5,
+        noise: None,
+        ells: vec![0, 2, 4],
+        parts: false,
+        cs2: 0.0,
+        galaxy: None,
+        ap: Some(Observed {
+            distortion,
+            k: k.clone(),
+        }),
+    };
+    let mut group = c.benchmark_group("ap");
+    group.bench_function(
+        BenchmarkId::new("observed (50 k, l = 0, 2, 4)", internal.len()),
+        |b| b.iter(|| pt_spectra::rsd::multipoles(&real, Some(&tns), black_box(&settings))),
+    );
+    group.finish();
+}
+
+criterion_group!(benches, tns, rsd_multipoles, bias_and_ap);
 criterion_main!(benches);
