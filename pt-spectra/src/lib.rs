@@ -55,3 +55,8 @@ pub mod table;
 #[doc = include_str!("../../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
+
+/// The reference's examples, compiled and run as doctests.
+#[doc = include_str!("../../docs/reference.md")]
+#[cfg(doctest)]
+pub struct ReferenceDoctests;
