@@ -28,6 +28,8 @@ pub struct PlanParts {
     pub tns: bool,
     /// The bias terms ([`crate::loops::bias`]).
     pub bias: bool,
+    /// The 1-loop redshift-space terms of the galaxy model ([`crate::loops::redshift`]).
+    pub redshift: bool,
     /// RegPT's Γ2 weights.
     pub gamma2: bool,
     /// 2-loop terms (basis tensors unless integrated directly).
@@ -44,6 +46,8 @@ const ONE_LOOP_PER_K: f64 = 0.4e6;
 const TNS_PER_K: f64 = 1.0e6;
 /// Bytes per output k of the bias plan at the default node density (7 f32 weights per P22 node).
 const BIAS_PER_K: f64 = 0.6e6;
+/// Bytes per output k of the redshift-space plan (31 f32 weights per P22 node: 3× the bias plan's bytes).
+const REDSHIFT_PER_K: f64 = 1.8e6;
 /// Bytes per output k of RegPT's Γ2 weights.
 const GAMMA2_PER_K: f64 = 1.2e6;
 /// Bytes per output k of the 2-loop basis tensors.
@@ -83,6 +87,9 @@ pub fn plan_bytes(nk: usize, parts: PlanParts, precision: &Precision) -> f64 {
     }
     if parts.bias {
         per_k += BIAS_PER_K * density;
+    }
+    if parts.redshift {
+        per_k += REDSHIFT_PER_K * density;
     }
     if parts.gamma2 {
         per_k += GAMMA2_PER_K;

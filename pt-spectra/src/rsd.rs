@@ -23,6 +23,7 @@ use std::fmt;
 use std::str::FromStr;
 
 pub mod ap;
+pub mod ept;
 mod multipoles;
 pub use multipoles::{
     multipoles, GalaxyTerms, Observed, RsdMultipoles, RsdPlan, RsdSettings, Sigma0,

@@ -45,6 +45,7 @@ mod p13;
 mod p15;
 mod p17;
 mod p22;
+pub mod redshift;
 mod tns;
 mod two_loop;
 

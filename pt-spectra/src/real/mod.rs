@@ -139,6 +139,7 @@ impl RealModel {
         crate::memory::PlanParts {
             tns: false,
             bias: false,
+            redshift: false,
             gamma2: self.needs_gamma2(),
             two_loop: self.needs_two_loop(),
             p15: self.needs_p15(),

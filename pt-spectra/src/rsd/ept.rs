@@ -1,0 +1,422 @@
+//! `ept`: the 1-loop Eulerian model of biased tracers in redshift space with the BAO resummed
+//! (Chen, Vlah, Castorina & White 2021, arXiv:2012.04636; velocileptors' `REPT`), in velocileptors'
+//! parameters and conventions:
+//!
+//!   P(k, μ) = P_nw^{1L}(k, μ) + e^{−k²Σ²(μ)} [ (1 + k²Σ²(μ)) Z₁²P_w + P_w^{1L}(k, μ) ]
+//!             + (α₀ + α₂μ² + α₄μ⁴ + α₆μ⁶) k² (P_nw + e^{−k²Σ²(μ)} P_w)
+//!             + sn + sn2 k²μ² + sn4 k⁴μ⁴,
+//!
+//! with Z₁ = b1 + fμ², P^{1L}[P] = Z₁²P + the 1-loop terms of [`crate::loops::redshift`] (bias b1, b2, bs,
+//! b3 as velocileptors: (b2/2)δ², bs s², b3 FAST-PT's b3nl — see the map below), P_nw the no-wiggle
+//! spectrum of velocileptors' Savitzky–Golay filter ([`crate::ir::savitzky_golay_no_wiggle`]), P_w = P − P_nw, P^{1L}_w = P^{1L}[P] − P^{1L}[P_nw], and
+//!   Σ²(μ) = [1 + fμ²(2 + f)] Σ²,   Σ² = (1/6π²) ∫ dq P_nw(q) [1 − j₀(q r_BAO)],   r_BAO = 110 Mpc/h
+//! (velocileptors' ½(X + Y/3) at r_BAO). Without IR resummation (`--no-ir`) P_nw = P: plain 1-loop SPT in
+//! redshift space, α's times k²P.
+//!
+//! Counterterms α_n [(Mpc/h)²], stochastic sn [(Mpc/h)³], sn2 [(Mpc/h)⁵], sn4 [(Mpc/h)⁷].
+//!
+//! Map to other bases:
+//! * CLASS-PT (Ivanov et al. 2019; Chudaykin et al. 2020): its δ_g ⊃ (b2/2)δ² + b_G2 G₂ with
+//!   G₂ = s² − (2/3)δ² in these normalisations (kernel μ₁₂² − 1 = S₂ − 2/3), so exactly
+//!   bs = b_G2 and b2 = b2^CLASS-PT − (4/3) b_G2. The cubic terms (b_Γ3 and the cubic part of b_G2)
+//!   share the one 1-loop shape of sig3nl, which b3 multiplies. Counterterms at the level of P(k, μ):
+//!   α_{2n} k²μ^{2n}P ↔ −2 c̃_{2n} f^n k²μ^{2n}P; stochastic sn = P_shot, sn2 = a2/k_NL² (k_NL = 0.45 h/Mpc);
+//!   CLASS-PT's isotropic a0 (k/k_NL)² has no counterpart here.
+//! * The paper's TNS (b, A_b, σ0, P_εε): b1 = b and sn = P_εε at large scales; its scale-dependent
+//!   A_b and Fingers-of-God σ0 have no counterpart (the counterterms α₂, α₄ take the k²μ² leading
+//!   order of the damping: α₂ = −f²σ0²b1², α₄ = −2f³σ0²b1, α₆ = −f⁴σ0² for a Gaussian D²).
+//!
+//! Multipoles ℓ ≤ 8: Gauss–Legendre in μ on [0, 1] ([`MU_NODES`]; the error the change from half as
+//! many nodes), exact when the model is a polynomial in μ (no IR, no AP). With AP
+//! ([`super::ap::Distortion`]) the terms are computed on the internal log grid and interpolated in ln k.
+
+use super::ap::Distortion;
+use super::{legendre_coefficients, MAX_ELL, MAX_MU_POWER};
+use crate::error::{Error, Result};
+use crate::estimate::Estimate;
+use crate::integrate::{lagrange4, legendre_nodes};
+use crate::ir::savitzky_golay_no_wiggle;
+use crate::linear::LinearSpectrum;
+use crate::loops::redshift::{RedshiftPlan, RedshiftTerms};
+use crate::precision::Precision;
+use std::f64::consts::PI;
+
+/// Gauss–Legendre nodes of the μ integral on [0, 1].
+pub const MU_NODES: usize = 24;
+/// The BAO scale of Σ² [Mpc/h] (velocileptors' `rbao`).
+pub const R_BAO: f64 = 110.0;
+
+/// The parameter names, in velocileptors' order (then f).
+pub const PARAM_NAMES: [&str; 12] = [
+    "b1", "b2", "bs", "b3", "alpha0", "alpha2", "alpha4", "alpha6", "sn", "sn2", "sn4", "f",
+];
+
+/// The parameters of the model (velocileptors' names and units; module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EptParams {
+    /// The values in the order of [`PARAM_NAMES`].
+    pub values: [f64; 12],
+}
+
+impl EptParams {
+    /// Linear bias `b1`, growth rate `f`, every other parameter 0.
+    pub fn new(b1: f64, f: f64) -> Self {
+        let mut values = [0.0; 12];
+        values[0] = b1;
+        values[11] = f;
+        Self { values }
+    }
+
+    /// The value of parameter `name`.
+    pub fn get(&self, name: &str) -> Option<f64> {
+        PARAM_NAMES
+            .iter()
+            .position(|&n| n == name)
+            .map(|i| self.values[i])
+    }
+
+    /// Sets parameter `name`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] for a name not in [`PARAM_NAMES`]; [`Error::InvalidParameter`] for a
+    /// value that is not finite.
+    pub fn set(&mut self, name: &str, value: f64) -> Result<()> {
+        let i =
+            PARAM_NAMES
+                .iter()
+                .position(|&n| n == name)
+                .ok_or_else(|| Error::InvalidChoice {
+                    what: format!("ept parameter `{name}`"),
+                    reason: format!("the parameters are {}", PARAM_NAMES.join(", ")),
+                })?;
+        if !value.is_finite() {
+            return Err(Error::InvalidParameter {
+                name: PARAM_NAMES[i],
+                value,
+                reason: "must be finite",
+            });
+        }
+        self.values[i] = value;
+        Ok(())
+    }
+
+    /// (b1, b2, bs, b3, f) for the loop terms.
+    fn bias(&self) -> [f64; 5] {
+        let v = &self.values;
+        [v[0], v[1], v[2], v[3], v[11]]
+    }
+
+    /// Checks the growth rate is physical (0 ≤ f ≤ 2) and every value finite.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the parameter.
+    pub fn validate(&self) -> Result<()> {
+        for (name, &v) in PARAM_NAMES.iter().zip(&self.values) {
+            if !v.is_finite() {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: v,
+                    reason: "must be finite",
+                });
+            }
+        }
+        let f = self.values[11];
+        let range = crate::cosmology::plausible("f").expect("f has a plausible range");
+        if !range.contains(f) {
+            return Err(Error::InvalidParameter {
+                name: "f",
+                value: f,
+                reason: range.reason,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// How the model is evaluated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EptSettings {
+    /// IR resummation of the BAO (on by default).
+    pub ir: bool,
+    /// The Alcock–Paczynski distortion, if any.
+    pub ap: Option<Distortion>,
+}
+
+impl Default for EptSettings {
+    fn default() -> Self {
+        Self { ir: true, ap: None }
+    }
+}
+
+/// The plan: the loop plan on the grid the model needs (the output k, or the AP internal grid).
+#[derive(Debug, Clone)]
+pub struct EptPlan {
+    k_out: Vec<f64>,
+    grid: Vec<f64>,
+    settings: EptSettings,
+    loops: RedshiftPlan,
+    split: Option<()>,
+}
+
+/// The loop terms of one linear spectrum: everything that does not depend on the parameters.
+#[derive(Debug, Clone)]
+pub struct EptTerms {
+    grid: Vec<f64>,
+    full: RedshiftTerms,
+    /// The no-wiggle terms and Σ² [(Mpc/h)²], with IR resummation.
+    nw: Option<(RedshiftTerms, Estimate)>,
+}
+
+impl EptPlan {
+    /// The plan for output wavenumbers `k` [h/Mpc].
+    ///
+    /// # Errors
+    /// As [`RedshiftPlan::new`] and [`Distortion::internal_grid`].
+    pub fn new(k: &[f64], settings: EptSettings, precision: &Precision) -> Result<Self> {
+        let grid = match &settings.ap {
+            Some(ap) => ap.internal_grid(k)?,
+            None => k.to_vec(),
+        };
+        let loops = RedshiftPlan::new(&grid, precision)?;
+        let split = settings.ir.then_some(());
+        Ok(Self {
+            k_out: k.to_vec(),
+            grid,
+            settings,
+            loops,
+            split,
+        })
+    }
+
+    /// The output wavenumbers [h/Mpc].
+    pub fn k(&self) -> &[f64] {
+        &self.k_out
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> EptSettings {
+        self.settings
+    }
+
+    /// The loop terms of `spectrum` (and of its no-wiggle part with IR resummation).
+    ///
+    /// # Errors
+    /// As [`savitzky_golay_no_wiggle`].
+    pub fn terms(&self, spectrum: &LinearSpectrum) -> Result<EptTerms> {
+        let full = self.loops.evaluate(spectrum);
+        let nw = match &self.split {
+            Some(()) => {
+                let p_nw = savitzky_golay_no_wiggle(spectrum)?;
+                let t = self.loops.evaluate(&p_nw);
+                let s2 = sigma2(&p_nw);
+                Some((t, s2))
+            }
+            None => None,
+        };
+        Ok(EptTerms {
+            grid: self.grid.clone(),
+            full,
+            nw,
+        })
+    }
+
+    /// The multipoles `ells` (even, ≤ 8) at the output k: `out[j][i]` for the j-th ℓ at the i-th k.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for an odd or too large ℓ or invalid parameters; as
+    /// [`Self::terms`].
+    pub fn multipoles(
+        &self,
+        terms: &EptTerms,
+        params: &EptParams,
+        ells: &[usize],
+    ) -> Result<Vec<Vec<Estimate>>> {
+        params.validate()?;
+        if let Some(&bad) = ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
+            return Err(Error::InvalidParameter {
+                name: "multipole ell",
+                value: bad as f64,
+                reason: "must be even and at most 8",
+            });
+        }
+        let model = terms.model(params);
+        let legendre: Vec<Vec<f64>> = ells.iter().map(|&l| legendre_coefficients(l)).collect();
+        let rules = [MU_NODES, MU_NODES / 2].map(|n| {
+            let (x, w) = legendre_nodes(n);
+            x.iter()
+                .zip(&w)
+                .map(|(&x, &w)| (0.5 * (x + 1.0), 0.5 * w))
+                .collect::<Vec<_>>()
+        });
+        let volume = self.settings.ap.map_or(1.0, |d| d.volume());
+        let mut out = vec![Vec::with_capacity(self.k_out.len()); ells.len()];
+        for (i, &k) in self.k_out.iter().enumerate() {
+            let mut sums = [vec![0.0; ells.len()], vec![0.0; ells.len()]];
+            let mut spread = vec![0.0; ells.len()];
+            for (r, nodes) in rules.iter().enumerate() {
+                for &(mu, w) in nodes {
+                    let p = match &self.settings.ap {
+                        None => model.at(i, k, mu),
+                        Some(ap) => {
+                            let (kt, mt) = ap.true_coordinates(k, mu);
+                            model.interpolated(kt, mt)?
+                        }
+                    };
+                    for (j, &l) in ells.iter().enumerate() {
+                        let lj = legendre[j].iter().rev().fold(0.0, |a, c| a * mu + c);
+                        let c = w * (2 * l + 1) as f64 * lj * volume;
+                        sums[r][j] += c * p.value;
+                        if r == 0 {
+                            spread[j] += c.abs() * p.error;
+                        }
+                    }
+                }
+            }
+            for j in 0..ells.len() {
+                let quadrature = (sums[0][j] - sums[1][j]).abs();
+                out[j].push(Estimate::new(sums[0][j], spread[j] + quadrature));
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// Σ² = (1/6π²)∫dq P_nw(q)[1 − j₀(q r_BAO)] over [1e-5, 1e3] h/Mpc: Simpson in ln q, error against
+/// the half rule.
+pub fn sigma2(no_wiggle: &LinearSpectrum) -> Estimate {
+    let integrand = |ln_q: f64| {
+        let q = ln_q.exp();
+        let x = q * R_BAO;
+        let one_minus_j0 = if x < 1e-3 {
+            x * x / 6.0
+        } else {
+            1.0 - x.sin() / x
+        };
+        q * no_wiggle.eval(q) * one_minus_j0
+    };
+    let (value, error) =
+        crate::integrate::simpson_ln(integrand, (1e-5_f64).ln(), (1e3_f64).ln(), 4096);
+    let norm = 1.0 / (6.0 * PI * PI);
+    Estimate::new(norm * value, norm * error)
+}
+
+/// Polynomials in μ² (coefficient n of μ^{2n}) with coefficient errors.
+type Poly = ([f64; MAX_MU_POWER + 1], [f64; MAX_MU_POWER + 1]);
+
+/// The model at fixed parameters on the terms' grid: P = N(μ²) + e^{−k²Σ²(1 + f(2+f)μ²)} W(μ²).
+struct Model<'a> {
+    grid: &'a [f64],
+    parts: Vec<(Poly, Poly)>,
+    sigma2: f64,
+    f: f64,
+}
+
+impl EptTerms {
+    fn model(&self, params: &EptParams) -> Model<'_> {
+        let v = &params.values;
+        let [b1, _, _, _, f] = params.bias();
+        let z1 = [b1 * b1, 2.0 * b1 * f, f * f];
+        let (alpha, [sn, sn2, sn4]) = ([v[4], v[5], v[6], v[7]], [v[8], v[9], v[10]]);
+        let s2 = self.nw.as_ref().map_or(0.0, |(_, s)| s.value);
+        let parts = (0..self.grid.len())
+            .map(|i| {
+                let k = self.grid[i];
+                let k2 = k * k;
+                let p = self.full.p_lin[i];
+                let (lv, le) = self.full.loop_polynomial(i, params.bias());
+                let mut n: Poly = (lv, le);
+                let mut w: Poly = ([0.0; 5], [0.0; 5]);
+                let (p_nw, p_w) = match &self.nw {
+                    Some((t, _)) => {
+                        let (nv, ne) = t.loop_polynomial(i, params.bias());
+                        n = (nv, ne);
+                        for j in 0..5 {
+                            w.0[j] = lv[j] - nv[j];
+                            w.1[j] = le[j] + ne[j];
+                        }
+                        (t.p_lin[i], p - t.p_lin[i])
+                    }
+                    None => (p, 0.0),
+                };
+                // Z₁² P_nw, the counterterms and the stochastic terms.
+                for (j, z) in z1.iter().enumerate() {
+                    n.0[j] += z * p_nw;
+                }
+                for (j, a) in alpha.iter().enumerate() {
+                    n.0[j] += a * k2 * p_nw;
+                    w.0[j] += a * k2 * p_w;
+                }
+                n.0[0] += sn;
+                n.0[1] += sn2 * k2;
+                n.0[2] += sn4 * k2 * k2;
+                // (1 + k²Σ²[1 + f(2+f)μ²]) Z₁² P_w.
+                let (c0, c1) = (1.0 + k2 * s2, k2 * s2 * f * (2.0 + f));
+                for (j, z) in z1.iter().enumerate() {
+                    w.0[j] += c0 * z * p_w;
+                    w.0[j + 1] += c1 * z * p_w;
+                }
+                (n, w)
+            })
+            .collect();
+        Model {
+            grid: &self.grid,
+            parts,
+            sigma2: s2,
+            f: params.values[11],
+        }
+    }
+}
+
+impl Model<'_> {
+    /// P(k, μ) at grid index `i` (k = grid[i]).
+    fn at(&self, i: usize, k: f64, mu: f64) -> Estimate {
+        let (n, w) = &self.parts[i];
+        self.combine(n, w, k, mu)
+    }
+
+    fn combine(&self, n: &Poly, w: &Poly, k: f64, mu: f64) -> Estimate {
+        let m2 = mu * mu;
+        let horner = |c: &[f64; 5]| c.iter().rev().fold(0.0, |a, c| a * m2 + c);
+        let damping = (-k * k * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
+        Estimate::new(
+            horner(&n.0) + damping * horner(&w.0),
+            horner(&n.1) + damping * horner(&w.1),
+        )
+    }
+
+    /// P(k, μ) at any k inside the grid: the polynomials interpolated in ln k (four-point Lagrange).
+    fn interpolated(&self, k: f64, mu: f64) -> Result<Estimate> {
+        let g = self.grid;
+        let (x0, step) = (
+            g[0].ln(),
+            (g[g.len() - 1] / g[0]).ln() / (g.len() - 1) as f64,
+        );
+        let u = (k.ln() - x0) / step;
+        let last = (g.len() - 1) as f64;
+        if !(1.0 - 1e-9..=last - 1.0 + 1e-9).contains(&u) {
+            return Err(Error::OutOfRange {
+                what: "the true spectrum of the Alcock-Paczynski projection".into(),
+                k,
+                min: g[1],
+                max: g[g.len() - 2],
+            });
+        }
+        let b = (u.floor() as usize).saturating_sub(1).min(g.len() - 4);
+        let l = lagrange4(u - b as f64);
+        let mut n: Poly = ([0.0; 5], [0.0; 5]);
+        let mut w: Poly = ([0.0; 5], [0.0; 5]);
+        for (j, lj) in l.iter().enumerate() {
+            let (pn, pw) = &self.parts[b + j];
+            for c in 0..5 {
+                n.0[c] += lj * pn.0[c];
+                n.1[c] += lj.abs() * pn.1[c];
+                w.0[c] += lj * pw.0[c];
+                w.1[c] += lj.abs() * pw.1[c];
+            }
+        }
+        Ok(self.combine(&n, &w, k, mu))
+    }
+}
+
+#[cfg(test)]
+mod tests;
