@@ -26,12 +26,15 @@ from . import _core
 from ._core import Table, eisenstein_hu, growth, log_grid, num_threads, set_num_threads
 
 __all__ = [
+    "EptPlan",
+    "EptTerms",
     "PtSpectraWarning",
     "RealPlan",
     "RsdPlan",
     "RsdTerms",
     "Table",
     "eisenstein_hu",
+    "ept",
     "fit",
     "fit_tables",
     "growth",
@@ -92,6 +95,61 @@ class RealPlan:
                  cs2=0.0, bias_terms=False, bias=None, b2=0.0, bs=0.0, b3=0.0):
         return _warn(self._plan(linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2,
                                 bs, b3))
+
+
+EPT_PARAMETERS = ("b1", "b2", "bs", "b3", "alpha0", "alpha2", "alpha4", "alpha6", "sn", "sn2",
+                  "sn4", "f")
+
+
+def _ept_params(params):
+    """The model parameters of ``params`` that are not None (velocileptors' names)."""
+    return {name: float(v) for name, v in params.items() if v is not None}
+
+
+class EptPlan:
+    """The galaxy model ``ept`` planned for one k grid (1-loop Eulerian PT of biased tracers in
+    redshift space with the BAO resummed, velocileptors' ``REPT`` conventions).
+
+    ``EptPlan(k, ir=True, apar=None, aperp=None, precision="default", q_range=None)``; calling it
+    takes the linear spectrum (``linear``, ``z``, ``z_input``, ``cosmology``, ``eh`` as in
+    :func:`real`), ``ells`` and the parameters by name: b1, b2, bs, b3, alpha0, alpha2, alpha4,
+    alpha6 [(Mpc/h)^2], sn [(Mpc/h)^3], sn2 [(Mpc/h)^5], sn4 [(Mpc/h)^7], f (default f(z)); an
+    unknown name is an error. ``terms(...)`` returns the loop terms of one spectrum
+    (:class:`EptTerms`), after which each parameter step costs microseconds.
+    """
+
+    def __init__(self, k, ir=True, apar=None, aperp=None, precision="default", q_range=None):
+        self._plan = _core.EptPlan(k, ir, apar, aperp, precision, q_range)
+
+    def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, ells=(0, 2, 4),
+                 **params):
+        return _warn(self._plan(linear, z, z_input, cosmology, eh, list(ells),
+                                **_ept_params(params)))
+
+    def terms(self, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None):
+        """The loop terms of one linear spectrum (the expensive part), as :class:`EptTerms`."""
+        return EptTerms(self._plan.terms(linear, z, z_input, cosmology, eh))
+
+
+class EptTerms:
+    """The loop terms of one linear spectrum on an :class:`EptPlan`'s grid:
+    ``terms.multipoles(ells=(0, 2, 4), **params)`` with the parameters of :class:`EptPlan`."""
+
+    def __init__(self, core):
+        self._terms = core
+
+    def multipoles(self, ells=(0, 2, 4), **params):
+        return _warn(self._terms.multipoles(list(ells), **_ept_params(params)))
+
+
+def ept(k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, ells=(0, 2, 4), ir=True,
+        apar=None, aperp=None, precision="default", q_range=None, k_min=1e-3, k_max=1.0, nk=100,
+        **params) -> Table:
+    """The galaxy model's multipoles (``pt-spectra rsd --rsd ept``): columns ``k P0 P2 P4 …
+    err_P0 …``. Parameters by velocileptors' names (see :class:`EptPlan`); ``ir=False`` for plain
+    1-loop SPT; ``apar``, ``aperp`` for the Alcock-Paczynski distortion."""
+    plan = EptPlan(_grid(k, k_min, k_max, nk), ir, apar, aperp, precision, q_range)
+    return plan(linear, z, z_input, cosmology, eh, ells, **params)
 
 
 class RsdPlan:

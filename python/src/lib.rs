@@ -22,6 +22,7 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
+mod ept;
 mod halo;
 mod inputs;
 mod kernel;
@@ -553,6 +554,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<RealPlan>()?;
     m.add_class::<redshift::RsdPlan>()?;
     m.add_class::<redshift::RsdTerms>()?;
+    m.add_class::<ept::EptPlan>()?;
+    m.add_class::<ept::EptTerms>()?;
     m.add_function(wrap_pyfunction!(real, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(growth, m)?)?;

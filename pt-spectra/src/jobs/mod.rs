@@ -35,10 +35,12 @@ use crate::real::{RealModel, RealPlan, RealSelection, RealSpectra};
 use crate::setup::Prepared;
 
 mod bias;
+mod ept;
 mod fit;
 mod halo;
 mod rsd;
 pub use bias::BiasOutput;
+pub use ept::{ept_plan, ept_table, ept_table_from_terms, EptRequest};
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use halo::{halo_table, HaloRequest};
 pub use rsd::{

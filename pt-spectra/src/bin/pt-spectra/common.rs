@@ -73,6 +73,11 @@ pub struct NoiseArgs {
 }
 
 impl NoiseArgs {
+    /// Whether any noise option is given.
+    pub fn is_set(&self) -> bool {
+        self.shot_noise.is_some() || self.number_density.is_some() || self.noise_file.is_some()
+    }
+
     /// The file these options read, by option.
     pub fn files(&self) -> Vec<(&'static str, Option<&Path>)> {
         vec![("--noise-file", self.noise_file.as_deref())]

@@ -1,10 +1,11 @@
 //! `pt-spectra rsd`: redshift-space multipoles P_ℓ(k) of a real-space model through an RSD model.
 
 use crate::common::{list, parse_cs2, parsed, BiasArgs, NoiseArgs};
+use crate::ept::{self, EptArgs, RsdChoice};
 use crate::input::Input;
 use crate::output::{check_outputs, write_output};
 use crate::progress::Bars;
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use pt_spectra::jobs::{rsd_table, xi_table, NonlinearBias, RsdRequest};
 use pt_spectra::linear::LogGrid;
 use pt_spectra::real::RealModel;
@@ -22,9 +23,11 @@ pub struct Args {
     #[arg(long = "real", value_name = "M", default_value = "1l-rpt-n1", value_parser = parsed::<RealModel>)]
     real_model: RealModel,
     /// Redshift-space model: kaiser, scoccimarro or tns (Scoccimarro + the A and B terms of Taruya,
-    /// Nishimichi & Saito 2010 at leading order).
-    #[arg(long, value_name = "MODEL", default_value = "tns", value_parser = parsed::<RsdModel>)]
-    rsd: RsdModel,
+    /// Nishimichi & Saito 2010 at leading order) on the --real model; or ept, the 1-loop galaxy model
+    /// with IR resummation (velocileptors' REPT: --bias is b1, with --b2 --bs --b3, --alpha0..6,
+    /// --sn --sn2 --sn4 in velocileptors' conventions, --no-ir).
+    #[arg(long, value_name = "MODEL", default_value = "tns", value_parser = parsed::<RsdChoice>)]
+    rsd: RsdChoice,
     /// Growth rate f. Default: f(z) of the cosmology.
     #[arg(long, value_name = "F", allow_hyphen_values = true)]
     f: Option<f64>,
@@ -46,17 +49,20 @@ pub struct Args {
     #[command(flatten)]
     bias: BiasArgs,
     /// Nonlinear galaxy bias b2 (scoccimarro, tns: the BOSS DR12 model of Beutler et al. 2017, with
-    /// the bias terms of `real --bias-terms`; b1 is --bias, constant).
+    /// the bias terms of `real --bias-terms`; b1 is --bias, constant; ept: velocileptors' b2, (b2/2)δ²).
     #[arg(long, value_name = "B2", allow_hyphen_values = true)]
     b2: Option<f64>,
-    /// Tidal bias b_s² of the nonlinear galaxy bias (FAST-PT's bs).
+    /// Tidal bias of the nonlinear galaxy bias: FAST-PT's bs, (bs/2)s² (scoccimarro, tns); ept:
+    /// velocileptors' bs, bs s².
     #[arg(long, value_name = "BS", allow_hyphen_values = true)]
     bs: Option<f64>,
-    /// Non-local cubic bias b3nl of the nonlinear galaxy bias.
+    /// Non-local cubic bias: b3nl (scoccimarro, tns); ept: velocileptors' b3 = 2 b3nl.
     #[arg(long, value_name = "B3", allow_hyphen_values = true)]
     b3: Option<f64>,
     #[command(flatten)]
     noise: NoiseArgs,
+    #[command(flatten)]
+    ept: EptArgs,
     /// Alcock–Paczynski α∥ = H^fid(z)/H(z) (velocileptors' apar): the multipoles as measured in a
     /// fiducial cosmology, integrated over the distorted μ with every ℓ ≤ 8 of the model (needs --aperp).
     #[arg(
@@ -107,6 +113,40 @@ pub struct Args {
 }
 
 impl Args {
+    /// The paper's model of --rsd; an error for ept options with it.
+    fn paper_model(&self) -> Result<RsdModel> {
+        match self.rsd {
+            RsdChoice::Paper(m) => {
+                if let Some(flag) = self.ept.given().first() {
+                    bail!("{flag} is an option of --rsd ept, not of --rsd {m}");
+                }
+                Ok(m)
+            }
+            RsdChoice::Ept => bail!("internal: ept has no paper model"),
+        }
+    }
+
+    /// Refuses the options of the paper's models with ept.
+    fn check_ept_options(&self) -> Result<()> {
+        let refused = [
+            ("--real", self.real_model != RealModel::OneLoopRptN1),
+            ("--fog", self.fog != Fog::None),
+            ("--sigma0", self.sigma0 != Sigma0::Value(0.0)),
+            ("--cs2", self.cs2 != 0.0),
+            ("--terms", self.terms),
+            ("--no-wiggle", self.no_wiggle),
+            ("--amplitude", self.bias.amplitude != 1.0),
+            (
+                "--shot-noise/--number-density/--noise-file (use --sn)",
+                self.noise.is_set(),
+            ),
+        ];
+        if let Some((flag, _)) = refused.iter().find(|(_, given)| *given) {
+            bail!("{flag} is not an option of --rsd ept (its Fingers of God are the counterterms --alpha2..6)");
+        }
+        Ok(())
+    }
+
     /// The nonlinear bias of --b2, --bs, --b3, if any is given.
     fn galaxy(&self) -> Option<NonlinearBias> {
         (self.b2.is_some() || self.bs.is_some() || self.b3.is_some()).then(|| NonlinearBias {
@@ -121,7 +161,7 @@ impl Args {
         let ells: Vec<usize> = list(&self.ells, "--ells")?;
         pt_spectra::rsd::MultipoleRule::new(&ells)?;
         Ok(RsdRequest {
-            rsd: self.rsd,
+            rsd: self.paper_model()?,
             f: self.f,
             bias: self.bias.bias()?,
             amplitude: self.bias.amplitude,
@@ -150,9 +190,6 @@ pub fn run(args: &Args) -> Result<()> {
         .filter(|p| p.is_file());
     inputs.push(("--fiducial", fiducial));
     check_outputs(&[("--out", args.out.as_deref())], &inputs)?;
-    let request = args.request()?;
-    request.validate_galaxy()?;
-    let mut request = request;
     let distortion = match (args.apar, args.aperp) {
         (Some(apar), Some(aperp)) => Some(Distortion::new(apar, aperp)?),
         _ => None,
@@ -172,6 +209,24 @@ pub fn run(args: &Args) -> Result<()> {
             )?)
         }
     };
+    if args.rsd == RsdChoice::Ept {
+        args.check_ept_options()?;
+        let ells: Vec<usize> = list(&args.ells, "--ells")?;
+        let shared = ept::Shared {
+            bias: args.bias.bias()?,
+            f: args.f,
+            b2: args.b2,
+            bs: args.bs,
+            b3: args.b3,
+            ells: ells.clone(),
+            distortion,
+        };
+        let table = ept::table(shared, &args.ept, k, &loaded)?;
+        return finish(args, &table, &ells);
+    }
+    let request = args.request()?;
+    request.validate_galaxy()?;
+    let mut request = request;
     let grid = match distortion {
         Some(distortion) => {
             let grid = distortion.internal_grid(&k)?;
@@ -182,17 +237,22 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let bars = Bars::default();
     let (precision, store) = (&loaded.precision, &loaded.store);
-    let mut plan = RsdPlan::new(&grid, args.real_model, args.rsd, precision, store, &bars)?;
+    let mut plan = RsdPlan::new(&grid, args.real_model, request.rsd, precision, store, &bars)?;
     if request.galaxy.is_some() {
         plan = plan.with_bias_terms()?;
     }
     let table = rsd_table(&plan, &request, &loaded.prepared, &bars)?;
+    finish(args, &table, &request.ells)
+}
+
+/// Writes the multipoles, or with --xi their correlation functions.
+fn finish(args: &Args, table: &pt_spectra::output::Table, ells: &[usize]) -> Result<()> {
     if args.xi {
         let s = LogGrid::new(args.s_min, args.s_max, args.ns)
             .context("invalid --s-min/--s-max/--ns")?
             .points();
-        let xi = xi_table(&table, &request.ells, &s)?;
+        let xi = xi_table(table, ells, &s)?;
         return write_output(args.out.as_ref(), &xi);
     }
-    write_output(args.out.as_ref(), &table)
+    write_output(args.out.as_ref(), table)
 }

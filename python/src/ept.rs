@@ -1,0 +1,152 @@
+//! The galaxy model `ept` from Python: `EptPlan` (loop plan once per k grid) and `EptTerms` (the loop
+//! terms of one linear spectrum, for cheap multipoles at other parameters: the nuisance steps of a
+//! chain). Parameters by velocileptors' names as keyword arguments.
+
+use crate::inputs::Inputs;
+use crate::tables::Table;
+use crate::{detached, floats, value_error};
+use pt_spectra::jobs::{self, EptRequest};
+use pt_spectra::rsd::ap::Distortion;
+use pt_spectra::rsd::ept::{EptParams, EptPlan as LibEptPlan, EptTerms as LibEptTerms};
+use pt_spectra::setup::Prepared;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// The parameters of `kwargs` (velocileptors' names; f may be absent: f(z) of the cosmology).
+fn params(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<EptParams> {
+    let mut p = EptParams::new(1.0, f64::NAN);
+    if let Some(kw) = kwargs {
+        for (key, value) in kw.iter() {
+            let name: String = key.extract()?;
+            let v: f64 = value.extract().map_err(|_| {
+                pyo3::exceptions::PyValueError::new_err(format!("{name}: expected a number"))
+            })?;
+            p.set(&name, v).map_err(value_error)?;
+        }
+    }
+    Ok(p)
+}
+
+/// The 1-loop galaxy model in redshift space planned for one k grid.
+#[pyclass(module = "pt_spectra._core", frozen)]
+pub(crate) struct EptPlan {
+    plan: LibEptPlan,
+    precision: pt_spectra::precision::Precision,
+}
+
+#[pymethods]
+impl EptPlan {
+    #[new]
+    #[pyo3(signature = (k, ir=true, apar=None, aperp=None, precision="default", q_range=None))]
+    fn new(
+        py: Python<'_>,
+        k: &Bound<'_, PyAny>,
+        ir: bool,
+        apar: Option<f64>,
+        aperp: Option<f64>,
+        precision: &str,
+        q_range: Option<(f64, f64)>,
+    ) -> PyResult<Self> {
+        let k = floats(k, "k")?;
+        let ap = match (apar, aperp) {
+            (None, None) => None,
+            (Some(a), Some(b)) => Some(Distortion::new(a, b).map_err(value_error)?),
+            _ => {
+                return Err(pyo3::exceptions::PyValueError::new_err(
+                    "give both apar and aperp (or neither)",
+                ))
+            }
+        };
+        let precision = crate::precision(precision, q_range, None, None)?;
+        let (plan, _) = detached(py, || jobs::ept_plan(&k, ir, ap, &precision))?;
+        Ok(Self { plan, precision })
+    }
+
+    /// The multipoles of the prepared spectrum at the parameters of `kwargs`.
+    #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, ells=vec![0, 2, 4], **kwargs))]
+    #[allow(clippy::too_many_arguments)]
+    fn __call__(
+        &self,
+        py: Python<'_>,
+        linear: Option<&Bound<'_, PyAny>>,
+        z: f64,
+        z_input: f64,
+        cosmology: Option<&Bound<'_, PyAny>>,
+        eh: Option<&str>,
+        ells: Vec<usize>,
+        kwargs: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Table> {
+        let request = EptRequest {
+            params: params(kwargs)?,
+            ells,
+        };
+        let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
+        let ((table, prepared), seconds) = detached(py, || {
+            let prepared = inputs.prepare(self.plan.k())?;
+            let table = jobs::ept_table(&self.plan, &request, &prepared, &self.precision)?;
+            Ok((table, prepared))
+        })?;
+        Table::new(py, table, &prepared, &self.precision, "ept", seconds)
+    }
+
+    /// The loop terms of a linear spectrum, for many cheap evaluations ([`EptTerms::multipoles`]).
+    #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None))]
+    fn terms(
+        &self,
+        py: Python<'_>,
+        linear: Option<&Bound<'_, PyAny>>,
+        z: f64,
+        z_input: f64,
+        cosmology: Option<&Bound<'_, PyAny>>,
+        eh: Option<&str>,
+    ) -> PyResult<EptTerms> {
+        let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
+        let ((terms, prepared), _) = detached(py, || {
+            let prepared = inputs.prepare(self.plan.k())?;
+            let terms = self.plan.terms(&prepared.spectrum)?;
+            Ok((terms, prepared))
+        })?;
+        Ok(EptTerms {
+            plan: self.plan.clone(),
+            terms,
+            prepared,
+            precision: self.precision.clone(),
+        })
+    }
+}
+
+/// The loop terms of one linear spectrum on an [`EptPlan`]'s grid.
+#[pyclass(module = "pt_spectra._core", frozen)]
+pub(crate) struct EptTerms {
+    plan: LibEptPlan,
+    terms: LibEptTerms,
+    prepared: Prepared,
+    precision: pt_spectra::precision::Precision,
+}
+
+#[pymethods]
+impl EptTerms {
+    /// The multipoles at the parameters of `kwargs` (velocileptors' names; f default f(z)).
+    #[pyo3(signature = (ells=vec![0, 2, 4], **kwargs))]
+    fn multipoles(
+        &self,
+        py: Python<'_>,
+        ells: Vec<usize>,
+        kwargs: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Table> {
+        let request = EptRequest {
+            params: params(kwargs)?,
+            ells,
+        };
+        let (table, seconds) = detached(py, || {
+            jobs::ept_table_from_terms(
+                &self.plan,
+                &self.terms,
+                &request,
+                &self.prepared,
+                &self.precision,
+            )
+        })?;
+        Table::new(py, table, &self.prepared, &self.precision, "ept", seconds)
+    }
+}

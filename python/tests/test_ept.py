@@ -1,0 +1,48 @@
+"""The galaxy model ``ept`` from Python: velocileptors' REPT table (set A, z = 1, no IR) through
+``pt.ept`` and the cheap-step ``EptTerms``, and the errors of unknown names and bad values."""
+
+import pathlib
+import warnings
+
+import numpy as np
+import pytest
+
+import pt_spectra as pt
+
+DATA = pathlib.Path(__file__).resolve().parents[2] / "tests" / "data"
+SET_A = dict(b1=1.8, b2=0.5, bs=-0.3, b3=0.1, alpha0=10, alpha2=-5, alpha4=3, alpha6=1, sn=1000,
+             sn2=500, sn4=100)
+
+
+@pytest.fixture(scope="module")
+def reference():
+    ref = np.loadtxt(DATA / "velocileptors_rept_planck2018_z1.0.dat")
+    lin = np.loadtxt(DATA / "linear_pk_planck2018_z1.0.dat")
+    return ref, (lin[:, 0], lin[:, 1])
+
+
+def test_ept_matches_rept_and_terms_give_the_same(reference):
+    ref, linear = reference
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pt.PtSpectraWarning)
+        t = pt.ept(k=ref[:, 0], linear=linear, ir=False, f=0.873875, **SET_A)
+        for col, ell in ((1, "P0"), (2, "P2"), (3, "P4")):
+            assert np.max(np.abs(t[ell] - ref[:, col]) / ref[:, 1]) < 2e-4
+        plan = pt.EptPlan(ref[:, 0], ir=False)
+        terms = plan.terms(linear=linear)
+        again = terms.multipoles(f=0.873875, **SET_A)
+    assert np.array_equal(again["P0"], t["P0"])
+
+
+def test_ept_names_bad_input(reference):
+    ref, linear = reference
+    plan = pt.EptPlan(ref[:5, 0], ir=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pt.PtSpectraWarning)
+        terms = plan.terms(linear=linear)
+        with pytest.raises(ValueError, match="alpha9"):
+            terms.multipoles(alpha9=1.0)
+        with pytest.raises(ValueError, match="f"):
+            terms.multipoles(f=-1.0)
+    with pytest.raises(ValueError, match="apar"):
+        pt.EptPlan(ref[:5, 0], apar=1.02)
