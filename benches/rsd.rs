@@ -11,6 +11,12 @@
 //! * `ap/observed`: P_0, P_2, P_4 of TNS with Lorentzian FoG observed with α∥ = 1.03, α⊥ = 0.98
 //!   ([`multipoles`] with the Alcock–Paczynski projection from its internal grid), per step of a fit.
 //!
+//! * `ept/terms`: the galaxy model's loop terms of a new linear spectrum with IR resummation (the
+//!   no-wiggle filter, the terms of P and P_nw, Σ²) on 50 k ([`EptPlan::terms`], rayon's pool;
+//!   `RAYON_NUM_THREADS=1` for one core);
+//! * `ept/step`: P_0, P_2, P_4 from those terms at new parameters (one nuisance step of a chain),
+//!   without and with AP (α∥ = 1.03, α⊥ = 0.98).
+//!
 //! Run with `cargo bench --bench rsd`.
 
 // `criterion_group!` defines an undocumented function.
@@ -23,6 +29,7 @@ use pt_spectra::loops::{TnsPlan, TnsTerms};
 use pt_spectra::precision::Precision;
 use pt_spectra::real::{real_space, RealModel, RealSpectra};
 use pt_spectra::rsd::ap::Distortion;
+use pt_spectra::rsd::ept::{EptParams, EptPlan, EptSettings};
 use pt_spectra::rsd::{Fog, MultipoleRule, Observed, RsdModel, RsdSettings};
 use pt_spectra::store::TableStore;
 use std::time::Duration;
@@ -139,5 +146,34 @@ fn bias_and_ap(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, tns, rsd_multipoles, bias_and_ap);
+/// The galaxy model: a new spectrum's terms, and one parameter step.
+fn ept(c: &mut Criterion) {
+    let p = LinearSpectrum::gm2012(0.0).expect("embedded spectrum");
+    let k = grid();
+    let mut group = c.benchmark_group("ept");
+    let plan = EptPlan::new(&k, EptSettings::default(), &Precision::default()).expect("valid plan");
+    group.bench_function(BenchmarkId::new("terms (IR)", 50), |b| {
+        b.iter(|| plan.terms(black_box(&p)).expect("valid spectrum"))
+    });
+    let terms = plan.terms(&p).expect("valid spectrum");
+    let mut params = EptParams::new(2.0, 0.48);
+    for (name, v) in [("b2", 0.3), ("bs", -0.2), ("alpha0", 5.0), ("sn", 800.0)] {
+        params.set(name, v).expect("known name");
+    }
+    group.bench_function(BenchmarkId::new("step (IR, l = 0, 2, 4)", 50), |b| {
+        b.iter(|| plan.multipoles(&terms, black_box(&params), &[0, 2, 4]))
+    });
+    let ap = EptSettings {
+        ir: true,
+        ap: Some(Distortion::new(1.03, 0.98).expect("valid alphas")),
+    };
+    let plan = EptPlan::new(&k, ap, &Precision::default()).expect("valid plan");
+    let terms = plan.terms(&p).expect("valid spectrum");
+    group.bench_function(BenchmarkId::new("step (IR + AP, l = 0, 2, 4)", 50), |b| {
+        b.iter(|| plan.multipoles(&terms, black_box(&params), &[0, 2, 4]))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, tns, rsd_multipoles, bias_and_ap, ept);
 criterion_main!(benches);

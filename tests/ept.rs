@@ -79,9 +79,9 @@ fn ir_matches_rept() {
         for set in 0..2 {
             let w = worst(z, f, 1, set);
             eprintln!("ir z {z} set {set}: {w:?}");
-            // The bound 1e-2 (different wiggle splits); with velocileptors' filter, measured
-            // ≤ 1.15e-3 (the filters' grids differ).
-            assert!(w.iter().all(|&d| d < 3e-3), "{w:?}");
+            // The bound 1e-2 (different wiggle splits); with velocileptors' filter on our own
+            // grid, measured ≤ 3.6e-4.
+            assert!(w.iter().all(|&d| d < 1e-3), "{w:?}");
         }
     }
 }

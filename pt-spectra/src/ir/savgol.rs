@@ -13,7 +13,7 @@ use crate::linear::LinearSpectrum;
 /// The width of the window in ln k.
 pub const WINDOW: f64 = 1.945_910_149_055_313_3; // ln 7
 /// Grid points per unit ln k.
-const PER_E_FOLD: f64 = 200.0;
+const PER_E_FOLD: f64 = 100.0;
 /// The degree of the fitted polynomial.
 const ORDER: usize = 4;
 

@@ -348,34 +348,45 @@ impl Rule {
         }
     }
 
-    /// The pair columns at k index `i` from the lattice `samples`.
-    fn pairs(&self, i: usize, samples: &[f64]) -> [f64; NPAIR] {
+    /// The pair columns at k index `i` of `S` spectra at once from their lattice `samples` (one
+    /// pass over the nodes: the weights are read once).
+    fn pairs<const S: usize>(&self, i: usize, samples: [&[f64]; S]) -> [[f64; NPAIR]; S] {
         let (mut start, outer) = self.pairs.ranges(i);
-        let mut total = [0.0; NPAIR];
+        let mut total = [[0.0; NPAIR]; S];
         for o in outer {
             let end = self.pairs.outer_end[o] as usize;
-            let mut acc = [0.0; NPAIR];
+            let mut acc = [[0.0; NPAIR]; S];
             let nodes = self.pairs.inner_b[start..end]
                 .iter()
                 .zip(&self.pairs.inner_l[start..end])
                 .zip(&self.pairs.inner_w[start..end]);
             for ((&b, l), w) in nodes {
-                let s = &samples[b as usize..b as usize + 4];
                 let l = l.map(f64::from);
-                let pp = (l[0] * s[0] + l[1] * s[1]) + (l[2] * s[2] + l[3] * s[3]);
-                for (a, w) in acc.iter_mut().zip(w) {
-                    *a += f64::from(*w) * pp;
+                let pp: [f64; S] = std::array::from_fn(|j| {
+                    let s = &samples[j][b as usize..b as usize + 4];
+                    (l[0] * s[0] + l[1] * s[1]) + (l[2] * s[2] + l[3] * s[3])
+                });
+                for (c, w) in w.iter().enumerate() {
+                    let w = f64::from(*w);
+                    for j in 0..S {
+                        acc[j][c] += w * pp[j];
+                    }
                 }
             }
-            let pq = self.lattice.interpolate(samples, self.pairs.outer_u[o]);
-            for (t, a) in total.iter_mut().zip(acc) {
-                *t += pq * a;
+            for j in 0..S {
+                let pq = self.lattice.interpolate(samples[j], self.pairs.outer_u[o]);
+                for (t, a) in total[j].iter_mut().zip(acc[j]) {
+                    *t += pq * a;
+                }
             }
             start = end;
         }
         total
     }
 }
+
+/// The pair columns and the lattice-weight terms of one k.
+type Row = ([Estimate; NPAIR], [Estimate; 6]);
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
@@ -409,9 +420,19 @@ impl RedshiftTerms {
     /// The loop part Σ monomial · values as coefficients of μ^{2n} (n ≤ 4) at k index `i` for
     /// `params` = [b1, b2, bs, b3, f]: (values, errors).
     pub fn loop_polynomial(&self, i: usize, params: [f64; 5]) -> ([f64; 5], [f64; 5]) {
+        self.loop_polynomial_with(i, &self.coefficients(params))
+    }
+
+    /// The value of every term's monomial at `params` = [b1, b2, bs, b3, f], in the order of
+    /// [`Self::terms`]: computed once per parameter point for [`Self::loop_polynomial_with`].
+    pub fn coefficients(&self, params: [f64; 5]) -> Vec<f64> {
+        self.terms.iter().map(|t| t.monomial.eval(params)).collect()
+    }
+
+    /// [`Self::loop_polynomial`] from the monomials' values `coefficients`.
+    pub fn loop_polynomial_with(&self, i: usize, coefficients: &[f64]) -> ([f64; 5], [f64; 5]) {
         let (mut v, mut e) = ([0.0; 5], [0.0; 5]);
-        for t in &self.terms {
-            let c = t.monomial.eval(params);
+        for (t, c) in self.terms.iter().zip(coefficients) {
             v[t.n] += c * t.values[i].value;
             e[t.n] += c.abs() * t.values[i].error;
         }
@@ -489,26 +510,97 @@ impl RedshiftPlan {
         let fine = self.fine.lattice.sample(spectrum);
         let coarse: Vec<f64> = fine.iter().step_by(2).copied().collect();
         let floor = self.precision.p22_error_floor;
-        let nk = self.k.len();
-        let rows: Vec<([Estimate; NPAIR], [Estimate; 6])> = (0..nk)
+        let rows: Vec<Row> = (0..self.k.len())
             .into_par_iter()
             .with_min_len(4)
             .map(|i| {
-                let (a, b) = (self.fine.pairs(i, &fine), self.coarse.pairs(i, &coarse));
-                let pairs = std::array::from_fn(|j| {
-                    Estimate::new(a[j], (a[j] - b[j]).abs().max(floor * a[j].abs()))
-                });
-                let p = spectrum.eval(self.k[i]);
-                let lw = std::array::from_fn(|j| {
-                    let s = dot(&self.fine.lattice_weights[i][j], &fine);
-                    let c = dot(&self.coarse.lattice_weights[i][j], &coarse);
-                    Estimate::new(p * s, (p * (s - c)).abs())
-                });
-                (pairs, lw)
+                let ([a], [b]) = (self.fine.pairs(i, [&fine]), self.coarse.pairs(i, [&coarse]));
+                self.row(i, spectrum.eval(self.k[i]), &a, &b, floor, &fine, &coarse)
             })
             .collect();
-        let sv = dot(&self.fine.sigma_v2, &fine);
-        let sv_coarse = dot(&self.coarse.sigma_v2, &coarse);
+        self.assemble(spectrum, &rows, &fine, &coarse)
+    }
+
+    /// The terms of `full` and of its no-wiggle part `no_wiggle` in one pass over the nodes (what
+    /// IR resummation needs). The errors of the no-wiggle terms are those of the full ones (the
+    /// rules are the same and the spectra differ by the wiggles only).
+    pub fn evaluate_with_no_wiggle(
+        &self,
+        full: &LinearSpectrum,
+        no_wiggle: &LinearSpectrum,
+    ) -> (RedshiftTerms, RedshiftTerms) {
+        let fine = self.fine.lattice.sample(full);
+        let fine_nw = self.fine.lattice.sample(no_wiggle);
+        let coarse: Vec<f64> = fine.iter().step_by(2).copied().collect();
+        let coarse_nw: Vec<f64> = fine_nw.iter().step_by(2).copied().collect();
+        let floor = self.precision.p22_error_floor;
+        let rows: Vec<(Row, Row)> = (0..self.k.len())
+            .into_par_iter()
+            .with_min_len(4)
+            .map(|i| {
+                let [a, a_nw] = self.fine.pairs(i, [&fine, &fine_nw]);
+                let [b] = self.coarse.pairs(i, [&coarse]);
+                let k = self.k[i];
+                let row = self.row(i, full.eval(k), &a, &b, floor, &fine, &coarse);
+                let mut row_nw = self.row(
+                    i,
+                    no_wiggle.eval(k),
+                    &a_nw,
+                    &a_nw,
+                    0.0,
+                    &fine_nw,
+                    &coarse_nw,
+                );
+                for (e, f) in row_nw.0.iter_mut().zip(&row.0) {
+                    e.error = f.error;
+                }
+                for (e, f) in row_nw.1.iter_mut().zip(&row.1) {
+                    e.error = f.error;
+                }
+                (row, row_nw)
+            })
+            .collect();
+        let (rows, rows_nw): (Vec<Row>, Vec<Row>) = rows.into_iter().unzip();
+        (
+            self.assemble(full, &rows, &fine, &coarse),
+            self.assemble(no_wiggle, &rows_nw, &fine_nw, &coarse_nw),
+        )
+    }
+
+    /// One k's pair columns (fine `a`, half-resolution `b`) and lattice-weight terms, with errors.
+    #[allow(clippy::too_many_arguments)]
+    fn row(
+        &self,
+        i: usize,
+        p: f64,
+        a: &[f64; NPAIR],
+        b: &[f64; NPAIR],
+        floor: f64,
+        fine: &[f64],
+        coarse: &[f64],
+    ) -> Row {
+        let pairs = std::array::from_fn(|j| {
+            Estimate::new(a[j], (a[j] - b[j]).abs().max(floor * a[j].abs()))
+        });
+        let lw = std::array::from_fn(|j| {
+            let s = dot(&self.fine.lattice_weights[i][j], fine);
+            let c = dot(&self.coarse.lattice_weights[i][j], coarse);
+            Estimate::new(p * s, (p * (s - c)).abs())
+        });
+        (pairs, lw)
+    }
+
+    /// The terms from the rows of every k.
+    fn assemble(
+        &self,
+        spectrum: &LinearSpectrum,
+        rows: &[Row],
+        fine: &[f64],
+        coarse: &[f64],
+    ) -> RedshiftTerms {
+        let nk = self.k.len();
+        let sv = dot(&self.fine.sigma_v2, fine);
+        let sv_coarse = dot(&self.coarse.sigma_v2, coarse);
         let sigma_v2 = Estimate::new(sv, (sv - sv_coarse).abs());
         let p_lin: Vec<f64> = self.k.iter().map(|&k| spectrum.eval(k)).collect();
         let mut out = RedshiftTerms {

@@ -151,6 +151,8 @@ impl Default for EptSettings {
 /// The plan: the loop plan on the grid the model needs (the output k, or the AP internal grid).
 #[derive(Debug, Clone)]
 pub struct EptPlan {
+    /// Gauss–Legendre rules on [0, 1] ([`MU_NODES`] and half as many): (μ, w, L_0…L_8(μ)).
+    rules: [Vec<(f64, f64, [f64; MAX_ELL + 1])>; 2],
     k_out: Vec<f64>,
     grid: Vec<f64>,
     settings: EptSettings,
@@ -179,7 +181,22 @@ impl EptPlan {
         };
         let loops = RedshiftPlan::new(&grid, precision)?;
         let split = settings.ir.then_some(());
+        let legendre: Vec<Vec<f64>> = (0..=MAX_ELL).map(legendre_coefficients).collect();
+        let rules = [MU_NODES, MU_NODES / 2].map(|n| {
+            let (x, w) = legendre_nodes(n);
+            x.iter()
+                .zip(&w)
+                .map(|(&x, &w)| {
+                    let mu = 0.5 * (x + 1.0);
+                    let l = std::array::from_fn(|ell| {
+                        legendre[ell].iter().rev().fold(0.0, |a, c| a * mu + c)
+                    });
+                    (mu, 0.5 * w, l)
+                })
+                .collect()
+        });
         Ok(Self {
+            rules,
             k_out: k.to_vec(),
             grid,
             settings,
@@ -203,15 +220,13 @@ impl EptPlan {
     /// # Errors
     /// As [`savitzky_golay_no_wiggle`].
     pub fn terms(&self, spectrum: &LinearSpectrum) -> Result<EptTerms> {
-        let full = self.loops.evaluate(spectrum);
-        let nw = match &self.split {
+        let (full, nw) = match &self.split {
             Some(()) => {
                 let p_nw = savitzky_golay_no_wiggle(spectrum)?;
-                let t = self.loops.evaluate(&p_nw);
-                let s2 = sigma2(&p_nw);
-                Some((t, s2))
+                let (full, t) = self.loops.evaluate_with_no_wiggle(spectrum, &p_nw);
+                (full, Some((t, sigma2(&p_nw))))
             }
-            None => None,
+            None => (self.loops.evaluate(spectrum), None),
         };
         Ok(EptTerms {
             grid: self.grid.clone(),
@@ -240,21 +255,14 @@ impl EptPlan {
             });
         }
         let model = terms.model(params);
-        let legendre: Vec<Vec<f64>> = ells.iter().map(|&l| legendre_coefficients(l)).collect();
-        let rules = [MU_NODES, MU_NODES / 2].map(|n| {
-            let (x, w) = legendre_nodes(n);
-            x.iter()
-                .zip(&w)
-                .map(|(&x, &w)| (0.5 * (x + 1.0), 0.5 * w))
-                .collect::<Vec<_>>()
-        });
         let volume = self.settings.ap.map_or(1.0, |d| d.volume());
         let mut out = vec![Vec::with_capacity(self.k_out.len()); ells.len()];
         for (i, &k) in self.k_out.iter().enumerate() {
             let mut sums = [vec![0.0; ells.len()], vec![0.0; ells.len()]];
             let mut spread = vec![0.0; ells.len()];
-            for (r, nodes) in rules.iter().enumerate() {
-                for &(mu, w) in nodes {
+            for (r, nodes) in self.rules.iter().enumerate() {
+                for (mu, w, legendre) in nodes {
+                    let (mu, w) = (*mu, *w);
                     let p = match &self.settings.ap {
                         None => model.at(i, k, mu),
                         Some(ap) => {
@@ -263,8 +271,7 @@ impl EptPlan {
                         }
                     };
                     for (j, &l) in ells.iter().enumerate() {
-                        let lj = legendre[j].iter().rev().fold(0.0, |a, c| a * mu + c);
-                        let c = w * (2 * l + 1) as f64 * lj * volume;
+                        let c = w * (2 * l + 1) as f64 * legendre[l] * volume;
                         sums[r][j] += c * p.value;
                         if r == 0 {
                             spread[j] += c.abs() * p.error;
@@ -318,17 +325,19 @@ impl EptTerms {
         let z1 = [b1 * b1, 2.0 * b1 * f, f * f];
         let (alpha, [sn, sn2, sn4]) = ([v[4], v[5], v[6], v[7]], [v[8], v[9], v[10]]);
         let s2 = self.nw.as_ref().map_or(0.0, |(_, s)| s.value);
+        // The terms of the full and no-wiggle spectra are in the same order.
+        let coefficients = self.full.coefficients(params.bias());
         let parts = (0..self.grid.len())
             .map(|i| {
                 let k = self.grid[i];
                 let k2 = k * k;
                 let p = self.full.p_lin[i];
-                let (lv, le) = self.full.loop_polynomial(i, params.bias());
+                let (lv, le) = self.full.loop_polynomial_with(i, &coefficients);
                 let mut n: Poly = (lv, le);
                 let mut w: Poly = ([0.0; 5], [0.0; 5]);
                 let (p_nw, p_w) = match &self.nw {
                     Some((t, _)) => {
-                        let (nv, ne) = t.loop_polynomial(i, params.bias());
+                        let (nv, ne) = t.loop_polynomial_with(i, &coefficients);
                         n = (nv, ne);
                         for j in 0..5 {
                             w.0[j] = lv[j] - nv[j];
