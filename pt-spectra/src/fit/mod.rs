@@ -26,6 +26,7 @@ use std::str::FromStr;
 
 mod contour;
 mod data;
+pub mod galaxy;
 mod minimise;
 pub use contour::{contour, contour_table, Contour, ContourGrid, CONTOUR_LEVELS};
 pub use data::MultipoleData;

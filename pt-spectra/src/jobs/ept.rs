@@ -112,3 +112,101 @@ pub fn ept_table_from_terms(
     }
     Ok(t)
 }
+
+/// `fit --rsd ept`: one best fit per k_max of `request` (its k_max replaced), a row each: `k_max
+/// points chi2 minus_2_ln_L` and, per parameter, its best value and (free or marginalised) `err_<p>`.
+///
+/// # Errors
+/// As [`crate::fit::galaxy::fit_galaxy`].
+pub fn ept_fit_table(
+    plan: &EptPlan,
+    terms: &EptTerms,
+    data: &crate::fit::MultipoleData,
+    request: &crate::fit::galaxy::GalaxyFitRequest,
+    k_max: &[f64],
+    header: Vec<String>,
+) -> Result<Table> {
+    use crate::fit::galaxy::fit_galaxy;
+    let mut fits = Vec::with_capacity(k_max.len());
+    for &k in k_max {
+        let mut r = request.clone();
+        r.k_max = k;
+        fits.push(fit_galaxy(plan, terms, data, &r)?);
+    }
+    let mut header = header;
+    header.push(format!(
+        "fit of ept to multipoles {:?} for k in [{}, k_max] h/Mpc: free {} (Gaussian errors from the \
+         Hessian of -2 ln L), marginalised analytically {} (errors sqrt((F^-1)_ii) at the best fit), \
+         priors {}; -2 ln L = chi2 + priors + ln det F",
+        request.ells,
+        request.k_min,
+        request.free.join(","),
+        if request.marginalise.is_empty() {
+            "none".to_string()
+        } else {
+            request.marginalise.join(",")
+        },
+        if request.priors.is_empty() {
+            "none".to_string()
+        } else {
+            request
+                .priors
+                .iter()
+                .map(|p| format!("{}: N({}, {}^2)", p.name, p.mean, p.sigma))
+                .collect::<Vec<_>>()
+                .join(", ")
+        }
+    ));
+    let mut t = Table::new(header);
+    t.push("k_max", WAVENUMBER, k_max.to_vec());
+    t.push(
+        "points",
+        "1",
+        fits.iter().map(|f| f.points as f64).collect(),
+    );
+    t.push("chi2", "1", fits.iter().map(|f| f.chi2).collect());
+    t.push(
+        "minus_2_ln_L",
+        "1",
+        fits.iter().map(|f| f.minus_two_log_l).collect(),
+    );
+    for (i, name) in PARAM_NAMES.iter().enumerate() {
+        t.push(
+            *name,
+            unit(name),
+            fits.iter().map(|f| f.best.values[i]).collect(),
+        );
+        let err = |f: &crate::fit::galaxy::GalaxyFit| {
+            if let Some(j) = request.free.iter().position(|n| n == name) {
+                Some(f.errors[j])
+            } else {
+                request
+                    .marginalise
+                    .iter()
+                    .position(|n| n == name)
+                    .map(|j| f.marginalised_errors[j])
+            }
+        };
+        if fits.first().and_then(err).is_some() {
+            let values: Vec<f64> = fits.iter().map(|f| err(f).unwrap_or(f64::NAN)).collect();
+            t.push_undefined_as(
+                format!("err_{name}"),
+                unit(name),
+                values,
+                "NaN where the Hessian of -2 ln L is not positive definite",
+            );
+        }
+    }
+    Ok(t)
+}
+
+/// The unit of an ept parameter.
+fn unit(name: &str) -> &'static str {
+    match name {
+        "alpha0" | "alpha2" | "alpha4" | "alpha6" => "(Mpc/h)^2",
+        "sn" => "(Mpc/h)^3",
+        "sn2" => "(Mpc/h)^5",
+        "sn4" => "(Mpc/h)^7",
+        _ => "1",
+    }
+}

@@ -1,7 +1,7 @@
 //! `rsd --rsd ept`: the galaxy model against velocileptors' REPT through the command line, and the
 //! refusals of options that belong to other models.
 
-use super::{column_names, fails_naming, rows, run};
+use super::{column_names, column_names_of, fails_naming, rows, run};
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/");
 
@@ -59,5 +59,109 @@ fn ept_refuses_other_models_options_and_bad_values() {
             "apar",
         ),
         (vec!["rsd", "--rsd", "ept", "--alpha2", "nan"], "alpha2"),
+    ]);
+}
+
+/// `fit --rsd ept` on noise-free multipoles made by `rsd --rsd ept`: f, b1, b2 free, α0 and sn
+/// marginalised, a prior on b2; the truth is recovered well within the errors.
+#[test]
+fn ept_fit_recovers_the_parameters_of_its_own_multipoles() {
+    let dir = super::scratch("ept_fit");
+    let (ok, out, err) = run(&[
+        "rsd",
+        "--rsd",
+        "ept",
+        "--bias",
+        "2",
+        "--b2",
+        "-0.4",
+        "--alpha0",
+        "8",
+        "--sn",
+        "900",
+        "--f",
+        "0.7",
+        "--k-min",
+        "0.02",
+        "--k-max",
+        "0.2",
+        "--nk",
+        "25",
+        "--precision",
+        "fast",
+    ]);
+    assert!(ok, "{err}");
+    let mut text = String::new();
+    for r in rows(&out) {
+        let s = 0.01 * r[1];
+        text += &format!("{} {} {s} {} {s} {} {s}\n", r[0], r[1], r[2], r[3]);
+    }
+    let data = super::write(&dir, "data.txt", &text);
+    let (ok, out, err) = run(&[
+        "fit",
+        "--rsd",
+        "ept",
+        "--data",
+        &data,
+        "--ells",
+        "0,2,4",
+        "--free",
+        "f,b1,b2",
+        "--marginalise",
+        "alpha0,sn",
+        "--prior",
+        "b2:0,2",
+        "--k-max",
+        "0.2",
+        "--precision",
+        "fast",
+        "--bias",
+        "1.8",
+        "--f",
+        "0.6",
+    ]);
+    assert!(ok, "{err}");
+    let names = column_names_of(&out, "# k_max ");
+    let row = &rows(&out)[0];
+    let get = |n: &str| row[names.iter().position(|c| *c == n).unwrap()];
+    for (name, truth) in [
+        ("f", 0.7),
+        ("b1", 2.0),
+        ("b2", -0.4),
+        ("alpha0", 8.0),
+        ("sn", 900.0),
+    ] {
+        let (v, e) = (get(name), get(&format!("err_{name}")));
+        assert!((v - truth).abs() < 0.1 * e, "{name}: {v} ± {e}");
+    }
+    fails_naming(&[
+        (
+            vec![
+                "fit",
+                "--rsd",
+                "ept",
+                "--data",
+                &data,
+                "--marginalise",
+                "b2",
+            ],
+            "linearly",
+        ),
+        (
+            vec!["fit", "--rsd", "ept", "--data", &data, "--prior", "b2:0,-1"],
+            "sigma",
+        ),
+        (
+            vec!["fit", "--rsd", "ept", "--data", &data, "--prior", "b2=0"],
+            "NAME:MEAN,SIGMA",
+        ),
+        (
+            vec!["fit", "--rsd", "ept", "--data", &data, "--free", "q"],
+            "`q`",
+        ),
+        (
+            vec!["fit", "--data", &data, "--prior", "f:0.5,0.1"],
+            "--prior",
+        ),
     ]);
 }

@@ -57,6 +57,24 @@ pub struct EptArgs {
 }
 
 impl EptArgs {
+    /// Whether --no-ir is given.
+    pub fn no_ir(&self) -> bool {
+        self.no_ir
+    }
+
+    /// The counterterm and stochastic values given, by parameter name.
+    pub fn values(&self) -> [(&'static str, Option<f64>); 7] {
+        [
+            ("alpha0", self.alpha0),
+            ("alpha2", self.alpha2),
+            ("alpha4", self.alpha4),
+            ("alpha6", self.alpha6),
+            ("sn", self.sn),
+            ("sn2", self.sn2),
+            ("sn4", self.sn4),
+        ]
+    }
+
     /// The options given, by name, for the error when a paper model gets them.
     pub fn given(&self) -> Vec<&'static str> {
         let mut out: Vec<&'static str> = [

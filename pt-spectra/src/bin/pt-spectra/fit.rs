@@ -1,14 +1,16 @@
 //! `pt-spectra fit`: best-fit f, σ0, A_b with Δχ² errors against measured multipoles, versus k_max.
 
 use crate::common::{list, parse_cs2, parsed, BiasArgs, NoiseArgs};
+use crate::ept::{EptArgs, RsdChoice};
 use crate::input::SpectrumInput;
 use crate::output::{check_outputs, write_output};
 use crate::progress::Bars;
 use anyhow::{bail, Context, Result};
+use pt_spectra::fit::galaxy::{GalaxyFitRequest, Prior};
 use pt_spectra::fit::{ContourGrid, MultipoleData, Parameter};
 use pt_spectra::jobs::{fit_tables, FitOutputs, FitRequest, RsdRequest};
 use pt_spectra::real::RealModel;
-use pt_spectra::rsd::{Fog, RsdModel, RsdPlan, Sigma0};
+use pt_spectra::rsd::{Fog, RsdPlan, Sigma0};
 use std::path::PathBuf;
 
 /// Arguments of `pt-spectra fit`.
@@ -35,15 +37,43 @@ pub struct Args {
     /// Real-space model: linear, 1l-spt, 2l-spt, 1l-rpt-n0..n3, 2l-rpt-n0..n3.
     #[arg(long = "real", value_name = "M", default_value = "1l-spt", value_parser = parsed::<RealModel>)]
     real_model: RealModel,
-    /// Redshift-space model: kaiser, scoccimarro or tns.
-    #[arg(long, value_name = "MODEL", default_value = "tns", value_parser = parsed::<RsdModel>)]
-    rsd: RsdModel,
+    /// Redshift-space model: kaiser, scoccimarro or tns; or ept, the galaxy model (free, marginalised
+    /// and prior parameters by velocileptors' names: b1 is --bias, then --b2 --bs --b3 --alpha0..6
+    /// --sn --sn2 --sn4 as start values or fixed values).
+    #[arg(long, value_name = "MODEL", default_value = "tns", value_parser = parsed::<RsdChoice>)]
+    rsd: RsdChoice,
     /// Fingers of God: none, lorentzian or gaussian.
     #[arg(long, value_name = "KIND", default_value = "lorentzian", value_parser = parsed::<Fog>)]
     fog: Fog,
-    /// Free parameters, comma separated: f, sigma0, ab, cs2 (the EFT counterterm of --cs2).
-    #[arg(long, value_name = "P,P", default_value = "f,sigma0")]
-    free: String,
+    /// Free parameters, comma separated: f, sigma0, ab, cs2 (the EFT counterterm of --cs2); with
+    /// --rsd ept any of f, b1, b2, bs, b3, alpha0, alpha2, alpha4, alpha6, sn, sn2, sn4. Default
+    /// f,sigma0 (ept: f,b1).
+    #[arg(long, value_name = "P,P")]
+    free: Option<String>,
+    /// --rsd ept: parameters that enter linearly, marginalised analytically (of alpha0, alpha2,
+    /// alpha4, alpha6, sn, sn2, sn4), comma separated.
+    #[arg(long, value_name = "P,P")]
+    marginalise: Option<String>,
+    /// --rsd ept: a Gaussian prior NAME:MEAN,SIGMA (repeat the option for several).
+    #[arg(long, value_name = "NAME:MEAN,SIGMA")]
+    prior: Vec<String>,
+    /// --rsd ept: second-order bias b2 (start or fixed value).
+    #[arg(long, value_name = "B2", allow_hyphen_values = true)]
+    b2: Option<f64>,
+    /// --rsd ept: tidal bias bs (start or fixed value).
+    #[arg(long, value_name = "BS", allow_hyphen_values = true)]
+    bs: Option<f64>,
+    /// --rsd ept: cubic bias b3 (start or fixed value).
+    #[arg(long, value_name = "B3", allow_hyphen_values = true)]
+    b3: Option<f64>,
+    /// --rsd ept: Alcock–Paczynski α∥ of the measurement (needs --aperp).
+    #[arg(long, value_name = "A", requires = "aperp")]
+    apar: Option<f64>,
+    /// --rsd ept: Alcock–Paczynski α⊥ of the measurement (needs --apar).
+    #[arg(long, value_name = "A", requires = "apar")]
+    aperp: Option<f64>,
+    #[command(flatten)]
+    ept: EptArgs,
     /// Growth rate: start value if free, value if fixed. Default: f(z) of the cosmology.
     #[arg(long, value_name = "F", allow_hyphen_values = true)]
     f: Option<f64>,
@@ -96,6 +126,134 @@ pub struct Args {
     contour_span: f64,
 }
 
+/// The data of --data (the multipoles of --ells) and --covariance, and the fitted ells.
+fn read_data(args: &Args) -> Result<(MultipoleData, Vec<usize>)> {
+    let data_ells: Vec<usize> = list(&args.data_ells, "--data-ells")?;
+    let ells: Vec<usize> = list(&args.ells, "--ells")?;
+    let cols: Vec<usize> = list(&args.data_columns, "--data-columns")?;
+    if cols.len() != 1 + 2 * data_ells.len() || cols.contains(&0) {
+        bail!(
+            "--data-columns {}: expected {} 1-based columns (k, then P_l, sigma_l for each of --data-ells {})",
+            args.data_columns,
+            1 + 2 * data_ells.len(),
+            args.data_ells
+        );
+    }
+    let mut spec = Vec::new();
+    for &l in &ells {
+        let Some(j) = data_ells.iter().position(|&d| d == l) else {
+            bail!(
+                "--ells: multipole {l} is not among --data-ells {}",
+                args.data_ells
+            );
+        };
+        spec.push((l, cols[1 + 2 * j] - 1, cols[2 + 2 * j] - 1));
+    }
+    let mut data = MultipoleData::read(&args.data, cols[0] - 1, &spec)?;
+    if let Some(path) = &args.covariance {
+        data = data.read_covariance(path).context("--covariance")?;
+    }
+    Ok((data, ells))
+}
+
+/// `fit --rsd ept`: the galaxy model's fits with marginalisation and priors.
+fn run_ept(args: &Args) -> Result<()> {
+    let refused = [
+        ("--real", args.real_model != RealModel::OneLoopSpt),
+        ("--fog", args.fog != Fog::Lorentzian),
+        ("--cs2", args.cs2 != 0.0),
+        ("--amplitude", args.bias.amplitude != 1.0),
+        (
+            "--shot-noise/--number-density/--noise-file (use --sn)",
+            args.noise.is_set(),
+        ),
+        ("--contour", args.contour.is_some()),
+        ("--model-out", args.model_out.is_some()),
+    ];
+    if let Some((flag, _)) = refused.iter().find(|(_, given)| *given) {
+        bail!("{flag} is not an option of fit --rsd ept");
+    }
+    let (data, ells) = read_data(args)?;
+    let b1 = match args.bias.bias()? {
+        pt_spectra::halo::Bias::Constant(b) => b,
+        pt_spectra::halo::Bias::Table(_) => bail!("--rsd ept takes a constant --bias (b1)"),
+    };
+    let loaded = args.spectrum.load()?;
+    let mut start =
+        pt_spectra::rsd::ept::EptParams::new(b1, args.f.unwrap_or(loaded.prepared.growth_rate));
+    for (name, value) in [("b2", args.b2), ("bs", args.bs), ("b3", args.b3)]
+        .into_iter()
+        .chain(args.ept.values())
+    {
+        if let Some(v) = value {
+            start.set(name, v)?;
+        }
+    }
+    let names = |s: Option<&str>, default: &str| -> Vec<String> {
+        s.unwrap_or(default)
+            .split(',')
+            .map(|n| n.trim().to_string())
+            .filter(|n| !n.is_empty())
+            .collect()
+    };
+    let priors = args
+        .prior
+        .iter()
+        .map(|text| parse_prior(text))
+        .collect::<Result<Vec<_>>>()?;
+    let distortion = match (args.apar, args.aperp) {
+        (Some(a), Some(b)) => Some(pt_spectra::rsd::ap::Distortion::new(a, b)?),
+        _ => None,
+    };
+    let request = GalaxyFitRequest {
+        start,
+        free: names(args.free.as_deref(), "f,b1"),
+        marginalise: names(args.marginalise.as_deref(), ""),
+        priors,
+        ells,
+        k_min: args.k_min,
+        k_max: 0.0,
+    };
+    let plan =
+        pt_spectra::jobs::ept_plan(&data.k, !args.ept.no_ir(), distortion, &loaded.precision)?;
+    let terms = plan.terms(&loaded.prepared.spectrum)?;
+    let mut header = vec![format!(
+        "pt-spectra {} fit: ept (velocileptors' REPT conventions{}) to {}",
+        pt_spectra::jobs::VERSION,
+        if args.ept.no_ir() {
+            ", no IR resummation"
+        } else {
+            ", IR resummed"
+        },
+        args.data.display()
+    )];
+    header.extend(pt_spectra::jobs::describe_inputs(
+        &loaded.prepared,
+        &loaded.precision,
+    ));
+    let table = pt_spectra::jobs::ept_fit_table(
+        &plan,
+        &terms,
+        &data,
+        &request,
+        &k_max_values(&args.k_max)?,
+        header,
+    )?;
+    write_output(args.out.as_ref(), &table)
+}
+
+/// NAME:MEAN,SIGMA.
+fn parse_prior(text: &str) -> Result<Prior> {
+    let bad = || anyhow::anyhow!("--prior {text}: expected NAME:MEAN,SIGMA, e.g. b2:0,1");
+    let (name, rest) = text.split_once(':').ok_or_else(bad)?;
+    let (mean, sigma) = rest.split_once(',').ok_or_else(bad)?;
+    Ok(Prior {
+        name: name.trim().to_string(),
+        mean: mean.trim().parse().map_err(|_| bad())?,
+        sigma: sigma.trim().parse().map_err(|_| bad())?,
+    })
+}
+
 /// `a:b:step` (inclusive, to rounding), a list, or one value.
 fn k_max_values(s: &str) -> Result<Vec<f64>> {
     let parts: Vec<&str> = s.split(':').collect();
@@ -131,39 +289,41 @@ pub fn run(args: &Args) -> Result<()> {
         ("--contour-out", args.contour_out.as_deref()),
     ];
     check_outputs(&outputs, &inputs)?;
+    if args.rsd == RsdChoice::Ept {
+        return run_ept(args);
+    }
+    let RsdChoice::Paper(rsd) = args.rsd else {
+        unreachable!("ept returned above")
+    };
+    let paper_only_refused = [
+        ("--marginalise", args.marginalise.is_some()),
+        ("--prior", !args.prior.is_empty()),
+        (
+            "--b2/--bs/--b3",
+            args.b2.is_some() || args.bs.is_some() || args.b3.is_some(),
+        ),
+        ("--apar/--aperp", args.apar.is_some()),
+    ];
+    if let Some(flag) = args
+        .ept
+        .given()
+        .first()
+        .copied()
+        .or_else(|| paper_only_refused.iter().find(|(_, g)| *g).map(|(f, _)| *f))
+    {
+        bail!("{flag} is an option of --rsd ept, not of --rsd {rsd}");
+    }
     let free: Vec<Parameter> = args
         .free
+        .as_deref()
+        .unwrap_or("f,sigma0")
         .split(',')
         .map(str::parse)
         .collect::<Result<_, _>>()?;
-    let data_ells: Vec<usize> = list(&args.data_ells, "--data-ells")?;
-    let ells: Vec<usize> = list(&args.ells, "--ells")?;
-    let cols: Vec<usize> = list(&args.data_columns, "--data-columns")?;
-    if cols.len() != 1 + 2 * data_ells.len() || cols.contains(&0) {
-        bail!(
-            "--data-columns {}: expected {} 1-based columns (k, then P_l, sigma_l for each of --data-ells {})",
-            args.data_columns,
-            1 + 2 * data_ells.len(),
-            args.data_ells
-        );
-    }
-    let mut spec = Vec::new();
-    for &l in &ells {
-        let Some(j) = data_ells.iter().position(|&d| d == l) else {
-            bail!(
-                "--ells: multipole {l} is not among --data-ells {}",
-                args.data_ells
-            );
-        };
-        spec.push((l, cols[1 + 2 * j] - 1, cols[2 + 2 * j] - 1));
-    }
-    let mut data = MultipoleData::read(&args.data, cols[0] - 1, &spec)?;
-    if let Some(path) = &args.covariance {
-        data = data.read_covariance(path).context("--covariance")?;
-    }
+    let (data, ells) = read_data(args)?;
     let request = FitRequest {
         model: RsdRequest {
-            rsd: args.rsd,
+            rsd,
             f: args.f,
             bias: args.bias.bias()?,
             amplitude: args.bias.amplitude,
@@ -200,7 +360,7 @@ pub fn run(args: &Args) -> Result<()> {
             Some(text) => Some(contour_grid(text, args, &request.free)?),
         },
     };
-    let plan = RsdPlan::new(&data.k, args.real_model, args.rsd, precision, store, &bars)?;
+    let plan = RsdPlan::new(&data.k, args.real_model, rsd, precision, store, &bars)?;
     let tables = fit_tables(&plan, data, &request, outputs, &loaded.prepared, &bars)?;
     for (path, table) in [
         (args.model_out.as_ref(), tables.model.as_ref()),

@@ -1,0 +1,482 @@
+//! Fits of the galaxy model `ept` ([`crate::rsd::ept`]) to measured multipoles: any parameter free,
+//! Gaussian priors, and analytic marginalisation of the parameters that enter linearly (counterterms
+//! α_n and stochastic terms sn, sn2, sn4), as CLASS-PT, PyBird and desilike do.
+//!
+//! With the data vector d (ℓ-major over the fitted multipoles, k_min ≤ k ≤ k_max), its covariance C,
+//! the model m(θ, a) = m₀(θ) + Σᵢ aᵢ Tᵢ(θ) linear in the marginalised a (Tᵢ = ∂m/∂aᵢ, exact: the model is
+//! linear in them) and Gaussian priors a ~ N(μ, S) (S diagonal; a parameter without a prior has a flat
+//! one, S⁻¹ = 0), the marginal likelihood is, up to a constant,
+//!   −2 ln L(θ) = χ²(θ, â) + (â − μ)ᵀS⁻¹(â − μ) + ln det F,   F = TᵀC⁻¹T + S⁻¹,
+//!   â = F⁻¹[TᵀC⁻¹(d − m₀) + S⁻¹μ],
+//! plus the Gaussian priors of the free θ. The best fit minimises it over θ (Nelder–Mead, restarted
+//! once from its own best point); â at the best θ is the best fit of the marginalised parameters and
+//! √(F⁻¹)ᵢᵢ their errors (at fixed θ). The errors of the free θ are Gaussian: the square roots of the
+//! diagonal of the inverse Hessian of −½ × (−2 ln L), by central differences — stated as such in the
+//! output. χ² alone (without the ln det F and prior terms) is also reported.
+
+use super::MultipoleData;
+use crate::error::{Error, Result};
+use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
+use argmin::core::{CostFunction, Executor, State};
+use argmin::solver::neldermead::NelderMead;
+
+/// The parameters that enter the model linearly and can be marginalised analytically.
+pub const LINEAR: [&str; 7] = ["alpha0", "alpha2", "alpha4", "alpha6", "sn", "sn2", "sn4"];
+
+/// A Gaussian prior on a parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Prior {
+    /// The parameter's name (one of [`PARAM_NAMES`]).
+    pub name: String,
+    /// Its mean.
+    pub mean: f64,
+    /// Its standard deviation (> 0).
+    pub sigma: f64,
+}
+
+/// What to fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GalaxyFitRequest {
+    /// Start values of the free parameters and values of the fixed ones.
+    pub start: EptParams,
+    /// The free parameters (minimised).
+    pub free: Vec<String>,
+    /// The linear parameters marginalised analytically (a subset of [`LINEAR`]).
+    pub marginalise: Vec<String>,
+    /// Gaussian priors.
+    pub priors: Vec<Prior>,
+    /// The fitted multipoles (a subset of the data's).
+    pub ells: Vec<usize>,
+    /// The fitted range [h/Mpc].
+    pub k_min: f64,
+    /// The fitted range [h/Mpc].
+    pub k_max: f64,
+}
+
+/// The result of a fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GalaxyFit {
+    /// Every parameter at the best fit (the marginalised ones at â).
+    pub best: EptParams,
+    /// The free parameters' Gaussian errors, in the order of the request.
+    pub errors: Vec<f64>,
+    /// The marginalised parameters' errors √(F⁻¹)ᵢᵢ at the best θ, in the order of the request.
+    pub marginalised_errors: Vec<f64>,
+    /// χ² of the best fit (data only).
+    pub chi2: f64,
+    /// −2 ln L of the best fit (χ² + the priors + ln det F).
+    pub minus_two_log_l: f64,
+    /// Data points fitted.
+    pub points: usize,
+}
+
+fn index(name: &str) -> Result<usize> {
+    PARAM_NAMES
+        .iter()
+        .position(|&n| n == name)
+        .ok_or_else(|| Error::InvalidChoice {
+            what: format!("fit parameter `{name}`"),
+            reason: format!("the ept parameters are {}", PARAM_NAMES.join(", ")),
+        })
+}
+
+/// The objective of one request on one data window.
+struct Objective<'a> {
+    plan: &'a EptPlan,
+    terms: &'a EptTerms,
+    start: EptParams,
+    ells: Vec<usize>,
+    free: Vec<usize>,
+    marg: Vec<usize>,
+    /// Per parameter: (mean, 1/σ²) of its prior, if any.
+    priors: Vec<Option<(f64, f64)>>,
+    /// Plan k indices of the window.
+    window: Vec<usize>,
+    /// L⁻¹ of the Cholesky factor of the window's covariance.
+    whiten: Vec<Vec<f64>>,
+    /// L⁻¹ d.
+    data: Vec<f64>,
+}
+
+impl Objective<'_> {
+    fn params(&self, x: &[f64]) -> EptParams {
+        let mut p = self.start;
+        for (&i, &v) in self.free.iter().zip(x) {
+            p.values[i] = v;
+        }
+        p
+    }
+
+    /// The whitened model at `p` (L⁻¹ m).
+    fn model(&self, p: &EptParams) -> Result<Vec<f64>> {
+        let m = self.plan.multipoles(self.terms, p, &self.ells)?;
+        let raw: Vec<f64> = m
+            .iter()
+            .flat_map(|l| self.window.iter().map(move |&i| l[i].value))
+            .collect();
+        Ok(self
+            .whiten
+            .iter()
+            .map(|row| row.iter().zip(&raw).map(|(a, b)| a * b).sum())
+            .collect())
+    }
+
+    /// (−2 ln L, χ², the parameters with â, the errors of â) at the free values `x`.
+    fn evaluate(&self, x: &[f64]) -> Result<(f64, f64, EptParams, Vec<f64>)> {
+        let mut p = self.params(x);
+        for &i in &self.marg {
+            p.values[i] = 0.0;
+        }
+        let m0 = self.model(&p)?;
+        let templates: Vec<Vec<f64>> = self
+            .marg
+            .iter()
+            .map(|&i| {
+                let mut q = p;
+                q.values[i] = 1.0;
+                self.model(&q)
+                    .map(|m| m.iter().zip(&m0).map(|(a, b)| a - b).collect())
+            })
+            .collect::<Result<_>>()?;
+        let r0: Vec<f64> = self.data.iter().zip(&m0).map(|(d, m)| d - m).collect();
+        let n = self.marg.len();
+        let mut f = vec![vec![0.0; n]; n];
+        let mut b = vec![0.0; n];
+        for a in 0..n {
+            let (mean, precision) = self.priors[self.marg[a]].unwrap_or((0.0, 0.0));
+            b[a] = dot(&templates[a], &r0) + precision * mean;
+            for c in 0..n {
+                f[a][c] = dot(&templates[a], &templates[c]);
+            }
+            f[a][a] += precision;
+        }
+        let (ahat, inverse, log_det) = solve_spd(&f, &b)?;
+        let mut chi2 = 0.0;
+        for (j, r) in r0.iter().enumerate() {
+            let fit: f64 = (0..n).map(|a| ahat[a] * templates[a][j]).sum();
+            chi2 += (r - fit).powi(2);
+        }
+        let mut total = chi2 + log_det;
+        for (a, &i) in self.marg.iter().enumerate() {
+            p.values[i] = ahat[a];
+            if let Some((mean, precision)) = self.priors[i] {
+                total += precision * (ahat[a] - mean).powi(2);
+            }
+        }
+        for &i in &self.free {
+            if let Some((mean, precision)) = self.priors[i] {
+                total += precision * (p.values[i] - mean).powi(2);
+            }
+        }
+        let errors = (0..n).map(|a| inverse[a][a].sqrt()).collect();
+        Ok((total, chi2, p, errors))
+    }
+}
+
+impl CostFunction for &Objective<'_> {
+    type Param = Vec<f64>;
+    type Output = f64;
+
+    fn cost(&self, x: &Vec<f64>) -> std::result::Result<f64, argmin::core::Error> {
+        // Outside the model's domain (e.g. f < 0) the cost is infinite.
+        Ok(self.evaluate(x).map_or(f64::INFINITY, |e| e.0))
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// Solves F a = b for symmetric positive definite F: (a, F⁻¹, ln det F).
+fn solve_spd(f: &[Vec<f64>], b: &[f64]) -> Result<(Vec<f64>, Vec<Vec<f64>>, f64)> {
+    let n = b.len();
+    let l = cholesky(f).ok_or(Error::InvalidParameter {
+        name: "marginalised parameters",
+        value: n as f64,
+        reason: "their templates are degenerate on the fitted data (give them priors or fewer)",
+    })?;
+    let log_det = 2.0 * (0..n).map(|i| l[i][i].ln()).sum::<f64>();
+    let solve = |rhs: &[f64]| {
+        let mut y = vec![0.0; n];
+        for i in 0..n {
+            y[i] = (rhs[i] - (0..i).map(|j| l[i][j] * y[j]).sum::<f64>()) / l[i][i];
+        }
+        let mut x = vec![0.0; n];
+        for i in (0..n).rev() {
+            x[i] = (y[i] - (i + 1..n).map(|j| l[j][i] * x[j]).sum::<f64>()) / l[i][i];
+        }
+        x
+    };
+    let inverse = (0..n)
+        .map(|i| {
+            solve(
+                &(0..n)
+                    .map(|j| f64::from(u8::from(i == j)))
+                    .collect::<Vec<_>>(),
+            )
+        })
+        .collect();
+    Ok((solve(b), inverse, log_det))
+}
+
+/// The lower Cholesky factor, or `None` if not positive definite.
+pub(super) fn cholesky(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
+    let n = a.len();
+    let mut l = vec![vec![0.0; n]; n];
+    for i in 0..n {
+        for j in 0..=i {
+            let s = a[i][j] - (0..j).map(|m| l[i][m] * l[j][m]).sum::<f64>();
+            if i == j {
+                if s.is_nan() || s <= 0.0 {
+                    return None;
+                }
+                l[i][i] = s.sqrt();
+            } else {
+                l[i][j] = s / l[j][j];
+            }
+        }
+    }
+    Some(l)
+}
+
+/// The inverse of a lower-triangular matrix.
+fn lower_inverse(l: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let n = l.len();
+    // Column by column: inv[.][c] solves L x = e_c.
+    let mut columns = vec![vec![0.0; n]; n];
+    for (c, x) in columns.iter_mut().enumerate() {
+        for i in c..n {
+            let s: f64 = (c..i).map(|m| l[i][m] * x[m]).sum();
+            x[i] = (f64::from(u8::from(i == c)) - s) / l[i][i];
+        }
+    }
+    (0..n)
+        .map(|i| (0..n).map(|c| columns[c][i]).collect())
+        .collect()
+}
+
+/// The free and marginalised parameter indices, and per parameter its prior (mean, 1/σ²).
+type Validated = (Vec<usize>, Vec<usize>, Vec<Option<(f64, f64)>>);
+
+/// Checks the request's names and values.
+fn validate(
+    request: &GalaxyFitRequest,
+) -> Result<Validated> {
+    let free = request
+        .free
+        .iter()
+        .map(|n| index(n))
+        .collect::<Result<Vec<_>>>()?;
+    let mut marg = Vec::new();
+    for name in &request.marginalise {
+        if !LINEAR.contains(&name.as_str()) {
+            return Err(Error::InvalidChoice {
+                what: format!("--marginalise {name}"),
+                reason: format!(
+                    "only parameters that enter linearly can be marginalised: {}",
+                    LINEAR.join(", ")
+                ),
+            });
+        }
+        marg.push(index(name)?);
+    }
+    let mut seen = std::collections::HashSet::new();
+    for name in request.free.iter().chain(&request.marginalise) {
+        if !seen.insert(name.as_str()) {
+            return Err(Error::InvalidChoice {
+                what: format!("fit parameter `{name}`"),
+                reason: "is listed twice (free and marginalised are exclusive)".into(),
+            });
+        }
+    }
+    if free.is_empty() {
+        return Err(Error::InvalidChoice {
+            what: "--free".into(),
+            reason: "name at least one free parameter".into(),
+        });
+    }
+    let mut priors = vec![None; PARAM_NAMES.len()];
+    for p in &request.priors {
+        let i = index(&p.name)?;
+        if !(p.sigma > 0.0 && p.sigma.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "prior sigma",
+                value: p.sigma,
+                reason: "a Gaussian prior needs 0 < sigma < infinity",
+            });
+        }
+        if !p.mean.is_finite() {
+            return Err(Error::InvalidParameter {
+                name: "prior mean",
+                value: p.mean,
+                reason: "must be finite",
+            });
+        }
+        priors[i] = Some((p.mean, 1.0 / (p.sigma * p.sigma)));
+    }
+    Ok((free, marg, priors))
+}
+
+/// The best fit of `request` to `data`, whose k must be the plan's output k.
+///
+/// # Errors
+/// [`Error::InvalidChoice`] for unknown, repeated or non-linear marginalised names;
+/// [`Error::InvalidParameter`] for a prior with σ ≤ 0, a window with too few points, a covariance that
+/// is not positive definite, degenerate marginalised templates; [`Error::GridMismatch`] if the data's
+/// k are not the plan's.
+pub fn fit_galaxy(
+    plan: &EptPlan,
+    terms: &EptTerms,
+    data: &MultipoleData,
+    request: &GalaxyFitRequest,
+) -> Result<GalaxyFit> {
+    let (free, marg, priors) = validate(request)?;
+    let k = plan.k();
+    if k.len() != data.k.len()
+        || k.iter()
+            .zip(&data.k)
+            .any(|(a, b)| (a / b - 1.0).abs() > 1e-9)
+    {
+        return Err(Error::InvalidChoice {
+            what: "the fit's model grid".into(),
+            reason: "the plan must be built on the data's k".into(),
+        });
+    }
+    let mut rows = Vec::new();
+    for &l in &request.ells {
+        let j = data
+            .ells
+            .iter()
+            .position(|&d| d == l)
+            .ok_or(Error::InvalidParameter {
+                name: "fitted multipole ell",
+                value: l as f64,
+                reason: "is not in the data",
+            })?;
+        rows.push(j);
+    }
+    let window: Vec<usize> = (0..k.len())
+        .filter(|&i| (request.k_min..=request.k_max).contains(&k[i]))
+        .collect();
+    let points = window.len() * rows.len();
+    if points <= free.len() + marg.len() {
+        return Err(Error::InvalidParameter {
+            name: "k_max [h/Mpc]",
+            value: request.k_max,
+            reason: "the fitted window holds no more points than parameters",
+        });
+    }
+    // The window's covariance: the data's full covariance (ℓ-major over the data's ells), or σ².
+    let position = |r: usize, i: usize| r * k.len() + i;
+    let cov: Vec<Vec<f64>> = rows
+        .iter()
+        .flat_map(|&r| window.iter().map(move |&i| (r, i)))
+        .map(|(r, i)| {
+            rows.iter()
+                .flat_map(|&s| window.iter().map(move |&j| (s, j)))
+                .map(|(s, j)| match &data.covariance {
+                    Some(c) => c[position(r, i)][position(s, j)],
+                    None if (r, i) == (s, j) => data.sigma[r][i].powi(2),
+                    None => 0.0,
+                })
+                .collect()
+        })
+        .collect();
+    let l = cholesky(&cov).ok_or(Error::InvalidParameter {
+        name: "covariance",
+        value: points as f64,
+        reason: "the fitted block is not positive definite",
+    })?;
+    let whiten = lower_inverse(&l);
+    let raw: Vec<f64> = rows
+        .iter()
+        .flat_map(|&r| window.iter().map(move |&i| data.values[r][i]))
+        .collect();
+    let data_vector = whiten.iter().map(|row| dot(row, &raw)).collect();
+    let objective = Objective {
+        plan,
+        terms,
+        start: request.start,
+        ells: request.ells.clone(),
+        free: free.clone(),
+        marg: marg.clone(),
+        priors,
+        window,
+        whiten,
+        data: data_vector,
+    };
+    let x0: Vec<f64> = free.iter().map(|&i| request.start.values[i]).collect();
+    objective.evaluate(&x0)?;
+    let mut best = x0;
+    for _ in 0..2 {
+        best = minimise(&objective, &best);
+    }
+    let (minus_two_log_l, chi2, params, marginalised_errors) = objective.evaluate(&best)?;
+    let errors = hessian_errors(&objective, &best, minus_two_log_l);
+    Ok(GalaxyFit {
+        best: params,
+        errors,
+        marginalised_errors,
+        chi2,
+        minus_two_log_l,
+        points,
+    })
+}
+
+/// Nelder–Mead from `x0` with a simplex of scale-aware steps.
+fn minimise(objective: &Objective<'_>, x0: &[f64]) -> Vec<f64> {
+    let mut simplex = vec![x0.to_vec()];
+    for i in 0..x0.len() {
+        let mut x = x0.to_vec();
+        x[i] += 0.05 * x[i].abs().max(1.0);
+        simplex.push(x);
+    }
+    let solver = NelderMead::new(simplex)
+        .with_sd_tolerance(1e-8)
+        .expect("valid tolerance");
+    match Executor::new(objective, solver)
+        .configure(|s| s.max_iters(3000))
+        .run()
+    {
+        Ok(r) => r
+            .state()
+            .get_best_param()
+            .cloned()
+            .unwrap_or_else(|| x0.to_vec()),
+        Err(_) => x0.to_vec(),
+    }
+}
+
+/// Gaussian errors of the free parameters: √diag of 2 H⁻¹, H the Hessian of −2 ln L by central
+/// differences (steps 1e-3 of each value's scale); NaN where H is not positive definite.
+fn hessian_errors(objective: &Objective<'_>, x: &[f64], f0: f64) -> Vec<f64> {
+    let n = x.len();
+    let h: Vec<f64> = x.iter().map(|v| 1e-3 * v.abs().max(1e-2)).collect();
+    let f = |dx: &[(usize, f64)]| {
+        let mut y = x.to_vec();
+        for &(i, d) in dx {
+            y[i] += d;
+        }
+        objective.evaluate(&y).map_or(f64::NAN, |e| e.0)
+    };
+    let mut hess = vec![vec![0.0; n]; n];
+    for i in 0..n {
+        hess[i][i] = (f(&[(i, h[i])]) - 2.0 * f0 + f(&[(i, -h[i])])) / (h[i] * h[i]);
+        for j in 0..i {
+            let v = (f(&[(i, h[i]), (j, h[j])])
+                - f(&[(i, h[i]), (j, -h[j])])
+                - f(&[(i, -h[i]), (j, h[j])])
+                + f(&[(i, -h[i]), (j, -h[j])]))
+                / (4.0 * h[i] * h[j]);
+            hess[i][j] = v;
+            hess[j][i] = v;
+        }
+    }
+    match solve_spd(&hess, &vec![0.0; n]) {
+        Ok((_, inverse, _)) => (0..n).map(|i| (2.0 * inverse[i][i]).sqrt()).collect(),
+        Err(_) => vec![f64::NAN; n],
+    }
+}
+
+#[cfg(test)]
+mod tests;

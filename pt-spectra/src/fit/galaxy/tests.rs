@@ -1,0 +1,181 @@
+use super::*;
+use crate::linear::{LinearSpectrum, LogGrid};
+use crate::precision::Precision;
+use crate::rsd::ept::EptSettings;
+
+fn setup() -> (EptPlan, EptTerms, EptParams, MultipoleData) {
+    let k = LogGrid::new(0.02, 0.2, 24).unwrap().points();
+    let plan = EptPlan::new(
+        &k,
+        EptSettings {
+            ir: false,
+            ap: None,
+        },
+        &Precision::fast(),
+    )
+    .unwrap();
+    let terms = plan.terms(&LinearSpectrum::gm2012(0.5).unwrap()).unwrap();
+    let mut truth = EptParams::new(2.0, 0.75);
+    for (n, v) in [
+        ("b2", -0.4),
+        ("bs", 0.2),
+        ("alpha0", 8.0),
+        ("alpha2", -6.0),
+        ("sn", 900.0),
+    ] {
+        truth.set(n, v).unwrap();
+    }
+    let m = plan.multipoles(&terms, &truth, &[0, 2, 4]).unwrap();
+    let values: Vec<Vec<f64>> = m
+        .iter()
+        .map(|l| l.iter().map(|e| e.value).collect())
+        .collect();
+    let sigma: Vec<Vec<f64>> = (0..3)
+        .map(|_| values[0].iter().map(|p| 0.01 * p).collect())
+        .collect();
+    let data = MultipoleData::from_arrays(k, &[0, 2, 4], values, sigma, "model").unwrap();
+    (plan, terms, truth, data)
+}
+
+/// Noise-free data made by the model: the fit recovers the free and the marginalised parameters.
+#[test]
+fn recovers_the_truth_with_marginalised_counterterms() {
+    let (plan, terms, truth, data) = setup();
+    let mut start = truth;
+    start.set("f", 0.65).unwrap();
+    start.set("b1", 1.8).unwrap();
+    start.set("b2", 0.0).unwrap();
+    let request = GalaxyFitRequest {
+        start,
+        free: vec!["f".into(), "b1".into(), "b2".into()],
+        marginalise: vec!["alpha0".into(), "alpha2".into(), "sn".into()],
+        priors: vec![],
+        ells: vec![0, 2, 4],
+        k_min: 0.0,
+        k_max: 0.2,
+    };
+    let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
+    // ln det F is nearly flat in θ, so the maximum of the marginal likelihood sits within a small
+    // fraction of σ of χ² = 0.
+    for (i, name) in ["f", "b1", "b2", "alpha0", "alpha2", "sn"]
+        .iter()
+        .enumerate()
+    {
+        let (got, want) = (fit.best.get(name).unwrap(), truth.get(name).unwrap());
+        let sigma = match i {
+            0..=2 => fit.errors[i],
+            _ => fit.marginalised_errors[i - 3],
+        };
+        assert!(sigma > 0.0 && sigma.is_finite(), "{name}: σ {sigma}");
+        assert!(
+            (got - want).abs() < 0.05 * sigma,
+            "{name}: {got} vs {want} (σ {sigma})"
+        );
+    }
+    assert!(fit.chi2 < 1e-2, "{}", fit.chi2);
+}
+
+/// −2 ln L of one marginalised parameter with a prior against a direct quadrature of
+/// ∫ exp(−½[χ²(a) + prior]) da: −2 ln of the integral = (−2 ln L) − ln 2π.
+#[test]
+fn analytic_marginalisation_is_the_integral() {
+    let (plan, terms, truth, data) = setup();
+    let mut start = truth;
+    start.set("alpha0", 0.0).unwrap();
+    let prior = Prior {
+        name: "alpha0".into(),
+        mean: 3.0,
+        sigma: 10.0,
+    };
+    let request = GalaxyFitRequest {
+        start,
+        free: vec!["f".into()],
+        marginalise: vec!["alpha0".into()],
+        priors: vec![prior.clone()],
+        ells: vec![0, 2],
+        k_min: 0.0,
+        k_max: 0.15,
+    };
+    let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
+    // χ² at fixed a (alpha0 fixed, nothing marginalised) on a grid, integrated by Simpson.
+    let chi2_at = |a: f64| {
+        let mut p = start;
+        p.set("f", fit.best.get("f").unwrap()).unwrap();
+        p.set("alpha0", a).unwrap();
+        let m = plan.multipoles(&terms, &p, &[0, 2]).unwrap();
+        let mut c = 0.0;
+        for l in 0..2 {
+            for (i, &k) in data.k.iter().enumerate() {
+                if k <= 0.15 {
+                    c += ((data.values[l][i] - m[l][i].value) / data.sigma[l][i]).powi(2);
+                }
+            }
+        }
+        c + ((a - prior.mean) / prior.sigma).powi(2)
+    };
+    let (lo, hi, n) = (
+        fit.best.get("alpha0").unwrap() - 8.0 * fit.marginalised_errors[0],
+        fit.best.get("alpha0").unwrap() + 8.0 * fit.marginalised_errors[0],
+        400,
+    );
+    let h = (hi - lo) / n as f64;
+    let c0 = chi2_at(fit.best.get("alpha0").unwrap());
+    let integral: f64 = (0..=n)
+        .map(|j| {
+            let w = if j == 0 || j == n {
+                1.0
+            } else if j % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            w * (-0.5 * (chi2_at(lo + h * j as f64) - c0)).exp()
+        })
+        .sum::<f64>()
+        * h
+        / 3.0;
+    let direct = c0 - 2.0 * integral.ln();
+    let analytic = fit.minus_two_log_l - (2.0 * std::f64::consts::PI).ln();
+    assert!(
+        (direct - analytic).abs() < 1e-6 * analytic.abs().max(1.0),
+        "{direct} vs {analytic}"
+    );
+}
+
+#[test]
+fn bad_requests_are_named() {
+    let (plan, terms, truth, data) = setup();
+    let base = GalaxyFitRequest {
+        start: truth,
+        free: vec!["f".into()],
+        marginalise: vec![],
+        priors: vec![],
+        ells: vec![0],
+        k_min: 0.0,
+        k_max: 0.2,
+    };
+    let err = |r: GalaxyFitRequest| {
+        fit_galaxy(&plan, &terms, &data, &r)
+            .unwrap_err()
+            .to_string()
+    };
+    let mut r = base.clone();
+    r.free = vec!["fsigma8".into()];
+    assert!(err(r).contains("fsigma8"));
+    let mut r = base.clone();
+    r.marginalise = vec!["b2".into()];
+    assert!(err(r).contains("b2"));
+    let mut r = base.clone();
+    r.priors = vec![Prior {
+        name: "b1".into(),
+        mean: 2.0,
+        sigma: 0.0,
+    }];
+    assert!(err(r).contains("sigma"));
+    let mut r = base.clone();
+    r.marginalise = vec!["f".into()];
+    assert!(err(r).contains("linearly"));
+    let mut r = base;
+    r.ells = vec![6];
+    assert!(err(r).contains("ell"));
+}
