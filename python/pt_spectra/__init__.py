@@ -36,6 +36,7 @@ __all__ = [
     "eisenstein_hu",
     "ept",
     "fit",
+    "fit_ept",
     "fit_tables",
     "growth",
     "halo",
@@ -150,6 +151,26 @@ def ept(k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, ells=(
     1-loop SPT; ``apar``, ``aperp`` for the Alcock-Paczynski distortion."""
     plan = EptPlan(_grid(k, k_min, k_max, nk), ir, apar, aperp, precision, q_range)
     return plan(linear, z, z_input, cosmology, eh, ells, **params)
+
+
+def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0, 2),
+            data_ells=(0, 2, 4), data_columns=None, covariance=None, k_min=0.0, ir=True, apar=None,
+            aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default",
+            q_range=None, eh=None, **start) -> Table:
+    """Fits of the galaxy model ``ept`` (``pt-spectra fit --rsd ept``), one row per k_max.
+
+    data, data_ells, data_columns, covariance, k_min as :func:`fit`; k_max: a list. free: any of
+    the model's parameters (see :class:`EptPlan`); marginalise: linear ones (alpha0, alpha2, alpha4,
+    alpha6, sn, sn2, sn4) marginalised analytically; priors: ``{"b2": (0.0, 1.0), …}`` Gaussian
+    (mean, sigma). ``start``: start values of the free parameters and values of the fixed ones
+    (e.g. ``b1=2.0, f=0.7``; f defaults to f(z)). Columns: ``k_max points chi2 minus_2_ln_L`` and
+    each parameter with ``err_<p>`` for the free (Gaussian, from the Hessian) and marginalised ones.
+    """
+    table = _core.fit_ept(data, list(k_max), list(free), list(marginalise), priors, list(ells),
+                          list(data_ells), None if data_columns is None else list(data_columns),
+                          covariance, k_min, ir, apar, aperp, linear, z, z_input, cosmology,
+                          precision, q_range, eh, **_ept_params(start))
+    return _warn(table)
 
 
 class RsdPlan:

@@ -150,3 +150,94 @@ impl EptTerms {
         Table::new(py, table, &self.prepared, &self.precision, "ept", seconds)
     }
 }
+
+/// `pt-spectra fit --rsd ept` as a function: see the Python wrapper `pt_spectra.fit_ept`.
+#[pyfunction]
+#[pyo3(signature = (data, k_max, free=vec!["f".to_string(), "b1".to_string()], marginalise=vec![],
+    priors=None, ells=vec![0, 2], data_ells=vec![0, 2, 4], data_columns=None, covariance=None, k_min=0.0,
+    ir=true, apar=None, aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default",
+    q_range=None, eh=None, **kwargs))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn fit_ept(
+    py: Python<'_>,
+    data: &Bound<'_, PyAny>,
+    k_max: Vec<f64>,
+    free: Vec<String>,
+    marginalise: Vec<String>,
+    priors: Option<&Bound<'_, PyDict>>,
+    ells: Vec<usize>,
+    data_ells: Vec<usize>,
+    data_columns: Option<Vec<usize>>,
+    covariance: Option<&Bound<'_, PyAny>>,
+    k_min: f64,
+    ir: bool,
+    apar: Option<f64>,
+    aperp: Option<f64>,
+    linear: Option<&Bound<'_, PyAny>>,
+    z: f64,
+    z_input: f64,
+    cosmology: Option<&Bound<'_, PyAny>>,
+    precision: &str,
+    q_range: Option<(f64, f64)>,
+    eh: Option<&str>,
+    kwargs: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Table> {
+    let (mut data, name) = crate::data(data, data_columns, &data_ells, &ells)?;
+    if let Some(c) = covariance {
+        data = data
+            .with_covariance(crate::covariance_rows(c)?)
+            .map_err(value_error)?;
+    }
+    let mut prior_list = Vec::new();
+    if let Some(p) = priors {
+        for (key, value) in p.iter() {
+            let (mean, sigma): (f64, f64) = value.extract().map_err(|_| {
+                pyo3::exceptions::PyValueError::new_err(format!(
+                    "priors[{key}]: expected (mean, sigma)"
+                ))
+            })?;
+            prior_list.push(pt_spectra::fit::galaxy::Prior {
+                name: key.extract()?,
+                mean,
+                sigma,
+            });
+        }
+    }
+    let mut start = params(kwargs)?;
+    let ap = match (apar, aperp) {
+        (None, None) => None,
+        (Some(a), Some(b)) => Some(Distortion::new(a, b).map_err(value_error)?),
+        _ => {
+            return Err(pyo3::exceptions::PyValueError::new_err(
+                "give both apar and aperp (or neither)",
+            ))
+        }
+    };
+    let precision = crate::precision(precision, q_range, None, None)?;
+    let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
+    let ((table, prepared), seconds) = detached(py, || {
+        let prepared = inputs.prepare(&data.k)?;
+        if start.values[11].is_nan() {
+            start.values[11] = prepared.growth_rate;
+        }
+        let request = pt_spectra::fit::galaxy::GalaxyFitRequest {
+            start,
+            free,
+            marginalise,
+            priors: prior_list,
+            ells,
+            k_min,
+            k_max: 0.0,
+        };
+        let plan = jobs::ept_plan(&data.k, ir, ap, &precision)?;
+        let terms = plan.terms(&prepared.spectrum)?;
+        let header = vec![format!(
+            "pt-spectra {} fit: ept ({}) to {name}",
+            jobs::VERSION,
+            if ir { "IR resummed" } else { "no IR resummation" }
+        )];
+        let table = jobs::ept_fit_table(&plan, &terms, &data, &request, &k_max, header)?;
+        Ok((table, prepared))
+    })?;
+    Table::new(py, table, &prepared, &precision, "ept fit", seconds)
+}

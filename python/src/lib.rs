@@ -290,8 +290,23 @@ fn real(
     )
 }
 
+/// A covariance matrix from a 2-D numpy array or nested lists.
+pub(crate) fn covariance_rows(c: &Bound<'_, PyAny>) -> PyResult<Vec<Vec<f64>>> {
+    match c.extract::<numpy::PyReadonlyArray2<'_, f64>>() {
+        Ok(a) => Ok(a
+            .as_array()
+            .rows()
+            .into_iter()
+            .map(|r| r.to_vec())
+            .collect()),
+        Err(_) => c
+            .extract()
+            .map_err(|_| PyValueError::new_err("covariance: expected a square 2-D array")),
+    }
+}
+
 /// Measured multipoles from a path (with columns) or a dict {"k", "P0", "s0", "P2", "s2", …}.
-fn data(
+pub(crate) fn data(
     data: &Bound<'_, PyAny>,
     data_columns: Option<Vec<usize>>,
     data_ells: &[usize],
@@ -382,18 +397,9 @@ fn fit(
 ) -> PyResult<(Table, Option<Table>, Option<Table>)> {
     let (mut data, data_name) = self::data(data, data_columns, &data_ells, &ells)?;
     if let Some(c) = covariance {
-        let rows: Vec<Vec<f64>> = match c.extract::<numpy::PyReadonlyArray2<'_, f64>>() {
-            Ok(a) => a
-                .as_array()
-                .rows()
-                .into_iter()
-                .map(|r| r.to_vec())
-                .collect(),
-            Err(_) => c
-                .extract()
-                .map_err(|_| PyValueError::new_err("covariance: expected a square 2-D array"))?,
-        };
-        data = data.with_covariance(rows).map_err(value_error)?;
+        data = data
+            .with_covariance(covariance_rows(c)?)
+            .map_err(value_error)?;
     }
     let one = 1.0f64.into_pyobject(py)?.into_any();
     let (bias, noise) = redshift::bias_and_noise(
@@ -556,6 +562,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<redshift::RsdTerms>()?;
     m.add_class::<ept::EptPlan>()?;
     m.add_class::<ept::EptTerms>()?;
+    m.add_function(wrap_pyfunction!(ept::fit_ept, m)?)?;
     m.add_function(wrap_pyfunction!(real, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(growth, m)?)?;

@@ -46,3 +46,21 @@ def test_ept_names_bad_input(reference):
             terms.multipoles(f=-1.0)
     with pytest.raises(ValueError, match="apar"):
         pt.EptPlan(ref[:5, 0], apar=1.02)
+
+
+def test_fit_ept_recovers_its_own_multipoles():
+    k = np.geomspace(0.02, 0.2, 25)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pt.PtSpectraWarning)
+        truth = dict(b1=2.0, b2=-0.4, alpha0=8.0, sn=900.0, f=0.7)
+        m = pt.ept(k=k, precision="fast", **truth)
+        s = 0.01 * m["P0"]
+        data = {"k": k, "P0": m["P0"], "s0": s, "P2": m["P2"], "s2": s}
+        t = pt.fit_ept(data, [0.2], free=("f", "b1", "b2"), marginalise=("alpha0", "sn"),
+                       priors={"b2": (0.0, 2.0)}, precision="fast", b1=1.8, f=0.6)
+    for name, value in truth.items():
+        assert abs(t[name][0] - value) < 0.1 * t[f"err_{name}"][0], name
+    with pytest.raises(ValueError, match="linearly"):
+        pt.fit_ept(data, [0.2], marginalise=("b2",), precision="fast")
+    with pytest.raises(ValueError, match="sigma"):
+        pt.fit_ept(data, [0.2], priors={"b2": (0.0, -1.0)}, precision="fast")
