@@ -43,6 +43,13 @@ Nuisance parameters, one set per redshift ``zs[i]`` (declare them in ``params``,
   real-space P_dd, P_dt, P_tt as -2, -4, -6 c_s^2 k^2 P_lin before the RSD model (``pt.rsd``'s
   ``cs2``); a fast parameter like the others.
 
+With ``rsd: ept`` the theory computes the galaxy model (:class:`pt_spectra.EptPlan`, velocileptors'
+conventions; ``ir`` (true) switches the BAO resummation) and its nuisance parameters per redshift are
+velocileptors' names with the suffix: ``b1_i`` (required), ``b2_i``, ``bs_i``, ``b3_i``,
+``alpha0_i``, ``alpha2_i``, ``alpha4_i``, ``alpha6_i`` [(Mpc/h)^2], ``sn_i``, ``sn2_i``, ``sn4_i``
+(default 0; sn is the constant stochastic term, so no separate P_shot); ``real``, ``fog``, ``two_loop``
+do not apply.
+
 The linear spectrum is the Boltzmann code's own ``Pk_grid`` at exactly each z (k [1/Mpc] and P
 [Mpc^3] converted to h/Mpc and (Mpc/h)^3 with its H0), rather than ``Pk_interpolator``: no second
 interpolation, and no need for the ≥ 4 redshifts that the interpolator requires. The growth rate is
@@ -65,7 +72,7 @@ except ImportError as e:  # pragma: no cover - depends on the environment
 
 import pt_spectra as pt
 
-__all__ = ["PTMultipoles", "NUISANCE"]
+__all__ = ["PTMultipoles", "NUISANCE", "EPT_NUISANCE"]
 
 #: The nuisance parameters of one redshift: name -> (required, default, unit).
 NUISANCE = {
@@ -74,6 +81,14 @@ NUISANCE = {
     "A_b": (False, 1.0, ""),
     "P_shot": (False, 0.0, "(Mpc/h)^3"),
     "cs2": (False, 0.0, "(Mpc/h)^2"),
+}
+
+#: The nuisance parameters of one redshift with ``rsd: ept`` (velocileptors' names).
+EPT_NUISANCE = {"b1": (True, None, "")} | {
+    name: (False, 0.0, unit) for name, unit in (
+        ("b2", ""), ("bs", ""), ("b3", ""), ("alpha0", "(Mpc/h)^2"), ("alpha2", "(Mpc/h)^2"),
+        ("alpha4", "(Mpc/h)^2"), ("alpha6", "(Mpc/h)^2"), ("sn", "(Mpc/h)^3"), ("sn2", "(Mpc/h)^5"),
+        ("sn4", "(Mpc/h)^7"))
 }
 
 # The library warns that without a cosmology the growth of its gm2012 cosmology is used. It does
@@ -110,6 +125,7 @@ class PTMultipoles(Theory):
     two_loop: str = "basis"
     var_pair: list = ["delta_tot", "delta_tot"]
     prefix: str = ""
+    ir: bool = True
 
     # ---- set-up ------------------------------------------------------------------------------
     def initialize(self):
@@ -121,6 +137,7 @@ class PTMultipoles(Theory):
         self.ells = [int(ell) for ell in np.atleast_1d(self.ells)]
         if not self.ells or any(ell < 0 or ell % 2 or ell > 8 for ell in self.ells):
             raise ValueError(f"PTMultipoles: `ells` must be even multipoles <= 8, got {self.ells}")
+        self._ept = str(self.rsd).lower() == "ept"
         if self.fog not in ("none", "lorentzian", "gaussian"):
             raise ValueError(f"PTMultipoles: unknown `fog` {self.fog!r}; "
                              "available: none, lorentzian, gaussian")
@@ -160,7 +177,16 @@ class PTMultipoles(Theory):
             return max(float(self.k_max_linear), 35.0)
         return float(self.k_max_linear)
 
+    def _table(self):
+        """The nuisance parameters of the model: name -> (required, default, unit)."""
+        return EPT_NUISANCE if self._ept else NUISANCE
+
     def _make_plan(self, k):
+        if self._ept:
+            self._plan = pt.EptPlan(k, ir=bool(self.ir), precision=self.precision,
+                                    q_range=None if self.q_range is None else tuple(self.q_range))
+            self._planned_k = np.asarray(k, dtype=float)
+            return
         self._plan = pt.RsdPlan(k, real=self.real, rsd=self.rsd, precision=self.precision,
                                 q_range=None if self.q_range is None else tuple(self.q_range),
                                 cache_dir=self.cache_dir, two_loop=self.two_loop)
@@ -171,13 +197,13 @@ class PTMultipoles(Theory):
         return f"{self.prefix}{name}_{i}"
 
     def get_can_support_params(self):
-        return [self.param_name(n, i) for i in range(len(self.zs)) for n in NUISANCE]
+        return [self.param_name(n, i) for i in range(len(self.zs)) for n in self._table()]
 
     def initialize_with_params(self):
         given = set(self.input_params)
         missing, defaulted = [], []
         for i in range(len(self.zs)):
-            for name, (required, default, _) in NUISANCE.items():
+            for name, (required, default, _) in self._table().items():
                 p = self.param_name(name, i)
                 if name == "sigma0" and self.fog == "none":
                     if p in given:
@@ -234,7 +260,7 @@ class PTMultipoles(Theory):
         # the required ones are in `params` (checked in initialize_with_params), except sigma0
         # with fog: none, where it has no effect
         return {name: float(params.get(self.param_name(name, i), 0.0 if d is None else d))
-                for name, (_, d, _) in NUISANCE.items()}
+                for name, (_, d, _) in self._table().items()}
 
     def calculate(self, state, want_derived=True, **params_values_dict):
         h = self.provider.get_param("H0") / 100.0
@@ -259,11 +285,14 @@ class PTMultipoles(Theory):
                 if cached is None or cached[0] != digest:
                     cached = (digest, self._plan.terms(linear=(k_lin, p_lin), z=z, z_input=z))
                     self._terms[i] = cached
-                t = cached[1].multipoles(f=f, bias=nu["b"], amplitude=nu["A_b"], fog=self.fog,
-                                         sigma0=nu["sigma0"], ells=self.ells, growth_factor=d,
-                                         cs2=nu["cs2"])
+                if self._ept:
+                    t = cached[1].multipoles(ells=self.ells, f=f, **nu)
+                else:
+                    t = cached[1].multipoles(f=f, bias=nu["b"], amplitude=nu["A_b"], fog=self.fog,
+                                             sigma0=nu["sigma0"], ells=self.ells,
+                                             growth_factor=d, cs2=nu["cs2"])
             p = np.array([t[f"P{ell}"] for ell in self.ells])
-            if 0 in self.ells:
+            if 0 in self.ells and not self._ept:
                 p[self.ells.index(0)] += nu["P_shot"]
             spectra[z] = p
             errors[z] = np.array([t[f"err_P{ell}"] for ell in self.ells])

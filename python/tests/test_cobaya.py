@@ -160,3 +160,31 @@ def test_k_from_the_likelihood_and_a_second_redshift(setup):
     # CAMB's P(z = 0.5) moves by ~1e-8 when z = 1 is computed too: chi2 ~ 1e-12, not exactly 0
     assert model.loglikes(point, as_dict=True)[0]["mock"] == pytest.approx(0.0, abs=1e-6)
     assert set(model.provider.get_pt_pk_ell()) == {0.5, 1.0}
+
+
+def test_the_galaxy_model_takes_velocileptors_names(setup):
+    """rsd: ept: nuisance b1_0, b2_0, …, sn_0; the multipoles equal a direct EptPlan call."""
+    info, point = setup
+    info = copy.deepcopy({k: v for k, v in info.items() if k != "sampler"})
+    theory = info["theory"]["pt"]
+    for key in ("real", "fog", "two_loop"):
+        theory.pop(key, None)
+    theory.update(rsd="ept", ir=False)
+    params = info["params"]
+    for name in [p for p in params if p.startswith(("b_", "sigma0_", "A_b_", "P_shot_", "cs2_"))]:
+        params.pop(name)
+    params.update(b1_0=1.9, b2_0=0.3, alpha0_0=5.0, sn_0=700.0)
+    m = get_model(info)
+    m.add_requirements({"CAMBdata": None, "pt_pk_ell": None, "pt_growth": None, "pt_k": None})
+    point = {p: v for p, v in point.items() if p in m.parameterization.sampled_params()}
+    m.logposterior(point)
+    got = np.asarray(m.provider.get_pt_pk_ell(z=Z))
+    results = m.provider.get_CAMBdata()
+    kh, zs, pk = results.get_linear_matter_power_spectrum(hubble_units=True, k_hunit=True)
+    f, _ = m.provider.get_pt_growth(z=Z)
+    plan = pt.EptPlan(m.provider.get_pt_k(), ir=False, precision="fast")
+    with pytest.warns(pt.PtSpectraWarning, match="no cosmology"):
+        t = plan(linear=(kh, pk[np.argmin(abs(zs - Z))]), z=0.0, z_input=0.0, f=f, b1=1.9, b2=0.3,
+                 alpha0=5.0, sn=700.0)
+    want = np.array([t["P0"], t["P2"], t["P4"]])
+    np.testing.assert_allclose(got, want, rtol=1e-6, atol=0)
