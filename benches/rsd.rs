@@ -14,8 +14,9 @@
 //! * `ept/terms`: the galaxy model's loop terms of a new linear spectrum with IR resummation (the
 //!   no-wiggle filter, the terms of P and P_nw, Σ²) on 50 k ([`EptPlan::terms`], rayon's pool;
 //!   `RAYON_NUM_THREADS=1` for one core);
-//! * `ept/step`: P_0, P_2, P_4 from those terms at new parameters (one nuisance step of a chain),
-//!   without and with AP (α∥ = 1.03, α⊥ = 0.98).
+//! * `ept/step`: P_0, P_2, P_4 from those terms at new parameters (one nuisance step of a chain,
+//!   [`EptPlan::multipole_values`]), without and with AP (α∥ = 1.03, α⊥ = 0.98), and with the error
+//!   estimates ([`EptPlan::multipoles`]).
 //!
 //! Run with `cargo bench --bench rsd`.
 
@@ -161,8 +162,12 @@ fn ept(c: &mut Criterion) {
         params.set(name, v).expect("known name");
     }
     group.bench_function(BenchmarkId::new("step (IR, l = 0, 2, 4)", 50), |b| {
-        b.iter(|| plan.multipoles(&terms, black_box(&params), &[0, 2, 4]))
+        b.iter(|| plan.multipole_values(&terms, black_box(&params), &[0, 2, 4]))
     });
+    group.bench_function(
+        BenchmarkId::new("step with errors (IR, l = 0, 2, 4)", 50),
+        |b| b.iter(|| plan.multipoles(&terms, black_box(&params), &[0, 2, 4])),
+    );
     let ap = EptSettings {
         ir: true,
         ap: Some(Distortion::new(1.03, 0.98).expect("valid alphas")),
@@ -170,7 +175,7 @@ fn ept(c: &mut Criterion) {
     let plan = EptPlan::new(&k, ap, &Precision::default()).expect("valid plan");
     let terms = plan.terms(&p).expect("valid spectrum");
     group.bench_function(BenchmarkId::new("step (IR + AP, l = 0, 2, 4)", 50), |b| {
-        b.iter(|| plan.multipoles(&terms, black_box(&params), &[0, 2, 4]))
+        b.iter(|| plan.multipole_values(&terms, black_box(&params), &[0, 2, 4]))
     });
     group.finish();
 }

@@ -109,10 +109,10 @@ impl Objective<'_> {
 
     /// The whitened model at `p` (L⁻¹ m).
     fn model(&self, p: &EptParams) -> Result<Vec<f64>> {
-        let m = self.plan.multipoles(self.terms, p, &self.ells)?;
+        let m = self.plan.multipole_values(self.terms, p, &self.ells)?;
         let raw: Vec<f64> = m
             .iter()
-            .flat_map(|l| self.window.iter().map(move |&i| l[i].value))
+            .flat_map(|l| self.window.iter().map(move |&i| l[i]))
             .collect();
         Ok(self
             .whiten
@@ -259,9 +259,7 @@ fn lower_inverse(l: &[Vec<f64>]) -> Vec<Vec<f64>> {
 type Validated = (Vec<usize>, Vec<usize>, Vec<Option<(f64, f64)>>);
 
 /// Checks the request's names and values.
-fn validate(
-    request: &GalaxyFitRequest,
-) -> Result<Validated> {
+fn validate(request: &GalaxyFitRequest) -> Result<Validated> {
     let free = request
         .free
         .iter()

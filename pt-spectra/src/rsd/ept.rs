@@ -286,6 +286,53 @@ impl EptPlan {
         }
         Ok(out)
     }
+
+    /// The values only of [`Self::multipoles`] (the [`MU_NODES`] rule, no error estimate): the
+    /// fast path of fits and chains, `out[j][i]` for the j-th ℓ at the i-th k.
+    ///
+    /// # Errors
+    /// As [`Self::multipoles`].
+    pub fn multipole_values(
+        &self,
+        terms: &EptTerms,
+        params: &EptParams,
+        ells: &[usize],
+    ) -> Result<Vec<Vec<f64>>> {
+        params.validate()?;
+        if let Some(&bad) = ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
+            return Err(Error::InvalidParameter {
+                name: "multipole ell",
+                value: bad as f64,
+                reason: "must be even and at most 8",
+            });
+        }
+        let model = terms.model(params);
+        let volume = self.settings.ap.map_or(1.0, |d| d.volume());
+        let weights: Vec<Vec<f64>> = self.rules[0]
+            .iter()
+            .map(|(_, w, legendre)| {
+                ells.iter()
+                    .map(|&l| w * (2 * l + 1) as f64 * legendre[l] * volume)
+                    .collect()
+            })
+            .collect();
+        let mut out = vec![vec![0.0; self.k_out.len()]; ells.len()];
+        for (i, &k) in self.k_out.iter().enumerate() {
+            for ((mu, _, _), c) in self.rules[0].iter().zip(&weights) {
+                let p = match &self.settings.ap {
+                    None => model.value_at(i, k, *mu),
+                    Some(ap) => {
+                        let (kt, mt) = ap.true_coordinates(k, *mu);
+                        model.interpolated_value(kt, mt)?
+                    }
+                };
+                for (o, c) in out.iter_mut().zip(c) {
+                    o[i] += c * p;
+                }
+            }
+        }
+        Ok(out)
+    }
 }
 
 /// Σ² = (1/6π²)∫dq P_nw(q)[1 − j₀(q r_BAO)] over [1e-5, 1e3] h/Mpc: Simpson in ln q, error against
@@ -383,6 +430,15 @@ impl Model<'_> {
         self.combine(n, w, k, mu)
     }
 
+    /// The value only of [`Self::at`].
+    fn value_at(&self, i: usize, k: f64, mu: f64) -> f64 {
+        let (n, w) = &self.parts[i];
+        let m2 = mu * mu;
+        let horner = |c: &[f64; 5]| c.iter().rev().fold(0.0, |a, c| a * m2 + c);
+        let damping = (-k * k * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
+        horner(&n.0) + damping * horner(&w.0)
+    }
+
     fn combine(&self, n: &Poly, w: &Poly, k: f64, mu: f64) -> Estimate {
         let m2 = mu * mu;
         let horner = |c: &[f64; 5]| c.iter().rev().fold(0.0, |a, c| a * m2 + c);
@@ -395,6 +451,37 @@ impl Model<'_> {
 
     /// P(k, μ) at any k inside the grid: the polynomials interpolated in ln k (four-point Lagrange).
     fn interpolated(&self, k: f64, mu: f64) -> Result<Estimate> {
+        let (b, l) = self.stencil(k)?;
+        let mut n: Poly = ([0.0; 5], [0.0; 5]);
+        let mut w: Poly = ([0.0; 5], [0.0; 5]);
+        for (j, lj) in l.iter().enumerate() {
+            let (pn, pw) = &self.parts[b + j];
+            for c in 0..5 {
+                n.0[c] += lj * pn.0[c];
+                n.1[c] += lj.abs() * pn.1[c];
+                w.0[c] += lj * pw.0[c];
+                w.1[c] += lj.abs() * pw.1[c];
+            }
+        }
+        Ok(self.combine(&n, &w, k, mu))
+    }
+
+    /// The value only of [`Self::interpolated`].
+    fn interpolated_value(&self, k: f64, mu: f64) -> Result<f64> {
+        let (b, l) = self.stencil(k)?;
+        let m2 = mu * mu;
+        let (mut n, mut w) = (0.0, 0.0);
+        for (j, lj) in l.iter().enumerate() {
+            let (pn, pw) = &self.parts[b + j];
+            n += lj * pn.0.iter().rev().fold(0.0, |a, c| a * m2 + c);
+            w += lj * pw.0.iter().rev().fold(0.0, |a, c| a * m2 + c);
+        }
+        let damping = (-k * k * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
+        Ok(n + damping * w)
+    }
+
+    /// The first grid index and the Lagrange weights of the four-point stencil of k.
+    fn stencil(&self, k: f64) -> Result<(usize, [f64; 4])> {
         let g = self.grid;
         let (x0, step) = (
             g[0].ln(),
@@ -411,19 +498,7 @@ impl Model<'_> {
             });
         }
         let b = (u.floor() as usize).saturating_sub(1).min(g.len() - 4);
-        let l = lagrange4(u - b as f64);
-        let mut n: Poly = ([0.0; 5], [0.0; 5]);
-        let mut w: Poly = ([0.0; 5], [0.0; 5]);
-        for (j, lj) in l.iter().enumerate() {
-            let (pn, pw) = &self.parts[b + j];
-            for c in 0..5 {
-                n.0[c] += lj * pn.0[c];
-                n.1[c] += lj.abs() * pn.1[c];
-                w.0[c] += lj * pw.0[c];
-                w.1[c] += lj.abs() * pw.1[c];
-            }
-        }
-        Ok(self.combine(&n, &w, k, mu))
+        Ok((b, lagrange4(u - b as f64)))
     }
 }
 

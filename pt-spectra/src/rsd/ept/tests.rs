@@ -83,3 +83,24 @@ fn resummation_changes_little_on_large_scales() {
     let b = pb.multipoles(&tb, &params, &[0]).unwrap()[0][0].value;
     assert!((a / b - 1.0).abs() < 1e-3, "{a} {b}");
 }
+
+/// The fast path gives the values of the full one (same rule).
+#[test]
+fn values_are_the_multipoles_values() {
+    let k = [0.05, 0.15];
+    for ap in [None, Some(Distortion::new(1.02, 0.97).unwrap())] {
+        let (plan, terms) = plan(&k, EptSettings { ir: true, ap });
+        let params = EptParams::new(1.7, 0.6);
+        let full = plan.multipoles(&terms, &params, &[0, 2, 4]).unwrap();
+        let fast = plan.multipole_values(&terms, &params, &[0, 2, 4]).unwrap();
+        for (a, b) in full.iter().zip(&fast) {
+            for (x, y) in a.iter().zip(b) {
+                assert!(
+                    (x.value - y).abs() <= 1e-12 * x.value.abs(),
+                    "{} {y}",
+                    x.value
+                );
+            }
+        }
+    }
+}
