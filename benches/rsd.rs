@@ -171,6 +171,7 @@ fn ept(c: &mut Criterion) {
     let ap = EptSettings {
         ir: true,
         ap: Some(Distortion::new(1.03, 0.98).expect("valid alphas")),
+        ap_range: None,
     };
     let plan = EptPlan::new(&k, ap, &Precision::default()).expect("valid plan");
     let terms = plan.terms(&p).expect("valid spectrum");

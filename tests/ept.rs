@@ -32,6 +32,7 @@ fn worst(z: &str, f: f64, variant: usize, set: usize) -> [f64; 3] {
     let settings = EptSettings {
         ir: variant == 1,
         ap: (variant == 2).then(|| Distortion::new(1.03, 0.98).unwrap()),
+        ap_range: None,
     };
     let plan = EptPlan::new(&k, settings, &Precision::default()).unwrap();
     let terms = plan.terms(&spectrum).unwrap();

@@ -58,7 +58,7 @@ impl EptPlan {
             }
         };
         let precision = crate::precision(precision, q_range, None, None)?;
-        let (plan, _) = detached(py, || jobs::ept_plan(&k, ir, ap, &precision))?;
+        let (plan, _) = detached(py, || jobs::ept_plan(&k, ir, ap, false, &precision))?;
         Ok(Self { plan, precision })
     }
 
@@ -220,8 +220,10 @@ pub(crate) fn fit_ept(
         if start.values[11].is_nan() {
             start.values[11] = prepared.growth_rate;
         }
+        let free_ap = free.iter().any(|n| n == "apar" || n == "aperp");
         let request = pt_spectra::fit::galaxy::GalaxyFitRequest {
             start,
+            ap,
             free,
             marginalise,
             priors: prior_list,
@@ -229,12 +231,16 @@ pub(crate) fn fit_ept(
             k_min,
             k_max: 0.0,
         };
-        let plan = jobs::ept_plan(&data.k, ir, ap, &precision)?;
+        let plan = jobs::ept_plan(&data.k, ir, ap, free_ap, &precision)?;
         let terms = plan.terms(&prepared.spectrum)?;
         let header = vec![format!(
             "pt-spectra {} fit: ept ({}) to {name}",
             jobs::VERSION,
-            if ir { "IR resummed" } else { "no IR resummation" }
+            if ir {
+                "IR resummed"
+            } else {
+                "no IR resummation"
+            }
         )];
         let table = jobs::ept_fit_table(&plan, &terms, &data, &request, &k_max, header)?;
         Ok((table, prepared))

@@ -13,6 +13,9 @@
 //! √(F⁻¹)ᵢᵢ their errors (at fixed θ). The errors of the free θ are Gaussian: the square roots of the
 //! diagonal of the inverse Hessian of −½ × (−2 ln L), by central differences — stated as such in the
 //! output. χ² alone (without the ln det F and prior terms) is also reported.
+//!
+//! With a distortion (`ap`), α∥ and α⊥ (`apar`, `aperp`) can be free too, on a plan built for an AP
+//! range ([`crate::rsd::ept::EptSettings::ap_range`]).
 
 use super::MultipoleData;
 use crate::error::{Error, Result};
@@ -22,6 +25,13 @@ use argmin::solver::neldermead::NelderMead;
 
 /// The parameters that enter the model linearly and can be marginalised analytically.
 pub const LINEAR: [&str; 7] = ["alpha0", "alpha2", "alpha4", "alpha6", "sn", "sn2", "sn4"];
+
+/// The Alcock–Paczynski parameters a fit can free (with a plan built for an AP range), after the
+/// model's [`PARAM_NAMES`].
+pub const AP_NAMES: [&str; 2] = ["apar", "aperp"];
+
+/// Slots of the fitted vector: the model's parameters, then α∥, α⊥.
+const SLOTS: usize = PARAM_NAMES.len() + AP_NAMES.len();
 
 /// A Gaussian prior on a parameter.
 #[derive(Debug, Clone, PartialEq)]
@@ -39,6 +49,8 @@ pub struct Prior {
 pub struct GalaxyFitRequest {
     /// Start values of the free parameters and values of the fixed ones.
     pub start: EptParams,
+    /// The distortion of the measurement (start values if apar, aperp are free), if any.
+    pub ap: Option<crate::rsd::ap::Distortion>,
     /// The free parameters (minimised).
     pub free: Vec<String>,
     /// The linear parameters marginalised analytically (a subset of [`LINEAR`]).
@@ -58,6 +70,8 @@ pub struct GalaxyFitRequest {
 pub struct GalaxyFit {
     /// Every parameter at the best fit (the marginalised ones at â).
     pub best: EptParams,
+    /// The distortion at the best fit.
+    pub ap: Option<crate::rsd::ap::Distortion>,
     /// The free parameters' Gaussian errors, in the order of the request.
     pub errors: Vec<f64>,
     /// The marginalised parameters' errors √(F⁻¹)ᵢᵢ at the best θ, in the order of the request.
@@ -73,10 +87,14 @@ pub struct GalaxyFit {
 fn index(name: &str) -> Result<usize> {
     PARAM_NAMES
         .iter()
+        .chain(&AP_NAMES)
         .position(|&n| n == name)
         .ok_or_else(|| Error::InvalidChoice {
             what: format!("fit parameter `{name}`"),
-            reason: format!("the ept parameters are {}", PARAM_NAMES.join(", ")),
+            reason: format!(
+                "the ept parameters are {} (and apar, aperp)",
+                PARAM_NAMES.join(", ")
+            ),
         })
 }
 
@@ -84,7 +102,10 @@ fn index(name: &str) -> Result<usize> {
 struct Objective<'a> {
     plan: &'a EptPlan,
     terms: &'a EptTerms,
-    start: EptParams,
+    /// Every slot's start or fixed value (the model's parameters, α∥, α⊥).
+    start: [f64; SLOTS],
+    /// Whether the measurement has a distortion.
+    has_ap: bool,
     ells: Vec<usize>,
     free: Vec<usize>,
     marg: Vec<usize>,
@@ -99,17 +120,31 @@ struct Objective<'a> {
 }
 
 impl Objective<'_> {
-    fn params(&self, x: &[f64]) -> EptParams {
-        let mut p = self.start;
-        for (&i, &v) in self.free.iter().zip(x) {
-            p.values[i] = v;
+    fn slots(&self, x: &[f64]) -> [f64; SLOTS] {
+        let mut v = self.start;
+        for (&i, &value) in self.free.iter().zip(x) {
+            v[i] = value;
         }
-        p
+        v
     }
 
-    /// The whitened model at `p` (L⁻¹ m).
-    fn model(&self, p: &EptParams) -> Result<Vec<f64>> {
-        let m = self.plan.multipole_values(self.terms, p, &self.ells)?;
+    fn split(&self, v: &[f64; SLOTS]) -> Result<(EptParams, Option<crate::rsd::ap::Distortion>)> {
+        let n = PARAM_NAMES.len();
+        let mut p = EptParams::new(0.0, 0.0);
+        p.values.copy_from_slice(&v[..n]);
+        let ap = if self.has_ap {
+            Some(crate::rsd::ap::Distortion::new(v[n], v[n + 1])?)
+        } else {
+            None
+        };
+        Ok((p, ap))
+    }
+
+    /// The whitened model at `p` with distortion `ap` (L⁻¹ m).
+    fn model(&self, p: &EptParams, ap: Option<crate::rsd::ap::Distortion>) -> Result<Vec<f64>> {
+        let m = self
+            .plan
+            .multipole_values_at(self.terms, p, &self.ells, ap)?;
         let raw: Vec<f64> = m
             .iter()
             .flat_map(|l| self.window.iter().map(move |&i| l[i]))
@@ -121,20 +156,21 @@ impl Objective<'_> {
             .collect())
     }
 
-    /// (−2 ln L, χ², the parameters with â, the errors of â) at the free values `x`.
-    fn evaluate(&self, x: &[f64]) -> Result<(f64, f64, EptParams, Vec<f64>)> {
-        let mut p = self.params(x);
+    /// (−2 ln L, χ², the slots with â, the errors of â) at the free values `x`.
+    fn evaluate(&self, x: &[f64]) -> Result<(f64, f64, [f64; SLOTS], Vec<f64>)> {
+        let mut v = self.slots(x);
+        let (mut p, ap) = self.split(&v)?;
         for &i in &self.marg {
             p.values[i] = 0.0;
         }
-        let m0 = self.model(&p)?;
+        let m0 = self.model(&p, ap)?;
         let templates: Vec<Vec<f64>> = self
             .marg
             .iter()
             .map(|&i| {
                 let mut q = p;
                 q.values[i] = 1.0;
-                self.model(&q)
+                self.model(&q, ap)
                     .map(|m| m.iter().zip(&m0).map(|(a, b)| a - b).collect())
             })
             .collect::<Result<_>>()?;
@@ -158,18 +194,18 @@ impl Objective<'_> {
         }
         let mut total = chi2 + log_det;
         for (a, &i) in self.marg.iter().enumerate() {
-            p.values[i] = ahat[a];
+            v[i] = ahat[a];
             if let Some((mean, precision)) = self.priors[i] {
                 total += precision * (ahat[a] - mean).powi(2);
             }
         }
         for &i in &self.free {
             if let Some((mean, precision)) = self.priors[i] {
-                total += precision * (p.values[i] - mean).powi(2);
+                total += precision * (v[i] - mean).powi(2);
             }
         }
         let errors = (0..n).map(|a| inverse[a][a].sqrt()).collect();
-        Ok((total, chi2, p, errors))
+        Ok((total, chi2, v, errors))
     }
 }
 
@@ -293,7 +329,7 @@ fn validate(request: &GalaxyFitRequest) -> Result<Validated> {
             reason: "name at least one free parameter".into(),
         });
     }
-    let mut priors = vec![None; PARAM_NAMES.len()];
+    let mut priors = vec![None; SLOTS];
     for p in &request.priors {
         let i = index(&p.name)?;
         if !(p.sigma > 0.0 && p.sigma.is_finite()) {
@@ -329,6 +365,12 @@ pub fn fit_galaxy(
     request: &GalaxyFitRequest,
 ) -> Result<GalaxyFit> {
     let (free, marg, priors) = validate(request)?;
+    if request.ap.is_none() && free.iter().any(|&i| i >= PARAM_NAMES.len()) {
+        return Err(Error::InvalidChoice {
+            what: "free apar/aperp".into(),
+            reason: "the fit needs a distortion to start from (the measurement's AP)".into(),
+        });
+    }
     let k = plan.k();
     if k.len() != data.k.len()
         || k.iter()
@@ -391,10 +433,17 @@ pub fn fit_galaxy(
         .flat_map(|&r| window.iter().map(move |&i| data.values[r][i]))
         .collect();
     let data_vector = whiten.iter().map(|row| dot(row, &raw)).collect();
+    let mut start = [0.0; SLOTS];
+    start[..PARAM_NAMES.len()].copy_from_slice(&request.start.values);
+    if let Some(d) = request.ap {
+        start[PARAM_NAMES.len()] = d.apar;
+        start[PARAM_NAMES.len() + 1] = d.aperp;
+    }
     let objective = Objective {
         plan,
         terms,
-        start: request.start,
+        start,
+        has_ap: request.ap.is_some(),
         ells: request.ells.clone(),
         free: free.clone(),
         marg: marg.clone(),
@@ -403,16 +452,18 @@ pub fn fit_galaxy(
         whiten,
         data: data_vector,
     };
-    let x0: Vec<f64> = free.iter().map(|&i| request.start.values[i]).collect();
+    let x0: Vec<f64> = free.iter().map(|&i| start[i]).collect();
     objective.evaluate(&x0)?;
     let mut best = x0;
     for _ in 0..2 {
         best = minimise(&objective, &best);
     }
-    let (minus_two_log_l, chi2, params, marginalised_errors) = objective.evaluate(&best)?;
+    let (minus_two_log_l, chi2, slots, marginalised_errors) = objective.evaluate(&best)?;
+    let (params, ap) = objective.split(&slots)?;
     let errors = hessian_errors(&objective, &best, minus_two_log_l);
     Ok(GalaxyFit {
         best: params,
+        ap,
         errors,
         marginalised_errors,
         chi2,

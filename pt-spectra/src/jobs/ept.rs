@@ -18,7 +18,11 @@ pub struct EptRequest {
     pub ells: Vec<usize>,
 }
 
-/// The plan of a request on the output `k`, with IR resummation `ir` and the distortion `ap`.
+/// The range of α∥, α⊥ of fits that free them: [`AP_FIT_RANGE`].0 … .1.
+pub const AP_FIT_RANGE: (f64, f64) = (0.8, 1.25);
+
+/// The plan of a request on the output `k`, with IR resummation `ir`, the distortion `ap`, and with
+/// `free_ap` the internal grid of every α∥, α⊥ in [`AP_FIT_RANGE`].
 ///
 /// # Errors
 /// As [`EptPlan::new`].
@@ -26,9 +30,18 @@ pub fn ept_plan(
     k: &[f64],
     ir: bool,
     ap: Option<Distortion>,
+    free_ap: bool,
     precision: &Precision,
 ) -> Result<EptPlan> {
-    EptPlan::new(k, crate::rsd::ept::EptSettings { ir, ap }, precision)
+    EptPlan::new(
+        k,
+        crate::rsd::ept::EptSettings {
+            ir,
+            ap,
+            ap_range: free_ap.then_some(AP_FIT_RANGE),
+        },
+        precision,
+    )
 }
 
 /// The multipole table of `request` on the prepared spectrum: columns `k P<l>… err_P<l>…`.
@@ -134,6 +147,21 @@ pub fn ept_fit_table(
         fits.push(fit_galaxy(plan, terms, data, &r)?);
     }
     let mut header = header;
+    if let Some(d) = request.ap {
+        header.push(format!(
+            "Alcock-Paczynski: the data measured with apar = {}, aperp = {}{}",
+            d.apar,
+            d.aperp,
+            if request.free.iter().any(|n| n == "apar" || n == "aperp") {
+                format!(
+                    " (start values; free ones searched in [{}, {}])",
+                    AP_FIT_RANGE.0, AP_FIT_RANGE.1
+                )
+            } else {
+                String::new()
+            }
+        ));
+    }
     header.push(format!(
         "fit of ept to multipoles {:?} for k in [{}, k_max] h/Mpc: free {} (Gaussian errors from the \
          Hessian of -2 ln L), marginalised analytically {} (errors sqrt((F^-1)_ii) at the best fit), \

@@ -140,11 +140,18 @@ pub struct EptSettings {
     pub ir: bool,
     /// The Alcock–Paczynski distortion, if any.
     pub ap: Option<Distortion>,
+    /// The range [lo, hi] of α∥ and α⊥ the plan must serve (fits with free AP parameters): the
+    /// internal grid then covers every distortion in it ([`EptPlan::multipole_values_at`]).
+    pub ap_range: Option<(f64, f64)>,
 }
 
 impl Default for EptSettings {
     fn default() -> Self {
-        Self { ir: true, ap: None }
+        Self {
+            ir: true,
+            ap: None,
+            ap_range: None,
+        }
     }
 }
 
@@ -175,9 +182,25 @@ impl EptPlan {
     /// # Errors
     /// As [`RedshiftPlan::new`] and [`Distortion::internal_grid`].
     pub fn new(k: &[f64], settings: EptSettings, precision: &Precision) -> Result<Self> {
-        let grid = match &settings.ap {
-            Some(ap) => ap.internal_grid(k)?,
-            None => k.to_vec(),
+        let grid = match (&settings.ap, settings.ap_range) {
+            (_, Some((lo, hi))) => {
+                // The widest k' of the range: k/hi … k/lo (module `ap`'s grid of α∥ = hi, α⊥ = lo).
+                let range = Distortion::new(hi, lo)?;
+                if let Some(ap) = &settings.ap {
+                    for a in [ap.apar, ap.aperp] {
+                        if !(lo..=hi).contains(&a) {
+                            return Err(Error::InvalidParameter {
+                                name: "apar/aperp",
+                                value: a,
+                                reason: "must lie inside the plan's AP range",
+                            });
+                        }
+                    }
+                }
+                range.internal_grid(k)?
+            }
+            (Some(ap), None) => ap.internal_grid(k)?,
+            (None, None) => k.to_vec(),
         };
         let loops = RedshiftPlan::new(&grid, precision)?;
         let split = settings.ir.then_some(());
@@ -264,7 +287,8 @@ impl EptPlan {
                 for (mu, w, legendre) in nodes {
                     let (mu, w) = (*mu, *w);
                     let p = match &self.settings.ap {
-                        None => model.at(i, k, mu),
+                        None if self.grid.len() == self.k_out.len() => model.at(i, k, mu),
+                        None => model.interpolated(k, mu)?,
                         Some(ap) => {
                             let (kt, mt) = ap.true_coordinates(k, mu);
                             model.interpolated(kt, mt)?
@@ -298,7 +322,29 @@ impl EptPlan {
         params: &EptParams,
         ells: &[usize],
     ) -> Result<Vec<Vec<f64>>> {
+        self.multipole_values_at(terms, params, ells, self.settings.ap)
+    }
+
+    /// [`Self::multipole_values`] with the distortion `ap` instead of the plan's (a plan with an
+    /// [`EptSettings::ap_range`] containing it, or `ap` = the plan's own).
+    ///
+    /// # Errors
+    /// As [`Self::multipoles`]; [`Error::InvalidChoice`] for a distortion on a plan without AP grid,
+    /// [`Error::OutOfRange`] for one outside the plan's range.
+    pub fn multipole_values_at(
+        &self,
+        terms: &EptTerms,
+        params: &EptParams,
+        ells: &[usize],
+        ap: Option<Distortion>,
+    ) -> Result<Vec<Vec<f64>>> {
         params.validate()?;
+        if ap.is_some() && self.settings.ap.is_none() && self.settings.ap_range.is_none() {
+            return Err(Error::InvalidChoice {
+                what: "an Alcock-Paczynski distortion".into(),
+                reason: "the plan was built without AP (give EptSettings::ap or ap_range)".into(),
+            });
+        }
         if let Some(&bad) = ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
             return Err(Error::InvalidParameter {
                 name: "multipole ell",
@@ -307,7 +353,7 @@ impl EptPlan {
             });
         }
         let model = terms.model(params);
-        let volume = self.settings.ap.map_or(1.0, |d| d.volume());
+        let volume = ap.map_or(1.0, |d| d.volume());
         let weights: Vec<Vec<f64>> = self.rules[0]
             .iter()
             .map(|(_, w, legendre)| {
@@ -319,8 +365,9 @@ impl EptPlan {
         let mut out = vec![vec![0.0; self.k_out.len()]; ells.len()];
         for (i, &k) in self.k_out.iter().enumerate() {
             for ((mu, _, _), c) in self.rules[0].iter().zip(&weights) {
-                let p = match &self.settings.ap {
-                    None => model.value_at(i, k, *mu),
+                let p = match &ap {
+                    None if self.grid.len() == self.k_out.len() => model.value_at(i, k, *mu),
+                    None => model.interpolated_value(k, *mu)?,
                     Some(ap) => {
                         let (kt, mt) = ap.true_coordinates(k, *mu);
                         model.interpolated_value(kt, mt)?

@@ -136,7 +136,7 @@ pub fn table(
             params.set(name, v)?;
         }
     }
-    let plan = ept_plan(&k, !args.no_ir, shared.distortion, &loaded.precision)?;
+    let plan = ept_plan(&k, !args.no_ir, shared.distortion, false, &loaded.precision)?;
     let request = EptRequest {
         params,
         ells: shared.ells,

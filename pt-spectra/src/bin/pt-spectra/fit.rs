@@ -66,9 +66,19 @@ pub struct Args {
     /// --rsd ept: cubic bias b3 (start or fixed value).
     #[arg(long, value_name = "B3", allow_hyphen_values = true)]
     b3: Option<f64>,
-    /// --rsd ept: Alcock–Paczynski α∥ of the measurement (needs --aperp).
-    #[arg(long, value_name = "A", requires = "aperp")]
+    /// --rsd ept: Alcock–Paczynski α∥ of the measurement (needs --aperp); start value if free
+    /// (`--free …,apar,aperp`, searched in [0.8, 1.25]).
+    #[arg(
+        long,
+        value_name = "A",
+        requires = "aperp",
+        conflicts_with = "fiducial"
+    )]
     apar: Option<f64>,
+    /// --rsd ept: the fiducial cosmology the data were measured in (preset or .ini): α∥, α⊥ from
+    /// its H(z), D_M(z) against --cosmology's.
+    #[arg(long, value_name = "NAME|FILE")]
+    fiducial: Option<String>,
     /// --rsd ept: Alcock–Paczynski α⊥ of the measurement (needs --apar).
     #[arg(long, value_name = "A", requires = "apar")]
     aperp: Option<f64>,
@@ -205,17 +215,41 @@ fn run_ept(args: &Args) -> Result<()> {
         (Some(a), Some(b)) => Some(pt_spectra::rsd::ap::Distortion::new(a, b)?),
         _ => None,
     };
+    let distortion = match (&args.fiducial, distortion) {
+        (Some(name), None) => {
+            let fiducial = pt_spectra::setup::NamedCosmology::parse(name)
+                .map_err(|e| anyhow::anyhow!("--fiducial: {e}"))?
+                .0;
+            Some(pt_spectra::rsd::ap::Distortion::from_cosmologies(
+                &loaded.prepared.cosmology.cosmology,
+                &fiducial.cosmology,
+                loaded.prepared.z,
+            )?)
+        }
+        (_, d) => d,
+    };
+    let free = names(args.free.as_deref(), "f,b1");
+    let free_ap = free.iter().any(|n| n == "apar" || n == "aperp");
+    if free_ap && distortion.is_none() {
+        bail!("free apar/aperp need the measurement's distortion: --apar/--aperp or --fiducial");
+    }
     let request = GalaxyFitRequest {
         start,
-        free: names(args.free.as_deref(), "f,b1"),
+        ap: distortion,
+        free,
         marginalise: names(args.marginalise.as_deref(), ""),
         priors,
         ells,
         k_min: args.k_min,
         k_max: 0.0,
     };
-    let plan =
-        pt_spectra::jobs::ept_plan(&data.k, !args.ept.no_ir(), distortion, &loaded.precision)?;
+    let plan = pt_spectra::jobs::ept_plan(
+        &data.k,
+        !args.ept.no_ir(),
+        distortion,
+        free_ap,
+        &loaded.precision,
+    )?;
     let terms = plan.terms(&loaded.prepared.spectrum)?;
     let mut header = vec![format!(
         "pt-spectra {} fit: ept (velocileptors' REPT conventions{}) to {}",
@@ -302,7 +336,10 @@ pub fn run(args: &Args) -> Result<()> {
             "--b2/--bs/--b3",
             args.b2.is_some() || args.bs.is_some() || args.b3.is_some(),
         ),
-        ("--apar/--aperp", args.apar.is_some()),
+        (
+            "--apar/--aperp/--fiducial",
+            args.apar.is_some() || args.fiducial.is_some(),
+        ),
     ];
     if let Some(flag) = args
         .ept

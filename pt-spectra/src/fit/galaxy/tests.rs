@@ -10,6 +10,7 @@ fn setup() -> (EptPlan, EptTerms, EptParams, MultipoleData) {
         EptSettings {
             ir: false,
             ap: None,
+            ap_range: None,
         },
         &Precision::fast(),
     )
@@ -47,6 +48,7 @@ fn recovers_the_truth_with_marginalised_counterterms() {
     start.set("b2", 0.0).unwrap();
     let request = GalaxyFitRequest {
         start,
+        ap: None,
         free: vec!["f".into(), "b1".into(), "b2".into()],
         marginalise: vec!["alpha0".into(), "alpha2".into(), "sn".into()],
         priors: vec![],
@@ -89,6 +91,7 @@ fn analytic_marginalisation_is_the_integral() {
     };
     let request = GalaxyFitRequest {
         start,
+        ap: None,
         free: vec!["f".into()],
         marginalise: vec!["alpha0".into()],
         priors: vec![prior.clone()],
@@ -147,6 +150,7 @@ fn bad_requests_are_named() {
     let (plan, terms, truth, data) = setup();
     let base = GalaxyFitRequest {
         start: truth,
+        ap: None,
         free: vec!["f".into()],
         marginalise: vec![],
         priors: vec![],
@@ -178,4 +182,53 @@ fn bad_requests_are_named() {
     let mut r = base;
     r.ells = vec![6];
     assert!(err(r).contains("ell"));
+}
+
+/// Free α∥, α⊥ on a plan built for an AP range: the injected distortion is recovered.
+#[test]
+fn recovers_the_distortion() {
+    let k = LogGrid::new(0.02, 0.2, 24).unwrap().points();
+    let settings = EptSettings {
+        ir: true,
+        ap: Some(crate::rsd::ap::Distortion::new(1.0, 1.0).unwrap()),
+        ap_range: Some((0.8, 1.25)),
+    };
+    let plan = EptPlan::new(&k, settings, &Precision::fast()).unwrap();
+    let terms = plan.terms(&LinearSpectrum::gm2012(0.5).unwrap()).unwrap();
+    let truth = crate::rsd::ap::Distortion::new(1.04, 0.97).unwrap();
+    let mut params = EptParams::new(2.0, 0.75);
+    params.set("sn", 900.0).unwrap();
+    let m = plan
+        .multipole_values_at(&terms, &params, &[0, 2, 4], Some(truth))
+        .unwrap();
+    let sigma: Vec<Vec<f64>> = (0..3)
+        .map(|_| m[0].iter().map(|p| 0.005 * p).collect())
+        .collect();
+    let data = MultipoleData::from_arrays(k, &[0, 2, 4], m, sigma, "model").unwrap();
+    let request = GalaxyFitRequest {
+        start: EptParams::new(1.9, 0.7),
+        ap: Some(crate::rsd::ap::Distortion::new(1.0, 1.0).unwrap()),
+        free: ["f", "b1", "apar", "aperp"].map(String::from).to_vec(),
+        marginalise: vec!["sn".into()],
+        priors: vec![],
+        ells: vec![0, 2, 4],
+        k_min: 0.0,
+        k_max: 0.2,
+    };
+    let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
+    let ap = fit.ap.unwrap();
+    for (got, want, err) in [
+        (ap.apar, 1.04, fit.errors[2]),
+        (ap.aperp, 0.97, fit.errors[3]),
+        (fit.best.get("f").unwrap(), 0.75, fit.errors[0]),
+    ] {
+        assert!((got - want).abs() < 0.05 * err, "{got} vs {want} ± {err}");
+    }
+    // Free AP without a distortion to start from is refused.
+    let mut bad = request;
+    bad.ap = None;
+    assert!(fit_galaxy(&plan, &terms, &data, &bad)
+        .unwrap_err()
+        .to_string()
+        .contains("apar"));
 }

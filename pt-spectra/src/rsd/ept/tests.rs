@@ -16,6 +16,7 @@ fn large_scales_are_kaiser_plus_noise() {
         EptSettings {
             ir: false,
             ap: None,
+            ap_range: None,
         },
     );
     let mut params = EptParams::new(2.0, 0.7);
@@ -50,6 +51,7 @@ fn counterterms_and_noise_have_their_mu_powers() {
         EptSettings {
             ir: false,
             ap: None,
+            ap_range: None,
         },
     );
     let base = EptParams::new(1.5, 0.6);
@@ -75,6 +77,7 @@ fn resummation_changes_little_on_large_scales() {
         EptSettings {
             ir: false,
             ap: None,
+            ap_range: None,
         },
     );
     let (pb, tb) = plan(&k, EptSettings::default());
@@ -89,7 +92,14 @@ fn resummation_changes_little_on_large_scales() {
 fn values_are_the_multipoles_values() {
     let k = [0.05, 0.15];
     for ap in [None, Some(Distortion::new(1.02, 0.97).unwrap())] {
-        let (plan, terms) = plan(&k, EptSettings { ir: true, ap });
+        let (plan, terms) = plan(
+            &k,
+            EptSettings {
+                ir: true,
+                ap,
+                ap_range: None,
+            },
+        );
         let params = EptParams::new(1.7, 0.6);
         let full = plan.multipoles(&terms, &params, &[0, 2, 4]).unwrap();
         let fast = plan.multipole_values(&terms, &params, &[0, 2, 4]).unwrap();
