@@ -156,20 +156,22 @@ def ept(k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, ells=(
 def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0, 2),
             data_ells=(0, 2, 4), data_columns=None, covariance=None, k_min=0.0, ir=True, apar=None,
             aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default",
-            q_range=None, eh=None, **start) -> Table:
+            q_range=None, eh=None, n_mocks=None, **start) -> Table:
     """Fits of the galaxy model ``ept`` (``pt-spectra fit --rsd ept``), one row per k_max.
 
     data, data_ells, data_columns, covariance, k_min as :func:`fit`; k_max: a list. free: any of
     the model's parameters (see :class:`EptPlan`); marginalise: linear ones (alpha0, alpha2, alpha4,
     alpha6, sn, sn2, sn4) marginalised analytically; priors: ``{"b2": (0.0, 1.0), …}`` Gaussian
     (mean, sigma). ``start``: start values of the free parameters and values of the fixed ones
-    (e.g. ``b1=2.0, f=0.7``; f defaults to f(z)). Columns: ``k_max points chi2 minus_2_ln_L`` and
+    (e.g. ``b1=2.0, f=0.7``; f defaults to f(z)). n_mocks: the Hartlap factor of a covariance from
+    that many mocks. apar, aperp: the measurement's distortion (free with ``free=(…, "apar",
+    "aperp")``). Columns: ``k_max points chi2 minus_2_ln_L`` and
     each parameter with ``err_<p>`` for the free (Gaussian, from the Hessian) and marginalised ones.
     """
     table = _core.fit_ept(data, list(k_max), list(free), list(marginalise), priors, list(ells),
                           list(data_ells), None if data_columns is None else list(data_columns),
                           covariance, k_min, ir, apar, aperp, linear, z, z_input, cosmology,
-                          precision, q_range, eh, **_ept_params(start))
+                          precision, q_range, eh, n_mocks, **_ept_params(start))
     return _warn(table)
 
 

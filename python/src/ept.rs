@@ -156,7 +156,7 @@ impl EptTerms {
 #[pyo3(signature = (data, k_max, free=vec!["f".to_string(), "b1".to_string()], marginalise=vec![],
     priors=None, ells=vec![0, 2], data_ells=vec![0, 2, 4], data_columns=None, covariance=None, k_min=0.0,
     ir=true, apar=None, aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default",
-    q_range=None, eh=None, **kwargs))]
+    q_range=None, eh=None, n_mocks=None, **kwargs))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit_ept(
     py: Python<'_>,
@@ -180,6 +180,7 @@ pub(crate) fn fit_ept(
     precision: &str,
     q_range: Option<(f64, f64)>,
     eh: Option<&str>,
+    n_mocks: Option<usize>,
     kwargs: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Table> {
     let (mut data, name) = crate::data(data, data_columns, &data_ells, &ells)?;
@@ -230,6 +231,7 @@ pub(crate) fn fit_ept(
             ells,
             k_min,
             k_max: 0.0,
+            n_mocks,
         };
         let plan = jobs::ept_plan(&data.k, ir, ap, free_ap, &precision)?;
         let terms = plan.terms(&prepared.spectrum)?;

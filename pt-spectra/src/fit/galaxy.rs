@@ -14,6 +14,9 @@
 //! diagonal of the inverse Hessian of −½ × (−2 ln L), by central differences — stated as such in the
 //! output. χ² alone (without the ln det F and prior terms) is also reported.
 //!
+//! With `n_mocks`, C⁻¹ carries the Hartlap factor (N − p − 2)/(N − 1) of a covariance estimated
+//! from N mocks (p = fitted points).
+//!
 //! With a distortion (`ap`), α∥ and α⊥ (`apar`, `aperp`) can be free too, on a plan built for an AP
 //! range ([`crate::rsd::ept::EptSettings::ap_range`]).
 
@@ -63,6 +66,9 @@ pub struct GalaxyFitRequest {
     pub k_min: f64,
     /// The fitted range [h/Mpc].
     pub k_max: f64,
+    /// The number of mocks the covariance was estimated from: C⁻¹ is scaled by the Hartlap factor
+    /// (N − p − 2)/(N − 1), p the number of fitted points (Hartlap, Simon & Schneider 2007).
+    pub n_mocks: Option<usize>,
 }
 
 /// The result of a fit.
@@ -422,6 +428,23 @@ pub fn fit_galaxy(
                 .collect()
         })
         .collect();
+    let mut cov = cov;
+    if let Some(n) = request.n_mocks {
+        if n < points + 3 {
+            return Err(Error::InvalidParameter {
+                name: "number of mocks",
+                value: n as f64,
+                reason: "the Hartlap factor needs more mocks than fitted points + 2",
+            });
+        }
+        // C⁻¹ → h C⁻¹ is C → C/h.
+        let h = (n - points - 2) as f64 / (n - 1) as f64;
+        for row in cov.iter_mut() {
+            for v in row.iter_mut() {
+                *v /= h;
+            }
+        }
+    }
     let l = cholesky(&cov).ok_or(Error::InvalidParameter {
         name: "covariance",
         value: points as f64,

@@ -54,6 +54,10 @@ pub struct Args {
     /// alpha4, alpha6, sn, sn2, sn4), comma separated.
     #[arg(long, value_name = "P,P")]
     marginalise: Option<String>,
+    /// --rsd ept: the number of mocks the --covariance was estimated from: its inverse is scaled by the
+    /// Hartlap factor (N − p − 2)/(N − 1), p the fitted points.
+    #[arg(long, value_name = "N")]
+    n_mocks: Option<usize>,
     /// --rsd ept: a Gaussian prior NAME:MEAN,SIGMA (repeat the option for several).
     #[arg(long, value_name = "NAME:MEAN,SIGMA")]
     prior: Vec<String>,
@@ -242,6 +246,7 @@ fn run_ept(args: &Args) -> Result<()> {
         ells,
         k_min: args.k_min,
         k_max: 0.0,
+        n_mocks: args.n_mocks,
     };
     let plan = pt_spectra::jobs::ept_plan(
         &data.k,
@@ -332,6 +337,7 @@ pub fn run(args: &Args) -> Result<()> {
     let paper_only_refused = [
         ("--marginalise", args.marginalise.is_some()),
         ("--prior", !args.prior.is_empty()),
+        ("--n-mocks", args.n_mocks.is_some()),
         (
             "--b2/--bs/--b3",
             args.b2.is_some() || args.bs.is_some() || args.b3.is_some(),

@@ -55,6 +55,7 @@ fn recovers_the_truth_with_marginalised_counterterms() {
         ells: vec![0, 2, 4],
         k_min: 0.0,
         k_max: 0.2,
+        n_mocks: None,
     };
     let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
     // ln det F is nearly flat in θ, so the maximum of the marginal likelihood sits within a small
@@ -98,6 +99,7 @@ fn analytic_marginalisation_is_the_integral() {
         ells: vec![0, 2],
         k_min: 0.0,
         k_max: 0.15,
+        n_mocks: None,
     };
     let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
     // χ² at fixed a (alpha0 fixed, nothing marginalised) on a grid, integrated by Simpson.
@@ -157,6 +159,7 @@ fn bad_requests_are_named() {
         ells: vec![0],
         k_min: 0.0,
         k_max: 0.2,
+        n_mocks: None,
     };
     let err = |r: GalaxyFitRequest| {
         fit_galaxy(&plan, &terms, &data, &r)
@@ -214,6 +217,7 @@ fn recovers_the_distortion() {
         ells: vec![0, 2, 4],
         k_min: 0.0,
         k_max: 0.2,
+        n_mocks: None,
     };
     let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
     let ap = fit.ap.unwrap();
@@ -231,4 +235,39 @@ fn recovers_the_distortion() {
         .unwrap_err()
         .to_string()
         .contains("apar"));
+}
+
+/// The Hartlap factor scales χ² by (N − p − 2)/(N − 1); too few mocks are refused.
+#[test]
+fn hartlap_factor_scales_chi2() {
+    let (plan, terms, truth, data) = setup();
+    let mut start = truth;
+    start.set("b1", 2.1).unwrap();
+    let base = GalaxyFitRequest {
+        start,
+        ap: None,
+        free: vec!["f".into()],
+        marginalise: vec![],
+        priors: vec![],
+        ells: vec![0],
+        k_min: 0.0,
+        k_max: 0.2,
+        n_mocks: None,
+    };
+    let plain = fit_galaxy(&plan, &terms, &data, &base).unwrap();
+    let mut with = base.clone();
+    with.n_mocks = Some(100);
+    let scaled = fit_galaxy(&plan, &terms, &data, &with).unwrap();
+    let h = (100 - plain.points - 2) as f64 / 99.0;
+    assert!(
+        (scaled.chi2 / plain.chi2 - h).abs() < 1e-3 * h,
+        "{} {} {h}",
+        scaled.chi2,
+        plain.chi2
+    );
+    with.n_mocks = Some(plain.points + 2);
+    assert!(fit_galaxy(&plan, &terms, &data, &with)
+        .unwrap_err()
+        .to_string()
+        .contains("mocks"));
 }
