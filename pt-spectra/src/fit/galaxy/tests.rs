@@ -1,3 +1,6 @@
+// Index loops mirror the formulae's subscripts.
+#![allow(clippy::needless_range_loop)]
+
 use super::*;
 use crate::linear::{LinearSpectrum, LogGrid};
 use crate::precision::Precision;

@@ -1,3 +1,6 @@
+// Index loops mirror the formulae's subscripts.
+#![allow(clippy::needless_range_loop)]
+
 use super::*;
 
 /// Z₂ of SPT in redshift space with bias (Scoccimarro, Couchman & Frieman 1999, with b2/2 δ² + bs s²)
@@ -33,7 +36,7 @@ fn pair_columns_are_the_azimuthal_average_of_z2_squared() {
         let y = (1.0_f64 - x * x).sqrt();
         let k1 = [q * y, 0.0, q * x];
         let k2 = [-q * y, 0.0, k - q * x];
-        let p = ((k2[0] * k2[0] + k2[2] * k2[2]) as f64).sqrt();
+        let p = (k2[0] * k2[0] + k2[2] * k2[2]).sqrt();
         let polys = pair_polynomials(k, q, p);
         for a in 0..6 {
             for b in a..6 {
@@ -51,7 +54,7 @@ fn pair_columns_are_the_azimuthal_average_of_z2_squared() {
             let avg: f64 = (0..nphi)
                 .map(|j| {
                     let phi = 2.0 * PI * j as f64 / nphi as f64;
-                    let s = (1.0 - mu * mu as f64).sqrt();
+                    let s = (1.0_f64 - mu * mu).sqrt();
                     let n = [s * phi.cos(), s * phi.sin(), mu];
                     z2_direct(k1, k2, n, params).powi(2)
                 })
