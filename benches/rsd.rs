@@ -13,7 +13,8 @@
 //!
 //! * `ept/terms`: the galaxy model's loop terms of a new linear spectrum with IR resummation (the
 //!   no-wiggle filter, the terms of P and P_nw, Σ²) on 50 k ([`EptPlan::terms`], rayon's pool;
-//!   `RAYON_NUM_THREADS=1` for one core);
+//!   `RAYON_NUM_THREADS=1` for one core), at the default and the fast precision (both within
+//!   2.7e-4 of velocileptors' REPT, tests/ept.rs);
 //! * `ept/step`: P_0, P_2, P_4 from those terms at new parameters (one nuisance step of a chain,
 //!   [`EptPlan::multipole_values`]), without and with AP (α∥ = 1.03, α⊥ = 0.98), and with the error
 //!   estimates ([`EptPlan::multipoles`]).
@@ -155,6 +156,10 @@ fn ept(c: &mut Criterion) {
     let plan = EptPlan::new(&k, EptSettings::default(), &Precision::default()).expect("valid plan");
     group.bench_function(BenchmarkId::new("terms (IR)", 50), |b| {
         b.iter(|| plan.terms(black_box(&p)).expect("valid spectrum"))
+    });
+    let fast = EptPlan::new(&k, EptSettings::default(), &Precision::fast()).expect("valid plan");
+    group.bench_function(BenchmarkId::new("terms (IR, precision fast)", 50), |b| {
+        b.iter(|| fast.terms(black_box(&p)).expect("valid spectrum"))
     });
     let terms = plan.terms(&p).expect("valid spectrum");
     let mut params = EptParams::new(2.0, 0.48);

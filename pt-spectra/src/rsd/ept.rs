@@ -396,7 +396,7 @@ pub fn sigma2(no_wiggle: &LinearSpectrum) -> Estimate {
         q * no_wiggle.eval(q) * one_minus_j0
     };
     let (value, error) =
-        crate::integrate::simpson_ln(integrand, (1e-5_f64).ln(), (1e3_f64).ln(), 4096);
+        crate::integrate::simpson_ln(integrand, (1e-5_f64).ln(), (1e3_f64).ln(), 2048);
     let norm = 1.0 / (6.0 * PI * PI);
     Estimate::new(norm * value, norm * error)
 }
