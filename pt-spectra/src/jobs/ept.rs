@@ -198,11 +198,22 @@ pub fn ept_fit_table(
         "1",
         fits.iter().map(|f| f.minus_two_log_l).collect(),
     );
-    for (i, name) in PARAM_NAMES.iter().enumerate() {
+    let ap_names: &[&str] = if request.ap.is_some() {
+        &crate::fit::galaxy::AP_NAMES
+    } else {
+        &[]
+    };
+    let value = |i: usize, f: &crate::fit::galaxy::GalaxyFit| match (i.checked_sub(12), f.ap) {
+        (None, _) => f.best.values[i],
+        (Some(0), Some(d)) => d.apar,
+        (Some(_), Some(d)) => d.aperp,
+        (Some(_), None) => f64::NAN,
+    };
+    for (i, name) in PARAM_NAMES.iter().chain(ap_names).enumerate() {
         t.push(
             *name,
             unit(name),
-            fits.iter().map(|f| f.best.values[i]).collect(),
+            fits.iter().map(|f| value(i, f)).collect(),
         );
         let err = |f: &crate::fit::galaxy::GalaxyFit| {
             if let Some(j) = request.free.iter().position(|n| n == name) {

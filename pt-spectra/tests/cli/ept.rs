@@ -165,3 +165,66 @@ fn ept_fit_recovers_the_parameters_of_its_own_multipoles() {
         ),
     ]);
 }
+
+/// With a distortion, the fit table has `apar aperp` (and their errors when free).
+#[test]
+fn ept_fit_prints_the_distortion() {
+    let dir = super::scratch("ept_fit_ap");
+    let (ok, out, err) = run(&[
+        "rsd",
+        "--rsd",
+        "ept",
+        "--bias",
+        "2",
+        "--f",
+        "0.7",
+        "--apar",
+        "1.03",
+        "--aperp",
+        "0.98",
+        "--k-min",
+        "0.02",
+        "--k-max",
+        "0.2",
+        "--nk",
+        "25",
+        "--precision",
+        "fast",
+    ]);
+    assert!(ok, "{err}");
+    let mut text = String::new();
+    for r in rows(&out) {
+        let s = 0.005 * r[1];
+        text += &format!("{} {} {s} {} {s} {} {s}\n", r[0], r[1], r[2], r[3]);
+    }
+    let data = super::write(&dir, "data.txt", &text);
+    let (ok, out, err) = run(&[
+        "fit",
+        "--rsd",
+        "ept",
+        "--data",
+        &data,
+        "--ells",
+        "0,2,4",
+        "--free",
+        "f,b1,apar,aperp",
+        "--apar",
+        "1",
+        "--aperp",
+        "1",
+        "--k-max",
+        "0.2",
+        "--precision",
+        "fast",
+        "--bias",
+        "1.9",
+    ]);
+    assert!(ok, "{err}");
+    let names = column_names_of(&out, "# k_max ");
+    let row = &rows(&out)[0];
+    let get = |n: &str| row[names.iter().position(|c| *c == n).unwrap()];
+    for (name, truth) in [("apar", 1.03), ("aperp", 0.98), ("f", 0.7)] {
+        let (v, e) = (get(name), get(&format!("err_{name}")));
+        assert!((v - truth).abs() < 0.1 * e, "{name}: {v} ± {e}");
+    }
+}
