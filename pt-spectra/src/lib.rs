@@ -49,6 +49,7 @@ pub mod resum;
 pub mod rsd;
 pub mod setup;
 pub mod store;
+pub mod survey;
 pub mod table;
 
 /// The README's library example, compiled and run as a doctest.
