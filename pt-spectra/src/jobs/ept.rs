@@ -249,3 +249,61 @@ fn unit(name: &str) -> &'static str {
         _ => "1",
     }
 }
+
+/// [`ept_table_from_terms`] through a window and bins (`observation`; the plan built on its
+/// [`Observation::k_model`](super::observe::Observation::k_model)): columns `k P<l>… err_P<l>…` at
+/// the observation's output k. The model's own error estimates are carried through the chain (applied
+/// to it as to the values, in absolute value) and added to the chain's.
+///
+/// # Errors
+/// As [`EptPlan::multipoles`] and [`super::observe::Observation::apply`];
+/// [`crate::error::Error::InvalidChoice`] if the plan is not on the observation's model k.
+pub fn ept_observed_table(
+    plan: &EptPlan,
+    terms: &EptTerms,
+    request: &EptRequest,
+    prepared: &Prepared,
+    precision: &Precision,
+    observation: &super::observe::Observation,
+) -> Result<Table> {
+    if plan.k() != observation.k_model() {
+        return Err(crate::error::Error::InvalidChoice {
+            what: "the ept plan of a windowed or binned table".into(),
+            reason: "must be built on the observation's model k".into(),
+        });
+    }
+    let mut model_request = request.clone();
+    model_request.ells = observation.model_ells().to_vec();
+    let model = ept_table_from_terms(plan, terms, &model_request, prepared, precision)?;
+    let column = |name: String| model.column(&name).map(<[f64]>::to_vec).unwrap_or_default();
+    let values: Vec<Vec<f64>> = model_request
+        .ells
+        .iter()
+        .map(|l| column(format!("P{l}")))
+        .collect();
+    let errors: Vec<Vec<f64>> = model_request
+        .ells
+        .iter()
+        .map(|l| column(format!("err_P{l}")))
+        .collect();
+    let observed = observation.apply(&values)?;
+    let carried = observation.apply(&errors)?;
+    let mut header: Vec<String> = model.header.clone();
+    header.extend(observation.description().iter().cloned());
+    let mut t = Table::new(header);
+    t.push("k", WAVENUMBER, observation.k_out().to_vec());
+    for (l, p) in request.ells.iter().zip(&observed) {
+        t.push(format!("P{l}"), POWER, p.iter().map(|e| e.value).collect());
+    }
+    for ((l, p), c) in request.ells.iter().zip(&observed).zip(&carried) {
+        t.push(
+            format!("err_P{l}"),
+            POWER,
+            p.iter()
+                .zip(c)
+                .map(|(e, c)| e.error + c.value.abs())
+                .collect(),
+        );
+    }
+    Ok(t)
+}

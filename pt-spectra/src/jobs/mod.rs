@@ -38,9 +38,12 @@ mod bias;
 mod ept;
 mod fit;
 mod halo;
+pub mod observe;
 mod rsd;
 pub use bias::BiasOutput;
-pub use ept::{ept_fit_table, ept_plan, ept_table, ept_table_from_terms, EptRequest};
+pub use ept::{
+    ept_fit_table, ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest,
+};
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use halo::{halo_table, HaloRequest};
 pub use rsd::{

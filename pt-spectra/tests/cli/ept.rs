@@ -228,3 +228,87 @@ fn ept_fit_prints_the_distortion() {
         assert!((v - truth).abs() < 0.1 * e, "{name}: {v} ± {e}");
     }
 }
+
+/// `--window` with a window that cuts nothing (Q0 = 1 to 10⁵ Mpc/h, Q2 = Q4 = 0) leaves the
+/// multipoles unchanged, `--k-edges` averages them over bins, and `--box` over a box's modes; the
+/// paper's models refuse them.
+#[test]
+fn ept_window_and_bins() {
+    let dir = super::scratch("ept_window");
+    let mut text = String::from("# s Q0 Q2 Q4\n");
+    for i in 0..400 {
+        let s = 0.01 * 1e7_f64.powf(i as f64 / 399.0);
+        text += &format!("{s} 1 0 0\n");
+    }
+    let window = super::write(&dir, "identity.dat", &text);
+    let base = [
+        "rsd",
+        "--rsd",
+        "ept",
+        "--bias",
+        "2",
+        "--no-ir",
+        "--precision",
+        "fast",
+    ];
+    let grid = ["--k-min", "0.02", "--k-max", "0.2", "--nk", "10"];
+    let (ok, plain, err) = run(&[&base[..], &grid[..]].concat());
+    assert!(ok, "{err}");
+    let (ok, windowed, err) = run(&[&base[..], &grid[..], &["--window", &window]].concat());
+    assert!(ok, "{err}");
+    for (a, b) in rows(&plain).iter().zip(rows(&windowed)) {
+        for l in 1..4 {
+            assert!(
+                (a[l] - b[l]).abs() < 1e-3 * a[1],
+                "k {}: {} vs {}",
+                a[0],
+                a[l],
+                b[l]
+            );
+        }
+    }
+    // One narrow bin is nearly the value at its effective k.
+    let (ok, binned, err) = run(&[&base[..], &["--k-edges", "0.099,0.101"]].concat());
+    assert!(ok, "{err}");
+    let b = &rows(&binned)[0];
+    let k_file = super::write(&dir, "k.dat", &format!("{}\n", b[0]));
+    let (ok, at, err) = run(&[&base[..], &["--k-file", &k_file]].concat());
+    assert!(ok, "{err}");
+    let a = &rows(&at)[0];
+    // The curvature of P across the bin: (width/k)² ~ 4e-4 of P at most.
+    assert!((a[1] - b[1]).abs() < 5e-4 * a[1], "{} vs {}", a[1], b[1]);
+    let (ok, boxed, err) =
+        run(&[&base[..], &["--k-edges", "0.05,0.06,0.07", "--box", "1000"]].concat());
+    assert!(ok, "{err}");
+    assert_eq!(rows(&boxed).len(), 2);
+    fails_naming(&[
+        (vec!["rsd", "--rsd", "tns", "--window", &window], "--window"),
+        (vec!["rsd", "--rsd", "ept", "--k-edges", "0.1"], "--k-edges"),
+        (
+            vec![
+                "rsd",
+                "--rsd",
+                "ept",
+                "--window",
+                &window,
+                "--window-mixing",
+                "x",
+            ],
+            "--window-mixing",
+        ),
+        (
+            vec![
+                "rsd",
+                "--rsd",
+                "ept",
+                "--window",
+                &window,
+                "--k-edges",
+                "0.05,0.1",
+                "--box",
+                "500",
+            ],
+            "box",
+        ),
+    ]);
+}

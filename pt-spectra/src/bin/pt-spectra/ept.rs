@@ -54,6 +54,23 @@ pub struct EptArgs {
     /// ept without IR resummation of the BAO: plain 1-loop SPT in redshift space.
     #[arg(long)]
     no_ir: bool,
+    /// ept: convolve with a survey window: Q_ℓ(s) multipoles (`s Q0 Q2 Q4 …`, s in Mpc/h, or the BOSS
+    /// DR12 file of Q0 Q2 Q4 without s), or a window matrix (`.npy` with a `.npy.txt` sidecar, or text
+    /// with an `ells_out` header). Wide-angle terms are neglected.
+    #[arg(long, value_name = "FILE")]
+    window: Option<std::path::PathBuf>,
+    /// ept: how Q_ℓ mix the multipoles: wilson (Wilson et al. 2017, every Q_ℓ given; the default) or
+    /// classpt-boss (the CLASS-PT BOSS likelihoods: Q ≤ 4, no ξ4 in ξ̂0, ξ̂2).
+    #[arg(long, value_name = "M", default_value = "wilson")]
+    window_mixing: String,
+    /// ept: average over k bins with the k² (mode-count) weight: edges [h/Mpc] as `a,b,c,…` or
+    /// `start:end:step`; the output k are the bins' effective k.
+    #[arg(long, value_name = "EDGES")]
+    k_edges: Option<String>,
+    /// ept: average over the discrete modes of a periodic box of side L [Mpc/h] in the bins of
+    /// --k-edges (what simulation measurements are).
+    #[arg(long, value_name = "L", requires = "k_edges")]
+    r#box: Option<f64>,
 }
 
 impl EptArgs {
@@ -93,8 +110,73 @@ impl EptArgs {
         if self.no_ir {
             out.push("--no-ir");
         }
+        for (flag, given) in [
+            ("--window", self.window.is_some()),
+            ("--k-edges", self.k_edges.is_some()),
+        ] {
+            if given {
+                out.push(flag);
+            }
+        }
         out
     }
+
+    /// The window and bins of the options, if any.
+    pub fn observation(
+        &self,
+    ) -> Result<(
+        Option<pt_spectra::jobs::observe::Window>,
+        Option<pt_spectra::jobs::observe::Bins>,
+    )> {
+        use pt_spectra::jobs::observe::{Bins, Window};
+        let mixing = match self.window_mixing.as_str() {
+            "wilson" => pt_spectra::survey::Mixing::Wilson,
+            "classpt-boss" => pt_spectra::survey::Mixing::ClassPtBoss,
+            other => bail!("--window-mixing {other}: expected wilson or classpt-boss"),
+        };
+        let window = match &self.window {
+            Some(path) => {
+                Some(Window::read(path, mixing).map_err(|e| anyhow::anyhow!("--window: {e}"))?)
+            }
+            None => None,
+        };
+        let bins = match &self.k_edges {
+            None => None,
+            Some(text) => {
+                let edges = edges(text)?;
+                Some(match self.r#box {
+                    Some(side) => Bins::Box { side, edges },
+                    None => Bins::Edges(edges),
+                })
+            }
+        };
+        Ok((window, bins))
+    }
+}
+
+/// Bin edges from `a,b,c,…` or `start:end:step` (inclusive, to rounding).
+fn edges(text: &str) -> Result<Vec<f64>> {
+    let parts: Vec<&str> = text.split(':').collect();
+    let v: Vec<f64> = match parts[..] {
+        [a, b, step] => {
+            let (a, b, step): (f64, f64, f64) =
+                (a.trim().parse()?, b.trim().parse()?, step.trim().parse()?);
+            if !(a.is_finite() && b > a && step > 0.0) {
+                bail!("--k-edges {text}: needs start < end and step > 0");
+            }
+            let n = ((b - a) / step + 1e-9).floor() as usize;
+            (0..=n).map(|i| a + step * i as f64).collect()
+        }
+        _ => text
+            .split(',')
+            .map(|x| x.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|e| anyhow::anyhow!("--k-edges {text}: {e}"))?,
+    };
+    if v.len() < 2 {
+        bail!("--k-edges {text}: give at least two edges");
+    }
+    Ok(v)
 }
 
 /// What `ept` takes from the shared `rsd` options.
@@ -136,15 +218,35 @@ pub fn table(
             params.set(name, v)?;
         }
     }
-    let plan = ept_plan(&k, !args.no_ir, shared.distortion, false, &loaded.precision)?;
     let request = EptRequest {
         params,
         ells: shared.ells,
     };
-    Ok(ept_table(
+    let (window, bins) = args.observation()?;
+    if window.is_none() && bins.is_none() {
+        let plan = ept_plan(&k, !args.no_ir, shared.distortion, false, &loaded.precision)?;
+        return Ok(ept_table(
+            &plan,
+            &request,
+            &loaded.prepared,
+            &loaded.precision,
+        )?);
+    }
+    let observation = pt_spectra::jobs::observe::Observation::new(&request.ells, &k, window, bins)?;
+    let plan = ept_plan(
+        observation.k_model(),
+        !args.no_ir,
+        shared.distortion,
+        false,
+        &loaded.precision,
+    )?;
+    let terms = plan.terms(&loaded.prepared.spectrum)?;
+    Ok(pt_spectra::jobs::ept_observed_table(
         &plan,
+        &terms,
         &request,
         &loaded.prepared,
         &loaded.precision,
+        &observation,
     )?)
 }

@@ -1,0 +1,269 @@
+//! From model multipoles to what a survey or a simulation measures: the window and the k bins of
+//! [`crate::survey`] chained in the order a measurement applies them (model → window → bins).
+//!
+//! The stages are planned backwards: the bins fix the output k (their effective k) and the k at which
+//! they need the windowed multipoles, the window fixes the k at which it needs the model. Combinations:
+//! a Q_ℓ window with k² bin averages or none; a window matrix alone (it maps onto its own output k,
+//! binning included); box modes alone (a periodic box has no window).
+
+use crate::error::{Error, Result};
+use crate::estimate::Estimate;
+use crate::linear::LogGrid;
+use crate::survey::{
+    BinAverage, BoxModes, BoxModesPlan, Mixing, WindowMatrix, WindowMultipoles, WindowPlan,
+};
+use std::path::Path;
+
+/// A window read from a file: Q_ℓ(s) multipoles or a matrix.
+#[derive(Debug, Clone)]
+pub enum Window {
+    /// Configuration-space multipoles Q_ℓ(s) and how they mix the model's.
+    Multipoles(WindowMultipoles, Mixing),
+    /// A window matrix (observed (ℓ, k_o) by theory (ℓ', k_t)).
+    Matrix(WindowMatrix),
+}
+
+impl Window {
+    /// Reads `path`: a `.npy` matrix (with its `.txt` sidecar) or a text matrix (its header names
+    /// `ells_out`), else Q_ℓ(s) multipoles mixed by `mixing`.
+    ///
+    /// # Errors
+    /// As [`WindowMatrix::from_file`] and [`WindowMultipoles::from_file`].
+    pub fn read(path: &Path, mixing: Mixing) -> Result<Self> {
+        let is_npy = path.extension().is_some_and(|e| e == "npy");
+        let text_matrix = !is_npy
+            && crate::table::read_text(path)
+                .map(|t| t.lines().take(40).any(|l| l.contains("ells_out")))
+                .unwrap_or(false);
+        if is_npy || text_matrix {
+            Ok(Self::Matrix(WindowMatrix::from_file(path)?))
+        } else {
+            Ok(Self::Multipoles(WindowMultipoles::from_file(path)?, mixing))
+        }
+    }
+}
+
+/// How the output is binned.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Bins {
+    /// The k²-weighted mean over each bin of these edges [h/Mpc].
+    Edges(Vec<f64>),
+    /// The mean over the discrete modes of a periodic box of side `side` [Mpc/h] in each bin.
+    Box {
+        /// The box side [Mpc/h].
+        side: f64,
+        /// The bin edges [h/Mpc].
+        edges: Vec<f64>,
+    },
+}
+
+enum WindowStage {
+    Plan(WindowPlan),
+    Matrix(WindowMatrix),
+}
+
+enum BinStage {
+    Average(BinAverage),
+    Box(BoxModesPlan),
+}
+
+/// The planned chain (module docs).
+pub struct Observation {
+    ells: Vec<usize>,
+    k_out: Vec<f64>,
+    k_model: Vec<f64>,
+    model_ells: Vec<usize>,
+    window: Option<WindowStage>,
+    bins: Option<BinStage>,
+    description: Vec<String>,
+}
+
+/// Model multipoles 0, 2, …, 8: what a window or the box modes need of a model with μ⁸ terms.
+const ALL_ELLS: [usize; 5] = [0, 2, 4, 6, 8];
+
+impl Observation {
+    /// The chain for output multipoles `ells` at `k` [h/Mpc] (used when there are no bins), with the
+    /// window and the bins given.
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] for a window matrix with bins or box modes with a window; as the
+    /// plans of [`crate::survey`].
+    pub fn new(
+        ells: &[usize],
+        k: &[f64],
+        window: Option<Window>,
+        bins: Option<Bins>,
+    ) -> Result<Self> {
+        let refuse = |reason: &str| Error::InvalidChoice {
+            what: "the window and bins".into(),
+            reason: reason.into(),
+        };
+        let mut description = Vec::new();
+        // Bins: the output k and where they need their input.
+        let (k_out, bin_input, bins) = match bins {
+            None => (k.to_vec(), k.to_vec(), None),
+            Some(Bins::Edges(edges)) => {
+                let b = BinAverage::new(&edges)?;
+                description.push(format!(
+                    "bins: the k^2-weighted mean over {} bins of edges {:e} ... {:e} h/Mpc (k = the \
+                     bins' effective k)",
+                    b.len(),
+                    edges[0],
+                    edges[edges.len() - 1]
+                ));
+                (b.k_eff(), b.k_theory().to_vec(), Some(BinStage::Average(b)))
+            }
+            Some(Bins::Box { side, edges }) => {
+                if window.is_some() {
+                    return Err(refuse(
+                        "box modes are those of a periodic box, which has no window",
+                    ));
+                }
+                let modes = BoxModes::new(side, &edges, ells)?;
+                let distinct = modes.distinct_k();
+                let (lo, hi) = (distinct[0], distinct[distinct.len() - 1]);
+                let n = ((hi / lo).log10() * 400.0).ceil() as usize + 8;
+                let grid = LogGrid::new(lo * 0.98, hi * 1.02, n)?.points();
+                let plan = modes.plan(&grid, ALL_ELLS.len())?;
+                description.push(format!(
+                    "bins: the mean over the discrete modes of a periodic box of side {side} Mpc/h in \
+                     {} bins of edges {:e} ... {:e} h/Mpc (k = the mean |k| of each bin's modes; the \
+                     model's P_0 ... P_8 interpolated on {n} log-spaced k)",
+                    edges.len() - 1,
+                    edges[0],
+                    edges[edges.len() - 1]
+                ));
+                let k_eff = modes.k_eff().to_vec();
+                return Ok(Self {
+                    ells: ells.to_vec(),
+                    k_out: k_eff,
+                    k_model: plan.k_theory().to_vec(),
+                    model_ells: ALL_ELLS.to_vec(),
+                    window: None,
+                    bins: Some(BinStage::Box(plan)),
+                    description,
+                });
+            }
+        };
+        let (window, k_model, model_ells, k_out) = match window {
+            None => (None, bin_input, ells.to_vec(), k_out),
+            Some(Window::Multipoles(w, mixing)) => {
+                let plan = WindowPlan::new(ells, &bin_input, &w, mixing)?;
+                description.push(format!(
+                    "window: Q_l(s) multipoles {:?} of `{}` (Q0(0) = {:.6}), {:?} mixing (Wilson et al. \
+                     2017), FFTLog on {} points; wide-angle terms neglected",
+                    w.ells(),
+                    w.origin(),
+                    w.normalisation(),
+                    mixing,
+                    plan.fft_points()
+                ));
+                if let Some(warning) = w.normalisation_warning() {
+                    description.push(format!("warning: {warning}"));
+                }
+                let k_model = plan.k_theory().to_vec();
+                (
+                    Some(WindowStage::Plan(plan)),
+                    k_model,
+                    ALL_ELLS.to_vec(),
+                    k_out,
+                )
+            }
+            Some(Window::Matrix(m)) => {
+                if bins.is_some() {
+                    return Err(refuse(
+                        "a window matrix maps onto its own (binned) output k",
+                    ));
+                }
+                let k_t = m
+                    .k_theory(m.ells_theory()[0])
+                    .ok_or_else(|| refuse("the window matrix has no theory k"))?
+                    .to_vec();
+                for &l in ells {
+                    if m.k_out(l).is_none() {
+                        return Err(refuse(&format!(
+                            "the window matrix has no output multipole {l}"
+                        )));
+                    }
+                }
+                let k_o = m.k_out(ells[0]).unwrap_or_default().to_vec();
+                description.push(format!(
+                    "window: matrix `{}` (observed l {:?} by theory l {:?} on {} k); wide-angle terms \
+                     as the matrix has them",
+                    m.origin(),
+                    m.ells_out(),
+                    m.ells_theory(),
+                    k_t.len()
+                ));
+                let model_ells = m.ells_theory().to_vec();
+                (Some(WindowStage::Matrix(m)), k_t, model_ells, k_o)
+            }
+        };
+        Ok(Self {
+            ells: ells.to_vec(),
+            k_out,
+            k_model,
+            model_ells,
+            window,
+            bins,
+            description,
+        })
+    }
+
+    /// The k [h/Mpc] at which the model's multipoles are needed.
+    pub fn k_model(&self) -> &[f64] {
+        &self.k_model
+    }
+
+    /// The model multipoles needed, in the order [`Self::apply`] takes them.
+    pub fn model_ells(&self) -> &[usize] {
+        &self.model_ells
+    }
+
+    /// The output k [h/Mpc] (the bins' effective k, or the window matrix's).
+    pub fn k_out(&self) -> &[f64] {
+        &self.k_out
+    }
+
+    /// Header lines saying what the chain does.
+    pub fn description(&self) -> &[String] {
+        &self.description
+    }
+
+    /// The observed multipoles (one vector per output ℓ) from the model's multipoles
+    /// [`Self::model_ells`] on [`Self::k_model`].
+    ///
+    /// # Errors
+    /// As the stages' `apply`.
+    pub fn apply(&self, model: &[Vec<f64>]) -> Result<Vec<Vec<Estimate>>> {
+        if let Some(BinStage::Box(plan)) = &self.bins {
+            let all = plan.apply(model)?;
+            return Ok(all);
+        }
+        let windowed: Vec<Vec<Estimate>> = match &self.window {
+            None => self
+                .ells
+                .iter()
+                .map(|l| {
+                    let j = self.model_ells.iter().position(|m| m == l).unwrap_or(0);
+                    model[j].iter().map(|&v| Estimate::exact(v)).collect()
+                })
+                .collect(),
+            Some(WindowStage::Plan(plan)) => plan.apply(model)?,
+            Some(WindowStage::Matrix(m)) => {
+                let all = m.apply(model)?;
+                self.ells
+                    .iter()
+                    .map(|l| {
+                        let j = m.ells_out().iter().position(|o| o == l).unwrap_or(0);
+                        all[j].clone()
+                    })
+                    .collect()
+            }
+        };
+        match &self.bins {
+            Some(BinStage::Average(b)) => windowed.iter().map(|w| b.apply_estimates(w)).collect(),
+            _ => Ok(windowed),
+        }
+    }
+}
