@@ -520,10 +520,12 @@ fn minimise(objective: &Objective<'_>, x0: &[f64]) -> Vec<f64> {
 }
 
 /// Gaussian errors of the free parameters: √diag of 2 H⁻¹, H the Hessian of −2 ln L by central
-/// differences (steps 1e-3 of each value's scale); NaN where H is not positive definite.
+/// differences (steps 1e-3 of max(|value|, 1)); NaN where H is not positive definite.
 fn hessian_errors(objective: &Objective<'_>, x: &[f64], f0: f64) -> Vec<f64> {
     let n = x.len();
-    let h: Vec<f64> = x.iter().map(|v| 1e-3 * v.abs().max(1e-2)).collect();
+    // Steps of 1e-3 of the value, at least 1e-3: a parameter near 0 (bs, b3) would otherwise get a
+    // step at the level of the minimiser's tolerance, and a Hessian of noise.
+    let h: Vec<f64> = x.iter().map(|v| 1e-3 * v.abs().max(1.0)).collect();
     let f = |dx: &[(usize, f64)]| {
         let mut y = x.to_vec();
         for &(i, d) in dx {
