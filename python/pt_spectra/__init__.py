@@ -259,8 +259,11 @@ def rsd(rsd="tns", real="1l-rpt-n1", k=None, linear=None, z=0.0, z_input=0.0, co
         f=None, bias=1.0, amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None,
         number_density=None, noise_table=None, ells=(0, 2, 4), terms=False, precision="default",
         q_range=None, cache_dir=None, eh=None, k_min=1e-3, k_max=1.0, nk=100,
-        no_wiggle=False, cs2=0.0, b2=None, bs=None, b3=None) -> Table:
+        no_wiggle=False, cs2=0.0, b2=None, bs=None, b3=None, **ept_params) -> Table:
     """Redshift-space multipoles (``pt-spectra rsd``): columns ``k P0 P2 P4 … err_P0 …``.
+
+    ``rsd="ept"`` is the galaxy model (:func:`ept`): ``bias`` is b1, ``b2``, ``bs``, ``b3`` and the
+    keyword arguments ``alpha0`` … ``sn4``, ``ir``, ``apar``, ``aperp`` in velocileptors' conventions.
 
     rsd: ``kaiser``, ``scoccimarro`` or ``tns``; real: the real-space model (as :func:`real`).
     f: growth rate (default f(z) of the cosmology). bias: a number, a path or ``(k, b)`` arrays;
@@ -277,6 +280,12 @@ def rsd(rsd="tns", real="1l-rpt-n1", k=None, linear=None, z=0.0, z_input=0.0, co
     the bias terms of :func:`real`'s ``bias_terms``; ``bias`` is b1, a number). The other arguments
     are those of :func:`real`.
     """
+    if str(rsd).lower() == "ept":
+        return ept(k=_grid(k, k_min, k_max, nk), linear=linear, z=z, z_input=z_input,
+                   cosmology=cosmology, eh=eh, ells=ells, precision=precision, q_range=q_range,
+                   b1=bias, b2=b2, bs=bs, b3=b3, f=f, **ept_params)
+    if ept_params:
+        raise ValueError(f"{', '.join(ept_params)}: options of rsd='ept', not of rsd={rsd!r}")
     plan = RsdPlan(_grid(k, k_min, k_max, nk), real, rsd, precision, q_range, cache_dir)
     return plan(linear, z, z_input, cosmology, f, bias, amplitude, fog, sigma0, shot_noise,
                 number_density, noise_table, ells, terms, eh, no_wiggle=no_wiggle, cs2=cs2, b2=b2,
@@ -287,9 +296,11 @@ def fit(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_
         covariance=None, rsd="tns", real="1l-spt", fog="lorentzian", f=None, sigma0=3.0, bias=1.0,
         amplitude=1.0, shot_noise=None, number_density=None, noise_table=None, k_min=0.0,
         linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default", q_range=None,
-        cache_dir=None, eh=None, cs2=0.0) -> Table:
+        cache_dir=None, eh=None, cs2=0.0, **ept_options) -> Table:
     """Fits of f, sigma0, A_b and the EFT counterterm c_s^2 (``free``, of ``"f"``, ``"sigma0"``,
-    ``"ab"``, ``"cs2"``) to measured multipoles (``pt-spectra fit``).
+    ``"ab"``, ``"cs2"``) to measured multipoles (``pt-spectra fit``). ``rsd="ept"`` fits the galaxy
+    model (:func:`fit_ept`: ``bias`` is the start b1; ``marginalise``, ``priors``, ``n_mocks``, ``ir``,
+    ``apar``, ``aperp`` and start values by name as keyword arguments).
 
     data: a file (columns ``k P0 s0 P2 s2 P4 s4``, or ``data_columns`` 1-based for ``data_ells``) or a
     dict ``{"k": …, "P0": …, "s0": …, …}`` with the multipoles of ``ells``. k_max: a list of k_max
@@ -300,6 +311,13 @@ def fit(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_
     columns ``sigma0_lin sigma0_1l`` give the theory sigma0.
     Returns ``k_max points <p> <p>_lo <p>_hi … chi2 dof chi2_dof``.
     """
+    if str(rsd).lower() == "ept":
+        return fit_ept(data, k_max, free=free, ells=ells, data_ells=data_ells,
+                       data_columns=data_columns, covariance=covariance, k_min=k_min, linear=linear,
+                       z=z, z_input=z_input, cosmology=cosmology, precision=precision,
+                       q_range=q_range, eh=eh, b1=bias, f=f, **ept_options)
+    if ept_options:
+        raise ValueError(f"{', '.join(ept_options)}: options of rsd='ept', not of rsd={rsd!r}")
     return fit_tables(data, k_max, free, ells, data_ells, data_columns, covariance, rsd, real, fog, f,
                       sigma0, bias, amplitude, shot_noise, number_density, noise_table, k_min, linear,
                       z, z_input, cosmology, precision, q_range, cache_dir, eh, cs2)["fit"]

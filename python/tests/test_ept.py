@@ -64,3 +64,21 @@ def test_fit_ept_recovers_its_own_multipoles():
         pt.fit_ept(data, [0.2], marginalise=("b2",), precision="fast")
     with pytest.raises(ValueError, match="sigma"):
         pt.fit_ept(data, [0.2], priors={"b2": (0.0, -1.0)}, precision="fast")
+
+
+def test_rsd_and_fit_route_ept(reference):
+    ref, linear = reference
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pt.PtSpectraWarning)
+        a = pt.rsd(rsd="ept", k=ref[:8, 0], linear=linear, bias=1.8, b2=0.5, f=0.8, ir=False,
+                   alpha0=3.0, precision="fast")
+        b = pt.ept(k=ref[:8, 0], linear=linear, b1=1.8, b2=0.5, f=0.8, ir=False, alpha0=3.0,
+                   precision="fast")
+        assert np.array_equal(a["P0"], b["P0"])
+        with pytest.raises(ValueError, match="alpha0"):
+            pt.rsd(rsd="tns", k=ref[:8, 0], alpha0=1.0)
+        s = 0.01 * b["P0"]
+        data = {"k": b["k"], "P0": b["P0"], "s0": s, "P2": b["P2"], "s2": s}
+        t = pt.fit(data, [0.3], free=("f", "b1"), ells=(0, 2), rsd="ept", linear=linear, bias=1.7,
+                   f=0.7, b2=0.5, alpha0=3.0, ir=False, precision="fast")
+    assert abs(t["f"][0] - 0.8) < 1e-3 and abs(t["b1"][0] - 1.8) < 1e-3
