@@ -181,23 +181,40 @@ class RsdPlan:
     ``RsdPlan(k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None, cache_dir=None,
     two_loop="auto")``; calling it takes the arguments of :func:`rsd` after ``k`` (linear, z,
     cosmology, f, bias, fog, sigma0, noise, ells, terms, cs2) and returns the multipoles.
-    ``two_loop`` as in :class:`RealPlan`.
+    ``two_loop`` as in :class:`RealPlan`. ``rsd="ept"`` plans the galaxy model (an
+    :class:`EptPlan`; ``ir``, ``apar``, ``aperp`` as keyword arguments): calling it takes ``bias``
+    (b1), ``b2``, ``bs``, ``b3``, ``f`` and velocileptors' other names; ``terms`` gives
+    :class:`EptTerms`.
     """
 
     def __init__(self, k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None,
-                 cache_dir=None, two_loop="auto"):
+                 cache_dir=None, two_loop="auto", **ept_settings):
+        self._ept = None
+        if str(rsd).lower() == "ept":
+            self._ept = EptPlan(k, precision=precision, q_range=q_range, **ept_settings)
+            return
+        if ept_settings:
+            raise ValueError(f"{', '.join(ept_settings)}: options of rsd='ept', not of rsd={rsd!r}")
         self._plan = _core.RsdPlan(k, real, rsd, precision, q_range, cache_dir, two_loop)
 
     def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=1.0,
                  amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None, number_density=None,
                  noise_table=None, ells=(0, 2, 4), terms=False, eh=None, growth_factor=None,
-                 no_wiggle=False, cs2=0.0, b2=None, bs=None, b3=None):
+                 no_wiggle=False, cs2=0.0, b2=None, bs=None, b3=None, **ept_params):
+        if self._ept is not None:
+            return self._ept(linear, z, z_input, cosmology, eh, ells, b1=bias, b2=b2, bs=bs, b3=b3,
+                             f=f, **ept_params)
+        if ept_params:
+            raise ValueError(f"{', '.join(ept_params)}: parameters of rsd='ept'")
         return _warn(self._plan(linear, z, z_input, cosmology, f, bias, amplitude, fog, sigma0,
                                 shot_noise, number_density, noise_table, list(ells), terms, eh,
                                 growth_factor, no_wiggle, cs2, b2, bs, b3))
 
     def terms(self, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None):
-        """The loop terms of one linear spectrum (the expensive part), as :class:`RsdTerms`."""
+        """The loop terms of one linear spectrum (the expensive part), as :class:`RsdTerms`
+        (:class:`EptTerms` for ``rsd="ept"``)."""
+        if self._ept is not None:
+            return self._ept.terms(linear, z, z_input, cosmology, eh)
         return RsdTerms(self._plan.terms(linear, z, z_input, cosmology, eh))
 
 

@@ -75,6 +75,9 @@ def test_rsd_and_fit_route_ept(reference):
         b = pt.ept(k=ref[:8, 0], linear=linear, b1=1.8, b2=0.5, f=0.8, ir=False, alpha0=3.0,
                    precision="fast")
         assert np.array_equal(a["P0"], b["P0"])
+        c = pt.RsdPlan(ref[:8, 0], rsd="ept", precision="fast", ir=False)(
+            linear=linear, bias=1.8, b2=0.5, f=0.8, alpha0=3.0)
+        assert np.array_equal(c["P0"], b["P0"])
         with pytest.raises(ValueError, match="alpha0"):
             pt.rsd(rsd="tns", k=ref[:8, 0], alpha0=1.0)
         s = 0.01 * b["P0"]
