@@ -244,7 +244,7 @@ pub(crate) fn fit_ept(
                 "no IR resummation"
             }
         )];
-        let table = jobs::ept_fit_table(&plan, &terms, &data, &request, &k_max, header)?;
+        let table = jobs::ept_fit_table(&plan, &terms, &data, &request, &k_max, header, None)?;
         Ok((table, prepared))
     })?;
     Table::new(py, table, &prepared, &precision, "ept fit", seconds)

@@ -23,6 +23,7 @@
 use super::MultipoleData;
 use crate::error::{Error, Result};
 use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
+use crate::survey::observe::Observation;
 use argmin::core::{CostFunction, Executor, State};
 use argmin::solver::neldermead::NelderMead;
 
@@ -108,6 +109,8 @@ fn index(name: &str) -> Result<usize> {
 struct Objective<'a> {
     plan: &'a EptPlan,
     terms: &'a EptTerms,
+    /// The window and bins between the model and the data, if any.
+    observation: Option<&'a Observation>,
     /// Every slot's start or fixed value (the model's parameters, α∥, α⊥).
     start: [f64; SLOTS],
     /// Whether the measurement has a distortion.
@@ -148,9 +151,20 @@ impl Objective<'_> {
 
     /// The whitened model at `p` with distortion `ap` (L⁻¹ m).
     fn model(&self, p: &EptParams, ap: Option<crate::rsd::ap::Distortion>) -> Result<Vec<f64>> {
-        let m = self
-            .plan
-            .multipole_values_at(self.terms, p, &self.ells, ap)?;
+        let m = match self.observation {
+            None => self
+                .plan
+                .multipole_values_at(self.terms, p, &self.ells, ap)?,
+            Some(o) => {
+                let model = self
+                    .plan
+                    .multipole_values_at(self.terms, p, o.model_ells(), ap)?;
+                o.apply(&model)?
+                    .iter()
+                    .map(|l| l.iter().map(|e| e.value).collect())
+                    .collect()
+            }
+        };
         let raw: Vec<f64> = m
             .iter()
             .flat_map(|l| self.window.iter().map(move |&i| l[i]))
@@ -370,6 +384,21 @@ pub fn fit_galaxy(
     data: &MultipoleData,
     request: &GalaxyFitRequest,
 ) -> Result<GalaxyFit> {
+    fit_galaxy_observed(plan, terms, data, request, None)
+}
+
+/// [`fit_galaxy`] with the model taken through a window and bins (`observation`, made for the
+/// request's multipoles; the plan on its model k, the data on its output k, row for row).
+///
+/// # Errors
+/// As [`fit_galaxy`]; [`Error::InvalidChoice`] if the observation's output does not match the data.
+pub fn fit_galaxy_observed(
+    plan: &EptPlan,
+    terms: &EptTerms,
+    data: &MultipoleData,
+    request: &GalaxyFitRequest,
+    observation: Option<&Observation>,
+) -> Result<GalaxyFit> {
     let (free, marg, priors) = validate(request)?;
     if request.ap.is_none() && free.iter().any(|&i| i >= PARAM_NAMES.len()) {
         return Err(Error::InvalidChoice {
@@ -377,11 +406,32 @@ pub fn fit_galaxy(
             reason: "the fit needs a distortion to start from (the measurement's AP)".into(),
         });
     }
-    let k = plan.k();
-    if k.len() != data.k.len()
-        || k.iter()
-            .zip(&data.k)
-            .any(|(a, b)| (a / b - 1.0).abs() > 1e-9)
+    let k = match observation {
+        None => plan.k(),
+        Some(o) => {
+            if plan.k() != o.k_model()
+                || o.k_out().len() != data.k.len()
+                || o.ells() != request.ells
+            {
+                return Err(Error::InvalidChoice {
+                    what: "the fit's window and bins".into(),
+                    reason: format!(
+                        "the plan must be on their model k and their output ({} k, l {:?}) the data's                          ({} k, l {:?})",
+                        o.k_out().len(),
+                        o.ells(),
+                        data.k.len(),
+                        request.ells
+                    ),
+                });
+            }
+            data.k.as_slice()
+        }
+    };
+    if observation.is_none()
+        && (k.len() != data.k.len()
+            || k.iter()
+                .zip(&data.k)
+                .any(|(a, b)| (a / b - 1.0).abs() > 1e-9))
     {
         return Err(Error::InvalidChoice {
             what: "the fit's model grid".into(),
@@ -465,6 +515,7 @@ pub fn fit_galaxy(
     let objective = Objective {
         plan,
         terms,
+        observation,
         start,
         has_ap: request.ap.is_some(),
         ells: request.ells.clone(),

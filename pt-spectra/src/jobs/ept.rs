@@ -138,15 +138,19 @@ pub fn ept_fit_table(
     request: &crate::fit::galaxy::GalaxyFitRequest,
     k_max: &[f64],
     header: Vec<String>,
+    observation: Option<&crate::survey::observe::Observation>,
 ) -> Result<Table> {
-    use crate::fit::galaxy::fit_galaxy;
+    use crate::fit::galaxy::fit_galaxy_observed;
     let mut fits = Vec::with_capacity(k_max.len());
     for &k in k_max {
         let mut r = request.clone();
         r.k_max = k;
-        fits.push(fit_galaxy(plan, terms, data, &r)?);
+        fits.push(fit_galaxy_observed(plan, terms, data, &r, observation)?);
     }
     let mut header = header;
+    if let Some(o) = observation {
+        header.extend(o.description().iter().cloned());
+    }
     if let Some(d) = request.ap {
         header.push(format!(
             "Alcock-Paczynski: the data measured with apar = {}, aperp = {}{}",
@@ -251,12 +255,12 @@ fn unit(name: &str) -> &'static str {
 }
 
 /// [`ept_table_from_terms`] through a window and bins (`observation`; the plan built on its
-/// [`Observation::k_model`](super::observe::Observation::k_model)): columns `k P<l>… err_P<l>…` at
+/// [`Observation::k_model`](crate::survey::observe::Observation::k_model)): columns `k P<l>… err_P<l>…` at
 /// the observation's output k. The model's own error estimates are carried through the chain (applied
 /// to it as to the values, in absolute value) and added to the chain's.
 ///
 /// # Errors
-/// As [`EptPlan::multipoles`] and [`super::observe::Observation::apply`];
+/// As [`EptPlan::multipoles`] and [`crate::survey::observe::Observation::apply`];
 /// [`crate::error::Error::InvalidChoice`] if the plan is not on the observation's model k.
 pub fn ept_observed_table(
     plan: &EptPlan,
@@ -264,7 +268,7 @@ pub fn ept_observed_table(
     request: &EptRequest,
     prepared: &Prepared,
     precision: &Precision,
-    observation: &super::observe::Observation,
+    observation: &crate::survey::observe::Observation,
 ) -> Result<Table> {
     if plan.k() != observation.k_model() {
         return Err(crate::error::Error::InvalidChoice {

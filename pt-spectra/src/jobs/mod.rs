@@ -38,7 +38,6 @@ mod bias;
 mod ept;
 mod fit;
 mod halo;
-pub mod observe;
 mod rsd;
 pub use bias::BiasOutput;
 pub use ept::{

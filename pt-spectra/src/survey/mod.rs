@@ -58,6 +58,7 @@
 //! ```
 
 pub mod bins;
+pub mod observe;
 mod text;
 pub mod window;
 

@@ -312,3 +312,62 @@ fn ept_window_and_bins() {
         ),
     ]);
 }
+
+/// `fit --rsd ept --k-edges` fits binned multipoles made by `rsd --rsd ept --k-edges`: the truth back.
+#[test]
+fn ept_fit_through_bins() {
+    let dir = super::scratch("ept_fit_bins");
+    let edges = "0.02:0.2:0.01";
+    let (ok, out, err) = run(&[
+        "rsd",
+        "--rsd",
+        "ept",
+        "--bias",
+        "2",
+        "--b2",
+        "-0.4",
+        "--f",
+        "0.7",
+        "--k-edges",
+        edges,
+        "--precision",
+        "fast",
+    ]);
+    assert!(ok, "{err}");
+    let mut text = String::new();
+    for r in rows(&out) {
+        let s = 0.01 * r[1];
+        text += &format!("{} {} {s} {} {s} {} {s}\n", r[0], r[1], r[2], r[3]);
+    }
+    let data = super::write(&dir, "binned.txt", &text);
+    let (ok, out, err) = run(&[
+        "fit",
+        "--rsd",
+        "ept",
+        "--data",
+        &data,
+        "--ells",
+        "0,2",
+        "--free",
+        "f,b1,b2",
+        "--k-edges",
+        edges,
+        "--k-max",
+        "0.2",
+        "--precision",
+        "fast",
+        "--bias",
+        "1.8",
+        "--f",
+        "0.6",
+    ]);
+    assert!(ok, "{err}");
+    let names = column_names_of(&out, "# k_max ");
+    let row = &rows(&out)[0];
+    let get = |n: &str| row[names.iter().position(|c| *c == n).unwrap()];
+    for (name, truth) in [("f", 0.7), ("b1", 2.0), ("b2", -0.4)] {
+        let (v, e) = (get(name), get(&format!("err_{name}")));
+        assert!((v - truth).abs() < 0.05 * e, "{name}: {v} ± {e}");
+    }
+    assert!(out.contains("bins: the k^2-weighted mean"));
+}

@@ -125,10 +125,10 @@ impl EptArgs {
     pub fn observation(
         &self,
     ) -> Result<(
-        Option<pt_spectra::jobs::observe::Window>,
-        Option<pt_spectra::jobs::observe::Bins>,
+        Option<pt_spectra::survey::observe::Window>,
+        Option<pt_spectra::survey::observe::Bins>,
     )> {
-        use pt_spectra::jobs::observe::{Bins, Window};
+        use pt_spectra::survey::observe::{Bins, Window};
         let mixing = match self.window_mixing.as_str() {
             "wilson" => pt_spectra::survey::Mixing::Wilson,
             "classpt-boss" => pt_spectra::survey::Mixing::ClassPtBoss,
@@ -232,7 +232,8 @@ pub fn table(
             &loaded.precision,
         )?);
     }
-    let observation = pt_spectra::jobs::observe::Observation::new(&request.ells, &k, window, bins)?;
+    let observation =
+        pt_spectra::survey::observe::Observation::new(&request.ells, &k, window, bins)?;
     let plan = ept_plan(
         observation.k_model(),
         !args.no_ir,

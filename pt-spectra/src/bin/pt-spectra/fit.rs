@@ -248,8 +248,22 @@ fn run_ept(args: &Args) -> Result<()> {
         k_max: 0.0,
         n_mocks: args.n_mocks,
     };
+    let (window, bins) = args.ept.observation()?;
+    let observation = if window.is_some() || bins.is_some() {
+        Some(pt_spectra::survey::observe::Observation::new(
+            &request.ells,
+            &data.k,
+            window,
+            bins,
+        )?)
+    } else {
+        None
+    };
+    let model_k = observation
+        .as_ref()
+        .map_or(data.k.as_slice(), |o| o.k_model());
     let plan = pt_spectra::jobs::ept_plan(
-        &data.k,
+        model_k,
         !args.ept.no_ir(),
         distortion,
         free_ap,
@@ -277,6 +291,7 @@ fn run_ept(args: &Args) -> Result<()> {
         &request,
         &k_max_values(&args.k_max)?,
         header,
+        observation.as_ref(),
     )?;
     write_output(args.out.as_ref(), &table)
 }

@@ -1,17 +1,17 @@
 //! From model multipoles to what a survey or a simulation measures: the window and the k bins of
-//! [`crate::survey`] chained in the order a measurement applies them (model → window → bins).
+//! this module chained in the order a measurement applies them (model → window → bins).
 //!
 //! The stages are planned backwards: the bins fix the output k (their effective k) and the k at which
 //! they need the windowed multipoles, the window fixes the k at which it needs the model. Combinations:
 //! a Q_ℓ window with k² bin averages or none; a window matrix alone (it maps onto its own output k,
 //! binning included); box modes alone (a periodic box has no window).
 
+use super::{
+    BinAverage, BoxModes, BoxModesPlan, Mixing, WindowMatrix, WindowMultipoles, WindowPlan,
+};
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
 use crate::linear::LogGrid;
-use crate::survey::{
-    BinAverage, BoxModes, BoxModesPlan, Mixing, WindowMatrix, WindowMultipoles, WindowPlan,
-};
 use std::path::Path;
 
 /// A window read from a file: Q_ℓ(s) multipoles or a matrix.
@@ -208,6 +208,11 @@ impl Observation {
             bins,
             description,
         })
+    }
+
+    /// The output multipoles.
+    pub fn ells(&self) -> &[usize] {
+        &self.ells
     }
 
     /// The k [h/Mpc] at which the model's multipoles are needed.
