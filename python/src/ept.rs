@@ -231,6 +231,7 @@ pub(crate) fn fit_ept(
             ells,
             k_min,
             k_max: 0.0,
+            ell_ranges: vec![],
             n_mocks,
         };
         let plan = jobs::ept_plan(&data.k, ir, ap, free_ap, &precision)?;

@@ -67,6 +67,10 @@ pub struct GalaxyFitRequest {
     pub k_min: f64,
     /// The fitted range [h/Mpc].
     pub k_max: f64,
+    /// Per-multipole ranges (ℓ, k_min, k_max) [h/Mpc] that narrow [k_min, k_max] for that ℓ: the
+    /// points of ℓ are those in [max(k_min, k_min_ℓ), min(k_max, k_max_ℓ)] (e.g. P4 to 0.1 h/Mpc while
+    /// P0 and P2 go to k_max). For ξ_ℓ data the ranges are in s [Mpc/h].
+    pub ell_ranges: Vec<(usize, f64, f64)>,
     /// The number of mocks the covariance was estimated from: C⁻¹ is scaled by the Hartlap factor
     /// (N − p − 2)/(N − 1), p the number of fitted points (Hartlap, Simon & Schneider 2007).
     pub n_mocks: Option<usize>,
@@ -120,8 +124,8 @@ struct Objective<'a> {
     marg: Vec<usize>,
     /// Per parameter: (mean, 1/σ²) of its prior, if any.
     priors: Vec<Option<(f64, f64)>>,
-    /// Plan k indices of the window.
-    window: Vec<usize>,
+    /// Per fitted ℓ (in the order of `ells`), the k indices of its fitted points.
+    window: Vec<Vec<usize>>,
     /// L⁻¹ of the Cholesky factor of the window's covariance.
     whiten: Vec<Vec<f64>>,
     /// L⁻¹ d.
@@ -167,7 +171,8 @@ impl Objective<'_> {
         };
         let raw: Vec<f64> = m
             .iter()
-            .flat_map(|l| self.window.iter().map(move |&i| l[i]))
+            .zip(&self.window)
+            .flat_map(|(l, window)| window.iter().map(move |&i| l[i]))
             .collect();
         Ok(self
             .whiten
@@ -349,6 +354,21 @@ fn validate(request: &GalaxyFitRequest) -> Result<Validated> {
             reason: "name at least one free parameter".into(),
         });
     }
+    for &(l, lo, hi) in &request.ell_ranges {
+        if !request.ells.contains(&l) {
+            return Err(Error::InvalidChoice {
+                what: format!("the k range of multipole {l}"),
+                reason: format!("{l} is not a fitted multipole ({:?})", request.ells),
+            });
+        }
+        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            return Err(Error::InvalidParameter {
+                name: "per-multipole k_max [h/Mpc]",
+                value: hi,
+                reason: "a multipole's range needs finite k_min < k_max",
+            });
+        }
+    }
     let mut priors = vec![None; SLOTS];
     for p in &request.priors {
         let i = index(&p.name)?;
@@ -451,10 +471,20 @@ pub fn fit_galaxy_observed(
             })?;
         rows.push(j);
     }
-    let window: Vec<usize> = (0..k.len())
-        .filter(|&i| (request.k_min..=request.k_max).contains(&k[i]))
-        .collect();
-    let points = window.len() * rows.len();
+    let mut window = Vec::with_capacity(rows.len());
+    for &l in &request.ells {
+        let (mut lo, mut hi) = (request.k_min, request.k_max);
+        for &(_, a, b) in request.ell_ranges.iter().filter(|r| r.0 == l) {
+            lo = lo.max(a);
+            hi = hi.min(b);
+        }
+        window.push(
+            (0..k.len())
+                .filter(|&i| (lo..=hi).contains(&k[i]))
+                .collect::<Vec<usize>>(),
+        );
+    }
+    let points: usize = window.iter().map(Vec::len).sum();
     if points <= free.len() + marg.len() {
         return Err(Error::InvalidParameter {
             name: "k_max [h/Mpc]",
@@ -464,13 +494,19 @@ pub fn fit_galaxy_observed(
     }
     // The window's covariance: the data's full covariance (ℓ-major over the data's ells), or σ².
     let position = |r: usize, i: usize| r * k.len() + i;
-    let cov: Vec<Vec<f64>> = rows
+    let points_of = |rows: &[usize], window: &[Vec<usize>]| -> Vec<(usize, usize)> {
+        rows.iter()
+            .zip(window)
+            .flat_map(|(&r, w)| w.iter().map(move |&i| (r, i)))
+            .collect()
+    };
+    let fitted = points_of(&rows, &window);
+    let cov: Vec<Vec<f64>> = fitted
         .iter()
-        .flat_map(|&r| window.iter().map(move |&i| (r, i)))
-        .map(|(r, i)| {
-            rows.iter()
-                .flat_map(|&s| window.iter().map(move |&j| (s, j)))
-                .map(|(s, j)| match &data.covariance {
+        .map(|&(r, i)| {
+            fitted
+                .iter()
+                .map(|&(s, j)| match &data.covariance {
                     Some(c) => c[position(r, i)][position(s, j)],
                     None if (r, i) == (s, j) => data.sigma[r][i].powi(2),
                     None => 0.0,
@@ -501,10 +537,7 @@ pub fn fit_galaxy_observed(
         reason: "the fitted block is not positive definite",
     })?;
     let whiten = lower_inverse(&l);
-    let raw: Vec<f64> = rows
-        .iter()
-        .flat_map(|&r| window.iter().map(move |&i| data.values[r][i]))
-        .collect();
+    let raw: Vec<f64> = fitted.iter().map(|&(r, i)| data.values[r][i]).collect();
     let data_vector = whiten.iter().map(|row| dot(row, &raw)).collect();
     let mut start = [0.0; SLOTS];
     start[..PARAM_NAMES.len()].copy_from_slice(&request.start.values);

@@ -166,10 +166,18 @@ pub fn ept_fit_table(
             }
         ));
     }
+    let xi = observation.is_some_and(crate::survey::observe::Observation::is_xi);
+    let (var, unit_of_var) = if xi { ("s", "Mpc/h") } else { ("k", "h/Mpc") };
+    let ranges: String = request
+        .ell_ranges
+        .iter()
+        .map(|(l, a, b)| format!(" (l = {l}: within [{a}, {b}] {unit_of_var})"))
+        .collect();
     header.push(format!(
-        "fit of ept to multipoles {:?} for k in [{}, k_max] h/Mpc: free {} (Gaussian errors from the \
+        "fit of ept to {} multipoles {:?} for {var} in [{}, {var}_max] {unit_of_var}{ranges}: free {} (Gaussian errors from the \
          Hessian of -2 ln L), marginalised analytically {} (errors sqrt((F^-1)_ii) at the best fit), \
          priors {}; -2 ln L = chi2 + priors + ln det F",
+        if xi { "correlation-function" } else { "power-spectrum" },
         request.ells,
         request.k_min,
         request.free.join(","),
@@ -190,7 +198,11 @@ pub fn ept_fit_table(
         }
     ));
     let mut t = Table::new(header);
-    t.push("k_max", WAVENUMBER, k_max.to_vec());
+    if xi {
+        t.push("s_max", "Mpc/h", k_max.to_vec());
+    } else {
+        t.push("k_max", WAVENUMBER, k_max.to_vec());
+    }
     t.push(
         "points",
         "1",
@@ -295,14 +307,23 @@ pub fn ept_observed_table(
     let mut header: Vec<String> = model.header.clone();
     header.extend(observation.description().iter().cloned());
     let mut t = Table::new(header);
-    t.push("k", WAVENUMBER, observation.k_out().to_vec());
+    let (x, name, unit) = if observation.is_xi() {
+        (("s", "Mpc/h"), "xi", "1")
+    } else {
+        (("k", WAVENUMBER), "P", POWER)
+    };
+    t.push(x.0, x.1, observation.k_out().to_vec());
     for (l, p) in request.ells.iter().zip(&observed) {
-        t.push(format!("P{l}"), POWER, p.iter().map(|e| e.value).collect());
+        t.push(
+            format!("{name}{l}"),
+            unit,
+            p.iter().map(|e| e.value).collect(),
+        );
     }
     for ((l, p), c) in request.ells.iter().zip(&observed).zip(&carried) {
         t.push(
-            format!("err_P{l}"),
-            POWER,
+            format!("err_{name}{l}"),
+            unit,
             p.iter()
                 .zip(c)
                 .map(|(e, c)| e.error + c.value.abs())

@@ -61,11 +61,13 @@ pub mod bins;
 pub mod observe;
 mod text;
 pub mod window;
+pub mod xi;
 
 pub use bins::{BinAverage, BoxModes, BoxModesPlan, ModeGroup};
 pub use window::{
     mixing_coefficient, Mixing, WindowMatrix, WindowMultipoles, WindowOptions, WindowPlan,
 };
+pub use xi::XiPlan;
 
 use crate::error::{Error, Result};
 

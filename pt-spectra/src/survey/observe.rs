@@ -7,7 +7,7 @@
 //! binning included); box modes alone (a periodic box has no window).
 
 use super::{
-    BinAverage, BoxModes, BoxModesPlan, Mixing, WindowMatrix, WindowMultipoles, WindowPlan,
+    BinAverage, BoxModes, BoxModesPlan, Mixing, WindowMatrix, WindowMultipoles, WindowPlan, XiPlan,
 };
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
@@ -65,6 +65,8 @@ enum WindowStage {
 enum BinStage {
     Average(BinAverage),
     Box(BoxModesPlan),
+    /// Correlation-function multipoles at s (or s bins): no window, no k bins.
+    Xi(XiPlan),
 }
 
 /// The planned chain (module docs).
@@ -210,6 +212,47 @@ impl Observation {
         })
     }
 
+    /// The chain for correlation-function multipoles ξ_ℓ at `s` [Mpc/h], or averaged over the s bins
+    /// of `s_edges` ([`XiPlan`]: no window, as a Landy–Szalay estimate divides it out). The output
+    /// "k" of the other methods are then s [Mpc/h].
+    ///
+    /// # Errors
+    /// As [`XiPlan::new`].
+    pub fn xi(ells: &[usize], s: &[f64], s_edges: Option<&[f64]>) -> Result<Self> {
+        let plan = XiPlan::new(ells, s, s_edges)?;
+        let mut description = vec![format!(
+            "correlation-function multipoles xi_l(s) = i^l int k^2 dk/(2 pi^2) P_l(k) j_l(ks) by \
+             FFTLog from the model on {} k in [{:e}, {:e}] h/Mpc (tapered to 0 above 2.25 h/Mpc); no \
+             window (a Landy-Szalay estimate divides it out), wide-angle terms neglected",
+            plan.k_theory().len(),
+            plan.k_theory()[0],
+            plan.k_theory()[plan.k_theory().len() - 1]
+        )];
+        if let Some(e) = s_edges {
+            description.push(format!(
+                "bins: the s^2-weighted mean over {} s bins of edges {} ... {} Mpc/h (s = the bins' \
+                 effective s)",
+                e.len() - 1,
+                e[0],
+                e[e.len() - 1]
+            ));
+        }
+        Ok(Self {
+            ells: ells.to_vec(),
+            k_out: plan.s_out().to_vec(),
+            k_model: plan.k_theory().to_vec(),
+            model_ells: ells.to_vec(),
+            window: None,
+            bins: Some(BinStage::Xi(plan)),
+            description,
+        })
+    }
+
+    /// Whether the output is correlation-function multipoles (at s [Mpc/h]).
+    pub fn is_xi(&self) -> bool {
+        matches!(self.bins, Some(BinStage::Xi(_)))
+    }
+
     /// The output multipoles.
     pub fn ells(&self) -> &[usize] {
         &self.ells
@@ -241,9 +284,10 @@ impl Observation {
     /// # Errors
     /// As the stages' `apply`.
     pub fn apply(&self, model: &[Vec<f64>]) -> Result<Vec<Vec<Estimate>>> {
-        if let Some(BinStage::Box(plan)) = &self.bins {
-            let all = plan.apply(model)?;
-            return Ok(all);
+        match &self.bins {
+            Some(BinStage::Box(plan)) => return plan.apply(model),
+            Some(BinStage::Xi(plan)) => return plan.apply(model),
+            _ => {}
         }
         let windowed: Vec<Vec<Estimate>> = match &self.window {
             None => self

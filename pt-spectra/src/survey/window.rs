@@ -244,20 +244,7 @@ impl WindowPlan {
         let n = fft_size(((k_hi / k_lo).log10() * options.fft_points_per_decade).ceil() as usize);
         let step = (k_hi / k_lo).ln() / (n - 1) as f64;
         let fft_k: Vec<f64> = (0..n).map(|j| k_lo * (step * j as f64).exp()).collect();
-        let width = (options.k_max / k_taper).ln();
-        let taper = fft_k
-            .iter()
-            .map(|&k| {
-                if k < options.k_min || k <= k_taper {
-                    1.0
-                } else if k >= options.k_max {
-                    0.0
-                } else {
-                    let x = ((options.k_max / k).ln() / width).clamp(0.0, 1.0);
-                    x - (2.0 * PI * x).sin() / (2.0 * PI)
-                }
-            })
-            .collect();
+        let taper = fft_k.iter().map(|&k| taper(k, options)).collect();
         let level = |stride| Level::new(stride, &fft_k, ells_out, k_out, window, mixing);
         Ok(Self {
             ells_out: ells_out.to_vec(),
@@ -374,7 +361,7 @@ impl WindowPlan {
 }
 
 /// The model's grid: log-uniform steps, at most `dk` over the output range ± `margin` (module docs).
-fn theory_grid(k_out: &[f64], margin: f64, o: &WindowOptions) -> Vec<f64> {
+pub(super) fn theory_grid(k_out: &[f64], margin: f64, o: &WindowOptions) -> Vec<f64> {
     let (lo, hi) = (k_out[0] - margin, k_out[k_out.len() - 1] + margin);
     let ratio = (LN_10 / o.points_per_decade).exp_m1();
     let mut grid = vec![o.k_min];
@@ -390,6 +377,20 @@ fn theory_grid(k_out: &[f64], margin: f64, o: &WindowOptions) -> Vec<f64> {
         }
         k += step;
         grid.push(k);
+    }
+}
+
+/// The taper of the model at k (step 2 of the module docs): 1 up to k_max·10^−taper_decades (and below
+/// k_min), T(x) = x − sin(2πx)/2π over the last `taper_decades`, 0 from k_max on.
+pub(super) fn taper(k: f64, o: &WindowOptions) -> f64 {
+    let k_taper = o.k_max * 10f64.powf(-o.taper_decades);
+    if k < o.k_min || k <= k_taper {
+        1.0
+    } else if k >= o.k_max {
+        0.0
+    } else {
+        let x = ((o.k_max / k).ln() / (o.k_max / k_taper).ln()).clamp(0.0, 1.0);
+        x - (2.0 * PI * x).sin() / (2.0 * PI)
     }
 }
 

@@ -12,6 +12,7 @@ mod fit;
 mod halo;
 mod plot;
 mod robustness;
+mod survey_fit;
 mod two_loop_basis;
 
 fn run(args: &[&str]) -> (bool, String, String) {

@@ -121,6 +121,16 @@ impl EptArgs {
         out
     }
 
+    /// Whether --window is given.
+    pub fn has_window(&self) -> bool {
+        self.window.is_some()
+    }
+
+    /// Whether --k-edges (or --box) is given.
+    pub fn has_bins(&self) -> bool {
+        self.k_edges.is_some() || self.r#box.is_some()
+    }
+
     /// The window and bins of the options, if any.
     pub fn observation(
         &self,
@@ -143,7 +153,7 @@ impl EptArgs {
         let bins = match &self.k_edges {
             None => None,
             Some(text) => {
-                let edges = edges(text)?;
+                let edges = edges(text, "--k-edges")?;
                 Some(match self.r#box {
                     Some(side) => Bins::Box { side, edges },
                     None => Bins::Edges(edges),
@@ -155,14 +165,14 @@ impl EptArgs {
 }
 
 /// Bin edges from `a,b,c,…` or `start:end:step` (inclusive, to rounding).
-fn edges(text: &str) -> Result<Vec<f64>> {
+pub fn edges(text: &str, flag: &str) -> Result<Vec<f64>> {
     let parts: Vec<&str> = text.split(':').collect();
     let v: Vec<f64> = match parts[..] {
         [a, b, step] => {
             let (a, b, step): (f64, f64, f64) =
                 (a.trim().parse()?, b.trim().parse()?, step.trim().parse()?);
             if !(a.is_finite() && b > a && step > 0.0) {
-                bail!("--k-edges {text}: needs start < end and step > 0");
+                bail!("{flag} {text}: needs start < end and step > 0");
             }
             let n = ((b - a) / step + 1e-9).floor() as usize;
             (0..=n).map(|i| a + step * i as f64).collect()
@@ -171,10 +181,10 @@ fn edges(text: &str) -> Result<Vec<f64>> {
             .split(',')
             .map(|x| x.trim().parse::<f64>())
             .collect::<Result<_, _>>()
-            .map_err(|e| anyhow::anyhow!("--k-edges {text}: {e}"))?,
+            .map_err(|e| anyhow::anyhow!("{flag} {text}: {e}"))?,
     };
     if v.len() < 2 {
-        bail!("--k-edges {text}: give at least two edges");
+        bail!("{flag} {text}: give at least two edges");
     }
     Ok(v)
 }
@@ -188,6 +198,8 @@ pub struct Shared {
     pub b3: Option<f64>,
     pub ells: Vec<usize>,
     pub distortion: Option<Distortion>,
+    /// --xi: the s [Mpc/h] of the correlation-function multipoles.
+    pub xi: Option<Vec<f64>>,
 }
 
 /// The table of `rsd --rsd ept` (the options of the paper's models are refused by the caller).
@@ -223,7 +235,10 @@ pub fn table(
         ells: shared.ells,
     };
     let (window, bins) = args.observation()?;
-    if window.is_none() && bins.is_none() {
+    if shared.xi.is_some() && (window.is_some() || bins.is_some()) {
+        bail!("--xi takes no --window or --k-edges (a Landy-Szalay xi has the window divided out)");
+    }
+    if window.is_none() && bins.is_none() && shared.xi.is_none() {
         let plan = ept_plan(&k, !args.no_ir, shared.distortion, false, &loaded.precision)?;
         return Ok(ept_table(
             &plan,
@@ -232,8 +247,10 @@ pub fn table(
             &loaded.precision,
         )?);
     }
-    let observation =
-        pt_spectra::survey::observe::Observation::new(&request.ells, &k, window, bins)?;
+    let observation = match &shared.xi {
+        Some(s) => pt_spectra::survey::observe::Observation::xi(&request.ells, s, None)?,
+        None => pt_spectra::survey::observe::Observation::new(&request.ells, &k, window, bins)?,
+    };
     let plan = ept_plan(
         observation.k_model(),
         !args.no_ir,

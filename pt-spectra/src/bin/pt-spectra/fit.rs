@@ -112,8 +112,27 @@ pub struct Args {
     #[arg(long, value_name = "K", default_value_t = 0.0)]
     k_min: f64,
     /// k_max [h/Mpc]: one value, a list `a,b,c`, or a scan `start:end:step`.
-    #[arg(long, value_name = "K", default_value = "0.05:0.25:0.01")]
+    #[arg(long, value_name = "K", default_value = K_MAX_SCAN)]
     k_max: String,
+    /// --rsd ept: a narrower range for one multipole, `L:KMIN,KMAX` [h/Mpc] (s [Mpc/h] with --xi;
+    /// repeat the option for several): ℓ = L is fitted over [max(k_min, KMIN), min(k_max, KMAX)].
+    #[arg(long = "k-range-ell", value_name = "L:KMIN,KMAX")]
+    k_range_ell: Vec<String>,
+    /// --rsd ept: the data are correlation-function multipoles ξ_ℓ(s), s [Mpc/h] in the first data
+    /// column (errors and covariance likewise): the model's ξ_ℓ by FFTLog, no window (a Landy–Szalay
+    /// estimate divides it out), fitted over --s-min ≤ s ≤ --s-max.
+    #[arg(long)]
+    xi: bool,
+    /// --xi: the smallest s fitted [Mpc/h].
+    #[arg(long, value_name = "S", default_value_t = 30.0, requires = "xi")]
+    s_min: f64,
+    /// --xi: the largest s fitted [Mpc/h]: one value, a list or a scan `start:end:step`.
+    #[arg(long, value_name = "S", default_value = "150", requires = "xi")]
+    s_max: String,
+    /// --xi: the data are means over s bins of these edges [Mpc/h] (`a,b,c,…` or `start:end:step`):
+    /// the model is averaged with the pair-count weight s².
+    #[arg(long, value_name = "EDGES", requires = "xi")]
+    s_edges: Option<String>,
     /// Write the table to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
@@ -139,6 +158,9 @@ pub struct Args {
     #[arg(long, value_name = "S", default_value_t = 2.5)]
     contour_span: f64,
 }
+
+/// The default scan of --k-max.
+const K_MAX_SCAN: &str = "0.05:0.25:0.01";
 
 /// The data of --data (the multipoles of --ells) and --covariance, and the fitted ells.
 fn read_data(args: &Args) -> Result<(MultipoleData, Vec<usize>)> {
@@ -186,6 +208,18 @@ fn run_ept(args: &Args) -> Result<()> {
     ];
     if let Some((flag, _)) = refused.iter().find(|(_, given)| *given) {
         bail!("{flag} is not an option of fit --rsd ept");
+    }
+    if args.xi {
+        for (flag, given) in [
+            ("--k-max (use --s-max)", args.k_max != K_MAX_SCAN),
+            ("--k-min (use --s-min)", args.k_min != 0.0),
+            ("--window (xi has none)", args.ept.has_window()),
+            ("--k-edges/--box (use --s-edges)", args.ept.has_bins()),
+        ] {
+            if given {
+                bail!("{flag} is not an option of fit --xi");
+            }
+        }
     }
     let (data, ells) = read_data(args)?;
     let b1 = match args.bias.bias()? {
@@ -244,12 +278,28 @@ fn run_ept(args: &Args) -> Result<()> {
         marginalise: names(args.marginalise.as_deref(), ""),
         priors,
         ells,
-        k_min: args.k_min,
+        k_min: if args.xi { args.s_min } else { args.k_min },
         k_max: 0.0,
+        ell_ranges: args
+            .k_range_ell
+            .iter()
+            .map(|t| parse_ell_range(t))
+            .collect::<Result<_>>()?,
         n_mocks: args.n_mocks,
     };
     let (window, bins) = args.ept.observation()?;
-    let observation = if window.is_some() || bins.is_some() {
+    let observation = if args.xi {
+        let edges = args
+            .s_edges
+            .as_deref()
+            .map(|t| crate::ept::edges(t, "--s-edges"))
+            .transpose()?;
+        Some(pt_spectra::survey::observe::Observation::xi(
+            &request.ells,
+            &data.k,
+            edges.as_deref(),
+        )?)
+    } else if window.is_some() || bins.is_some() {
         Some(pt_spectra::survey::observe::Observation::new(
             &request.ells,
             &data.k,
@@ -289,11 +339,25 @@ fn run_ept(args: &Args) -> Result<()> {
         &terms,
         &data,
         &request,
-        &k_max_values(&args.k_max)?,
+        &k_max_values(if args.xi { &args.s_max } else { &args.k_max })?,
         header,
         observation.as_ref(),
     )?;
     write_output(args.out.as_ref(), &table)
+}
+
+/// L:KMIN,KMAX of --k-range-ell.
+fn parse_ell_range(text: &str) -> Result<(usize, f64, f64)> {
+    let parse = || -> Option<(usize, f64, f64)> {
+        let (l, range) = text.split_once(':')?;
+        let (a, b) = range.split_once(',')?;
+        Some((
+            l.trim().parse().ok()?,
+            a.trim().parse().ok()?,
+            b.trim().parse().ok()?,
+        ))
+    };
+    parse().ok_or_else(|| anyhow::anyhow!("--k-range-ell {text}: expected L:KMIN,KMAX"))
 }
 
 /// NAME:MEAN,SIGMA.
@@ -325,7 +389,7 @@ fn k_max_values(s: &str) -> Result<Vec<f64>> {
         _ => bail!("--k-max {s}: expected K, a list K,K,… or start:end:step"),
     };
     if let Some(bad) = v.iter().find(|k| !(k.is_finite() && **k > 0.0)) {
-        bail!("--k-max: {bad} is not a positive wavenumber");
+        bail!("--k-max/--s-max: {bad} is not positive");
     }
     Ok(v)
 }
@@ -351,6 +415,8 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let paper_only_refused = [
         ("--marginalise", args.marginalise.is_some()),
+        ("--xi", args.xi),
+        ("--k-range-ell", !args.k_range_ell.is_empty()),
         ("--prior", !args.prior.is_empty()),
         ("--n-mocks", args.n_mocks.is_some()),
         (

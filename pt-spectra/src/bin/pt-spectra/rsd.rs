@@ -220,9 +220,20 @@ pub fn run(args: &Args) -> Result<()> {
             b3: args.b3,
             ells: ells.clone(),
             distortion,
+            xi: if args.xi {
+                Some(
+                    LogGrid::new(args.s_min, args.s_max, args.ns)
+                        .context("invalid --s-min/--s-max/--ns")?
+                        .points(),
+                )
+            } else {
+                None
+            },
         };
+        // ξ_ℓ of ept comes from the model on the transform's own k grid (survey::xi), not from the
+        // table at --k-min..--k-max.
         let table = ept::table(shared, &args.ept, k, &loaded)?;
-        return finish(args, &table, &ells);
+        return write_output(args.out.as_ref(), &table);
     }
     let request = args.request()?;
     request.validate_galaxy()?;

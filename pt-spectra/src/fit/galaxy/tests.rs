@@ -58,6 +58,7 @@ fn recovers_the_truth_with_marginalised_counterterms() {
         ells: vec![0, 2, 4],
         k_min: 0.0,
         k_max: 0.2,
+        ell_ranges: vec![],
         n_mocks: None,
     };
     let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
@@ -102,6 +103,7 @@ fn analytic_marginalisation_is_the_integral() {
         ells: vec![0, 2],
         k_min: 0.0,
         k_max: 0.15,
+        ell_ranges: vec![],
         n_mocks: None,
     };
     let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
@@ -162,6 +164,7 @@ fn bad_requests_are_named() {
         ells: vec![0],
         k_min: 0.0,
         k_max: 0.2,
+        ell_ranges: vec![],
         n_mocks: None,
     };
     let err = |r: GalaxyFitRequest| {
@@ -220,6 +223,7 @@ fn recovers_the_distortion() {
         ells: vec![0, 2, 4],
         k_min: 0.0,
         k_max: 0.2,
+        ell_ranges: vec![],
         n_mocks: None,
     };
     let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
@@ -255,6 +259,7 @@ fn hartlap_factor_scales_chi2() {
         ells: vec![0],
         k_min: 0.0,
         k_max: 0.2,
+        ell_ranges: vec![],
         n_mocks: None,
     };
     let plain = fit_galaxy(&plan, &terms, &data, &base).unwrap();
