@@ -19,6 +19,11 @@
 //!   [`EptPlan::multipole_values`]), without and with AP (α∥ = 1.03, α⊥ = 0.98), and with the error
 //!   estimates ([`EptPlan::multipoles`]).
 //!
+//! * `survey/…`: what a survey likelihood pays for a new linear spectrum: `ept` (IR on, precision fast)
+//!   on the model k of a window and bins ([`Observation`]: Q_ℓ(s) of a 300 Mpc/h sphere on 128 s points,
+//!   Wilson mixing, P_0, P_2, P_4 averaged over 48 bins of 0.005 h/Mpc), the loop terms, P_0 … P_8 on
+//!   that grid and the window and bins; and the window and bins alone (one core).
+//!
 //! Run with `cargo bench --bench rsd`.
 
 // `criterion_group!` defines an undocumented function.
@@ -34,6 +39,8 @@ use pt_spectra::rsd::ap::Distortion;
 use pt_spectra::rsd::ept::{EptParams, EptPlan, EptSettings};
 use pt_spectra::rsd::{Fog, MultipoleRule, Observed, RsdModel, RsdSettings};
 use pt_spectra::store::TableStore;
+use pt_spectra::survey::observe::{Bins, Observation, Window};
+use pt_spectra::survey::{Mixing, WindowMultipoles};
 use std::time::Duration;
 
 fn grid() -> Vec<f64> {
@@ -186,5 +193,55 @@ fn ept(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, tns, rsd_multipoles, bias_and_ap, ept);
+/// A windowed, binned `ept` evaluation for a new linear spectrum (module docs).
+fn survey(c: &mut Criterion) {
+    let p = LinearSpectrum::gm2012(0.0).expect("embedded spectrum");
+    let r = 300.0;
+    let s: Vec<f64> = (0..128)
+        .map(|i| 0.01 * (2.0 * r / 0.01f64).powf(f64::from(i) / 127.0))
+        .collect();
+    let q0 = s
+        .iter()
+        .map(|&s| 1.0 - 0.75 * s / r + (s / r).powi(3) / 16.0)
+        .collect();
+    let window = WindowMultipoles::from_columns(s, vec![0], vec![q0]).expect("valid window");
+    let edges: Vec<f64> = (0..=48).map(|i| 0.005 * f64::from(i)).collect();
+    let observation = Observation::new(
+        &[0, 2, 4],
+        &[],
+        Some(Window::Multipoles(window, Mixing::Wilson)),
+        Some(Bins::Edges(edges)),
+    )
+    .expect("valid observation");
+    let k = observation.k_model().to_vec();
+    let plan = EptPlan::new(&k, EptSettings::default(), &Precision::fast()).expect("valid plan");
+    let mut params = EptParams::new(2.0, 0.48);
+    for (name, v) in [("b2", 0.3), ("bs", -0.2), ("alpha0", 5.0), ("sn", 800.0)] {
+        params.set(name, v).expect("known name");
+    }
+    let mut group = c.benchmark_group("survey");
+    group.bench_function(
+        BenchmarkId::new("ept windowed binned (48 bins, 128 s), model k", k.len()),
+        |b| {
+            b.iter(|| {
+                let terms = plan.terms(black_box(&p)).expect("valid spectrum");
+                let model = plan
+                    .multipole_values(&terms, &params, observation.model_ells())
+                    .expect("valid parameters");
+                observation.apply(&model).expect("valid model")
+            })
+        },
+    );
+    let terms = plan.terms(&p).expect("valid spectrum");
+    let model = plan
+        .multipole_values(&terms, &params, observation.model_ells())
+        .expect("valid parameters");
+    group.bench_function(
+        BenchmarkId::new("window and bins alone", observation.k_out().len()),
+        |b| b.iter(|| observation.apply(black_box(&model)).expect("valid model")),
+    );
+    group.finish();
+}
+
+criterion_group!(benches, tns, rsd_multipoles, bias_and_ap, ept, survey);
 criterion_main!(benches);
