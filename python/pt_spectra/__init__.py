@@ -23,10 +23,12 @@ from __future__ import annotations
 import warnings as _warnings
 
 from . import _core
-from ._core import Table, eisenstein_hu, growth, log_grid, num_threads, set_num_threads
+from ._core import (Observation, Table, eisenstein_hu, growth, log_grid, num_threads,
+                    set_num_threads)
 
 __all__ = [
     "EptPlan",
+    "Observation",
     "EptTerms",
     "PtSpectraWarning",
     "RealPlan",
@@ -111,16 +113,20 @@ class EptPlan:
     """The galaxy model ``ept`` planned for one k grid (1-loop Eulerian PT of biased tracers in
     redshift space with the BAO resummed, velocileptors' ``REPT`` conventions).
 
-    ``EptPlan(k, ir=True, apar=None, aperp=None, precision="default", q_range=None)``; calling it
+    ``EptPlan(k, ir=True, apar=None, aperp=None, precision="default", q_range=None,
+    free_ap=False)``; calling it
     takes the linear spectrum (``linear``, ``z``, ``z_input``, ``cosmology``, ``eh`` as in
     :func:`real`), ``ells`` and the parameters by name: b1, b2, bs, b3, alpha0, alpha2, alpha4,
     alpha6 [(Mpc/h)^2], sn [(Mpc/h)^3], sn2 [(Mpc/h)^5], sn4 [(Mpc/h)^7], f (default f(z)); an
     unknown name is an error. ``terms(...)`` returns the loop terms of one spectrum
-    (:class:`EptTerms`), after which each parameter step costs microseconds.
+    (:class:`EptTerms`), after which each parameter step costs microseconds. ``free_ap=True`` builds
+    the plan for any distortion with 0.8 <= apar, aperp <= 1.25, given per call to
+    :meth:`EptTerms.multipoles` (a chain that varies the cosmology against a fiducial).
     """
 
-    def __init__(self, k, ir=True, apar=None, aperp=None, precision="default", q_range=None):
-        self._plan = _core.EptPlan(k, ir, apar, aperp, precision, q_range)
+    def __init__(self, k, ir=True, apar=None, aperp=None, precision="default", q_range=None,
+                 free_ap=False):
+        self._plan = _core.EptPlan(k, ir, apar, aperp, precision, q_range, free_ap)
 
     def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, ells=(0, 2, 4),
                  **params):
@@ -134,7 +140,8 @@ class EptPlan:
 
 class EptTerms:
     """The loop terms of one linear spectrum on an :class:`EptPlan`'s grid:
-    ``terms.multipoles(ells=(0, 2, 4), **params)`` with the parameters of :class:`EptPlan`."""
+    ``terms.multipoles(ells=(0, 2, 4), apar=None, aperp=None, **params)`` with the parameters of
+    :class:`EptPlan`; apar, aperp: a distortion replacing the plan's (a plan with ``free_ap=True``)."""
 
     def __init__(self, core):
         self._terms = core
@@ -156,7 +163,8 @@ def ept(k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, ells=(
 def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0, 2),
             data_ells=(0, 2, 4), data_columns=None, covariance=None, k_min=0.0, ir=True, apar=None,
             aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default",
-            q_range=None, eh=None, n_mocks=None, **start) -> Table:
+            q_range=None, eh=None, n_mocks=None, k_ranges=None, window=None,
+            window_mixing="wilson", k_edges=None, box=None, xi=False, s_edges=None, **start) -> Table:
     """Fits of the galaxy model ``ept`` (``pt-spectra fit --rsd ept``), one row per k_max.
 
     data, data_ells, data_columns, covariance, k_min as :func:`fit`; k_max: a list. free: any of
@@ -165,13 +173,22 @@ def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0,
     (mean, sigma). ``start``: start values of the free parameters and values of the fixed ones
     (e.g. ``b1=2.0, f=0.7``; f defaults to f(z)). n_mocks: the Hartlap factor of a covariance from
     that many mocks. apar, aperp: the measurement's distortion (free with ``free=(…, "apar",
-    "aperp")``). Columns: ``k_max points chi2 minus_2_ln_L`` and
-    each parameter with ``err_<p>`` for the free (Gaussian, from the Hessian) and marginalised ones.
+    "aperp")``). k_ranges: ``{4: (0.02, 0.1)}`` narrows the range of a multipole. window (a file of
+    Q_ℓ(s) or a window matrix, as ``rsd --window``), window_mixing ("wilson" or "classpt-boss"),
+    k_edges [h/Mpc] (k²-weighted bins; with box [Mpc/h] the modes of a periodic box): the model
+    goes through them before the comparison. xi=True: the data are ξ_ℓ(s) (s [Mpc/h] in place of k;
+    k_min, k_max, k_ranges in s), optionally averaged over s_edges. Columns: ``k_max`` (``s_max``)
+    ``points chi2 minus_2_ln_L`` and each parameter with ``err_<p>`` for the free (Gaussian, from the
+    Hessian) and marginalised ones.
     """
     table = _core.fit_ept(data, list(k_max), list(free), list(marginalise), priors, list(ells),
                           list(data_ells), None if data_columns is None else list(data_columns),
                           covariance, k_min, ir, apar, aperp, linear, z, z_input, cosmology,
-                          precision, q_range, eh, n_mocks, **_ept_params(start))
+                          precision, q_range, eh, n_mocks,
+                          None if k_ranges is None else {int(l): tuple(map(float, r))
+                                                         for l, r in k_ranges.items()},
+                          None if window is None else str(window), window_mixing,
+                          k_edges, box, bool(xi), s_edges, **_ept_params(start))
     return _warn(table)
 
 

@@ -43,6 +43,15 @@ Nuisance parameters, one set per redshift ``zs[i]`` (declare them in ``params``,
   real-space P_dd, P_dt, P_tt as -2, -4, -6 c_s^2 k^2 P_lin before the RSD model (``pt.rsd``'s
   ``cs2``); a fast parameter like the others.
 
+Alcock–Paczynski (``rsd: ept`` only): ``ap_fiducial: {Omega_m: 0.31}`` is the flat ΛCDM cosmology the
+data were measured in (radiation neglected: ≲ 1e-4 in the α's at z < 3); at each step α∥ =
+E_fid(z)/E(z) and α⊥ = D_M(z)/D_M,fid(z) (distances in Mpc/h; E, D_M of the Boltzmann code) distort the
+model (plan built for 0.8 ≤ α ≤ 1.25; a step outside has zero likelihood, with a log message), and
+``get_pt_ap(z)`` returns them.
+
+The multipoles requested by a likelihood (``pt_pk_ell: {ells: [...]}``, e.g. 0 … 8 for a window) are
+added to ``ells``.
+
 With ``rsd: ept`` the theory computes the galaxy model (:class:`pt_spectra.EptPlan`, velocileptors'
 conventions; ``ir`` (true) switches the BAO resummation) and its nuisance parameters per redshift are
 velocileptors' names with the suffix: ``b1_i`` (required), ``b2_i``, ``bs_i``, ``b3_i``,
@@ -126,6 +135,7 @@ class PTMultipoles(Theory):
     var_pair: list = ["delta_tot", "delta_tot"]
     prefix: str = ""
     ir: bool = True
+    ap_fiducial: dict | None = None
 
     # ---- set-up ------------------------------------------------------------------------------
     def initialize(self):
@@ -145,6 +155,15 @@ class PTMultipoles(Theory):
             raise ValueError(f"PTMultipoles: `k_max_linear` must be > 0, got {self.k_max_linear}")
         if len(self.var_pair) != 2:
             raise ValueError(f"PTMultipoles: `var_pair` must be two names, got {self.var_pair}")
+        self._ap_omega_m = None
+        if self.ap_fiducial is not None:
+            if not self._ept:
+                raise ValueError("PTMultipoles: `ap_fiducial` is supported with rsd: ept only")
+            om = dict(self.ap_fiducial).get("Omega_m")
+            if om is None or not 0.0 < float(om) < 1.0:
+                raise ValueError("PTMultipoles: `ap_fiducial` needs Omega_m in (0, 1) of the flat "
+                                 f"fiducial, got {self.ap_fiducial}")
+            self._ap_omega_m = float(om)
         self._k = self._option_grid()
         self._requested_k: list[float] = []
         self._plan = None
@@ -184,7 +203,8 @@ class PTMultipoles(Theory):
     def _make_plan(self, k):
         if self._ept:
             self._plan = pt.EptPlan(k, ir=bool(self.ir), precision=self.precision,
-                                    q_range=None if self.q_range is None else tuple(self.q_range))
+                                    q_range=None if self.q_range is None else tuple(self.q_range),
+                                    free_ap=self._ap_omega_m is not None)
             self._planned_k = np.asarray(k, dtype=float)
             return
         self._plan = pt.RsdPlan(k, real=self.real, rsd=self.rsd, precision=self.precision,
@@ -221,13 +241,35 @@ class PTMultipoles(Theory):
 
     def get_requirements(self):
         zs = self.zs
-        return {
+        requirements = {
             "Pk_grid": {"z": zs, "k_max": self._k_max_linear(), "nonlinear": False,
                         "vars_pairs": [list(self.var_pair)]},
             "fsigma8": {"z": zs},
             "sigma8_z": {"z": sorted(set([0.0] + zs))},
             "H0": None,
         }
+        if self._ap_omega_m is not None:
+            requirements["Hubble"] = {"z": zs}
+            requirements["angular_diameter_distance"] = {"z": zs}
+        return requirements
+
+    def _alphas(self, h):
+        """(α∥, α⊥) per z against the flat fiducial of ``ap_fiducial`` (module docs)."""
+        om = self._ap_omega_m
+        hubble = np.atleast_1d(self.provider.get_Hubble(self.zs))
+        d_a = np.atleast_1d(self.provider.get_angular_diameter_distance(self.zs))
+        out = {}
+        for i, z in enumerate(self.zs):
+            zz = np.linspace(0.0, z, 2001)
+            e_fid = np.sqrt(om * (1 + zz) ** 3 + 1 - om)
+            # D_M,fid in Mpc/h: (c/100) ∫ dz/E_fid (Simpson).
+            w = np.ones_like(zz)
+            w[1:-1:2], w[2:-1:2] = 4.0, 2.0
+            dm_fid = 2997.92458 * (zz[1] - zz[0]) / 3.0 * np.sum(w / e_fid) if z > 0 else 0.0
+            e = hubble[i] / (100.0 * h)
+            dm = (1 + z) * d_a[i] * h
+            out[z] = (e_fid[-1] / e, dm / dm_fid if z > 0 else e_fid[-1] / e)
+        return out
 
     def must_provide(self, **requirements):
         super().must_provide(**requirements)
@@ -235,9 +277,11 @@ class PTMultipoles(Theory):
         for z in np.atleast_1d(options.get("z", [])):
             _close_index(self.zs, float(z), "requested pt_pk_ell z")
         for ell in options.get("ells") or []:
-            if int(ell) not in self.ells:
-                raise ValueError(f"PTMultipoles: multipole {ell} is requested but "
-                                 f"`ells` = {self.ells}")
+            ell = int(ell)
+            if ell < 0 or ell % 2 or ell > 8:
+                raise ValueError(f"PTMultipoles: requested multipole {ell} is not even and <= 8")
+            if ell not in self.ells:
+                self.ells = sorted(self.ells + [ell])
         k = np.atleast_1d(options.get("k", [])).astype(float)
         if k.size and self._k is not None:
             for ki in k:
@@ -271,6 +315,7 @@ class PTMultipoles(Theory):
         s8 = np.atleast_1d(self.provider.get_sigma8_z(self.zs))
         s8_0 = float(np.atleast_1d(self.provider.get_sigma8_z([0.0]))[0])
         spectra, errors, growth = {}, {}, {}
+        alphas = self._alphas(h) if self._ap_omega_m is not None else {}
         for i, z in enumerate(self.zs):
             p_lin = np.asarray(pk[_close_index(z_grid, z, "z of the Boltzmann P(k) grid")]) * h**3
             f, d = fs8[i] / s8[i], s8[i] / s8_0
@@ -285,7 +330,15 @@ class PTMultipoles(Theory):
                 if cached is None or cached[0] != digest:
                     cached = (digest, self._plan.terms(linear=(k_lin, p_lin), z=z, z_input=z))
                     self._terms[i] = cached
-                if self._ept:
+                if self._ept and z in alphas:
+                    apar, aperp = alphas[z]
+                    try:
+                        t = cached[1].multipoles(ells=self.ells, f=f, apar=apar, aperp=aperp, **nu)
+                    except ValueError as e:
+                        self.log.debug("z = %g: alpha_par %.4f, alpha_perp %.4f outside the plan: %s",
+                                       z, apar, aperp, e)
+                        return False
+                elif self._ept:
                     t = cached[1].multipoles(ells=self.ells, f=f, **nu)
                 else:
                     t = cached[1].multipoles(f=f, bias=nu["b"], amplitude=nu["A_b"], fog=self.fog,
@@ -300,6 +353,7 @@ class PTMultipoles(Theory):
         state["pt_pk_ell"] = spectra
         state["pt_pk_ell_err"] = errors
         state["pt_growth"] = growth
+        state["pt_ap"] = alphas
 
     # ---- products ----------------------------------------------------------------------------
     def _at(self, name, z):
@@ -317,6 +371,11 @@ class PTMultipoles(Theory):
     def get_pt_growth(self, z=None):
         """{z: (f, D)} with f = fσ8/σ8 and D = σ8(z)/σ8(0) of the Boltzmann code."""
         return self._at("pt_growth", z)
+
+    def get_pt_ap(self, z=None):
+        """{z: (α∥, α⊥)} against ``ap_fiducial`` (empty without it), or the pair of one z."""
+        values = self.current_state["pt_ap"]
+        return values if z is None else values[self.zs[_close_index(self.zs, z, "z")]]
 
     def get_pt_k(self):
         """The k grid [h/Mpc] of the multipoles."""

@@ -1,5 +1,11 @@
 """cobaya likelihoods for the multipoles of :mod:`pt_spectra.cobaya`.
 
+``SurveyMultipoles``: a survey measurement, as analyses of BOSS or DESI fit it: a data vector of any
+multipoles P_ℓ(k) (or ξ_ℓ(s)) with a full covariance (its inverse scaled by the Hartlap factor with
+``n_mocks``), the model taken through the survey window and the k bins (:class:`pt_spectra.Observation`)
+and, with the theory's ``ap_fiducial``, distorted by AP; a k range per multipole. Below it,
+``MultipoleGaussian``, the simplest case (diagonal errors, the model at the data's k).
+
 ``MultipoleGaussian``: a Gaussian likelihood with diagonal errors of measured multipoles at one
 redshift, logp = -χ²/2 with χ² = Σ_ℓ Σ_k [(P_ℓ^model - P_ℓ^data) / σ_ℓ]². The model is
 ``pt_pk_ell`` of a :class:`pt_spectra.cobaya.PTMultipoles` theory at the same k.
@@ -23,12 +29,14 @@ import os
 
 import numpy as np
 
+import pt_spectra as pt
+
 try:
     from cobaya.likelihood import Likelihood
 except ImportError as e:  # pragma: no cover - depends on the environment
     raise ImportError("pt_spectra.likelihoods needs cobaya: pip install cobaya camb") from e
 
-__all__ = ["MultipoleGaussian", "read_multipoles"]
+__all__ = ["MultipoleGaussian", "SurveyMultipoles", "read_multipoles"]
 
 
 def read_multipoles(path, data_ells=(0, 2, 4)):
@@ -126,3 +134,141 @@ class MultipoleGaussian(Likelihood):
     def logp(self, **params_values):
         chi2 = float(np.sum(((self.model() - self.data) * self.inv_sigma) ** 2))
         return -0.5 * chi2
+
+
+class SurveyMultipoles(Likelihood):
+    """Gaussian likelihood of survey multipoles with a full covariance, window and bins.
+
+    Options:
+
+    - ``data_file``, ``data_ells`` as :class:`MultipoleGaussian` (k [h/Mpc]; with ``xi: true`` the
+      first column is s [Mpc/h] and the values ξ_ℓ); ``z``; ``ells`` (the fitted multipoles, default
+      all in the file).
+    - ``covariance_file``: the full covariance of the data vector (text or ``.npy``), ℓ-major over
+      ``data_ells`` and every k of the file (the P0, P2, P4 blocks); default: the files' σ², diagonal.
+      ``n_mocks``: the number of mocks it was estimated from; C⁻¹ is scaled by (N − p − 2)/(N − 1), p
+      the fitted points (Hartlap et al. 2007).
+    - ``k_min``, ``k_max`` [h/Mpc] (s [Mpc/h] with ``xi``) and ``k_ranges`` ``{ℓ: [min, max]}``,
+      narrowing the range of one multipole.
+    - ``window``: a window file (Q_ℓ(s) multipoles ``s Q0 Q2 Q4 …`` or the BOSS format, or a window
+      matrix, as ``pt-spectra rsd --window``), ``window_mixing`` ("wilson", default, or
+      "classpt-boss"); ``k_edges`` [h/Mpc]: the data are k²-weighted bin means over these edges (then
+      the data's k column only labels the rows); ``box`` [Mpc/h] with ``k_edges``: the mean over the
+      modes of a periodic box. Wide-angle terms are neglected.
+    - ``xi: true``: the data are correlation-function multipoles; ``s_edges`` [Mpc/h]: s-bin means.
+
+    The theory (``pt_spectra.cobaya.PTMultipoles``, without its own ``k``) is asked for the model
+    multipoles the window needs (ℓ ≤ 8) on the window's k grid. ``logp = −χ²/2`` with χ² = rᵀ C⁻¹ r.
+    """
+
+    data_file: str | None = None
+    z: float | None = None
+    ells: list | None = None
+    data_ells: list = [0, 2, 4]
+    k_min: float = 0.0
+    k_max: float = np.inf
+    k_ranges: dict | None = None
+    covariance_file: str | None = None
+    n_mocks: int | None = None
+    window: str | None = None
+    window_mixing: str = "wilson"
+    k_edges: list | None = None
+    box: float | None = None
+    xi: bool = False
+    s_edges: list | None = None
+
+    def initialize(self):
+        if self.data_file is None or self.z is None:
+            raise ValueError("SurveyMultipoles: options `data_file` and `z` are required")
+        self.z = float(self.z)
+        data_ells = [int(ell) for ell in self.data_ells]
+        k, values, sigma = read_multipoles(self.data_file, data_ells)
+        ells = sorted(values) if self.ells is None else [int(ell) for ell in self.ells]
+        absent = [ell for ell in ells if ell not in values]
+        if absent:
+            raise ValueError(f"SurveyMultipoles: `ells` {absent} are not in {self.data_file}")
+        if self.xi:
+            if self.window is not None or self.k_edges is not None or self.box is not None:
+                raise ValueError("SurveyMultipoles: xi takes s_edges, not window, k_edges or box")
+            self.observation = pt.Observation.xi(ells, k, s_edges=self.s_edges)
+        else:
+            self.observation = pt.Observation(ells, k, window=self.window,
+                                              window_mixing=self.window_mixing,
+                                              k_edges=self.k_edges, box=self.box)
+        k_out = np.asarray(self.observation.k_out)
+        if k_out.size != k.size:
+            raise ValueError(f"SurveyMultipoles: the window and bins give {k_out.size} k, the data "
+                             f"file has {k.size} rows")
+        # The fitted points: per ℓ, its range.
+        ranges = {int(l): tuple(map(float, r)) for l, r in (self.k_ranges or {}).items()}
+        for ell in ranges:
+            if ell not in ells:
+                raise ValueError(f"SurveyMultipoles: k_ranges names multipole {ell}, not fitted")
+        mask = []
+        for ell in ells:
+            lo, hi = ranges.get(ell, (-np.inf, np.inf))
+            mask.append((k >= max(float(self.k_min), lo)) & (k <= min(float(self.k_max), hi)))
+        mask = np.array(mask)
+        points = int(mask.sum())
+        if points == 0:
+            raise ValueError("SurveyMultipoles: no data point in the fitted ranges")
+        n_k = k.size
+        index = np.concatenate([data_ells.index(ell) * n_k + np.flatnonzero(m)
+                                for ell, m in zip(ells, mask)])
+        if self.covariance_file is not None:
+            path = str(self.covariance_file)
+            cov = np.load(path) if path.endswith(".npy") else np.loadtxt(path)
+            n = len(data_ells) * n_k
+            if cov.shape != (n, n):
+                raise ValueError(f"SurveyMultipoles: covariance {path!r} is {cov.shape}, expected "
+                                 f"({n}, {n}) (data_ells x every k of the data file)")
+            cov = cov[np.ix_(index, index)]
+        else:
+            cov = np.diag(np.concatenate([sigma[ell][m] for ell, m in zip(ells, mask)]) ** 2)
+        if self.n_mocks is not None:
+            n_mocks = int(self.n_mocks)
+            if n_mocks < points + 3:
+                raise ValueError(f"SurveyMultipoles: n_mocks = {n_mocks} needs to exceed the "
+                                 f"{points} fitted points + 2 (Hartlap factor)")
+            cov = cov * (n_mocks - 1) / (n_mocks - points - 2)
+        try:
+            chol = np.linalg.cholesky(cov)
+        except np.linalg.LinAlgError as e:
+            raise ValueError("SurveyMultipoles: the fitted covariance block is not positive "
+                             "definite") from e
+        self._whiten = np.linalg.inv(chol)
+        self.ells, self._mask, self.points = ells, mask, points
+        self.data = np.concatenate([values[ell][m] for ell, m in zip(ells, mask)])
+        self._cols = None
+        self.log.info("%d points (multipoles %s) at z = %g; %s", points, ells, self.z,
+                      "; ".join(self.observation.description) or "no window, no bins")
+
+    def get_requirements(self):
+        return {"pt_pk_ell": {"z": [self.z], "k": np.asarray(self.observation.k_model).tolist(),
+                              "ells": list(self.observation.model_ells)},
+                "pt_k": None, "pt_ells": None}
+
+    def _select(self):
+        theory_k = np.asarray(self.provider.get_pt_k())
+        want = np.asarray(self.observation.k_model)
+        cols = np.searchsorted(theory_k, want)
+        cols = np.clip(cols, 0, theory_k.size - 1)
+        bad = ~np.isclose(theory_k[cols], want, rtol=1e-8, atol=0.0)
+        if bad.any():
+            raise ValueError("SurveyMultipoles: the theory's k grid lacks the window's k (give the "
+                             "theory no `k` option: it then takes the k the likelihoods ask for)")
+        theory_ells = list(self.provider.get_pt_ells())
+        self._rows = [theory_ells.index(ell) for ell in self.observation.model_ells]
+        self._cols = cols
+
+    def model(self):
+        """The observed model at the fitted points (the data vector's order)."""
+        if self._cols is None:
+            self._select()
+        p = np.asarray(self.provider.get_pt_pk_ell(z=self.z))[self._rows][:, self._cols]
+        observed, _ = self.observation.apply(np.ascontiguousarray(p))
+        return np.concatenate([np.asarray(observed)[j][m] for j, m in enumerate(self._mask)])
+
+    def logp(self, **params_values):
+        r = self._whiten @ (self.data - self.model())
+        return -0.5 * float(r @ r)

@@ -9,8 +9,20 @@ use pt_spectra::jobs::{self, EptRequest};
 use pt_spectra::rsd::ap::Distortion;
 use pt_spectra::rsd::ept::{EptParams, EptPlan as LibEptPlan, EptTerms as LibEptTerms};
 use pt_spectra::setup::Prepared;
+use pt_spectra::survey::observe::{Bins, Observation, Window};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+
+/// The distortion of `apar`, `aperp` (both or neither).
+fn distortion(apar: Option<f64>, aperp: Option<f64>) -> PyResult<Option<Distortion>> {
+    match (apar, aperp) {
+        (None, None) => Ok(None),
+        (Some(a), Some(b)) => Ok(Some(Distortion::new(a, b).map_err(value_error)?)),
+        _ => Err(pyo3::exceptions::PyValueError::new_err(
+            "give both apar and aperp (or neither)",
+        )),
+    }
+}
 
 /// The parameters of `kwargs` (velocileptors' names; f may be absent: f(z) of the cosmology).
 fn params(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<EptParams> {
@@ -37,7 +49,8 @@ pub(crate) struct EptPlan {
 #[pymethods]
 impl EptPlan {
     #[new]
-    #[pyo3(signature = (k, ir=true, apar=None, aperp=None, precision="default", q_range=None))]
+    #[pyo3(signature = (k, ir=true, apar=None, aperp=None, precision="default", q_range=None, free_ap=false))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         k: &Bound<'_, PyAny>,
@@ -46,19 +59,12 @@ impl EptPlan {
         aperp: Option<f64>,
         precision: &str,
         q_range: Option<(f64, f64)>,
+        free_ap: bool,
     ) -> PyResult<Self> {
         let k = floats(k, "k")?;
-        let ap = match (apar, aperp) {
-            (None, None) => None,
-            (Some(a), Some(b)) => Some(Distortion::new(a, b).map_err(value_error)?),
-            _ => {
-                return Err(pyo3::exceptions::PyValueError::new_err(
-                    "give both apar and aperp (or neither)",
-                ))
-            }
-        };
+        let ap = distortion(apar, aperp)?;
         let precision = crate::precision(precision, q_range, None, None)?;
-        let (plan, _) = detached(py, || jobs::ept_plan(&k, ir, ap, false, &precision))?;
+        let (plan, _) = detached(py, || jobs::ept_plan(&k, ir, ap, free_ap, &precision))?;
         Ok(Self { plan, precision })
     }
 
@@ -79,6 +85,7 @@ impl EptPlan {
         let request = EptRequest {
             params: params(kwargs)?,
             ells,
+            ap: None,
         };
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
         let ((table, prepared), seconds) = detached(py, || {
@@ -127,16 +134,19 @@ pub(crate) struct EptTerms {
 #[pymethods]
 impl EptTerms {
     /// The multipoles at the parameters of `kwargs` (velocileptors' names; f default f(z)).
-    #[pyo3(signature = (ells=vec![0, 2, 4], **kwargs))]
+    #[pyo3(signature = (ells=vec![0, 2, 4], apar=None, aperp=None, **kwargs))]
     fn multipoles(
         &self,
         py: Python<'_>,
         ells: Vec<usize>,
+        apar: Option<f64>,
+        aperp: Option<f64>,
         kwargs: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Table> {
         let request = EptRequest {
             params: params(kwargs)?,
             ells,
+            ap: distortion(apar, aperp)?,
         };
         let (table, seconds) = detached(py, || {
             jobs::ept_table_from_terms(
@@ -156,7 +166,8 @@ impl EptTerms {
 #[pyo3(signature = (data, k_max, free=vec!["f".to_string(), "b1".to_string()], marginalise=vec![],
     priors=None, ells=vec![0, 2], data_ells=vec![0, 2, 4], data_columns=None, covariance=None, k_min=0.0,
     ir=true, apar=None, aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default",
-    q_range=None, eh=None, n_mocks=None, **kwargs))]
+    q_range=None, eh=None, n_mocks=None, k_ranges=None, window=None, window_mixing="wilson",
+    k_edges=None, r#box=None, xi=false, s_edges=None, **kwargs))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit_ept(
     py: Python<'_>,
@@ -181,6 +192,13 @@ pub(crate) fn fit_ept(
     q_range: Option<(f64, f64)>,
     eh: Option<&str>,
     n_mocks: Option<usize>,
+    k_ranges: Option<std::collections::HashMap<usize, (f64, f64)>>,
+    window: Option<std::path::PathBuf>,
+    window_mixing: &str,
+    k_edges: Option<&Bound<'_, PyAny>>,
+    r#box: Option<f64>,
+    xi: bool,
+    s_edges: Option<&Bound<'_, PyAny>>,
     kwargs: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Table> {
     let (mut data, name) = crate::data(data, data_columns, &data_ells, &ells)?;
@@ -205,19 +223,44 @@ pub(crate) fn fit_ept(
         }
     }
     let mut start = params(kwargs)?;
-    let ap = match (apar, aperp) {
+    let ap = distortion(apar, aperp)?;
+    let mut ell_ranges: Vec<(usize, f64, f64)> = k_ranges
+        .unwrap_or_default()
+        .into_iter()
+        .map(|(l, (a, b))| (l, a, b))
+        .collect();
+    ell_ranges.sort_by_key(|r| r.0);
+    if xi && (window.is_some() || k_edges.is_some() || r#box.is_some()) {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "xi=True takes s_edges, not window, k_edges or box (a Landy-Szalay xi has the window divided out)",
+        ));
+    }
+    let s_edges = s_edges.map(|e| floats(e, "s_edges")).transpose()?;
+    let window = window
+        .map(|path| Window::read(&path, crate::survey::mixing(window_mixing)?).map_err(value_error))
+        .transpose()?;
+    let bins = match (k_edges.map(|e| floats(e, "k_edges")).transpose()?, r#box) {
         (None, None) => None,
-        (Some(a), Some(b)) => Some(Distortion::new(a, b).map_err(value_error)?),
-        _ => {
-            return Err(pyo3::exceptions::PyValueError::new_err(
-                "give both apar and aperp (or neither)",
-            ))
+        (Some(edges), None) => Some(Bins::Edges(edges)),
+        (Some(edges), Some(side)) => Some(Bins::Box { side, edges }),
+        (None, Some(_)) => {
+            return Err(pyo3::exceptions::PyValueError::new_err("box needs k_edges"))
         }
     };
+    let observation = match (xi, window, bins) {
+        (true, _, _) => Some(Observation::xi(&ells, &data.k, s_edges.as_deref())),
+        (false, None, None) => None,
+        (false, window, bins) => Some(Observation::new(&ells, &data.k, window, bins)),
+    }
+    .transpose()
+    .map_err(value_error)?;
+    let model_k = observation
+        .as_ref()
+        .map_or(data.k.clone(), |o| o.k_model().to_vec());
     let precision = crate::precision(precision, q_range, None, None)?;
     let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
     let ((table, prepared), seconds) = detached(py, || {
-        let prepared = inputs.prepare(&data.k)?;
+        let prepared = inputs.prepare(&model_k)?;
         if start.values[11].is_nan() {
             start.values[11] = prepared.growth_rate;
         }
@@ -231,10 +274,10 @@ pub(crate) fn fit_ept(
             ells,
             k_min,
             k_max: 0.0,
-            ell_ranges: vec![],
+            ell_ranges,
             n_mocks,
         };
-        let plan = jobs::ept_plan(&data.k, ir, ap, free_ap, &precision)?;
+        let plan = jobs::ept_plan(&model_k, ir, ap, free_ap, &precision)?;
         let terms = plan.terms(&prepared.spectrum)?;
         let header = vec![format!(
             "pt-spectra {} fit: ept ({}) to {name}",
@@ -245,7 +288,15 @@ pub(crate) fn fit_ept(
                 "no IR resummation"
             }
         )];
-        let table = jobs::ept_fit_table(&plan, &terms, &data, &request, &k_max, header, None)?;
+        let table = jobs::ept_fit_table(
+            &plan,
+            &terms,
+            &data,
+            &request,
+            &k_max,
+            header,
+            observation.as_ref(),
+        )?;
         Ok((table, prepared))
     })?;
     Table::new(py, table, &prepared, &precision, "ept fit", seconds)

@@ -27,6 +27,7 @@ mod halo;
 mod inputs;
 mod kernel;
 mod redshift;
+mod survey;
 mod tables;
 
 use inputs::Inputs;
@@ -292,6 +293,11 @@ fn real(
 
 /// A covariance matrix from a 2-D numpy array or nested lists.
 pub(crate) fn covariance_rows(c: &Bound<'_, PyAny>) -> PyResult<Vec<Vec<f64>>> {
+    matrix_rows(c, "covariance: expected a square 2-D array")
+}
+
+/// The rows of a 2-D numpy array or nested lists (`message` if it is neither).
+pub(crate) fn matrix_rows(c: &Bound<'_, PyAny>, message: &str) -> PyResult<Vec<Vec<f64>>> {
     match c.extract::<numpy::PyReadonlyArray2<'_, f64>>() {
         Ok(a) => Ok(a
             .as_array()
@@ -301,7 +307,7 @@ pub(crate) fn covariance_rows(c: &Bound<'_, PyAny>) -> PyResult<Vec<Vec<f64>>> {
             .collect()),
         Err(_) => c
             .extract()
-            .map_err(|_| PyValueError::new_err("covariance: expected a square 2-D array")),
+            .map_err(|_| PyValueError::new_err(message.to_string())),
     }
 }
 
@@ -562,6 +568,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<redshift::RsdTerms>()?;
     m.add_class::<ept::EptPlan>()?;
     m.add_class::<ept::EptTerms>()?;
+    m.add_class::<survey::Observation>()?;
     m.add_function(wrap_pyfunction!(ept::fit_ept, m)?)?;
     m.add_function(wrap_pyfunction!(real, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;

@@ -16,6 +16,9 @@ pub struct EptRequest {
     pub params: EptParams,
     /// Multipoles to compute (even, ≤ 8).
     pub ells: Vec<usize>,
+    /// A distortion replacing the plan's (on a plan built with an AP range, [`ept_plan`]'s
+    /// `free_ap`); `None`: the plan's own.
+    pub ap: Option<Distortion>,
 }
 
 /// The range of α∥, α⊥ of fits that free them: [`AP_FIT_RANGE`].0 … .1.
@@ -73,8 +76,9 @@ pub fn ept_table_from_terms(
     if params.values[11].is_nan() {
         params.values[11] = prepared.growth_rate;
     }
-    let m = plan.multipoles(terms, &params, &request.ells)?;
     let settings = plan.settings();
+    let ap = request.ap.or(settings.ap);
+    let m = plan.multipoles_at(terms, &params, &request.ells, ap)?;
     let values: Vec<String> = PARAM_NAMES
         .iter()
         .zip(params.values)
@@ -100,7 +104,7 @@ pub fn ept_table_from_terms(
     } else {
         "no IR resummation (--no-ir): plain 1-loop SPT in redshift space".into()
     });
-    if let Some(d) = settings.ap {
+    if let Some(d) = ap {
         header.push(format!(
             "Alcock-Paczynski: apar = {}, aperp = {}; the model on the log grid of the AP projection \
              (interpolated cubically in ln k), {}-point Gauss-Legendre in mu (error from half as many); \

@@ -269,7 +269,23 @@ impl EptPlan {
         params: &EptParams,
         ells: &[usize],
     ) -> Result<Vec<Vec<Estimate>>> {
+        self.multipoles_at(terms, params, ells, self.settings.ap)
+    }
+
+    /// [`Self::multipoles`] with the distortion `ap` instead of the plan's (as
+    /// [`Self::multipole_values_at`]).
+    ///
+    /// # Errors
+    /// As [`Self::multipole_values_at`].
+    pub fn multipoles_at(
+        &self,
+        terms: &EptTerms,
+        params: &EptParams,
+        ells: &[usize],
+        ap: Option<Distortion>,
+    ) -> Result<Vec<Vec<Estimate>>> {
         params.validate()?;
+        self.check_ap(ap)?;
         if let Some(&bad) = ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
             return Err(Error::InvalidParameter {
                 name: "multipole ell",
@@ -278,7 +294,7 @@ impl EptPlan {
             });
         }
         let model = terms.model(params);
-        let volume = self.settings.ap.map_or(1.0, |d| d.volume());
+        let volume = ap.map_or(1.0, |d| d.volume());
         let mut out = vec![Vec::with_capacity(self.k_out.len()); ells.len()];
         for (i, &k) in self.k_out.iter().enumerate() {
             let mut sums = [vec![0.0; ells.len()], vec![0.0; ells.len()]];
@@ -286,7 +302,7 @@ impl EptPlan {
             for (r, nodes) in self.rules.iter().enumerate() {
                 for (mu, w, legendre) in nodes {
                     let (mu, w) = (*mu, *w);
-                    let p = match &self.settings.ap {
+                    let p = match &ap {
                         None if self.grid.len() == self.k_out.len() => model.at(i, k, mu),
                         None => model.interpolated(k, mu)?,
                         Some(ap) => {
@@ -339,12 +355,7 @@ impl EptPlan {
         ap: Option<Distortion>,
     ) -> Result<Vec<Vec<f64>>> {
         params.validate()?;
-        if ap.is_some() && self.settings.ap.is_none() && self.settings.ap_range.is_none() {
-            return Err(Error::InvalidChoice {
-                what: "an Alcock-Paczynski distortion".into(),
-                reason: "the plan was built without AP (give EptSettings::ap or ap_range)".into(),
-            });
-        }
+        self.check_ap(ap)?;
         if let Some(&bad) = ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
             return Err(Error::InvalidParameter {
                 name: "multipole ell",
@@ -379,6 +390,19 @@ impl EptPlan {
             }
         }
         Ok(out)
+    }
+}
+
+impl EptPlan {
+    /// A distortion needs a plan built with one (its AP grid) or with an AP range.
+    fn check_ap(&self, ap: Option<Distortion>) -> Result<()> {
+        if ap.is_some() && self.settings.ap.is_none() && self.settings.ap_range.is_none() {
+            return Err(Error::InvalidChoice {
+                what: "an Alcock-Paczynski distortion".into(),
+                reason: "the plan was built without AP (give EptSettings::ap or ap_range)".into(),
+            });
+        }
+        Ok(())
     }
 }
 

@@ -233,6 +233,7 @@ pub fn table(
     let request = EptRequest {
         params,
         ells: shared.ells,
+        ap: None,
     };
     let (window, bins) = args.observation()?;
     if shared.xi.is_some() && (window.is_some() || bins.is_some()) {
