@@ -295,44 +295,5 @@ pub fn ept_observed_table(
     let mut model_request = request.clone();
     model_request.ells = observation.model_ells().to_vec();
     let model = ept_table_from_terms(plan, terms, &model_request, prepared, precision)?;
-    let column = |name: String| model.column(&name).map(<[f64]>::to_vec).unwrap_or_default();
-    let values: Vec<Vec<f64>> = model_request
-        .ells
-        .iter()
-        .map(|l| column(format!("P{l}")))
-        .collect();
-    let errors: Vec<Vec<f64>> = model_request
-        .ells
-        .iter()
-        .map(|l| column(format!("err_P{l}")))
-        .collect();
-    let observed = observation.apply(&values)?;
-    let carried = observation.apply(&errors)?;
-    let mut header: Vec<String> = model.header.clone();
-    header.extend(observation.description().iter().cloned());
-    let mut t = Table::new(header);
-    let (x, name, unit) = if observation.is_xi() {
-        (("s", "Mpc/h"), "xi", "1")
-    } else {
-        (("k", WAVENUMBER), "P", POWER)
-    };
-    t.push(x.0, x.1, observation.k_out().to_vec());
-    for (l, p) in request.ells.iter().zip(&observed) {
-        t.push(
-            format!("{name}{l}"),
-            unit,
-            p.iter().map(|e| e.value).collect(),
-        );
-    }
-    for ((l, p), c) in request.ells.iter().zip(&observed).zip(&carried) {
-        t.push(
-            format!("err_{name}{l}"),
-            unit,
-            p.iter()
-                .zip(c)
-                .map(|(e, c)| e.error + c.value.abs())
-                .collect(),
-        );
-    }
-    Ok(t)
+    super::observed_table(&model, observation)
 }

@@ -38,6 +38,7 @@ mod bias;
 mod ept;
 mod fit;
 mod halo;
+mod observe;
 mod rsd;
 pub use bias::BiasOutput;
 pub use ept::{
@@ -45,6 +46,7 @@ pub use ept::{
 };
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use halo::{halo_table, HaloRequest};
+pub use observe::observed_table;
 pub use rsd::{
     describe_sigma0, no_wiggle_multipoles, rsd_table, rsd_table_from_terms,
     rsd_table_with_bias_terms, xi_table, NonlinearBias, RsdRequest, SN_LEVELS,

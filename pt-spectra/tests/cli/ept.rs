@@ -282,7 +282,10 @@ fn ept_window_and_bins() {
     assert!(ok, "{err}");
     assert_eq!(rows(&boxed).len(), 2);
     fails_naming(&[
-        (vec!["rsd", "--rsd", "tns", "--window", &window], "--window"),
+        (
+            vec!["rsd", "--rsd", "tns", "--window", &window, "--terms"],
+            "--terms",
+        ),
         (vec!["rsd", "--rsd", "ept", "--k-edges", "0.1"], "--k-edges"),
         (
             vec![

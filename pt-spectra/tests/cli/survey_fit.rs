@@ -251,3 +251,53 @@ fn a_range_per_multipole_leaves_out_the_points_beyond_it() {
         ),
     ]);
 }
+
+/// The paper's models through a window: one that cuts nothing (Q0 = 1 to s = 1e9 Mpc/h) leaves linear
+/// Kaiser's multipoles as they are; --terms with a window, and a window in a paper model's fit, are
+/// refused.
+#[test]
+fn paper_models_take_a_window() {
+    let dir = super::scratch("paper_window");
+    let mut text = String::from("# s Q0 Q2 Q4\n");
+    for i in 0..600 {
+        let s = 1e-3 * (1e12f64).powf(f64::from(i) / 599.0);
+        text += &format!("{s:e} 1 0 0\n");
+    }
+    let window = super::write(&dir, "window.txt", &text);
+    let base = [
+        "rsd", "--rsd", "kaiser", "--real", "linear", "--bias", "2", "--f", "0.7", "--k-min",
+        "0.02", "--k-max", "0.25", "--nk", "12",
+    ];
+    let (ok, plain, err) = run(&base);
+    assert!(ok, "{err}");
+    let mut windowed = base.to_vec();
+    windowed.extend(["--window", &window]);
+    let (ok, out, err) = run(&windowed);
+    assert!(ok, "{err}");
+    assert!(out.contains("wide-angle terms neglected"));
+    let (a, b) = (rows(&plain), rows(&out));
+    let largest = a.iter().fold(0.0_f64, |m, r| m.max(r[1]));
+    for (r, w) in a.iter().zip(&b) {
+        assert!((r[0] / w[0] - 1.0).abs() < 1e-12);
+        for l in 1..4 {
+            assert!(
+                (r[l] - w[l]).abs() < 2e-5 * largest,
+                "k {} column {l}: {} vs {}",
+                r[0],
+                r[l],
+                w[l]
+            );
+        }
+    }
+    let mut terms = windowed.clone();
+    terms.push("--terms");
+    fails_naming(&[
+        (terms, "--terms"),
+        (
+            vec![
+                "fit", "--rsd", "tns", "--data", &window, "--window", &window,
+            ],
+            "--window",
+        ),
+    ]);
+}

@@ -54,20 +54,20 @@ pub struct EptArgs {
     /// ept without IR resummation of the BAO: plain 1-loop SPT in redshift space.
     #[arg(long)]
     no_ir: bool,
-    /// ept: convolve with a survey window: Q_ℓ(s) multipoles (`s Q0 Q2 Q4 …`, s in Mpc/h, or the BOSS
+    /// Any model (fit: ept): convolve with a survey window: Q_ℓ(s) multipoles (`s Q0 Q2 Q4 …`, s in Mpc/h, or the BOSS
     /// DR12 file of Q0 Q2 Q4 without s), or a window matrix (`.npy` with a `.npy.txt` sidecar, or text
     /// with an `ells_out` header). Wide-angle terms are neglected.
     #[arg(long, value_name = "FILE")]
     window: Option<std::path::PathBuf>,
-    /// ept: how Q_ℓ mix the multipoles: wilson (Wilson et al. 2017, every Q_ℓ given; the default) or
+    /// How Q_ℓ mix the multipoles: wilson (Wilson et al. 2017, every Q_ℓ given; the default) or
     /// classpt-boss (the CLASS-PT BOSS likelihoods: Q ≤ 4, no ξ4 in ξ̂0, ξ̂2).
     #[arg(long, value_name = "M", default_value = "wilson")]
     window_mixing: String,
-    /// ept: average over k bins with the k² (mode-count) weight: edges [h/Mpc] as `a,b,c,…` or
+    /// Any model (fit: ept): average over k bins with the k² (mode-count) weight: edges [h/Mpc] as `a,b,c,…` or
     /// `start:end:step`; the output k are the bins' effective k.
     #[arg(long, value_name = "EDGES")]
     k_edges: Option<String>,
-    /// ept: average over the discrete modes of a periodic box of side L [Mpc/h] in the bins of
+    /// Any model (fit: ept): average over the discrete modes of a periodic box of side L [Mpc/h] in the bins of
     /// --k-edges (what simulation measurements are).
     #[arg(long, value_name = "L", requires = "k_edges")]
     r#box: Option<f64>,
@@ -109,14 +109,6 @@ impl EptArgs {
         .collect();
         if self.no_ir {
             out.push("--no-ir");
-        }
-        for (flag, given) in [
-            ("--window", self.window.is_some()),
-            ("--k-edges", self.k_edges.is_some()),
-        ] {
-            if given {
-                out.push(flag);
-            }
         }
         out
     }

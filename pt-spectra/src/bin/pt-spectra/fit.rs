@@ -417,6 +417,10 @@ pub fn run(args: &Args) -> Result<()> {
         ("--marginalise", args.marginalise.is_some()),
         ("--xi", args.xi),
         ("--k-range-ell", !args.k_range_ell.is_empty()),
+        (
+            "--window/--k-edges/--box (fit --rsd ept takes them)",
+            args.ept.has_window() || args.ept.has_bins(),
+        ),
         ("--prior", !args.prior.is_empty()),
         ("--n-mocks", args.n_mocks.is_some()),
         (

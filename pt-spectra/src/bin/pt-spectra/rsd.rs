@@ -12,6 +12,7 @@ use pt_spectra::real::RealModel;
 use pt_spectra::rsd::ap::Distortion;
 use pt_spectra::rsd::{Fog, Observed, RsdModel, RsdPlan, Sigma0};
 use pt_spectra::setup::NamedCosmology;
+use pt_spectra::survey::observe::Observation;
 use std::path::PathBuf;
 
 /// Arguments of `pt-spectra rsd`.
@@ -238,6 +239,23 @@ pub fn run(args: &Args) -> Result<()> {
     let request = args.request()?;
     request.validate_galaxy()?;
     let mut request = request;
+    // A window or bins: the model on their model k, with every multipole they need.
+    let (window, bins) = args.ept.observation()?;
+    let observation = if window.is_some() || bins.is_some() {
+        if args.xi || args.terms {
+            bail!("--window/--k-edges/--box take neither --xi nor --terms (the observed table has the multipoles only)");
+        }
+        Some(Observation::new(&request.ells, &k, window, bins)?)
+    } else {
+        None
+    };
+    let k = match &observation {
+        Some(o) => {
+            request.ells = o.model_ells().to_vec();
+            o.k_model().to_vec()
+        }
+        None => k,
+    };
     let grid = match distortion {
         Some(distortion) => {
             let grid = distortion.internal_grid(&k)?;
@@ -253,6 +271,10 @@ pub fn run(args: &Args) -> Result<()> {
         plan = plan.with_bias_terms()?;
     }
     let table = rsd_table(&plan, &request, &loaded.prepared, &bars)?;
+    if let Some(o) = &observation {
+        let observed = pt_spectra::jobs::observed_table(&table, o)?;
+        return write_output(args.out.as_ref(), &observed);
+    }
     finish(args, &table, &request.ells)
 }
 
