@@ -44,6 +44,19 @@ pub enum Error {
         hint: &'static str,
     },
 
+    /// A plan used for a model it was not built for.
+    #[error(
+        "the plan was built for {found}, but {expected} is asked for: build the plan for it{hint}"
+    )]
+    PlanMismatch {
+        /// What the request needs, e.g. `model 2l-spt`.
+        expected: String,
+        /// What the plan is for.
+        found: String,
+        /// How to build the right plan (may be empty).
+        hint: &'static str,
+    },
+
     /// Two inputs that must share a k grid do not.
     #[error("{what}: {found} does not match the {expected} it must match")]
     GridMismatch {
@@ -313,11 +326,7 @@ pub enum Error {
         source: Box<Error>,
     },
     /// A parameter-file key whose value is outside the plausible range of its quantity.
-    #[error(
-        "{origin}:{line}: {key} is outside the plausible range of {}, {}{hint}",
-        .range.name,
-        .range.describe()
-    )]
+    #[error("{origin}:{line}: {key} is outside the plausible range of {quantity}, {range}{hint}")]
     Implausible {
         /// File path or description of the input.
         origin: String,
@@ -326,8 +335,10 @@ pub enum Error {
         /// The `key = value` as written, quoted, with the quantity's value where the units differ,
         /// e.g. `` `H0 = 6766` (h = 67.66)``.
         key: String,
-        /// The range.
-        range: &'static crate::cosmology::Plausible,
+        /// The quantity (`h`, `A_s`, …: [`crate::cosmology::Plausible::name`]).
+        quantity: &'static str,
+        /// Its plausible range, `[min, max]`.
+        range: String,
         /// A guess at what was meant (may be empty), e.g. that h was given as H0.
         hint: &'static str,
     },

@@ -19,8 +19,9 @@ use crate::error::{Error, Result};
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct Precision {
-    /// The preset these settings started from (`fast`, `default`, `reference`), for table headers.
-    pub preset: &'static str,
+    /// The preset these settings started from (`fast`, `default`, `reference`); headers print
+    /// [`label`](Precision::label), which also says which of its fields were changed.
+    preset: &'static str,
     /// Lower limit of every loop integral over q [h/Mpc]; P = 0 below. Default 1e-5, as FAST-PT's
     /// `low_extrap = −5` with which the reference tables were made; below the linear table the
     /// spectrum's power-law extrapolation is used.
@@ -222,6 +223,62 @@ impl Precision {
         }
     }
 
+    /// The preset these settings started from (`fast`, `default` or `reference`).
+    pub fn preset_name(&self) -> &'static str {
+        self.preset
+    }
+
+    /// What table headers say: the preset's name, followed by ` (modified: …)` with the fields that
+    /// differ from it, except those stated on their own in headers or not about accuracy (q_min, q_max,
+    /// two_loop, two_loop_tolerance, max_memory).
+    pub fn label(&self) -> String {
+        let base = Self::preset(self.preset).unwrap_or_default();
+        let changed: Vec<&str> = [
+            ("lattice_step", self.lattice_step != base.lattice_step),
+            ("p13_cell_order", self.p13_cell_order != base.p13_cell_order),
+            ("p22_order", self.p22_order != base.p22_order),
+            (
+                "p22_narrow_order",
+                self.p22_narrow_order != base.p22_narrow_order,
+            ),
+            (
+                "p22_narrow_width",
+                self.p22_narrow_width != base.p22_narrow_width,
+            ),
+            ("p22_ln_width", self.p22_ln_width != base.p22_ln_width),
+            (
+                "p22_tail_growth",
+                self.p22_tail_growth != base.p22_tail_growth,
+            ),
+            (
+                "p22_linear_width",
+                self.p22_linear_width != base.p22_linear_width,
+            ),
+            ("p22_band_end", self.p22_band_end != base.p22_band_end),
+            (
+                "p22_error_floor",
+                self.p22_error_floor != base.p22_error_floor,
+            ),
+            (
+                "two_loop_points",
+                self.two_loop_points != base.two_loop_points,
+            ),
+            (
+                "two_loop_replicas",
+                self.two_loop_replicas != base.two_loop_replicas,
+            ),
+            ("two_loop_seed", self.two_loop_seed != base.two_loop_seed),
+        ]
+        .into_iter()
+        .filter_map(|(name, differs)| differs.then_some(name))
+        .collect();
+        if changed.is_empty() {
+            self.preset.to_string()
+        } else {
+            format!("{} (modified: {})", self.preset, changed.join(", "))
+        }
+    }
+
     /// These settings with the loop integrals over q ∈ [`q_min`, `q_max`] h/Mpc.
     ///
     /// # Errors
@@ -344,14 +401,22 @@ mod tests {
         };
         assert!(p.validate().unwrap_err().to_string().contains("p22_order"));
         for name in Precision::PRESETS {
-            assert_eq!(Precision::preset(name).unwrap().preset, name);
+            assert_eq!(Precision::preset(name).unwrap().preset_name(), name);
+            assert_eq!(Precision::preset(name).unwrap().label(), name);
         }
         assert!(Precision::preset("best")
             .unwrap_err()
             .to_string()
             .contains("fast, default"));
         let p = Precision::fast().with_q_range(1e-4, 10.0).unwrap();
-        assert_eq!((p.q_min, p.q_max, p.preset), (1e-4, 10.0, "fast"));
+        assert_eq!((p.q_min, p.q_max, p.label().as_str()), (1e-4, 10.0, "fast"));
+        let mut q = Precision::fast();
+        q.lattice_step = 0.005;
+        q.two_loop_replicas = 4;
+        assert_eq!(
+            q.label(),
+            "fast (modified: lattice_step, two_loop_replicas)"
+        );
         assert!(Precision::fast().with_q_range(1.0, 0.5).is_err());
         assert!(Precision::fast().with_q_range(f64::NAN, 0.5).is_err());
     }

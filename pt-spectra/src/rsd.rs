@@ -26,7 +26,7 @@ pub mod ap;
 pub mod ept;
 mod multipoles;
 pub use multipoles::{
-    multipoles, GalaxyTerms, Observed, RsdMultipoles, RsdPlan, RsdSettings, Sigma0,
+    multipoles, Dispersions, GalaxyTerms, Observed, RsdMultipoles, RsdPlan, RsdSettings, Sigma0,
 };
 
 /// Largest multipole order ℓ supported.

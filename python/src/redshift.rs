@@ -213,6 +213,7 @@ impl RsdPlan {
             prepared,
             precision: self.plan.real().precision().clone(),
             rsd: self.rsd,
+            dispersions: pt_spectra::rsd::Dispersions::default(),
         })
     }
 }
@@ -296,6 +297,8 @@ pub(crate) struct RsdTerms {
     prepared: Prepared,
     precision: pt_spectra::precision::Precision,
     rsd: RsdModel,
+    /// The theory σ0 of this spectrum, computed at the first call that asks for it.
+    dispersions: pt_spectra::rsd::Dispersions,
 }
 
 #[pymethods]
@@ -336,12 +339,13 @@ impl RsdTerms {
         let request = rsd_request(py, self.rsd, bias, sigma0, noise_table, settings)?;
         let ((table, prepared), seconds) = detached(py, || {
             let prepared = with_growth(self.prepared.clone(), growth_factor)?;
-            let table = jobs::rsd_table_from_terms(
+            let table = jobs::rsd_table_from_terms_memo(
                 &self.spectra,
                 self.tns.as_ref(),
                 &self.precision,
                 &request,
                 &prepared,
+                &self.dispersions,
             )?;
             Ok((table, prepared))
         })?;

@@ -39,7 +39,7 @@ impl Table {
             "cosmology_parameters",
             prepared.cosmology.cosmology.describe(),
         )?;
-        meta.set_item("precision", precision.preset)?;
+        meta.set_item("precision", precision.label())?;
         meta.set_item("q_range", (precision.q_min, precision.q_max))?;
         meta.set_item("model", model)?;
         meta.set_item("linear", prepared.spectrum.origin())?;

@@ -490,7 +490,8 @@ impl<'a> Values<'a> {
                                 crate::error::number(&value)
                             ),
                         },
-                        range,
+                        quantity: range.name,
+                        range: range.describe(),
                         hint: range.hint(value),
                     });
                 }

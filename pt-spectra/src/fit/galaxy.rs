@@ -251,10 +251,10 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 /// Solves F a = b for symmetric positive definite F: (a, F⁻¹, ln det F).
 fn solve_spd(f: &[Vec<f64>], b: &[f64]) -> Result<(Vec<f64>, Vec<Vec<f64>>, f64)> {
     let n = b.len();
-    let l = cholesky(f).ok_or(Error::InvalidParameter {
-        name: "marginalised parameters",
-        value: n as f64,
-        reason: "their templates are degenerate on the fitted data (give them priors or fewer)",
+    let l = cholesky(f).ok_or_else(|| Error::InvalidChoice {
+        what: format!("the {n} marginalised (or free) parameters"),
+        reason: "their templates are degenerate on the fitted data (give them priors, or fewer)"
+            .into(),
     })?;
     let log_det = 2.0 * (0..n).map(|i| l[i][i].ln()).sum::<f64>();
     let solve = |rhs: &[f64]| {
@@ -531,10 +531,9 @@ pub fn fit_galaxy_observed(
             }
         }
     }
-    let l = cholesky(&cov).ok_or(Error::InvalidParameter {
-        name: "covariance",
-        value: points as f64,
-        reason: "the fitted block is not positive definite",
+    let l = cholesky(&cov).ok_or_else(|| Error::InvalidChoice {
+        what: format!("the covariance of the {points} fitted points"),
+        reason: "is not positive definite".into(),
     })?;
     let whiten = lower_inverse(&l);
     let raw: Vec<f64> = fitted.iter().map(|&(r, i)| data.values[r][i]).collect();

@@ -284,25 +284,34 @@ pub fn delta_chi2(n: usize) -> f64 {
 /// Checks that `free` names 1 to 4 distinct parameters and that `model` is on the grid and ells of
 /// `data`.
 fn check(model: &MultipoleModel, data: &MultipoleData, free: &[Parameter]) -> Result<()> {
-    if free.is_empty() || free.len() > 4 || (1..free.len()).any(|i| free[..i].contains(&free[i])) {
-        return Err(Error::InvalidParameter {
-            name: "number of distinct free parameters",
-            value: free.len() as f64,
-            reason: "must be 1 to 4 distinct of f, sigma0, ab, cs2",
+    let names = || free.iter().map(|p| p.name()).collect::<Vec<_>>().join(",");
+    if let Some(i) = (1..free.len()).find(|&i| free[..i].contains(&free[i])) {
+        return Err(Error::InvalidChoice {
+            what: format!("free parameters {}", names()),
+            reason: format!("{} is named twice", free[i].name()),
         });
     }
+    if free.is_empty() || free.len() > 4 {
+        return Err(Error::InvalidChoice {
+            what: format!("free parameters `{}`", names()),
+            reason: "name 1 to 4 of f, sigma0, ab, cs2".into(),
+        });
+    }
+    let describe = |k: &[f64]| match (k.first(), k.last()) {
+        (Some(a), Some(b)) => format!("{} k in [{a:e}, {b:e}] h/Mpc", k.len()),
+        _ => "no k".into(),
+    };
     if model.k() != data.k.as_slice() {
-        return Err(Error::InvalidParameter {
-            name: "model k grid",
-            value: model.k().len() as f64,
-            reason: "must be the data k grid",
+        return Err(Error::GridMismatch {
+            what: "the fit's model and data",
+            expected: describe(&data.k),
+            found: describe(model.k()),
         });
     }
     if model.ells() != data.ells.as_slice() {
-        return Err(Error::InvalidParameter {
-            name: "number of multipoles",
-            value: model.ells().len() as f64,
-            reason: "the model must have the data's ells, in order",
+        return Err(Error::InvalidChoice {
+            what: format!("the model's multipoles {:?}", model.ells()),
+            reason: format!("must be the data's {:?}, in order", data.ells),
         });
     }
     Ok(())

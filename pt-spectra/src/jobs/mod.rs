@@ -49,7 +49,8 @@ pub use halo::{halo_table, HaloRequest};
 pub use observe::observed_table;
 pub use rsd::{
     describe_sigma0, no_wiggle_multipoles, rsd_table, rsd_table_from_terms,
-    rsd_table_with_bias_terms, xi_table, NonlinearBias, RsdRequest, SN_LEVELS,
+    rsd_table_from_terms_memo, rsd_table_with_bias_terms, xi_table, NonlinearBias, RsdRequest,
+    SN_LEVELS,
 };
 
 /// The version of pt-spectra, for table headers.
@@ -80,7 +81,7 @@ pub fn describe_inputs(prepared: &Prepared, precision: &Precision) -> Vec<String
          {:e}] h/Mpc and is extended by power laws (slopes {low:.3}, {high:.3})",
         precision.q_min,
         precision.q_max,
-        precision.preset,
+        precision.label(),
         spectrum.k_min(),
         spectrum.k_max(),
     ));
@@ -110,7 +111,7 @@ pub fn two_loop_line(precision: &Precision) -> String {
 /// header states c_s² and, with `terms`, the columns `P_ct_dd P_ct_dt P_ct_tt` give it.
 ///
 /// # Errors
-/// [`Error::GridMismatch`] if the plan does not cover the selection ([`RealPlan::for_selection`]); as [`RealPlan::evaluate`],
+/// [`Error::PlanMismatch`] if the plan does not cover the selection ([`RealPlan::for_selection`]); as [`RealPlan::evaluate`],
 /// [`RealSpectra::with_counterterm`] and [`Prepared::no_wiggle`].
 pub fn real_table(
     plan: &RealPlan,
@@ -152,10 +153,10 @@ pub fn real_table_with_bias(
 ) -> Result<Table> {
     let bias_terms = bias::terms(plan, bias_plan, selection, prepared, bias)?;
     if !plan.covers(selection) {
-        return Err(Error::GridMismatch {
-            what: "real-space plan and model",
-            expected: format!("a plan for {}", selection.plan_model()),
-            found: format!("a plan for {}", plan.model()),
+        return Err(Error::PlanMismatch {
+            expected: format!("model {}", selection.plan_model()),
+            found: format!("model {}", plan.model()),
+            hint: " (RealPlan::for_selection)",
         });
     }
     crate::real::check_cs2(cs2)?;

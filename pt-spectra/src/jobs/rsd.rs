@@ -199,6 +199,23 @@ pub fn rsd_table_from_terms(
     rsd_table_with_bias_terms(spectra, tns, None, precision, request, prepared)
 }
 
+/// [`rsd_table_from_terms`] with the theory σ0 of the spectrum kept in `memo` between calls
+/// ([`crate::rsd::Dispersions`], one per spectrum and precision): the steps of a chain with
+/// `sigma0 = lin` or `1l-spt` then integrate it once.
+///
+/// # Errors
+/// As [`rsd_table`].
+pub fn rsd_table_from_terms_memo(
+    spectra: &RealSpectra,
+    tns: Option<&TnsTerms>,
+    precision: &Precision,
+    request: &RsdRequest,
+    prepared: &Prepared,
+    memo: &crate::rsd::Dispersions,
+) -> Result<Table> {
+    rsd_table_memo(spectra, tns, None, precision, request, prepared, memo)
+}
+
 /// [`rsd_table_from_terms`] with the bias terms of the spectrum, which a request with nonlinear bias
 /// ([`RsdRequest::galaxy`]) needs.
 ///
@@ -213,13 +230,29 @@ pub fn rsd_table_with_bias_terms(
     request: &RsdRequest,
     prepared: &Prepared,
 ) -> Result<Table> {
+    let memo = crate::rsd::Dispersions::default();
+    rsd_table_memo(
+        spectra, tns, bias_terms, precision, request, prepared, &memo,
+    )
+}
+
+/// The body of the tables above, the theory σ0 kept in `memo`.
+fn rsd_table_memo(
+    spectra: &RealSpectra,
+    tns: Option<&TnsTerms>,
+    bias_terms: Option<BiasTerms>,
+    precision: &Precision,
+    request: &RsdRequest,
+    prepared: &Prepared,
+    memo: &crate::rsd::Dispersions,
+) -> Result<Table> {
     let k = &spectra.k;
     let f = request.f.unwrap_or(prepared.growth_rate);
     check_growth_rate(f)?;
     let growth = prepared.growth_factor;
     let sigma0 = request
         .sigma0
-        .resolve(&prepared.spectrum, growth, precision)?;
+        .resolve_with(&prepared.spectrum, growth, precision, memo)?;
     let sigma = fog_sigma(sigma0, growth, f);
     let bias = request.bias.values(k, request.amplitude)?;
     request.validate_galaxy()?;

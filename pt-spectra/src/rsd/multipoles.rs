@@ -413,12 +413,55 @@ impl Sigma0 {
         growth_factor: f64,
         precision: &Precision,
     ) -> Result<f64> {
+        self.resolve_with(spectrum, growth_factor, precision, &Dispersions::default())
+    }
+
+    /// [`Self::resolve`] with the theory values of `spectrum` at `precision` kept in `memo` (computed
+    /// at its first use: the 1-loop value needs a 400-node 1-loop plan). `memo` must belong to this
+    /// spectrum and precision.
+    ///
+    /// # Errors
+    /// As [`dispersion_theory`].
+    pub fn resolve_with(
+        self,
+        spectrum: &LinearSpectrum,
+        growth_factor: f64,
+        precision: &Precision,
+        memo: &Dispersions,
+    ) -> Result<f64> {
         match self {
             Sigma0::Value(v) => Ok(v),
             Sigma0::Theory(input) => {
-                Ok(dispersion_theory(spectrum, input, precision)?.value / growth_factor)
+                let cell = match input {
+                    DispersionInput::Linear => &memo.linear,
+                    DispersionInput::OneLoopSpt => &memo.one_loop,
+                };
+                let value = match cell.get() {
+                    Some(&v) => v,
+                    None => {
+                        let v = dispersion_theory(spectrum, input, precision)?.value;
+                        *cell.get_or_init(|| v)
+                    }
+                };
+                Ok(value / growth_factor)
             }
         }
+    }
+}
+
+/// The theory velocity dispersions σ_v [Mpc/h] of one linear spectrum at one precision, each computed
+/// at its first use ([`Sigma0::resolve_with`]): what a chain's fast steps with `sigma0 = lin` or `1l-spt`
+/// reuse instead of integrating again.
+#[derive(Debug, Default)]
+pub struct Dispersions {
+    linear: std::sync::OnceLock<f64>,
+    one_loop: std::sync::OnceLock<f64>,
+}
+
+impl Dispersions {
+    /// The values computed so far: (linear, 1-loop SPT), σ_v at the spectrum's redshift [Mpc/h].
+    pub fn computed(&self) -> (Option<f64>, Option<f64>) {
+        (self.linear.get().copied(), self.one_loop.get().copied())
     }
 }
 

@@ -56,6 +56,35 @@ fn damped_multipoles_match_closed_forms_and_tend_to_the_undamped_ones() {
     }
 }
 
+/// The memo of `Sigma0::resolve_with` holds each theory value after its first use and gives what
+/// `resolve` integrates, divided by the growth factor of each call.
+#[test]
+fn theory_sigma0_is_computed_once_per_spectrum() {
+    use crate::linear::LinearSpectrum;
+    use crate::precision::Precision;
+    let p = LinearSpectrum::gm2012(0.0).unwrap();
+    let precision = Precision::fast();
+    let memo = Dispersions::default();
+    assert_eq!(memo.computed(), (None, None));
+    let s = Sigma0::Theory(DispersionInput::OneLoopSpt);
+    let first = s.resolve_with(&p, 1.0, &precision, &memo).unwrap();
+    let (lin, one) = memo.computed();
+    assert!(lin.is_none() && one == Some(first));
+    assert_eq!(first, s.resolve(&p, 1.0, &precision).unwrap());
+    let half = s.resolve_with(&p, 0.5, &precision, &memo).unwrap();
+    assert!((half - 2.0 * first).abs() < 1e-12 * first);
+    let lin = Sigma0::Theory(DispersionInput::Linear)
+        .resolve_with(&p, 1.0, &precision, &memo)
+        .unwrap();
+    assert_eq!(memo.computed(), (Some(lin), Some(first)));
+    assert_eq!(
+        Sigma0::Value(3.0)
+            .resolve_with(&p, 0.5, &precision, &memo)
+            .unwrap(),
+        3.0
+    );
+}
+
 #[test]
 fn linear_theory_dispersion_is_sigma_v() {
     use crate::linear::LinearSpectrum;
