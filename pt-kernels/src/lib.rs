@@ -16,7 +16,7 @@
 //! * [`generated`]: the raw generic functions behind all of these. Prefer the wrappers above: they call
 //!   instances compiled once in this crate for `f64` and `BigRational` ([`Evaluate`]), whereas a direct
 //!   call instantiates a kernel of up to ~9,000 statements anew in the calling crate;
-//! * [`reference`]: a slow, obviously correct evaluator (the unsymmetrised recursion averaged over all n!
+//! * [`reference`](mod@reference): a slow, obviously correct evaluator (the unsymmetrised recursion averaged over all n!
 //!   permutations), the oracle the generated code is tested against.
 //!
 //! ```

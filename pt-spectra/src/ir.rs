@@ -11,7 +11,7 @@
 //!   scale ℓ = [`BAO_SCALE`] and k_s = [`SIGMA_CUTOFF`] (the choices of CLASS-PT, Chudaykin, Ivanov,
 //!   Philcox & Simonović 2020).
 //! * **Models** (per pair X, Y, with the loop terms P^(n)[·] of the no-wiggle and full spectra and
-//!   P^(n)_w = P^(n)[P_lin] − P^(n)[P_nw]):
+//!   P^(n)_w = P^(n)\[P_lin\] − P^(n)\[P_nw\]):
 //!   - `1l-spt-ir`: P_nw + P^(1)_nw + e^{−k²Σ²}[(1 + k²Σ²) P_w + P^(1)_w];
 //!   - `2l-spt-ir`: P_nw + P^(1)_nw + P^(2)_nw + e^{−k²Σ²}[(1 + k²Σ² + k⁴Σ⁴/2) P_w + (1 + k²Σ²) P^(1)_w
 //!     + P^(2)_w].

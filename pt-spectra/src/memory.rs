@@ -76,7 +76,7 @@ pub fn env_max_memory() -> Result<Option<f64>> {
 /// The fraction of the machine's memory a plan may take by default.
 pub const DEFAULT_FRACTION: f64 = 0.5;
 
-/// The estimated peak memory [bytes] of a plan of `parts` on `nk` output wavenumbers (the 1-loop terms
+/// The estimated peak memory \[bytes\] of a plan of `parts` on `nk` output wavenumbers (the 1-loop terms
 /// are always part of it).
 pub fn plan_bytes(nk: usize, parts: PlanParts, precision: &Precision) -> f64 {
     // The P22-type rules have ~(order / panel width)² nodes per k; 20² at the default.
@@ -107,7 +107,7 @@ pub fn plan_bytes(nk: usize, parts: PlanParts, precision: &Precision) -> f64 {
     fixed + per_k * nk as f64
 }
 
-/// The total memory of this machine [bytes] (`MemTotal` of `/proc/meminfo`), if known.
+/// The total memory of this machine \[bytes\] (`MemTotal` of `/proc/meminfo`), if known.
 pub fn machine_bytes() -> Option<f64> {
     let text = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;

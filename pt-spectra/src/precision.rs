@@ -80,7 +80,7 @@ pub struct Precision {
     /// How the 2-loop terms (P15 and the 2-loop correction) of a spectrum are computed: from basis
     /// tensors or by direct integration ([`TwoLoopMethod`]). Default [`TwoLoopMethod::Auto`].
     pub two_loop: TwoLoopMethod,
-    /// The most memory [bytes] a plan may take: a plan whose estimate ([`crate::memory`]) exceeds it
+    /// The most memory \[bytes\] a plan may take: a plan whose estimate ([`crate::memory`]) exceeds it
     /// is refused before it allocates. Default `None`: half of the machine's memory.
     pub max_memory: Option<f64>,
 }

@@ -25,9 +25,9 @@ use std::str::FromStr;
 pub mod ap;
 pub mod ept;
 mod multipoles;
-pub use multipoles::{
-    multipoles, Dispersions, GalaxyTerms, Observed, RsdMultipoles, RsdPlan, RsdSettings, Sigma0,
-};
+mod sigma0;
+pub use multipoles::{multipoles, GalaxyTerms, Observed, RsdMultipoles, RsdPlan, RsdSettings};
+pub use sigma0::{Dispersions, Sigma0};
 
 /// Largest multipole order ℓ supported.
 pub const MAX_ELL: usize = 8;

@@ -7,7 +7,7 @@ use crate::recursion::RecursionStats;
 use crate::spec::Spec;
 use num_traits::Zero;
 
-/// A signed permutation of the basis vectors: e_a ↦ sign[a] · e_perm[a], with σ² = 1.
+/// A signed permutation of the basis vectors: e_a ↦ sign\[a\] · e_perm\[a\], with σ² = 1.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Involution {
     /// Image index of each basis vector.

@@ -4,7 +4,7 @@
 //! E²(z) = Ω_r(1+z)⁴ + Ω_m(1+z)³ + Ω_k(1+z)² + (Ω_DE − Ω_r) ρ_DE(z)/ρ_DE(0): the radiation of the CMB
 //! photons (T_CMB = [`T_CMB`]) and of [`N_EFF`] massless neutrinos, Ω_r h² = 4.18e-5, is taken from the
 //! dark energy so that E(0) = 1 with the cosmology's Ω_m and Ω_k, as CAMB and CLASS close the budget
-//! (the growth, [`crate::cosmology::growth`], neglects radiation: its effect on D(z) is ~1e-4 and is
+//! (the growth, `crate::cosmology::growth`, neglects radiation: its effect on D(z) is ~1e-4 and is
 //! common to the models). Without radiation H(z = 3) would be off by 5.7e-4 and D_M by 2.5e-4; with it,
 //! the tests find CAMB's H and D_M to ≤ 1e-7. Distances are in Mpc/h and H in h km/s/Mpc, the units
 //! in which an AP analysis compares two cosmologies (k in h/Mpc of each).
@@ -12,11 +12,11 @@
 use super::Cosmology;
 use crate::integrate::GaussLegendre;
 
-/// The CMB temperature today [K] (Fixsen 2009).
+/// The CMB temperature today \[K\] (Fixsen 2009).
 pub const T_CMB: f64 = 2.7255;
 /// The effective number of neutrino species, all massless.
 pub const N_EFF: f64 = 3.046;
-/// c / (100 km/s) [Mpc]: the Hubble distance c/H0 in Mpc/h.
+/// c / (100 km/s) \[Mpc\]: the Hubble distance c/H0 in Mpc/h.
 pub const HUBBLE_DISTANCE: f64 = 2_997.924_58;
 
 impl Cosmology {

@@ -20,6 +20,7 @@
 //! With a distortion (`ap`), α∥ and α⊥ (`apar`, `aperp`) can be free too, on a plan built for an AP
 //! range ([`crate::rsd::ept::EptSettings::ap_range`]).
 
+use super::linalg::{cholesky, dot, invert_lower, solve_spd};
 use super::MultipoleData;
 use crate::error::{Error, Result};
 use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
@@ -244,78 +245,6 @@ impl CostFunction for &Objective<'_> {
     }
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-/// Solves F a = b for symmetric positive definite F: (a, F⁻¹, ln det F).
-fn solve_spd(f: &[Vec<f64>], b: &[f64]) -> Result<(Vec<f64>, Vec<Vec<f64>>, f64)> {
-    let n = b.len();
-    let l = cholesky(f).ok_or_else(|| Error::InvalidChoice {
-        what: format!("the {n} marginalised (or free) parameters"),
-        reason: "their templates are degenerate on the fitted data (give them priors, or fewer)"
-            .into(),
-    })?;
-    let log_det = 2.0 * (0..n).map(|i| l[i][i].ln()).sum::<f64>();
-    let solve = |rhs: &[f64]| {
-        let mut y = vec![0.0; n];
-        for i in 0..n {
-            y[i] = (rhs[i] - (0..i).map(|j| l[i][j] * y[j]).sum::<f64>()) / l[i][i];
-        }
-        let mut x = vec![0.0; n];
-        for i in (0..n).rev() {
-            x[i] = (y[i] - (i + 1..n).map(|j| l[j][i] * x[j]).sum::<f64>()) / l[i][i];
-        }
-        x
-    };
-    let inverse = (0..n)
-        .map(|i| {
-            solve(
-                &(0..n)
-                    .map(|j| f64::from(u8::from(i == j)))
-                    .collect::<Vec<_>>(),
-            )
-        })
-        .collect();
-    Ok((solve(b), inverse, log_det))
-}
-
-/// The lower Cholesky factor, or `None` if not positive definite.
-pub(super) fn cholesky(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
-    let n = a.len();
-    let mut l = vec![vec![0.0; n]; n];
-    for i in 0..n {
-        for j in 0..=i {
-            let s = a[i][j] - (0..j).map(|m| l[i][m] * l[j][m]).sum::<f64>();
-            if i == j {
-                if s.is_nan() || s <= 0.0 {
-                    return None;
-                }
-                l[i][i] = s.sqrt();
-            } else {
-                l[i][j] = s / l[j][j];
-            }
-        }
-    }
-    Some(l)
-}
-
-/// The inverse of a lower-triangular matrix.
-fn lower_inverse(l: &[Vec<f64>]) -> Vec<Vec<f64>> {
-    let n = l.len();
-    // Column by column: inv[.][c] solves L x = e_c.
-    let mut columns = vec![vec![0.0; n]; n];
-    for (c, x) in columns.iter_mut().enumerate() {
-        for i in c..n {
-            let s: f64 = (c..i).map(|m| l[i][m] * x[m]).sum();
-            x[i] = (f64::from(u8::from(i == c)) - s) / l[i][i];
-        }
-    }
-    (0..n)
-        .map(|i| (0..n).map(|c| columns[c][i]).collect())
-        .collect()
-}
-
 /// The free and marginalised parameter indices, and per parameter its prior (mean, 1/σ²).
 type Validated = (Vec<usize>, Vec<usize>, Vec<Option<(f64, f64)>>);
 
@@ -535,7 +464,7 @@ pub fn fit_galaxy_observed(
         what: format!("the covariance of the {points} fitted points"),
         reason: "is not positive definite".into(),
     })?;
-    let whiten = lower_inverse(&l);
+    let whiten = invert_lower(&l);
     let raw: Vec<f64> = fitted.iter().map(|&(r, i)| data.values[r][i]).collect();
     let data_vector = whiten.iter().map(|row| dot(row, &raw)).collect();
     let mut start = [0.0; SLOTS];

@@ -1,6 +1,7 @@
 //! χ² of one fit window and its minimisation: Nelder–Mead over the free parameters, 1-D Brent along one,
 //! and the profile χ² with some parameters held at given values and the others re-minimised.
 
+use super::linalg::{cholesky, invert_lower};
 use super::{MultipoleData, MultipoleModel, Parameter, Params};
 use crate::error::{Error, Result};
 use argmin::core::{CostFunction, Executor, State};
@@ -247,40 +248,4 @@ pub(super) fn steps(free: &[Parameter], x0: &[f64]) -> Vec<f64> {
             0.05 * v.abs().max(floor)
         })
         .collect()
-}
-
-/// Lower-triangular Cholesky factor of a symmetric positive-definite matrix, or `None`.
-fn cholesky(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
-    let n = a.len();
-    let mut l = vec![vec![0.0; n]; n];
-    for i in 0..n {
-        for j in 0..=i {
-            let s: f64 = (0..j).map(|m| l[i][m] * l[j][m]).sum();
-            if i == j {
-                let d = a[i][i] - s;
-                // Also refuse NaN and infinity: huge elements overflow the sums.
-                if !(d > 0.0 && d.is_finite()) {
-                    return None;
-                }
-                l[i][i] = d.sqrt();
-            } else {
-                l[i][j] = (a[i][j] - s) / l[j][j];
-            }
-        }
-    }
-    Some(l)
-}
-
-/// L⁻¹ for lower-triangular L (forward substitution on the identity).
-#[allow(clippy::needless_range_loop)] // the triangular index ranges read as the algorithm
-fn invert_lower(l: &[Vec<f64>]) -> Vec<Vec<f64>> {
-    let n = l.len();
-    let mut inv = vec![vec![0.0; n]; n];
-    for c in 0..n {
-        for i in c..n {
-            let s: f64 = (c..i).map(|m| l[i][m] * inv[m][c]).sum();
-            inv[i][c] = ((if i == c { 1.0 } else { 0.0 }) - s) / l[i][i];
-        }
-    }
-    inv
 }

@@ -27,6 +27,7 @@ use std::str::FromStr;
 mod contour;
 mod data;
 pub mod galaxy;
+mod linalg;
 mod minimise;
 pub use contour::{contour, contour_table, Contour, ContourGrid, CONTOUR_LEVELS};
 pub use data::MultipoleData;

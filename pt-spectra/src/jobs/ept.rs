@@ -25,7 +25,7 @@ pub struct EptRequest {
 pub const AP_FIT_RANGE: (f64, f64) = (0.8, 1.25);
 
 /// The plan of a request on the output `k`, with IR resummation `ir`, the distortion `ap`, and with
-/// `free_ap` the internal grid of every α∥, α⊥ in [`AP_FIT_RANGE`].
+/// `free_ap` the internal grid of every α∥, α⊥ in `AP_FIT_RANGE` (0.8 … 1.25).
 ///
 /// # Errors
 /// As [`EptPlan::new`].

@@ -2,7 +2,7 @@
 //! both write: `real` ([`real_table`]), `rsd` ([`rsd_table`]), `fit` ([`fit_table`]; with the model
 //! multipoles and Δχ² surfaces, [`fit_tables`]) and `halo` ([`halo_table`]). The caller
 //! parses its input into the typed requests here, builds the plan once per k grid ([`RealPlan`],
-//! [`RsdPlan`]) and prepares the linear spectrum of each cosmology ([`crate::setup::prepare`]); the
+//! [`crate::rsd::RsdPlan`]) and prepares the linear spectrum of each cosmology ([`crate::setup::prepare`]); the
 //! job does the rest, with the header saying what was computed, with which cosmology, q range and
 //! precision.
 //!

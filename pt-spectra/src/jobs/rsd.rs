@@ -403,7 +403,7 @@ pub fn check_growth_rate(f: f64) -> Result<()> {
 
 /// `rsd --xi`: the correlation-function multipoles ξ_ℓ(s) of a multipole table `t` (columns `k`,
 /// `P<l>`, `err_P<l>` for each of `ells`) at `s` [Mpc/h], by FFTLog ([`crate::hankel::xi_from_pk`]:
-/// the multipoles on the table's k, extended beyond its ends by power laws). err_xi<l> bounds the
+/// the multipoles on the table's k, extended beyond its ends by power laws). `err_xi<l>` bounds the
 /// error that the multipoles' errors carry, ∫ k²/(2π²) err_P_l(k) |j_l(ks)| dk ≤ ∫ k²/(2π²) err_P_l dk
 /// (trapezoid on the table's k), plus 1e-6 of max |ξ_l| for the transform.
 ///

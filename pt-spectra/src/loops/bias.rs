@@ -19,7 +19,7 @@
 //! stochastic term that analyses subtract or absorb into the shot noise; Pd1d2, Pd1s2, Pt1d2, Pt1s2
 //! and sig3nl vanish there.
 //!
-//! Numerics: the pair terms on the node sets of P22 ([`super::p22`], the same half p ≥ q of the
+//! Numerics: the pair terms on the node sets of P22 (`loops::p22`, the same half p ≥ q of the
 //! (q, p) plane, every kernel being symmetric), sig3nl with the angle done analytically,
 //!   sig3nl = P_lin(k) k³/(2π²) ∫ dr r² P(kr) A(r),
 //!   A(r) = [4r⁵(11 − 3r²) + 44r³ − 12r + 6(r² − 1)⁴ ln|(1 + r)/(1 − r)|]/(504 r⁵),

@@ -11,7 +11,7 @@
 //! | `2l-spt`    | P_lin + P22 + 2P13 + (2P15 + 2P24 + P33) (2-loop SPT)  |
 //! | `2l-rpt-n0`, `2l-rpt-n1`, `2l-rpt-n2` | [P_lin + P22_XY + P33^{2L}_XY] N_X N_Y |
 //! | `1l-rpt-n3`, `2l-rpt-n3` | as the N2 models, with N3 from P13, P15 and P17 (eq. N3) |
-//! | `1l-regpt`, `2l-regpt` | RegPT (Taruya et al. 2012), [`crate::resum::regpt_one_loop`], [`crate::resum::regpt_two_loop`] |
+//! | `1l-regpt`, `2l-regpt` | RegPT (Taruya et al. 2012), [`crate::resum::regpt_one_loop`], `crate::resum::regpt_two_loop` |
 //! | `1l-spt-ir`, `2l-spt-ir` | SPT with IR-resummed BAO ([`crate::ir`]) |
 //!
 //! Every value carries an error estimate propagated from the loop integrals ([`crate::loops`]).
@@ -61,7 +61,7 @@ pub enum RealModel {
     /// σ_d² at the running cut-off k/2 ([`crate::resum::regpt_one_loop`]).
     OneLoopRegPt,
     /// 2-loop RegPT: regularised propagators to two loops, P24 and PΓ2 from the 1-loop vertex Γ2
-    /// ([`crate::resum::regpt_two_loop`]).
+    /// (`crate::resum::regpt_two_loop`).
     TwoLoopRegPt,
     /// 1-loop SPT with the BAO wiggles IR-resummed ([`crate::ir`]).
     OneLoopSptIr,

@@ -279,7 +279,7 @@ impl RealPlan {
     /// The model's spectra for the linear `spectrum` (at the output redshift).
     ///
     /// # Errors
-    /// None in practice: the plan computes every term its model needs (a [`Error::MissingTerm`]
+    /// None in practice: the plan computes every term its model needs (a [`crate::error::Error::MissingTerm`]
     /// would be a bug).
     pub fn evaluate(
         &self,

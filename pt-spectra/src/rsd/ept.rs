@@ -6,9 +6,9 @@
 //!             + (α₀ + α₂μ² + α₄μ⁴ + α₆μ⁶) k² (P_nw + e^{−k²Σ²(μ)} P_w)
 //!             + sn + sn2 k²μ² + sn4 k⁴μ⁴,
 //!
-//! with Z₁ = b1 + fμ², P^{1L}[P] = Z₁²P + the 1-loop terms of [`crate::loops::redshift`] (bias b1, b2, bs,
+//! with Z₁ = b1 + fμ², P^{1L}\[P\] = Z₁²P + the 1-loop terms of [`crate::loops::redshift`] (bias b1, b2, bs,
 //! b3 as velocileptors: (b2/2)δ², bs s², b3 FAST-PT's b3nl — see the map below), P_nw the no-wiggle
-//! spectrum of velocileptors' Savitzky–Golay filter ([`crate::ir::savitzky_golay_no_wiggle`]), P_w = P − P_nw, P^{1L}_w = P^{1L}[P] − P^{1L}[P_nw], and
+//! spectrum of velocileptors' Savitzky–Golay filter ([`crate::ir::savitzky_golay_no_wiggle`]), P_w = P − P_nw, P^{1L}_w = P^{1L}\[P\] − P^{1L}\[P_nw\], and
 //!   Σ²(μ) = [1 + fμ²(2 + f)] Σ²,   Σ² = (1/6π²) ∫ dq P_nw(q) [1 − j₀(q r_BAO)],   r_BAO = 110 Mpc/h
 //! (velocileptors' ½(X + Y/3) at r_BAO). Without IR resummation (`--no-ir`) P_nw = P: plain 1-loop SPT in
 //! redshift space, α's times k²P.

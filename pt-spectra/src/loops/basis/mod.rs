@@ -7,10 +7,10 @@
 //! cosmology-independent tensor with c ⊗ c ⊗ c (or c ⊗ c). The tensors are made once per k grid and
 //! [`Precision`] with the integrators of the direct path and cached ([`TableStore::two_loop_basis`]):
 //! * P15 and the propagator part 2P15 − P33red: the angular table's radial sums as bilinear forms
-//!   ([`p15_forms`]), with their error terms;
+//!   (`p15_forms`), with their error terms;
 //! * the mode-coupling part 2P24 + P33irr + 2P33red, 2P24 and P33irr: the quasi-Monte-Carlo integral
 //!   of [`super::two_loop`] on the same Sobol points, shifts and points per k as the direct path, each
-//!   point adding the products of basis functions at its momenta ([`tensors`]); one tensor per random
+//!   point adding the products of basis functions at its momenta (`tensors`); one tensor per random
 //!   shift, so the error is the same standard error over the shifts.
 //!
 //! Because the points are the same, the basis result equals the direct result for the projected
