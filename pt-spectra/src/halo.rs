@@ -221,23 +221,9 @@ impl MeasuredSpectrum {
                 min: 1,
             });
         }
+        crate::table::check_k_grid(origin, &k, lines)?;
         for i in 0..k.len() {
             let line = lines[i];
-            if !(k[i].is_finite() && k[i] > 0.0) {
-                return Err(Error::InvalidK {
-                    origin: origin.into(),
-                    line,
-                    k: k[i],
-                });
-            }
-            if i > 0 && k[i] <= k[i - 1] {
-                return Err(Error::NonIncreasingK {
-                    origin: origin.into(),
-                    line,
-                    k: k[i],
-                    previous: k[i - 1],
-                });
-            }
             if !p[i].is_finite() {
                 return Err(Error::InvalidValue {
                     origin: origin.into(),

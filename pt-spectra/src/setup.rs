@@ -219,6 +219,28 @@ pub fn prepare(request: Request) -> Result<Prepared> {
     })
 }
 
+/// The warnings both faces add to those of [`prepare`], in the same words: the keys of a cosmology
+/// file that were ignored (`ignored_keys`, from [`NamedCosmology::parse`]) and, for output wavenumbers
+/// `k` [h/Mpc] (any order; none: no check), a range that reaches the power-law extrapolation of the
+/// linear table.
+pub fn input_warnings(prepared: &Prepared, ignored_keys: &[String], k: &[f64]) -> Vec<String> {
+    let mut out = Vec::new();
+    if !ignored_keys.is_empty() {
+        out.push(format!(
+            "cosmology: keys ignored (they do not set the background or growth): {}",
+            ignored_keys.join(", ")
+        ));
+    }
+    if !k.is_empty() {
+        let lo = k.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = k.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if let Some(ext) = prepared.spectrum.extrapolation_in(lo, hi) {
+            out.push(format!("output {ext}"));
+        }
+    }
+    out
+}
+
 impl Prepared {
     /// The Eisenstein & Hu (1998) no-wiggle spectrum of the cosmology at the output redshift, scaled to
     /// the σ8 of the linear spectrum: the smooth reference by which BAO are divided out.

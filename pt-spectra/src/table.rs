@@ -249,23 +249,9 @@ impl Tabulated {
                 min: 2,
             });
         }
+        check_k_grid(origin, &k, lines)?;
         let line = |i: usize| lines.get(i).copied().unwrap_or(i + 1);
         for i in 0..k.len() {
-            if !(k[i].is_finite() && k[i] > 0.0) {
-                return Err(Error::InvalidK {
-                    origin: origin.into(),
-                    line: line(i),
-                    k: k[i],
-                });
-            }
-            if i > 0 && k[i] <= k[i - 1] {
-                return Err(Error::NonIncreasingK {
-                    origin: origin.into(),
-                    line: line(i),
-                    k: k[i],
-                    previous: k[i - 1],
-                });
-            }
             if i > 0 && k[i].ln() <= k[i - 1].ln() {
                 return Err(Error::InvalidValue {
                     origin: origin.into(),
@@ -377,6 +363,34 @@ impl Tabulated {
             (1.0 - t) * v0 + t * v1
         })
     }
+}
+
+/// Checks a k grid [h/Mpc]: every k finite and positive, strictly increasing. Errors name `origin` and
+/// the line of the value (`lines[i]`, or i + 1 where `lines` is shorter): the one check of every reader
+/// of k (tables, linear spectra, measured spectra, fit data, k files).
+///
+/// # Errors
+/// [`Error::InvalidK`], [`Error::NonIncreasingK`].
+pub fn check_k_grid(origin: &str, k: &[f64], lines: &[usize]) -> Result<()> {
+    let line = |i: usize| lines.get(i).copied().unwrap_or(i + 1);
+    for (i, &v) in k.iter().enumerate() {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(Error::InvalidK {
+                origin: origin.into(),
+                line: line(i),
+                k: v,
+            });
+        }
+        if i > 0 && v <= k[i - 1] {
+            return Err(Error::NonIncreasingK {
+                origin: origin.into(),
+                line: line(i),
+                k: v,
+                previous: k[i - 1],
+            });
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -144,17 +144,8 @@ impl Inputs {
             cosmology,
             z: self.z,
         })?;
-        if !ignored.is_empty() {
-            prepared.warnings.push(format!(
-                "cosmology: keys ignored (they do not set the background or growth): {}",
-                ignored.join(", ")
-            ));
-        }
-        let lo = k.iter().copied().fold(f64::MAX, f64::min);
-        let hi = k.iter().copied().fold(0.0, f64::max);
-        if let Some(ext) = prepared.spectrum.extrapolation_in(lo, hi) {
-            prepared.warnings.push(format!("output {ext}"));
-        }
+        let extra = setup::input_warnings(&prepared, &ignored, k);
+        prepared.warnings.extend(extra);
         Ok(prepared)
     }
 }

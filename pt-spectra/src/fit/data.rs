@@ -118,24 +118,7 @@ impl MultipoleData {
                 min: 1,
             });
         }
-        for i in 0..k.len() {
-            let line = table.lines[i];
-            if !(k[i].is_finite() && k[i] > 0.0) {
-                return Err(Error::InvalidK {
-                    origin: origin.clone(),
-                    line,
-                    k: k[i],
-                });
-            }
-            if i > 0 && k[i] <= k[i - 1] {
-                return Err(Error::NonIncreasingK {
-                    origin: origin.clone(),
-                    line,
-                    k: k[i],
-                    previous: k[i - 1],
-                });
-            }
-        }
+        crate::table::check_k_grid(origin, &k, &table.lines)?;
         let (mut values, mut sigma) = (Vec::new(), Vec::new());
         for (j, _) in columns.iter().enumerate() {
             let (v, s) = (&table.columns[1 + 2 * j], &table.columns[2 + 2 * j]);

@@ -116,6 +116,9 @@ fn check_ells(what: &str, ells: &[usize]) -> Result<()> {
 
 /// Checks that `k` are finite, positive (or zero if `zero_ok`) and strictly increasing.
 fn check_increasing(origin: &str, k: &[f64], zero_ok: bool) -> Result<()> {
+    if !zero_ok {
+        return crate::table::check_k_grid(origin, k, &[]);
+    }
     for (i, &v) in k.iter().enumerate() {
         if !(v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0))) {
             return Err(Error::InvalidK {

@@ -3,7 +3,6 @@
 
 use anyhow::{bail, Context, Result};
 use pt_spectra::cosmology::TransferKind;
-use pt_spectra::error::Error;
 use pt_spectra::linear::{Columns, LinearSpectrum, LogGrid};
 use pt_spectra::precision::{Precision, TwoLoopMethod};
 use pt_spectra::setup::{self, LinearSource, NamedCosmology, Prepared, Request};
@@ -167,18 +166,12 @@ impl SpectrumInput {
                 bail!("{name} {z}: a redshift must be finite and > -1");
             }
         }
-        let cosmology = match &self.cosmology {
-            None => None,
+        let (cosmology, ignored) = match &self.cosmology {
+            None => (None, Vec::new()),
             Some(s) => {
                 let (named, ignored) =
                     NamedCosmology::parse(s).map_err(|e| anyhow::anyhow!("--cosmology: {e}"))?;
-                if !ignored.is_empty() {
-                    eprintln!(
-                        "note: --cosmology {s}: keys ignored (they do not set the background or growth): {}",
-                        ignored.join(", ")
-                    );
-                }
-                Some(named)
+                (Some(named), ignored)
             }
         };
         let source = match (&self.linear, self.eh) {
@@ -199,6 +192,10 @@ impl SpectrumInput {
             cosmology,
             z: self.z,
         })?;
+        // Ignored keys are a note (the file may hold a Boltzmann code's other settings).
+        for w in setup::input_warnings(&prepared, &ignored, &[]) {
+            eprintln!("note: {w}");
+        }
         for w in &prepared.warnings {
             eprintln!("warning: {w}");
         }
@@ -272,12 +269,8 @@ impl Input {
                 .points(),
         };
         let loaded = self.spectrum.load()?;
-        if let Some(ext) = loaded
-            .prepared
-            .spectrum
-            .extrapolation_in(k[0], k[k.len() - 1])
-        {
-            eprintln!("warning: output {ext}");
+        for w in setup::input_warnings(&loaded.prepared, &[], &k) {
+            eprintln!("warning: {w}");
         }
         Ok((k, loaded))
     }
@@ -291,21 +284,7 @@ pub fn read_k_file(path: &PathBuf) -> Result<Vec<f64>> {
     let Some(k) = table.columns.into_iter().next().filter(|k| !k.is_empty()) else {
         bail!("--k-file `{}` contains no k values", path.display());
     };
-    for (i, (&v, &line)) in k.iter().zip(&table.lines).enumerate() {
-        let origin = table.origin.clone();
-        if !(v.is_finite() && v > 0.0) {
-            return Err(Error::InvalidK { origin, line, k: v }).context("--k-file");
-        }
-        if let Some(&previous) = i.checked_sub(1).map(|j| &k[j]).filter(|&&p| v <= p) {
-            return Err(Error::NonIncreasingK {
-                origin,
-                line,
-                k: v,
-                previous,
-            })
-            .context("--k-file");
-        }
-    }
+    pt_spectra::table::check_k_grid(&table.origin, &k, &table.lines).context("--k-file")?;
     Ok(k)
 }
 
