@@ -341,21 +341,9 @@ pub(crate) fn data(
     let path: PathBuf = data
         .extract()
         .map_err(|_| PyValueError::new_err("data: expected a path or a dict of arrays"))?;
-    let columns = data_columns.unwrap_or_else(|| (1..=1 + 2 * data_ells.len()).collect());
-    if columns.len() != 1 + 2 * data_ells.len() || columns.contains(&0) {
-        return Err(PyValueError::new_err(format!(
-            "data_columns: expected {} 1-based columns (k, then P_l, sigma_l for each of data_ells)",
-            1 + 2 * data_ells.len()
-        )));
-    }
-    let mut spec = Vec::new();
-    for &l in ells {
-        let j = data_ells.iter().position(|&d| d == l).ok_or_else(|| {
-            PyValueError::new_err(format!("ells: multipole {l} is not among data_ells"))
-        })?;
-        spec.push((l, columns[1 + 2 * j] - 1, columns[2 + 2 * j] - 1));
-    }
-    let d = MultipoleData::read(&path, columns[0] - 1, &spec).map_err(value_error)?;
+    let layout = pt_spectra::fit::DataLayout::new(data_ells, data_columns.as_deref())
+        .map_err(value_error)?;
+    let d = layout.read(&path, ells).map_err(value_error)?;
     Ok((d, path.display().to_string()))
 }
 

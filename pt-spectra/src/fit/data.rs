@@ -224,7 +224,7 @@ impl MultipoleData {
 
     /// Attaches the n×n matrix `c` after checking it; `lines` numbers its rows for messages (row numbers if
     /// empty).
-    fn checked_covariance(
+    pub(super) fn checked_covariance(
         mut self,
         c: Vec<Vec<f64>>,
         origin: &str,

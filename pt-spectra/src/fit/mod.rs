@@ -27,10 +27,12 @@ use std::str::FromStr;
 mod contour;
 mod data;
 pub mod galaxy;
+mod layout;
 mod linalg;
 mod minimise;
 pub use contour::{contour, contour_table, Contour, ContourGrid, CONTOUR_LEVELS};
 pub use data::MultipoleData;
+pub use layout::DataLayout;
 
 /// A parameter that can be fitted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -167,27 +167,15 @@ fn read_data(args: &Args) -> Result<(MultipoleData, Vec<usize>)> {
     let data_ells: Vec<usize> = list(&args.data_ells, "--data-ells")?;
     let ells: Vec<usize> = list(&args.ells, "--ells")?;
     let cols: Vec<usize> = list(&args.data_columns, "--data-columns")?;
-    if cols.len() != 1 + 2 * data_ells.len() || cols.contains(&0) {
-        bail!(
-            "--data-columns {}: expected {} 1-based columns (k, then P_l, sigma_l for each of --data-ells {})",
-            args.data_columns,
-            1 + 2 * data_ells.len(),
-            args.data_ells
-        );
-    }
-    let mut spec = Vec::new();
-    for &l in &ells {
-        let Some(j) = data_ells.iter().position(|&d| d == l) else {
-            bail!(
-                "--ells: multipole {l} is not among --data-ells {}",
-                args.data_ells
-            );
-        };
-        spec.push((l, cols[1 + 2 * j] - 1, cols[2 + 2 * j] - 1));
-    }
-    let mut data = MultipoleData::read(&args.data, cols[0] - 1, &spec)?;
+    let layout = pt_spectra::fit::DataLayout::new(&data_ells, Some(&cols))
+        .map_err(|e| anyhow::anyhow!("--data-columns/--data-ells: {e}"))?;
+    let mut data = layout
+        .read(&args.data, &ells)
+        .map_err(|e| anyhow::anyhow!("--ells/--data: {e}"))?;
     if let Some(path) = &args.covariance {
-        data = data.read_covariance(path).context("--covariance")?;
+        data = layout
+            .read_covariance(data, path)
+            .context("--covariance")?;
     }
     Ok((data, ells))
 }
