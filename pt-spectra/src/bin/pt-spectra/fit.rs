@@ -173,9 +173,7 @@ fn read_data(args: &Args) -> Result<(MultipoleData, Vec<usize>)> {
         .read(&args.data, &ells)
         .map_err(|e| anyhow::anyhow!("--ells/--data: {e}"))?;
     if let Some(path) = &args.covariance {
-        data = layout
-            .read_covariance(data, path)
-            .context("--covariance")?;
+        data = layout.read_covariance(data, path).context("--covariance")?;
     }
     Ok((data, ells))
 }
