@@ -29,6 +29,7 @@
 //! assert!(f3.is_finite());
 //! ```
 
+pub mod exact;
 pub mod generated;
 mod instances;
 mod lanes;

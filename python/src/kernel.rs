@@ -2,15 +2,17 @@
 
 use num_bigint::BigInt;
 use num_rational::BigRational;
-use num_traits::{One, Zero};
+use num_traits::Zero;
+use pt_kernels::exact::{check_exact_size, format_rational, parse_rational};
 use pt_kernels::kernels;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyFloat, PyInt};
 use std::str::FromStr;
 
-/// One component as an exact rational: an int, a `fractions.Fraction`, a string `p/q` or integer, or
-/// a float (its exact binary value).
+/// One component as an exact rational: an int, a `fractions.Fraction`, a string (`p/q`, an integer
+/// or a decimal, parsed as the command line does: `pt_kernels::exact`), or a float (its exact binary
+/// value).
 fn rational(c: &Bound<'_, PyAny>) -> PyResult<BigRational> {
     let bad = || PyValueError::new_err(format!("kernel: component {c} is not a number"));
     let int = |o: &Bound<'_, PyAny>| -> PyResult<BigInt> {
@@ -30,13 +32,7 @@ fn rational(c: &Bound<'_, PyAny>) -> PyResult<BigRational> {
         return Ok(BigRational::new(n, d));
     }
     if let Ok(s) = c.extract::<String>() {
-        let (p, q) = s.split_once('/').unwrap_or((&s, "1"));
-        let p = BigInt::from_str(p.trim()).map_err(|_| bad())?;
-        let q = BigInt::from_str(q.trim()).map_err(|_| bad())?;
-        if q.is_zero() {
-            return Err(bad());
-        }
-        return Ok(BigRational::new(p, q));
+        return parse_rational(&s).map_err(|e| PyValueError::new_err(format!("kernel: {e}")));
     }
     let v: f64 = c.extract().map_err(|_| bad())?;
     BigRational::from_float(v).ok_or_else(bad)
@@ -51,15 +47,6 @@ fn components<'py>(v: &Bound<'py, PyAny>) -> PyResult<Vec<Bound<'py, PyAny>>> {
         )));
     }
     Ok(c)
-}
-
-/// `p/q` in lowest terms, or an integer.
-fn format_rational(r: &BigRational) -> String {
-    if r.denom().is_one() {
-        r.numer().to_string()
-    } else {
-        format!("{}/{}", r.numer(), r.denom())
-    }
 }
 
 /// F_n^s or G_n^s (`which` = "F" or "G") at the n = len(vectors) vectors (1 ≤ n ≤ 7), each [x, y, z]
@@ -101,7 +88,11 @@ pub fn kernel(which: &str, vectors: Vec<Bound<'_, PyAny>>, exact: bool) -> PyRes
                 Ok([rational(&c[0])?, rational(&c[1])?, rational(&c[2])?])
             })
             .collect::<PyResult<_>>()?;
-        let value = kernels(&q).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        check_exact_size(&q).map_err(|e| PyValueError::new_err(format!("kernel: {e}")))?;
+        // The exact kernel can take seconds: without the GIL.
+        let value = py
+            .detach(|| kernels(&q))
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
         return Ok(format_rational(&value[index])
             .into_pyobject(py)?
             .into_any()

@@ -352,3 +352,15 @@ def test_theory_sigma0_of_rsd_terms_is_computed_once_and_equals_a_direct_call():
     # σ = σ0 D f with σ0 = σ_v/D: the theory value does not depend on the growth factor given.
     half = terms.multipoles(f=0.5, bias=2.0, fog="lorentzian", sigma0="1l-spt", growth_factor=0.5)
     np.testing.assert_allclose(half["P0"], direct["P0"], rtol=1e-12)
+
+
+def test_exact_kernel_strings_parse_as_the_command_line_and_huge_inputs_are_refused():
+    """Decimal strings are exact (0.1 = 1/10), as `pt-spectra kernel --exact` parses them; numbers too
+    large for the exact kernel to finish are refused with the command line's guard."""
+    a = pt.kernel("F", [["0.5", "0", "0"], ["1e-1", "1/3", "0"]], exact=True)
+    b = pt.kernel("F", [[Fraction(1, 2), 0, 0], [Fraction(1, 10), Fraction(1, 3), 0]], exact=True)
+    assert a == b
+    with pytest.raises(ValueError, match="at most 300 for n = 7"):
+        pt.kernel("F", [["1/" + "3" * 400, "0", "0"]] * 7, exact=True)
+    with pytest.raises(ValueError, match="zero denominator"):
+        pt.kernel("F", [["1/0", "0", "0"]], exact=True)
