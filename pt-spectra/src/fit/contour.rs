@@ -10,7 +10,6 @@
 use super::minimise::{steps, Residuals, Window};
 use super::{check, FitResult, FitSettings, MultipoleData, MultipoleModel, Parameter, Params};
 use crate::error::{Error, Result};
-use crate::output::{Table, WAVENUMBER};
 
 /// The Δχ² levels of the 68.3% and 95.4% joint regions of two parameters (Δχ² = −2 ln(1 − p) for two
 /// degrees of freedom; the values of the Δχ² table of Press et al., Numerical Recipes, §15.6).
@@ -242,41 +241,6 @@ pub fn contour(
         chi2,
         at,
     })
-}
-
-/// Δχ² surfaces as one table with `header` lines, a row per grid point (i outer, j inner, k_max
-/// outermost): `k_max i j <x> <y> chi2 delta_chi2`, then the re-minimised value of each other free
-/// parameter of `free`.
-pub fn contour_table(contours: &[Contour], free: &[Parameter], header: Vec<String>) -> Table {
-    let mut t = Table::new(header);
-    let Some(first) = contours.first() else {
-        return t;
-    };
-    let (x, y) = (first.x, first.y);
-    let others: Vec<Parameter> = free.iter().copied().filter(|&p| p != x && p != y).collect();
-    let rows = || {
-        contours.iter().flat_map(|c| {
-            (0..c.points.len()).flat_map(move |i| (0..c.points[i].len()).map(move |j| (c, i, j)))
-        })
-    };
-    let column = |f: &dyn Fn(&Contour, usize, usize) -> f64| -> Vec<f64> {
-        rows().map(|(c, i, j)| f(c, i, j)).collect()
-    };
-    t.push("k_max", WAVENUMBER, column(&|c, _, _| c.k_max));
-    t.push("i", "1", column(&|_, i, _| i as f64));
-    t.push("j", "1", column(&|_, _, j| j as f64));
-    t.push(x.name(), x.unit(), column(&|c, i, j| c.points[i][j].0));
-    t.push(y.name(), y.unit(), column(&|c, i, j| c.points[i][j].1));
-    t.push("chi2", "1", column(&|c, i, j| c.chi2[i][j]));
-    t.push(
-        "delta_chi2",
-        "1",
-        column(&|c, i, j| c.chi2[i][j] - c.chi2_min),
-    );
-    for p in others {
-        t.push(p.name(), p.unit(), column(&|c, i, j| c.at[i][j].get(p)));
-    }
-    t
 }
 
 #[cfg(test)]
@@ -515,7 +479,7 @@ mod tests {
                 "{grid:?}"
             );
         }
-        let t = contour_table(
+        let t = crate::jobs::contour_table(
             &[contour(
                 &model,
                 &data,

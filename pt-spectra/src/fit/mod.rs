@@ -30,7 +30,7 @@ pub mod galaxy;
 mod layout;
 mod linalg;
 mod minimise;
-pub use contour::{contour, contour_table, Contour, ContourGrid, CONTOUR_LEVELS};
+pub use contour::{contour, Contour, ContourGrid, CONTOUR_LEVELS};
 pub use data::MultipoleData;
 pub use layout::DataLayout;
 

@@ -5,8 +5,8 @@ use super::rsd::{describe_sigma0, no_wiggle_multipoles, RsdRequest};
 use super::{counterterm_line, describe_inputs, VERSION};
 use crate::error::{Error, Result};
 use crate::fit::{
-    contour, contour_table, delta_chi2, fit, ContourGrid, FitResult, FitSettings, MultipoleData,
-    MultipoleModel, Parameter, Params, CONTOUR_LEVELS,
+    contour, delta_chi2, fit, ContourGrid, FitResult, FitSettings, MultipoleData, MultipoleModel,
+    Parameter, Params, CONTOUR_LEVELS,
 };
 use crate::output::{Table, POWER, WAVENUMBER};
 use crate::progress::Progress;
@@ -227,7 +227,7 @@ pub fn fit_tables(
                  bound the 68.3% and 95.4% regions of two parameters; chi2 is even in sigma0",
                 grid.points, grid.x, grid.y, grid.span, CONTOUR_LEVELS[0], CONTOUR_LEVELS[1]
             ));
-            Some(contour_table(&surfaces, &request.free, h))
+            Some(super::contour_table(&surfaces, &request.free, h))
         }
     };
     Ok(FitTables {

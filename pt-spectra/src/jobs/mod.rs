@@ -39,6 +39,7 @@ mod ept;
 mod fit;
 mod halo;
 mod observe;
+mod report;
 mod rsd;
 pub use bias::BiasOutput;
 pub use ept::{
@@ -47,6 +48,7 @@ pub use ept::{
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use halo::{halo_table, HaloRequest};
 pub use observe::observed_table;
+pub use report::{contour_table, real_spectra_table, rsd_multipoles_table};
 pub use rsd::{
     describe_sigma0, no_wiggle_multipoles, rsd_table, rsd_table_from_terms,
     rsd_table_from_terms_memo, rsd_table_with_bias_terms, xi_table, NonlinearBias, RsdRequest,
@@ -178,7 +180,7 @@ pub fn real_table_with_bias(
         RealSelection::One(model) => {
             header.extend(model_header(model, &spectra, precision, terms));
             let spectra = spectra.with_counterterm(cs2)?;
-            let mut t = spectra.table(header, terms);
+            let mut t = real_spectra_table(&spectra, header, terms);
             if terms && cs2 != 0.0 {
                 for pair in Pair::ALL {
                     let name = format!("P_ct_{}", pair.suffix());

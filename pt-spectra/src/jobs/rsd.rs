@@ -357,7 +357,7 @@ fn rsd_table_memo(
             crate::rsd::ap::MU_NODES
         ));
     }
-    let mut t = m.table(header);
+    let mut t = super::rsd_multipoles_table(&m, header);
     if request.no_wiggle {
         let (k, bias) = match &request.ap {
             None => (k.clone(), bias.clone()),

@@ -21,7 +21,6 @@
 
 use crate::error::{Error, Result};
 use crate::loops::{ByPair, Estimate, LoopTerms, Pair};
-use crate::output::{Table, POWER, WAVENUMBER};
 use crate::resum::{self, Propagator};
 use std::fmt;
 use std::str::FromStr;
@@ -364,87 +363,6 @@ impl RealSpectra {
     }
 }
 
-impl RealSpectra {
-    /// The spectra as a table with `header` lines: `k P_lin P_dd P_dt P_tt`, and with `terms` also
-    /// their errors, every loop term the model uses with its error (`P22_xx`, `P13_xx`, then `P15_xx`,
-    /// `P17_xx`, `P24_xx P33_xx P33_2L_xx P2loop_xx` as the model needs them), σ_v² and, for RPT, the
-    /// factors `N_xx` (xx = dd, dt, tt).
-    pub fn table(&self, header: Vec<String>, terms: bool) -> Table {
-        let mut t = Table::new(header);
-        t.push("k", WAVENUMBER, self.k.clone());
-        t.push("P_lin", POWER, self.p_lin.clone());
-        for (pair, s) in self.spectra.iter() {
-            t.push(format!("P_{}", pair.suffix()), POWER, values(s));
-        }
-        if !terms {
-            return t;
-        }
-        for (pair, s) in self.spectra.iter() {
-            t.push(format!("err_P_{}", pair.suffix()), POWER, errors(s));
-        }
-        let one = &self.terms.one_loop;
-        for pair in Pair::ALL {
-            t.push_estimates(&format!("P22_{}", pair.suffix()), POWER, &one.p22[pair]);
-            t.push_estimates(&format!("P13_{}", pair.suffix()), POWER, &one.p13[pair]);
-        }
-        let model = self.model;
-        for (name, term, needed) in [
-            ("P15", &self.terms.p15, model.needs_p15()),
-            ("P17", &self.terms.p17, model.needs_p17()),
-        ] {
-            if let (Some(term), true) = (term, needed) {
-                for (pair, v) in term.iter() {
-                    t.push_estimates(&format!("{name}_{}", pair.suffix()), POWER, v);
-                }
-            }
-        }
-        if let (Some(two), true) = (&self.terms.two_loop, model.needs_two_loop()) {
-            for (pair, p) in two.pairs.iter() {
-                let s = pair.suffix();
-                let p33: Vec<Estimate> = (0..self.k.len())
-                    .map(|i| one.p33_reducible(pair, i) + p.p33_2l[i])
-                    .collect();
-                t.push_estimates(&format!("P24_{s}"), POWER, &p.p24);
-                t.push_estimates(&format!("P33_{s}"), POWER, &p33);
-                t.push_estimates(&format!("P33_2L_{s}"), POWER, &p.p33_2l);
-                t.push_estimates(&format!("P2loop_{s}"), POWER, &p.total);
-            }
-        }
-        t.push_estimates("sigma_v2", "(Mpc/h)^2", &vec![one.sigma_v2; self.k.len()]);
-        if let (Some(sigma_d2), RealModel::OneLoopRegPt | RealModel::TwoLoopRegPt) =
-            (&self.terms.sigma_d2, model)
-        {
-            t.push_estimates("sigma_d2", "(Mpc/h)^2", sigma_d2);
-        }
-        if let (Some(g), true) = (&self.terms.gamma2, model.needs_gamma2()) {
-            for (pair, v) in g.p24.iter() {
-                t.push_estimates(&format!("P24_Gamma2_{}", pair.suffix()), POWER, v);
-            }
-            for (pair, v) in g.p_gamma2.iter() {
-                t.push_estimates(&format!("PGamma2_{}", pair.suffix()), POWER, v);
-            }
-        }
-        if let (Some(ir), true) = (&self.terms.ir, model.needs_ir()) {
-            t.push("P_nw", POWER, ir.no_wiggle.one_loop.p_lin.clone());
-            t.push_estimates("Sigma2_bao", "(Mpc/h)^2", &vec![ir.sigma2; self.k.len()]);
-        }
-        if let Some(factors) = &self.factors {
-            for (pair, f) in factors.iter() {
-                t.push_estimates(&format!("N_{}", pair.suffix()), "1", f);
-            }
-        }
-        t
-    }
-}
-
-fn values(e: &[Estimate]) -> Vec<f64> {
-    e.iter().map(|e| e.value).collect()
-}
-
-fn errors(e: &[Estimate]) -> Vec<f64> {
-    e.iter().map(|e| e.error).collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::plan::CHUNKED_GRID;
@@ -505,7 +423,7 @@ mod tests {
                 let Ok(spectra) = RealSpectra::from_terms(model, terms.clone()) else {
                     continue;
                 };
-                let t = spectra.table(vec![], with_terms);
+                let t = crate::jobs::real_spectra_table(&spectra, vec![], with_terms);
                 assert!(t.columns.iter().all(|c| c.values.len() == 2), "{model}");
                 let text = t.to_text();
                 let names = text.lines().find(|l| l.starts_with("# k")).unwrap();

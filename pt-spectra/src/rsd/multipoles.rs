@@ -9,7 +9,6 @@ use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
 use crate::loops::bias::{BiasPlan, BiasTerms, GalaxyBias};
 use crate::loops::{Pair, TnsPlan, TnsTerms};
-use crate::output::{Table, POWER, WAVENUMBER};
 use crate::precision::Precision;
 use crate::progress::Progress;
 use crate::real::{counterterm, RealModel, RealPlan, RealSpectra};
@@ -299,42 +298,6 @@ fn observed(
     })
 }
 
-impl RsdMultipoles {
-    /// The multipoles as a table with `header` lines: `k P<l>…`, with the parts `P<l>_sc P<l>_A
-    /// P<l>_B` if computed, `P_eps SN SN_s` with a noise (SN = b² P_δδ/P_εε, SN_s = P0/P_εε), and the
-    /// errors `err_P<l>`.
-    pub fn table(&self, header: Vec<String>) -> Table {
-        let mut t = Table::new(header);
-        t.push("k", WAVENUMBER, self.k.clone());
-        let values = |e: &Vec<Estimate>| e.iter().map(|e| e.value).collect::<Vec<f64>>();
-        for (l, p) in self.ells.iter().zip(&self.total) {
-            t.push(format!("P{l}"), POWER, values(p));
-        }
-        if let Some(parts) = &self.parts {
-            for (name, part) in ["sc", "A", "B"].into_iter().zip(parts) {
-                for (l, p) in self.ells.iter().zip(part) {
-                    t.push(format!("P{l}_{name}"), POWER, values(p));
-                }
-            }
-        }
-        if let (Some(noise), Some(sn), Some(sn_s)) =
-            (&self.noise, &self.signal_to_noise, &self.signal_to_noise_s)
-        {
-            t.push("P_eps", POWER, noise.clone());
-            t.push("SN", "1", sn.clone());
-            t.push("SN_s", "1", sn_s.clone());
-        }
-        for (l, p) in self.ells.iter().zip(&self.total) {
-            t.push(
-                format!("err_P{l}"),
-                POWER,
-                p.iter().map(|e| e.error).collect(),
-            );
-        }
-        t
-    }
-}
-
 fn push(out: &mut [Vec<Estimate>], values: Vec<Estimate>) {
     for (o, v) in out.iter_mut().zip(values) {
         o.push(v);
@@ -542,8 +505,7 @@ mod tests {
             let kaiser = (b * b + 2.0 * b * f / 3.0 + f * f / 5.0) / (b * b);
             assert!((sn_s[i] / sn[i] / kaiser - 1.0).abs() < 1e-12);
         }
-        assert!(m
-            .table(vec![])
+        assert!(crate::jobs::rsd_multipoles_table(&m, vec![])
             .names()
             .ends_with(&["P_eps", "SN", "SN_s", "err_P0", "err_P2"]));
     }
