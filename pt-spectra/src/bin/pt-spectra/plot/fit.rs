@@ -151,7 +151,7 @@ pub fn contour(args: &Args) -> Result<Figure> {
     if n.len() < 7 || n[0] != "k_max" || n[1] != "i" || n[2] != "j" || n[6] != "delta_chi2" {
         bail!(
             "`{}`: expected `k_max i j <P1> <P2> chi2 delta_chi2 …` (fit --contour-out), found {}",
-            t.path,
+            t.origin,
             n.join(" ")
         );
     }
@@ -178,7 +178,7 @@ pub fn contour(args: &Args) -> Result<Figure> {
     if ni < 2 || nj < 2 || ni * nj != rows.len() {
         bail!(
             "`{}`: the rows of k_max = {chosen} are not a grid (i, j) of {xn} and {yn}",
-            t.path
+            t.origin
         );
     }
     let (mut gx, mut gy, mut gd) = (
@@ -190,7 +190,7 @@ pub fn contour(args: &Args) -> Result<Figure> {
         let (Some(i), Some(j)) = (index(gi[r]), index(gj[r])) else {
             bail!(
                 "`{}`: row with i = {}, j = {} is not on the grid",
-                t.path,
+                t.origin,
                 gi[r],
                 gj[r]
             );

@@ -1,119 +1,38 @@
 //! Reading the tables the other subcommands write (by column name) and measured data (by position).
 
-use anyhow::{bail, Context, Result};
+use anyhow::Result;
 use std::path::Path;
 
-/// A table written by pt-spectra: its header lines, the names of its `# k …` line, and its rows.
-pub struct Named {
-    /// The file, for messages.
-    pub path: String,
-    /// The header lines without `# ` (the first says what was computed).
-    pub header: Vec<String>,
-    /// The column names.
-    pub names: Vec<String>,
-    rows: Vec<Vec<f64>>,
+/// A table written by pt-spectra, read back by name (the library's reader), with the plot's own
+/// helpers.
+pub struct Named(pub pt_spectra::output::WrittenTable);
+
+impl std::ops::Deref for Named {
+    type Target = pt_spectra::output::WrittenTable;
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
 }
 
 impl Named {
-    /// Reads a table: the names are on the last `#` line before the first row, which must start with
-    /// `# k` (`k`, `k_max`).
+    /// Reads a table (see [`pt_spectra::output::WrittenTable::parse`]).
     pub fn read(path: &Path) -> Result<Self> {
-        let shown = path.display().to_string();
-        let text =
-            std::fs::read_to_string(path).with_context(|| format!("cannot read `{shown}`"))?;
-        let header: Vec<String> = text
-            .lines()
-            .take_while(|l| l.starts_with('#'))
-            .map(|l| l.trim_start_matches('#').trim().to_string())
-            .collect();
-        let names: Vec<String> = header
-            .last()
-            .filter(|l| l.starts_with('k'))
-            .with_context(|| format!("`{shown}`: no `# k …` names line (not a pt-spectra table?)"))?
-            .split_whitespace()
-            .map(str::to_string)
-            .collect();
-        let mut rows = Vec::new();
-        for (i, line) in text
-            .lines()
-            .enumerate()
-            .filter(|(_, l)| !l.starts_with('#') && !l.trim().is_empty())
-        {
-            let row: Vec<f64> = line
-                .split_whitespace()
-                .map(|v| v.parse::<f64>())
-                .collect::<std::result::Result<_, _>>()
-                .with_context(|| format!("`{shown}`:{}: not a row of numbers", i + 1))?;
-            if row.len() != names.len() {
-                bail!(
-                    "`{shown}`:{}: {} values for {} columns",
-                    i + 1,
-                    row.len(),
-                    names.len()
-                );
-            }
-            rows.push(row);
-        }
-        if rows.is_empty() {
-            bail!("`{shown}`: no data rows");
-        }
-        Ok(Self {
-            path: shown,
-            header,
-            names,
-            rows,
-        })
-    }
-
-    /// The first header line (what was computed).
-    pub fn title(&self) -> &str {
-        self.header.first().map_or("", String::as_str)
-    }
-
-    /// The text of the first header line after `key` up to the next `,` (e.g. the model after `rsd: `).
-    pub fn after(&self, key: &str) -> Option<String> {
-        let t = self.title();
-        let at = t.find(key)? + key.len();
-        Some(t[at..].split(',').next().unwrap_or("").trim().to_string())
-    }
-
-    /// The number after `key` in any header line (e.g. `sigma_v2 = `).
-    pub fn header_number(&self, key: &str) -> Option<f64> {
-        self.header.iter().find_map(|l| {
-            let at = l.find(key)? + key.len();
-            let rest = &l[at..];
-            let end = rest
-                .find(|c: char| c == ',' || c == ';' || c.is_whitespace())
-                .unwrap_or(rest.len());
-            rest[..end].parse().ok()
-        })
+        Ok(Self(pt_spectra::output::WrittenTable::read(path)?))
     }
 
     /// A legend label: `z = …` from the first header line, else the file name.
     pub fn z_label(&self) -> String {
         match self.after(" z = ") {
             Some(z) if !z.is_empty() => format!("z = {}", z.split(';').next().unwrap_or(&z)),
-            _ => Path::new(&self.path)
+            _ => Path::new(&self.origin)
                 .file_stem()
-                .map_or_else(|| self.path.clone(), |s| s.to_string_lossy().into_owned()),
+                .map_or_else(|| self.origin.clone(), |s| s.to_string_lossy().into_owned()),
         }
-    }
-
-    /// The values of the column `name`.
-    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
-        let j = self.names.iter().position(|n| n == name)?;
-        Some(self.rows.iter().map(|r| r[j]).collect())
     }
 
     /// The values of the column `name`, or an error naming the table's columns.
     pub fn need(&self, name: &str) -> Result<Vec<f64>> {
-        self.column(name).with_context(|| {
-            format!(
-                "`{}` has no column `{name}` (it has {})",
-                self.path,
-                self.names.join(" ")
-            )
-        })
+        Ok(self.0.need(name)?)
     }
 }
 

@@ -18,6 +18,9 @@
 //!             an input outside what the model handles; please report it with the command)");
 //! ```
 
+mod written;
+pub use written::WrittenTable;
+
 use crate::error::{number, Error, Result};
 use crate::estimate::Estimate;
 
