@@ -52,6 +52,9 @@ __all__ = [
 
 __version__ = _core.__version__
 
+#: The defaults of the keyword arguments, spelled once in the library (``pt_spectra::jobs::defaults``).
+_D = _core.DEFAULTS
+
 
 class PtSpectraWarning(UserWarning):
     """A default or an input that may not be what you meant (also stated in the table header)."""
@@ -83,8 +86,8 @@ class RealPlan:
     terms and spectra; both as in :func:`real`).
     """
 
-    def __init__(self, k, model="1l-spt", precision="default", q_range=None,
-                 two_loop_tolerance=None, cache_dir=None, two_loop="auto"):
+    def __init__(self, k, model=_D["real_model"], precision=_D["precision"], q_range=None,
+                 two_loop_tolerance=None, cache_dir=None, two_loop=_D["two_loop"]):
         self._plan = _core.RealPlan(k, model, precision, q_range, two_loop_tolerance, cache_dir,
                                     two_loop)
         self.model = model
@@ -124,7 +127,7 @@ class EptPlan:
     :meth:`EptTerms.multipoles` (a chain that varies the cosmology against a fiducial).
     """
 
-    def __init__(self, k, ir=True, apar=None, aperp=None, precision="default", q_range=None,
+    def __init__(self, k, ir=True, apar=None, aperp=None, precision=_D["precision"], q_range=None,
                  free_ap=False):
         self._plan = _core.EptPlan(k, ir, apar, aperp, precision, q_range, free_ap)
 
@@ -151,7 +154,7 @@ class EptTerms:
 
 
 def ept(k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, ells=(0, 2, 4), ir=True,
-        apar=None, aperp=None, precision="default", q_range=None, k_min=1e-3, k_max=1.0, nk=100,
+        apar=None, aperp=None, precision=_D["precision"], q_range=None, k_min=1e-3, k_max=1.0, nk=100,
         **params) -> Table:
     """The galaxy model's multipoles (``pt-spectra rsd --rsd ept``): columns ``k P0 P2 P4 …
     err_P0 …``. Parameters by velocileptors' names (see :class:`EptPlan`); ``ir=False`` for plain
@@ -162,7 +165,7 @@ def ept(k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, ells=(
 
 def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0, 2),
             data_ells=(0, 2, 4), data_columns=None, covariance=None, k_min=0.0, ir=True, apar=None,
-            aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default",
+            aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision=_D["precision"],
             q_range=None, eh=None, n_mocks=None, k_ranges=None, window=None,
             window_mixing="wilson", k_edges=None, box=None, xi=False, s_edges=None, **start) -> Table:
     """Fits of the galaxy model ``ept`` (``pt-spectra fit --rsd ept``), one row per k_max.
@@ -204,8 +207,8 @@ class RsdPlan:
     :class:`EptTerms`.
     """
 
-    def __init__(self, k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None,
-                 cache_dir=None, two_loop="auto", **ept_settings):
+    def __init__(self, k, real=_D["rsd_real_model"], rsd=_D["rsd_model"], precision=_D["precision"],
+                 q_range=None, cache_dir=None, two_loop=_D["two_loop"], **ept_settings):
         self._ept = None
         if str(rsd).lower() == "ept":
             self._ept = EptPlan(k, precision=precision, q_range=q_range, **ept_settings)
@@ -257,9 +260,9 @@ class RsdTerms:
                                             growth_factor, no_wiggle, cs2))
 
 
-def real(model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False,
-         precision="default", q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None,
-         k_min=1e-3, k_max=1.0, nk=100, cs2=0.0, two_loop="auto", bias_terms=False, bias=None,
+def real(model=_D["real_model"], k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False,
+         precision=_D["precision"], q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None,
+         k_min=1e-3, k_max=1.0, nk=100, cs2=0.0, two_loop=_D["two_loop"], bias_terms=False, bias=None,
          b2=0.0, bs=0.0, b3=0.0) -> Table:
     """Real-space P_dd, P_dt, P_tt of a model (``pt-spectra real``).
 
@@ -289,9 +292,10 @@ def real(model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None
     return plan(linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2, bs, b3)
 
 
-def rsd(rsd="tns", real="1l-rpt-n1", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None,
-        f=None, bias=1.0, amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None,
-        number_density=None, noise_table=None, ells=(0, 2, 4), terms=False, precision="default",
+def rsd(rsd=_D["rsd_model"], real=_D["rsd_real_model"], k=None, linear=None, z=0.0, z_input=0.0,
+        cosmology=None,
+        f=None, bias=1.0, amplitude=1.0, fog=_D["rsd_fog"], sigma0=0.0, shot_noise=None,
+        number_density=None, noise_table=None, ells=(0, 2, 4), terms=False, precision=_D["precision"],
         q_range=None, cache_dir=None, eh=None, k_min=1e-3, k_max=1.0, nk=100,
         no_wiggle=False, cs2=0.0, b2=None, bs=None, b3=None, **ept_params) -> Table:
     """Redshift-space multipoles (``pt-spectra rsd``): columns ``k P0 P2 P4 … err_P0 …``.
@@ -327,9 +331,10 @@ def rsd(rsd="tns", real="1l-rpt-n1", k=None, linear=None, z=0.0, z_input=0.0, co
 
 
 def fit(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_columns=None,
-        covariance=None, rsd="tns", real="1l-spt", fog="lorentzian", f=None, sigma0=3.0, bias=1.0,
-        amplitude=1.0, shot_noise=None, number_density=None, noise_table=None, k_min=0.0,
-        linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default", q_range=None,
+        covariance=None, rsd=_D["rsd_model"], real=_D["fit_real_model"], fog=_D["fit_fog"], f=None,
+        sigma0=float(_D["fit_sigma0"]), bias=1.0, amplitude=1.0, shot_noise=None,
+        number_density=None, noise_table=None, k_min=0.0, linear=None, z=0.0, z_input=0.0,
+        cosmology=None, precision=_D["precision"], q_range=None,
         cache_dir=None, eh=None, cs2=0.0, **ept_options) -> Table:
     """Fits of f, sigma0, A_b and the EFT counterterm c_s^2 (``free``, of ``"f"``, ``"sigma0"``,
     ``"ab"``, ``"cs2"``) to measured multipoles (``pt-spectra fit``). ``rsd="ept"`` fits the galaxy
@@ -358,9 +363,10 @@ def fit(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_
 
 
 def fit_tables(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_columns=None,
-               covariance=None, rsd="tns", real="1l-spt", fog="lorentzian", f=None, sigma0=3.0,
-               bias=1.0, amplitude=1.0, shot_noise=None, number_density=None, noise_table=None,
-               k_min=0.0, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default",
+               covariance=None, rsd=_D["rsd_model"], real=_D["fit_real_model"],
+               fog=_D["fit_fog"], f=None, sigma0=float(_D["fit_sigma0"]), bias=1.0, amplitude=1.0,
+               shot_noise=None, number_density=None, noise_table=None, k_min=0.0, linear=None,
+               z=0.0, z_input=0.0, cosmology=None, precision=_D["precision"],
                q_range=None, cache_dir=None, eh=None, cs2=0.0, model=False, contour=None,
                contour_points=41, contour_span=2.5) -> dict:
     """:func:`fit` with the command line's ``--model-out`` and ``--contour`` tables.

@@ -49,7 +49,7 @@ pub(crate) struct EptPlan {
 #[pymethods]
 impl EptPlan {
     #[new]
-    #[pyo3(signature = (k, ir=true, apar=None, aperp=None, precision="default", q_range=None, free_ap=false))]
+    #[pyo3(signature = (k, ir=true, apar=None, aperp=None, precision=pt_spectra::jobs::defaults::PRECISION, q_range=None, free_ap=false))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -165,7 +165,7 @@ impl EptTerms {
 #[pyfunction]
 #[pyo3(signature = (data, k_max, free=vec!["f".to_string(), "b1".to_string()], marginalise=vec![],
     priors=None, ells=vec![0, 2], data_ells=vec![0, 2, 4], data_columns=None, covariance=None, k_min=0.0,
-    ir=true, apar=None, aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default",
+    ir=true, apar=None, aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision=pt_spectra::jobs::defaults::PRECISION,
     q_range=None, eh=None, n_mocks=None, k_ranges=None, window=None, window_mixing="wilson",
     k_edges=None, r#box=None, xi=false, s_edges=None, **kwargs))]
 #[allow(clippy::too_many_arguments)]

@@ -147,7 +147,7 @@ struct RealPlan {
 impl RealPlan {
     #[new]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (k, model="1l-spt", precision="default", q_range=None, two_loop_tolerance=None, cache_dir=None, two_loop="auto"))]
+    #[pyo3(signature = (k, model=pt_spectra::jobs::defaults::REAL_MODEL, precision=pt_spectra::jobs::defaults::PRECISION, q_range=None, two_loop_tolerance=None, cache_dir=None, two_loop=pt_spectra::jobs::defaults::TWO_LOOP))]
     fn new(
         py: Python<'_>,
         k: &Bound<'_, PyAny>,
@@ -246,9 +246,9 @@ impl RealPlan {
 
 /// `pt-spectra real` as a function: see the Python wrapper's docstring.
 #[pyfunction]
-#[pyo3(signature = (model="1l-spt", k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false,
-    precision="default", q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None, k_min=1e-3,
-    k_max=1.0, nk=100, cs2=0.0, two_loop="auto", bias_terms=false, bias=None, b2=0.0, bs=0.0, b3=0.0))]
+#[pyo3(signature = (model=pt_spectra::jobs::defaults::REAL_MODEL, k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false,
+    precision=pt_spectra::jobs::defaults::PRECISION, q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None, k_min=1e-3,
+    k_max=1.0, nk=100, cs2=0.0, two_loop=pt_spectra::jobs::defaults::TWO_LOOP, bias_terms=false, bias=None, b2=0.0, bs=0.0, b3=0.0))]
 #[allow(clippy::too_many_arguments)]
 fn real(
     py: Python<'_>,
@@ -350,9 +350,9 @@ pub(crate) fn data(
 /// `pt-spectra fit` as a function: see the Python wrapper's docstring.
 #[pyfunction]
 #[pyo3(signature = (data, k_max, free=vec!["f".to_string(), "sigma0".to_string()], ells=vec![0],
-    data_ells=vec![0, 2, 4], data_columns=None, covariance=None, rsd="tns", real="1l-spt", fog="lorentzian",
+    data_ells=vec![0, 2, 4], data_columns=None, covariance=None, rsd=pt_spectra::jobs::defaults::RSD_MODEL, real=pt_spectra::jobs::defaults::FIT_REAL_MODEL, fog=pt_spectra::jobs::defaults::FIT_FOG,
     f=None, sigma0=None, bias=None, amplitude=1.0, shot_noise=None, number_density=None, noise_table=None,
-    k_min=0.0, linear=None, z=0.0, z_input=0.0, cosmology=None, precision="default", q_range=None,
+    k_min=0.0, linear=None, z=0.0, z_input=0.0, cosmology=None, precision=pt_spectra::jobs::defaults::PRECISION, q_range=None,
     cache_dir=None, eh=None, cs2=0.0, model_out=false, contour=None, contour_points=41, contour_span=2.5))]
 #[allow(clippy::too_many_arguments)]
 fn fit(
@@ -550,6 +550,11 @@ fn log_grid<'py>(
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    let defaults = PyDict::new(m.py());
+    for (name, value) in pt_spectra::jobs::defaults::ALL {
+        defaults.set_item(name, value)?;
+    }
+    m.add("DEFAULTS", defaults)?;
     m.add_class::<Table>()?;
     m.add_class::<RealPlan>()?;
     m.add_class::<redshift::RsdPlan>()?;

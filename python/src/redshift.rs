@@ -83,7 +83,7 @@ pub(crate) struct RsdPlan {
 impl RsdPlan {
     #[new]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None, cache_dir=None, two_loop="auto"))]
+    #[pyo3(signature = (k, real=pt_spectra::jobs::defaults::RSD_REAL_MODEL, rsd=pt_spectra::jobs::defaults::RSD_MODEL, precision=pt_spectra::jobs::defaults::PRECISION, q_range=None, cache_dir=None, two_loop=pt_spectra::jobs::defaults::TWO_LOOP))]
     fn new(
         py: Python<'_>,
         k: &Bound<'_, PyAny>,

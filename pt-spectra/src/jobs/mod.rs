@@ -35,6 +35,7 @@ use crate::real::{RealModel, RealPlan, RealSelection, RealSpectra};
 use crate::setup::Prepared;
 
 mod bias;
+pub mod defaults;
 mod ept;
 mod fit;
 mod halo;

@@ -35,15 +35,15 @@ pub struct Args {
     #[arg(long, value_name = "FILE")]
     covariance: Option<PathBuf>,
     /// Real-space model: linear, 1l-spt, 2l-spt, 1l-rpt-n0..n3, 2l-rpt-n0..n3.
-    #[arg(long = "real", value_name = "M", default_value = "1l-spt", value_parser = parsed::<RealModel>)]
+    #[arg(long = "real", value_name = "M", default_value = pt_spectra::jobs::defaults::FIT_REAL_MODEL, value_parser = parsed::<RealModel>)]
     real_model: RealModel,
     /// Redshift-space model: kaiser, scoccimarro or tns; or ept, the galaxy model (free, marginalised
     /// and prior parameters by velocileptors' names: b1 is --bias, then --b2 --bs --b3 --alpha0..6
     /// --sn --sn2 --sn4 as start values or fixed values).
-    #[arg(long, value_name = "MODEL", default_value = "tns", value_parser = parsed::<RsdChoice>)]
+    #[arg(long, value_name = "MODEL", default_value = pt_spectra::jobs::defaults::RSD_MODEL, value_parser = parsed::<RsdChoice>)]
     rsd: RsdChoice,
     /// Fingers of God: none, lorentzian or gaussian.
-    #[arg(long, value_name = "KIND", default_value = "lorentzian", value_parser = parsed::<Fog>)]
+    #[arg(long, value_name = "KIND", default_value = pt_spectra::jobs::defaults::FIT_FOG, value_parser = parsed::<Fog>)]
     fog: Fog,
     /// Free parameters, comma separated: f, sigma0, ab, cs2 (the EFT counterterm of --cs2); with
     /// --rsd ept any of f, b1, b2, bs, b3, alpha0, alpha2, alpha4, alpha6, sn, sn2, sn4. Default
@@ -96,7 +96,7 @@ pub struct Args {
     #[arg(
         long,
         value_name = "S",
-        default_value = "3",
+        default_value = pt_spectra::jobs::defaults::FIT_SIGMA0_TEXT,
         allow_hyphen_values = true,
         value_parser = parsed::<Sigma0>
     )]

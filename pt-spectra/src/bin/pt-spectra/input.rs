@@ -111,7 +111,7 @@ pub struct SpectrumInput {
     )]
     z: f64,
     /// Accuracy of the loop integrals: fast, default or reference.
-    #[arg(long, value_name = "PRESET", default_value = "default", value_parser = parse_precision)]
+    #[arg(long, value_name = "PRESET", default_value = pt_spectra::jobs::defaults::PRECISION, value_parser = parse_precision)]
     precision: Precision,
     /// Range of every loop integral over q [h/Mpc], QMIN,QMAX (default 1e-5,1e3). The 2-loop and
     /// propagator terms P15, P17 depend on QMAX (UV sensitivity); the header states the range.
@@ -127,7 +127,7 @@ pub struct SpectrumInput {
     /// then milliseconds per spectrum; a spectrum the basis does not represent is computed directly,
     /// with a warning), `direct` (integrals for every spectrum, seconds), or `auto` (basis if the
     /// tensors of this grid are already cached, else direct). The header says which was used.
-    #[arg(long, value_name = "METHOD", default_value = "auto", value_parser = parse_two_loop)]
+    #[arg(long, value_name = "METHOD", default_value = pt_spectra::jobs::defaults::TWO_LOOP, value_parser = parse_two_loop)]
     two_loop: TwoLoopMethod,
     /// Directory of the cached angular tables (P15, P17). Default: $PT_SPECTRA_CACHE, else
     /// $XDG_CACHE_HOME/pt-spectra, else ~/.cache/pt-spectra.

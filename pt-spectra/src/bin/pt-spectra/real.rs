@@ -18,7 +18,7 @@ pub struct Args {
     /// Model: linear, 1l-spt, 2l-spt, 1l-rpt-n0..n3, 2l-rpt-n0..n3 (N3 builds the P17 table once),
     /// 1l-regpt, 2l-regpt (RegPT), 1l-spt-ir, 2l-spt-ir (IR-resummed BAO);
     /// or `all`: P_dd/P_nowiggle of every model, one column each (the paper's real-space comparison).
-    #[arg(long, value_name = "M", default_value = "1l-spt", value_parser = parsed::<RealSelection>)]
+    #[arg(long, value_name = "M", default_value = pt_spectra::jobs::defaults::REAL_MODEL, value_parser = parsed::<RealSelection>)]
     model: RealSelection,
     /// Also print the separate loop terms, σ_v² and propagators, each with its error estimate (and,
     /// with --cs2, the counterterms P_ct_dd P_ct_dt P_ct_tt).

@@ -21,19 +21,19 @@ pub struct Args {
     #[command(flatten)]
     input: Input,
     /// Real-space model for P_δδ, P_δθ, P_θθ: linear, 1l-spt, 2l-spt, 1l-rpt-n0..n3 or 2l-rpt-n0..n3.
-    #[arg(long = "real", value_name = "M", default_value = "1l-rpt-n1", value_parser = parsed::<RealModel>)]
+    #[arg(long = "real", value_name = "M", default_value = pt_spectra::jobs::defaults::RSD_REAL_MODEL, value_parser = parsed::<RealModel>)]
     real_model: RealModel,
     /// Redshift-space model: kaiser, scoccimarro or tns (Scoccimarro + the A and B terms of Taruya,
     /// Nishimichi & Saito 2010 at leading order) on the --real model; or ept, the 1-loop galaxy model
     /// with IR resummation (velocileptors' REPT: --bias is b1, with --b2 --bs --b3, --alpha0..6,
     /// --sn --sn2 --sn4 in velocileptors' conventions, --no-ir).
-    #[arg(long, value_name = "MODEL", default_value = "tns", value_parser = parsed::<RsdChoice>)]
+    #[arg(long, value_name = "MODEL", default_value = pt_spectra::jobs::defaults::RSD_MODEL, value_parser = parsed::<RsdChoice>)]
     rsd: RsdChoice,
     /// Growth rate f. Default: f(z) of the cosmology.
     #[arg(long, value_name = "F", allow_hyphen_values = true)]
     f: Option<f64>,
     /// Fingers-of-God damping: none, lorentzian or gaussian (P^s → P^s D², D of kμσ0 D(z) f).
-    #[arg(long, value_name = "KIND", default_value = "none", value_parser = parsed::<Fog>)]
+    #[arg(long, value_name = "KIND", default_value = pt_spectra::jobs::defaults::RSD_FOG, value_parser = parsed::<Fog>)]
     fog: Fog,
     /// σ0 of the damping [Mpc/h] (its z = 0 value; scaled by D(z) f), or its theory value σ(z)/D(z) from
     /// eq. sigmav, σ² = (1/6π²)∫P_θθ dq, with linear (`lin`) or 1-loop SPT (`1l-spt`) P_θθ; `1l-spt`
