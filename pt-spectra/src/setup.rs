@@ -242,6 +242,25 @@ pub fn input_warnings(prepared: &Prepared, ignored_keys: &[String], k: &[f64]) -
 }
 
 impl Prepared {
+    /// These inputs with the growth factor D(z) replaced by `d` (e.g. a Boltzmann code's σ8(z)/σ8(0)),
+    /// stated in the header lines.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] unless `d` is finite and positive.
+    pub fn with_growth_factor(mut self, d: f64) -> Result<Self> {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "growth_factor",
+                value: d,
+                reason: "must be finite and positive",
+            });
+        }
+        self.growth_factor = d;
+        self.description
+            .push(format!("growth factor D(z) = {d} given by the caller"));
+        Ok(self)
+    }
+
     /// The Eisenstein & Hu (1998) no-wiggle spectrum of the cosmology at the output redshift, scaled to
     /// the σ8 of the linear spectrum: the smooth reference by which BAO are divided out.
     ///
@@ -334,5 +353,25 @@ mod tests {
         })
         .unwrap_err();
         assert!(e.to_string().contains("z = -1"), "{e}");
+    }
+
+    #[test]
+    fn a_given_growth_factor_replaces_d_and_is_stated() {
+        let p = prepare(Request {
+            source: LinearSource::Embedded,
+            cosmology: None,
+            z: 0.5,
+        })
+        .unwrap();
+        let q = p.clone().with_growth_factor(0.7).unwrap();
+        assert_eq!(q.growth_factor, 0.7);
+        assert!(q
+            .description
+            .last()
+            .unwrap()
+            .contains("D(z) = 0.7 given by the caller"));
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(p.clone().with_growth_factor(bad).is_err(), "{bad}");
+        }
     }
 }

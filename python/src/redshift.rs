@@ -65,7 +65,7 @@ pub(crate) fn bias_and_noise(
 /// σ0 as a number or `lin` / `1l-spt`.
 pub(crate) fn sigma0(obj: &Bound<'_, PyAny>) -> PyResult<Sigma0> {
     match obj.extract::<f64>() {
-        Ok(v) => format!("{v}").parse().map_err(value_error),
+        Ok(v) => Sigma0::value(v).map_err(value_error),
         Err(_) => obj.extract::<String>()?.parse().map_err(value_error),
     }
 }
@@ -267,25 +267,15 @@ fn rsd_request(
     })
 }
 
-/// `prepared` with its growth factor D(z) replaced (e.g. by a Boltzmann code's σ8(z)/σ8(0)).
+/// `prepared` with its growth factor D(z) replaced, if given ([`Prepared::with_growth_factor`]).
 fn with_growth(
-    mut prepared: Prepared,
+    prepared: Prepared,
     growth_factor: Option<f64>,
 ) -> pt_spectra::error::Result<Prepared> {
-    if let Some(d) = growth_factor {
-        if !(d.is_finite() && d > 0.0) {
-            return Err(pt_spectra::error::Error::InvalidParameter {
-                name: "growth_factor",
-                value: d,
-                reason: "must be finite and positive",
-            });
-        }
-        prepared.growth_factor = d;
-        prepared
-            .description
-            .push(format!("growth factor D(z) = {d} given by the caller"));
+    match growth_factor {
+        Some(d) => prepared.with_growth_factor(d),
+        None => Ok(prepared),
     }
-    Ok(prepared)
 }
 
 /// The loop terms of one linear spectrum on an [`RsdPlan`]'s grid; [`multipoles`](Self::multipoles)

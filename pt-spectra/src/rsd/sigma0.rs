@@ -25,7 +25,7 @@ impl std::str::FromStr for Sigma0 {
             "lin" => Ok(Sigma0::Theory(DispersionInput::Linear)),
             "1l-spt" => Ok(Sigma0::Theory(DispersionInput::OneLoopSpt)),
             t => match t.parse::<f64>() {
-                Ok(v) if v.is_finite() && v >= 0.0 => Ok(Sigma0::Value(v)),
+                Ok(v) => Sigma0::value(v),
                 _ => Err(Error::UnknownName {
                     what: "sigma0",
                     name: s.to_string(),
@@ -37,6 +37,22 @@ impl std::str::FromStr for Sigma0 {
 }
 
 impl Sigma0 {
+    /// The value `v` [Mpc/h].
+    ///
+    /// # Errors
+    /// [`Error::UnknownName`] unless `v` is finite and ≥ 0 (the message lists what is accepted).
+    pub fn value(v: f64) -> Result<Self> {
+        if v.is_finite() && v >= 0.0 {
+            Ok(Sigma0::Value(v))
+        } else {
+            Err(Error::UnknownName {
+                what: "sigma0",
+                name: v.to_string(),
+                available: "a finite non-negative number [Mpc/h], lin, 1l-spt",
+            })
+        }
+    }
+
     /// σ0 [Mpc/h]: the value, or the theory value for the linear `spectrum` at a redshift where the
     /// growth factor is `growth_factor`, integrated with `precision`.
     ///
