@@ -201,10 +201,10 @@ pub(crate) fn fit_ept(
     s_edges: Option<&Bound<'_, PyAny>>,
     kwargs: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Table> {
-    let (mut data, name) = crate::data(data, data_columns, &data_ells, &ells)?;
+    let (mut data, name, layout) = crate::data(data, data_columns, &data_ells, &ells)?;
     if let Some(c) = covariance {
-        data = data
-            .with_covariance(crate::covariance_rows(c)?)
+        data = layout
+            .attach_covariance(data, crate::covariance_rows(c)?)
             .map_err(value_error)?;
     }
     let mut prior_list = Vec::new();

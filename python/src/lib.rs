@@ -311,13 +311,14 @@ pub(crate) fn matrix_rows(c: &Bound<'_, PyAny>, message: &str) -> PyResult<Vec<V
     }
 }
 
-/// Measured multipoles from a path (with columns) or a dict {"k", "P0", "s0", "P2", "s2", …}.
+/// Measured multipoles from a path (with columns) or a dict {"k", "P0", "s0", "P2", "s2", …}, and the
+/// layout they were read with (for a covariance over all the file's multipoles).
 pub(crate) fn data(
     data: &Bound<'_, PyAny>,
     data_columns: Option<Vec<usize>>,
     data_ells: &[usize],
     ells: &[usize],
-) -> PyResult<(MultipoleData, String)> {
+) -> PyResult<(MultipoleData, String, pt_spectra::fit::DataLayout)> {
     if let Ok(dict) = data.cast::<PyDict>() {
         let get = |name: &str| -> PyResult<Vec<f64>> {
             let v = dict
@@ -336,7 +337,8 @@ pub(crate) fn data(
             .collect::<PyResult<_>>()?;
         let d =
             MultipoleData::from_arrays(k, ells, values, sigma, "data dict").map_err(value_error)?;
-        return Ok((d, "dict".into()));
+        let layout = pt_spectra::fit::DataLayout::new(ells, None).map_err(value_error)?;
+        return Ok((d, "dict".into(), layout));
     }
     let path: PathBuf = data
         .extract()
@@ -344,7 +346,7 @@ pub(crate) fn data(
     let layout = pt_spectra::fit::DataLayout::new(data_ells, data_columns.as_deref())
         .map_err(value_error)?;
     let d = layout.read(&path, ells).map_err(value_error)?;
-    Ok((d, path.display().to_string()))
+    Ok((d, path.display().to_string(), layout))
 }
 
 /// `pt-spectra fit` as a function: see the Python wrapper's docstring.
@@ -389,10 +391,10 @@ fn fit(
     contour_points: usize,
     contour_span: f64,
 ) -> PyResult<(Table, Option<Table>, Option<Table>)> {
-    let (mut data, data_name) = self::data(data, data_columns, &data_ells, &ells)?;
+    let (mut data, data_name, layout) = self::data(data, data_columns, &data_ells, &ells)?;
     if let Some(c) = covariance {
-        data = data
-            .with_covariance(covariance_rows(c)?)
+        data = layout
+            .attach_covariance(data, covariance_rows(c)?)
             .map_err(value_error)?;
     }
     let one = 1.0f64.into_pyobject(py)?.into_any();

@@ -134,3 +134,21 @@ def test_survey_likelihood_with_window_covariance_and_ap(tmp_path):
     assert chi2_true < 0.05
     chi2_off = -2 * model.loglikes({"b1_0": 1.03 * nu["b1"]}, as_dict=True)[0]["survey"]
     assert chi2_off > 20
+
+
+def test_a_covariance_over_all_the_files_multipoles_gives_the_fitted_blocks(tmp_path):
+    """fit_ept of P0, P2 from a file of P0, P2, P4: the covariance of all three (as surveys ship it)
+    gives the same fit as its P0, P2 blocks."""
+    k = np.linspace(0.02, 0.2, 10)
+    t = pt.EptPlan(k, precision="fast")(b1=2.0, f=0.7, alpha0=5.0)
+    sig = 0.01 * t["P0"]
+    path = tmp_path / "data.txt"
+    np.savetxt(path, np.column_stack([k, t["P0"], sig, t["P2"], sig, t["P4"], sig]))
+    n = k.size
+    full = np.diag(np.tile(sig, 3) ** 2)
+    full += 0.2 * np.sqrt(np.outer(np.diag(full), np.diag(full))) * (1 - np.eye(3 * n))
+    args = dict(k_max=[0.2], free=("f", "b1"), ells=(0, 2), precision="fast", b1=1.8, f=0.6)
+    a = pt.fit_ept(str(path), covariance=full, **args)
+    b = pt.fit_ept(str(path), covariance=full[: 2 * n, : 2 * n], **args)
+    for name in ("f", "b1", "chi2", "err_f"):
+        assert a[name][0] == pytest.approx(b[name][0], rel=1e-12), name

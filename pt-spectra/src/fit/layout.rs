@@ -95,20 +95,49 @@ impl DataLayout {
                 ),
             });
         }
-        let index: Vec<usize> = data
-            .ells
-            .iter()
-            .map(|&l| self.position(l))
-            .collect::<Result<Vec<_>>>()?
-            .into_iter()
-            .flat_map(|j| (0..n_k).map(move |i| j * n_k + i))
-            .collect();
+        let index = self.block_index(&data)?;
         let c = index
             .iter()
             .map(|&r| index.iter().map(|&s| table.columns[s][r]).collect())
             .collect();
         let lines: Vec<usize> = index.iter().map(|&r| table.lines[r]).collect();
         data.checked_covariance(c, &origin, &lines)
+    }
+
+    /// Attaches to `data` the covariance matrix `c` (rows), ℓ-major over either the fitted multipoles
+    /// or all the file's (the fitted blocks are taken), every k.
+    ///
+    /// # Errors
+    /// As [`MultipoleData::with_covariance`]; [`Error::LengthMismatch`] for a size that is neither.
+    pub fn attach_covariance(
+        &self,
+        data: MultipoleData,
+        c: Vec<Vec<f64>>,
+    ) -> Result<MultipoleData> {
+        let n_k = data.k.len();
+        let full = self.data_ells.len() * n_k;
+        if c.len() != full || data.ells == self.data_ells || c.iter().any(|r| r.len() != full) {
+            return data.with_covariance(c);
+        }
+        let index = self.block_index(&data)?;
+        let sub = index
+            .iter()
+            .map(|&r| index.iter().map(|&s| c[r][s]).collect())
+            .collect();
+        data.checked_covariance(sub, "covariance matrix", &[])
+    }
+
+    /// The positions in the full (all the file's multipoles) data vector of the fitted ones.
+    fn block_index(&self, data: &MultipoleData) -> Result<Vec<usize>> {
+        let n_k = data.k.len();
+        Ok(data
+            .ells
+            .iter()
+            .map(|&l| self.position(l))
+            .collect::<Result<Vec<_>>>()?
+            .into_iter()
+            .flat_map(|j| (0..n_k).map(move |i| j * n_k + i))
+            .collect())
     }
 
     fn position(&self, l: usize) -> Result<usize> {
