@@ -266,8 +266,8 @@ class SurveyMultipoles(Likelihood):
         if self._cols is None:
             self._select()
         p = np.asarray(self.provider.get_pt_pk_ell(z=self.z))[self._rows][:, self._cols]
-        observed, _ = self.observation.apply(np.ascontiguousarray(p))
-        return np.concatenate([np.asarray(observed)[j][m] for j, m in enumerate(self._mask)])
+        observed = np.asarray(self.observation.apply_values(np.ascontiguousarray(p)))
+        return np.concatenate([observed[j][m] for j, m in enumerate(self._mask)])
 
     def logp(self, **params_values):
         r = self._whiten @ (self.data - self.model())

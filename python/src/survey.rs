@@ -108,6 +108,21 @@ impl Observation {
         self.inner.description().to_vec()
     }
 
+    /// The values of `apply` without the error estimates (what a likelihood needs at every step;
+    /// about half the transforms): shape (len(ells), len(k_out)).
+    fn apply_values<'py>(
+        &self,
+        py: Python<'py>,
+        model: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let rows = matrix_rows(
+            model,
+            "model: expected a 2-D array (len(model_ells), len(k_model))",
+        )?;
+        let (out, _) = detached(py, || self.inner.apply_values(&rows))?;
+        PyArray2::from_vec2(py, &out).map_err(|e| PyValueError::new_err(e.to_string()))
+    }
+
     /// The observed multipoles from the model's: `model` of shape (len(model_ells), len(k_model));
     /// returns (values, errors), each of shape (len(ells), len(k_out)).
     #[allow(clippy::type_complexity)]

@@ -23,7 +23,9 @@ def test_a_window_that_cuts_nothing_and_fine_bins_leave_the_model(tmp_path):
     assert obs.model_ells == [0, 2, 4, 6, 8]
     plan = pt.EptPlan(obs.k_model, ir=False, precision="fast")
     t = plan(ells=obs.model_ells, b1=2.0, f=0.6, alpha0=3.0)
-    values, errors = obs.apply(np.array([t[f"P{l}"] for l in obs.model_ells]))
+    model = np.array([t[f"P{l}"] for l in obs.model_ells])
+    values, errors = obs.apply(model)
+    np.testing.assert_array_equal(obs.apply_values(model), values)
     direct = pt.EptPlan(k, ir=False, precision="fast")(b1=2.0, f=0.6, alpha0=3.0)
     for j, ell in enumerate((0, 2, 4)):
         np.testing.assert_allclose(values[j], direct[f"P{ell}"], rtol=0, atol=2e-5 * direct["P0"].max())

@@ -164,10 +164,7 @@ impl Objective<'_> {
                 let model = self
                     .plan
                     .multipole_values_at(self.terms, p, o.model_ells(), ap)?;
-                o.apply(&model)?
-                    .iter()
-                    .map(|l| l.iter().map(|e| e.value).collect())
-                    .collect()
+                o.apply_values(&model)?
             }
         };
         let raw: Vec<f64> = m
@@ -423,13 +420,12 @@ pub fn fit_galaxy_observed(
     }
     // The window's covariance: the data's full covariance (ℓ-major over the data's ells), or σ².
     let position = |r: usize, i: usize| r * k.len() + i;
-    let points_of = |rows: &[usize], window: &[Vec<usize>]| -> Vec<(usize, usize)> {
-        rows.iter()
-            .zip(window)
-            .flat_map(|(&r, w)| w.iter().map(move |&i| (r, i)))
-            .collect()
-    };
-    let fitted = points_of(&rows, &window);
+    // The fitted points (data row, k index), ℓ-major.
+    let fitted: Vec<(usize, usize)> = rows
+        .iter()
+        .zip(&window)
+        .flat_map(|(&r, w)| w.iter().map(move |&i| (r, i)))
+        .collect();
     let cov: Vec<Vec<f64>> = fitted
         .iter()
         .map(|&(r, i)| {

@@ -278,6 +278,45 @@ impl Observation {
         &self.description
     }
 
+    /// The values of [`Self::apply`] without the error estimates of the window and the ξ transform
+    /// (the cheaper path a fit takes at every step; bins and box modes cost little either way).
+    ///
+    /// # Errors
+    /// As [`Self::apply`].
+    pub fn apply_values(&self, model: &[Vec<f64>]) -> Result<Vec<Vec<f64>>> {
+        let values = |rows: Vec<Vec<Estimate>>| -> Vec<Vec<f64>> {
+            rows.into_iter()
+                .map(|r| r.into_iter().map(|e| e.value).collect())
+                .collect()
+        };
+        let windowed = match (&self.window, &self.bins) {
+            (_, Some(BinStage::Xi(plan))) => return plan.apply_values(model),
+            (_, Some(BinStage::Box(_))) | (Some(WindowStage::Matrix(_)), _) => {
+                return Ok(values(self.apply(model)?))
+            }
+            (Some(WindowStage::Plan(plan)), _) => plan.apply_values(model)?,
+            (None, _) => self.select(model),
+        };
+        match &self.bins {
+            Some(BinStage::Average(b)) => windowed
+                .iter()
+                .map(|w| Ok(b.apply(w)?.into_iter().map(|e| e.value).collect()))
+                .collect(),
+            _ => Ok(windowed),
+        }
+    }
+
+    /// The model's multipoles of the output ℓ (no window).
+    fn select(&self, model: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        self.ells
+            .iter()
+            .map(|l| {
+                let j = self.model_ells.iter().position(|m| m == l).unwrap_or(0);
+                model[j].clone()
+            })
+            .collect()
+    }
+
     /// The observed multipoles (one vector per output ℓ) from the model's multipoles
     /// [`Self::model_ells`] on [`Self::k_model`].
     ///
@@ -291,12 +330,9 @@ impl Observation {
         }
         let windowed: Vec<Vec<Estimate>> = match &self.window {
             None => self
-                .ells
-                .iter()
-                .map(|l| {
-                    let j = self.model_ells.iter().position(|m| m == l).unwrap_or(0);
-                    model[j].iter().map(|&v| Estimate::exact(v)).collect()
-                })
+                .select(model)
+                .into_iter()
+                .map(|r| r.into_iter().map(Estimate::exact).collect())
                 .collect(),
             Some(WindowStage::Plan(plan)) => plan.apply(model)?,
             Some(WindowStage::Matrix(m)) => {

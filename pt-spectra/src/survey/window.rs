@@ -300,21 +300,7 @@ impl WindowPlan {
         let mut spline_error = Vec::with_capacity(p.len());
         for values in p {
             let model = Resampled::new(&self.k_theory, values);
-            on_grid.push(
-                self.fft_k
-                    .iter()
-                    .zip(&self.taper)
-                    .map(|(&k, &t)| {
-                        if k < self.k_min {
-                            model.extend(k)
-                        } else if t == 0.0 {
-                            0.0
-                        } else {
-                            t * model.eval(k)
-                        }
-                    })
-                    .collect::<Vec<f64>>(),
-            );
+            on_grid.push(self.on_fft_grid(&model));
             let coarse = Resampled::new_half(&self.k_theory, values);
             let at_midpoints: Vec<f64> = self
                 .midpoints
@@ -357,6 +343,47 @@ impl WindowPlan {
             out.push(row);
         }
         Ok(out)
+    }
+
+    /// The values of [`apply`](Self::apply) without its error estimate (one FFTLog level, no spline
+    /// probe): what a fit evaluates at every step.
+    ///
+    /// # Errors
+    /// As [`apply`](Self::apply).
+    pub fn apply_values(&self, p: &[Vec<f64>]) -> Result<Vec<Vec<f64>>> {
+        check_model("WindowPlan::apply_values", p, self.k_theory.len())?;
+        let on_grid: Vec<Vec<f64>> = p
+            .iter()
+            .map(|values| self.on_fft_grid(&Resampled::new(&self.k_theory, values)))
+            .collect();
+        let windowed = self.levels[0].apply(&on_grid)?;
+        for (row, &ell) in windowed.iter().zip(&self.ells_out) {
+            if let Some((j, &value)) = row.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                return Err(Error::NonFiniteOutput {
+                    column: format!("windowed P_{ell}"),
+                    at: format!("k = {} h/Mpc", self.k_out[j]),
+                    value,
+                });
+            }
+        }
+        Ok(windowed)
+    }
+
+    /// The model on the FFTLog grid: the power law below k_min, tapered to zero towards k_max.
+    fn on_fft_grid(&self, model: &Resampled) -> Vec<f64> {
+        self.fft_k
+            .iter()
+            .zip(&self.taper)
+            .map(|(&k, &t)| {
+                if k < self.k_min {
+                    model.extend(k)
+                } else if t == 0.0 {
+                    0.0
+                } else {
+                    t * model.eval(k)
+                }
+            })
+            .collect()
     }
 }
 

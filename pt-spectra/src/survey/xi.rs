@@ -128,17 +128,7 @@ impl XiPlan {
     /// [`Error::InvalidChoice`] or [`Error::LengthMismatch`] for a model of the wrong shape,
     /// [`Error::InvalidValue`] for a value that is not finite; those of the transform.
     pub fn apply(&self, p: &[Vec<f64>]) -> Result<Vec<Vec<Estimate>>> {
-        check_model("XiPlan::apply", p, self.k_theory.len())?;
-        if p.len() != self.ells.len() {
-            return Err(Error::InvalidChoice {
-                what: "XiPlan::apply".into(),
-                reason: format!(
-                    "takes the model's P_l for l = {:?}, got {} multipoles",
-                    self.ells,
-                    p.len()
-                ),
-            });
-        }
+        self.check(p)?;
         let full = HankelOptions::default();
         let coarse = HankelOptions {
             points_per_decade: 0.5 * full.points_per_decade,
@@ -164,6 +154,45 @@ impl XiPlan {
             });
         }
         Ok(out)
+    }
+
+    /// The values of [`apply`](Self::apply) without its error estimate (one transform per ℓ): what a
+    /// fit evaluates at every step.
+    ///
+    /// # Errors
+    /// As [`apply`](Self::apply).
+    pub fn apply_values(&self, p: &[Vec<f64>]) -> Result<Vec<Vec<f64>>> {
+        self.check(p)?;
+        let options = HankelOptions::default();
+        self.ells
+            .iter()
+            .zip(p)
+            .map(|(&ell, values)| {
+                let tapered: Vec<f64> =
+                    values.iter().zip(&self.taper).map(|(v, t)| v * t).collect();
+                let xi = xi_from_pk_with(&self.k_theory, &tapered, ell, &self.s_eval, &options)?;
+                match &self.bins {
+                    None => Ok(xi),
+                    Some(b) => Ok(b.apply(&xi)?.iter().map(|e| e.value).collect()),
+                }
+            })
+            .collect()
+    }
+
+    /// The model's shape: one P_ℓ per ℓ of the plan, each on k_theory.
+    fn check(&self, p: &[Vec<f64>]) -> Result<()> {
+        check_model("XiPlan::apply", p, self.k_theory.len())?;
+        if p.len() != self.ells.len() {
+            return Err(Error::InvalidChoice {
+                what: "XiPlan::apply".into(),
+                reason: format!(
+                    "takes the model's P_l for l = {:?}, got {} multipoles",
+                    self.ells,
+                    p.len()
+                ),
+            });
+        }
+        Ok(())
     }
 }
 
@@ -222,6 +251,13 @@ mod tests {
         let model = vec![p.clone(), p.iter().map(|v| 0.5 * v).collect()];
         let xb = binned.apply(&model).unwrap();
         let xf = unbinned.apply(&model).unwrap();
+        // The values-only path of fits gives the same numbers, with and without bins.
+        for (plan, full) in [(&binned, &xb), (&unbinned, &xf)] {
+            let values = plan.apply_values(&model).unwrap();
+            for (v, e) in values.iter().zip(full) {
+                assert!(v.iter().zip(e).all(|(a, b)| *a == b.value));
+            }
+        }
         for l in 0..2 {
             let largest = xf[l].iter().fold(0.0_f64, |m, e| m.max(e.value.abs()));
             for (b, binned) in xb[l].iter().enumerate() {
