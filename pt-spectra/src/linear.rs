@@ -372,6 +372,21 @@ impl LinearSpectrum {
         }
     }
 
+    /// P at ln k = `x` (k in h/Mpc), as [`eval`](Self::eval) (equal to round-off) without its
+    /// exp/ln pair: for samples on a grid uniform in ln k (the loop lattice).
+    pub fn eval_ln(&self, x: f64) -> f64 {
+        let (lo, hi) = self.spline.range();
+        if x.is_nan() {
+            f64::NAN
+        } else if x < lo {
+            self.low.eval_ln(x)
+        } else if x > hi {
+            self.high.eval_ln(x)
+        } else {
+            self.spline.eval(x).exp()
+        }
+    }
+
     /// Smallest tabulated k [h/Mpc].
     pub fn k_min(&self) -> f64 {
         self.k[0]

@@ -33,6 +33,8 @@ pub enum Stage {
     Gamma2Weights,
     /// The 2-loop basis tensors of a k grid (once; cached).
     TwoLoopBasis,
+    /// The 1-loop basis tensors of a k grid (once; cached).
+    OneLoopBasis,
 }
 
 impl fmt::Display for Stage {
@@ -44,6 +46,7 @@ impl fmt::Display for Stage {
             Stage::TwoLoopPoints => "2-loop mode coupling",
             Stage::Gamma2Weights => "RegPT vertex weights (once per k grid)",
             Stage::TwoLoopBasis => "2-loop basis tensors (once per k grid, minutes; cached)",
+            Stage::OneLoopBasis => "1-loop basis tensors (once per k grid; cached)",
         })
     }
 }

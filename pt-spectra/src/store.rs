@@ -22,8 +22,8 @@
 //! ```
 
 use crate::error::{Error, Result};
-use crate::loops::basis::TwoLoopBasis;
-use crate::loops::{P15Table, P17Table};
+use crate::loops::basis::{OneLoopBasis, TwoLoopBasis};
+use crate::loops::{OneLoopPlan, P15Table, P17Table};
 use crate::precision::Precision;
 use crate::progress::{Progress, Stage};
 use std::fs::{File, OpenOptions, TryLockError};
@@ -155,26 +155,81 @@ impl TableStore {
         progress: &dyn Progress,
     ) -> Option<Arc<TwoLoopBasis>> {
         let path = self.path(&TwoLoopBasis::file_name(k, precision))?;
-        let tensors = match read_f64s(&path) {
-            Stored::Missing => None,
-            Stored::Invalid(why) => {
-                progress.note(&format!(
-                    "the cached 2-loop basis tensors `{}` {why}: not used (method basis rebuilds them)",
-                    path.display()
-                ));
-                return None;
-            }
-            Stored::Values(v) => TwoLoopBasis::from_f64s(&v, k, precision),
+        read_cached(&path, "2-loop basis tensors", progress, |v| {
+            TwoLoopBasis::from_f64s(v, k, precision)
+        })
+    }
+
+    /// The 1-loop basis tensors ([`OneLoopBasis`]) of `plan`'s k grid and precision: read from their
+    /// file, or built (reporting [`Stage::OneLoopBasis`]; about a second per 100 k) and written.
+    /// Without a directory they are built each time.
+    ///
+    /// # Errors
+    /// [`Error::Cache`] if the directory cannot be created or the file cannot be written or locked.
+    pub fn one_loop_basis(
+        &self,
+        plan: &OneLoopPlan,
+        progress: &dyn Progress,
+    ) -> Result<Arc<OneLoopBasis>> {
+        let (k, precision) = (plan.k(), plan.precision());
+        let build =
+            || OneLoopBasis::build(plan, &|d, t| progress.update(Stage::OneLoopBasis, d, t));
+        let tensors = match self.path(&OneLoopBasis::file_name(k, precision)) {
+            None => build(),
+            Some(path) => cached(
+                &path,
+                "1-loop basis",
+                |v| OneLoopBasis::from_f64s(v, k, precision),
+                build,
+                OneLoopBasis::to_f64s,
+                progress,
+            )?,
         };
-        if tensors.is_none() && path.exists() {
+        Ok(Arc::new(tensors))
+    }
+
+    /// The 1-loop basis tensors for `k` and `precision` if their file is in the directory and valid
+    /// (never builds them).
+    pub fn cached_one_loop_basis(
+        &self,
+        k: &[f64],
+        precision: &Precision,
+        progress: &dyn Progress,
+    ) -> Option<Arc<OneLoopBasis>> {
+        let path = self.path(&OneLoopBasis::file_name(k, precision))?;
+        read_cached(&path, "1-loop basis tensors", progress, |v| {
+            OneLoopBasis::from_f64s(v, k, precision)
+        })
+    }
+}
+
+/// Tensors from the file at `path` if it is there and passes `read`'s checks; a corrupted file is
+/// reported to `progress` (as `what`) and not used.
+fn read_cached<T>(
+    path: &Path,
+    what: &str,
+    progress: &dyn Progress,
+    read: impl Fn(&[f64]) -> Option<T>,
+) -> Option<Arc<T>> {
+    let tensors = match read_f64s(path) {
+        Stored::Missing => None,
+        Stored::Invalid(why) => {
             progress.note(&format!(
-                "the cached 2-loop basis tensors `{}` fail their consistency checks: not used \
-                 (method basis rebuilds them)",
+                "the cached {what} `{}` {why}: not used (method basis rebuilds them)",
                 path.display()
             ));
+            return None;
         }
-        tensors.map(Arc::new)
+        Stored::Values(v) => read(&v),
+    };
+    if tensors.is_none() && path.exists() {
+        progress.note(&format!(
+            "the cached {what} `{}` fail their consistency checks: not used \
+             (method basis rebuilds them)",
+            path.display()
+        ));
     }
+    tensors.map(Arc::new)
 }
 
 /// The table in `slot`, else from [`cached`], kept in `slot`.

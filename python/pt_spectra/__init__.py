@@ -21,6 +21,7 @@ Computations release the GIL and run on rayon's thread pool: its size is ``RAYON
 from __future__ import annotations
 
 import warnings as _warnings
+import numpy as np
 
 from . import _core
 from ._core import (Observation, Table, eisenstein_hu, growth, log_grid, num_threads,
@@ -101,6 +102,20 @@ class RealPlan:
                  cs2=0.0, bias_terms=False, bias=None, b2=0.0, bs=0.0, b3=0.0):
         return _warn(self._plan(linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2,
                                 bs, b3))
+
+    def batch(self, k_lin, P, terms=False):
+        """The model for many linear spectra at once, spread over the threads
+        (:func:`set_num_threads`): ``P`` of shape (n_spectra, len(k_lin)) [(Mpc/h)^3] tabulated at
+        ``k_lin`` [h/Mpc], each already at the output redshift. Returns a dict of arrays of shape
+        (n_spectra, n_k) named as the columns of :func:`real` (``P_lin``, ``P_dd``, ``P_dt``,
+        ``P_tt``; with ``terms`` their errors and the loop terms) and ``k``. No header and no
+        :class:`Table` per spectrum: the path for chains and training sets. A 1-D ``P`` is one
+        spectrum (leading axis of length 1).
+        """
+        P = np.asarray(P, dtype=float)
+        if P.ndim == 1:
+            P = P[None, :]
+        return _core.real_batch(self._plan, np.asarray(k_lin, dtype=float), P, terms)
 
 
 EPT_PARAMETERS = ("b1", "b2", "bs", "b3", "alpha0", "alpha2", "alpha4", "alpha6", "sn", "sn2",

@@ -22,6 +22,7 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
+mod batch;
 mod ept;
 mod halo;
 mod inputs;
@@ -138,7 +139,7 @@ pub(crate) fn detached<T: Send>(
 #[pyclass(module = "pt_spectra._core", frozen)]
 struct RealPlan {
     plan: LibRealPlan,
-    selection: RealSelection,
+    pub(crate) selection: RealSelection,
     /// The bias terms' plan, built at the first call that asks for them.
     bias_plan: OnceLock<BiasPlan>,
 }
@@ -565,6 +566,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ept::EptTerms>()?;
     m.add_class::<survey::Observation>()?;
     m.add_function(wrap_pyfunction!(ept::fit_ept, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::real_batch, m)?)?;
     m.add_function(wrap_pyfunction!(real, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(growth, m)?)?;

@@ -196,6 +196,7 @@ pub fn real_table_with_bias(
         RealSelection::All => {
             header.push(two_loop_line(precision));
             header.extend(spectra.terms.two_loop_source.map(|s| s.describe()));
+            header.extend(spectra.terms.one_loop_source.map(|s| s.describe()));
             header.push(
                 "P_nw: Eisenstein & Hu (1998) no-wiggle fit of the cosmology, scaled to the sigma8 of \
                  the linear input; columns <model> = P_dd(model)/P_nw, err_<model> its estimated \
@@ -237,6 +238,7 @@ fn model_header(
         h.push(two_loop_line(precision));
         h.extend(spectra.terms.two_loop_source.map(|s| s.describe()));
     }
+    h.extend(spectra.terms.one_loop_source.map(|s| s.describe()));
     if matches!(model, RealModel::OneLoopRegPt | RealModel::TwoLoopRegPt) {
         h.push(
             "RegPT (Taruya et al. 2012): x = k^2 sigma_d2/2, sigma_d2 = (1/6pi^2) int_qmin^(k/2) P dq; \

@@ -70,6 +70,11 @@ impl LogSpline {
         self.x.partition_point(|&v| v <= x).clamp(1, last + 1) - 1
     }
 
+    /// The first and last node x_0, x_{n−1}.
+    pub(crate) fn range(&self) -> (f64, f64) {
+        (self.x[0], self.x[self.x.len() - 1])
+    }
+
     /// y(x) for x inside [x_0, x_{n−1}].
     pub(crate) fn eval(&self, x: f64) -> f64 {
         let i = self.interval(x);
@@ -145,6 +150,8 @@ pub(super) struct PowerLaw {
     pub(super) k0: f64,
     pub(super) p0: f64,
     pub(super) slope: f64,
+    /// ln k0.
+    pub(super) ln_k0: f64,
 }
 
 impl PowerLaw {
@@ -158,12 +165,18 @@ impl PowerLaw {
             k0: x[anchor].exp(),
             p0: y[anchor].exp(),
             slope: sxy / sxx,
+            ln_k0: x[anchor],
         }
     }
 
     /// P(k).
     pub(super) fn eval(&self, k: f64) -> f64 {
         self.p0 * (k / self.k0).powf(self.slope)
+    }
+
+    /// P at ln k = `x`.
+    pub(super) fn eval_ln(&self, x: f64) -> f64 {
+        self.p0 * (self.slope * (x - self.ln_k0)).exp()
     }
 }
 

@@ -254,6 +254,50 @@ pub struct LoopTerms {
     pub gamma2: Option<Gamma2Terms>,
     /// How P15 and the 2-loop terms were computed, if they were.
     pub two_loop_source: Option<TwoLoopSource>,
+    /// How P22, P13, σ_v² and σ_d² were computed: `None` for the direct integrals.
+    pub one_loop_source: Option<OneLoopSource>,
+}
+
+/// How the 1-loop terms of a spectrum were computed, when not directly.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum OneLoopSource {
+    /// From the 1-loop basis tensors ([`basis::OneLoopBasis`]).
+    Basis {
+        /// Basis functions.
+        functions: usize,
+        /// The projection residual ε ([`basis::Projection::residual`]: smoothed).
+        residual: f64,
+    },
+    /// Directly, since the spectrum's projection residual exceeded the basis's limit.
+    Fallback {
+        /// The projection residual.
+        residual: f64,
+        /// The largest residual the basis accepts.
+        max_residual: f64,
+    },
+}
+
+impl OneLoopSource {
+    /// One line for table headers.
+    pub fn describe(&self) -> String {
+        match *self {
+            Self::Basis {
+                functions,
+                residual,
+            } => format!(
+                "1-loop terms (P22, P13, sigma_v^2, sigma_d^2): basis tensors on {functions} \
+                 functions, the same quadrature nodes as direct; projection residual {residual:.1e}; \
+                 errors include the projection error (residual x |P13|, 2 x residual x |P22|)"
+            ),
+            Self::Fallback {
+                residual,
+                max_residual,
+            } => format!(
+                "1-loop terms: direct integration, since the spectrum's projection residual on the \
+                 basis, {residual:.1e}, exceeds {max_residual:.1e}"
+            ),
+        }
+    }
 }
 
 /// How P15 and the 2-loop terms of a [`LoopTerms`] were computed.
@@ -338,6 +382,7 @@ impl LoopTerms {
             ir: None,
             gamma2: None,
             two_loop_source: None,
+            one_loop_source: None,
         }
     }
 

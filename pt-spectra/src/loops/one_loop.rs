@@ -32,11 +32,11 @@ impl Samples {
 
 /// Weights of one lattice (fine or half-resolution).
 #[derive(Debug, Clone)]
-struct Rule {
-    lattice: Lattice,
-    sigma_v2: Vec<f64>,
-    p13: Vec<P13Weights>,
-    p22: P22Nodes,
+pub(crate) struct Rule {
+    pub lattice: Lattice,
+    pub sigma_v2: Vec<f64>,
+    pub p13: Vec<P13Weights>,
+    pub p22: P22Nodes,
 }
 
 impl Rule {
@@ -155,6 +155,12 @@ impl OneLoopPlan {
     /// The settings the plan was built with.
     pub fn precision(&self) -> &Precision {
         &self.precision
+    }
+
+    /// The fine rule and the half-resolution rule of the error estimates (the basis tensors of
+    /// [`super::basis::OneLoopBasis`] are made from them).
+    pub(crate) fn rules(&self) -> (&Rule, &Rule) {
+        (&self.fine, &self.coarse)
     }
 
     /// Number of P22 quadrature nodes (fine rule, all k), a measure of the cost of an evaluation.

@@ -3,9 +3,9 @@
 use super::{RealModel, RealSelection, RealSpectra};
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
-use crate::loops::basis::TwoLoopBasis;
+use crate::loops::basis::{OneLoopBasis, Projection, TwoLoopBasis, MAX_RESIDUAL};
 use crate::loops::{self, ByPair, Estimate, Gamma2Plan, LoopTerms, OneLoopPlan, OneLoopTerms};
-use crate::loops::{P15Table, P17Table, TwoLoopCorrection, TwoLoopSource};
+use crate::loops::{OneLoopSource, P15Table, P17Table, TwoLoopCorrection, TwoLoopSource};
 use crate::precision::{Precision, TwoLoopMethod};
 use crate::progress::{stage_callback, Progress, Silent, Stage};
 use crate::resum;
@@ -50,6 +50,8 @@ pub struct RealPlan {
     gamma2: Option<Gamma2Plan>,
     /// The 2-loop basis tensors, if the 2-loop terms come from them ([`TwoLoopMethod`]).
     basis: Option<Arc<TwoLoopBasis>>,
+    /// The 1-loop basis tensors, if the 1-loop terms come from them ([`TwoLoopMethod`]).
+    one_loop_basis: Option<Arc<OneLoopBasis>>,
 }
 
 impl RealPlan {
@@ -140,10 +142,18 @@ impl RealPlan {
             },
             _ => None,
         };
+        // The 1-loop tensors (one chunk only): built with the 2-loop ones by method basis, used by
+        // auto when cached.
+        let one_loop_basis = match (one_loop.as_slice(), precision.two_loop) {
+            ([plan], TwoLoopMethod::Basis) => Some(store.one_loop_basis(plan, progress)?),
+            ([_], TwoLoopMethod::Auto) => store.cached_one_loop_basis(k, precision, progress),
+            _ => None,
+        };
         Ok(Self {
             k: k.to_vec(),
             model,
             precision: precision.clone(),
+            one_loop_basis,
             one_loop,
             p15,
             p17,
@@ -193,6 +203,71 @@ impl RealPlan {
     }
 
     fn loop_terms(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> LoopTerms {
+        let (k, precision) = (&self.k, &self.precision);
+        let (one_loop, sigma_d2, one_loop_source, projection) =
+            match self.one_loop_on_basis(spectrum, progress) {
+                Ok((terms, projection)) => {
+                    let source = OneLoopSource::Basis {
+                        functions: projection.coefficients.len(),
+                        residual: projection.residual,
+                    };
+                    (terms.terms, terms.sigma_d2, Some(source), Some(projection))
+                }
+                Err(source) => (
+                    self.one_loop_direct(spectrum, progress),
+                    resum::sigma_d2(spectrum, k, precision),
+                    source,
+                    None,
+                ),
+            };
+        let p17 = self
+            .p17
+            .as_ref()
+            .map(|table| loops::p17_terms(table, k, spectrum, precision));
+        let (p15, two_loop, two_loop_source) =
+            self.two_loop_terms(spectrum, &one_loop, projection, progress);
+        let gamma2 = self.gamma2.as_ref().map(|plan| plan.evaluate(spectrum));
+        LoopTerms {
+            one_loop,
+            p15,
+            p17,
+            two_loop,
+            sigma_d2: Some(sigma_d2),
+            ir: None,
+            gamma2,
+            two_loop_source,
+            one_loop_source,
+        }
+    }
+
+    /// The 1-loop terms and σ_d² from the basis tensors with the spectrum's projection, or, if the
+    /// plan has none or the spectrum does not project well enough, `Err` with what to report
+    /// (noted to `progress`).
+    fn one_loop_on_basis(
+        &self,
+        spectrum: &LinearSpectrum,
+        progress: &dyn Progress,
+    ) -> std::result::Result<(loops::basis::BasisOneLoop, Projection), Option<OneLoopSource>> {
+        let Some(tensors) = &self.one_loop_basis else {
+            return Err(None);
+        };
+        let basis = tensors.basis();
+        let projection = basis.project(&basis.sample(spectrum));
+        // A NaN residual (a spectrum with non-positive values) is refused too.
+        if projection.residual.is_nan() || projection.residual > MAX_RESIDUAL {
+            let source = OneLoopSource::Fallback {
+                residual: projection.residual,
+                max_residual: MAX_RESIDUAL,
+            };
+            progress.note(&source.describe());
+            return Err(Some(source));
+        }
+        let p_lin: Vec<f64> = self.k.iter().map(|&k| spectrum.eval(k)).collect();
+        Ok((tensors.evaluate(&p_lin, &projection), projection))
+    }
+
+    /// The 1-loop terms from the plan's quadrature (in chunks on long grids).
+    fn one_loop_direct(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> OneLoopTerms {
         let mut one_loop: Option<OneLoopTerms> = None;
         for (i, plan) in self.one_loop.iter().enumerate() {
             let part = plan.par_evaluate(spectrum);
@@ -205,25 +280,7 @@ impl RealPlan {
                 progress.update(Stage::OneLoop, done, 2 * self.k.len());
             }
         }
-        let one_loop = one_loop.expect("a plan has at least one chunk");
-        let (k, precision) = (&self.k, &self.precision);
-        let p17 = self
-            .p17
-            .as_ref()
-            .map(|table| loops::p17_terms(table, k, spectrum, precision));
-        let (p15, two_loop, two_loop_source) = self.two_loop_terms(spectrum, &one_loop, progress);
-        let sigma_d2 = Some(resum::sigma_d2(spectrum, k, precision));
-        let gamma2 = self.gamma2.as_ref().map(|plan| plan.evaluate(spectrum));
-        LoopTerms {
-            one_loop,
-            p15,
-            p17,
-            two_loop,
-            sigma_d2,
-            ir: None,
-            gamma2,
-            two_loop_source,
-        }
+        one_loop.expect("a plan has at least one chunk")
     }
 
     /// P15 and, for 2-loop models, the 2-loop terms: from the basis tensors if the plan has them and
@@ -233,6 +290,7 @@ impl RealPlan {
         &self,
         spectrum: &LinearSpectrum,
         one_loop: &OneLoopTerms,
+        projection: Option<Projection>,
         progress: &dyn Progress,
     ) -> (
         Option<ByPair<Vec<Estimate>>>,
@@ -248,7 +306,19 @@ impl RealPlan {
             _ => TwoLoopSource::Direct,
         };
         if let Some(basis) = &self.basis {
-            match basis.evaluate(spectrum, one_loop) {
+            // The projection made for the 1-loop tensors if it is on the same basis (accepted there
+            // with the same limit), else the 2-loop basis's own.
+            let shared = projection.filter(|_| {
+                self.one_loop_basis
+                    .as_ref()
+                    .is_some_and(|b| b.basis() == basis.basis())
+                    && basis.max_residual() >= MAX_RESIDUAL
+            });
+            let result = match shared {
+                Some(projection) => Ok(basis.evaluate_projected(spectrum, projection, one_loop)),
+                None => basis.evaluate(spectrum, one_loop),
+            };
+            match result {
                 Ok(terms) => {
                     let source = TwoLoopSource::Basis {
                         functions: basis.basis().len(),
@@ -287,6 +357,21 @@ impl RealPlan {
         progress: &dyn Progress,
     ) -> Result<RealSpectra> {
         RealSpectra::from_terms(self.model, self.terms(spectrum, progress)?)
+    }
+}
+
+impl RealPlan {
+    /// The model's spectra for each of `spectra` (each at the output redshift), spread over
+    /// rayon's threads one spectrum per task: a batch of cosmologies. The results are those of
+    /// [`evaluate`](Self::evaluate), in order. Memory: the plan once, and per spectrum its table
+    /// and its [`RealSpectra`] (values and errors of every term: ~0.4 kB per k for 1-loop models
+    /// with terms).
+    pub fn evaluate_batch(&self, spectra: &[LinearSpectrum]) -> Vec<Result<RealSpectra>> {
+        use rayon::prelude::*;
+        spectra
+            .par_iter()
+            .map(|s| self.evaluate(s, &Silent))
+            .collect()
     }
 }
 

@@ -170,6 +170,13 @@ impl LinearBasis {
         }
     }
 
+    /// The samples of `spectrum` on the basis's lattice (what [`project`](Self::project) takes).
+    pub fn sample(&self, spectrum: &crate::linear::LinearSpectrum) -> Vec<f64> {
+        (0..self.lattice.len)
+            .map(|j| spectrum.eval_ln(self.lattice.x(j)))
+            .collect()
+    }
+
     /// The projection of the lattice `samples` of a spectrum: c_a = ⟨φ_a, P⟩ and the residual.
     pub fn project(&self, samples: &[f64]) -> Projection {
         let n = self.n;
@@ -236,9 +243,16 @@ fn smoothed(values: &[f64], width: f64) -> Vec<f64> {
     let g: Vec<f64> = (0..=reach)
         .map(|d| (-0.5 * (d as f64 / width).powi(2)).exp())
         .collect();
-    (0..values.len())
+    let len = values.len();
+    // Interior points: one dot product with the whole symmetric kernel, normalised once.
+    let kernel: Vec<f64> = (0..=2 * reach).map(|i| g[i.abs_diff(reach)]).collect();
+    let norm = 1.0 / kernel.iter().sum::<f64>();
+    (0..len)
         .map(|j| {
-            let (lo, hi) = (j.saturating_sub(reach), (j + reach).min(values.len() - 1));
+            if j >= reach && j + reach < len {
+                return norm * super::dot(&values[j - reach..=j + reach], &kernel);
+            }
+            let (lo, hi) = (j.saturating_sub(reach), (j + reach).min(len - 1));
             let (mut s, mut w) = (0.0, 0.0);
             for (i, v) in values.iter().enumerate().take(hi + 1).skip(lo) {
                 let gi = g[i.abs_diff(j)];

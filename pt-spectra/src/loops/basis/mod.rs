@@ -34,11 +34,13 @@
 //! [`TableStore::two_loop_basis`]: crate::store::TableStore::two_loop_basis
 
 mod linear_basis;
+mod one_loop;
 mod p15_forms;
 mod tensors;
 pub mod training;
 
 pub use linear_basis::{LinearBasis, Projection, SMOOTHING};
+pub use one_loop::{BasisOneLoop, OneLoopBasis};
 
 use super::lattice::Lattice;
 use super::mode_coupling::ACC;
@@ -292,6 +294,17 @@ impl TwoLoopBasis {
         if projection.residual.is_nan() || projection.residual > self.max_residual {
             return Err(projection);
         }
+        Ok(self.evaluate_projected(spectrum, projection, one_loop))
+    }
+
+    /// As [`evaluate`](Self::evaluate) with the spectrum's `projection` on [`basis`](Self::basis)
+    /// already made (and accepted) by the caller.
+    pub fn evaluate_projected(
+        &self,
+        spectrum: &LinearSpectrum,
+        projection: Projection,
+        one_loop: &OneLoopTerms,
+    ) -> BasisTwoLoop {
         let c = &projection.coefficients;
         let n = c.len();
         let mut s2 = vec![0.0; n * (n + 1) / 2];
@@ -370,11 +383,11 @@ impl TwoLoopBasis {
             p15.dt[i].error += eps * 0.5 * (dd + tt);
             p15.tt[i].error += eps * tt;
         }
-        Ok(BasisTwoLoop {
+        BasisTwoLoop {
             correction,
             p15,
             projection,
-        })
+        }
     }
 
     /// The tensors as the values of their cache file.

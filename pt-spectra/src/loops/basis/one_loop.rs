@@ -1,0 +1,579 @@
+//! The 1-loop terms of a new spectrum as contractions: P22 = cᵀ T c, P13 = P(k) wᵀc, σ_v² = sᵀc,
+//! σ_d²(k) = d(k)ᵀc, with tensors made once per k grid from the weights of the 1-loop plan.
+//!
+//! The 1-loop plan ([`OneLoopPlan`]) samples the spectrum on a lattice and integrates the lattice
+//! interpolant with fixed weights: P22 is a bilinear form of the samples, P13 and σ_v² linear ones.
+//! With the samples replaced by the projection P̂ = Σ_a c_a φ_a ([`LinearBasis`]), every term is a
+//! contraction of a cosmology-independent tensor with c (or c ⊗ c): the same quadrature nodes, the
+//! same interpolation, so the result equals the direct plan's result for P̂ to round-off. The only
+//! difference from the direct plan is the response to the projection residual P − P̂, bounded by
+//! ε|T| for the linear terms and 2ε|T| for P22 (ε: the smoothed residual of [`Projection`]; the
+//! kernels F₂², G₂² are positive and F₂G₂ nearly so), and added to every error. The quadrature error
+//! is the direct plan's: fine rule minus half-resolution rule, contracted on the first
+//! [`ERROR_FUNCTIONS`](super::ERROR_FUNCTIONS) functions for P22 (as the 2-loop tensors do; this gives 0.6–2.5 times
+//! the difference on all functions, immaterial beside the projection error, which is 50 times
+//! larger for CAMB spectra).
+//!
+//! The P22 tensors are stored in f32: a contraction then differs from the f64 one by ≲ 1e-7 of
+//! P22 (measured; the terms hardly cancel), far below the projection error, at half the memory
+//! traffic, which bounds the cost of an evaluation (100 k: 0.8 MB per spectrum).
+//!
+//! σ_d²(k) = (1/6π²) ∫_{q_min}^{k/2} P dq (RegPT's damping) is integrated on the lattice interpolant
+//! here (the direct path uses Simpson on the spectrum): exact for P̂, error ε σ_d² + the interpolation
+//! error, ≲ 1e-8.
+
+use super::{error_functions, pair_index, LinearBasis, Projection, BASIS_SIZE};
+use crate::integrate::{lagrange4, legendre_nodes};
+use crate::loops::lattice::{add_product_weights, Lattice};
+use crate::loops::one_loop::Rule;
+use crate::loops::{ByPair, Estimate, OneLoopPlan, OneLoopTerms};
+use crate::precision::Precision;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+/// Version of the tensor layout and rules, part of the cache file name.
+const VERSION: u32 = 1;
+
+/// Linear forms per k: P13_F/P and P13_G/P (fine rule), their fine − coarse differences, and their
+/// absolute weights (the projection error's scale), each of length n.
+const P13_FORMS: usize = 6;
+
+/// The 1-loop basis tensors on one k grid for one [`Precision`] (cosmology independent).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OneLoopBasis {
+    k: Vec<f64>,
+    key: Vec<f64>,
+    basis: LinearBasis,
+    /// Per k: P22 δδ, δθ, θθ of the fine rule on the pairs a ≤ b of all n functions.
+    p22: Vec<f32>,
+    /// Per k: fine − half-resolution P22 δδ, δθ, θθ on the pairs of the first n_err functions.
+    p22_diff: Vec<f32>,
+    /// Per k: [`P13_FORMS`] linear forms of length n.
+    p13: Vec<f64>,
+    /// σ_v²: the fine form and fine − coarse, each of length n.
+    sigma_v2: Vec<f64>,
+    /// Per k: σ_d²(k) as a linear form of length n.
+    sigma_d2: Vec<f64>,
+    p22_error_floor: f64,
+}
+
+/// The 1-loop terms of a spectrum from the basis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BasisOneLoop {
+    /// P_lin, σ_v², P22 and P13 (errors include the projection error).
+    pub terms: OneLoopTerms,
+    /// σ_d²(k) at every k (RegPT's damping).
+    pub sigma_d2: Vec<Estimate>,
+}
+
+/// The settings that make the tensors (their cache key).
+fn key(k: &[f64], precision: &Precision) -> Vec<f64> {
+    let p = precision;
+    let mut key = vec![
+        f64::from(VERSION),
+        BASIS_SIZE as f64,
+        p.q_min,
+        p.q_max,
+        p.lattice_step,
+        p.p13_cell_order as f64,
+        p.p22_order as f64,
+        p.p22_narrow_order as f64,
+        p.p22_narrow_width,
+        p.p22_ln_width,
+        p.p22_tail_growth,
+        p.p22_linear_width,
+        p.p22_band_end,
+        p.p22_error_floor,
+        f64::from(super::training::VERSION),
+        k.len() as f64,
+    ];
+    key.extend(k);
+    key
+}
+
+/// The basis functions' samples on the lattice of `rule`, row by row (every `stride`-th fine row).
+fn rows_on(basis: &LinearBasis, stride: usize) -> Vec<f64> {
+    (0..basis.lattice().len)
+        .step_by(stride)
+        .flat_map(|j| basis.row(j).iter().copied())
+        .collect()
+}
+
+/// The interpolants of all n functions (rows of `rows`) at fractional index `u` of `lattice`.
+fn interpolate_rows(lattice: &Lattice, rows: &[f64], n: usize, u: f64, out: &mut [f64]) {
+    let (b, t) = lattice.stencil(u);
+    interpolate_stencil(rows, n, b, lagrange4(t), out);
+}
+
+fn interpolate_stencil(rows: &[f64], n: usize, b: usize, l: [f64; 4], out: &mut [f64]) {
+    out.iter_mut().for_each(|o| *o = 0.0);
+    for (m, lm) in l.iter().enumerate() {
+        for (o, p) in out.iter_mut().zip(&rows[(b + m) * n..(b + m + 1) * n]) {
+            *o += lm * p;
+        }
+    }
+}
+
+/// P22 δδ, δθ, θθ at k index `i` of `rule` as symmetric bilinear forms on the pairs a ≤ b of the
+/// first `n` functions: Σ_{a≤b} T_ab c_a c_b = Σ_nodes w P̂(q) P̂(p). `rows` holds `stride`
+/// functions per lattice point.
+fn p22_forms(rule: &Rule, i: usize, rows: &[f64], stride: usize, n: usize) -> [Vec<f64>; 3] {
+    let nodes = &rule.p22;
+    let (mut start, outer) = nodes.ranges(i);
+    let mut full = [vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]];
+    let (mut phi_q, mut phi_p) = (vec![0.0; stride], vec![0.0; stride]);
+    let mut acc = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+    for o in outer {
+        let end = nodes.outer_end[o] as usize;
+        acc.iter_mut()
+            .for_each(|a| a.iter_mut().for_each(|v| *v = 0.0));
+        for j in start..end {
+            let l = nodes.inner_l[j].map(f64::from);
+            interpolate_stencil(rows, stride, nodes.inner_b[j] as usize, l, &mut phi_p);
+            for (a, w) in acc.iter_mut().zip(nodes.inner_w[j]) {
+                let w = f64::from(w);
+                a.iter_mut().zip(&phi_p[..n]).for_each(|(a, p)| *a += w * p);
+            }
+        }
+        interpolate_rows(&rule.lattice, rows, stride, nodes.outer_u[o], &mut phi_q);
+        for (t, a) in full.iter_mut().zip(&acc) {
+            for (row, q) in t.chunks_exact_mut(n).zip(&phi_q[..n]) {
+                row.iter_mut().zip(a).for_each(|(t, a)| *t += q * a);
+            }
+        }
+        start = end;
+    }
+    full.map(|t| {
+        let mut sym = vec![0.0; n * (n + 1) / 2];
+        for b in 0..n {
+            for a in 0..b {
+                sym[pair_index(a, b)] = t[a * n + b] + t[b * n + a];
+            }
+            sym[pair_index(b, b)] = t[b * n + b];
+        }
+        sym
+    })
+}
+
+/// Σ_j w_j φ_a(q_j) for every a (`rows` of stride n on the rule's lattice).
+fn linear_form(weights: &[f64], rows: &[f64], n: usize) -> Vec<f64> {
+    let mut out = vec![0.0; n];
+    for (w, row) in weights.iter().zip(rows.chunks_exact(n)) {
+        out.iter_mut().zip(row).for_each(|(o, p)| *o += w * p);
+    }
+    out
+}
+
+impl OneLoopBasis {
+    /// The cache file name of the tensors for `k` and `precision`.
+    pub fn file_name(k: &[f64], precision: &Precision) -> String {
+        let hash = key(k, precision)
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+                (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+            });
+        format!("one-loop-basis-v{VERSION}-n{BASIS_SIZE}-{hash:016x}.bin")
+    }
+
+    /// Builds the tensors of `plan` (its k grid and precision) in parallel over k; `progress(done,
+    /// total)` counts the k values.
+    pub fn build(plan: &OneLoopPlan, progress: &(dyn Fn(usize, usize) + Sync)) -> Self {
+        let (k, precision) = (plan.k(), plan.precision());
+        let (fine, coarse) = plan.rules();
+        let basis = super::training::camb_basis(fine.lattice.clone(), BASIS_SIZE);
+        let n = basis.len();
+        let n_err = error_functions(n);
+        let (rows_fine, rows_coarse) = (rows_on(&basis, 1), rows_on(&basis, 2));
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let per_k: Vec<(Vec<f32>, Vec<f32>, Vec<f64>)> = (0..k.len())
+            .into_par_iter()
+            .map(|i| {
+                let f = p22_forms(fine, i, &rows_fine, n, n);
+                let c = p22_forms(coarse, i, &rows_coarse, n, n_err);
+                let mut p22 = Vec::with_capacity(3 * f[0].len());
+                let mut diff = Vec::with_capacity(3 * c[0].len());
+                for (f, c) in f.iter().zip(&c) {
+                    p22.extend(f.iter().map(|&v| v as f32));
+                    // The pairs of the first n_err functions come first in the symmetric storage.
+                    diff.extend(f.iter().zip(c).map(|(f, c)| (f - c) as f32));
+                }
+                let (wf, wc) = (&fine.p13[i], &coarse.p13[i]);
+                let abs = |w: &[f64]| w.iter().map(|v| v.abs()).collect::<Vec<_>>();
+                let forms = [
+                    linear_form(&wf.f, &rows_fine, n),
+                    linear_form(&wf.g, &rows_fine, n),
+                    linear_form(&wc.f, &rows_coarse, n),
+                    linear_form(&wc.g, &rows_coarse, n),
+                    linear_form(&abs(&wf.f), &rows_fine, n),
+                    linear_form(&abs(&wf.g), &rows_fine, n),
+                ];
+                let mut p13 = Vec::with_capacity(P13_FORMS * n);
+                p13.extend(&forms[0]);
+                p13.extend(&forms[1]);
+                p13.extend(forms[0].iter().zip(&forms[2]).map(|(f, c)| f - c));
+                p13.extend(forms[1].iter().zip(&forms[3]).map(|(f, c)| f - c));
+                p13.extend(&forms[4]);
+                p13.extend(&forms[5]);
+                let d = std::sync::atomic::Ordering::Relaxed;
+                progress(done.fetch_add(1, d) + 1, k.len());
+                (p22, diff, p13)
+            })
+            .collect();
+        let sv_fine = linear_form(&fine.sigma_v2, &rows_fine, n);
+        let sv_coarse = linear_form(&coarse.sigma_v2, &rows_coarse, n);
+        let mut sigma_v2 = sv_fine.clone();
+        sigma_v2.extend(sv_fine.iter().zip(&sv_coarse).map(|(f, c)| f - c));
+        let sigma_d2 = sigma_d2_forms(k, &fine.lattice, &rows_fine, n);
+        let (mut p22, mut p22_diff, mut p13) = (Vec::new(), Vec::new(), Vec::new());
+        for (a, b, c) in per_k {
+            p22.extend(a);
+            p22_diff.extend(b);
+            p13.extend(c);
+        }
+        Self {
+            k: k.to_vec(),
+            key: key(k, precision),
+            basis,
+            p22,
+            p22_diff,
+            p13,
+            sigma_v2,
+            sigma_d2,
+            p22_error_floor: precision.p22_error_floor,
+        }
+    }
+
+    /// The wavenumbers [h/Mpc].
+    pub fn k(&self) -> &[f64] {
+        &self.k
+    }
+
+    /// The basis.
+    pub fn basis(&self) -> &LinearBasis {
+        &self.basis
+    }
+
+    /// The 1-loop terms of the spectrum whose values at the grid's k are `p_lin` and whose projection
+    /// on the basis is `projection` (see [`super::TwoLoopBasis::project`]; the caller decides whether
+    /// its residual is small enough).
+    pub fn evaluate(&self, p_lin: &[f64], projection: &Projection) -> BasisOneLoop {
+        let c = &projection.coefficients;
+        let n = c.len();
+        let pairs = n * (n + 1) / 2;
+        let n_err = error_functions(n);
+        let pairs_err = n_err * (n_err + 1) / 2;
+        let mut s2 = vec![0.0; pairs];
+        for b in 0..n {
+            for a in 0..=b {
+                s2[pair_index(a, b)] = c[a] * c[b];
+            }
+        }
+        let eps = projection.residual;
+        let nk = self.k.len();
+        let mut terms = OneLoopTerms {
+            k: self.k.clone(),
+            p_lin: p_lin.to_vec(),
+            sigma_v2: {
+                let v = dot(&self.sigma_v2[..n], c);
+                Estimate::new(v, dot(&self.sigma_v2[n..], c).abs() + eps * v.abs())
+            },
+            p22: ByPair::from_fn(|_| Vec::with_capacity(nk)),
+            p13: ByPair::from_fn(|_| Vec::with_capacity(nk)),
+        };
+        for (i, &p) in p_lin.iter().enumerate() {
+            let t = &self.p22[i * 3 * pairs..(i + 1) * 3 * pairs];
+            let d = &self.p22_diff[i * 3 * pairs_err..(i + 1) * 3 * pairs_err];
+            let p22: [Estimate; 3] = std::array::from_fn(|m| {
+                let v = dot32(&t[m * pairs..(m + 1) * pairs], &s2);
+                let quadrature = dot32(&d[m * pairs_err..(m + 1) * pairs_err], &s2[..pairs_err])
+                    .abs()
+                    .max(self.p22_error_floor * v.abs());
+                Estimate::new(v, quadrature + 2.0 * eps * v.abs())
+            });
+            let w = &self.p13[i * P13_FORMS * n..(i + 1) * P13_FORMS * n];
+            let form = |m: usize| dot(&w[m * n..(m + 1) * n], c);
+            let p13 = |m: usize| {
+                Estimate::new(
+                    p * form(m),
+                    p.abs() * (form(m + 2).abs() + eps * form(m + 4).abs()),
+                )
+            };
+            let (f13, g13) = (p13(0), p13(1));
+            terms.p13.dd.push(f13);
+            terms.p13.tt.push(g13);
+            terms.p13.dt.push(Estimate::mean(f13, g13));
+            terms.p22.dd.push(p22[0]);
+            terms.p22.dt.push(p22[1]);
+            terms.p22.tt.push(p22[2]);
+        }
+        let sigma_d2 = self
+            .sigma_d2
+            .chunks_exact(n)
+            .map(|w| {
+                let v = dot(w, c);
+                Estimate::new(v, eps * v.abs())
+            })
+            .collect();
+        BasisOneLoop { terms, sigma_d2 }
+    }
+
+    /// The tensors as the values of their cache file.
+    pub(crate) fn to_f64s(&self) -> Vec<f64> {
+        let mut v = vec![self.key.len() as f64];
+        v.extend(&self.key);
+        v.extend(self.basis.to_f64s());
+        v.extend(self.p22.iter().map(|&t| f64::from(t)));
+        v.extend(self.p22_diff.iter().map(|&t| f64::from(t)));
+        for part in [&self.p13, &self.sigma_v2, &self.sigma_d2] {
+            v.extend(part);
+        }
+        v
+    }
+
+    /// The tensors for `k` and `precision` from the values of their file, or `None` if the file was
+    /// made for other settings or does not fit them.
+    pub(crate) fn from_f64s(values: &[f64], k: &[f64], precision: &Precision) -> Option<Self> {
+        let expected = key(k, precision);
+        let len = *values.first()? as usize;
+        if len != expected.len() || values.get(1..1 + len)? != expected.as_slice() {
+            return None;
+        }
+        if values.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let lattice = Lattice::new(precision.q_min, precision.q_max, precision.lattice_step);
+        let (basis, rest) = LinearBasis::from_f64s(lattice, &values[1 + len..])?;
+        let n = basis.len();
+        let n_err = error_functions(n);
+        let nk = k.len();
+        let sizes = [
+            nk * 3 * n * (n + 1) / 2,
+            nk * 3 * n_err * (n_err + 1) / 2,
+            nk * P13_FORMS * n,
+            2 * n,
+            nk * n,
+        ];
+        if rest.len() != sizes.iter().sum::<usize>() {
+            return None;
+        }
+        let mut parts = Vec::with_capacity(sizes.len());
+        let mut rest = rest;
+        for size in sizes {
+            let (part, r) = rest.split_at(size);
+            parts.push(part.to_vec());
+            rest = r;
+        }
+        let [p22, p22_diff, p13, sigma_v2, sigma_d2] = parts.try_into().ok()?;
+        let single = |v: Vec<f64>| v.into_iter().map(|t| t as f32).collect();
+        let (p22, p22_diff) = (single(p22), single(p22_diff));
+        Some(Self {
+            k: k.to_vec(),
+            key: expected,
+            basis,
+            p22,
+            p22_diff,
+            p13,
+            sigma_v2,
+            sigma_d2,
+            p22_error_floor: precision.p22_error_floor,
+        })
+    }
+}
+
+/// σ_d²(k) = (1/6π²) ∫_{q_min}^{min(k/2, q_max)} P̂ dq as linear forms on the basis, per k.
+fn sigma_d2_forms(k: &[f64], lattice: &Lattice, rows: &[f64], n: usize) -> Vec<f64> {
+    let (nodes, weights) = legendre_nodes(6);
+    let norm = 1.0 / (6.0 * PI * PI);
+    k.iter()
+        .flat_map(|&k| {
+            let mut w = [vec![0.0; lattice.len]];
+            let end = (0.5 * k).ln().min(lattice.x_end());
+            if end > lattice.x0 {
+                add_product_weights(
+                    lattice,
+                    &mut w,
+                    (lattice.x0, end),
+                    (&nodes, &weights),
+                    |x| [norm * x.exp()],
+                );
+            }
+            linear_form(&w[0], rows, n)
+        })
+        .collect()
+}
+
+/// Σ a_i b_i with four partial sums (so that it vectorises).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    super::dot(a, b)
+}
+
+/// Σ a_i b_i of f32 tensor entries and f64 products, summed in f64 with four partial sums.
+fn dot32(a: &[f32], b: &[f64]) -> f64 {
+    let mut s = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(x, y)| f64::from(*x) * y)
+        .sum();
+    for (x, y) in ca.zip(cb) {
+        for i in 0..4 {
+            s[i] += f64::from(x[i]) * y[i];
+        }
+    }
+    (s[0] + s[1]) + (s[2] + s[3]) + tail
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linear::LinearSpectrum;
+    use crate::loops::Pair;
+
+    fn held_out(i: usize) -> LinearSpectrum {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/");
+        LinearSpectrum::from_file(format!("{dir}linear_pk_camb_heldout_{i}.dat")).unwrap()
+    }
+
+    fn setup() -> (OneLoopPlan, OneLoopBasis) {
+        let k: Vec<f64> = (0..12).map(|i| 0.005 * 1.45_f64.powi(i)).collect();
+        let plan = OneLoopPlan::new(&k, &Precision::fast()).unwrap();
+        let basis = OneLoopBasis::build(&plan, &|_, _| {});
+        (plan, basis)
+    }
+
+    fn evaluate(basis: &OneLoopBasis, p: &LinearSpectrum) -> BasisOneLoop {
+        let projection = basis.basis.project(&basis.basis.lattice().sample(p));
+        let p_lin: Vec<f64> = basis.k.iter().map(|&k| p.eval(k)).collect();
+        basis.evaluate(&p_lin, &projection)
+    }
+
+    #[test]
+    fn the_projected_spectrum_gives_the_direct_result_to_round_off() {
+        let (plan, basis) = setup();
+        let projection = basis
+            .basis
+            .project(&basis.basis.lattice().sample(&held_out(0)));
+        // The spectrum P̂ itself: its lattice samples are the projection's.
+        let p_hat =
+            LinearSpectrum::from_nodes(basis.basis.q(), projection.samples.clone()).unwrap();
+        let direct = plan.evaluate(&p_hat);
+        let fit = basis.basis.project(&basis.basis.lattice().sample(&p_hat));
+        assert!(fit.residual < 1e-12, "{}", fit.residual);
+        let on_basis = basis.evaluate(&direct.p_lin, &fit).terms;
+        for pair in Pair::ALL {
+            for i in 0..plan.k().len() {
+                for (a, b) in [
+                    (on_basis.p22[pair][i], direct.p22[pair][i]),
+                    (on_basis.p13[pair][i], direct.p13[pair][i]),
+                ] {
+                    // f32 tensors: ≲ 1e-7 of the value.
+                    assert!(
+                        (a.value - b.value).abs() < 3e-7 * b.value.abs(),
+                        "{pair:?} k={} {a:?} {b:?}",
+                        plan.k()[i]
+                    );
+                    // The same quadrature error (P22's on the first functions only: 0.6–2.5 of it).
+                    assert!(
+                        a.error < 3.0 * b.error + 1e-12 && a.error > 0.4 * b.error,
+                        "{pair:?} {i} {a:?} {b:?}"
+                    );
+                }
+            }
+        }
+        let (a, b) = (on_basis.sigma_v2, direct.sigma_v2);
+        assert!((a.value - b.value).abs() < 1e-12 * b.value);
+    }
+
+    #[test]
+    fn spectra_outside_the_training_set_agree_with_direct_within_their_errors() {
+        let (plan, basis) = setup();
+        for i in 0..3 {
+            let p = held_out(i);
+            let direct = plan.evaluate(&p);
+            let b = evaluate(&basis, &p);
+            let sd2 = crate::resum::sigma_d2(&p, plan.k(), plan.precision());
+            for pair in Pair::ALL {
+                for (j, &sd2) in sd2.iter().enumerate() {
+                    for (a, d) in [
+                        (b.terms.p22[pair][j], direct.p22[pair][j]),
+                        (b.terms.p13[pair][j], direct.p13[pair][j]),
+                        (b.sigma_d2[j], sd2),
+                    ] {
+                        let diff = (a.value - d.value).abs();
+                        assert!(diff < 1e-3 * d.value.abs(), "{pair:?} {j}: {a:?} {d:?}");
+                        assert!(diff < a.error + d.error, "{pair:?} {j}: {a:?} {d:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn tensors_survive_their_file_and_refuse_other_settings() {
+        let (plan, basis) = setup();
+        let v = basis.to_f64s();
+        let back = OneLoopBasis::from_f64s(&v, plan.k(), plan.precision()).unwrap();
+        assert_eq!(back, basis);
+        assert!(OneLoopBasis::from_f64s(&v, &plan.k()[1..], plan.precision()).is_none());
+        assert!(OneLoopBasis::from_f64s(&v, plan.k(), &Precision::default()).is_none());
+        assert!(OneLoopBasis::from_f64s(&v[..v.len() - 1], plan.k(), plan.precision()).is_none());
+    }
+}
+
+#[cfg(test)]
+mod plan_tests {
+    use crate::linear::LinearSpectrum;
+    use crate::loops::{OneLoopSource, Pair};
+    use crate::precision::{Precision, TwoLoopMethod};
+    use crate::progress::Silent;
+    use crate::real::{RealModel, RealPlan};
+    use crate::store::TableStore;
+
+    #[test]
+    fn plans_use_the_tensors_for_basis_spectra_in_batches_and_fall_back_for_others() {
+        let k: Vec<f64> = (0..8).map(|i| 0.01 * 1.6_f64.powi(i)).collect();
+        let store = TableStore::in_memory();
+        let mut precision = Precision::fast();
+        let direct = RealPlan::new(&k, RealModel::OneLoopSpt, &precision, &store, &Silent).unwrap();
+        precision.two_loop = TwoLoopMethod::Basis;
+        let plan = RealPlan::new(&k, RealModel::OneLoopSpt, &precision, &store, &Silent).unwrap();
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/");
+        let camb = LinearSpectrum::from_file(format!("{dir}linear_pk_camb_heldout_2.dat")).unwrap();
+        // Eisenstein & Hu: outside the basis (residual ~4e-3), computed directly.
+        let eh = crate::cosmology::Cosmology::gm2012()
+            .eisenstein_hu_spectrum(
+                crate::cosmology::TransferKind::Wiggle,
+                0.0,
+                &crate::linear::LogGrid::default(),
+            )
+            .unwrap();
+        let batch = plan.evaluate_batch(&[camb.clone(), eh.clone()]);
+        let (on_basis, fallback) = (batch[0].as_ref().unwrap(), batch[1].as_ref().unwrap());
+        assert!(matches!(
+            on_basis.terms.one_loop_source,
+            Some(OneLoopSource::Basis { .. })
+        ));
+        assert!(matches!(
+            fallback.terms.one_loop_source,
+            Some(OneLoopSource::Fallback { .. })
+        ));
+        let eh_direct = direct.evaluate(&eh, &Silent).unwrap();
+        for pair in Pair::ALL {
+            assert_eq!(fallback.pair(pair), eh_direct.pair(pair));
+        }
+        let reference = direct.evaluate(&camb, &Silent).unwrap();
+        for pair in Pair::ALL {
+            for (a, b) in on_basis.pair(pair).iter().zip(reference.pair(pair)) {
+                assert!((a.value - b.value).abs() < 1e-4 * b.value, "{a:?} {b:?}");
+                assert!(
+                    (a.value - b.value).abs() <= a.error + b.error,
+                    "{a:?} {b:?}"
+                );
+            }
+        }
+        assert_eq!(on_basis, &plan.evaluate(&camb, &Silent).unwrap());
+    }
+}
