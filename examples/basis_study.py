@@ -15,7 +15,7 @@ Measured (seed 1): N = 12: 2.3e-3 (median 4.3e-4); 16: 8.3e-4 (1.5e-4); 20: 4.2e
 
 This was the first step only: such an Eisenstein-Hu basis leaves 1-3e-2 on CAMB tables, whose shape
 differs from the fit's by percents, so the library's basis (pt_spectra::loops::basis) is built from CAMB
-spectra instead (examples/make_two_loop_training.py; README, "2-loop terms per cosmology").
+spectra instead (pt-spectra/data/make_two_loop_training.py; README, "2-loop terms per cosmology").
 """
 import warnings
 

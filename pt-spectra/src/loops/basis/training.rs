@@ -1,6 +1,6 @@
 //! The training spectra of the basis: CAMB linear spectra over the EuclidEmulator2 prior, shipped
 //! with the crate (`pt-spectra/data/two_loop_training_camb.f32`, made by
-//! `examples/make_two_loop_training.py`).
+//! `pt-spectra/data/make_two_loop_training.py`).
 //!
 //! [`TRAINING_SPECTRA`] CAMB tables at z = 0 (1200 log-spaced k in [1e-4, 50] h/Mpc, the settings of
 //! the test tables: massless neutrinos, N_eff = 3.046) for cosmologies drawn uniformly from the box

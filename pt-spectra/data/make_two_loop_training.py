@@ -10,10 +10,10 @@ ln k, power-law extrapolation), so the basis represents tables made the same way
 
 File layout (little-endian float32): the 1200 k [h/Mpc], then 1200 P [(Mpc/h)^3] per spectrum.
 
-    python examples/make_two_loop_training.py train 0 50 a.npz &   # two halves in parallel,
-    python examples/make_two_loop_training.py train 50 100 b.npz    # ~4 s per spectrum each
-    python examples/make_two_loop_training.py write a.npz b.npz     # -> pt-spectra/data/
-    python examples/make_two_loop_training.py heldout               # -> tests/data/ (3 tables)
+    python pt-spectra/data/make_two_loop_training.py train 0 50 a.npz &   # two halves in parallel,
+    python pt-spectra/data/make_two_loop_training.py train 50 100 b.npz    # ~4 s per spectrum each
+    python pt-spectra/data/make_two_loop_training.py write a.npz b.npz     # -> pt-spectra/data/
+    python pt-spectra/data/make_two_loop_training.py heldout               # -> tests/data/ (3 tables)
 """
 import os
 import sys
@@ -58,16 +58,16 @@ def main():
         parts = [np.load(f) for f in sys.argv[2:]]
         k = parts[0]["k"]
         p = np.vstack([d["P"] for d in parts])
-        out = os.path.join(HERE, "..", "pt-spectra", "data", "two_loop_training_camb.f32")
+        out = os.path.join(HERE, "two_loop_training_camb.f32")
         np.concatenate([k, p.ravel()]).astype("<f4").tofile(out)
         print(out, p.shape)
     elif mode == "heldout":
         # Three cosmologies of the box that are not training points, one at z = 0.5 with another A_s.
         for i, (p, a_s, z) in enumerate(zip(draws(7, 3), [2.1e-9, 1.8e-9, 2.4e-9], [0.0, 0.5, 0.0])):
             k, pk = spectrum(*p, a_s=a_s, z=z)
-            name = os.path.join(HERE, "..", "tests", "data", f"linear_pk_camb_heldout_{i}.dat")
+            name = os.path.join(HERE, "..", "..", "tests", "data", f"linear_pk_camb_heldout_{i}.dat")
             with open(name, "w") as f:
-                f.write(f"# CAMB {camb.__version__} linear total-matter P(k) (examples/make_two_loop_training.py "
+                f.write(f"# CAMB {camb.__version__} linear total-matter P(k) (pt-spectra/data/make_two_loop_training.py "
                         f"heldout): Omega_m={p[0]:.6f} Omega_b={p[1]:.6f} n_s={p[2]:.6f} h={p[3]:.6f} "
                         f"w0={p[4]:.6f} (PPF) As={a_s:.3e}, massless neutrinos, flat, z = {z}\n")
                 f.write("# k [h/Mpc]  P [(Mpc/h)^3]\n")
