@@ -15,7 +15,7 @@ fn block(best: &mut f64, calls: usize, per_call: usize, mut f: impl FnMut()) {
 }
 
 fn main() {
-    // The fixed vectors of the criterion bench (benches/kernels.rs).
+    // The fixed vectors of the criterion bench (tests/benches/kernels.rs).
     let v: Vec<[f64; 3]> = (0..7)
         .map(|i| {
             let a = i as f64;

@@ -35,6 +35,8 @@ pub enum Stage {
     TwoLoopBasis,
     /// The 1-loop basis tensors of a k grid (once; cached).
     OneLoopBasis,
+    /// The TNS A and B basis tensors of a k grid (once; cached).
+    TnsBasis,
 }
 
 impl fmt::Display for Stage {
@@ -47,6 +49,7 @@ impl fmt::Display for Stage {
             Stage::Gamma2Weights => "RegPT vertex weights (once per k grid)",
             Stage::TwoLoopBasis => "2-loop basis tensors (once per k grid, minutes; cached)",
             Stage::OneLoopBasis => "1-loop basis tensors (once per k grid; cached)",
+            Stage::TnsBasis => "TNS basis tensors (once per k grid; cached)",
         })
     }
 }

@@ -22,8 +22,8 @@
 //! ```
 
 use crate::error::{Error, Result};
-use crate::loops::basis::{OneLoopBasis, TwoLoopBasis};
-use crate::loops::{OneLoopPlan, P15Table, P17Table};
+use crate::loops::basis::{OneLoopBasis, TnsBasis, TwoLoopBasis};
+use crate::loops::{OneLoopPlan, P15Table, P17Table, TnsPlan};
 use crate::precision::Precision;
 use crate::progress::{Progress, Stage};
 use std::fs::{File, OpenOptions, TryLockError};
@@ -199,6 +199,45 @@ impl TableStore {
         let path = self.path(&OneLoopBasis::file_name(k, precision))?;
         read_cached(&path, "1-loop basis tensors", progress, |v| {
             OneLoopBasis::from_f64s(v, k, precision)
+        })
+    }
+}
+
+impl TableStore {
+    /// The TNS basis tensors ([`TnsBasis`]) of `plan`'s k grid and precision: read from their file,
+    /// or built (reporting [`Stage::TnsBasis`]; seconds) and written. Without a directory they are
+    /// built each time.
+    ///
+    /// # Errors
+    /// [`Error::Cache`] if the directory cannot be created or the file cannot be written or locked.
+    pub fn tns_basis(&self, plan: &TnsPlan, progress: &dyn Progress) -> Result<Arc<TnsBasis>> {
+        let (k, precision) = (plan.k(), plan.precision());
+        let build = || TnsBasis::build(plan, &|d, t| progress.update(Stage::TnsBasis, d, t));
+        let tensors = match self.path(&TnsBasis::file_name(k, precision)) {
+            None => build(),
+            Some(path) => cached(
+                &path,
+                "TNS basis",
+                |v| TnsBasis::from_f64s(v, k, precision),
+                build,
+                TnsBasis::to_f64s,
+                progress,
+            )?,
+        };
+        Ok(Arc::new(tensors))
+    }
+
+    /// The TNS basis tensors for `k` and `precision` if their file is in the directory and valid
+    /// (never builds them).
+    pub fn cached_tns_basis(
+        &self,
+        k: &[f64],
+        precision: &Precision,
+        progress: &dyn Progress,
+    ) -> Option<Arc<TnsBasis>> {
+        let path = self.path(&TnsBasis::file_name(k, precision))?;
+        read_cached(&path, "TNS basis tensors", progress, |v| {
+            TnsBasis::from_f64s(v, k, precision)
         })
     }
 }

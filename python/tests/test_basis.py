@@ -46,3 +46,19 @@ def test_batch_names_a_bad_row(camb):
         plan.batch(k_lin, bad)
     with pytest.raises(ValueError, match="columns"):
         plan.batch(k_lin[:-1], bad)
+
+
+def test_tns_multipoles_through_the_basis_match_direct(camb, tmp_path):
+    k_lin, p = camb
+    k = np.geomspace(0.01, 0.3, 10)
+    args = dict(real="1l-spt", rsd="tns", precision="fast")
+    on_basis = pt.RsdPlan(k, two_loop="basis", cache_dir=tmp_path, **args)
+    direct = pt.RsdPlan(k, two_loop="direct", **args)
+    call = dict(linear=(k_lin, p), cosmology="planck2018", f=0.6, bias=1.8, fog="lorentzian",
+                sigma0=3.0)
+    a, d = on_basis(**call), direct(**call)
+    assert any("TNS A and B: basis tensors" in line for line in a.header)
+    assert any("1-loop terms (P22" in line for line in a.header)
+    for ell in ("P0", "P2"):
+        assert np.abs(a[ell] - d[ell]).max() < 1e-4 * np.abs(d["P0"]).max(), ell
+        assert (np.abs(a[ell] - d[ell]) <= a["err_" + ell] + d["err_" + ell]).all(), ell

@@ -300,12 +300,20 @@ fn rsd_table_memo(
     if request.cs2 != 0.0 {
         header.push(counterterm_line(request.cs2));
     }
+    header.extend(spectra.terms.one_loop_source.map(|s| s.describe()));
     if rsd.needs_tns() {
         header.push(
             "TNS A and B at leading order (linear P, tree-level bispectrum), A = b^3 A(f/b), \
              B = b^4 B(f/b)"
                 .into(),
         );
+        if let Some(residual) = tns.and_then(|t| t.basis_residual) {
+            header.push(format!(
+                "TNS A and B: basis tensors, the same quadrature nodes as direct; projection \
+                 residual {residual:.1e}; errors include the projection error (2 x residual x the \
+                 magnitudes of each coefficient's parts)"
+            ));
+        }
     }
     if let Some(g) = request.galaxy {
         header.push(format!(

@@ -35,11 +35,11 @@ use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// Number of (n, m) coefficients of A: m = 1..3, n = 1..m.
-const A_LEN: usize = 6;
+pub(crate) const A_LEN: usize = 6;
 /// Number of (n, m) coefficients of B: m = 2..4, n = 1..m.
-const B_LEN: usize = 9;
+pub(crate) const B_LEN: usize = 9;
 /// Weights per node: A and B for P(q)P(p), then A for P(k)P(p), then A for P(k)P(q).
-const WEIGHTS: usize = 2 * A_LEN + A_LEN + B_LEN;
+pub(crate) const WEIGHTS: usize = 2 * A_LEN + A_LEN + B_LEN;
 
 /// Index of μ^{2n} f^m in the packed A coefficients.
 const fn a_index(n: usize, m: usize) -> usize {
@@ -61,6 +61,11 @@ pub struct TnsCoefficients {
 }
 
 impl TnsCoefficients {
+    /// The coefficients from their packed arrays (A: m = 1..3, n = 1..m; B: m = 2..4, n = 1..m).
+    pub(crate) fn from_packed(a: [Estimate; A_LEN], b: [Estimate; B_LEN]) -> Self {
+        Self { a, b }
+    }
+
     /// The coefficient a_{nm} of μ^{2n} f^m in A (b = 1); zero outside 1 ≤ n ≤ m ≤ 3.
     pub fn a(&self, n: usize, m: usize) -> Estimate {
         if (1..=3).contains(&m) && (1..=m).contains(&n) {
@@ -121,6 +126,9 @@ pub struct TnsTerms {
     pub p_lin: Vec<f64>,
     /// The coefficients at each k.
     pub coefficients: Vec<TnsCoefficients>,
+    /// The spectrum's projection residual if the coefficients come from the basis tensors
+    /// ([`super::basis::TnsBasis`]); `None` for the direct integrals.
+    pub basis_residual: Option<f64>,
 }
 
 /// A homogeneous polynomial Σ_i c_i μ^{d−i} w^i of degree d = `c.len()` − 1 in μ and w.
@@ -263,9 +271,9 @@ fn node_weights(k: f64, q: f64, p: f64, measure: f64) -> [f64; WEIGHTS] {
 
 /// The nodes of one resolution.
 #[derive(Debug, Clone)]
-struct Rule {
-    lattice: Lattice,
-    nodes: PairNodes<WEIGHTS>,
+pub(crate) struct Rule {
+    pub lattice: Lattice,
+    pub nodes: PairNodes<WEIGHTS>,
 }
 
 impl Rule {
@@ -358,6 +366,17 @@ impl TnsPlan {
         &self.k
     }
 
+    /// The settings the plan was built with.
+    pub fn precision(&self) -> &Precision {
+        &self.precision
+    }
+
+    /// The fine rule and the half-resolution rule of the error estimates (the basis tensors of
+    /// [`super::basis::TnsBasis`] are made from them).
+    pub(crate) fn rules(&self) -> (&Rule, &Rule) {
+        (&self.fine, &self.coarse)
+    }
+
     /// The coefficients for `spectrum`, one k after the other on the calling thread.
     pub fn evaluate(&self, spectrum: &LinearSpectrum) -> TnsTerms {
         let samples = self.samples(spectrum);
@@ -403,6 +422,7 @@ impl TnsPlan {
             k: self.k.clone(),
             p_lin: self.k.iter().map(|&k| spectrum.eval(k)).collect(),
             coefficients,
+            basis_residual: None,
         }
     }
 

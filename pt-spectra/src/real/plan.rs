@@ -191,21 +191,47 @@ impl RealPlan {
     /// # Errors
     /// As [`crate::ir::no_wiggle`].
     pub fn terms(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> Result<LoopTerms> {
-        let mut terms = self.loop_terms(spectrum, progress);
+        self.terms_projected(spectrum, None, progress)
+    }
+
+    /// The projection of `spectrum` on the plan's basis, if the plan has 1-loop basis tensors (for
+    /// other plans on the same grid and precision to share: [`crate::rsd::RsdPlan`]).
+    pub fn project(&self, spectrum: &LinearSpectrum) -> Option<Projection> {
+        let basis = self.one_loop_basis.as_ref()?.basis();
+        Some(basis.project(&basis.sample(spectrum)))
+    }
+
+    /// As [`terms`](Self::terms) with the spectrum's `projection` from [`project`](Self::project)
+    /// already made (`None`: made here if needed).
+    ///
+    /// # Errors
+    /// As [`terms`](Self::terms).
+    pub fn terms_projected(
+        &self,
+        spectrum: &LinearSpectrum,
+        projection: Option<Projection>,
+        progress: &dyn Progress,
+    ) -> Result<LoopTerms> {
+        let mut terms = self.loop_terms(spectrum, projection, progress);
         if let Some(split) = &self.ir {
             let nw = split.no_wiggle(spectrum)?;
             terms.ir = Some(Box::new(loops::IrTerms {
                 sigma2: crate::ir::sigma2_bao(&nw, self.precision.q_min),
-                no_wiggle: self.loop_terms(&nw, progress),
+                no_wiggle: self.loop_terms(&nw, None, progress),
             }));
         }
         Ok(terms)
     }
 
-    fn loop_terms(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> LoopTerms {
+    fn loop_terms(
+        &self,
+        spectrum: &LinearSpectrum,
+        projection: Option<Projection>,
+        progress: &dyn Progress,
+    ) -> LoopTerms {
         let (k, precision) = (&self.k, &self.precision);
         let (one_loop, sigma_d2, one_loop_source, projection) =
-            match self.one_loop_on_basis(spectrum, progress) {
+            match self.one_loop_on_basis(spectrum, projection, progress) {
                 Ok((terms, projection)) => {
                     let source = OneLoopSource::Basis {
                         functions: projection.coefficients.len(),
@@ -246,13 +272,14 @@ impl RealPlan {
     fn one_loop_on_basis(
         &self,
         spectrum: &LinearSpectrum,
+        projection: Option<Projection>,
         progress: &dyn Progress,
     ) -> std::result::Result<(loops::basis::BasisOneLoop, Projection), Option<OneLoopSource>> {
         let Some(tensors) = &self.one_loop_basis else {
             return Err(None);
         };
         let basis = tensors.basis();
-        let projection = basis.project(&basis.sample(spectrum));
+        let projection = projection.unwrap_or_else(|| basis.project(&basis.sample(spectrum)));
         // A NaN residual (a spectrum with non-positive values) is refused too.
         if projection.residual.is_nan() || projection.residual > MAX_RESIDUAL {
             let source = OneLoopSource::Fallback {
@@ -357,6 +384,22 @@ impl RealPlan {
         progress: &dyn Progress,
     ) -> Result<RealSpectra> {
         RealSpectra::from_terms(self.model, self.terms(spectrum, progress)?)
+    }
+
+    /// As [`evaluate`](Self::evaluate) with the spectrum's `projection` already made.
+    ///
+    /// # Errors
+    /// As [`evaluate`](Self::evaluate).
+    pub fn evaluate_projected(
+        &self,
+        spectrum: &LinearSpectrum,
+        projection: Option<Projection>,
+        progress: &dyn Progress,
+    ) -> Result<RealSpectra> {
+        RealSpectra::from_terms(
+            self.model,
+            self.terms_projected(spectrum, projection, progress)?,
+        )
     }
 }
 

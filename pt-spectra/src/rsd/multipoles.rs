@@ -7,9 +7,10 @@ use super::{Fog, MuPolynomial, MultipoleRule, Parts, RsdModel};
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
+use crate::loops::basis::{TnsBasis, MAX_RESIDUAL};
 use crate::loops::bias::{BiasPlan, BiasTerms, GalaxyBias};
 use crate::loops::{Pair, TnsPlan, TnsTerms};
-use crate::precision::Precision;
+use crate::precision::{Precision, TwoLoopMethod};
 use crate::progress::Progress;
 use crate::real::{counterterm, RealModel, RealPlan, RealSpectra};
 use crate::store::TableStore;
@@ -338,6 +339,9 @@ pub(crate) fn describe_grid(k: &[f64]) -> String {
 pub struct RsdPlan {
     real: RealPlan,
     tns: Option<TnsPlan>,
+    /// The TNS basis tensors, if the A and B terms come from them (as the real plan's 1-loop terms:
+    /// [`crate::precision::TwoLoopMethod`]).
+    tns_basis: Option<std::sync::Arc<TnsBasis>>,
     /// The bias terms' plan, for nonlinear galaxy bias ([`with_bias_terms`](Self::with_bias_terms)).
     bias: Option<BiasPlan>,
 }
@@ -376,9 +380,15 @@ impl RsdPlan {
         } else {
             None
         };
+        let tns_basis = match (&tns, precision.two_loop) {
+            (Some(plan), TwoLoopMethod::Basis) => Some(store.tns_basis(plan, progress)?),
+            (Some(_), TwoLoopMethod::Auto) => store.cached_tns_basis(k, precision, progress),
+            _ => None,
+        };
         Ok(Self {
             real,
             tns,
+            tns_basis,
             bias: None,
         })
     }
@@ -413,8 +423,32 @@ impl RsdPlan {
         spectrum: &LinearSpectrum,
         progress: &dyn Progress,
     ) -> Result<(RealSpectra, Option<TnsTerms>)> {
-        let real = self.real.evaluate(spectrum, progress)?;
-        let tns = self.tns.as_ref().map(|plan| plan.par_evaluate(spectrum));
+        // One projection on the basis for the real-space and the TNS tensors (the same basis: both
+        // are built from the shipped training set on the plan's lattice).
+        let projection = self.real.project(spectrum);
+        let tns = self.tns.as_ref().map(|plan| {
+            let on_basis = self.tns_basis.as_ref().and_then(|tensors| {
+                let basis = tensors.basis();
+                let projection = match &projection {
+                    Some(p) => p.clone(),
+                    None => basis.project(&basis.sample(spectrum)),
+                };
+                if projection.residual.is_nan() || projection.residual > MAX_RESIDUAL {
+                    progress.note(&format!(
+                        "TNS A and B: direct integration, since the spectrum's projection residual \
+                         on the basis, {:.1e}, exceeds {MAX_RESIDUAL:.1e}",
+                        projection.residual
+                    ));
+                    return None;
+                }
+                let p_lin: Vec<f64> = plan.k().iter().map(|&k| spectrum.eval(k)).collect();
+                Some(tensors.evaluate(&p_lin, &projection))
+            });
+            on_basis.unwrap_or_else(|| plan.par_evaluate(spectrum))
+        });
+        let real = self
+            .real
+            .evaluate_projected(spectrum, projection, progress)?;
         Ok((real, tns))
     }
 }

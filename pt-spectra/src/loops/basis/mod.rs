@@ -19,7 +19,7 @@
 //! P33irr, P33red), with ε the largest relative residual smoothed over [`SMOOTHING`] in ln q
 //! ([`PROJECTION_ERROR_FACTOR`], [`Projection`]); it is added to every error. At high k the terms
 //! cancel to a small remainder (at k = 0.4, −114 of terms ±1.7e4), so there the projection error
-//! dominates. Measured on 40 k in [0.005, 0.4] (`benches/two_loop.rs`): the correction of six CAMB
+//! dominates. Measured on 40 k in [0.005, 0.4] (`tests/benches/two_loop.rs`): the correction of six CAMB
 //! tables not in the training set is within 8.4e-4 of `direct` for k ≤ 0.3; at k = 0.4 (gm2012, δδ)
 //! within 4.8e-3, inside the reported error.
 //! A spectrum whose residual exceeds [`TwoLoopBasis::max_residual`] is not evaluated on the basis
@@ -33,14 +33,17 @@
 //!
 //! [`TableStore::two_loop_basis`]: crate::store::TableStore::two_loop_basis
 
+mod forms;
 mod linear_basis;
 mod one_loop;
 mod p15_forms;
 mod tensors;
+mod tns;
 pub mod training;
 
 pub use linear_basis::{LinearBasis, Projection, SMOOTHING};
 pub use one_loop::{BasisOneLoop, OneLoopBasis};
+pub use tns::TnsBasis;
 
 use super::lattice::Lattice;
 use super::mode_coupling::ACC;

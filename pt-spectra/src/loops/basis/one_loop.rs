@@ -22,8 +22,9 @@
 //! here (the direct path uses Simpson on the spectrum): exact for P̂, error ε σ_d² + the interpolation
 //! error, ≲ 1e-8.
 
-use super::{error_functions, pair_index, LinearBasis, Projection, BASIS_SIZE};
-use crate::integrate::{lagrange4, legendre_nodes};
+use super::forms::{dot32, linear_form, pair_forms, pair_products, Rows};
+use super::{error_functions, LinearBasis, Projection, BASIS_SIZE};
+use crate::integrate::legendre_nodes;
 use crate::loops::lattice::{add_product_weights, Lattice};
 use crate::loops::one_loop::Rule;
 use crate::loops::{ByPair, Estimate, OneLoopPlan, OneLoopTerms};
@@ -91,77 +92,18 @@ fn key(k: &[f64], precision: &Precision) -> Vec<f64> {
     key
 }
 
-/// The basis functions' samples on the lattice of `rule`, row by row (every `stride`-th fine row).
-fn rows_on(basis: &LinearBasis, stride: usize) -> Vec<f64> {
+/// The basis functions' samples on the lattice, row by row (every `stride`-th fine row).
+pub(super) fn rows_on(basis: &LinearBasis, stride: usize) -> Vec<f64> {
     (0..basis.lattice().len)
         .step_by(stride)
         .flat_map(|j| basis.row(j).iter().copied())
         .collect()
 }
 
-/// The interpolants of all n functions (rows of `rows`) at fractional index `u` of `lattice`.
-fn interpolate_rows(lattice: &Lattice, rows: &[f64], n: usize, u: f64, out: &mut [f64]) {
-    let (b, t) = lattice.stencil(u);
-    interpolate_stencil(rows, n, b, lagrange4(t), out);
-}
-
-fn interpolate_stencil(rows: &[f64], n: usize, b: usize, l: [f64; 4], out: &mut [f64]) {
-    out.iter_mut().for_each(|o| *o = 0.0);
-    for (m, lm) in l.iter().enumerate() {
-        for (o, p) in out.iter_mut().zip(&rows[(b + m) * n..(b + m + 1) * n]) {
-            *o += lm * p;
-        }
-    }
-}
-
 /// P22 δδ, δθ, θθ at k index `i` of `rule` as symmetric bilinear forms on the pairs a ≤ b of the
-/// first `n` functions: Σ_{a≤b} T_ab c_a c_b = Σ_nodes w P̂(q) P̂(p). `rows` holds `stride`
-/// functions per lattice point.
-fn p22_forms(rule: &Rule, i: usize, rows: &[f64], stride: usize, n: usize) -> [Vec<f64>; 3] {
-    let nodes = &rule.p22;
-    let (mut start, outer) = nodes.ranges(i);
-    let mut full = [vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]];
-    let (mut phi_q, mut phi_p) = (vec![0.0; stride], vec![0.0; stride]);
-    let mut acc = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
-    for o in outer {
-        let end = nodes.outer_end[o] as usize;
-        acc.iter_mut()
-            .for_each(|a| a.iter_mut().for_each(|v| *v = 0.0));
-        for j in start..end {
-            let l = nodes.inner_l[j].map(f64::from);
-            interpolate_stencil(rows, stride, nodes.inner_b[j] as usize, l, &mut phi_p);
-            for (a, w) in acc.iter_mut().zip(nodes.inner_w[j]) {
-                let w = f64::from(w);
-                a.iter_mut().zip(&phi_p[..n]).for_each(|(a, p)| *a += w * p);
-            }
-        }
-        interpolate_rows(&rule.lattice, rows, stride, nodes.outer_u[o], &mut phi_q);
-        for (t, a) in full.iter_mut().zip(&acc) {
-            for (row, q) in t.chunks_exact_mut(n).zip(&phi_q[..n]) {
-                row.iter_mut().zip(a).for_each(|(t, a)| *t += q * a);
-            }
-        }
-        start = end;
-    }
-    full.map(|t| {
-        let mut sym = vec![0.0; n * (n + 1) / 2];
-        for b in 0..n {
-            for a in 0..b {
-                sym[pair_index(a, b)] = t[a * n + b] + t[b * n + a];
-            }
-            sym[pair_index(b, b)] = t[b * n + b];
-        }
-        sym
-    })
-}
-
-/// Σ_j w_j φ_a(q_j) for every a (`rows` of stride n on the rule's lattice).
-fn linear_form(weights: &[f64], rows: &[f64], n: usize) -> Vec<f64> {
-    let mut out = vec![0.0; n];
-    for (w, row) in weights.iter().zip(rows.chunks_exact(n)) {
-        out.iter_mut().zip(row).for_each(|(o, p)| *o += w * p);
-    }
-    out
+/// first `n` functions: Σ_{a≤b} T_ab c_a c_b = Σ_nodes w P̂(q) P̂(p).
+fn p22_forms(rule: &Rule, i: usize, rows: &Rows<'_>, n: usize) -> Vec<Vec<f64>> {
+    pair_forms(&rule.p22, i, rows, n, 0..3, 0..0, 0..0).pairs
 }
 
 impl OneLoopBasis {
@@ -185,12 +127,22 @@ impl OneLoopBasis {
         let n = basis.len();
         let n_err = error_functions(n);
         let (rows_fine, rows_coarse) = (rows_on(&basis, 1), rows_on(&basis, 2));
+        let fine_rows = Rows {
+            rows: &rows_fine,
+            stride: n,
+            lattice: &fine.lattice,
+        };
+        let coarse_rows = Rows {
+            rows: &rows_coarse,
+            stride: n,
+            lattice: &coarse.lattice,
+        };
         let done = std::sync::atomic::AtomicUsize::new(0);
         let per_k: Vec<(Vec<f32>, Vec<f32>, Vec<f64>)> = (0..k.len())
             .into_par_iter()
             .map(|i| {
-                let f = p22_forms(fine, i, &rows_fine, n, n);
-                let c = p22_forms(coarse, i, &rows_coarse, n, n_err);
+                let f = p22_forms(fine, i, &fine_rows, n);
+                let c = p22_forms(coarse, i, &coarse_rows, n_err);
                 let mut p22 = Vec::with_capacity(3 * f[0].len());
                 let mut diff = Vec::with_capacity(3 * c[0].len());
                 for (f, c) in f.iter().zip(&c) {
@@ -201,12 +153,12 @@ impl OneLoopBasis {
                 let (wf, wc) = (&fine.p13[i], &coarse.p13[i]);
                 let abs = |w: &[f64]| w.iter().map(|v| v.abs()).collect::<Vec<_>>();
                 let forms = [
-                    linear_form(&wf.f, &rows_fine, n),
-                    linear_form(&wf.g, &rows_fine, n),
-                    linear_form(&wc.f, &rows_coarse, n),
-                    linear_form(&wc.g, &rows_coarse, n),
-                    linear_form(&abs(&wf.f), &rows_fine, n),
-                    linear_form(&abs(&wf.g), &rows_fine, n),
+                    linear_form(&wf.f, &fine_rows),
+                    linear_form(&wf.g, &fine_rows),
+                    linear_form(&wc.f, &coarse_rows),
+                    linear_form(&wc.g, &coarse_rows),
+                    linear_form(&abs(&wf.f), &fine_rows),
+                    linear_form(&abs(&wf.g), &fine_rows),
                 ];
                 let mut p13 = Vec::with_capacity(P13_FORMS * n);
                 p13.extend(&forms[0]);
@@ -220,11 +172,11 @@ impl OneLoopBasis {
                 (p22, diff, p13)
             })
             .collect();
-        let sv_fine = linear_form(&fine.sigma_v2, &rows_fine, n);
-        let sv_coarse = linear_form(&coarse.sigma_v2, &rows_coarse, n);
+        let sv_fine = linear_form(&fine.sigma_v2, &fine_rows);
+        let sv_coarse = linear_form(&coarse.sigma_v2, &coarse_rows);
         let mut sigma_v2 = sv_fine.clone();
         sigma_v2.extend(sv_fine.iter().zip(&sv_coarse).map(|(f, c)| f - c));
-        let sigma_d2 = sigma_d2_forms(k, &fine.lattice, &rows_fine, n);
+        let sigma_d2 = sigma_d2_forms(k, &fine_rows);
         let (mut p22, mut p22_diff, mut p13) = (Vec::new(), Vec::new(), Vec::new());
         for (a, b, c) in per_k {
             p22.extend(a);
@@ -263,12 +215,7 @@ impl OneLoopBasis {
         let pairs = n * (n + 1) / 2;
         let n_err = error_functions(n);
         let pairs_err = n_err * (n_err + 1) / 2;
-        let mut s2 = vec![0.0; pairs];
-        for b in 0..n {
-            for a in 0..=b {
-                s2[pair_index(a, b)] = c[a] * c[b];
-            }
-        }
+        let s2 = pair_products(c);
         let eps = projection.residual;
         let nk = self.k.len();
         let mut terms = OneLoopTerms {
@@ -382,9 +329,10 @@ impl OneLoopBasis {
 }
 
 /// σ_d²(k) = (1/6π²) ∫_{q_min}^{min(k/2, q_max)} P̂ dq as linear forms on the basis, per k.
-fn sigma_d2_forms(k: &[f64], lattice: &Lattice, rows: &[f64], n: usize) -> Vec<f64> {
+fn sigma_d2_forms(k: &[f64], rows: &Rows<'_>) -> Vec<f64> {
     let (nodes, weights) = legendre_nodes(6);
     let norm = 1.0 / (6.0 * PI * PI);
+    let lattice = rows.lattice;
     k.iter()
         .flat_map(|&k| {
             let mut w = [vec![0.0; lattice.len]];
@@ -398,7 +346,7 @@ fn sigma_d2_forms(k: &[f64], lattice: &Lattice, rows: &[f64], n: usize) -> Vec<f
                     |x| [norm * x.exp()],
                 );
             }
-            linear_form(&w[0], rows, n)
+            linear_form(&w[0], rows)
         })
         .collect()
 }
@@ -406,24 +354,6 @@ fn sigma_d2_forms(k: &[f64], lattice: &Lattice, rows: &[f64], n: usize) -> Vec<f
 /// Σ a_i b_i with four partial sums (so that it vectorises).
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     super::dot(a, b)
-}
-
-/// Σ a_i b_i of f32 tensor entries and f64 products, summed in f64 with four partial sums.
-fn dot32(a: &[f32], b: &[f64]) -> f64 {
-    let mut s = [0.0; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = ca
-        .remainder()
-        .iter()
-        .zip(cb.remainder())
-        .map(|(x, y)| f64::from(*x) * y)
-        .sum();
-    for (x, y) in ca.zip(cb) {
-        for i in 0..4 {
-            s[i] += f64::from(x[i]) * y[i];
-        }
-    }
-    (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 """Times FAST-PT's 1-loop P_dd and its TNS A and B terms (RSD_components) on the embedded gm2012 z = 0 CAMB spectrum, for the README's comparison.
 
 Not part of the build or the tests (the project needs no Python). Run with `pip install fast-pt` and
-`python3 benches/external/fastpt_timing.py`. FAST-PT works on its input grid, which must be log-uniform: we
+`python3 tests/benches/external/fastpt_timing.py`. FAST-PT works on its input grid, which must be log-uniform: we
 time it on the 1200-point CAMB table (its normal use, and how the reference tables were made) and on a
 100-point log grid in [1e-3, 1] h/Mpc resampled from it (the grid of our benchmark; far too coarse for
 FAST-PT's accuracy, shown for the timing only).
@@ -13,7 +13,7 @@ import numpy as np
 import fastpt
 
 here = os.path.dirname(os.path.abspath(__file__))
-table = np.loadtxt(os.path.join(here, "..", "..", "pt-spectra", "data", "linear_pk_gm2012_z0.0.dat"))
+table = np.loadtxt(os.path.join(here, "..", "..", "..", "pt-spectra", "data", "linear_pk_gm2012_z0.0.dat"))
 k, p = table[:, 0], table[:, 1]
 
 def measure(k, p, label):

@@ -2,6 +2,9 @@
 //!
 //! * `tns/evaluate`: the TNS A and B coefficients of μ^{2n} f^m ([`TnsPlan::evaluate`], one core);
 //! * `tns/plan`: building the cosmology-independent TNS plan (rayon's pool);
+//! * `tns/new spectrum through the basis`: the whole TNS model of a new CAMB table's (k, P) arrays on
+//!   the 1- and TNS basis tensors ([`RsdPlan`] with method basis, 1L-SPT): the spline, the projection,
+//!   the real-space terms, A and B, and P_0, P_2, P_4 with Lorentzian FoG (one core);
 //! * `multipoles/…`: P_0, P_2, P_4 of the TNS model at one (f, σ0, b) from the precomputed real-space
 //!   spectra and TNS coefficients: what a fit pays per step, undamped (exact) and with Lorentzian FoG
 //!   (32-point Gauss–Legendre plus the 16-point error estimate).
@@ -14,7 +17,7 @@
 //! * `ept/terms`: the galaxy model's loop terms of a new linear spectrum with IR resummation (the
 //!   no-wiggle filter, the terms of P and P_nw, Σ²) on 50 k ([`EptPlan::terms`], rayon's pool;
 //!   `RAYON_NUM_THREADS=1` for one core), at the default and the fast precision (both within
-//!   2.7e-4 of velocileptors' REPT, tests/ept.rs);
+//!   2.7e-4 of velocileptors' REPT, tests/tests/ept.rs);
 //! * `ept/step`: P_0, P_2, P_4 from those terms at new parameters (one nuisance step of a chain,
 //!   [`EptPlan::multipole_values`]), without and with AP (α∥ = 1.03, α⊥ = 0.98), and with the error
 //!   estimates ([`EptPlan::multipoles`]).
@@ -33,10 +36,12 @@ use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criteri
 use pt_spectra::linear::{LinearSpectrum, LogGrid};
 use pt_spectra::loops::bias::BiasPlan;
 use pt_spectra::loops::{TnsPlan, TnsTerms};
-use pt_spectra::precision::Precision;
+use pt_spectra::precision::{Precision, TwoLoopMethod};
+use pt_spectra::progress::Silent;
 use pt_spectra::real::{real_space, RealModel, RealSpectra};
 use pt_spectra::rsd::ap::Distortion;
 use pt_spectra::rsd::ept::{EptParams, EptPlan, EptSettings};
+use pt_spectra::rsd::RsdPlan;
 use pt_spectra::rsd::{Fog, MultipoleRule, Observed, RsdModel, RsdSettings};
 use pt_spectra::store::TableStore;
 use pt_spectra::survey::observe::{Bins, Observation, Window};
@@ -56,6 +61,37 @@ fn tns(c: &mut Criterion) {
     group.bench_function(BenchmarkId::new("evaluate (1 core)", 50), |b| {
         b.iter(|| plan.evaluate(black_box(&p)))
     });
+    let table = LinearSpectrum::from_file(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/data/linear_pk_camb_heldout_1.dat"
+    ))
+    .expect("test table");
+    let (k_in, p_in) = table.nodes();
+    let (k_in, p_in) = (k_in.to_vec(), p_in.to_vec());
+    let mut precision = Precision::default();
+    precision.two_loop = TwoLoopMethod::Basis;
+    let store = TableStore::in_memory();
+    let rsd = RsdPlan::new(
+        &k,
+        RealModel::OneLoopSpt,
+        RsdModel::Tns,
+        &precision,
+        &store,
+        &Silent,
+    )
+    .expect("valid plan");
+    let rule = MultipoleRule::new(&[0, 2, 4]).expect("valid ells");
+    group.bench_function(
+        BenchmarkId::new("new spectrum through the basis", 50),
+        |b| {
+            b.iter(|| {
+                let p = LinearSpectrum::from_nodes(k_in.clone(), p_in.clone()).expect("valid");
+                let (real, tns) = rsd.evaluate(black_box(&p), &Silent).expect("evaluates");
+                let tns = tns.expect("TNS terms");
+                multipoles(&rule, &real, &tns, (0.6, 3.5, 2.0), Fog::Lorentzian)
+            })
+        },
+    );
     group.sample_size(10);
     group.bench_function(BenchmarkId::new("plan (rayon)", 50), |b| {
         b.iter(|| TnsPlan::new(black_box(&k), &Precision::default()).expect("valid plan"))

@@ -185,7 +185,7 @@ fn gaussian_through_a_sphere_three_ways() {
 fn windowed_binned_evaluation_is_fast() {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/window_boss_ellipsoid.dat"
+        "/data/window_boss_ellipsoid.dat"
     );
     let window = WindowMultipoles::from_file(path).unwrap();
     let edges: Vec<f64> = (0..=48).map(|i| 0.005 * i as f64).collect();
@@ -226,7 +226,7 @@ fn windowed_binned_evaluation_is_fast() {
 fn boss_format_window_matches_the_python_reference() {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/window_boss_ellipsoid.dat"
+        "/data/window_boss_ellipsoid.dat"
     );
     let window = WindowMultipoles::from_file(path).unwrap();
     assert_eq!(window.ells(), &[0, 2, 4]);

@@ -1,0 +1,166 @@
+//! The bilinear and linear forms on the basis of a node set of the 2-D loop integrals ([`PairNodes`]):
+//! what turns a plan's quadrature of a spectrum's lattice samples into contractions with the
+//! spectrum's coefficients.
+//!
+//! A node set at k index i integrates Σ_outer P̃(q_o) Σ_inner w_m P̃(p_j), with P̃ the lattice
+//! interpolant of the samples. With P̃ = Σ_a c_a φ̃_a this is Σ_{a,b} c_a c_b T^m_ab, T^m_ab =
+//! Σ_outer φ̃_a(q_o) Σ_inner w_m φ̃_b(p_j) ([`pair_forms`]); kernels that multiply P(k) rather than
+//! P(q) or P(p) leave linear forms ([`NodeForms::inner`]: Σ_outer Σ_inner w φ̃(p), and
+//! [`NodeForms::outer`]: Σ_outer φ̃(q) Σ_inner w).
+
+use super::pair_index;
+use crate::integrate::lagrange4;
+use crate::loops::lattice::Lattice;
+use crate::loops::p22::PairNodes;
+use std::ops::Range;
+
+/// The basis functions' samples on a lattice, row by row: `rows[j * stride + a]` = φ_a(q_j).
+pub(crate) struct Rows<'a> {
+    pub rows: &'a [f64],
+    pub stride: usize,
+    pub lattice: &'a Lattice,
+}
+
+impl Rows<'_> {
+    /// The interpolants of all functions at the stencil (first point `b`, Lagrange weights `l`).
+    fn stencil(&self, b: usize, l: [f64; 4], out: &mut [f64]) {
+        out.iter_mut().for_each(|o| *o = 0.0);
+        let n = self.stride;
+        for (m, lm) in l.iter().enumerate() {
+            for (o, p) in out.iter_mut().zip(&self.rows[(b + m) * n..(b + m + 1) * n]) {
+                *o += lm * p;
+            }
+        }
+    }
+
+    /// The interpolants of all functions at fractional lattice index `u`.
+    pub fn at(&self, u: f64, out: &mut [f64]) {
+        let (b, t) = self.lattice.stencil(u);
+        self.stencil(b, lagrange4(t), out);
+    }
+}
+
+/// The forms of one k: symmetric bilinear forms (pairs a ≤ b of the first n functions) and linear
+/// forms (length `stride`).
+pub(crate) struct NodeForms {
+    /// One per bilinear weight.
+    pub pairs: Vec<Vec<f64>>,
+    /// Σ_outer Σ_inner w φ̃(p), one per weight of the `inner` range.
+    pub inner: Vec<Vec<f64>>,
+    /// Σ_outer φ̃(q) Σ_inner w, one per weight of the `outer` range.
+    pub outer: Vec<Vec<f64>>,
+}
+
+/// The forms of node set `nodes` at k index `i`: bilinear ones for the weights `bilinear` on the first
+/// `n` functions, linear ones for the weights `inner` and `outer`.
+pub(crate) fn pair_forms<const M: usize>(
+    nodes: &PairNodes<M>,
+    i: usize,
+    rows: &Rows<'_>,
+    n: usize,
+    bilinear: Range<usize>,
+    inner: Range<usize>,
+    outer: Range<usize>,
+) -> NodeForms {
+    let stride = rows.stride;
+    let nb = bilinear.len();
+    let (mut start, outer_nodes) = nodes.ranges(i);
+    let mut full = vec![vec![0.0; n * n]; nb];
+    let mut lin_inner = vec![vec![0.0; stride]; inner.len()];
+    let mut lin_outer = vec![vec![0.0; stride]; outer.len()];
+    let (mut phi_q, mut phi_p) = (vec![0.0; stride], vec![0.0; stride]);
+    let mut acc = vec![vec![0.0; n]; nb];
+    for o in outer_nodes {
+        let end = nodes.outer_end[o] as usize;
+        acc.iter_mut()
+            .for_each(|a| a.iter_mut().for_each(|v| *v = 0.0));
+        let mut weight_sums = vec![0.0; outer.len()];
+        for j in start..end {
+            let w = &nodes.inner_w[j];
+            rows.stencil(
+                nodes.inner_b[j] as usize,
+                nodes.inner_l[j].map(f64::from),
+                &mut phi_p,
+            );
+            for (a, m) in acc.iter_mut().zip(bilinear.clone()) {
+                let w = f64::from(w[m]);
+                a.iter_mut().zip(&phi_p[..n]).for_each(|(a, p)| *a += w * p);
+            }
+            for (l, m) in lin_inner.iter_mut().zip(inner.clone()) {
+                let w = f64::from(w[m]);
+                l.iter_mut().zip(&phi_p).for_each(|(l, p)| *l += w * p);
+            }
+            for (s, m) in weight_sums.iter_mut().zip(outer.clone()) {
+                *s += f64::from(w[m]);
+            }
+        }
+        rows.at(nodes.outer_u[o], &mut phi_q);
+        for (t, a) in full.iter_mut().zip(&acc) {
+            for (row, q) in t.chunks_exact_mut(n).zip(&phi_q[..n]) {
+                row.iter_mut().zip(a).for_each(|(t, a)| *t += q * a);
+            }
+        }
+        for (l, s) in lin_outer.iter_mut().zip(&weight_sums) {
+            l.iter_mut().zip(&phi_q).for_each(|(l, q)| *l += s * q);
+        }
+        start = end;
+    }
+    let pairs = full
+        .into_iter()
+        .map(|t| {
+            let mut sym = vec![0.0; n * (n + 1) / 2];
+            for b in 0..n {
+                for a in 0..b {
+                    sym[pair_index(a, b)] = t[a * n + b] + t[b * n + a];
+                }
+                sym[pair_index(b, b)] = t[b * n + b];
+            }
+            sym
+        })
+        .collect();
+    NodeForms {
+        pairs,
+        inner: lin_inner,
+        outer: lin_outer,
+    }
+}
+
+/// Σ_j w_j φ_a(q_j) for every a.
+pub(crate) fn linear_form(weights: &[f64], rows: &Rows<'_>) -> Vec<f64> {
+    let n = rows.stride;
+    let mut out = vec![0.0; n];
+    for (w, row) in weights.iter().zip(rows.rows.chunks_exact(n)) {
+        out.iter_mut().zip(row).for_each(|(o, p)| *o += w * p);
+    }
+    out
+}
+
+/// Σ a_i b_i of f32 tensor entries and f64 products, summed in f64 with four partial sums.
+pub(crate) fn dot32(a: &[f32], b: &[f64]) -> f64 {
+    let mut s = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(x, y)| f64::from(*x) * y)
+        .sum();
+    for (x, y) in ca.zip(cb) {
+        for i in 0..4 {
+            s[i] += f64::from(x[i]) * y[i];
+        }
+    }
+    (s[0] + s[1]) + (s[2] + s[3]) + tail
+}
+
+/// The products c_a c_b on the pairs a ≤ b.
+pub(crate) fn pair_products(c: &[f64]) -> Vec<f64> {
+    let n = c.len();
+    let mut s2 = vec![0.0; n * (n + 1) / 2];
+    for b in 0..n {
+        for a in 0..=b {
+            s2[pair_index(a, b)] = c[a] * c[b];
+        }
+    }
+    s2
+}

@@ -1,1 +1,0 @@
-//! Cross-crate tests and benchmarks of the pt-spectra workspace live in `tests/` and `benches/`.
