@@ -37,6 +37,8 @@ pub enum Stage {
     OneLoopBasis,
     /// The TNS A and B basis tensors of a k grid (once; cached).
     TnsBasis,
+    /// The basis tensors of the galaxy model's loop terms on a k grid (once; cached).
+    RedshiftBasis,
 }
 
 impl fmt::Display for Stage {
@@ -50,6 +52,7 @@ impl fmt::Display for Stage {
             Stage::TwoLoopBasis => "2-loop basis tensors (once per k grid, minutes; cached)",
             Stage::OneLoopBasis => "1-loop basis tensors (once per k grid; cached)",
             Stage::TnsBasis => "TNS basis tensors (once per k grid; cached)",
+            Stage::RedshiftBasis => "galaxy-model basis tensors (once per k grid; cached)",
         })
     }
 }

@@ -22,7 +22,9 @@
 //! ```
 
 use crate::error::{Error, Result};
-use crate::loops::basis::{OneLoopBasis, TnsBasis, TwoLoopBasis};
+use crate::loops::basis::{LinearBasis, OneLoopBasis, RedshiftBasis, SpectrumFamily};
+use crate::loops::basis::{TnsBasis, TwoLoopBasis};
+use crate::loops::redshift::RedshiftPlan;
 use crate::loops::{OneLoopPlan, P15Table, P17Table, TnsPlan};
 use crate::precision::Precision;
 use crate::progress::{Progress, Stage};
@@ -238,6 +240,57 @@ impl TableStore {
         let path = self.path(&TnsBasis::file_name(k, precision))?;
         read_cached(&path, "TNS basis tensors", progress, |v| {
             TnsBasis::from_f64s(v, k, precision)
+        })
+    }
+}
+
+impl TableStore {
+    /// The basis tensors of the galaxy model's loop terms ([`RedshiftBasis`]) of `plan`'s k grid and
+    /// precision for the spectra `family`: read from their file, or built on the basis `basis()`
+    /// (reporting [`Stage::RedshiftBasis`]; seconds) and written. Without a directory they are
+    /// built each time.
+    ///
+    /// # Errors
+    /// [`Error::Cache`] if the directory cannot be created or the file cannot be written or locked.
+    pub fn redshift_basis(
+        &self,
+        plan: &RedshiftPlan,
+        family: SpectrumFamily,
+        basis: &dyn Fn() -> LinearBasis,
+        progress: &dyn Progress,
+    ) -> Result<Arc<RedshiftBasis>> {
+        let (k, precision) = (plan.k(), plan.precision());
+        let build = || {
+            RedshiftBasis::build(plan, family, basis(), &|d, t| {
+                progress.update(Stage::RedshiftBasis, d, t)
+            })
+        };
+        let tensors = match self.path(&RedshiftBasis::file_name(k, precision, family)) {
+            None => build(),
+            Some(path) => cached(
+                &path,
+                "redshift-space basis",
+                |v| RedshiftBasis::from_f64s(v, k, precision, family),
+                build,
+                RedshiftBasis::to_f64s,
+                progress,
+            )?,
+        };
+        Ok(Arc::new(tensors))
+    }
+
+    /// The galaxy model's basis tensors for `k`, `precision` and `family` if their file is in the
+    /// directory and valid (never builds them).
+    pub fn cached_redshift_basis(
+        &self,
+        k: &[f64],
+        precision: &Precision,
+        family: SpectrumFamily,
+        progress: &dyn Progress,
+    ) -> Option<Arc<RedshiftBasis>> {
+        let path = self.path(&RedshiftBasis::file_name(k, precision, family))?;
+        read_cached(&path, "redshift-space basis tensors", progress, |v| {
+            RedshiftBasis::from_f64s(v, k, precision, family)
         })
     }
 }

@@ -6,7 +6,8 @@ in under a millisecond), one core, a new CAMB spectrum at every call, tensors ca
 * 1-loop SPT δδ, δθ, θθ with all terms, 100 k in [1e-3, 1]: ``RealPlan.batch`` (arrays) and the
   ``RealPlan`` call (a Table with its header), against FAST-PT's ``one_loop_dd`` on its 1200-point
   grid in the same run;
-* TNS multipoles ℓ = 0, 2, 4 from 1L-SPT, 50 k; the galaxy model ``ept`` with IR, 50 k;
+* TNS multipoles ℓ = 0, 2, 4 from 1L-SPT, 50 k; the galaxy model ``ept`` with IR, 50 k (both with
+  ``two_loop="basis"``: the real-space, TNS and galaxy-model terms from their basis tensors);
 * a batch of 100 spectra on 1 and on 2 threads (separate processes: the pool is set once).
 
 Medians over the calls; the spectra are CAMB's for 8 cosmologies inside the EuclidEmulator2 box.
@@ -76,7 +77,7 @@ def main():
     spectra = camb_spectra()
     real = pt.RealPlan(np.geomspace(1e-3, 1, 100), model="1l-spt", two_loop="basis")
     tns = pt.RsdPlan(np.geomspace(0.01, 0.3, 50), real="1l-spt", rsd="tns", two_loop="basis")
-    ept = pt.EptPlan(np.geomspace(0.01, 0.3, 50), ir=True)
+    ept = pt.EptPlan(np.geomspace(0.01, 0.3, 50), ir=True, two_loop="basis")
     rows = [
         ("1-loop SPT + terms, 100 k: batch (arrays)",
          median_ms(lambda k, p: real.batch(k, p, terms=True), spectra)),

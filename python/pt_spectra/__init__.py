@@ -132,7 +132,9 @@ class EptPlan:
     redshift space with the BAO resummed, velocileptors' ``REPT`` conventions).
 
     ``EptPlan(k, ir=True, apar=None, aperp=None, precision="default", q_range=None,
-    free_ap=False)``; calling it
+    free_ap=False, two_loop="auto", cache_dir=None)`` (``two_loop="basis"``: the loop terms of every
+    spectrum from basis tensors, built once per k grid in seconds and cached, as for
+    :class:`RealPlan`); calling it
     takes the linear spectrum (``linear``, ``z``, ``z_input``, ``cosmology``, ``eh`` as in
     :func:`real`), ``ells`` and the parameters by name: b1, b2, bs, b3, alpha0, alpha2, alpha4,
     alpha6 [(Mpc/h)^2], sn [(Mpc/h)^3], sn2 [(Mpc/h)^5], sn4 [(Mpc/h)^7], f (default f(z)); an
@@ -143,8 +145,9 @@ class EptPlan:
     """
 
     def __init__(self, k, ir=True, apar=None, aperp=None, precision=_D["precision"], q_range=None,
-                 free_ap=False):
-        self._plan = _core.EptPlan(k, ir, apar, aperp, precision, q_range, free_ap)
+                 free_ap=False, two_loop=_D["two_loop"], cache_dir=None):
+        self._plan = _core.EptPlan(k, ir, apar, aperp, precision, q_range, free_ap, two_loop,
+                                   cache_dir)
 
     def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, ells=(0, 2, 4),
                  **params):

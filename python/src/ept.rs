@@ -6,6 +6,7 @@ use crate::inputs::Inputs;
 use crate::tables::Table;
 use crate::{detached, floats, value_error};
 use pt_spectra::jobs::{self, EptRequest};
+use pt_spectra::progress::Silent;
 use pt_spectra::rsd::ap::Distortion;
 use pt_spectra::rsd::ept::{EptParams, EptPlan as LibEptPlan, EptTerms as LibEptTerms};
 use pt_spectra::setup::Prepared;
@@ -49,7 +50,7 @@ pub(crate) struct EptPlan {
 #[pymethods]
 impl EptPlan {
     #[new]
-    #[pyo3(signature = (k, ir=true, apar=None, aperp=None, precision=pt_spectra::jobs::defaults::PRECISION, q_range=None, free_ap=false))]
+    #[pyo3(signature = (k, ir=true, apar=None, aperp=None, precision=pt_spectra::jobs::defaults::PRECISION, q_range=None, free_ap=false, two_loop=pt_spectra::jobs::defaults::TWO_LOOP, cache_dir=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -60,11 +61,16 @@ impl EptPlan {
         precision: &str,
         q_range: Option<(f64, f64)>,
         free_ap: bool,
+        two_loop: &str,
+        cache_dir: Option<std::path::PathBuf>,
     ) -> PyResult<Self> {
         let k = floats(k, "k")?;
         let ap = distortion(apar, aperp)?;
-        let precision = crate::precision(precision, q_range, None, None)?;
-        let (plan, _) = detached(py, || jobs::ept_plan(&k, ir, ap, free_ap, &precision))?;
+        let precision = crate::precision(precision, q_range, None, Some(two_loop))?;
+        let store = crate::Store::new(cache_dir);
+        let (plan, _) = detached(py, || {
+            jobs::ept_plan(&k, ir, ap, free_ap, &precision, store.get(), &Silent)
+        })?;
         Ok(Self { plan, precision })
     }
 
@@ -277,7 +283,8 @@ pub(crate) fn fit_ept(
             ell_ranges,
             n_mocks,
         };
-        let plan = jobs::ept_plan(&model_k, ir, ap, free_ap, &precision)?;
+        let store = crate::Store::new(None);
+        let plan = jobs::ept_plan(&model_k, ir, ap, free_ap, &precision, store.get(), &Silent)?;
         let terms = plan.terms(&prepared.spectrum)?;
         let header = vec![format!(
             "pt-spectra {} fit: ept ({}) to {name}",

@@ -18,6 +18,9 @@
 //!   no-wiggle filter, the terms of P and P_nw, Σ²) on 50 k ([`EptPlan::terms`], rayon's pool;
 //!   `RAYON_NUM_THREADS=1` for one core), at the default and the fast precision (both within
 //!   2.7e-4 of velocileptors' REPT, tests/tests/ept.rs);
+//! * `ept/new spectrum through the basis`: a new CAMB table's arrays to P_0, P_2, P_4 with the loop
+//!   terms from the basis tensors (the spline, the no-wiggle filter, both projections, the
+//!   contractions, one parameter step; one core);
 //! * `ept/step`: P_0, P_2, P_4 from those terms at new parameters (one nuisance step of a chain,
 //!   [`EptPlan::multipole_values`]), without and with AP (α∥ = 1.03, α⊥ = 0.98), and with the error
 //!   estimates ([`EptPlan::multipoles`]).
@@ -204,8 +207,34 @@ fn ept(c: &mut Criterion) {
     group.bench_function(BenchmarkId::new("terms (IR, precision fast)", 50), |b| {
         b.iter(|| fast.terms(black_box(&p)).expect("valid spectrum"))
     });
-    let terms = plan.terms(&p).expect("valid spectrum");
+    // A new CAMB table's arrays through the basis tensors (method basis, built once here).
+    let table = LinearSpectrum::from_file(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/data/linear_pk_camb_heldout_1.dat"
+    ))
+    .expect("test table");
+    let (k_in, p_in) = (table.nodes().0.to_vec(), table.nodes().1.to_vec());
+    let mut basis_precision = Precision::default();
+    basis_precision.two_loop = TwoLoopMethod::Basis;
+    let on_basis = EptPlan::new(&k, EptSettings::default(), &basis_precision)
+        .expect("valid plan")
+        .with_basis(&TableStore::in_memory(), &Silent)
+        .expect("tensors");
     let mut params = EptParams::new(2.0, 0.48);
+    for (name, v) in [("b2", 0.3), ("bs", -0.2), ("alpha0", 5.0), ("sn", 800.0)] {
+        params.set(name, v).expect("known name");
+    }
+    group.bench_function(
+        BenchmarkId::new("new spectrum through the basis (IR, l = 0, 2, 4)", 50),
+        |b| {
+            b.iter(|| {
+                let p = LinearSpectrum::from_nodes(k_in.clone(), p_in.clone()).expect("valid");
+                let terms = on_basis.terms(black_box(&p)).expect("valid spectrum");
+                on_basis.multipole_values(&terms, &params, &[0, 2, 4])
+            })
+        },
+    );
+    let terms = plan.terms(&p).expect("valid spectrum");
     for (name, v) in [("b2", 0.3), ("bs", -0.2), ("alpha0", 5.0), ("sn", 800.0)] {
         params.set(name, v).expect("known name");
     }

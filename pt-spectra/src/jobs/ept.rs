@@ -27,14 +27,19 @@ pub const AP_FIT_RANGE: (f64, f64) = (0.8, 1.25);
 /// The plan of a request on the output `k`, with IR resummation `ir`, the distortion `ap`, and with
 /// `free_ap` the internal grid of every α∥, α⊥ in `AP_FIT_RANGE` (0.8 … 1.25).
 ///
+/// The loop terms come from basis tensors as `precision.two_loop` says ([`EptPlan::with_basis`]:
+/// `basis` reads or builds them in `store`, reporting to `progress`; `auto` uses cached ones).
+///
 /// # Errors
-/// As [`EptPlan::new`].
+/// As [`EptPlan::new`] and [`EptPlan::with_basis`].
 pub fn ept_plan(
     k: &[f64],
     ir: bool,
     ap: Option<Distortion>,
     free_ap: bool,
     precision: &Precision,
+    store: &crate::store::TableStore,
+    progress: &dyn crate::progress::Progress,
 ) -> Result<EptPlan> {
     EptPlan::new(
         k,
@@ -44,7 +49,8 @@ pub fn ept_plan(
             ap_range: free_ap.then_some(AP_FIT_RANGE),
         },
         precision,
-    )
+    )?
+    .with_basis(store, progress)
 }
 
 /// The multipole table of `request` on the prepared spectrum: columns `k P<l>… err_P<l>…`.
@@ -115,6 +121,7 @@ pub fn ept_table_from_terms(
         ));
     }
     header.extend(describe_inputs(prepared, precision));
+    header.extend(terms.describe_source());
     let mut t = Table::new(header);
     t.push("k", WAVENUMBER, plan.k().to_vec());
     for (l, p) in request.ells.iter().zip(&m) {
@@ -152,6 +159,7 @@ pub fn ept_fit_table(
         fits.push(fit_galaxy_observed(plan, terms, data, &r, observation)?);
     }
     let mut header = header;
+    header.extend(terms.describe_source());
     if let Some(o) = observation {
         header.extend(o.description().iter().cloned());
     }

@@ -46,7 +46,8 @@ use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
 #[cfg(test)]
 use kernels::pair_polynomials;
-use kernels::{pair_columns, KERNEL_COEFFICIENTS, NLOS, NPAIR};
+pub(crate) use kernels::NPAIR;
+use kernels::{pair_columns, KERNEL_COEFFICIENTS, NLOS};
 pub use kernels::{Monomial, PAIR_COLUMNS};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -115,12 +116,12 @@ fn los_kernels(r: f64, rule: &XRule) -> [f64; NLOS] {
 
 /// The lattice weights (fine or half-resolution) of one plan.
 #[derive(Debug, Clone)]
-struct Rule {
-    lattice: Lattice,
-    pairs: PairNodes<NPAIR>,
+pub(crate) struct Rule {
+    pub lattice: Lattice,
+    pub pairs: PairNodes<NPAIR>,
     /// Per k: weights of [3∫F₃P, 3∫G₃P, sig3nl/P, LOS₁, LOS₂, LOS₃] (all per unit P_lin(k)).
-    lattice_weights: Vec<[Vec<f64>; 6]>,
-    sigma_v2: Vec<f64>,
+    pub lattice_weights: Vec<[Vec<f64>; 6]>,
+    pub sigma_v2: Vec<f64>,
 }
 
 impl Rule {
@@ -207,7 +208,7 @@ impl Rule {
 }
 
 /// The pair columns and the lattice-weight terms of one k.
-type Row = ([Estimate; NPAIR], [Estimate; 6]);
+pub(crate) type Row = ([Estimate; NPAIR], [Estimate; 6]);
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
@@ -326,6 +327,17 @@ impl RedshiftPlan {
         &self.k
     }
 
+    /// The settings the plan was built with.
+    pub fn precision(&self) -> &Precision {
+        &self.precision
+    }
+
+    /// The fine rule and the half-resolution rule of the error estimates (the basis tensors of
+    /// [`super::basis::RedshiftBasis`] are made from them).
+    pub(crate) fn rules(&self) -> (&Rule, &Rule) {
+        (&self.fine, &self.coarse)
+    }
+
     /// The terms of `spectrum` (over the plan's q range, through its power-law extrapolation).
     pub fn evaluate(&self, spectrum: &LinearSpectrum) -> RedshiftTerms {
         let fine = self.fine.lattice.sample(spectrum);
@@ -419,11 +431,21 @@ impl RedshiftPlan {
         fine: &[f64],
         coarse: &[f64],
     ) -> RedshiftTerms {
-        let nk = self.k.len();
         let sv = dot(&self.fine.sigma_v2, fine);
         let sv_coarse = dot(&self.coarse.sigma_v2, coarse);
         let sigma_v2 = Estimate::new(sv, (sv - sv_coarse).abs());
         let p_lin: Vec<f64> = self.k.iter().map(|&k| spectrum.eval(k)).collect();
+        self.assemble_rows(p_lin, rows, sigma_v2)
+    }
+
+    /// The terms from the rows of every k, P_lin at k and σ_v².
+    pub(crate) fn assemble_rows(
+        &self,
+        p_lin: Vec<f64>,
+        rows: &[Row],
+        sigma_v2: Estimate,
+    ) -> RedshiftTerms {
+        let nk = self.k.len();
         let mut out = RedshiftTerms {
             k: self.k.clone(),
             p_lin: p_lin.clone(),

@@ -165,6 +165,8 @@ pub struct EptPlan {
     settings: EptSettings,
     loops: RedshiftPlan,
     split: Option<()>,
+    /// The basis tensors of the loop terms, if they come from them ([`Self::with_basis`]).
+    tensors: Option<basis::Tensors>,
 }
 
 /// The loop terms of one linear spectrum: everything that does not depend on the parameters.
@@ -174,6 +176,8 @@ pub struct EptTerms {
     full: RedshiftTerms,
     /// The no-wiggle terms and Σ² [(Mpc/h)²], with IR resummation.
     nw: Option<(RedshiftTerms, Estimate)>,
+    /// The projection residuals (full, no-wiggle) if the terms come from basis tensors.
+    basis_residual: Option<(f64, Option<f64>)>,
 }
 
 impl EptPlan {
@@ -225,6 +229,7 @@ impl EptPlan {
             settings,
             loops,
             split,
+            tensors: None,
         })
     }
 
@@ -243,6 +248,9 @@ impl EptPlan {
     /// # Errors
     /// As [`savitzky_golay_no_wiggle`].
     pub fn terms(&self, spectrum: &LinearSpectrum) -> Result<EptTerms> {
+        if let Some(terms) = self.terms_on_basis(spectrum)? {
+            return Ok(terms);
+        }
         let (full, nw) = match &self.split {
             Some(()) => {
                 let p_nw = savitzky_golay_no_wiggle(spectrum)?;
@@ -255,6 +263,7 @@ impl EptPlan {
             grid: self.grid.clone(),
             full,
             nw,
+            basis_residual: None,
         })
     }
 
@@ -572,6 +581,8 @@ impl Model<'_> {
         Ok((b, lagrange4(u - b as f64)))
     }
 }
+
+mod basis;
 
 #[cfg(test)]
 mod tests;

@@ -9,6 +9,7 @@ mod bias;
 mod counterterm;
 mod ept;
 mod fit;
+mod fixtures;
 mod halo;
 mod plot;
 mod robustness;

@@ -1,5 +1,6 @@
 //! `pt-spectra rsd --rsd ept`: the galaxy model's options and run.
 
+use crate::progress::Bars;
 use anyhow::{bail, Result};
 use pt_spectra::halo::Bias;
 use pt_spectra::jobs::{ept_plan, ept_table, EptRequest};
@@ -232,7 +233,15 @@ pub fn table(
         bail!("--xi takes no --window or --k-edges (a Landy-Szalay xi has the window divided out)");
     }
     if window.is_none() && bins.is_none() && shared.xi.is_none() {
-        let plan = ept_plan(&k, !args.no_ir, shared.distortion, false, &loaded.precision)?;
+        let plan = ept_plan(
+            &k,
+            !args.no_ir,
+            shared.distortion,
+            false,
+            &loaded.precision,
+            &loaded.store,
+            &Bars::default(),
+        )?;
         return Ok(ept_table(
             &plan,
             &request,
@@ -250,6 +259,8 @@ pub fn table(
         shared.distortion,
         false,
         &loaded.precision,
+        &loaded.store,
+        &Bars::default(),
     )?;
     let terms = plan.terms(&loaded.prepared.spectrum)?;
     Ok(pt_spectra::jobs::ept_observed_table(

@@ -304,6 +304,8 @@ fn run_ept(args: &Args) -> Result<()> {
         distortion,
         free_ap,
         &loaded.precision,
+        &loaded.store,
+        &Bars::default(),
     )?;
     let terms = plan.terms(&loaded.prepared.spectrum)?;
     let mut header = vec![format!(

@@ -37,12 +37,14 @@ mod forms;
 mod linear_basis;
 mod one_loop;
 mod p15_forms;
+mod redshift;
 mod tensors;
 mod tns;
 pub mod training;
 
 pub use linear_basis::{LinearBasis, Projection, SMOOTHING};
 pub use one_loop::{BasisOneLoop, OneLoopBasis};
+pub use redshift::{RedshiftBasis, SpectrumFamily};
 pub use tns::TnsBasis;
 
 use super::lattice::Lattice;

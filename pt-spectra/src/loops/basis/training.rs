@@ -65,8 +65,20 @@ const CUTS: [(f64, f64); 4] = [(1e-4, 10.0), (1e-4, 20.0), (1e-4, 30.0), (1e-3, 
 /// The training spectra on `lattice`: the tables of [`camb_training`], and every fourth of them cut to
 /// each range of [`CUTS`] (power-law ends beyond, as the library extends any table).
 pub(crate) fn camb_samples(lattice: &Lattice) -> Vec<Vec<f64>> {
+    samples_with(lattice, &|p| p.clone())
+}
+
+/// As [`camb_samples`] with every table (and cut) first turned into `transform(table)`: e.g. its
+/// no-wiggle part, for a basis of the spectra the galaxy model's IR resummation integrates.
+fn samples_with(
+    lattice: &Lattice,
+    transform: &(dyn Fn(&LinearSpectrum) -> LinearSpectrum + Sync),
+) -> Vec<Vec<f64>> {
     let tables = camb_training();
-    let mut samples: Vec<Vec<f64>> = tables.iter().map(|p| lattice.sample(p)).collect();
+    let mut samples: Vec<Vec<f64>> = tables
+        .iter()
+        .map(|p| lattice.sample(&transform(p)))
+        .collect();
     for p in tables.iter().step_by(4) {
         let (k, pk) = p.nodes();
         for (lo, hi) in CUTS {
@@ -76,7 +88,7 @@ pub(crate) fn camb_samples(lattice: &Lattice) -> Vec<Vec<f64>> {
                 keep.iter().map(|&i| pk[i]).collect(),
             )
             .expect("a cut of a valid table is valid");
-            samples.push(lattice.sample(&cut));
+            samples.push(lattice.sample(&transform(&cut)));
         }
     }
     samples
@@ -120,6 +132,21 @@ fn cubic_b_spline(t: f64) -> f64 {
 /// choice from [`camb_samples`].
 pub(crate) fn camb_basis(lattice: Lattice, n: usize) -> LinearBasis {
     let training = camb_samples(&lattice);
+    basis_of(lattice, training, n)
+}
+
+/// The basis of `n` functions for the training tables (and cuts) each turned into
+/// `transform(table)` first, with the tail functions: the basis of a family of spectra derived from
+/// the training set (the galaxy model's no-wiggle spectra, [`crate::rsd::ept::EptPlan`]).
+pub(crate) fn transformed_basis(
+    lattice: &Lattice,
+    n: usize,
+    transform: &(dyn Fn(&LinearSpectrum) -> LinearSpectrum + Sync),
+) -> LinearBasis {
+    basis_of(lattice.clone(), samples_with(lattice, transform), n)
+}
+
+fn basis_of(lattice: Lattice, training: Vec<Vec<f64>>, n: usize) -> LinearBasis {
     let mean: Vec<f64> = (0..lattice.len)
         .map(|j| training.iter().map(|t| t[j]).sum::<f64>() / training.len() as f64)
         .collect();

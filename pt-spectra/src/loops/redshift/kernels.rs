@@ -111,7 +111,7 @@ pub const PAIR_COLUMNS: [(usize, usize, usize); 31] = [
     (4, 5, 0),
     (5, 5, 0),
 ];
-pub(super) const NPAIR: usize = PAIR_COLUMNS.len();
+pub(crate) const NPAIR: usize = PAIR_COLUMNS.len();
 
 /// The line-of-sight P13-type kernels (module docs) per unit of 6Z₁P(k)∫d³q/(2π)³P: the b1fμ², f²μ²
 /// and f²μ⁴ parts.

@@ -1,0 +1,369 @@
+//! The terms of the galaxy model in redshift space ([`RedshiftPlan`], the `ept` model) of a new
+//! spectrum as contractions on the basis.
+//!
+//! The 31 pair columns are bilinear forms of the lattice samples on the plan's P22 nodes, the six
+//! lattice-weight terms (P13 of F₃ and G₃, sig3nl, the three line-of-sight terms) P(k) times linear
+//! forms, σ_v² a linear form: on the basis, contractions with c ⊗ c and c (module `forms`), the same
+//! nodes and interpolation as the direct plan, so the only difference from `direct` is the
+//! response to the projection residual ε, added to the errors as 2ε|T| for the pair columns and
+//! ε P(k) Σ|w|P̂ for the others. The quadrature error is the plan's (fine minus half-resolution, the
+//! bilinear part of the half-resolution rule on the first [`super::ERROR_FUNCTIONS`] functions). With
+//! IR resummation the no-wiggle spectrum is projected too; its terms carry the errors of the full
+//! ones (as in the direct plan) plus its own projection error.
+
+use super::forms::{dot32, linear_form, pair_forms, pair_products, Rows};
+use super::one_loop::rows_on;
+use super::{error_functions, LinearBasis, Projection, BASIS_SIZE};
+use crate::loops::redshift::{RedshiftPlan, RedshiftTerms, Row, NPAIR};
+use crate::loops::Estimate;
+use crate::precision::Precision;
+use rayon::prelude::*;
+
+/// Version of the tensor layout and rules, part of the cache file name.
+const VERSION: u32 = 1;
+
+/// Lattice-weight terms per k.
+const LW: usize = 6;
+
+/// Linear forms per k: the six lattice-weight terms of the fine rule, of the half-resolution rule,
+/// and with absolute weights (the projection error's scale).
+const LINEAR: usize = 3 * LW;
+
+/// Which spectra a [`RedshiftBasis`] is for: linear spectra (the shipped CAMB training set), or
+/// their no-wiggle parts (the same set through the galaxy model's no-wiggle filter: those are not in
+/// the span of the linear basis, their smoothed tails differ by ~1e-2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpectrumFamily {
+    /// Linear spectra.
+    Linear,
+    /// No-wiggle parts of linear spectra.
+    NoWiggle,
+}
+
+impl SpectrumFamily {
+    fn tag(self) -> &'static str {
+        match self {
+            Self::Linear => "lin",
+            Self::NoWiggle => "nw",
+        }
+    }
+}
+
+/// The redshift-space basis tensors on one k grid for one [`Precision`] (cosmology independent).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RedshiftBasis {
+    k: Vec<f64>,
+    key: Vec<f64>,
+    basis: LinearBasis,
+    /// Per k: the pair columns of the fine rule on the pairs of all n functions.
+    pairs: Vec<f32>,
+    /// Per k: fine − half-resolution pair columns on the pairs of the first n_err functions.
+    pairs_diff: Vec<f32>,
+    /// Per k: [`LINEAR`] forms of length n.
+    linear: Vec<f64>,
+    /// σ_v²: the fine form and fine − coarse.
+    sigma_v2: Vec<f64>,
+    p22_error_floor: f64,
+}
+
+/// The settings that make the tensors (their cache key).
+fn key(k: &[f64], precision: &Precision, family: SpectrumFamily) -> Vec<f64> {
+    let p = precision;
+    let mut key = vec![
+        f64::from(VERSION),
+        f64::from(u8::from(family == SpectrumFamily::NoWiggle)),
+        BASIS_SIZE as f64,
+        NPAIR as f64,
+        p.q_min,
+        p.q_max,
+        p.lattice_step,
+        p.p13_cell_order as f64,
+        p.p22_order as f64,
+        p.p22_narrow_order as f64,
+        p.p22_narrow_width,
+        p.p22_ln_width,
+        p.p22_tail_growth,
+        p.p22_linear_width,
+        p.p22_band_end,
+        p.p22_error_floor,
+        f64::from(super::training::VERSION),
+        k.len() as f64,
+    ];
+    key.extend(k);
+    key
+}
+
+impl RedshiftBasis {
+    /// The cache file name of the tensors for `k`, `precision` and `family`.
+    pub fn file_name(k: &[f64], precision: &Precision, family: SpectrumFamily) -> String {
+        let hash = key(k, precision, family)
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+                (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+            });
+        let tag = family.tag();
+        format!("redshift-basis-{tag}-v{VERSION}-n{BASIS_SIZE}-{hash:016x}.bin")
+    }
+
+    /// Builds the tensors of `plan` on `basis` (of the spectra `family`, on the plan's lattice) in
+    /// parallel over k; `progress(done, total)` counts the k values.
+    pub fn build(
+        plan: &RedshiftPlan,
+        family: SpectrumFamily,
+        basis: LinearBasis,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Self {
+        let (k, precision) = (plan.k(), plan.precision());
+        let (fine, coarse) = plan.rules();
+        let n = basis.len();
+        let n_err = error_functions(n);
+        let (rows_fine, rows_coarse) = (rows_on(&basis, 1), rows_on(&basis, 2));
+        let fine_rows = Rows {
+            rows: &rows_fine,
+            stride: n,
+            lattice: &fine.lattice,
+        };
+        let coarse_rows = Rows {
+            rows: &rows_coarse,
+            stride: n,
+            lattice: &coarse.lattice,
+        };
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let per_k: Vec<(Vec<f32>, Vec<f32>, Vec<f64>)> = (0..k.len())
+            .into_par_iter()
+            .map(|i| {
+                let f = pair_forms(&fine.pairs, i, &fine_rows, n, 0..NPAIR, 0..0, 0..0).pairs;
+                let c = pair_forms(&coarse.pairs, i, &coarse_rows, n_err, 0..NPAIR, 0..0, 0..0);
+                let mut pairs = Vec::new();
+                let mut diff = Vec::new();
+                for (f, c) in f.iter().zip(&c.pairs) {
+                    pairs.extend(f.iter().map(|&v| v as f32));
+                    diff.extend(f.iter().zip(c).map(|(f, c)| (f - c) as f32));
+                }
+                let mut linear = Vec::with_capacity(LINEAR * n);
+                for w in &fine.lattice_weights[i] {
+                    linear.extend(linear_form(w, &fine_rows));
+                }
+                for w in &coarse.lattice_weights[i] {
+                    linear.extend(linear_form(w, &coarse_rows));
+                }
+                for w in &fine.lattice_weights[i] {
+                    let abs: Vec<f64> = w.iter().map(|v| v.abs()).collect();
+                    linear.extend(linear_form(&abs, &fine_rows));
+                }
+                let d = std::sync::atomic::Ordering::Relaxed;
+                progress(done.fetch_add(1, d) + 1, k.len());
+                (pairs, diff, linear)
+            })
+            .collect();
+        let sv_fine = linear_form(&fine.sigma_v2, &fine_rows);
+        let sv_coarse = linear_form(&coarse.sigma_v2, &coarse_rows);
+        let mut sigma_v2 = sv_fine.clone();
+        sigma_v2.extend(sv_fine.iter().zip(&sv_coarse).map(|(f, c)| f - c));
+        let (mut pairs, mut pairs_diff, mut linear) = (Vec::new(), Vec::new(), Vec::new());
+        for (a, b, c) in per_k {
+            pairs.extend(a);
+            pairs_diff.extend(b);
+            linear.extend(c);
+        }
+        Self {
+            k: k.to_vec(),
+            key: key(k, precision, family),
+            basis,
+            pairs,
+            pairs_diff,
+            linear,
+            sigma_v2,
+            p22_error_floor: precision.p22_error_floor,
+        }
+    }
+
+    /// The basis.
+    pub fn basis(&self) -> &LinearBasis {
+        &self.basis
+    }
+
+    /// The rows (pair columns and lattice-weight terms with errors) and σ_v² of the spectrum with
+    /// P_lin = `p_lin` at the grid's k and projection `projection`.
+    fn rows(&self, p_lin: &[f64], projection: &Projection) -> (Vec<Row>, Estimate) {
+        let c = &projection.coefficients;
+        let n = c.len();
+        let (pairs, n_err) = (n * (n + 1) / 2, error_functions(n));
+        let pairs_err = n_err * (n_err + 1) / 2;
+        let s2 = pair_products(c);
+        let eps = projection.residual;
+        let floor = self.p22_error_floor;
+        let rows = p_lin
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| {
+                let t = &self.pairs[i * NPAIR * pairs..][..NPAIR * pairs];
+                let d = &self.pairs_diff[i * NPAIR * pairs_err..][..NPAIR * pairs_err];
+                let l = &self.linear[i * LINEAR * n..][..LINEAR * n];
+                let pair = std::array::from_fn(|m| {
+                    let a = dot32(&t[m * pairs..(m + 1) * pairs], &s2);
+                    let diff = dot32(&d[m * pairs_err..(m + 1) * pairs_err], &s2[..pairs_err]);
+                    let quadrature = diff.abs().max(floor * a.abs());
+                    Estimate::new(a, quadrature + 2.0 * eps * a.abs())
+                });
+                let form = |m: usize| super::dot(&l[m * n..(m + 1) * n], c);
+                let lw = std::array::from_fn(|m| {
+                    let (s, sc, abs) = (form(m), form(LW + m), form(2 * LW + m));
+                    Estimate::new(p * s, (p * (s - sc)).abs() + eps * (p * abs).abs())
+                });
+                (pair, lw)
+            })
+            .collect();
+        let sv = super::dot(&self.sigma_v2[..n], c);
+        let sv_diff = super::dot(&self.sigma_v2[n..], c);
+        (rows, Estimate::new(sv, sv_diff.abs() + eps * sv.abs()))
+    }
+
+    /// The terms of `plan` (whose tensors these are) for the spectrum with P_lin = `p_lin` at the
+    /// grid's k and projection `projection`.
+    pub fn evaluate(
+        &self,
+        plan: &RedshiftPlan,
+        p_lin: &[f64],
+        projection: &Projection,
+    ) -> RedshiftTerms {
+        let (rows, sigma_v2) = self.rows(p_lin, projection);
+        plan.assemble_rows(p_lin.to_vec(), &rows, sigma_v2)
+    }
+
+    /// The terms of a spectrum and of its no-wiggle part (as
+    /// [`RedshiftPlan::evaluate_with_no_wiggle`]), the latter on the tensors `no_wiggle` (of the
+    /// no-wiggle family): the no-wiggle terms carry the full terms' errors plus their own projection
+    /// error.
+    pub fn evaluate_with_no_wiggle(
+        &self,
+        plan: &RedshiftPlan,
+        (p_lin, projection): (&[f64], &Projection),
+        no_wiggle: &RedshiftBasis,
+        (p_nw, projection_nw): (&[f64], &Projection),
+    ) -> (RedshiftTerms, RedshiftTerms) {
+        let (rows, sigma_v2) = self.rows(p_lin, projection);
+        let (mut rows_nw, mut sigma_v2_nw) = no_wiggle.rows(p_nw, projection_nw);
+        let eps = projection_nw.residual;
+        let keep = |nw: &mut Estimate, full: &Estimate, scale: f64| {
+            nw.error = full.error + scale * eps * nw.value.abs();
+        };
+        for (nw, full) in rows_nw.iter_mut().zip(&rows) {
+            nw.0.iter_mut()
+                .zip(&full.0)
+                .for_each(|(a, b)| keep(a, b, 2.0));
+            nw.1.iter_mut()
+                .zip(&full.1)
+                .for_each(|(a, b)| keep(a, b, 1.0));
+        }
+        keep(&mut sigma_v2_nw, &sigma_v2, 1.0);
+        (
+            plan.assemble_rows(p_lin.to_vec(), &rows, sigma_v2),
+            plan.assemble_rows(p_nw.to_vec(), &rows_nw, sigma_v2_nw),
+        )
+    }
+
+    /// The tensors as the values of their cache file.
+    pub(crate) fn to_f64s(&self) -> Vec<f64> {
+        let mut v = vec![self.key.len() as f64];
+        v.extend(&self.key);
+        v.extend(self.basis.to_f64s());
+        v.extend(self.pairs.iter().map(|&t| f64::from(t)));
+        v.extend(self.pairs_diff.iter().map(|&t| f64::from(t)));
+        v.extend(&self.linear);
+        v.extend(&self.sigma_v2);
+        v
+    }
+
+    /// The tensors for `k` and `precision` from the values of their file, or `None` if the file was
+    /// made for other settings or does not fit them.
+    pub(crate) fn from_f64s(
+        values: &[f64],
+        k: &[f64],
+        precision: &Precision,
+        family: SpectrumFamily,
+    ) -> Option<Self> {
+        let expected = key(k, precision, family);
+        let len = *values.first()? as usize;
+        if len != expected.len() || values.get(1..1 + len)? != expected.as_slice() {
+            return None;
+        }
+        if values.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let lattice = super::lattice_of(precision);
+        let (basis, rest) = LinearBasis::from_f64s(lattice, &values[1 + len..])?;
+        let n = basis.len();
+        let n_err = error_functions(n);
+        let nk = k.len();
+        let sizes = [
+            nk * NPAIR * n * (n + 1) / 2,
+            nk * NPAIR * n_err * (n_err + 1) / 2,
+            nk * LINEAR * n,
+            2 * n,
+        ];
+        if rest.len() != sizes.iter().sum::<usize>() {
+            return None;
+        }
+        let (pairs, rest) = rest.split_at(sizes[0]);
+        let (pairs_diff, rest) = rest.split_at(sizes[1]);
+        let (linear, sigma_v2) = rest.split_at(sizes[2]);
+        let single = |v: &[f64]| v.iter().map(|&t| t as f32).collect();
+        Some(Self {
+            k: k.to_vec(),
+            key: expected,
+            basis,
+            pairs: single(pairs),
+            pairs_diff: single(pairs_diff),
+            linear: linear.to_vec(),
+            sigma_v2: sigma_v2.to_vec(),
+            p22_error_floor: precision.p22_error_floor,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linear::LinearSpectrum;
+
+    #[test]
+    fn terms_agree_with_direct_for_spectra_not_trained_on_and_survive_their_file() {
+        let k: Vec<f64> = (0..8).map(|i| 0.01 * 1.5_f64.powi(i)).collect();
+        let plan = RedshiftPlan::new(&k, &Precision::fast()).unwrap();
+        let lattice = plan.rules().0.lattice.clone();
+        let linear = super::super::training::camb_basis(lattice, BASIS_SIZE);
+        let tensors = RedshiftBasis::build(&plan, SpectrumFamily::Linear, linear, &|_, _| {});
+        let basis = tensors.basis();
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/");
+        for i in 0..3 {
+            let p =
+                LinearSpectrum::from_file(format!("{dir}linear_pk_camb_heldout_{i}.dat")).unwrap();
+            let direct = plan.evaluate(&p);
+            let projection = basis.project(&basis.sample(&p));
+            let on_basis = tensors.evaluate(&plan, &direct.p_lin, &projection);
+            assert_eq!(on_basis.terms.len(), direct.terms.len());
+            for (a, d) in on_basis.terms.iter().zip(&direct.terms) {
+                assert_eq!((a.monomial, a.n), (d.monomial, d.n));
+                for (j, (a, d)) in a.values.iter().zip(&d.values).enumerate() {
+                    let diff = (a.value - d.value).abs();
+                    // Within 3e-4 of P_lin and within the errors.
+                    assert!(diff < 3e-4 * direct.p_lin[j], "{i} {j}: {a:?} {d:?}");
+                    assert!(diff <= a.error + d.error, "{i} {j}: {a:?} {d:?}");
+                }
+            }
+        }
+        let v = tensors.to_f64s();
+        assert_eq!(
+            RedshiftBasis::from_f64s(&v, &k, plan.precision(), SpectrumFamily::Linear).unwrap(),
+            tensors
+        );
+        let nw = SpectrumFamily::NoWiggle;
+        assert!(RedshiftBasis::from_f64s(&v, &k, plan.precision(), nw).is_none());
+        assert!(
+            RedshiftBasis::from_f64s(&v, &k[1..], plan.precision(), SpectrumFamily::Linear)
+                .is_none()
+        );
+    }
+}
