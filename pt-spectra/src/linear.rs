@@ -117,6 +117,11 @@ impl LogGrid {
         Ok(Self { k_min, k_max, n })
     }
 
+    /// The points as a validated [`crate::table::KGrid`] (valid by construction).
+    pub fn k_grid(&self) -> crate::table::KGrid {
+        crate::table::KGrid::valid(self.points())
+    }
+
     /// The wavenumbers k_i = k_min (k_max/k_min)^(i/(n−1)) [h/Mpc].
     pub fn points(&self) -> Vec<f64> {
         let (a, b) = (self.k_min.ln(), self.k_max.ln());

@@ -393,9 +393,70 @@ pub fn check_k_grid(origin: &str, k: &[f64], lines: &[usize]) -> Result<()> {
     Ok(())
 }
 
+/// A validated grid of wavenumbers [h/Mpc]: not empty, finite, positive and strictly increasing (the
+/// checks of [`check_k_grid`]). What both faces turn a user's k (a file, arrays, `--k-min/--k-max/--nk`)
+/// into before any plan is made; it derefs to `[f64]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KGrid(Vec<f64>);
+
+impl KGrid {
+    /// The grid `k` read from `origin` (`lines[i]`: the line of value i, for the errors).
+    ///
+    /// # Errors
+    /// [`Error::TooFewPoints`] for no values; as [`check_k_grid`].
+    pub fn new(origin: &str, k: Vec<f64>, lines: &[usize]) -> Result<Self> {
+        if k.is_empty() {
+            return Err(Error::TooFewPoints {
+                origin: origin.into(),
+                found: 0,
+                min: 1,
+            });
+        }
+        check_k_grid(origin, &k, lines)?;
+        Ok(Self(k))
+    }
+
+    /// A grid made valid by construction (e.g. [`crate::linear::LogGrid::k_grid`]).
+    pub(crate) fn valid(k: Vec<f64>) -> Self {
+        debug_assert!(check_k_grid("a constructed grid", &k, &[]).is_ok() && !k.is_empty());
+        Self(k)
+    }
+
+    /// The wavenumbers [h/Mpc].
+    pub fn as_slice(&self) -> &[f64] {
+        &self.0
+    }
+
+    /// The wavenumbers as a vector.
+    pub fn into_vec(self) -> Vec<f64> {
+        self.0
+    }
+}
+
+impl std::ops::Deref for KGrid {
+    type Target = [f64];
+
+    fn deref(&self) -> &[f64] {
+        &self.0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn k_grids_are_checked_once_and_name_the_bad_value() {
+        let g = KGrid::new("k.dat", vec![0.01, 0.02, 0.04], &[3, 4, 5]).unwrap();
+        assert_eq!(g.len(), 3);
+        assert_eq!(g.as_slice(), &[0.01, 0.02, 0.04]);
+        let e = KGrid::new("k.dat", vec![0.01, 0.01], &[3, 4]).unwrap_err();
+        assert!(e.to_string().starts_with("k.dat:4:"), "{e}");
+        let e = KGrid::new("k.dat", vec![0.01, f64::NAN], &[]).unwrap_err();
+        assert!(e.to_string().contains("k.dat:2"), "{e}");
+        assert!(KGrid::new("k.dat", vec![], &[]).is_err());
+        assert!(KGrid::new("k.dat", vec![-0.1], &[]).is_err());
+    }
 
     #[test]
     fn columns_are_selected_and_bad_rows_named() {

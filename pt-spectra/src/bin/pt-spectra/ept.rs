@@ -7,6 +7,7 @@ use pt_spectra::jobs::{ept_plan, ept_table, EptRequest};
 use pt_spectra::output::Table;
 use pt_spectra::rsd::ap::Distortion;
 use pt_spectra::rsd::ept::EptParams;
+use pt_spectra::table::KGrid;
 use std::str::FromStr;
 
 /// `--rsd`: one of the paper's models or the galaxy model `ept`.
@@ -199,7 +200,7 @@ pub struct Shared {
 pub fn table(
     shared: Shared,
     args: &EptArgs,
-    k: Vec<f64>,
+    k: KGrid,
     loaded: &crate::input::Loaded,
 ) -> Result<Table> {
     let b1 = match shared.bias {

@@ -7,7 +7,7 @@ use pt_spectra::linear::{Columns, LinearSpectrum, LogGrid};
 use pt_spectra::precision::{Precision, TwoLoopMethod};
 use pt_spectra::setup::{self, LinearSource, NamedCosmology, Prepared, Request};
 use pt_spectra::store::TableStore;
-use pt_spectra::table::Table;
+use pt_spectra::table::{KGrid, Table};
 use std::path::{Path, PathBuf};
 
 /// `K,P` (1-based column numbers) as 0-based [`Columns`].
@@ -261,12 +261,12 @@ impl Input {
 
     /// The output k grid [h/Mpc] and the loaded input (with a warning when the grid reaches the
     /// extrapolated ends of the linear table).
-    pub fn load(&self) -> Result<(Vec<f64>, Loaded)> {
+    pub fn load(&self) -> Result<(KGrid, Loaded)> {
         let k = match &self.k_file {
             Some(path) => read_k_file(path)?,
             None => LogGrid::new(self.k_min, self.k_max, self.nk)
                 .context("invalid --k-min/--k-max/--nk")?
-                .points(),
+                .k_grid(),
         };
         let loaded = self.spectrum.load()?;
         for w in setup::input_warnings(&loaded.prepared, &[], &k) {
@@ -279,13 +279,12 @@ impl Input {
 /// k values from the first column of a file: finite, positive, strictly increasing. The file is read as
 /// any table (`#` comments, one optional row of column names, comma or blank separated, any line ends);
 /// every error names the file and the line.
-pub fn read_k_file(path: &PathBuf) -> Result<Vec<f64>> {
+pub fn read_k_file(path: &PathBuf) -> Result<KGrid> {
     let table = Table::read(path, &[0]).context("--k-file")?;
     let Some(k) = table.columns.into_iter().next().filter(|k| !k.is_empty()) else {
         bail!("--k-file `{}` contains no k values", path.display());
     };
-    pt_spectra::table::check_k_grid(&table.origin, &k, &table.lines).context("--k-file")?;
-    Ok(k)
+    KGrid::new(&table.origin, k, &table.lines).context("--k-file")
 }
 
 #[cfg(test)]
@@ -302,7 +301,7 @@ mod tests {
     #[test]
     fn k_files_are_validated_with_line_numbers() {
         let ok = write("ok", "# k\n0.01 1\n\n0.1, 2 # comment\n");
-        assert_eq!(read_k_file(&ok).unwrap(), vec![0.01, 0.1]);
+        assert_eq!(read_k_file(&ok).unwrap().into_vec(), vec![0.01, 0.1]);
         for (name, text, needle) in [
             ("dec", "0.1\n0.05\n", ":2: k = 0.05"),
             ("nan", "0.1\nNaN\n", ":2: k = NaN"),
@@ -323,9 +322,12 @@ mod tests {
     #[test]
     fn k_files_of_any_origin_are_read_or_refused_at_a_line() {
         let windows = write("crlf", "\u{feff}# k\r\n0.01\r\n0.02, x\r\n");
-        assert_eq!(read_k_file(&windows).unwrap(), vec![0.01, 0.02]);
+        assert_eq!(read_k_file(&windows).unwrap().into_vec(), vec![0.01, 0.02]);
         let mac = write("cr", "k\r0.01\r0.02\r0.03");
-        assert_eq!(read_k_file(&mac).unwrap(), vec![0.01, 0.02, 0.03]);
+        assert_eq!(
+            read_k_file(&mac).unwrap().into_vec(),
+            vec![0.01, 0.02, 0.03]
+        );
         let cases: [(&str, &[u8], &str); 9] = [
             (
                 "dup",

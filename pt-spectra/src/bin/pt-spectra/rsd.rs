@@ -254,7 +254,7 @@ pub fn run(args: &Args) -> Result<()> {
             request.ells = o.model_ells().to_vec();
             o.k_model().to_vec()
         }
-        None => k,
+        None => k.into_vec(),
     };
     let grid = match distortion {
         Some(distortion) => {
