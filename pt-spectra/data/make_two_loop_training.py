@@ -1,7 +1,7 @@
 """Makes the training spectra of the 2-loop basis (pt-spectra/data/two_loop_training_camb.f32) and
-held-out CAMB test spectra (tests/data/linear_pk_camb_heldout_*.dat).
+held-out CAMB test spectra (pt-spectra/tests/data/linear_pk_camb_heldout_*.dat).
 
-CAMB linear total-matter P(k) at z = 0 with the settings of tests/data/make_planck2018.py (massless
+CAMB linear total-matter P(k) at z = 0 with the settings of pt-spectra/tests/data/make_planck2018.py (massless
 neutrinos, N_eff = 3.046, kmax = 60/Mpc, 1200 log-spaced k in [1e-4, 50] h/Mpc), for cosmologies drawn
 uniformly (numpy default_rng, fixed seeds) from the EuclidEmulator2 box: Omega_m 0.24-0.40, Omega_b
 0.04-0.06, n_s 0.92-1.00, h 0.61-0.73, w0 -1.3 to -0.7 (PPF dark energy); A_s = 2.1e-9 (it only
@@ -13,7 +13,7 @@ File layout (little-endian float32): the 1200 k [h/Mpc], then 1200 P [(Mpc/h)^3]
     python pt-spectra/data/make_two_loop_training.py train 0 50 a.npz &   # two halves in parallel,
     python pt-spectra/data/make_two_loop_training.py train 50 100 b.npz    # ~4 s per spectrum each
     python pt-spectra/data/make_two_loop_training.py write a.npz b.npz     # -> pt-spectra/data/
-    python pt-spectra/data/make_two_loop_training.py heldout               # -> tests/data/ (3 tables)
+    python pt-spectra/data/make_two_loop_training.py heldout               # -> pt-spectra/tests/data/ (3 tables)
 """
 import os
 import sys
@@ -65,7 +65,7 @@ def main():
         # Three cosmologies of the box that are not training points, one at z = 0.5 with another A_s.
         for i, (p, a_s, z) in enumerate(zip(draws(7, 3), [2.1e-9, 1.8e-9, 2.4e-9], [0.0, 0.5, 0.0])):
             k, pk = spectrum(*p, a_s=a_s, z=z)
-            name = os.path.join(HERE, "..", "..", "tests", "data", f"linear_pk_camb_heldout_{i}.dat")
+            name = os.path.join(HERE, "..", "tests", "data", f"linear_pk_camb_heldout_{i}.dat")
             with open(name, "w") as f:
                 f.write(f"# CAMB {camb.__version__} linear total-matter P(k) (pt-spectra/data/make_two_loop_training.py "
                         f"heldout): Omega_m={p[0]:.6f} Omega_b={p[1]:.6f} n_s={p[2]:.6f} h={p[3]:.6f} "

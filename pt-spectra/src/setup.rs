@@ -283,7 +283,7 @@ mod tests {
 
     fn planck(z: f64) -> LinearSpectrum {
         let path = format!(
-            "{}/../tests/data/linear_pk_planck2018_z{z:.1}.dat",
+            "{}/tests/data/linear_pk_planck2018_z{z:.1}.dat",
             env!("CARGO_MANIFEST_DIR")
         );
         LinearSpectrum::from_file(path).unwrap()

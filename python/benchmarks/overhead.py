@@ -33,7 +33,7 @@ def measure(call, repeats):
 
 
 def main():
-    d = np.loadtxt(ROOT / "tests" / "data" / "linear_pk_planck2018_z0.0.dat")
+    d = np.loadtxt(ROOT / "pt-spectra" / "tests" / "data" / "linear_pk_planck2018_z0.0.dat")
     linear = (d[:, 0], d[:, 1])
     real = pt.RealPlan(np.geomspace(0.001, 1.0, 100), model="1l-spt")
     rsd = pt.RsdPlan(np.geomspace(0.01, 0.3, 50), real="1l-spt", rsd="tns")

@@ -8,7 +8,7 @@ import pytest
 
 import pt_spectra as pt
 
-DATA = Path(__file__).resolve().parents[2] / "tests" / "data"
+DATA = Path(__file__).resolve().parents[2] / "pt-spectra" / "tests" / "data"
 
 
 @pytest.fixture(scope="module")

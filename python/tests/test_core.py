@@ -20,6 +20,7 @@ import pt_spectra as pt
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "data"
+SPECTRA = ROOT / "pt-spectra" / "tests" / "data"  # the linear spectra the library's tests share
 CLI = Path(os.environ.get("PT_SPECTRA_BIN", ROOT / "target" / "release" / "pt-spectra"))
 
 
@@ -32,7 +33,7 @@ def cli(*args):
 
 
 def planck(z):
-    d = np.loadtxt(DATA / f"linear_pk_planck2018_z{z:.1f}.dat")
+    d = np.loadtxt(SPECTRA / f"linear_pk_planck2018_z{z:.1f}.dat")
     return d[:, 0], d[:, 1]
 
 
@@ -52,7 +53,7 @@ def test_python_tables_equal_the_command_line_text():
     assert m.columns == names
     for j, name in enumerate(names):
         np.testing.assert_allclose(m[name], rows[:, j], rtol=1e-9)
-    path = str(DATA / "linear_pk_planck2018_z0.0.dat")
+    path = str(SPECTRA / "linear_pk_planck2018_z0.0.dat")
     t = pt.real(model="1l-spt", linear=path, cosmology="planck2018", z=1.0, precision="fast",
                 k_min=0.01, k_max=0.3, nk=5)
     assert t.to_text() == cli("real", "--linear", path, "--cosmology", "planck2018", "--z", "1",
@@ -255,7 +256,7 @@ def test_signal_to_noise_halo_tables_and_theory_sigma0(tmp_path):
 
 
 def test_growth_matches_camb_for_planck2018():
-    # CAMB 2.0.5 headers of tests/data/linear_pk_planck2018_z*.dat: sigma8(z) and f(z).
+    # CAMB 2.0.5 headers of pt-spectra/tests/data/linear_pk_planck2018_z*.dat: sigma8(z) and f(z).
     d, f = pt.growth(1.0, "planck2018")
     assert abs(f / 0.873875 - 1) < 2e-3
     assert abs(d / (0.500091 / 0.821734) - 1) < 2e-3

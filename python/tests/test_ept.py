@@ -9,7 +9,7 @@ import pytest
 
 import pt_spectra as pt
 
-DATA = pathlib.Path(__file__).resolve().parents[2] / "tests" / "data"
+DATA = pathlib.Path(__file__).resolve().parents[2] / "pt-spectra" / "tests" / "data"
 SET_A = dict(b1=1.8, b2=0.5, bs=-0.3, b3=0.1, alpha0=10, alpha2=-5, alpha4=3, alpha6=1, sn=1000,
              sn2=500, sn4=100)
 

@@ -76,7 +76,7 @@ fn plan(c: &mut Criterion) {
 fn basis(c: &mut Criterion) {
     let table = LinearSpectrum::from_file(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/data/linear_pk_camb_heldout_1.dat"
+        "/../pt-spectra/tests/data/linear_pk_camb_heldout_1.dat"
     ))
     .expect("test table");
     let (k_in, p_in) = table.nodes();

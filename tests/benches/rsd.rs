@@ -66,7 +66,7 @@ fn tns(c: &mut Criterion) {
     });
     let table = LinearSpectrum::from_file(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/data/linear_pk_camb_heldout_1.dat"
+        "/../pt-spectra/tests/data/linear_pk_camb_heldout_1.dat"
     ))
     .expect("test table");
     let (k_in, p_in) = table.nodes();
@@ -210,7 +210,7 @@ fn ept(c: &mut Criterion) {
     // A new CAMB table's arrays through the basis tensors (method basis, built once here).
     let table = LinearSpectrum::from_file(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/data/linear_pk_camb_heldout_1.dat"
+        "/../pt-spectra/tests/data/linear_pk_camb_heldout_1.dat"
     ))
     .expect("test table");
     let (k_in, p_in) = (table.nodes().0.to_vec(), table.nodes().1.to_vec());

@@ -124,7 +124,10 @@ fn basis(c: &mut Criterion) {
         .expect("tensors");
     let plan = OneLoopPlan::new(&k, &precision).expect("valid");
     let data = |name: &str| {
-        let path = format!("{}/data/{name}", env!("CARGO_MANIFEST_DIR"));
+        let path = format!(
+            "{}/../pt-spectra/tests/data/{name}",
+            env!("CARGO_MANIFEST_DIR")
+        );
         LinearSpectrum::from_file(&path).expect("test table")
     };
     let planck = data("linear_pk_planck2018_z0.0.dat");

@@ -27,7 +27,7 @@ P_WINDOW, C_WINDOW = np.array([0.2, 0.2]), 0.75
 INPUTS = [
     ("gm2012_z0.0", "../../pt-spectra/data/linear_pk_gm2012_z0.0.dat", "pt-spectra/data/linear_pk_gm2012_z0.0.dat"),
     ("gm2012_z1.0", "../../pt-spectra/data/linear_pk_gm2012_z1.0.dat", "pt-spectra/data/linear_pk_gm2012_z1.0.dat"),
-    ("planck2018_z0.0", "linear_pk_planck2018_z0.0.dat", "tests/data/linear_pk_planck2018_z0.0.dat"),
+    ("planck2018_z0.0", "../../pt-spectra/tests/data/linear_pk_planck2018_z0.0.dat", "pt-spectra/tests/data/linear_pk_planck2018_z0.0.dat"),
 ]
 CHECK_K = [0.01, 0.05, 0.1, 0.2, 0.3]
 NAMES = ["Pd1d2", "Pd2d2", "Pd1s2", "Pd2s2", "Ps2s2", "sig3nl"]

@@ -70,7 +70,7 @@ fn compare(spectrum: &LinearSpectrum, file: &str) -> f64 {
 #[test]
 fn bias_terms_agree_with_fastpt() {
     let planck = LinearSpectrum::from_file(format!(
-        "{}/data/linear_pk_planck2018_z0.0.dat",
+        "{}/../pt-spectra/tests/data/linear_pk_planck2018_z0.0.dat",
         env!("CARGO_MANIFEST_DIR")
     ))
     .unwrap();

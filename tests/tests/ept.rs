@@ -29,7 +29,7 @@ fn worst(z: &str, f: f64, variant: usize, set: usize) -> [f64; 3] {
 fn worst_at(z: &str, f: f64, variant: usize, set: usize, precision: &Precision) -> [f64; 3] {
     let reference = rows(&data(&format!("velocileptors_rept_planck2018_z{z}.dat")));
     let spectrum = LinearSpectrum::from_file(format!(
-        "{}/data/linear_pk_planck2018_z{z}.dat",
+        "{}/../pt-spectra/tests/data/linear_pk_planck2018_z{z}.dat",
         env!("CARGO_MANIFEST_DIR")
     ))
     .unwrap();

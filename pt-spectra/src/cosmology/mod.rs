@@ -254,7 +254,7 @@ impl Cosmology {
         }
     }
 
-    /// Planck 2018 best fit as in the CAMB reference tables of the tests (`tests/data/make_planck2018.py`):
+    /// Planck 2018 best fit as in the CAMB reference tables of the tests (`pt-spectra/tests/data/make_planck2018.py`):
     /// h = 0.6766, Ω_b h² = 0.02242, Ω_c h² = 0.11933, n_s = 0.9665, A_s = 2.105209e-9 at k_pivot = 0.05/Mpc,
     /// flat, Λ. Ω_m = (Ω_b h² + Ω_c h²)/h² = 0.309641: neutrinos are massless (their radiation is
     /// neglected in the growth, as is the photons').

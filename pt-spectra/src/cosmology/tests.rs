@@ -68,14 +68,14 @@ const PLANCK2018_TABLES: [(f64, &str); 2] = [
         0.0,
         concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/../tests/data/linear_pk_planck2018_z0.0.dat"
+            "/tests/data/linear_pk_planck2018_z0.0.dat"
         ),
     ),
     (
         1.0,
         concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/../tests/data/linear_pk_planck2018_z1.0.dat"
+            "/tests/data/linear_pk_planck2018_z1.0.dat"
         ),
     ),
 ];

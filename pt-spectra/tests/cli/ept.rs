@@ -3,7 +3,7 @@
 
 use super::{column_names, column_names_of, fails_naming, rows, run};
 
-const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/");
+const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
 
 /// Set A of tests/data/velocileptors_rept_planck2018_z1.0.dat without IR (columns 2–4) at every
 /// fifth k: within 2e-4 of P0 (the library test's bound).

@@ -365,9 +365,9 @@ fn bad_input_exits_non_zero_naming_the_problem() {
     ]);
 }
 
-/// A reference table of the workspace's `tests/data`.
+/// A reference table of this crate's `tests/data`.
 fn data(name: &str) -> String {
-    format!("{}/../tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
+    format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
 }
 
 /// The value after `key = ` in a header line.

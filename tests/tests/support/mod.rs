@@ -14,9 +14,18 @@ pub fn store() -> &'static TableStore {
     STORE.get_or_init(TableStore::from_env)
 }
 
-/// The text of `tests/data/<name>`.
+/// The text of the reference table `name`: in this crate's `data/`, or, for the linear spectra and
+/// velocileptors tables that pt-spectra's own tests read too, in `pt-spectra/tests/data/`.
 pub fn data(name: &str) -> String {
-    let path = format!("{}/data/{name}", env!("CARGO_MANIFEST_DIR"));
+    let own = format!("{}/data/{name}", env!("CARGO_MANIFEST_DIR"));
+    let path = if std::path::Path::new(&own).exists() {
+        own
+    } else {
+        format!(
+            "{}/../pt-spectra/tests/data/{name}",
+            env!("CARGO_MANIFEST_DIR")
+        )
+    };
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
 }
 

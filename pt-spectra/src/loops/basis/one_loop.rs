@@ -363,7 +363,7 @@ mod tests {
     use crate::loops::Pair;
 
     fn held_out(i: usize) -> LinearSpectrum {
-        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/");
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
         LinearSpectrum::from_file(format!("{dir}linear_pk_camb_heldout_{i}.dat")).unwrap()
     }
 
@@ -420,7 +420,7 @@ mod tests {
     #[test]
     fn spectra_outside_the_training_set_agree_with_direct_within_their_errors() {
         let (plan, basis) = setup();
-        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/");
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
         let class = format!("{dir}linear_pk_class_planck2018_z0.0_pk_lin.dat");
         // A curved (Ω_k = 0.01) w0–wa CAMB spectrum turns up below 3e-4 h/Mpc (horizon-scale
         // curvature), which the basis does not span: refused whole (computed directly), it projects
@@ -490,7 +490,7 @@ mod plan_tests {
         let direct = RealPlan::new(&k, RealModel::OneLoopSpt, &precision, &store, &Silent).unwrap();
         precision.two_loop = TwoLoopMethod::Basis;
         let plan = RealPlan::new(&k, RealModel::OneLoopSpt, &precision, &store, &Silent).unwrap();
-        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/");
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
         let camb = LinearSpectrum::from_file(format!("{dir}linear_pk_camb_heldout_2.dat")).unwrap();
         // Eisenstein & Hu: outside the basis (residual ~4e-3), computed directly.
         let eh = crate::cosmology::Cosmology::gm2012()

@@ -336,7 +336,7 @@ mod tests {
         let linear = super::super::training::camb_basis(lattice, BASIS_SIZE);
         let tensors = RedshiftBasis::build(&plan, SpectrumFamily::Linear, linear, &|_, _| {});
         let basis = tensors.basis();
-        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/");
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
         for i in 0..3 {
             let p =
                 LinearSpectrum::from_file(format!("{dir}linear_pk_camb_heldout_{i}.dat")).unwrap();

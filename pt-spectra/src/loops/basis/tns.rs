@@ -273,7 +273,7 @@ mod tests {
     use crate::linear::LinearSpectrum;
 
     fn held_out(i: usize) -> LinearSpectrum {
-        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/");
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
         LinearSpectrum::from_file(format!("{dir}linear_pk_camb_heldout_{i}.dat")).unwrap()
     }
 

@@ -160,7 +160,7 @@ mod tests {
 
     /// The table `name` of tests/data cut to k ∈ [lo, hi] (then extended by power laws).
     fn cut(name: &str, lo: f64, hi: f64) -> LinearSpectrum {
-        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/");
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
         let p = LinearSpectrum::from_file(format!("{dir}{name}")).unwrap();
         let (k, pk) = p.nodes();
         let keep: Vec<usize> = (0..k.len()).filter(|&i| k[i] >= lo && k[i] <= hi).collect();

@@ -122,7 +122,7 @@ fn values_are_the_multipoles_values() {
 fn the_basis_gives_the_direct_multipoles_and_falls_back_outside_its_span() {
     use crate::precision::TwoLoopMethod;
     let k: Vec<f64> = (0..10).map(|i| 0.01 * 1.4_f64.powi(i)).collect();
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/");
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
     let camb = LinearSpectrum::from_file(format!("{dir}linear_pk_camb_heldout_0.dat")).unwrap();
     let eh = crate::cosmology::Cosmology::gm2012()
         .eisenstein_hu_spectrum(

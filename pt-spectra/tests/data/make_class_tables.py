@@ -1,4 +1,4 @@
-"""CLASS linear spectra for the 2-loop basis test of CLASS input (tests/data/linear_pk_class_*.dat).
+"""CLASS linear spectra for the 2-loop basis test of CLASS input (pt-spectra/tests/data/linear_pk_class_*.dat).
 
 Planck 2018 (h 0.6766, omega_b 0.02242, omega_cdm 0.11933, n_s 0.9665, A_s 2.105e-9, massless
 neutrinos N_ur 3.046), z = 0, written in h/Mpc and (Mpc/h)^3:
@@ -13,7 +13,7 @@ import classy
 
 PLANCK = {"h": 0.6766, "omega_b": 0.02242, "omega_cdm": 0.11933, "n_s": 0.9665, "A_s": 2.105e-9,
           "N_ur": 3.046}
-OUT = "tests/data/linear_pk_class_planck2018_z0.0"
+OUT = "pt-spectra/tests/data/linear_pk_class_planck2018_z0.0"
 
 
 def pk_lin():

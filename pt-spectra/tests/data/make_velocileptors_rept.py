@@ -191,8 +191,8 @@ def main(do_checks=True):
 
         # ---- write the multipole file
         out = f"velocileptors_rept_planck2018_{tag}.dat"
-        H = [f"tool: {ver}; script tests/data/make_velocileptors_rept.py (REPT from velocileptors.EPT.ept_fullresum_fftw)",
-             f"input: tests/data/{inp} (all rows, unchanged); f = {f}"] + ["input header: " + h[1:].strip() for h in ihdr] + [
+        H = [f"tool: {ver}; script pt-spectra/tests/data/make_velocileptors_rept.py (REPT from velocileptors.EPT.ept_fullresum_fftw)",
+             f"input: pt-spectra/tests/data/{inp} (all rows, unchanged); f = {f}"] + ["input header: " + h[1:].strip() for h in ihdr] + [
              f"REPT(k, p, pnw=<p | None>, rbao=110, sbao=None, kmin={kmin:.10e}, kmax={kmax:.10e}, nk={nk}, N={NUM['N']}, extrap_min={NUM['extrap_min']}, "
              f"extrap_max={NUM['extrap_max']}, cutoff={NUM['cutoff']}, jn={NUM['jn']}, threads={NUM['threads']}, beyond_gauss=True, one_loop=True, shear=True, third_order=True, import_wisdom=False)",
              f"output k = logspace(log10 0.005, log10 0.3, 50) = REPT grid points kv[{idx[0]}::{SUB}] exactly (no interpolation by the script)",
@@ -232,8 +232,8 @@ def main(do_checks=True):
             C.append(v[idx]); N2.append(n)
         assert np.max(np.abs(r.pktable_w[:, 1:])) <= 1e-12 * np.max(np.abs(r.pktable[:, 1])) and np.all(r.plin_w == 0)
         out = f"velocileptors_rept_components_planck2018_{tag}.dat"
-        H = [f"tool: {ver}; script tests/data/make_velocileptors_rept.py",
-             f"input: tests/data/{inp}; f = {f} (the tables below do not depend on f); REPT settings as in velocileptors_rept_planck2018_{tag}.dat",
+        H = [f"tool: {ver}; script pt-spectra/tests/data/make_velocileptors_rept.py",
+             f"input: pt-spectra/tests/data/{inp}; f = {f} (the tables below do not depend on f); REPT settings as in velocileptors_rept_planck2018_{tag}.dat",
              "content: REPT's internal 1-loop term tables of variant noir (pnw = p; REPT.pktable, vktable, s0ktable, s2ktable, g1ktable, g3ktable, k0, k2, k4; "
              "wiggle parts identically 0) at the 50 output k (exact REPT grid points), plus P_lin = REPT.plin (loginterp of the input) and "
              "P_nw_ir = REPT.plin_nw, P_w_ir = P_lin - P_nw_ir of the default-IR object (variant ir).",
