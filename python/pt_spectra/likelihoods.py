@@ -30,6 +30,7 @@ import os
 import numpy as np
 
 import pt_spectra as pt
+from pt_spectra import _core
 
 try:
     from cobaya.likelihood import Likelihood
@@ -58,14 +59,8 @@ def read_multipoles(path, data_ells=(0, 2, 4)):
             values = {ell: np.asarray(d[f"P{ell}"], dtype=float) for ell in ells}
             sigma = {ell: np.asarray(d[f"s{ell}"], dtype=float) for ell in ells}
     else:
-        table = np.atleast_2d(np.loadtxt(path))
-        if table.shape[1] != 1 + 2 * len(data_ells):
-            raise ValueError(f"data_file {path!r}: {table.shape[1]} columns, expected "
-                             f"{1 + 2 * len(data_ells)} (k, then P_l, sigma_l for data_ells = "
-                             f"{list(data_ells)})")
-        k = table[:, 0]
-        values = {int(ell): table[:, 1 + 2 * j] for j, ell in enumerate(data_ells)}
-        sigma = {int(ell): table[:, 2 + 2 * j] for j, ell in enumerate(data_ells)}
+        # The library's reader (the one `fit --data` uses): every error names the file and line.
+        k, values, sigma = _core.read_multipoles(path, [int(ell) for ell in data_ells])
     for ell in values:
         if values[ell].shape != k.shape or sigma[ell].shape != k.shape:
             raise ValueError(f"data_file {path!r}: P{ell} or s{ell} has not the length of k")

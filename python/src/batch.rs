@@ -1,6 +1,6 @@
-//! `RealPlan.batch`: many linear spectra on one k table at once, over rayon's threads, returned as
-//! arrays with a leading spectrum axis (no header, no per-spectrum Table: the path of chains and
-//! emulator training sets).
+//! Arrays for chains: `RealPlan.batch` (many linear spectra on one k table at once, over rayon's
+//! threads, returned as arrays with a leading spectrum axis: no header, no per-spectrum Table) and
+//! `read_multipoles` (a likelihood's data file through the library's reader).
 
 use crate::{detached, floats, value_error, RealPlan};
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
@@ -73,4 +73,30 @@ pub(crate) fn real_batch<'py>(
         out.set_item(name, PyArray2::from_vec2(py, &rows).map_err(value_error)?)?;
     }
     Ok(out)
+}
+
+/// The measured multipoles of a text file with exactly the columns k, then (P_ℓ, σ_ℓ) for each of
+/// `data_ells` (the library's reader, `fit::DataLayout::read_exact`): (k, {ℓ: P_ℓ}, {ℓ: σ_ℓ}).
+#[pyfunction]
+pub(crate) fn read_multipoles<'py>(
+    py: Python<'py>,
+    path: std::path::PathBuf,
+    data_ells: Vec<usize>,
+) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+    let data = pt_spectra::fit::DataLayout::new(&data_ells, None)
+        .and_then(|layout| layout.read_exact(&path))
+        .map_err(value_error)?;
+    let (values, sigma) = (PyDict::new(py), PyDict::new(py));
+    for (j, &ell) in data.ells.iter().enumerate() {
+        values.set_item(ell, data.values[j].clone().into_pyarray(py))?;
+        sigma.set_item(ell, data.sigma[j].clone().into_pyarray(py))?;
+    }
+    pyo3::types::PyTuple::new(
+        py,
+        [
+            data.k.into_pyarray(py).into_any(),
+            values.into_any(),
+            sigma.into_any(),
+        ],
+    )
 }

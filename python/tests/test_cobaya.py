@@ -145,8 +145,18 @@ def test_text_data_files_are_read_like_npz(setup, tmp_path):
     k2, values2, sigma2 = read_multipoles(tmp_path / "mock.txt")
     assert np.array_equal(k, k2)
     assert all(np.array_equal(values[ell], values2[ell]) for ell in values)
-    with pytest.raises(ValueError, match="columns"):
+    with pytest.raises(ValueError, match="more than the 5 columns"):
         read_multipoles(tmp_path / "mock.txt", data_ells=(0, 2))
+    # The library's reader: comments, a row of names and commas are read as by `fit --data`, and a
+    # bad row is named by its line.
+    text = (tmp_path / "mock.txt").read_text().splitlines()
+    (tmp_path / "named.txt").write_text("# k P0 s0 P2 s2 P4 s4\nk,P0,s0,P2,s2,P4,s4\n"
+                                        + "\n".join(l.replace(" ", ",") for l in text) + "\n")
+    k3, values3, _ = read_multipoles(tmp_path / "named.txt")
+    assert np.array_equal(k, k3) and np.array_equal(values[2], values3[2])
+    (tmp_path / "bad.txt").write_text("\n".join(text[:3] + ["0.5 x 1 1 1 1 1"]) + "\n")
+    with pytest.raises(ValueError, match="bad.txt:4"):
+        read_multipoles(tmp_path / "bad.txt")
 
 
 def test_k_from_the_likelihood_and_a_second_redshift(setup):

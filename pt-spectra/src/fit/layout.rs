@@ -63,6 +63,31 @@ impl DataLayout {
         MultipoleData::read(path, self.columns[0] - 1, &spec)
     }
 
+    /// Every multipole of the file at `path`, which must have exactly the layout's columns (no
+    /// more: a file of more multipoles than declared is refused rather than read in part), as a
+    /// likelihood declaring its data's multipoles wants.
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] for a row with more columns than the layout; as [`Self::read`].
+    pub fn read_exact(&self, path: impl AsRef<Path>) -> Result<MultipoleData> {
+        let path = path.as_ref();
+        let data = self.read(path, &self.data_ells)?;
+        let last = self.columns.iter().copied().max().unwrap_or(1);
+        // Ask for the column after the last one: every row must lack it.
+        match Table::read(path, &[last]) {
+            Err(Error::MissingColumn { .. }) => Ok(data),
+            Err(e) => Err(e),
+            Ok(_) => Err(Error::InvalidChoice {
+                what: format!("the data file `{}`", path.display()),
+                reason: format!(
+                    "has more than the {last} columns of k and (P_l, sigma_l) for l in {:?}; \
+                     declare all its multipoles",
+                    self.data_ells
+                ),
+            }),
+        }
+    }
+
     /// Attaches to `data` (read by [`Self::read`]) the covariance in `path`: ℓ-major over either the
     /// fitted multipoles or all the file's (`data_ells`, e.g. the P0, P2, P4 blocks of a survey's
     /// covariance while P0, P2 are fitted: the fitted blocks are taken from it), every k of the file.
@@ -219,5 +244,29 @@ mod tests {
             .contains("6"));
         assert!(DataLayout::new(&[0, 2], Some(&[1, 2, 3])).is_err());
         assert!(DataLayout::new(&[0, 0], None).is_err());
+    }
+}
+
+#[cfg(test)]
+mod exact_tests {
+    use super::*;
+
+    #[test]
+    fn read_exact_refuses_undeclared_columns_and_reads_declared_ones() {
+        let dir = std::env::temp_dir().join(format!("pt-spectra-exact-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("p.dat");
+        std::fs::write(&path, "# k P0 s0 P2 s2\n0.1 10 1 5 1\n0.2 8 1 4 1\n").unwrap();
+        let two = DataLayout::new(&[0, 2], None).unwrap();
+        let data = two.read_exact(&path).unwrap();
+        assert_eq!(
+            (data.ells.clone(), data.values[1].clone()),
+            (vec![0, 2], vec![5.0, 4.0])
+        );
+        let one = DataLayout::new(&[0], None).unwrap();
+        let e = one.read_exact(&path).unwrap_err().to_string();
+        assert!(e.contains("more than the 3 columns"), "{e}");
+        // `read` takes the declared columns of a wider file (as `fit --data` does).
+        assert_eq!(one.read(&path, &[0]).unwrap().values, vec![vec![10.0, 8.0]]);
     }
 }
