@@ -85,7 +85,10 @@ pub struct Precision {
     pub max_memory: Option<f64>,
 }
 
-/// How a [`RealPlan`](crate::real::RealPlan) computes the 2-loop terms of a spectrum.
+/// How the plans compute the loop terms of a spectrum: the 2-loop terms of a
+/// [`RealPlan`](crate::real::RealPlan), and the 1-loop, TNS and galaxy-model terms of `RealPlan`,
+/// [`RsdPlan`](crate::rsd::RsdPlan) and [`EptPlan`](crate::rsd::ept::EptPlan) (their tensors take
+/// seconds to build).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum TwoLoopMethod {
     /// From the basis tensors ([`crate::loops::basis`]) if they are already cached for the k grid and
