@@ -116,6 +116,23 @@ impl TableStore {
 }
 
 impl TableStore {
+    /// Tensors from the file `file` of the directory (read, or built and written), or built in
+    /// memory without a directory.
+    fn tensors<T>(
+        &self,
+        file: &str,
+        name: &str,
+        read: impl Fn(&[f64]) -> Option<T>,
+        build: impl FnOnce() -> T,
+        write: impl Fn(&T) -> Vec<f64>,
+        progress: &dyn Progress,
+    ) -> Result<Arc<T>> {
+        Ok(Arc::new(match self.path(file) {
+            None => build(),
+            Some(path) => cached(&path, name, read, build, write, progress)?,
+        }))
+    }
+
     /// The 2-loop basis tensors ([`TwoLoopBasis`]) for the wavenumbers `k` and `precision`: read
     /// from their file, or built with the P15 `table` (reporting [`Stage::TwoLoopBasis`]; minutes)
     /// and written. Without a directory they are built each time.
@@ -134,18 +151,14 @@ impl TableStore {
                 progress.update(Stage::TwoLoopBasis, d, t)
             })
         };
-        let tensors = match self.path(&TwoLoopBasis::file_name(k, precision)) {
-            None => build(),
-            Some(path) => cached(
-                &path,
-                "2-loop basis",
-                |v| TwoLoopBasis::from_f64s(v, k, precision),
-                build,
-                TwoLoopBasis::to_f64s,
-                progress,
-            )?,
-        };
-        Ok(Arc::new(tensors))
+        self.tensors(
+            &TwoLoopBasis::file_name(k, precision),
+            "2-loop basis",
+            |v| TwoLoopBasis::from_f64s(v, k, precision),
+            build,
+            TwoLoopBasis::to_f64s,
+            progress,
+        )
     }
 
     /// The 2-loop basis tensors for `k` and `precision` if their file is in the directory and valid
@@ -176,18 +189,14 @@ impl TableStore {
         let (k, precision) = (plan.k(), plan.precision());
         let build =
             || OneLoopBasis::build(plan, &|d, t| progress.update(Stage::OneLoopBasis, d, t));
-        let tensors = match self.path(&OneLoopBasis::file_name(k, precision)) {
-            None => build(),
-            Some(path) => cached(
-                &path,
-                "1-loop basis",
-                |v| OneLoopBasis::from_f64s(v, k, precision),
-                build,
-                OneLoopBasis::to_f64s,
-                progress,
-            )?,
-        };
-        Ok(Arc::new(tensors))
+        self.tensors(
+            &OneLoopBasis::file_name(k, precision),
+            "1-loop basis",
+            |v| OneLoopBasis::from_f64s(v, k, precision),
+            build,
+            OneLoopBasis::to_f64s,
+            progress,
+        )
     }
 
     /// The 1-loop basis tensors for `k` and `precision` if their file is in the directory and valid
@@ -215,18 +224,14 @@ impl TableStore {
     pub fn tns_basis(&self, plan: &TnsPlan, progress: &dyn Progress) -> Result<Arc<TnsBasis>> {
         let (k, precision) = (plan.k(), plan.precision());
         let build = || TnsBasis::build(plan, &|d, t| progress.update(Stage::TnsBasis, d, t));
-        let tensors = match self.path(&TnsBasis::file_name(k, precision)) {
-            None => build(),
-            Some(path) => cached(
-                &path,
-                "TNS basis",
-                |v| TnsBasis::from_f64s(v, k, precision),
-                build,
-                TnsBasis::to_f64s,
-                progress,
-            )?,
-        };
-        Ok(Arc::new(tensors))
+        self.tensors(
+            &TnsBasis::file_name(k, precision),
+            "TNS basis",
+            |v| TnsBasis::from_f64s(v, k, precision),
+            build,
+            TnsBasis::to_f64s,
+            progress,
+        )
     }
 
     /// The TNS basis tensors for `k` and `precision` if their file is in the directory and valid
@@ -265,18 +270,14 @@ impl TableStore {
                 progress.update(Stage::RedshiftBasis, d, t)
             })
         };
-        let tensors = match self.path(&RedshiftBasis::file_name(k, precision, family)) {
-            None => build(),
-            Some(path) => cached(
-                &path,
-                "redshift-space basis",
-                |v| RedshiftBasis::from_f64s(v, k, precision, family),
-                build,
-                RedshiftBasis::to_f64s,
-                progress,
-            )?,
-        };
-        Ok(Arc::new(tensors))
+        self.tensors(
+            &RedshiftBasis::file_name(k, precision, family),
+            "redshift-space basis",
+            |v| RedshiftBasis::from_f64s(v, k, precision, family),
+            build,
+            RedshiftBasis::to_f64s,
+            progress,
+        )
     }
 
     /// The galaxy model's basis tensors for `k`, `precision` and `family` if their file is in the

@@ -164,3 +164,81 @@ pub(crate) fn pair_products(c: &[f64]) -> Vec<f64> {
     }
     s2
 }
+
+/// The basis functions on a plan's fine lattice and on its half-resolution lattice (every other
+/// point), as the plans sample a spectrum.
+pub(crate) struct RuleRows {
+    fine: Vec<f64>,
+    coarse: Vec<f64>,
+    n: usize,
+}
+
+impl RuleRows {
+    pub fn new(basis: &super::LinearBasis) -> Self {
+        let rows = |stride: usize| {
+            (0..basis.lattice().len)
+                .step_by(stride)
+                .flat_map(|j| basis.row(j).iter().copied())
+                .collect()
+        };
+        Self {
+            fine: rows(1),
+            coarse: rows(2),
+            n: basis.len(),
+        }
+    }
+
+    /// The rows on the fine `lattice` and on the half-resolution `coarse` one.
+    pub fn on<'a>(&'a self, fine: &'a Lattice, coarse: &'a Lattice) -> (Rows<'a>, Rows<'a>) {
+        let rows = |rows: &'a [f64], lattice| Rows {
+            rows,
+            stride: self.n,
+            lattice,
+        };
+        (rows(&self.fine, fine), rows(&self.coarse, coarse))
+    }
+}
+
+/// `make(i)` for every k index i < `nk` in parallel, in order, counting them to `progress`.
+pub(crate) fn per_k<T: Send>(
+    nk: usize,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    make: impl Fn(usize) -> T + Sync,
+) -> Vec<T> {
+    use rayon::prelude::*;
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    (0..nk)
+        .into_par_iter()
+        .map(|i| {
+            let t = make(i);
+            progress(
+                done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
+                nk,
+            );
+            t
+        })
+        .collect()
+}
+
+/// The fine-rule bilinear forms in f32, and fine minus half-resolution on the pairs the latter was
+/// made on (the first n_err functions, whose pairs come first in the symmetric storage).
+pub(crate) fn fine_and_diff(fine: &[Vec<f64>], coarse: &[Vec<f64>]) -> (Vec<f32>, Vec<f32>) {
+    let mut pairs = Vec::new();
+    let mut diff = Vec::new();
+    for (f, c) in fine.iter().zip(coarse) {
+        pairs.extend(f.iter().map(|&v| v as f32));
+        diff.extend(f.iter().zip(c).map(|(f, c)| (f - c) as f32));
+    }
+    (pairs, diff)
+}
+
+/// The per-k parts of three tensors, each concatenated over k.
+pub(crate) fn concat<A, B, C>(per_k: Vec<(Vec<A>, Vec<B>, Vec<C>)>) -> (Vec<A>, Vec<B>, Vec<C>) {
+    let (mut a, mut b, mut c) = (Vec::new(), Vec::new(), Vec::new());
+    for (x, y, z) in per_k {
+        a.extend(x);
+        b.extend(y);
+        c.extend(z);
+    }
+    (a, b, c)
+}

@@ -97,6 +97,31 @@ pub(crate) fn triple_index(a: usize, b: usize, c: usize) -> usize {
     c * (c + 1) * (c + 2) / 6 + pair_index(a, b)
 }
 
+/// The cache file name `<prefix>-v<version>-n<BASIS_SIZE>-<hash>.bin` of tensors made with the
+/// settings `key` (FNV-1a over its bits).
+pub(crate) fn cache_file_name(prefix: &str, version: u32, key: &[f64]) -> String {
+    let hash = key
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+        });
+    format!("{prefix}-v{version}-n{BASIS_SIZE}-{hash:016x}.bin")
+}
+
+/// The values of a cache file after its key, if the file starts with `expected` (the key's length,
+/// then the key) and every value is finite; `None` for a file made for other settings.
+pub(crate) fn after_key<'a>(values: &'a [f64], expected: &[f64]) -> Option<&'a [f64]> {
+    let len = *values.first()? as usize;
+    if len != expected.len() || values.get(1..1 + len)? != expected {
+        return None;
+    }
+    if values.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    Some(&values[1 + len..])
+}
+
 /// Basis functions of the per-shift tensors for a basis of `n`.
 fn error_functions(n: usize) -> usize {
     ERROR_FUNCTIONS.min(n)
@@ -160,14 +185,7 @@ fn key(k: &[f64], precision: &Precision) -> Vec<f64> {
 impl TwoLoopBasis {
     /// The cache file name of the tensors for `k` and `precision`: `two-loop-basis-v<version>-<hash>.bin`.
     pub fn file_name(k: &[f64], precision: &Precision) -> String {
-        // FNV-1a over the key's bits.
-        let hash = key(k, precision)
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
-                (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-            });
-        format!("two-loop-basis-v{VERSION}-n{BASIS_SIZE}-{hash:016x}.bin")
+        cache_file_name("two-loop-basis", VERSION, &key(k, precision))
     }
 
     /// Builds the tensors on `k` [h/Mpc] for `precision` with the P15 angular `table`, in parallel;
@@ -414,14 +432,7 @@ impl TwoLoopBasis {
     /// made for other settings or does not fit them.
     pub(crate) fn from_f64s(values: &[f64], k: &[f64], precision: &Precision) -> Option<Self> {
         let expected = key(k, precision);
-        let len = *values.first()? as usize;
-        if len != expected.len() || values.get(1..1 + len)? != expected.as_slice() {
-            return None;
-        }
-        if values.iter().any(|v| !v.is_finite()) {
-            return None;
-        }
-        let rest = &values[1 + len..];
+        let rest = after_key(values, &expected)?;
         let points: Vec<usize> = rest.get(..k.len())?.iter().map(|&p| p as usize).collect();
         let replicas = *rest.get(k.len())? as usize;
         let (basis, mut rest) =

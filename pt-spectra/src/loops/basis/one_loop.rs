@@ -22,14 +22,15 @@
 //! here (the direct path uses Simpson on the spectrum): exact for P̂, error ε σ_d² + the interpolation
 //! error, ≲ 1e-8.
 
-use super::forms::{dot32, linear_form, pair_forms, pair_products, Rows};
+use super::forms::{
+    concat, dot32, fine_and_diff, linear_form, pair_forms, pair_products, per_k, Rows, RuleRows,
+};
 use super::{error_functions, LinearBasis, Projection, BASIS_SIZE};
 use crate::integrate::legendre_nodes;
 use crate::loops::lattice::{add_product_weights, Lattice};
 use crate::loops::one_loop::Rule;
 use crate::loops::{ByPair, Estimate, OneLoopPlan, OneLoopTerms};
 use crate::precision::Precision;
-use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// Version of the tensor layout and rules, part of the cache file name.
@@ -92,14 +93,6 @@ fn key(k: &[f64], precision: &Precision) -> Vec<f64> {
     key
 }
 
-/// The basis functions' samples on the lattice, row by row (every `stride`-th fine row).
-pub(super) fn rows_on(basis: &LinearBasis, stride: usize) -> Vec<f64> {
-    (0..basis.lattice().len)
-        .step_by(stride)
-        .flat_map(|j| basis.row(j).iter().copied())
-        .collect()
-}
-
 /// P22 δδ, δθ, θθ at k index `i` of `rule` as symmetric bilinear forms on the pairs a ≤ b of the
 /// first `n` functions: Σ_{a≤b} T_ab c_a c_b = Σ_nodes w P̂(q) P̂(p).
 fn p22_forms(rule: &Rule, i: usize, rows: &Rows<'_>, n: usize) -> Vec<Vec<f64>> {
@@ -109,13 +102,7 @@ fn p22_forms(rule: &Rule, i: usize, rows: &Rows<'_>, n: usize) -> Vec<Vec<f64>> 
 impl OneLoopBasis {
     /// The cache file name of the tensors for `k` and `precision`.
     pub fn file_name(k: &[f64], precision: &Precision) -> String {
-        let hash = key(k, precision)
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
-                (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-            });
-        format!("one-loop-basis-v{VERSION}-n{BASIS_SIZE}-{hash:016x}.bin")
+        super::cache_file_name("one-loop-basis", VERSION, &key(k, precision))
     }
 
     /// Builds the tensors of `plan` (its k grid and precision) in parallel over k; `progress(done,
@@ -126,63 +113,37 @@ impl OneLoopBasis {
         let basis = super::training::camb_basis(fine.lattice.clone(), BASIS_SIZE);
         let n = basis.len();
         let n_err = error_functions(n);
-        let (rows_fine, rows_coarse) = (rows_on(&basis, 1), rows_on(&basis, 2));
-        let fine_rows = Rows {
-            rows: &rows_fine,
-            stride: n,
-            lattice: &fine.lattice,
-        };
-        let coarse_rows = Rows {
-            rows: &rows_coarse,
-            stride: n,
-            lattice: &coarse.lattice,
-        };
-        let done = std::sync::atomic::AtomicUsize::new(0);
-        let per_k: Vec<(Vec<f32>, Vec<f32>, Vec<f64>)> = (0..k.len())
-            .into_par_iter()
-            .map(|i| {
-                let f = p22_forms(fine, i, &fine_rows, n);
-                let c = p22_forms(coarse, i, &coarse_rows, n_err);
-                let mut p22 = Vec::with_capacity(3 * f[0].len());
-                let mut diff = Vec::with_capacity(3 * c[0].len());
-                for (f, c) in f.iter().zip(&c) {
-                    p22.extend(f.iter().map(|&v| v as f32));
-                    // The pairs of the first n_err functions come first in the symmetric storage.
-                    diff.extend(f.iter().zip(c).map(|(f, c)| (f - c) as f32));
-                }
-                let (wf, wc) = (&fine.p13[i], &coarse.p13[i]);
-                let abs = |w: &[f64]| w.iter().map(|v| v.abs()).collect::<Vec<_>>();
-                let forms = [
-                    linear_form(&wf.f, &fine_rows),
-                    linear_form(&wf.g, &fine_rows),
-                    linear_form(&wc.f, &coarse_rows),
-                    linear_form(&wc.g, &coarse_rows),
-                    linear_form(&abs(&wf.f), &fine_rows),
-                    linear_form(&abs(&wf.g), &fine_rows),
-                ];
-                let mut p13 = Vec::with_capacity(P13_FORMS * n);
-                p13.extend(&forms[0]);
-                p13.extend(&forms[1]);
-                p13.extend(forms[0].iter().zip(&forms[2]).map(|(f, c)| f - c));
-                p13.extend(forms[1].iter().zip(&forms[3]).map(|(f, c)| f - c));
-                p13.extend(&forms[4]);
-                p13.extend(&forms[5]);
-                let d = std::sync::atomic::Ordering::Relaxed;
-                progress(done.fetch_add(1, d) + 1, k.len());
-                (p22, diff, p13)
-            })
-            .collect();
+        let rows = RuleRows::new(&basis);
+        let (fine_rows, coarse_rows) = rows.on(&fine.lattice, &coarse.lattice);
+        let per_k = per_k(k.len(), progress, |i| {
+            let f = p22_forms(fine, i, &fine_rows, n);
+            let c = p22_forms(coarse, i, &coarse_rows, n_err);
+            let (p22, diff) = fine_and_diff(&f, &c);
+            let (wf, wc) = (&fine.p13[i], &coarse.p13[i]);
+            let abs = |w: &[f64]| w.iter().map(|v| v.abs()).collect::<Vec<_>>();
+            let forms = [
+                linear_form(&wf.f, &fine_rows),
+                linear_form(&wf.g, &fine_rows),
+                linear_form(&wc.f, &coarse_rows),
+                linear_form(&wc.g, &coarse_rows),
+                linear_form(&abs(&wf.f), &fine_rows),
+                linear_form(&abs(&wf.g), &fine_rows),
+            ];
+            let mut p13 = Vec::with_capacity(P13_FORMS * n);
+            p13.extend(&forms[0]);
+            p13.extend(&forms[1]);
+            p13.extend(forms[0].iter().zip(&forms[2]).map(|(f, c)| f - c));
+            p13.extend(forms[1].iter().zip(&forms[3]).map(|(f, c)| f - c));
+            p13.extend(&forms[4]);
+            p13.extend(&forms[5]);
+            (p22, diff, p13)
+        });
         let sv_fine = linear_form(&fine.sigma_v2, &fine_rows);
         let sv_coarse = linear_form(&coarse.sigma_v2, &coarse_rows);
         let mut sigma_v2 = sv_fine.clone();
         sigma_v2.extend(sv_fine.iter().zip(&sv_coarse).map(|(f, c)| f - c));
         let sigma_d2 = sigma_d2_forms(k, &fine_rows);
-        let (mut p22, mut p22_diff, mut p13) = (Vec::new(), Vec::new(), Vec::new());
-        for (a, b, c) in per_k {
-            p22.extend(a);
-            p22_diff.extend(b);
-            p13.extend(c);
-        }
+        let (p22, p22_diff, p13) = concat(per_k);
         Self {
             k: k.to_vec(),
             key: key(k, precision),
@@ -282,15 +243,9 @@ impl OneLoopBasis {
     /// made for other settings or does not fit them.
     pub(crate) fn from_f64s(values: &[f64], k: &[f64], precision: &Precision) -> Option<Self> {
         let expected = key(k, precision);
-        let len = *values.first()? as usize;
-        if len != expected.len() || values.get(1..1 + len)? != expected.as_slice() {
-            return None;
-        }
-        if values.iter().any(|v| !v.is_finite()) {
-            return None;
-        }
+        let rest = super::after_key(values, &expected)?;
         let lattice = Lattice::new(precision.q_min, precision.q_max, precision.lattice_step);
-        let (basis, rest) = LinearBasis::from_f64s(lattice, &values[1 + len..])?;
+        let (basis, rest) = LinearBasis::from_f64s(lattice, rest)?;
         let n = basis.len();
         let n_err = error_functions(n);
         let nk = k.len();

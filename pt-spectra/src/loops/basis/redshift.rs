@@ -11,13 +11,13 @@
 //! IR resummation the no-wiggle spectrum is projected too; its terms carry the errors of the full
 //! ones (as in the direct plan) plus its own projection error.
 
-use super::forms::{dot32, linear_form, pair_forms, pair_products, Rows};
-use super::one_loop::rows_on;
+use super::forms::{
+    concat, dot32, fine_and_diff, linear_form, pair_forms, pair_products, per_k, RuleRows,
+};
 use super::{error_functions, LinearBasis, Projection, BASIS_SIZE};
 use crate::loops::redshift::{RedshiftPlan, RedshiftTerms, Row, NPAIR};
 use crate::loops::Estimate;
 use crate::precision::Precision;
-use rayon::prelude::*;
 
 /// Version of the tensor layout and rules, part of the cache file name.
 const VERSION: u32 = 1;
@@ -96,14 +96,8 @@ fn key(k: &[f64], precision: &Precision, family: SpectrumFamily) -> Vec<f64> {
 impl RedshiftBasis {
     /// The cache file name of the tensors for `k`, `precision` and `family`.
     pub fn file_name(k: &[f64], precision: &Precision, family: SpectrumFamily) -> String {
-        let hash = key(k, precision, family)
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
-                (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-            });
-        let tag = family.tag();
-        format!("redshift-basis-{tag}-v{VERSION}-n{BASIS_SIZE}-{hash:016x}.bin")
+        let prefix = format!("redshift-basis-{}", family.tag());
+        super::cache_file_name(&prefix, VERSION, &key(k, precision, family))
     }
 
     /// Builds the tensors of `plan` on `basis` (of the spectra `family`, on the plan's lattice) in
@@ -118,55 +112,30 @@ impl RedshiftBasis {
         let (fine, coarse) = plan.rules();
         let n = basis.len();
         let n_err = error_functions(n);
-        let (rows_fine, rows_coarse) = (rows_on(&basis, 1), rows_on(&basis, 2));
-        let fine_rows = Rows {
-            rows: &rows_fine,
-            stride: n,
-            lattice: &fine.lattice,
-        };
-        let coarse_rows = Rows {
-            rows: &rows_coarse,
-            stride: n,
-            lattice: &coarse.lattice,
-        };
-        let done = std::sync::atomic::AtomicUsize::new(0);
-        let per_k: Vec<(Vec<f32>, Vec<f32>, Vec<f64>)> = (0..k.len())
-            .into_par_iter()
-            .map(|i| {
-                let f = pair_forms(&fine.pairs, i, &fine_rows, n, 0..NPAIR, 0..0, 0..0).pairs;
-                let c = pair_forms(&coarse.pairs, i, &coarse_rows, n_err, 0..NPAIR, 0..0, 0..0);
-                let mut pairs = Vec::new();
-                let mut diff = Vec::new();
-                for (f, c) in f.iter().zip(&c.pairs) {
-                    pairs.extend(f.iter().map(|&v| v as f32));
-                    diff.extend(f.iter().zip(c).map(|(f, c)| (f - c) as f32));
-                }
-                let mut linear = Vec::with_capacity(LINEAR * n);
-                for w in &fine.lattice_weights[i] {
-                    linear.extend(linear_form(w, &fine_rows));
-                }
-                for w in &coarse.lattice_weights[i] {
-                    linear.extend(linear_form(w, &coarse_rows));
-                }
-                for w in &fine.lattice_weights[i] {
-                    let abs: Vec<f64> = w.iter().map(|v| v.abs()).collect();
-                    linear.extend(linear_form(&abs, &fine_rows));
-                }
-                let d = std::sync::atomic::Ordering::Relaxed;
-                progress(done.fetch_add(1, d) + 1, k.len());
-                (pairs, diff, linear)
-            })
-            .collect();
+        let rows = RuleRows::new(&basis);
+        let (fine_rows, coarse_rows) = rows.on(&fine.lattice, &coarse.lattice);
+        let per_k = per_k(k.len(), progress, |i| {
+            let f = pair_forms(&fine.pairs, i, &fine_rows, n, 0..NPAIR, 0..0, 0..0).pairs;
+            let c = pair_forms(&coarse.pairs, i, &coarse_rows, n_err, 0..NPAIR, 0..0, 0..0);
+            let (pairs, diff) = fine_and_diff(&f, &c.pairs);
+            let mut linear = Vec::with_capacity(LINEAR * n);
+            for w in &fine.lattice_weights[i] {
+                linear.extend(linear_form(w, &fine_rows));
+            }
+            for w in &coarse.lattice_weights[i] {
+                linear.extend(linear_form(w, &coarse_rows));
+            }
+            for w in &fine.lattice_weights[i] {
+                let abs: Vec<f64> = w.iter().map(|v| v.abs()).collect();
+                linear.extend(linear_form(&abs, &fine_rows));
+            }
+            (pairs, diff, linear)
+        });
         let sv_fine = linear_form(&fine.sigma_v2, &fine_rows);
         let sv_coarse = linear_form(&coarse.sigma_v2, &coarse_rows);
         let mut sigma_v2 = sv_fine.clone();
         sigma_v2.extend(sv_fine.iter().zip(&sv_coarse).map(|(f, c)| f - c));
-        let (mut pairs, mut pairs_diff, mut linear) = (Vec::new(), Vec::new(), Vec::new());
-        for (a, b, c) in per_k {
-            pairs.extend(a);
-            pairs_diff.extend(b);
-            linear.extend(c);
-        }
+        let (pairs, pairs_diff, linear) = concat(per_k);
         Self {
             k: k.to_vec(),
             key: key(k, precision, family),
@@ -285,15 +254,9 @@ impl RedshiftBasis {
         family: SpectrumFamily,
     ) -> Option<Self> {
         let expected = key(k, precision, family);
-        let len = *values.first()? as usize;
-        if len != expected.len() || values.get(1..1 + len)? != expected.as_slice() {
-            return None;
-        }
-        if values.iter().any(|v| !v.is_finite()) {
-            return None;
-        }
+        let rest = super::after_key(values, &expected)?;
         let lattice = super::lattice_of(precision);
-        let (basis, rest) = LinearBasis::from_f64s(lattice, &values[1 + len..])?;
+        let (basis, rest) = LinearBasis::from_f64s(lattice, rest)?;
         let n = basis.len();
         let n_err = error_functions(n);
         let nk = k.len();

@@ -13,13 +13,13 @@
 //! half-resolution difference (the bilinear part of the half-resolution rule on the first
 //! [`super::ERROR_FUNCTIONS`] functions) plus the floor of [`Precision::p22_error_floor`].
 
-use super::forms::{dot32, pair_forms, pair_products, Rows};
-use super::one_loop::rows_on;
+use super::forms::{
+    concat, dot32, fine_and_diff, pair_forms, pair_products, per_k, Rows, RuleRows,
+};
 use super::{error_functions, LinearBasis, Projection, BASIS_SIZE};
 use crate::loops::tns::{Rule, A_LEN, B_LEN};
 use crate::loops::{Estimate, TnsCoefficients, TnsPlan, TnsTerms};
 use crate::precision::Precision;
-use rayon::prelude::*;
 
 /// Version of the tensor layout and rules, part of the cache file name.
 const VERSION: u32 = 1;
@@ -93,13 +93,7 @@ fn forms(rule: &Rule, i: usize, rows: &Rows<'_>, n: usize) -> (Vec<Vec<f64>>, Ve
 impl TnsBasis {
     /// The cache file name of the tensors for `k` and `precision`.
     pub fn file_name(k: &[f64], precision: &Precision) -> String {
-        let hash = key(k, precision)
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
-                (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-            });
-        format!("tns-basis-v{VERSION}-n{BASIS_SIZE}-{hash:016x}.bin")
+        super::cache_file_name("tns-basis", VERSION, &key(k, precision))
     }
 
     /// Builds the tensors of `plan` in parallel over k; `progress(done, total)` counts the k values.
@@ -109,41 +103,16 @@ impl TnsBasis {
         let basis = super::training::camb_basis(fine.lattice.clone(), BASIS_SIZE);
         let n = basis.len();
         let n_err = error_functions(n);
-        let (rows_fine, rows_coarse) = (rows_on(&basis, 1), rows_on(&basis, 2));
-        let fine_rows = Rows {
-            rows: &rows_fine,
-            stride: n,
-            lattice: &fine.lattice,
-        };
-        let coarse_rows = Rows {
-            rows: &rows_coarse,
-            stride: n,
-            lattice: &coarse.lattice,
-        };
-        let done = std::sync::atomic::AtomicUsize::new(0);
-        let per_k: Vec<(Vec<f32>, Vec<f32>, Vec<f64>)> = (0..k.len())
-            .into_par_iter()
-            .map(|i| {
-                let (f, mut linear) = forms(fine, i, &fine_rows, n);
-                let (c, linear_coarse) = forms(coarse, i, &coarse_rows, n_err);
-                linear.extend(linear_coarse);
-                let mut pairs = Vec::new();
-                let mut diff = Vec::new();
-                for (f, c) in f.iter().zip(&c) {
-                    pairs.extend(f.iter().map(|&v| v as f32));
-                    diff.extend(f.iter().zip(c).map(|(f, c)| (f - c) as f32));
-                }
-                let d = std::sync::atomic::Ordering::Relaxed;
-                progress(done.fetch_add(1, d) + 1, k.len());
-                (pairs, diff, linear)
-            })
-            .collect();
-        let (mut pairs, mut pairs_diff, mut linear) = (Vec::new(), Vec::new(), Vec::new());
-        for (a, b, c) in per_k {
-            pairs.extend(a);
-            pairs_diff.extend(b);
-            linear.extend(c);
-        }
+        let rows = RuleRows::new(&basis);
+        let (fine_rows, coarse_rows) = rows.on(&fine.lattice, &coarse.lattice);
+        let per_k = per_k(k.len(), progress, |i| {
+            let (f, mut linear) = forms(fine, i, &fine_rows, n);
+            let (c, linear_coarse) = forms(coarse, i, &coarse_rows, n_err);
+            linear.extend(linear_coarse);
+            let (pairs, diff) = fine_and_diff(&f, &c);
+            (pairs, diff, linear)
+        });
+        let (pairs, pairs_diff, linear) = concat(per_k);
         Self {
             k: k.to_vec(),
             key: key(k, precision),
@@ -232,15 +201,9 @@ impl TnsBasis {
     /// made for other settings or does not fit them.
     pub(crate) fn from_f64s(values: &[f64], k: &[f64], precision: &Precision) -> Option<Self> {
         let expected = key(k, precision);
-        let len = *values.first()? as usize;
-        if len != expected.len() || values.get(1..1 + len)? != expected.as_slice() {
-            return None;
-        }
-        if values.iter().any(|v| !v.is_finite()) {
-            return None;
-        }
+        let rest = super::after_key(values, &expected)?;
         let lattice = super::lattice_of(precision);
-        let (basis, rest) = LinearBasis::from_f64s(lattice, &values[1 + len..])?;
+        let (basis, rest) = LinearBasis::from_f64s(lattice, rest)?;
         let n = basis.len();
         let n_err = error_functions(n);
         let nk = k.len();
