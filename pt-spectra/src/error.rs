@@ -210,6 +210,34 @@ pub enum Error {
         reason: &'static str,
     },
 
+    /// A cosmological parameter outside the box the linear-spectrum emulator was trained on.
+    #[error(
+        "{name} = {} is outside the linear-spectrum emulator's prior [{}, {}]: give a linear spectrum \
+         (--linear FILE) or use Eisenstein & Hu (--eh)",
+        number(.value), number(.min), number(.max)
+    )]
+    OutsidePrior {
+        /// The parameter, e.g. `m_nu`.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// Smallest value of the prior.
+        min: f64,
+        /// Largest value of the prior.
+        max: f64,
+    },
+
+    /// A data file embedded in or shipped with the library is malformed.
+    #[error("{what}: malformed at byte {offset}: {reason}")]
+    BadDataFile {
+        /// The file, e.g. `embedded linear-spectrum emulator`.
+        what: String,
+        /// Where reading stopped.
+        offset: usize,
+        /// What was expected.
+        reason: &'static str,
+    },
+
     /// No linear spectrum is embedded for the requested redshift.
     #[error("no embedded linear spectrum at z = {z}; embedded redshifts: {available}")]
     NoEmbeddedSpectrum {

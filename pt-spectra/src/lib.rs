@@ -10,6 +10,8 @@
 //! * [`cosmology`]: [`Cosmology`](cosmology::Cosmology), flat or curved with w0–wa dark energy, normalised by
 //!   σ8 or A_s: linear growth D(z), f(z) (exact for Λ, an ODE otherwise), the Eisenstein & Hu (1998)
 //!   transfer functions with and without BAO wiggles, presets and CLASS/CAMB parameter files.
+//! * [`emulator`]: the linear spectra P_m(k, z) and P_cb(k, z) and the growth rate f_cb(k, z) of a flat
+//!   w0–wa cosmology with massive neutrinos from its parameters, without a Boltzmann code (trained on CAMB).
 //! * [`loops`], [`resum`], [`real`]: 1- and 2-loop SPT terms, the propagator terms P13, P15, P17 (angular
 //!   tables), and TNS terms, all with error estimates; RPT propagators N0..N3; real-space models.
 //! * [`rsd`]: Kaiser, Scoccimarro and TNS redshift-space models, Fingers of God, Legendre multipoles.
@@ -30,6 +32,7 @@
 //! ```
 
 pub mod cosmology;
+pub mod emulator;
 pub mod error;
 pub mod estimate;
 pub mod fit;

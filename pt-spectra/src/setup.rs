@@ -20,6 +20,7 @@
 //! ```
 
 use crate::cosmology::{Cosmology, TransferKind};
+use crate::emulator::LinearEmulator;
 use crate::error::{Error, Result};
 use crate::linear::{LinearSpectrum, LogGrid, GM2012_REDSHIFTS};
 
@@ -65,8 +66,12 @@ impl NamedCosmology {
 #[derive(Debug, Clone)]
 pub enum LinearSource {
     /// The embedded CAMB spectra of the gm2012 cosmology (z = 0, 0.5, 1, 1.5; other redshifts rescaled
-    /// from z = 0). With another cosmology, its Eisenstein & Hu spectrum with BAO, with a warning.
+    /// from z = 0). With another cosmology, [`LinearSource::Emulator`].
     Embedded,
+    /// The linear-spectrum emulator ([`crate::emulator`]): P_m of the cosmology at z, and P_cb and the
+    /// growth rate of cold dark matter + baryons with massive neutrinos. An error names a parameter
+    /// outside its prior.
+    Emulator,
     /// A tabulated spectrum (a file or arrays) at redshift `z_input`.
     Table {
         /// The spectrum.
@@ -92,8 +97,11 @@ pub struct Request {
 /// The linear spectrum at the output redshift, with the growth of its cosmology.
 #[derive(Debug, Clone)]
 pub struct Prepared {
-    /// The linear spectrum at `z`.
+    /// The linear spectrum at `z` (all matter).
     pub spectrum: LinearSpectrum,
+    /// The linear spectrum of cold dark matter + baryons at `z` when it differs from `spectrum` (the
+    /// emulator with massive neutrinos); `None` otherwise.
+    pub spectrum_cb: Option<LinearSpectrum>,
     /// The cosmology.
     pub cosmology: NamedCosmology,
     /// The output redshift.
@@ -131,7 +139,8 @@ pub fn prepare(request: Request) -> Result<Prepared> {
     let defaulted = request.cosmology.is_none();
     let named = request.cosmology.unwrap_or_else(NamedCosmology::gm2012);
     let c = named.cosmology;
-    let (d, f) = (c.growth_factor(z), c.growth_rate(z));
+    let (d, mut f) = (c.growth_factor(z), c.growth_rate(z));
+    let mut spectrum_cb = None;
     let mut warnings = Vec::new();
     let mut description = vec![format!(
         "cosmology: {}{} ({}); D(z)/D(0) = {d:.6}, f(z) = {f:.6} at z = {z}",
@@ -159,17 +168,14 @@ pub fn prepare(request: Request) -> Result<Prepared> {
             ));
             spectrum
         }
-        LinearSource::Embedded => {
-            warnings.push(format!(
-                "no linear spectrum was given for cosmology {}: using its Eisenstein & Hu (1998) fit with \
-                 BAO, good to a few per cent; give a Boltzmann-code spectrum (--linear) for precise work",
-                named.name
-            ));
-            description.push(format!(
-                "linear spectrum: Eisenstein & Hu (1998) with BAO of cosmology {} at z = {z}",
-                named.name
-            ));
-            eh(TransferKind::Wiggle)?
+        LinearSource::Embedded | LinearSource::Emulator => {
+            let emulated = emulate(&c, z)?;
+            description.extend(emulated.description);
+            if let Some((cb, f_cb)) = emulated.cb {
+                spectrum_cb = Some(cb);
+                f = f_cb;
+            }
+            emulated.spectrum
         }
         LinearSource::EisensteinHu(kind) => {
             let what = match kind {
@@ -210,11 +216,74 @@ pub fn prepare(request: Request) -> Result<Prepared> {
     }
     Ok(Prepared {
         spectrum,
+        spectrum_cb,
         cosmology: named,
         z,
         growth_factor: d,
         growth_rate: f,
         warnings,
+        description,
+    })
+}
+
+/// The wavenumber in h/Mpc at which the scale-dependent growth rate f_cb(k, z) of a cosmology with
+/// massive neutrinos gives the scalar f of the redshift-space models.
+pub const K_GROWTH_RATE: f64 = 0.1;
+
+/// What [`prepare`] takes from the emulator.
+struct Emulated {
+    spectrum: LinearSpectrum,
+    /// P_cb and f_cb(K_GROWTH_RATE) with massive neutrinos.
+    cb: Option<(LinearSpectrum, f64)>,
+    description: Vec<String>,
+}
+
+/// The emulated spectra of `c` at `z`, with the header lines that say so.
+fn emulate(c: &Cosmology, z: f64) -> Result<Emulated> {
+    let emulator = LinearEmulator::embedded()?;
+    let e = emulator.spectra(c, z)?;
+    let spectrum = e.matter()?;
+    let accuracy = |err: &[f64]| {
+        e.k.iter()
+            .zip(err)
+            .filter(|(k, _)| (1e-3..=1.0).contains(*k))
+            .map(|(_, v)| *v)
+            .fold(0.0, f64::max)
+    };
+    let mut description = vec![
+        format!(
+            "linear spectrum: P_m at z = {z} from the {} (sigma8(z) = {:.6}, A_s = {:.6e}); error \
+             (99th percentile on held-out CAMB cosmologies, 1e-3 <= k <= 1 h/Mpc) {:.1e}",
+            emulator.describe(),
+            e.sigma8,
+            e.a_s,
+            accuracy(&e.error_m)
+        ),
+        format!(
+            "linear spectrum: emulated for {:.4e} <= k <= {:.4e} h/Mpc, power laws beyond",
+            e.k[0],
+            e.k[e.k.len() - 1]
+        ),
+    ];
+    let cb = if c.m_nu > 0.0 {
+        let cb = e.cb()?;
+        let f_of_k = LinearSpectrum::from_nodes(e.k.clone(), e.f_cb.clone())?;
+        let f = f_of_k.eval(K_GROWTH_RATE);
+        description.push(format!(
+            "massive neutrinos: P_cb (cold dark matter + baryons) emulated too (error {:.1e}): the \
+             redshift-space and galaxy models use P_cb, with the growth rate f = f_cb(k = \
+             {K_GROWTH_RATE} h/Mpc, z) = {f:.6} (scale-dependent: {:.6} at k = 0.01, {:.6} at k = 0.3)",
+            accuracy(&e.error_cb),
+            f_of_k.eval(0.01),
+            f_of_k.eval(0.3)
+        ));
+        Some((cb, f))
+    } else {
+        None
+    };
+    Ok(Emulated {
+        spectrum,
+        cb,
         description,
     })
 }
@@ -259,6 +328,19 @@ impl Prepared {
         self.description
             .push(format!("growth factor D(z) = {d} given by the caller"));
         Ok(self)
+    }
+
+    /// The linear spectrum that haloes and galaxies trace, and that the redshift-space models use: that of
+    /// cold dark matter + baryons with massive neutrinos ([`spectrum_cb`](Self::spectrum_cb)),
+    /// otherwise [`spectrum`](Self::spectrum).
+    pub fn tracer_spectrum(&self) -> &LinearSpectrum {
+        self.spectrum_cb.as_ref().unwrap_or(&self.spectrum)
+    }
+
+    /// The share of cold dark matter + baryons in the matter density, f_cb = 1 − ω_ν/ω_m.
+    pub fn cold_fraction(&self) -> f64 {
+        let c = &self.cosmology.cosmology;
+        1.0 - c.omega_nu() / (c.omega_m * c.h * c.h)
     }
 
     /// The Eisenstein & Hu (1998) no-wiggle spectrum of the cosmology at the output redshift, scaled to
@@ -323,7 +405,7 @@ mod tests {
     }
 
     #[test]
-    fn the_default_growth_is_warned_about_and_other_cosmologies_without_a_table_use_eh() {
+    fn the_default_growth_is_warned_about_and_other_cosmologies_without_a_table_are_emulated() {
         let p = prepare(Request {
             source: table(0.0),
             cosmology: None,
@@ -338,14 +420,43 @@ mod tests {
             z: 0.5,
         })
         .unwrap();
-        assert!(
-            p.warnings[0].contains("Eisenstein & Hu"),
-            "{:?}",
-            p.warnings
-        );
-        // The EH spectrum normalised by A_s has CAMB's σ8 to ~1% (EH is a fit).
-        let s8 = p.spectrum.sigma8() / p.growth_factor;
-        assert!((s8 / planck(0.0).sigma8() - 1.0).abs() < 0.02, "{s8}");
+        assert!(p.warnings.is_empty(), "{:?}", p.warnings);
+        assert!(p.description.iter().any(|l| l.contains("emulator")));
+        // The emulated spectrum is CAMB's to its error (1e-3 here, k in [0.01, 0.3]).
+        let camb = planck(0.0);
+        for k in LogGrid::new(0.01, 0.3, 30).unwrap().points() {
+            let rel = p.spectrum.eval(k) / (camb.eval(k) * p.growth_factor.powi(2)) - 1.0;
+            assert!(rel.abs() < 3e-3, "k = {k}: {rel:e}");
+        }
+        assert!(p.spectrum_cb.is_none());
+        // with massive neutrinos: P_cb too, the scale-dependent f at k = 0.1, and P_cb ≥ P_m
+        let c = Cosmology::planck2018().with_neutrinos(0.3).unwrap();
+        let named = NamedCosmology {
+            name: "nu".into(),
+            cosmology: c,
+        };
+        let p = prepare(Request {
+            source: LinearSource::Emulator,
+            cosmology: Some(named),
+            z: 0.5,
+        })
+        .unwrap();
+        let cb = p.spectrum_cb.as_ref().unwrap();
+        assert!(cb.eval(0.5) > p.spectrum.eval(0.5) * 1.02);
+        assert!((p.growth_rate - c.growth_rate(0.5)).abs() < 0.02);
+        assert!(p.growth_rate < c.growth_rate(0.5));
+        // outside the prior: an error naming the parameter
+        let far = NamedCosmology {
+            name: "far".into(),
+            cosmology: Cosmology::planck2018().with_neutrinos(1.0).unwrap(),
+        };
+        let e = prepare(Request {
+            source: LinearSource::Emulator,
+            cosmology: Some(far),
+            z: 0.0,
+        })
+        .unwrap_err();
+        assert!(e.to_string().contains("m_nu = 1"), "{e}");
         let e = prepare(Request {
             source: LinearSource::Embedded,
             cosmology: None,

@@ -116,7 +116,7 @@ impl EptPlan {
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
         let ((terms, prepared), _) = detached(py, || {
             let prepared = inputs.prepare(self.plan.k())?;
-            let terms = self.plan.terms(&prepared.spectrum)?;
+            let terms = self.plan.terms(prepared.tracer_spectrum())?;
             Ok((terms, prepared))
         })?;
         Ok(EptTerms {
@@ -285,7 +285,7 @@ pub(crate) fn fit_ept(
         };
         let store = crate::Store::new(None);
         let plan = jobs::ept_plan(&model_k, ir, ap, free_ap, &precision, store.get(), &Silent)?;
-        let terms = plan.terms(&prepared.spectrum)?;
+        let terms = plan.terms(prepared.tracer_spectrum())?;
         let header = vec![format!(
             "pt-spectra {} fit: ept ({}) to {name}",
             jobs::VERSION,

@@ -168,8 +168,11 @@ impl RsdPlan {
                     let plan = pt_spectra::loops::bias::BiasPlan::new(real.k(), real.precision())?;
                     let _ = self.bias_plan.set(plan);
                 }
-                let (spectra, tns) = self.plan.evaluate(&prepared.spectrum, &Silent)?;
-                let terms = self.bias_plan.get().map(|p| p.evaluate(&prepared.spectrum));
+                let (spectra, tns) = self.plan.evaluate(prepared.tracer_spectrum(), &Silent)?;
+                let terms = self
+                    .bias_plan
+                    .get()
+                    .map(|p| p.evaluate(prepared.tracer_spectrum()));
                 let precision = real.precision();
                 jobs::rsd_table_with_bias_terms(
                     &spectra,
@@ -204,7 +207,7 @@ impl RsdPlan {
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
         let ((spectra, tns, prepared), _) = detached(py, || {
             let prepared = inputs.prepare(self.plan.real().k())?;
-            let (spectra, tns) = self.plan.evaluate(&prepared.spectrum, &Silent)?;
+            let (spectra, tns) = self.plan.evaluate(prepared.tracer_spectrum(), &Silent)?;
             Ok((spectra, tns, prepared))
         })?;
         Ok(RsdTerms {

@@ -175,8 +175,13 @@ def test_warnings_for_defaults_that_may_not_fit():
     with pytest.warns(pt.PtSpectraWarning, match="gm2012"):
         t = pt.real(k=[0.1], linear=(kl, pl), z=1.0, precision="fast")
     assert any("gm2012" in line for line in t.header)
-    with pytest.warns(pt.PtSpectraWarning, match="Eisenstein"):
-        pt.real(k=[0.1], cosmology="planck2018", precision="fast")
+    # a cosmology without a spectrum is emulated (no warning; the header says so), CAMB's to 0.2%
+    t = pt.real(k=[0.1], model="linear", cosmology="planck2018")
+    assert any("emulator" in line for line in t.header)
+    assert abs(t["P_lin"][0] / np.interp(0.1, kl, pl) - 1) < 2e-3
+    with pytest.raises(ValueError, match="m_nu = 0.8"):
+        pt.real(k=[0.1], model="linear", cosmology={"h": 0.67, "omega_b": 0.022, "omega_cdm": 0.12,
+                                                   "n_s": 0.96, "A_s": 2.1e-9, "m_ncdm": 0.8})
 
 
 def test_the_gil_is_released_during_a_computation():

@@ -106,6 +106,30 @@ impl Cosmology {
         scale_factor(z).map_or(f64::NAN, |a| self.rate(a, self.method()))
     }
 
+    /// The growing mode normalised to D = a deep in matter domination, D_md(z), and f(z), from one
+    /// integration (Heath's integral for a cosmological constant, the ODE otherwise). NaN unless z is
+    /// finite and > −1.
+    pub fn growth_md_and_rate(&self, z: f64) -> (f64, f64) {
+        let Some(a) = scale_factor(z) else {
+            return (f64::NAN, f64::NAN);
+        };
+        match self.method() {
+            Method::Heath => {
+                // heath_d_md and heath_rate, sharing the integral
+                let integral = self.growth_integral(a);
+                let e2 = self.a2e2(a) / (a * a);
+                let d_md = 2.5 * self.omega_m * self.a2e2(a).sqrt() / a * integral;
+                let dln_e =
+                    -(3.0 * self.omega_m / a.powi(3) + 2.0 * self.omega_k() / (a * a)) / (2.0 * e2);
+                (d_md, dln_e + 1.0 / (a * a * e2.powf(1.5) * integral))
+            }
+            Method::Ode => {
+                let [s, _] = self.ode_states([a.ln(), a.ln()]);
+                (a * s[0], 1.0 + s[1] / s[0])
+            }
+        }
+    }
+
     /// The method that [`growth_factor`](Self::growth_factor) and [`growth_rate`](Self::growth_rate) use.
     pub(super) fn method(&self) -> Method {
         if self.is_lambda() {

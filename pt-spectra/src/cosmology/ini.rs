@@ -18,10 +18,11 @@
 //! | k_pivot, 1/Mpc (default 0.05) | `k_pivot` | `pivot_scalar` |
 //! | w0 (default −1) | `w0_fld` | `w` |
 //! | wa (default 0) | `wa_fld` | `wa` |
+//! | Σm_ν in eV (default 0) | `m_ncdm` (list, eV per species; with `N_ncdm`, `deg_ncdm`) | `mnu`; `omnuh2` (ω_ν, Σm_ν = 93.14 eV ω_ν) |
 //!
 //! h, ω_b, ω_cdm, n_s and one of σ8 or A_s are needed; σ8 and A_s together are a conflict. Derived:
-//! Ω_m = (ω_b + ω_cdm)/h² and Ω_DE = 1 − Ω_m − Ω_k. Neutrinos are taken to be massless: their density
-//! (like that of the photons) is not part of Ω_m, so `omnuh2`, `m_ncdm`, `N_ur` etc. are ignored.
+//! Ω_m = (ω_b + ω_cdm + ω_ν)/h² with ω_ν = Σm_ν/93.14 eV (all matter, as CLASS's `Omega_m`), and
+//! Ω_DE = 1 − Ω_m − Ω_k. Massless species (`N_ur`) are ignored, like the photons.
 //! Every key not in the table is ignored and listed in [`ParsedCosmology::ignored`], so that the caller
 //! can say once which were. Not followed: CAMB's `DEFAULT(file)` and `INCLUDE(file)` lines (syntax
 //! errors), CAMB's `use_physical = F` parameters, and CLASS's split of the dark energy into
@@ -62,6 +63,7 @@ enum Quantity {
     Pivot,
     W0,
     Wa,
+    NeutrinoMass,
 }
 
 impl Quantity {
@@ -78,6 +80,7 @@ impl Quantity {
             Self::Pivot => "the pivot scale of A_s",
             Self::W0 => "the dark-energy equation of state w0",
             Self::Wa => "the dark-energy equation-of-state slope wa",
+            Self::NeutrinoMass => "the sum of the neutrino masses",
         }
     }
 
@@ -91,7 +94,7 @@ impl Quantity {
             Self::Sigma8 | Self::PrimordialAmplitude => {
                 "`sigma8`, `A_s`, `ln10^{10}A_s` (CLASS), `As` or `scalar_amp(1)` (CAMB)"
             }
-            Self::OmegaK | Self::Pivot | Self::W0 | Self::Wa => "",
+            Self::OmegaK | Self::Pivot | Self::W0 | Self::Wa | Self::NeutrinoMass => "",
         }
     }
 
@@ -108,6 +111,7 @@ impl Quantity {
             Self::Pivot => "k_pivot",
             Self::W0 => "w0",
             Self::Wa => "wa",
+            Self::NeutrinoMass => "m_nu",
         }
     }
 }
@@ -123,10 +127,15 @@ enum Unit {
     TimesH2,
     /// ln(10¹⁰ A_s).
     Ln1e10,
+    /// ω_ν = Ω_ν h²: Σm_ν = 93.14 eV ω_ν.
+    OmegaNu,
+    /// CLASS's masses of the `N_ncdm` species in eV, a comma-separated list, each times its
+    /// `deg_ncdm` (default 1): Σm_ν is the sum.
+    NcdmList,
 }
 
 /// The keys that are read (see the module docs).
-const KEYS: [(&str, Quantity, Unit); 25] = [
+const KEYS: [(&str, Quantity, Unit); 28] = [
     ("h", Quantity::Hubble, Unit::Same),
     ("H0", Quantity::Hubble, Unit::KmPerSecPerMpc),
     ("hubble", Quantity::Hubble, Unit::KmPerSecPerMpc),
@@ -156,7 +165,14 @@ const KEYS: [(&str, Quantity, Unit); 25] = [
     ("w", Quantity::W0, Unit::Same),
     ("wa_fld", Quantity::Wa, Unit::Same),
     ("wa", Quantity::Wa, Unit::Same),
+    ("m_ncdm", Quantity::NeutrinoMass, Unit::NcdmList),
+    ("mnu", Quantity::NeutrinoMass, Unit::Same),
+    ("omnuh2", Quantity::NeutrinoMass, Unit::OmegaNu),
 ];
+
+/// CLASS keys read with `m_ncdm`: the number of species (checked against the list) and their
+/// degeneracies.
+const NCDM_KEYS: [&str; 2] = ["N_ncdm", "deg_ncdm"];
 
 /// One `key = value` of the input.
 #[derive(Debug, Clone, Copy)]
@@ -328,6 +344,35 @@ fn parse_number(text: &str) -> Option<f64> {
     value.is_finite().then_some(value)
 }
 
+/// Σm_ν of CLASS's `m_ncdm` list (eV per species) times `deg_ncdm` (a number for all species or a list,
+/// default 1); `None` if a number does not parse, or the lengths disagree with each other or with
+/// `N_ncdm`.
+fn ncdm_sum(m_ncdm: Entry<'_>, entries: &[Entry<'_>]) -> Option<f64> {
+    let list = |text: &str| -> Option<Vec<f64>> {
+        text.split(',').map(|v| parse_number(v.trim())).collect()
+    };
+    let masses = list(m_ncdm.value)?;
+    let find = |key: &str| entries.iter().find(|e| e.key == key).map(|e| e.value);
+    if let Some(n) = find("N_ncdm") {
+        if parse_number(n)? != masses.len() as f64 {
+            return None;
+        }
+    }
+    let degeneracy = match find("deg_ncdm").map(list) {
+        None => vec![1.0; masses.len()],
+        Some(d) => {
+            let d = d?;
+            match d.len() {
+                1 => vec![d[0]; masses.len()],
+                n if n == masses.len() => d,
+                _ => return None,
+            }
+        }
+    };
+    let sum: f64 = masses.iter().zip(&degeneracy).map(|(m, g)| m * g).sum();
+    sum.is_finite().then_some(sum)
+}
+
 /// Whether two values of the same quantity agree to [`SYNONYM_TOL`].
 fn agree(x: f64, y: f64) -> bool {
     (x - y).abs() <= SYNONYM_TOL * x.abs().max(y.abs())
@@ -348,11 +393,19 @@ fn resolve(entries: &[Entry<'_>], origin: &str) -> Result<ParsedCosmology> {
             });
         }
         first_line.insert(entry.key, entry.line);
+        if NCDM_KEYS.contains(&entry.key) {
+            continue; // read with m_ncdm
+        }
         let Some((quantity, unit)) = lookup(entry.key) else {
             ignored.push((entry.line, entry.key));
             continue;
         };
-        let number = parse_number(entry.value).ok_or_else(|| Error::IniValue {
+        let parsed = if unit == Unit::NcdmList {
+            ncdm_sum(entry, entries)
+        } else {
+            parse_number(entry.value)
+        };
+        let number = parsed.ok_or_else(|| Error::IniValue {
             origin: origin.to_string(),
             line: entry.line,
             key: entry.key.to_string(),
@@ -412,7 +465,16 @@ fn resolve(entries: &[Entry<'_>], origin: &str) -> Result<ParsedCosmology> {
             })
         }
     };
-    let omega_m = (omega_b + omega_cdm) / h2;
+    let m_nu = values.get(Quantity::NeutrinoMass, h2)?.unwrap_or(0.0);
+    if m_nu == 0.0 {
+        ignored.extend(
+            entries
+                .iter()
+                .filter(|e| NCDM_KEYS.contains(&e.key))
+                .map(|e| (e.line, e.key)),
+        );
+    }
+    let omega_m = (omega_b + omega_cdm + m_nu / super::EV_PER_OMEGA_NU) / h2;
     let cosmology = Cosmology {
         omega_m,
         omega_lambda: 1.0 - omega_m - omega_k,
@@ -422,6 +484,7 @@ fn resolve(entries: &[Entry<'_>], origin: &str) -> Result<ParsedCosmology> {
         amplitude,
         w0,
         wa,
+        m_nu,
     };
     cosmology
         .validate()
@@ -475,6 +538,8 @@ impl<'a> Values<'a> {
                 Unit::KmPerSecPerMpc => f.number / 100.0,
                 Unit::TimesH2 => f.number * h2,
                 Unit::Ln1e10 => f.number.exp() * 1e-10,
+                Unit::OmegaNu => f.number * super::EV_PER_OMEGA_NU,
+                Unit::NcdmList => f.number,
             };
             if let Some(range) = super::plausible(quantity.plausible_name()) {
                 if !range.contains(value) {

@@ -39,6 +39,9 @@ pub const T_CMB_K: f64 = 2.7255;
 /// The Hubble distance c/H0 in Mpc/h (c = 299792.458 km/s, H0 = 100 h km/s/Mpc).
 pub const HUBBLE_DISTANCE_MPC_H: f64 = 2997.92458;
 
+/// Σm_ν/ω_ν in eV: ω_ν = Ω_ν h² = Σm_ν/93.14 eV for neutrinos of the standard temperature.
+pub const EV_PER_OMEGA_NU: f64 = 93.14;
+
 /// Names accepted by [`Cosmology::preset`].
 pub const PRESETS: [&str; 2] = ["gm2012", "planck2018"];
 
@@ -46,9 +49,11 @@ pub mod distance;
 mod eisenstein_hu;
 mod growth;
 pub mod ini;
+mod plausible;
 
 pub use eisenstein_hu::{EisensteinHu, TransferKind};
 pub use ini::ParsedCosmology;
+pub use plausible::{plausible, Plausible, PLAUSIBLE};
 
 /// How the amplitude of the linear spectrum is fixed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -101,134 +106,10 @@ pub struct Cosmology {
     pub w0: f64,
     /// Dark-energy equation-of-state slope wa, w(a) = w0 + wa (1 − a) (0 for a cosmological constant).
     pub wa: f64,
-}
-
-/// The range in which a cosmological parameter is accepted, and what is said otherwise.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Plausible {
-    /// The parameter: `h`, `omega_b` (Ω_b h²), `omega_cdm` (Ω_cdm h²), `Omega_m`, `Omega_k`, `n_s`,
-    /// `sigma8`, `A_s`, `k_pivot` (1/Mpc), `w0`, `wa`, `f` (the growth rate).
-    pub name: &'static str,
-    /// The smallest accepted value.
-    pub min: f64,
-    /// The largest accepted value.
-    pub max: f64,
-    /// The message of a value outside, with the range.
-    pub reason: &'static str,
-}
-
-impl Plausible {
-    /// Whether `v` is in [min, max].
-    pub fn contains(&self, v: f64) -> bool {
-        (self.min..=self.max).contains(&v)
-    }
-
-    /// The range as `[min, max]`.
-    pub fn describe(&self) -> String {
-        let n = crate::error::number;
-        format!("[{}, {}]", n(&self.min), n(&self.max))
-    }
-
-    /// What a value outside may have meant (empty if nothing specific).
-    pub fn hint(&self, v: f64) -> &'static str {
-        match self.name {
-            "h" if (20.0..=150.0).contains(&v) => {
-                " (h is H0/100: this looks like H0 in km/s/Mpc; give `H0` or divide by 100)"
-            }
-            "A_s" if (0.1..=100.0).contains(&v) => {
-                " (A_s is the amplitude itself, e.g. 2.1e-9; this looks like 1e9 A_s, or ln10^{10}A_s)"
-            }
-            "omega_b" | "omega_cdm" if v > self.max => {
-                " (omega_b and omega_cdm are physical densities Omega h^2; Omega_b and Omega_cdm are \
-                 the fractions)"
-            }
-            _ => "",
-        }
-    }
-}
-
-/// The plausible ranges of the cosmological parameters: wide enough for any model a survey analysis
-/// explores (EuclidEmulator2's box is well inside), narrow enough that a value in the wrong units
-/// (h = 67.66, A_s = 2.1, σ8 = 80) is refused rather than computed.
-pub const PLAUSIBLE: [Plausible; 12] = [
-    Plausible {
-        name: "h",
-        min: 0.2,
-        max: 1.5,
-        reason: "must be in [0.2, 1.5] (h = H0/(100 km/s/Mpc); a value in the tens is H0)",
-    },
-    Plausible {
-        name: "omega_b",
-        min: 0.005,
-        max: 0.1,
-        reason: "must be in [0.005, 0.1] (Omega_b h^2)",
-    },
-    Plausible {
-        name: "omega_cdm",
-        min: 0.0,
-        max: 1.5,
-        reason: "must be in [0, 1.5] (Omega_cdm h^2)",
-    },
-    Plausible {
-        name: "Omega_m",
-        min: 0.01,
-        max: 2.0,
-        reason: "must be in [0.01, 2]",
-    },
-    Plausible {
-        name: "Omega_k",
-        min: -1.0,
-        max: 1.0,
-        reason: "must be in [-1, 1]",
-    },
-    Plausible {
-        name: "n_s",
-        min: 0.5,
-        max: 1.5,
-        reason: "must be in [0.5, 1.5]",
-    },
-    Plausible {
-        name: "sigma8",
-        min: 0.05,
-        max: 3.0,
-        reason: "must be in [0.05, 3]",
-    },
-    Plausible {
-        name: "A_s",
-        min: 1e-11,
-        max: 1e-7,
-        reason: "must be in [1e-11, 1e-7] (e.g. 2.1e-9; ln10^{10}A_s is the logarithmic form)",
-    },
-    Plausible {
-        name: "k_pivot",
-        min: 1e-4,
-        max: 10.0,
-        reason: "must be in [1e-4, 10] 1/Mpc",
-    },
-    Plausible {
-        name: "w0",
-        min: -3.0,
-        max: 0.0,
-        reason: "must be in [-3, 0]",
-    },
-    Plausible {
-        name: "wa",
-        min: -5.0,
-        max: 3.0,
-        reason: "must be in [-5, 3]",
-    },
-    Plausible {
-        name: "f",
-        min: 0.0,
-        max: 2.0,
-        reason: "must be in [0, 2] (the linear growth rate dln D/dln a: ~0.5-1 for any plausible \
-                 cosmology; 0 turns redshift-space distortions off)",
-    },
-];
-
-/// The [`PLAUSIBLE`] range of the parameter `name`.
-pub fn plausible(name: &str) -> Option<&'static Plausible> {
-    PLAUSIBLE.iter().find(|p| p.name == name)
+    /// Sum of the neutrino masses Σm_ν in eV (three degenerate neutrinos; 0: massless). Their density
+    /// ω_ν = Σm_ν/93.14 eV is part of Ω_m; the growth here treats them as matter (scale-independent),
+    /// the emulator ([`crate::emulator`]) gives the scale-dependent growth of CDM + baryons.
+    pub m_nu: f64,
 }
 
 impl Default for Cosmology {
@@ -251,6 +132,7 @@ impl Cosmology {
             amplitude: Amplitude::Sigma8(0.8),
             w0: -1.0,
             wa: 0.0,
+            m_nu: 0.0,
         }
     }
 
@@ -271,6 +153,7 @@ impl Cosmology {
             amplitude: Amplitude::a_s(2.105209e-9),
             w0: -1.0,
             wa: 0.0,
+            m_nu: 0.0,
         }
     }
 
@@ -311,6 +194,7 @@ impl Cosmology {
             amplitude: Amplitude::Sigma8(sigma8),
             w0: -1.0,
             wa: 0.0,
+            m_nu: 0.0,
         };
         c.validate()?;
         Ok(c)
@@ -331,6 +215,17 @@ impl Cosmology {
     /// As [`validate`](Self::validate), e.g. unless w0 + wa < 0.
     pub fn with_dark_energy(self, w0: f64, wa: f64) -> Result<Self> {
         let c = Self { w0, wa, ..self };
+        c.validate()?;
+        Ok(c)
+    }
+
+    /// The same cosmology with neutrinos of total mass `m_nu` eV (three degenerate), at the same Ω_m:
+    /// the cold dark matter gives way to them, ω_cdm = Ω_m h² − ω_b − Σm_ν/93.14 eV.
+    ///
+    /// # Errors
+    /// As [`validate`](Self::validate), e.g. if ω_cdm would not stay positive.
+    pub fn with_neutrinos(self, m_nu: f64) -> Result<Self> {
+        let c = Self { m_nu, ..self };
         c.validate()?;
         Ok(c)
     }
@@ -388,6 +283,9 @@ impl Cosmology {
                 "must be positive and below Omega_m h^2",
             );
         }
+        if !(self.m_nu.is_finite() && self.m_nu >= 0.0) {
+            return bad("m_nu [eV]", self.m_nu, "must be finite and non-negative");
+        }
         for (name, v) in [("n_s", self.n_s), ("w0", self.w0), ("wa", self.wa)] {
             if !v.is_finite() {
                 return bad(name, v, "must be finite");
@@ -412,7 +310,7 @@ impl Cosmology {
             Amplitude::Sigma8(s) => (Some(s), None, None),
             Amplitude::As { a_s, k_pivot } => (None, Some(a_s), Some(k_pivot)),
         };
-        let omega_cdm = self.omega_m * self.h * self.h - self.omega_b_h2;
+        let omega_cdm = self.omega_m * self.h * self.h - self.omega_b_h2 - self.omega_nu();
         for (name, v) in [
             ("h", Some(self.h)),
             ("omega_b", Some(self.omega_b_h2)),
@@ -425,6 +323,7 @@ impl Cosmology {
             ("k_pivot", k_pivot),
             ("w0", Some(self.w0)),
             ("wa", Some(self.wa)),
+            ("m_nu", Some(self.m_nu)),
         ] {
             let (Some(v), Some(range)) = (v, plausible(name)) else {
                 continue;
@@ -434,6 +333,11 @@ impl Cosmology {
             }
         }
         Ok(())
+    }
+
+    /// The neutrino density ω_ν = Ω_ν h² = Σm_ν/93.14 eV.
+    pub fn omega_nu(&self) -> f64 {
+        self.m_nu / EV_PER_OMEGA_NU
     }
 
     /// Curvature density Ω_k = 1 − Ω_m − Ω_DE.
@@ -531,9 +435,14 @@ impl Cosmology {
         };
         let omega_k = self.omega_k();
         let omega_k = if omega_k.abs() < 1e-12 { 0.0 } else { omega_k };
+        let neutrinos = if self.m_nu > 0.0 {
+            format!(", m_nu = {} eV", number(self.m_nu))
+        } else {
+            String::new()
+        };
         format!(
             "Omega_m = {}, Omega_DE = {}, Omega_k = {}, h = {}, omega_b = {}, n_s = {}, {amplitude}, \
-             w0 = {}, wa = {}",
+             w0 = {}, wa = {}{neutrinos}",
             significant(self.omega_m),
             significant(self.omega_lambda),
             significant(omega_k),

@@ -69,7 +69,7 @@ pub(super) fn terms(
             found: format!("{} k", bias_plan.k().len()),
         });
     }
-    Ok(Some(bias_plan.evaluate(&prepared.spectrum)))
+    Ok(Some(bias_plan.evaluate(prepared.tracer_spectrum())))
 }
 
 /// Appends the columns and header lines of `output` to the table `t` of `spectra`.

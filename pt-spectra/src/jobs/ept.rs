@@ -63,7 +63,7 @@ pub fn ept_table(
     prepared: &Prepared,
     precision: &Precision,
 ) -> Result<Table> {
-    let terms = plan.terms(&prepared.spectrum)?;
+    let terms = plan.terms(prepared.tracer_spectrum())?;
     ept_table_from_terms(plan, &terms, request, prepared, precision)
 }
 

@@ -93,7 +93,9 @@ pub fn fit_tables(
     let m = &request.model;
     let precision = plan.real().precision();
     let growth = prepared.growth_factor;
-    let sigma0 = m.sigma0.resolve(&prepared.spectrum, growth, precision)?;
+    let sigma0 = m
+        .sigma0
+        .resolve(prepared.tracer_spectrum(), growth, precision)?;
     let f0 = m.f.unwrap_or(prepared.growth_rate);
     super::rsd::check_growth_rate(f0)?;
     let fields = [
@@ -121,7 +123,7 @@ pub fn fit_tables(
         }
     }
     let b = m.bias.values(&data.k, 1.0)?;
-    let (spectra, tns) = plan.evaluate(&prepared.spectrum, progress)?;
+    let (spectra, tns) = plan.evaluate(prepared.tracer_spectrum(), progress)?;
     let model = MultipoleModel::new(
         &spectra,
         tns.as_ref(),
@@ -187,7 +189,7 @@ pub fn fit_tables(
              h/Mpc, P_lin above)"
         ));
         let value = |input| -> Result<f64> {
-            Ok(dispersion_theory(&prepared.spectrum, input, precision)?.value / growth)
+            Ok(dispersion_theory(prepared.tracer_spectrum(), input, precision)?.value / growth)
         };
         Some([
             value(DispersionInput::Linear)?,

@@ -164,7 +164,18 @@ pub fn real_table_with_bias(
     }
     crate::real::check_cs2(cs2)?;
     let precision = plan.precision();
-    let spectra = plan.evaluate(&prepared.spectrum, progress)?;
+    let spectra = match &prepared.spectrum_cb {
+        Some(cb) => {
+            let spectra = plan.evaluate(cb, progress)?;
+            let p_m: Vec<f64> = spectra
+                .k
+                .iter()
+                .map(|&k| prepared.spectrum.eval(k))
+                .collect();
+            spectra.with_massive_neutrinos(&p_m, prepared.cold_fraction())?
+        }
+        None => plan.evaluate(&prepared.spectrum, progress)?,
+    };
     let mut header = vec![format!(
         "pt-spectra {VERSION} real: model {}, z = {}",
         match selection {
@@ -174,6 +185,14 @@ pub fn real_table_with_bias(
         prepared.z
     )];
     header.extend(describe_inputs(prepared, precision));
+    if prepared.spectrum_cb.is_some() {
+        header.push(format!(
+            "massive neutrinos: loops of P_cb; P_dd of all matter = P_lin + f_cb^2 (P_dd,cb - P_lin_cb) \
+             (neutrinos linear), f_cb = 1 - omega_nu/omega_m = {:.6}; P_dt, P_tt of cold dark matter + \
+             baryons; P_lin is P_m, P_lin_cb the linear P_cb",
+            prepared.cold_fraction()
+        ));
+    }
     if cs2 != 0.0 {
         header.push(counterterm_line(cs2));
     }
@@ -182,6 +201,13 @@ pub fn real_table_with_bias(
             header.extend(model_header(model, &spectra, precision, terms));
             let spectra = spectra.with_counterterm(cs2)?;
             let mut t = real_spectra_table(&spectra, header, terms);
+            if let Some(cb) = &prepared.spectrum_cb {
+                t.push(
+                    "P_lin_cb",
+                    POWER,
+                    spectra.k.iter().map(|&k| cb.eval(k)).collect(),
+                );
+            }
             if terms && cs2 != 0.0 {
                 for pair in Pair::ALL {
                     let name = format!("P_ct_{}", pair.suffix());

@@ -161,11 +161,11 @@ pub fn rsd_table(
     prepared: &Prepared,
     progress: &dyn Progress,
 ) -> Result<Table> {
-    let (spectra, tns) = plan.evaluate(&prepared.spectrum, progress)?;
+    let (spectra, tns) = plan.evaluate(prepared.tracer_spectrum(), progress)?;
     let bias_terms = match request.galaxy {
         None => None,
         Some(_) => Some(
-            plan.bias_terms(&prepared.spectrum)
+            plan.bias_terms(prepared.tracer_spectrum())
                 .ok_or(Error::MissingTerm {
                     term: "the bias terms",
                     needed_by: "the nonlinear galaxy bias".into(),
@@ -250,9 +250,10 @@ fn rsd_table_memo(
     let f = request.f.unwrap_or(prepared.growth_rate);
     check_growth_rate(f)?;
     let growth = prepared.growth_factor;
-    let sigma0 = request
-        .sigma0
-        .resolve_with(&prepared.spectrum, growth, precision, memo)?;
+    let sigma0 =
+        request
+            .sigma0
+            .resolve_with(prepared.tracer_spectrum(), growth, precision, memo)?;
     let sigma = fog_sigma(sigma0, growth, f);
     let bias = request.bias.values(k, request.amplitude)?;
     request.validate_galaxy()?;

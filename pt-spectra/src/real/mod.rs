@@ -260,6 +260,31 @@ pub struct RealSpectra {
 }
 
 impl RealSpectra {
+    /// Massive neutrinos, by the usual prescription (Saito, Takada & Taruya 2008; Castorina et al.
+    /// 2015): these spectra, computed from the linear spectrum of cold dark matter + baryons P_cb,
+    /// become for all matter P_δδ,m = P_m,lin + f_cb² (P_δδ,cb − P_cb,lin), with `p_m_lin` = P_m,lin at
+    /// the same k and f_cb = 1 − ω_ν/ω_m: neutrinos stay linear, and so does their cross-spectrum with
+    /// cold matter. P_δθ and P_θθ stay those of cold dark matter + baryons (the velocities that
+    /// galaxies follow). `p_lin` becomes P_m,lin.
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] unless `p_m_lin` has one value per k.
+    pub fn with_massive_neutrinos(mut self, p_m_lin: &[f64], f_cb: f64) -> Result<Self> {
+        if p_m_lin.len() != self.k.len() {
+            return Err(Error::LengthMismatch {
+                what: "k and P_m,lin",
+                left: self.k.len(),
+                right: p_m_lin.len(),
+            });
+        }
+        let dd = &mut self.spectra[Pair::DeltaDelta];
+        for ((v, &p_cb), &p_m) in dd.iter_mut().zip(&self.p_lin).zip(p_m_lin) {
+            *v = (*v + (-p_cb)) * (f_cb * f_cb) + p_m;
+        }
+        self.p_lin = p_m_lin.to_vec();
+        Ok(self)
+    }
+
     /// The spectrum of `pair`.
     pub fn pair(&self, pair: Pair) -> &[Estimate] {
         &self.spectra[pair]

@@ -263,7 +263,7 @@ pub fn table(
         &loaded.store,
         &Bars::default(),
     )?;
-    let terms = plan.terms(&loaded.prepared.spectrum)?;
+    let terms = plan.terms(loaded.prepared.tracer_spectrum())?;
     Ok(pt_spectra::jobs::ept_observed_table(
         &plan,
         &terms,

@@ -307,7 +307,7 @@ fn run_ept(args: &Args) -> Result<()> {
         &loaded.store,
         &Bars::default(),
     )?;
-    let terms = plan.terms(&loaded.prepared.spectrum)?;
+    let terms = plan.terms(loaded.prepared.tracer_spectrum())?;
     let mut header = vec![format!(
         "pt-spectra {} fit: ept (velocileptors' REPT conventions{}) to {}",
         pt_spectra::jobs::VERSION,

@@ -1,0 +1,364 @@
+//! The linear-spectrum emulator: P_lin(k, z) of all matter and of cold dark matter + baryons from the
+//! cosmological parameters, without a Boltzmann code.
+//!
+//! * **What is emulated.** G = ln P_cb(k, z) − ln A_s − (n_s − 1) ln(k h/k_pivot) − 2 ln(D_md(z)/Ω_m)
+//!   and ln(P_m/P_cb) (set to 0, exactly, without massive neutrinos), as functions of the six parameters that shape the transfer functions (Ω_b, Ω_m,
+//!   h, Σm_ν, w0, wa), on nodes in x = k r_d (r_d, the drag sound horizon of Aubourg et al. 2015, eq. 16, in Mpc/h: the
+//!   baryon oscillations then sit at the same x for every cosmology) and in redshift. A_s and n_s enter
+//!   through the primordial factor, which is exact in linear theory, so any A_s and n_s are accepted.
+//!   D_md(z) is the growing mode of the background ([`Cosmology::growth_md_and_rate`]: all matter as
+//!   dust, normalised to a deep in matter domination); dividing it out takes the steep dependence of
+//!   the amplitude on w0, wa and Ω_m out of what the polynomials must fit.
+//! * **How.** Each quantity is the training mean plus its leading principal components; each component's
+//!   coefficient is a polynomial (Legendre products, the terms listed in the file) of seven
+//!   coordinates: the shape parameters mapped to [−1, 1] by the prior box, and the early dark-energy
+//!   density ([`PriorPoint::coordinates`]). Between redshift nodes (uniform in ln(1 + z)) the four nearest
+//!   nodes are joined by a cubic (Lagrange) polynomial in s = ln(1 + z), whose derivative gives the
+//!   scale-dependent growth rate f_cb(k, z) = d ln D_cb/d ln a = f_md(z) − ½ ∂G/∂s.
+//! * **Trained on** CAMB spectra (`pt-spectra/data/make_emulator_training.py`, fitted by
+//!   `pt-spectra/data/fit_emulator.py`): three degenerate massive neutrinos of total mass Σm_ν,
+//!   N_eff = 3.046, T_CMB = 2.7255 K, flat, w0–wa dark energy in CAMB's PPF model. Its accuracy on
+//!   cosmologies it was not trained on is in the file (per k) and in `docs/emulator.md`.
+//! * **Units:** k in h/Mpc, P in (Mpc/h)³; Σm_ν in eV.
+//!
+//! ```
+//! use pt_spectra::{cosmology::Cosmology, emulator::LinearEmulator};
+//! let emulator = LinearEmulator::embedded()?;
+//! let spectra = emulator.spectra(&Cosmology::planck2018(), 0.0)?;
+//! assert!((spectra.sigma8 / 0.821734 - 1.0).abs() < 2e-3); // CAMB, massless neutrinos
+//! # Ok::<(), pt_spectra::error::Error>(())
+//! ```
+
+mod format;
+pub mod prior;
+
+use crate::cosmology::{Cosmology, EV_PER_OMEGA_NU};
+use crate::error::{Error, Result};
+use crate::linear::{top_hat, LinearSpectrum};
+pub use prior::{PriorPoint, PriorRange, COORDINATES, PARAMETER_NAMES, SHAPE_PARAMETERS};
+use std::f64::consts::PI;
+
+/// The emulator file shipped with the library.
+const EMBEDDED: &[u8] = include_bytes!("../../data/linear_emulator.bin");
+
+/// The drag sound horizon r_d in Mpc/h from the fit of Aubourg et al. (2015, eq. 16), accurate to ~0.1%
+/// for massive neutrinos; here only a coordinate that aligns the baryon oscillations of all cosmologies.
+pub fn drag_horizon(omega_b: f64, omega_m: f64, h: f64, m_nu: f64) -> f64 {
+    let w_nu = m_nu / EV_PER_OMEGA_NU;
+    let w_b = omega_b * h * h;
+    let w_cb = omega_m * h * h - w_nu;
+    55.154 * (-72.3 * (w_nu + 0.0006).powi(2)).exp() / (w_cb.powf(0.25351) * w_b.powf(0.12807)) * h
+}
+
+/// The emulator: parsed once, then [`spectra`](Self::spectra) per cosmology.
+#[derive(Debug, Clone)]
+pub struct LinearEmulator {
+    file: format::Parsed,
+    max_degree: usize,
+    origin: String,
+}
+
+/// The emulated linear spectra of one cosmology at one redshift.
+#[derive(Debug, Clone)]
+pub struct EmulatedSpectra {
+    /// The redshift.
+    pub z: f64,
+    /// Wavenumbers in h/Mpc (uniform in ln k; the range depends on r_d).
+    pub k: Vec<f64>,
+    /// P of all matter (CDM, baryons and massive neutrinos) in (Mpc/h)³.
+    pub p_m: Vec<f64>,
+    /// P of cold dark matter + baryons in (Mpc/h)³ (equal to `p_m` for massless neutrinos).
+    pub p_cb: Vec<f64>,
+    /// Growth rate of cold dark matter + baryons, f_cb(k, z) = d ln D_cb(k, z)/d ln a.
+    pub f_cb: Vec<f64>,
+    /// Estimated relative error of `p_cb` per k (the test set's 99th percentile of |Δ ln P|).
+    pub error_cb: Vec<f64>,
+    /// Estimated relative error of `p_m` per k.
+    pub error_m: Vec<f64>,
+    /// σ8 of all matter at `z`.
+    pub sigma8: f64,
+    /// A_s at the pivot (given, or set by σ8).
+    pub a_s: f64,
+}
+
+impl EmulatedSpectra {
+    /// P_m as a [`LinearSpectrum`] (power-law extrapolation beyond the nodes).
+    ///
+    /// # Errors
+    /// As [`LinearSpectrum::from_nodes`].
+    pub fn matter(&self) -> Result<LinearSpectrum> {
+        LinearSpectrum::from_nodes(self.k.clone(), self.p_m.clone())
+    }
+
+    /// P_cb as a [`LinearSpectrum`].
+    ///
+    /// # Errors
+    /// As [`LinearSpectrum::from_nodes`].
+    pub fn cb(&self) -> Result<LinearSpectrum> {
+        LinearSpectrum::from_nodes(self.k.clone(), self.p_cb.clone())
+    }
+}
+
+impl LinearEmulator {
+    /// The emulator shipped with the library (`pt-spectra/data/linear_emulator.bin`).
+    ///
+    /// # Errors
+    /// [`Error::BadDataFile`] if the embedded file is malformed (a build error, tested).
+    pub fn embedded() -> Result<Self> {
+        Self::from_bytes(EMBEDDED, "embedded linear-spectrum emulator")
+    }
+
+    /// An emulator from the bytes of a file written by `fit_emulator.py`; `origin` names it.
+    ///
+    /// # Errors
+    /// [`Error::BadDataFile`] naming the byte where the layout breaks.
+    pub fn from_bytes(bytes: &[u8], origin: &str) -> Result<Self> {
+        let file = format::parse(bytes, origin)?;
+        let max_degree = file
+            .exponents
+            .iter()
+            .flat_map(|e| e.iter())
+            .map(|&d| usize::from(d))
+            .max()
+            .unwrap_or(0);
+        Ok(Self {
+            file,
+            max_degree,
+            origin: origin.to_string(),
+        })
+    }
+
+    /// The prior: the range of each of the eight parameters it was trained or tested on. The six shape
+    /// parameters must lie inside; A_s and n_s may lie outside (their dependence is exact).
+    pub fn prior(&self) -> &[PriorRange] {
+        &self.file.prior
+    }
+
+    /// The redshift range, [z_min, z_max].
+    pub fn z_range(&self) -> (f64, f64) {
+        let z = &self.file.z_nodes;
+        (z[0], z[z.len() - 1])
+    }
+
+    /// One line for output headers: what the emulator is and where it is valid.
+    pub fn describe(&self) -> String {
+        let prior: Vec<String> = self.file.prior[..SHAPE_PARAMETERS]
+            .iter()
+            .map(|p| format!("{} in [{}, {}]", p.name, p.min, p.max))
+            .collect();
+        let (z0, z1) = self.z_range();
+        format!(
+            "{} (trained on CAMB; prior {}; z in [{z0}, {z1}]; three degenerate neutrinos, PPF dark energy, flat)",
+            self.origin,
+            prior.join(", ")
+        )
+    }
+
+    /// P_m, P_cb and f_cb of `cosmology` at redshift `z`.
+    ///
+    /// # Errors
+    /// [`Error::OutsidePrior`] naming a shape parameter outside the prior; [`Error::InvalidParameter`]
+    /// for a curved cosmology or a redshift outside [`z_range`](Self::z_range).
+    pub fn spectra(&self, cosmology: &Cosmology, z: f64) -> Result<EmulatedSpectra> {
+        let point = PriorPoint::of(cosmology)?;
+        let u = point.coordinates(&self.file.prior, self.file.a_early, self.file.q_max)?;
+        let (z0, z1) = self.z_range();
+        if !(z >= z0 - 1e-12 && z <= z1 + 1e-12) {
+            return Err(Error::InvalidParameter {
+                name: "z",
+                value: z,
+                reason: "outside the linear-spectrum emulator's redshift range [0, 3]",
+            });
+        }
+        let [ob, om, h, m_nu, ..] = point.values;
+        let n_s = point.values[7];
+        let r_d = if self.file.rescale {
+            drag_horizon(ob, om, h, m_nu)
+        } else {
+            1.0
+        };
+        let (lx0, lx1) = self.file.ln_x;
+        let n_x = self.file.n_x;
+        let step = (lx1 - lx0) / (n_x - 1) as f64;
+        let ln_k: Vec<f64> = (0..n_x).map(|i| lx0 + step * i as f64 - r_d.ln()).collect();
+        // k_i = k_0 q^i (a geometric progression: no exponential per node)
+        let ratio = step.exp();
+        let k: Vec<f64> = std::iter::successors(Some(ln_k[0].exp()), |k| Some(k * ratio))
+            .take(n_x)
+            .collect();
+        let coefficients = self.coefficients(&u);
+        let z = z.clamp(z0, z1);
+        let shape = self.at_redshift(&coefficients, z);
+        // ln P_cb = G_cb + 2 ln(D_md/Ω_m) + ln A_s + (n_s − 1) ln(k h/k_pivot)
+        let growth = |z: f64| {
+            let (d_md, f) = cosmology.growth_md_and_rate(z);
+            (2.0 * (d_md / om).ln(), f)
+        };
+        let (growth_z, f_ode) = growth(z);
+        // P_m = P_cb exactly for massless neutrinos (the emulated ratio is then its own error)
+        let massive = if m_nu > 0.0 { 1.0 } else { 0.0 };
+        let tilt: Vec<f64> = ln_k
+            .iter()
+            .map(|&lk| (n_s - 1.0) * (lk + (h / point.k_pivot).ln()))
+            .collect();
+        let ln_as = match point.a_s {
+            Some(a_s) => a_s.ln(),
+            None => {
+                let today = self.at_redshift(&coefficients, z0);
+                let growth_0 = growth(z0).0;
+                let sigma8_unit = sigma8(&k, step, |i| {
+                    (today.cb[i] + growth_0 + massive * today.ratio[i] + tilt[i]).exp()
+                });
+                let crate::cosmology::Amplitude::Sigma8(target) = cosmology.amplitude else {
+                    unreachable!("a_s is None only for a σ8 amplitude")
+                };
+                2.0 * (target / sigma8_unit).ln()
+            }
+        };
+        let ln_p_cb: Vec<f64> = (0..n_x)
+            .map(|i| shape.cb[i] + growth_z + ln_as + tilt[i])
+            .collect();
+        let p_cb: Vec<f64> = ln_p_cb.iter().map(|v| v.exp()).collect();
+        let p_m: Vec<f64> = (0..n_x)
+            .map(|i| (ln_p_cb[i] + massive * shape.ratio[i]).exp())
+            .collect();
+        let sigma8 = sigma8(&k, step, |i| p_m[i]);
+        Ok(EmulatedSpectra {
+            z,
+            k,
+            p_m,
+            p_cb,
+            f_cb: shape.d_cb_ds.iter().map(|d| f_ode - 0.5 * d).collect(),
+            error_cb: self.file.error[0].clone(),
+            error_m: self.file.error[1].clone(),
+            sigma8,
+            a_s: ln_as.exp(),
+        })
+    }
+
+    /// The principal-component coefficients of both targets at the unit point `u`.
+    fn coefficients(&self, u: &[f64; COORDINATES]) -> [Vec<f64>; 2] {
+        let legendre: Vec<Vec<f64>> = u.iter().map(|&x| legendre(x, self.max_degree)).collect();
+        let features: Vec<f64> = self
+            .file
+            .exponents
+            .iter()
+            .map(|e| {
+                e.iter()
+                    .enumerate()
+                    .map(|(d, &n)| legendre[d][usize::from(n)])
+                    .product()
+            })
+            .collect();
+        [0, 1].map(|t| {
+            let t = &self.file.targets[t];
+            let mut c = vec![0.0; t.n_pc];
+            for (row, f) in t.coefficients.chunks_exact(t.n_pc).zip(&features) {
+                for (cj, r) in c.iter_mut().zip(row) {
+                    *cj += f * r;
+                }
+            }
+            c
+        })
+    }
+
+    /// Both targets at redshift `z` (four-node Lagrange interpolation in s = ln(1 + z)), and
+    /// ∂ ln P_cb/∂s.
+    fn at_redshift(&self, coefficients: &[Vec<f64>; 2], z: f64) -> Shape {
+        let nodes: Vec<f64> = self.file.z_nodes.iter().map(|z| z.ln_1p()).collect();
+        let s = z.ln_1p();
+        let interval = nodes.partition_point(|&v| v <= s).saturating_sub(1);
+        let first = interval.saturating_sub(1).min(nodes.len() - 4);
+        let window = &nodes[first..first + 4];
+        let (w, dw) = lagrange(window, s);
+        let n_x = self.file.n_x;
+        let mut out = [vec![0.0; n_x], vec![0.0; n_x], vec![0.0; n_x]];
+        // one node's Σ_p c_p V_p, accumulated in f32 (the components are f32; |sum| ≲ 10, so the
+        // rounding is ~1e-6 in ln P)
+        let mut row = vec![0.0_f32; n_x];
+        for (t, (target, c)) in self.file.targets.iter().zip(coefficients).enumerate() {
+            let stride = target.mean.len();
+            for j in 0..4 {
+                let node = first + j;
+                row.fill(0.0);
+                for (p, &cp) in c.iter().enumerate() {
+                    let cp = cp as f32;
+                    let v = &target.components[p * stride + node * n_x..][..n_x];
+                    for (r, &vi) in row.iter_mut().zip(v) {
+                        *r += cp * vi;
+                    }
+                }
+                let mean = &target.mean[node * n_x..(node + 1) * n_x];
+                for ((o, &r), &m) in out[t].iter_mut().zip(&row).zip(mean) {
+                    *o += w[j] * (m + f64::from(r));
+                }
+                if t == 0 {
+                    for ((o, &r), &m) in out[2].iter_mut().zip(&row).zip(mean) {
+                        *o += dw[j] * (m + f64::from(r));
+                    }
+                }
+            }
+        }
+        let [cb, ratio, d_cb_ds] = out;
+        Shape { cb, ratio, d_cb_ds }
+    }
+}
+
+/// The targets at one redshift.
+struct Shape {
+    cb: Vec<f64>,
+    ratio: Vec<f64>,
+    d_cb_ds: Vec<f64>,
+}
+
+/// Legendre polynomials P_0..P_n at x.
+fn legendre(x: f64, n: usize) -> Vec<f64> {
+    let mut p = vec![1.0, x];
+    for m in 1..n {
+        let m_f = m as f64;
+        p.push(((2.0 * m_f + 1.0) * x * p[m] - m_f * p[m - 1]) / (m_f + 1.0));
+    }
+    p.truncate(n + 1);
+    p
+}
+
+/// Lagrange weights of four nodes at s, and of the derivative.
+fn lagrange(nodes: &[f64], s: f64) -> ([f64; 4], [f64; 4]) {
+    let mut w = [0.0; 4];
+    let mut dw = [0.0; 4];
+    for j in 0..4 {
+        let others: Vec<usize> = (0..4).filter(|&m| m != j).collect();
+        let denominator: f64 = others.iter().map(|&m| nodes[j] - nodes[m]).product();
+        w[j] = others.iter().map(|&m| s - nodes[m]).product::<f64>() / denominator;
+        dw[j] = others
+            .iter()
+            .map(|&skip| {
+                others
+                    .iter()
+                    .filter(|&&m| m != skip)
+                    .map(|&m| s - nodes[m])
+                    .product::<f64>()
+            })
+            .sum::<f64>()
+            / denominator;
+    }
+    (w, dw)
+}
+
+/// σ8 from P on k uniform in ln k with spacing `step`: σ² = (1/2π²) ∫ k³ P W²(8k) d ln k by the
+/// trapezoidal rule (the integrand vanishes at both ends of the emulator's range).
+fn sigma8(k: &[f64], step: f64, p: impl Fn(usize) -> f64) -> f64 {
+    let last = k.len() - 1;
+    let sum: f64 = k
+        .iter()
+        .enumerate()
+        .map(|(i, &k)| {
+            let end = if i == 0 || i == last { 0.5 } else { 1.0 };
+            end * k.powi(3) * p(i) * top_hat(8.0 * k).powi(2)
+        })
+        .sum();
+    (sum * step / (2.0 * PI * PI)).sqrt()
+}
+
+#[cfg(test)]
+mod tests;

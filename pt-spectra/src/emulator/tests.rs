@@ -1,0 +1,221 @@
+use super::*;
+use crate::cosmology::Amplitude;
+
+/// One held-out CAMB cosmology of `tests/data/emulator_heldout.dat`.
+struct Heldout {
+    params: [f64; 8],
+    z: f64,
+    k: Vec<f64>,
+    p_cb: Vec<f64>,
+    p_m: Vec<f64>,
+    f_cb: Vec<f64>,
+    sigma8: f64,
+}
+
+fn heldout() -> Vec<Heldout> {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/emulator_heldout.dat"
+    );
+    let text = std::fs::read_to_string(path).expect("held-out table");
+    let mut out: Vec<Heldout> = Vec::new();
+    for line in text.lines().filter(|l| !l.starts_with('#')) {
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        let index = v[0] as usize;
+        if out.len() == index {
+            out.push(Heldout {
+                params: v[1..9].try_into().unwrap(),
+                z: v[9],
+                k: Vec::new(),
+                p_cb: Vec::new(),
+                p_m: Vec::new(),
+                f_cb: Vec::new(),
+                sigma8: v[14],
+            });
+        }
+        let h = &mut out[index];
+        h.k.push(v[10]);
+        h.p_cb.push(v[11]);
+        h.p_m.push(v[12]);
+        h.f_cb.push(v[13]);
+    }
+    out
+}
+
+fn cosmology(p: &[f64; 8]) -> Cosmology {
+    let [ob, om, h, m_nu, w0, wa, ln_as, n_s] = *p;
+    let mut c = Cosmology::planck2018();
+    c.omega_m = om;
+    c.omega_lambda = 1.0 - om;
+    c.h = h;
+    c.omega_b_h2 = ob * h * h;
+    c.n_s = n_s;
+    c.amplitude = Amplitude::a_s(ln_as.exp() * 1e-10);
+    c.w0 = w0;
+    c.wa = wa;
+    c.m_nu = m_nu;
+    c.validate().unwrap();
+    c
+}
+
+#[test]
+fn held_out_camb_spectra_growth_rates_and_sigma8() {
+    let emulator = LinearEmulator::embedded().unwrap();
+    let (mut worst_p, mut worst_f, mut worst_s8) = (0.0_f64, 0.0_f64, 0.0_f64);
+    for h in heldout() {
+        let e = emulator.spectra(&cosmology(&h.params), h.z).unwrap();
+        let (m, cb) = (e.matter().unwrap(), e.cb().unwrap());
+        let f = LinearSpectrum::from_nodes(e.k.clone(), e.f_cb.iter().map(|v| v + 1.0).collect())
+            .unwrap();
+        for i in 0..h.k.len() {
+            worst_p = worst_p
+                .max((m.eval(h.k[i]) / h.p_m[i] - 1.0).abs())
+                .max((cb.eval(h.k[i]) / h.p_cb[i] - 1.0).abs());
+            worst_f = worst_f.max(((f.eval(h.k[i]) - 1.0) / h.f_cb[i] - 1.0).abs());
+        }
+        worst_s8 = worst_s8.max((e.sigma8 / h.sigma8 - 1.0).abs());
+    }
+    eprintln!("held out: P {worst_p:.2e}, f_cb {worst_f:.2e}, sigma8 {worst_s8:.2e}");
+    assert!(worst_p < 2e-3, "P: {worst_p}");
+    assert!(worst_f < 3e-3, "f_cb: {worst_f}");
+    assert!(worst_s8 < 1e-3, "sigma8: {worst_s8}");
+}
+
+#[test]
+fn sigma8_normalisation_matches_a_s_and_the_library_integral() {
+    let emulator = LinearEmulator::embedded().unwrap();
+    let c = Cosmology::planck2018().with_neutrinos(0.2).unwrap();
+    let by_as = emulator.spectra(&c, 0.5).unwrap();
+    // σ8 of the emulator's own quadrature against LinearSpectrum::sigma_r on the same nodes
+    let (s, err) = by_as.matter().unwrap().sigma_r(8.0).unwrap();
+    assert!(
+        (by_as.sigma8 / s - 1.0).abs() < 1e-4 + err / s,
+        "{} {s}",
+        by_as.sigma8
+    );
+    // normalising by σ8(z = 0) instead gives back A_s
+    let today = emulator.spectra(&c, 0.0).unwrap().sigma8;
+    let by_s8 = emulator
+        .spectra(&c.with_amplitude(Amplitude::Sigma8(today)).unwrap(), 0.5)
+        .unwrap();
+    assert!(
+        (by_s8.a_s / 2.105209e-9 - 1.0).abs() < 1e-10,
+        "{}",
+        by_s8.a_s
+    );
+    assert!((by_s8.p_m[200] / by_as.p_m[200] - 1.0).abs() < 1e-10);
+}
+
+#[test]
+fn massless_neutrinos_give_p_cb_equal_to_p_m_and_the_ode_growth_rate() {
+    let emulator = LinearEmulator::embedded().unwrap();
+    let c = Cosmology::planck2018();
+    for z in [0.0, 0.7, 2.0] {
+        let e = emulator.spectra(&c, z).unwrap();
+        for i in (0..e.k.len()).step_by(25) {
+            // the ODE neglects radiation: 2e-3 at these redshifts
+            if (1e-3..1.0).contains(&e.k[i]) {
+                // the emulated ratio is the emulator's error here (exactly 1 in CAMB)
+                assert!((e.p_m[i] / e.p_cb[i] - 1.0).abs() < 1e-3, "{z} {}", e.k[i]);
+                let f = c.growth_rate(z);
+                assert!(
+                    (e.f_cb[i] / f - 1.0).abs() < 3e-3,
+                    "{z} {} {}",
+                    e.f_cb[i],
+                    f
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn neutrinos_suppress_small_scales_by_the_free_streaming_limit() {
+    // Linear theory: P_m(k ≫ k_fs)/P_m(m_nu = 0) → ≈ 1 − 8 f_ν at z = 0 (Hu, Eisenstein & Tegmark 1998)
+    let emulator = LinearEmulator::embedded().unwrap();
+    let c0 = Cosmology::planck2018();
+    let c = c0.with_neutrinos(0.3).unwrap();
+    let f_nu = c.omega_nu() / (c.omega_m * c.h * c.h);
+    let (a, b) = (
+        emulator.spectra(&c, 0.0).unwrap(),
+        emulator.spectra(&c0, 0.0).unwrap(),
+    );
+    let i = a.k.iter().position(|&k| k > 2.0).unwrap();
+    let ratio = a.p_m[i] / b.matter().unwrap().eval(a.k[i]);
+    assert!((ratio - (1.0 - 8.0 * f_nu)).abs() < 0.03, "{ratio} {f_nu}");
+    // large scales unchanged (same A_s, Omega_m)
+    let j = a.k.iter().position(|&k| k > 2e-4).unwrap();
+    assert!((a.p_m[j] / b.matter().unwrap().eval(a.k[j]) - 1.0).abs() < 0.02);
+}
+
+#[test]
+fn outside_the_prior_names_the_parameter() {
+    let emulator = LinearEmulator::embedded().unwrap();
+    let c = Cosmology::planck2018().with_neutrinos(0.7).unwrap();
+    let e = emulator.spectra(&c, 0.0).unwrap_err().to_string();
+    assert!(e.contains("m_nu = 0.7") && e.contains("[0, 0.5]"), "{e}");
+    let curved = Cosmology::new(0.3, 0.65, 0.7, 0.022, 0.96, 0.8).unwrap();
+    let e = emulator.spectra(&curved, 0.0).unwrap_err().to_string();
+    assert!(e.contains("Omega_k"), "{e}");
+    let e = emulator
+        .spectra(&Cosmology::planck2018(), 3.5)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("z = 3.5"), "{e}");
+}
+
+#[test]
+fn a_broken_file_is_an_error_with_the_offset() {
+    let e = LinearEmulator::from_bytes(b"PTEMU001\x01", "test file").unwrap_err();
+    assert!(
+        e.to_string().contains("test file: malformed at byte 8"),
+        "{e}"
+    );
+    let e = LinearEmulator::from_bytes(b"NOTEMU01", "x").unwrap_err();
+    assert!(e.to_string().contains("not an emulator file"), "{e}");
+}
+
+#[test]
+fn lagrange_weights_reproduce_a_cubic_and_its_derivative() {
+    let nodes = [0.1, 0.3, 0.5, 0.7];
+    let cubic = |s: f64| 2.0 - s + 3.0 * s * s - 0.5 * s * s * s;
+    let d_cubic = |s: f64| -1.0 + 6.0 * s - 1.5 * s * s;
+    let (w, dw) = lagrange(&nodes, 0.42);
+    let v: f64 = (0..4).map(|j| w[j] * cubic(nodes[j])).sum();
+    let d: f64 = (0..4).map(|j| dw[j] * cubic(nodes[j])).sum();
+    assert!((v - cubic(0.42)).abs() < 1e-13 && (d - d_cubic(0.42)).abs() < 1e-12);
+}
+
+#[test]
+fn class_spectra_of_six_cosmologies_agree() {
+    // A second Boltzmann code: CLASS with the same neutrinos and PPF dark energy
+    // (tests/data/make_emulator_class.py). CAMB and CLASS themselves, both at default precision,
+    // differ on these by 0.7e-3 (Planck, massless) to 5.7e-3 (m_nu = 0.45 eV): the bound is theirs.
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/emulator_class.dat");
+    let text = std::fs::read_to_string(path).expect("CLASS table");
+    let emulator = LinearEmulator::embedded().unwrap();
+    let mut worst = 0.0_f64;
+    let mut current: Option<(usize, EmulatedSpectra)> = None;
+    for line in text.lines().filter(|l| !l.starts_with('#')) {
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        let index = v[0] as usize;
+        if current.as_ref().map(|c| c.0) != Some(index) {
+            let params: [f64; 8] = v[1..9].try_into().unwrap();
+            current = Some((index, emulator.spectra(&cosmology(&params), v[9]).unwrap()));
+        }
+        let e = &current.as_ref().unwrap().1;
+        let (m, cb) = (e.matter().unwrap(), e.cb().unwrap());
+        let d = (cb.eval(v[10]) / v[11] - 1.0)
+            .abs()
+            .max((m.eval(v[10]) / v[12] - 1.0).abs());
+        worst = worst.max(d);
+    }
+    eprintln!("CLASS: worst {worst:.2e}");
+    assert!(worst < 7e-3, "{worst}");
+}
