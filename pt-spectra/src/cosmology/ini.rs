@@ -370,6 +370,8 @@ fn ncdm_sum(m_ncdm: Entry<'_>, entries: &[Entry<'_>]) -> Option<f64> {
         }
     };
     let sum: f64 = masses.iter().zip(&degeneracy).map(|(m, g)| m * g).sum();
+    // to 1e-12 eV: 3 × 0.1 is 0.3, not 0.30000000000000004
+    let sum = (sum * 1e12).round() / 1e12;
     sum.is_finite().then_some(sum)
 }
 

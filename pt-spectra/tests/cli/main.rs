@@ -7,6 +7,7 @@ use std::process::Command;
 
 mod bias;
 mod counterterm;
+mod emulator;
 mod ept;
 mod fit;
 mod fixtures;

@@ -78,8 +78,9 @@ pub enum EhKind {
 pub struct SpectrumInput {
     /// Cosmology: a preset (`gm2012`, the default, or `planck2018`) or a CLASS/CAMB `.ini` parameter
     /// file. It sets the growth D(z) and f(z) (rescaling from --z-input to --z, default f, FoG scale)
-    /// and the no-wiggle reference; without --linear, a cosmology other than gm2012 uses its
-    /// Eisenstein & Hu spectrum.
+    /// and the no-wiggle reference; without --linear, a cosmology other than gm2012 is emulated
+    /// (CAMB's P_m and, with massive neutrinos, P_cb; a parameter outside the emulator's prior is an
+    /// error, --eh keeps Eisenstein & Hu).
     #[arg(long, value_name = "NAME|FILE")]
     cosmology: Option<String>,
     /// Linear spectrum table (k [h/Mpc], P [(Mpc/h)^3]; CAMB or CLASS format). Default: the embedded

@@ -316,3 +316,36 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn neutrino_masses_from_class_lists_camb_mnu_and_omnuh2() {
+    let base = "h = 0.67\nomega_b = 0.022\nomega_cdm = 0.12\nn_s = 0.96\nA_s = 2.1e-9\n";
+    let class = |extra: &str| Cosmology::from_ini_str(&format!("{base}{extra}"), "nu.ini");
+    let c = class("N_ncdm = 3\nm_ncdm = 0.02, 0.02, 0.02\n")
+        .unwrap()
+        .cosmology;
+    assert_eq!(c.m_nu, 0.06);
+    // ω_ν is part of Ω_m
+    let expected = (0.022 + 0.12 + 0.06 / 93.14) / (0.67 * 0.67);
+    assert!((c.omega_m / expected - 1.0).abs() < 1e-14);
+    assert_eq!(
+        class("m_ncdm = 0.05\ndeg_ncdm = 3\n")
+            .unwrap()
+            .cosmology
+            .m_nu,
+        0.15
+    );
+    let camb = "H0 = 67\nombh2 = 0.022\nomch2 = 0.12\nns = 0.96\nAs = 2.1e-9\n";
+    let c = Cosmology::from_ini_str(&format!("{camb}mnu = 0.06\n"), "camb.ini").unwrap();
+    assert_eq!(c.cosmology.m_nu, 0.06);
+    let c = Cosmology::from_ini_str(&format!("{camb}omnuh2 = 0.001\n"), "params.ini").unwrap();
+    assert!((c.cosmology.m_nu - 0.09314).abs() < 1e-12);
+    // a list that disagrees with N_ncdm is an error naming the line
+    let e = class("N_ncdm = 2\nm_ncdm = 0.02, 0.02, 0.02\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("m_ncdm") && e.contains("nu.ini:7"), "{e}");
+    // without neutrino masses, N_ncdm and deg_ncdm are listed as ignored
+    let c = class("N_ncdm = 0\n").unwrap();
+    assert_eq!(c.ignored, ["N_ncdm"]);
+}
