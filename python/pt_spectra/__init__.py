@@ -24,13 +24,14 @@ import warnings as _warnings
 import numpy as np
 
 from . import _core
-from ._core import (Observation, Table, eisenstein_hu, growth, log_grid, num_threads,
-                    set_num_threads)
+from ._core import (LinearEmulator, Observation, Table, eisenstein_hu, growth, log_grid,
+                    num_threads, set_num_threads)
 
 __all__ = [
     "EptPlan",
     "Observation",
     "EptTerms",
+    "LinearEmulator",
     "PtSpectraWarning",
     "RealPlan",
     "RsdPlan",

@@ -59,6 +59,15 @@ velocileptors' names with the suffix: ``b1_i`` (required), ``b2_i``, ``bs_i``, `
 (default 0; sn is the constant stochastic term, so no separate P_shot); ``real``, ``fog``, ``two_loop``
 do not apply.
 
+Without a Boltzmann code (``emulator: true``): the theory takes the cosmological parameters itself and
+computes the linear spectrum with the library's emulator (:class:`pt_spectra.LinearEmulator`, 0.1 ms per
+redshift; see the documentation for its prior and accuracy). Parameters (cobaya/CAMB or CLASS names, each
+fixed or sampled in ``params``): ``ombh2``/``omega_b``, ``omch2``/``omega_cdm``, ``H0``/``h``,
+``logA``/``As``/``A_s``, ``ns``/``n_s`` (required), ``mnu``/``m_ncdm`` (Σm_ν in eV, three degenerate;
+default 0), ``w``/``w0_fld`` (-1), ``wa``/``wa_fld`` (0). The models use P_cb (cold dark matter +
+baryons), f = f_cb(k = 0.1 h/Mpc, z) and D = σ8(z)/σ8(0) of P_m; a cosmology outside the prior gets zero
+likelihood (logged). ``ap_fiducial`` is not yet available with the emulator.
+
 The linear spectrum is the Boltzmann code's own ``Pk_grid`` at exactly each z (k [1/Mpc] and P
 [Mpc^3] converted to h/Mpc and (Mpc/h)^3 with its H0), rather than ``Pk_interpolator``: no second
 interpolation, and no need for the ≥ 4 redshifts that the interpolator requires. The growth rate is
@@ -90,6 +99,18 @@ NUISANCE = {
     "A_b": (False, 1.0, ""),
     "P_shot": (False, 0.0, "(Mpc/h)^3"),
     "cs2": (False, 0.0, "(Mpc/h)^2"),
+}
+
+#: The cosmological parameters of ``emulator: true``: accepted names -> (ini key, required, default).
+COSMOLOGY = {
+    "ombh2": ("ombh2", True, None), "omega_b": ("ombh2", True, None),
+    "omch2": ("omch2", True, None), "omega_cdm": ("omch2", True, None),
+    "H0": ("H0", True, None), "h": ("h", True, None),
+    "logA": ("ln10^{10}A_s", True, None), "As": ("As", True, None), "A_s": ("As", True, None),
+    "ns": ("ns", True, None), "n_s": ("ns", True, None),
+    "mnu": ("mnu", False, 0.0), "m_ncdm": ("mnu", False, 0.0),
+    "w": ("w", False, -1.0), "w0_fld": ("w", False, -1.0),
+    "wa": ("wa", False, 0.0), "wa_fld": ("wa", False, 0.0),
 }
 
 #: The nuisance parameters of one redshift with ``rsd: ept`` (velocileptors' names).
@@ -136,6 +157,7 @@ class PTMultipoles(Theory):
     prefix: str = ""
     ir: bool = True
     ap_fiducial: dict | None = None
+    emulator: bool = False
 
     # ---- set-up ------------------------------------------------------------------------------
     def initialize(self):
@@ -156,6 +178,9 @@ class PTMultipoles(Theory):
         if len(self.var_pair) != 2:
             raise ValueError(f"PTMultipoles: `var_pair` must be two names, got {self.var_pair}")
         self._ap_omega_m = None
+        self._emulator = pt.LinearEmulator() if self.emulator else None
+        if self.emulator and self.ap_fiducial is not None:
+            raise ValueError("PTMultipoles: `ap_fiducial` is not yet available with `emulator: true`")
         if self.ap_fiducial is not None:
             if not self._ept:
                 raise ValueError("PTMultipoles: `ap_fiducial` is supported with rsd: ept only")
@@ -217,11 +242,18 @@ class PTMultipoles(Theory):
         return f"{self.prefix}{name}_{i}"
 
     def get_can_support_params(self):
-        return [self.param_name(n, i) for i in range(len(self.zs)) for n in self._table()]
+        nuisance = [self.param_name(n, i) for i in range(len(self.zs)) for n in self._table()]
+        return nuisance + (list(COSMOLOGY) if self.emulator else [])
 
     def initialize_with_params(self):
         given = set(self.input_params)
         missing, defaulted = [], []
+        if self.emulator:
+            for key in ("ombh2", "omch2", "H0", "As", "ns"):
+                names = [n for n, (k, _, _) in COSMOLOGY.items() if k == key or
+                         (key == "H0" and k == "h") or (key == "As" and k == "ln10^{10}A_s")]
+                if not given & set(names):
+                    missing.append(" or ".join(names))
         for i in range(len(self.zs)):
             for name, (required, default, _) in self._table().items():
                 p = self.param_name(name, i)
@@ -240,6 +272,8 @@ class PTMultipoles(Theory):
             self.log.info("Nuisance parameters not given, fixed at: %s", ", ".join(defaulted))
 
     def get_requirements(self):
+        if self.emulator:
+            return {}
         zs = self.zs
         requirements = {
             "Pk_grid": {"z": zs, "k_max": self._k_max_linear(), "nonlinear": False,
@@ -306,7 +340,27 @@ class PTMultipoles(Theory):
         return {name: float(params.get(self.param_name(name, i), 0.0 if d is None else d))
                 for name, (_, d, _) in self._table().items()}
 
+    def _emulated(self, params):
+        """{z: (k, P_cb, f, D)} from the emulator, or None outside its prior (logged)."""
+        keys = {COSMOLOGY[n][0]: params[n] for n in COSMOLOGY if n in params}
+        try:
+            today = self._emulator.spectra(keys, 0.0)
+            out = {}
+            for z in self.zs:
+                s = self._emulator.spectra(keys, z)
+                f = float(np.interp(np.log(0.1), np.log(s["k"]), s["f_cb"]))
+                out[z] = (s["k"], s["P_cb"], f, s["sigma8"] / today["sigma8"])
+            return out
+        except ValueError as e:
+            self.log.debug("emulator: %s", e)
+            return None
+
     def calculate(self, state, want_derived=True, **params_values_dict):
+        if self.emulator:
+            emulated = self._emulated(params_values_dict)
+            if emulated is None:
+                return False
+            return self._multipoles(state, params_values_dict, emulated, {})
         h = self.provider.get_param("H0") / 100.0
         k_mpc, z_grid, pk = self.provider.get_Pk_grid(var_pair=tuple(self.var_pair),
                                                       nonlinear=False)
@@ -314,11 +368,18 @@ class PTMultipoles(Theory):
         fs8 = np.atleast_1d(self.provider.get_fsigma8(self.zs))
         s8 = np.atleast_1d(self.provider.get_sigma8_z(self.zs))
         s8_0 = float(np.atleast_1d(self.provider.get_sigma8_z([0.0]))[0])
-        spectra, errors, growth = {}, {}, {}
         alphas = self._alphas(h) if self._ap_omega_m is not None else {}
+        linear = {}
         for i, z in enumerate(self.zs):
             p_lin = np.asarray(pk[_close_index(z_grid, z, "z of the Boltzmann P(k) grid")]) * h**3
-            f, d = fs8[i] / s8[i], s8[i] / s8_0
+            linear[z] = (k_lin, p_lin, fs8[i] / s8[i], s8[i] / s8_0)
+        return self._multipoles(state, params_values_dict, linear, alphas)
+
+    def _multipoles(self, state, params_values_dict, linear, alphas):
+        """The multipoles of each z from {z: (k [h/Mpc], P_lin [(Mpc/h)^3], f, D)}."""
+        spectra, errors, growth = {}, {}, {}
+        for i, z in enumerate(self.zs):
+            k_lin, p_lin, f, d = linear[z]
             nu = self._nuisance(params_values_dict, i)
             digest = hashlib.sha1(k_lin.tobytes() + p_lin.tobytes()).digest()
             with warnings.catch_warnings():

@@ -23,6 +23,7 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 mod batch;
+mod emulator;
 mod ept;
 mod halo;
 mod inputs;
@@ -560,6 +561,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULTS", defaults)?;
     m.add_class::<Table>()?;
     m.add_class::<RealPlan>()?;
+    m.add_class::<emulator::LinearEmulator>()?;
     m.add_class::<redshift::RsdPlan>()?;
     m.add_class::<redshift::RsdTerms>()?;
     m.add_class::<ept::EptPlan>()?;

@@ -198,3 +198,43 @@ def test_the_galaxy_model_takes_velocileptors_names(setup):
                  alpha0=5.0, sn=700.0)
     want = np.array([t["P0"], t["P2"], t["P4"]])
     np.testing.assert_allclose(got, want, rtol=1e-6, atol=0)
+
+
+def test_without_a_boltzmann_code_the_emulator_gives_the_linear_spectrum(setup, model):
+    """emulator: true: no CAMB; the multipoles are those of the emulated P_cb and f_cb(k = 0.1), and
+    within 2% of the CAMB run's (which uses P_m of one massive neutrino of 0.06 eV)."""
+    info, point = setup
+    info = copy.deepcopy({k: v for k, v in info.items() if k != "sampler"})
+    info["theory"].pop("camb")
+    info["theory"]["pt"]["emulator"] = True
+    info["params"].pop("tau")
+    m = get_model(info)
+    m.add_requirements({"pt_pk_ell": None, "pt_growth": None, "pt_k": None})
+    sampled = {p: v for p, v in point.items() if p in m.parameterization.sampled_params()}
+    m.logposterior(sampled)
+    got = np.asarray(m.provider.get_pt_pk_ell(z=Z))
+    f, d = m.provider.get_pt_growth(z=Z)
+    cosmology = {"ombh2": point["ombh2"], "omch2": 0.12, "H0": 67.36, "ns": 0.9649, "mnu": 0.06,
+                 "As": 1e-10 * np.exp(point["logA"])}
+    emulator = pt.LinearEmulator()
+    s, s0 = emulator.spectra(cosmology, Z), emulator.spectra(cosmology, 0.0)
+    assert f == pytest.approx(np.interp(np.log(0.1), np.log(s["k"]), s["f_cb"]), rel=1e-12)
+    assert d == pytest.approx(s["sigma8"] / s0["sigma8"], rel=1e-12)
+    plan = pt.RsdPlan(m.provider.get_pt_k(), real="1l-spt", rsd="tns", precision="fast")
+    nu = {p: point[p] for p in ("b_0", "sigma0_0")}
+    # z = z_input = 0: no rescaling and D_library = 1, so the FoG scale is (sigma0 D) f
+    with pytest.warns(pt.PtSpectraWarning, match="no cosmology"):
+        t = plan(linear=(s["k"], s["P_cb"]), z=0.0, z_input=0.0, f=f, bias=nu["b_0"],
+                 fog="lorentzian", sigma0=nu["sigma0_0"] * d, ells=(0, 2, 4))
+    want = np.array([t["P0"], t["P2"], t["P4"]])
+    want[0] += point.get("P_shot_0", 0.0)
+    np.testing.assert_allclose(got, want, rtol=1e-6, atol=0)
+    model.logposterior({p: v for p, v in point.items()
+                        if p in model.parameterization.sampled_params()})
+    camb = np.asarray(model.provider.get_pt_pk_ell(z=Z))
+    # P_cb/P_m ~ 1/f_cb^2 = 1.009 at small scales, and f_cb(k = 0.1) against CAMB's f of P_m
+    assert np.max(np.abs(got[0] / camb[0] - 1)) < 0.02
+    # outside the prior: zero likelihood, not an exception
+    bad = dict(sampled, ombh2=0.035) if "ombh2" in sampled else None
+    if bad is not None:
+        assert m.logposterior(bad).logpost == -np.inf
