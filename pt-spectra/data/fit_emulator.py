@@ -14,7 +14,7 @@ DATA_DIR holds the train_*.npz and test_*.npz files of make_emulator_training.py
   3. Each component's coefficient as a polynomial (Legendre products, least squares) in seven coordinates:
      the six shape parameters mapped to [-1, 1] by the prior box, and q = rho_DE/rho_m at a = 0.1 (as
      2 sqrt(q/q_max) - 1), on which the amplitude of large scales depends steeply when w0 + wa -> 0.
-     Terms: total degree <= D (--degree 4), and up to --w-degree 6 in the dark-energy coordinates
+     Terms: total degree <= D (--degree 5), and up to --w-degree 6 in the dark-energy coordinates
      (w0, wa, q) alone.
   4. The test set (cosmologies drawn independently over the whole prior, at the nodes and at random
      redshifts) is predicted exactly as the Rust code does (four-node Lagrange interpolation in
@@ -211,7 +211,7 @@ def predict(model, F):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("data")
-    ap.add_argument("--degree", type=int, default=4)
+    ap.add_argument("--degree", type=int, default=5)
     ap.add_argument("--w-degree", type=int, default=6)
     ap.add_argument("--total", type=int, default=6)
     ap.add_argument("--pcs", type=int, nargs=2, default=[40, 20])

@@ -15,6 +15,8 @@ transfer functions (Omega_b, Omega_m, h, m_nu, w0, wa), at A_s = 2e-9, n_s = 1: 
 A_s (k h / 0.05)^(n_s - 1) is exact and divided out by the emulator. Redshifts: Z_NODES.
 Test set ('test'): uniform random draws (seed 7) over all eight parameters, each at Z_NODES and three
 random redshifts in [0.02, 2.98], each of those also at z +- DZ for the growth rate by finite differences.
+The shipped linear_emulator.bin was fitted to train 0..3072 (in chunks of 256 or 512; the Sobol points
+do not depend on the chunking) and tested on test 0..240; about 1.5 s per cosmology on one core.
 Output: OUTDIR/{train|test}_START_STOP.npz with params (n, 8: Omega_b, Omega_m, h, m_nu, w0, wa,
 ln10^10 A_s, n_s), z (n, nz), pk_cb and pk_m (n, nz, nk), sigma8 (n, nz: CAMB's sigma8 of delta_tot), k.
 """
@@ -96,7 +98,7 @@ def camb_spectra(x, zs):
 
 def main():
     kind, start, stop, outdir = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
-    x = draws(kind, max(stop, 2048 if kind == "train" else 256))[start:stop]
+    x = draws(kind, max(stop, 4096 if kind == "train" else 256))[start:stop]
     zs_all, cb_all, m_all, s8_all = [], [], [], []
     t0 = time.time()
     for j, xi in enumerate(x):
