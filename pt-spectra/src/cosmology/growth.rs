@@ -115,13 +115,11 @@ impl Cosmology {
         };
         match self.method() {
             Method::Heath => {
-                // heath_d_md and heath_rate, sharing the integral
                 let integral = self.growth_integral(a);
-                let e2 = self.a2e2(a) / (a * a);
-                let d_md = 2.5 * self.omega_m * self.a2e2(a).sqrt() / a * integral;
-                let dln_e =
-                    -(3.0 * self.omega_m / a.powi(3) + 2.0 * self.omega_k() / (a * a)) / (2.0 * e2);
-                (d_md, dln_e + 1.0 / (a * a * e2.powf(1.5) * integral))
+                (
+                    self.heath_d_md_of(a, integral),
+                    self.heath_rate_of(a, integral),
+                )
             }
             Method::Ode => {
                 let [s, _] = self.ode_states([a.ln(), a.ln()]);
@@ -181,14 +179,24 @@ impl Cosmology {
 
     /// Heath's growing mode (5Ω_m/2) E(a) I(a), equal to a deep in matter domination (Λ only).
     fn heath_d_md(&self, a: f64) -> f64 {
-        2.5 * self.omega_m * self.a2e2(a).sqrt() / a * self.growth_integral(a)
+        self.heath_d_md_of(a, self.growth_integral(a))
+    }
+
+    /// [`heath_d_md`](Self::heath_d_md) given the integral I(a).
+    fn heath_d_md_of(&self, a: f64, integral: f64) -> f64 {
+        2.5 * self.omega_m * self.a2e2(a).sqrt() / a * integral
     }
 
     /// f = −(3Ω_m a⁻³ + 2Ω_k a⁻²)/(2E²) + 1/(a²E³ I(a)) (Λ only).
     fn heath_rate(&self, a: f64) -> f64 {
+        self.heath_rate_of(a, self.growth_integral(a))
+    }
+
+    /// [`heath_rate`](Self::heath_rate) given the integral I(a).
+    fn heath_rate_of(&self, a: f64, integral: f64) -> f64 {
         let e2 = self.a2e2(a) / (a * a);
         let dln_e = -(3.0 * self.omega_m / a.powi(3) + 2.0 * self.omega_k() / (a * a)) / (2.0 * e2);
-        dln_e + 1.0 / (a * a * e2.powf(1.5) * self.growth_integral(a))
+        dln_e + 1.0 / (a * a * e2.powf(1.5) * integral)
     }
 
     /// Right-hand side of the growth ODE for (g, g′), g = D/a, in x = ln a:

@@ -294,3 +294,19 @@ fn growth_evaluation_is_cheap() {
     );
     assert!(sum.is_finite());
 }
+
+#[test]
+fn growth_md_and_rate_equals_the_separate_calls() {
+    // one integration for both (Heath for Λ, the ODE otherwise) gives what the separate calls give
+    for c in [
+        Cosmology::planck2018(),
+        Cosmology::planck2018().with_dark_energy(-0.9, 0.3).unwrap(),
+    ] {
+        let (d0, _) = c.growth_md_and_rate(0.0);
+        for z in [0.0, 0.5, 2.0] {
+            let (d, f) = c.growth_md_and_rate(z);
+            assert!((f / c.growth_rate(z) - 1.0).abs() < 1e-12, "{z}");
+            assert!((d / d0 / c.growth_factor(z) - 1.0).abs() < 1e-12, "{z}");
+        }
+    }
+}
