@@ -24,7 +24,7 @@ import warnings as _warnings
 import numpy as np
 
 from . import _core
-from ._core import (LinearEmulator, Observation, Table, eisenstein_hu, growth, log_grid,
+from ._core import (LinearEmulator, Observation, Table, distances, eisenstein_hu, growth, log_grid,
                     num_threads, set_num_threads)
 
 __all__ = [
@@ -42,6 +42,7 @@ __all__ = [
     "fit",
     "fit_ept",
     "fit_tables",
+    "distances",
     "growth",
     "halo",
     "kernel",

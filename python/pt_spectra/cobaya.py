@@ -66,7 +66,12 @@ fixed or sampled in ``params``): ``ombh2``/``omega_b``, ``omch2``/``omega_cdm``,
 ``logA``/``As``/``A_s``, ``ns``/``n_s`` (required), ``mnu``/``m_ncdm`` (Σm_ν in eV, three degenerate;
 default 0), ``w``/``w0_fld`` (-1), ``wa``/``wa_fld`` (0). The models use P_cb (cold dark matter +
 baryons), f = f_cb(k = 0.1 h/Mpc, z) and D = σ8(z)/σ8(0) of P_m; a cosmology outside the prior gets zero
-likelihood (logged). ``ap_fiducial`` is not yet available with the emulator.
+likelihood (logged). With ``ap_fiducial``, H(z) and D_M(z) of the sampled cosmology come from
+:func:`pt_spectra.distances` (radiation as CAMB closes the budget; massive neutrinos as matter: within
+2e-5 of CAMB's at z ≤ 3).
+
+Derived parameters (declare them in ``params`` to have them in the chain): ``fsigma8_i`` = f σ8(zs[i])
+with the f of the model, and ``sigma8_i`` = σ8(zs[i]) of all matter (Boltzmann code or emulator).
 
 The linear spectrum is the Boltzmann code's own ``Pk_grid`` at exactly each z (k [1/Mpc] and P
 [Mpc^3] converted to h/Mpc and (Mpc/h)^3 with its H0), rather than ``Pk_interpolator``: no second
@@ -112,6 +117,10 @@ COSMOLOGY = {
     "w": ("w", False, -1.0), "w0_fld": ("w", False, -1.0),
     "wa": ("wa", False, 0.0), "wa_fld": ("wa", False, 0.0),
 }
+
+#: The k [h/Mpc] at which the emulator's scale-dependent f_cb(k, z) is taken as the model's f (as the
+#: library's K_GROWTH_RATE).
+K_GROWTH_RATE = 0.1
 
 #: The nuisance parameters of one redshift with ``rsd: ept`` (velocileptors' names).
 EPT_NUISANCE = {"b1": (True, None, "")} | {
@@ -179,8 +188,6 @@ class PTMultipoles(Theory):
             raise ValueError(f"PTMultipoles: `var_pair` must be two names, got {self.var_pair}")
         self._ap_omega_m = None
         self._emulator = pt.LinearEmulator() if self.emulator else None
-        if self.emulator and self.ap_fiducial is not None:
-            raise ValueError("PTMultipoles: `ap_fiducial` is not yet available with `emulator: true`")
         if self.ap_fiducial is not None:
             if not self._ept:
                 raise ValueError("PTMultipoles: `ap_fiducial` is supported with rsd: ept only")
@@ -245,6 +252,11 @@ class PTMultipoles(Theory):
         nuisance = [self.param_name(n, i) for i in range(len(self.zs)) for n in self._table()]
         return nuisance + (list(COSMOLOGY) if self.emulator else [])
 
+    def get_can_provide_params(self):
+        """Derived: ``fsigma8_i`` (f σ8(zs[i]) of the model's f) and ``sigma8_i`` (σ8 of all matter at
+        zs[i]), with the prefix."""
+        return [self.param_name(n, i) for i in range(len(self.zs)) for n in ("fsigma8", "sigma8")]
+
     def initialize_with_params(self):
         given = set(self.input_params)
         missing, defaulted = [], []
@@ -287,21 +299,19 @@ class PTMultipoles(Theory):
             requirements["angular_diameter_distance"] = {"z": zs}
         return requirements
 
-    def _alphas(self, h):
-        """(α∥, α⊥) per z against the flat fiducial of ``ap_fiducial`` (module docs)."""
+    def _alphas(self, background):
+        """{z: (α∥, α⊥)} against the flat fiducial of ``ap_fiducial`` from {z: (E(z), D_M(z) [Mpc/h])}
+        of the sampled cosmology (module docs)."""
         om = self._ap_omega_m
-        hubble = np.atleast_1d(self.provider.get_Hubble(self.zs))
-        d_a = np.atleast_1d(self.provider.get_angular_diameter_distance(self.zs))
         out = {}
-        for i, z in enumerate(self.zs):
+        for z in self.zs:
+            e, dm = background[z]
             zz = np.linspace(0.0, z, 2001)
             e_fid = np.sqrt(om * (1 + zz) ** 3 + 1 - om)
             # D_M,fid in Mpc/h: (c/100) ∫ dz/E_fid (Simpson).
             w = np.ones_like(zz)
             w[1:-1:2], w[2:-1:2] = 4.0, 2.0
             dm_fid = 2997.92458 * (zz[1] - zz[0]) / 3.0 * np.sum(w / e_fid) if z > 0 else 0.0
-            e = hubble[i] / (100.0 * h)
-            dm = (1 + z) * d_a[i] * h
             out[z] = (e_fid[-1] / e, dm / dm_fid if z > 0 else e_fid[-1] / e)
         return out
 
@@ -341,16 +351,24 @@ class PTMultipoles(Theory):
                 for name, (_, d, _) in self._table().items()}
 
     def _emulated(self, params):
-        """{z: (k, P_cb, f, D)} from the emulator, or None outside its prior (logged)."""
+        """({z: (k, P_cb, f, D, σ8)}, {z: (α∥, α⊥)}) from the emulator and the library's background,
+        or None outside the emulator's prior (logged)."""
         keys = {COSMOLOGY[n][0]: params[n] for n in COSMOLOGY if n in params}
         try:
             today = self._emulator.spectra(keys, 0.0)
             out = {}
             for z in self.zs:
                 s = self._emulator.spectra(keys, z)
-                f = float(np.interp(np.log(0.1), np.log(s["k"]), s["f_cb"]))
-                out[z] = (s["k"], s["P_cb"], f, s["sigma8"] / today["sigma8"])
-            return out
+                f = float(np.interp(np.log(K_GROWTH_RATE), np.log(s["k"]), s["f_cb"]))
+                out[z] = (s["k"], s["P_cb"], f, s["sigma8"] / today["sigma8"], s["sigma8"])
+            alphas = {}
+            if self._ap_omega_m is not None:
+                background = {}
+                for z in self.zs:
+                    hubble, dm = pt.distances(z, keys)
+                    background[z] = (hubble / 100.0, dm)
+                alphas = self._alphas(background)
+            return out, alphas
         except ValueError as e:
             self.log.debug("emulator: %s", e)
             return None
@@ -360,7 +378,8 @@ class PTMultipoles(Theory):
             emulated = self._emulated(params_values_dict)
             if emulated is None:
                 return False
-            return self._multipoles(state, params_values_dict, emulated, {})
+            linear, alphas = emulated
+            return self._multipoles(state, params_values_dict, linear, alphas, want_derived)
         h = self.provider.get_param("H0") / 100.0
         k_mpc, z_grid, pk = self.provider.get_Pk_grid(var_pair=tuple(self.var_pair),
                                                       nonlinear=False)
@@ -368,18 +387,25 @@ class PTMultipoles(Theory):
         fs8 = np.atleast_1d(self.provider.get_fsigma8(self.zs))
         s8 = np.atleast_1d(self.provider.get_sigma8_z(self.zs))
         s8_0 = float(np.atleast_1d(self.provider.get_sigma8_z([0.0]))[0])
-        alphas = self._alphas(h) if self._ap_omega_m is not None else {}
+        alphas = {}
+        if self._ap_omega_m is not None:
+            hubble = np.atleast_1d(self.provider.get_Hubble(self.zs))
+            d_a = np.atleast_1d(self.provider.get_angular_diameter_distance(self.zs))
+            alphas = self._alphas({z: (hubble[i] / (100.0 * h), (1 + z) * d_a[i] * h)
+                                   for i, z in enumerate(self.zs)})
         linear = {}
         for i, z in enumerate(self.zs):
             p_lin = np.asarray(pk[_close_index(z_grid, z, "z of the Boltzmann P(k) grid")]) * h**3
-            linear[z] = (k_lin, p_lin, fs8[i] / s8[i], s8[i] / s8_0)
-        return self._multipoles(state, params_values_dict, linear, alphas)
+            linear[z] = (k_lin, p_lin, fs8[i] / s8[i], s8[i] / s8_0, s8[i])
+        return self._multipoles(state, params_values_dict, linear, alphas, want_derived)
 
-    def _multipoles(self, state, params_values_dict, linear, alphas):
-        """The multipoles of each z from {z: (k [h/Mpc], P_lin [(Mpc/h)^3], f, D)}."""
-        spectra, errors, growth = {}, {}, {}
+    def _multipoles(self, state, params_values_dict, linear, alphas, want_derived=True):
+        """The multipoles of each z from {z: (k [h/Mpc], P_lin [(Mpc/h)^3], f, D, σ8(z))}."""
+        spectra, errors, growth, derived = {}, {}, {}, {}
         for i, z in enumerate(self.zs):
-            k_lin, p_lin, f, d = linear[z]
+            k_lin, p_lin, f, d, s8 = linear[z]
+            derived[self.param_name("fsigma8", i)] = f * s8
+            derived[self.param_name("sigma8", i)] = s8
             nu = self._nuisance(params_values_dict, i)
             digest = hashlib.sha1(k_lin.tobytes() + p_lin.tobytes()).digest()
             with warnings.catch_warnings():
@@ -415,6 +441,8 @@ class PTMultipoles(Theory):
         state["pt_pk_ell_err"] = errors
         state["pt_growth"] = growth
         state["pt_ap"] = alphas
+        if want_derived:
+            state["derived"] = derived
 
     # ---- products ----------------------------------------------------------------------------
     def _at(self, name, z):

@@ -49,6 +49,24 @@ impl LinearEmulator {
         Ok(out)
     }
 
+    /// The scale-dependent growth of cold dark matter + baryons at `z`: a dict with ``k`` [h/Mpc],
+    /// ``D_cb`` (= sqrt(P_cb(k, z)/P_cb(k, 0)), 1 at z = 0) and ``f_cb``.
+    #[pyo3(signature = (cosmology, z))]
+    fn growth_cb<'py>(
+        &self,
+        py: Python<'py>,
+        cosmology: &Bound<'py, PyAny>,
+        z: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let c = inputs::cosmology_of(Some(cosmology))?;
+        let g = self.inner.growth_cb(&c, z).map_err(value_error)?;
+        let out = PyDict::new(py);
+        out.set_item("k", g.k.into_pyarray(py))?;
+        out.set_item("D_cb", g.d_cb.into_pyarray(py))?;
+        out.set_item("f_cb", g.f_cb.into_pyarray(py))?;
+        Ok(out)
+    }
+
     /// {name: (min, max)} of the prior (Omega_b, Omega_m, h, m_nu [eV], w0, wa, and the tested range
     /// of ln10^{10}A_s and n_s, in which the emulator is exact).
     #[getter]

@@ -489,6 +489,21 @@ fn growth(z: f64, cosmology: Option<&Bound<'_, PyAny>>) -> PyResult<(f64, f64)> 
     Ok((c.growth_factor(z), c.growth_rate(z)))
 }
 
+/// The background of a cosmology at z: (H(z) [h km/s/Mpc], D_M(z) [Mpc/h]), with radiation (photons,
+/// and massless neutrinos unless m_nu > 0) as CAMB and CLASS close the budget; for the
+/// Alcock–Paczynski ratios α∥ = H_fid/H, α⊥ = D_M/D_M,fid.
+#[pyfunction]
+#[pyo3(signature = (z, cosmology=None))]
+fn distances(z: f64, cosmology: Option<&Bound<'_, PyAny>>) -> PyResult<(f64, f64)> {
+    let c = inputs::cosmology_of(cosmology)?;
+    if !(z.is_finite() && z >= 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "z = {z}: a redshift must be finite and >= 0"
+        )));
+    }
+    Ok((c.hubble(z), c.transverse_comoving_distance(z)))
+}
+
 /// The Eisenstein & Hu (1998) linear spectrum of a cosmology at `k` [h/Mpc] and z.
 #[pyfunction]
 #[pyo3(signature = (k, z=0.0, cosmology=None, wiggle=true))]
@@ -573,6 +588,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(real, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(growth, m)?)?;
+    m.add_function(wrap_pyfunction!(distances, m)?)?;
     m.add_function(wrap_pyfunction!(eisenstein_hu, m)?)?;
     m.add_function(wrap_pyfunction!(kernel::kernel, m)?)?;
     m.add_function(wrap_pyfunction!(halo::halo, m)?)?;

@@ -370,3 +370,20 @@ def test_exact_kernel_strings_parse_as_the_command_line_and_huge_inputs_are_refu
         pt.kernel("F", [["1/" + "3" * 400, "0", "0"]] * 7, exact=True)
     with pytest.raises(ValueError, match="zero denominator"):
         pt.kernel("F", [["1/0", "0", "0"]], exact=True)
+
+
+def test_emulated_growth_is_the_ode_growth_without_neutrinos_and_scale_dependent_with():
+    """LinearEmulator.growth_cb: massless neutrinos give the scale-independent D(z)/D(0) of pt.growth
+    (to the emulator's 2e-3); 0.3 eV slow the small scales (D larger at high k since z = 1)."""
+    emulator = pt.LinearEmulator()
+    base = {"ombh2": 0.0224, "omch2": 0.12, "H0": 67.5, "As": 2.1e-9, "ns": 0.965}
+    g = emulator.growth_cb(base, 1.0)
+    d, _ = pt.growth(1.0, base)
+    assert np.max(np.abs(g["D_cb"] / d - 1)) < 2e-3
+    heavy = emulator.growth_cb(dict(base, mnu=0.3), 1.0)
+    small = np.interp(1.0, heavy["k"], heavy["D_cb"]) / np.interp(1e-3, heavy["k"], heavy["D_cb"])
+    assert small > 1.005
+    with pytest.raises(ValueError, match="m_nu"):
+        emulator.growth_cb(dict(base, mnu=0.9), 1.0)
+    hubble, dm = pt.distances(1.0, base)
+    assert hubble > 100 and 2000 < dm < 3000  # h km/s/Mpc, Mpc/h

@@ -92,6 +92,36 @@ fn distances_agree_with_camb() {
     assert!(worst[0] < CAMB_TOL && worst[1] < CAMB_TOL, "{worst:?}");
 }
 
+/// With three degenerate massive neutrinos (Σm_ν = 0.06, 0.3, 0.5 eV, part of Ω_m) against CAMB
+/// (`camb_distances_mnu.dat`): the neutrinos are matter at z ≤ 3 and the photons the only radiation,
+/// measured ≤ 2e-5 (counting the neutrinos as massless radiation too would be 2.3e-4 off).
+#[test]
+fn distances_with_massive_neutrinos_agree_with_camb() {
+    let mut worst = [0.0_f64; 2];
+    for row in rows(&data("camb_distances_mnu.dat")) {
+        let (z, m_nu, h_camb, dm_camb) = (row[1], row[2], row[3], row[4]);
+        let keys = [
+            ("h", "0.675".to_string()),
+            ("omega_b", "0.0224".to_string()),
+            ("omega_cdm", "0.12".to_string()),
+            ("m_ncdm", (m_nu / 3.0).to_string()),
+            ("deg_ncdm", "3".to_string()),
+            ("n_s", "0.96".to_string()),
+            ("sigma8", "0.8".to_string()),
+        ];
+        let keys: Vec<(&str, &str)> = keys.iter().map(|(k, v)| (*k, v.as_str())).collect();
+        let c = Cosmology::from_keys(keys, "test").unwrap().cosmology;
+        assert!((c.m_nu - m_nu).abs() < 1e-9, "{}", c.m_nu);
+        worst[0] = worst[0].max((c.hubble(z) * c.h / h_camb - 1.0).abs());
+        worst[1] = worst[1].max((c.transverse_comoving_distance(z) / c.h / dm_camb - 1.0).abs());
+    }
+    println!(
+        "massive neutrinos, worst |ours/CAMB − 1|: H {:.1e}, D_M {:.1e}",
+        worst[0], worst[1]
+    );
+    assert!(worst[0] < 3e-5 && worst[1] < 3e-5, "{worst:?}");
+}
+
 fn settings(model: RsdModel, bias: f64, f: f64, fog: Fog, sigma: f64, n: usize) -> RsdSettings {
     RsdSettings {
         model,

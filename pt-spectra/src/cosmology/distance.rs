@@ -3,7 +3,8 @@
 //!
 //! E²(z) = Ω_r(1+z)⁴ + Ω_m(1+z)³ + Ω_k(1+z)² + (Ω_DE − Ω_r) ρ_DE(z)/ρ_DE(0): the radiation of the CMB
 //! photons (T_CMB = [`T_CMB`]) and of [`N_EFF`] massless neutrinos, Ω_r h² = 4.18e-5, is taken from the
-//! dark energy so that E(0) = 1 with the cosmology's Ω_m and Ω_k, as CAMB and CLASS close the budget
+//! dark energy (with massive neutrinos, `m_nu > 0`, the three degenerate species are matter, part of
+//! Ω_m, and the photons are the only radiation: at z ≤ 3 CAMB's H and D_M are then matched to 2e-5) so that E(0) = 1 with the cosmology's Ω_m and Ω_k, as CAMB and CLASS close the budget
 //! (the growth, `crate::cosmology::growth`, neglects radiation: its effect on D(z) is ~1e-4 and is
 //! common to the models). Without radiation H(z = 3) would be off by 5.7e-4 and D_M by 2.5e-4; with it,
 //! the tests find CAMB's H and D_M to ≤ 1e-7. Distances are in Mpc/h and H in h km/s/Mpc, the units
@@ -21,7 +22,7 @@ pub const HUBBLE_DISTANCE: f64 = 2_997.924_58;
 
 impl Cosmology {
     /// The radiation density Ω_r = Ω_γ (1 + (7/8)(4/11)^{4/3} N_eff) of photons at [`T_CMB`] and
-    /// [`N_EFF`] massless neutrinos.
+    /// [`N_EFF`] massless neutrinos; Ω_γ alone with massive neutrinos (module docs).
     pub fn omega_radiation(&self) -> f64 {
         // Ω_γ h² = (π²/15) (k_B T)⁴/(ħ³c⁵) / ρ_crit,100, ρ_crit,100 = 3 (100 km/s/Mpc)²/(8πG).
         let (k_b, hbar, c, g): (f64, f64, f64, f64) = (
@@ -36,7 +37,11 @@ impl Cosmology {
         let h100 = 1e5 / mpc;
         let rho_crit = 3.0 * h100 * h100 / (8.0 * std::f64::consts::PI * g);
         let omega_gamma_h2 = rho_gamma / rho_crit;
-        let neutrinos = 1.0 + 7.0 / 8.0 * (4.0_f64 / 11.0).powf(4.0 / 3.0) * N_EFF;
+        let neutrinos = if self.m_nu > 0.0 {
+            1.0
+        } else {
+            1.0 + 7.0 / 8.0 * (4.0_f64 / 11.0).powf(4.0 / 3.0) * N_EFF
+        };
         omega_gamma_h2 * neutrinos / (self.h * self.h)
     }
 

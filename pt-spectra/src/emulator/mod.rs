@@ -81,6 +81,19 @@ pub struct EmulatedSpectra {
     pub a_s: f64,
 }
 
+/// The growth of cold dark matter + baryons with massive neutrinos ([`LinearEmulator::growth_cb`]).
+#[derive(Debug, Clone)]
+pub struct ScaleDependentGrowth {
+    /// The redshift.
+    pub z: f64,
+    /// Wavenumbers in h/Mpc.
+    pub k: Vec<f64>,
+    /// D_cb(k, z), normalised to 1 at z = 0 at every k.
+    pub d_cb: Vec<f64>,
+    /// f_cb(k, z) = d ln D_cb/d ln a.
+    pub f_cb: Vec<f64>,
+}
+
 impl EmulatedSpectra {
     /// P_m as a [`LinearSpectrum`] (power-law extrapolation beyond the nodes).
     ///
@@ -233,6 +246,30 @@ impl LinearEmulator {
             error_m: self.file.error[1].clone(),
             sigma8,
             a_s: ln_as.exp(),
+        })
+    }
+
+    /// The scale-dependent growth of cold dark matter + baryons at `z`: D_cb(k, z) = T_cb(k, z)/T_cb(k, 0)
+    /// = √(P_cb(k, z)/P_cb(k, 0)) and f_cb(k, z), on the nodes of [`spectra`](Self::spectra) (two
+    /// evaluations; with massless neutrinos D_cb is the scale-independent D(z)/D(0) to the emulator's
+    /// accuracy).
+    ///
+    /// # Errors
+    /// As [`spectra`](Self::spectra).
+    pub fn growth_cb(&self, cosmology: &Cosmology, z: f64) -> Result<ScaleDependentGrowth> {
+        let at_z = self.spectra(cosmology, z)?;
+        let today = self.spectra(cosmology, self.z_range().0)?;
+        let d_cb = at_z
+            .p_cb
+            .iter()
+            .zip(&today.p_cb)
+            .map(|(p, p0)| (p / p0).sqrt())
+            .collect();
+        Ok(ScaleDependentGrowth {
+            z: at_z.z,
+            k: at_z.k,
+            d_cb,
+            f_cb: at_z.f_cb,
         })
     }
 

@@ -219,3 +219,42 @@ fn class_spectra_of_six_cosmologies_agree() {
     eprintln!("CLASS: worst {worst:.2e}");
     assert!(worst < 7e-3, "{worst}");
 }
+
+#[test]
+fn scale_dependent_growth_agrees_with_camb_transfer_functions() {
+    // CAMB's D_cb(k, z) = T_cb(k, z)/T_cb(k, 0) for Σm_ν = 0.06 … 0.5 eV at z = 0.5 … 3
+    // (tests/data/emulator_growth.dat, make_emulator_growth.py); the issue asks for 0.3%.
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/emulator_growth.dat"
+    );
+    let text = std::fs::read_to_string(path).expect("growth table");
+    let emulator = LinearEmulator::embedded().unwrap();
+    let (mut worst, mut spread) = (0.0_f64, 0.0_f64);
+    let mut current: Option<((usize, u64), ScaleDependentGrowth)> = None;
+    for line in text.lines().filter(|l| !l.starts_with('#')) {
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        let key = (v[0] as usize, v[9].to_bits());
+        if current.as_ref().map(|c| c.0) != Some(key) {
+            let g = emulator
+                .growth_cb(&cosmology(&v[1..9].try_into().unwrap()), v[9])
+                .unwrap();
+            current = Some((key, g));
+        }
+        let g = &current.as_ref().unwrap().1;
+        let i = g.k.partition_point(|&k| k < v[10]);
+        let t = (v[10].ln() - g.k[i - 1].ln()) / (g.k[i].ln() - g.k[i - 1].ln());
+        let d = g.d_cb[i - 1] + t * (g.d_cb[i] - g.d_cb[i - 1]);
+        worst = worst.max((d / v[11] - 1.0).abs());
+        spread = spread.max(g.d_cb[i] / g.d_cb[0] - 1.0);
+    }
+    println!(
+        "D_cb(k, z): worst |emulated/CAMB − 1| {worst:.1e}; D(1)/D(1e-3) − 1 up to {spread:.3}"
+    );
+    assert!(worst < 3e-3, "{worst}");
+    // the scale dependence is resolved: since z, the small scales grew less (free streaming) by percents
+    assert!(spread > 0.01, "{spread}");
+}
