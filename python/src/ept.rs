@@ -13,6 +13,7 @@ use pt_spectra::setup::Prepared;
 use pt_spectra::survey::observe::{Bins, Observation, Window};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::sync::Arc;
 
 /// The distortion of `apar`, `aperp` (both or neither).
 fn distortion(apar: Option<f64>, aperp: Option<f64>) -> PyResult<Option<Distortion>> {
@@ -43,7 +44,7 @@ fn params(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<EptParams> {
 /// The 1-loop galaxy model in redshift space planned for one k grid.
 #[pyclass(module = "pt_spectra._core", frozen)]
 pub(crate) struct EptPlan {
-    plan: LibEptPlan,
+    plan: Arc<LibEptPlan>,
     precision: pt_spectra::precision::Precision,
 }
 
@@ -71,7 +72,10 @@ impl EptPlan {
         let (plan, _) = detached(py, || {
             jobs::ept_plan(&k, ir, ap, free_ap, &precision, store.get(), &Silent)
         })?;
-        Ok(Self { plan, precision })
+        Ok(Self {
+            plan: Arc::new(plan),
+            precision,
+        })
     }
 
     /// The multipoles of the prepared spectrum at the parameters of `kwargs`.
@@ -120,7 +124,7 @@ impl EptPlan {
             Ok((terms, prepared))
         })?;
         Ok(EptTerms {
-            plan: self.plan.clone(),
+            plan: Arc::clone(&self.plan),
             terms,
             prepared,
             precision: self.precision.clone(),
@@ -131,7 +135,7 @@ impl EptPlan {
 /// The loop terms of one linear spectrum on an [`EptPlan`]'s grid.
 #[pyclass(module = "pt_spectra._core", frozen)]
 pub(crate) struct EptTerms {
-    plan: LibEptPlan,
+    plan: Arc<LibEptPlan>,
     terms: LibEptTerms,
     prepared: Prepared,
     precision: pt_spectra::precision::Precision,
