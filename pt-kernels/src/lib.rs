@@ -33,6 +33,7 @@ pub mod exact;
 pub mod generated;
 mod instances;
 mod lanes;
+pub mod redshift;
 pub mod reference;
 mod scalar;
 
