@@ -422,13 +422,18 @@ def halo(pmm, pmh, phh, number_density=None) -> Table:
     return _core.halo(tuple(pmm), tuple(pmh), tuple(phh), number_density)
 
 
-def kernel(which, vectors, exact=False):
-    """The symmetrised kernel F_n^s or G_n^s (``which`` = "F" or "G") at the vectors [x, y, z].
+def kernel(which, vectors, exact=False, f=None, los=None):
+    """The symmetrised kernel F_n^s or G_n^s (``which`` = "F" or "G", n <= 7) at the vectors [x, y, z],
+    or the redshift-space kernel Z_n (``which`` = "Z", n <= 5) with growth rate ``f`` along the line of
+    sight ``los`` (default [0, 0, 1]).
 
-    With ``exact=True`` the components may be ints, ``fractions.Fraction`` or "p/q" strings and the
-    result is the reduced fraction as a string; otherwise a float.
+    With ``exact=True`` the components (and f, los) may be ints, ``fractions.Fraction`` or "p/q" strings
+    and the result is the reduced fraction as a string; otherwise a float.
 
     >>> kernel("F", [[1, 0, 0], [0, 1, 0]])
     0.7142857142857143
+    >>> kernel("Z", [[0, 0, 1]], exact=True, f="1/2")
+    '3/2'
     """
-    return _core.kernel(which, [list(v) for v in vectors], exact)
+    return _core.kernel(which, [list(v) for v in vectors], exact, f,
+                        None if los is None else list(los))

@@ -50,11 +50,20 @@ fn components<'py>(v: &Bound<'py, PyAny>) -> PyResult<Vec<Bound<'py, PyAny>>> {
 }
 
 /// F_n^s or G_n^s (`which` = "F" or "G") at the n = len(vectors) vectors (1 ≤ n ≤ 7), each [x, y, z]
-/// in h/Mpc. With `exact`, in rational arithmetic (components as ints, Fractions, "p/q" strings or
-/// floats taken exactly), returned as the string of the reduced fraction; otherwise a float.
+/// in h/Mpc, or the redshift-space Z_n (`which` = "Z", n ≤ 5; Scoccimarro, Couchman & Frieman 1999)
+/// with growth rate `f` (required) along the line of sight `los` (default [0, 0, 1]; only its
+/// direction enters). With `exact`, in rational arithmetic (components, f and los as ints, Fractions,
+/// "p/q" strings or floats taken exactly), returned as the string of the reduced fraction; otherwise a
+/// float.
 #[pyfunction]
-#[pyo3(signature = (which, vectors, exact=false))]
-pub fn kernel(which: &str, vectors: Vec<Bound<'_, PyAny>>, exact: bool) -> PyResult<Py<PyAny>> {
+#[pyo3(signature = (which, vectors, exact=false, f=None, los=None))]
+pub fn kernel(
+    which: &str,
+    vectors: Vec<Bound<'_, PyAny>>,
+    exact: bool,
+    f: Option<Bound<'_, PyAny>>,
+    los: Option<Bound<'_, PyAny>>,
+) -> PyResult<Py<PyAny>> {
     let py = match vectors.first() {
         Some(v) => v.py(),
         None => {
@@ -67,19 +76,38 @@ pub fn kernel(which: &str, vectors: Vec<Bound<'_, PyAny>>, exact: bool) -> PyRes
     let index = match which {
         "F" | "f" => 0,
         "G" | "g" => 1,
+        "Z" | "z" => 2,
         _ => {
             return Err(PyValueError::new_err(format!(
-                "kernel: unknown kernel `{which}`; available: F, G"
+                "kernel: unknown kernel `{which}`; available: F, G, Z"
             )))
         }
     };
-    if vectors.len() > pt_kernels::MAX_ORDER {
+    let max = if index == 2 {
+        pt_kernels::redshift::MAX_REDSHIFT_ORDER
+    } else {
+        pt_kernels::MAX_ORDER
+    };
+    if vectors.len() > max {
         return Err(PyValueError::new_err(format!(
-            "kernel: order n = {} is not supported: at most {} vectors",
-            vectors.len(),
-            pt_kernels::MAX_ORDER
+            "kernel: order n = {} is not supported for {which}: at most {max} vectors",
+            vectors.len()
         )));
     }
+    let redshift = match (index, &f) {
+        (2, None) => {
+            return Err(PyValueError::new_err(
+                "kernel: Z needs the growth rate f (f=...)",
+            ))
+        }
+        (2, Some(f)) => Some((f.clone(), los.clone())),
+        (_, Some(_)) => {
+            return Err(PyValueError::new_err(format!(
+                "kernel: f and los are for Z, not {which}"
+            )))
+        }
+        _ => None,
+    };
     if exact {
         let q: Vec<[BigRational; 3]> = vectors
             .iter()
@@ -89,6 +117,27 @@ pub fn kernel(which: &str, vectors: Vec<Bound<'_, PyAny>>, exact: bool) -> PyRes
             })
             .collect::<PyResult<_>>()?;
         check_exact_size(&q).map_err(|e| PyValueError::new_err(format!("kernel: {e}")))?;
+        if let Some((f, los)) = &redshift {
+            let f = rational(f)?;
+            let los = match los {
+                Some(v) => {
+                    let c = components(v)?;
+                    [rational(&c[0])?, rational(&c[1])?, rational(&c[2])?]
+                }
+                None => [
+                    BigRational::zero(),
+                    BigRational::zero(),
+                    BigRational::from_integer(1.into()),
+                ],
+            };
+            let value = py
+                .detach(|| pt_kernels::redshift::redshift_kernel(&q, &f, &los))
+                .map_err(|e| PyValueError::new_err(e.to_string()))?;
+            return Ok(format_rational(&value)
+                .into_pyobject(py)?
+                .into_any()
+                .unbind());
+        }
         // The exact kernel can take seconds: without the GIL.
         let value = py
             .detach(|| kernels(&q))
@@ -119,7 +168,18 @@ pub fn kernel(which: &str, vectors: Vec<Bound<'_, PyAny>>, exact: bool) -> PyRes
         let category = py.get_type::<pyo3::exceptions::PyRuntimeWarning>();
         PyErr::warn(py, &category, &std::ffi::CString::new(note)?, 1)?;
     }
-    let value = kernels(&q).map_err(|e| PyValueError::new_err(e.to_string()))?[index];
+    let value = match &redshift {
+        Some((f, los)) => {
+            let f: f64 = f.extract()?;
+            let los: [f64; 3] = match los {
+                Some(v) => v.extract()?,
+                None => [0.0, 0.0, 1.0],
+            };
+            pt_kernels::redshift::redshift_kernel(&q, &f, &los)
+        }
+        None => kernels(&q).map(|v| v[index]),
+    }
+    .map_err(|e| PyValueError::new_err(e.to_string()))?;
     if !value.is_finite() {
         return Err(PyValueError::new_err(format!(
             "kernel: the value overflows double precision ({value}); use exact=True"

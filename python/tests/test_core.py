@@ -387,3 +387,26 @@ def test_emulated_growth_is_the_ode_growth_without_neutrinos_and_scale_dependent
         emulator.growth_cb(dict(base, mnu=0.9), 1.0)
     hubble, dm = pt.distances(1.0, base)
     assert hubble > 100 and 2000 < dm < 3000  # h km/s/Mpc, Mpc/h
+
+
+def test_redshift_kernel_z2_closed_form_and_errors():
+    """kernel("Z"): Z_1 = 1 + f mu^2 exactly; Z_2 of two vectors against the SCF99 closed form; f is
+    required, and n <= 5."""
+    from fractions import Fraction as Fr
+    assert pt.kernel("Z", [[0, 3, 4]], exact=True, f="1/2", los=[0, 0, 1]) == "33/25"  # 1 + 16/50
+    q1, q2 = np.array([0.3, -0.2, 0.5]), np.array([-0.1, 0.4, 0.2])
+    f, n = 0.7, np.array([0.0, 0.0, 1.0])
+    k = q1 + q2
+    mu = lambda v: v @ n / np.sqrt(v @ v)  # noqa: E731
+    f2, g2 = pt.kernel("F", [q1, q2]), pt.kernel("G", [q1, q2])
+    closed = (f2 + f * mu(k) ** 2 * g2 + f * mu(k) * np.sqrt(k @ k) / 2 * (
+        mu(q1) / np.sqrt(q1 @ q1) * (1 + f * mu(q2) ** 2)
+        + mu(q2) / np.sqrt(q2 @ q2) * (1 + f * mu(q1) ** 2)))
+    assert pt.kernel("Z", [q1, q2], f=f) == pytest.approx(closed, rel=1e-13)
+    assert Fr(pt.kernel("Z", [[1, 0, 0], [0, 1, 0]], exact=True, f=0)) == Fr(5, 7)
+    with pytest.raises(ValueError, match="growth rate f"):
+        pt.kernel("Z", [[1, 0, 0]])
+    with pytest.raises(ValueError, match="at most 5"):
+        pt.kernel("Z", [[1, 0, 0]] * 6, f=0.5)
+    with pytest.raises(ValueError, match="for Z, not F"):
+        pt.kernel("F", [[1, 0, 0]], f=0.5)
