@@ -5,7 +5,7 @@ The Python face of the Rust library: the same entry points, names and columns as
 
 >>> import numpy as np, pt_spectra as pt
 >>> t = pt.real(model="1l-spt", k=np.geomspace(0.01, 0.3, 20), terms=True, precision="fast")
->>> t["P_dd"][0] > t["P_lin"][0] * 0.99
+>>> bool(t["P_dd"][0] > t["P_lin"][0] * 0.99)
 True
 
 Every function returns a :class:`Table`: ``t.columns`` (the command line's column names), ``t[name]``
