@@ -86,6 +86,9 @@ pub enum KernelError {
     /// An argument is the zero vector, where the kernels have a pole.
     #[error("argument q{0} is the zero vector; the kernels are singular there")]
     ZeroVector(usize),
+    /// The line of sight of a redshift-space kernel is the zero vector.
+    #[error("the line of sight is the zero vector: it needs a direction")]
+    ZeroLineOfSight,
 }
 
 /// The metadata of the general kernel of order n (1..=7).

@@ -71,7 +71,7 @@ fn check<T: Scalar>(q: &[[T; 3]], los: &[T; 3]) -> Result<(), KernelError> {
         return Err(KernelError::ZeroVector(i + 1));
     }
     if los.iter().all(Scalar::is_zero) {
-        return Err(KernelError::ZeroVector(0));
+        return Err(KernelError::ZeroLineOfSight);
     }
     Ok(())
 }
@@ -81,7 +81,7 @@ fn check<T: Scalar>(q: &[[T; 3]], los: &[T; 3]) -> Result<(), KernelError> {
 ///
 /// # Errors
 /// [`KernelError::Order`] for n outside 1..=5, [`KernelError::ZeroVector`] for a zero argument (index
-/// from 1) or a zero line of sight (index 0).
+/// from 1), [`KernelError::ZeroLineOfSight`].
 pub fn redshift_kernel<T: Evaluate>(q: &[[T; 3]], f: &T, los: &[T; 3]) -> Result<T, KernelError> {
     check(q, los)?;
     let n = q.len();

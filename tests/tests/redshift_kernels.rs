@@ -112,6 +112,6 @@ fn zero_momentum_subsets_and_f64() {
     );
     assert_eq!(
         redshift_kernel(&qs[..2], &q(1, 2), &v(0, 0, 0, 1)),
-        Err(KernelError::ZeroVector(0))
+        Err(KernelError::ZeroLineOfSight)
     );
 }

@@ -539,3 +539,35 @@ fn bad_files_and_overflowing_kernels_are_errors_naming_file_and_line() {
     ]);
     assert!(ok && out.starts_with("3/14"), "{out}{err}");
 }
+
+#[test]
+fn kernel_z_is_the_redshift_space_kernel() {
+    // Z_1 = 1 + f mu^2: q = (0, 3, 4), mu^2 = 16/25, f = 1/2 -> 33/25
+    let (ok, out, err) = run(&["kernel", "Z", "--q", "0,3,4", "--f", "1/2", "--exact"]);
+    assert!(ok && out.trim() == "33/25", "{out}{err}");
+    // f = 0: F_2 of orthogonal vectors, 5/7; only the direction of --los enters
+    let (ok, out, err) = run(&[
+        "kernel", "Z", "--q", "1,0,0", "--q", "0,1,0", "--f", "0", "--los", "0,0,7",
+    ]);
+    assert!(
+        ok && (out.trim().parse::<f64>().unwrap() - 5.0 / 7.0).abs() < 1e-15,
+        "{out}{err}"
+    );
+    for (args, expected) in [
+        (vec!["kernel", "Z", "--q", "1,0,0"], "--f"),
+        (vec!["kernel", "F", "--q", "1,0,0", "--f", "0.5"], "not F"),
+        (
+            vec!["kernel", "Z", "--q", "1,0,0", "--f", "nan"],
+            "--f 'nan'",
+        ),
+        (
+            vec![
+                "kernel", "Z", "--q", "1,0,0", "--f", "0.5", "--los", "0,0,0",
+            ],
+            "line of sight is the zero vector",
+        ),
+    ] {
+        let (ok, _, err) = run(&args);
+        assert!(!ok && err.contains(expected), "{args:?}: {err}");
+    }
+}

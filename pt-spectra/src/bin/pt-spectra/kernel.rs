@@ -1,4 +1,4 @@
-//! `pt-spectra kernel F|G --q x,y,z [--q …] [--exact]`.
+//! `pt-spectra kernel F|G|Z --q x,y,z [--q …] [--f F] [--los x,y,z] [--exact]`.
 
 use anyhow::{bail, Context, Result};
 use num_rational::BigRational;
@@ -13,14 +13,27 @@ pub enum Which {
     F,
     /// The velocity-divergence kernel G_n^s.
     G,
+    /// The redshift-space kernel Z_n (Scoccimarro, Couchman & Frieman 1999), n ≤ 5; needs --f.
+    Z,
 }
 
 /// Arguments of `pt-spectra kernel`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// F (density) or G (velocity divergence).
+    /// F (density), G (velocity divergence) or Z (density in redshift space).
     #[arg(value_enum, ignore_case = true)]
     which: Which,
+    /// The growth rate f of Z (a number, or p/q with --exact).
+    #[arg(long, allow_hyphen_values = true)]
+    f: Option<String>,
+    /// The line of sight of Z as x,y,z (only its direction enters).
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        default_value = "0,0,1",
+        allow_hyphen_values = true
+    )]
+    los: String,
     /// One argument vector as x,y,z (h/Mpc); repeat for each of the n arguments.
     #[arg(long = "q", value_name = "X,Y,Z", allow_hyphen_values = true)]
     q: Vec<String>,
@@ -39,6 +52,15 @@ pub fn run(args: &Args) -> Result<()> {
     }
     if n > MAX_ORDER {
         bail!("kernel order n = {n} is not supported: at most {MAX_ORDER} --q vectors");
+    }
+    if let Which::Z = args.which {
+        return run_redshift(args);
+    }
+    if args.f.is_some() {
+        bail!(
+            "--f is for the redshift-space kernel Z, not {:?}",
+            args.which
+        );
     }
     if args.exact {
         let vectors: Vec<[BigRational; 3]> = args
@@ -66,6 +88,46 @@ pub fn run(args: &Args) -> Result<()> {
     Ok(())
 }
 
+/// `kernel Z`: Z_n of the --q vectors with --f along --los.
+fn run_redshift(args: &Args) -> Result<()> {
+    use pt_kernels::redshift::{redshift_kernel, MAX_REDSHIFT_ORDER};
+    let n = args.q.len();
+    if n > MAX_REDSHIFT_ORDER {
+        bail!("Z_n is available for n <= {MAX_REDSHIFT_ORDER}, got {n} --q vectors");
+    }
+    let Some(f) = &args.f else {
+        bail!("kernel Z needs the growth rate: --f F (e.g. --f 0.75)");
+    };
+    if args.exact {
+        let vectors: Vec<[BigRational; 3]> = args
+            .q
+            .iter()
+            .map(|s| parse_vector(s))
+            .collect::<Result<_>>()?;
+        check_exact_size(&vectors).context("--exact")?;
+        let f = parse_rational(f).context("--f")?;
+        let los = parse_vector(&args.los).context("--los")?;
+        println!("{}", format_rational(&redshift_kernel(&vectors, &f, &los)?));
+    } else {
+        let v: Vec<[f64; 3]> = args
+            .q
+            .iter()
+            .map(|s| parse_float_vector(s))
+            .collect::<Result<_>>()?;
+        let f: f64 = f
+            .parse()
+            .ok()
+            .filter(|x: &f64| x.is_finite())
+            .with_context(|| format!("--f '{f}' is not a finite number"))?;
+        let los = parse_float_vector(&args.los).context("--los")?;
+        println!(
+            "{}",
+            finite(args.which, &args.q, redshift_kernel(&v, &f, &los)?)?
+        );
+    }
+    Ok(())
+}
+
 /// `value` if finite; otherwise an error naming the kernel and the inputs. Components near the ends of
 /// the f64 range overflow (or underflow to zero) in the dot products of the kernel's Gram matrix.
 fn finite(which: Which, q: &[String], value: f64) -> Result<f64> {
@@ -75,6 +137,7 @@ fn finite(which: Which, q: &[String], value: f64) -> Result<f64> {
     let name = match which {
         Which::F => "F",
         Which::G => "G",
+        Which::Z => "Z",
     };
     let args: Vec<String> = q.iter().map(|v| format!("--q {v}")).collect();
     bail!(
@@ -87,8 +150,8 @@ fn finite(which: Which, q: &[String], value: f64) -> Result<f64> {
 
 fn pick<T: Scalar>(which: Which, [f, g]: [T; 2]) -> T {
     match which {
-        Which::F => f,
         Which::G => g,
+        _ => f,
     }
 }
 
