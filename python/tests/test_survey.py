@@ -154,3 +154,38 @@ def test_a_covariance_over_all_the_files_multipoles_gives_the_fitted_blocks(tmp_
     b = pt.fit_ept(str(path), covariance=full[: 2 * n, : 2 * n], **args)
     for name in ("f", "b1", "chi2", "err_f"):
         assert a[name][0] == pytest.approx(b[name][0], rel=1e-12), name
+
+
+def test_without_a_window_the_theory_is_asked_only_for_the_fitted_k(tmp_path):
+    """SurveyMultipoles without window or bins: the theory computes the model at the fitted k only
+    (k_max and the k_ranges of each multipole), not at every k of the file; the χ² is unchanged (data
+    made by EptPlan at every k from the same emulated spectrum: χ² ≈ 0, and > 20 for b1 3% off)."""
+    from cobaya.model import get_model
+
+    z = 0.5
+    cosmo = {"ombh2": 0.0224, "omch2": 0.12, "H0": 67.5, "As": 2.1e-9, "ns": 0.965}
+    s = pt.LinearEmulator().spectra(cosmo, z)
+    f = float(np.interp(np.log(0.1), np.log(s["k"]), s["f_cb"]))
+    k = np.linspace(0.01, 0.3, 30)
+    plan = pt.EptPlan(k, precision="fast")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pt.PtSpectraWarning)
+        t = plan.terms(linear=(s["k"], s["P_cb"]), z=z, z_input=z).multipoles(
+            ells=(0, 2), f=f, b1=2.0, alpha0=3.0)
+    sigma = 0.01 * t["P0"]
+    data = tmp_path / "data.txt"
+    np.savetxt(data, np.column_stack([k, t["P0"], sigma, t["P2"], sigma]))
+    info = {
+        "theory": {"pt": {"class": "pt_spectra.cobaya.PTMultipoles", "zs": [z], "rsd": "ept",
+                          "precision": "fast", "emulator": True}},
+        "likelihood": {"survey": {"class": "pt_spectra.likelihoods.SurveyMultipoles",
+                                  "data_file": str(data), "data_ells": [0, 2], "z": z,
+                                  "k_max": 0.2, "k_ranges": {2: [0.05, 0.15]}}},
+        "params": {**cosmo, "b1_0": {"prior": {"min": 1, "max": 3}}, "alpha0_0": 3.0},
+    }
+    model = get_model(info)
+    model.add_requirements({"pt_k": None})
+    chi2 = -2 * model.loglikes({"b1_0": 2.0}, as_dict=True)[0]["survey"]
+    np.testing.assert_allclose(model.provider.get_pt_k(), k[k <= 0.2 + 1e-12])
+    assert chi2 < 1e-8
+    assert -2 * model.loglikes({"b1_0": 2.06}, as_dict=True)[0]["survey"] > 20
