@@ -9,7 +9,7 @@ against the fiducial) with omch2, H0, logA and the nuisance parameters b1, b2, b
 1. the emulated chain: `emulator: true`, no Boltzmann code, run to R - 1 < --rminus1 (0.02) or
    --emu-samples accepted points; --reuse-emulated reads a previous (or stopped) one instead;
 2. the CAMB chain: the same model with CAMB's linear spectrum, growth and distances, a short chain
-   (--camb-samples accepted points; at ~1.5 s per new cosmology it cannot converge in minutes);
+   (--camb-samples accepted points; at ~0.8 s per new cosmology it cannot converge in minutes);
 3. the comparison within 0.1 sigma: the emulated chain's points re-weighted by exp(ln L_CAMB - ln L_emu)
    (importance sampling, the same points evaluated by both models, CAMB's derived f sigma8 at each):
    the posterior means and widths of f sigma8 and the bias parameters of the two, without the Monte Carlo
