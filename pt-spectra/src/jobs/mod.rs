@@ -187,9 +187,9 @@ pub fn real_table_with_bias(
     header.extend(describe_inputs(prepared, precision));
     if prepared.spectrum_cb.is_some() {
         header.push(format!(
-            "massive neutrinos: loops of P_cb; P_dd of all matter = P_lin + f_cb^2 (P_dd,cb - P_lin_cb) \
+            "massive neutrinos: loops of P_cb; P_dd of all matter = P_lin + f_cb^2 (P_dd,cb - P_cb) \
              (neutrinos linear), f_cb = 1 - omega_nu/omega_m = {:.6}; P_dt, P_tt of cold dark matter + \
-             baryons; P_lin is P_m, P_lin_cb the linear P_cb",
+             baryons; P_lin is the linear P_m, P_cb the linear P of cold dark matter + baryons",
             prepared.cold_fraction()
         ));
     }
@@ -203,7 +203,7 @@ pub fn real_table_with_bias(
             let mut t = real_spectra_table(&spectra, header, terms);
             if let Some(cb) = &prepared.spectrum_cb {
                 t.push(
-                    "P_lin_cb",
+                    "P_cb",
                     POWER,
                     spectra.k.iter().map(|&k| cb.eval(k)).collect(),
                 );

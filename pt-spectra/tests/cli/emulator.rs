@@ -30,11 +30,11 @@ fn a_cosmology_with_massive_neutrinos_is_emulated_with_p_cb_and_the_prescription
         "{out}"
     );
     assert_eq!(column_names(&out)[..2], ["k", "P_lin"]);
-    assert!(column_names(&out).contains(&"P_lin_cb"), "{out}");
+    assert!(column_names(&out).contains(&"P_cb"), "{out}");
     let t = rows(&out);
     let cb = column_names(&out)
         .iter()
-        .position(|&c| c == "P_lin_cb")
+        .position(|&c| c == "P_cb")
         .unwrap();
     // neutrinos suppress all matter more than cold matter: P_cb/P_m ≈ 1/f_cb² at high k
     let f_cb = 1.0 - 0.3 / 93.14 / (0.02242 + 0.11933 + 0.3 / 93.14);
