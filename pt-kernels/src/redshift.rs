@@ -32,16 +32,15 @@ use crate::{dot, kernels, one, zero, Evaluate, KernelError, Scalar, MAX_ORDER};
 /// Largest order of the redshift-space kernels.
 pub const MAX_REDSHIFT_ORDER: usize = 5;
 
-fn sum_of<T: Scalar>(q: &[[T; 3]], mask: usize) -> [T; 3] {
-    let mut s = [zero::<T>(), zero(), zero()];
-    for (i, v) in q.iter().enumerate() {
-        if mask >> i & 1 == 1 {
-            for c in 0..3 {
-                s[c] = s[c].clone() + v[c].clone();
-            }
-        }
-    }
-    s
+/// Σ v over `vectors`.
+fn total<T: Scalar>(vectors: &[[T; 3]]) -> [T; 3] {
+    vectors.iter().fold([zero::<T>(), zero(), zero()], |a, v| {
+        [
+            a[0].clone() + v[0].clone(),
+            a[1].clone() + v[1].clone(),
+            a[2].clone() + v[2].clone(),
+        ]
+    })
 }
 
 fn factorial<T: Scalar>(n: usize) -> T {
@@ -86,8 +85,9 @@ pub fn redshift_kernel<T: Evaluate>(q: &[[T; 3]], f: &T, los: &[T; 3]) -> Result
     check(q, los)?;
     let n = q.len();
     let full = (1usize << n) - 1;
-    let k = sum_of(q, full);
-    // D and U of every non-empty subset (F_S, G_S from the generated kernels)
+    let k = total(q);
+    // D and U of every non-empty subset (F_S, G_S from the generated kernels, which, like `pieces`,
+    // give the limit of a subset with zero total momentum)
     let mut d = vec![zero::<T>(); full + 1];
     let mut u = vec![zero::<T>(); full + 1];
     for mask in 1..=full {
@@ -95,13 +95,7 @@ pub fn redshift_kernel<T: Evaluate>(q: &[[T; 3]], f: &T, los: &[T; 3]) -> Result
             .filter(|i| mask >> i & 1 == 1)
             .map(|i| q[i].clone())
             .collect();
-        let k_s = sum_of(q, mask);
-        let fg = if dot(&k_s, &k_s).is_zero() {
-            [zero(), zero()]
-        } else {
-            kernels(&members)?
-        };
-        [d[mask], u[mask]] = pieces(f, los, &k, &k_s, fg);
+        [d[mask], u[mask]] = pieces(f, los, &k, &total(&members), kernels(&members)?);
     }
     // E(R): the blocks B containing the lowest member of R, then the rest
     let mut e = vec![zero::<T>(); full + 1];
@@ -144,19 +138,13 @@ pub fn brute_force_redshift<T: Scalar>(
 ) -> Result<T, ReferenceError> {
     check(q, los)?;
     let n = q.len();
-    let k = sum_of(q, (1 << n) - 1);
-    let mut total = zero::<T>();
+    let k = total(q);
+    let mut sum = zero::<T>();
     let mut count = 0i64;
     for order in orderings(n) {
         let block = |range: std::ops::Range<usize>| -> Result<[T; 2], ReferenceError> {
             let members: Vec<[T; 3]> = order[range].iter().map(|&i| q[i].clone()).collect();
-            let k_s = members.iter().fold([zero::<T>(), zero(), zero()], |a, v| {
-                [
-                    a[0].clone() + v[0].clone(),
-                    a[1].clone() + v[1].clone(),
-                    a[2].clone() + v[2].clone(),
-                ]
-            });
+            let k_s = total(&members);
             if dot(&k_s, &k_s).is_zero() {
                 return Err(ReferenceError::ZeroMomentumRun);
             }
@@ -171,11 +159,11 @@ pub fn brute_force_redshift<T: Scalar>(
                 product = product * if j == 0 { d } else { u };
                 start += len;
             }
-            total = total + product / factorial::<T>(m);
+            sum = sum + product / factorial::<T>(m);
         }
         count += 1;
     }
-    Ok(total / T::from_ratio(count, 1))
+    Ok(sum / T::from_ratio(count, 1))
 }
 
 /// Every ordering of 0..n.

@@ -118,9 +118,9 @@ COSMOLOGY = {
     "wa": ("wa", False, 0.0), "wa_fld": ("wa", False, 0.0),
 }
 
-#: The k [h/Mpc] at which the emulator's scale-dependent f_cb(k, z) is taken as the model's f (as the
-#: library's K_GROWTH_RATE).
-K_GROWTH_RATE = 0.1
+#: The k [h/Mpc] at which the emulator's scale-dependent f_cb(k, z) is taken as the model's f (the
+#: library's, as the command line and pt.rsd take it).
+K_GROWTH_RATE = pt._core.K_GROWTH_RATE
 
 #: The nuisance parameters of one redshift with ``rsd: ept`` (velocileptors' names).
 EPT_NUISANCE = {"b1": (True, None, "")} | {

@@ -208,7 +208,7 @@ class SurveyMultipoles(Likelihood):
         if points == 0:
             raise ValueError("SurveyMultipoles: no data point in the fitted ranges")
         n_k = k.size
-        self._full_mask = mask
+        fitted = mask  # over every k of the file: selects the data and covariance
         if not self.xi and self.window is None and self.k_edges is None:
             # No window and no bins: the model is needed at the fitted k only (the theory's cost
             # grows with its k grid), so the observation is rebuilt on them.
@@ -216,7 +216,7 @@ class SurveyMultipoles(Likelihood):
             self.observation = pt.Observation(ells, k[used], box=self.box)
             mask = mask[:, used]
         index = np.concatenate([data_ells.index(ell) * n_k + np.flatnonzero(m)
-                                for ell, m in zip(ells, self._full_mask)])
+                                for ell, m in zip(ells, fitted)])
         if self.covariance_file is not None:
             path = str(self.covariance_file)
             cov = np.load(path) if path.endswith(".npy") else np.loadtxt(path)
@@ -227,7 +227,7 @@ class SurveyMultipoles(Likelihood):
             cov = cov[np.ix_(index, index)]
         else:
             cov = np.diag(np.concatenate([sigma[ell][m]
-                                          for ell, m in zip(ells, self._full_mask)]) ** 2)
+                                          for ell, m in zip(ells, fitted)]) ** 2)
         if self.n_mocks is not None:
             n_mocks = int(self.n_mocks)
             if n_mocks < points + 3:
@@ -241,7 +241,7 @@ class SurveyMultipoles(Likelihood):
                              "definite") from e
         self._whiten = np.linalg.inv(chol)
         self.ells, self._mask, self.points = ells, mask, points
-        self.data = np.concatenate([values[ell][m] for ell, m in zip(ells, self._full_mask)])
+        self.data = np.concatenate([values[ell][m] for ell, m in zip(ells, fitted)])
         self._cols = None
         self.log.info("%d points (multipoles %s) at z = %g; %s", points, ells, self.z,
                       "; ".join(self.observation.description) or "no window, no bins")

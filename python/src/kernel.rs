@@ -49,6 +49,31 @@ fn components<'py>(v: &Bound<'py, PyAny>) -> PyResult<Vec<Bound<'py, PyAny>>> {
     Ok(c)
 }
 
+/// One vector as three exact rationals.
+fn rational_vector(v: &Bound<'_, PyAny>) -> PyResult<[BigRational; 3]> {
+    let c = components(v)?;
+    Ok([rational(&c[0])?, rational(&c[1])?, rational(&c[2])?])
+}
+
+/// One vector as three finite floats.
+fn float_vector(v: &Bound<'_, PyAny>) -> PyResult<[f64; 3]> {
+    let c = components(v)?;
+    let x = |i: usize| finite_float(&c[i], "component");
+    Ok([x(0)?, x(1)?, x(2)?])
+}
+
+/// A finite float, or an error naming `what`.
+fn finite_float(c: &Bound<'_, PyAny>, what: &str) -> PyResult<f64> {
+    let v: f64 = c.extract()?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(PyValueError::new_err(format!(
+            "kernel: {what} {v} is not finite"
+        )))
+    }
+}
+
 /// F_n^s or G_n^s (`which` = "F" or "G") at the n = len(vectors) vectors (1 ≤ n ≤ 7), each [x, y, z]
 /// in h/Mpc, or the redshift-space Z_n (`which` = "Z", n ≤ 5; Scoccimarro, Couchman & Frieman 1999)
 /// with growth rate `f` (required) along the line of sight `los` (default [0, 0, 1]; only its
@@ -111,19 +136,13 @@ pub fn kernel(
     if exact {
         let q: Vec<[BigRational; 3]> = vectors
             .iter()
-            .map(|v| {
-                let c = components(v)?;
-                Ok([rational(&c[0])?, rational(&c[1])?, rational(&c[2])?])
-            })
+            .map(rational_vector)
             .collect::<PyResult<_>>()?;
         check_exact_size(&q).map_err(|e| PyValueError::new_err(format!("kernel: {e}")))?;
         if let Some((f, los)) = &redshift {
             let f = rational(f)?;
             let los = match los {
-                Some(v) => {
-                    let c = components(v)?;
-                    [rational(&c[0])?, rational(&c[1])?, rational(&c[2])?]
-                }
+                Some(v) => rational_vector(v)?,
                 None => [
                     BigRational::zero(),
                     BigRational::zero(),
@@ -147,32 +166,16 @@ pub fn kernel(
             .into_any()
             .unbind());
     }
-    let q: Vec<[f64; 3]> = vectors
-        .iter()
-        .map(|v| {
-            let c = components(v)?;
-            let x = |i: usize| -> PyResult<f64> {
-                let v: f64 = c[i].extract()?;
-                if v.is_finite() {
-                    Ok(v)
-                } else {
-                    Err(PyValueError::new_err(format!(
-                        "kernel: component {v} is not finite"
-                    )))
-                }
-            };
-            Ok([x(0)?, x(1)?, x(2)?])
-        })
-        .collect::<PyResult<_>>()?;
+    let q: Vec<[f64; 3]> = vectors.iter().map(float_vector).collect::<PyResult<_>>()?;
     if let Some(note) = pt_kernels::cancellation_note(&q) {
         let category = py.get_type::<pyo3::exceptions::PyRuntimeWarning>();
         PyErr::warn(py, &category, &std::ffi::CString::new(note)?, 1)?;
     }
     let value = match &redshift {
         Some((f, los)) => {
-            let f: f64 = f.extract()?;
-            let los: [f64; 3] = match los {
-                Some(v) => v.extract()?,
+            let f = finite_float(f, "f")?;
+            let los = match los {
+                Some(v) => float_vector(v)?,
                 None => [0.0, 0.0, 1.0],
             };
             pt_kernels::redshift::redshift_kernel(&q, &f, &los)

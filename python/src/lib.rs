@@ -574,6 +574,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
         defaults.set_item(name, value)?;
     }
     m.add("DEFAULTS", defaults)?;
+    m.add("K_GROWTH_RATE", pt_spectra::setup::K_GROWTH_RATE)?;
     m.add_class::<Table>()?;
     m.add_class::<RealPlan>()?;
     m.add_class::<emulator::LinearEmulator>()?;

@@ -3,10 +3,11 @@
 //!
 //! E²(z) = Ω_r(1+z)⁴ + Ω_m(1+z)³ + Ω_k(1+z)² + (Ω_DE − Ω_r) ρ_DE(z)/ρ_DE(0): the radiation of the CMB
 //! photons (T_CMB = [`T_CMB`]) and of [`N_EFF`] massless neutrinos, Ω_r h² = 4.18e-5, is taken from the
-//! dark energy (with massive neutrinos, `m_nu > 0`, the three degenerate species are matter, part of
-//! Ω_m, and the photons are the only radiation: at z ≤ 3 CAMB's H and D_M are then matched to 2e-5) so that E(0) = 1 with the cosmology's Ω_m and Ω_k, as CAMB and CLASS close the budget
-//! (the growth, `crate::cosmology::growth`, neglects radiation: its effect on D(z) is ~1e-4 and is
-//! common to the models). Without radiation H(z = 3) would be off by 5.7e-4 and D_M by 2.5e-4; with it,
+//! dark energy so that E(0) = 1 with the cosmology's Ω_m and Ω_k, as CAMB and CLASS close the budget.
+//! With massive neutrinos (`m_nu > 0`) the three degenerate species are matter, part of Ω_m, and the
+//! photons are the only radiation: at z ≤ 3 CAMB's H and D_M are then matched to 2e-5. (The growth,
+//! `crate::cosmology::growth`, neglects radiation: its effect on D(z) is ~1e-4 and is
+//! common to the models.) Without radiation H(z = 3) would be off by 5.7e-4 and D_M by 2.5e-4; with it,
 //! the tests find CAMB's H and D_M to ≤ 1e-7. Distances are in Mpc/h and H in h km/s/Mpc, the units
 //! in which an AP analysis compares two cosmologies (k in h/Mpc of each).
 

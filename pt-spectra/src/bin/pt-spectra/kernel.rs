@@ -63,29 +63,36 @@ pub fn run(args: &Args) -> Result<()> {
         );
     }
     if args.exact {
-        let vectors: Vec<[BigRational; 3]> = args
-            .q
-            .iter()
-            .map(|s| parse_vector(s))
-            .collect::<Result<_>>()?;
-        check_exact_size(&vectors).context("--exact")?;
-        let value = pick(args.which, kernels(&vectors)?);
+        let value = pick(args.which, kernels(&exact_vectors(&args.q)?)?);
         println!("{}", format_rational(&value));
     } else {
-        let v: Vec<[f64; 3]> = args
-            .q
-            .iter()
-            .map(|s| parse_float_vector(s))
-            .collect::<Result<_>>()?;
-        if let Some(note) = pt_kernels::cancellation_note(&v) {
-            eprintln!("warning: {note}");
-        }
+        let v = float_vectors(&args.q)?;
         println!(
             "{}",
             finite(args.which, &args.q, pick(args.which, kernels(&v)?))?
         );
     }
     Ok(())
+}
+
+/// The --q vectors in exact rationals, within the size budget of their order.
+fn exact_vectors(q: &[String]) -> Result<Vec<[BigRational; 3]>> {
+    let vectors: Vec<[BigRational; 3]> =
+        q.iter().map(|s| parse_vector(s)).collect::<Result<_>>()?;
+    check_exact_size(&vectors).context("--exact")?;
+    Ok(vectors)
+}
+
+/// The --q vectors in f64, with a warning if their lengths differ enough to cost digits.
+fn float_vectors(q: &[String]) -> Result<Vec<[f64; 3]>> {
+    let v: Vec<[f64; 3]> = q
+        .iter()
+        .map(|s| parse_float_vector(s))
+        .collect::<Result<_>>()?;
+    if let Some(note) = pt_kernels::cancellation_note(&v) {
+        eprintln!("warning: {note}");
+    }
+    Ok(v)
 }
 
 /// `kernel Z`: Z_n of the --q vectors with --f along --los.
@@ -99,21 +106,12 @@ fn run_redshift(args: &Args) -> Result<()> {
         bail!("kernel Z needs the growth rate: --f F (e.g. --f 0.75)");
     };
     if args.exact {
-        let vectors: Vec<[BigRational; 3]> = args
-            .q
-            .iter()
-            .map(|s| parse_vector(s))
-            .collect::<Result<_>>()?;
-        check_exact_size(&vectors).context("--exact")?;
+        let vectors = exact_vectors(&args.q)?;
         let f = parse_rational(f).context("--f")?;
         let los = parse_vector(&args.los).context("--los")?;
         println!("{}", format_rational(&redshift_kernel(&vectors, &f, &los)?));
     } else {
-        let v: Vec<[f64; 3]> = args
-            .q
-            .iter()
-            .map(|s| parse_float_vector(s))
-            .collect::<Result<_>>()?;
+        let v = float_vectors(&args.q)?;
         let f: f64 = f
             .parse()
             .ok()
