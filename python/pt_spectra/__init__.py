@@ -84,9 +84,9 @@ class RealPlan:
     spectrum (seconds), ``"auto"`` uses the tensors if they are already cached. A spectrum the basis
     does not represent (e.g. Eisenstein & Hu) is integrated directly, with a warning.
     ``plan(linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False, eh=None, cs2=0.0,
-    bias_terms=False, bias=None, b2=0.0, bs=0.0, b3=0.0)`` returns a :class:`Table` with no set-up cost
-    beyond the computation itself (``cs2``: the EFT counterterm; the bias arguments: the galaxy bias
-    terms and spectra; both as in :func:`real`).
+    bias_terms=False, bias=None, b2=0.0, bs=0.0, b3=0.0, ct=None)`` returns a :class:`Table` with no
+    set-up cost beyond the computation itself (``cs2``, ``ct``: the EFT counterterms; the bias
+    arguments: the galaxy bias terms and spectra; all as in :func:`real`).
     """
 
     def __init__(self, k, model=_D["real_model"], precision=_D["precision"], q_range=None,
@@ -101,9 +101,9 @@ class RealPlan:
         return self._plan.k
 
     def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False, eh=None,
-                 cs2=0.0, bias_terms=False, bias=None, b2=0.0, bs=0.0, b3=0.0):
+                 cs2=0.0, bias_terms=False, bias=None, b2=0.0, bs=0.0, b3=0.0, ct=None):
         return _warn(self._plan(linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2,
-                                bs, b3))
+                                bs, b3, ct))
 
     def batch(self, k_lin, P, terms=False):
         """The model for many linear spectra at once, spread over the threads
@@ -283,11 +283,12 @@ class RsdTerms:
 def real(model=_D["real_model"], k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False,
          precision=_D["precision"], q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None,
          k_min=1e-3, k_max=1.0, nk=100, cs2=0.0, two_loop=_D["two_loop"], bias_terms=False, bias=None,
-         b2=0.0, bs=0.0, b3=0.0) -> Table:
+         b2=0.0, bs=0.0, b3=0.0, ct=None) -> Table:
     """Real-space P_dd, P_dt, P_tt of a model (``pt-spectra real``).
 
     model: ``linear``, ``1l-spt``, ``2l-spt``, ``1l-rpt-n0`` … ``1l-rpt-n3``, ``2l-rpt-n0`` …
-    ``2l-rpt-n3``, or ``all`` (P_dd/P_nw of every model).
+    ``2l-rpt-n3``, ``1l-regpt``, ``2l-regpt``, ``1l-spt-ir``, ``2l-spt-ir``, ``2l-eft``, ``2l-eft-ir``
+    (2-loop SPT with the EFT counterterms of ``ct``), or ``all`` (P_dd/P_nw of every model).
     k: wavenumbers [h/Mpc] (default ``nk`` log-spaced in [k_min, k_max]).
     linear: ``None`` (the embedded gm2012 CAMB spectra), a file path, or ``(k_lin, p_lin)`` arrays at
     ``z_input``; rescaled to ``z`` with D(z) of ``cosmology``.
@@ -302,6 +303,11 @@ def real(model=_D["real_model"], k=None, linear=None, z=0.0, z_input=0.0, cosmol
     P_dt - 4 cs2 k^2 P_lin, P_tt - 6 cs2 k^2 P_lin (delta_ct grows as D^3 and theta_ct = 3 delta_ct by
     mass conservation); exact; stated in the header, and with ``terms`` the columns ``P_ct_dd P_ct_dt
     P_ct_tt``.
+    ct: the EFT counterterms as a dict, e.g. ``{"cs2": 1.0, "cs2_1loop": 0.3, "c4": -2.0}``: ``cs2``
+    as above (any model; give it once), and for ``2l-eft``, ``2l-eft-ir`` ``cs2_1loop`` [(Mpc/h)^2]
+    (P_dd - 2 cs2_1loop k^2 P_1loop) and ``c4`` [(Mpc/h)^4] (P_dd - 2 c4 k^4 P_lin); docs/eft.md.
+    With ``terms`` the EFT models add ``T_dd_X``, ``T_dt_X``, ``T_tt_X`` = dP/dX for each X, so that
+    P = P(ct = 0) + sum_X X T_X: a least-squares fit of the counterterms is linear.
     bias_terms: add the 1-loop bias terms ``Pd1d2 Pd2d2 Pd1s2 Pd2s2 Ps2s2`` (FAST-PT's names and
     normalisation, no constant subtracted), ``Pt1d2 Pt1s2`` (their velocity counterparts) and
     ``sig3nl``, each with ``err_``. bias: b1; with it, ``P_gg`` and ``P_gm`` of the bias expansion
@@ -309,7 +315,7 @@ def real(model=_D["real_model"], k=None, linear=None, z=0.0, z_input=0.0, cosmol
     """
     plan = RealPlan(_grid(k, k_min, k_max, nk), model, precision, q_range, two_loop_tolerance,
                     cache_dir, two_loop)
-    return plan(linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2, bs, b3)
+    return plan(linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2, bs, b3, ct)
 
 
 def rsd(rsd=_D["rsd_model"], real=_D["rsd_real_model"], k=None, linear=None, z=0.0, z_input=0.0,

@@ -13,7 +13,7 @@ use pt_spectra::linear::LogGrid;
 use pt_spectra::loops::bias::{BiasPlan, GalaxyBias};
 use pt_spectra::precision::Precision;
 use pt_spectra::progress::Silent;
-use pt_spectra::real::{RealPlan as LibRealPlan, RealSelection};
+use pt_spectra::real::{Counterterms, RealPlan as LibRealPlan, RealSelection};
 use pt_spectra::rsd::{RsdModel, RsdPlan as LibRsdPlan, Sigma0};
 use pt_spectra::store::TableStore;
 use pyo3::exceptions::{PyKeyError, PyRuntimeError, PyValueError};
@@ -183,7 +183,7 @@ impl RealPlan {
     /// The spectra of `linear` (None: the embedded gm2012 spectrum; a path; or (k, P)) at z, with the
     /// EFT counterterm c_s² = `cs2` [(Mpc/h)²], and the galaxy bias terms and spectra if asked for.
     #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false, eh=None, cs2=0.0,
-        bias_terms=false, bias=None, b2=0.0, bs=0.0, b3=0.0))]
+        bias_terms=false, bias=None, b2=0.0, bs=0.0, b3=0.0, ct=None))]
     #[allow(clippy::too_many_arguments)]
     fn __call__(
         &self,
@@ -200,8 +200,16 @@ impl RealPlan {
         b2: f64,
         bs: f64,
         b3: f64,
+        ct: Option<std::collections::BTreeMap<String, f64>>,
     ) -> PyResult<Table> {
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
+        let assignments = ct
+            .iter()
+            .flatten()
+            .map(|(name, value)| format!("{name}={value}"));
+        let counterterms = Counterterms::from_assignments(assignments)
+            .and_then(|c| c.with_cs2(cs2))
+            .map_err(value_error)?;
         let output = BiasOutput {
             terms: bias_terms,
             galaxy: bias.map(|b1| GalaxyBias {
@@ -229,7 +237,7 @@ impl RealPlan {
                 self.selection,
                 &prepared,
                 terms,
-                cs2,
+                &counterterms,
                 output,
                 &Silent,
             )?;
@@ -250,7 +258,8 @@ impl RealPlan {
 #[pyfunction]
 #[pyo3(signature = (model=pt_spectra::jobs::defaults::REAL_MODEL, k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false,
     precision=pt_spectra::jobs::defaults::PRECISION, q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None, k_min=1e-3,
-    k_max=1.0, nk=100, cs2=0.0, two_loop=pt_spectra::jobs::defaults::TWO_LOOP, bias_terms=false, bias=None, b2=0.0, bs=0.0, b3=0.0))]
+    k_max=1.0, nk=100, cs2=0.0, two_loop=pt_spectra::jobs::defaults::TWO_LOOP, bias_terms=false, bias=None, b2=0.0, bs=0.0, b3=0.0,
+    ct=None))]
 #[allow(clippy::too_many_arguments)]
 fn real(
     py: Python<'_>,
@@ -276,6 +285,7 @@ fn real(
     b2: f64,
     bs: f64,
     b3: f64,
+    ct: Option<std::collections::BTreeMap<String, f64>>,
 ) -> PyResult<Table> {
     let k = k_grid(k, k_min, k_max, nk)?;
     let plan = RealPlan::new(
@@ -289,7 +299,7 @@ fn real(
         two_loop,
     )?;
     plan.__call__(
-        py, linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2, bs, b3,
+        py, linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2, bs, b3, ct,
     )
 }
 

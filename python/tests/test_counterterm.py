@@ -96,3 +96,25 @@ def test_non_finite_cs2_raises_value_error_naming_it(bad):
     with pytest.raises(ValueError, match="cs2"):
         pt.fit({"k": K, "P0": K, "s0": K}, k_max=0.2, free=("f",), real="linear", rsd="kaiser",
                fog="none", cs2=bad)
+
+
+def test_two_loop_eft_takes_its_counterterms_as_a_dict_and_prints_their_templates():
+    k = [0.05, 0.1, 0.2]
+    zero = pt.real(model="2l-eft", k=k, precision="fast", terms=True)
+    ct = {"cs2": 1.2, "cs2_1loop": 0.4, "c4": -3.0}
+    with_ct = pt.real(model="2l-eft", k=k, precision="fast", terms=True, ct=ct)
+    for pair in ("dd", "dt", "tt"):
+        want = sum(v * np.asarray(zero[f"T_{pair}_{c}"]) for c, v in ct.items())
+        got = np.asarray(with_ct[f"P_{pair}"]) - np.asarray(zero[f"P_{pair}"])
+        np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9)
+    # T_dd_cs2 = -2 k^2 P_lin; the plan call takes the same dict.
+    np.testing.assert_allclose(zero["T_dd_cs2"], -2 * np.asarray(k) ** 2 * zero["P_lin"], rtol=1e-12)
+    plan = pt.RealPlan(k, model="2l-eft", precision="fast")
+    np.testing.assert_allclose(plan(ct=ct)["P_dd"], with_ct["P_dd"], rtol=1e-12)
+    for bad, needle in (({"cs3": 1.0}, "cs2_1loop"), ({"c4": float("nan")}, "finite")):
+        with pytest.raises(ValueError, match=needle):
+            pt.real(model="2l-eft", k=k, precision="fast", ct=bad)
+    with pytest.raises(ValueError, match="2l-eft and 2l-eft-ir"):
+        pt.real(model="2l-spt", k=k, precision="fast", ct={"c4": 1.0})
+    with pytest.raises(ValueError, match="given twice"):
+        pt.real(model="2l-eft", k=k, precision="fast", ct={"cs2": 1.0}, cs2=2.0)

@@ -9,7 +9,7 @@ pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 /// Lower-triangular Cholesky factor of a symmetric positive-definite matrix, or `None` (also for NaN
 /// or infinite pivots: huge elements overflow the sums).
-pub(super) fn cholesky(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
+pub(crate) fn cholesky(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
     let n = a.len();
     let mut l = vec![vec![0.0; n]; n];
     for i in 0..n {
@@ -44,7 +44,7 @@ pub(super) fn invert_lower(l: &[Vec<f64>]) -> Vec<Vec<f64>> {
 }
 
 /// Solves F a = b for symmetric positive definite F: (a, F⁻¹, ln det F).
-pub(super) fn solve_spd(f: &[Vec<f64>], b: &[f64]) -> Result<(Vec<f64>, Vec<Vec<f64>>, f64)> {
+pub(crate) fn solve_spd(f: &[Vec<f64>], b: &[f64]) -> Result<(Vec<f64>, Vec<Vec<f64>>, f64)> {
     let n = b.len();
     let l = cholesky(f).ok_or_else(|| Error::InvalidChoice {
         what: format!("the {n} marginalised (or free) parameters"),

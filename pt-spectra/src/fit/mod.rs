@@ -28,7 +28,7 @@ mod contour;
 mod data;
 pub mod galaxy;
 mod layout;
-mod linalg;
+pub(crate) mod linalg;
 mod minimise;
 pub use contour::{contour, Contour, ContourGrid, CONTOUR_LEVELS};
 pub use data::MultipoleData;

@@ -8,17 +8,18 @@
 //!
 //! ```
 //! use pt_spectra::{jobs, precision::Precision, progress::Silent, store::TableStore};
-//! use pt_spectra::real::{RealPlan, RealSelection};
+//! use pt_spectra::real::{Counterterms, RealPlan, RealSelection};
 //! use pt_spectra::setup::{prepare, LinearSource, Request};
 //! let prepared = prepare(Request { source: LinearSource::Embedded, cosmology: None, z: 0.0 })?;
 //! let selection: RealSelection = "1l-spt".parse()?;
 //! let plan = RealPlan::for_selection(&[0.05, 0.1], selection, &Precision::fast(),
 //!                                    &TableStore::in_memory(), &Silent)?;
-//! let t = jobs::real_table(&plan, selection, &prepared, true, 0.0, &Silent)?;
+//! let none = Counterterms::default();
+//! let t = jobs::real_table(&plan, selection, &prepared, true, &none, &Silent)?;
 //! assert_eq!(t.names()[..5], ["k", "P_lin", "P_dd", "P_dt", "P_tt"]);
 //! assert!(t.column("P22_dd").is_some() && t.header[0].contains("1l-spt"));
 //! // With the EFT counterterm c_s² = 1 (Mpc/h)²: P_dd − 2 k² P_lin, stated in the header.
-//! let c = jobs::real_table(&plan, selection, &prepared, true, 1.0, &Silent)?;
+//! let c = jobs::real_table(&plan, selection, &prepared, true, &Counterterms::cs2(1.0), &Silent)?;
 //! let (p, q, p_lin) = (t.column("P_dd").unwrap(), c.column("P_dd").unwrap(), t.column("P_lin").unwrap());
 //! assert!((q[1] - p[1] + 2.0 * 0.1 * 0.1 * p_lin[1]).abs() < 1e-9 * p[1]);
 //! assert!(c.header.iter().any(|h| h.contains("cs2 = 1")) && c.column("P_ct_tt").is_some());
@@ -31,7 +32,7 @@ use crate::loops::Pair;
 use crate::output::{Table, POWER, WAVENUMBER};
 use crate::precision::Precision;
 use crate::progress::Progress;
-use crate::real::{RealModel, RealPlan, RealSelection, RealSpectra};
+use crate::real::{Counterterms, RealModel, RealPlan, RealSelection, RealSpectra};
 use crate::setup::Prepared;
 
 mod bias;
@@ -109,9 +110,11 @@ pub fn two_loop_line(precision: &Precision) -> String {
 }
 
 /// `pt-spectra real`: the spectra of the selected model (or P_dd/P_nw of every model) for the
-/// prepared linear spectrum, with the loop terms if `terms`, and the EFT counterterm of c_s² = `cs2`
-/// [(Mpc/h)²] added to every model (0: none; [`crate::real::counterterm`](mod@crate::real::counterterm)). With a counterterm the
-/// header states c_s² and, with `terms`, the columns `P_ct_dd P_ct_dt P_ct_tt` give it.
+/// prepared linear spectrum, with the loop terms if `terms`, and the EFT `counterterms` added (c_s²
+/// to every model, [`crate::real::counterterm`](mod@crate::real::counterterm); the 2-loop set to
+/// `2l-eft`, `2l-eft-ir`, [`crate::real::eft`]). The header states them; with `terms`, the columns
+/// `P_ct_dd P_ct_dt P_ct_tt` give their sum and, for the EFT models, `T_dd_X T_dt_X T_tt_X` the
+/// derivatives ∂P/∂X of each parameter X.
 ///
 /// # Errors
 /// [`Error::PlanMismatch`] if the plan does not cover the selection ([`RealPlan::for_selection`]); as [`RealPlan::evaluate`],
@@ -121,7 +124,7 @@ pub fn real_table(
     selection: RealSelection,
     prepared: &Prepared,
     terms: bool,
-    cs2: f64,
+    counterterms: &Counterterms,
     progress: &dyn Progress,
 ) -> Result<Table> {
     real_table_with_bias(
@@ -130,7 +133,7 @@ pub fn real_table(
         selection,
         prepared,
         terms,
-        cs2,
+        counterterms,
         BiasOutput::default(),
         progress,
     )
@@ -150,7 +153,7 @@ pub fn real_table_with_bias(
     selection: RealSelection,
     prepared: &Prepared,
     terms: bool,
-    cs2: f64,
+    counterterms: &Counterterms,
     bias: BiasOutput,
     progress: &dyn Progress,
 ) -> Result<Table> {
@@ -162,7 +165,11 @@ pub fn real_table_with_bias(
             hint: " (RealPlan::for_selection)",
         });
     }
-    crate::real::check_cs2(cs2)?;
+    // `all` takes c_s² alone, as the non-EFT models do.
+    counterterms.check(match selection {
+        RealSelection::One(model) => model,
+        RealSelection::All => RealModel::Linear,
+    })?;
     let precision = plan.precision();
     let spectra = match &prepared.spectrum_cb {
         Some(cb) => {
@@ -193,13 +200,11 @@ pub fn real_table_with_bias(
             prepared.cold_fraction()
         ));
     }
-    if cs2 != 0.0 {
-        header.push(counterterm_line(cs2));
-    }
     match selection {
         RealSelection::One(model) => {
+            header.extend(counterterms.describe(model));
             header.extend(model_header(model, &spectra, precision, terms));
-            let spectra = spectra.with_counterterm(cs2)?;
+            let spectra = spectra.with_counterterms(counterterms)?;
             let mut t = real_spectra_table(&spectra, header, terms);
             if let Some(cb) = &prepared.spectrum_cb {
                 t.push(
@@ -208,7 +213,7 @@ pub fn real_table_with_bias(
                     spectra.k.iter().map(|&k| cb.eval(k)).collect(),
                 );
             }
-            if terms && cs2 != 0.0 {
+            if terms && !counterterms.is_zero() {
                 for pair in Pair::ALL {
                     let name = format!("P_ct_{}", pair.suffix());
                     t.push(name, POWER, spectra.counterterm(pair));
@@ -229,7 +234,8 @@ pub fn real_table_with_bias(
                  numerical error"
                     .into(),
             );
-            all_models(header, &spectra, cs2, &prepared.no_wiggle()?)
+            header.extend(counterterms.describe(RealModel::Linear));
+            all_models(header, &spectra, counterterms.cs2, &prepared.no_wiggle()?)
         }
     }
 }

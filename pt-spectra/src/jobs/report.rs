@@ -11,7 +11,8 @@ use crate::rsd::RsdMultipoles;
 /// The spectra as a table with `header` lines: `k P_lin P_dd P_dt P_tt`, and with `terms` also
 /// their errors, every loop term the model uses with its error (`P22_xx`, `P13_xx`, then `P15_xx`,
 /// `P17_xx`, `P24_xx P33_xx P33_2L_xx P2loop_xx` as the model needs them), σ_v² and, for RPT, the
-/// factors `N_xx` (xx = dd, dt, tt).
+/// factors `N_xx` (xx = dd, dt, tt); for the EFT models the counterterm templates `T_xx_X` = ∂P_xx/∂X
+/// of each counterterm X ([`crate::real::eft`]).
 pub fn real_spectra_table(r: &RealSpectra, header: Vec<String>, terms: bool) -> Table {
     let mut t = Table::new(header);
     t.push("k", WAVENUMBER, r.k.clone());
@@ -70,6 +71,18 @@ pub fn real_spectra_table(r: &RealSpectra, header: Vec<String>, terms: bool) -> 
     if let (Some(ir), true) = (&r.terms.ir, model.needs_ir()) {
         t.push("P_nw", POWER, ir.no_wiggle.one_loop.p_lin.clone());
         t.push_estimates("Sigma2_bao", "(Mpc/h)^2", &vec![ir.sigma2; r.k.len()]);
+    }
+    if model.is_eft() {
+        for c in crate::real::Counterterm::ALL {
+            let unit = if c == crate::real::Counterterm::C4 {
+                "(Mpc/h)^-1"
+            } else {
+                "Mpc/h"
+            };
+            for (pair, v) in r.counterterm_template(c).iter() {
+                t.push_estimates(&format!("T_{}_{c}", pair.suffix()), unit, v);
+            }
+        }
     }
     if let Some(factors) = &r.factors {
         for (pair, f) in factors.iter() {

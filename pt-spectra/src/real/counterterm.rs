@@ -30,7 +30,8 @@
 //! Here one parameter is kept, with the pair factors that mass conservation fixes; the velocity
 //! counterterms, the EFT redshift-space counterterms (Senatore & Zaldarriaga 2014, arXiv:1409.1225) and
 //! halo derivative bias are not modelled. The counterterm is added to the output of every model as it
-//! is (SPT, RPT, RegPT, IR-resummed: outside the propagator factors and with the undamped P_lin).
+//! is (SPT, RPT, RegPT: outside the propagator factors; the IR-resummed models: on the IR-resummed
+//! P_nw + e^{−k²Σ²} P_w, [`super::eft`]). The 2-loop counterterms of `2l-eft` are in [`super::eft`].
 //!
 //! The counterterm is exact: it adds nothing to the error estimates. With c_s² = 0 nothing is added
 //! and every value is bit-identical to a run without it.
@@ -80,8 +81,9 @@ pub fn check_cs2(cs2: f64) -> Result<()> {
 
 impl RealSpectra {
     /// The spectra with the EFT counterterm of c_s² = `cs2` [(Mpc/h)²] added to P_δδ, P_δθ and P_θθ
-    /// ([`counterterm`]; module docs), [`cs2`](Self::cs2) increased by `cs2`. The errors are unchanged
-    /// (the counterterm is exact); `cs2` = 0 returns the spectra untouched.
+    /// ([`counterterm`]; module docs), [`counterterms`](Self::counterterms)`.cs2` increased by `cs2`:
+    /// [`with_counterterms`](Self::with_counterterms) with c_s² alone. The errors are unchanged (the
+    /// counterterm is exact); `cs2` = 0 returns the spectra untouched.
     ///
     /// ```
     /// use pt_spectra::{linear::LinearSpectrum, loops::Pair, precision::Precision, store::TableStore};
@@ -91,33 +93,15 @@ impl RealSpectra {
     /// let with = s.clone().with_counterterm(2.0)?;
     /// let shift = with.pair(Pair::DeltaTheta)[0].value - s.pair(Pair::DeltaTheta)[0].value;
     /// assert!((shift / (-4.0 * 2.0 * 0.01 * s.p_lin[0]) - 1.0).abs() < 1e-9);
-    /// assert_eq!(with.cs2, 2.0);
+    /// assert_eq!(with.counterterms.cs2, 2.0);
     /// # Ok::<(), pt_spectra::error::Error>(())
     /// ```
     ///
     /// # Errors
     /// As [`check_cs2`].
-    pub fn with_counterterm(mut self, cs2: f64) -> Result<Self> {
+    pub fn with_counterterm(self, cs2: f64) -> Result<Self> {
         check_cs2(cs2)?;
-        if cs2 == 0.0 {
-            return Ok(self);
-        }
-        for pair in Pair::ALL {
-            for ((e, &k), &p) in self.spectra[pair].iter_mut().zip(&self.k).zip(&self.p_lin) {
-                e.value += counterterm(pair, cs2, k, p);
-            }
-        }
-        self.cs2 += cs2;
-        Ok(self)
-    }
-
-    /// The counterterm of `pair` that [`spectra`](Self::spectra) include, at each k [(Mpc/h)^3].
-    pub fn counterterm(&self, pair: Pair) -> Vec<f64> {
-        self.k
-            .iter()
-            .zip(&self.p_lin)
-            .map(|(&k, &p)| counterterm(pair, self.cs2, k, p))
-            .collect()
+        self.with_counterterms(&super::Counterterms::cs2(cs2))
     }
 }
 
@@ -142,7 +126,7 @@ mod tests {
             let base = real_space(model, &p, &k, &Precision::fast(), &store).unwrap();
             for cs2 in [1.5, -0.7] {
                 let with = base.clone().with_counterterm(cs2).unwrap();
-                assert_eq!(with.cs2, cs2);
+                assert_eq!(with.counterterms.cs2, cs2);
                 for (pair, factor) in Pair::ALL.into_iter().zip([2.0, 4.0, 6.0]) {
                     for (i, &ki) in k.iter().enumerate() {
                         // Closed form, with P_lin read from the input spectrum itself.
@@ -172,7 +156,7 @@ mod tests {
             &store,
         )
         .unwrap();
-        assert_eq!(base.cs2, 0.0);
+        assert_eq!(base.counterterms.cs2, 0.0);
         assert_eq!(base.clone().with_counterterm(0.0).unwrap(), base);
         for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
             let e = base.clone().with_counterterm(bad).unwrap_err().to_string();
@@ -182,7 +166,7 @@ mod tests {
         let twice = base.clone().with_counterterm(1.0).unwrap();
         let twice = twice.with_counterterm(0.5).unwrap();
         let once = base.with_counterterm(1.5).unwrap();
-        assert_eq!(twice.cs2, 1.5);
+        assert_eq!(twice.counterterms.cs2, 1.5);
         for pair in Pair::ALL {
             for (a, b) in twice.spectra[pair].iter().zip(&once.spectra[pair]) {
                 assert!((a.value - b.value).abs() < 1e-12 * a.value.abs());

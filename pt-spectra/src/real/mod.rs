@@ -13,6 +13,7 @@
 //! | `1l-rpt-n3`, `2l-rpt-n3` | as the N2 models, with N3 from P13, P15 and P17 (eq. N3) |
 //! | `1l-regpt`, `2l-regpt` | RegPT (Taruya et al. 2012), [`crate::resum::regpt_one_loop`], `crate::resum::regpt_two_loop` |
 //! | `1l-spt-ir`, `2l-spt-ir` | SPT with IR-resummed BAO ([`crate::ir`]) |
+//! | `2l-eft`, `2l-eft-ir` | 2-loop SPT (IR-resummed) + the EFT counterterms cs2, cs2_1loop, c4 ([`eft`]) |
 //!
 //! Every value carries an error estimate propagated from the loop integrals ([`crate::loops`]).
 //! Any model takes the EFT counterterm −(2, 4, 6) c_s² k² P_lin of δδ, δθ, θθ
@@ -26,8 +27,10 @@ use std::fmt;
 use std::str::FromStr;
 
 pub mod counterterm;
+pub mod eft;
 mod plan;
 pub use counterterm::{check_cs2, counterterm, counterterm_factor};
+pub use eft::{fit_counterterms, Counterterm, Counterterms};
 pub use plan::{real_space, RealPlan};
 
 /// A real-space model, named as on the command line.
@@ -66,16 +69,20 @@ pub enum RealModel {
     OneLoopSptIr,
     /// 2-loop SPT with the BAO wiggles IR-resummed ([`crate::ir`]).
     TwoLoopSptIr,
+    /// 2-loop SPT with the EFT counterterms to that order ([`eft`]).
+    TwoLoopEft,
+    /// 2-loop SPT with IR-resummed BAO and the EFT counterterms ([`eft`]).
+    TwoLoopEftIr,
 }
 
 /// The accepted model names, for messages.
 const MODEL_NAMES: &str = "linear, 1l-spt, 1l-rpt-n0, 1l-rpt-n1, 1l-rpt-n2, 1l-rpt-n3, 2l-spt, \
                            2l-rpt-n0, 2l-rpt-n1, 2l-rpt-n2, 2l-rpt-n3, 1l-regpt, 2l-regpt, 1l-spt-ir, \
-                           2l-spt-ir";
+                           2l-spt-ir, 2l-eft, 2l-eft-ir";
 
 impl RealModel {
     /// Every model.
-    pub const ALL: [RealModel; 15] = [
+    pub const ALL: [RealModel; 17] = [
         RealModel::Linear,
         RealModel::OneLoopSpt,
         RealModel::OneLoopRptN0,
@@ -91,6 +98,8 @@ impl RealModel {
         RealModel::TwoLoopRegPt,
         RealModel::OneLoopSptIr,
         RealModel::TwoLoopSptIr,
+        RealModel::TwoLoopEft,
+        RealModel::TwoLoopEftIr,
     ];
 
     /// The model's name (`linear`, `1l-spt`, `1l-rpt-n0`, `1l-rpt-n1`).
@@ -111,6 +120,8 @@ impl RealModel {
             RealModel::TwoLoopRegPt => "2l-regpt",
             RealModel::OneLoopSptIr => "1l-spt-ir",
             RealModel::TwoLoopSptIr => "2l-spt-ir",
+            RealModel::TwoLoopEft => "2l-eft",
+            RealModel::TwoLoopEftIr => "2l-eft-ir",
         }
     }
 
@@ -129,7 +140,9 @@ impl RealModel {
             | RealModel::OneLoopRegPt
             | RealModel::TwoLoopRegPt
             | RealModel::OneLoopSptIr
-            | RealModel::TwoLoopSptIr => None,
+            | RealModel::TwoLoopSptIr
+            | RealModel::TwoLoopEft
+            | RealModel::TwoLoopEftIr => None,
         }
     }
 
@@ -167,6 +180,8 @@ impl RealModel {
                 | RealModel::TwoLoopRptN3
                 | RealModel::TwoLoopSptIr
                 | RealModel::TwoLoopRegPt
+                | RealModel::TwoLoopEft
+                | RealModel::TwoLoopEftIr
         )
     }
 
@@ -178,7 +193,15 @@ impl RealModel {
     /// Whether the model resums the BAO ([`crate::ir`]): its terms include those of the no-wiggle
     /// spectrum.
     pub fn needs_ir(self) -> bool {
-        matches!(self, RealModel::OneLoopSptIr | RealModel::TwoLoopSptIr)
+        matches!(
+            self,
+            RealModel::OneLoopSptIr | RealModel::TwoLoopSptIr | RealModel::TwoLoopEftIr
+        )
+    }
+
+    /// Whether the model is an EFT model, with the counterterms cs2, cs2_1loop, c4 ([`eft`]).
+    pub fn is_eft(self) -> bool {
+        matches!(self, RealModel::TwoLoopEft | RealModel::TwoLoopEftIr)
     }
 }
 
@@ -254,9 +277,12 @@ pub struct RealSpectra {
     pub factors: Option<ByPair<Vec<Estimate>>>,
     /// The loop terms (every term the model needs is there; others may be too).
     pub terms: LoopTerms,
-    /// The EFT counterterm c_s² [(Mpc/h)²] included in `spectra` (0: none;
-    /// [`with_counterterm`](Self::with_counterterm)).
-    pub cs2: f64,
+    /// The EFT counterterms included in `spectra` (all 0: none;
+    /// [`with_counterterms`](Self::with_counterterms)).
+    pub counterterms: Counterterms,
+    /// With massive neutrinos, f_cb = 1 − ω_ν/ω_m of [`with_massive_neutrinos`](Self::with_massive_neutrinos):
+    /// P_δδ is then that of all matter, and its counterterms are f_cb² times those of cold matter.
+    pub cold_fraction: Option<f64>,
 }
 
 impl RealSpectra {
@@ -282,6 +308,7 @@ impl RealSpectra {
             *v = (*v + (-p_cb)) * (f_cb * f_cb) + p_m;
         }
         self.p_lin = p_m_lin.to_vec();
+        self.cold_fraction = Some(self.cold_fraction.unwrap_or(1.0) * f_cb);
         Ok(self)
     }
 
@@ -383,7 +410,8 @@ impl RealSpectra {
             spectra,
             factors,
             terms,
-            cs2: 0.0,
+            counterterms: Counterterms::default(),
+            cold_fraction: None,
         })
     }
 }

@@ -316,3 +316,54 @@ fn bad_cs2_values_are_named_errors() {
         ),
     ]);
 }
+
+#[test]
+fn two_loop_eft_prints_its_templates_and_adds_each_counterterm_linearly() {
+    // `2l-eft` is 2-loop SPT plus Σ X T_X: the run with counterterms minus the run without is that
+    // sum of the printed templates, and T_dd_cs2 is the closed form −2 k² P_lin.
+    let mut base = vec!["real", "--model", "2l-eft", "--terms"];
+    base.extend(GRID);
+    let (ok, zero, err) = run(&base);
+    assert!(ok, "{err}");
+    assert!(err.contains("every counterterm of 2l-eft is 0"), "{err}");
+    assert!(zero.contains("# warning: every counterterm is 0"));
+    let mut with = base.clone();
+    with.extend(["--ct", "cs2=1.5", "--ct", "cs2_1loop=-0.5", "--ct", "c4=2"]);
+    let (ok, out, err) = run(&with);
+    assert!(ok && !err.contains("warning"), "{err}");
+    assert!(out.contains("cs2 = 1.5 (Mpc/h)^2, cs2_1loop = -0.5 (Mpc/h)^2, c4 = 2 (Mpc/h)^4"));
+    let (k, lin) = (column(&zero, "k"), column(&zero, "P_lin"));
+    for pair in ["dd", "dt", "tt"] {
+        let p0 = column(&zero, &format!("P_{pair}"));
+        let p = column(&out, &format!("P_{pair}"));
+        let t = |c: &str| column(&zero, &format!("T_{pair}_{c}"));
+        let (a, b, c) = (t("cs2"), t("cs2_1loop"), t("c4"));
+        for i in 0..k.len() {
+            let want = 1.5 * a[i] - 0.5 * b[i] + 2.0 * c[i];
+            assert!(
+                (p[i] - p0[i] - want).abs() < 1e-8 * p0[i].abs(),
+                "{pair} k={}",
+                k[i]
+            );
+        }
+    }
+    let t = column(&zero, "T_dd_cs2");
+    for i in 0..k.len() {
+        assert!((t[i] + 2.0 * k[i] * k[i] * lin[i]).abs() < 1e-8 * t[i].abs());
+    }
+    let fails = |extra: &[&str], needle: &str| {
+        let mut args = vec!["real", "--model", "2l-eft"];
+        args.extend(GRID);
+        args.extend(extra);
+        let (ok, _, err) = run(&args);
+        assert!(!ok && err.contains(needle), "{extra:?}: {err}");
+    };
+    fails(&["--ct", "cs3=1"], "available: cs2, cs2_1loop, c4");
+    fails(&["--ct", "c4"], "NAME=VALUE");
+    fails(&["--ct", "c4=inf"], "finite");
+    fails(&["--ct", "cs2=1", "--cs2", "2"], "given twice");
+    let mut spt = vec!["real", "--model", "2l-spt", "--ct", "c4=1"];
+    spt.extend(GRID);
+    let (ok, _, err) = run(&spt);
+    assert!(!ok && err.contains("2l-eft and 2l-eft-ir"), "{err}");
+}
