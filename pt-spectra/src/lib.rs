@@ -41,6 +41,7 @@ pub mod hankel;
 pub mod integrate;
 pub mod ir;
 pub mod jobs;
+pub(crate) mod linalg;
 pub mod linear;
 pub mod loops;
 pub mod memory;

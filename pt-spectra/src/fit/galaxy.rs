@@ -20,9 +20,9 @@
 //! With a distortion (`ap`), α∥ and α⊥ (`apar`, `aperp`) can be free too, on a plan built for an AP
 //! range ([`crate::rsd::ept::EptSettings::ap_range`]).
 
-use super::linalg::{cholesky, dot, invert_lower, solve_spd};
 use super::MultipoleData;
 use crate::error::{Error, Result};
+use crate::linalg::{cholesky, dot, invert_lower, solve_spd};
 use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
 use crate::survey::observe::Observation;
 use argmin::core::{CostFunction, Executor, State};

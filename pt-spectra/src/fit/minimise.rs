@@ -1,9 +1,9 @@
 //! χ² of one fit window and its minimisation: Nelder–Mead over the free parameters, 1-D Brent along one,
 //! and the profile χ² with some parameters held at given values and the others re-minimised.
 
-use super::linalg::{cholesky, invert_lower};
 use super::{MultipoleData, MultipoleModel, Parameter, Params};
 use crate::error::{Error, Result};
+use crate::linalg::{cholesky, invert_lower};
 use argmin::core::{CostFunction, Executor, State};
 use argmin::solver::brent::BrentOpt;
 use argmin::solver::neldermead::NelderMead;

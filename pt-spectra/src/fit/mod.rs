@@ -28,7 +28,6 @@ mod contour;
 mod data;
 pub mod galaxy;
 mod layout;
-pub(crate) mod linalg;
 mod minimise;
 pub use contour::{contour, Contour, ContourGrid, CONTOUR_LEVELS};
 pub use data::MultipoleData;

@@ -32,6 +32,7 @@ use crate::loops::Pair;
 use crate::output::{Table, POWER, WAVENUMBER};
 use crate::precision::Precision;
 use crate::progress::Progress;
+pub use crate::real::counterterm::counterterm_line;
 use crate::real::{Counterterms, RealModel, RealPlan, RealSelection, RealSpectra};
 use crate::setup::Prepared;
 
@@ -240,15 +241,6 @@ pub fn real_table_with_bias(
     }
 }
 
-/// The header line of an EFT counterterm c_s² = `cs2` ≠ 0 [(Mpc/h)²].
-pub fn counterterm_line(cs2: f64) -> String {
-    format!(
-        "EFT counterterm cs2 = {cs2} (Mpc/h)^2 added to P_dd, P_dt, P_tt: -2, -4, -6 cs2 k^2 P_lin \
-         (delta_ct = -cs2 k^2 delta_lin growing as D^3, theta_ct = 3 delta_ct by mass conservation; \
-         exact, no error added)"
-    )
-}
-
 /// The header lines of one model: conventions, σ_v², the 2-loop settings and the RPT factors.
 fn model_header(
     model: RealModel,
@@ -297,7 +289,7 @@ fn model_header(
     h
 }
 
-/// `k P_nw`, then P_dd/P_nw of every model and their errors.
+/// `k P_nw`, then P_dd/P_nw of every model but the EFT ones (2-loop SPT until fitted) and their errors.
 fn all_models(
     header: Vec<String>,
     spectra: &RealSpectra,
@@ -305,8 +297,10 @@ fn all_models(
     p_nw: &crate::linear::LinearSpectrum,
 ) -> Result<Table> {
     let nw: Vec<f64> = spectra.k.iter().map(|&k| p_nw.eval(k)).collect();
+    // The EFT models are 2-loop SPT until their counterterms are fitted: not repeated here.
     let models = RealModel::ALL
         .iter()
+        .filter(|m| !m.is_eft())
         .map(|&m| RealSpectra::from_terms(m, spectra.terms.clone())?.with_counterterm(cs2))
         .collect::<Result<Vec<_>>>()?;
     let mut t = Table::new(header);

@@ -79,6 +79,15 @@ pub fn check_cs2(cs2: f64) -> Result<()> {
     }
 }
 
+/// The header line of an EFT counterterm c_s² = `cs2` ≠ 0 [(Mpc/h)²].
+pub fn counterterm_line(cs2: f64) -> String {
+    format!(
+        "EFT counterterm cs2 = {cs2} (Mpc/h)^2 added to P_dd, P_dt, P_tt: -2, -4, -6 cs2 k^2 P_lin \
+         (delta_ct = -cs2 k^2 delta_lin growing as D^3, theta_ct = 3 delta_ct by mass conservation; \
+         exact, no error added)"
+    )
+}
+
 impl RealSpectra {
     /// The spectra with the EFT counterterm of c_s² = `cs2` [(Mpc/h)²] added to P_δδ, P_δθ and P_θθ
     /// ([`counterterm`]; module docs), [`counterterms`](Self::counterterms)`.cs2` increased by `cs2`:

@@ -22,7 +22,7 @@
 //! That this set is complete at two loops is tested by what it must do: absorb how the loops depend on
 //! their cut-off. Between q_max = 2 h/Mpc and 10³ h/Mpc, 2-loop SPT at z = 0 changes by 12% of P_lin
 //! at k = 0.3 h/Mpc; a least-squares cs2 alone leaves 2.9e-3 of P_lin, the set leaves 2.7e-4, the
-//! integration error of the 2-loop terms (tests/tests/eft.rs).
+//! level of the 2-loop integration error (tests/tests/eft.rs; docs/eft.md).
 //!
 //! **Velocities.** With c ∝ D^n (the time dependence of the P13, resp. 2-loop, UV limit that each
 //! counterterm renormalises: n = 2 for cs2 and cs2_1loop, 4 for c4), mass conservation linearised in
@@ -271,7 +271,7 @@ impl Counterterms {
             return if self.cs2 == 0.0 {
                 vec![]
             } else {
-                vec![crate::jobs::counterterm_line(self.cs2)]
+                vec![super::counterterm::counterterm_line(self.cs2)]
             };
         }
         let values: Vec<String> = Counterterm::ALL
@@ -452,7 +452,7 @@ pub fn fit_counterterms(
             }
         }
     }
-    let (solution, inverse, _) = crate::fit::linalg::solve_spd(&normal, &rhs)?;
+    let (solution, inverse, _) = crate::linalg::solve_spd(&normal, &rhs)?;
     let (mut values, mut errors) = (Counterterms::default(), Counterterms::default());
     for (p, &c) in Counterterm::ALL.iter().enumerate() {
         values.set(c, solution[p]);

@@ -1,9 +1,10 @@
-//! Small dense linear algebra of the fits: Cholesky factors, triangular inverses, SPD solves.
+//! Small dense linear algebra of the fits (the multipole fits, the counterterms of `2l-eft`): Cholesky
+//! factors, triangular inverses, SPD solves.
 
 use crate::error::{Error, Result};
 
 /// Σ aᵢbᵢ.
-pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
@@ -31,7 +32,7 @@ pub(crate) fn cholesky(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
 
 /// L⁻¹ for lower-triangular L (forward substitution on the identity).
 #[allow(clippy::needless_range_loop)] // the triangular index ranges read as the algorithm
-pub(super) fn invert_lower(l: &[Vec<f64>]) -> Vec<Vec<f64>> {
+pub(crate) fn invert_lower(l: &[Vec<f64>]) -> Vec<Vec<f64>> {
     let n = l.len();
     let mut inv = vec![vec![0.0; n]; n];
     for c in 0..n {
