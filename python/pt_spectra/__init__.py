@@ -78,7 +78,8 @@ class RealPlan:
 
     ``RealPlan(k, model="1l-spt", precision="default", q_range=None, two_loop_tolerance=None,
     cache_dir=None, two_loop="auto")``; models ``linear, 1l-spt, 2l-spt, 1l-rpt-n0..n3,
-    2l-rpt-n0..n3`` or ``all``. ``two_loop``: ``"basis"`` computes the 2-loop terms of every spectrum
+    2l-rpt-n0..n3``, ``1l-regpt``, ``2l-regpt``, ``1l-spt-ir``, ``2l-spt-ir``, ``2l-eft``, ``2l-eft-ir`` or
+    ``all``. ``two_loop``: ``"basis"`` computes the 2-loop terms of every spectrum
     from precomputed tensors on a basis of CAMB spectra (built and cached once per k grid, minutes;
     then milliseconds per spectrum: the choice for chains), ``"direct"`` integrates them for every
     spectrum (seconds), ``"auto"`` uses the tensors if they are already cached. A spectrum the basis

@@ -243,14 +243,23 @@ impl RealPlan {
             )?;
             Ok((table, prepared))
         })?;
-        Table::new(
+        let mut table = Table::new(
             py,
             table,
             &prepared,
             self.plan.precision(),
             &self.selection.plan_model().to_string(),
             seconds,
-        )
+        )?;
+        if let RealSelection::One(model) = self.selection {
+            if model.is_eft() && counterterms.is_zero() {
+                table.warn(format!(
+                    "every counterterm of {model} is 0 (it is then 2-loop SPT): set them with ct={{...}} \
+                     or fit them with the T_ columns of terms=True"
+                ));
+            }
+        }
+        Ok(table)
     }
 }
 

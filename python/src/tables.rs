@@ -52,6 +52,11 @@ impl Table {
         })
     }
 
+    /// Adds a warning that the Python wrapper raises as a `PtSpectraWarning`.
+    pub fn warn(&mut self, message: String) {
+        self.warnings.push(message);
+    }
+
     /// A table of a job without a cosmology (`halo`): `meta` has the model and the seconds.
     pub fn plain(
         py: Python<'_>,
