@@ -175,41 +175,47 @@ impl TableStore {
         })
     }
 
-    /// The 1-loop basis tensors ([`OneLoopBasis`]) of `plan`'s k grid and precision: read from their
-    /// file, or built (reporting [`Stage::OneLoopBasis`]; about a second per 100 k) and written.
-    /// Without a directory they are built each time.
+    /// The 1-loop basis tensors ([`OneLoopBasis`]) of `plan`'s k grid and precision for the spectra
+    /// of `family` on `basis()`: read from their file, or built (reporting [`Stage::OneLoopBasis`];
+    /// about a second per 100 k) and written. Without a directory they are built each time.
     ///
     /// # Errors
     /// [`Error::Cache`] if the directory cannot be created or the file cannot be written or locked.
     pub fn one_loop_basis(
         &self,
         plan: &OneLoopPlan,
+        family: SpectrumFamily,
+        basis: &dyn Fn() -> LinearBasis,
         progress: &dyn Progress,
     ) -> Result<Arc<OneLoopBasis>> {
         let (k, precision) = (plan.k(), plan.precision());
-        let build =
-            || OneLoopBasis::build(plan, &|d, t| progress.update(Stage::OneLoopBasis, d, t));
+        let build = || {
+            OneLoopBasis::build(plan, family, basis(), &|d, t| {
+                progress.update(Stage::OneLoopBasis, d, t)
+            })
+        };
         self.tensors(
-            &OneLoopBasis::file_name(k, precision),
+            &OneLoopBasis::file_name(k, precision, family),
             "1-loop basis",
-            |v| OneLoopBasis::from_f64s(v, k, precision),
+            |v| OneLoopBasis::from_f64s(v, k, precision, family),
             build,
             OneLoopBasis::to_f64s,
             progress,
         )
     }
 
-    /// The 1-loop basis tensors for `k` and `precision` if their file is in the directory and valid
-    /// (never builds them).
+    /// The 1-loop basis tensors for `k`, `precision` and `family` if their file is in the directory
+    /// and valid (never builds them).
     pub fn cached_one_loop_basis(
         &self,
         k: &[f64],
         precision: &Precision,
+        family: SpectrumFamily,
         progress: &dyn Progress,
     ) -> Option<Arc<OneLoopBasis>> {
-        let path = self.path(&OneLoopBasis::file_name(k, precision))?;
+        let path = self.path(&OneLoopBasis::file_name(k, precision, family))?;
         read_cached(&path, "1-loop basis tensors", progress, |v| {
-            OneLoopBasis::from_f64s(v, k, precision)
+            OneLoopBasis::from_f64s(v, k, precision, family)
         })
     }
 }

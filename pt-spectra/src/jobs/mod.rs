@@ -263,6 +263,13 @@ fn model_header(
         h.extend(spectra.terms.two_loop_source.map(|s| s.describe()));
     }
     h.extend(spectra.terms.one_loop_source.map(|s| s.describe()));
+    if let (Some(ir), true) = (&spectra.terms.ir, model.needs_ir()) {
+        let source = ir.no_wiggle.one_loop_source.map_or_else(
+            || "1-loop terms: direct integration".to_string(),
+            |s| s.describe(),
+        );
+        h.push(format!("no-wiggle spectrum: {source}"));
+    }
     if matches!(model, RealModel::OneLoopRegPt | RealModel::TwoLoopRegPt) {
         h.push(
             "RegPT (Taruya et al. 2012): x = k^2 sigma_d2/2, sigma_d2 = (1/6pi^2) int_qmin^(k/2) P dq; \

@@ -3,7 +3,10 @@
 use super::{RealModel, RealSelection, RealSpectra};
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
-use crate::loops::basis::{OneLoopBasis, Projection, TwoLoopBasis, MAX_RESIDUAL};
+use crate::loops::basis::training::{camb_basis, transformed_basis};
+use crate::loops::basis::{
+    OneLoopBasis, Projection, SpectrumFamily, TwoLoopBasis, BASIS_SIZE, MAX_RESIDUAL,
+};
 use crate::loops::{self, ByPair, Estimate, Gamma2Plan, LoopTerms, OneLoopPlan, OneLoopTerms};
 use crate::loops::{OneLoopSource, P15Table, P17Table, TwoLoopCorrection, TwoLoopSource};
 use crate::precision::{Precision, TwoLoopMethod};
@@ -52,6 +55,9 @@ pub struct RealPlan {
     basis: Option<Arc<TwoLoopBasis>>,
     /// The 1-loop basis tensors, if the 1-loop terms come from them ([`TwoLoopMethod`]).
     one_loop_basis: Option<Arc<OneLoopBasis>>,
+    /// For the IR-resummed models, the 1-loop tensors of the no-wiggle spectra (on a basis of the
+    /// training spectra's no-wiggle parts), if the 1-loop terms come from tensors.
+    one_loop_basis_nw: Option<Arc<OneLoopBasis>>,
 }
 
 impl RealPlan {
@@ -144,9 +150,34 @@ impl RealPlan {
         };
         // The 1-loop tensors (one chunk only): built with the 2-loop ones by method basis, used by
         // auto when cached.
-        let one_loop_basis = match (one_loop.as_slice(), precision.two_loop) {
-            ([plan], TwoLoopMethod::Basis) => Some(store.one_loop_basis(plan, progress)?),
-            ([_], TwoLoopMethod::Auto) => store.cached_one_loop_basis(k, precision, progress),
+        let split = if model.needs_ir() {
+            Some(crate::ir::WiggleSplit::new()?)
+        } else {
+            None
+        };
+        let tensors = |family: SpectrumFamily| -> Result<Option<Arc<OneLoopBasis>>> {
+            let lattice = one_loop[0].rules().0.lattice.clone();
+            let basis = || match (family, &split) {
+                (SpectrumFamily::NoWiggle, Some(split)) => {
+                    transformed_basis(&lattice, BASIS_SIZE, &|p: &LinearSpectrum| {
+                        split.no_wiggle(p).unwrap_or_else(|_| p.clone())
+                    })
+                }
+                _ => camb_basis(lattice.clone(), BASIS_SIZE),
+            };
+            Ok(match (one_loop.as_slice(), precision.two_loop) {
+                ([plan], TwoLoopMethod::Basis) => {
+                    Some(store.one_loop_basis(plan, family, &basis, progress)?)
+                }
+                ([_], TwoLoopMethod::Auto) => {
+                    store.cached_one_loop_basis(k, precision, family, progress)
+                }
+                _ => None,
+            })
+        };
+        let one_loop_basis = tensors(SpectrumFamily::Linear)?;
+        let one_loop_basis_nw = match (&one_loop_basis, &split) {
+            (Some(_), Some(_)) => tensors(SpectrumFamily::NoWiggle)?,
             _ => None,
         };
         Ok(Self {
@@ -154,14 +185,11 @@ impl RealPlan {
             model,
             precision: precision.clone(),
             one_loop_basis,
+            one_loop_basis_nw,
             one_loop,
             p15,
             p17,
-            ir: if model.needs_ir() {
-                Some(crate::ir::WiggleSplit::new()?)
-            } else {
-                None
-            },
+            ir: split,
             gamma2: model
                 .needs_gamma2()
                 .then(|| gamma2_plan(k, precision, progress)),
@@ -212,26 +240,30 @@ impl RealPlan {
         projection: Option<Projection>,
         progress: &dyn Progress,
     ) -> Result<LoopTerms> {
-        let mut terms = self.loop_terms(spectrum, projection, progress);
+        let mut terms =
+            self.loop_terms(spectrum, projection, self.one_loop_basis.as_ref(), progress);
         if let Some(split) = &self.ir {
             let nw = split.no_wiggle(spectrum)?;
             terms.ir = Some(Box::new(loops::IrTerms {
                 sigma2: crate::ir::sigma2_bao(&nw, self.precision.q_min),
-                no_wiggle: self.loop_terms(&nw, None, progress),
+                no_wiggle: self.loop_terms(&nw, None, self.one_loop_basis_nw.as_ref(), progress),
             }));
         }
         Ok(terms)
     }
 
+    /// The loop terms of `spectrum`, the 1-loop ones from `tensors` (the plan's linear or no-wiggle
+    /// ones) if given and the spectrum projects on their basis well enough.
     fn loop_terms(
         &self,
         spectrum: &LinearSpectrum,
         projection: Option<Projection>,
+        tensors: Option<&Arc<OneLoopBasis>>,
         progress: &dyn Progress,
     ) -> LoopTerms {
         let (k, precision) = (&self.k, &self.precision);
         let (one_loop, sigma_d2, one_loop_source, projection) =
-            match self.one_loop_on_basis(spectrum, projection, progress) {
+            match self.one_loop_on_basis(tensors, spectrum, projection, progress) {
                 Ok((terms, projection)) => {
                     let source = OneLoopSource::Basis {
                         functions: projection.coefficients.len(),
@@ -250,6 +282,13 @@ impl RealPlan {
             .p17
             .as_ref()
             .map(|table| loops::p17_terms(table, k, spectrum, precision));
+        // A projection on the no-wiggle basis is no use to the 2-loop tensors (of linear spectra).
+        let linear = tensors.is_some_and(|t| {
+            self.one_loop_basis
+                .as_ref()
+                .is_some_and(|b| Arc::ptr_eq(t, b))
+        });
+        let projection = projection.filter(|_| linear);
         let (p15, two_loop, two_loop_source) =
             self.two_loop_terms(spectrum, &one_loop, projection, progress);
         let gamma2 = self.gamma2.as_ref().map(|plan| plan.evaluate(spectrum));
@@ -271,11 +310,12 @@ impl RealPlan {
     /// (noted to `progress`).
     fn one_loop_on_basis(
         &self,
+        tensors: Option<&Arc<OneLoopBasis>>,
         spectrum: &LinearSpectrum,
         projection: Option<Projection>,
         progress: &dyn Progress,
     ) -> std::result::Result<(loops::basis::BasisOneLoop, Projection), Option<OneLoopSource>> {
-        let Some(tensors) = &self.one_loop_basis else {
+        let Some(tensors) = tensors else {
             return Err(None);
         };
         let basis = tensors.basis();

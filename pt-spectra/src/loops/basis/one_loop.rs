@@ -25,7 +25,7 @@
 use super::forms::{
     concat, dot32, fine_and_diff, linear_form, pair_forms, pair_products, per_k, Rows, RuleRows,
 };
-use super::{error_functions, LinearBasis, Projection, BASIS_SIZE};
+use super::{error_functions, LinearBasis, Projection, SpectrumFamily, BASIS_SIZE};
 use crate::integrate::legendre_nodes;
 use crate::loops::lattice::{add_product_weights, Lattice};
 use crate::loops::one_loop::Rule;
@@ -68,8 +68,8 @@ pub struct BasisOneLoop {
     pub sigma_d2: Vec<Estimate>,
 }
 
-/// The settings that make the tensors (their cache key).
-fn key(k: &[f64], precision: &Precision) -> Vec<f64> {
+/// The settings that make the tensors (their cache key), and for the no-wiggle family a marker.
+fn key(k: &[f64], precision: &Precision, family: SpectrumFamily) -> Vec<f64> {
     let p = precision;
     let mut key = vec![
         f64::from(VERSION),
@@ -90,6 +90,11 @@ fn key(k: &[f64], precision: &Precision) -> Vec<f64> {
         k.len() as f64,
     ];
     key.extend(k);
+    // The no-wiggle split is part of the basis (as for the redshift-space tensors): a change of its
+    // filter must come with a new VERSION.
+    if family == SpectrumFamily::NoWiggle {
+        key.push(1.0);
+    }
     key
 }
 
@@ -100,17 +105,26 @@ fn p22_forms(rule: &Rule, i: usize, rows: &Rows<'_>, n: usize) -> Vec<Vec<f64>> 
 }
 
 impl OneLoopBasis {
-    /// The cache file name of the tensors for `k` and `precision`.
-    pub fn file_name(k: &[f64], precision: &Precision) -> String {
-        super::cache_file_name("one-loop-basis", VERSION, &key(k, precision))
+    /// The cache file name of the tensors for `k`, `precision` and the spectra of `family`.
+    pub fn file_name(k: &[f64], precision: &Precision, family: SpectrumFamily) -> String {
+        let name = match family {
+            SpectrumFamily::Linear => "one-loop-basis",
+            SpectrumFamily::NoWiggle => "one-loop-basis-nw",
+        };
+        super::cache_file_name(name, VERSION, &key(k, precision, family))
     }
 
-    /// Builds the tensors of `plan` (its k grid and precision) in parallel over k; `progress(done,
-    /// total)` counts the k values.
-    pub fn build(plan: &OneLoopPlan, progress: &(dyn Fn(usize, usize) + Sync)) -> Self {
+    /// Builds the tensors of `plan` (its k grid and precision) on `basis` (of the spectra of
+    /// `family`: [`super::training::camb_basis`] for linear spectra, a transformed basis for their
+    /// no-wiggle parts) in parallel over k; `progress(done, total)` counts the k values.
+    pub fn build(
+        plan: &OneLoopPlan,
+        family: SpectrumFamily,
+        basis: LinearBasis,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Self {
         let (k, precision) = (plan.k(), plan.precision());
         let (fine, coarse) = plan.rules();
-        let basis = super::training::camb_basis(fine.lattice.clone(), BASIS_SIZE);
         let n = basis.len();
         let n_err = error_functions(n);
         let rows = RuleRows::new(&basis);
@@ -146,7 +160,7 @@ impl OneLoopBasis {
         let (p22, p22_diff, p13) = concat(per_k);
         Self {
             k: k.to_vec(),
-            key: key(k, precision),
+            key: key(k, precision, family),
             basis,
             p22,
             p22_diff,
@@ -241,8 +255,13 @@ impl OneLoopBasis {
 
     /// The tensors for `k` and `precision` from the values of their file, or `None` if the file was
     /// made for other settings or does not fit them.
-    pub(crate) fn from_f64s(values: &[f64], k: &[f64], precision: &Precision) -> Option<Self> {
-        let expected = key(k, precision);
+    pub(crate) fn from_f64s(
+        values: &[f64],
+        k: &[f64],
+        precision: &Precision,
+        family: SpectrumFamily,
+    ) -> Option<Self> {
+        let expected = key(k, precision, family);
         let rest = super::after_key(values, &expected)?;
         let lattice = Lattice::new(precision.q_min, precision.q_max, precision.lattice_step);
         let (basis, rest) = LinearBasis::from_f64s(lattice, rest)?;
@@ -325,7 +344,9 @@ mod tests {
     fn setup() -> (OneLoopPlan, OneLoopBasis) {
         let k: Vec<f64> = (0..12).map(|i| 0.005 * 1.45_f64.powi(i)).collect();
         let plan = OneLoopPlan::new(&k, &Precision::fast()).unwrap();
-        let basis = OneLoopBasis::build(&plan, &|_, _| {});
+        let lattice = plan.rules().0.lattice.clone();
+        let basis = super::super::training::camb_basis(lattice, BASIS_SIZE);
+        let basis = OneLoopBasis::build(&plan, SpectrumFamily::Linear, basis, &|_, _| {});
         (plan, basis)
     }
 
@@ -420,11 +441,30 @@ mod tests {
     fn tensors_survive_their_file_and_refuse_other_settings() {
         let (plan, basis) = setup();
         let v = basis.to_f64s();
-        let back = OneLoopBasis::from_f64s(&v, plan.k(), plan.precision()).unwrap();
+        let back = OneLoopBasis::from_f64s(&v, plan.k(), plan.precision(), SpectrumFamily::Linear)
+            .unwrap();
         assert_eq!(back, basis);
-        assert!(OneLoopBasis::from_f64s(&v, &plan.k()[1..], plan.precision()).is_none());
-        assert!(OneLoopBasis::from_f64s(&v, plan.k(), &Precision::default()).is_none());
-        assert!(OneLoopBasis::from_f64s(&v[..v.len() - 1], plan.k(), plan.precision()).is_none());
+        assert!(OneLoopBasis::from_f64s(
+            &v,
+            &plan.k()[1..],
+            plan.precision(),
+            SpectrumFamily::Linear
+        )
+        .is_none());
+        assert!(OneLoopBasis::from_f64s(
+            &v,
+            plan.k(),
+            &Precision::default(),
+            SpectrumFamily::Linear
+        )
+        .is_none());
+        assert!(OneLoopBasis::from_f64s(
+            &v[..v.len() - 1],
+            plan.k(),
+            plan.precision(),
+            SpectrumFamily::Linear
+        )
+        .is_none());
     }
 }
 
