@@ -22,7 +22,7 @@
 //! ```
 
 use crate::error::{Error, Result};
-use crate::loops::basis::{LinearBasis, OneLoopBasis, RedshiftBasis, SpectrumFamily};
+use crate::loops::basis::{LinearBasis, OneLoopBasis, RedshiftBasis, SpectrumFamily, BASIS_SIZE};
 use crate::loops::basis::{TnsBasis, TwoLoopBasis};
 use crate::loops::redshift::RedshiftPlan;
 use crate::loops::{OneLoopPlan, P15Table, P17Table, TnsPlan};
@@ -133,7 +133,7 @@ impl TableStore {
         }))
     }
 
-    /// The 2-loop basis tensors ([`TwoLoopBasis`]) for the wavenumbers `k` and `precision`: read
+    /// The 2-loop basis tensors ([`TwoLoopBasis`]) of linear spectra for the wavenumbers `k` and `precision`: read
     /// from their file, or built with the P15 `table` (reporting [`Stage::TwoLoopBasis`]; minutes)
     /// and written. Without a directory they are built each time.
     ///
@@ -146,15 +146,41 @@ impl TableStore {
         table: &P15Table,
         progress: &dyn Progress,
     ) -> Result<Arc<TwoLoopBasis>> {
+        let lattice = TwoLoopBasis::lattice(precision);
+        let basis = || crate::loops::basis::training::camb_basis(lattice.clone(), BASIS_SIZE);
+        self.two_loop_basis_of(
+            k,
+            precision,
+            table,
+            SpectrumFamily::Linear,
+            &basis,
+            progress,
+        )
+    }
+
+    /// [`two_loop_basis`](Self::two_loop_basis) for the spectra of `family` on `basis()` (made on
+    /// the tensors' lattice).
+    ///
+    /// # Errors
+    /// As [`two_loop_basis`](Self::two_loop_basis).
+    pub fn two_loop_basis_of(
+        &self,
+        k: &[f64],
+        precision: &Precision,
+        table: &P15Table,
+        family: SpectrumFamily,
+        basis: &dyn Fn() -> LinearBasis,
+        progress: &dyn Progress,
+    ) -> Result<Arc<TwoLoopBasis>> {
         let build = || {
-            TwoLoopBasis::build(k, precision, table, &|d, t| {
+            TwoLoopBasis::build(k, precision, table, family, basis(), &|d, t| {
                 progress.update(Stage::TwoLoopBasis, d, t)
             })
         };
         self.tensors(
-            &TwoLoopBasis::file_name(k, precision),
+            &TwoLoopBasis::file_name(k, precision, family),
             "2-loop basis",
-            |v| TwoLoopBasis::from_f64s(v, k, precision),
+            |v| TwoLoopBasis::from_f64s(v, k, precision, family),
             build,
             TwoLoopBasis::to_f64s,
             progress,
@@ -169,9 +195,20 @@ impl TableStore {
         precision: &Precision,
         progress: &dyn Progress,
     ) -> Option<Arc<TwoLoopBasis>> {
-        let path = self.path(&TwoLoopBasis::file_name(k, precision))?;
+        self.cached_two_loop_basis_of(k, precision, SpectrumFamily::Linear, progress)
+    }
+
+    /// [`cached_two_loop_basis`](Self::cached_two_loop_basis) for the spectra of `family`.
+    pub fn cached_two_loop_basis_of(
+        &self,
+        k: &[f64],
+        precision: &Precision,
+        family: SpectrumFamily,
+        progress: &dyn Progress,
+    ) -> Option<Arc<TwoLoopBasis>> {
+        let path = self.path(&TwoLoopBasis::file_name(k, precision, family))?;
         read_cached(&path, "2-loop basis tensors", progress, |v| {
-            TwoLoopBasis::from_f64s(v, k, precision)
+            TwoLoopBasis::from_f64s(v, k, precision, family)
         })
     }
 

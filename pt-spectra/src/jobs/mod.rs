@@ -269,6 +269,10 @@ fn model_header(
             |s| s.describe(),
         );
         h.push(format!("no-wiggle spectrum: {source}"));
+        if model.needs_two_loop() {
+            let two = ir.no_wiggle.two_loop_source.map(|s| s.describe());
+            h.extend(two.map(|s| format!("no-wiggle spectrum: {s}")));
+        }
     }
     if matches!(model, RealModel::OneLoopRegPt | RealModel::TwoLoopRegPt) {
         h.push(

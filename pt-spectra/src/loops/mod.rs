@@ -38,7 +38,7 @@
 pub mod basis;
 pub mod bias;
 mod gamma2;
-mod lattice;
+pub(crate) mod lattice;
 mod mode_coupling;
 mod one_loop;
 mod p13;

@@ -5,8 +5,9 @@ use crate::error::Result;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::training::{camb_basis, transformed_basis};
 use crate::loops::basis::{
-    OneLoopBasis, Projection, SpectrumFamily, TwoLoopBasis, BASIS_SIZE, MAX_RESIDUAL,
+    LinearBasis, OneLoopBasis, Projection, SpectrumFamily, TwoLoopBasis, BASIS_SIZE, MAX_RESIDUAL,
 };
+use crate::loops::lattice::Lattice;
 use crate::loops::{self, ByPair, Estimate, Gamma2Plan, LoopTerms, OneLoopPlan, OneLoopTerms};
 use crate::loops::{OneLoopSource, P15Table, P17Table, TwoLoopCorrection, TwoLoopSource};
 use crate::precision::{Precision, TwoLoopMethod};
@@ -53,6 +54,8 @@ pub struct RealPlan {
     gamma2: Option<Gamma2Plan>,
     /// The 2-loop basis tensors, if the 2-loop terms come from them ([`TwoLoopMethod`]).
     basis: Option<Arc<TwoLoopBasis>>,
+    /// For the IR-resummed 2-loop models, the 2-loop tensors of the no-wiggle spectra.
+    basis_nw: Option<Arc<TwoLoopBasis>>,
     /// The 1-loop basis tensors, if the 1-loop terms come from them ([`TwoLoopMethod`]).
     one_loop_basis: Option<Arc<OneLoopBasis>>,
     /// For the IR-resummed models, the 1-loop tensors of the no-wiggle spectra (on a basis of the
@@ -140,6 +143,37 @@ impl RealPlan {
         } else {
             None
         };
+        let split = if model.needs_ir() {
+            Some(crate::ir::WiggleSplit::new()?)
+        } else {
+            None
+        };
+        // The basis of the no-wiggle parts of the training spectra, on `lattice`.
+        let no_wiggle_basis = |lattice: &Lattice| -> Option<LinearBasis> {
+            let split = split.as_ref()?;
+            Some(transformed_basis(
+                lattice,
+                BASIS_SIZE,
+                &|p: &LinearSpectrum| split.no_wiggle(p).unwrap_or_else(|_| p.clone()),
+            ))
+        };
+        let basis_nw = match (&p15, precision.two_loop) {
+            (Some(table), method) if model.needs_two_loop() && model.needs_ir() => {
+                let nw = SpectrumFamily::NoWiggle;
+                match method {
+                    TwoLoopMethod::Direct => None,
+                    TwoLoopMethod::Auto => {
+                        store.cached_two_loop_basis_of(k, precision, nw, progress)
+                    }
+                    TwoLoopMethod::Basis => {
+                        let lattice = TwoLoopBasis::lattice(precision);
+                        let basis = || no_wiggle_basis(&lattice).expect("an IR model has a split");
+                        Some(store.two_loop_basis_of(k, precision, table, nw, &basis, progress)?)
+                    }
+                }
+            }
+            _ => None,
+        };
         let basis = match (&p15, precision.two_loop) {
             (Some(table), method) if model.needs_two_loop() => match method {
                 TwoLoopMethod::Direct => None,
@@ -150,20 +184,13 @@ impl RealPlan {
         };
         // The 1-loop tensors (one chunk only): built with the 2-loop ones by method basis, used by
         // auto when cached.
-        let split = if model.needs_ir() {
-            Some(crate::ir::WiggleSplit::new()?)
-        } else {
-            None
-        };
         let tensors = |family: SpectrumFamily| -> Result<Option<Arc<OneLoopBasis>>> {
             let lattice = one_loop[0].rules().0.lattice.clone();
-            let basis = || match (family, &split) {
-                (SpectrumFamily::NoWiggle, Some(split)) => {
-                    transformed_basis(&lattice, BASIS_SIZE, &|p: &LinearSpectrum| {
-                        split.no_wiggle(p).unwrap_or_else(|_| p.clone())
-                    })
+            let basis = || match family {
+                SpectrumFamily::NoWiggle => {
+                    no_wiggle_basis(&lattice).expect("only IR models ask for it")
                 }
-                _ => camb_basis(lattice.clone(), BASIS_SIZE),
+                SpectrumFamily::Linear => camb_basis(lattice.clone(), BASIS_SIZE),
             };
             Ok(match (one_loop.as_slice(), precision.two_loop) {
                 ([plan], TwoLoopMethod::Basis) => {
@@ -194,6 +221,7 @@ impl RealPlan {
                 .needs_gamma2()
                 .then(|| gamma2_plan(k, precision, progress)),
             basis,
+            basis_nw,
         })
     }
 
@@ -240,25 +268,30 @@ impl RealPlan {
         projection: Option<Projection>,
         progress: &dyn Progress,
     ) -> Result<LoopTerms> {
-        let mut terms =
-            self.loop_terms(spectrum, projection, self.one_loop_basis.as_ref(), progress);
+        let tensors = (self.one_loop_basis.as_ref(), self.basis.as_ref());
+        let mut terms = self.loop_terms(spectrum, projection, tensors, progress);
         if let Some(split) = &self.ir {
             let nw = split.no_wiggle(spectrum)?;
             terms.ir = Some(Box::new(loops::IrTerms {
                 sigma2: crate::ir::sigma2_bao(&nw, self.precision.q_min),
-                no_wiggle: self.loop_terms(&nw, None, self.one_loop_basis_nw.as_ref(), progress),
+                no_wiggle: self.loop_terms(
+                    &nw,
+                    None,
+                    (self.one_loop_basis_nw.as_ref(), self.basis_nw.as_ref()),
+                    progress,
+                ),
             }));
         }
         Ok(terms)
     }
 
-    /// The loop terms of `spectrum`, the 1-loop ones from `tensors` (the plan's linear or no-wiggle
-    /// ones) if given and the spectrum projects on their basis well enough.
+    /// The loop terms of `spectrum`, from `tensors` (the plan's 1- and 2-loop tensors of linear or
+    /// of no-wiggle spectra) where given and the spectrum projects on their basis well enough.
     fn loop_terms(
         &self,
         spectrum: &LinearSpectrum,
         projection: Option<Projection>,
-        tensors: Option<&Arc<OneLoopBasis>>,
+        (tensors, two_loop_tensors): (Option<&Arc<OneLoopBasis>>, Option<&Arc<TwoLoopBasis>>),
         progress: &dyn Progress,
     ) -> LoopTerms {
         let (k, precision) = (&self.k, &self.precision);
@@ -290,7 +323,7 @@ impl RealPlan {
         });
         let projection = projection.filter(|_| linear);
         let (p15, two_loop, two_loop_source) =
-            self.two_loop_terms(spectrum, &one_loop, projection, progress);
+            self.two_loop_terms(two_loop_tensors, spectrum, &one_loop, projection, progress);
         let gamma2 = self.gamma2.as_ref().map(|plan| plan.evaluate(spectrum));
         LoopTerms {
             one_loop,
@@ -355,6 +388,7 @@ impl RealPlan {
     /// passed over).
     fn two_loop_terms(
         &self,
+        tensors: Option<&Arc<TwoLoopBasis>>,
         spectrum: &LinearSpectrum,
         one_loop: &OneLoopTerms,
         projection: Option<Projection>,
@@ -372,7 +406,7 @@ impl RealPlan {
             TwoLoopMethod::Auto => TwoLoopSource::DirectUncached,
             _ => TwoLoopSource::Direct,
         };
-        if let Some(basis) = &self.basis {
+        if let Some(basis) = tensors {
             // The projection made for the 1-loop tensors if it is on the same basis (accepted there
             // with the same limit), else the 2-loop basis's own.
             let shared = projection.filter(|_| {

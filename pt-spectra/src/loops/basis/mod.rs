@@ -161,8 +161,9 @@ pub struct TwoLoopBasis {
     max_residual: f64,
 }
 
-/// The settings that make the tensors: k grid and [`Precision`] fields, as a vector (file header).
-fn key(k: &[f64], precision: &Precision) -> Vec<f64> {
+/// The settings that make the tensors: k grid and [`Precision`] fields, as a vector (file header),
+/// and for the no-wiggle family a marker.
+fn key(k: &[f64], precision: &Precision, family: SpectrumFamily) -> Vec<f64> {
     let radial_width = TwoLoopSettings::default().radial_width;
     let mut key = vec![
         f64::from(VERSION),
@@ -179,25 +180,39 @@ fn key(k: &[f64], precision: &Precision) -> Vec<f64> {
         k.len() as f64,
     ];
     key.extend(k);
+    if family == SpectrumFamily::NoWiggle {
+        key.push(1.0);
+    }
     key
 }
 
 impl TwoLoopBasis {
-    /// The cache file name of the tensors for `k` and `precision`: `two-loop-basis-v<version>-<hash>.bin`.
-    pub fn file_name(k: &[f64], precision: &Precision) -> String {
-        cache_file_name("two-loop-basis", VERSION, &key(k, precision))
+    /// The cache file name of the tensors for `k`, `precision` and `family`:
+    /// `two-loop-basis[-nw]-v<version>-<hash>.bin`.
+    pub fn file_name(k: &[f64], precision: &Precision, family: SpectrumFamily) -> String {
+        let name = match family {
+            SpectrumFamily::Linear => "two-loop-basis",
+            SpectrumFamily::NoWiggle => "two-loop-basis-nw",
+        };
+        cache_file_name(name, VERSION, &key(k, precision, family))
     }
 
-    /// Builds the tensors on `k` [h/Mpc] for `precision` with the P15 angular `table`, in parallel;
-    /// `progress(done, total)` counts the quasi-Monte-Carlo points.
+    /// The lattice of the tensors for `precision` (what a family's basis is made on).
+    pub(crate) fn lattice(precision: &Precision) -> Lattice {
+        lattice_of(precision)
+    }
+
+    /// Builds the tensors on `k` [h/Mpc] for `precision` with the P15 angular `table`, in parallel,
+    /// on `basis` (of the spectra of `family`, on the tensors' lattice: the CAMB basis for
+    /// linear spectra); `progress(done, total)` counts the quasi-Monte-Carlo points.
     pub fn build(
         k: &[f64],
         precision: &Precision,
         table: &P15Table,
+        family: SpectrumFamily,
+        basis: LinearBasis,
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Self {
-        let lattice = lattice_of(precision);
-        let basis = training::camb_basis(lattice, BASIS_SIZE);
         let n = basis.len();
         let settings = TwoLoopSettings {
             points: precision.two_loop_points,
@@ -264,7 +279,7 @@ impl TwoLoopBasis {
         let forms = k.par_iter().map(|&k| p15_forms(table, k, &basis)).collect();
         Self {
             k: k.to_vec(),
-            key: key(k, precision),
+            key: key(k, precision, family),
             basis,
             points,
             replicas,
@@ -430,8 +445,13 @@ impl TwoLoopBasis {
 
     /// The tensors for `k` and `precision` from the values of their file, or `None` if the file was
     /// made for other settings or does not fit them.
-    pub(crate) fn from_f64s(values: &[f64], k: &[f64], precision: &Precision) -> Option<Self> {
-        let expected = key(k, precision);
+    pub(crate) fn from_f64s(
+        values: &[f64],
+        k: &[f64],
+        precision: &Precision,
+        family: SpectrumFamily,
+    ) -> Option<Self> {
+        let expected = key(k, precision, family);
         let rest = after_key(values, &expected)?;
         let points: Vec<usize> = rest.get(..k.len())?.iter().map(|&p| p as usize).collect();
         let replicas = *rest.get(k.len())? as usize;

@@ -115,7 +115,7 @@ impl OneLoopBasis {
     }
 
     /// Builds the tensors of `plan` (its k grid and precision) on `basis` (of the spectra of
-    /// `family`: [`super::training::camb_basis`] for linear spectra, a transformed basis for their
+    /// `family`: the CAMB training basis for linear spectra, a transformed basis for their
     /// no-wiggle parts) in parallel over k; `progress(done, total)` counts the k values.
     pub fn build(
         plan: &OneLoopPlan,
