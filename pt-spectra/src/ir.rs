@@ -154,6 +154,38 @@ fn j2(x: f64) -> f64 {
     }
 }
 
+/// The wiggle split of `pair` at k index `i`: the linear spectrum and 1-loop correction of the
+/// no-wiggle spectrum and their wiggle parts, x = k²Σ² and the damping e^{−k²Σ²} (module docs).
+pub struct WiggleParts {
+    /// P_nw.
+    pub p_nw: Estimate,
+    /// P_w = P − P_nw.
+    pub p_w: Estimate,
+    /// P^(1)\[P_nw\].
+    pub one_nw: Estimate,
+    /// P^(1)_w = P^(1)\[P\] − P^(1)\[P_nw\].
+    pub one_w: Estimate,
+    /// k²Σ².
+    pub x: Estimate,
+    /// e^{−k²Σ²}.
+    pub d: Estimate,
+}
+
+/// The [`WiggleParts`] of `pair` at k index `i`, from the loop terms `t` of the linear spectrum and
+/// those of the no-wiggle spectrum in `ir`.
+pub fn wiggle_parts(t: &OneLoopTerms, ir: &IrTerms, pair: Pair, i: usize) -> WiggleParts {
+    let nw = &ir.no_wiggle.one_loop;
+    let k = t.k[i];
+    WiggleParts {
+        p_nw: Estimate::exact(nw.p_lin[i]),
+        p_w: Estimate::exact(t.p_lin[i] - nw.p_lin[i]),
+        one_nw: nw.one_loop(pair, i),
+        one_w: t.one_loop(pair, i) - nw.one_loop(pair, i),
+        x: k * k * ir.sigma2,
+        d: damping(k, ir.sigma2),
+    }
+}
+
 /// The IR-resummed spectrum of `pair` at k index `i` (module docs), from the loop terms `t` of the
 /// linear spectrum, those of the no-wiggle spectrum in `ir`, and for `2l-spt-ir` the 2-loop terms
 /// of both (full, no-wiggle).
@@ -164,16 +196,14 @@ pub fn resummed(
     pair: Pair,
     i: usize,
 ) -> Estimate {
-    let nw = &ir.no_wiggle.one_loop;
-    let k = t.k[i];
-    let p_nw = Estimate::exact(nw.p_lin[i]);
-    let p_w = Estimate::exact(t.p_lin[i] - nw.p_lin[i]);
-    let (one_nw, one_w) = (
-        nw.one_loop(pair, i),
-        t.one_loop(pair, i) - nw.one_loop(pair, i),
-    );
-    let x = k * k * ir.sigma2;
-    let d = damping(k, ir.sigma2);
+    let WiggleParts {
+        p_nw,
+        p_w,
+        one_nw,
+        one_w,
+        x,
+        d,
+    } = wiggle_parts(t, ir, pair, i);
     match two_loop {
         None => p_nw + one_nw + d * ((1.0 + x) * p_w + one_w),
         Some((full, no_wiggle)) => {

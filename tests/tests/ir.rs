@@ -75,66 +75,81 @@ fn on_large_scales_the_resummation_is_spt_and_it_damps_the_wiggles() {
     assert!((w_ir / w_damped - 1.0).abs() < 0.3, "{w_ir} {w_damped}");
 }
 
+/// `model`'s spectra of the held-out CAMB tables `names` (not in the training set), through basis
+/// tensors (from `store`) and directly, otherwise with `precision`.
+fn basis_and_direct<'a>(
+    model: RealModel,
+    k: &[f64],
+    precision: &Precision,
+    store: &TableStore,
+    names: [&'a str; 2],
+) -> Vec<(&'a str, RealSpectra, RealSpectra)> {
+    use pt_spectra::precision::TwoLoopMethod;
+    let plan = |method| {
+        let mut precision = precision.clone();
+        precision.two_loop = method;
+        RealPlan::new(k, model, &precision, store, &Silent).unwrap()
+    };
+    let (basis, direct) = (plan(TwoLoopMethod::Basis), plan(TwoLoopMethod::Direct));
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../pt-spectra/tests/data/");
+    names
+        .into_iter()
+        .map(|name| {
+            let p = LinearSpectrum::from_file(format!("{dir}{name}")).unwrap();
+            let evaluate = |plan: &RealPlan| plan.evaluate(&p, &Silent).unwrap();
+            (name, evaluate(&basis), evaluate(&direct))
+        })
+        .collect()
+}
+
+/// Every pair of the basis result `a` within `tolerance(i, direct value)` of the direct `b` at each
+/// k index i, and within its own error.
+fn assert_close(
+    name: &str,
+    a: &RealSpectra,
+    b: &RealSpectra,
+    tolerance: impl Fn(usize, f64) -> f64,
+) {
+    for pair in Pair::ALL {
+        for (i, ki) in a.k.iter().enumerate() {
+            let (x, y) = (a.spectra[pair][i], b.spectra[pair][i]);
+            let d = (x.value - y.value).abs();
+            assert!(
+                d < tolerance(i, y.value),
+                "{name} {pair:?} k={ki}: {x:?} {y:?}"
+            );
+            assert!(
+                d <= x.error,
+                "{name} {pair:?} k={ki}: {d:e} > {:e}",
+                x.error
+            );
+        }
+    }
+}
+
 #[test]
 fn the_no_wiggle_terms_come_from_their_own_basis_and_match_the_direct_integrals() {
     // 1l-spt-ir through basis tensors: the linear spectrum on the CAMB basis, its no-wiggle part on a
     // basis of the training spectra's no-wiggle parts. Held-out CAMB spectra (not in the training
     // set) must give the direct result to 1e-4 of each spectrum and within the reported errors, with
-    // the header's source saying both came from tensors.
+    // the source saying the no-wiggle terms came from tensors.
     use pt_spectra::loops::OneLoopSource;
-    use pt_spectra::precision::TwoLoopMethod;
     let k = LogGrid::new(0.01, 0.3, 20).unwrap().points();
     let store = TableStore::in_memory();
-    let mut basis = Precision::fast();
-    basis.two_loop = TwoLoopMethod::Basis;
-    let mut direct = Precision::fast();
-    direct.two_loop = TwoLoopMethod::Direct;
-    let plan = |precision: &Precision| {
-        RealPlan::new(&k, RealModel::OneLoopSptIr, precision, &store, &Silent).unwrap()
-    };
-    let (with, without) = (plan(&basis), plan(&direct));
-    for name in [
+    let names = [
         "linear_pk_camb_heldout_0.dat",
         "linear_pk_camb_heldout_2.dat",
-    ] {
-        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../pt-spectra/tests/data/");
-        let p = LinearSpectrum::from_file(format!("{dir}{name}")).unwrap();
-        let (a, b) = (
-            with.evaluate(&p, &Silent).unwrap(),
-            without.evaluate(&p, &Silent).unwrap(),
-        );
-        let nw = a.terms.ir.as_deref().unwrap();
+    ];
+    let model = RealModel::OneLoopSptIr;
+    for (name, a, b) in basis_and_direct(model, &k, &Precision::fast(), &store, names) {
+        let source = |s: &RealSpectra| s.terms.ir.as_deref().unwrap().no_wiggle.one_loop_source;
         assert!(
-            matches!(
-                nw.no_wiggle.one_loop_source,
-                Some(OneLoopSource::Basis { .. })
-            ),
+            matches!(source(&a), Some(OneLoopSource::Basis { .. })),
             "{name}: {:?}",
-            nw.no_wiggle.one_loop_source
+            source(&a)
         );
-        assert!(b
-            .terms
-            .ir
-            .as_deref()
-            .unwrap()
-            .no_wiggle
-            .one_loop_source
-            .is_none());
-        for pair in Pair::ALL {
-            for (i, ki) in k.iter().enumerate() {
-                let (x, y) = (a.spectra[pair][i], b.spectra[pair][i]);
-                let d = (x.value - y.value).abs();
-                assert!(
-                    d < 1e-4 * y.value.abs(),
-                    "{name} {pair:?} k={ki}: {x:?} {y:?}"
-                );
-                assert!(
-                    d <= x.error,
-                    "{name} {pair:?} k={ki}: {d:e} > {:e}",
-                    x.error
-                );
-            }
-        }
+        assert!(source(&b).is_none());
+        assert_close(name, &a, &b, |_, y| 1e-4 * y.abs());
     }
 }
 
@@ -144,46 +159,21 @@ fn two_loop_no_wiggle_terms_come_from_their_own_basis_too() {
     // no-wiggle basis (built here with 2^11 points per shift, on the same points as direct). Held-out
     // CAMB spectra give the direct result to 1e-4 of P_lin and within the reported errors.
     use pt_spectra::loops::TwoLoopSource;
-    use pt_spectra::precision::TwoLoopMethod;
     let k = LogGrid::new(0.02, 0.3, 6).unwrap().points();
-    let mut basis = Precision::fast();
-    basis.two_loop_points = 2048;
-    basis.two_loop = TwoLoopMethod::Basis;
-    let mut direct = basis.clone();
-    direct.two_loop = TwoLoopMethod::Direct;
-    let store = support::store();
-    let plan = |precision: &Precision| {
-        RealPlan::new(&k, RealModel::TwoLoopSptIr, precision, store, &Silent).unwrap()
-    };
-    let (with, without) = (plan(&basis), plan(&direct));
-    for name in [
+    let mut precision = Precision::fast();
+    precision.two_loop_points = 2048;
+    let names = [
         "linear_pk_camb_heldout_1.dat",
         "linear_pk_camb_heldout_2.dat",
-    ] {
-        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../pt-spectra/tests/data/");
-        let p = LinearSpectrum::from_file(format!("{dir}{name}")).unwrap();
-        let (a, b) = (
-            with.evaluate(&p, &Silent).unwrap(),
-            without.evaluate(&p, &Silent).unwrap(),
-        );
-        let nw = &a.terms.ir.as_deref().unwrap().no_wiggle;
+    ];
+    let model = RealModel::TwoLoopSptIr;
+    for (name, a, b) in basis_and_direct(model, &k, &precision, support::store(), names) {
+        let source = a.terms.ir.as_deref().unwrap().no_wiggle.two_loop_source;
         assert!(
-            matches!(nw.two_loop_source, Some(TwoLoopSource::Basis { .. })),
-            "{name}: {:?}",
-            nw.two_loop_source
+            matches!(source, Some(TwoLoopSource::Basis { .. })),
+            "{name}: {source:?}"
         );
-        for pair in Pair::ALL {
-            for (i, ki) in k.iter().enumerate() {
-                let (x, y) = (a.spectra[pair][i], b.spectra[pair][i]);
-                let d = (x.value - y.value).abs();
-                // Of P_lin: at k = 0.3 2-loop SPT's P_dt, P_tt are small remainders (P_tt < 0).
-                assert!(d < 1e-4 * a.p_lin[i], "{name} {pair:?} k={ki}: {x:?} {y:?}");
-                assert!(
-                    d <= x.error,
-                    "{name} {pair:?} k={ki}: {d:e} > {:e}",
-                    x.error
-                );
-            }
-        }
+        // Of P_lin: at k = 0.3 2-loop SPT's P_dt, P_tt are small remainders (P_tt < 0).
+        assert_close(name, &a, &b, |i, _| 1e-4 * a.p_lin[i]);
     }
 }

@@ -309,15 +309,11 @@ impl RealSpectra {
         let one_loop = c == Counterterm::Cs2OneLoop;
         match (&self.terms.ir, self.model.needs_ir()) {
             (Some(ir), true) => {
-                let nw = &ir.no_wiggle.one_loop;
-                let p_w = Estimate::exact(t.p_lin[i] - nw.p_lin[i]);
-                let d = crate::ir::damping(t.k[i], ir.sigma2);
+                let w = crate::ir::wiggle_parts(t, ir, pair, i);
                 if one_loop {
-                    let x = t.k[i] * t.k[i] * ir.sigma2;
-                    let one_w = t.one_loop(pair, i) - nw.one_loop(pair, i);
-                    nw.one_loop(pair, i) + d * (x * p_w + one_w)
+                    w.one_nw + w.d * (w.x * w.p_w + w.one_w)
                 } else {
-                    Estimate::exact(nw.p_lin[i]) + d * p_w
+                    w.p_nw + w.d * w.p_w
                 }
             }
             _ if one_loop => t.one_loop(pair, i),
