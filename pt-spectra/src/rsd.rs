@@ -26,6 +26,7 @@ pub mod ap;
 pub mod ept;
 mod multipoles;
 mod sigma0;
+pub mod spt2;
 pub use multipoles::{multipoles, GalaxyTerms, Observed, RsdMultipoles, RsdPlan, RsdSettings};
 pub use sigma0::{Dispersions, Sigma0};
 
@@ -404,7 +405,7 @@ pub(crate) fn legendre_coefficients(ell: usize) -> Vec<f64> {
 }
 
 /// (2ℓ+1)∫_0^1 μ^{2n} L_ℓ(μ) dμ, exactly (as an f64 sum of exact rationals).
-fn polynomial_moment(ell: usize, n: usize) -> f64 {
+pub(crate) fn polynomial_moment(ell: usize, n: usize) -> f64 {
     let c = legendre_coefficients(ell);
     let integral: f64 = c
         .iter()

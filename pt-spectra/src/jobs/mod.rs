@@ -44,6 +44,7 @@ mod halo;
 mod observe;
 mod report;
 mod rsd;
+mod spt2;
 pub use bias::BiasOutput;
 pub use ept::{
     ept_fit_table, ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest,
@@ -57,6 +58,7 @@ pub use rsd::{
     rsd_table_from_terms_memo, rsd_table_with_bias_terms, xi_table, NonlinearBias, RsdRequest,
     SN_LEVELS,
 };
+pub use spt2::spt2_table;
 
 /// The version of pt-spectra, for table headers.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -46,6 +46,7 @@ mod p15;
 mod p17;
 mod p22;
 pub mod redshift;
+pub mod rsd_two_loop;
 mod tns;
 mod two_loop;
 
@@ -55,6 +56,9 @@ pub use p13::{k1_kernels, p13_kernels};
 pub use p15::{p15_angular_kernel, P15Table};
 pub use p17::{p17_angular_kernel, P17Table};
 pub use p22::f2_g2;
+pub use rsd_two_loop::{
+    check_ells as check_two_loop_ells, mu2_nodes, rsd_two_loop, RsdTwoLoopTerms, MAX_TWO_LOOP_ELL,
+};
 pub use tns::{tns, TnsCoefficients, TnsPlan, TnsTerms};
 pub use two_loop::{
     two_loop, two_loop_refined, two_loop_with_progress, TwoLoopPair, TwoLoopSettings, TwoLoopTerms,

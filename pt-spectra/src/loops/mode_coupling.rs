@@ -100,8 +100,14 @@ pub(crate) struct Sampler {
 
 impl Sampler {
     /// The map at `k` [h/Mpc] on ln q ∈ [`lo`, `hi`], with the low-k radial width `radial_width`.
-    pub fn new(k: f64, (lo, hi): (f64, f64), radial_width: f64) -> Self {
+    pub fn new(k: f64, range: (f64, f64), radial_width: f64) -> Self {
         let (centre, width) = radial_density(k, radial_width);
+        Self::with_density(centre, width, range)
+    }
+
+    /// The map on ln q ∈ [`lo`, `hi`] with the radial density ∝ 1/(w² + (ln q − c)²) of centre c =
+    /// `centre` and width w = `width`.
+    pub fn with_density(centre: f64, width: f64, (lo, hi): (f64, f64)) -> Self {
         Self {
             centre,
             width,

@@ -32,6 +32,11 @@ pub struct BiasArgs {
 }
 
 impl BiasArgs {
+    /// Whether any of the options differs from its default (b = 1, no table, A_b = 1).
+    pub fn is_set(&self) -> bool {
+        self.bias != 1.0 || self.bias_file.is_some() || self.amplitude != 1.0
+    }
+
     /// The file these options read, by option.
     pub fn files(&self) -> Vec<(&'static str, Option<&Path>)> {
         vec![("--bias-file", self.bias_file.as_deref())]

@@ -17,6 +17,8 @@ pub enum RsdChoice {
     Paper(pt_spectra::rsd::RsdModel),
     /// The 1-loop galaxy model (velocileptors' REPT).
     Ept,
+    /// The matter multipoles of 2-loop SPT in redshift space.
+    Spt2,
 }
 
 impl FromStr for RsdChoice {
@@ -24,6 +26,9 @@ impl FromStr for RsdChoice {
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         if s.eq_ignore_ascii_case("ept") {
             return Ok(Self::Ept);
+        }
+        if s.eq_ignore_ascii_case("spt2") {
+            return Ok(Self::Spt2);
         }
         s.parse().map(Self::Paper)
     }

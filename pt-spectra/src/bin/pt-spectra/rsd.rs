@@ -6,10 +6,11 @@ use crate::input::Input;
 use crate::output::{check_outputs, write_output};
 use crate::progress::Bars;
 use anyhow::{bail, Context, Result};
-use pt_spectra::jobs::{rsd_table, xi_table, NonlinearBias, RsdRequest};
+use pt_spectra::jobs::{rsd_table, spt2_table, xi_table, NonlinearBias, RsdRequest};
 use pt_spectra::linear::LogGrid;
 use pt_spectra::real::RealModel;
 use pt_spectra::rsd::ap::Distortion;
+use pt_spectra::rsd::spt2::Spt2Plan;
 use pt_spectra::rsd::{Fog, Observed, RsdModel, RsdPlan, Sigma0};
 use pt_spectra::setup::NamedCosmology;
 use pt_spectra::survey::observe::Observation;
@@ -26,7 +27,9 @@ pub struct Args {
     /// Redshift-space model: kaiser, scoccimarro or tns (Scoccimarro + the A and B terms of Taruya,
     /// Nishimichi & Saito 2010 at leading order) on the --real model; or ept, the 1-loop galaxy model
     /// with IR resummation (velocileptors' REPT: --bias is b1, with --b2 --bs --b3, --alpha0..6,
-    /// --sn --sn2 --sn4 in velocileptors' conventions, --no-ir).
+    /// --sn --sn2 --sn4 in velocileptors' conventions, --no-ir); or spt2, the matter multipoles of
+    /// 2-loop SPT in redshift space (kernels Z_2..Z_5; no FoG, IR resummation or counterterms; the
+    /// 2-loop terms by quasi-Monte Carlo, ~1 s per k at default precision; --f, --ells, --terms).
     #[arg(long, value_name = "MODEL", default_value = pt_spectra::jobs::defaults::RSD_MODEL, value_parser = parsed::<RsdChoice>)]
     rsd: RsdChoice,
     /// Growth rate f. Default: f(z) of the cosmology.
@@ -123,7 +126,9 @@ impl Args {
                 }
                 Ok(m)
             }
-            RsdChoice::Ept => bail!("internal: ept has no paper model"),
+            RsdChoice::Ept | RsdChoice::Spt2 => {
+                bail!("internal: {:?} has no paper model", self.rsd)
+            }
         }
     }
 
@@ -144,6 +149,39 @@ impl Args {
         ];
         if let Some((flag, _)) = refused.iter().find(|(_, given)| *given) {
             bail!("{flag} is not an option of --rsd ept (its Fingers of God are the counterterms --alpha2..6)");
+        }
+        Ok(())
+    }
+
+    /// Refuses every option that `spt2` (matter, no FoG, no bias) does not take.
+    fn check_spt2_options(&self) -> Result<()> {
+        let refused = [
+            ("--real", self.real_model != RealModel::OneLoopRptN1),
+            ("--fog", self.fog != Fog::None),
+            ("--sigma0", self.sigma0 != Sigma0::Value(0.0)),
+            ("--cs2", self.cs2 != 0.0),
+            ("--no-wiggle", self.no_wiggle),
+            ("--xi", self.xi),
+            ("--bias/--bias-file/--amplitude", self.bias.is_set()),
+            ("--b2/--bs/--b3", self.galaxy().is_some()),
+            (
+                "--shot-noise/--number-density/--noise-file",
+                self.noise.is_set(),
+            ),
+            (
+                "--apar/--aperp/--fiducial",
+                self.apar.is_some() || self.fiducial.is_some(),
+            ),
+            (
+                "--window/--k-edges/--box",
+                self.ept.has_window() || self.ept.has_bins(),
+            ),
+        ];
+        if let Some((flag, _)) = refused.iter().find(|(_, given)| *given) {
+            bail!("{flag} is not an option of --rsd spt2 (matter multipoles of plain 2-loop SPT: --f, --ells, --terms)");
+        }
+        if let Some(flag) = self.ept.given().first() {
+            bail!("{flag} is an option of --rsd ept, not of --rsd spt2");
         }
         Ok(())
     }
@@ -210,6 +248,24 @@ pub fn run(args: &Args) -> Result<()> {
             )?)
         }
     };
+    if args.rsd == RsdChoice::Spt2 {
+        args.check_spt2_options()?;
+        let ells: Vec<usize> = list(&args.ells, "--ells")?;
+        pt_spectra::rsd::MultipoleRule::new(&ells)?;
+        let precision = &loaded.precision;
+        let plan = Spt2Plan::new(&k, precision)?;
+        let terms = plan.terms(loaded.prepared.tracer_spectrum(), &Bars::default())?;
+        let table = spt2_table(
+            &plan,
+            &terms,
+            args.f,
+            &ells,
+            args.terms,
+            &loaded.prepared,
+            precision,
+        )?;
+        return write_output(args.out.as_ref(), &table);
+    }
     if args.rsd == RsdChoice::Ept {
         args.check_ept_options()?;
         let ells: Vec<usize> = list(&args.ells, "--ells")?;
