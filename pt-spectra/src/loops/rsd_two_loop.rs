@@ -1,7 +1,7 @@
 //! The 2-loop SPT correction of the matter power spectrum in redshift space, P^(2)_s(k, μ; f), by
 //! randomised quasi-Monte Carlo over both loop momenta and the azimuth of the line of sight.
 //!
-//! With the redshift-space kernels Z_n ([`zn`]; Scoccimarro, Couchman & Frieman 1999) in place of F_n,
+//! With the redshift-space kernels Z_n (module `zn`; Scoccimarro, Couchman & Frieman 1999) in place of F_n,
 //! the 2-loop terms are those of real space ([`super::two_loop`]; Taule & Garny 2023 compute the same):
 //!
 //! ```text
@@ -13,7 +13,7 @@
 //! ```
 //!
 //! ∫ ≡ ∫d³q/(2π)³, Z₁(k) = 1 + fμ². Everything is integrated at once, on the points, map and infrared
-//! grouping of the real-space mode-coupling integral ([`super::mode_coupling`]): P24 restricted to
+//! grouping of the real-space mode-coupling integral ([`super::two_loop`]): P24 restricted to
 //! |k − q₁| > q₁ and P33irr to q₃ > q₁, q₂ by smooth partitions of unity, symmetrised in q₁ ↔ q₂ and
 //! averaged over the four images q_i → ±q_i, so that the infrared pieces of 2P15 + P33red (each
 //! ∝ [(k + fμk n̂)·q]²/q⁴ as q → 0, the redshift-space displacement) and of 2P24 + P33irr cancel at

@@ -6,7 +6,7 @@
 //!
 //! P^(1)_s the 1-loop terms P22 + 2P13 with the kernels Z₂, Z₃ ([`crate::loops::redshift`] at b1 = 1 and
 //! no other bias: exact in μ, deterministic quadrature), P^(2)_s the 2-loop terms 2P15 + 2P24 + P33
-//! with Z₄, Z₅ ([`crate::loops::rsd_two_loop`]: quasi-Monte Carlo, a polynomial of degree 6 in f and
+//! with Z₄, Z₅ ([`mod@crate::loops::rsd_two_loop`]: quasi-Monte Carlo, a polynomial of degree 6 in f and
 //! in μ²). Every term is a polynomial in f, so a new f costs no integral. No Fingers-of-God damping, no
 //! IR resummation, no counterterms: plain SPT, whose reach in redshift space is short (the issue's
 //! figures: 1-loop to k ≈ 0.1, 2-loop to ≈ 0.18 h/Mpc at z ≈ 1 with counterterms).
@@ -95,7 +95,7 @@ impl Spt2Plan {
     /// ([`Stage::TwoLoopPoints`]).
     ///
     /// # Errors
-    /// As [`rsd_two_loop`].
+    /// As [`rsd_two_loop()`].
     pub fn terms(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> Result<Spt2Terms> {
         let p = &self.precision;
         let k = self.k();
