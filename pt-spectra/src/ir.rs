@@ -127,6 +127,21 @@ pub fn sigma2_bao(no_wiggle: &LinearSpectrum, q_min: f64) -> Estimate {
     Estimate::new(norm * value, norm * error)
 }
 
+/// δΣ² = (1/2π²)∫_{q_min}^{k_s} dq P_nw(q) j2(qℓ) [(Mpc/h)²], the anisotropic part of the damping in
+/// redshift space (Ivanov, Simonović & Zaldarriaga 2020, as CLASS-PT): Σ²_tot(μ) = [1 + fμ²(2 + f)]Σ²
+/// + f²μ²(μ² − 1)δΣ², with ℓ = [`BAO_SCALE`], k_s = [`SIGMA_CUTOFF`]; Simpson in ln q as [`sigma2_bao`].
+pub fn delta_sigma2_bao(no_wiggle: &LinearSpectrum, q_min: f64) -> Estimate {
+    const INTERVALS: usize = 2048;
+    let integrand = |ln_q: f64| {
+        let q = ln_q.exp();
+        q * no_wiggle.eval(q) * j2(q * BAO_SCALE)
+    };
+    let (value, error) =
+        crate::integrate::simpson_ln(integrand, q_min.ln(), SIGMA_CUTOFF.ln(), INTERVALS);
+    let norm = 1.0 / (2.0 * PI * PI);
+    Estimate::new(norm * value, norm * error)
+}
+
 /// Spherical Bessel j0(x) = sin x / x.
 fn j0(x: f64) -> f64 {
     if x.abs() < 1e-4 {

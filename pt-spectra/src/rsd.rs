@@ -23,6 +23,7 @@ use std::fmt;
 use std::str::FromStr;
 
 pub mod ap;
+pub mod eft2;
 pub mod ept;
 mod multipoles;
 mod sigma0;

@@ -58,7 +58,7 @@ pub use rsd::{
     rsd_table_from_terms_memo, rsd_table_with_bias_terms, xi_table, NonlinearBias, RsdRequest,
     SN_LEVELS,
 };
-pub use spt2::spt2_table;
+pub use spt2::{eft2_table, spt2_table};
 
 /// The version of pt-spectra, for table headers.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

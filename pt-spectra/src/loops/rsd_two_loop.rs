@@ -70,23 +70,64 @@ pub struct RsdTwoLoopTerms {
     replicas: Vec<Vec<NodeIntegrals>>,
 }
 
+/// The node weights w_j for which Σ_j w_j P(μ_j²) = ∫₀¹ g(μ) P(μ²) dμ for every polynomial P of
+/// degree 6 in μ², by a 32-point Gauss–Legendre rule (exact for polynomial g of degree ≤ 50; g smooth
+/// otherwise, e.g. a damping).
+pub fn node_weights(g: impl Fn(f64) -> f64) -> [f64; MU_NODES] {
+    let (x, w) = legendre_nodes(32);
+    let nodes = mu2_nodes();
+    std::array::from_fn(|j| {
+        x.iter()
+            .zip(&w)
+            .map(|(&x, &w)| {
+                let mu = 0.5 * (x + 1.0);
+                0.5 * w * g(mu) * lagrange(&nodes, j, mu * mu)
+            })
+            .sum()
+    })
+}
+
+/// The mean and standard error over the random shifts of Σ_t Σ_j w_tj P_t^(2)(k_i, μ_j; f) for terms
+/// P_t of spectra integrated together ([`rsd_two_loop_of`]: the same points and shifts), with node
+/// weights w_t ([`node_weights`]), so that correlated errors cancel as they should.
+///
+/// # Panics
+/// If the terms were not integrated together (different shifts or k grids).
+pub fn combined(terms: &[(&RsdTwoLoopTerms, [f64; MU_NODES])], i: usize, f: f64) -> Estimate {
+    let powers: [f64; F_POWERS] = std::array::from_fn(|m| f.powi(m as i32));
+    let replicas = terms[0].0.replicas[i].len();
+    assert!(
+        terms
+            .iter()
+            .all(|(t, _)| t.replicas[i].len() == replicas && t.k == terms[0].0.k),
+        "terms integrated together"
+    );
+    let values: Vec<f64> = (0..replicas)
+        .map(|r| {
+            terms
+                .iter()
+                .map(|(t, weights)| {
+                    t.replicas[i][r]
+                        .iter()
+                        .zip(weights)
+                        .map(|(node, w)| {
+                            w * node.iter().zip(&powers).map(|(c, p)| c * p).sum::<f64>()
+                        })
+                        .sum::<f64>()
+                })
+                .sum()
+        })
+        .collect();
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+    Estimate::new(mean, (var / n).sqrt())
+}
+
 impl RsdTwoLoopTerms {
     /// The mean and standard error over the replicas of Σ_j w_j P^(2)(k_i, μ_j; f).
-    fn functional(&self, i: usize, f: f64, weights: &[f64; MU_NODES]) -> Estimate {
-        let powers: [f64; F_POWERS] = std::array::from_fn(|m| f.powi(m as i32));
-        let values: Vec<f64> = self.replicas[i]
-            .iter()
-            .map(|r| {
-                r.iter()
-                    .zip(weights)
-                    .map(|(node, w)| w * node.iter().zip(&powers).map(|(c, p)| c * p).sum::<f64>())
-                    .sum()
-            })
-            .collect();
-        let n = values.len() as f64;
-        let mean = values.iter().sum::<f64>() / n;
-        let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
-        Estimate::new(mean, (var / n).sqrt())
+    pub fn functional(&self, i: usize, f: f64, weights: &[f64; MU_NODES]) -> Estimate {
+        combined(&[(self, *weights)], i, f)
     }
 
     /// P^(2)_s(k_i, μ) at growth rate `f` [(Mpc/h)³].
@@ -207,28 +248,46 @@ fn norm2(a: [f64; 3]) -> f64 {
     a[0] * a[0] + a[1] * a[1] + a[2] * a[2]
 }
 
-/// Adds c · Z_a Z_b (polynomials in f) to `acc`.
-#[inline]
-fn add_product(acc: &mut [f64; F_POWERS], c: f64, a: &FPoly, b: &FPoly) {
-    for (s, p) in acc.iter_mut().zip(product(a, b)) {
-        *s += c * p;
-    }
-}
-
 /// The line of sight at each node for the azimuth `phi_n`.
 fn lines_of_sight(phi_n: f64, nodes: &[(f64, f64); MU_NODES]) -> [[f64; 3]; MU_NODES] {
     let (cos_n, sin_n) = (phi_n.cos(), phi_n.sin());
     nodes.map(|(mu, smu)| [smu * cos_n, smu * sin_n, mu])
 }
 
-/// The vectors k, q₁, q₂ of a point (k along z, q₁ in the xz plane) and the measure
-/// d³q₁d³q₂/(2π)⁶ (as the real-space integrand's, with ¼ for the images) times P(q₁)P(q₂) and the
-/// sampling Jacobian; `None` where P(q₁)P(q₂) = 0.
-fn vectors(k: f64, point: &Point, sampled: &Sampled) -> Option<([[f64; 3]; 3], f64)> {
-    let (p1, p2) = (sampled.at_ln(point.ln_q[0]), sampled.at_ln(point.ln_q[1]));
-    if p1 == 0.0 || p2 == 0.0 {
-        return None;
+/// The integrand at one sample point, linear in each of its three spectra: P(q₁)P(q₂) Σ_t C_t P(z_t)
+/// with third legs z_t and coefficients C_t (kernels, partitions, measure and sampling Jacobian) per
+/// node in μ² and power of f, none of which depend on the spectrum.
+struct PointLegs {
+    ln_q: [f64; 2],
+    /// (ln z_t, C_t).
+    legs: Vec<(f64, NodeIntegrals)>,
+}
+
+impl PointLegs {
+    /// Adds the integrand for the spectrum `sampled` to `acc`.
+    fn add_to(&self, sampled: &Sampled, acc: &mut NodeIntegrals) {
+        let p12 = sampled.at_ln(self.ln_q[0]) * sampled.at_ln(self.ln_q[1]);
+        if p12 == 0.0 {
+            return;
+        }
+        for (ln_z, coef) in &self.legs {
+            let p = sampled.at_ln(*ln_z);
+            if p == 0.0 {
+                continue;
+            }
+            for (out, c) in acc.iter_mut().zip(coef) {
+                for (o, c) in out.iter_mut().zip(c) {
+                    *o += p12 * p * c;
+                }
+            }
+        }
     }
+}
+
+/// The vectors k, q₁, q₂ of a point (k along z, q₁ in the xz plane) and the measure
+/// d³q₁d³q₂/(2π)⁶ (as the real-space integrand's, with ¼ for the images) times the sampling
+/// Jacobian.
+fn vectors(k: f64, point: &Point) -> ([[f64; 3]; 3], f64) {
     let q = [point.ln_q[0].exp(), point.ln_q[1].exp()];
     let x = point.x;
     let (s1, s2) = (
@@ -241,96 +300,76 @@ fn vectors(k: f64, point: &Point, sampled: &Sampled) -> Option<([[f64; 3]; 3], f
     );
     let q1 = [q[0] * s1, 0.0, q[0] * x[0]];
     let q2 = [q[1] * s2 * c, q[1] * s2 * s, q[1] * x[1]];
-    let measure =
-        0.25 * (q[0] * q[1]).powi(3) * 4.0 * PI / (2.0 * PI).powi(6) * p1 * p2 * point.jacobian;
-    Some(([[0.0, 0.0, k], q1, q2], measure))
+    let measure = 0.25 * (q[0] * q[1]).powi(3) * 4.0 * PI / (2.0 * PI).powi(6) * point.jacobian;
+    ([[0.0, 0.0, k], q1, q2], measure)
 }
 
-/// Adds the propagator part 2P15 − P33red at one point to `acc` (it is the same in the four images).
-fn add_propagator(
-    k: f64,
-    point: &Point,
-    los: &[[f64; 3]; MU_NODES],
-    sampled: &Sampled,
-    acc: &mut NodeIntegrals,
-) {
-    let p_k = sampled.at_ln(k.ln());
-    let Some(([kv, q1, q2], measure)) = vectors(k, point, sampled) else {
-        return;
-    };
+/// c · Z_a Z_b at every node (polynomials in f), from the kernels' values at the nodes.
+fn products(c: f64, a: &[FPoly; MU_NODES], b: &[FPoly; MU_NODES]) -> NodeIntegrals {
+    std::array::from_fn(|j| product(&a[j], &b[j]).map(|v| c * v))
+}
+
+/// Z of the vectors `args` of `kernels` at every line of sight.
+fn at_nodes(kernels: &SubsetKernels, args: usize, los: &[[f64; 3]; MU_NODES]) -> [FPoly; MU_NODES] {
+    std::array::from_fn(|j| kernels.redshift(args, &los[j]))
+}
+
+/// The propagator part 2P15 − P33red at one point (the same in the four images): one leg, z = k.
+fn propagator_legs(k: f64, point: &Point, los: &[[f64; 3]; MU_NODES]) -> PointLegs {
+    let ([kv, q1, q2], measure) = vectors(k, point);
     let kernels = SubsetKernels::new(&[kv, q1, neg(q1), q2, neg(q2)]);
-    let c = 4.0 * measure * p_k;
-    for (out, los) in acc.iter_mut().zip(los) {
-        let z1 = kernels.redshift(0b00001, los);
-        let z5 = kernels.redshift(0b11111, los);
-        let z3a = kernels.redshift(0b00111, los);
-        let z3b = kernels.redshift(0b11001, los);
-        add_product(out, 30.0 * c, &z1, &z5);
-        add_product(out, -9.0 * c, &z3a, &z3b);
+    let c = 4.0 * measure;
+    let z1 = at_nodes(&kernels, 0b00001, los);
+    let z5 = at_nodes(&kernels, 0b11111, los);
+    let z3a = at_nodes(&kernels, 0b00111, los);
+    let z3b = at_nodes(&kernels, 0b11001, los);
+    let mut coef = products(30.0 * c, &z1, &z5);
+    for (row, add) in coef.iter_mut().zip(products(-9.0 * c, &z3a, &z3b)) {
+        row.iter_mut().zip(add).for_each(|(r, a)| *r += a);
+    }
+    PointLegs {
+        ln_q: point.ln_q,
+        legs: vec![(k.ln(), coef)],
     }
 }
 
-/// Adds the mode-coupling part 2P24 + P33irr + 2P33red at one point to `acc`, averaged over the
-/// four images.
-fn add_mode_coupling(
-    k: f64,
-    point: &Point,
-    los: &[[f64; 3]; MU_NODES],
-    sampled: &Sampled,
-    acc: &mut NodeIntegrals,
-) {
-    let p_k = sampled.at_ln(k.ln());
-    let Some(([kv, q1, q2], measure)) = vectors(k, point, sampled) else {
-        return;
-    };
+/// The mode-coupling part 2P24 + P33irr + 2P33red at one point, averaged over the four images:
+/// legs z = k (2P33red), |k ∓ q_i| (2P24) and the four q₃ (P33irr).
+fn mode_coupling_legs(k: f64, point: &Point, los: &[[f64; 3]; MU_NODES]) -> PointLegs {
+    let ([kv, q1, q2], measure) = vectors(k, point);
+    let mut legs = Vec::with_capacity(9);
     // 2P33red: the same in all four images
     let reducible = SubsetKernels::new(&[kv, q1, neg(q1), q2, neg(q2)]);
+    let z3a = at_nodes(&reducible, 0b00111, los);
+    let z3b = at_nodes(&reducible, 0b11001, los);
+    legs.push((k.ln(), products(4.0 * 18.0 * measure, &z3a, &z3b)));
     // 2P24: the half of q₁ (both signs) and of q₂, each with the partition w = p⁴/(q⁴ + p⁴), p = k − q
-    let mut p24: Vec<(SubsetKernels, f64)> = Vec::with_capacity(4);
     for (a, b) in [(q1, q2), (neg(q1), q2), (q2, q1), (neg(q2), q1)] {
         let p = sub(kv, a);
         let (pp, aa) = (norm2(p), norm2(a));
         let w = pp * pp / (aa * aa + pp * pp);
-        if w <= 1e-12 {
-            continue;
-        }
-        let leg = sampled.at_ln(0.5 * pp.ln());
-        if leg != 0.0 {
-            p24.push((SubsetKernels::new(&[a, p, b, neg(b)]), 48.0 * w * leg));
+        if w > 1e-12 {
+            let kernels = SubsetKernels::new(&[a, p, b, neg(b)]);
+            let z2 = at_nodes(&kernels, 0b0011, los);
+            let z4 = at_nodes(&kernels, 0b1111, los);
+            legs.push((0.5 * pp.ln(), products(48.0 * w * measure, &z2, &z4)));
         }
     }
     // P33irr: the four images, each with the partition w₃ = q₃⁴/(q₁⁴ + q₂⁴ + q₃⁴)
-    let mut p33: Vec<(SubsetKernels, f64)> = Vec::with_capacity(4);
     let (q11, q22) = (norm2(q1), norm2(q2));
     for (a, b) in [(q1, q2), (neg(q1), neg(q2)), (neg(q1), q2), (q1, neg(q2))] {
         let q3 = sub(sub(kv, a), b);
         let q33 = norm2(q3);
         let w3 = q33 * q33 / (q11 * q11 + q22 * q22 + q33 * q33);
-        if w3 <= 1e-12 {
-            continue;
-        }
-        let leg = sampled.at_ln(0.5 * q33.ln());
-        if leg != 0.0 {
-            p33.push((SubsetKernels::new(&[a, b, q3]), 18.0 * w3 * leg));
+        if w3 > 1e-12 {
+            let kernels = SubsetKernels::new(&[a, b, q3]);
+            let z3 = at_nodes(&kernels, 0b111, los);
+            legs.push((0.5 * q33.ln(), products(18.0 * w3 * measure, &z3, &z3)));
         }
     }
-    for (out, los) in acc.iter_mut().zip(los) {
-        let mut v = [0.0; F_POWERS];
-        let z3a = reducible.redshift(0b00111, los);
-        let z3b = reducible.redshift(0b11001, los);
-        add_product(&mut v, 4.0 * 18.0 * p_k, &z3a, &z3b);
-        for (kernels, coef) in &p24 {
-            let z2 = kernels.redshift(0b0011, los);
-            let z4 = kernels.redshift(0b1111, los);
-            add_product(&mut v, *coef, &z2, &z4);
-        }
-        for (kernels, coef) in &p33 {
-            let z3 = kernels.redshift(0b111, los);
-            add_product(&mut v, *coef, &z3, &z3);
-        }
-        for (o, x) in out.iter_mut().zip(v) {
-            *o += measure * x;
-        }
+    PointLegs {
+        ln_q: point.ln_q,
+        legs,
     }
 }
 
@@ -372,7 +411,7 @@ fn shifts(replicas: usize, seed: u64) -> Vec<[f64; 6]> {
 /// `settings.replicas` shifts; `progress(done, total)` counts the points.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] for fewer than 2 replicas or an empty or non-positive k.
+/// [`Error::InvalidParameter`] for fewer than 2 replicas or a k that is not positive and finite.
 pub fn rsd_two_loop(
     k: &[f64],
     spectrum: &LinearSpectrum,
@@ -381,11 +420,37 @@ pub fn rsd_two_loop(
     settings: &TwoLoopSettings,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<RsdTwoLoopTerms> {
+    let mut terms = rsd_two_loop_of(k, &[spectrum], q_range, lattice_step, settings, progress)?;
+    Ok(terms.remove(0))
+}
+
+/// [`rsd_two_loop`] of several spectra on the same points: the kernels, the costly part, are
+/// evaluated once per point for all of them, and their Monte Carlo errors are correlated, so a
+/// difference such as P^(2)\[P\] − P^(2)\[P_nw\] (through [`combined`]) carries a much smaller error
+/// than either.
+///
+/// # Errors
+/// As [`rsd_two_loop`]; [`Error::InvalidParameter`] for no spectra.
+pub fn rsd_two_loop_of(
+    k: &[f64],
+    spectra: &[&LinearSpectrum],
+    q_range: (f64, f64),
+    lattice_step: f64,
+    settings: &TwoLoopSettings,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<Vec<RsdTwoLoopTerms>> {
     if settings.replicas < 2 {
         return Err(Error::InvalidParameter {
             name: "two_loop_replicas",
             value: settings.replicas as f64,
             reason: "at least 2 random shifts are needed for an error estimate",
+        });
+    }
+    if spectra.is_empty() {
+        return Err(Error::InvalidParameter {
+            name: "number of spectra of the 2-loop redshift-space terms",
+            value: 0.0,
+            reason: "must be at least 1",
         });
     }
     if let Some(&bad) = k.iter().find(|&&k| !(k > 0.0 && k.is_finite())) {
@@ -396,11 +461,14 @@ pub fn rsd_two_loop(
         });
     }
     let lattice = Lattice::new(q_range.0, q_range.1, lattice_step);
-    let samples = lattice.sample(spectrum);
-    let sampled = Sampled {
-        lattice: &lattice,
-        samples: &samples,
-    };
+    let samples: Vec<Vec<f64>> = spectra.iter().map(|s| lattice.sample(s)).collect();
+    let sampled: Vec<Sampled> = samples
+        .iter()
+        .map(|samples| Sampled {
+            lattice: &lattice,
+            samples,
+        })
+        .collect();
     let counts: Vec<usize> = k.iter().map(|&k| points_at(k, settings.points)).collect();
     let points = sobol_points(counts.iter().copied().max().unwrap_or(0));
     let shifts = shifts(settings.replicas, settings.seed);
@@ -410,35 +478,47 @@ pub fn rsd_two_loop(
     let replicas = shifts.len();
     let total: usize = counts.iter().map(|n| n * replicas).sum();
     let done = AtomicUsize::new(0);
-    let integrals: Vec<NodeIntegrals> = (0..k.len() * replicas)
+    // per job (k, shift): the integrals of every spectrum
+    let integrals: Vec<Vec<NodeIntegrals>> = (0..k.len() * replicas)
         .into_par_iter()
         .map(|job| {
             let (i, shift) = (job / replicas, &shifts[job % replicas]);
             let coupling = Sampler::new(k[i], ln_range, settings.radial_width);
             let propagator = propagator_sampler(ln_range);
             let head: [f64; 5] = std::array::from_fn(|d| shift[d]);
-            let mut acc = [[0.0; F_POWERS]; MU_NODES];
+            let mut acc = vec![[[0.0; F_POWERS]; MU_NODES]; spectra.len()];
             for p in &points[..counts[i]] {
                 let unit: [f64; 5] = std::array::from_fn(|d| p[d]);
                 let los = lines_of_sight(2.0 * PI * (p[5] + shift[5]).fract(), &nodes);
-                let point = propagator.point(&unit, &head);
-                add_propagator(k[i], &point, &los, &sampled, &mut acc);
-                let point = coupling.point(&unit, &head);
-                add_mode_coupling(k[i], &point, &los, &sampled, &mut acc);
+                for legs in [
+                    propagator_legs(k[i], &propagator.point(&unit, &head), &los),
+                    mode_coupling_legs(k[i], &coupling.point(&unit, &head), &los),
+                ] {
+                    for (s, a) in sampled.iter().zip(acc.iter_mut()) {
+                        legs.add_to(s, a);
+                    }
+                }
             }
             let scale = integral_scale(counts[i]);
             progress(
                 done.fetch_add(counts[i], Ordering::Relaxed) + counts[i],
                 total,
             );
-            acc.map(|row| row.map(|v| v * scale))
+            acc.into_iter()
+                .map(|a| a.map(|row| row.map(|v| v * scale)))
+                .collect()
         })
         .collect();
-    Ok(RsdTwoLoopTerms {
-        k: k.to_vec(),
-        points: counts,
-        replicas: integrals.chunks(replicas).map(<[_]>::to_vec).collect(),
-    })
+    Ok((0..spectra.len())
+        .map(|s| RsdTwoLoopTerms {
+            k: k.to_vec(),
+            points: counts.clone(),
+            replicas: integrals
+                .chunks(replicas)
+                .map(|jobs| jobs.iter().map(|per| per[s]).collect())
+                .collect(),
+        })
+        .collect())
 }
 
 #[cfg(test)]

@@ -26,6 +26,17 @@ use crate::progress::{stage_callback, Progress, Stage};
 /// of sight, nine configurations) against ~1 μs in real space.
 pub const POINTS_DIVISOR: usize = 4;
 
+/// The 2-loop integration settings of `precision` in redshift space: the real-space ones with
+/// [`POINTS_DIVISOR`] times fewer points.
+pub fn two_loop_settings(precision: &Precision) -> TwoLoopSettings {
+    TwoLoopSettings {
+        points: (precision.two_loop_points / POINTS_DIVISOR).max(1),
+        replicas: precision.two_loop_replicas,
+        seed: precision.two_loop_seed,
+        ..TwoLoopSettings::default()
+    }
+}
+
 /// The plan of `spt2` on a k grid: the 1-loop weights (cosmology independent) and the settings of the
 /// 2-loop integration.
 #[derive(Debug, Clone)]
@@ -80,15 +91,9 @@ impl Spt2Plan {
         self.one_loop.k()
     }
 
-    /// The 2-loop integration settings: the real-space ones with [`POINTS_DIVISOR`] times fewer points.
+    /// The 2-loop integration settings ([`two_loop_settings`]).
     pub fn two_loop_settings(&self) -> TwoLoopSettings {
-        let p = &self.precision;
-        TwoLoopSettings {
-            points: (p.two_loop_points / POINTS_DIVISOR).max(1),
-            replicas: p.two_loop_replicas,
-            seed: p.two_loop_seed,
-            ..TwoLoopSettings::default()
-        }
+        two_loop_settings(&self.precision)
     }
 
     /// The terms of `spectrum`; the 2-loop points are reported to `progress`

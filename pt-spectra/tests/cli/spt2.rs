@@ -89,3 +89,90 @@ fn options_spt2_does_not_take_are_refused_by_name() {
         (with(&["--f", "nan"]), "f"),
     ]);
 }
+
+#[test]
+fn eft2_is_linear_in_its_counterterms_and_refuses_bad_ones() {
+    let base = [
+        "rsd",
+        "--rsd",
+        "eft2",
+        "--k-min",
+        "0.05",
+        "--k-max",
+        "0.2",
+        "--nk",
+        "3",
+        "--precision",
+        "fast",
+        "--ells",
+        "0,2",
+    ];
+    let (ok, zero, err) = run(&base);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("warning: every counterterm of eft2 is 0"),
+        "{err}"
+    );
+    assert!(zero.contains("IR resummation: P_nw") && zero.contains("dSigma^2 ="));
+    let mut with = base.to_vec();
+    with.extend([
+        "--ct",
+        "c0=1.5",
+        "--ct",
+        "c2_1loop=-3",
+        "--ct",
+        "ctilde=40",
+        "--terms",
+    ]);
+    let (ok, out, err) = run(&with);
+    assert!(ok, "{err}");
+    for l in ["0", "2"] {
+        let (p, p0) = (
+            column(&out, &format!("P{l}")),
+            column(&zero, &format!("P{l}")),
+        );
+        let t: Vec<Vec<f64>> = ["c0", "c2_1loop", "ctilde"]
+            .iter()
+            .map(|c| column(&out, &format!("T{l}_{c}")))
+            .collect();
+        for i in 0..p.len() {
+            let want = p0[i] + 1.5 * t[0][i] - 3.0 * t[1][i] + 40.0 * t[2][i];
+            assert!(
+                (p[i] - want).abs() < 1e-7 * p[i].abs().max(1.0),
+                "P{l}: {} vs {want}",
+                p[i]
+            );
+        }
+    }
+    let mut no_ir = base.to_vec();
+    no_ir.push("--no-ir");
+    let (ok, out, err) = run(&no_ir);
+    assert!(ok && out.contains("no IR resummation (--no-ir)"), "{err}");
+    let eft2 = |extra: &[&'static str]| {
+        let mut a = vec!["rsd", "--rsd", "eft2", "--nk", "2"];
+        a.extend_from_slice(extra);
+        a
+    };
+    fails_naming(&[
+        (eft2(&["--ct", "c6=1"]), "unknown eft2 counterterm `c6`"),
+        (eft2(&["--ct", "c0"]), "write NAME=VALUE"),
+        (eft2(&["--ct", "c0=1", "--ct", "c0=2"]), "c0 is given twice"),
+        (eft2(&["--ct", "c0=inf"]), "finite number"),
+        (
+            eft2(&["--fog", "gaussian"]),
+            "--fog is not an option of --rsd eft2",
+        ),
+        (
+            vec!["rsd", "--rsd", "spt2", "--ct", "c0=1"],
+            "--ct is an option of --rsd eft2",
+        ),
+        (
+            vec!["rsd", "--rsd", "tns", "--ct", "c0=1"],
+            "--ct is an option of --rsd eft2",
+        ),
+        (
+            vec!["rsd", "--rsd", "spt2", "--no-ir"],
+            "--no-ir is an option of --rsd ept",
+        ),
+    ]);
+}

@@ -19,6 +19,8 @@ pub enum RsdChoice {
     Ept,
     /// The matter multipoles of 2-loop SPT in redshift space.
     Spt2,
+    /// The matter multipoles of the 2-loop EFT in redshift space, BAO resummed.
+    Eft2,
 }
 
 impl FromStr for RsdChoice {
@@ -29,6 +31,9 @@ impl FromStr for RsdChoice {
         }
         if s.eq_ignore_ascii_case("spt2") {
             return Ok(Self::Spt2);
+        }
+        if s.eq_ignore_ascii_case("eft2") {
+            return Ok(Self::Eft2);
         }
         s.parse().map(Self::Paper)
     }

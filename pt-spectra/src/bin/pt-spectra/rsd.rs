@@ -6,10 +6,11 @@ use crate::input::Input;
 use crate::output::{check_outputs, write_output};
 use crate::progress::Bars;
 use anyhow::{bail, Context, Result};
-use pt_spectra::jobs::{rsd_table, spt2_table, xi_table, NonlinearBias, RsdRequest};
+use pt_spectra::jobs::{eft2_table, rsd_table, spt2_table, xi_table, NonlinearBias, RsdRequest};
 use pt_spectra::linear::LogGrid;
 use pt_spectra::real::RealModel;
 use pt_spectra::rsd::ap::Distortion;
+use pt_spectra::rsd::eft2::{Eft2Plan, RsdCounterterms};
 use pt_spectra::rsd::spt2::Spt2Plan;
 use pt_spectra::rsd::{Fog, Observed, RsdModel, RsdPlan, Sigma0};
 use pt_spectra::setup::NamedCosmology;
@@ -29,7 +30,8 @@ pub struct Args {
     /// with IR resummation (velocileptors' REPT: --bias is b1, with --b2 --bs --b3, --alpha0..6,
     /// --sn --sn2 --sn4 in velocileptors' conventions, --no-ir); or spt2, the matter multipoles of
     /// 2-loop SPT in redshift space (kernels Z_2..Z_5; no FoG, IR resummation or counterterms; the
-    /// 2-loop terms by quasi-Monte Carlo, ~1 s per k at default precision; --f, --ells, --terms).
+    /// 2-loop terms by quasi-Monte Carlo, ~1 s per k at default precision; --f, --ells, --terms); or
+    /// eft2, the same with the BAO resummed (--no-ir: without) and the counterterms of --ct.
     #[arg(long, value_name = "MODEL", default_value = pt_spectra::jobs::defaults::RSD_MODEL, value_parser = parsed::<RsdChoice>)]
     rsd: RsdChoice,
     /// Growth rate f. Default: f(z) of the cosmology.
@@ -87,6 +89,11 @@ pub struct Args {
     /// 2 c_s² k² P_lin, P_dt − 4 c_s² k² P_lin, P_tt − 6 c_s² k² P_lin (as `real --cs2`).
     #[arg(long, value_name = "CS2", default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_cs2)]
     cs2: f64,
+    /// eft2 counterterm NAME=VALUE, repeatable: c0, c2, c4 [(Mpc/h)²] (−2 c k² μ^{2n} P_IR), c0_1loop,
+    /// c2_1loop, c4_1loop [(Mpc/h)²] (−2 c k² μ^{2n} P^(1)_IR) and ctilde [(Mpc/h)⁴] (−c̃ k⁴ f⁴ μ⁴
+    /// (1 + fμ²)² P_IR); docs/reference.md. Default 0.
+    #[arg(long = "ct", value_name = "NAME=VALUE", allow_hyphen_values = true)]
+    ct: Vec<String>,
     /// Multipoles to print, even ℓ ≤ 8, comma separated.
     #[arg(long, value_name = "L,L,…", default_value = "0,2,4")]
     ells: String,
@@ -126,7 +133,7 @@ impl Args {
                 }
                 Ok(m)
             }
-            RsdChoice::Ept | RsdChoice::Spt2 => {
+            RsdChoice::Ept | RsdChoice::Spt2 | RsdChoice::Eft2 => {
                 bail!("internal: {:?} has no paper model", self.rsd)
             }
         }
@@ -153,8 +160,16 @@ impl Args {
         Ok(())
     }
 
-    /// Refuses every option that `spt2` (matter, no FoG, no bias) does not take.
+    /// Refuses every option that `spt2` and `eft2` (matter, no FoG, no bias) do not take.
     fn check_spt2_options(&self) -> Result<()> {
+        let name = if self.rsd == RsdChoice::Eft2 {
+            "eft2"
+        } else {
+            "spt2"
+        };
+        if self.rsd == RsdChoice::Spt2 && !self.ct.is_empty() {
+            bail!("--ct is an option of --rsd eft2 (spt2 has no counterterms)");
+        }
         let refused = [
             ("--real", self.real_model != RealModel::OneLoopRptN1),
             ("--fog", self.fog != Fog::None),
@@ -178,10 +193,12 @@ impl Args {
             ),
         ];
         if let Some((flag, _)) = refused.iter().find(|(_, given)| *given) {
-            bail!("{flag} is not an option of --rsd spt2 (matter multipoles of plain 2-loop SPT: --f, --ells, --terms)");
+            bail!("{flag} is not an option of --rsd {name} (matter multipoles of 2-loop perturbation theory: --f, --ells, --terms; eft2: --ct, --no-ir)");
         }
-        if let Some(flag) = self.ept.given().first() {
-            bail!("{flag} is an option of --rsd ept, not of --rsd spt2");
+        let ept_only = self.ept.given();
+        let allowed = |f: &&&str| self.rsd == RsdChoice::Eft2 && **f == "--no-ir";
+        if let Some(flag) = ept_only.iter().find(|f| !allowed(f)) {
+            bail!("{flag} is an option of --rsd ept, not of --rsd {name}");
         }
         Ok(())
     }
@@ -248,6 +265,9 @@ pub fn run(args: &Args) -> Result<()> {
             )?)
         }
     };
+    if !args.ct.is_empty() && args.rsd != RsdChoice::Eft2 {
+        bail!("--ct is an option of --rsd eft2 (the paper's models take --cs2; ept --alpha0..6)");
+    }
     if args.rsd == RsdChoice::Spt2 {
         args.check_spt2_options()?;
         let ells: Vec<usize> = list(&args.ells, "--ells")?;
@@ -260,6 +280,29 @@ pub fn run(args: &Args) -> Result<()> {
             &terms,
             args.f,
             &ells,
+            args.terms,
+            &loaded.prepared,
+            precision,
+        )?;
+        return write_output(args.out.as_ref(), &table);
+    }
+    if args.rsd == RsdChoice::Eft2 {
+        args.check_spt2_options()?;
+        let ells: Vec<usize> = list(&args.ells, "--ells")?;
+        pt_spectra::rsd::MultipoleRule::new(&ells)?;
+        let ct = RsdCounterterms::from_assignments(&args.ct)?;
+        if ct.values.iter().all(|&v| v == 0.0) {
+            eprintln!("warning: every counterterm of eft2 is 0 (it is then IR-resummed 2-loop SPT): set them with --ct NAME=VALUE");
+        }
+        let precision = &loaded.precision;
+        let plan = Eft2Plan::new(&k, !args.ept.no_ir(), precision)?;
+        let terms = plan.terms(loaded.prepared.tracer_spectrum(), &Bars::default())?;
+        let table = eft2_table(
+            &plan,
+            &terms,
+            args.f,
+            &ells,
+            &ct,
             args.terms,
             &loaded.prepared,
             precision,
