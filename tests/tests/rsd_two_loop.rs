@@ -436,5 +436,8 @@ fn the_counterterms_absorb_the_loop_cut_off() {
     // level of the two runs' Monte Carlo errors (~1% of P0_lin at k = 0.25), where the difference
     // itself is 33% (ℓ = 0) and 68% (ℓ = 2) of P0_lin.
     assert!(all < 1.2e-2, "{all}");
-    assert!(k2 > 3.0 * all, "the single-hard templates should matter: {k2} vs {all}");
+    assert!(
+        k2 > 3.0 * all,
+        "the single-hard templates should matter: {k2} vs {all}"
+    );
 }
