@@ -569,5 +569,6 @@ fn read_f64s(path: &Path) -> Stored {
     )
 }
 
+mod rsd_two_loop;
 #[cfg(test)]
 mod tests;

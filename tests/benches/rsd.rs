@@ -30,6 +30,13 @@
 //!   Wilson mixing, P_0, P_2, P_4 averaged over 48 bins of 0.005 h/Mpc), the loop terms, P_0 … P_8 on
 //!   that grid and the window and bins; and the window and bins alone (one core).
 //!
+//! * `two_loop_rsd/spt2 …`, `two_loop_rsd/eft2 …`: a new CAMB table's arrays to the 2-loop matter
+//!   multipoles P_0, P_2, P_4 in redshift space on 40 log-spaced k in [0.005, 0.4] with the 2-loop terms
+//!   from the basis tensors (precision fast; the tensors read from the cache of `PT_SPECTRA_CACHE`, or
+//!   built once outside the timing, a few minutes): the spline, the 1-loop terms, the projection, the
+//!   contraction and the multipoles; `eft2` with IR resummation (the no-wiggle split, its 1-loop terms
+//!   and both contractions). Rayon's pool; `RAYON_NUM_THREADS=1` for one core.
+//!
 //! Run with `cargo bench --bench rsd`.
 
 // `criterion_group!` defines an undocumented function.
@@ -258,6 +265,55 @@ fn ept(c: &mut Criterion) {
     group.finish();
 }
 
+/// The 2-loop redshift-space multipoles of a new spectrum through the basis tensors (module docs).
+fn two_loop_rsd(c: &mut Criterion) {
+    use pt_spectra::rsd::eft2::{Eft2Plan, RsdCounterterms};
+    use pt_spectra::rsd::spt2::Spt2Plan;
+    let k = LogGrid::new(0.005, 0.4, 40).expect("valid grid").points();
+    let table = LinearSpectrum::from_file(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../pt-spectra/tests/data/linear_pk_camb_heldout_1.dat"
+    ))
+    .expect("test table");
+    let (k_in, p_in) = (table.nodes().0.to_vec(), table.nodes().1.to_vec());
+    let mut precision = Precision::fast();
+    precision.two_loop = TwoLoopMethod::Basis;
+    let store = TableStore::from_env();
+    let spt2 = Spt2Plan::new(&k, &precision)
+        .expect("valid plan")
+        .with_basis(&store, &Silent)
+        .expect("tensors");
+    let eft2 = Eft2Plan::new(&k, true, &precision)
+        .expect("valid plan")
+        .with_basis(&store, &Silent)
+        .expect("tensors");
+    let ct = RsdCounterterms::from_assignments(&["c0=2", "c2_1loop=-1"]).expect("valid");
+    let mut group = c.benchmark_group("two_loop_rsd");
+    group.sample_size(20);
+    group.bench_function(
+        BenchmarkId::new("spt2 new spectrum through the basis", 40),
+        |b| {
+            b.iter(|| {
+                let p = LinearSpectrum::from_nodes(k_in.clone(), p_in.clone()).expect("valid");
+                let terms = spt2.terms(black_box(&p), &Silent).expect("valid spectrum");
+                assert!(terms.source.contains("basis"));
+                terms.multipoles(0.7, &[0, 2, 4]).expect("valid")
+            })
+        },
+    );
+    group.bench_function(
+        BenchmarkId::new("eft2 new spectrum through the basis (IR)", 40),
+        |b| {
+            b.iter(|| {
+                let p = LinearSpectrum::from_nodes(k_in.clone(), p_in.clone()).expect("valid");
+                let terms = eft2.terms(black_box(&p), &Silent).expect("valid spectrum");
+                terms.multipoles(0.7, &[0, 2, 4], &ct).expect("valid")
+            })
+        },
+    );
+    group.finish();
+}
+
 /// A windowed, binned `ept` evaluation for a new linear spectrum (module docs).
 fn survey(c: &mut Criterion) {
     let p = LinearSpectrum::gm2012(0.0).expect("embedded spectrum");
@@ -308,5 +364,13 @@ fn survey(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, tns, rsd_multipoles, bias_and_ap, ept, survey);
+criterion_group!(
+    benches,
+    tns,
+    rsd_multipoles,
+    bias_and_ap,
+    ept,
+    survey,
+    two_loop_rsd
+);
 criterion_main!(benches);

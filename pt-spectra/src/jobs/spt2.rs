@@ -42,6 +42,7 @@ pub fn spt2_table(
              k^3.5), seed {}, 7 nodes in mu^2; errors are the shifts' standard errors",
             settings.replicas, settings.points, settings.seed
         ),
+        terms.source.clone(),
     ];
     if prepared.cold_fraction() < 1.0 {
         header.push(
@@ -137,6 +138,7 @@ pub fn eft2_table(
         },
         crate::rsd::eft2::MU_NODES
     ));
+    header.push(terms.source.clone());
     if prepared.cold_fraction() < 1.0 {
         header.push(
             "massive neutrinos: the multipoles of cold dark matter + baryons (P_cb), not of total \

@@ -29,20 +29,20 @@
 //! functional (a multipole at one f) computed replica by replica, so correlations between the nodes
 //! and powers of f are carried.
 
+mod integrand;
 mod zn;
 
-use super::mode_coupling::{Point, Sampled, Sampler};
-use super::two_loop::{integral_scale, points_at};
+pub(crate) use integrand::Sampling;
+
+use super::mode_coupling::Sampled;
+use super::two_loop::integral_scale;
 use super::{lattice::Lattice, Estimate, TwoLoopSettings};
 use crate::error::{Error, Result};
 use crate::integrate::legendre_nodes;
 use crate::linear::LinearSpectrum;
 use rayon::prelude::*;
-use sobol::params::JoeKuoD6;
-use sobol::Sobol;
 use std::f64::consts::PI;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use zn::{product, FPoly, SubsetKernels};
 
 /// Nodes in μ² (and the degree + 1 of the polynomial in μ²).
 pub const MU_NODES: usize = 7;
@@ -52,7 +52,7 @@ pub const F_POWERS: usize = 7;
 pub const MAX_TWO_LOOP_ELL: usize = 12;
 
 /// The integrals of one replica at one k: `[node][power of f]`.
-type NodeIntegrals = [[f64; F_POWERS]; MU_NODES];
+pub(crate) type NodeIntegrals = [[f64; F_POWERS]; MU_NODES];
 
 /// μ² at the nodes: Chebyshev points of [0, 1] (the interpolation in μ² is then well conditioned).
 pub fn mu2_nodes() -> [f64; MU_NODES] {
@@ -68,6 +68,9 @@ pub struct RsdTwoLoopTerms {
     pub points: Vec<usize>,
     /// The replicas' integrals at each k.
     replicas: Vec<Vec<NodeIntegrals>>,
+    /// Relative error added for the projection on a basis (0 for the direct integral): ε|value| is
+    /// added to the error of every functional ([`RsdTwoLoopBasis`](crate::loops::basis::RsdTwoLoopBasis)).
+    pub projection_error: f64,
 }
 
 /// The node weights w_j for which Σ_j w_j P(μ_j²) = ∫₀¹ g(μ) P(μ²) dμ for every polynomial P of
@@ -121,10 +124,87 @@ pub fn combined(terms: &[(&RsdTwoLoopTerms, [f64; MU_NODES])], i: usize, f: f64)
     let n = values.len() as f64;
     let mean = values.iter().sum::<f64>() / n;
     let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
-    Estimate::new(mean, (var / n).sqrt())
+    // the projection error of each term: ε times the size of its own functional
+    let projection: f64 = terms
+        .iter()
+        .filter(|(t, _)| t.projection_error > 0.0)
+        .map(|(t, w)| t.projection_error * combined_value(t, w, i, &powers).abs())
+        .sum();
+    Estimate::new(mean, (var / n).sqrt() + projection)
+}
+
+/// The mean over the replicas of one term's functional.
+fn combined_value(
+    t: &RsdTwoLoopTerms,
+    weights: &[f64; MU_NODES],
+    i: usize,
+    powers: &[f64; F_POWERS],
+) -> f64 {
+    let r = &t.replicas[i];
+    r.iter()
+        .map(|rep| {
+            rep.iter()
+                .zip(weights)
+                .map(|(node, w)| w * node.iter().zip(powers).map(|(c, p)| c * p).sum::<f64>())
+                .sum::<f64>()
+        })
+        .sum::<f64>()
+        / r.len() as f64
+}
+
+/// Coefficients kept per node set: f^m μ^{2j} with j ≤ m (Z_n's f^m part is homogeneous of degree 2m
+/// in the line of sight, so after the azimuth its degree in μ² is at most m).
+pub(crate) const COEFFICIENTS: usize = 28;
+
+/// The coefficients c_{m,j} of f^m μ^{2j}, j ≤ m, at index m(m+1)/2 + j, of the node values (the
+/// interpolant's higher powers of μ², zero in expectation, dropped).
+pub(crate) fn to_coefficients(nodes: &NodeIntegrals) -> [f64; COEFFICIENTS] {
+    let inverse = vandermonde_inverse();
+    let mut c = [0.0; COEFFICIENTS];
+    for m in 0..F_POWERS {
+        for j in 0..=m {
+            c[m * (m + 1) / 2 + j] = (0..MU_NODES).map(|n| inverse[j][n] * nodes[n][m]).sum();
+        }
+    }
+    c
+}
+
+/// The node values of the coefficients of [`to_coefficients`].
+pub(crate) fn from_coefficients(c: &[f64; COEFFICIENTS]) -> NodeIntegrals {
+    let x = mu2_nodes();
+    std::array::from_fn(|n| {
+        std::array::from_fn(|m| {
+            (0..=m)
+                .map(|j| c[m * (m + 1) / 2 + j] * x[n].powi(j as i32))
+                .sum()
+        })
+    })
+}
+
+/// The node values with the powers of μ² above f's dropped.
+fn truncated(nodes: &NodeIntegrals) -> NodeIntegrals {
+    from_coefficients(&to_coefficients(nodes))
 }
 
 impl RsdTwoLoopTerms {
+    /// The terms from the replicas' coefficients ([`to_coefficients`]) at each k.
+    pub(crate) fn from_coefficients(
+        k: &[f64],
+        points: Vec<usize>,
+        replicas: &[Vec<[f64; COEFFICIENTS]>],
+        projection_error: f64,
+    ) -> Self {
+        Self {
+            k: k.to_vec(),
+            points,
+            replicas: replicas
+                .iter()
+                .map(|r| r.iter().map(from_coefficients).collect())
+                .collect(),
+            projection_error,
+        }
+    }
+
     /// The mean and standard error over the replicas of Σ_j w_j P^(2)(k_i, μ_j; f).
     pub fn functional(&self, i: usize, f: f64, weights: &[f64; MU_NODES]) -> Estimate {
         combined(&[(self, *weights)], i, f)
@@ -233,178 +313,6 @@ pub fn check_ells(ells: &[usize]) -> Result<()> {
     }
 }
 
-#[inline]
-fn neg(v: [f64; 3]) -> [f64; 3] {
-    v.map(|x| -x)
-}
-
-#[inline]
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline]
-fn norm2(a: [f64; 3]) -> f64 {
-    a[0] * a[0] + a[1] * a[1] + a[2] * a[2]
-}
-
-/// The line of sight at each node for the azimuth `phi_n`.
-fn lines_of_sight(phi_n: f64, nodes: &[(f64, f64); MU_NODES]) -> [[f64; 3]; MU_NODES] {
-    let (cos_n, sin_n) = (phi_n.cos(), phi_n.sin());
-    nodes.map(|(mu, smu)| [smu * cos_n, smu * sin_n, mu])
-}
-
-/// The integrand at one sample point, linear in each of its three spectra: P(q₁)P(q₂) Σ_t C_t P(z_t)
-/// with third legs z_t and coefficients C_t (kernels, partitions, measure and sampling Jacobian) per
-/// node in μ² and power of f, none of which depend on the spectrum.
-struct PointLegs {
-    ln_q: [f64; 2],
-    /// (ln z_t, C_t).
-    legs: Vec<(f64, NodeIntegrals)>,
-}
-
-impl PointLegs {
-    /// Adds the integrand for the spectrum `sampled` to `acc`.
-    fn add_to(&self, sampled: &Sampled, acc: &mut NodeIntegrals) {
-        let p12 = sampled.at_ln(self.ln_q[0]) * sampled.at_ln(self.ln_q[1]);
-        if p12 == 0.0 {
-            return;
-        }
-        for (ln_z, coef) in &self.legs {
-            let p = sampled.at_ln(*ln_z);
-            if p == 0.0 {
-                continue;
-            }
-            for (out, c) in acc.iter_mut().zip(coef) {
-                for (o, c) in out.iter_mut().zip(c) {
-                    *o += p12 * p * c;
-                }
-            }
-        }
-    }
-}
-
-/// The vectors k, q₁, q₂ of a point (k along z, q₁ in the xz plane) and the measure
-/// d³q₁d³q₂/(2π)⁶ (as the real-space integrand's, with ¼ for the images) times the sampling
-/// Jacobian.
-fn vectors(k: f64, point: &Point) -> ([[f64; 3]; 3], f64) {
-    let q = [point.ln_q[0].exp(), point.ln_q[1].exp()];
-    let x = point.x;
-    let (s1, s2) = (
-        (1.0 - x[0] * x[0]).max(0.0).sqrt(),
-        (1.0 - x[1] * x[1]).max(0.0).sqrt(),
-    );
-    let (c, s) = (
-        point.cos_phi,
-        (1.0 - point.cos_phi * point.cos_phi).max(0.0).sqrt(),
-    );
-    let q1 = [q[0] * s1, 0.0, q[0] * x[0]];
-    let q2 = [q[1] * s2 * c, q[1] * s2 * s, q[1] * x[1]];
-    let measure = 0.25 * (q[0] * q[1]).powi(3) * 4.0 * PI / (2.0 * PI).powi(6) * point.jacobian;
-    ([[0.0, 0.0, k], q1, q2], measure)
-}
-
-/// c · Z_a Z_b at every node (polynomials in f), from the kernels' values at the nodes.
-fn products(c: f64, a: &[FPoly; MU_NODES], b: &[FPoly; MU_NODES]) -> NodeIntegrals {
-    std::array::from_fn(|j| product(&a[j], &b[j]).map(|v| c * v))
-}
-
-/// Z of the vectors `args` of `kernels` at every line of sight.
-fn at_nodes(kernels: &SubsetKernels, args: usize, los: &[[f64; 3]; MU_NODES]) -> [FPoly; MU_NODES] {
-    std::array::from_fn(|j| kernels.redshift(args, &los[j]))
-}
-
-/// The propagator part 2P15 − P33red at one point (the same in the four images): one leg, z = k.
-fn propagator_legs(k: f64, point: &Point, los: &[[f64; 3]; MU_NODES]) -> PointLegs {
-    let ([kv, q1, q2], measure) = vectors(k, point);
-    let kernels = SubsetKernels::new(&[kv, q1, neg(q1), q2, neg(q2)]);
-    let c = 4.0 * measure;
-    let z1 = at_nodes(&kernels, 0b00001, los);
-    let z5 = at_nodes(&kernels, 0b11111, los);
-    let z3a = at_nodes(&kernels, 0b00111, los);
-    let z3b = at_nodes(&kernels, 0b11001, los);
-    let mut coef = products(30.0 * c, &z1, &z5);
-    for (row, add) in coef.iter_mut().zip(products(-9.0 * c, &z3a, &z3b)) {
-        row.iter_mut().zip(add).for_each(|(r, a)| *r += a);
-    }
-    PointLegs {
-        ln_q: point.ln_q,
-        legs: vec![(k.ln(), coef)],
-    }
-}
-
-/// The mode-coupling part 2P24 + P33irr + 2P33red at one point, averaged over the four images:
-/// legs z = k (2P33red), |k ∓ q_i| (2P24) and the four q₃ (P33irr).
-fn mode_coupling_legs(k: f64, point: &Point, los: &[[f64; 3]; MU_NODES]) -> PointLegs {
-    let ([kv, q1, q2], measure) = vectors(k, point);
-    let mut legs = Vec::with_capacity(9);
-    // 2P33red: the same in all four images
-    let reducible = SubsetKernels::new(&[kv, q1, neg(q1), q2, neg(q2)]);
-    let z3a = at_nodes(&reducible, 0b00111, los);
-    let z3b = at_nodes(&reducible, 0b11001, los);
-    legs.push((k.ln(), products(4.0 * 18.0 * measure, &z3a, &z3b)));
-    // 2P24: the half of q₁ (both signs) and of q₂, each with the partition w = p⁴/(q⁴ + p⁴), p = k − q
-    for (a, b) in [(q1, q2), (neg(q1), q2), (q2, q1), (neg(q2), q1)] {
-        let p = sub(kv, a);
-        let (pp, aa) = (norm2(p), norm2(a));
-        let w = pp * pp / (aa * aa + pp * pp);
-        if w > 1e-12 {
-            let kernels = SubsetKernels::new(&[a, p, b, neg(b)]);
-            let z2 = at_nodes(&kernels, 0b0011, los);
-            let z4 = at_nodes(&kernels, 0b1111, los);
-            legs.push((0.5 * pp.ln(), products(48.0 * w * measure, &z2, &z4)));
-        }
-    }
-    // P33irr: the four images, each with the partition w₃ = q₃⁴/(q₁⁴ + q₂⁴ + q₃⁴)
-    let (q11, q22) = (norm2(q1), norm2(q2));
-    for (a, b) in [(q1, q2), (neg(q1), neg(q2)), (neg(q1), q2), (q1, neg(q2))] {
-        let q3 = sub(sub(kv, a), b);
-        let q33 = norm2(q3);
-        let w3 = q33 * q33 / (q11 * q11 + q22 * q22 + q33 * q33);
-        if w3 > 1e-12 {
-            let kernels = SubsetKernels::new(&[a, b, q3]);
-            let z3 = at_nodes(&kernels, 0b111, los);
-            legs.push((0.5 * q33.ln(), products(18.0 * w3 * measure, &z3, &z3)));
-        }
-    }
-    PointLegs {
-        ln_q: point.ln_q,
-        legs,
-    }
-}
-
-/// The radial map of the propagator part: 2P15 − P33red gathers q³P(q) · k²/q² from q ≫ k (where
-/// the pointwise kernel is O(k²/q²) and only its angular average smaller), so its density is
-/// ∝ 1/(w² + ln²(q/c)) with c = [`PROPAGATOR_CENTRE`] and w = [`PROPAGATOR_WIDTH`] at every k: among
-/// c ∈ {0.03, 0.1, 0.3, 1} h/Mpc and w ∈ {1.5, 2.5, 4} this gave the smallest variance at k = 0.01,
-/// 0.1 and 0.3 h/Mpc (z = 0), 1.5–2.4 times below the mode-coupling map's.
-fn propagator_sampler(range: (f64, f64)) -> Sampler {
-    Sampler::with_density(PROPAGATOR_CENTRE.ln(), PROPAGATOR_WIDTH, range)
-}
-
-/// Centre [h/Mpc] of the radial density of the propagator part.
-const PROPAGATOR_CENTRE: f64 = 0.3;
-/// Width in ln q of the radial density of the propagator part.
-const PROPAGATOR_WIDTH: f64 = 1.5;
-
-/// The 6-D Sobol sequence (ln q₁, ln q₂, x₁, x₂, φ, φ_n) without its first point.
-fn sobol_points(n: usize) -> Vec<[f64; 6]> {
-    Sobol::<f64>::new(6, &JoeKuoD6::standard())
-        .skip(1)
-        .take(n)
-        .map(|p| std::array::from_fn(|d| p[d]))
-        .collect()
-}
-
-/// The Cranley–Patterson shifts of the replicas (ChaCha8 from `seed`).
-fn shifts(replicas: usize, seed: u64) -> Vec<[f64; 6]> {
-    use rand::{Rng, SeedableRng};
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    (0..replicas)
-        .map(|_| std::array::from_fn(|_| rng.gen::<f64>()))
-        .collect()
-}
-
 /// The 2-loop redshift-space correction of `spectrum` at `k` [h/Mpc], over q ∈ `q_range` (P̃ on a
 /// lattice of step `lattice_step` in ln q), with `settings.points` Sobol points per shift at
 /// k = 0.16 h/Mpc scaled as the real-space ones ([`TwoLoopSettings::points`]; no refinement),
@@ -469,31 +377,20 @@ pub fn rsd_two_loop_of(
             samples,
         })
         .collect();
-    let counts: Vec<usize> = k.iter().map(|&k| points_at(k, settings.points)).collect();
-    let points = sobol_points(counts.iter().copied().max().unwrap_or(0));
-    let shifts = shifts(settings.replicas, settings.seed);
-    let ln_range = (q_range.0.ln(), q_range.1.ln());
-    let nodes: [(f64, f64); MU_NODES] =
-        mu2_nodes().map(|m2| (m2.sqrt(), (1.0 - m2).max(0.0).sqrt()));
-    let replicas = shifts.len();
+    let sampling = Sampling::new(k, q_range, settings);
+    let counts = &sampling.counts;
+    let replicas = sampling.shifts.len();
     let total: usize = counts.iter().map(|n| n * replicas).sum();
     let done = AtomicUsize::new(0);
     // per job (k, shift): the integrals of every spectrum
     let integrals: Vec<Vec<NodeIntegrals>> = (0..k.len() * replicas)
         .into_par_iter()
         .map(|job| {
-            let (i, shift) = (job / replicas, &shifts[job % replicas]);
-            let coupling = Sampler::new(k[i], ln_range, settings.radial_width);
-            let propagator = propagator_sampler(ln_range);
-            let head: [f64; 5] = std::array::from_fn(|d| shift[d]);
+            let (i, shift) = (job / replicas, &sampling.shifts[job % replicas]);
+            let samplers = sampling.samplers(k[i]);
             let mut acc = vec![[[0.0; F_POWERS]; MU_NODES]; spectra.len()];
-            for p in &points[..counts[i]] {
-                let unit: [f64; 5] = std::array::from_fn(|d| p[d]);
-                let los = lines_of_sight(2.0 * PI * (p[5] + shift[5]).fract(), &nodes);
-                for legs in [
-                    propagator_legs(k[i], &propagator.point(&unit, &head), &los),
-                    mode_coupling_legs(k[i], &coupling.point(&unit, &head), &los),
-                ] {
+            for unit in &sampling.points[..counts[i]] {
+                for legs in sampling.legs(k[i], unit, shift, &samplers) {
                     for (s, a) in sampled.iter().zip(acc.iter_mut()) {
                         legs.add_to(s, a);
                     }
@@ -504,8 +401,9 @@ pub fn rsd_two_loop_of(
                 done.fetch_add(counts[i], Ordering::Relaxed) + counts[i],
                 total,
             );
+            // the powers of μ² above f's, zero in expectation, dropped (as the basis tensors do)
             acc.into_iter()
-                .map(|a| a.map(|row| row.map(|v| v * scale)))
+                .map(|a| truncated(&a.map(|row| row.map(|v| v * scale))))
                 .collect()
         })
         .collect();
@@ -513,6 +411,7 @@ pub fn rsd_two_loop_of(
         .map(|s| RsdTwoLoopTerms {
             k: k.to_vec(),
             points: counts.clone(),
+            projection_error: 0.0,
             replicas: integrals
                 .chunks(replicas)
                 .map(|jobs| jobs.iter().map(|per| per[s]).collect())

@@ -36,16 +36,21 @@
 //! for the deterministic parts, and for the 2-loop parts as functionals of their μ² nodes
 //! ([`crate::loops::combined`], error the shifts' standard error).
 
+use super::spt2::{tensors_of, two_loop_terms};
 use crate::error::{Error, Result};
 use crate::integrate::legendre_nodes;
 use crate::ir::{delta_sigma2_bao, sigma2_bao, WiggleSplit};
 use crate::linear::LinearSpectrum;
+use crate::loops::basis::training::{camb_basis, transformed_basis};
+use crate::loops::basis::{RsdTwoLoopBasis, SpectrumFamily, BASIS_SIZE};
 use crate::loops::redshift::{RedshiftPlan, RedshiftTerms};
-use crate::loops::{combined, node_weights, rsd_two_loop_of, Estimate, RsdTwoLoopTerms};
+use crate::loops::{combined, node_weights, Estimate, RsdTwoLoopTerms};
 use crate::precision::Precision;
-use crate::progress::{stage_callback, Progress, Stage};
+use crate::progress::Progress;
+use crate::store::TableStore;
 use std::fmt;
 use std::str::FromStr;
+use std::sync::Arc;
 
 /// The counterterms of `eft2` (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -195,6 +200,8 @@ pub struct Eft2Plan {
     split: WiggleSplit,
     ir: bool,
     precision: Precision,
+    /// The 2-loop basis tensors of the linear and (with IR resummation) no-wiggle spectra.
+    tensors: Vec<Arc<RsdTwoLoopBasis>>,
 }
 
 /// The terms of `eft2` for one linear spectrum.
@@ -211,6 +218,8 @@ pub struct Eft2Terms {
     one_nw: Option<RedshiftTerms>,
     two_full: RsdTwoLoopTerms,
     two_nw: Option<RsdTwoLoopTerms>,
+    /// Where the 2-loop terms came from (basis tensors or direct), for a header.
+    pub source: String,
 }
 
 /// The multipoles of `eft2` per ℓ then per k, and those of each counterterm template.
@@ -233,7 +242,42 @@ impl Eft2Plan {
             split: WiggleSplit::new()?,
             ir,
             precision: precision.clone(),
+            tensors: Vec::new(),
         })
+    }
+
+    /// The plan with the 2-loop basis tensors (of the linear spectra and, with IR resummation, of
+    /// their no-wiggle parts) as `precision.two_loop` says ([`super::spt2::Spt2Plan::with_basis`]).
+    ///
+    /// # Errors
+    /// As [`TableStore::rsd_two_loop_basis`].
+    pub fn with_basis(mut self, store: &TableStore, progress: &dyn Progress) -> Result<Self> {
+        let p = &self.precision;
+        let lattice = RsdTwoLoopBasis::lattice((p.q_min, p.q_max), p.lattice_step);
+        let k = self.k().to_vec();
+        let linear = || camb_basis(lattice.clone(), BASIS_SIZE);
+        let mut tensors: Vec<_> =
+            tensors_of(&k, p, SpectrumFamily::Linear, &linear, store, progress)?
+                .into_iter()
+                .collect();
+        if self.ir {
+            let split = &self.split;
+            let no_wiggle = || {
+                transformed_basis(&lattice, BASIS_SIZE, &|s: &LinearSpectrum| {
+                    split.no_wiggle(s).unwrap_or_else(|_| s.clone())
+                })
+            };
+            tensors.extend(tensors_of(
+                &k,
+                p,
+                SpectrumFamily::NoWiggle,
+                &no_wiggle,
+                store,
+                progress,
+            )?);
+        }
+        self.tensors = tensors;
+        Ok(self)
     }
 
     /// The wavenumbers [h/Mpc].
@@ -255,17 +299,13 @@ impl Eft2Plan {
     /// of both on the same points); the points are reported to `progress`.
     ///
     /// # Errors
-    /// As [`rsd_two_loop_of`] and [`WiggleSplit::no_wiggle`].
+    /// As [`crate::loops::rsd_two_loop_of`] and [`WiggleSplit::no_wiggle`].
     pub fn terms(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> Result<Eft2Terms> {
         let p = &self.precision;
         let k = self.k();
-        let callback = stage_callback(progress, Stage::TwoLoopPoints);
-        let settings = self.two_loop_settings();
-        let range = (p.q_min, p.q_max);
         let p_lin: Vec<f64> = k.iter().map(|&k| spectrum.eval(k)).collect();
         if !self.ir {
-            let mut two =
-                rsd_two_loop_of(k, &[spectrum], range, p.lattice_step, &settings, &callback)?;
+            let (mut two, source) = two_loop_terms(k, &[spectrum], &self.tensors, p, progress)?;
             return Ok(Eft2Terms {
                 k: k.to_vec(),
                 p_nw: p_lin.clone(),
@@ -275,17 +315,11 @@ impl Eft2Plan {
                 one_nw: None,
                 two_full: two.remove(0),
                 two_nw: None,
+                source,
             });
         }
         let nw = self.split.no_wiggle(spectrum)?;
-        let mut two = rsd_two_loop_of(
-            k,
-            &[spectrum, &nw],
-            range,
-            p.lattice_step,
-            &settings,
-            &callback,
-        )?;
+        let (mut two, source) = two_loop_terms(k, &[spectrum, &nw], &self.tensors, p, progress)?;
         let two_nw = two.pop();
         Ok(Eft2Terms {
             k: k.to_vec(),
@@ -296,6 +330,7 @@ impl Eft2Plan {
             one_nw: Some(self.one_loop.evaluate(&nw)),
             two_full: two.remove(0),
             two_nw,
+            source,
         })
     }
 }

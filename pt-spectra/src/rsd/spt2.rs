@@ -16,10 +16,16 @@
 
 use crate::error::{Error, Result};
 use crate::linear::LinearSpectrum;
+use crate::loops::basis::training::camb_basis;
+use crate::loops::basis::{LinearBasis, RsdTwoLoopBasis, SpectrumFamily, BASIS_SIZE};
 use crate::loops::redshift::{RedshiftPlan, RedshiftTerms};
-use crate::loops::{check_two_loop_ells, rsd_two_loop, Estimate, RsdTwoLoopTerms, TwoLoopSettings};
-use crate::precision::Precision;
+use crate::loops::{
+    check_two_loop_ells, rsd_two_loop_of, Estimate, RsdTwoLoopTerms, TwoLoopSettings,
+};
+use crate::precision::{Precision, TwoLoopMethod};
 use crate::progress::{stage_callback, Progress, Stage};
+use crate::store::TableStore;
+use std::sync::Arc;
 
 /// The redshift-space 2-loop Sobol points per shift are the real-space ones
 /// ([`Precision::two_loop_points`]) over this factor: each point costs ~16 μs of kernels (seven lines
@@ -37,12 +43,92 @@ pub fn two_loop_settings(precision: &Precision) -> TwoLoopSettings {
     }
 }
 
-/// The plan of `spt2` on a k grid: the 1-loop weights (cosmology independent) and the settings of the
-/// 2-loop integration.
+/// The 2-loop redshift-space terms of `spectra` (a spectrum and, for IR resummation, its no-wiggle
+/// part) from the basis `tensors` of their families when every spectrum is represented by its basis,
+/// else integrated directly on the same points; with where they came from (a header line).
+///
+/// # Errors
+/// As [`rsd_two_loop_of`].
+pub(crate) fn two_loop_terms(
+    k: &[f64],
+    spectra: &[&LinearSpectrum],
+    tensors: &[Arc<RsdTwoLoopBasis>],
+    precision: &Precision,
+    progress: &dyn Progress,
+) -> Result<(Vec<RsdTwoLoopTerms>, String)> {
+    let mut note = String::from("2-loop terms integrated for this spectrum (direct)");
+    if tensors.len() == spectra.len() {
+        let from_basis: Vec<_> = spectra
+            .iter()
+            .zip(tensors)
+            .map(|(s, t)| t.evaluate(s))
+            .collect();
+        if from_basis.iter().all(|r| r.is_ok()) {
+            let residuals: Vec<String> = spectra
+                .iter()
+                .zip(tensors)
+                .map(|(s, t)| format!("{:.1e}", t.project(s).residual))
+                .collect();
+            let terms = from_basis.into_iter().map(|r| r.expect("all ok")).collect();
+            let note = format!(
+                "2-loop terms from basis tensors (projection residual {}; the projection error, {} x \
+                 residual x |value|, is in the errors)",
+                residuals.join(", "),
+                crate::loops::basis::RSD_PROJECTION_FACTOR
+            );
+            return Ok((terms, note));
+        }
+        note = format!(
+            "2-loop terms integrated for this spectrum (direct): its projection residual exceeds {:e}, \
+             the basis tensors' limit",
+            crate::loops::basis::MAX_RESIDUAL
+        );
+    }
+    let callback = stage_callback(progress, Stage::TwoLoopPoints);
+    let terms = rsd_two_loop_of(
+        k,
+        spectra,
+        (precision.q_min, precision.q_max),
+        precision.lattice_step,
+        &two_loop_settings(precision),
+        &callback,
+    )?;
+    Ok((terms, note))
+}
+
+/// The basis tensors of `family` on `basis()` as `precision.two_loop` says: built (`basis`), read if
+/// cached (`auto`), or none (`direct`).
+///
+/// # Errors
+/// As [`TableStore::rsd_two_loop_basis`].
+pub(crate) fn tensors_of(
+    k: &[f64],
+    precision: &Precision,
+    family: SpectrumFamily,
+    basis: &dyn Fn() -> LinearBasis,
+    store: &TableStore,
+    progress: &dyn Progress,
+) -> Result<Option<Arc<RsdTwoLoopBasis>>> {
+    let (range, step) = ((precision.q_min, precision.q_max), precision.lattice_step);
+    let settings = two_loop_settings(precision);
+    Ok(match precision.two_loop {
+        TwoLoopMethod::Direct => None,
+        TwoLoopMethod::Auto => {
+            store.cached_rsd_two_loop_basis(k, range, step, &settings, family, progress)
+        }
+        TwoLoopMethod::Basis => {
+            Some(store.rsd_two_loop_basis(k, range, step, &settings, family, basis, progress)?)
+        }
+    })
+}
+
+/// The plan of `spt2` on a k grid: the 1-loop weights (cosmology independent), the settings of the
+/// 2-loop integration and, with [`with_basis`](Self::with_basis), the 2-loop basis tensors.
 #[derive(Debug, Clone)]
 pub struct Spt2Plan {
     one_loop: RedshiftPlan,
     precision: Precision,
+    tensors: Vec<Arc<RsdTwoLoopBasis>>,
 }
 
 /// The three parts of the model for one linear spectrum.
@@ -56,6 +142,8 @@ pub struct Spt2Terms {
     pub one_loop: RedshiftTerms,
     /// The 2-loop terms.
     pub two_loop: RsdTwoLoopTerms,
+    /// Where the 2-loop terms came from (basis tensors or direct), for a header.
+    pub source: String,
 }
 
 /// The multipoles of one part or of the whole, per ℓ then per k.
@@ -83,7 +171,33 @@ impl Spt2Plan {
         Ok(Self {
             one_loop: RedshiftPlan::new(k, precision)?,
             precision: precision.clone(),
+            tensors: Vec::new(),
         })
+    }
+
+    /// The plan with the 2-loop basis tensors as `precision.two_loop` says (`basis`: read or built in
+    /// `store`, minutes once per k grid and precision; `auto`: if cached; `direct`: none).
+    ///
+    /// # Errors
+    /// As [`TableStore::rsd_two_loop_basis`].
+    pub fn with_basis(mut self, store: &TableStore, progress: &dyn Progress) -> Result<Self> {
+        let lattice = RsdTwoLoopBasis::lattice(
+            (self.precision.q_min, self.precision.q_max),
+            self.precision.lattice_step,
+        );
+        let basis = || camb_basis(lattice.clone(), BASIS_SIZE);
+        let k = self.k().to_vec();
+        self.tensors = tensors_of(
+            &k,
+            &self.precision,
+            SpectrumFamily::Linear,
+            &basis,
+            store,
+            progress,
+        )?
+        .into_iter()
+        .collect();
+        Ok(self)
     }
 
     /// The wavenumbers [h/Mpc].
@@ -96,28 +210,22 @@ impl Spt2Plan {
         two_loop_settings(&self.precision)
     }
 
-    /// The terms of `spectrum`; the 2-loop points are reported to `progress`
-    /// ([`Stage::TwoLoopPoints`]).
+    /// The terms of `spectrum`, the 2-loop ones from the basis tensors when the plan has them and
+    /// the spectrum projects well, else integrated (the points reported to `progress`,
+    /// [`Stage::TwoLoopPoints`]).
     ///
     /// # Errors
-    /// As [`rsd_two_loop()`].
+    /// As [`rsd_two_loop_of`].
     pub fn terms(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> Result<Spt2Terms> {
-        let p = &self.precision;
         let k = self.k();
-        let callback = stage_callback(progress, Stage::TwoLoopPoints);
-        let two_loop = rsd_two_loop(
-            k,
-            spectrum,
-            (p.q_min, p.q_max),
-            p.lattice_step,
-            &self.two_loop_settings(),
-            &callback,
-        )?;
+        let (mut two, source) =
+            two_loop_terms(k, &[spectrum], &self.tensors, &self.precision, progress)?;
         Ok(Spt2Terms {
             k: k.to_vec(),
             p_lin: k.iter().map(|&k| spectrum.eval(k)).collect(),
             one_loop: self.one_loop.evaluate(spectrum),
-            two_loop,
+            two_loop: two.remove(0),
+            source,
         })
     }
 }

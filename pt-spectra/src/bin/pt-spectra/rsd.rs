@@ -273,7 +273,7 @@ pub fn run(args: &Args) -> Result<()> {
         let ells: Vec<usize> = list(&args.ells, "--ells")?;
         pt_spectra::rsd::MultipoleRule::new(&ells)?;
         let precision = &loaded.precision;
-        let plan = Spt2Plan::new(&k, precision)?;
+        let plan = Spt2Plan::new(&k, precision)?.with_basis(&loaded.store, &Bars::default())?;
         let terms = plan.terms(loaded.prepared.tracer_spectrum(), &Bars::default())?;
         let table = spt2_table(
             &plan,
@@ -295,7 +295,8 @@ pub fn run(args: &Args) -> Result<()> {
             eprintln!("warning: every counterterm of eft2 is 0 (it is then IR-resummed 2-loop SPT): set them with --ct NAME=VALUE");
         }
         let precision = &loaded.precision;
-        let plan = Eft2Plan::new(&k, !args.ept.no_ir(), precision)?;
+        let plan = Eft2Plan::new(&k, !args.ept.no_ir(), precision)?
+            .with_basis(&loaded.store, &Bars::default())?;
         let terms = plan.terms(loaded.prepared.tracer_spectrum(), &Bars::default())?;
         let table = eft2_table(
             &plan,

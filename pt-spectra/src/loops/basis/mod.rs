@@ -38,6 +38,7 @@ mod linear_basis;
 mod one_loop;
 mod p15_forms;
 mod redshift;
+mod rsd_two_loop;
 mod tensors;
 mod tns;
 pub mod training;
@@ -45,6 +46,7 @@ pub mod training;
 pub use linear_basis::{LinearBasis, Projection, SMOOTHING};
 pub use one_loop::{BasisOneLoop, OneLoopBasis};
 pub use redshift::{RedshiftBasis, SpectrumFamily};
+pub use rsd_two_loop::{RsdTwoLoopBasis, RSD_PROJECTION_FACTOR};
 pub use tns::TnsBasis;
 
 use super::lattice::Lattice;

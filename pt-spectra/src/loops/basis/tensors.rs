@@ -69,13 +69,13 @@ pub(super) fn shifted_tensor(
         rank_update(&mut acc, &left, &right, used, pairs, row);
         tick(used);
     }
-    fold(&acc, n)
+    fold(&acc, n, ACC)
 }
 
 /// acc[i][j] += Σ_{p < used} left[p][i] right[p][j] for the (`rows` × `cols`) matrix `acc`: blocks of
 /// 4 × 4 entries kept in (eight SSE2) registers across the points, 4 + 4 loads per 16 multiply-adds
 /// (4 × 8 blocks spill to the stack).
-fn rank_update(
+pub(super) fn rank_update(
     acc: &mut [f64],
     left: &[f64],
     right: &[f64],
@@ -116,18 +116,19 @@ fn rank_update(
     }
 }
 
-/// The (ab, quantity, c) sums folded onto the symmetric [quantity][a ≤ b ≤ c] tensor.
-fn fold(acc: &[f64], n: usize) -> Vec<f64> {
+/// The (ab, quantity, c) sums of `quantities` quantities folded onto the symmetric
+/// [quantity][a ≤ b ≤ c] tensor.
+pub(super) fn fold(acc: &[f64], n: usize, quantities: usize) -> Vec<f64> {
     let triples = n * (n + 1) * (n + 2) / 6;
-    let mut out = vec![0.0; ACC * triples];
+    let mut out = vec![0.0; quantities * triples];
     for b in 0..n {
         for a in 0..=b {
-            let row = &acc[pair_index(a, b) * ACC * n..][..ACC * n];
+            let row = &acc[pair_index(a, b) * quantities * n..][..quantities * n];
             for c in 0..n {
                 let mut s = [a, b, c];
                 s.sort_unstable();
                 let t = triple_index(s[0], s[1], s[2]);
-                for v in 0..ACC {
+                for v in 0..quantities {
                     out[v * triples + t] += row[v * n + c];
                 }
             }

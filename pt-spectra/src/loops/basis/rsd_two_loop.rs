@@ -1,0 +1,345 @@
+//! The 2-loop redshift-space terms ([`crate::loops::rsd_two_loop`]) of a new linear spectrum from
+//! basis tensors: the same quasi-Monte-Carlo points, shifts and legs as the direct integral, each point
+//! adding the products of basis functions φ_a(q₁)φ_b(q₂)φ_c(z) of its legs, per coefficient of
+//! f^m μ^{2j} (j ≤ m: 28 of them), so that the contraction with c ⊗ c ⊗ c of the spectrum's projection
+//! gives the direct result for the projected spectrum to round-off.
+//!
+//! The error is the spread over the shifts (contracted on the first [`ERROR_FUNCTIONS`] coefficients,
+//! as the real-space tensors) plus the projection error ε|value| with ε =
+//! [`RSD_PROJECTION_FACTOR`] × the smoothed projection residual; spectra whose residual exceeds
+//! [`MAX_RESIDUAL`] are refused (the caller integrates them directly).
+
+use super::tensors::{fold, rank_update};
+use super::{
+    after_key, cache_file_name, error_functions, pair_index, triple_index, triples, LinearBasis,
+    Projection, SpectrumFamily, BASIS_SIZE, ERROR_FUNCTIONS, MAX_RESIDUAL,
+};
+use crate::linear::LinearSpectrum;
+use crate::loops::lattice::Lattice;
+use crate::loops::rsd_two_loop::{to_coefficients, RsdTwoLoopTerms, Sampling, COEFFICIENTS};
+use crate::loops::two_loop::integral_scale;
+use crate::loops::TwoLoopSettings;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Version of the layout, part of the cache file name.
+const VERSION: u32 = 1;
+
+/// Points per batch of the rank update.
+const BATCH: usize = 32;
+
+/// The projection error of a 2-loop redshift-space value is this times the smoothed projection
+/// residual times its size: on two CAMB and one CLASS spectrum outside the training set the basis
+/// multipoles differed from direct by at most 4.6 times residual × |value| (CLASS Planck 2018 at
+/// k = 0.2, residual 1.9e-4; tests/tests/rsd_two_loop.rs); twice that, to be safe.
+pub const RSD_PROJECTION_FACTOR: f64 = 10.0;
+
+/// The basis tensors of the 2-loop redshift-space terms on one k grid (cosmology independent).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RsdTwoLoopBasis {
+    k: Vec<f64>,
+    key: Vec<f64>,
+    basis: LinearBasis,
+    points: Vec<usize>,
+    replicas: usize,
+    /// Per k: the mean over shifts [coefficient][triple].
+    mean: Vec<Vec<f64>>,
+    /// Per k: each shift's deviation from the mean, [shift][coefficient][triple < triples(n_err)].
+    deviations: Vec<Vec<f64>>,
+}
+
+/// The settings that make the tensors (their file header).
+fn key(
+    k: &[f64],
+    q_range: (f64, f64),
+    lattice_step: f64,
+    settings: &TwoLoopSettings,
+    family: SpectrumFamily,
+) -> Vec<f64> {
+    let mut key = vec![
+        f64::from(VERSION),
+        BASIS_SIZE as f64,
+        ERROR_FUNCTIONS as f64,
+        q_range.0,
+        q_range.1,
+        lattice_step,
+        settings.points as f64,
+        settings.replicas as f64,
+        settings.seed as f64,
+        settings.radial_width,
+        f64::from(super::training::VERSION),
+        f64::from(u8::from(family == SpectrumFamily::NoWiggle)),
+        k.len() as f64,
+    ];
+    key.extend(k);
+    key
+}
+
+/// The sum over `sampling`'s points of k index `i` moved by `shift` of the basis tensor
+/// [coefficient][a ≤ b ≤ c]; `tick(points)` after each batch.
+fn shifted_tensor(
+    k: f64,
+    i: usize,
+    shift: &[f64; 6],
+    sampling: &Sampling,
+    basis: &LinearBasis,
+    tick: &dyn Fn(usize),
+) -> Vec<f64> {
+    let n = basis.len();
+    let pairs = n * (n + 1) / 2;
+    let row = COEFFICIENTS * n;
+    let mut acc = vec![0.0; pairs * row];
+    // two rows (propagator and mode-coupling parts) per point
+    let mut left = vec![0.0; 2 * BATCH * pairs];
+    let mut right = vec![0.0; 2 * BATCH * row];
+    let (mut phi1, mut phi2, mut phiz) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let samplers = sampling.samplers(k);
+    for chunk in sampling.points[..sampling.counts[i]].chunks(BATCH) {
+        let mut used = 0;
+        for unit in chunk {
+            for legs in sampling.legs(k, unit, shift, &samplers) {
+                basis.at_ln(legs.ln_q[0], &mut phi1);
+                basis.at_ln(legs.ln_q[1], &mut phi2);
+                let l = &mut left[used * pairs..(used + 1) * pairs];
+                for b in 0..n {
+                    for a in 0..b {
+                        l[pair_index(a, b)] = phi1[a] * phi2[b] + phi1[b] * phi2[a];
+                    }
+                    l[pair_index(b, b)] = phi1[b] * phi2[b];
+                }
+                let r = &mut right[used * row..(used + 1) * row];
+                r.iter_mut().for_each(|x| *x = 0.0);
+                for (ln_z, coef) in &legs.legs {
+                    basis.at_ln(*ln_z, &mut phiz);
+                    for (v, c) in to_coefficients(coef).iter().enumerate() {
+                        if *c != 0.0 {
+                            let rv = &mut r[v * n..(v + 1) * n];
+                            rv.iter_mut().zip(&phiz).for_each(|(x, z)| *x += c * z);
+                        }
+                    }
+                }
+                used += 1;
+            }
+        }
+        rank_update(&mut acc, &left, &right, used, pairs, row);
+        tick(chunk.len());
+    }
+    fold(&acc, n, COEFFICIENTS)
+}
+
+impl RsdTwoLoopBasis {
+    /// The cache file name for these settings: `rsd-two-loop-basis[-nw]-v<version>-<hash>.bin`.
+    pub fn file_name(
+        k: &[f64],
+        q_range: (f64, f64),
+        lattice_step: f64,
+        settings: &TwoLoopSettings,
+        family: SpectrumFamily,
+    ) -> String {
+        let name = match family {
+            SpectrumFamily::Linear => "rsd-two-loop-basis",
+            SpectrumFamily::NoWiggle => "rsd-two-loop-basis-nw",
+        };
+        cache_file_name(
+            name,
+            VERSION,
+            &key(k, q_range, lattice_step, settings, family),
+        )
+    }
+
+    /// The lattice of the tensors (what a family's basis is made on).
+    pub(crate) fn lattice(q_range: (f64, f64), lattice_step: f64) -> Lattice {
+        Lattice::new(q_range.0, q_range.1, lattice_step)
+    }
+
+    /// Builds the tensors on `k` [h/Mpc] for the integration `settings` over `q_range` on `basis` (of
+    /// the spectra of `family`, on the tensors' lattice of q_range and lattice_step), in parallel; `progress(done, total)`
+    /// counts the points.
+    pub fn build(
+        k: &[f64],
+        q_range: (f64, f64),
+        lattice_step: f64,
+        settings: &TwoLoopSettings,
+        family: SpectrumFamily,
+        basis: LinearBasis,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Self {
+        let n = basis.len();
+        let sampling = Sampling::new(k, q_range, settings);
+        let replicas = sampling.shifts.len();
+        let total = replicas * sampling.counts.iter().sum::<usize>();
+        let done = AtomicUsize::new(0);
+        let tick = |m: usize| progress(done.fetch_add(m, Ordering::Relaxed) + m, total);
+        let mut jobs: Vec<usize> = (0..k.len() * replicas).collect();
+        jobs.sort_by_key(|&j| std::cmp::Reverse(sampling.counts[j / replicas]));
+        let mut tensors: Vec<(usize, Vec<f64>)> = jobs
+            .par_iter()
+            .map(|&job| {
+                let i = job / replicas;
+                let shift = &sampling.shifts[job % replicas];
+                (
+                    job,
+                    shifted_tensor(k[i], i, shift, &sampling, &basis, &tick),
+                )
+            })
+            .collect();
+        tensors.sort_by_key(|t| t.0);
+        let (t, t_err) = (triples(n), triples(error_functions(n)));
+        let (mut mean, mut deviations) = (Vec::new(), Vec::new());
+        for (i, shifts) in tensors.chunks(replicas).enumerate() {
+            let scale = integral_scale(sampling.counts[i]);
+            let mut m = vec![0.0; COEFFICIENTS * t];
+            for (_, s) in shifts {
+                m.iter_mut()
+                    .zip(s)
+                    .for_each(|(m, s)| *m += scale * s / replicas as f64);
+            }
+            let mut d = Vec::with_capacity(replicas * COEFFICIENTS * t_err);
+            for (_, s) in shifts {
+                for v in 0..COEFFICIENTS {
+                    let range = v * t..v * t + t_err;
+                    d.extend(
+                        s[range.clone()]
+                            .iter()
+                            .zip(&m[range])
+                            .map(|(s, m)| scale * s - m),
+                    );
+                }
+            }
+            mean.push(m);
+            deviations.push(d);
+        }
+        Self {
+            k: k.to_vec(),
+            key: key(k, q_range, lattice_step, settings, family),
+            basis,
+            points: sampling.counts,
+            replicas,
+            mean,
+            deviations,
+        }
+    }
+
+    /// [`build`](Self::build) for linear spectra, on the CAMB basis of [`BASIS_SIZE`] functions.
+    pub fn build_linear(
+        k: &[f64],
+        q_range: (f64, f64),
+        lattice_step: f64,
+        settings: &TwoLoopSettings,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Self {
+        let basis = super::training::camb_basis(Self::lattice(q_range, lattice_step), BASIS_SIZE);
+        let family = SpectrumFamily::Linear;
+        Self::build(k, q_range, lattice_step, settings, family, basis, progress)
+    }
+
+    /// The wavenumbers [h/Mpc].
+    pub fn k(&self) -> &[f64] {
+        &self.k
+    }
+
+    /// The projection of `spectrum` on the basis.
+    pub fn project(&self, spectrum: &LinearSpectrum) -> Projection {
+        self.basis.project(&self.basis.lattice().sample(spectrum))
+    }
+
+    /// The 2-loop redshift-space terms of `spectrum`, or `Err` with its projection if the residual
+    /// exceeds [`MAX_RESIDUAL`] (integrate such spectra directly).
+    ///
+    /// # Errors
+    /// The projection, when the basis does not represent the spectrum well enough.
+    pub fn evaluate(&self, spectrum: &LinearSpectrum) -> Result<RsdTwoLoopTerms, Projection> {
+        let projection = self.project(spectrum);
+        if projection.residual.is_nan() || projection.residual > MAX_RESIDUAL {
+            return Err(projection);
+        }
+        let c = &projection.coefficients;
+        let n = c.len();
+        let mut s3 = vec![0.0; triples(n)];
+        for b in 0..n {
+            for a in 0..=b {
+                for (j, cc) in c[b..].iter().enumerate() {
+                    s3[triple_index(a, b, b + j)] = c[a] * c[b] * cc;
+                }
+            }
+        }
+        let (t, t_err) = (triples(n), triples(error_functions(n)));
+        let replicas: Vec<Vec<[f64; COEFFICIENTS]>> = (0..self.k.len())
+            .into_par_iter()
+            .map(|i| {
+                let mean: [f64; COEFFICIENTS] =
+                    std::array::from_fn(|v| super::dot(&self.mean[i][v * t..(v + 1) * t], &s3));
+                self.deviations[i]
+                    .chunks_exact(COEFFICIENTS * t_err)
+                    .map(|d| {
+                        std::array::from_fn(|v| {
+                            mean[v] + super::dot(&d[v * t_err..(v + 1) * t_err], &s3[..t_err])
+                        })
+                    })
+                    .collect()
+            })
+            .collect();
+        Ok(RsdTwoLoopTerms::from_coefficients(
+            &self.k,
+            self.points.clone(),
+            &replicas,
+            RSD_PROJECTION_FACTOR * projection.residual,
+        ))
+    }
+
+    /// The tensors as the values of their cache file.
+    pub(crate) fn to_f64s(&self) -> Vec<f64> {
+        let mut v = vec![self.key.len() as f64];
+        v.extend(&self.key);
+        v.extend(self.points.iter().map(|&p| p as f64));
+        v.push(self.replicas as f64);
+        v.extend(self.basis.to_f64s());
+        for i in 0..self.k.len() {
+            v.extend(&self.mean[i]);
+            v.extend(&self.deviations[i]);
+        }
+        v
+    }
+
+    /// The tensors from the values of their file, or `None` for a file made for other settings.
+    pub(crate) fn from_f64s(
+        values: &[f64],
+        k: &[f64],
+        q_range: (f64, f64),
+        lattice_step: f64,
+        settings: &TwoLoopSettings,
+        family: SpectrumFamily,
+    ) -> Option<Self> {
+        let expected = key(k, q_range, lattice_step, settings, family);
+        let rest = after_key(values, &expected)?;
+        let points: Vec<usize> = rest.get(..k.len())?.iter().map(|&p| p as usize).collect();
+        let replicas = *rest.get(k.len())? as usize;
+        let (basis, mut rest) =
+            LinearBasis::from_f64s(Self::lattice(q_range, lattice_step), &rest[k.len() + 1..])?;
+        let n = basis.len();
+        let sizes = [
+            COEFFICIENTS * triples(n),
+            replicas * COEFFICIENTS * triples(error_functions(n)),
+        ];
+        if rest.len() != k.len() * (sizes[0] + sizes[1]) {
+            return None;
+        }
+        let (mut mean, mut deviations) = (Vec::new(), Vec::new());
+        for _ in k {
+            let (m, r) = rest.split_at(sizes[0]);
+            let (d, r) = r.split_at(sizes[1]);
+            mean.push(m.to_vec());
+            deviations.push(d.to_vec());
+            rest = r;
+        }
+        Some(Self {
+            k: k.to_vec(),
+            key: expected,
+            basis,
+            points,
+            replicas,
+            mean,
+            deviations,
+        })
+    }
+}
