@@ -37,6 +37,7 @@ __all__ = [
     "RsdPlan",
     "RsdTerms",
     "Table",
+    "TwoLoopRsdPlan",
     "eisenstein_hu",
     "ept",
     "fit",
@@ -184,6 +185,31 @@ def ept(k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, ells=(
     return plan(linear, z, z_input, cosmology, eh, ells, **params)
 
 
+class TwoLoopRsdPlan:
+    """2-loop matter multipoles in redshift space planned for one k grid: ``model="spt2"`` (plain
+    2-loop SPT, kernels Z_2 … Z_5) or ``"eft2"`` (with the BAO resummed, ``ir=False`` to switch it
+    off, and the counterterms c0, c2, c4, c0_1loop, c2_1loop, c4_1loop [(Mpc/h)^2], ctilde
+    [(Mpc/h)^4]; see docs/reference.md).
+
+    ``TwoLoopRsdPlan(k, model="eft2", ir=True, precision="default", q_range=None, two_loop="auto",
+    cache_dir=None)``: ``two_loop="basis"`` builds the 2-loop basis tensors once per k grid and
+    precision (minutes; cached), after which a new spectrum costs milliseconds; ``"direct"``
+    integrates every spectrum (about a second per k at the default precision). Calling it takes the
+    linear spectrum (``linear``, ``z``, ``z_input``, ``cosmology``, ``eh`` as in :func:`real`), ``f``
+    (default f(z)), ``ells`` (even, <= 8), ``terms`` (spt2: the parts ``P<l>_lin P<l>_1loop
+    P<l>_2loop``; eft2: the templates ``T<l>_<name>`` = dP_l/d<name>) and the counterterms by name.
+    """
+
+    def __init__(self, k, model="eft2", ir=True, precision=_D["precision"], q_range=None,
+                 two_loop=_D["two_loop"], cache_dir=None):
+        self._plan = _core.TwoLoopRsdPlan(k, model, ir, precision, q_range, two_loop, cache_dir)
+
+    def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, f=None,
+                 ells=(0, 2, 4), terms=False, **counterterms):
+        return _warn(self._plan(linear, z, z_input, cosmology, eh, f, list(ells), terms,
+                                **counterterms))
+
+
 def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0, 2),
             data_ells=(0, 2, 4), data_columns=None, covariance=None, k_min=0.0, ir=True, apar=None,
             aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision=_D["precision"],
@@ -329,6 +355,9 @@ def rsd(rsd=_D["rsd_model"], real=_D["rsd_real_model"], k=None, linear=None, z=0
 
     ``rsd="ept"`` is the galaxy model (:func:`ept`): ``bias`` is b1, ``b2``, ``bs``, ``b3`` and the
     keyword arguments ``alpha0`` … ``sn4``, ``ir``, ``apar``, ``aperp`` in velocileptors' conventions.
+    ``rsd="spt2"`` and ``"eft2"`` are the 2-loop matter multipoles (:class:`TwoLoopRsdPlan`; eft2's
+    counterterms ``c0=…`` and ``ir`` as keyword arguments; the bias, noise and FoG options do not
+    apply).
 
     rsd: ``kaiser``, ``scoccimarro`` or ``tns``; real: the real-space model (as :func:`real`).
     f: growth rate (default f(z) of the cosmology). bias: a number, a path or ``(k, b)`` arrays;
@@ -349,6 +378,21 @@ def rsd(rsd=_D["rsd_model"], real=_D["rsd_real_model"], k=None, linear=None, z=0
         return ept(k=_grid(k, k_min, k_max, nk), linear=linear, z=z, z_input=z_input,
                    cosmology=cosmology, eh=eh, ells=ells, precision=precision, q_range=q_range,
                    b1=bias, b2=b2, bs=bs, b3=b3, f=f, **ept_params)
+    if str(rsd).lower() in ("spt2", "eft2"):
+        given = [name for name, value, default in [
+            ("real", real, _D["rsd_real_model"]), ("bias", bias, 1.0), ("amplitude", amplitude, 1.0),
+            ("fog", str(fog).lower(), "none"), ("sigma0", sigma0, 0.0), ("shot_noise", shot_noise, None),
+            ("number_density", number_density, None), ("noise_table", noise_table, None),
+            ("no_wiggle", no_wiggle, False), ("cs2", cs2, 0.0), ("b2", b2, None), ("bs", bs, None),
+            ("b3", b3, None)] if not (value is default or value == default)]
+        if given:
+            raise ValueError(f"{', '.join(given)}: not options of rsd={rsd!r} (matter multipoles of "
+                             "2-loop perturbation theory: f, ells, terms; eft2: counterterms, ir)")
+        counterterms = dict(ept_params)
+        ir = counterterms.pop("ir", True)
+        plan = TwoLoopRsdPlan(_grid(k, k_min, k_max, nk), str(rsd).lower(), ir, precision, q_range,
+                              cache_dir=cache_dir)
+        return plan(linear, z, z_input, cosmology, eh, f, ells, terms, **counterterms)
     if ept_params:
         raise ValueError(f"{', '.join(ept_params)}: options of rsd='ept', not of rsd={rsd!r}")
     plan = RsdPlan(_grid(k, k_min, k_max, nk), real, rsd, precision, q_range, cache_dir)

@@ -31,6 +31,7 @@ mod kernel;
 mod redshift;
 mod survey;
 mod tables;
+mod two_loop_rsd;
 
 use inputs::Inputs;
 
@@ -601,6 +602,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<redshift::RsdTerms>()?;
     m.add_class::<ept::EptPlan>()?;
     m.add_class::<ept::EptTerms>()?;
+    m.add_class::<two_loop_rsd::TwoLoopRsdPlan>()?;
     m.add_class::<survey::Observation>()?;
     m.add_function(wrap_pyfunction!(ept::fit_ept, m)?)?;
     m.add_function(wrap_pyfunction!(batch::real_batch, m)?)?;
