@@ -12,8 +12,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 enum Plan {
-    Spt2(Spt2Plan),
-    Eft2(Eft2Plan),
+    Spt2(Box<Spt2Plan>),
+    Eft2(Box<Eft2Plan>),
 }
 
 /// `spt2` or `eft2` planned for one k grid.
@@ -69,9 +69,13 @@ impl TwoLoopRsdPlan {
         }
         let (plan, _) = detached(py, || {
             Ok(if model == "spt2" {
-                Plan::Spt2(Spt2Plan::new(&k, &precision)?.with_basis(store.get(), &Silent)?)
+                Plan::Spt2(Box::new(
+                    Spt2Plan::new(&k, &precision)?.with_basis(store.get(), &Silent)?,
+                ))
             } else {
-                Plan::Eft2(Eft2Plan::new(&k, ir, &precision)?.with_basis(store.get(), &Silent)?)
+                Plan::Eft2(Box::new(
+                    Eft2Plan::new(&k, ir, &precision)?.with_basis(store.get(), &Silent)?,
+                ))
             })
         })?;
         Ok(Self { plan, precision })
