@@ -12,22 +12,28 @@
 //! P33irr = 6 ∫∫ Z₃(q₁, q₂, q₃)² P(q₁)P(q₂)P(q₃),  q₃ = k − q₁ − q₂,
 //! ```
 //!
-//! ∫ ≡ ∫d³q/(2π)³, Z₁(k) = 1 + fμ². Everything is integrated at once, on the points, map and infrared
-//! grouping of the real-space mode-coupling integral ([`super::two_loop`]): P24 restricted to
-//! |k − q₁| > q₁ and P33irr to q₃ > q₁, q₂ by smooth partitions of unity, symmetrised in q₁ ↔ q₂ and
-//! averaged over the four images q_i → ±q_i, so that the infrared pieces of 2P15 + P33red (each
-//! ∝ [(k + fμk n̂)·q]²/q⁴ as q → 0, the redshift-space displacement) and of 2P24 + P33irr cancel at
-//! every point. A sixth dimension is the azimuth φ_n of the line of sight n̂ about k̂; its cosine μ
-//! runs over seven fixed nodes (Chebyshev points in μ² ∈ [0, 1]) at every point. P^(2)_s is a
-//! polynomial of degree 6 in f and in μ² (Z_n is of degree n in f and each f brings at most μ²), so
-//! the seven nodes' values, as polynomials in f, determine it exactly: P(k, μ) is their Lagrange
-//! interpolant in μ², and the multipoles its exact Legendre moments (any even ℓ ≤ 12).
+//! ∫ ≡ ∫d³q/(2π)³, Z₁(k) = 1 + fμ². The sum is integrated as the two infrared-safe parts of the
+//! real-space correction, on the same 6-D Sobol points (module `integrand`): the propagator part
+//! 2P15 − P33red on a broad radial map (its UV tail reaches q ≫ k), and the mode-coupling part
+//! 2P24 + P33irr + 2P33red on the real-space mode-coupling map ([`super::two_loop`]): P24 restricted
+//! to |k − q₁| > q₁ and P33irr to q₃ > q₁, q₂ by smooth partitions of unity, symmetrised in q₁ ↔ q₂
+//! and averaged over the four images q_i → ±q_i. In each part the infrared pieces (∝ [(k + fμk n̂)·q]²/q⁴
+//! as q → 0, the redshift-space displacement) cancel at every point. The sixth dimension is the
+//! azimuth φ_n of the line of sight n̂ about k̂, taken with its opposite φ_n + π; its cosine μ runs
+//! over seven fixed nodes (Chebyshev points in μ² ∈ [0, 1]) at every point.
 //!
-//! At f = 0 the integrand is the real-space one (Z_n = F_n), integrated by the same method; the large-
-//! scale limit is P^(2)_s/P_lin → 0 (∝ k⁴), leaving Kaiser. The value is the mean over R independent
-//! random shifts of the Sobol sequence and its error their standard error, for every linear
-//! functional (a multipole at one f) computed replica by replica, so correlations between the nodes
-//! and powers of f are carried.
+//! P^(2)_s is a polynomial of degree 6 in f, and its f^m part one of degree ≤ m in μ² (Z_n's f^m part
+//! is homogeneous of degree 2m in n̂); with the two opposite azimuths every point's integrand is
+//! already such a polynomial, so the seven nodes' values, as polynomials in f, hold it exactly, and
+//! the 28 coefficients of f^m μ^{2j}, j ≤ m, are kept ([`COEFFICIENTS`]). P(k, μ) is the Lagrange
+//! interpolant of the nodes in μ², the multipoles its exact Legendre moments (any even ℓ ≤ 12).
+//!
+//! At f = 0 the integrand is the real-space one (Z_n = F_n); the large-scale limit is
+//! P^(2)_s/P_lin → 0 (∝ k², from its UV-sensitive k²P(k) pieces), leaving Kaiser. The value is the
+//! mean over R independent random shifts of the Sobol sequence and its error their standard error,
+//! for every linear functional (a multipole at one f) computed replica by replica, so correlations
+//! between the nodes, the powers of f and spectra integrated together ([`rsd_two_loop_of`]) are
+//! carried.
 
 mod integrand;
 mod zn;
@@ -109,15 +115,7 @@ pub fn combined(terms: &[(&RsdTwoLoopTerms, [f64; MU_NODES])], i: usize, f: f64)
         .map(|r| {
             terms
                 .iter()
-                .map(|(t, weights)| {
-                    t.replicas[i][r]
-                        .iter()
-                        .zip(weights)
-                        .map(|(node, w)| {
-                            w * node.iter().zip(&powers).map(|(c, p)| c * p).sum::<f64>()
-                        })
-                        .sum::<f64>()
-                })
+                .map(|(t, w)| replica_value(&t.replicas[i][r], w, &powers))
                 .sum()
         })
         .collect();
@@ -133,6 +131,19 @@ pub fn combined(terms: &[(&RsdTwoLoopTerms, [f64; MU_NODES])], i: usize, f: f64)
     Estimate::new(mean, (var / n).sqrt() + projection)
 }
 
+/// Σ_j w_j Σ_m f^m c_jm of one replica's integrals `nodes` at one k.
+fn replica_value(
+    nodes: &NodeIntegrals,
+    weights: &[f64; MU_NODES],
+    powers: &[f64; F_POWERS],
+) -> f64 {
+    nodes
+        .iter()
+        .zip(weights)
+        .map(|(node, w)| w * node.iter().zip(powers).map(|(c, p)| c * p).sum::<f64>())
+        .sum()
+}
+
 /// The mean over the replicas of one term's functional.
 fn combined_value(
     t: &RsdTwoLoopTerms,
@@ -142,12 +153,7 @@ fn combined_value(
 ) -> f64 {
     let r = &t.replicas[i];
     r.iter()
-        .map(|rep| {
-            rep.iter()
-                .zip(weights)
-                .map(|(node, w)| w * node.iter().zip(powers).map(|(c, p)| c * p).sum::<f64>())
-                .sum::<f64>()
-        })
+        .map(|rep| replica_value(rep, weights, powers))
         .sum::<f64>()
         / r.len() as f64
 }
