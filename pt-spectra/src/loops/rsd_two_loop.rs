@@ -25,7 +25,7 @@
 //! P^(2)_s is a polynomial of degree 6 in f, and its f^m part one of degree ≤ m in μ² (Z_n's f^m part
 //! is homogeneous of degree 2m in n̂); with the two opposite azimuths every point's integrand is
 //! already such a polynomial, so the seven nodes' values, as polynomials in f, hold it exactly, and
-//! the 28 coefficients of f^m μ^{2j}, j ≤ m, are kept ([`COEFFICIENTS`]). P(k, μ) is the Lagrange
+//! the 28 coefficients of f^m μ^{2j}, j ≤ m, are kept. P(k, μ) is the Lagrange
 //! interpolant of the nodes in μ², the multipoles its exact Legendre moments (any even ℓ ≤ 12).
 //!
 //! At f = 0 the integrand is the real-space one (Z_n = F_n); the large-scale limit is
