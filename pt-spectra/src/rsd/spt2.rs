@@ -8,8 +8,12 @@
 //! no other bias: exact in μ, deterministic quadrature), P^(2)_s the 2-loop terms 2P15 + 2P24 + P33
 //! with Z₄, Z₅ ([`mod@crate::loops::rsd_two_loop`]: quasi-Monte Carlo, a polynomial of degree 6 in f and
 //! in μ²). Every term is a polynomial in f, so a new f costs no integral. No Fingers-of-God damping, no
-//! IR resummation, no counterterms: plain SPT, whose reach in redshift space is short (the issue's
-//! figures: 1-loop to k ≈ 0.1, 2-loop to ≈ 0.18 h/Mpc at z ≈ 1 with counterterms).
+//! IR resummation, no counterterms: plain SPT, the base of [`super::eft2`] (with counterterms and IR
+//! resummation, Taule & Garny 2023 find 1-loop within sample variance of Quijote to k ≈ 0.1 and
+//! 2-loop to ≈ 0.18 h/Mpc at z = 0 and 0.5).
+//!
+//! The 2-loop terms come from basis tensors ([`Spt2Plan::with_basis`]) when the plan has them and the
+//! spectrum projects well, else they are integrated; [`Spt2Terms::source`] says which.
 //!
 //! Errors: the 1-loop coefficients' error bounds times (2ℓ+1) (as [`super::MultipoleRule`]), plus the
 //! standard error over the random shifts of the 2-loop multipole at this f.
@@ -28,8 +32,8 @@ use crate::store::TableStore;
 use std::sync::Arc;
 
 /// The redshift-space 2-loop Sobol points per shift are the real-space ones
-/// ([`Precision::two_loop_points`]) over this factor: each point costs ~16 μs of kernels (seven lines
-/// of sight, nine configurations) against ~1 μs in real space.
+/// ([`Precision::two_loop_points`]) over this factor: each point costs ~30 μs of kernels (seven nodes
+/// in μ² at two azimuths, nine configurations) against ~1 μs in real space.
 pub const POINTS_DIVISOR: usize = 4;
 
 /// The 2-loop integration settings of `precision` in redshift space: the real-space ones with
