@@ -430,20 +430,32 @@ impl Eft2Terms {
             if self.ir() {
                 one_loop_error += nw.1.iter().sum::<f64>();
             }
-            for (l, &ell) in ells.iter().enumerate() {
-                let project = |rule: &[(f64, f64)]| -> [f64; 8] {
-                    let mut out = [0.0; 8];
-                    for &(mu, w) in rule {
-                        let weight = (2 * ell + 1) as f64 * w * legendre(ell, mu);
+            // the model without its 2-loop terms and every template at the nodes of both rules
+            let at_nodes = |rule: &[(f64, f64)]| -> Vec<(f64, f64, [f64; 8])> {
+                rule.iter()
+                    .map(|&(mu, w)| {
                         let [value, lin, one] = self.deterministic(i, f, mu, &polys);
-                        out[0] += weight * value;
+                        let mut out = [value; 8];
                         for (c, o) in RsdCounterterm::ALL.iter().zip(&mut out[1..]) {
-                            *o += weight * c.template(self.k[i], f, mu, lin, one);
+                            *o = c.template(self.k[i], f, mu, lin, one);
+                        }
+                        (mu, w, out)
+                    })
+                    .collect()
+            };
+            let (fine_values, coarse_values) = (at_nodes(&fine), at_nodes(&coarse));
+            for (l, &ell) in ells.iter().enumerate() {
+                let project = |values: &[(f64, f64, [f64; 8])]| -> [f64; 8] {
+                    let mut out = [0.0; 8];
+                    for (mu, w, v) in values {
+                        let weight = (2 * ell + 1) as f64 * w * legendre(ell, *mu);
+                        for (o, x) in out.iter_mut().zip(v) {
+                            *o += weight * x;
                         }
                     }
                     out
                 };
-                let (a, b) = (project(&fine), project(&coarse));
+                let (a, b) = (project(&fine_values), project(&coarse_values));
                 let mut value = a[0];
                 let mut error = (a[0] - b[0]).abs() + (2 * ell + 1) as f64 * one_loop_error;
                 for (j, (&c, t)) in ct.values.iter().zip(&a[1..]).enumerate() {
