@@ -484,3 +484,89 @@ impl Eft2Terms {
         Ok(Eft2Multipoles { total, templates })
     }
 }
+
+/// Measured multipoles to fit: P_ℓ(k) at the terms' k with 1σ errors, per ℓ.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredMultipole {
+    /// The multipole order (even, ≤ 8).
+    pub ell: usize,
+    /// P_ℓ at each k of the terms [(Mpc/h)³].
+    pub values: Vec<f64>,
+    /// Its 1σ errors.
+    pub sigma: Vec<f64>,
+}
+
+/// The counterterms `free` that fit `data` by weighted least squares over k ≤ `k_max` at growth rate
+/// `f` (the others held at `fixed`'s values): the model is linear in them, so the solution is exact
+/// (diagonal errors, the model's own errors neglected). Returns the values (every counterterm:
+/// `fixed`'s with the fitted ones replaced) and the 1σ errors of the fitted ones (0 for the others).
+///
+/// # Errors
+/// [`Error::LengthMismatch`] unless every data vector has one value per k; [`Error::InvalidChoice`]
+/// for no free counterterm, a non-positive σ, fewer points than parameters + 1, or templates
+/// degenerate on the data; as [`Eft2Terms::multipoles`] for a bad ℓ or f.
+pub fn fit_counterterms(
+    terms: &Eft2Terms,
+    f: f64,
+    data: &[MeasuredMultipole],
+    free: &[RsdCounterterm],
+    fixed: &RsdCounterterms,
+    k_max: f64,
+) -> Result<(RsdCounterterms, RsdCounterterms)> {
+    let bad = |reason: String| Error::InvalidChoice {
+        what: "eft2 counterterm fit".into(),
+        reason,
+    };
+    if free.is_empty() {
+        return Err(bad("no free counterterm".into()));
+    }
+    for d in data {
+        for (what, v) in [("k and the data", &d.values), ("k and sigma", &d.sigma)] {
+            if v.len() != terms.k.len() {
+                return Err(Error::LengthMismatch {
+                    what,
+                    left: terms.k.len(),
+                    right: v.len(),
+                });
+            }
+        }
+        if d.sigma.iter().any(|&s| s.is_nan() || s <= 0.0) {
+            return Err(bad(format!("every sigma of P{} must be positive", d.ell)));
+        }
+    }
+    let ells: Vec<usize> = data.iter().map(|d| d.ell).collect();
+    let model = terms.multipoles(f, &ells, fixed)?;
+    let index = |c: &RsdCounterterm| RsdCounterterm::ALL.iter().position(|x| x == c).unwrap_or(0);
+    let n = free.len();
+    let (mut normal, mut rhs) = (vec![vec![0.0; n]; n], vec![0.0; n]);
+    let mut points = 0;
+    for (l, d) in data.iter().enumerate() {
+        for (i, &k) in terms.k.iter().enumerate() {
+            if k > k_max {
+                continue;
+            }
+            points += 1;
+            let w = 1.0 / (d.sigma[i] * d.sigma[i]);
+            let r = d.values[i] - model.total[l][i].value;
+            for (p, cp) in free.iter().enumerate() {
+                let tp = model.templates[index(cp)][l][i];
+                rhs[p] += w * tp * r;
+                for (q, cq) in free.iter().enumerate() {
+                    normal[p][q] += w * tp * model.templates[index(cq)][l][i];
+                }
+            }
+        }
+    }
+    if points <= n {
+        return Err(bad(format!(
+            "{points} data points with k <= {k_max} for {n} counterterms: need more"
+        )));
+    }
+    let (solution, inverse, _) = crate::linalg::solve_spd(&normal, &rhs)?;
+    let (mut values, mut errors) = (*fixed, RsdCounterterms::default());
+    for (p, c) in free.iter().enumerate() {
+        values.values[index(c)] += solution[p];
+        errors.values[index(c)] = inverse[p][p].sqrt();
+    }
+    Ok((values, errors))
+}
