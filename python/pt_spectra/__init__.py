@@ -209,6 +209,17 @@ class TwoLoopRsdPlan:
         return _warn(self._plan(linear, z, z_input, cosmology, eh, f, list(ells), terms,
                                 **counterterms))
 
+    def fit_counterterms(self, data, free, k_max, linear=None, z=0.0, z_input=0.0, cosmology=None,
+                         eh=None, f=None, **fixed):
+        """eft2's counterterms ``free`` (names) fitted by weighted least squares to measured
+        multipoles ``data`` = ``{ell: (P_ell, sigma)}`` at the plan's k, over k <= ``k_max``; the
+        others held at ``fixed``'s values (default 0). Exact (the model is linear in them). Returns
+        ``{name: (value, error)}`` for every counterterm (error 0 for the fixed ones)."""
+        data = {int(ell): ([float(x) for x in v], [float(x) for x in s])
+                for ell, (v, s) in data.items()}
+        return self._plan.fit_counterterms(data, list(free), k_max, linear, z, z_input, cosmology,
+                                           eh, f, **fixed)
+
 
 def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0, 2),
             data_ells=(0, 2, 4), data_columns=None, covariance=None, k_min=0.0, ir=True, apar=None,

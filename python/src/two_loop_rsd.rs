@@ -154,4 +154,51 @@ impl TwoLoopRsdPlan {
         }
         Ok(table)
     }
+
+    /// The eft2 counterterms `free` fitted to measured multipoles `data` ({ell: (values, sigma)} at
+    /// the plan's k) over k <= `k_max`, the others at `kwargs`' values: {name: (value, error)}.
+    #[pyo3(signature = (data, free, k_max, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, f=None, **kwargs))]
+    #[allow(clippy::too_many_arguments)]
+    fn fit_counterterms(
+        &self,
+        py: Python<'_>,
+        data: std::collections::BTreeMap<usize, (Vec<f64>, Vec<f64>)>,
+        free: Vec<String>,
+        k_max: f64,
+        linear: Option<&Bound<'_, PyAny>>,
+        z: f64,
+        z_input: f64,
+        cosmology: Option<&Bound<'_, PyAny>>,
+        eh: Option<&str>,
+        f: Option<f64>,
+        kwargs: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<std::collections::BTreeMap<String, (f64, f64)>> {
+        use pt_spectra::rsd::eft2::{fit_counterterms, MeasuredMultipole, RsdCounterterm};
+        let Plan::Eft2(plan) = &self.plan else {
+            return Err(pyo3::exceptions::PyValueError::new_err(
+                "counterterms are options of eft2 (spt2 has none)",
+            ));
+        };
+        let fixed = counterterms(kwargs)?;
+        let free: Vec<RsdCounterterm> = free
+            .iter()
+            .map(|n| n.parse().map_err(value_error))
+            .collect::<PyResult<_>>()?;
+        let measured: Vec<MeasuredMultipole> = data
+            .into_iter()
+            .map(|(ell, (values, sigma))| MeasuredMultipole { ell, values, sigma })
+            .collect();
+        let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
+        let ((values, errors), _) = detached(py, || {
+            let prepared = inputs.prepare(plan.k())?;
+            let terms = plan.terms(prepared.tracer_spectrum(), &Silent)?;
+            let f = f.unwrap_or(prepared.growth_rate);
+            fit_counterterms(&terms, f, &measured, &free, &fixed, k_max)
+        })?;
+        Ok(RsdCounterterm::ALL
+            .iter()
+            .enumerate()
+            .map(|(j, c)| (c.name().to_string(), (values.values[j], errors.values[j])))
+            .collect())
+    }
 }

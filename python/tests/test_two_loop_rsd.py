@@ -37,3 +37,18 @@ def test_bad_input_raises():
         pt.rsd(rsd="eft2", k=K, bias=2.0)
     with pytest.raises(ValueError, match="counterterms are options of eft2"):
         pt.TwoLoopRsdPlan(K, "spt2", precision="fast", two_loop="direct")(c0=1.0)
+
+
+def test_eft2_counterterm_fit_recovers_injected_values():
+    plan = pt.TwoLoopRsdPlan(np.array([0.03, 0.06, 0.09, 0.12, 0.15]), "eft2", precision="fast",
+                             two_loop="direct")
+    truth = {"c0": -1.5, "c2": 4.0, "c0_1loop": 2.0}
+    t = plan(f=0.7, **truth)
+    data = {ell: (t[f"P{ell}"], 0.01 * np.abs(t[f"P{ell}"])) for ell in (0, 2, 4)}
+    fit = plan.fit_counterterms(data, ["c0", "c2", "c0_1loop"], 0.2, f=0.7)
+    for name, value in truth.items():
+        assert abs(fit[name][0] - value) < 1e-5 * (1 + abs(value)), (name, fit[name])
+        assert fit[name][1] > 0
+    assert fit["ctilde"] == (0.0, 0.0)
+    with pytest.raises(ValueError, match="unknown eft2 counterterm"):
+        plan.fit_counterterms(data, ["c6"], 0.2, f=0.7)
