@@ -29,14 +29,8 @@ fn distortion(apar: Option<f64>, aperp: Option<f64>) -> PyResult<Option<Distorti
 /// The parameters of `kwargs` (velocileptors' names; f may be absent: f(z) of the cosmology).
 fn params(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<EptParams> {
     let mut p = EptParams::new(1.0, f64::NAN);
-    if let Some(kw) = kwargs {
-        for (key, value) in kw.iter() {
-            let name: String = key.extract()?;
-            let v: f64 = value.extract().map_err(|_| {
-                pyo3::exceptions::PyValueError::new_err(format!("{name}: expected a number"))
-            })?;
-            p.set(&name, v).map_err(value_error)?;
-        }
+    for (name, v) in crate::number_kwargs(kwargs)? {
+        p.set(&name, v).map_err(value_error)?;
     }
     Ok(p)
 }

@@ -72,6 +72,25 @@ impl Store {
     }
 }
 
+/// The keyword arguments `kwargs` as (name, number) pairs; a value that is not a number is a
+/// `ValueError` naming it.
+pub(crate) fn number_kwargs(
+    kwargs: Option<&Bound<'_, pyo3::types::PyDict>>,
+) -> PyResult<Vec<(String, f64)>> {
+    let Some(kw) = kwargs else {
+        return Ok(Vec::new());
+    };
+    kw.iter()
+        .map(|(key, value)| {
+            let name: String = key.extract()?;
+            let v: f64 = value
+                .extract()
+                .map_err(|_| PyValueError::new_err(format!("{name}: expected a number")))?;
+            Ok((name, v))
+        })
+        .collect()
+}
+
 /// A float array from a numpy array or any sequence of numbers.
 pub(crate) fn floats(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
     if let Ok(a) = obj.extract::<PyReadonlyArray1<'_, f64>>() {

@@ -25,16 +25,10 @@ pub(crate) struct TwoLoopRsdPlan {
 
 /// The counterterms of `kwargs` as `NAME=VALUE` assignments (values must be numbers).
 fn counterterms(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<RsdCounterterms> {
-    let mut assignments = Vec::new();
-    if let Some(kw) = kwargs {
-        for (key, value) in kw.iter() {
-            let name: String = key.extract()?;
-            let v: f64 = value.extract().map_err(|_| {
-                pyo3::exceptions::PyValueError::new_err(format!("{name}: expected a number"))
-            })?;
-            assignments.push(format!("{name}={v}"));
-        }
-    }
+    let assignments: Vec<String> = crate::number_kwargs(kwargs)?
+        .into_iter()
+        .map(|(name, v)| format!("{name}={v}"))
+        .collect();
     RsdCounterterms::from_assignments(&assignments).map_err(value_error)
 }
 

@@ -304,6 +304,14 @@ fn eft2_without_resummation_or_counterterms_is_spt2_and_the_templates_are_exact(
                     ells[l]
                 );
             }
+            // c0_1loop is −2k² times the 1-loop multipole; ctilde's monopole −k⁴f⁴P(1/5 + 2f/7 + f²/9)
+            let one = -2.0 * ki * ki * s.one_loop[l][i].value;
+            assert!((zero.templates[3][l][i] - one).abs() < 1e-9 * one.abs().max(1e-6 * p));
+            if l == 0 {
+                let want = -ki.powi(4) * f.powi(4) * p * (0.2 + 2.0 * f / 7.0 + f * f / 9.0);
+                let t = zero.templates[6][0][i];
+                assert!((t - want).abs() < 1e-12 * p, "ctilde: {t} vs {want}");
+            }
         }
     }
 }

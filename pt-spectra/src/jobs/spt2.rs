@@ -3,6 +3,7 @@
 
 use super::{describe_inputs, VERSION};
 use crate::error::Result;
+use crate::loops::Estimate;
 use crate::output::{Table, POWER, WAVENUMBER};
 use crate::precision::Precision;
 use crate::rsd::eft2::{Eft2Plan, Eft2Terms, RsdCounterterm, RsdCounterterms};
@@ -28,7 +29,7 @@ pub fn spt2_table(
     super::rsd::check_growth_rate(f)?;
     let m = terms.multipoles(f, ells)?;
     let settings = plan.two_loop_settings();
-    let mut header = vec![
+    let header = vec![
         format!(
             "pt-spectra {VERSION} rsd: spt2 (matter, 2-loop SPT in redshift space), z = {}, f = {f}",
             prepared.z
@@ -44,24 +45,9 @@ pub fn spt2_table(
         ),
         terms.source.clone(),
     ];
-    if prepared.cold_fraction() < 1.0 {
-        header.push(
-            "massive neutrinos: the multipoles of cold dark matter + baryons (P_cb), not of total \
-             matter"
-                .into(),
-        );
-    }
-    header.extend(describe_inputs(prepared, precision));
-    let mut t = Table::new(header);
-    t.push("k", WAVENUMBER, terms.k.clone());
-    let values = |p: &[crate::loops::Estimate]| p.iter().map(|e| e.value).collect::<Vec<_>>();
-    let errors = |p: &[crate::loops::Estimate]| p.iter().map(|e| e.error).collect::<Vec<_>>();
-    for (l, p) in ells.iter().zip(&m.total) {
-        t.push(format!("P{l}"), POWER, values(p));
-    }
-    for (l, p) in ells.iter().zip(&m.total) {
-        t.push(format!("err_P{l}"), POWER, errors(p));
-    }
+    let mut t = multipole_table(header, &terms.k, ells, &m.total, prepared, precision);
+    let values = |p: &[Estimate]| p.iter().map(|e| e.value).collect::<Vec<_>>();
+    let errors = |p: &[Estimate]| p.iter().map(|e| e.error).collect::<Vec<_>>();
     if parts {
         for (l, ((lin, one), two)) in ells
             .iter()
@@ -139,26 +125,7 @@ pub fn eft2_table(
         crate::rsd::eft2::MU_NODES
     ));
     header.push(terms.source.clone());
-    if prepared.cold_fraction() < 1.0 {
-        header.push(
-            "massive neutrinos: the multipoles of cold dark matter + baryons (P_cb), not of total \
-             matter"
-                .into(),
-        );
-    }
-    header.extend(describe_inputs(prepared, precision));
-    let mut t = Table::new(header);
-    t.push("k", WAVENUMBER, terms.k.clone());
-    for (l, p) in ells.iter().zip(&m.total) {
-        t.push(format!("P{l}"), POWER, p.iter().map(|e| e.value).collect());
-    }
-    for (l, p) in ells.iter().zip(&m.total) {
-        t.push(
-            format!("err_P{l}"),
-            POWER,
-            p.iter().map(|e| e.error).collect(),
-        );
-    }
+    let mut t = multipole_table(header, &terms.k, ells, &m.total, prepared, precision);
     if parts {
         for (c, per_ell) in RsdCounterterm::ALL.iter().zip(&m.templates) {
             let unit = if *c == RsdCounterterm::Ctilde {
@@ -172,4 +139,37 @@ pub fn eft2_table(
         }
     }
     Ok(t)
+}
+
+/// The table of multipoles `total` (per ℓ of `ells`, per k) with `header`, then the line on massive
+/// neutrinos and the inputs: columns `k P<l>… err_P<l>…`.
+fn multipole_table(
+    mut header: Vec<String>,
+    k: &[f64],
+    ells: &[usize],
+    total: &[Vec<Estimate>],
+    prepared: &Prepared,
+    precision: &Precision,
+) -> Table {
+    if prepared.cold_fraction() < 1.0 {
+        header.push(
+            "massive neutrinos: the multipoles of cold dark matter + baryons (P_cb), not of total \
+             matter"
+                .into(),
+        );
+    }
+    header.extend(describe_inputs(prepared, precision));
+    let mut t = Table::new(header);
+    t.push("k", WAVENUMBER, k.to_vec());
+    for (l, p) in ells.iter().zip(total) {
+        t.push(format!("P{l}"), POWER, p.iter().map(|e| e.value).collect());
+    }
+    for (l, p) in ells.iter().zip(total) {
+        t.push(
+            format!("err_P{l}"),
+            POWER,
+            p.iter().map(|e| e.error).collect(),
+        );
+    }
+    t
 }

@@ -248,7 +248,7 @@ fn lagrange(nodes: &[f64; MU_NODES], j: usize, x: f64) -> f64 {
 }
 
 /// L_ℓ(μ) by the upward recursion.
-fn legendre(ell: usize, mu: f64) -> f64 {
+pub(crate) fn legendre(ell: usize, mu: f64) -> f64 {
     let (mut prev, mut cur) = (1.0, mu);
     if ell == 0 {
         return 1.0;
@@ -261,20 +261,9 @@ fn legendre(ell: usize, mu: f64) -> f64 {
     cur
 }
 
-/// w_j = (2ℓ+1)∫₀¹ L_ℓ(μ) ℓ_j(μ²) dμ: Gauss–Legendre with 16 nodes on [0, 1] is exact for the degree
-/// 12 + ℓ ≤ 24 of the integrand.
+/// w_j = (2ℓ+1)∫₀¹ L_ℓ(μ) ℓ_j(μ²) dμ ([`node_weights`]: exact, the integrand is of degree 12 + ℓ).
 fn moment_weights(ell: usize) -> [f64; MU_NODES] {
-    let (x, w) = legendre_nodes(16);
-    let nodes = mu2_nodes();
-    std::array::from_fn(|j| {
-        x.iter()
-            .zip(&w)
-            .map(|(&x, &w)| {
-                let mu = 0.5 * (x + 1.0);
-                (2 * ell + 1) as f64 * 0.5 * w * legendre(ell, mu) * lagrange(&nodes, j, mu * mu)
-            })
-            .sum()
-    })
+    node_weights(|mu| (2 * ell + 1) as f64 * legendre(ell, mu))
 }
 
 /// Row n gives the coefficient of x^n of the interpolant from the node values: the coefficients of

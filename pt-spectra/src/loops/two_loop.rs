@@ -169,16 +169,16 @@ pub fn two_loop_with_progress(
     )
 }
 
-/// The 5-D Sobol sequence (Joe–Kuo direction numbers) whose prefixes every k takes, without its first
-/// point (the origin).
-pub(crate) fn sobol_sequence() -> impl Iterator<Item = [f64; 5]> {
-    Sobol::<f64>::new(5, &JoeKuoD6::standard())
+/// The D-dimensional Sobol sequence (Joe–Kuo direction numbers) whose prefixes every k takes, without
+/// its first point (the origin): D = 5 here, 6 in redshift space (the line-of-sight azimuth).
+pub(crate) fn sobol_sequence<const D: usize>() -> impl Iterator<Item = [f64; D]> {
+    Sobol::<f64>::new(D, &JoeKuoD6::standard())
         .skip(1)
         .map(|p| std::array::from_fn(|d| p[d]))
 }
 
 /// The Cranley–Patterson random shifts of the replicas (ChaCha8 from `settings.seed`).
-pub(crate) fn random_shifts(settings: &TwoLoopSettings) -> Vec<[f64; 5]> {
+pub(crate) fn random_shifts<const D: usize>(settings: &TwoLoopSettings) -> Vec<[f64; D]> {
     use rand::{Rng, SeedableRng};
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(settings.seed);
     (0..settings.replicas)

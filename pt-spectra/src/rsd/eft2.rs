@@ -44,6 +44,7 @@ use crate::linear::LinearSpectrum;
 use crate::loops::basis::training::{camb_basis, transformed_basis};
 use crate::loops::basis::{RsdTwoLoopBasis, SpectrumFamily, BASIS_SIZE};
 use crate::loops::redshift::{RedshiftPlan, RedshiftTerms};
+use crate::loops::rsd_two_loop::legendre;
 use crate::loops::{combined, node_weights, Estimate, RsdTwoLoopTerms};
 use crate::precision::Precision;
 use crate::progress::Progress;
@@ -342,12 +343,6 @@ fn mu_rule(n: usize) -> Vec<(f64, f64)> {
         .zip(&w)
         .map(|(&x, &w)| (0.5 * (x + 1.0), 0.5 * w))
         .collect()
-}
-
-/// L_ℓ(μ).
-fn legendre(ell: usize, mu: f64) -> f64 {
-    let c = super::legendre_coefficients(ell);
-    c.iter().rev().fold(0.0, |acc, cj| acc * mu + cj)
 }
 
 /// Nodes of the multipole rule in μ (its error from half as many).

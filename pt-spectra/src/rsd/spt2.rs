@@ -62,18 +62,21 @@ pub(crate) fn two_loop_terms(
 ) -> Result<(Vec<RsdTwoLoopTerms>, String)> {
     let mut note = String::from("2-loop terms integrated for this spectrum (direct)");
     if tensors.len() == spectra.len() {
-        let from_basis: Vec<_> = spectra
+        let projections: Vec<_> = spectra
             .iter()
             .zip(tensors)
-            .map(|(s, t)| t.evaluate(s))
+            .map(|(s, t)| t.project(s))
             .collect();
-        if from_basis.iter().all(|r| r.is_ok()) {
-            let residuals: Vec<String> = spectra
+        if projections.iter().all(RsdTwoLoopBasis::accepts) {
+            let residuals: Vec<String> = projections
                 .iter()
-                .zip(tensors)
-                .map(|(s, t)| format!("{:.1e}", t.project(s).residual))
+                .map(|p| format!("{:.1e}", p.residual))
                 .collect();
-            let terms = from_basis.into_iter().map(|r| r.expect("all ok")).collect();
+            let terms = tensors
+                .iter()
+                .zip(&projections)
+                .map(|(t, p)| t.evaluate_projected(p))
+                .collect();
             let note = format!(
                 "2-loop terms from basis tensors (projection residual {}; the projection error, {} x \
                  residual x |value|, is in the errors)",

@@ -251,33 +251,8 @@ impl TwoLoopBasis {
             })
             .collect();
         tensors.sort_by_key(|t| t.0);
-        let t = triples(n);
-        let t_err = triples(error_functions(n));
-        let (mut mean, mut deviations) = (Vec::new(), Vec::new());
-        for (i, shifts) in tensors.chunks(replicas).enumerate() {
-            // Each shift's integral is its sum times the scale; the mean is over the shifts.
-            let scale = integral_scale(points[i]);
-            let mut m = vec![0.0; ACC * t];
-            for (_, s) in shifts {
-                m.iter_mut()
-                    .zip(s)
-                    .for_each(|(m, s)| *m += scale * s / replicas as f64);
-            }
-            let mut d = Vec::with_capacity(replicas * ACC * t_err);
-            for (_, s) in shifts {
-                for v in 0..ACC {
-                    let range = v * t..v * t + t_err;
-                    d.extend(
-                        s[range.clone()]
-                            .iter()
-                            .zip(&m[range])
-                            .map(|(s, m)| scale * s - m),
-                    );
-                }
-            }
-            mean.push(m);
-            deviations.push(d);
-        }
+        let (mean, deviations) =
+            shift_statistics(&tensors, replicas, ACC, n, |i| integral_scale(points[i]));
         let forms = k.par_iter().map(|&k| p15_forms(table, k, &basis)).collect();
         Self {
             k: k.to_vec(),
@@ -348,16 +323,12 @@ impl TwoLoopBasis {
         let c = &projection.coefficients;
         let n = c.len();
         let mut s2 = vec![0.0; n * (n + 1) / 2];
-        let mut s3 = vec![0.0; triples(n)];
         for b in 0..n {
             for a in 0..=b {
                 s2[pair_index(a, b)] = c[a] * c[b];
-                for (i, cc) in c[b..].iter().enumerate() {
-                    s3[triple_index(a, b, b + i)] = c[a] * c[b] * cc;
-                }
             }
         }
-        let (t, t_err) = (triples(n), triples(error_functions(n)));
+        let s3 = triple_products(c);
         let mut p15_rows = Vec::with_capacity(self.k.len());
         let mut propagator = Vec::with_capacity(self.k.len());
         let mut rows = Vec::with_capacity(self.k.len());
@@ -377,16 +348,8 @@ impl TwoLoopBasis {
             let (dd, tt) = (kernel(0), kernel(1));
             p15_rows.push([dd, Estimate::mean(dd, tt), tt]);
             propagator.push([kernel(2), kernel(3), kernel(4)]);
-            let mean: [f64; ACC] =
-                std::array::from_fn(|v| dot(&self.mean[i][v * t..(v + 1) * t], &s3));
-            let integrals: Vec<[f64; ACC]> = self.deviations[i]
-                .chunks_exact(ACC * t_err)
-                .map(|d| {
-                    std::array::from_fn(|v| {
-                        mean[v] + dot(&d[v * t_err..(v + 1) * t_err], &s3[..t_err])
-                    })
-                })
-                .collect();
+            let integrals: Vec<[f64; ACC]> =
+                replica_contractions(&self.mean[i], &self.deviations[i], &s3, n);
             rows.push(replica_estimates(&integrals));
         }
         // Assembled as the direct path does (the same choice between its two estimates of the
@@ -490,6 +453,78 @@ impl TwoLoopBasis {
             max_residual: MAX_RESIDUAL,
         })
     }
+}
+
+/// Per k, from the summed tensors of each (k, shift) job in job order ([quantity][triple], `quantities`
+/// of them on a basis of `n`), each times `scale(k index)`: the mean over the shifts, and each shift's
+/// deviation from it kept on the first [`ERROR_FUNCTIONS`] functions ([shift][quantity][triple]).
+pub(crate) fn shift_statistics(
+    tensors: &[(usize, Vec<f64>)],
+    replicas: usize,
+    quantities: usize,
+    n: usize,
+    scale: impl Fn(usize) -> f64,
+) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+    let (t, t_err) = (triples(n), triples(error_functions(n)));
+    let (mut mean, mut deviations) = (Vec::new(), Vec::new());
+    for (i, shifts) in tensors.chunks(replicas).enumerate() {
+        // Each shift's integral is its sum times the scale; the mean is over the shifts.
+        let scale = scale(i);
+        let mut m = vec![0.0; quantities * t];
+        for (_, s) in shifts {
+            m.iter_mut()
+                .zip(s)
+                .for_each(|(m, s)| *m += scale * s / replicas as f64);
+        }
+        let mut d = Vec::with_capacity(replicas * quantities * t_err);
+        for (_, s) in shifts {
+            for v in 0..quantities {
+                let range = v * t..v * t + t_err;
+                d.extend(
+                    s[range.clone()]
+                        .iter()
+                        .zip(&m[range])
+                        .map(|(s, m)| scale * s - m),
+                );
+            }
+        }
+        mean.push(m);
+        deviations.push(d);
+    }
+    (mean, deviations)
+}
+
+/// The products c_a c_b c_c on the triples a ≤ b ≤ c.
+pub(crate) fn triple_products(c: &[f64]) -> Vec<f64> {
+    let n = c.len();
+    let mut s3 = vec![0.0; triples(n)];
+    for b in 0..n {
+        for a in 0..=b {
+            for (i, cc) in c[b..].iter().enumerate() {
+                s3[triple_index(a, b, b + i)] = c[a] * c[b] * cc;
+            }
+        }
+    }
+    s3
+}
+
+/// Each shift's integrals of the Q quantities at one k: the `mean` tensor contracted with the
+/// triple products `s3` plus that shift's deviation tensor (from [`shift_statistics`]) contracted
+/// with their first [`ERROR_FUNCTIONS`] functions.
+pub(crate) fn replica_contractions<const Q: usize>(
+    mean: &[f64],
+    deviations: &[f64],
+    s3: &[f64],
+    n: usize,
+) -> Vec<[f64; Q]> {
+    let (t, t_err) = (triples(n), triples(error_functions(n)));
+    let mean: [f64; Q] = std::array::from_fn(|v| dot(&mean[v * t..(v + 1) * t], s3));
+    deviations
+        .chunks_exact(Q * t_err)
+        .map(|d| {
+            std::array::from_fn(|v| mean[v] + dot(&d[v * t_err..(v + 1) * t_err], &s3[..t_err]))
+        })
+        .collect()
 }
 
 /// The lattice of the loop integrals of `precision`.

@@ -11,8 +11,9 @@
 
 use super::tensors::{fold, rank_update};
 use super::{
-    after_key, cache_file_name, error_functions, pair_index, triple_index, triples, LinearBasis,
-    Projection, SpectrumFamily, BASIS_SIZE, ERROR_FUNCTIONS, MAX_RESIDUAL,
+    after_key, cache_file_name, error_functions, pair_index, replica_contractions,
+    shift_statistics, triple_products, triples, LinearBasis, Projection, SpectrumFamily,
+    BASIS_SIZE, ERROR_FUNCTIONS, MAX_RESIDUAL,
 };
 use crate::linear::LinearSpectrum;
 use crate::loops::lattice::Lattice;
@@ -185,31 +186,9 @@ impl RsdTwoLoopBasis {
             })
             .collect();
         tensors.sort_by_key(|t| t.0);
-        let (t, t_err) = (triples(n), triples(error_functions(n)));
-        let (mut mean, mut deviations) = (Vec::new(), Vec::new());
-        for (i, shifts) in tensors.chunks(replicas).enumerate() {
-            let scale = integral_scale(sampling.counts[i]);
-            let mut m = vec![0.0; COEFFICIENTS * t];
-            for (_, s) in shifts {
-                m.iter_mut()
-                    .zip(s)
-                    .for_each(|(m, s)| *m += scale * s / replicas as f64);
-            }
-            let mut d = Vec::with_capacity(replicas * COEFFICIENTS * t_err);
-            for (_, s) in shifts {
-                for v in 0..COEFFICIENTS {
-                    let range = v * t..v * t + t_err;
-                    d.extend(
-                        s[range.clone()]
-                            .iter()
-                            .zip(&m[range])
-                            .map(|(s, m)| scale * s - m),
-                    );
-                }
-            }
-            mean.push(m);
-            deviations.push(d);
-        }
+        let (mean, deviations) = shift_statistics(&tensors, replicas, COEFFICIENTS, n, |i| {
+            integral_scale(sampling.counts[i])
+        });
         Self {
             k: k.to_vec(),
             key: key(k, q_range, lattice_step, settings, family),
@@ -251,41 +230,33 @@ impl RsdTwoLoopBasis {
     /// The projection, when the basis does not represent the spectrum well enough.
     pub fn evaluate(&self, spectrum: &LinearSpectrum) -> Result<RsdTwoLoopTerms, Projection> {
         let projection = self.project(spectrum);
-        if projection.residual.is_nan() || projection.residual > MAX_RESIDUAL {
+        if !Self::accepts(&projection) {
             return Err(projection);
         }
-        let c = &projection.coefficients;
-        let n = c.len();
-        let mut s3 = vec![0.0; triples(n)];
-        for b in 0..n {
-            for a in 0..=b {
-                for (j, cc) in c[b..].iter().enumerate() {
-                    s3[triple_index(a, b, b + j)] = c[a] * c[b] * cc;
-                }
-            }
-        }
-        let (t, t_err) = (triples(n), triples(error_functions(n)));
+        Ok(self.evaluate_projected(&projection))
+    }
+
+    /// Whether a spectrum with this projection is evaluated on the basis: its residual is at most
+    /// [`MAX_RESIDUAL`] (a NaN residual, from non-positive values, is refused).
+    pub fn accepts(projection: &Projection) -> bool {
+        projection.residual <= MAX_RESIDUAL
+    }
+
+    /// As [`evaluate`](Self::evaluate) with the spectrum's `projection` made (and accepted) by the
+    /// caller.
+    pub fn evaluate_projected(&self, projection: &Projection) -> RsdTwoLoopTerms {
+        let n = projection.coefficients.len();
+        let s3 = triple_products(&projection.coefficients);
         let replicas: Vec<Vec<[f64; COEFFICIENTS]>> = (0..self.k.len())
             .into_par_iter()
-            .map(|i| {
-                let mean: [f64; COEFFICIENTS] =
-                    std::array::from_fn(|v| super::dot(&self.mean[i][v * t..(v + 1) * t], &s3));
-                self.deviations[i]
-                    .chunks_exact(COEFFICIENTS * t_err)
-                    .map(|d| {
-                        std::array::from_fn(|v| {
-                            mean[v] + super::dot(&d[v * t_err..(v + 1) * t_err], &s3[..t_err])
-                        })
-                    })
-                    .collect()
-            })
+            .map(|i| replica_contractions(&self.mean[i], &self.deviations[i], &s3, n))
             .collect();
-        Ok(RsdTwoLoopTerms::from_coefficients(
+        RsdTwoLoopTerms::from_coefficients(
             &self.k,
             self.points.clone(),
             &replicas,
             RSD_PROJECTION_FACTOR * projection.residual,
-        ))
+        )
     }
 
     /// The tensors as the values of their cache file.

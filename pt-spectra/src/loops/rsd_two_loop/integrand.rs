@@ -5,17 +5,15 @@
 use super::zn::{product, FPoly, SubsetKernels};
 use super::{mu2_nodes, NodeIntegrals, MU_NODES};
 use crate::loops::mode_coupling::{Point, Sampled, Sampler};
-use crate::loops::two_loop::points_at;
+use crate::loops::two_loop::{points_at, random_shifts, sobol_sequence};
 use crate::loops::TwoLoopSettings;
-use sobol::params::JoeKuoD6;
-use sobol::Sobol;
 use std::f64::consts::PI;
 
 /// The points, shifts and maps of one integration on a k grid.
 pub(crate) struct Sampling {
     /// Sobol points per shift at each k.
     pub counts: Vec<usize>,
-    /// The Sobol points (the longest k's prefix).
+    /// The Sobol points (ln q₁, ln q₂, x₁, x₂, φ, φ_n; the longest k's prefix).
     pub points: Vec<[f64; 6]>,
     /// The Cranley–Patterson shifts of the replicas.
     pub shifts: Vec<[f64; 6]>,
@@ -29,9 +27,11 @@ impl Sampling {
     pub fn new(k: &[f64], q_range: (f64, f64), settings: &TwoLoopSettings) -> Self {
         let counts: Vec<usize> = k.iter().map(|&k| points_at(k, settings.points)).collect();
         Self {
-            points: sobol_points(counts.iter().copied().max().unwrap_or(0)),
+            points: sobol_sequence()
+                .take(counts.iter().copied().max().unwrap_or(0))
+                .collect(),
             counts,
-            shifts: shifts(settings.replicas, settings.seed),
+            shifts: random_shifts(settings),
             nodes: mu2_nodes().map(|m2| (m2.sqrt(), (1.0 - m2).max(0.0).sqrt())),
             ln_range: (q_range.0.ln(), q_range.1.ln()),
             radial_width: settings.radial_width,
@@ -244,21 +244,3 @@ fn propagator_sampler(range: (f64, f64)) -> Sampler {
 const PROPAGATOR_CENTRE: f64 = 0.3;
 /// Width in ln q of the radial density of the propagator part.
 const PROPAGATOR_WIDTH: f64 = 1.5;
-
-/// The 6-D Sobol sequence (ln q₁, ln q₂, x₁, x₂, φ, φ_n) without its first point.
-fn sobol_points(n: usize) -> Vec<[f64; 6]> {
-    Sobol::<f64>::new(6, &JoeKuoD6::standard())
-        .skip(1)
-        .take(n)
-        .map(|p| std::array::from_fn(|d| p[d]))
-        .collect()
-}
-
-/// The Cranley–Patterson shifts of the replicas (ChaCha8 from `seed`).
-fn shifts(replicas: usize, seed: u64) -> Vec<[f64; 6]> {
-    use rand::{Rng, SeedableRng};
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    (0..replicas)
-        .map(|_| std::array::from_fn(|_| rng.gen::<f64>()))
-        .collect()
-}
