@@ -2,8 +2,8 @@
 //!
 //! Every function here is `name<T: Scalar + Copy>(g: &[T; N]) -> [T; 2]`: it takes the Gram matrix of its basis
 //! vectors (upper triangle, row-major; the order is in `NAME_INFO.inputs` and in each function's docs)
-//! and returns `[F^s, G^s]`. Nothing here is hand-written: the bodies are flattened straight-line code
-//! emitted by `kernelgen` from the symmetrised subset recursion, with exact rational coefficients. The
+//! and returns `[F^s, G^s]`; the `redshift_n` functions return the n + 1 coefficients of Z_n in f
+//! (`[T; n + 1]`). Nothing here is hand-written: the bodies are flattened straight-line code emitted by `kernelgen` from the symmetrised subset recursion, with exact rational coefficients. The
 //! `_paired` functions take the Gram matrix as lane scalars and run in a [`PairScalar`] (see there).
 #![allow(clippy::all, clippy::pedantic, unused_parens, missing_docs)]
 
@@ -38,6 +38,17 @@ kernelgen::kernels! {
     /// The P17 propagator kernel in lane pairs: one evaluation, lane 1 running the mirror image of lane 0
     /// under a symmetry of the arguments (`pt_kernels::propagator_7` for `f64` runs it in [`crate::F64x2`]).
     propagator_7_paired = propagator(3) paired;
+
+    /// Z_1(q1; f, los) = 1 + f μ1², as `[1, μ1²]`.
+    redshift_1 = redshift(1);
+    /// Z_2(q1, q2; f, los) as its coefficients in f.
+    redshift_2 = redshift(2);
+    /// Z_3(q1, q2, q3; f, los) as its coefficients in f.
+    redshift_3 = redshift(3);
+    /// Z_4(q1, …, q4; f, los) as its coefficients in f.
+    redshift_4 = redshift(4);
+    /// Z_5(q1, …, q5; f, los) as its coefficients in f.
+    redshift_5 = redshift(5);
 
     /// The P22 mode-coupling kernel F_2^s(q, k − q).
     mode_coupling_2 = basis(k, q) args(q, k - q);

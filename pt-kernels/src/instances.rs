@@ -25,6 +25,13 @@ pub trait Evaluate: Scalar {
     /// # Errors
     /// [`KernelError::Order`] if n is outside 1..=7 or `g` does not have n(n+1)/2 entries.
     fn general(n: usize, g: &[Self]) -> Result<[Self; 2], KernelError>;
+    /// The coefficients `[Z^(0), …, Z^(n)]` of the redshift-space kernel Z_n = Σ_m f^m Z^(m), n = 1..=5,
+    /// from the Gram matrix of (q_1, …, q_n, line of sight) ((n+1)(n+2)/2 entries; see
+    /// [`generated::redshift_5`] for the order).
+    ///
+    /// # Errors
+    /// [`KernelError::Order`] if n is outside 1..=5 or `g` has the wrong length.
+    fn redshift(n: usize, g: &[Self]) -> Result<Vec<Self>, KernelError>;
     /// F_3^s(k, q, −q) from [k·k, k·q, q·q].
     fn propagator_3(g: &[Self; 3]) -> [Self; 2];
     /// F_5^s(k, q1, −q1, q2, −q2) from [k·k, k·q1, k·q2, q1·q1, q1·q2, q2·q2].
@@ -68,6 +75,28 @@ fn general_dispatch<T: Scalar + Copy>(n: usize, g: &[T]) -> Result<[T; 2], Kerne
     })
 }
 
+/// Calls the generated redshift-space kernel of order n with a slice of the right length.
+fn redshift_dispatch<T: Scalar + Copy>(n: usize, g: &[T]) -> Result<Vec<T>, KernelError> {
+    fn call<T: Scalar + Copy, const N: usize, const M: usize>(
+        g: &[T],
+        f: fn(&[T; N]) -> [T; M],
+    ) -> Vec<T> {
+        f(g.try_into().expect("length checked by the caller")).to_vec()
+    }
+    if g.len() != (n + 1) * (n + 2) / 2 {
+        return Err(KernelError::Order(n));
+    }
+    use generated::*;
+    Ok(match n {
+        1 => call(g, redshift_1),
+        2 => call(g, redshift_2),
+        3 => call(g, redshift_3),
+        4 => call(g, redshift_4),
+        5 => call(g, redshift_5),
+        _ => return Err(KernelError::Order(n)),
+    })
+}
+
 impl Evaluate for f64 {
     fn normalised(q: &[[f64; 3]]) -> Vec<[f64; 3]> {
         let largest = q.iter().flatten().fold(0.0_f64, |m, c| m.max(c.abs()));
@@ -96,6 +125,9 @@ impl Evaluate for f64 {
     }
     fn general(n: usize, g: &[f64]) -> Result<[f64; 2], KernelError> {
         general_dispatch(n, g)
+    }
+    fn redshift(n: usize, g: &[f64]) -> Result<Vec<f64>, KernelError> {
+        redshift_dispatch(n, g)
     }
     fn propagator_3(g: &[f64; 3]) -> [f64; 2] {
         generated::propagator_3(g)
@@ -132,6 +164,15 @@ impl Evaluate for BigRational {
         tape::record(|| {
             let g: Vec<Exact> = g.iter().cloned().map(Exact::new).collect();
             Ok(general_dispatch(n, &g)?.map(Exact::value))
+        })
+    }
+    fn redshift(n: usize, g: &[BigRational]) -> Result<Vec<BigRational>, KernelError> {
+        tape::record(|| {
+            let g: Vec<Exact> = g.iter().cloned().map(Exact::new).collect();
+            Ok(redshift_dispatch(n, &g)?
+                .into_iter()
+                .map(Exact::value)
+                .collect())
         })
     }
     fn propagator_3(g: &[BigRational; 3]) -> [BigRational; 2] {

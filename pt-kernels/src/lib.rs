@@ -119,6 +119,11 @@ pub fn all_info() -> Vec<&'static KernelInfo> {
         &MODE_COUPLING_2_INFO,
         &MODE_COUPLING_3_INFO,
         &MODE_COUPLING_4_INFO,
+        &REDSHIFT_1_INFO,
+        &REDSHIFT_2_INFO,
+        &REDSHIFT_3_INFO,
+        &REDSHIFT_4_INFO,
+        &REDSHIFT_5_INFO,
     ]);
     v
 }

@@ -19,15 +19,19 @@
 //! Z_1 = 1 + fμ², Z_2 = F_2 + fμ²G_2 + (fμk/2)[μ_1/q_1 (1 + fμ_2²) + μ_2/q_2 (1 + fμ_1²)], and Z_n = F_n at
 //! f = 0. Everything is rational in the dot products: (kμ)(μ_S/k_S) = (n̂·k)(n̂·k_S)/(n̂·n̂ k_S²) and
 //! μ_S² = (n̂·k_S)²/(n̂·n̂ k_S²), so the line of sight need not be a unit vector and the kernels are exact
-//! in [`num_rational::BigRational`]. The F_S, G_S come from the generated kernels; a subset with exactly
-//! zero total momentum contributes its limit, zero (F_S, G_S ∝ k_S²).
+//! in [`num_rational::BigRational`]; a subset with exactly zero total momentum contributes its limit, zero
+//! (F_S, G_S ∝ k_S²).
+//!
+//! [`redshift_coefficients`] and [`redshift_kernel`] run straight-line code that `kernelgen` emits from this
+//! expansion (with the F_S, G_S recursion inlined and every rational constant folded) as the coefficients of
+//! f^0 … f^n, from the Gram matrix of (q_1, …, q_n, n̂): like F_n and G_n, it runs in `f64` and exactly.
 //!
 //! [`brute_force_redshift`] is the oracle: the same expansion with the *unsymmetrised* kernels of
 //! [`crate::reference`] on consecutive blocks of an ordering, averaged over all n! orderings (no subsets,
 //! no set partitions, no factorial weights).
 
 use crate::reference::{unsymmetrised, ReferenceError};
-use crate::{dot, kernels, one, zero, Evaluate, KernelError, Scalar, MAX_ORDER};
+use crate::{dot, gram, one, zero, Evaluate, KernelError, Scalar, MAX_ORDER};
 
 /// Largest order of the redshift-space kernels.
 pub const MAX_REDSHIFT_ORDER: usize = 5;
@@ -75,53 +79,35 @@ fn check<T: Scalar>(q: &[[T; 3]], los: &[T; 3]) -> Result<(), KernelError> {
     Ok(())
 }
 
-/// Z_n(q_1, …, q_n; f, n̂) for n = 1..=[`MAX_REDSHIFT_ORDER`] (module docs): `f` the growth rate, `los`
-/// the line of sight (any non-zero vector; only its direction enters).
+/// The coefficients `[Z^(0), …, Z^(n)]` of Z_n(q_1, …, q_n; f, n̂) = Σ_m f^m Z^(m), n = 1..=[`MAX_REDSHIFT_ORDER`]
+/// (module docs), from the generated straight-line code ([`crate::generated::redshift_5`] and its
+/// siblings): `los` is the line of sight (any non-zero vector; only its direction enters). Z^(0) = F_n^s.
+///
+/// In `f64` the q's and the line of sight are each scaled by a power of two first (the kernels are
+/// homogeneous of degree 0 in both), as [`crate::kernels`] does.
 ///
 /// # Errors
 /// [`KernelError::Order`] for n outside 1..=5, [`KernelError::ZeroVector`] for a zero argument (index
 /// from 1), [`KernelError::ZeroLineOfSight`].
-pub fn redshift_kernel<T: Evaluate>(q: &[[T; 3]], f: &T, los: &[T; 3]) -> Result<T, KernelError> {
+pub fn redshift_coefficients<T: Evaluate>(
+    q: &[[T; 3]],
+    los: &[T; 3],
+) -> Result<Vec<T>, KernelError> {
     check(q, los)?;
-    let n = q.len();
-    let full = (1usize << n) - 1;
-    let k = total(q);
-    // D and U of every non-empty subset (F_S, G_S from the generated kernels, which, like `pieces`,
-    // give the limit of a subset with zero total momentum)
-    let mut d = vec![zero::<T>(); full + 1];
-    let mut u = vec![zero::<T>(); full + 1];
-    for mask in 1..=full {
-        let members: Vec<[T; 3]> = (0..n)
-            .filter(|i| mask >> i & 1 == 1)
-            .map(|i| q[i].clone())
-            .collect();
-        [d[mask], u[mask]] = pieces(f, los, &k, &total(&members), kernels(&members)?);
-    }
-    // E(R): the blocks B containing the lowest member of R, then the rest
-    let mut e = vec![zero::<T>(); full + 1];
-    e[0] = one();
-    for r in 1..=full {
-        let low = r & r.wrapping_neg();
-        let rest = r ^ low;
-        let mut sum = zero::<T>();
-        let mut sub = rest;
-        loop {
-            let block = sub | low;
-            let size = block.count_ones() as usize;
-            sum = sum + factorial::<T>(size) * u[block].clone() * e[r ^ block].clone();
-            if sub == 0 {
-                break;
-            }
-            sub = (sub - 1) & rest;
-        }
-        e[r] = sum;
-    }
-    let mut z = zero::<T>();
-    for s0 in 1..=full {
-        let size = s0.count_ones() as usize;
-        z = z + factorial::<T>(size) * d[s0].clone() * e[full ^ s0].clone();
-    }
-    Ok(z / factorial::<T>(n))
+    let mut vectors = T::normalised(q);
+    vectors.extend(T::normalised(std::slice::from_ref(los)));
+    T::redshift(q.len(), &gram(&vectors))
+}
+
+/// Z_n(q_1, …, q_n; f, n̂) for n = 1..=[`MAX_REDSHIFT_ORDER`]: [`redshift_coefficients`] summed in f.
+///
+/// # Errors
+/// As [`redshift_coefficients`].
+pub fn redshift_kernel<T: Evaluate>(q: &[[T; 3]], f: &T, los: &[T; 3]) -> Result<T, KernelError> {
+    let c = redshift_coefficients(q, los)?;
+    Ok(c.iter()
+        .rev()
+        .fold(zero::<T>(), |acc, c| acc * f.clone() + c.clone()))
 }
 
 /// The oracle of [`redshift_kernel`]: for every ordering of the arguments, every composition

@@ -21,6 +21,7 @@ fn spec_of(info: &KernelInfo) -> Spec {
     match info.name {
         n if n.starts_with("general_") => Spec::free(n, info.order).unwrap(),
         n if n.starts_with("propagator_") => Spec::propagator(n, (info.order - 1) / 2).unwrap(),
+        n if n.starts_with("redshift_") => Spec::redshift(n, info.order).unwrap(),
         "mode_coupling_2" => Spec::new(
             "mode_coupling_2",
             basis_of(&["k", "q"]),

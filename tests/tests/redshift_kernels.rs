@@ -1,13 +1,14 @@
-//! The redshift-space kernels Z_n (n ≤ 5) in exact rationals: against the brute-force oracle (the
-//! unsymmetrised expansion averaged over all n! orderings), the closed forms of Z_1 and Z_2
-//! (Scoccimarro, Couchman & Frieman 1999), and the limit f = 0, where Z_n = F_n^s.
+//! The redshift-space kernels Z_n (n ≤ 5), generated as straight-line code by kernelgen, in exact
+//! rationals: against the brute-force oracle (the unsymmetrised expansion averaged over all n! orderings),
+//! the closed forms of Z_1 and Z_2 (Scoccimarro, Couchman & Frieman 1999), the limit f = 0, where
+//! Z_n = F_n^s, and the highest power of f, a product of linear velocity terms.
 
 mod common;
 
 use common::*;
 use num_traits::{ToPrimitive, Zero};
 use proptest::prelude::*;
-use pt_kernels::redshift::{brute_force_redshift, redshift_kernel};
+use pt_kernels::redshift::{brute_force_redshift, redshift_coefficients, redshift_kernel};
 use pt_kernels::reference::ReferenceError;
 use pt_kernels::{dot, kernels, KernelError};
 
@@ -42,8 +43,45 @@ macro_rules! against_brute_force {
 against_brute_force!(z1_equals_brute_force_exactly, 1, 16);
 against_brute_force!(z2_equals_brute_force_exactly, 2, 48);
 against_brute_force!(z3_equals_brute_force_exactly, 3, 32);
-against_brute_force!(z4_equals_brute_force_exactly, 4, 12);
-against_brute_force!(z5_equals_brute_force_exactly, 5, 4);
+against_brute_force!(z4_equals_brute_force_exactly, 4, 24);
+against_brute_force!(z5_equals_brute_force_exactly, 5, 12);
+
+/// The coefficient of f^n in Z_n: only S_0 = {i} with the rest in singletons reaches it, so
+/// Z^(n) = (kμ)^(n−1)/n! Σ_i μ_i² Π_{j≠i} μ_j/q_j (unit line of sight), exactly, n ≤ 5.
+#[test]
+fn the_highest_power_of_f_is_a_product_of_linear_velocity_terms() {
+    let qs = [
+        v(1, 2, -1, 2),
+        v(-1, 1, 3, 3),
+        v(2, -1, 1, 1),
+        v(0, 1, -2, 3),
+        v(3, 0, 1, 2),
+    ];
+    let los = v(0, 3, 4, 5);
+    for n in 1..=5 {
+        let args = &qs[..n];
+        let k = args.iter().fold(v(0, 0, 0, 1), |a, b| add(&a, b));
+        let mu2 = |a: &[Q; 3]| dot(&los, a) * dot(&los, a) / dot(a, a);
+        let mu_over = |a: &[Q; 3]| dot(&los, a) / dot(a, a);
+        let mut sum = Q::zero();
+        for i in 0..n {
+            let mut term = mu2(&args[i]);
+            for (j, a) in args.iter().enumerate() {
+                if j != i {
+                    term *= mu_over(a);
+                }
+            }
+            sum += term;
+        }
+        let kmu = dot(&los, &k);
+        let factorial: i64 = (1..=n as i64).product();
+        let expected = (0..n - 1).fold(sum, |acc, _| acc * &kmu) / q(factorial, 1);
+        let z = redshift_coefficients(args, &los).unwrap();
+        assert_eq!(z.len(), n + 1);
+        assert_eq!(z[n], expected, "n = {n}");
+        assert_eq!(z[0], kernels(args).unwrap()[0], "n = {n}");
+    }
+}
 
 /// Z_1 = 1 + fμ², Z_2 = F_2 + fμ²G_2 + (fμk/2)[μ_1/q_1 (1 + fμ_2²) + μ_2/q_2 (1 + fμ_1²)]
 /// (SCF99 eq. 21 with b_1 = 1, b_2 = 0), with μ's along a unit line of sight.

@@ -10,6 +10,7 @@ fn main() {
     specs.extend(
         (1..=3).map(|x| Spec::propagator(&format!("propagator_{}", 2 * x + 1), x).unwrap()),
     );
+    specs.extend((1..=5).map(|n| Spec::redshift(&format!("redshift_{n}"), n).unwrap()));
     let b = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
     specs.push(
         Spec::new(

@@ -17,11 +17,12 @@ pub mod pairing;
 pub mod parse;
 pub mod program;
 pub mod recursion;
+pub mod redshift;
 pub mod spec;
 
 pub use program::{OpCounts, Program};
 pub use recursion::vertices;
-pub use spec::Spec;
+pub use spec::{Kind, Spec};
 
 use proc_macro2::TokenStream;
 
@@ -34,6 +35,12 @@ pub fn expand(input: TokenStream) -> syn::Result<TokenStream> {
     let mut out = TokenStream::new();
     for item in &input.items {
         let program = Program::build(&item.spec);
+        if item.paired && item.spec.kind != Kind::Spt {
+            return Err(syn::Error::new(
+                proc_macro2::Span::call_site(),
+                format!("`{}`: only F^s, G^s kernels can be paired", item.spec.name),
+            ));
+        }
         if item.paired {
             let paired = pairing::best_pairing(&program).ok_or_else(|| {
                 syn::Error::new(

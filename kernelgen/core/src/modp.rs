@@ -124,7 +124,7 @@ pub fn evaluate_direct(program: &Program, g: &[Fp]) -> (Fp, Fp) {
         let c = Fp::from_q(&x.coef);
         x.node.map_or(c, |id| c.mul(v[id]))
     };
-    (out(&program.f), out(&program.g))
+    (out(&program.outputs[0]), out(&program.outputs[1]))
 }
 
 /// Evaluates the paired program modulo p at `g` (both lanes), for tests: returns (F, G).

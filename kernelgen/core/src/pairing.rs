@@ -166,7 +166,7 @@ fn pair_at(program: &Program, inv: &Involution, samples: &Samples) -> Option<Pai
             }
         }
     };
-    let (f, g) = (output(&program.f), output(&program.g));
+    let (f, g) = (output(&program.outputs[0]), output(&program.outputs[1]));
     b.counts.statements = b.ops.len();
     b.counts.direct = program.op_counts().statements;
     let paired = Paired {

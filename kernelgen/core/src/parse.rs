@@ -6,6 +6,7 @@
 //! /// docs …
 //! general_3 = free(3);                            // F_3^s(q1, q2, q3) of free vectors
 //! propagator_5 = propagator(2);                   // F_5^s(k, q1, −q1, q2, −q2)
+//! redshift_3 = redshift(3);                       // Z_3(q1, q2, q3; f, los) as [Z^(0), …, Z^(3)] in f
 //! mode_coupling_3 = basis(k, q1, q2) args(q1, q2, k - q1 - q2);
 //! propagator_7_paired = propagator(3) paired;     // in lane pairs (needs `pair = <trait>;` after `info`)
 //! ```
@@ -80,6 +81,7 @@ impl Parse for KernelItem {
         let spec = match kind.to_string().as_str() {
             "free" => Spec::free(&fname, parenthesized_int(input)?).map_err(err)?,
             "propagator" => Spec::propagator(&fname, parenthesized_int(input)?).map_err(err)?,
+            "redshift" => Spec::redshift(&fname, parenthesized_int(input)?).map_err(err)?,
             "basis" => {
                 let content;
                 parenthesized!(content in input);
@@ -100,7 +102,7 @@ impl Parse for KernelItem {
             other => {
                 return Err(syn::Error::new(
                     kind.span(),
-                    format!("unknown configuration `{other}`: expected free(n), propagator(x) or basis(..) args(..)"),
+                    format!("unknown configuration `{other}`: expected free(n), propagator(x), redshift(n) or basis(..) args(..)"),
                 ))
             }
         };
@@ -180,10 +182,12 @@ mod tests {
              b = propagator(2);
              c = basis(k, q1, q2) args(q1, q2, k - q1 - q2);
              d = basis(k, q) args(2*q - k, -(k - q));
-             e = propagator(3) paired;",
+             e = propagator(3) paired;
+             z = redshift(2);",
         )
         .unwrap();
-        assert_eq!(input.items.len(), 5);
+        assert_eq!(input.items.len(), 6);
+        assert_eq!(input.items[5].spec.line_of_sight(), Some(2));
         assert!(input.items[4].paired && !input.items[3].paired);
         assert!(input.paths.pair.is_none());
         assert_eq!(input.items[0].docs.len(), 1);

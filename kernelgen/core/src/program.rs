@@ -6,7 +6,7 @@
 
 use crate::dag::{coefficient_muls, q, Dag, Op, Value, Q};
 use crate::recursion::{momentum, Algebra, Mask, Recursion, RecursionStats};
-use crate::spec::Spec;
+use crate::spec::{Kind, Spec};
 use num_traits::Zero;
 use std::collections::HashMap;
 
@@ -20,7 +20,7 @@ pub struct Graph<'s> {
 }
 
 impl<'s> Graph<'s> {
-    fn new(spec: &'s Spec) -> Self {
+    pub(crate) fn new(spec: &'s Spec) -> Self {
         Graph {
             spec,
             dag: Dag::new(),
@@ -70,6 +70,28 @@ impl<'s> Graph<'s> {
         v
     }
 
+    /// k_S·e_b, the dot product of a subset's momentum with basis vector `b`: a linear form in the inputs.
+    pub fn basis_dot(&mut self, s: Mask, b: usize) -> Value {
+        let mut unit = vec![0; self.spec.basis.len()];
+        unit[b] = 1;
+        let f = self.form(&momentum(self.spec, s), &unit);
+        self.form_value(f.clone(), |g| {
+            let terms: Vec<(Q, Value)> = f
+                .iter()
+                .enumerate()
+                .filter(|(_, &x)| x != 0)
+                .map(|(i, &x)| (q(x, 1), g.dag.input(i)))
+                .collect();
+            g.dag.lin(&terms)
+        })
+    }
+
+    /// e_a·e_b, one input.
+    pub fn input(&mut self, a: usize, b: usize) -> Value {
+        let i = self.spec.gram_index(a, b);
+        self.dag.input(i)
+    }
+
     /// (k_X² + k_Y² − k_Z²)/2 from three subset norms: a dot product in two additions.
     fn half_sum(&mut self, x: Mask, y: Mask, z: Mask) -> Value {
         let (x, y, z) = (self.norm(x), self.norm(y), self.norm(z));
@@ -114,16 +136,14 @@ impl Algebra for Graph<'_> {
     }
 }
 
-/// A generated kernel: its configuration, its straight-line program and the two outputs.
+/// A generated kernel: its configuration, its straight-line program and its outputs.
 pub struct Program {
     /// The configuration.
     pub spec: Spec,
     /// The expression graph (only nodes reachable from the outputs are emitted).
     pub dag: Dag,
-    /// F^s of the configuration.
-    pub f: Value,
-    /// G^s of the configuration.
-    pub g: Value,
+    /// `[F^s, G^s]` of the configuration, or the n + 1 coefficients of Z_n ([`Kind::Redshift`]).
+    pub outputs: Vec<Value>,
     /// What the recursion did.
     pub stats: RecursionStats,
 }
@@ -152,20 +172,25 @@ impl Program {
     /// Runs the recursion for `spec` on a fresh graph.
     pub fn build(spec: &Spec) -> Program {
         let mut rec = Recursion::new(spec, Graph::new(spec));
-        let (f, g) = rec.top();
+        let outputs = match spec.kind {
+            Kind::Spt => {
+                let (f, g) = rec.top();
+                vec![f, g]
+            }
+            Kind::Redshift => crate::redshift::coefficients(spec, &mut rec),
+        };
         let stats = rec.stats;
         Program {
             spec: spec.clone(),
             dag: rec.alg.dag,
-            f,
-            g,
+            outputs,
             stats,
         }
     }
 
     /// Which graph nodes the outputs need.
     pub fn live(&self) -> Vec<bool> {
-        self.dag.live(&[&self.f, &self.g])
+        self.dag.live(&self.outputs.iter().collect::<Vec<_>>())
     }
 
     /// Operation counts of the emitted code.
@@ -204,8 +229,7 @@ impl Program {
                 }
             }
         }
-        push(&self.f.coef.abs_value());
-        push(&self.g.coef.abs_value());
+        self.outputs.iter().for_each(|o| push(&o.coef.abs_value()));
         out
     }
 

@@ -16,6 +16,19 @@ pub struct Spec {
     pub basis: Vec<String>,
     /// The kernel's arguments; `args[i][b]` is the coefficient of basis vector `b` in argument `i`.
     pub args: Vec<Vec<i64>>,
+    /// What is generated: F^s, G^s, or the redshift-space Z_n with the last basis vector as the line of
+    /// sight.
+    pub kind: Kind,
+}
+
+/// What a configuration generates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// `[F^s, G^s]` of the arguments.
+    Spt,
+    /// `[Z^(0), …, Z^(n)]`, the coefficients of f^m in the redshift-space kernel Z_n of the arguments
+    /// (see [`crate::redshift`]); the last basis vector is the line of sight, on which no argument depends.
+    Redshift,
 }
 
 /// Largest kernel order the engine generates.
@@ -68,7 +81,32 @@ impl Spec {
             name: name.to_owned(),
             basis,
             args,
+            kind: Kind::Spt,
         })
+    }
+
+    /// The redshift-space kernel Z_n(q1, …, qn) of n free vectors, with the line of sight `los` as an
+    /// extra basis vector (its dot products with the q_i and with itself are inputs).
+    pub fn redshift(name: &str, n: usize) -> Result<Self, SpecError> {
+        let mut basis: Vec<String> = (1..=n).map(|i| format!("q{i}")).collect();
+        basis.push("los".to_owned());
+        let args = (0..n).map(|i| unit(n + 1, i)).collect();
+        let mut spec = Spec::new(name, basis, args)?;
+        spec.kind = Kind::Redshift;
+        Ok(spec)
+    }
+
+    /// Index of the line of sight among the basis vectors, for [`Kind::Redshift`].
+    pub fn line_of_sight(&self) -> Option<usize> {
+        (self.kind == Kind::Redshift).then(|| self.basis.len() - 1)
+    }
+
+    /// Number of outputs: 2 (F, G), or n + 1 coefficients of Z_n.
+    pub fn n_outputs(&self) -> usize {
+        match self.kind {
+            Kind::Spt => 2,
+            Kind::Redshift => self.order() + 1,
+        }
     }
 
     /// The general kernel F_n^s(q1, …, qn) of n free vectors.
@@ -194,6 +232,18 @@ mod tests {
             spec.input_names(),
             ["k.k", "k.q1", "k.q2", "q1.q1", "q1.q2", "q2.q2"]
         );
+    }
+
+    #[test]
+    fn redshift_configurations_carry_the_line_of_sight_last() {
+        let spec = Spec::redshift("z2", 2).unwrap();
+        assert_eq!(spec.arg_names(), ["q1", "q2"]);
+        assert_eq!(
+            spec.input_names(),
+            ["q1.q1", "q1.q2", "q1.los", "q2.q2", "q2.los", "los.los"]
+        );
+        assert_eq!((spec.line_of_sight(), spec.n_outputs()), (Some(2), 3));
+        assert_eq!(Spec::free("f", 2).unwrap().line_of_sight(), None);
     }
 
     #[test]
