@@ -135,23 +135,7 @@ pub(crate) fn linear_form(weights: &[f64], rows: &Rows<'_>) -> Vec<f64> {
     out
 }
 
-/// Σ a_i b_i of f32 tensor entries and f64 products, summed in f64 with four partial sums.
-pub(crate) fn dot32(a: &[f32], b: &[f64]) -> f64 {
-    let mut s = [0.0; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = ca
-        .remainder()
-        .iter()
-        .zip(cb.remainder())
-        .map(|(x, y)| f64::from(*x) * y)
-        .sum();
-    for (x, y) in ca.zip(cb) {
-        for i in 0..4 {
-            s[i] += f64::from(x[i]) * y[i];
-        }
-    }
-    (s[0] + s[1]) + (s[2] + s[3]) + tail
-}
+pub(crate) use super::simd::dot32;
 
 /// The products c_a c_b on the pairs a ≤ b.
 pub(crate) fn pair_products(c: &[f64]) -> Vec<f64> {

@@ -188,7 +188,7 @@ impl LinearBasis {
             }
         }
         let projected: Vec<f64> = (0..self.lattice.len)
-            .map(|j| dot(self.row(j), &c))
+            .map(|j| super::dot(self.row(j), &c))
             .collect();
         let relative: Vec<f64> = projected
             .iter()
@@ -197,7 +197,7 @@ impl LinearBasis {
             .collect();
         let finite = |r: f64| if r.is_nan() { f64::INFINITY } else { r };
         let pointwise = relative.iter().map(|r| r.abs()).fold(0.0, f64::max);
-        let residual = smoothed(&relative, SMOOTHING / self.lattice.step)
+        let residual = smoothed(&relative, SMOOTHING / self.lattice.step, RESIDUAL_STRIDE)
             .iter()
             .map(|r| r.abs())
             .fold(0.0, f64::max);
@@ -236,9 +236,14 @@ impl LinearBasis {
     }
 }
 
+/// The smoothed residual is evaluated at every this many lattice points (0.4 of the smoothing width
+/// apart at the lattice step 0.01): a peak of the smoothed residual, at least the smoothing width wide,
+/// is then underestimated by at most 1 − e^{−0.2²/2} = 2%, for a quarter of the work.
+const RESIDUAL_STRIDE: usize = 4;
+
 /// `values` smoothed with a Gaussian of `width` points (standard deviation), truncated at 3 widths
-/// and renormalised at the ends.
-fn smoothed(values: &[f64], width: f64) -> Vec<f64> {
+/// and renormalised at the ends, at every `stride`-th point (and the last).
+fn smoothed(values: &[f64], width: f64, stride: usize) -> Vec<f64> {
     let reach = (3.0 * width).ceil() as usize;
     let g: Vec<f64> = (0..=reach)
         .map(|d| (-0.5 * (d as f64 / width).powi(2)).exp())
@@ -248,6 +253,8 @@ fn smoothed(values: &[f64], width: f64) -> Vec<f64> {
     let kernel: Vec<f64> = (0..=2 * reach).map(|i| g[i.abs_diff(reach)]).collect();
     let norm = 1.0 / kernel.iter().sum::<f64>();
     (0..len)
+        .step_by(stride)
+        .chain((len > 0 && !(len - 1).is_multiple_of(stride)).then(|| len - 1))
         .map(|j| {
             if j >= reach && j + reach < len {
                 return norm * super::dot(&values[j - reach..=j + reach], &kernel);
@@ -319,7 +326,7 @@ mod tests {
     fn smoothing_keeps_straight_lines_and_spreads_a_spike_over_its_width() {
         // A symmetric window keeps a linear function exactly away from the ends.
         let line: Vec<f64> = (0..200).map(|j| 0.3 - 0.01 * j as f64).collect();
-        let s = smoothed(&line, 10.0);
+        let s = smoothed(&line, 10.0, 1);
         for j in 30..170 {
             assert!((s[j] - line[j]).abs() < 1e-14, "{j}");
         }
@@ -327,8 +334,13 @@ mod tests {
         // one width away e^{−1/2} of that.
         let mut spike = vec![0.0; 200];
         spike[100] = 1.0;
-        let s = smoothed(&spike, 10.0);
+        let s = smoothed(&spike, 10.0, 1);
         assert!((s[100] * 10.0 * (2.0 * std::f64::consts::PI).sqrt() - 1.0).abs() < 3e-3);
         assert!((s[110] / s[100] - (-0.5f64).exp()).abs() < 1e-14);
+        // Every fourth point, and the last: the same values there.
+        let every = smoothed(&spike, 10.0, 4);
+        assert_eq!(every.len(), 51);
+        assert_eq!(every[25], s[100]);
+        assert_eq!(every[50], s[199]);
     }
 }

@@ -39,6 +39,7 @@ mod one_loop;
 mod p15_forms;
 mod redshift;
 mod rsd_two_loop;
+mod simd;
 mod tensors;
 mod tns;
 pub mod training;
@@ -532,20 +533,7 @@ fn lattice_of(precision: &Precision) -> Lattice {
     Lattice::new(precision.q_min, precision.q_max, precision.lattice_step)
 }
 
-/// Σ a_i b_i with four partial sums (so that it vectorises).
+/// Σ a_i b_i, vectorised for the processor ([`simd`]).
 fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut s = [0.0; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = ca
-        .remainder()
-        .iter()
-        .zip(cb.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (x, y) in ca.zip(cb) {
-        for i in 0..4 {
-            s[i] += x[i] * y[i];
-        }
-    }
-    (s[0] + s[1]) + (s[2] + s[3]) + tail
+    simd::dot(a, b)
 }
