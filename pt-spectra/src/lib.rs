@@ -52,6 +52,7 @@ pub mod real;
 pub mod resum;
 pub mod rsd;
 pub mod setup;
+mod simd;
 pub mod store;
 pub mod survey;
 pub mod table;

@@ -8,6 +8,8 @@ in under a millisecond), one core, a new CAMB spectrum at every call, tensors ca
   grid in the same run;
 * TNS multipoles ℓ = 0, 2, 4 from 1L-SPT, 50 k; the galaxy model ``ept`` with IR, 50 k (both with
   ``two_loop="basis"``: the real-space, TNS and galaxy-model terms from their basis tensors);
+* 2L-SPT and 2L-RegPT, 40 k in [0.005, 0.4] (1- and 2-loop terms from the basis tensors, RegPT's
+  vertex terms integrated), ``RealPlan.batch`` with terms;
 * a batch of 100 spectra on 1 and on 2 threads (separate processes: the pool is set once).
 
 Medians over the calls; the spectra are CAMB's for 8 cosmologies inside the EuclidEmulator2 box.
@@ -78,6 +80,9 @@ def main():
     real = pt.RealPlan(np.geomspace(1e-3, 1, 100), model="1l-spt", two_loop="basis")
     tns = pt.RsdPlan(np.geomspace(0.01, 0.3, 50), real="1l-spt", rsd="tns", two_loop="basis")
     ept = pt.EptPlan(np.geomspace(0.01, 0.3, 50), ir=True, two_loop="basis")
+    two_loop_k = np.geomspace(0.005, 0.4, 40)
+    spt2l = pt.RealPlan(two_loop_k, model="2l-spt", two_loop="basis")
+    regpt = pt.RealPlan(two_loop_k, model="2l-regpt", two_loop="basis")
     rows = [
         ("1-loop SPT + terms, 100 k: batch (arrays)",
          median_ms(lambda k, p: real.batch(k, p, terms=True), spectra)),
@@ -88,6 +93,10 @@ def main():
                                     fog="lorentzian", sigma0=3.5), spectra, 50)),
         ("ept (IR on), 50 k",
          median_ms(lambda k, p: ept(linear=(k, p), cosmology="planck2018", b1=2.0), spectra, 50)),
+        ("2L-SPT + terms, 40 k: batch (arrays)",
+         median_ms(lambda k, p: spt2l.batch(k, p, terms=True), spectra, 50)),
+        ("2L-RegPT + terms, 40 k: batch (arrays)",
+         median_ms(lambda k, p: regpt.batch(k, p, terms=True), spectra, 50)),
     ]
     try:
         import fastpt

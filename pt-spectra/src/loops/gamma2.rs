@@ -38,6 +38,7 @@ use super::lattice::Lattice;
 use super::{ByPair, Estimate, Pair};
 use crate::integrate::{panel_edges, GaussLegendre};
 use crate::linear::LinearSpectrum;
+use crate::simd::dot32;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -133,8 +134,8 @@ struct Nodes {
     /// Per k: the range of its outer nodes.
     k_start: Vec<usize>,
     outer: Vec<Outer>,
-    /// Per outer node, per radial node: the weights of P(r_j) in [Γ2_F, Γ2_G].
-    weights: Vec<[f32; 2]>,
+    /// Per outer node: the weights of P(r_j) in Γ2_F over the radial nodes, then those in Γ2_G.
+    weights: Vec<f32>,
 }
 
 /// The angular nodes (x₂, s₂ cos φ, weight) of the `n` × `n` Gauss–Legendre rule on [0, 1] × [0, π].
@@ -266,7 +267,7 @@ impl Nodes {
             .par_chunks(CHUNK)
             .zip(ks.par_chunks(CHUNK))
             .flat_map_iter(|(outer, ks)| {
-                let w: Vec<[f32; 2]> = outer
+                let w: Vec<f32> = outer
                     .iter()
                     .zip(ks)
                     .flat_map(|(o, &k)| {
@@ -274,7 +275,9 @@ impl Nodes {
                             (lattice.x0 + o.u_q * lattice.step).exp(),
                             (lattice.x0 + o.u_p * lattice.step).exp(),
                         );
-                        inner_weights(k, q, p, &self.radial, [&near, &far])
+                        let w = inner_weights(k, q, p, &self.radial, [&near, &far]);
+                        let (f, g): (Vec<f32>, Vec<f32>) = w.iter().map(|w| (w[0], w[1])).unzip();
+                        f.into_iter().chain(g)
                     })
                     .collect();
                 report(outer.len());
@@ -298,11 +301,8 @@ impl Nodes {
         let mut out = [[0.0; 3]; 2];
         for j in self.k_start[i]..self.k_start[i + 1] {
             let o = &self.outer[j];
-            let mut g = [0.0; 2];
-            for (w, &p) in self.weights[j * n..(j + 1) * n].iter().zip(p_r) {
-                g[0] += f64::from(w[0]) * p;
-                g[1] += f64::from(w[1]) * p;
-            }
+            let w = &self.weights[2 * j * n..2 * (j + 1) * n];
+            let g = [dot32(&w[..n], p_r), dot32(&w[n..], p_r)];
             let spectra = o.weight
                 * lattice.interpolate(samples, o.u_q)
                 * lattice.interpolate(samples, o.u_p);

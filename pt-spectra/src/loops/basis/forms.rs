@@ -135,7 +135,7 @@ pub(crate) fn linear_form(weights: &[f64], rows: &Rows<'_>) -> Vec<f64> {
     out
 }
 
-pub(crate) use super::simd::dot32;
+pub(crate) use crate::simd::dot32;
 
 /// The products c_a c_b on the pairs a ≤ b.
 pub(crate) fn pair_products(c: &[f64]) -> Vec<f64> {

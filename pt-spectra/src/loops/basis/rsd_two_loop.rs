@@ -44,10 +44,10 @@ pub struct RsdTwoLoopBasis {
     basis: LinearBasis,
     points: Vec<usize>,
     replicas: usize,
-    /// Per k: the mean over shifts [coefficient][triple].
-    mean: Vec<Vec<f64>>,
+    /// Per k: the mean over shifts [coefficient][triple], in f32 ([`super::shift_statistics`]).
+    mean: Vec<Vec<f32>>,
     /// Per k: each shift's deviation from the mean, [shift][coefficient][triple < triples(n_err)].
-    deviations: Vec<Vec<f64>>,
+    deviations: Vec<Vec<f32>>,
 }
 
 /// The settings that make the tensors (their file header).
@@ -267,8 +267,8 @@ impl RsdTwoLoopBasis {
         v.push(self.replicas as f64);
         v.extend(self.basis.to_f64s());
         for i in 0..self.k.len() {
-            v.extend(&self.mean[i]);
-            v.extend(&self.deviations[i]);
+            v.extend(self.mean[i].iter().map(|&x| f64::from(x)));
+            v.extend(self.deviations[i].iter().map(|&x| f64::from(x)));
         }
         v
     }
@@ -300,8 +300,8 @@ impl RsdTwoLoopBasis {
         for _ in k {
             let (m, r) = rest.split_at(sizes[0]);
             let (d, r) = r.split_at(sizes[1]);
-            mean.push(m.to_vec());
-            deviations.push(d.to_vec());
+            mean.push(m.iter().map(|&x| x as f32).collect());
+            deviations.push(d.iter().map(|&x| x as f32).collect());
             rest = r;
         }
         Some(Self {

@@ -1,7 +1,9 @@
-//! The dot products of the tensor contractions, vectorised for the processor they run on.
+//! The dot products of the tensor contractions and of the fixed quadrature weights, vectorised for the
+//! processor they run on.
 //!
 //! Every basis evaluation is a few thousand dot products of a tensor row with the products of the
-//! spectrum's coefficients; they are most of its cost. The build targets baseline x86-64 (SSE2, two f64
+//! spectrum's coefficients, and RegPT's vertex a dot product of stored weights with the spectrum per
+//! outer node; they are most of the cost of a new spectrum. The build targets baseline x86-64 (SSE2, two f64
 //! lanes), so that a binary runs on any node of a cluster; these functions choose at run time, through
 //! the `pulp` crate (safe wrappers of the processor's vector instructions, detected once), the widest
 //! instructions the processor has: on x86-64 AVX2 with fused multiply–add (four f64 lanes), else the
