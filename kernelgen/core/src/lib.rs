@@ -11,6 +11,7 @@
 
 pub mod dag;
 pub mod emit;
+pub mod graph;
 pub mod modp;
 pub mod paired;
 pub mod pairing;

@@ -23,7 +23,7 @@
 //! F_n^s. The only reciprocals beyond the recursion's 1/k_S² is 1/(n̂·n̂).
 
 use crate::dag::{q, Value, Q};
-use crate::program::Graph;
+use crate::graph::Graph;
 use crate::recursion::{Mask, Recursion};
 use crate::spec::Spec;
 use num_traits::{One, Zero};
