@@ -46,17 +46,22 @@ against_brute_force!(z3_equals_brute_force_exactly, 3, 32);
 against_brute_force!(z4_equals_brute_force_exactly, 4, 24);
 against_brute_force!(z5_equals_brute_force_exactly, 5, 12);
 
-/// The coefficient of f^n in Z_n: only S_0 = {i} with the rest in singletons reaches it, so
-/// Z^(n) = (kμ)^(n−1)/n! Σ_i μ_i² Π_{j≠i} μ_j/q_j (unit line of sight), exactly, n ≤ 5.
-#[test]
-fn the_highest_power_of_f_is_a_product_of_linear_velocity_terms() {
-    let qs = [
+/// Five rational vectors, no subset of which sums to zero.
+fn five_vectors() -> [[Q; 3]; 5] {
+    [
         v(1, 2, -1, 2),
         v(-1, 1, 3, 3),
         v(2, -1, 1, 1),
         v(0, 1, -2, 3),
         v(3, 0, 1, 2),
-    ];
+    ]
+}
+
+/// The coefficient of f^n in Z_n: only S_0 = {i} with the rest in singletons reaches it, so
+/// Z^(n) = (kμ)^(n−1)/n! Σ_i μ_i² Π_{j≠i} μ_j/q_j (unit line of sight), exactly, n ≤ 5.
+#[test]
+fn the_highest_power_of_f_is_a_product_of_linear_velocity_terms() {
+    let qs = five_vectors();
     let los = v(0, 3, 4, 5);
     for n in 1..=5 {
         let args = &qs[..n];
@@ -114,13 +119,7 @@ fn z1_and_z2_match_the_closed_forms() {
 /// f = 0: real space, Z_n = F_n^s exactly, n ≤ 5.
 #[test]
 fn without_velocities_z_n_is_f_n() {
-    let qs = [
-        v(1, 2, -1, 2),
-        v(-1, 1, 3, 3),
-        v(2, -1, 1, 1),
-        v(0, 1, -2, 3),
-        v(3, 0, 1, 2),
-    ];
+    let qs = five_vectors();
     for n in 1..=5 {
         let z = redshift_kernel(&qs[..n], &Q::zero(), &v(0, 0, 1, 1)).unwrap();
         assert_eq!(z, kernels(&qs[..n]).unwrap()[0], "n = {n}");

@@ -41,6 +41,8 @@ pub struct LinearBasis {
     weights: Vec<f64>,
     /// φ_a(q_j) at row j: `phi[j * n + a]`.
     phi: Vec<f64>,
+    /// The same by function: `columns[a * len + j]` (what the projection reads, contiguously).
+    columns: Vec<f64>,
     n: usize,
 }
 
@@ -116,10 +118,21 @@ impl LinearBasis {
                 phi[j * n + a] = e[j] / root[j];
             }
         }
+        Self::new(lattice, weights, phi, n)
+    }
+
+    /// The basis from its weights and its functions by row, with the columns made from them.
+    fn new(lattice: Lattice, weights: Vec<f64>, phi: Vec<f64>, n: usize) -> Self {
+        let len = lattice.len;
+        let columns = (0..n)
+            .flat_map(|a| (0..len).map(move |j| (j, a)))
+            .map(|(j, a)| phi[j * n + a])
+            .collect();
         Self {
             lattice,
             weights,
             phi,
+            columns,
             n,
         }
     }
@@ -179,17 +192,21 @@ impl LinearBasis {
 
     /// The projection of the lattice `samples` of a spectrum: c_a = ⟨φ_a, P⟩ and the residual.
     pub fn project(&self, samples: &[f64]) -> Projection {
-        let n = self.n;
-        let mut c = vec![0.0; n];
-        for (j, (&p, &w)) in samples.iter().zip(&self.weights).enumerate() {
-            let wp = w * p;
-            for (ca, phi) in c.iter_mut().zip(self.row(j)) {
-                *ca += wp * phi;
-            }
-        }
-        let projected: Vec<f64> = (0..self.lattice.len)
-            .map(|j| super::dot(self.row(j), &c))
+        let len = self.lattice.len;
+        let wp: Vec<f64> = samples
+            .iter()
+            .zip(&self.weights)
+            .map(|(p, w)| w * p)
             .collect();
+        let columns = self.columns.chunks_exact(len);
+        let c: Vec<f64> = columns.clone().map(|phi| super::dot(phi, &wp)).collect();
+        let mut projected = vec![0.0; len];
+        for (phi, &ca) in columns.zip(&c) {
+            projected
+                .iter_mut()
+                .zip(phi)
+                .for_each(|(p, phi)| *p += ca * phi);
+        }
         let relative: Vec<f64> = projected
             .iter()
             .zip(samples)
@@ -226,12 +243,12 @@ impl LinearBasis {
         if n == 0 || values.len() < size {
             return None;
         }
-        let basis = Self {
-            weights: values[1..1 + len].to_vec(),
-            phi: values[1 + len..size].to_vec(),
+        let basis = Self::new(
             lattice,
+            values[1..1 + len].to_vec(),
+            values[1 + len..size].to_vec(),
             n,
-        };
+        );
         Some((basis, &values[size..]))
     }
 }
