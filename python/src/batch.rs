@@ -4,8 +4,7 @@
 
 use crate::{detached, floats, value_error, RealPlan};
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
-use pt_spectra::jobs::real_spectra_table;
-use pt_spectra::linear::LinearSpectrum;
+use pt_spectra::jobs::real_batch_tables;
 use pt_spectra::real::RealSelection;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -38,24 +37,15 @@ pub(crate) fn real_batch<'py>(
             k_lin.len()
         )));
     }
-    // Each row's spline (validated: a bad row is an error naming it).
-    let spectra = p
-        .rows()
-        .into_iter()
-        .enumerate()
-        .map(|(i, row)| {
-            LinearSpectrum::from_nodes(k_lin.clone(), row.to_vec())
-                .map_err(|e| PyValueError::new_err(format!("row {i} of P: {e}")))
-        })
-        .collect::<PyResult<Vec<_>>>()?;
-    let (results, _) = detached(py, || Ok(plan.plan.evaluate_batch(&spectra)))?;
+    // Each row's spline, model and table on the threads (a bad row is an error naming it).
+    let rows: Vec<Vec<f64>> = p.rows().into_iter().map(|row| row.to_vec()).collect();
+    let (results, _) = detached(py, || {
+        Ok(real_batch_tables(&plan.plan, &k_lin, &rows, terms))
+    })?;
     let tables = results
         .into_iter()
         .enumerate()
-        .map(|(i, r)| {
-            r.map(|s| real_spectra_table(&s, Vec::new(), terms))
-                .map_err(|e| PyValueError::new_err(format!("row {i} of P: {e}")))
-        })
+        .map(|(i, r)| r.map_err(|e| PyValueError::new_err(format!("row {i} of P: {e}"))))
         .collect::<PyResult<Vec<_>>>()?;
     let out = PyDict::new(py);
     out.set_item("k", plan.plan.k().to_vec().into_pyarray(py))?;

@@ -36,6 +36,7 @@ pub use crate::real::counterterm::counterterm_line;
 use crate::real::{Counterterms, RealModel, RealPlan, RealSelection, RealSpectra};
 use crate::setup::Prepared;
 
+mod batch;
 mod bias;
 pub mod defaults;
 mod ept;
@@ -45,6 +46,7 @@ mod observe;
 mod report;
 mod rsd;
 mod spt2;
+pub use batch::real_batch_tables;
 pub use bias::BiasOutput;
 pub use ept::{
     ept_fit_table, ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest,
