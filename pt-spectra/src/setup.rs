@@ -139,7 +139,7 @@ pub fn prepare(request: Request) -> Result<Prepared> {
     let defaulted = request.cosmology.is_none();
     let named = request.cosmology.unwrap_or_else(NamedCosmology::gm2012);
     let c = named.cosmology;
-    let (d, mut f) = (c.growth_factor(z), c.growth_rate(z));
+    let (d, mut f) = c.growth_factor_and_rate(z);
     let mut spectrum_cb = None;
     let mut warnings = Vec::new();
     let mut description = vec![format!(
@@ -190,7 +190,12 @@ pub fn prepare(request: Request) -> Result<Prepared> {
         }
         LinearSource::Table { spectrum, z_input } => {
             check_z("z_input", z_input)?;
-            let ratio = d / c.growth_factor(z_input);
+            // A table already at z (the usual chain call) needs no second growth integral.
+            let ratio = if z_input == z {
+                1.0
+            } else {
+                d / c.growth_factor(z_input)
+            };
             if defaulted {
                 warnings.push(format!(
                     "no cosmology was given for the linear spectrum `{}`: the growth of the gm2012 \

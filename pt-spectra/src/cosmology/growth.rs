@@ -106,6 +106,28 @@ impl Cosmology {
         scale_factor(z).map_or(f64::NAN, |a| self.rate(a, self.method()))
     }
 
+    /// D(z)/D(0) and f(z) together: [`growth_factor`](Self::growth_factor) and
+    /// [`growth_rate`](Self::growth_rate) from one integral at z (and one at z = 0), where calling
+    /// both costs three. NaN unless z is finite and > −1.
+    pub fn growth_factor_and_rate(&self, z: f64) -> (f64, f64) {
+        let Some(a) = scale_factor(z) else {
+            return (f64::NAN, f64::NAN);
+        };
+        match self.method() {
+            Method::Heath => {
+                let integral = self.growth_integral(a);
+                (
+                    self.heath_d_md_of(a, integral) / self.heath_d_md(1.0),
+                    self.heath_rate_of(a, integral),
+                )
+            }
+            Method::Ode => {
+                let [s_a, s_1] = self.ode_states([a.ln(), 0.0]);
+                (a * s_a[0] / s_1[0], 1.0 + s_a[1] / s_a[0])
+            }
+        }
+    }
+
     /// The growing mode normalised to D = a deep in matter domination, D_md(z), and f(z), from one
     /// integration (Heath's integral for a cosmological constant, the ODE otherwise). NaN unless z is
     /// finite and > −1.

@@ -310,3 +310,20 @@ fn growth_md_and_rate_equals_the_separate_calls() {
         }
     }
 }
+
+#[test]
+fn growth_factor_and_rate_equals_the_separate_calls() {
+    // D(z)/D(0) and f(z) from one integral at z, for Λ (Heath) and w0–wa with curvature (the ODE)
+    for c in [
+        Cosmology::planck2018(),
+        Cosmology::planck2018().with_dark_energy(-0.9, 0.3).unwrap(),
+    ] {
+        for z in [0.0, 0.5, 2.0] {
+            let (d, f) = c.growth_factor_and_rate(z);
+            assert!((f / c.growth_rate(z) - 1.0).abs() < 1e-12, "{z}");
+            assert!((d / c.growth_factor(z) - 1.0).abs() < 1e-12, "{z}");
+        }
+        let (d, f) = c.growth_factor_and_rate(-1.0);
+        assert!(d.is_nan() && f.is_nan());
+    }
+}
