@@ -114,23 +114,16 @@ pub fn legendre_nodes(n: usize) -> (Vec<f64>, Vec<f64>) {
     let mut nodes = vec![0.0; n];
     let mut weights = vec![0.0; n];
     let nf = n as f64;
-    // The recurrence's coefficients (2k+1)/(k+1) and k/(k+1), once (a division per step cost most).
-    let recurrence: Vec<(f64, f64)> = (1..n)
-        .map(|k| {
-            let kf = k as f64;
-            ((2.0 * kf + 1.0) / (kf + 1.0), kf / (kf + 1.0))
-        })
-        .collect();
     for i in 0..n.div_ceil(2) {
         let mut x = (PI * (i as f64 + 0.75) / (nf + 0.5)).cos();
         let mut dp = 1.0;
         for _ in 0..100 {
-            let (p, d) = legendre_and_derivative(n, x, &recurrence);
+            let (p, d) = legendre_and_derivative(n, x);
             dp = d;
             let dx = p / d;
             x -= dx;
             if dx.abs() < 1e-16 {
-                dp = legendre_and_derivative(n, x, &recurrence).1;
+                dp = legendre_and_derivative(n, x).1;
                 break;
             }
         }
@@ -146,13 +139,13 @@ pub fn legendre_nodes(n: usize) -> (Vec<f64>, Vec<f64>) {
     (nodes, weights)
 }
 
-/// (P_n(x), P_n′(x)) for n ≥ 1 by the recurrence P_{k+1} = (2k+1)/(k+1) x P_k − k/(k+1) P_{k−1} (the
-/// coefficients of k = 1..n−1 in `recurrence`) and
+/// (P_n(x), P_n′(x)) for n ≥ 1 by the recurrence (k+1) P_{k+1} = (2k+1) x P_k − k P_{k−1} and
 /// (x² − 1) P_n′ = n (x P_n − P_{n−1}).
-fn legendre_and_derivative(n: usize, x: f64, recurrence: &[(f64, f64)]) -> (f64, f64) {
+fn legendre_and_derivative(n: usize, x: f64) -> (f64, f64) {
     let (mut p0, mut p1) = (1.0, x);
-    for &(a, b) in recurrence {
-        let p2 = a * x * p1 - b * p0;
+    for k in 1..n {
+        let kf = k as f64;
+        let p2 = ((2.0 * kf + 1.0) * x * p1 - kf * p0) / (kf + 1.0);
         p0 = p1;
         p1 = p2;
     }
