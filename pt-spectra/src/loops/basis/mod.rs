@@ -323,12 +323,7 @@ impl TwoLoopBasis {
     ) -> BasisTwoLoop {
         let c = &projection.coefficients;
         let n = c.len();
-        let mut s2 = vec![0.0; n * (n + 1) / 2];
-        for b in 0..n {
-            for a in 0..=b {
-                s2[pair_index(a, b)] = c[a] * c[b];
-            }
-        }
+        let s2 = forms::pair_products(c);
         let s3 = triple_products(c);
         let mut p15_rows = Vec::with_capacity(self.k.len());
         let mut propagator = Vec::with_capacity(self.k.len());
