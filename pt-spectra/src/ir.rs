@@ -28,6 +28,7 @@ use std::f64::consts::PI;
 
 mod savgol;
 pub use savgol::savitzky_golay_no_wiggle;
+pub(crate) use savgol::{no_wiggle_samples, no_wiggle_weights};
 
 /// Width of the Gaussian filter in ln k.
 pub const FILTER_WIDTH: f64 = 0.25;

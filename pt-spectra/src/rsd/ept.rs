@@ -176,8 +176,8 @@ pub struct EptTerms {
     full: RedshiftTerms,
     /// The no-wiggle terms and Σ² [(Mpc/h)²], with IR resummation.
     nw: Option<(RedshiftTerms, Estimate)>,
-    /// The projection residuals (full, no-wiggle) if the terms come from basis tensors.
-    basis_residual: Option<(f64, Option<f64>)>,
+    /// The projection residual if the terms come from basis tensors.
+    basis_residual: Option<f64>,
 }
 
 impl EptPlan {

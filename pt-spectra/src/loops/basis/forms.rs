@@ -172,6 +172,17 @@ impl RuleRows {
         }
     }
 
+    /// Functions given by row on the fine lattice (`rows[j * n + a]`, e.g.
+    /// [`super::LinearBasis::transformed_rows`]).
+    pub fn from_rows(rows: Vec<f64>, n: usize) -> Self {
+        let coarse = rows.chunks_exact(n).step_by(2).flatten().copied().collect();
+        Self {
+            fine: rows,
+            coarse,
+            n,
+        }
+    }
+
     /// The rows on the fine `lattice` and on the half-resolution `coarse` one.
     pub fn on<'a>(&'a self, fine: &'a Lattice, coarse: &'a Lattice) -> (Rows<'a>, Rows<'a>) {
         let rows = |rows: &'a [f64], lattice| Rows {

@@ -164,6 +164,20 @@ impl LinearBasis {
         &self.phi[j * self.n..(j + 1) * self.n]
     }
 
+    /// The functions f(φ_a), f a linear map of lattice samples (e.g. a filter), by row as
+    /// [`row`](Self::row): `out[j * n + a]` = f(φ_a)(q_j). The coefficients of a spectrum on this
+    /// basis are those of f(spectrum) on these functions.
+    pub(crate) fn transformed_rows(&self, f: &dyn Fn(&[f64]) -> Vec<f64>) -> Vec<f64> {
+        let (len, n) = (self.lattice.len, self.n);
+        let mut rows = vec![0.0; len * n];
+        for (a, column) in self.columns.chunks_exact(len).enumerate() {
+            for (j, v) in f(column).into_iter().enumerate().take(len) {
+                rows[j * n + a] = v;
+            }
+        }
+        rows
+    }
+
     /// The functions' lattice interpolants at ln q = `x` into `out` (length n), zero outside the
     /// lattice (as the loop integrals take the spectrum).
     #[inline]

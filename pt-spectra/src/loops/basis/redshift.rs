@@ -10,6 +10,12 @@
 //! bilinear part of the half-resolution rule on the first [`super::ERROR_FUNCTIONS`] functions). With
 //! IR resummation the no-wiggle spectrum is projected too; its terms carry the errors of the full
 //! ones (as in the direct plan) plus its own projection error.
+//!
+//! The no-wiggle spectrum of the galaxy model is a fixed linear filter of P on a log grid
+//! ([`crate::ir::savitzky_golay_no_wiggle`]); on the lattice it is linear in the samples, so the
+//! no-wiggle part of P = Σ c_a φ_a is Σ c_a S[φ_a]. The [`SpectrumFamily::NoWiggle`] tensors are
+//! therefore those of the filtered basis functions S[φ_a], contracted with the spectrum's own
+//! coefficients: one projection, no filter and no second basis per spectrum.
 
 use super::forms::{
     concat, dot32, fine_and_diff, linear_form, pair_forms, pair_products, per_k, RuleRows,
@@ -20,7 +26,7 @@ use crate::loops::Estimate;
 use crate::precision::Precision;
 
 /// Version of the tensor layout and rules, part of the cache file name.
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 /// Lattice-weight terms per k.
 const LW: usize = 6;
@@ -29,9 +35,11 @@ const LW: usize = 6;
 /// and with absolute weights (the projection error's scale).
 const LINEAR: usize = 3 * LW;
 
-/// Which spectra a [`RedshiftBasis`] is for: linear spectra (the shipped CAMB training set), or
-/// their no-wiggle parts (the same set through the galaxy model's no-wiggle filter: those are not in
-/// the span of the linear basis, their smoothed tails differ by ~1e-2).
+/// Which spectra basis tensors are for: linear spectra (the shipped CAMB training set), or their
+/// no-wiggle parts. The real-space and 2-loop bases take the latter on a basis of their own (the
+/// training set through the no-wiggle filter: those are not in the span of the linear basis, their
+/// smoothed tails differ by ~1e-2); [`RedshiftBasis`], whose filter is linear, on the filtered
+/// functions of the linear basis (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SpectrumFamily {
     /// Linear spectra.
@@ -100,8 +108,9 @@ impl RedshiftBasis {
         super::cache_file_name(&prefix, VERSION, &key(k, precision, family))
     }
 
-    /// Builds the tensors of `plan` on `basis` (of the spectra `family`, on the plan's lattice) in
-    /// parallel over k; `progress(done, total)` counts the k values.
+    /// Builds the tensors of `plan` on the linear `basis` (on the plan's lattice; for the no-wiggle
+    /// `family` on its filtered functions) in parallel over k; `progress(done, total)` counts the k
+    /// values.
     pub fn build(
         plan: &RedshiftPlan,
         family: SpectrumFamily,
@@ -112,7 +121,14 @@ impl RedshiftBasis {
         let (fine, coarse) = plan.rules();
         let n = basis.len();
         let n_err = error_functions(n);
-        let rows = RuleRows::new(&basis);
+        let rows = match family {
+            SpectrumFamily::Linear => RuleRows::new(&basis),
+            SpectrumFamily::NoWiggle => {
+                let step = fine.lattice.step;
+                let filter = |f: &[f64]| crate::ir::no_wiggle_samples(f, step);
+                RuleRows::from_rows(basis.transformed_rows(&filter), n)
+            }
+        };
         let (fine_rows, coarse_rows) = rows.on(&fine.lattice, &coarse.lattice);
         let per_k = per_k(k.len(), progress, |i| {
             let f = pair_forms(&fine.pairs, i, &fine_rows, n, 0..NPAIR, 0..0, 0..0).pairs;

@@ -1,25 +1,139 @@
 //! The galaxy model's loop terms from basis tensors ([`RedshiftBasis`]): a new spectrum's terms as
-//! contractions with its projection (and, with IR resummation, its no-wiggle part's projection on a
-//! basis of no-wiggle spectra) instead of the plan's integrals.
+//! contractions with its projection instead of the plan's integrals.
+//!
+//! With IR resummation nothing else is per spectrum either: the no-wiggle filter is linear in P on
+//! the lattice ([`crate::ir::no_wiggle_samples`]), so with P ≈ Σ c_a φ_a the no-wiggle spectrum is
+//! Σ c_a S[φ_a] with the filtered functions S[φ_a] made once per plan. Its terms are contractions of
+//! the same c with the tensors of S[φ_a] ([`SpectrumFamily::NoWiggle`]), Σ² is a linear form in c
+//! (Simpson's rule on the lattice, its error the difference from the half-resolution rule), and
+//! P_nw(k) at the output k, which the model uses directly, a fixed linear form of the spectrum's own
+//! lattice samples (the filter's taps composed with the lattice interpolation), not of the
+//! projection.
 
-use super::{sigma2, EptPlan, EptTerms};
+use super::{EptPlan, EptTerms, R_BAO};
 use crate::error::Result;
-use crate::ir::savitzky_golay_no_wiggle;
 use crate::linear::LinearSpectrum;
-use crate::loops::basis::training::{camb_basis, transformed_basis};
-use crate::loops::basis::{
-    LinearBasis, Projection, RedshiftBasis, SpectrumFamily, BASIS_SIZE, MAX_RESIDUAL,
-};
+use crate::loops::basis::training::camb_basis;
+use crate::loops::basis::{LinearBasis, RedshiftBasis, SpectrumFamily, BASIS_SIZE, MAX_RESIDUAL};
+use crate::loops::Estimate;
 use crate::precision::TwoLoopMethod;
 use crate::progress::Progress;
 use crate::store::TableStore;
+use std::f64::consts::PI;
 use std::sync::Arc;
 
-/// The tensors of the linear spectrum's terms and, with IR resummation, of the no-wiggle terms.
+/// The tensors of the linear spectrum's terms and, with IR resummation, of the no-wiggle terms and
+/// the forms of the no-wiggle spectrum.
 #[derive(Debug, Clone)]
 pub(super) struct Tensors {
     linear: Arc<RedshiftBasis>,
-    no_wiggle: Option<Arc<RedshiftBasis>>,
+    no_wiggle: Option<(Arc<RedshiftBasis>, NoWiggleForms)>,
+}
+
+/// The no-wiggle spectrum of a spectrum with coefficients c as linear forms in c.
+#[derive(Debug, Clone)]
+struct NoWiggleForms {
+    /// Per output k: P_nw(k) as weights over the lattice samples from a first index.
+    at_k: Vec<(usize, Vec<f64>)>,
+    /// Σ² on the lattice (Simpson), and its difference from the half-resolution rule.
+    sigma2: [Vec<f64>; 2],
+}
+
+impl NoWiggleForms {
+    fn new(basis: &LinearBasis, grid: &[f64]) -> Self {
+        let lattice = basis.lattice();
+        let n = basis.len();
+        let step = lattice.step;
+        let filtered = basis.transformed_rows(&|f| crate::ir::no_wiggle_samples(f, step));
+        let at_k = grid
+            .iter()
+            .map(|&k| {
+                let (b, t) = lattice.stencil((k.ln() - lattice.x0) / step);
+                let l = crate::integrate::lagrange4(t);
+                let rows: Vec<_> = (0..4)
+                    .map(|s| crate::ir::no_wiggle_weights(lattice.len, step, b + s))
+                    .collect();
+                let first = rows.iter().map(|r| r.0).min().unwrap_or(0);
+                let last = rows.iter().map(|r| r.0 + r.1.len()).max().unwrap_or(0);
+                let mut w = vec![0.0; last - first];
+                for (ls, (start, row)) in l.iter().zip(&rows) {
+                    for (i, v) in row.iter().enumerate() {
+                        w[start + i - first] += ls * v;
+                    }
+                }
+                (first, w)
+            })
+            .collect();
+        // Σ² = 1/(6π²) ∫ d ln q q P_nw(q) (1 − j₀(q r_BAO)), as sigma2 integrates it.
+        let integrand: Vec<f64> = (0..lattice.len)
+            .map(|j| {
+                let q = lattice.x(j).exp();
+                let x = q * R_BAO;
+                let one_minus_j0 = if x < 1e-3 {
+                    x * x / 6.0
+                } else {
+                    1.0 - x.sin() / x
+                };
+                q * one_minus_j0 / (6.0 * PI * PI)
+            })
+            .collect();
+        let form = |stride: usize| {
+            let weights = simpson_weights(lattice.len.div_ceil(stride), step * stride as f64);
+            let mut form = vec![0.0; n];
+            for (i, w) in weights.iter().enumerate() {
+                let j = i * stride;
+                let row = &filtered[j * n..(j + 1) * n];
+                form.iter_mut()
+                    .zip(row)
+                    .for_each(|(f, r)| *f += w * integrand[j] * r);
+            }
+            form
+        };
+        let (fine, coarse) = (form(1), form(2));
+        let diff = fine.iter().zip(&coarse).map(|(f, c)| f - c).collect();
+        Self {
+            at_k,
+            sigma2: [fine, diff],
+        }
+    }
+
+    /// P_nw at the output k of the spectrum with lattice samples `samples` and coefficients `c`, and
+    /// Σ² with its error (quadrature, and `eps` of it for the projection).
+    fn evaluate(&self, samples: &[f64], c: &[f64], eps: f64) -> (Vec<f64>, Estimate) {
+        let dot = crate::simd::dot;
+        let p_nw = self
+            .at_k
+            .iter()
+            .map(|(first, w)| dot(w, &samples[*first..first + w.len()]))
+            .collect();
+        let sigma2 = dot(&self.sigma2[0], c);
+        let error = dot(&self.sigma2[1], c).abs() + eps * sigma2.abs();
+        (p_nw, Estimate::new(sigma2, error))
+    }
+}
+
+/// Composite Simpson weights for `len` points spaced `h` (the last interval by the trapezoid rule if
+/// their number is odd).
+fn simpson_weights(len: usize, h: f64) -> Vec<f64> {
+    let mut w = vec![0.0; len];
+    if len < 2 {
+        return w;
+    }
+    let even = if (len - 1).is_multiple_of(2) {
+        len
+    } else {
+        len - 1
+    };
+    for i in (0..even.saturating_sub(1)).step_by(2) {
+        w[i] += h / 3.0;
+        w[i + 1] += 4.0 * h / 3.0;
+        w[i + 2] += h / 3.0;
+    }
+    if even < len {
+        w[len - 2] += h / 2.0;
+        w[len - 1] += h / 2.0;
+    }
+    w
 }
 
 impl EptPlan {
@@ -34,15 +148,10 @@ impl EptPlan {
         let lattice = self.loops.rules().0.lattice.clone();
         let ir = self.split.is_some();
         let linear_basis = || camb_basis(lattice.clone(), BASIS_SIZE);
-        let no_wiggle_basis = || {
-            transformed_basis(&lattice, BASIS_SIZE, &|p| {
-                savitzky_golay_no_wiggle(p).unwrap_or_else(|_| p.clone())
-            })
-        };
-        let get = |family, basis: &dyn Fn() -> LinearBasis| -> Result<_> {
+        let get = |family| -> Result<_> {
             Ok(match precision.two_loop {
                 TwoLoopMethod::Basis => {
-                    Some(store.redshift_basis(&self.loops, family, basis, progress)?)
+                    Some(store.redshift_basis(&self.loops, family, &linear_basis, progress)?)
                 }
                 TwoLoopMethod::Auto => {
                     store.cached_redshift_basis(&self.grid, &precision, family, progress)
@@ -50,15 +159,23 @@ impl EptPlan {
                 TwoLoopMethod::Direct => None,
             })
         };
-        let linear = get(SpectrumFamily::Linear, &linear_basis)?;
+        let linear = get(SpectrumFamily::Linear)?;
         let no_wiggle = if ir {
-            get(SpectrumFamily::NoWiggle, &no_wiggle_basis)?
+            get(SpectrumFamily::NoWiggle)?
         } else {
             None
         };
         self.tensors = match (linear, no_wiggle, ir) {
-            (Some(linear), no_wiggle, false) | (Some(linear), no_wiggle @ Some(_), true) => {
-                Some(Tensors { linear, no_wiggle })
+            (Some(linear), None, false) => Some(Tensors {
+                linear,
+                no_wiggle: None,
+            }),
+            (Some(linear), Some(nw), true) => {
+                let forms = NoWiggleForms::new(linear.basis(), &self.grid);
+                Some(Tensors {
+                    linear,
+                    no_wiggle: Some((nw, forms)),
+                })
             }
             _ => None,
         };
@@ -70,37 +187,30 @@ impl EptPlan {
         self.tensors.is_some()
     }
 
-    /// The loop terms from the basis tensors, or `None` without tensors or for a spectrum (or its
-    /// no-wiggle part) its basis does not represent well enough.
+    /// The loop terms from the basis tensors, or `None` without tensors or for a spectrum its basis
+    /// does not represent well enough.
     pub(super) fn terms_on_basis(&self, spectrum: &LinearSpectrum) -> Result<Option<EptTerms>> {
         let Some(tensors) = &self.tensors else {
             return Ok(None);
         };
-        let accepted = |tensors: &RedshiftBasis, p: &LinearSpectrum| -> Option<Projection> {
-            let basis = tensors.basis();
-            let projection = basis.project(&basis.sample(p));
-            (projection.residual <= MAX_RESIDUAL).then_some(projection)
-        };
-        let Some(projection) = accepted(&tensors.linear, spectrum) else {
+        let basis = tensors.linear.basis();
+        let samples = basis.sample(spectrum);
+        let projection = basis.project(&samples);
+        if projection.residual > MAX_RESIDUAL {
             return Ok(None);
-        };
-        let on_grid = |p: &LinearSpectrum| self.grid.iter().map(|&k| p.eval(k)).collect::<Vec<_>>();
-        let p_lin = on_grid(spectrum);
-        let mut residual = (projection.residual, None);
+        }
+        let p_lin: Vec<f64> = self.grid.iter().map(|&k| spectrum.eval(k)).collect();
         let (full, nw) = match (&self.split, &tensors.no_wiggle) {
-            (Some(()), Some(nw_tensors)) => {
-                let p_nw = savitzky_golay_no_wiggle(spectrum)?;
-                let Some(projection_nw) = accepted(nw_tensors, &p_nw) else {
-                    return Ok(None);
-                };
-                residual.1 = Some(projection_nw.residual);
+            (Some(()), Some((nw_tensors, forms))) => {
+                let c = &projection.coefficients;
+                let (p_nw, sigma2) = forms.evaluate(&samples, c, projection.residual);
                 let (full, t) = tensors.linear.evaluate_with_no_wiggle(
                     &self.loops,
                     (&p_lin, &projection),
                     nw_tensors,
-                    (&on_grid(&p_nw), &projection_nw),
+                    (&p_nw, &projection),
                 );
-                (full, Some((t, sigma2(&p_nw))))
+                (full, Some((t, sigma2)))
             }
             _ => (
                 tensors.linear.evaluate(&self.loops, &p_lin, &projection),
@@ -111,7 +221,7 @@ impl EptPlan {
             grid: self.grid.clone(),
             full,
             nw,
-            basis_residual: Some(residual),
+            basis_residual: Some(projection.residual),
         }))
     }
 }
@@ -119,14 +229,38 @@ impl EptPlan {
 impl EptTerms {
     /// One header line if the terms come from basis tensors: the projection residuals.
     pub fn describe_source(&self) -> Option<String> {
-        let (full, nw) = self.basis_residual?;
-        let nw = nw.map_or(String::new(), |r| {
-            format!(", of the no-wiggle spectrum {r:.1e}")
-        });
+        let residual = self.basis_residual?;
         Some(format!(
-            "loop terms: basis tensors on the same quadrature nodes as direct; projection residual \
-             {full:.1e}{nw}; errors include the projection error (2 x residual x |term| for the \
+            "loop terms: basis tensors on the same quadrature nodes as direct (no-wiggle terms: the \
+             tensors of the filtered basis functions); projection residual {residual:.1e}; errors \
+             include the projection error (2 x residual x |term| for the \
              P22-type terms, residual x P int |w| P for the others)"
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::simpson_weights;
+
+    #[test]
+    fn simpson_weights_integrate_cubics_exactly_and_lines_with_a_trapezoid_end() {
+        // 11 points (10 intervals): exact for x³ on [0, 1]; 12 points: the last interval by the
+        // trapezoid rule, still exact for straight lines.
+        let w = simpson_weights(11, 0.1);
+        let cubic: f64 = w
+            .iter()
+            .enumerate()
+            .map(|(i, w)| w * (0.1 * i as f64).powi(3))
+            .sum();
+        assert!((cubic - 0.25).abs() < 1e-15, "{cubic}");
+        let w = simpson_weights(12, 0.1);
+        let line: f64 = w
+            .iter()
+            .enumerate()
+            .map(|(i, w)| w * (1.0 + 0.1 * i as f64))
+            .sum();
+        assert!((line - (1.1 + 1.1 * 1.1 / 2.0)).abs() < 1e-14, "{line}");
+        assert!(simpson_weights(1, 0.1).iter().all(|&v| v == 0.0));
     }
 }

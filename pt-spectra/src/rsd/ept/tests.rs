@@ -115,15 +115,14 @@ fn values_are_the_multipoles_values() {
     }
 }
 
-/// With basis tensors (method basis) a CAMB spectrum not trained on gives the direct multipoles
-/// within 1e-4 of P0 and inside the errors, with and without IR; an Eisenstein–Hu spectrum (outside
-/// the basis) falls back to the direct terms exactly.
+/// With basis tensors (method basis) two CAMB spectra and a CLASS one not trained on give the direct
+/// multipoles within 3e-4 of P0 and inside the errors, with and without IR; an Eisenstein–Hu
+/// spectrum (outside the basis) falls back to the direct terms exactly.
 #[test]
 fn the_basis_gives_the_direct_multipoles_and_falls_back_outside_its_span() {
     use crate::precision::TwoLoopMethod;
     let k: Vec<f64> = (0..10).map(|i| 0.01 * 1.4_f64.powi(i)).collect();
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
-    let camb = LinearSpectrum::from_file(format!("{dir}linear_pk_camb_heldout_0.dat")).unwrap();
     let eh = crate::cosmology::Cosmology::gm2012()
         .eisenstein_hu_spectrum(
             crate::cosmology::TransferKind::Wiggle,
@@ -149,18 +148,29 @@ fn the_basis_gives_the_direct_multipoles_and_falls_back_outside_its_span() {
             .with_basis(&store, &crate::progress::Silent)
             .unwrap();
         assert!(plan.has_basis());
-        let terms = plan.terms(&camb).unwrap();
-        assert!(terms.describe_source().is_some());
-        let a = plan.multipoles(&terms, &params, &[0, 2, 4]).unwrap();
-        let d = direct
-            .multipoles(&direct.terms(&camb).unwrap(), &params, &[0, 2, 4])
-            .unwrap();
-        let p0: Vec<f64> = d[0].iter().map(|e| e.value).collect();
-        for (a, d) in a.iter().zip(&d) {
-            for (i, (a, d)) in a.iter().zip(d).enumerate() {
-                let diff = (a.value - d.value).abs();
-                assert!(diff < 1e-4 * p0[i], "ir {ir} {i}: {a:?} {d:?}");
-                assert!(diff <= a.error + d.error, "ir {ir} {i}: {a:?} {d:?}");
+        // Spectra the basis was not trained on: two CAMB and a CLASS table.
+        for name in [
+            "linear_pk_camb_heldout_0.dat",
+            "linear_pk_camb_heldout_2.dat",
+            "linear_pk_class_planck2018_z0.0_pk_lin.dat",
+        ] {
+            let p = LinearSpectrum::from_file(format!("{dir}{name}")).unwrap();
+            let terms = plan.terms(&p).unwrap();
+            assert!(terms.describe_source().is_some(), "{name}");
+            let a = plan.multipoles(&terms, &params, &[0, 2, 4]).unwrap();
+            let d = direct
+                .multipoles(&direct.terms(&p).unwrap(), &params, &[0, 2, 4])
+                .unwrap();
+            let p0: Vec<f64> = d[0].iter().map(|e| e.value).collect();
+            for (a, d) in a.iter().zip(&d) {
+                for (i, (a, d)) in a.iter().zip(d).enumerate() {
+                    let diff = (a.value - d.value).abs();
+                    // The no-wiggle terms share the spectrum's projection (module basis): the CLASS
+                    // table (residual 1.9e-4) differs by up to 1.9e-4 of P_0 with IR, the CAMB
+                    // ones by ≤ 8.6e-5.
+                    assert!(diff < 3e-4 * p0[i], "{name} ir {ir} {i}: {a:?} {d:?}");
+                    assert!(diff <= a.error + d.error, "{name} ir {ir} {i}: {a:?} {d:?}");
+                }
             }
         }
         let fallback = plan.terms(&eh).unwrap();
