@@ -293,6 +293,13 @@ fn model_header(
              Gauss-Legendre quadrature, error = difference from a coarser layout"
                 .into(),
         );
+        let residual = spectra.terms.gamma2.as_ref().and_then(|g| g.basis_residual);
+        h.extend(residual.map(|r| {
+            format!(
+                "Gamma2: linear forms on the basis functions (the same nodes), projection residual \
+                 {r:.1e}; errors add its response, 2 x residual x sum |w| P"
+            )
+        }));
     }
     if terms && model.propagator().is_some() {
         h.push(

@@ -34,6 +34,10 @@
 //! angular nodes), at least 5e-5 |I|. Against a layout with 1.5–2 times the points in every direction
 //! the values differ by ≤ 3.4e-5 (k = 0.02, 0.1, 0.25 h/Mpc), against pyregpt by ≤ 6e-4 (k ≤ 0.3).
 
+mod basis;
+
+pub use basis::Gamma2Basis;
+
 use super::lattice::Lattice;
 use super::{ByPair, Estimate, Pair};
 use crate::integrate::{panel_edges, GaussLegendre};
@@ -331,6 +335,8 @@ pub struct Gamma2Terms {
     pub p24: ByPair<Vec<Estimate>>,
     /// PΓ2_XY = 2∫Γ2_X Γ2_Y P P (3-loop order; in the 2-loop RegPT spectrum).
     pub p_gamma2: ByPair<Vec<Estimate>>,
+    /// The projection residual if Γ2 came from linear forms on a basis ([`Gamma2Basis`]).
+    pub basis_residual: Option<f64>,
 }
 
 /// The Γ2 weights of a k grid (cosmology independent); [`evaluate`](Self::evaluate) per spectrum.
@@ -406,6 +412,7 @@ impl Gamma2Plan {
         Gamma2Terms {
             p24: column(0),
             p_gamma2: column(1),
+            basis_residual: None,
         }
     }
 }

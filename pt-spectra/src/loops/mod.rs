@@ -50,7 +50,7 @@ pub mod rsd_two_loop;
 mod tns;
 mod two_loop;
 
-pub use gamma2::{Gamma2Plan, Gamma2Terms};
+pub use gamma2::{Gamma2Basis, Gamma2Plan, Gamma2Terms};
 pub use one_loop::OneLoopPlan;
 pub use p13::{k1_kernels, p13_kernels};
 pub use p15::{p15_angular_kernel, P15Table};

@@ -8,7 +8,9 @@ use crate::loops::basis::{
     LinearBasis, OneLoopBasis, Projection, SpectrumFamily, TwoLoopBasis, BASIS_SIZE, MAX_RESIDUAL,
 };
 use crate::loops::lattice::Lattice;
-use crate::loops::{self, ByPair, Estimate, Gamma2Plan, LoopTerms, OneLoopPlan, OneLoopTerms};
+use crate::loops::{
+    self, ByPair, Estimate, Gamma2Basis, Gamma2Plan, LoopTerms, OneLoopPlan, OneLoopTerms,
+};
 use crate::loops::{OneLoopSource, P15Table, P17Table, TwoLoopCorrection, TwoLoopSource};
 use crate::precision::{Precision, TwoLoopMethod};
 use crate::progress::{stage_callback, Progress, Silent, Stage};
@@ -52,6 +54,8 @@ pub struct RealPlan {
     ir: Option<crate::ir::WiggleSplit>,
     /// RegPT's vertex weights (2-loop RegPT, and `all`).
     gamma2: Option<Gamma2Plan>,
+    /// Its inner integrals as linear forms on the 1-loop tensors' basis, if the plan has them.
+    gamma2_basis: Option<Gamma2Basis>,
     /// The 2-loop basis tensors, if the 2-loop terms come from them ([`TwoLoopMethod`]).
     basis: Option<Arc<TwoLoopBasis>>,
     /// For the IR-resummed 2-loop models, the 2-loop tensors of the no-wiggle spectra.
@@ -207,6 +211,13 @@ impl RealPlan {
             (Some(_), Some(_)) => tensors(SpectrumFamily::NoWiggle)?,
             _ => None,
         };
+        let gamma2 = model
+            .needs_gamma2()
+            .then(|| gamma2_plan(k, precision, progress));
+        let gamma2_basis = match (&gamma2, &one_loop_basis) {
+            (Some(plan), Some(tensors)) => plan.on_basis(tensors.basis()),
+            _ => None,
+        };
         Ok(Self {
             k: k.to_vec(),
             model,
@@ -217,9 +228,8 @@ impl RealPlan {
             p15,
             p17,
             ir: split,
-            gamma2: model
-                .needs_gamma2()
-                .then(|| gamma2_plan(k, precision, progress)),
+            gamma2,
+            gamma2_basis,
             basis,
             basis_nw,
         })
@@ -322,9 +332,14 @@ impl RealPlan {
                 .is_some_and(|b| Arc::ptr_eq(t, b))
         });
         let projection = projection.filter(|_| linear);
+        let gamma2 = self.gamma2.as_ref().map(|plan| {
+            let on_basis = self.gamma2_basis.as_ref().zip(projection.as_ref());
+            on_basis
+                .and_then(|(forms, projection)| forms.evaluate(plan, spectrum, projection))
+                .unwrap_or_else(|| plan.evaluate(spectrum))
+        });
         let (p15, two_loop, two_loop_source) =
             self.two_loop_terms(two_loop_tensors, spectrum, &one_loop, projection, progress);
-        let gamma2 = self.gamma2.as_ref().map(|plan| plan.evaluate(spectrum));
         LoopTerms {
             one_loop,
             p15,

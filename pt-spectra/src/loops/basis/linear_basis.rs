@@ -154,6 +154,14 @@ impl LinearBasis {
             .collect()
     }
 
+    /// The mean training spectrum P̄ on the lattice (the weights are ω_j = Δln q / P̄_j²).
+    pub(crate) fn mean_samples(&self) -> Vec<f64> {
+        self.weights
+            .iter()
+            .map(|w| (self.lattice.step / w).sqrt())
+            .collect()
+    }
+
     /// The lattice the functions are sampled on.
     pub(crate) fn lattice(&self) -> &Lattice {
         &self.lattice
@@ -199,9 +207,7 @@ impl LinearBasis {
 
     /// The samples of `spectrum` on the basis's lattice (what [`project`](Self::project) takes).
     pub fn sample(&self, spectrum: &crate::linear::LinearSpectrum) -> Vec<f64> {
-        (0..self.lattice.len)
-            .map(|j| spectrum.eval_ln(self.lattice.x(j)))
-            .collect()
+        spectrum.eval_ln_many((0..self.lattice.len).map(|j| self.lattice.x(j)))
     }
 
     /// The projection of the lattice `samples` of a spectrum: c_a = ⟨φ_a, P⟩ and the residual.
