@@ -97,6 +97,62 @@ fn dot32_portable(a: &[f32], b: &[f64]) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
+/// Σ a_i b_i of f32 tensor entries and f32 products over the common length, multiplied in f32 in
+/// 32 partial sums (each of ⌈n/32⌉ terms: for the 1-loop pair rows, 21, a rounding of ~1e-7 of
+/// Σ|a_i b_i|, the size of the entries' own f32 rounding), then summed in f64. Twice the
+/// throughput of [`dot32`] when the tensor is in cache (eight lanes, no widening).
+pub(crate) fn dot_f32(a: &[f32], b: &[f32]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    #[cfg(target_arch = "x86_64")]
+    if let Some(simd) = pulp::x86::V3::try_new() {
+        return simd.vectorize(|| dot_f32_v3(simd, a, b));
+    }
+    dot_f32_portable(a, b)
+}
+
+/// [`dot_f32`] with AVX2 and FMA: four accumulators of eight lanes.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn dot_f32_v3(simd: pulp::x86::V3, a: &[f32], b: &[f32]) -> f64 {
+    use pulp::f32x8;
+    let (a32, a_rest) = pulp::as_arrays::<32, _>(a);
+    let (b32, b_rest) = pulp::as_arrays::<32, _>(b);
+    let mut acc = [simd.splat_f32x8(0.0); 4];
+    for (x, y) in a32.iter().zip(b32) {
+        let x: [f32x8; 4] = pulp::cast(*x);
+        let y: [f32x8; 4] = pulp::cast(*y);
+        for h in 0..4 {
+            acc[h] = simd.mul_add_f32x8(x[h], y[h], acc[h]);
+        }
+    }
+    let lanes: [[f32; 8]; 4] = pulp::cast(acc);
+    sum_lanes(&lanes, a_rest, b_rest)
+}
+
+/// The 32 partial sums in f64, plus the tail's products.
+fn sum_lanes(lanes: &[[f32; 8]; 4], a_rest: &[f32], b_rest: &[f32]) -> f64 {
+    let tail: f64 = a_rest
+        .iter()
+        .zip(b_rest)
+        .map(|(x, y)| f64::from(*x) * f64::from(*y))
+        .sum();
+    lanes.iter().flatten().map(|&v| f64::from(v)).sum::<f64>() + tail
+}
+
+/// [`dot_f32`] in portable code: the same 32 partial sums.
+fn dot_f32_portable(a: &[f32], b: &[f32]) -> f64 {
+    let (ca, cb) = (a.chunks_exact(32), b.chunks_exact(32));
+    let (a_rest, b_rest) = (ca.remainder(), cb.remainder());
+    let mut lanes = [[0.0f32; 8]; 4];
+    for (x, y) in ca.zip(cb) {
+        for (i, (x, y)) in x.iter().zip(y).enumerate() {
+            lanes[i / 8][i % 8] += x * y;
+        }
+    }
+    sum_lanes(&lanes, a_rest, b_rest)
+}
+
 /// e^v for every v in `values`, in place, to within 2 ulp of [`f64::exp`] for v ∈ [−708, 709]
 /// (clamped there): the samples of a spectrum on the loop lattice are exp of its ln-spline, a few
 /// thousand per spectrum. Range reduction v = n ln 2 + r, |r| ≤ ln 2 / 2, the Taylor series of e^r
@@ -165,6 +221,9 @@ mod tests {
             let a32: Vec<f32> = a.iter().map(|&x| x as f32).collect();
             assert_eq!(dot32(&a32, &b), expected, "n = {n}");
             assert_eq!(dot32_portable(&a32, &b), expected, "n = {n}");
+            let b32: Vec<f32> = b.iter().map(|&x| x as f32).collect();
+            assert_eq!(dot_f32(&a32, &b32), expected, "n = {n}");
+            assert_eq!(dot_f32_portable(&a32, &b32), expected, "n = {n}");
         }
     }
 

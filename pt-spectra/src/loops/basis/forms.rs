@@ -135,7 +135,15 @@ pub(crate) fn linear_form(weights: &[f64], rows: &Rows<'_>) -> Vec<f64> {
     out
 }
 
-pub(crate) use crate::simd::dot32;
+pub(crate) use crate::simd::{dot32, dot_f32};
+
+/// The products c_a c_b on the pairs a ≤ b in f64 (for the short error rows, [`dot32`]) and in f32
+/// (for the long rows of the values, [`dot_f32`]).
+pub(crate) fn pair_products_both(c: &[f64]) -> (Vec<f64>, Vec<f32>) {
+    let s2 = pair_products(c);
+    let single = s2.iter().map(|&v| v as f32).collect();
+    (s2, single)
+}
 
 /// The products c_a c_b on the pairs a ≤ b.
 pub(crate) fn pair_products(c: &[f64]) -> Vec<f64> {

@@ -23,7 +23,8 @@
 //! error, ≲ 1e-8.
 
 use super::forms::{
-    concat, dot32, fine_and_diff, linear_form, pair_forms, pair_products, per_k, Rows, RuleRows,
+    concat, dot32, dot_f32, fine_and_diff, linear_form, pair_forms, pair_products_both, per_k,
+    Rows, RuleRows,
 };
 use super::{error_functions, LinearBasis, Projection, SpectrumFamily, BASIS_SIZE};
 use crate::integrate::legendre_nodes;
@@ -190,7 +191,7 @@ impl OneLoopBasis {
         let pairs = n * (n + 1) / 2;
         let n_err = error_functions(n);
         let pairs_err = n_err * (n_err + 1) / 2;
-        let s2 = pair_products(c);
+        let (s2, s2_single) = pair_products_both(c);
         let eps = projection.residual;
         let nk = self.k.len();
         let mut terms = OneLoopTerms {
@@ -207,7 +208,7 @@ impl OneLoopBasis {
             let t = &self.p22[i * 3 * pairs..(i + 1) * 3 * pairs];
             let d = &self.p22_diff[i * 3 * pairs_err..(i + 1) * 3 * pairs_err];
             let p22: [Estimate; 3] = std::array::from_fn(|m| {
-                let v = dot32(&t[m * pairs..(m + 1) * pairs], &s2);
+                let v = dot_f32(&t[m * pairs..(m + 1) * pairs], &s2_single);
                 let quadrature = dot32(&d[m * pairs_err..(m + 1) * pairs_err], &s2[..pairs_err])
                     .abs()
                     .max(self.p22_error_floor * v.abs());

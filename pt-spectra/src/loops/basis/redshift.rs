@@ -18,7 +18,8 @@
 //! coefficients: one projection, no filter and no second basis per spectrum.
 
 use super::forms::{
-    concat, dot32, fine_and_diff, linear_form, pair_forms, pair_products, per_k, RuleRows,
+    concat, dot32, dot_f32, fine_and_diff, linear_form, pair_forms, pair_products_both, per_k,
+    RuleRows,
 };
 use super::{error_functions, LinearBasis, Projection, BASIS_SIZE};
 use crate::loops::redshift::{RedshiftPlan, RedshiftTerms, Row, NPAIR};
@@ -176,7 +177,7 @@ impl RedshiftBasis {
         let n = c.len();
         let (pairs, n_err) = (n * (n + 1) / 2, error_functions(n));
         let pairs_err = n_err * (n_err + 1) / 2;
-        let s2 = pair_products(c);
+        let (s2, s2_single) = pair_products_both(c);
         let eps = projection.residual;
         let floor = self.p22_error_floor;
         let rows = p_lin
@@ -187,7 +188,7 @@ impl RedshiftBasis {
                 let d = &self.pairs_diff[i * NPAIR * pairs_err..][..NPAIR * pairs_err];
                 let l = &self.linear[i * LINEAR * n..][..LINEAR * n];
                 let pair = std::array::from_fn(|m| {
-                    let a = dot32(&t[m * pairs..(m + 1) * pairs], &s2);
+                    let a = dot_f32(&t[m * pairs..(m + 1) * pairs], &s2_single);
                     let diff = dot32(&d[m * pairs_err..(m + 1) * pairs_err], &s2[..pairs_err]);
                     let quadrature = diff.abs().max(floor * a.abs());
                     Estimate::new(a, quadrature + 2.0 * eps * a.abs())

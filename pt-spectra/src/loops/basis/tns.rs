@@ -14,7 +14,7 @@
 //! [`super::ERROR_FUNCTIONS`] functions) plus the floor of [`Precision::p22_error_floor`].
 
 use super::forms::{
-    concat, dot32, fine_and_diff, pair_forms, pair_products, per_k, Rows, RuleRows,
+    concat, dot32, dot_f32, fine_and_diff, pair_forms, pair_products_both, per_k, Rows, RuleRows,
 };
 use super::{error_functions, LinearBasis, Projection, BASIS_SIZE};
 use crate::loops::tns::{Rule, A_LEN, B_LEN};
@@ -142,7 +142,7 @@ impl TnsBasis {
         let n = c.len();
         let (pairs, n_err) = (n * (n + 1) / 2, error_functions(n));
         let pairs_err = n_err * (n_err + 1) / 2;
-        let s2 = pair_products(c);
+        let (s2, s2_single) = pair_products_both(c);
         let eps = PROJECTION_FACTOR * projection.residual;
         let floor = self.p22_error_floor;
         let coefficients = (0..self.k.len())
@@ -157,7 +157,7 @@ impl TnsBasis {
                     super::dot(&l[at..at + n], c)
                 };
                 let value = |m: usize| -> Estimate {
-                    let bilinear = dot32(&t[m * pairs..(m + 1) * pairs], &s2);
+                    let bilinear = dot_f32(&t[m * pairs..(m + 1) * pairs], &s2_single);
                     let diff = dot32(&d[m * pairs_err..(m + 1) * pairs_err], &s2[..pairs_err]);
                     let (mut fine, mut coarse) = (bilinear, bilinear - diff);
                     let mut linear = 0.0;
