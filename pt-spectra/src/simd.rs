@@ -44,6 +44,32 @@ impl WithSimd for Dot<'_> {
     }
 }
 
+/// y += a x over the common length (a spectrum's projection rebuilt from its basis functions).
+pub(crate) fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+    let n = y.len().min(x.len());
+    Arch::new().dispatch(Axpy(&mut y[..n], a, &x[..n]));
+}
+
+struct Axpy<'a>(&'a mut [f64], f64, &'a [f64]);
+
+impl WithSimd for Axpy<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let Axpy(y, a, x) = self;
+        let (ys, y_tail) = S::as_mut_simd_f64s(y);
+        let (xs, x_tail) = S::as_simd_f64s(x);
+        let av = simd.splat_f64s(a);
+        for (y, x) in ys.iter_mut().zip(xs) {
+            *y = simd.mul_add_f64s(av, *x, *y);
+        }
+        for (y, x) in y_tail.iter_mut().zip(x_tail) {
+            *y += a * x;
+        }
+    }
+}
+
 /// Σ a_i b_i of f32 tensor entries and f64 products, summed in f64, over the common length.
 pub(crate) fn dot32(a: &[f32], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
@@ -235,6 +261,15 @@ mod tests {
             let b: Vec<f64> = (0..n).map(|i| f64::from(i % 5) + 1.0).collect();
             let expected: f64 = a.iter().zip(&b).map(|(x, y)| x * y).sum();
             assert_eq!(dot(&a, &b), expected, "n = {n}");
+            let mut y = b.clone();
+            axpy(&mut y, 2.0, &a);
+            assert!(
+                y.iter()
+                    .zip(&a)
+                    .zip(&b)
+                    .all(|((y, a), b)| *y == b + 2.0 * a),
+                "n = {n}"
+            );
             let a32: Vec<f32> = a.iter().map(|&x| x as f32).collect();
             assert_eq!(dot32(&a32, &b), expected, "n = {n}");
             assert_eq!(dot32_portable(&a32, &b), expected, "n = {n}");

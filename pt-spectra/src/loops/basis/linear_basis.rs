@@ -222,10 +222,7 @@ impl LinearBasis {
         let c: Vec<f64> = columns.clone().map(|phi| super::dot(phi, &wp)).collect();
         let mut projected = vec![0.0; len];
         for (phi, &ca) in columns.zip(&c) {
-            projected
-                .iter_mut()
-                .zip(phi)
-                .for_each(|(p, phi)| *p += ca * phi);
+            crate::simd::axpy(&mut projected, ca, phi);
         }
         let relative: Vec<f64> = projected
             .iter()
