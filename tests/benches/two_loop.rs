@@ -13,7 +13,11 @@
 //!   cosmology-independent weights (once per grid), and a spectrum on them (per cosmology).
 //!
 //! * `two_loop/basis/40`: the same 2-loop set for a new spectrum from the basis tensors (with its 1-loop
-//!   terms; run with `RAYON_NUM_THREADS=1` for one core).
+//!   terms; run with `RAYON_NUM_THREADS=1` for one core);
+//! * `new spectrum through the basis/2l-spt/40`, `…/2l-regpt/40`: the whole model from a new CAMB
+//!   table's (k, P) arrays through `RealPlan::evaluate` with method basis (the spline, the
+//!   projection, the 1- and 2-loop contractions, and for RegPT the vertex Γ2 as linear forms on the
+//!   basis), as the Python timing script measures it.
 //!
 //! The angular table is read from its cache (or built once, outside the timing). Run with
 //! `cargo bench --bench two_loop`.
@@ -192,5 +196,34 @@ fn basis(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, p15, two_loop, basis);
+/// 2L-SPT and 2L-RegPT of a new spectrum through `RealPlan` with the basis (module docs).
+fn models(c: &mut Criterion) {
+    use pt_spectra::precision::TwoLoopMethod;
+    let k = LogGrid::new(0.005, 0.4, 40).expect("valid grid").points();
+    let mut precision = Precision::default();
+    precision.two_loop = TwoLoopMethod::Basis;
+    let store = TableStore::from_env();
+    let table = LinearSpectrum::from_file(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../pt-spectra/tests/data/linear_pk_camb_heldout_1.dat"
+    ))
+    .expect("test table");
+    let (k_in, p_in) = (table.nodes().0.to_vec(), table.nodes().1.to_vec());
+    let mut group = c.benchmark_group("new spectrum through the basis");
+    for (name, model) in [
+        ("2l-spt/40", RealModel::TwoLoopSpt),
+        ("2l-regpt/40", RealModel::TwoLoopRegPt),
+    ] {
+        let plan = RealPlan::new(&k, model, &precision, &store, &Silent).expect("valid plan");
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let p = LinearSpectrum::from_nodes(k_in.clone(), p_in.clone()).expect("valid");
+                plan.evaluate(black_box(&p), &Silent).expect("evaluates")
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, p15, two_loop, basis, models);
 criterion_main!(benches);
