@@ -9,7 +9,7 @@ in under a millisecond), one core, a new CAMB spectrum at every call, tensors ca
 * TNS multipoles ℓ = 0, 2, 4 from 1L-SPT, 50 k; the galaxy model ``ept`` with IR, 50 k (both with
   ``two_loop="basis"``: the real-space, TNS and galaxy-model terms from their basis tensors);
 * 2L-SPT and 2L-RegPT, 40 k in [0.005, 0.4] (1- and 2-loop terms from the basis tensors, RegPT's
-  vertex terms integrated), ``RealPlan.batch`` with terms;
+  vertex Γ2 from linear forms on the basis), ``RealPlan.batch`` with terms;
 * a batch of 100 spectra on 1 and on 2 threads (separate processes: the pool is set once).
 
 Medians over the calls; the spectra are CAMB's for 8 cosmologies inside the EuclidEmulator2 box.
