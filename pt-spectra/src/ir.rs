@@ -26,9 +26,7 @@ use crate::linear::{LinearSpectrum, LogGrid};
 use crate::loops::{IrTerms, OneLoopTerms, Pair, TwoLoopCorrection};
 use std::f64::consts::PI;
 
-mod savgol;
-pub use savgol::savitzky_golay_no_wiggle;
-pub(crate) use savgol::{no_wiggle_samples, no_wiggle_weights};
+pub use crate::savgol::savitzky_golay_no_wiggle;
 
 /// Width of the Gaussian filter in ln k.
 pub const FILTER_WIDTH: f64 = 0.25;

@@ -51,6 +51,7 @@ pub mod progress;
 pub mod real;
 pub mod resum;
 pub mod rsd;
+mod savgol;
 pub mod setup;
 mod simd;
 pub mod store;

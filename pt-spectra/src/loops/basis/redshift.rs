@@ -126,7 +126,7 @@ impl RedshiftBasis {
             SpectrumFamily::Linear => RuleRows::new(&basis),
             SpectrumFamily::NoWiggle => {
                 let step = fine.lattice.step;
-                let filter = |f: &[f64]| crate::ir::no_wiggle_samples(f, step);
+                let filter = |f: &[f64]| crate::savgol::no_wiggle_samples(f, step);
                 RuleRows::from_rows(basis.transformed_rows(&filter), n)
             }
         };

@@ -2,7 +2,7 @@
 //! contractions with its projection instead of the plan's integrals.
 //!
 //! With IR resummation nothing else is per spectrum either: the no-wiggle filter is linear in P on
-//! the lattice ([`crate::ir::no_wiggle_samples`]), so with P ≈ Σ c_a φ_a the no-wiggle spectrum is
+//! the lattice ([`crate::savgol::no_wiggle_samples`]), so with P ≈ Σ c_a φ_a the no-wiggle spectrum is
 //! Σ c_a S[φ_a] with the filtered functions S[φ_a] made once per plan. Its terms are contractions of
 //! the same c with the tensors of S[φ_a] ([`SpectrumFamily::NoWiggle`]), Σ² is a linear form in c
 //! (Simpson's rule on the lattice, its error the difference from the half-resolution rule), and
@@ -44,14 +44,14 @@ impl NoWiggleForms {
         let lattice = basis.lattice();
         let n = basis.len();
         let step = lattice.step;
-        let filtered = basis.transformed_rows(&|f| crate::ir::no_wiggle_samples(f, step));
+        let filtered = basis.transformed_rows(&|f| crate::savgol::no_wiggle_samples(f, step));
         let at_k = grid
             .iter()
             .map(|&k| {
                 let (b, t) = lattice.stencil((k.ln() - lattice.x0) / step);
                 let l = crate::integrate::lagrange4(t);
                 let rows: Vec<_> = (0..4)
-                    .map(|s| crate::ir::no_wiggle_weights(lattice.len, step, b + s))
+                    .map(|s| crate::savgol::no_wiggle_weights(lattice.len, step, b + s))
                     .collect();
                 let first = rows.iter().map(|r| r.0).min().unwrap_or(0);
                 let last = rows.iter().map(|r| r.0 + r.1.len()).max().unwrap_or(0);

@@ -6,6 +6,9 @@
 //! least-squares quartic is Σ_j c_j P_j with c_j = e₀ᵀ(AᵀA)⁻¹Aᵀ, A_jp = t_j^p. The grid extends half a
 //! window beyond the spectrum's range on each side (through its power-law extrapolation), so every
 //! returned node has its full window.
+//!
+//! A leaf module (public as [`crate::ir::savitzky_golay_no_wiggle`]): the loops' basis tensors use
+//! the filter on the lattice ([`no_wiggle_samples`]) without importing `ir`, which imports the loops.
 
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
