@@ -3,16 +3,14 @@
 //! once per plan ([`Gamma2Plan::on_basis`]): per node 2n numbers instead of the 2 × (radial nodes)
 //! weights, and no radial spectrum. The outer P(q) P(|k − q|) stay the spectrum's own lattice samples.
 //!
-//! Error: the plan's |fine − coarse|, both layouts on the first [`ERROR_FUNCTIONS`] functions only
-//! (the coarse forms are kept on those: a third of their bytes; the spectrum truncated to them differs
-//! by a few 1e-3, immaterial for the difference of two quadratures, as for the tensors' error parts),
-//! plus the response to the projection residual ε: each Γ2 moves by at most ε Σ_r |w_r| P(r), taken as 2ε R S with S = Σ_r |w_r| P̄(r) for
+//! Error: the plan's |fine − coarse| (both layouts on the basis) plus the response to the projection
+//! residual ε: each Γ2 moves by at most ε Σ_r |w_r| P(r), taken as 2ε R S with S = Σ_r |w_r| P̄(r) for
 //! the basis's mean spectrum P̄ (stored per node) and R the spectrum's mean ratio to it over the
 //! lattice (the factor 2 covers the spread of shapes in the basis's span).
 
 use super::{Gamma2Plan, Gamma2Terms, Nodes, ERROR_FLOOR, PAIRS};
 use crate::linear::LinearSpectrum;
-use crate::loops::basis::{LinearBasis, Projection, ERROR_FUNCTIONS};
+use crate::loops::basis::{LinearBasis, Projection};
 use crate::loops::lattice::Lattice;
 use crate::loops::{ByPair, Estimate, Pair};
 use crate::simd::dot32;
@@ -22,25 +20,21 @@ use rayon::prelude::*;
 #[derive(Debug, Clone)]
 pub struct Gamma2Basis {
     n: usize,
-    /// Functions of the error estimate (the coarse layout's forms).
-    n_err: usize,
     fine: NodeForms,
     coarse: NodeForms,
     /// 1/P̄ on the lattice divided by its length: R = Σ_j P_j this_j.
     inverse_mean: Vec<f64>,
 }
 
-/// Per outer node of one layout: W_F then W_G (on the first m functions each), and S_F, S_G.
+/// Per outer node of one layout: W_F then W_G (n each), and S_F, S_G.
 #[derive(Debug, Clone)]
 struct NodeForms {
-    m: usize,
     forms: Vec<f32>,
     scales: Vec<[f64; 2]>,
 }
 
 impl NodeForms {
-    /// The forms of `nodes` on the first `m` functions of `basis`.
-    fn new(nodes: &Nodes, lattice: &Lattice, basis: &LinearBasis, mean: &[f64], m: usize) -> Self {
+    fn new(nodes: &Nodes, lattice: &Lattice, basis: &LinearBasis, mean: &[f64]) -> Self {
         let n = basis.len();
         let radial = nodes.radial.len();
         // φ_a at the radial nodes (row r) and P̄ there.
@@ -57,12 +51,12 @@ impl NodeForms {
             .into_par_iter()
             .map(|j| {
                 let w = &nodes.weights[2 * j * radial..2 * (j + 1) * radial];
-                let mut forms = vec![0.0f64; 2 * m];
+                let mut forms = vec![0.0f64; 2 * n];
                 let mut scales = [0.0; 2];
                 for (x, wx) in w.chunks_exact(radial).enumerate() {
                     for ((&wr, row), pr) in wx.iter().zip(phi.chunks_exact(n)).zip(&mean_r) {
                         let wr = f64::from(wr);
-                        forms[x * m..(x + 1) * m]
+                        forms[x * n..(x + 1) * n]
                             .iter_mut()
                             .zip(row)
                             .for_each(|(f, p)| *f += wr * p);
@@ -72,36 +66,32 @@ impl NodeForms {
                 (forms.iter().map(|&v| v as f32).collect(), scales)
             })
             .collect();
-        let mut forms = Vec::with_capacity(per_node.len() * 2 * m);
+        let mut forms = Vec::with_capacity(per_node.len() * 2 * n);
         let mut scales = Vec::with_capacity(per_node.len());
         for (f, s) in per_node {
             forms.extend(f);
             scales.push(s);
         }
-        Self { m, forms, scales }
+        Self { forms, scales }
     }
 
-    /// [P24, PΓ2] of the three pairs at k index `i` for the coefficients `c` (on the first m
-    /// functions), their projection errors for ε R = `eps_r`, and the same terms for the coefficients
-    /// truncated to the first `m_err` functions.
+    /// [P24, PΓ2] of the three pairs at k index `i`, and their projection errors for ε R = `eps_r`.
     fn evaluate(
         &self,
         nodes: &Nodes,
         i: usize,
         (lattice, samples): (&Lattice, &[f64]),
-        (c, m_err): (&[f64], usize),
+        c: &[f64],
         eps_r: f64,
-    ) -> [[[f64; 3]; 2]; 3] {
-        let n = self.m;
-        let (c, c_err) = (&c[..n], &c[..m_err]);
-        let (mut out, mut err, mut truncated) = ([[0.0; 3]; 2], [[0.0; 3]; 2], [[0.0; 3]; 2]);
+    ) -> ([[f64; 3]; 2], [[f64; 3]; 2]) {
+        let n = c.len();
+        let (mut out, mut err) = ([[0.0; 3]; 2], [[0.0; 3]; 2]);
         // The nodes of one q follow each other (q-major layout): P(q) once per q.
         let mut p_q = (f64::NAN, 0.0);
         for j in nodes.k_start[i]..nodes.k_start[i + 1] {
             let o = &nodes.outer[j];
             let w = &self.forms[2 * j * n..2 * (j + 1) * n];
             let g = [dot32(&w[..n], c), dot32(&w[n..], c)];
-            let gt = [dot32(&w[..m_err], c_err), dot32(&w[n..n + m_err], c_err)];
             let dg = self.scales[j].map(|s| eps_r * s);
             if o.u_q != p_q.0 {
                 p_q = (o.u_q, lattice.interpolate(samples, o.u_q));
@@ -113,11 +103,9 @@ impl NodeForms {
                 let s = spectra.abs();
                 err[0][m] += s * (o.f2[x].abs() * dg[y] + dg[x] * o.f2[y].abs());
                 err[1][m] += s * (g[x].abs() * dg[y] + dg[x] * g[y].abs() + dg[x] * dg[y]);
-                truncated[0][m] += spectra * (o.f2[x] * gt[y] + gt[x] * o.f2[y]);
-                truncated[1][m] += spectra * gt[x] * gt[y];
             }
         }
-        [out, err, truncated]
+        (out, err)
     }
 }
 
@@ -131,12 +119,10 @@ impl Gamma2Plan {
         let lattice = &self.lattice;
         let mean = basis.mean_samples();
         let inverse_mean = mean.iter().map(|m| 1.0 / (m * mean.len() as f64)).collect();
-        let (n, n_err) = (basis.len(), ERROR_FUNCTIONS.min(basis.len()));
         Some(Gamma2Basis {
-            n,
-            n_err,
-            fine: NodeForms::new(&self.fine, lattice, basis, &mean, n),
-            coarse: NodeForms::new(&self.coarse, lattice, basis, &mean, n_err),
+            n: basis.len(),
+            fine: NodeForms::new(&self.fine, lattice, basis, &mean),
+            coarse: NodeForms::new(&self.coarse, lattice, basis, &mean),
             inverse_mean,
         })
     }
@@ -164,17 +150,11 @@ impl Gamma2Basis {
         let rows: Vec<[[Estimate; 3]; 2]> = (0..plan.len())
             .into_par_iter()
             .map(|i| {
-                let [a, da, a_err] = self
-                    .fine
-                    .evaluate(&plan.fine, i, on, (c, self.n_err), eps_r);
-                let [.., b] = self
-                    .coarse
-                    .evaluate(&plan.coarse, i, on, (c, self.n_err), eps_r);
+                let (a, da) = self.fine.evaluate(&plan.fine, i, on, c, eps_r);
+                let (b, _) = self.coarse.evaluate(&plan.coarse, i, on, c, eps_r);
                 std::array::from_fn(|t| {
                     std::array::from_fn(|m| {
-                        let quadrature = (a_err[t][m] - b[t][m])
-                            .abs()
-                            .max(ERROR_FLOOR * a[t][m].abs());
+                        let quadrature = (a[t][m] - b[t][m]).abs().max(ERROR_FLOOR * a[t][m].abs());
                         Estimate::new(a[t][m], quadrature + da[t][m])
                     })
                 })
