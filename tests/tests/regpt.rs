@@ -135,7 +135,7 @@ fn two_loop_regpt_and_its_vertex_terms_match_pyregpt() {
 
 /// With basis tensors (method basis) the vertex Γ2 comes from linear forms on the basis: for a CAMB
 /// spectrum not trained on, P24 and PΓ2 equal the direct integrals to 5e-5 of their size and within
-/// the errors, and the terms say so (their projection residual).
+/// the errors, and the terms say so (their projection residual), as does the table's header.
 #[test]
 fn two_loop_regpt_vertex_terms_through_the_basis_match_the_integrals() {
     use pt_spectra::precision::TwoLoopMethod;
@@ -159,6 +159,30 @@ fn two_loop_regpt_vertex_terms_through_the_basis_match_the_integrals() {
         &Silent,
     )
     .unwrap();
+    // The table says where Γ2 came from.
+    let prepared = pt_spectra::setup::prepare(pt_spectra::setup::Request {
+        source: pt_spectra::setup::LinearSource::Embedded,
+        cosmology: None,
+        z: 0.0,
+    })
+    .unwrap();
+    let table = pt_spectra::jobs::real_table(
+        &on_basis,
+        pt_spectra::real::RealSelection::One(RealModel::TwoLoopRegPt),
+        &prepared,
+        false,
+        &Default::default(),
+        &Silent,
+    )
+    .unwrap();
+    assert!(
+        table
+            .header
+            .iter()
+            .any(|l| l.starts_with("Gamma2: linear forms on the basis")),
+        "{:?}",
+        table.header
+    );
     let a = on_basis.evaluate(&spectrum, &Silent).unwrap().terms;
     let d = direct.evaluate(&spectrum, &Silent).unwrap().terms;
     let (a, d) = (a.gamma2.unwrap(), d.gamma2.unwrap());
