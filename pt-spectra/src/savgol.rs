@@ -85,37 +85,13 @@ pub fn savitzky_golay_no_wiggle(spectrum: &LinearSpectrum) -> Result<LinearSpect
 /// grid, without a full window (m = ⌈ln 7 / step⌉ / 2), are kept unfiltered (on the loop lattice
 /// q < 2.7e-5 and q > 370 h/Mpc, far from the BAO).
 pub(crate) fn no_wiggle_samples(samples: &[f64], step: f64) -> Vec<f64> {
-    let r = ((step * PER_E_FOLD).round() as usize).max(1);
+    let filter = LatticeFilter::new(step);
     let n = samples.len();
-    if n < 4 {
-        return samples.to_vec();
-    }
-    let fine: Vec<f64> = if r == 1 {
-        samples.to_vec()
-    } else {
-        (0..(n - 1) * r + 1)
-            .map(|i| {
-                let (j, t) = (i / r, (i % r) as f64 / r as f64);
-                if t == 0.0 {
-                    return samples[j];
-                }
-                let b = j.saturating_sub(1).min(n - 4);
-                let w = crate::integrate::lagrange4(j as f64 + t - b as f64);
-                (0..4).map(|s| w[s] * samples[b + s]).sum()
-            })
-            .collect()
-    };
-    let m = ((WINDOW * r as f64 / step).ceil() as usize) / 2;
-    let c = coefficients(m);
-    let len = fine.len();
     (0..n)
         .map(|j| {
-            let i = j * r;
-            if i < m || i + m >= len {
-                fine[i]
-            } else {
-                crate::simd::dot(&c, &fine[i - m..=i + m])
-            }
+            let mut v = 0.0;
+            filter.taps(n, j, |i, w| v += w * samples[i]);
+            v
         })
         .collect()
 }
@@ -124,30 +100,59 @@ pub(crate) fn no_wiggle_samples(samples: &[f64], step: f64) -> Vec<f64> {
 /// as weights over the samples: (first index, weights), Σ_i w_i P_{first + i}. For a no-wiggle
 /// spectrum at a few points from the samples themselves, not their projection on a basis.
 pub(crate) fn no_wiggle_weights(n: usize, step: f64, j: usize) -> (usize, Vec<f64>) {
-    let r = ((step * PER_E_FOLD).round() as usize).max(1);
-    let m = ((WINDOW * r as f64 / step).ceil() as usize) / 2;
-    let (i, len) = (j * r, (n.max(1) - 1) * r + 1);
-    if n < 4 || i < m || i + m >= len {
-        return (j, vec![1.0]);
-    }
-    let c = coefficients(m);
-    let first = ((i - m) / r).saturating_sub(1).min(n - 4);
-    let last = ((i + m) / r + 2).min(n - 1);
+    let mut taps = Vec::new();
+    LatticeFilter::new(step).taps(n, j, |i, w| taps.push((i, w)));
+    let first = taps.iter().map(|t| t.0).min().unwrap_or(j);
+    let last = taps.iter().map(|t| t.0).max().unwrap_or(j);
     let mut w = vec![0.0; last + 1 - first];
-    for (t, ct) in c.iter().enumerate() {
-        let u = i - m + t;
-        let (k, frac) = (u / r, (u % r) as f64 / r as f64);
-        if frac == 0.0 {
-            w[k - first] += ct;
-        } else {
-            let b = k.saturating_sub(1).min(n - 4);
-            let l = crate::integrate::lagrange4(k as f64 + frac - b as f64);
-            for (s, ls) in l.iter().enumerate() {
-                w[b + s - first] += ct * ls;
+    for (i, v) in taps {
+        w[i - first] += v;
+    }
+    (first, w)
+}
+
+/// The filter on a lattice (module docs, [`no_wiggle_samples`]): the refinement r, the half-width m
+/// of the window on the refined grid and its coefficients.
+struct LatticeFilter {
+    r: usize,
+    m: usize,
+    coefficients: Vec<f64>,
+}
+
+impl LatticeFilter {
+    fn new(step: f64) -> Self {
+        let r = ((step * PER_E_FOLD).round() as usize).max(1);
+        let m = ((WINDOW * r as f64 / step).ceil() as usize) / 2;
+        Self {
+            r,
+            m,
+            coefficients: coefficients(m),
+        }
+    }
+
+    /// Calls `tap(i, w)` for each sample i of a lattice of `n` and its weight w in the filtered value
+    /// at index `j` (the refined grid's points interpolated from the samples; the sample itself where
+    /// the window does not fit).
+    fn taps(&self, n: usize, j: usize, mut tap: impl FnMut(usize, f64)) {
+        let (r, m) = (self.r, self.m);
+        let (i, len) = (j * r, (n.max(1) - 1) * r + 1);
+        if n < 4 || i < m || i + m >= len {
+            return tap(j, 1.0);
+        }
+        for (t, c) in self.coefficients.iter().enumerate() {
+            let u = i - m + t;
+            let (k, frac) = (u / r, (u % r) as f64 / r as f64);
+            if frac == 0.0 {
+                tap(k, *c);
+            } else {
+                let b = k.saturating_sub(1).min(n - 4);
+                let l = crate::integrate::lagrange4(k as f64 + frac - b as f64);
+                for (s, ls) in l.iter().enumerate() {
+                    tap(b + s, c * ls);
+                }
             }
         }
     }
-    (first, w)
 }
 
 #[cfg(test)]

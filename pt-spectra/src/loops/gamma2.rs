@@ -398,21 +398,38 @@ impl Gamma2Plan {
             .map(|i| {
                 let a = self.fine.evaluate(i, &self.lattice, &samples, &p_fine);
                 let b = self.coarse.evaluate(i, &self.lattice, &samples, &p_coarse);
-                std::array::from_fn(|t| {
-                    std::array::from_fn(|m| {
-                        let error = (a[t][m] - b[t][m]).abs().max(ERROR_FLOOR * a[t][m].abs());
-                        Estimate::new(a[t][m], error)
-                    })
-                })
+                estimates(a, b, [[0.0; 3]; 2])
             })
             .collect();
+        Gamma2Terms::from_rows(&rows, None)
+    }
+}
+
+/// [P24, PΓ2] of the three pairs from the fine and coarse layouts' values, with the error
+/// |fine − coarse| (at least [`ERROR_FLOOR`] of the value) plus `extra`.
+fn estimates(
+    fine: [[f64; 3]; 2],
+    coarse: [[f64; 3]; 2],
+    extra: [[f64; 3]; 2],
+) -> [[Estimate; 3]; 2] {
+    std::array::from_fn(|t| {
+        std::array::from_fn(|m| {
+            let (a, b) = (fine[t][m], coarse[t][m]);
+            Estimate::new(a, (a - b).abs().max(ERROR_FLOOR * a.abs()) + extra[t][m])
+        })
+    })
+}
+
+impl Gamma2Terms {
+    /// The terms from their per-k [P24, PΓ2] rows.
+    fn from_rows(rows: &[[[Estimate; 3]; 2]], basis_residual: Option<f64>) -> Self {
         let column = |t: usize| {
             ByPair::from_fn(|pair: Pair| rows.iter().map(|r| r[t][pair as usize]).collect())
         };
-        Gamma2Terms {
+        Self {
             p24: column(0),
             p_gamma2: column(1),
-            basis_residual: None,
+            basis_residual,
         }
     }
 }

@@ -420,18 +420,22 @@ impl EptPlan {
 pub fn sigma2(no_wiggle: &LinearSpectrum) -> Estimate {
     let integrand = |ln_q: f64| {
         let q = ln_q.exp();
-        let x = q * R_BAO;
-        let one_minus_j0 = if x < 1e-3 {
-            x * x / 6.0
-        } else {
-            1.0 - x.sin() / x
-        };
-        q * no_wiggle.eval(q) * one_minus_j0
+        sigma2_kernel(q) * no_wiggle.eval(q)
     };
     let (value, error) =
         crate::integrate::simpson_ln(integrand, (1e-5_f64).ln(), (1e3_f64).ln(), 2048);
-    let norm = 1.0 / (6.0 * PI * PI);
-    Estimate::new(norm * value, norm * error)
+    Estimate::new(value, error)
+}
+
+/// The weight of P_nw(q) in Σ² per unit ln q: q [1 − j₀(q r_BAO)] / (6π²).
+fn sigma2_kernel(q: f64) -> f64 {
+    let x = q * R_BAO;
+    let one_minus_j0 = if x < 1e-3 {
+        x * x / 6.0
+    } else {
+        1.0 - x.sin() / x
+    };
+    q * one_minus_j0 / (6.0 * PI * PI)
 }
 
 /// Polynomials in μ² (coefficient n of μ^{2n}) with coefficient errors.

@@ -8,11 +8,11 @@
 //! the basis's mean spectrum P̄ (stored per node) and R the spectrum's mean ratio to it over the
 //! lattice (the factor 2 covers the spread of shapes in the basis's span).
 
-use super::{Gamma2Plan, Gamma2Terms, Nodes, ERROR_FLOOR, PAIRS};
+use super::{estimates, Gamma2Plan, Gamma2Terms, Nodes, PAIRS};
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::{LinearBasis, Projection};
 use crate::loops::lattice::Lattice;
-use crate::loops::{ByPair, Estimate, Pair};
+use crate::loops::Estimate;
 use crate::simd::dot32;
 use rayon::prelude::*;
 
@@ -152,22 +152,10 @@ impl Gamma2Basis {
             .map(|i| {
                 let (a, da) = self.fine.evaluate(&plan.fine, i, on, c, eps_r);
                 let (b, _) = self.coarse.evaluate(&plan.coarse, i, on, c, eps_r);
-                std::array::from_fn(|t| {
-                    std::array::from_fn(|m| {
-                        let quadrature = (a[t][m] - b[t][m]).abs().max(ERROR_FLOOR * a[t][m].abs());
-                        Estimate::new(a[t][m], quadrature + da[t][m])
-                    })
-                })
+                estimates(a, b, da)
             })
             .collect();
-        let column = |t: usize| {
-            ByPair::from_fn(|pair: Pair| rows.iter().map(|r| r[t][pair as usize]).collect())
-        };
-        Some(Gamma2Terms {
-            p24: column(0),
-            p_gamma2: column(1),
-            basis_residual: Some(projection.residual),
-        })
+        Some(Gamma2Terms::from_rows(&rows, Some(projection.residual)))
     }
 }
 

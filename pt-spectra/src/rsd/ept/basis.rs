@@ -10,7 +10,7 @@
 //! lattice samples (the filter's taps composed with the lattice interpolation), not of the
 //! projection.
 
-use super::{EptPlan, EptTerms, R_BAO};
+use super::{sigma2_kernel, EptPlan, EptTerms};
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::training::camb_basis;
@@ -19,7 +19,6 @@ use crate::loops::Estimate;
 use crate::precision::TwoLoopMethod;
 use crate::progress::Progress;
 use crate::store::TableStore;
-use std::f64::consts::PI;
 use std::sync::Arc;
 
 /// The tensors of the linear spectrum's terms and, with IR resummation, of the no-wiggle terms and
@@ -64,18 +63,9 @@ impl NoWiggleForms {
                 (first, w)
             })
             .collect();
-        // Σ² = 1/(6π²) ∫ d ln q q P_nw(q) (1 − j₀(q r_BAO)), as sigma2 integrates it.
+        // Σ² = ∫ d ln q (weight) P_nw(q), as sigma2 integrates it.
         let integrand: Vec<f64> = (0..lattice.len)
-            .map(|j| {
-                let q = lattice.x(j).exp();
-                let x = q * R_BAO;
-                let one_minus_j0 = if x < 1e-3 {
-                    x * x / 6.0
-                } else {
-                    1.0 - x.sin() / x
-                };
-                q * one_minus_j0 / (6.0 * PI * PI)
-            })
+            .map(|j| sigma2_kernel(lattice.x(j).exp()))
             .collect();
         let form = |stride: usize| {
             let weights = simpson_weights(lattice.len.div_ceil(stride), step * stride as f64);
