@@ -24,24 +24,58 @@ impl WithSimd for Dot<'_> {
 
     #[inline(always)]
     fn with_simd<S: Simd>(self, simd: S) -> f64 {
-        let (a, a_tail) = S::as_simd_f64s(self.0);
-        let (b, b_tail) = S::as_simd_f64s(self.1);
-        // Four independent accumulators hide the latency of the fused multiply–add.
-        let (a4, a_rest) = pulp::as_arrays::<4, _>(a);
-        let (b4, b_rest) = pulp::as_arrays::<4, _>(b);
-        let mut acc = [simd.splat_f64s(0.0); 4];
-        for (x, y) in a4.iter().zip(b4) {
-            for i in 0..4 {
-                acc[i] = simd.mul_add_f64s(x[i], y[i], acc[i]);
-            }
-        }
-        for (x, y) in a_rest.iter().zip(b_rest) {
-            acc[0] = simd.mul_add_f64s(*x, *y, acc[0]);
-        }
-        let sum = simd.add_f64s(simd.add_f64s(acc[0], acc[1]), simd.add_f64s(acc[2], acc[3]));
-        let tail: f64 = a_tail.iter().zip(b_tail).map(|(x, y)| x * y).sum();
-        simd.reduce_sum_f64s(sum) + tail
+        dot_simd(simd, self.0, self.1)
     }
+}
+
+/// The rows of `a` (each of the length of `x`, as many as `out` holds) times `x`, each as [`dot`],
+/// with one detection of the instructions for all of them (short rows: linear forms on the basis).
+pub(crate) fn matvec(a: &[f64], x: &[f64], out: &mut [f64]) {
+    assert!(
+        a.len() >= x.len() * out.len(),
+        "a matrix of {} rows",
+        out.len()
+    );
+    if x.is_empty() {
+        out.iter_mut().for_each(|o| *o = 0.0);
+        return;
+    }
+    Arch::new().dispatch(MatVec(a, x, out));
+}
+
+struct MatVec<'a>(&'a [f64], &'a [f64], &'a mut [f64]);
+
+impl WithSimd for MatVec<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let MatVec(a, x, out) = self;
+        for (o, row) in out.iter_mut().zip(a.chunks_exact(x.len())) {
+            *o = dot_simd(simd, row, x);
+        }
+    }
+}
+
+#[inline(always)]
+fn dot_simd<S: Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
+    let (a, a_tail) = S::as_simd_f64s(a);
+    let (b, b_tail) = S::as_simd_f64s(b);
+    // Four independent accumulators hide the latency of the fused multiply–add.
+    let (a4, a_rest) = pulp::as_arrays::<4, _>(a);
+    let (b4, b_rest) = pulp::as_arrays::<4, _>(b);
+    let mut acc = [simd.splat_f64s(0.0); 4];
+    for (x, y) in a4.iter().zip(b4) {
+        for i in 0..4 {
+            acc[i] = simd.mul_add_f64s(x[i], y[i], acc[i]);
+        }
+    }
+    for (x, y) in a_rest.iter().zip(b_rest) {
+        acc[0] = simd.mul_add_f64s(*x, *y, acc[0]);
+    }
+    let sum = simd.add_f64s(simd.add_f64s(acc[0], acc[1]), simd.add_f64s(acc[2], acc[3]));
+    let tail: f64 = a_tail.iter().zip(b_tail).map(|(x, y)| x * y).sum();
+    simd.reduce_sum_f64s(sum) + tail
 }
 
 /// y += a x over the common length (a spectrum's projection rebuilt from its basis functions).
@@ -135,6 +169,52 @@ pub(crate) fn dot_f32(a: &[f32], b: &[f32]) -> f64 {
         return simd.vectorize(|| dot_f32_v3(simd, a, b));
     }
     dot_f32_portable(a, b)
+}
+
+/// The rows of `a` (each of the length of `x`, as many as `out` holds) times `x`, each as
+/// [`dot_f32`] (the same sums), with one detection of the instructions for all of them: a
+/// low-rank tensor's thousands of short rows ([`crate::loops::basis`]).
+pub(crate) fn matvec_f32(a: &[f32], x: &[f32], out: &mut [f64]) {
+    let n = x.len();
+    assert!(
+        a.len() >= n * out.len(),
+        "a matrix of {} rows of {n}",
+        out.len()
+    );
+    if n == 0 {
+        out.iter_mut().for_each(|o| *o = 0.0);
+        return;
+    }
+    #[cfg(target_arch = "x86_64")]
+    if let Some(simd) = pulp::x86::V3::try_new() {
+        return simd.vectorize(MatVecV3 { simd, a, x, out });
+    }
+    for (o, row) in out.iter_mut().zip(a.chunks_exact(n)) {
+        *o = dot_f32_portable(row, x);
+    }
+}
+
+/// [`matvec_f32`] with AVX2 and FMA. A type rather than a closure: its `call` is inlined whole into
+/// the dispatch, so that the loop over rows is compiled for those instructions (a closure with a
+/// loop is not inlined, and its intrinsics become calls, five times slower).
+#[cfg(target_arch = "x86_64")]
+struct MatVecV3<'a> {
+    simd: pulp::x86::V3,
+    a: &'a [f32],
+    x: &'a [f32],
+    out: &'a mut [f64],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl pulp::NullaryFnOnce for MatVecV3<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn call(self) {
+        for (o, row) in self.out.iter_mut().zip(self.a.chunks_exact(self.x.len())) {
+            *o = dot_f32_v3(self.simd, row, self.x);
+        }
+    }
 }
 
 /// [`dot_f32`] with AVX2 and FMA: four accumulators of eight lanes, then the remainder by eight.
@@ -261,6 +341,9 @@ mod tests {
             let b: Vec<f64> = (0..n).map(|i| f64::from(i % 5) + 1.0).collect();
             let expected: f64 = a.iter().zip(&b).map(|(x, y)| x * y).sum();
             assert_eq!(dot(&a, &b), expected, "n = {n}");
+            let mut out = [f64::NAN; 2];
+            matvec(&[b.clone(), a.clone()].concat(), &a, &mut out);
+            assert_eq!(out, [expected, dot(&a, &a)], "n = {n}");
             let mut y = b.clone();
             axpy(&mut y, 2.0, &a);
             assert!(
@@ -276,6 +359,12 @@ mod tests {
             let b32: Vec<f32> = b.iter().map(|&x| x as f32).collect();
             assert_eq!(dot_f32(&a32, &b32), expected, "n = {n}");
             assert_eq!(dot_f32_portable(&a32, &b32), expected, "n = {n}");
+            // Three rows of a matrix at once: each row's own dot product.
+            let rows: Vec<f32> = [a32.clone(), b32.clone(), a32.clone()].concat();
+            let mut out = [f64::NAN; 3];
+            matvec_f32(&rows, &b32, &mut out);
+            let bb: f64 = b.iter().map(|x| x * x).sum();
+            assert_eq!(out, [expected, bb, expected], "n = {n}");
         }
     }
 

@@ -77,6 +77,9 @@ pub struct RsdTwoLoopTerms {
     /// Relative error added for the projection on a basis (0 for the direct integral): ε|value| is
     /// added to the error of every functional ([`RsdTwoLoopBasis`](crate::loops::basis::RsdTwoLoopBasis)).
     pub projection_error: f64,
+    /// Per k: a bound on the change of each coefficient ([`to_coefficients`]) by the low-rank form
+    /// of basis tensors (empty for the direct integral), added to the error of every functional.
+    truncation: Vec<[f64; COEFFICIENTS]>,
 }
 
 /// The node weights w_j for which Σ_j w_j P(μ_j²) = ∫₀¹ g(μ) P(μ²) dμ for every polynomial P of
@@ -128,7 +131,30 @@ pub fn combined(terms: &[(&RsdTwoLoopTerms, [f64; MU_NODES])], i: usize, f: f64)
         .filter(|(t, _)| t.projection_error > 0.0)
         .map(|(t, w)| t.projection_error * combined_value(t, w, i, &powers).abs())
         .sum();
-    Estimate::new(mean, (var / n).sqrt() + projection)
+    let truncation: f64 = terms
+        .iter()
+        .filter_map(|(t, w)| Some(truncation_bound(t.truncation.get(i)?, w, &powers)))
+        .sum();
+    Estimate::new(mean, (var / n).sqrt() + projection + truncation)
+}
+
+/// The largest change of Σ_j w_j Σ_m f^m c_m(μ_j²) for coefficients c_{m,l} (of f^m μ^{2l}) each
+/// changed by at most `bound`: Σ_{m,l} f^m |Σ_j w_j μ_j^{2l}| bound_{m,l}.
+fn truncation_bound(
+    bound: &[f64; COEFFICIENTS],
+    weights: &[f64; MU_NODES],
+    powers: &[f64; F_POWERS],
+) -> f64 {
+    let x = mu2_nodes();
+    let moment = |l: usize| -> f64 {
+        (x.iter().zip(weights))
+            .map(|(x, w)| w * x.powi(l as i32))
+            .sum()
+    };
+    (0..F_POWERS)
+        .flat_map(|m| (0..=m).map(move |l| (m, l)))
+        .map(|(m, l)| powers[m].abs() * moment(l).abs() * bound[m * (m + 1) / 2 + l])
+        .sum()
 }
 
 /// Σ_j w_j Σ_m f^m c_jm of one replica's integrals `nodes` at one k.
@@ -199,6 +225,7 @@ impl RsdTwoLoopTerms {
         points: Vec<usize>,
         replicas: &[Vec<[f64; COEFFICIENTS]>],
         projection_error: f64,
+        truncation: Vec<[f64; COEFFICIENTS]>,
     ) -> Self {
         Self {
             k: k.to_vec(),
@@ -208,6 +235,7 @@ impl RsdTwoLoopTerms {
                 .map(|r| r.iter().map(from_coefficients).collect())
                 .collect(),
             projection_error,
+            truncation,
         }
     }
 
@@ -407,6 +435,7 @@ pub fn rsd_two_loop_of(
             k: k.to_vec(),
             points: counts.clone(),
             projection_error: 0.0,
+            truncation: Vec::new(),
             replicas: integrals
                 .chunks(replicas)
                 .map(|jobs| jobs.iter().map(|per| per[s]).collect())

@@ -35,6 +35,7 @@
 
 mod forms;
 mod linear_basis;
+mod low_rank;
 mod one_loop;
 mod p15_forms;
 mod redshift;
@@ -61,6 +62,7 @@ use super::{
 use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
 use crate::simd::dot32;
+use low_rank::{LowRank, TRIPLE_TOLERANCE};
 use p15_forms::{p15_forms, FORM_KERNELS};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -86,7 +88,7 @@ pub const PROJECTION_ERROR_FACTOR: f64 = 1.0;
 pub const MAX_RESIDUAL: f64 = 3e-4;
 
 /// Version of the tensor layout and rules, part of the cache file name.
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 /// Index of the pair a ≤ b in the symmetric storage (pairs with b < n come first).
 #[inline]
@@ -157,8 +159,9 @@ pub struct TwoLoopBasis {
     replicas: usize,
     /// Per k: [type][kernel][pair] ([`p15_forms`]).
     forms: Vec<Vec<f64>>,
-    /// Per k: the mean over shifts [quantity][triple], in f32 ([`shift_statistics`]).
-    mean: Vec<Vec<f32>>,
+    /// The mean over shifts, row k × quantity, column triple, in low-rank form ([`LowRank`]:
+    /// its truncation bound is added to the errors).
+    mean: LowRank,
     /// Per k: each shift's deviation from the mean, [shift][quantity][triple < triples(n_err)].
     deviations: Vec<Vec<f32>>,
     max_residual: f64,
@@ -254,6 +257,8 @@ impl TwoLoopBasis {
         tensors.sort_by_key(|t| t.0);
         let (mean, deviations) =
             shift_statistics(&tensors, replicas, ACC, n, |i| integral_scale(points[i]));
+        let sigma = training::coefficient_scale(&basis);
+        let mean = LowRank::new(&mean.concat(), k.len() * ACC, 3, &sigma, TRIPLE_TOLERANCE);
         let forms = k.par_iter().map(|&k| p15_forms(table, k, &basis)).collect();
         Self {
             k: k.to_vec(),
@@ -325,6 +330,8 @@ impl TwoLoopBasis {
         let n = c.len();
         let s2 = forms::pair_products(c);
         let s3 = triple_products(c);
+        let z = self.mean.reduce(&s3);
+        let scale = self.mean.norm(c);
         let mut p15_rows = Vec::with_capacity(self.k.len());
         let mut propagator = Vec::with_capacity(self.k.len());
         let mut rows = Vec::with_capacity(self.k.len());
@@ -344,9 +351,21 @@ impl TwoLoopBasis {
             let (dd, tt) = (kernel(0), kernel(1));
             p15_rows.push([dd, Estimate::mean(dd, tt), tt]);
             propagator.push([kernel(2), kernel(3), kernel(4)]);
+            let mean: [f64; ACC] = std::array::from_fn(|v| self.mean.row(i * ACC + v, &z));
             let integrals: Vec<[f64; ACC]> =
-                replica_contractions(&self.mean[i], &self.deviations[i], &s3, n);
-            rows.push(replica_estimates(&integrals));
+                replica_contractions(mean, &self.deviations[i], &s3, n);
+            let mut row = replica_estimates(&integrals);
+            // The truncation of the low-rank mean: each accumulated quantity's bound, and for the
+            // sums of two (the last VALUES − ACC) the sum of theirs.
+            let bound = |v: usize| self.mean.bound(i * ACC + v, scale);
+            for (v, r) in row.iter_mut().enumerate() {
+                r.error += if v < ACC {
+                    bound(v)
+                } else {
+                    bound(v - 6) + bound(v - 3)
+                };
+            }
+            rows.push(row);
         }
         // Assembled as the direct path does (the same choice between its two estimates of the
         // total), then the projection error added: ε times the sum of the sizes of the terms of each
@@ -398,9 +417,9 @@ impl TwoLoopBasis {
         v.extend(self.basis.to_f64s());
         for i in 0..self.k.len() {
             v.extend(&self.forms[i]);
-            v.extend(self.mean[i].iter().map(|&x| f64::from(x)));
             v.extend(self.deviations[i].iter().map(|&x| f64::from(x)));
         }
+        v.extend(self.mean.to_f64s());
         v
     }
 
@@ -421,21 +440,23 @@ impl TwoLoopBasis {
         let n = basis.len();
         let sizes = [
             3 * FORM_KERNELS * n * (n + 1) / 2,
-            ACC * triples(n),
             replicas * ACC * triples(error_functions(n)),
         ];
-        if rest.len() != k.len() * sizes.iter().sum::<usize>() {
+        let per_k = k.len() * sizes.iter().sum::<usize>();
+        if rest.len() < per_k {
             return None;
         }
-        let (mut forms, mut mean, mut deviations) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut forms, mut deviations) = (Vec::new(), Vec::new());
         for _ in k {
             let (f, r) = rest.split_at(sizes[0]);
-            let (m, r) = r.split_at(sizes[1]);
-            let (d, r) = r.split_at(sizes[2]);
+            let (d, r) = r.split_at(sizes[1]);
             forms.push(f.to_vec());
-            mean.push(m.iter().map(|&x| x as f32).collect());
             deviations.push(d.iter().map(|&x| x as f32).collect());
             rest = r;
+        }
+        let (mean, rest) = LowRank::from_f64s(rest)?;
+        if !rest.is_empty() || !mean.has_shape(k.len() * ACC, triples(n)) {
+            return None;
         }
         Some(Self {
             k: k.to_vec(),
@@ -455,17 +476,18 @@ impl TwoLoopBasis {
 /// of them on a basis of `n`), each times `scale(k index)`: the mean over the shifts, and each shift's
 /// deviation from it kept on the first [`ERROR_FUNCTIONS`] functions ([shift][quantity][triple]).
 ///
-/// Both are kept in f32 (summed in f64 when contracted, [`simd::dot32`]): the contraction reads them
-/// from memory at every evaluation, and half the bytes is what makes it fast. Rounding the tensors to
-/// f32 moved the 2-loop redshift-space multipoles of two held-out spectra by 3e-8 of the monopole
-/// (1e-5 of their Monte Carlo error).
+/// The mean is returned in f64 (for its low-rank form, or to be rounded by the caller), the
+/// deviations in f32 (summed in f64 when contracted, [`dot32`]): the contraction reads them from
+/// memory at every evaluation, and half the bytes is what makes it fast. Rounding the tensors to f32
+/// moved the 2-loop redshift-space multipoles of two held-out spectra by 3e-8 of the monopole (1e-5
+/// of their Monte Carlo error).
 pub(crate) fn shift_statistics(
     tensors: &[(usize, Vec<f64>)],
     replicas: usize,
     quantities: usize,
     n: usize,
     scale: impl Fn(usize) -> f64,
-) -> (Vec<Vec<f32>>, Vec<Vec<f32>>) {
+) -> (Vec<Vec<f64>>, Vec<Vec<f32>>) {
     let (t, t_err) = (triples(n), triples(error_functions(n)));
     let (mut mean, mut deviations) = (Vec::new(), Vec::new());
     for (i, shifts) in tensors.chunks(replicas).enumerate() {
@@ -489,7 +511,7 @@ pub(crate) fn shift_statistics(
                 );
             }
         }
-        mean.push(m.iter().map(|&x| x as f32).collect());
+        mean.push(m);
         deviations.push(d.iter().map(|&x| x as f32).collect());
     }
     (mean, deviations)
@@ -509,17 +531,16 @@ pub(crate) fn triple_products(c: &[f64]) -> Vec<f64> {
     s3
 }
 
-/// Each shift's integrals of the Q quantities at one k: the `mean` tensor contracted with the
-/// triple products `s3` plus that shift's deviation tensor (from [`shift_statistics`]) contracted
-/// with their first [`ERROR_FUNCTIONS`] functions.
+/// Each shift's integrals of the Q quantities at one k: the `mean` integrals (the mean tensor
+/// contracted with the triple products `s3`) plus that shift's deviation tensor (from
+/// [`shift_statistics`]) contracted with their first [`ERROR_FUNCTIONS`] functions.
 pub(crate) fn replica_contractions<const Q: usize>(
-    mean: &[f32],
+    mean: [f64; Q],
     deviations: &[f32],
     s3: &[f64],
     n: usize,
 ) -> Vec<[f64; Q]> {
-    let (t, t_err) = (triples(n), triples(error_functions(n)));
-    let mean: [f64; Q] = std::array::from_fn(|v| dot32(&mean[v * t..(v + 1) * t], s3));
+    let t_err = triples(error_functions(n));
     deviations
         .chunks_exact(Q * t_err)
         .map(|d| {

@@ -17,17 +17,15 @@
 //! therefore those of the filtered basis functions S[φ_a], contracted with the spectrum's own
 //! coefficients: one projection, no filter and no second basis per spectrum.
 
-use super::forms::{
-    concat, dot32, dot_f32, fine_and_diff, linear_form, pair_forms, pair_products_both, per_k,
-    RuleRows,
-};
+use super::forms::{concat, linear_form, pair_forms, pair_products_both, per_k, RuleRows};
+use super::low_rank::{LowRank, PAIR_TOLERANCE};
 use super::{error_functions, LinearBasis, Projection, BASIS_SIZE};
 use crate::loops::redshift::{RedshiftPlan, RedshiftTerms, Row, NPAIR};
 use crate::loops::Estimate;
 use crate::precision::Precision;
 
 /// Version of the tensor layout and rules, part of the cache file name.
-const VERSION: u32 = 2;
+const VERSION: u32 = 3;
 
 /// Lattice-weight terms per k.
 const LW: usize = 6;
@@ -64,9 +62,11 @@ pub struct RedshiftBasis {
     k: Vec<f64>,
     key: Vec<f64>,
     basis: LinearBasis,
-    /// Per k: the pair columns of the fine rule on the pairs of all n functions.
-    pairs: Vec<f32>,
-    /// Per k: fine − half-resolution pair columns on the pairs of the first n_err functions.
+    /// The pair columns of the fine rule on the pairs of all n functions, row k × column, in
+    /// low-rank form ([`LowRank`]: its truncation bound is added to the errors).
+    pairs: LowRank,
+    /// Per k: fine − half-resolution pair columns on the pairs of the first n_err functions (the
+    /// quadrature error estimate; not of low rank).
     pairs_diff: Vec<f32>,
     /// Per k: [`LINEAR`] forms of length n.
     linear: Vec<f64>,
@@ -134,7 +134,12 @@ impl RedshiftBasis {
         let per_k = per_k(k.len(), progress, |i| {
             let f = pair_forms(&fine.pairs, i, &fine_rows, n, 0..NPAIR, 0..0, 0..0).pairs;
             let c = pair_forms(&coarse.pairs, i, &coarse_rows, n_err, 0..NPAIR, 0..0, 0..0);
-            let (pairs, diff) = fine_and_diff(&f, &c.pairs);
+            let pairs: Vec<f64> = f.concat();
+            let diff: Vec<f32> = f
+                .iter()
+                .zip(&c.pairs)
+                .flat_map(|(f, c)| f.iter().zip(c).map(|(f, c)| (f - c) as f32))
+                .collect();
             let mut linear = Vec::with_capacity(LINEAR * n);
             for w in &fine.lattice_weights[i] {
                 linear.extend(linear_form(w, &fine_rows));
@@ -153,6 +158,8 @@ impl RedshiftBasis {
         let mut sigma_v2 = sv_fine.clone();
         sigma_v2.extend(sv_fine.iter().zip(&sv_coarse).map(|(f, c)| f - c));
         let (pairs, pairs_diff, linear) = concat(per_k);
+        let sigma = super::training::coefficient_scale(&basis);
+        let pairs = LowRank::new(&pairs, k.len() * NPAIR, 2, &sigma, PAIR_TOLERANCE);
         Self {
             k: k.to_vec(),
             key: key(k, precision, family),
@@ -175,25 +182,30 @@ impl RedshiftBasis {
     fn rows(&self, p_lin: &[f64], projection: &Projection) -> (Vec<Row>, Estimate) {
         let c = &projection.coefficients;
         let n = c.len();
-        let (pairs, n_err) = (n * (n + 1) / 2, error_functions(n));
-        let pairs_err = n_err * (n_err + 1) / 2;
-        let (s2, s2_single) = pair_products_both(c);
+        let pairs_err = error_functions(n) * (error_functions(n) + 1) / 2;
+        let (_, s2_single) = pair_products_both(c);
+        let values = self
+            .pairs
+            .expand_single(&self.pairs.reduce_single(&s2_single));
+        let mut diffs = vec![0.0; values.len()];
+        crate::simd::matvec_f32(&self.pairs_diff, &s2_single[..pairs_err], &mut diffs);
+        let mut forms = vec![0.0; self.linear.len() / n];
+        crate::simd::matvec(&self.linear, c, &mut forms);
+        let norm = self.pairs.norm(c);
         let eps = projection.residual;
         let floor = self.p22_error_floor;
         let rows = p_lin
             .iter()
             .enumerate()
             .map(|(i, &p)| {
-                let t = &self.pairs[i * NPAIR * pairs..][..NPAIR * pairs];
-                let d = &self.pairs_diff[i * NPAIR * pairs_err..][..NPAIR * pairs_err];
-                let l = &self.linear[i * LINEAR * n..][..LINEAR * n];
+                let form = |m: usize| forms[i * LINEAR + m];
                 let pair = std::array::from_fn(|m| {
-                    let a = dot_f32(&t[m * pairs..(m + 1) * pairs], &s2_single);
-                    let diff = dot32(&d[m * pairs_err..(m + 1) * pairs_err], &s2[..pairs_err]);
+                    let row = i * NPAIR + m;
+                    let (a, diff) = (values[row], diffs[row]);
                     let quadrature = diff.abs().max(floor * a.abs());
-                    Estimate::new(a, quadrature + 2.0 * eps * a.abs())
+                    let truncation = self.pairs.bound(row, norm);
+                    Estimate::new(a, quadrature + 2.0 * eps * a.abs() + truncation)
                 });
-                let form = |m: usize| super::dot(&l[m * n..(m + 1) * n], c);
                 let lw = std::array::from_fn(|m| {
                     let (s, sc, abs) = (form(m), form(LW + m), form(2 * LW + m));
                     Estimate::new(p * s, (p * (s - sc)).abs() + eps * (p * abs).abs())
@@ -255,7 +267,7 @@ impl RedshiftBasis {
         let mut v = vec![self.key.len() as f64];
         v.extend(&self.key);
         v.extend(self.basis.to_f64s());
-        v.extend(self.pairs.iter().map(|&t| f64::from(t)));
+        v.extend(self.pairs.to_f64s());
         v.extend(self.pairs_diff.iter().map(|&t| f64::from(t)));
         v.extend(&self.linear);
         v.extend(&self.sigma_v2);
@@ -274,28 +286,24 @@ impl RedshiftBasis {
         let rest = super::after_key(values, &expected)?;
         let lattice = super::lattice_of(precision);
         let (basis, rest) = LinearBasis::from_f64s(lattice, rest)?;
+        let (pairs, rest) = LowRank::from_f64s(rest)?;
         let n = basis.len();
         let n_err = error_functions(n);
         let nk = k.len();
-        let sizes = [
-            nk * NPAIR * n * (n + 1) / 2,
-            nk * NPAIR * n_err * (n_err + 1) / 2,
-            nk * LINEAR * n,
-            2 * n,
-        ];
-        if rest.len() != sizes.iter().sum::<usize>() {
+        let sizes = [nk * NPAIR * n_err * (n_err + 1) / 2, nk * LINEAR * n, 2 * n];
+        if rest.len() != sizes.iter().sum::<usize>()
+            || !pairs.has_shape(nk * NPAIR, n * (n + 1) / 2)
+        {
             return None;
         }
-        let (pairs, rest) = rest.split_at(sizes[0]);
-        let (pairs_diff, rest) = rest.split_at(sizes[1]);
-        let (linear, sigma_v2) = rest.split_at(sizes[2]);
-        let single = |v: &[f64]| v.iter().map(|&t| t as f32).collect();
+        let (pairs_diff, rest) = rest.split_at(sizes[0]);
+        let (linear, sigma_v2) = rest.split_at(sizes[1]);
         Some(Self {
             k: k.to_vec(),
             key: expected,
             basis,
-            pairs: single(pairs),
-            pairs_diff: single(pairs_diff),
+            pairs,
+            pairs_diff: pairs_diff.iter().map(|&t| t as f32).collect(),
             linear: linear.to_vec(),
             sigma_v2: sigma_v2.to_vec(),
             p22_error_floor: precision.p22_error_floor,

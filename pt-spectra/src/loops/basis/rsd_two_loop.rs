@@ -9,6 +9,7 @@
 //! [`RSD_PROJECTION_FACTOR`] × the smoothed projection residual; spectra whose residual exceeds
 //! [`MAX_RESIDUAL`] are refused (the caller integrates them directly).
 
+use super::low_rank::{LowRank, TRIPLE_TOLERANCE};
 use super::tensors::{fold, rank_update};
 use super::{
     after_key, cache_file_name, error_functions, pair_index, replica_contractions,
@@ -24,7 +25,7 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Version of the layout, part of the cache file name.
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 /// Points per batch of the rank update.
 const BATCH: usize = 32;
@@ -44,8 +45,9 @@ pub struct RsdTwoLoopBasis {
     basis: LinearBasis,
     points: Vec<usize>,
     replicas: usize,
-    /// Per k: the mean over shifts [coefficient][triple], in f32 ([`super::shift_statistics`]).
-    mean: Vec<Vec<f32>>,
+    /// The mean over shifts, row k × coefficient, column triple, in low-rank form ([`LowRank`]: its
+    /// truncation bound is added to the errors).
+    mean: LowRank,
     /// Per k: each shift's deviation from the mean, [shift][coefficient][triple < triples(n_err)].
     deviations: Vec<Vec<f32>>,
 }
@@ -189,6 +191,14 @@ impl RsdTwoLoopBasis {
         let (mean, deviations) = shift_statistics(&tensors, replicas, COEFFICIENTS, n, |i| {
             integral_scale(sampling.counts[i])
         });
+        let sigma = super::training::coefficient_scale(&basis);
+        let mean = LowRank::new(
+            &mean.concat(),
+            k.len() * COEFFICIENTS,
+            3,
+            &sigma,
+            TRIPLE_TOLERANCE,
+        );
         Self {
             k: k.to_vec(),
             key: key(k, q_range, lattice_step, settings, family),
@@ -247,15 +257,25 @@ impl RsdTwoLoopBasis {
     pub fn evaluate_projected(&self, projection: &Projection) -> RsdTwoLoopTerms {
         let n = projection.coefficients.len();
         let s3 = triple_products(&projection.coefficients);
+        let z = self.mean.reduce(&s3);
+        let scale = self.mean.norm(&projection.coefficients);
+        let row = |i: usize, v: usize| i * COEFFICIENTS + v;
         let replicas: Vec<Vec<[f64; COEFFICIENTS]>> = (0..self.k.len())
             .into_par_iter()
-            .map(|i| replica_contractions(&self.mean[i], &self.deviations[i], &s3, n))
+            .map(|i| {
+                let mean = std::array::from_fn(|v| self.mean.row(row(i, v), &z));
+                replica_contractions(mean, &self.deviations[i], &s3, n)
+            })
+            .collect();
+        let truncation = (0..self.k.len())
+            .map(|i| std::array::from_fn(|v| self.mean.bound(row(i, v), scale)))
             .collect();
         RsdTwoLoopTerms::from_coefficients(
             &self.k,
             self.points.clone(),
             &replicas,
             RSD_PROJECTION_FACTOR * projection.residual,
+            truncation,
         )
     }
 
@@ -267,9 +287,9 @@ impl RsdTwoLoopBasis {
         v.push(self.replicas as f64);
         v.extend(self.basis.to_f64s());
         for i in 0..self.k.len() {
-            v.extend(self.mean[i].iter().map(|&x| f64::from(x)));
             v.extend(self.deviations[i].iter().map(|&x| f64::from(x)));
         }
+        v.extend(self.mean.to_f64s());
         v
     }
 
@@ -289,20 +309,19 @@ impl RsdTwoLoopBasis {
         let (basis, mut rest) =
             LinearBasis::from_f64s(Self::lattice(q_range, lattice_step), &rest[k.len() + 1..])?;
         let n = basis.len();
-        let sizes = [
-            COEFFICIENTS * triples(n),
-            replicas * COEFFICIENTS * triples(error_functions(n)),
-        ];
-        if rest.len() != k.len() * (sizes[0] + sizes[1]) {
+        let size = replicas * COEFFICIENTS * triples(error_functions(n));
+        if rest.len() < k.len() * size {
             return None;
         }
-        let (mut mean, mut deviations) = (Vec::new(), Vec::new());
+        let mut deviations = Vec::new();
         for _ in k {
-            let (m, r) = rest.split_at(sizes[0]);
-            let (d, r) = r.split_at(sizes[1]);
-            mean.push(m.iter().map(|&x| x as f32).collect());
+            let (d, r) = rest.split_at(size);
             deviations.push(d.iter().map(|&x| x as f32).collect());
             rest = r;
+        }
+        let (mean, rest) = LowRank::from_f64s(rest)?;
+        if !rest.is_empty() || !mean.has_shape(k.len() * COEFFICIENTS, triples(n)) {
+            return None;
         }
         Some(Self {
             k: k.to_vec(),

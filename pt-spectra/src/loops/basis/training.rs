@@ -146,6 +146,21 @@ pub(crate) fn transformed_basis(
     basis_of(lattice.clone(), samples_with(lattice, transform), n)
 }
 
+/// σ_a: the largest |c_a| of the training spectra (and cuts, [`camb_samples`]) projected on `basis`,
+/// the scale of each coefficient for the low-rank tensors ([`super::low_rank`]). For a basis of
+/// another family (no-wiggle parts) the linear spectra give the same scales to a few per cent.
+pub(crate) fn coefficient_scale(basis: &LinearBasis) -> Vec<f64> {
+    let mut sigma = vec![0.0_f64; basis.len()];
+    for samples in camb_samples(basis.lattice()) {
+        let c = basis.project(&samples).coefficients;
+        sigma
+            .iter_mut()
+            .zip(&c)
+            .for_each(|(s, c)| *s = s.max(c.abs()));
+    }
+    sigma
+}
+
 fn basis_of(lattice: Lattice, training: Vec<Vec<f64>>, n: usize) -> LinearBasis {
     let mean: Vec<f64> = (0..lattice.len)
         .map(|j| training.iter().map(|t| t[j]).sum::<f64>() / training.len() as f64)
