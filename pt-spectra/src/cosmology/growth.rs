@@ -116,8 +116,14 @@ impl Cosmology {
         match self.method() {
             Method::Heath => {
                 let integral = self.growth_integral(a);
+                // At z = 0 the normalisation is the same integral (the same value, once).
+                let today = if a == 1.0 {
+                    self.heath_d_md_of(1.0, integral)
+                } else {
+                    self.heath_d_md(1.0)
+                };
                 (
-                    self.heath_d_md_of(a, integral) / self.heath_d_md(1.0),
+                    self.heath_d_md_of(a, integral) / today,
                     self.heath_rate_of(a, integral),
                 )
             }
