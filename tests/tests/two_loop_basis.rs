@@ -67,6 +67,7 @@ fn basis_two_loop_terms_match_the_direct_integrals() {
         let name = format!("linear_pk_camb_heldout_{i}.dat");
         spectra.push(("held-out", camb(&name)));
     }
+    spectra.push(("flat w0-wa z=1", camb("linear_pk_camb_w0wa_z1.0.dat")));
     let mut worst: f64 = 0.0;
     for (name, p) in &spectra {
         let one_loop = plan.par_evaluate(p);

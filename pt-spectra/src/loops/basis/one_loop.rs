@@ -413,8 +413,9 @@ mod tests {
             keep.iter().map(|&i| p[i]).collect(),
         )
         .unwrap();
-        // Three w0 ≠ −1 CAMB cosmologies, the curved one, and CLASS.
-        let others = [curved_cut, LinearSpectrum::from_file(class).unwrap()];
+        // Three w0 ≠ −1 CAMB cosmologies, the curved one, a flat w0–wa one at z = 1, and CLASS.
+        let w0wa = LinearSpectrum::from_file(format!("{dir}linear_pk_camb_w0wa_z1.0.dat")).unwrap();
+        let others = [curved_cut, w0wa, LinearSpectrum::from_file(class).unwrap()];
         for p in (0..3).map(held_out).chain(others) {
             let direct = plan.evaluate(&p);
             let residual = basis.basis.project(&basis.basis.sample(&p)).residual;

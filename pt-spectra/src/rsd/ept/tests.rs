@@ -148,10 +148,11 @@ fn the_basis_gives_the_direct_multipoles_and_falls_back_outside_its_span() {
             .with_basis(&store, &crate::progress::Silent)
             .unwrap();
         assert!(plan.has_basis());
-        // Spectra the basis was not trained on: two CAMB and a CLASS table.
+        // Spectra the basis was not trained on: two CAMB tables, a flat w0–wa one and a CLASS table.
         for name in [
             "linear_pk_camb_heldout_0.dat",
             "linear_pk_camb_heldout_2.dat",
+            "linear_pk_camb_w0wa_z1.0.dat",
             "linear_pk_class_planck2018_z0.0_pk_lin.dat",
         ] {
             let p = LinearSpectrum::from_file(format!("{dir}{name}")).unwrap();
