@@ -57,8 +57,8 @@ pub use p15::{p15_angular_kernel, P15Table};
 pub use p17::{p17_angular_kernel, P17Table};
 pub use p22::f2_g2;
 pub use rsd_two_loop::{
-    check_ells as check_two_loop_ells, combined, mu2_nodes, node_weights, rsd_two_loop,
-    rsd_two_loop_of, RsdTwoLoopTerms, MAX_TWO_LOOP_ELL,
+    check_ells as check_two_loop_ells, combined, mu2_nodes, node_weights, node_weights_on,
+    rsd_two_loop, rsd_two_loop_of, NodeRule, RsdTwoLoopTerms, MAX_TWO_LOOP_ELL,
 };
 pub use tns::{tns, TnsCoefficients, TnsPlan, TnsTerms};
 pub use two_loop::{

@@ -86,11 +86,35 @@ pub struct RsdTwoLoopTerms {
 /// degree 6 in μ², by a 32-point Gauss–Legendre rule (exact for polynomial g of degree ≤ 50; g smooth
 /// otherwise, e.g. a damping).
 pub fn node_weights(g: impl Fn(f64) -> f64) -> [f64; MU_NODES] {
-    let (x, w) = legendre_nodes(32);
+    node_weights_on(&NodeRule::new(), g)
+}
+
+/// The 32-point Gauss–Legendre rule of [`node_weights`], made once for many calls
+/// ([`node_weights_on`]: the same weights).
+#[derive(Debug, Clone)]
+pub struct NodeRule(Vec<f64>, Vec<f64>);
+
+impl NodeRule {
+    /// The rule.
+    pub fn new() -> Self {
+        let (x, w) = legendre_nodes(32);
+        Self(x, w)
+    }
+}
+
+impl Default for NodeRule {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// [`node_weights`] on a rule made before.
+pub fn node_weights_on(rule: &NodeRule, g: impl Fn(f64) -> f64) -> [f64; MU_NODES] {
+    let NodeRule(x, w) = rule;
     let nodes = mu2_nodes();
     std::array::from_fn(|j| {
         x.iter()
-            .zip(&w)
+            .zip(w.iter())
             .map(|(&x, &w)| {
                 let mu = 0.5 * (x + 1.0);
                 0.5 * w * g(mu) * lagrange(&nodes, j, mu * mu)
@@ -257,6 +281,15 @@ impl RsdTwoLoopTerms {
     pub fn multipoles(&self, i: usize, f: f64, ells: &[usize]) -> Vec<Estimate> {
         ells.iter()
             .map(|&ell| self.functional(i, f, &moment_weights(ell)))
+            .collect()
+    }
+
+    /// [`multipoles`](Self::multipoles) at every k (by k, then ℓ), with the moment weights of each ℓ
+    /// made once.
+    pub fn multipoles_at_every_k(&self, f: f64, ells: &[usize]) -> Vec<Vec<Estimate>> {
+        let weights: Vec<[f64; MU_NODES]> = ells.iter().map(|&ell| moment_weights(ell)).collect();
+        (0..self.k.len())
+            .map(|i| weights.iter().map(|w| self.functional(i, f, w)).collect())
             .collect()
     }
 

@@ -45,7 +45,7 @@ use crate::loops::basis::training::{camb_basis, transformed_basis};
 use crate::loops::basis::{RsdTwoLoopBasis, SpectrumFamily, BASIS_SIZE};
 use crate::loops::redshift::{RedshiftPlan, RedshiftTerms};
 use crate::loops::rsd_two_loop::legendre;
-use crate::loops::{combined, node_weights, Estimate, RsdTwoLoopTerms};
+use crate::loops::{combined, node_weights_on, Estimate, NodeRule, RsdTwoLoopTerms};
 use crate::precision::Precision;
 use crate::progress::Progress;
 use crate::store::TableStore;
@@ -412,6 +412,7 @@ impl Eft2Terms {
         let params = [1.0, 0.0, 0.0, 0.0, f];
         let coefficients = self.one_full.coefficients(params);
         let (fine, coarse) = (mu_rule(MU_NODES), mu_rule(MU_NODES / 2));
+        let rule = NodeRule::new();
         let mut total = vec![Vec::with_capacity(self.k.len()); ells.len()];
         let mut templates = vec![vec![Vec::with_capacity(self.k.len()); ells.len()]; 7];
         for i in 0..self.k.len() {
@@ -460,13 +461,13 @@ impl Eft2Terms {
                 }
                 let g = |mu: f64| (2 * ell + 1) as f64 * legendre(ell, mu);
                 let two = match &self.two_nw {
-                    None => self.two_full.functional(i, f, &node_weights(g)),
+                    None => self.two_full.functional(i, f, &node_weights_on(&rule, g)),
                     Some(nw) => {
                         let d = |mu: f64| (-self.x(i, f, mu)).exp();
                         combined(
                             &[
-                                (&self.two_full, node_weights(|mu| g(mu) * d(mu))),
-                                (nw, node_weights(|mu| g(mu) * (1.0 - d(mu)))),
+                                (&self.two_full, node_weights_on(&rule, |mu| g(mu) * d(mu))),
+                                (nw, node_weights_on(&rule, |mu| g(mu) * (1.0 - d(mu)))),
                             ],
                             i,
                             f,

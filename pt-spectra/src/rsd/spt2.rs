@@ -280,9 +280,7 @@ impl Spt2Terms {
             let value = v.iter().enumerate().map(|(n, c)| c * moment(ell, n)).sum();
             Estimate::new(value, (2 * ell + 1) as f64 * e.iter().sum::<f64>())
         });
-        let two: Vec<Vec<Estimate>> = (0..self.k.len())
-            .map(|i| self.two_loop.multipoles(i, f, ells))
-            .collect();
+        let two = self.two_loop.multipoles_at_every_k(f, ells);
         let two_loop: Multipoles = (0..ells.len())
             .map(|l| two.iter().map(|row| row[l]).collect())
             .collect();
