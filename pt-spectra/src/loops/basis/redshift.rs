@@ -178,8 +178,14 @@ impl RedshiftBasis {
     }
 
     /// The rows (pair columns and lattice-weight terms with errors) and σ_v² of the spectrum with
-    /// P_lin = `p_lin` at the grid's k and projection `projection`.
-    fn rows(&self, p_lin: &[f64], projection: &Projection) -> (Vec<Row>, Estimate) {
+    /// P_lin = `p_lin` at the grid's k and projection `projection`; the pair columns' quadrature
+    /// error only if `quadrature` (the no-wiggle terms take the full ones' errors instead).
+    fn rows(
+        &self,
+        p_lin: &[f64],
+        projection: &Projection,
+        quadrature: bool,
+    ) -> (Vec<Row>, Estimate) {
         let c = &projection.coefficients;
         let n = c.len();
         let pairs_err = error_functions(n) * (error_functions(n) + 1) / 2;
@@ -188,7 +194,9 @@ impl RedshiftBasis {
             .pairs
             .expand_single(&self.pairs.reduce_single(&s2_single));
         let mut diffs = vec![0.0; values.len()];
-        crate::simd::matvec_f32(&self.pairs_diff, &s2_single[..pairs_err], &mut diffs);
+        if quadrature {
+            crate::simd::matvec_f32(&self.pairs_diff, &s2_single[..pairs_err], &mut diffs);
+        }
         let mut forms = vec![0.0; self.linear.len() / n];
         crate::simd::matvec(&self.linear, c, &mut forms);
         let norm = self.pairs.norm(c);
@@ -226,14 +234,14 @@ impl RedshiftBasis {
         p_lin: &[f64],
         projection: &Projection,
     ) -> RedshiftTerms {
-        let (rows, sigma_v2) = self.rows(p_lin, projection);
+        let (rows, sigma_v2) = self.rows(p_lin, projection, true);
         plan.assemble_rows(p_lin.to_vec(), &rows, sigma_v2)
     }
 
     /// The terms of a spectrum and of its no-wiggle part (as
     /// [`RedshiftPlan::evaluate_with_no_wiggle`]), the latter on the tensors `no_wiggle` (of the
-    /// no-wiggle family): the no-wiggle terms carry the full terms' errors plus their own projection
-    /// error.
+    /// no-wiggle family): the no-wiggle terms carry the full terms' errors (their quadrature error:
+    /// the same nodes) plus their own projection and truncation errors.
     pub fn evaluate_with_no_wiggle(
         &self,
         plan: &RedshiftPlan,
@@ -241,21 +249,14 @@ impl RedshiftBasis {
         no_wiggle: &RedshiftBasis,
         (p_nw, projection_nw): (&[f64], &Projection),
     ) -> (RedshiftTerms, RedshiftTerms) {
-        let (rows, sigma_v2) = self.rows(p_lin, projection);
-        let (mut rows_nw, mut sigma_v2_nw) = no_wiggle.rows(p_nw, projection_nw);
-        let eps = projection_nw.residual;
-        let keep = |nw: &mut Estimate, full: &Estimate, scale: f64| {
-            nw.error = full.error + scale * eps * nw.value.abs();
-        };
+        let (rows, sigma_v2) = self.rows(p_lin, projection, true);
+        let (mut rows_nw, mut sigma_v2_nw) = no_wiggle.rows(p_nw, projection_nw, false);
+        let add = |nw: &mut Estimate, full: &Estimate| nw.error += full.error;
         for (nw, full) in rows_nw.iter_mut().zip(&rows) {
-            nw.0.iter_mut()
-                .zip(&full.0)
-                .for_each(|(a, b)| keep(a, b, 2.0));
-            nw.1.iter_mut()
-                .zip(&full.1)
-                .for_each(|(a, b)| keep(a, b, 1.0));
+            nw.0.iter_mut().zip(&full.0).for_each(|(a, b)| add(a, b));
+            nw.1.iter_mut().zip(&full.1).for_each(|(a, b)| add(a, b));
         }
-        keep(&mut sigma_v2_nw, &sigma_v2, 1.0);
+        add(&mut sigma_v2_nw, &sigma_v2);
         (
             plan.assemble_rows(p_lin.to_vec(), &rows, sigma_v2),
             plan.assemble_rows(p_nw.to_vec(), &rows_nw, sigma_v2_nw),
