@@ -23,8 +23,7 @@
 //! error, ≲ 1e-8.
 
 use super::forms::{
-    concat, dot32, dot_f32, fine_and_diff, linear_form, pair_forms, pair_products_both, per_k,
-    Rows, RuleRows,
+    concat, fine_and_diff, linear_form, pair_forms, pair_products_both, per_k, Rows, RuleRows,
 };
 use super::{error_functions, LinearBasis, Projection, SpectrumFamily, BASIS_SIZE};
 use crate::integrate::legendre_nodes;
@@ -188,12 +187,21 @@ impl OneLoopBasis {
     pub fn evaluate(&self, p_lin: &[f64], projection: &Projection) -> BasisOneLoop {
         let c = &projection.coefficients;
         let n = c.len();
-        let pairs = n * (n + 1) / 2;
         let n_err = error_functions(n);
         let pairs_err = n_err * (n_err + 1) / 2;
-        let (s2, s2_single) = pair_products_both(c);
+        let (_, s2_single) = pair_products_both(c);
         let eps = projection.residual;
         let nk = self.k.len();
+        // Every row at once (one detection of the instructions for all): P22 and its quadrature
+        // difference (an error estimate, summed in f32 too), the P13 and σ_d² forms.
+        let mut p22_values = vec![0.0; 3 * nk];
+        crate::simd::matvec_f32(&self.p22, &s2_single, &mut p22_values);
+        let mut p22_diffs = vec![0.0; 3 * nk];
+        crate::simd::matvec_f32(&self.p22_diff, &s2_single[..pairs_err], &mut p22_diffs);
+        let mut forms = vec![0.0; P13_FORMS * nk];
+        crate::simd::matvec(&self.p13, c, &mut forms);
+        let mut sigma_d2 = vec![0.0; nk];
+        crate::simd::matvec(&self.sigma_d2, c, &mut sigma_d2);
         let mut terms = OneLoopTerms {
             k: self.k.clone(),
             p_lin: p_lin.to_vec(),
@@ -205,17 +213,14 @@ impl OneLoopBasis {
             p13: ByPair::from_fn(|_| Vec::with_capacity(nk)),
         };
         for (i, &p) in p_lin.iter().enumerate() {
-            let t = &self.p22[i * 3 * pairs..(i + 1) * 3 * pairs];
-            let d = &self.p22_diff[i * 3 * pairs_err..(i + 1) * 3 * pairs_err];
             let p22: [Estimate; 3] = std::array::from_fn(|m| {
-                let v = dot_f32(&t[m * pairs..(m + 1) * pairs], &s2_single);
-                let quadrature = dot32(&d[m * pairs_err..(m + 1) * pairs_err], &s2[..pairs_err])
+                let v = p22_values[3 * i + m];
+                let quadrature = p22_diffs[3 * i + m]
                     .abs()
                     .max(self.p22_error_floor * v.abs());
                 Estimate::new(v, quadrature + 2.0 * eps * v.abs())
             });
-            let w = &self.p13[i * P13_FORMS * n..(i + 1) * P13_FORMS * n];
-            let form = |m: usize| dot(&w[m * n..(m + 1) * n], c);
+            let form = |m: usize| forms[P13_FORMS * i + m];
             let p13 = |m: usize| {
                 Estimate::new(
                     p * form(m),
@@ -230,13 +235,9 @@ impl OneLoopBasis {
             terms.p22.dt.push(p22[1]);
             terms.p22.tt.push(p22[2]);
         }
-        let sigma_d2 = self
-            .sigma_d2
-            .chunks_exact(n)
-            .map(|w| {
-                let v = dot(w, c);
-                Estimate::new(v, eps * v.abs())
-            })
+        let sigma_d2 = sigma_d2
+            .into_iter()
+            .map(|v| Estimate::new(v, eps * v.abs()))
             .collect();
         BasisOneLoop { terms, sigma_d2 }
     }
