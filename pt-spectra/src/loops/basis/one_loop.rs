@@ -25,6 +25,7 @@
 use super::forms::{
     concat, fine_and_diff, linear_form, pair_forms, pair_products_both, per_k, Rows, RuleRows,
 };
+use super::low_rank::{LowRank, PAIR_TOLERANCE};
 use super::{error_functions, LinearBasis, Projection, SpectrumFamily, BASIS_SIZE};
 use crate::integrate::legendre_nodes;
 use crate::loops::lattice::{add_product_weights, Lattice};
@@ -34,7 +35,7 @@ use crate::precision::Precision;
 use std::f64::consts::PI;
 
 /// Version of the tensor layout and rules, part of the cache file name.
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 /// Linear forms per k: P13_F/P and P13_G/P (fine rule), their fine − coarse differences, and their
 /// absolute weights (the projection error's scale), each of length n.
@@ -46,8 +47,9 @@ pub struct OneLoopBasis {
     k: Vec<f64>,
     key: Vec<f64>,
     basis: LinearBasis,
-    /// Per k: P22 δδ, δθ, θθ of the fine rule on the pairs a ≤ b of all n functions.
-    p22: Vec<f32>,
+    /// P22 δδ, δθ, θθ of the fine rule on the pairs a ≤ b of all n functions, row k × pair, in
+    /// low-rank form ([`LowRank`]: its truncation bound is added to the errors).
+    p22: LowRank,
     /// Per k: fine − half-resolution P22 δδ, δθ, θθ on the pairs of the first n_err functions.
     p22_diff: Vec<f32>,
     /// Per k: [`P13_FORMS`] linear forms of length n.
@@ -132,7 +134,8 @@ impl OneLoopBasis {
         let per_k = per_k(k.len(), progress, |i| {
             let f = p22_forms(fine, i, &fine_rows, n);
             let c = p22_forms(coarse, i, &coarse_rows, n_err);
-            let (p22, diff) = fine_and_diff(&f, &c);
+            let (_, diff) = fine_and_diff(&f, &c);
+            let p22: Vec<f64> = f.concat();
             let (wf, wc) = (&fine.p13[i], &coarse.p13[i]);
             let abs = |w: &[f64]| w.iter().map(|v| v.abs()).collect::<Vec<_>>();
             let forms = [
@@ -158,6 +161,8 @@ impl OneLoopBasis {
         sigma_v2.extend(sv_fine.iter().zip(&sv_coarse).map(|(f, c)| f - c));
         let sigma_d2 = sigma_d2_forms(k, &fine_rows);
         let (p22, p22_diff, p13) = concat(per_k);
+        let sigma = super::training::coefficient_scale(&basis);
+        let p22 = LowRank::new(&p22, 3 * k.len(), 2, &sigma, PAIR_TOLERANCE);
         Self {
             k: k.to_vec(),
             key: key(k, precision, family),
@@ -194,8 +199,8 @@ impl OneLoopBasis {
         let nk = self.k.len();
         // Every row at once (one detection of the instructions for all): P22 and its quadrature
         // difference (an error estimate, summed in f32 too), the P13 and σ_d² forms.
-        let mut p22_values = vec![0.0; 3 * nk];
-        crate::simd::matvec_f32(&self.p22, &s2_single, &mut p22_values);
+        let p22_values = self.p22.expand_single(&self.p22.reduce_single(&s2_single));
+        let scale = self.p22.norm(c);
         let mut p22_diffs = vec![0.0; 3 * nk];
         crate::simd::matvec_f32(&self.p22_diff, &s2_single[..pairs_err], &mut p22_diffs);
         let mut forms = vec![0.0; P13_FORMS * nk];
@@ -218,7 +223,8 @@ impl OneLoopBasis {
                 let quadrature = p22_diffs[3 * i + m]
                     .abs()
                     .max(self.p22_error_floor * v.abs());
-                Estimate::new(v, quadrature + 2.0 * eps * v.abs())
+                let truncation = self.p22.bound(3 * i + m, scale);
+                Estimate::new(v, quadrature + 2.0 * eps * v.abs() + truncation)
             });
             let form = |m: usize| forms[P13_FORMS * i + m];
             let p13 = |m: usize| {
@@ -247,7 +253,7 @@ impl OneLoopBasis {
         let mut v = vec![self.key.len() as f64];
         v.extend(&self.key);
         v.extend(self.basis.to_f64s());
-        v.extend(self.p22.iter().map(|&t| f64::from(t)));
+        v.extend(self.p22.to_f64s());
         v.extend(self.p22_diff.iter().map(|&t| f64::from(t)));
         for part in [&self.p13, &self.sigma_v2, &self.sigma_d2] {
             v.extend(part);
@@ -267,11 +273,14 @@ impl OneLoopBasis {
         let rest = super::after_key(values, &expected)?;
         let lattice = Lattice::new(precision.q_min, precision.q_max, precision.lattice_step);
         let (basis, rest) = LinearBasis::from_f64s(lattice, rest)?;
+        let (p22, rest) = LowRank::from_f64s(rest)?;
         let n = basis.len();
         let n_err = error_functions(n);
         let nk = k.len();
+        if !p22.has_shape(3 * nk, n * (n + 1) / 2) {
+            return None;
+        }
         let sizes = [
-            nk * 3 * n * (n + 1) / 2,
             nk * 3 * n_err * (n_err + 1) / 2,
             nk * P13_FORMS * n,
             2 * n,
@@ -287,9 +296,8 @@ impl OneLoopBasis {
             parts.push(part.to_vec());
             rest = r;
         }
-        let [p22, p22_diff, p13, sigma_v2, sigma_d2] = parts.try_into().ok()?;
-        let single = |v: Vec<f64>| v.into_iter().map(|t| t as f32).collect();
-        let (p22, p22_diff) = (single(p22), single(p22_diff));
+        let [p22_diff, p13, sigma_v2, sigma_d2] = parts.try_into().ok()?;
+        let p22_diff = p22_diff.into_iter().map(|t| t as f32).collect();
         Some(Self {
             k: k.to_vec(),
             key: expected,
