@@ -341,6 +341,20 @@ mod tests {
             .collect()
     }
 
+    /// Per row of `a` (by row, the products `s` of the coefficients `c` as columns): the difference
+    /// of the low-rank row from the exact one, the exact one, and the bound.
+    fn against_exact(form: &LowRank, a: &[f64], s: &[f64], c: &[f64]) -> Vec<(f64, f64, f64)> {
+        let z = form.reduce(s);
+        let norm = form.norm(c);
+        a.chunks_exact(s.len())
+            .enumerate()
+            .map(|(i, row)| {
+                let exact: f64 = row.iter().zip(s).map(|(x, y)| x * y).sum();
+                ((form.row(i, &z) - exact).abs(), exact, form.bound(i, norm))
+            })
+            .collect()
+    }
+
     #[test]
     fn a_low_rank_form_is_within_its_bound_and_survives_its_file() {
         let n = 12;
@@ -356,18 +370,9 @@ mod tests {
             .map(|(i, s)| s * (3.0 * ((i * 7) as f64).sin()))
             .collect();
         let s = super::super::forms::pair_products(&c);
-        let z = form.reduce(&s);
-        let norm = form.norm(&c);
-        let columns = s.len();
         let mut worst: f64 = 0.0;
-        for i in 0..rows {
-            let exact: f64 = a[i * columns..(i + 1) * columns]
-                .iter()
-                .zip(&s)
-                .map(|(x, y)| x * y)
-                .sum();
-            let diff = (form.row(i, &z) - exact).abs();
-            assert!(diff <= form.bound(i, norm), "{i}: {diff:e}");
+        for (i, (diff, exact, bound)) in against_exact(&form, &a, &s, &c).into_iter().enumerate() {
+            assert!(diff <= bound, "{i}: {diff:e}");
             worst = worst.max(diff / exact.abs());
         }
         assert!(worst < 1e-6, "{worst:e}");
@@ -393,18 +398,8 @@ mod tests {
         assert_eq!(form.rank(), rows);
         let c = [0.3, -0.2, 0.1, 1.5];
         let s = super::super::triple_products(&c);
-        let z = form.reduce(&s);
-        for i in 0..rows {
-            let exact: f64 = a[i * columns..(i + 1) * columns]
-                .iter()
-                .zip(&s)
-                .map(|(x, y)| x * y)
-                .sum();
-            let diff = (form.row(i, &z) - exact).abs();
-            assert!(
-                diff <= form.bound(i, form.norm(&c)) + 1e-15,
-                "{i}: {diff:e}"
-            );
+        for (i, (diff, _, bound)) in against_exact(&form, &a, &s, &c).into_iter().enumerate() {
+            assert!(diff <= bound + 1e-15, "{i}: {diff:e}");
             assert!(diff < 1e-6, "{i}: {diff:e}");
         }
     }
