@@ -3,18 +3,20 @@
 //! The rows of a basis tensor (one per k and term) are linear forms on the products of the
 //! coefficients s_j (c_a c_b on the pairs a ≤ b, or c_a c_b c_c on the triples): a matrix A of
 //! rows × columns. Its rows are smooth in k and the terms are related, so A has a small numerical
-//! rank: the 31 × 50 rows of the galaxy model on 666 pairs are represented to 1e-8 of their size by
-//! ~200 directions, the 2-loop accumulators by ~200 of 8,436 triples. Then A s ≈ U (V s): r products
-//! of length `columns` and `rows` of length r, a third of the bytes and work of A s.
+//! rank: the galaxy model's 31 × 50 rows on 666 pairs need 160 directions (112 for the no-wiggle
+//! set), the 2-loop means' 9 × 40 rows 192 of 8,436 triples. Then A s ≈ U (V s): r products of
+//! length `columns` and `rows` of length r, a third to a half of the bytes and work of A s.
 //!
 //! The factorisation is made in scaled coordinates B = R⁻¹ A C, with C = diag(σ_a σ_b …) the
-//! largest product of each column over the training spectra (σ_a = max |c_a|) and R = diag(Σ_j |A_ij| C_jj)
-//! the size of each row, by a randomised range finder (blocks of random ±1 probes, each orthogonalised
-//! twice against those before) until the residual is below a tolerance ([`PAIR_TOLERANCE`]). The residual of each row
-//! of A − U V is then computed exactly with the rounded f32 factors, e_i = ‖(A − U V)_i C‖₂, so
-//! that by Cauchy–Schwarz the truncation changes row i of any spectrum by at most
-//! e_i ‖s / C‖₂ ≤ e_i ‖c / σ‖₂^d (d = 2 for pairs, 3 for triples): a bound, not an estimate, which the
-//! callers add to the errors.
+//! largest product of each column over the training spectra (σ_a = max |c_a|) and R =
+//! diag(Σ_j |A_ij| C_jj) the size of each row, by a randomised range finder (blocks of random ±1
+//! probes, each orthogonalised twice against those before) until the residual of every scaled row
+//! is below a tolerance ([`PAIR_TOLERANCE`], [`TRIPLE_TOLERANCE`]). The residual of each row of
+//! A − U V is then computed exactly with the rounded f32 factors, e_i = ‖(A − U V)_i C‖₂, so that by
+//! Cauchy–Schwarz the truncation changes row i of any spectrum by at most e_i ‖s / C‖₂ ≤
+//! e_i ‖c / σ‖₂^d (d = 2 for pairs, 3 for triples): a bound, not an estimate, which the callers add
+//! to the errors. On held-out CAMB and CLASS tables it is ≤ 3e-5 of each galaxy-model column
+//! (median 6e-7), against a projection error of ~1e-4.
 
 use crate::simd::{dot32, matvec_f32};
 use rand::Rng;
