@@ -14,8 +14,9 @@
 //!   shift, so the error is the same standard error over the shifts.
 //!
 //! Because the points are the same, the basis result equals the direct result for the projected
-//! spectrum P̂ (to round-off): the only difference from `direct` is the response to the projection
-//! residual P − P̂. That is taken as ε Σ|T| over the terms T that make up a result (P15, 2P24,
+//! spectrum P̂ (to round-off, and to the low-rank form of the mean tensors, whose bound is added to
+//! the errors: module `low_rank`): the only other difference from `direct` is the response to the
+//! projection residual P − P̂. That is taken as ε Σ|T| over the terms T that make up a result (P15, 2P24,
 //! P33irr, P33red), with ε the largest relative residual smoothed over [`SMOOTHING`] in ln q
 //! ([`PROJECTION_ERROR_FACTOR`], [`Projection`]); it is added to every error. At high k the terms
 //! cancel to a small remainder (at k = 0.4, −114 of terms ±1.7e4), so there the projection error

@@ -4,8 +4,9 @@
 //! The 31 pair columns are bilinear forms of the lattice samples on the plan's P22 nodes, the six
 //! lattice-weight terms (P13 of F₃ and G₃, sig3nl, the three line-of-sight terms) P(k) times linear
 //! forms, σ_v² a linear form: on the basis, contractions with c ⊗ c and c (module `forms`), the same
-//! nodes and interpolation as the direct plan, so the only difference from `direct` is the
-//! response to the projection residual ε, added to the errors as 2ε|T| for the pair columns and
+//! nodes and interpolation as the direct plan, so the only difference from `direct` (beside the
+//! low-rank form of the pair columns, whose bound is added to their errors: module `low_rank`) is
+//! the response to the projection residual ε, added to the errors as 2ε|T| for the pair columns and
 //! ε P(k) Σ|w|P̂ for the others. The quadrature error is the plan's (fine minus half-resolution, the
 //! bilinear part of the half-resolution rule on the first [`super::ERROR_FUNCTIONS`] functions). With
 //! IR resummation the no-wiggle spectrum is projected too; its terms carry the errors of the full
