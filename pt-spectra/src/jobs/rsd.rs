@@ -308,11 +308,13 @@ fn rsd_table_memo(
              B = b^4 B(f/b)"
                 .into(),
         );
-        if let Some(residual) = tns.and_then(|t| t.basis_residual) {
+        if let Some(tns) = tns.filter(|t| t.basis_residual.is_some()) {
             header.push(format!(
                 "TNS A and B: basis tensors, the same quadrature nodes as direct; projection \
-                 residual {residual:.1e}; errors include the projection error (2 x residual x the \
-                 magnitudes of each coefficient's parts)"
+                 residual {:.1e}; errors include the projection error (2 x residual x the \
+                 magnitudes of each coefficient's parts){}",
+                tns.basis_residual.unwrap_or_default(),
+                crate::loops::basis::soft::describe(tns.basis_soft)
             ));
         }
     }

@@ -272,6 +272,8 @@ pub enum OneLoopSource {
         functions: usize,
         /// The projection residual ε ([`basis::Projection::residual`]: smoothed).
         residual: f64,
+        /// For a spectrum projected cut below the soft modes ([`basis::soft`]): Δ [(Mpc/h)²].
+        soft: Option<f64>,
     },
     /// Directly, since the spectrum's projection residual exceeded the basis's limit.
     Fallback {
@@ -289,10 +291,12 @@ impl OneLoopSource {
             Self::Basis {
                 functions,
                 residual,
+                soft,
             } => format!(
                 "1-loop terms (P22, P13, sigma_v^2, sigma_d^2): basis tensors on {functions} \
                  functions, the same quadrature nodes as direct; projection residual {residual:.1e}; \
-                 errors include the projection error (residual x |P13|, 2 x residual x |P22|)"
+                 errors include the projection error (residual x |P13|, 2 x residual x |P22|){}",
+                basis::soft::describe(soft)
             ),
             Self::Fallback {
                 residual,
@@ -322,6 +326,8 @@ pub enum TwoLoopSource {
         residual: f64,
         /// The largest pointwise relative residual ([`basis::Projection::pointwise`]).
         pointwise: f64,
+        /// For a spectrum projected cut below the soft modes ([`basis::soft`]): Δ [(Mpc/h)²].
+        soft: Option<f64>,
     },
     /// Direct integration because the spectrum's projection residual exceeded the basis's limit.
     Fallback {
@@ -345,13 +351,15 @@ impl TwoLoopSource {
                 functions,
                 residual,
                 pointwise,
+                soft,
             } => format!(
                 "2-loop terms (P15, P24, P33, total): basis tensors on {functions} functions (CAMB \
                  spectra over the EuclidEmulator2 box), the same quasi-Monte-Carlo points as direct; \
                  fixed points (no refinement); projection residual {residual:.1e} (smoothed over {} \
                  in ln q; pointwise {pointwise:.1e}); errors include the projection error residual x \
-                 the sum of |P15|, |P24|, |P33| terms of each value",
-                basis::SMOOTHING
+                 the sum of |P15|, |P24|, |P33| terms of each value{}",
+                basis::SMOOTHING,
+                basis::soft::describe(soft)
             ),
             Self::Fallback {
                 residual,

@@ -129,6 +129,8 @@ pub struct TnsTerms {
     /// The spectrum's projection residual if the coefficients come from the basis tensors
     /// ([`super::basis::TnsBasis`]); `None` for the direct integrals.
     pub basis_residual: Option<f64>,
+    /// Δ [(Mpc/h)²] if the spectrum was projected cut below the soft modes ([`super::basis::soft`]).
+    pub basis_soft: Option<f64>,
 }
 
 /// A homogeneous polynomial Σ_i c_i μ^{d−i} w^i of degree d = `c.len()` − 1 in μ and w.
@@ -423,6 +425,7 @@ impl TnsPlan {
             p_lin: self.k.iter().map(|&k| spectrum.eval(k)).collect(),
             coefficients,
             basis_residual: None,
+            basis_soft: None,
         }
     }
 

@@ -264,7 +264,7 @@ impl RealPlan {
     /// other plans on the same grid and precision to share: [`crate::rsd::RsdPlan`]).
     pub fn project(&self, spectrum: &LinearSpectrum) -> Option<Projection> {
         let basis = self.one_loop_basis.as_ref()?.basis();
-        Some(basis.project(&basis.sample(spectrum)))
+        Some(basis.project_spectrum(spectrum, MAX_RESIDUAL))
     }
 
     /// As [`terms`](Self::terms) with the spectrum's `projection` from [`project`](Self::project)
@@ -311,6 +311,7 @@ impl RealPlan {
                     let source = OneLoopSource::Basis {
                         functions: projection.coefficients.len(),
                         residual: projection.residual,
+                        soft: projection.soft.as_ref().map(|s| s.delta),
                     };
                     (terms.terms, terms.sigma_d2, Some(source), Some(projection))
                 }
@@ -367,7 +368,8 @@ impl RealPlan {
             return Err(None);
         };
         let basis = tensors.basis();
-        let projection = projection.unwrap_or_else(|| basis.project(&basis.sample(spectrum)));
+        let projection =
+            projection.unwrap_or_else(|| basis.project_spectrum(spectrum, MAX_RESIDUAL));
         // A NaN residual (a spectrum with non-positive values) is refused too.
         if projection.residual.is_nan() || projection.residual > MAX_RESIDUAL {
             let source = OneLoopSource::Fallback {
@@ -440,6 +442,7 @@ impl RealPlan {
                         functions: basis.basis().len(),
                         residual: terms.projection.residual,
                         pointwise: terms.projection.pointwise,
+                        soft: terms.projection.soft.as_ref().map(|s| s.delta),
                     };
                     return (Some(terms.p15), Some(terms.correction), Some(source));
                 }

@@ -178,6 +178,8 @@ pub struct EptTerms {
     nw: Option<(RedshiftTerms, Estimate)>,
     /// The projection residual if the terms come from basis tensors.
     basis_residual: Option<f64>,
+    /// Δ [(Mpc/h)²] if the spectrum was projected cut below the soft modes.
+    basis_soft: Option<f64>,
 }
 
 impl EptPlan {
@@ -264,6 +266,7 @@ impl EptPlan {
             full,
             nw,
             basis_residual: None,
+            basis_soft: None,
         })
     }
 

@@ -431,7 +431,7 @@ impl RsdPlan {
                 let basis = tensors.basis();
                 let projection = match &projection {
                     Some(p) => p.clone(),
-                    None => basis.project(&basis.sample(spectrum)),
+                    None => basis.project_spectrum(spectrum, MAX_RESIDUAL),
                 };
                 if projection.residual.is_nan() || projection.residual > MAX_RESIDUAL {
                     progress.note(&format!(

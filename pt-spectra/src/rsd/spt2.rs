@@ -77,11 +77,15 @@ pub(crate) fn two_loop_terms(
                 .zip(&projections)
                 .map(|(t, p)| t.evaluate_projected(p))
                 .collect();
+            let soft = projections
+                .iter()
+                .find_map(|p| p.soft.as_ref().map(|s| s.delta));
             let note = format!(
                 "2-loop terms from basis tensors (projection residual {}; the projection error, {} x \
-                 residual x |value|, is in the errors)",
+                 residual x |value|, is in the errors){}",
                 residuals.join(", "),
-                crate::loops::basis::RSD_PROJECTION_FACTOR
+                crate::loops::basis::RSD_PROJECTION_FACTOR,
+                crate::loops::basis::soft::describe(soft)
             );
             return Ok((terms, note));
         }

@@ -19,3 +19,20 @@ with open("linear_pk_camb_curved_wa_z0.5.dat", "w") as f:
     f.write(f"# z = {z[0]}  sigma8(z) = {res.get_sigma8()[0]:.6f}\n# k [h/Mpc]  P [(Mpc/h)^3]\n")
     for k, p in zip(kh, pk[0]):
         f.write(f"{k:.8e} {p:.8e}\n")
+
+# And linear_pk_camb_closed_z0.0.dat: a closed LCDM cosmology (Omega_k = -0.01; the soft modes then
+# lower P below 1e-3 h/Mpc, the opposite sign), z = 0, the same k sampling.
+pars = camb.CAMBparams()
+pars.set_cosmology(H0=67.0, ombh2=0.0222, omch2=0.121, mnu=0.0, omk=-0.01, num_massive_neutrinos=0,
+                   nnu=3.046)
+pars.InitPower.set_params(As=2.05e-9, ns=0.97)
+pars.set_matter_power(redshifts=[0.0], kmax=60.0)
+pars.NonLinear = camb.model.NonLinear_none
+res = camb.get_results(pars)
+kh, z, pk = res.get_matter_power_spectrum(minkh=1e-4, maxkh=50, npoints=1200)
+with open("linear_pk_camb_closed_z0.0.dat", "w") as f:
+    f.write(f"# CAMB {camb.__version__} linear total-matter P(k): H0=67 ombh2=0.0222 omch2=0.121 omk=-0.01 "
+            "(LCDM) ns=0.97 As=2.05e-9, massless neutrinos (N_eff=3.046)\n")
+    f.write(f"# z = {z[0]}  sigma8(z) = {res.get_sigma8()[0]:.6f}\n# k [h/Mpc]  P [(Mpc/h)^3]\n")
+    for k, p in zip(kh, pk[0]):
+        f.write(f"{k:.8e} {p:.8e}\n")

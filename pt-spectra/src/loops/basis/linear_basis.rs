@@ -31,6 +31,9 @@ pub struct Projection {
     pub residual: f64,
     /// The largest pointwise relative residual |P̂ − P|/P over the lattice.
     pub pointwise: f64,
+    /// For a spectrum projected cut below [`super::soft::SOFT_CUT`]
+    /// ([`LinearBasis::project_spectrum`]): what the cut changed, which the evaluations put back.
+    pub soft: Option<super::soft::SoftModes>,
 }
 
 /// Basis functions sampled on a loop lattice, orthonormal in the weighted inner product.
@@ -240,7 +243,47 @@ impl LinearBasis {
             samples: projected,
             residual: finite(residual),
             pointwise: finite(pointwise),
+            soft: None,
         }
+    }
+
+    /// The projection of `spectrum`; if its residual exceeds `max_residual` (or is NaN), that of the
+    /// spectrum cut below [`super::soft::SOFT_CUT`] with what the cut changed
+    /// ([`super::soft`]), if that one is within `max_residual` (else the first).
+    pub fn project_spectrum(
+        &self,
+        spectrum: &crate::linear::LinearSpectrum,
+        max_residual: f64,
+    ) -> Projection {
+        self.project_spectrum_sampled(spectrum, &self.sample(spectrum), max_residual)
+    }
+
+    /// As [`project_spectrum`](Self::project_spectrum) with the spectrum's lattice `samples`
+    /// ([`sample`](Self::sample)) already made.
+    pub fn project_spectrum_sampled(
+        &self,
+        spectrum: &crate::linear::LinearSpectrum,
+        samples: &[f64],
+        max_residual: f64,
+    ) -> Projection {
+        let whole = self.project(samples);
+        if whole.residual <= max_residual {
+            return whole;
+        }
+        let Some(cut) = super::soft::cut(spectrum) else {
+            return whole;
+        };
+        let cut_samples = self.sample(&cut);
+        let mut projection = self.project(&cut_samples);
+        if projection.residual.is_nan() || projection.residual > max_residual {
+            return whole;
+        }
+        projection.soft = Some(super::soft::soft_modes(
+            &self.lattice,
+            samples,
+            &cut_samples,
+        ));
+        projection
     }
 
     /// The basis as values for a cache file: n, then ω, then φ row by row.

@@ -203,21 +203,27 @@ impl RedshiftBasis {
         let norm = self.pairs.norm(c);
         let eps = projection.residual;
         let floor = self.p22_error_floor;
+        // A spectrum cut below the soft modes (module `soft`): every column and σ_v² are the cut
+        // spectrum's, so that the terms (infrared-safe sums) are the whole one's up to (q/k)².
+        let soft = projection.soft.as_ref();
         let rows = p_lin
             .iter()
             .enumerate()
             .map(|(i, &p)| {
+                let soft = soft.map_or(0.0, |s| {
+                    super::soft::RESPONSE_FACTOR * s.error(self.k[i], p)
+                });
                 let form = |m: usize| forms[i * LINEAR + m];
                 let pair = std::array::from_fn(|m| {
                     let row = i * NPAIR + m;
                     let (a, diff) = (values[row], diffs[row]);
                     let quadrature = diff.abs().max(floor * a.abs());
                     let truncation = self.pairs.bound(row, norm);
-                    Estimate::new(a, quadrature + 2.0 * eps * a.abs() + truncation)
+                    Estimate::new(a, quadrature + 2.0 * eps * a.abs() + truncation + soft)
                 });
                 let lw = std::array::from_fn(|m| {
                     let (s, sc, abs) = (form(m), form(LW + m), form(2 * LW + m));
-                    Estimate::new(p * s, (p * (s - sc)).abs() + eps * (p * abs).abs())
+                    Estimate::new(p * s, (p * (s - sc)).abs() + eps * (p * abs).abs() + soft)
                 });
                 (pair, lw)
             })

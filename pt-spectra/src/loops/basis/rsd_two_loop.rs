@@ -228,9 +228,10 @@ impl RsdTwoLoopBasis {
         &self.k
     }
 
-    /// The projection of `spectrum` on the basis.
+    /// The projection of `spectrum` on the basis (cut below the soft modes if it projects only so:
+    /// [`LinearBasis::project_spectrum`]).
     pub fn project(&self, spectrum: &LinearSpectrum) -> Projection {
-        self.basis.project(&self.basis.lattice().sample(spectrum))
+        self.basis.project_spectrum(spectrum, MAX_RESIDUAL)
     }
 
     /// The 2-loop redshift-space terms of `spectrum`, or `Err` with its projection if the residual
@@ -270,11 +271,17 @@ impl RsdTwoLoopBasis {
         let truncation = (0..self.k.len())
             .map(|i| std::array::from_fn(|v| self.mean.bound(row(i, v), scale)))
             .collect();
+        // A spectrum cut below the soft modes (module `soft`): the coefficients, infrared-safe sums
+        // of diagrams, are the whole spectrum's up to (q/k)² of the diagrams' soft responses.
+        let soft = projection
+            .soft
+            .as_ref()
+            .map_or(0.0, |s| super::soft::SOFT_CUT.powi(2) * s.delta_abs);
         RsdTwoLoopTerms::from_coefficients(
             &self.k,
             self.points.clone(),
             &replicas,
-            RSD_PROJECTION_FACTOR * projection.residual,
+            RSD_PROJECTION_FACTOR * projection.residual + soft,
             truncation,
         )
     }

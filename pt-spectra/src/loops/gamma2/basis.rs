@@ -165,9 +165,10 @@ mod tests {
     use crate::loops::basis::training::camb_basis;
     use crate::loops::basis::BASIS_SIZE;
 
-    /// On spectra the basis was not trained on (two CAMB tables and a CLASS one) P24 and PΓ2 from the
-    /// linear forms equal the integrals of the spectrum itself to 5e-5 of their size (measured:
-    /// ≤ 1.1e-5) and within the errors (there ≤ 5.2e-3 of the value, mostly the quadrature's).
+    /// On spectra the basis was not trained on (two CAMB tables, two curved ones and a CLASS one) P24
+    /// and PΓ2 from the linear forms equal the integrals of the spectrum itself to 5e-5 of their size
+    /// (measured: ≤ 1.1e-5; curved ones 2e-4, measured 8.2e-5) and within the errors (there ≤ 5.2e-3
+    /// of the value, mostly the quadrature's).
     #[test]
     fn terms_on_the_basis_agree_with_the_integrals_for_spectra_not_trained_on() {
         let k = [0.02, 0.1, 0.25];
@@ -180,10 +181,19 @@ mod tests {
         for name in [
             "linear_pk_camb_heldout_0.dat",
             "linear_pk_camb_heldout_1.dat",
+            "linear_pk_camb_curved_wa_z0.5.dat",
+            "linear_pk_camb_closed_z0.0.dat",
             "linear_pk_class_planck2018_z0.0_pk_lin.dat",
         ] {
             let p = LinearSpectrum::from_file(format!("{dir}{name}")).unwrap();
-            let projection = basis.project(&basis.sample(&p));
+            let projection = basis.project_spectrum(&p, crate::loops::basis::MAX_RESIDUAL);
+            // The curved ones project cut below the soft modes (loops::basis::soft), to which each
+            // 1-loop vertex responds by ~Δ/σ_v² of itself: measured ≤ 8.2e-5.
+            let bound = if projection.soft.is_some() {
+                2e-4
+            } else {
+                5e-5
+            };
             let direct = plan.evaluate(&p);
             let on_basis = forms.evaluate(&plan, &p, &projection).unwrap();
             assert_eq!(on_basis.basis_residual, Some(projection.residual));
@@ -194,7 +204,7 @@ mod tests {
                 for ((_, a), (_, d)) in a.iter().zip(d.iter()) {
                     for (i, (a, d)) in a.iter().zip(d).enumerate() {
                         let diff = (a.value - d.value).abs();
-                        assert!(diff <= 5e-5 * d.value.abs(), "{name} {i}: {a:?} {d:?}");
+                        assert!(diff <= bound * d.value.abs(), "{name} {i}: {a:?} {d:?}");
                         assert!(diff <= a.error, "{name} {i}: {a:?} {d:?}");
                     }
                 }

@@ -185,8 +185,8 @@ impl EptPlan {
         };
         let basis = tensors.linear.basis();
         let samples = basis.sample(spectrum);
-        let projection = basis.project(&samples);
-        if projection.residual > MAX_RESIDUAL {
+        let projection = basis.project_spectrum_sampled(spectrum, &samples, MAX_RESIDUAL);
+        if projection.residual.is_nan() || projection.residual > MAX_RESIDUAL {
             return Ok(None);
         }
         let p_lin: Vec<f64> = self.grid.iter().map(|&k| spectrum.eval(k)).collect();
@@ -212,6 +212,7 @@ impl EptPlan {
             full,
             nw,
             basis_residual: Some(projection.residual),
+            basis_soft: projection.soft.as_ref().map(|s| s.delta),
         }))
     }
 }
@@ -224,7 +225,8 @@ impl EptTerms {
             "loop terms: basis tensors on the same quadrature nodes as direct (no-wiggle terms: the \
              tensors of the filtered basis functions); projection residual {residual:.1e}; errors \
              include the projection error (2 x residual x |term| for the \
-             P22-type terms, residual x P int |w| P for the others)"
+             P22-type terms, residual x P int |w| P for the others){}",
+            crate::loops::basis::soft::describe(self.basis_soft)
         ))
     }
 }

@@ -115,7 +115,8 @@ fn values_are_the_multipoles_values() {
     }
 }
 
-/// With basis tensors (method basis) two CAMB spectra and a CLASS one not trained on give the direct
+/// With basis tensors (method basis) two CAMB spectra, a flat w0–wa one, a curved one (projected cut
+/// below the soft modes: loops::basis::soft) and a CLASS one not trained on give the direct
 /// multipoles within 3e-4 of P0 and inside the errors, with and without IR; an Eisenstein–Hu
 /// spectrum (outside the basis) falls back to the direct terms exactly.
 #[test]
@@ -148,11 +149,13 @@ fn the_basis_gives_the_direct_multipoles_and_falls_back_outside_its_span() {
             .with_basis(&store, &crate::progress::Silent)
             .unwrap();
         assert!(plan.has_basis());
-        // Spectra the basis was not trained on: two CAMB tables, a flat w0–wa one and a CLASS table.
+        // Spectra the basis was not trained on: two CAMB tables, a flat w0–wa one, a curved one and a
+        // CLASS table.
         for name in [
             "linear_pk_camb_heldout_0.dat",
             "linear_pk_camb_heldout_2.dat",
             "linear_pk_camb_w0wa_z1.0.dat",
+            "linear_pk_camb_curved_wa_z0.5.dat",
             "linear_pk_class_planck2018_z0.0_pk_lin.dat",
         ] {
             let p = LinearSpectrum::from_file(format!("{dir}{name}")).unwrap();
