@@ -60,6 +60,33 @@ pub(crate) fn two_loop_terms(
     precision: &Precision,
     progress: &dyn Progress,
 ) -> Result<(Vec<RsdTwoLoopTerms>, String)> {
+    let (terms, note) = two_loop_terms_noted(k, spectra, tensors, precision, progress)?;
+    Ok((terms, note + &few_points_caveat(precision)))
+}
+
+/// The header's caveat for fewer points than [`Precision::reference`]'s: against cosPT (an
+/// independent Monte Carlo code, `tests/cospt.rs`) and reference precision, the default's 2-loop
+/// multipoles at k ≤ 0.1 h/Mpc come out 0.7–0.9% smaller in magnitude, all of one sign, beyond
+/// their reported errors (its 8 random shifts of 2^14 points miss the rare large contributions of
+/// the nearly singular integrand there); ≲ 1e-4 of P0.
+fn few_points_caveat(precision: &Precision) -> String {
+    if precision.two_loop_points >= Precision::reference().two_loop_points {
+        return String::new();
+    }
+    "; caveat: fewer 2-loop points than --precision reference: in a cross-check against cosPT the \
+     2-loop multipoles at k <= 0.1 h/Mpc ran 0.7-0.9% smaller in magnitude than at reference and in \
+     cosPT, beyond their errors (<~ 1e-4 of P0); use --precision reference where that matters"
+        .into()
+}
+
+/// [`two_loop_terms`] without the caveat.
+fn two_loop_terms_noted(
+    k: &[f64],
+    spectra: &[&LinearSpectrum],
+    tensors: &[Arc<RsdTwoLoopBasis>],
+    precision: &Precision,
+    progress: &dyn Progress,
+) -> Result<(Vec<RsdTwoLoopTerms>, String)> {
     let mut note = String::from("2-loop terms integrated for this spectrum (direct)");
     if tensors.len() == spectra.len() {
         let projections: Vec<_> = spectra
