@@ -25,7 +25,7 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Version of the layout, part of the cache file name.
-const VERSION: u32 = 2;
+const VERSION: u32 = 3;
 
 /// Points per batch of the rank update.
 const BATCH: usize = 32;
