@@ -40,8 +40,12 @@ pub fn spt2_table(
         format!(
             "2-loop terms: randomised quasi-Monte Carlo over q1, q2 and the line-of-sight azimuth, {} \
              shifts x {} Sobol points at k = 0.16 (real-space points / {POINTS_DIVISOR}, scaled as \
-             k^3.5), seed {}, 7 nodes in mu^2; errors are the shifts' standard errors",
-            settings.replicas, settings.points, settings.seed
+             k^3.5, at least {} at every k), seed {}, 7 nodes in mu^2; errors are the shifts' \
+             standard errors",
+            settings.replicas,
+            settings.points,
+            2 * settings.points,
+            settings.seed
         ),
         terms.source.clone(),
     ];
@@ -112,10 +116,11 @@ pub fn eft2_table(
     }
     header.push(format!(
         "2-loop terms: randomised quasi-Monte Carlo over q1, q2 and the line-of-sight azimuth, {} shifts \
-         x {} Sobol points at k = 0.16 (scaled as k^3.5), seed {}{}; multipoles by {}-node \
-         Gauss-Legendre in mu (error from half as many)",
+         x {} Sobol points at k = 0.16 (scaled as k^3.5, at least {} at every k), seed {}{}; \
+         multipoles by {}-node Gauss-Legendre in mu (error from half as many)",
         settings.replicas,
         settings.points,
+        2 * settings.points,
         settings.seed,
         if terms.ir() {
             ", the spectrum and its no-wiggle part on the same points"

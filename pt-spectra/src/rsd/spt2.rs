@@ -64,24 +64,25 @@ pub(crate) fn two_loop_terms(
     Ok((terms, note + &few_points_caveat(precision)))
 }
 
-/// Points per shift at low k below which the header warns ([`few_points_caveat`]): 2^15, the
+/// Points per shift at low k below which the header warns ([`few_points_caveat`]): 2^13, the
 /// count of the default precision there, checked against cosPT (`tests/cospt.rs`).
-const VALIDATED_LOW_K_POINTS: usize = 1 << 15;
+const VALIDATED_LOW_K_POINTS: usize = 1 << 13;
 
 /// The header's caveat for fewer points at low k than [`VALIDATED_LOW_K_POINTS`] (`--precision
-/// fast`): with 2^13 there, 2-loop multipoles at k ≤ 0.1 h/Mpc came out 0.7–0.9% smaller in
-/// magnitude than cosPT's, all of one sign, beyond their reported errors (8 random shifts miss the
-/// rare large contributions of the nearly singular integrand); ≲ 1e-4 of P0.
+/// fast`: 2^11): with 2^11 there (the default's count before), the 2-loop multipoles at k ≤ 0.1
+/// h/Mpc came out 0.7–0.9% smaller in magnitude than cosPT's, all of one sign, beyond their
+/// reported errors (8 random shifts miss the rare large contributions of the nearly singular
+/// integrand); ≲ 1e-4 of P0.
 fn few_points_caveat(precision: &Precision) -> String {
-    let low_k = crate::loops::rsd_two_loop::rsd_points_at(0.01, precision.two_loop_points);
+    let points = two_loop_settings(precision).points;
+    let low_k = crate::loops::rsd_two_loop::rsd_points_at(0.01, points);
     if low_k >= VALIDATED_LOW_K_POINTS {
         return String::new();
     }
     format!(
-        "; caveat: {low_k} 2-loop points per shift at k <= 0.1 h/Mpc, fewer than the {} checked \
-         against cosPT (--precision default): with 8192 the 2-loop multipoles there ran 0.7-0.9% \
-         smaller in magnitude, beyond their errors (<~ 1e-4 of P0)",
-        VALIDATED_LOW_K_POINTS
+        "; caveat: {low_k} 2-loop points per shift at k <= 0.1 h/Mpc, fewer than the \
+         {VALIDATED_LOW_K_POINTS} checked against cosPT (--precision default): with 2048 the 2-loop \
+         multipoles there ran 0.7-0.9% smaller in magnitude, beyond their errors (<~ 1e-4 of P0)"
     )
 }
 
