@@ -408,6 +408,22 @@ impl LinearSpectrum {
         })
     }
 
+    /// The spectrum of the table's nodes with k ∈ [`k_lo`, `k_hi`] only, extended by power laws beyond
+    /// them as any table is (what a table of that range would give).
+    ///
+    /// # Errors
+    /// As [`from_nodes`](Self::from_nodes), e.g. [`Error::TooFewPoints`] if the range keeps too few
+    /// nodes.
+    pub fn restricted(&self, k_lo: f64, k_hi: f64) -> Result<Self> {
+        let (k, p): (Vec<f64>, Vec<f64>) = self
+            .k
+            .iter()
+            .zip(&self.p)
+            .filter(|(&k, _)| k >= k_lo && k <= k_hi)
+            .unzip();
+        Self::from_nodes(k, p)
+    }
+
     /// The spectrum multiplied by a constant `factor` (e.g. a growth ratio D²(z)/D²(z_in)).
     ///
     /// # Errors

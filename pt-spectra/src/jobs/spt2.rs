@@ -44,7 +44,7 @@ pub fn spt2_table(
              standard errors",
             settings.replicas,
             settings.points,
-            2 * settings.points,
+            crate::loops::rsd_two_loop::rsd_min_points(settings.points),
             settings.seed
         ),
         terms.source.clone(),
@@ -120,7 +120,7 @@ pub fn eft2_table(
          multipoles by {}-node Gauss-Legendre in mu (error from half as many)",
         settings.replicas,
         settings.points,
-        2 * settings.points,
+        crate::loops::rsd_two_loop::rsd_min_points(settings.points),
         settings.seed,
         if terms.ir() {
             ", the spectrum and its no-wiggle part on the same points"

@@ -38,7 +38,7 @@
 mod integrand;
 mod zn;
 
-pub(crate) use integrand::{rsd_points_at, Sampling};
+pub(crate) use integrand::{rsd_min_points, rsd_points_at, Sampling};
 
 use super::mode_coupling::Sampled;
 use super::two_loop::integral_scale;

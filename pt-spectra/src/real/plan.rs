@@ -311,7 +311,7 @@ impl RealPlan {
                     let source = OneLoopSource::Basis {
                         functions: projection.coefficients.len(),
                         residual: projection.residual,
-                        soft: projection.soft.as_ref().map(|s| s.delta),
+                        soft: projection.soft_delta(),
                     };
                     (terms.terms, terms.sigma_d2, Some(source), Some(projection))
                 }
@@ -442,7 +442,7 @@ impl RealPlan {
                         functions: basis.basis().len(),
                         residual: terms.projection.residual,
                         pointwise: terms.projection.pointwise,
-                        soft: terms.projection.soft.as_ref().map(|s| s.delta),
+                        soft: terms.projection.soft_delta(),
                     };
                     return (Some(terms.p15), Some(terms.correction), Some(source));
                 }

@@ -113,7 +113,7 @@ fn two_loop_terms_noted(
                 .collect();
             let soft = projections
                 .iter()
-                .find_map(|p| p.soft.as_ref().map(|s| s.delta));
+                .find_map(crate::loops::basis::Projection::soft_delta);
             let note = format!(
                 "2-loop terms from basis tensors (projection residual {}; the projection error, {} x \
                  residual x |value|, is in the errors){}",
@@ -335,5 +335,26 @@ impl Spt2Terms {
             two_loop,
             total,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The redshift-space points: at least twice the settings' at every k (the real-space rule's
+    /// beyond), so the default has the 2^13 per shift at low k that cosPT checked and only `fast`
+    /// gets the header's caveat, with its count.
+    #[test]
+    fn fewer_low_k_points_than_checked_get_the_caveat() {
+        use crate::loops::rsd_two_loop::rsd_points_at;
+        let points = two_loop_settings(&Precision::default()).points;
+        assert_eq!(rsd_points_at(0.01, points), 1 << 13);
+        // k = 0.4: the real-space rule's 2^round(3.5 log2(0.4/0.16)) = 32 times.
+        assert_eq!(rsd_points_at(0.4, points), 32 * points);
+        assert!(few_points_caveat(&Precision::default()).is_empty());
+        assert!(few_points_caveat(&Precision::reference()).is_empty());
+        let fast = few_points_caveat(&Precision::fast());
+        assert!(fast.contains("caveat: 2048 2-loop points"), "{fast}");
     }
 }

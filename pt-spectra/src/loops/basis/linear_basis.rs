@@ -36,6 +36,13 @@ pub struct Projection {
     pub soft: Option<super::soft::SoftModes>,
 }
 
+impl Projection {
+    /// Δ [(Mpc/h)²] of the soft modes if the spectrum was projected cut ([`Self::soft`]), for headers.
+    pub fn soft_delta(&self) -> Option<f64> {
+        self.soft.as_ref().map(|s| s.delta)
+    }
+}
+
 /// Basis functions sampled on a loop lattice, orthonormal in the weighted inner product.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearBasis {

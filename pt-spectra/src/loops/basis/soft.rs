@@ -89,6 +89,11 @@ impl SoftModes {
         self.shift(terms, 1.0);
         for (i, &k) in terms.k.iter().enumerate() {
             sigma_d2[i].value += self.delta_below(0.5 * k);
+            let error = RESPONSE_FACTOR * self.error(k, terms.p_lin[i]);
+            for pair in Pair::ALL {
+                terms.p22[pair][i].error += error;
+                terms.p13[pair][i].error += error;
+            }
         }
     }
 
@@ -101,19 +106,14 @@ impl SoftModes {
         terms
     }
 
+    /// The values of P22, P13 and σ_v² moved by `sign` times their soft limits.
     fn shift(&self, terms: &mut OneLoopTerms, sign: f64) {
         terms.sigma_v2.value += sign * self.delta;
         for i in 0..terms.k.len() {
-            let (k, p) = (terms.k[i], terms.p_lin[i]);
-            let shift = sign * self.p22_shift(k, p);
-            let error = RESPONSE_FACTOR * self.error(k, p);
+            let shift = sign * self.p22_shift(terms.k[i], terms.p_lin[i]);
             for pair in Pair::ALL {
                 terms.p22[pair][i].value += shift;
                 terms.p13[pair][i].value -= 0.5 * shift;
-                if sign > 0.0 {
-                    terms.p22[pair][i].error += error;
-                    terms.p13[pair][i].error += error;
-                }
             }
         }
     }
@@ -134,12 +134,12 @@ pub fn describe(soft: Option<f64>) -> String {
 /// The spectrum cut below [`SOFT_CUT`] (the library's power law below its first node), or `None`
 /// if its table starts above the cut or keeps fewer than 8 nodes.
 pub fn cut(spectrum: &LinearSpectrum) -> Option<LinearSpectrum> {
-    let (k, p) = spectrum.nodes();
+    let k = spectrum.nodes().0;
     let first = k.iter().position(|&k| k >= SOFT_CUT)?;
     if first == 0 || k.len() - first < 8 {
         return None;
     }
-    LinearSpectrum::from_nodes(k[first..].to_vec(), p[first..].to_vec()).ok()
+    spectrum.restricted(SOFT_CUT, f64::INFINITY).ok()
 }
 
 /// Δ, |Δ| and the running Δ of the lattice samples `full` of a spectrum and `cut` of its cut

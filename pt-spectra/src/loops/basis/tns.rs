@@ -188,7 +188,7 @@ impl TnsBasis {
             p_lin: p_lin.to_vec(),
             coefficients,
             basis_residual: Some(projection.residual),
-            basis_soft: projection.soft.as_ref().map(|s| s.delta),
+            basis_soft: projection.soft_delta(),
         }
     }
 
@@ -282,7 +282,6 @@ mod tests {
                     .fold(0.0, f64::max);
                 for (a, d) in all(&on_basis, j).iter().zip(all(&direct, j)) {
                     let diff = (a.value - d.value).abs();
-
                     // Within 3e-4 of the largest coefficient at this k (measured 1.1e-4; 1.3e-4
                     // for the curved spectrum, 5e-4 of the coefficient itself), and within the
                     // errors.

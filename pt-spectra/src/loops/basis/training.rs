@@ -80,14 +80,10 @@ fn samples_with(
         .map(|p| lattice.sample(&transform(p)))
         .collect();
     for p in tables.iter().step_by(4) {
-        let (k, pk) = p.nodes();
         for (lo, hi) in CUTS {
-            let keep: Vec<usize> = (0..k.len()).filter(|&i| k[i] >= lo && k[i] <= hi).collect();
-            let cut = LinearSpectrum::from_nodes(
-                keep.iter().map(|&i| k[i]).collect(),
-                keep.iter().map(|&i| pk[i]).collect(),
-            )
-            .expect("a cut of a valid table is valid");
+            let cut = p
+                .restricted(lo, hi)
+                .expect("a cut of a valid table is valid");
             samples.push(lattice.sample(&transform(&cut)));
         }
     }
@@ -177,13 +173,7 @@ mod tests {
     fn cut(name: &str, lo: f64, hi: f64) -> LinearSpectrum {
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
         let p = LinearSpectrum::from_file(format!("{dir}{name}")).unwrap();
-        let (k, pk) = p.nodes();
-        let keep: Vec<usize> = (0..k.len()).filter(|&i| k[i] >= lo && k[i] <= hi).collect();
-        LinearSpectrum::from_nodes(
-            keep.iter().map(|&i| k[i]).collect(),
-            keep.iter().map(|&i| pk[i]).collect(),
-        )
-        .unwrap()
+        p.restricted(lo, hi).unwrap()
     }
 
     #[test]

@@ -212,7 +212,7 @@ impl EptPlan {
             full,
             nw,
             basis_residual: Some(projection.residual),
-            basis_soft: projection.soft.as_ref().map(|s| s.delta),
+            basis_soft: projection.soft_delta(),
         }))
     }
 }
