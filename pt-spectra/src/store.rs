@@ -22,7 +22,9 @@
 //! ```
 
 use crate::error::{Error, Result};
-use crate::loops::basis::{LinearBasis, OneLoopBasis, RedshiftBasis, SpectrumFamily, BASIS_SIZE};
+use crate::loops::basis::{
+    LinearBasis, OneLoopBasis, RedshiftBasis, RedshiftFamily, SpectrumFamily, BASIS_SIZE,
+};
 use crate::loops::basis::{TnsBasis, TwoLoopBasis};
 use crate::loops::redshift::RedshiftPlan;
 use crate::loops::{OneLoopPlan, P15Table, P17Table, TnsPlan};
@@ -303,7 +305,7 @@ impl TableStore {
     pub fn redshift_basis(
         &self,
         plan: &RedshiftPlan,
-        family: SpectrumFamily,
+        family: RedshiftFamily,
         basis: &dyn Fn() -> LinearBasis,
         progress: &dyn Progress,
     ) -> Result<Arc<RedshiftBasis>> {
@@ -329,7 +331,7 @@ impl TableStore {
         &self,
         k: &[f64],
         precision: &Precision,
-        family: SpectrumFamily,
+        family: RedshiftFamily,
         progress: &dyn Progress,
     ) -> Option<Arc<RedshiftBasis>> {
         let path = self.path(&RedshiftBasis::file_name(k, precision, family))?;

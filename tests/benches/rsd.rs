@@ -31,11 +31,11 @@
 //!   that grid and the window and bins; and the window and bins alone (one core).
 //!
 //! * `two_loop_rsd/spt2 …`, `two_loop_rsd/eft2 …`: a new CAMB table's arrays to the 2-loop matter
-//!   multipoles P_0, P_2, P_4 in redshift space on 40 log-spaced k in [0.005, 0.4] with the 2-loop terms
-//!   from the basis tensors (precision fast; the tensors read from the cache of `PT_SPECTRA_CACHE`, or
-//!   built once outside the timing, a few minutes): the spline, the 1-loop terms, the projection, the
-//!   contraction and the multipoles; `eft2` with IR resummation (the no-wiggle split, its 1-loop terms
-//!   and both contractions). Rayon's pool; `RAYON_NUM_THREADS=1` for one core.
+//!   multipoles P_0, P_2, P_4 in redshift space on 40 log-spaced k in [0.005, 0.4] with the 1- and
+//!   2-loop terms from the basis tensors (precision fast; the tensors read from the cache of
+//!   `PT_SPECTRA_CACHE`, or built once outside the timing, a few minutes): the spline, the projection,
+//!   the contractions and the multipoles; `eft2` with IR resummation (the no-wiggle split and both
+//!   spectra's contractions). Rayon's pool; `RAYON_NUM_THREADS=1` for one core.
 //!
 //! Run with `cargo bench --bench rsd`.
 

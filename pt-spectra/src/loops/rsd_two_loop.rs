@@ -90,15 +90,27 @@ pub fn node_weights(g: impl Fn(f64) -> f64) -> [f64; MU_NODES] {
 }
 
 /// The 32-point Gauss–Legendre rule of [`node_weights`], made once for many calls
-/// ([`node_weights_on`]: the same weights).
+/// ([`node_weights_on`]: the same weights): its μ on [0, 1] and, per node j, the weights times the
+/// node's Lagrange polynomial in μ², so that a call evaluates g 32 times.
 #[derive(Debug, Clone)]
-pub struct NodeRule(Vec<f64>, Vec<f64>);
+pub struct NodeRule {
+    mu: Vec<f64>,
+    weights: [Vec<f64>; MU_NODES],
+}
 
 impl NodeRule {
     /// The rule.
     pub fn new() -> Self {
         let (x, w) = legendre_nodes(32);
-        Self(x, w)
+        let nodes = mu2_nodes();
+        let mu: Vec<f64> = x.iter().map(|&x| 0.5 * (x + 1.0)).collect();
+        let weights = std::array::from_fn(|j| {
+            mu.iter()
+                .zip(&w)
+                .map(|(&mu, &w)| 0.5 * w * lagrange(&nodes, j, mu * mu))
+                .collect()
+        });
+        Self { mu, weights }
     }
 }
 
@@ -110,17 +122,8 @@ impl Default for NodeRule {
 
 /// [`node_weights`] on a rule made before.
 pub fn node_weights_on(rule: &NodeRule, g: impl Fn(f64) -> f64) -> [f64; MU_NODES] {
-    let NodeRule(x, w) = rule;
-    let nodes = mu2_nodes();
-    std::array::from_fn(|j| {
-        x.iter()
-            .zip(w.iter())
-            .map(|(&x, &w)| {
-                let mu = 0.5 * (x + 1.0);
-                0.5 * w * g(mu) * lagrange(&nodes, j, mu * mu)
-            })
-            .sum()
-    })
+    let g: Vec<f64> = rule.mu.iter().map(|&mu| g(mu)).collect();
+    std::array::from_fn(|j| rule.weights[j].iter().zip(&g).map(|(w, g)| w * g).sum())
 }
 
 /// The mean and standard error over the random shifts of Σ_t Σ_j w_tj P_t^(2)(k_i, μ_j; f) for terms

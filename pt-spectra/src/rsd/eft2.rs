@@ -36,13 +36,13 @@
 //! for the deterministic parts, and for the 2-loop parts as functionals of their μ² nodes
 //! ([`crate::loops::combined`], error the shifts' standard error).
 
-use super::spt2::{tensors_of, two_loop_terms};
+use super::spt2::{loop_terms, LoopTensors};
 use crate::error::{Error, Result};
 use crate::integrate::legendre_nodes;
 use crate::ir::{delta_sigma2_bao, sigma2_bao, WiggleSplit};
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::training::{camb_basis, transformed_basis};
-use crate::loops::basis::{RsdTwoLoopBasis, SpectrumFamily, BASIS_SIZE};
+use crate::loops::basis::{LinearBasis, RsdTwoLoopBasis, SpectrumFamily, BASIS_SIZE};
 use crate::loops::redshift::{RedshiftPlan, RedshiftTerms};
 use crate::loops::rsd_two_loop::legendre;
 use crate::loops::{combined, node_weights_on, Estimate, NodeRule, RsdTwoLoopTerms};
@@ -51,7 +51,6 @@ use crate::progress::Progress;
 use crate::store::TableStore;
 use std::fmt;
 use std::str::FromStr;
-use std::sync::Arc;
 
 /// The counterterms of `eft2` (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -201,8 +200,8 @@ pub struct Eft2Plan {
     split: WiggleSplit,
     ir: bool,
     precision: Precision,
-    /// The 2-loop basis tensors of the linear and (with IR resummation) no-wiggle spectra.
-    tensors: Vec<Arc<RsdTwoLoopBasis>>,
+    /// The 1- and 2-loop basis tensors of the linear and (with IR resummation) no-wiggle spectra.
+    tensors: LoopTensors,
 }
 
 /// The terms of `eft2` for one linear spectrum.
@@ -243,41 +242,38 @@ impl Eft2Plan {
             split: WiggleSplit::new()?,
             ir,
             precision: precision.clone(),
-            tensors: Vec::new(),
+            tensors: LoopTensors::default(),
         })
     }
 
-    /// The plan with the 2-loop basis tensors (of the linear spectra and, with IR resummation, of
-    /// their no-wiggle parts) as `precision.two_loop` says ([`super::spt2::Spt2Plan::with_basis`]).
+    /// The plan with the basis tensors of the 2-loop and 1-loop terms (of the linear spectra and,
+    /// with IR resummation, of their no-wiggle parts) as `precision.two_loop` says
+    /// ([`super::spt2::Spt2Plan::with_basis`]).
     ///
     /// # Errors
-    /// As [`TableStore::rsd_two_loop_basis`].
+    /// As [`TableStore::rsd_two_loop_basis`] and [`TableStore::redshift_basis`].
     pub fn with_basis(mut self, store: &TableStore, progress: &dyn Progress) -> Result<Self> {
         let p = &self.precision;
         let lattice = RsdTwoLoopBasis::lattice((p.q_min, p.q_max), p.lattice_step);
-        let k = self.k().to_vec();
         let linear = || camb_basis(lattice.clone(), BASIS_SIZE);
-        let mut tensors: Vec<_> =
-            tensors_of(&k, p, SpectrumFamily::Linear, &linear, store, progress)?
-                .into_iter()
-                .collect();
-        if self.ir {
-            let split = &self.split;
-            let no_wiggle = || {
-                transformed_basis(&lattice, BASIS_SIZE, &|s: &LinearSpectrum| {
-                    split.no_wiggle(s).unwrap_or_else(|_| s.clone())
+        // Made at most once (the training set through the split), for both tensors.
+        let split_basis = std::cell::OnceCell::new();
+        let split = &self.split;
+        let no_wiggle = || {
+            split_basis
+                .get_or_init(|| {
+                    transformed_basis(&lattice, BASIS_SIZE, &|s: &LinearSpectrum| {
+                        split.no_wiggle(s).unwrap_or_else(|_| s.clone())
+                    })
                 })
-            };
-            tensors.extend(tensors_of(
-                &k,
-                p,
-                SpectrumFamily::NoWiggle,
-                &no_wiggle,
-                store,
-                progress,
-            )?);
+                .clone()
+        };
+        let mut families: Vec<(_, &dyn Fn() -> LinearBasis)> =
+            vec![(SpectrumFamily::Linear, &linear)];
+        if self.ir {
+            families.push((SpectrumFamily::NoWiggle, &no_wiggle));
         }
-        self.tensors = tensors;
+        self.tensors = LoopTensors::load(&self.one_loop, &families, store, progress)?;
         Ok(self)
     }
 
@@ -302,17 +298,17 @@ impl Eft2Plan {
     /// # Errors
     /// As [`crate::loops::rsd_two_loop_of`] and [`WiggleSplit::no_wiggle`].
     pub fn terms(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> Result<Eft2Terms> {
-        let p = &self.precision;
         let k = self.k();
         let p_lin: Vec<f64> = k.iter().map(|&k| spectrum.eval(k)).collect();
         if !self.ir {
-            let (mut two, source) = two_loop_terms(k, &[spectrum], &self.tensors, p, progress)?;
+            let (mut one, mut two, source) =
+                loop_terms(&self.one_loop, &[spectrum], &self.tensors, progress)?;
             return Ok(Eft2Terms {
                 k: k.to_vec(),
                 p_nw: p_lin.clone(),
                 p_lin,
                 sigma2: (Estimate::default(), Estimate::default()),
-                one_full: self.one_loop.evaluate(spectrum),
+                one_full: one.remove(0),
                 one_nw: None,
                 two_full: two.remove(0),
                 two_nw: None,
@@ -320,17 +316,18 @@ impl Eft2Plan {
             });
         }
         let nw = self.split.no_wiggle(spectrum)?;
-        let (mut two, source) = two_loop_terms(k, &[spectrum, &nw], &self.tensors, p, progress)?;
-        let two_nw = two.pop();
+        let (mut one, mut two, source) =
+            loop_terms(&self.one_loop, &[spectrum, &nw], &self.tensors, progress)?;
+        let q_min = self.precision.q_min;
         Ok(Eft2Terms {
             k: k.to_vec(),
             p_nw: k.iter().map(|&k| nw.eval(k)).collect(),
             p_lin,
-            sigma2: (sigma2_bao(&nw, p.q_min), delta_sigma2_bao(&nw, p.q_min)),
-            one_full: self.one_loop.evaluate(spectrum),
-            one_nw: Some(self.one_loop.evaluate(&nw)),
+            sigma2: (sigma2_bao(&nw, q_min), delta_sigma2_bao(&nw, q_min)),
+            one_nw: one.pop(),
+            one_full: one.remove(0),
+            two_nw: two.pop(),
             two_full: two.remove(0),
-            two_nw,
             source,
         })
     }

@@ -21,7 +21,10 @@
 use crate::error::{Error, Result};
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::training::camb_basis;
-use crate::loops::basis::{LinearBasis, RsdTwoLoopBasis, SpectrumFamily, BASIS_SIZE};
+use crate::loops::basis::{
+    LinearBasis, Projection, RedshiftBasis, RedshiftFamily, RsdTwoLoopBasis, SpectrumFamily,
+    BASIS_SIZE,
+};
 use crate::loops::redshift::{RedshiftPlan, RedshiftTerms};
 use crate::loops::{
     check_two_loop_ells, rsd_two_loop_of, Estimate, RsdTwoLoopTerms, TwoLoopSettings,
@@ -47,21 +50,95 @@ pub fn two_loop_settings(precision: &Precision) -> TwoLoopSettings {
     }
 }
 
-/// The 2-loop redshift-space terms of `spectra` (a spectrum and, for IR resummation, its no-wiggle
-/// part) from the basis `tensors` of their families when every spectrum is represented by its basis,
-/// else integrated directly on the same points; with where they came from (a header line).
+/// The basis tensors of a 2-loop model for the spectra of [`loop_terms`] (the linear spectrum,
+/// then with IR resummation its no-wiggle part): the 2-loop ones and the 1-loop ones on the same
+/// basis functions, so that one projection per spectrum serves both (the 1-loop ones are kept only
+/// if there are 2-loop ones for every spectrum).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct LoopTensors {
+    two_loop: Vec<Arc<RsdTwoLoopBasis>>,
+    one_loop: Vec<Arc<RedshiftBasis>>,
+}
+
+impl LoopTensors {
+    /// The tensors of the spectra `families` (each with the basis its tensors are built on) for the
+    /// 1-loop `plan`, as `precision.two_loop` says: built (`basis`), read if cached (`auto`), or none
+    /// (`direct`).
+    ///
+    /// # Errors
+    /// As [`TableStore::rsd_two_loop_basis`] and [`TableStore::redshift_basis`].
+    pub(crate) fn load(
+        plan: &RedshiftPlan,
+        families: &[(SpectrumFamily, &dyn Fn() -> LinearBasis)],
+        store: &TableStore,
+        progress: &dyn Progress,
+    ) -> Result<Self> {
+        let (k, precision) = (plan.k(), plan.precision());
+        let mut two_loop = Vec::new();
+        let mut one_loop = Vec::new();
+        for &(family, basis) in families {
+            two_loop.extend(tensors_of(k, precision, family, basis, store, progress)?);
+            let family = match family {
+                SpectrumFamily::Linear => RedshiftFamily::Linear,
+                SpectrumFamily::NoWiggle => RedshiftFamily::SplitNoWiggle,
+            };
+            one_loop.extend(match precision.two_loop {
+                TwoLoopMethod::Direct => None,
+                TwoLoopMethod::Auto => store.cached_redshift_basis(k, precision, family, progress),
+                TwoLoopMethod::Basis => Some(store.redshift_basis(plan, family, basis, progress)?),
+            });
+        }
+        if two_loop.len() != families.len() {
+            two_loop.clear();
+        }
+        let same_functions = one_loop.len() == two_loop.len()
+            && one_loop
+                .iter()
+                .zip(&two_loop)
+                .all(|(one, two)| one.basis() == two.basis());
+        if !same_functions {
+            one_loop.clear();
+        }
+        Ok(Self { two_loop, one_loop })
+    }
+}
+
+/// The 1- and 2-loop redshift-space terms of `spectra` (a spectrum and, for IR resummation, its
+/// no-wiggle part): from the basis `tensors` when every spectrum is represented by its basis
+/// (the 1-loop terms from the plan's own integrals if there are no 1-loop tensors), else integrated
+/// directly (the 2-loop terms on the same points for all spectra); with where they came from (a
+/// header line).
 ///
 /// # Errors
 /// As [`rsd_two_loop_of`].
-pub(crate) fn two_loop_terms(
-    k: &[f64],
+pub(crate) fn loop_terms(
+    plan: &RedshiftPlan,
     spectra: &[&LinearSpectrum],
-    tensors: &[Arc<RsdTwoLoopBasis>],
-    precision: &Precision,
+    tensors: &LoopTensors,
     progress: &dyn Progress,
-) -> Result<(Vec<RsdTwoLoopTerms>, String)> {
-    let (terms, note) = two_loop_terms_noted(k, spectra, tensors, precision, progress)?;
-    Ok((terms, note + &few_points_caveat(precision)))
+) -> Result<(Vec<RedshiftTerms>, Vec<RsdTwoLoopTerms>, String)> {
+    let (k, precision) = (plan.k(), plan.precision());
+    let (two, note, projections) =
+        two_loop_terms_noted(k, spectra, &tensors.two_loop, precision, progress)?;
+    let (one, note) = match projections {
+        Some(projections) if tensors.one_loop.len() == spectra.len() => {
+            let one = spectra
+                .iter()
+                .zip(&tensors.one_loop)
+                .zip(&projections)
+                .map(|((s, t), projection)| {
+                    let p_lin: Vec<f64> = k.iter().map(|&k| s.eval(k)).collect();
+                    t.evaluate(plan, &p_lin, projection)
+                })
+                .collect();
+            (
+                one,
+                note.replacen("2-loop terms from", "1- and 2-loop terms from", 1),
+            )
+        }
+        _ => (spectra.iter().map(|s| plan.evaluate(s)).collect(), note),
+    };
+    Ok((one, two, note + &few_points_caveat(precision)))
 }
 
 /// Points per shift at low k below which the header warns ([`few_points_caveat`]): 2^13, the
@@ -86,14 +163,16 @@ fn few_points_caveat(precision: &Precision) -> String {
     )
 }
 
-/// [`two_loop_terms`] without the caveat.
+/// The 2-loop terms of [`loop_terms`], where they came from (without the caveat) and, from the
+/// basis, the spectra's projections.
+#[allow(clippy::type_complexity)]
 fn two_loop_terms_noted(
     k: &[f64],
     spectra: &[&LinearSpectrum],
     tensors: &[Arc<RsdTwoLoopBasis>],
     precision: &Precision,
     progress: &dyn Progress,
-) -> Result<(Vec<RsdTwoLoopTerms>, String)> {
+) -> Result<(Vec<RsdTwoLoopTerms>, String, Option<Vec<Projection>>)> {
     let mut note = String::from("2-loop terms integrated for this spectrum (direct)");
     if tensors.len() == spectra.len() {
         let projections: Vec<_> = spectra
@@ -121,7 +200,7 @@ fn two_loop_terms_noted(
                 crate::loops::basis::RSD_PROJECTION_FACTOR,
                 crate::loops::basis::soft::describe(soft)
             );
-            return Ok((terms, note));
+            return Ok((terms, note, Some(projections)));
         }
         note = format!(
             "2-loop terms integrated for this spectrum (direct): its projection residual exceeds {:e}, \
@@ -138,7 +217,7 @@ fn two_loop_terms_noted(
         &two_loop_settings(precision),
         &callback,
     )?;
-    Ok((terms, note))
+    Ok((terms, note, None))
 }
 
 /// The basis tensors of `family` on `basis()` as `precision.two_loop` says: built (`basis`), read if
@@ -173,7 +252,7 @@ pub(crate) fn tensors_of(
 pub struct Spt2Plan {
     one_loop: RedshiftPlan,
     precision: Precision,
-    tensors: Vec<Arc<RsdTwoLoopBasis>>,
+    tensors: LoopTensors,
 }
 
 /// The three parts of the model for one linear spectrum.
@@ -216,7 +295,7 @@ impl Spt2Plan {
         Ok(Self {
             one_loop: RedshiftPlan::new(k, precision)?,
             precision: precision.clone(),
-            tensors: Vec::new(),
+            tensors: LoopTensors::default(),
         })
     }
 
@@ -231,17 +310,8 @@ impl Spt2Plan {
             self.precision.lattice_step,
         );
         let basis = || camb_basis(lattice.clone(), BASIS_SIZE);
-        let k = self.k().to_vec();
-        self.tensors = tensors_of(
-            &k,
-            &self.precision,
-            SpectrumFamily::Linear,
-            &basis,
-            store,
-            progress,
-        )?
-        .into_iter()
-        .collect();
+        let families: [(_, &dyn Fn() -> LinearBasis); 1] = [(SpectrumFamily::Linear, &basis)];
+        self.tensors = LoopTensors::load(&self.one_loop, &families, store, progress)?;
         Ok(self)
     }
 
@@ -263,12 +333,12 @@ impl Spt2Plan {
     /// As [`rsd_two_loop_of`].
     pub fn terms(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> Result<Spt2Terms> {
         let k = self.k();
-        let (mut two, source) =
-            two_loop_terms(k, &[spectrum], &self.tensors, &self.precision, progress)?;
+        let (mut one, mut two, source) =
+            loop_terms(&self.one_loop, &[spectrum], &self.tensors, progress)?;
         Ok(Spt2Terms {
             k: k.to_vec(),
             p_lin: k.iter().map(|&k| spectrum.eval(k)).collect(),
-            one_loop: self.one_loop.evaluate(spectrum),
+            one_loop: one.remove(0),
             two_loop: two.remove(0),
             source,
         })

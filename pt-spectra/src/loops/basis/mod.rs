@@ -48,7 +48,7 @@ pub mod training;
 
 pub use linear_basis::{LinearBasis, Projection, SMOOTHING};
 pub use one_loop::{BasisOneLoop, OneLoopBasis};
-pub use redshift::{RedshiftBasis, SpectrumFamily};
+pub use redshift::{RedshiftBasis, RedshiftFamily, SpectrumFamily};
 pub use rsd_two_loop::{RsdTwoLoopBasis, RSD_PROJECTION_FACTOR};
 pub use tns::TnsBasis;
 

@@ -14,9 +14,14 @@
 //!
 //! The no-wiggle spectrum of the galaxy model is a fixed linear filter of P on a log grid
 //! ([`crate::ir::savitzky_golay_no_wiggle`]); on the lattice it is linear in the samples, so the
-//! no-wiggle part of P = Σ c_a φ_a is Σ c_a S[φ_a]. The [`SpectrumFamily::NoWiggle`] tensors are
+//! no-wiggle part of P = Σ c_a φ_a is Σ c_a S[φ_a]. The [`RedshiftFamily::FilteredNoWiggle`] tensors are
 //! therefore those of the filtered basis functions S[φ_a], contracted with the spectrum's own
 //! coefficients: one projection, no filter and no second basis per spectrum.
+//!
+//! The 2-loop redshift-space models (`spt2`, `eft2`) take their 1-loop terms from these tensors
+//! too: on the CAMB basis for the linear spectrum and, for the no-wiggle spectrum of their IR split
+//! (not a linear filter), on the split training set's basis ([`RedshiftFamily::SplitNoWiggle`]),
+//! with the projections their 2-loop tensors already made.
 
 use super::forms::{concat, linear_form, pair_forms, pair_products_both, per_k, RuleRows};
 use super::low_rank::{LowRank, PAIR_TOLERANCE};
@@ -38,8 +43,7 @@ const LINEAR: usize = 3 * LW;
 /// Which spectra basis tensors are for: linear spectra (the shipped CAMB training set), or their
 /// no-wiggle parts. The real-space and 2-loop bases take the latter on a basis of their own (the
 /// training set through the no-wiggle filter: those are not in the span of the linear basis, their
-/// smoothed tails differ by ~1e-2); [`RedshiftBasis`], whose filter is linear, on the filtered
-/// functions of the linear basis (module docs).
+/// smoothed tails differ by ~1e-2). [`RedshiftBasis`] has families of its own ([`RedshiftFamily`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SpectrumFamily {
     /// Linear spectra.
@@ -48,11 +52,37 @@ pub enum SpectrumFamily {
     NoWiggle,
 }
 
-impl SpectrumFamily {
+/// Which spectra a [`RedshiftBasis`] is for, and how its functions are read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RedshiftFamily {
+    /// Linear spectra, on the functions of the given basis (the CAMB training set's).
+    Linear,
+    /// The galaxy model's no-wiggle parts ([`crate::savgol::no_wiggle_samples`], linear in P): the
+    /// filtered functions S[φ_a] of the given linear basis, contracted with the spectrum's own
+    /// coefficients (module docs).
+    FilteredNoWiggle,
+    /// The no-wiggle parts of the IR split ([`crate::ir::WiggleSplit`], not linear in P) of the
+    /// 2-loop redshift-space models: the functions of the given basis, the training set through the
+    /// split (as the 2-loop tensors of [`SpectrumFamily::NoWiggle`]), on which the no-wiggle spectrum
+    /// is projected itself.
+    SplitNoWiggle,
+}
+
+impl RedshiftFamily {
     fn tag(self) -> &'static str {
         match self {
             Self::Linear => "lin",
-            Self::NoWiggle => "nw",
+            Self::FilteredNoWiggle => "nw",
+            Self::SplitNoWiggle => "splitnw",
+        }
+    }
+
+    /// Its code in the cache key (0 and 1 as before the split family existed).
+    fn code(self) -> f64 {
+        match self {
+            Self::Linear => 0.0,
+            Self::FilteredNoWiggle => 1.0,
+            Self::SplitNoWiggle => 2.0,
         }
     }
 }
@@ -77,11 +107,11 @@ pub struct RedshiftBasis {
 }
 
 /// The settings that make the tensors (their cache key).
-fn key(k: &[f64], precision: &Precision, family: SpectrumFamily) -> Vec<f64> {
+fn key(k: &[f64], precision: &Precision, family: RedshiftFamily) -> Vec<f64> {
     let p = precision;
     let mut key = vec![
         f64::from(VERSION),
-        f64::from(u8::from(family == SpectrumFamily::NoWiggle)),
+        family.code(),
         BASIS_SIZE as f64,
         NPAIR as f64,
         p.q_min,
@@ -105,17 +135,17 @@ fn key(k: &[f64], precision: &Precision, family: SpectrumFamily) -> Vec<f64> {
 
 impl RedshiftBasis {
     /// The cache file name of the tensors for `k`, `precision` and `family`.
-    pub fn file_name(k: &[f64], precision: &Precision, family: SpectrumFamily) -> String {
+    pub fn file_name(k: &[f64], precision: &Precision, family: RedshiftFamily) -> String {
         let prefix = format!("redshift-basis-{}", family.tag());
         super::cache_file_name(&prefix, VERSION, &key(k, precision, family))
     }
 
-    /// Builds the tensors of `plan` on the linear `basis` (on the plan's lattice; for the no-wiggle
-    /// `family` on its filtered functions) in parallel over k; `progress(done, total)` counts the k
-    /// values.
+    /// Builds the tensors of `plan` on `basis` (on the plan's lattice; for
+    /// [`RedshiftFamily::FilteredNoWiggle`] on its filtered functions) in parallel over k;
+    /// `progress(done, total)` counts the k values.
     pub fn build(
         plan: &RedshiftPlan,
-        family: SpectrumFamily,
+        family: RedshiftFamily,
         basis: LinearBasis,
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Self {
@@ -124,8 +154,8 @@ impl RedshiftBasis {
         let n = basis.len();
         let n_err = error_functions(n);
         let rows = match family {
-            SpectrumFamily::Linear => RuleRows::new(&basis),
-            SpectrumFamily::NoWiggle => {
+            RedshiftFamily::Linear | RedshiftFamily::SplitNoWiggle => RuleRows::new(&basis),
+            RedshiftFamily::FilteredNoWiggle => {
                 let step = fine.lattice.step;
                 let filter = |f: &[f64]| crate::savgol::no_wiggle_samples(f, step);
                 RuleRows::from_rows(basis.transformed_rows(&filter), n)
@@ -288,7 +318,7 @@ impl RedshiftBasis {
         values: &[f64],
         k: &[f64],
         precision: &Precision,
-        family: SpectrumFamily,
+        family: RedshiftFamily,
     ) -> Option<Self> {
         let expected = key(k, precision, family);
         let rest = super::after_key(values, &expected)?;
@@ -330,7 +360,7 @@ mod tests {
         let plan = RedshiftPlan::new(&k, &Precision::fast()).unwrap();
         let lattice = plan.rules().0.lattice.clone();
         let linear = super::super::training::camb_basis(lattice, BASIS_SIZE);
-        let tensors = RedshiftBasis::build(&plan, SpectrumFamily::Linear, linear, &|_, _| {});
+        let tensors = RedshiftBasis::build(&plan, RedshiftFamily::Linear, linear, &|_, _| {});
         let basis = tensors.basis();
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
         for i in 0..3 {
@@ -352,13 +382,17 @@ mod tests {
         }
         let v = tensors.to_f64s();
         assert_eq!(
-            RedshiftBasis::from_f64s(&v, &k, plan.precision(), SpectrumFamily::Linear).unwrap(),
+            RedshiftBasis::from_f64s(&v, &k, plan.precision(), RedshiftFamily::Linear).unwrap(),
             tensors
         );
-        let nw = SpectrumFamily::NoWiggle;
-        assert!(RedshiftBasis::from_f64s(&v, &k, plan.precision(), nw).is_none());
+        for other in [
+            RedshiftFamily::FilteredNoWiggle,
+            RedshiftFamily::SplitNoWiggle,
+        ] {
+            assert!(RedshiftBasis::from_f64s(&v, &k, plan.precision(), other).is_none());
+        }
         assert!(
-            RedshiftBasis::from_f64s(&v, &k[1..], plan.precision(), SpectrumFamily::Linear)
+            RedshiftBasis::from_f64s(&v, &k[1..], plan.precision(), RedshiftFamily::Linear)
                 .is_none()
         );
     }

@@ -4,7 +4,7 @@
 //! With IR resummation nothing else is per spectrum either: the no-wiggle filter is linear in P on
 //! the lattice ([`crate::savgol::no_wiggle_samples`]), so with P ≈ Σ c_a φ_a the no-wiggle spectrum is
 //! Σ c_a S[φ_a] with the filtered functions S[φ_a] made once per plan. Its terms are contractions of
-//! the same c with the tensors of S[φ_a] ([`SpectrumFamily::NoWiggle`]), Σ² is a linear form in c
+//! the same c with the tensors of S[φ_a] ([`RedshiftFamily::FilteredNoWiggle`]), Σ² is a linear form in c
 //! (Simpson's rule on the lattice, its error the difference from the half-resolution rule), and
 //! P_nw(k) at the output k, which the model uses directly, a fixed linear form of the spectrum's own
 //! lattice samples (the filter's taps composed with the lattice interpolation), not of the
@@ -14,7 +14,7 @@ use super::{sigma2_kernel, EptPlan, EptTerms};
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::training::camb_basis;
-use crate::loops::basis::{LinearBasis, RedshiftBasis, SpectrumFamily, BASIS_SIZE, MAX_RESIDUAL};
+use crate::loops::basis::{LinearBasis, RedshiftBasis, RedshiftFamily, BASIS_SIZE, MAX_RESIDUAL};
 use crate::loops::Estimate;
 use crate::precision::TwoLoopMethod;
 use crate::progress::Progress;
@@ -149,9 +149,9 @@ impl EptPlan {
                 TwoLoopMethod::Direct => None,
             })
         };
-        let linear = get(SpectrumFamily::Linear)?;
+        let linear = get(RedshiftFamily::Linear)?;
         let no_wiggle = if ir {
-            get(SpectrumFamily::NoWiggle)?
+            get(RedshiftFamily::FilteredNoWiggle)?
         } else {
             None
         };
