@@ -8,16 +8,16 @@ P(k) of three suites of simulations (examples/data/nbody/, provenance in each RE
   abacus_c000  AbacusSummit c000 base, mean of 13 boxes of 2 Gpc/h (Planck 2018, 0.06 eV), z = 0.5
 
 The counterterms are fitted by linear least squares (each model is P(0) + Σ X T_X, the T_dd_X columns of
-`terms=True`) on 0.01 ≤ k ≤ k_fit, k_fit = 0.15, 0.2, 0.25, 0.3, with σ = the error of the N-body mean
+`terms=True`) on 0.01 ≤ k ≤ k_fit, k_fit = 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, with σ = the error of the N-body mean
 (fit "N") and with that error plus a 0.5% floor in quadrature (fit "N+0.5%"; the floor stands for what
 the error of the mean leaves out: the simulations' own systematics, which code comparisons put at
 ~0.5% for k ≲ 0.3, and the linear input, CAMB against the spectra the simulations started from,
 0.1–0.3%). Writes examples/out/nbody_reach.md (reach tables, fitted counterterms as k_fit moves, χ²)
 and, with matplotlib, examples/out/nbody_reach.png (copied to docs/results/).
 
-    python examples/nbody_reach.py [--out DIR] [--precision default]
+    python examples/nbody_reach.py [--out DIR] [--precision default] [--cache FILE.npz]
 
-Reach: the first k ≥ 0.01 h/Mpc (bins up to 0.45) where |P_model/P_N-body − 1| > max(1%, 1σ of the
+Reach: the first k ≥ 0.01 h/Mpc (bins up to 0.6) where |P_model/P_N-body − 1| > max(1%, 1σ of the
 N-body mean) (the issue's criterion), and the same counted from k = 0.08: below it the error of the
 mean is 0.4–0.9% per bin, a bin can leave ±1% by the simulations' sample variance (2.1–2.3σ bins at
 k = 0.035 in Okumura, the same at all three z, and at 0.053 in Quijote, for all three models alike), and
@@ -27,9 +27,13 @@ Fourier lattice for the others, whose tables give bin centres), plus a bin-avera
 <P>_bin − P(k_eff) computed with `1l-spt-ir` on every lattice shell of the bin (largest at low k and on
 the BAO; reported). Abacus's bins of width k_F are merged three by three (mode-weighted) so that all
 sets have bins of ~0.006–0.01 h/Mpc. The linear input is CAMB at each snapshot's z (the make_linear.py
-beside each table); `2l-eft-ir` is integrated directly (`two_loop="direct"`: 5 grids of 44–70 k, under
-1 s per k on 2 cores, where the basis tensors would take minutes per grid to build). About 3 minutes on
-2 cores (plus the one-time angular table, ~1 min).
+beside each table); `2l-eft-ir` is integrated directly (`two_loop="direct"`: 5 grids of 59–94 k, about
+1 s per k on 2 cores, where the basis tensors would take minutes per grid to build). About 12 minutes on
+2 cores (plus the one-time angular table, ~1 min); with `--cache` a rerun takes seconds.
+
+The last tables give the reach against redshift: going up in k_fit while the fit is acceptable (χ²
+p-value ≥ P_VALUE) and its counterterms stay within STABLE σ of the previous k_fit's, the reach at the
+last such k_fit.
 """
 
 import argparse
@@ -42,8 +46,10 @@ from scipy.interpolate import CubicSpline
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "examples" / "data" / "nbody"
-K_FITS = (0.15, 0.2, 0.25, 0.3)
-K_MIN, K_MAX = 0.01, 0.45
+K_FITS = (0.15, 0.2, 0.25, 0.3, 0.35, 0.4)
+K_MIN, K_MAX = 0.01, 0.6
+P_VALUE = 0.01  # a fit is accepted while its χ² has p ≥ this (the summary table) …
+STABLE = 2.0  # … and its counterterms are within this many σ of the previous k_fit's
 K_LINEAR = 0.08  # the second reach counts from here (docstring)
 TOLERANCE = 0.01
 FLOOR = 0.005
@@ -171,7 +177,11 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=ROOT / "examples" / "out")
     ap.add_argument("--precision", default="default")
+    ap.add_argument("--cache", type=Path, default=None,
+                    help="an .npz file keeping the computed model terms, so that a rerun (new tables, fits) "
+                         "computes nothing")
     args = ap.parse_args()
+    cache = dict(np.load(args.cache)) if args.cache and args.cache.exists() else {}
     results, curves, info = {}, {}, {}
     snaps = []
     for name, cosmology in COSMOLOGIES.items():
@@ -182,14 +192,22 @@ def main():
             linear = (lin[:, 0], lin[:, 1])
             snaps.append((name, z))
             log(f"{name} z = {z}: {len(k)} bins in [{k[0]:.4f}, {k[-1]:.4f}]")
-            corr = bin_correction(k, sh, z, linear, cosmology, args.precision)
+            key = f"{name}_{z:g}_{args.precision}_{K_MAX}"
+            if f"{key}_corr" not in cache:
+                cache[f"{key}_corr"] = bin_correction(k, sh, z, linear, cosmology, args.precision)
+            corr = cache[f"{key}_corr"]
             info[name, z] = (len(k), k[0], k[-1], corr, data, err, k)
             computed = {}
             for label, (model, names) in MODELS.items():
                 if model not in computed:
                     log(f"  {model}")
-                    p0, tmpl = templates(model, k, z, linear, cosmology, args.precision)
-                    computed[model] = (p0 + corr, tmpl)
+                    mkey = f"{key}_{model}"
+                    if f"{mkey}_p0" not in cache:
+                        p0, tmpl = templates(model, k, z, linear, cosmology, args.precision)
+                        cache[f"{mkey}_p0"] = p0
+                        cache.update({f"{mkey}_T_{c}": t for c, t in tmpl.items()})
+                    tmpl = {c[len(mkey) + 3:]: t for c, t in cache.items() if c.startswith(f"{mkey}_T_")}
+                    computed[model] = (cache[f"{mkey}_p0"] + corr, tmpl)
                 p0, tmpl = computed[model]
                 for fit_name, floor in FITS.items():
                     sigma = np.sqrt(err**2 + (floor * data) ** 2)
@@ -205,7 +223,57 @@ def main():
                             amp=amp)
                         if k_fit == 0.25:
                             curves[name, z, label, fit_name] = (k, ratio, err / data)
+    if args.cache:
+        np.savez(args.cache, **cache)
     write(args, results, curves, info, snaps)
+
+
+def summary(results, snaps):
+    """The reach of 2l-eft-ir per snapshot with the largest k_fit it is valid to: going up K_FITS, a
+    fit is accepted while its χ² has p-value ≥ P_VALUE (the model describes the data to k_fit within
+    their errors) and every counterterm stays within STABLE σ (the previous fit's errors) of its value
+    at the previous k_fit (stable counterterms); the last accepted k_fit, its reach from 0.08 and its
+    counterterms, then the reach of every k_fit marked."""
+    from scipy.stats import chi2 as chi2_dist
+    label = "2l-eft-ir (cs2, cs2_1loop, c4)"
+    names = ("cs2", "cs2_1loop", "c4")
+    out = []
+    for fit_name in FITS:
+        out += ["", f"### 2l-eft-ir reach against redshift, fit {fit_name}", "",
+                f"Going up in k_fit, a fit is accepted while its χ² p-value is ≥ {P_VALUE} and each counterterm "
+                f"is within {STABLE:g}σ (of the previous fit) of its value at the previous k_fit; the last "
+                "accepted k_fit, the reach (from 0.08) with it and its counterterms, then the reach of every "
+                "k_fit (\"χ²\": p-value below; \"moved\": a counterterm moved; \"–\": above one that failed).",
+                "", "| data | z | k_fit | reach | cs2 | cs2_1loop | c4 | "
+                + " | ".join(f"k_fit {x}" for x in K_FITS) + " |",
+                "|---|---|---|---|---|---|---|" + "---|" * len(K_FITS)]
+        for n, z in snaps:
+            cells, best, prev, failed = [], None, None, False
+            for k_fit in K_FITS:
+                r = results[n, z, label, fit_name, k_fit]
+                reach_text = fmt_reach(r["r2"], K_MAX)
+                if failed:
+                    cells.append(f"– ({reach_text})")
+                    continue
+                if chi2_dist.sf(r["chi2"], r["dof"]) < P_VALUE:
+                    failed = True
+                    cells.append(f"χ² ({reach_text})")
+                    continue
+                if prev is not None and any(abs(r["coef"][c] - prev["coef"][c]) > STABLE * prev["err"][c]
+                                            for c in names):
+                    failed = True
+                    cells.append(f"moved ({reach_text})")
+                    continue
+                cells.append(reach_text)
+                best, prev = (k_fit, r), r
+            if best is None:
+                out.append(f"| {n} | {z:g} | none | | | | | " + " | ".join(cells) + " |")
+                continue
+            k_fit, r = best
+            ct = [f"{r['coef'][c]:+.2f} ± {r['err'][c]:.2f}" for c in names]
+            out.append(f"| {n} | {z:g} | {k_fit} | {fmt_reach(r['r2'], K_MAX)} | " + " | ".join(ct) + " | "
+                       + " | ".join(cells) + " |")
+    return out
 
 
 def write(args, results, curves, info, snaps):
@@ -213,9 +281,9 @@ def write(args, results, curves, info, snaps):
     out = ["<!-- written by examples/nbody_reach.py -->", "",
            "k [h/Mpc] where P_dd(model)/P_N-body first leaves ±max(1%, 1σ of the N-body mean), counted from "
            "k = 0.01 / from k = 0.08, with the counterterms fitted on 0.01 ≤ k ≤ k_fit (module docstring). Fit N: "
-           "σ = error of the N-body mean; fit N+0.5%: that and 0.5% of P in quadrature. Bins up to 0.45 h/Mpc "
-           "(\"> 0.45\": none leaves).", "",
-           "Data (bins with 0.01 ≤ k ≤ 0.45) and the bin-average correction <P>_bin − P(k_eff) of 1l-spt-ir "
+           f"σ = error of the N-body mean; fit N+0.5%: that and 0.5% of P in quadrature. Bins up to {K_MAX} h/Mpc "
+           f"(\"> {K_MAX}\": none leaves).", "",
+           f"Data (bins with 0.01 ≤ k ≤ {K_MAX}) and the bin-average correction <P>_bin − P(k_eff) of 1l-spt-ir "
            "added to every model (largest |correction|/P below and above k = 0.05):", "",
            "| data | z | bins | k range | σ/P of the mean at k ≈ 0.1, 0.2, 0.3 | bin correction k < 0.05 / ≥ 0.05 |",
            "|---|---|---|---|---|---|"]
@@ -235,7 +303,8 @@ def write(args, results, curves, info, snaps):
                 cells = [" / ".join(fmt_reach(results[n, z, label, fit_name, k_fit][s], K_MAX)
                                     for s in ("r1", "r2")) for n, z in snaps]
                 out.append(f"| {label} | {k_fit} | " + " | ".join(cells) + " |")
-    k_show = (0.035, 0.053, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4)
+    out += summary(results, snaps)
+    k_show = (0.035, 0.053, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5)
     for fit_name in FITS:
         out += ["", f"### 2l-eft-ir residuals at k_fit = 0.25, fit {fit_name}", "",
                 "100 (P_model/P_N-body − 1) in the bin nearest each k, with 100 σ/P of the N-body mean in brackets.",
