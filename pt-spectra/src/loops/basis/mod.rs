@@ -34,6 +34,7 @@
 //!
 //! [`TableStore::two_loop_basis`]: crate::store::TableStore::two_loop_basis
 
+mod cache_key;
 mod forms;
 mod linear_basis;
 mod low_rank;
@@ -46,6 +47,7 @@ mod tensors;
 mod tns;
 pub mod training;
 
+pub(crate) use cache_key::{after_key, cache_file_name};
 pub use linear_basis::{LinearBasis, Projection, SMOOTHING};
 pub use one_loop::{BasisOneLoop, OneLoopBasis};
 pub use redshift::{RedshiftBasis, RedshiftFamily, SpectrumFamily};
@@ -102,31 +104,6 @@ pub(crate) fn pair_index(a: usize, b: usize) -> usize {
 #[inline]
 pub(crate) fn triple_index(a: usize, b: usize, c: usize) -> usize {
     c * (c + 1) * (c + 2) / 6 + pair_index(a, b)
-}
-
-/// The cache file name `<prefix>-v<version>-n<BASIS_SIZE>-<hash>.bin` of tensors made with the
-/// settings `key` (FNV-1a over its bits).
-pub(crate) fn cache_file_name(prefix: &str, version: u32, key: &[f64]) -> String {
-    let hash = key
-        .iter()
-        .flat_map(|v| v.to_le_bytes())
-        .fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
-            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-        });
-    format!("{prefix}-v{version}-n{BASIS_SIZE}-{hash:016x}.bin")
-}
-
-/// The values of a cache file after its key, if the file starts with `expected` (the key's length,
-/// then the key) and every value is finite; `None` for a file made for other settings.
-pub(crate) fn after_key<'a>(values: &'a [f64], expected: &[f64]) -> Option<&'a [f64]> {
-    let len = *values.first()? as usize;
-    if len != expected.len() || values.get(1..1 + len)? != expected {
-        return None;
-    }
-    if values.iter().any(|v| !v.is_finite()) {
-        return None;
-    }
-    Some(&values[1 + len..])
 }
 
 /// Basis functions of the per-shift tensors for a basis of `n`.
