@@ -171,18 +171,26 @@ pub(crate) fn dot_f32(a: &[f32], b: &[f32]) -> f64 {
     dot_f32_portable(a, b)
 }
 
-/// The rows of `a` (each of the length of `x`, as many as `out` holds) times `x`, each as
-/// [`dot_f32`] (the same sums), with one detection of the instructions for all of them: a
-/// low-rank tensor's thousands of short rows ([`crate::loops::basis`]).
-pub(crate) fn matvec_f32(a: &[f32], x: &[f32], out: &mut [f64]) {
-    let n = x.len();
+/// Checks that a matrix of `len` entries holds `out.len()` rows of `n`; with `n` = 0 zeroes `out`
+/// and says so (the product is then done).
+fn no_columns(len: usize, n: usize, out: &mut [f64]) -> bool {
     assert!(
-        a.len() >= n * out.len(),
+        len >= n * out.len(),
         "a matrix of {} rows of {n}",
         out.len()
     );
     if n == 0 {
         out.iter_mut().for_each(|o| *o = 0.0);
+    }
+    n == 0
+}
+
+/// The rows of `a` (each of the length of `x`, as many as `out` holds) times `x`, each as
+/// [`dot_f32`] (the same sums), with one detection of the instructions for all of them: a
+/// low-rank tensor's thousands of short rows ([`crate::loops::basis`]).
+pub(crate) fn matvec_f32(a: &[f32], x: &[f32], out: &mut [f64]) {
+    let n = x.len();
+    if no_columns(a.len(), n, out) {
         return;
     }
     #[cfg(target_arch = "x86_64")]
@@ -300,13 +308,7 @@ pub(crate) fn from_bf16(h: u16) -> f32 {
 /// processor's instructions for all rows.
 pub(crate) fn matvec_bf16(a: &[u16], x: &[f32], out: &mut [f64]) {
     let n = x.len();
-    assert!(
-        a.len() >= n * out.len(),
-        "a matrix of {} rows of {n}",
-        out.len()
-    );
-    if n == 0 {
-        out.iter_mut().for_each(|o| *o = 0.0);
+    if no_columns(a.len(), n, out) {
         return;
     }
     Arch::new().dispatch(MatVecBf16 { a, x, out });
