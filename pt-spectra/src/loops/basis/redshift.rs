@@ -57,8 +57,8 @@ pub enum SpectrumFamily {
 pub enum RedshiftFamily {
     /// Linear spectra, on the functions of the given basis (the CAMB training set's).
     Linear,
-    /// The galaxy model's no-wiggle parts ([`crate::savgol::no_wiggle_samples`], linear in P): the
-    /// filtered functions S[φ_a] of the given linear basis, contracted with the spectrum's own
+    /// The galaxy model's no-wiggle parts ([`crate::ir::savitzky_golay_no_wiggle`], linear in P):
+    /// the filtered functions S\[φ_a\] of the given linear basis, contracted with the spectrum's own
     /// coefficients (module docs).
     FilteredNoWiggle,
     /// The no-wiggle parts of the IR split ([`crate::ir::WiggleSplit`], not linear in P) of the
