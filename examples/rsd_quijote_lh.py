@@ -568,19 +568,22 @@ def main():
         r = [results[(vname, mname, z, x, kfit)] for x in BOXES]
         return r, sum(q["chi2"] for q in r), sum(q["dof"] for q in r)
 
-    for z in ZS:
-        say(f"## z = {z:g}")
-        say()
-        say("### chi2/dof per box (P0 + P2, baseline)")
+    def per_box_table(title, vname, models, z):
+        say(title)
         say()
         say("| model | k_fit | " + " | ".join(f"LH{x}" for x in BOXES) + " | stacked chi2/dof | p |")
         say("|---|---:|" + "---:|" * len(BOXES) + "---:|---:|")
-        for mname in MODELS:
+        for mname in models:
             for kfit in K_FITS:
-                r, chi2, dof = stacked("baseline", mname, z, kfit)
+                r, chi2, dof = stacked(vname, mname, z, kfit)
                 say(f"| {mname} | {kfit} | " + " | ".join(f"{q['chi2'] / q['dof']:.2f}" for q in r)
                     + f" | {chi2:.0f}/{dof} = {chi2 / dof:.2f} | {chi2_sf(chi2, dof):.2g} |")
         say()
+
+    for z in ZS:
+        say(f"## z = {z:g}")
+        say()
+        per_box_table("### chi2/dof per box (P0 + P2, baseline)", "baseline", MODELS, z)
         say("### stacked chi2/dof (all boxes) of the error and shot-noise variants")
         say()
         say("| variant | model | " + " | ".join(f"k_fit {kf}" for kf in K_FITS) + " |")
@@ -593,18 +596,8 @@ def main():
                     cells.append(f"{chi2:.0f}/{dof} = {chi2 / dof:.2f}")
                 say(f"| {v} | {mname} | " + " | ".join(cells) + " |")
         say()
-        say("### chi2/dof per box with the calibrated 3-LOS covariance")
-        say()
-        say("| model | k_fit | " + " | ".join(f"LH{x}" for x in BOXES) + " | stacked chi2/dof | p |")
-        say("|---|---:|" + "---:|" * len(BOXES) + "---:|---:|")
-        for mname in MODELS:
-            if mname == "eft2 c=0":
-                continue
-            for kfit in K_FITS:
-                r, chi2, dof = stacked("3-LOS calibrated", mname, z, kfit)
-                say(f"| {mname} | {kfit} | " + " | ".join(f"{q['chi2'] / q['dof']:.2f}" for q in r)
-                    + f" | {chi2:.0f}/{dof} = {chi2 / dof:.2f} | {chi2_sf(chi2, dof):.2g} |")
-        say()
+        per_box_table("### chi2/dof per box with the calibrated 3-LOS covariance", "3-LOS calibrated",
+                      [m for m in MODELS if m != "eft2 c=0"], z)
         for vname, kfit in [("baseline", kf) for kf in K_FITS] + [("3-LOS calibrated", 0.2)]:
             say(f"### model/data - 1, mean over the {len(BOXES)} boxes +- scatter/sqrt({len(BOXES)}) "
                 f"({vname}, k_fit = {kfit}; bands k +- {HALF_BAND}; * = beyond k_fit)")
