@@ -118,25 +118,25 @@ pub(crate) fn loop_terms(
     progress: &dyn Progress,
 ) -> Result<(Vec<RedshiftTerms>, Vec<RsdTwoLoopTerms>, String)> {
     let (k, precision) = (plan.k(), plan.precision());
+    let one_on_basis = tensors.one_loop.len() == spectra.len();
+    let subject = if one_on_basis {
+        "1- and 2-loop terms"
+    } else {
+        "2-loop terms"
+    };
     let (two, note, projections) =
-        two_loop_terms_noted(k, spectra, &tensors.two_loop, precision, progress)?;
-    let (one, note) = match projections {
-        Some(projections) if tensors.one_loop.len() == spectra.len() => {
-            let one = spectra
-                .iter()
-                .zip(&tensors.one_loop)
-                .zip(&projections)
-                .map(|((s, t), projection)| {
-                    let p_lin: Vec<f64> = k.iter().map(|&k| s.eval(k)).collect();
-                    t.evaluate(plan, &p_lin, projection)
-                })
-                .collect();
-            (
-                one,
-                note.replacen("2-loop terms from", "1- and 2-loop terms from", 1),
-            )
-        }
-        _ => (spectra.iter().map(|s| plan.evaluate(s)).collect(), note),
+        two_loop_terms_noted(k, spectra, &tensors.two_loop, subject, precision, progress)?;
+    let one = match projections {
+        Some(projections) if one_on_basis => spectra
+            .iter()
+            .zip(&tensors.one_loop)
+            .zip(&projections)
+            .map(|((s, t), projection)| {
+                let p_lin: Vec<f64> = k.iter().map(|&k| s.eval(k)).collect();
+                t.evaluate(plan, &p_lin, projection)
+            })
+            .collect(),
+        _ => spectra.iter().map(|s| plan.evaluate(s)).collect(),
     };
     Ok((one, two, note + &few_points_caveat(precision)))
 }
@@ -163,13 +163,14 @@ fn few_points_caveat(precision: &Precision) -> String {
     )
 }
 
-/// The 2-loop terms of [`loop_terms`], where they came from (without the caveat) and, from the
-/// basis, the spectra's projections.
+/// The 2-loop terms of [`loop_terms`], where they came from (without the caveat; from the basis,
+/// "`subject` from basis tensors …") and, from the basis, the spectra's projections.
 #[allow(clippy::type_complexity)]
 fn two_loop_terms_noted(
     k: &[f64],
     spectra: &[&LinearSpectrum],
     tensors: &[Arc<RsdTwoLoopBasis>],
+    subject: &str,
     precision: &Precision,
     progress: &dyn Progress,
 ) -> Result<(Vec<RsdTwoLoopTerms>, String, Option<Vec<Projection>>)> {
@@ -194,7 +195,7 @@ fn two_loop_terms_noted(
                 .iter()
                 .find_map(crate::loops::basis::Projection::soft_delta);
             let note = format!(
-                "2-loop terms from basis tensors (projection residual {}; the projection error, {} x \
+                "{subject} from basis tensors (projection residual {}; the projection error, {} x \
                  residual x |value|, is in the errors){}",
                 residuals.join(", "),
                 crate::loops::basis::RSD_PROJECTION_FACTOR,

@@ -41,6 +41,15 @@ impl Projection {
     pub fn soft_delta(&self) -> Option<f64> {
         self.soft.as_ref().map(|s| s.delta)
     }
+
+    /// The error of an infrared-safe sum of 1-loop diagrams at `k` (linear spectrum `p` there)
+    /// evaluated on the cut spectrum: [`super::soft::RESPONSE_FACTOR`] × k² P |Δ|, 0 if the spectrum
+    /// was projected whole.
+    pub(crate) fn soft_response_error(&self, k: f64, p: f64) -> f64 {
+        self.soft
+            .as_ref()
+            .map_or(0.0, |s| super::soft::RESPONSE_FACTOR * s.error(k, p))
+    }
 }
 
 /// Basis functions sampled on a loop lattice, orthonormal in the weighted inner product.

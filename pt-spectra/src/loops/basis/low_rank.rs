@@ -164,8 +164,7 @@ impl LowRank {
     /// for the 2-loop redshift-space means, whose 8,436 products per row make the f64
     /// [`reduce`](Self::reduce) bound by its arithmetic. On the held-out CAMB spectra the multipoles
     /// move by ≤ 3e-3 of their Monte Carlo error from the f64 sums and f32 deviations (this and the
-    /// bfloat16 deviations of module `rsd_two_loop` together).
-    /// Blocks of 64 rows of V in parallel.
+    /// bfloat16 deviations of module `rsd_two_loop` together). Blocks of 64 rows of V in parallel.
     pub(crate) fn reduce_f32(&self, s: &[f32]) -> Vec<f64> {
         const BLOCK_ROWS: usize = 64;
         let mut z = vec![0.0; self.rank];

@@ -14,9 +14,9 @@
 //!
 //! The no-wiggle spectrum of the galaxy model is a fixed linear filter of P on a log grid
 //! ([`crate::ir::savitzky_golay_no_wiggle`]); on the lattice it is linear in the samples, so the
-//! no-wiggle part of P = Σ c_a φ_a is Σ c_a S[φ_a]. The [`RedshiftFamily::FilteredNoWiggle`] tensors are
-//! therefore those of the filtered basis functions S[φ_a], contracted with the spectrum's own
-//! coefficients: one projection, no filter and no second basis per spectrum.
+//! no-wiggle part of P = Σ c_a φ_a is Σ c_a S[φ_a]. The [`RedshiftFamily::FilteredNoWiggle`]
+//! tensors are therefore those of the filtered basis functions S[φ_a], contracted with the
+//! spectrum's own coefficients: one projection, no filter and no second basis per spectrum.
 //!
 //! The 2-loop redshift-space models (`spt2`, `eft2`) take their 1-loop terms from these tensors
 //! too: on the CAMB basis for the linear spectrum and, for the no-wiggle spectrum of their IR split
@@ -235,14 +235,11 @@ impl RedshiftBasis {
         let floor = self.p22_error_floor;
         // A spectrum cut below the soft modes (module `soft`): every column and σ_v² are the cut
         // spectrum's, so that the terms (infrared-safe sums) are the whole one's up to (q/k)².
-        let soft = projection.soft.as_ref();
         let rows = p_lin
             .iter()
             .enumerate()
             .map(|(i, &p)| {
-                let soft = soft.map_or(0.0, |s| {
-                    super::soft::RESPONSE_FACTOR * s.error(self.k[i], p)
-                });
+                let soft = projection.soft_response_error(self.k[i], p);
                 let form = |m: usize| forms[i * LINEAR + m];
                 let pair = std::array::from_fn(|m| {
                     let row = i * NPAIR + m;

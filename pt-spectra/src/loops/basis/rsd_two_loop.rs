@@ -6,9 +6,10 @@
 //!
 //! The error is the spread over the shifts (contracted on the first [`ERROR_FUNCTIONS`] coefficients,
 //! as the real-space tensors, each shift's deviation from the mean stored in bfloat16: a rounding of
-//! ≤ 0.4% of each entry, in an estimate of the error, for half the bytes a new spectrum streams) plus the projection error ε|value| with ε =
-//! [`RSD_PROJECTION_FACTOR`] × the smoothed projection residual; spectra whose residual exceeds
-//! [`MAX_RESIDUAL`] are refused (the caller integrates them directly).
+//! ≤ 0.4% of each entry, in an estimate of the error, for half the bytes a new spectrum streams)
+//! plus the projection error ε|value| with ε = [`RSD_PROJECTION_FACTOR`] × the smoothed projection
+//! residual; spectra whose residual exceeds [`MAX_RESIDUAL`] are refused (the caller integrates them
+//! directly).
 
 use super::low_rank::{LowRank, TRIPLE_TOLERANCE};
 use super::tensors::{fold, rank_update};

@@ -150,9 +150,7 @@ impl TnsBasis {
                 let p_k = p_lin[i];
                 // A spectrum cut below the soft modes (module `soft`): the coefficients are
                 // infrared safe (measured response ≤ 0.03 k²P|Δ|).
-                let soft = projection.soft.as_ref().map_or(0.0, |s| {
-                    super::soft::RESPONSE_FACTOR * s.error(self.k[i], p_k)
-                });
+                let soft = projection.soft_response_error(self.k[i], p_k);
                 let t = &self.pairs[i * COEFFICIENTS * pairs..][..COEFFICIENTS * pairs];
                 let d =
                     &self.pairs_diff[i * COEFFICIENTS * pairs_err..][..COEFFICIENTS * pairs_err];
