@@ -393,6 +393,58 @@ pub fn check_k_grid(origin: &str, k: &[f64], lines: &[usize]) -> Result<()> {
     Ok(())
 }
 
+/// Checks wavenumbers given as an array (a library or Python argument named `what`, e.g. `k` or
+/// `linear k`): not empty, every k finite and positive, strictly increasing, as [`check_k_grid`] for
+/// files, but the errors name the 0-based index, `what[i]`, the way the caller indexes the array.
+///
+/// # Errors
+/// [`Error::InvalidChoice`] naming `what`, the index, the value and the rule.
+pub fn check_k_values(what: &str, k: &[f64]) -> Result<()> {
+    let bad = |i: usize, reason: String| Error::InvalidChoice {
+        what: format!("{what}[{i}] = {} h/Mpc", crate::error::number(&k[i])),
+        reason,
+    };
+    if k.is_empty() {
+        return Err(Error::InvalidChoice {
+            what: what.into(),
+            reason: "the k grid is empty (at least one k is needed)".into(),
+        });
+    }
+    for (i, &v) in k.iter().enumerate() {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(bad(i, "every k must be finite and positive".into()));
+        }
+        if i > 0 && v <= k[i - 1] {
+            return Err(bad(
+                i,
+                format!(
+                    "does not exceed {what}[{}] = {} h/Mpc (k must be strictly increasing)",
+                    i - 1,
+                    crate::error::number(&k[i - 1])
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// `n k in [a, b] h/Mpc`: a k grid [h/Mpc] in a message.
+pub(crate) fn describe_grid(k: &[f64]) -> String {
+    match (k.first(), k.last()) {
+        (Some(a), Some(b)) => format!("{} k in [{a}, {b}] h/Mpc", k.len()),
+        _ => "an empty k grid".into(),
+    }
+}
+
+/// The relative difference below which two k [h/Mpc] are the same point: values written and read
+/// back as text with 10 or more significant digits.
+const SAME_K: f64 = 1e-9;
+
+/// Whether `a` and `b` are the same k grid, point by point (never by their lengths alone).
+pub(crate) fn same_k(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x / y - 1.0).abs() <= SAME_K)
+}
+
 /// A validated grid of wavenumbers [h/Mpc]: not empty, finite, positive and strictly increasing (the
 /// checks of [`check_k_grid`]). What both faces turn a user's k (a file, arrays, `--k-min/--k-max/--nk`)
 /// into before any plan is made; it derefs to `[f64]`.
@@ -413,6 +465,15 @@ impl KGrid {
             });
         }
         check_k_grid(origin, &k, lines)?;
+        Ok(Self(k))
+    }
+
+    /// The grid of an array argument named `what` (e.g. a Python `k`).
+    ///
+    /// # Errors
+    /// As [`check_k_values`].
+    pub fn from_values(what: &str, k: Vec<f64>) -> Result<Self> {
+        check_k_values(what, &k)?;
         Ok(Self(k))
     }
 
@@ -456,6 +517,25 @@ mod tests {
         assert!(e.to_string().contains("k.dat:2"), "{e}");
         assert!(KGrid::new("k.dat", vec![], &[]).is_err());
         assert!(KGrid::new("k.dat", vec![-0.1], &[]).is_err());
+    }
+
+    /// Arrays are checked as files are, but the errors name the argument and the 0-based index.
+    #[test]
+    fn k_arrays_name_the_argument_the_index_and_the_rule() {
+        let g = KGrid::from_values("k", vec![0.01, 0.02]).unwrap();
+        assert_eq!(g.as_slice(), &[0.01, 0.02]);
+        let e = |k: Vec<f64>| KGrid::from_values("k", k).unwrap_err().to_string();
+        assert_eq!(
+            e(vec![0.2, 0.1, 0.05]),
+            "k[1] = 0.1 h/Mpc: does not exceed k[0] = 0.2 h/Mpc (k must be strictly increasing)"
+        );
+        assert!(e(vec![0.1, 0.1, 0.1]).starts_with("k[1] = 0.1 h/Mpc: does not exceed k[0]"));
+        assert_eq!(
+            e(vec![0.1, f64::NAN]),
+            "k[1] = NaN h/Mpc: every k must be finite and positive"
+        );
+        assert!(e(vec![-0.1]).starts_with("k[0] = -0.1 h/Mpc: every k must be finite"));
+        assert!(e(vec![]).starts_with("k: the k grid is empty"));
     }
 
     #[test]

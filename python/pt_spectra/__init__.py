@@ -10,7 +10,10 @@ True
 
 Every function returns a :class:`Table`: ``t.columns`` (the command line's column names), ``t[name]``
 (numpy arrays), ``t.units``, ``t.header``, ``t.meta`` (z, f, D, cosmology, precision, q range, model)
-and ``t.to_text()``. Bad input raises ``ValueError`` with the library's message; defaults that may not
+and ``t.to_text()``. Bad input raises ``ValueError`` with the library's message: every k array (``k``,
+the ``k`` of ``linear``, ``k_lin``, the k of tables and measured spectra, ``data["k"]``) must be 1-D,
+non-empty, finite, positive and strictly increasing, and the message names the argument, the index
+and the rule (``k[1] = 0.1 h/Mpc: does not exceed k[0] = 0.2 h/Mpc ...``); defaults that may not
 fit the input (e.g. the gm2012 growth for a spectrum given without a cosmology) raise a
 :class:`PtSpectraWarning`.
 

@@ -2,7 +2,7 @@
 //! threads, returned as arrays with a leading spectrum axis: no header, no per-spectrum Table) and
 //! `read_multipoles` (a likelihood's data file through the library's reader).
 
-use crate::{detached, floats, value_error, RealPlan};
+use crate::{detached, value_error, RealPlan};
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
 use pt_spectra::jobs::real_batch_tables;
 use pt_spectra::real::RealSelection;
@@ -28,7 +28,7 @@ pub(crate) fn real_batch<'py>(
             "batch: a plan of model `all` computes several models; plan one model for batches",
         ));
     }
-    let k_lin = floats(k_lin, "k_lin")?;
+    let k_lin = crate::k_array(k_lin, "k_lin")?.into_vec();
     let p = p.as_array();
     if p.ncols() != k_lin.len() {
         return Err(PyValueError::new_err(format!(

@@ -59,7 +59,7 @@ impl EptPlan {
         two_loop: &str,
         cache_dir: Option<std::path::PathBuf>,
     ) -> PyResult<Self> {
-        let k = floats(k, "k")?;
+        let k = crate::k_array(k, "k")?;
         let ap = distortion(apar, aperp)?;
         let precision = crate::precision(precision, q_range, None, Some(two_loop))?;
         let store = crate::Store::new(cache_dir);

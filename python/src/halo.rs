@@ -19,7 +19,7 @@ fn measured(name: &'static str, obj: &Bound<'_, PyAny>) -> PyResult<MeasuredSpec
             parts.len()
         )));
     }
-    let k = floats(&parts[0], &format!("{name} k"))?;
+    let k = crate::k_array(&parts[0], &format!("{name} k"))?.into_vec();
     let p = floats(&parts[1], &format!("{name} P"))?;
     let error = match parts.get(2) {
         Some(e) => Some(floats(e, &format!("{name} sigma"))?),

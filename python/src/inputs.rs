@@ -3,9 +3,11 @@
 //! ([`Inputs::prepare`]) with the GIL released, as part of the library call.
 
 use crate::value_error;
+use numpy::PyReadonlyArray1;
 use pt_spectra::cosmology::{Cosmology, TransferKind};
 use pt_spectra::linear::LinearSpectrum;
 use pt_spectra::setup::{self, LinearSource, NamedCosmology, Prepared, Request};
+use pt_spectra::table::KGrid;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
@@ -71,8 +73,8 @@ impl Inputs {
                     )
                 })?;
                 Linear::Arrays(
-                    crate::floats(&k, "linear k")?,
-                    crate::floats(&p, "linear P")?,
+                    crate::k_array(&k, "linear k")?.into_vec(),
+                    positive(crate::floats(&p, "linear P")?, "linear P")?,
                 )
             }
         };
@@ -150,9 +152,47 @@ impl Inputs {
     }
 }
 
+/// `values` if every one is finite and positive, else a `ValueError` naming `what` and the index.
+fn positive(values: Vec<f64>, what: &str) -> PyResult<Vec<f64>> {
+    match values.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
+        None => Ok(values),
+        Some(i) => Err(PyValueError::new_err(format!(
+            "{what}[{i}] = {}: every P must be finite and positive",
+            values[i]
+        ))),
+    }
+}
+
 /// The cosmology of a Python argument (for the small helpers), gm2012 by default.
 pub fn cosmology_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Cosmology> {
     let inputs = Inputs::extract(None, 0.0, 0.0, obj, None)?;
     let (named, _) = inputs.cosmology().map_err(value_error)?;
     Ok(named.map_or(Cosmology::gm2012(), |n| n.cosmology))
+}
+
+/// A float array from a numpy array or any sequence of numbers.
+pub(crate) fn floats(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+    // A numpy array of other than one dimension (whose elements would convert one by one).
+    if let Ok(ndim) = obj.getattr("ndim").and_then(|n| n.extract::<usize>()) {
+        if ndim != 1 {
+            return Err(PyValueError::new_err(format!(
+                "{what}: expected a 1-D array, got a {ndim}-D one"
+            )));
+        }
+    }
+    if let Ok(a) = obj.extract::<PyReadonlyArray1<'_, f64>>() {
+        return Ok(a.as_array().to_vec());
+    }
+    obj.extract::<Vec<f64>>().map_err(|_| {
+        PyValueError::new_err(format!(
+            "{what}: expected a 1-D array or sequence of numbers"
+        ))
+    })
+}
+
+/// A k grid [h/Mpc] from the array argument `what` ([`floats`]), checked as every k grid is
+/// ([`KGrid::from_values`]: non-empty, finite, positive, strictly increasing): a `ValueError` names the
+/// argument, the index and the rule.
+pub(crate) fn k_array(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<KGrid> {
+    KGrid::from_values(what, floats(obj, what)?).map_err(value_error)
 }

@@ -5,7 +5,7 @@
 //! [`Table`] whose columns have the names the command line prints. Errors of the library become
 //! `ValueError` with its message. The pure-Python package `pt_spectra` wraps these (warnings, docs).
 
-use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray1};
 use pt_spectra::cosmology::TransferKind;
 use pt_spectra::fit::{ContourGrid, MultipoleData, Parameter};
 use pt_spectra::jobs::{self, BiasOutput, FitRequest, RsdRequest};
@@ -34,6 +34,7 @@ mod tables;
 mod two_loop_rsd;
 
 use inputs::Inputs;
+pub(crate) use inputs::{floats, k_array};
 
 pub use tables::Table;
 
@@ -91,18 +92,6 @@ pub(crate) fn number_kwargs(
         .collect()
 }
 
-/// A float array from a numpy array or any sequence of numbers.
-pub(crate) fn floats(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
-    if let Ok(a) = obj.extract::<PyReadonlyArray1<'_, f64>>() {
-        return Ok(a.as_array().to_vec());
-    }
-    obj.extract::<Vec<f64>>().map_err(|_| {
-        PyValueError::new_err(format!(
-            "{what}: expected a 1-D array or sequence of numbers"
-        ))
-    })
-}
-
 /// The precision preset `name`, with the q range, 2-loop tolerance and 2-loop method
 /// (`auto`, `basis`, `direct`) if given.
 pub(crate) fn precision(
@@ -129,13 +118,7 @@ pub(crate) fn precision(
 /// The output k grid: `k` if given, else `nk` log-spaced values in [k_min, k_max].
 fn k_grid(k: Option<&Bound<'_, PyAny>>, k_min: f64, k_max: f64, nk: usize) -> PyResult<Vec<f64>> {
     match k {
-        Some(k) => {
-            let k = floats(k, "k")?;
-            if k.is_empty() {
-                return Err(PyValueError::new_err("k: the grid is empty"));
-            }
-            Ok(k)
-        }
+        Some(k) => Ok(k_array(k, "k")?.into_vec()),
         None => Ok(LogGrid::new(k_min, k_max, nk)
             .map_err(value_error)?
             .points()),
@@ -180,7 +163,7 @@ impl RealPlan {
         cache_dir: Option<PathBuf>,
         two_loop: &str,
     ) -> PyResult<Self> {
-        let k = floats(k, "k")?;
+        let k = crate::k_array(k, "k")?;
         let selection: RealSelection = model.parse().map_err(value_error)?;
         let precision = self::precision(precision, q_range, two_loop_tolerance, Some(two_loop))?;
         let store = Store::new(cache_dir);
@@ -367,7 +350,10 @@ pub(crate) fn data(
                 .ok_or_else(|| PyKeyError::new_err(format!("data: no `{name}`")))?;
             floats(&v, name)
         };
-        let k = get("k")?;
+        let k = match dict.get_item("k")? {
+            Some(k) => k_array(&k, "data['k']")?.into_vec(),
+            None => return Err(PyKeyError::new_err("data: no `k`")),
+        };
         let values = ells
             .iter()
             .map(|l| get(&format!("P{l}")))
@@ -553,7 +539,7 @@ fn eisenstein_hu<'py>(
     cosmology: Option<&Bound<'py, PyAny>>,
     wiggle: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let k = floats(k, "k")?;
+    let k = crate::k_array(k, "k")?;
     let c = inputs::cosmology_of(cosmology)?;
     let kind = if wiggle {
         TransferKind::Wiggle

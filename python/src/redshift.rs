@@ -29,7 +29,7 @@ fn tabulated(obj: &Bound<'_, PyAny>, name: &'static str, column: &str) -> PyResu
     Tabulated::new(
         name,
         "array",
-        floats(&k, name)?,
+        crate::k_array(&k, &format!("{name} k"))?.into_vec(),
         floats(&v, name)?,
         true,
         &[],
@@ -94,7 +94,7 @@ impl RsdPlan {
         cache_dir: Option<PathBuf>,
         two_loop: &str,
     ) -> PyResult<Self> {
-        let k = floats(k, "k")?;
+        let k = crate::k_array(k, "k")?;
         let real = real.parse().map_err(value_error)?;
         let rsd: RsdModel = rsd.parse().map_err(value_error)?;
         let precision = crate::precision(precision, q_range, None, Some(two_loop))?;

@@ -43,7 +43,10 @@ impl Observation {
         k_edges: Option<&Bound<'_, PyAny>>,
         r#box: Option<f64>,
     ) -> PyResult<Self> {
-        let k = k.map(|k| floats(k, "k")).transpose()?.unwrap_or_default();
+        let k = match k {
+            Some(k) => crate::k_array(k, "k")?.into_vec(),
+            None => Vec::new(),
+        };
         let window = window
             .map(|path| Window::read(&path, mixing(window_mixing)?).map_err(value_error))
             .transpose()?;

@@ -4,7 +4,7 @@
 
 use crate::inputs::Inputs;
 use crate::tables::Table;
-use crate::{detached, floats, value_error};
+use crate::{detached, value_error};
 use pt_spectra::progress::Silent;
 use pt_spectra::rsd::eft2::{Eft2Plan, RsdCounterterms};
 use pt_spectra::rsd::spt2::Spt2Plan;
@@ -47,7 +47,7 @@ impl TwoLoopRsdPlan {
         two_loop: &str,
         cache_dir: Option<std::path::PathBuf>,
     ) -> PyResult<Self> {
-        let k = floats(k, "k")?;
+        let k = crate::k_array(k, "k")?;
         let precision = crate::precision(precision, q_range, None, Some(two_loop))?;
         let store = crate::Store::new(cache_dir);
         let model = model.to_ascii_lowercase();

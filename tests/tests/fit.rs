@@ -95,6 +95,43 @@ fn tns_model(k: &[f64], b: f64) -> MultipoleModel {
     .unwrap()
 }
 
+/// TNS terms of another k grid of the same length are refused (they were taken for the spectra's
+/// grid by their length, and read at the wrong k).
+#[test]
+fn tns_terms_of_other_k_are_refused() {
+    let k = LogGrid::new(0.01, 0.3, 12).unwrap().points();
+    let other = LogGrid::new(0.02, 0.3, 12).unwrap().points();
+    let p = LinearSpectrum::gm2012(0.0).unwrap();
+    let real = real_space(
+        RealModel::OneLoopSpt,
+        &p,
+        &k,
+        &Precision::fast(),
+        &TableStore::in_memory(),
+    )
+    .unwrap();
+    let model = |k_tns: &[f64]| {
+        let tns = TnsPlan::new(k_tns, &Precision::fast())
+            .unwrap()
+            .evaluate(&p);
+        MultipoleModel::new(
+            &real,
+            Some(&tns),
+            RsdModel::Tns,
+            Fog::Lorentzian,
+            1.0,
+            vec![2.0; k.len()],
+            &[0, 2],
+        )
+    };
+    assert!(model(&k).is_ok());
+    let e = model(&other).unwrap_err().to_string();
+    assert!(
+        e.contains("TNS terms and real-space spectra") && e.contains("12 k in [0.02, 0.3"),
+        "{e}"
+    );
+}
+
 #[test]
 fn fit_recovers_f_from_an_independent_kaiser_mock() {
     let k = LogGrid::new(0.01, 0.3, 40).unwrap().points();

@@ -25,6 +25,7 @@ use crate::error::{Error, Result};
 use crate::linalg::{cholesky, dot, invert_lower, solve_spd};
 use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
 use crate::survey::observe::Observation;
+use crate::table::{describe_grid, same_k};
 use argmin::core::{CostFunction, Executor, State};
 use argmin::solver::neldermead::NelderMead;
 
@@ -312,6 +313,28 @@ fn validate(request: &GalaxyFitRequest) -> Result<Validated> {
                 reason: "must be finite",
             });
         }
+        if !free.contains(&i) && !marg.contains(&i) {
+            return Err(Error::InvalidChoice {
+                what: format!("the prior on {}", p.name),
+                reason: format!(
+                    "{} is fixed, and a prior acts only on a free or marginalised parameter \
+                     (free: {}; marginalised: {})",
+                    p.name,
+                    request.free.join(", "),
+                    if request.marginalise.is_empty() {
+                        "none".to_string()
+                    } else {
+                        request.marginalise.join(", ")
+                    }
+                ),
+            });
+        }
+        if priors[i].is_some() {
+            return Err(Error::InvalidChoice {
+                what: format!("the prior on {}", p.name),
+                reason: "is given twice".into(),
+            });
+        }
         priors[i] = Some((p.mean, 1.0 / (p.sigma * p.sigma)));
     }
     Ok((free, marg, priors))
@@ -355,17 +378,15 @@ pub fn fit_galaxy_observed(
     let k = match observation {
         None => plan.k(),
         Some(o) => {
-            if plan.k() != o.k_model()
-                || o.k_out().len() != data.k.len()
-                || o.ells() != request.ells
-            {
+            if plan.k() != o.k_model() || !same_k(o.k_out(), &data.k) || o.ells() != request.ells {
                 return Err(Error::InvalidChoice {
                     what: "the fit's window and bins".into(),
                     reason: format!(
-                        "the plan must be on their model k and their output ({} k, l {:?}) the data's                          ({} k, l {:?})",
-                        o.k_out().len(),
+                        "the plan must be on their model k and their output ({}, l {:?}) on the \
+                         data's ({}, l {:?})",
+                        describe_grid(o.k_out()),
                         o.ells(),
-                        data.k.len(),
+                        describe_grid(&data.k),
                         request.ells
                     ),
                 });
@@ -373,12 +394,7 @@ pub fn fit_galaxy_observed(
             data.k.as_slice()
         }
     };
-    if observation.is_none()
-        && (k.len() != data.k.len()
-            || k.iter()
-                .zip(&data.k)
-                .any(|(a, b)| (a / b - 1.0).abs() > 1e-9))
-    {
+    if observation.is_none() && !same_k(k, &data.k) {
         return Err(Error::InvalidChoice {
             what: "the fit's model grid".into(),
             reason: "the plan must be built on the data's k".into(),

@@ -145,8 +145,9 @@ impl MultipoleModel {
     /// The counterterm of [`Params::cs2`] is added to the spectra of `real` (on top of any they hold).
     ///
     /// # Errors
-    /// [`Error::LengthMismatch`] if the grids differ, [`Error::InvalidParameter`] for TNS without `tns`
-    /// or a bad ℓ.
+    /// [`Error::LengthMismatch`] if `bias` is not on the k of `real`, [`Error::GridMismatch`] if `tns` is
+    /// on other k (compared point by point), [`Error::MissingTerm`] for TNS without `tns`,
+    /// [`Error::InvalidParameter`] for a bad ℓ.
     pub fn new(
         real: &RealSpectra,
         tns: Option<&TnsTerms>,
@@ -172,11 +173,14 @@ impl MultipoleModel {
                     hint: " (TnsPlan, or an RsdPlan)",
                 })
             }
-            (true, Some(t)) if t.coefficients.len() != n => {
-                return Err(Error::LengthMismatch {
-                    what: "TNS coefficients and k",
-                    left: t.coefficients.len(),
-                    right: n,
+            // By value: TNS terms of another grid of the same length would be read at the wrong k.
+            (true, Some(t))
+                if !crate::table::same_k(&t.k, &real.k) || t.coefficients.len() != n =>
+            {
+                return Err(Error::GridMismatch {
+                    what: "TNS terms and real-space spectra",
+                    expected: crate::table::describe_grid(&real.k),
+                    found: crate::table::describe_grid(&t.k),
                 })
             }
             (true, Some(t)) => Some(t.coefficients.clone()),

@@ -20,15 +20,51 @@ impl LogGrid {
     /// # Errors
     /// [`crate::error::Error::InvalidParameter`] unless 0 < `k_min` < `k_max` < ∞ and `n` ≥ 2.
     pub fn new(k_min: f64, k_max: f64, n: usize) -> Result<Self> {
-        check_positive("k_min [h/Mpc]", k_min)?;
-        check_positive("k_max [h/Mpc]", k_max)?;
-        if k_max <= k_min {
-            return Err(invalid("k_max [h/Mpc]", k_max, "must exceed k_min"));
+        Self::named(
+            (k_min, k_max, n),
+            [
+                "k_min [h/Mpc]",
+                "k_max [h/Mpc]",
+                "must exceed k_min",
+                "n (grid points)",
+            ],
+        )
+    }
+
+    /// `n` log-spaced separations from `s_min` to `s_max` [Mpc/h] (the grid of ξ_ℓ(s); the fields
+    /// keep the names of [`LogGrid::new`]).
+    ///
+    /// # Errors
+    /// [`crate::error::Error::InvalidParameter`] naming s_min, s_max or ns unless 0 < `s_min` <
+    /// `s_max` < ∞ and `n` ≥ 2.
+    pub fn separations(s_min: f64, s_max: f64, n: usize) -> Result<Self> {
+        Self::named(
+            (s_min, s_max, n),
+            [
+                "s_min [Mpc/h]",
+                "s_max [Mpc/h]",
+                "must exceed s_min",
+                "ns (grid points)",
+            ],
+        )
+    }
+
+    /// The grid with the checks of [`LogGrid::new`], the values named by `names`: lower end, upper
+    /// end, the reason an upper end is too small, the number of points.
+    fn named((lo, hi, n): (f64, f64, usize), names: [&'static str; 4]) -> Result<Self> {
+        check_positive(names[0], lo)?;
+        check_positive(names[1], hi)?;
+        if hi <= lo {
+            return Err(invalid(names[1], hi, names[2]));
         }
         if n < 2 {
-            return Err(invalid("n (grid points)", n as f64, "must be at least 2"));
+            return Err(invalid(names[3], n as f64, "must be at least 2"));
         }
-        Ok(Self { k_min, k_max, n })
+        Ok(Self {
+            k_min: lo,
+            k_max: hi,
+            n,
+        })
     }
 
     /// The points as a validated [`crate::table::KGrid`] (valid by construction).

@@ -80,16 +80,11 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
-/// Checks `precision` and that `k` is a non-empty list of finite wavenumbers inside (q_min, q_max).
+/// Checks `precision` and that `k` is a grid ([`crate::table::check_k_values`]: non-empty, finite,
+/// positive, strictly increasing) inside (q_min, q_max).
 pub(crate) fn validate_grid(k: &[f64], precision: &Precision) -> Result<()> {
     precision.validate()?;
-    if k.is_empty() {
-        return Err(Error::InvalidParameter {
-            name: "number of k values",
-            value: 0.0,
-            reason: "must be at least 1",
-        });
-    }
+    crate::table::check_k_values("k", k)?;
     if let Some(&bad) = k
         .iter()
         .find(|&&v| !(v.is_finite() && v > precision.q_min && v < precision.q_max))
@@ -126,11 +121,12 @@ pub struct OneLoopPlan {
 }
 
 impl OneLoopPlan {
-    /// The plan for wavenumbers `k` [h/Mpc] (any order; usually increasing).
+    /// The plan for wavenumbers `k` [h/Mpc] (strictly increasing).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for invalid `precision` (see [`Precision::validate`]), an empty grid, or
-    /// a k that is not finite or not inside (q_min, q_max).
+    /// [`Error::InvalidParameter`] for invalid `precision` (see [`Precision::validate`]) or a k not
+    /// inside (q_min, q_max); [`Error::InvalidChoice`] for an empty grid or a k that is not finite,
+    /// positive and above the previous one.
     pub fn new(k: &[f64], precision: &Precision) -> Result<Self> {
         validate_grid(k, precision)?;
         let lattice = Lattice::new(precision.q_min, precision.q_max, precision.lattice_step);

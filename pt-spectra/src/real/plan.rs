@@ -122,6 +122,8 @@ impl RealPlan {
         progress: &dyn Progress,
     ) -> Result<Self> {
         precision.validate()?;
+        // The whole grid (the chunks below are checked one by one).
+        crate::table::check_k_values("k", k)?;
         crate::memory::check(
             crate::memory::plan_bytes(k.len(), model.plan_parts(), precision),
             precision,

@@ -31,10 +31,10 @@
 //! ([`super::ap::Distortion`]) the terms are computed on the internal log grid and interpolated in ln k.
 
 use super::ap::Distortion;
-use super::{legendre_coefficients, MAX_ELL, MAX_MU_POWER};
+use super::{legendre_coefficients, MAX_ELL};
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
-use crate::integrate::{lagrange4, legendre_nodes};
+use crate::integrate::legendre_nodes;
 use crate::ir::savitzky_golay_no_wiggle;
 use crate::linear::LinearSpectrum;
 use crate::loops::redshift::{RedshiftPlan, RedshiftTerms};
@@ -162,11 +162,24 @@ pub struct EptPlan {
     rules: [Vec<(f64, f64, [f64; MAX_ELL + 1])>; 2],
     k_out: Vec<f64>,
     grid: Vec<f64>,
+    /// Whether `grid` is `k_out` itself or the AP grid the terms are interpolated on: told by how
+    /// the plan was built, never by comparing lengths (an output grid may have the AP grid's length).
+    grid_use: GridUse,
     settings: EptSettings,
     loops: RedshiftPlan,
     split: Option<()>,
     /// The basis tensors of the loop terms, if they come from them ([`Self::with_basis`]).
     tensors: Option<basis::Tensors>,
+}
+
+/// What the plan's loop grid is to its output k.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum GridUse {
+    /// The loop grid is the output grid: term i is at output k i.
+    Output,
+    /// The loop grid is the internal log grid of the Alcock–Paczynski distortions
+    /// ([`Distortion::internal_grid`]): every output k is interpolated in ln k.
+    Internal,
 }
 
 /// The loop terms of one linear spectrum: everything that does not depend on the parameters.
@@ -188,6 +201,11 @@ impl EptPlan {
     /// # Errors
     /// As [`RedshiftPlan::new`] and [`Distortion::internal_grid`].
     pub fn new(k: &[f64], settings: EptSettings, precision: &Precision) -> Result<Self> {
+        crate::table::check_k_values("k", k)?;
+        let grid_use = match (&settings.ap, settings.ap_range) {
+            (None, None) => GridUse::Output,
+            _ => GridUse::Internal,
+        };
         let grid = match (&settings.ap, settings.ap_range) {
             (_, Some((lo, hi))) => {
                 // The widest k' of the range: k/hi … k/lo (module `ap`'s grid of α∥ = hi, α⊥ = lo).
@@ -228,6 +246,7 @@ impl EptPlan {
             rules,
             k_out: k.to_vec(),
             grid,
+            grid_use,
             settings,
             loops,
             split,
@@ -298,6 +317,7 @@ impl EptPlan {
     ) -> Result<Vec<Vec<Estimate>>> {
         params.validate()?;
         self.check_ap(ap)?;
+        self.check_terms(terms)?;
         if let Some(&bad) = ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
             return Err(Error::InvalidParameter {
                 name: "multipole ell",
@@ -315,7 +335,7 @@ impl EptPlan {
                 for (mu, w, legendre) in nodes {
                     let (mu, w) = (*mu, *w);
                     let p = match &ap {
-                        None if self.grid.len() == self.k_out.len() => model.at(i, k, mu),
+                        None if self.grid_use == GridUse::Output => model.at(i, k, mu),
                         None => model.interpolated(k, mu)?,
                         Some(ap) => {
                             let (kt, mt) = ap.true_coordinates(k, mu);
@@ -368,6 +388,7 @@ impl EptPlan {
     ) -> Result<Vec<Vec<f64>>> {
         params.validate()?;
         self.check_ap(ap)?;
+        self.check_terms(terms)?;
         if let Some(&bad) = ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
             return Err(Error::InvalidParameter {
                 name: "multipole ell",
@@ -389,7 +410,7 @@ impl EptPlan {
         for (i, &k) in self.k_out.iter().enumerate() {
             for ((mu, _, _), c) in self.rules[0].iter().zip(&weights) {
                 let p = match &ap {
-                    None if self.grid.len() == self.k_out.len() => model.value_at(i, k, *mu),
+                    None if self.grid_use == GridUse::Output => model.value_at(i, k, *mu),
                     None => model.interpolated_value(k, *mu)?,
                     Some(ap) => {
                         let (kt, mt) = ap.true_coordinates(k, *mu);
@@ -412,6 +433,19 @@ impl EptPlan {
             return Err(Error::InvalidChoice {
                 what: "an Alcock-Paczynski distortion".into(),
                 reason: "the plan was built without AP (give EptSettings::ap or ap_range)".into(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Terms must be on this plan's loop grid (compared by value: another plan's terms on a grid of
+    /// the same length would be read at the wrong k).
+    fn check_terms(&self, terms: &EptTerms) -> Result<()> {
+        if terms.grid != self.grid {
+            return Err(Error::GridMismatch {
+                what: "ept terms and plan",
+                expected: crate::table::describe_grid(&self.grid),
+                found: crate::table::describe_grid(&terms.grid),
             });
         }
         Ok(())
@@ -441,155 +475,8 @@ fn sigma2_kernel(q: f64) -> f64 {
     q * one_minus_j0 / (6.0 * PI * PI)
 }
 
-/// Polynomials in μ² (coefficient n of μ^{2n}) with coefficient errors.
-type Poly = ([f64; MAX_MU_POWER + 1], [f64; MAX_MU_POWER + 1]);
-
-/// The model at fixed parameters on the terms' grid: P = N(μ²) + e^{−k²Σ²(1 + f(2+f)μ²)} W(μ²).
-struct Model<'a> {
-    grid: &'a [f64],
-    parts: Vec<(Poly, Poly)>,
-    sigma2: f64,
-    f: f64,
-}
-
-impl EptTerms {
-    fn model(&self, params: &EptParams) -> Model<'_> {
-        let v = &params.values;
-        let [b1, _, _, _, f] = params.bias();
-        let z1 = [b1 * b1, 2.0 * b1 * f, f * f];
-        let (alpha, [sn, sn2, sn4]) = ([v[4], v[5], v[6], v[7]], [v[8], v[9], v[10]]);
-        let s2 = self.nw.as_ref().map_or(0.0, |(_, s)| s.value);
-        // The terms of the full and no-wiggle spectra are in the same order.
-        let coefficients = self.full.coefficients(params.bias());
-        let parts = (0..self.grid.len())
-            .map(|i| {
-                let k = self.grid[i];
-                let k2 = k * k;
-                let p = self.full.p_lin[i];
-                let (lv, le) = self.full.loop_polynomial_with(i, &coefficients);
-                let mut n: Poly = (lv, le);
-                let mut w: Poly = ([0.0; 5], [0.0; 5]);
-                let (p_nw, p_w) = match &self.nw {
-                    Some((t, _)) => {
-                        let (nv, ne) = t.loop_polynomial_with(i, &coefficients);
-                        n = (nv, ne);
-                        for j in 0..5 {
-                            w.0[j] = lv[j] - nv[j];
-                            w.1[j] = le[j] + ne[j];
-                        }
-                        (t.p_lin[i], p - t.p_lin[i])
-                    }
-                    None => (p, 0.0),
-                };
-                // Z₁² P_nw, the counterterms and the stochastic terms.
-                for (j, z) in z1.iter().enumerate() {
-                    n.0[j] += z * p_nw;
-                }
-                for (j, a) in alpha.iter().enumerate() {
-                    n.0[j] += a * k2 * p_nw;
-                    w.0[j] += a * k2 * p_w;
-                }
-                n.0[0] += sn;
-                n.0[1] += sn2 * k2;
-                n.0[2] += sn4 * k2 * k2;
-                // (1 + k²Σ²[1 + f(2+f)μ²]) Z₁² P_w.
-                let (c0, c1) = (1.0 + k2 * s2, k2 * s2 * f * (2.0 + f));
-                for (j, z) in z1.iter().enumerate() {
-                    w.0[j] += c0 * z * p_w;
-                    w.0[j + 1] += c1 * z * p_w;
-                }
-                (n, w)
-            })
-            .collect();
-        Model {
-            grid: &self.grid,
-            parts,
-            sigma2: s2,
-            f: params.values[11],
-        }
-    }
-}
-
-impl Model<'_> {
-    /// P(k, μ) at grid index `i` (k = grid[i]).
-    fn at(&self, i: usize, k: f64, mu: f64) -> Estimate {
-        let (n, w) = &self.parts[i];
-        self.combine(n, w, k, mu)
-    }
-
-    /// The value only of [`Self::at`].
-    fn value_at(&self, i: usize, k: f64, mu: f64) -> f64 {
-        let (n, w) = &self.parts[i];
-        let m2 = mu * mu;
-        let horner = |c: &[f64; 5]| c.iter().rev().fold(0.0, |a, c| a * m2 + c);
-        let damping = (-k * k * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
-        horner(&n.0) + damping * horner(&w.0)
-    }
-
-    fn combine(&self, n: &Poly, w: &Poly, k: f64, mu: f64) -> Estimate {
-        let m2 = mu * mu;
-        let horner = |c: &[f64; 5]| c.iter().rev().fold(0.0, |a, c| a * m2 + c);
-        let damping = (-k * k * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
-        Estimate::new(
-            horner(&n.0) + damping * horner(&w.0),
-            horner(&n.1) + damping * horner(&w.1),
-        )
-    }
-
-    /// P(k, μ) at any k inside the grid: the polynomials interpolated in ln k (four-point Lagrange).
-    fn interpolated(&self, k: f64, mu: f64) -> Result<Estimate> {
-        let (b, l) = self.stencil(k)?;
-        let mut n: Poly = ([0.0; 5], [0.0; 5]);
-        let mut w: Poly = ([0.0; 5], [0.0; 5]);
-        for (j, lj) in l.iter().enumerate() {
-            let (pn, pw) = &self.parts[b + j];
-            for c in 0..5 {
-                n.0[c] += lj * pn.0[c];
-                n.1[c] += lj.abs() * pn.1[c];
-                w.0[c] += lj * pw.0[c];
-                w.1[c] += lj.abs() * pw.1[c];
-            }
-        }
-        Ok(self.combine(&n, &w, k, mu))
-    }
-
-    /// The value only of [`Self::interpolated`].
-    fn interpolated_value(&self, k: f64, mu: f64) -> Result<f64> {
-        let (b, l) = self.stencil(k)?;
-        let m2 = mu * mu;
-        let (mut n, mut w) = (0.0, 0.0);
-        for (j, lj) in l.iter().enumerate() {
-            let (pn, pw) = &self.parts[b + j];
-            n += lj * pn.0.iter().rev().fold(0.0, |a, c| a * m2 + c);
-            w += lj * pw.0.iter().rev().fold(0.0, |a, c| a * m2 + c);
-        }
-        let damping = (-k * k * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
-        Ok(n + damping * w)
-    }
-
-    /// The first grid index and the Lagrange weights of the four-point stencil of k.
-    fn stencil(&self, k: f64) -> Result<(usize, [f64; 4])> {
-        let g = self.grid;
-        let (x0, step) = (
-            g[0].ln(),
-            (g[g.len() - 1] / g[0]).ln() / (g.len() - 1) as f64,
-        );
-        let u = (k.ln() - x0) / step;
-        let last = (g.len() - 1) as f64;
-        if !(1.0 - 1e-9..=last - 1.0 + 1e-9).contains(&u) {
-            return Err(Error::OutOfRange {
-                what: "the true spectrum of the Alcock-Paczynski projection".into(),
-                k,
-                min: g[1],
-                max: g[g.len() - 2],
-            });
-        }
-        let b = (u.floor() as usize).saturating_sub(1).min(g.len() - 4);
-        Ok((b, lagrange4(u - b as f64)))
-    }
-}
-
 mod basis;
+mod model;
 
 #[cfg(test)]
 mod tests;

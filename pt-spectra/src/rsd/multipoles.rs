@@ -14,6 +14,7 @@ use crate::precision::{Precision, TwoLoopMethod};
 use crate::progress::Progress;
 use crate::real::{counterterm, RealModel, RealPlan, RealSpectra};
 use crate::store::TableStore;
+use crate::table::describe_grid;
 
 /// What turns real-space spectra into redshift-space multipoles.
 #[derive(Debug, Clone, PartialEq)]
@@ -323,14 +324,6 @@ fn check_grid(what: &'static str, k: &[f64], n: usize) -> Result<()> {
         expected: describe_grid(k),
         found: format!("{n} values"),
     })
-}
-
-/// `n k in [a, b] h/Mpc`.
-pub(crate) fn describe_grid(k: &[f64]) -> String {
-    match (k.first(), k.last()) {
-        (Some(a), Some(b)) => format!("{} k in [{a}, {b}] h/Mpc", k.len()),
-        _ => "an empty k grid".into(),
-    }
 }
 
 /// The loop terms a redshift-space model needs on one k grid, planned once: the real-space plan and,

@@ -155,6 +155,12 @@ fn ept_fit_recovers_the_parameters_of_its_own_multipoles() {
             vec!["fit", "--rsd", "ept", "--data", &data, "--prior", "b2=0"],
             "NAME:MEAN,SIGMA",
         ),
+        // A prior on a fixed parameter was listed in the header and ignored.
+        (
+            vec!["fit", "--rsd", "ept", "--data", &data, "--prior", "b2:0,1"],
+            "the prior on b2: b2 is fixed, and a prior acts only on a free or marginalised parameter \
+             (free: f, b1; marginalised: none)",
+        ),
         (
             vec!["fit", "--rsd", "ept", "--data", &data, "--free", "q"],
             "`q`",

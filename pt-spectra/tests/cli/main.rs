@@ -14,6 +14,7 @@ mod fixtures;
 mod halo;
 mod plot;
 mod robustness;
+mod seams;
 mod spt2;
 mod survey_fit;
 mod two_loop_basis;

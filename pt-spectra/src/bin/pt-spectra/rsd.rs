@@ -321,15 +321,7 @@ pub fn run(args: &Args) -> Result<()> {
             b3: args.b3,
             ells: ells.clone(),
             distortion,
-            xi: if args.xi {
-                Some(
-                    LogGrid::new(args.s_min, args.s_max, args.ns)
-                        .context("invalid --s-min/--s-max/--ns")?
-                        .points(),
-                )
-            } else {
-                None
-            },
+            xi: if args.xi { Some(s_grid(args)?) } else { None },
         };
         // ξ_ℓ of ept comes from the model on the transform's own k grid (survey::xi), not from the
         // table at --k-min..--k-max.
@@ -378,12 +370,17 @@ pub fn run(args: &Args) -> Result<()> {
     finish(args, &table, &request.ells)
 }
 
+/// The separations of --xi: --ns log-spaced s in [--s-min, --s-max] Mpc/h.
+fn s_grid(args: &Args) -> Result<Vec<f64>> {
+    Ok(LogGrid::separations(args.s_min, args.s_max, args.ns)
+        .context("invalid --s-min/--s-max/--ns")?
+        .points())
+}
+
 /// Writes the multipoles, or with --xi their correlation functions.
 fn finish(args: &Args, table: &pt_spectra::output::Table, ells: &[usize]) -> Result<()> {
     if args.xi {
-        let s = LogGrid::new(args.s_min, args.s_max, args.ns)
-            .context("invalid --s-min/--s-max/--ns")?
-            .points();
+        let s = s_grid(args)?;
         let xi = xi_table(table, ells, &s)?;
         return write_output(args.out.as_ref(), &xi);
     }

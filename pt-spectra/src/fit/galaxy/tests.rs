@@ -279,3 +279,92 @@ fn hartlap_factor_scales_chi2() {
         .to_string()
         .contains("mocks"));
 }
+
+/// A prior on a parameter that is neither free nor marginalised would be listed and ignored: it is
+/// refused, naming the parameter and the free ones; a second prior on one parameter likewise.
+#[test]
+fn priors_on_fixed_parameters_are_refused() {
+    let (plan, terms, truth, data) = setup();
+    let request = GalaxyFitRequest {
+        start: truth,
+        ap: None,
+        free: vec!["f".into(), "b1".into()],
+        marginalise: vec!["sn".into()],
+        priors: vec![Prior {
+            name: "b2".into(),
+            mean: 0.0,
+            sigma: 1.0,
+        }],
+        ells: vec![0, 2],
+        k_min: 0.0,
+        k_max: 0.2,
+        ell_ranges: vec![],
+        n_mocks: None,
+    };
+    let e = fit_galaxy(&plan, &terms, &data, &request)
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        e,
+        "the prior on b2: b2 is fixed, and a prior acts only on a free or marginalised parameter \
+         (free: f, b1; marginalised: sn)"
+    );
+    let mut twice = request.clone();
+    twice.priors = vec![
+        Prior {
+            name: "sn".into(),
+            mean: 0.0,
+            sigma: 1e3,
+        };
+        2
+    ];
+    let e = fit_galaxy(&plan, &terms, &data, &twice).unwrap_err();
+    assert_eq!(e.to_string(), "the prior on sn: is given twice");
+    let mut ok = request;
+    ok.priors[0].name = "b1".into();
+    assert!(fit_galaxy(&plan, &terms, &data, &ok).is_ok());
+}
+
+/// An observation whose output has as many k as the data but other values is refused (it was taken
+/// for the data's grid by its length), and the message reads as one sentence.
+#[test]
+fn an_observation_on_other_k_of_the_same_length_is_refused() {
+    let (_, _, truth, data) = setup();
+    let edges = LogGrid::new(0.05, 0.3, data.k.len() + 1).unwrap().points();
+    let observation = Observation::new(
+        &[0, 2],
+        &data.k,
+        None,
+        Some(crate::survey::observe::Bins::Edges(edges)),
+    )
+    .unwrap();
+    assert_eq!(observation.k_out().len(), data.k.len());
+    let settings = EptSettings {
+        ir: false,
+        ap: None,
+        ap_range: None,
+    };
+    let plan = EptPlan::new(observation.k_model(), settings, &Precision::fast()).unwrap();
+    let terms = plan.terms(&LinearSpectrum::gm2012(0.5).unwrap()).unwrap();
+    let request = GalaxyFitRequest {
+        start: truth,
+        ap: None,
+        free: vec!["f".into()],
+        marginalise: vec![],
+        priors: vec![],
+        ells: vec![0, 2],
+        k_min: 0.0,
+        k_max: 0.2,
+        ell_ranges: vec![],
+        n_mocks: None,
+    };
+    let e = fit_galaxy_observed(&plan, &terms, &data, &request, Some(&observation))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("output (24 k in [0.0")
+            && e.contains("on the data's (24 k in [0.02, 0.2] h/Mpc"),
+        "{e}"
+    );
+    assert!(!e.contains("  "), "stray spaces: {e:?}");
+}

@@ -1,0 +1,156 @@
+//! The ept model at fixed parameters on the terms' grid, evaluated at grid points or interpolated in
+//! ln k ([`super::EptPlan`]'s multipoles).
+
+use super::{EptParams, EptTerms};
+use crate::error::{Error, Result};
+use crate::estimate::Estimate;
+use crate::integrate::lagrange4;
+use crate::rsd::MAX_MU_POWER;
+
+/// Polynomials in μ² (coefficient n of μ^{2n}) with coefficient errors.
+type Poly = ([f64; MAX_MU_POWER + 1], [f64; MAX_MU_POWER + 1]);
+
+/// The model at fixed parameters on the terms' grid: P = N(μ²) + e^{−k²Σ²(1 + f(2+f)μ²)} W(μ²).
+pub(super) struct Model<'a> {
+    grid: &'a [f64],
+    parts: Vec<(Poly, Poly)>,
+    sigma2: f64,
+    f: f64,
+}
+
+impl EptTerms {
+    pub(super) fn model(&self, params: &EptParams) -> Model<'_> {
+        let v = &params.values;
+        let [b1, _, _, _, f] = params.bias();
+        let z1 = [b1 * b1, 2.0 * b1 * f, f * f];
+        let (alpha, [sn, sn2, sn4]) = ([v[4], v[5], v[6], v[7]], [v[8], v[9], v[10]]);
+        let s2 = self.nw.as_ref().map_or(0.0, |(_, s)| s.value);
+        // The terms of the full and no-wiggle spectra are in the same order.
+        let coefficients = self.full.coefficients(params.bias());
+        let parts = (0..self.grid.len())
+            .map(|i| {
+                let k = self.grid[i];
+                let k2 = k * k;
+                let p = self.full.p_lin[i];
+                let (lv, le) = self.full.loop_polynomial_with(i, &coefficients);
+                let mut n: Poly = (lv, le);
+                let mut w: Poly = ([0.0; 5], [0.0; 5]);
+                let (p_nw, p_w) = match &self.nw {
+                    Some((t, _)) => {
+                        let (nv, ne) = t.loop_polynomial_with(i, &coefficients);
+                        n = (nv, ne);
+                        for j in 0..5 {
+                            w.0[j] = lv[j] - nv[j];
+                            w.1[j] = le[j] + ne[j];
+                        }
+                        (t.p_lin[i], p - t.p_lin[i])
+                    }
+                    None => (p, 0.0),
+                };
+                // Z₁² P_nw, the counterterms and the stochastic terms.
+                for (j, z) in z1.iter().enumerate() {
+                    n.0[j] += z * p_nw;
+                }
+                for (j, a) in alpha.iter().enumerate() {
+                    n.0[j] += a * k2 * p_nw;
+                    w.0[j] += a * k2 * p_w;
+                }
+                n.0[0] += sn;
+                n.0[1] += sn2 * k2;
+                n.0[2] += sn4 * k2 * k2;
+                // (1 + k²Σ²[1 + f(2+f)μ²]) Z₁² P_w.
+                let (c0, c1) = (1.0 + k2 * s2, k2 * s2 * f * (2.0 + f));
+                for (j, z) in z1.iter().enumerate() {
+                    w.0[j] += c0 * z * p_w;
+                    w.0[j + 1] += c1 * z * p_w;
+                }
+                (n, w)
+            })
+            .collect();
+        Model {
+            grid: &self.grid,
+            parts,
+            sigma2: s2,
+            f: params.values[11],
+        }
+    }
+}
+
+impl Model<'_> {
+    /// P(k, μ) at grid index `i` (k = grid[i]).
+    pub(super) fn at(&self, i: usize, k: f64, mu: f64) -> Estimate {
+        let (n, w) = &self.parts[i];
+        self.combine(n, w, k, mu)
+    }
+
+    /// The value only of [`Self::at`].
+    pub(super) fn value_at(&self, i: usize, k: f64, mu: f64) -> f64 {
+        let (n, w) = &self.parts[i];
+        let m2 = mu * mu;
+        let horner = |c: &[f64; 5]| c.iter().rev().fold(0.0, |a, c| a * m2 + c);
+        let damping = (-k * k * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
+        horner(&n.0) + damping * horner(&w.0)
+    }
+
+    fn combine(&self, n: &Poly, w: &Poly, k: f64, mu: f64) -> Estimate {
+        let m2 = mu * mu;
+        let horner = |c: &[f64; 5]| c.iter().rev().fold(0.0, |a, c| a * m2 + c);
+        let damping = (-k * k * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
+        Estimate::new(
+            horner(&n.0) + damping * horner(&w.0),
+            horner(&n.1) + damping * horner(&w.1),
+        )
+    }
+
+    /// P(k, μ) at any k inside the grid: the polynomials interpolated in ln k (four-point Lagrange).
+    pub(super) fn interpolated(&self, k: f64, mu: f64) -> Result<Estimate> {
+        let (b, l) = self.stencil(k)?;
+        let mut n: Poly = ([0.0; 5], [0.0; 5]);
+        let mut w: Poly = ([0.0; 5], [0.0; 5]);
+        for (j, lj) in l.iter().enumerate() {
+            let (pn, pw) = &self.parts[b + j];
+            for c in 0..5 {
+                n.0[c] += lj * pn.0[c];
+                n.1[c] += lj.abs() * pn.1[c];
+                w.0[c] += lj * pw.0[c];
+                w.1[c] += lj.abs() * pw.1[c];
+            }
+        }
+        Ok(self.combine(&n, &w, k, mu))
+    }
+
+    /// The value only of [`Self::interpolated`].
+    pub(super) fn interpolated_value(&self, k: f64, mu: f64) -> Result<f64> {
+        let (b, l) = self.stencil(k)?;
+        let m2 = mu * mu;
+        let (mut n, mut w) = (0.0, 0.0);
+        for (j, lj) in l.iter().enumerate() {
+            let (pn, pw) = &self.parts[b + j];
+            n += lj * pn.0.iter().rev().fold(0.0, |a, c| a * m2 + c);
+            w += lj * pw.0.iter().rev().fold(0.0, |a, c| a * m2 + c);
+        }
+        let damping = (-k * k * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
+        Ok(n + damping * w)
+    }
+
+    /// The first grid index and the Lagrange weights of the four-point stencil of k.
+    fn stencil(&self, k: f64) -> Result<(usize, [f64; 4])> {
+        let g = self.grid;
+        let (x0, step) = (
+            g[0].ln(),
+            (g[g.len() - 1] / g[0]).ln() / (g.len() - 1) as f64,
+        );
+        let u = (k.ln() - x0) / step;
+        let last = (g.len() - 1) as f64;
+        if !(1.0 - 1e-9..=last - 1.0 + 1e-9).contains(&u) {
+            return Err(Error::OutOfRange {
+                what: "the true spectrum of the Alcock-Paczynski projection".into(),
+                k,
+                min: g[1],
+                max: g[g.len() - 2],
+            });
+        }
+        let b = (u.floor() as usize).saturating_sub(1).min(g.len() - 4);
+        Ok((b, lagrange4(u - b as f64)))
+    }
+}
