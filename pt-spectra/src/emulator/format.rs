@@ -184,3 +184,43 @@ pub fn parse(bytes: &[u8], what: &str) -> Result<Parsed> {
         error,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A crafted header (the largest counts allowed, or a count beyond them) on a file too short for
+    /// them: an error naming the file and the byte offset, before any table is allocated.
+    #[test]
+    fn a_crafted_header_is_an_error_naming_the_file() {
+        let header = |counts: [u32; 3]| {
+            let mut b = MAGIC.to_vec();
+            for c in counts {
+                b.extend(c.to_le_bytes());
+            }
+            b.extend([0u8; 4]);
+            for c in [10_000u32, 10_000] {
+                b.extend(c.to_le_bytes());
+            }
+            for i in 0..8 {
+                b.extend((i as f64).to_le_bytes());
+                b.extend((i as f64 + 1.0).to_le_bytes());
+            }
+            b
+        };
+        let e = parse(&header([100_000, 1000, 100_000]), "crafted.bin")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("crafted.bin") && e.contains("file ends early"),
+            "{e}"
+        );
+        let e = parse(&header([u32::MAX, 1000, 100_000]), "crafted.bin")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("crafted.bin") && e.contains("implausibly large"),
+            "{e}"
+        );
+    }
+}
