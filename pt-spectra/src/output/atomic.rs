@@ -41,7 +41,7 @@ pub fn write_atomic_with(
     write: impl FnOnce(&mut File) -> io::Result<()>,
 ) -> io::Result<()> {
     replace_with(path, |tmp| {
-        let mut file = File::create_new(tmp)?;
+        let mut file = File::create(tmp)?;
         write(&mut file)?;
         file.flush()
     })
@@ -51,11 +51,17 @@ pub fn write_atomic_with(
 /// directory to create and fill; its name ends in the target's extension (`.png`, `.svg`, …), for
 /// writers that choose the format by it. The temporary file is then synced and renamed over `path`
 /// (over the file a symbolic link `path` points to, which stays a link), keeping the permissions of
-/// the file it replaces.
+/// the file it replaces. A `path` that is neither a regular file nor a directory (`/dev/null`,
+/// `/dev/stdout`, a FIFO) is given to `write` itself: nothing can be renamed over it.
 ///
 /// # Errors
 /// As [`write_atomic`], or the error `write` returns.
 pub fn replace_with(path: &Path, write: impl FnOnce(&Path) -> io::Result<()>) -> io::Result<()> {
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+        // A device, FIFO or terminal (`/dev/null`, `/dev/stdout`): written in place, since renaming
+        // a file over it would replace the device itself.
+        return write(path);
+    }
     let target = resolved(path);
     let tmp = temporary(&target);
     let result = write(&tmp).and_then(|()| {
@@ -166,6 +172,28 @@ mod tests {
         assert_eq!(seen.extension().unwrap(), "png", "{}", seen.display());
         assert_eq!(seen.parent(), Some(dir.as_path()));
         assert!(leftovers(&dir).is_empty(), "{:?}", leftovers(&dir));
+    }
+
+    /// A FIFO (as `/dev/stdout` can be) is written through, not replaced by a regular file.
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_is_written_in_place() {
+        use std::os::unix::fs::FileTypeExt;
+        let dir = scratch("fifo");
+        let fifo = dir.join("pipe.dat");
+        assert!(std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success());
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read(fifo).unwrap())
+        };
+        write_atomic(&fifo, b"# k P\n").unwrap();
+        assert_eq!(reader.join().unwrap(), b"# k P\n");
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+        assert!(leftovers(&dir).is_empty());
     }
 
     /// A symbolic link keeps pointing to the replaced file, and the file keeps its permissions.
