@@ -348,7 +348,13 @@ mod tests {
         // RealPlan::evaluate_batch holds every result: refused above the limit, before evaluating.
         let p = LinearSpectrum::gm2012(0.0).unwrap();
         let tight = plan(Some(plan_bytes + 5e3));
-        assert_eq!(tight.evaluate_batch(&[p.clone()]).unwrap().len(), 1);
+        assert_eq!(
+            tight
+                .evaluate_batch(std::slice::from_ref(&p))
+                .unwrap()
+                .len(),
+            1
+        );
         let e = tight.evaluate_batch(&[p.clone(), p.clone()]).unwrap_err();
         assert!(e.to_string().contains("a batch of 2 spectra on 3 k"), "{e}");
     }

@@ -162,7 +162,7 @@ pub(super) fn fnv1a(bytes: &[u8]) -> u64 {
 }
 
 /// Writes `values` to `path` behind the [`HEADER`], atomically
-/// ([`write_atomic`](crate::output::write_atomic)).
+/// ([`write_atomic`](crate::output::write_atomic)), replacing a FIFO or device there.
 pub(super) fn write_f64s(path: &Path, values: &[f64]) -> std::io::Result<()> {
     let payload: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
     let mut bytes = Vec::with_capacity(HEADER + payload.len());
@@ -170,6 +170,14 @@ pub(super) fn write_f64s(path: &Path, values: &[f64]) -> std::io::Result<()> {
     bytes.extend_from_slice(&(values.len() as u64).to_le_bytes());
     bytes.extend_from_slice(&fnv1a(&payload).to_le_bytes());
     bytes.extend_from_slice(&payload);
+    // A FIFO or device in place of the table is removed, then replaced: written through, it would
+    // wait for a reader (write_atomic writes such targets in place, for `--out /dev/stdout`).
+    if std::fs::symlink_metadata(path).is_ok_and(|m| {
+        let t = m.file_type();
+        !t.is_file() && !t.is_dir() && !t.is_symlink()
+    }) {
+        std::fs::remove_file(path)?;
+    }
     crate::output::write_atomic(path, &bytes)
 }
 

@@ -47,6 +47,34 @@ pub(crate) fn after_key<'a>(values: &'a [f64], expected: &[f64]) -> Option<&'a [
     Some(&values[1 + len..])
 }
 
+/// The most basis functions a cache file may declare: the bases in use have [`BASIS_SIZE`]; a larger
+/// count is a corrupted or crafted header, refused before any size is computed from it (so that the
+/// n³-sized products of the tensors stay far from overflow).
+pub(crate) const MAX_STORED_BASIS: usize = 1024;
+
+/// `value`, a size read from a cache file, as a count if it is a whole number in `0..=max`; `None`
+/// (the file is not used) otherwise. Every size read from a file goes through this before it is used,
+/// with `max` a sane maximum or the number of values the file still holds.
+pub(crate) fn stored_count(value: f64, max: usize) -> Option<usize> {
+    (value.is_finite() && value >= 0.0 && value.fract() == 0.0 && value <= max as f64)
+        .then_some(value as usize)
+}
+
+/// The values after the points per k and the number of replicas of a tensor file, if they are
+/// `points` and `replicas` (those the settings give: a file that disagrees is not used).
+pub(crate) fn after_points<'a>(
+    values: &'a [f64],
+    points: &[usize],
+    replicas: usize,
+) -> Option<&'a [f64]> {
+    let stored = values.get(..=points.len())?;
+    let equal = stored[..points.len()]
+        .iter()
+        .zip(points)
+        .all(|(&s, &p)| s == p as f64);
+    (equal && stored[points.len()] == replicas as f64).then(|| &values[points.len() + 1..])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -71,17 +99,4 @@ mod tests {
         assert_eq!(canonical(0.0), 0.0);
         assert!(canonical(f64::NAN).is_nan());
     }
-}
-
-/// The most basis functions a cache file may declare: the bases in use have [`BASIS_SIZE`]; a larger
-/// count is a corrupted or crafted header, refused before any size is computed from it (so that the
-/// n³-sized products of the tensors stay far from overflow).
-pub(crate) const MAX_STORED_BASIS: usize = 1024;
-
-/// `value`, a size read from a cache file, as a count if it is a whole number in `0..=max`; `None`
-/// (the file is not used) otherwise. Every size read from a file goes through this before it is used,
-/// with `max` a sane maximum or the number of values the file still holds.
-pub(crate) fn stored_count(value: f64, max: usize) -> Option<usize> {
-    (value.is_finite() && value >= 0.0 && value.fract() == 0.0 && value <= max as f64)
-        .then_some(value as usize)
 }

@@ -47,7 +47,9 @@ mod tensors;
 mod tns;
 pub mod training;
 
-pub(crate) use cache_key::{after_key, cache_file_name, stored_count, MAX_STORED_BASIS};
+pub(crate) use cache_key::{
+    after_key, after_points, cache_file_name, stored_count, MAX_STORED_BASIS,
+};
 #[cfg(test)]
 pub(crate) use linear_basis::wrapping_basis_size;
 pub use linear_basis::{LinearBasis, Projection, SMOOTHING};
@@ -434,18 +436,9 @@ impl TwoLoopBasis {
             .iter()
             .map(|&k| points_at(k, precision.two_loop_points))
             .collect();
-        let stored = rest.get(..=k.len())?;
-        if stored[..k.len()]
-            .iter()
-            .zip(&points)
-            .any(|(&s, &p)| s != p as f64)
-            || stored[k.len()] != precision.two_loop_replicas as f64
-        {
-            return None;
-        }
         let replicas = precision.two_loop_replicas;
-        let (basis, mut rest) =
-            LinearBasis::from_f64s(lattice_of(precision), &rest[k.len() + 1..])?;
+        let rest = after_points(rest, &points, replicas)?;
+        let (basis, mut rest) = LinearBasis::from_f64s(lattice_of(precision), rest)?;
         let n = basis.len();
         let sizes = [
             3 * FORM_KERNELS * n * (n + 1) / 2,

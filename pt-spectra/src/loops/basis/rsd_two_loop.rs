@@ -338,18 +338,9 @@ impl RsdTwoLoopBasis {
             .iter()
             .map(|&k| rsd_points_at(k, settings.points))
             .collect();
-        let stored = rest.get(..=k.len())?;
-        if stored[..k.len()]
-            .iter()
-            .zip(&points)
-            .any(|(&s, &p)| s != p as f64)
-            || stored[k.len()] != settings.replicas as f64
-        {
-            return None;
-        }
         let replicas = settings.replicas;
-        let (basis, mut rest) =
-            LinearBasis::from_f64s(Self::lattice(q_range, lattice_step), &rest[k.len() + 1..])?;
+        let rest = super::after_points(rest, &points, replicas)?;
+        let (basis, mut rest) = LinearBasis::from_f64s(Self::lattice(q_range, lattice_step), rest)?;
         let n = basis.len();
         let size = replicas.checked_mul(COEFFICIENTS * triples(error_functions(n)))?;
         if rest.len() < k.len().checked_mul(size)? {
