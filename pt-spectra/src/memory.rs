@@ -139,6 +139,45 @@ pub fn limit(precision: &Precision) -> (f64, String) {
     }
 }
 
+/// The address space \[bytes\] this process may still map under an address-space limit (`ulimit -v`,
+/// `RLIMIT_AS`): the limit of `/proc/self/limits` less the `VmSize` of `/proc/self/status`; `None`
+/// without such a limit (or off Linux). Beyond it an allocation fails, which Rust turns into an abort,
+/// so plans that allocate per user input (batches) count it as part of their limit.
+pub fn address_space_left() -> Option<f64> {
+    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let line = limits
+        .lines()
+        .find(|l| l.starts_with("Max address space"))?;
+    let soft: f64 = line
+        .trim_start_matches("Max address space")
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()?;
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kib: f64 = status
+        .lines()
+        .find(|l| l.starts_with("VmSize:"))?
+        .split_whitespace()
+        .nth(1)?
+        .parse()
+        .ok()?;
+    Some((soft - kib * 1024.0).max(0.0))
+}
+
+/// An allocation of `bytes` for `what` that failed (the system gave less than [`limit`] allows: an
+/// address-space limit, or the machine's memory), as [`Error::MemoryLimit`].
+pub fn allocation_failed(bytes: f64, what: &str) -> Error {
+    Error::MemoryLimit {
+        what: what.to_string(),
+        needed: size(bytes),
+        limit: "what the system gives this process".into(),
+        origin: "the allocation failed: an address-space limit (ulimit -v) or the machine's \
+                 memory; a smaller batch or a larger limit helps"
+            .into(),
+    }
+}
+
 /// `bytes` against the limit of `precision`; `what` says what would be built.
 ///
 /// # Errors
@@ -154,6 +193,24 @@ pub fn check(bytes: f64, precision: &Precision, what: &str) -> Result<()> {
         });
     }
     Ok(())
+}
+
+/// [`check`], and `bytes` against the address space the process has left
+/// ([`address_space_left`]), for allocations that would otherwise abort the process.
+///
+/// # Errors
+/// [`Error::MemoryLimit`] with both figures.
+pub fn check_allocation(bytes: f64, precision: &Precision, what: &str) -> Result<()> {
+    check(bytes, precision, what)?;
+    match address_space_left() {
+        Some(left) if bytes > left => Err(Error::MemoryLimit {
+            what: what.to_string(),
+            needed: size(bytes),
+            limit: size(left),
+            origin: "the address space this process has left under its limit (ulimit -v)".into(),
+        }),
+        _ => Ok(()),
+    }
 }
 
 /// `bytes` as `12 GB`, `340 MB` (decimal units, two significant figures).

@@ -7,8 +7,10 @@
 //! values, a few entries recomputed); otherwise it is built and written atomically (a temporary file
 //! renamed into place), so a reader never sees half a table, and a corrupted, truncated or stale file
 //! is rebuilt, with a note through [`Progress::note`] that says why. A table that cannot be written
-//! (full disk, read-only directory) is used from memory, with a note, and the temporary file is
-//! removed. While a
+//! (full disk, read-only directory, a file where the directory should be, a lock file that cannot be
+//! opened) is built and used from memory, with a note naming the path and the reason, and any
+//! temporary file is removed: a cache never stops a run. A cache file that is not a regular file (a
+//! FIFO, a device) is never read (it is rebuilt, with a note), so it cannot hang a run. While a
 //! process builds a table it holds an operating-system lock on `<table>.lock` beside it
 //! ([`std::fs::File::lock`]): another process that needs the same table waits for it (and says so
 //! through [`Progress::note`]) instead of building it twice, and a process that dies while building
@@ -21,7 +23,7 @@
 //! # Ok::<(), pt_spectra::error::Error>(())
 //! ```
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::loops::basis::{
     LinearBasis, OneLoopBasis, RedshiftBasis, RedshiftFamily, SpectrumFamily, BASIS_SIZE,
 };
@@ -30,7 +32,6 @@ use crate::loops::redshift::RedshiftPlan;
 use crate::loops::{OneLoopPlan, P15Table, P17Table, TnsPlan};
 use crate::precision::Precision;
 use crate::progress::{Progress, Stage};
-use std::fs::{File, OpenOptions, TryLockError};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
@@ -87,7 +88,7 @@ impl TableStore {
     /// (reporting [`Stage::P15Table`]) and written.
     ///
     /// # Errors
-    /// [`Error::Cache`] if the directory cannot be created or the table cannot be written or locked.
+    /// None from the cache (a cache that cannot be used means a table built in memory, with a note).
     pub fn p15(&self, progress: &dyn Progress) -> Result<Arc<P15Table>> {
         load(
             &self.p15,
@@ -140,7 +141,7 @@ impl TableStore {
     /// and written. Without a directory they are built each time.
     ///
     /// # Errors
-    /// [`Error::Cache`] if the directory cannot be created or the file cannot be written or locked.
+    /// None from the cache (a cache that cannot be used means tensors built in memory, with a note).
     pub fn two_loop_basis(
         &self,
         k: &[f64],
@@ -219,7 +220,7 @@ impl TableStore {
     /// about a second per 100 k) and written. Without a directory they are built each time.
     ///
     /// # Errors
-    /// [`Error::Cache`] if the directory cannot be created or the file cannot be written or locked.
+    /// None from the cache (a cache that cannot be used means tensors built in memory, with a note).
     pub fn one_loop_basis(
         &self,
         plan: &OneLoopPlan,
@@ -265,7 +266,7 @@ impl TableStore {
     /// built each time.
     ///
     /// # Errors
-    /// [`Error::Cache`] if the directory cannot be created or the file cannot be written or locked.
+    /// None from the cache (a cache that cannot be used means tensors built in memory, with a note).
     pub fn tns_basis(&self, plan: &TnsPlan, progress: &dyn Progress) -> Result<Arc<TnsBasis>> {
         let (k, precision) = (plan.k(), plan.precision());
         let build = || TnsBasis::build(plan, &|d, t| progress.update(Stage::TnsBasis, d, t));
@@ -301,7 +302,7 @@ impl TableStore {
     /// built each time.
     ///
     /// # Errors
-    /// [`Error::Cache`] if the directory cannot be created or the file cannot be written or locked.
+    /// None from the cache (a cache that cannot be used means tensors built in memory, with a note).
     pub fn redshift_basis(
         &self,
         plan: &RedshiftPlan,
@@ -395,182 +396,12 @@ fn load<T>(
     Ok(t)
 }
 
-/// The table at `path` if it is there and valid, otherwise built under an exclusive lock on
-/// `<path>.lock` (after waiting for any other process holding it, which may have built it meanwhile)
-/// and written atomically.
-///
-/// # Errors
-/// [`Error::Cache`] naming the file when the directory, the lock or the table file fails.
-pub(crate) fn cached<T>(
-    path: &Path,
-    name: &str,
-    read: impl Fn(&[f64]) -> Option<T>,
-    build: impl FnOnce() -> T,
-    write: impl Fn(&T) -> Vec<f64>,
-    progress: &dyn Progress,
-) -> Result<T> {
-    // The table if the file holds a valid one; else why not (None: no file, nothing to say).
-    let read_file = || -> std::result::Result<T, Option<String>> {
-        match read_f64s(path) {
-            Stored::Missing => Err(None),
-            Stored::Invalid(why) => Err(Some(why)),
-            Stored::Values(v) => {
-                read(&v).ok_or_else(|| Some("fails the table's consistency checks".to_string()))
-            }
-        }
-    };
-    let first = match read_file() {
-        Ok(t) => return Ok(t),
-        Err(why) => why,
-    };
-    let fail = |path: &Path, what: &'static str| {
-        let path = path.to_path_buf();
-        move |source| Error::Cache { path, what, source }
-    };
-    if let Some(dir) = path.parent() {
-        if dir.exists() && !dir.is_dir() {
-            return Err(Error::Cache {
-                path: dir.to_path_buf(),
-                what: "use as the cache directory",
-                source: std::io::Error::other("it exists and is not a directory"),
-            });
-        }
-        std::fs::create_dir_all(dir).map_err(fail(dir, "create the cache directory"))?;
-    }
-    let lock_path = path.with_extension("lock");
-    let lock = OpenOptions::new()
-        .create(true)
-        .truncate(false)
-        .write(true)
-        .open(&lock_path)
-        .map_err(fail(&lock_path, "open the lock file"))?;
-    acquire(&lock, &lock_path, name, progress)?;
-    // Another process may have finished the table while this one waited.
-    let why = match read_file() {
-        Ok(t) => return Ok(t),
-        Err(why) => why.or(first),
-    };
-    if let Some(why) = why {
-        progress.note(&format!(
-            "the cached {name} table `{}` {why}: rebuilding it",
-            path.display()
-        ));
-    }
-    let t = build();
-    if let Err(e) = write_f64s(path, &write(&t)) {
-        progress.note(&format!(
-            "cannot write the {name} table to `{}` ({e}): using it from memory; it will be built \
-             again by the next process",
-            path.display()
-        ));
-    }
-    // The lock is released when `lock` is dropped (or the process dies); the file stays, empty.
-    drop(lock);
-    Ok(t)
-}
-
-/// Takes the exclusive lock on `lock`, telling `progress` when it has to wait for another process.
-fn acquire(lock: &File, lock_path: &Path, name: &str, progress: &dyn Progress) -> Result<()> {
-    let fail = |source| Error::Cache {
-        path: lock_path.to_path_buf(),
-        what: "lock the table",
-        source,
-    };
-    match lock.try_lock() {
-        Ok(()) => Ok(()),
-        Err(TryLockError::WouldBlock) => {
-            progress.note(&format!(
-                "waiting for another process that is building the {name} table (it holds the lock \
-                 `{}`)",
-                lock_path.display()
-            ));
-            lock.lock().map_err(fail)
-        }
-        Err(TryLockError::Error(e)) => Err(fail(e)),
-    }
-}
-
-/// The first bytes of every table file (the format's version is its last two characters).
-const MAGIC: &[u8; 8] = b"PTSTAB01";
-/// The header: [`MAGIC`], the number of values (u64) and the [`fnv1a`] hash of the payload (u64).
-const HEADER: usize = 24;
-
-/// The 64-bit FNV-1a hash of `bytes` (Fowler, Noll & Vo): any change of one byte changes it, and a
-/// random change goes unnoticed with probability 2^-64.
-pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-    })
-}
-
-/// Writes `values` to `path` atomically (a temporary file of this process, then renamed into place)
-/// behind the [`HEADER`]; the temporary file is removed if anything fails.
-fn write_f64s(path: &Path, values: &[f64]) -> std::io::Result<()> {
-    let payload: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-    let mut bytes = Vec::with_capacity(HEADER + payload.len());
-    bytes.extend_from_slice(MAGIC);
-    bytes.extend_from_slice(&(values.len() as u64).to_le_bytes());
-    bytes.extend_from_slice(&fnv1a(&payload).to_le_bytes());
-    bytes.extend_from_slice(&payload);
-    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
-    let result = std::fs::write(&tmp, &bytes).and_then(|()| std::fs::rename(&tmp, path));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
-
-/// What a table file holds.
-enum Stored {
-    /// No file (or none that can be read): build the table without comment.
-    Missing,
-    /// A file that is not a whole, intact table: why.
-    Invalid(String),
-    /// The values, their hash verified.
-    Values(Vec<f64>),
-}
-
-/// Reads a table file written by [`write_f64s`], verifying its header, length and hash.
-fn read_f64s(path: &Path) -> Stored {
-    let Ok(bytes) = std::fs::read(path) else {
-        return Stored::Missing;
-    };
-    let word = |i: usize| {
-        let mut b = [0u8; 8];
-        b.copy_from_slice(&bytes[8 * i..8 * i + 8]);
-        u64::from_le_bytes(b)
-    };
-    if bytes.len() < HEADER || &bytes[..8] != MAGIC {
-        return Stored::Invalid(
-            "is not a table file of this version (no PTSTAB01 header)".to_string(),
-        );
-    }
-    let payload = &bytes[HEADER..];
-    let (count, hash) = (word(1), word(2));
-    if payload.len() as u64 != count.saturating_mul(8) {
-        return Stored::Invalid(format!(
-            "is truncated or extended: {} bytes of values where the header says {count} values",
-            payload.len()
-        ));
-    }
-    let actual = fnv1a(payload);
-    if actual != hash {
-        return Stored::Invalid(format!(
-            "is corrupted: its checksum is {actual:016x}, the header says {hash:016x}"
-        ));
-    }
-    Stored::Values(
-        payload
-            .chunks_exact(8)
-            .map(|c| {
-                let mut b = [0u8; 8];
-                b.copy_from_slice(c);
-                f64::from_le_bytes(b)
-            })
-            .collect(),
-    )
-}
-
+mod file;
 mod rsd_two_loop;
+
+pub(crate) use file::cached;
+#[cfg(test)]
+use file::{fnv1a, HEADER};
+use file::{read_f64s, Stored};
 #[cfg(test)]
 mod tests;

@@ -203,8 +203,11 @@ def _rank_arrays(config, indices):
             tables = _point_tables(plan, config, cosmology)
         except ValueError as e:
             raise ValueError(f"point {i} {cosmology}: {e}") from e
+        shape = (len(indices), nz, len(config["k"]))
+        if row == 0:  # the columns are known: the arrays are checked against the memory limit
+            columns = [c for c in tables[0].columns if c != "k" and (config["terms"] or c in BASIC)]
+            _check_memory(config, shape, len(columns))
         for j, t in enumerate(tables):
-            shape = (len(indices), nz, len(config["k"]))
             for c in t.columns:
                 if c != "k" and (config["terms"] or c in BASIC):
                     out.setdefault(c, np.full(shape, np.nan))[row, j] = t[c]
@@ -215,6 +218,38 @@ def _rank_arrays(config, indices):
         out[f"param_{key}"] = np.array([config["points"][i].get(key, np.nan) for i in indices])
     out["z"], out["k"] = np.asarray(config["z"]), np.asarray(config["k"])
     return out, meta
+
+
+def _check_memory(config, shape, columns):
+    """Refuses (``MemoryError``, with the estimate and the limit) a rank's arrays of `shape` for
+    `columns` columns, with the merged arrays of every point that rank 0 holds at the end, above the
+    memory limit ($PT_SPECTRA_MAX_MEMORY, else half the machine's memory), before they are
+    allocated."""
+    rank_bytes = 8.0 * np.prod(shape) * (columns + 3)
+    merged = 2 * 8.0 * len(config["points"]) * shape[1] * shape[2] * (columns + 3)
+    pt._core.check_memory(rank_bytes + merged,
+                          f"the arrays of {shape[0]} points × {shape[1]} z × {shape[2]} k × "
+                          f"{columns} columns and their merge over {len(config['points'])} points")
+
+
+def _write_atomic(path, write):
+    """Writes `path` whole or not at all: `write(file)` fills a temporary file in the same
+    directory, which is flushed to the disk and renamed over `path` (a failure leaves the old file and
+    no temporary file)."""
+    directory, name = os.path.split(os.path.abspath(path))
+    tmp = os.path.join(directory, f".{name}.{os.getpid()}.tmp")
+    try:
+        with open(tmp, "wb") as fh:
+            write(fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.remove(tmp)
+        except OSError:
+            pass
+        raise
 
 
 def _merge(output, size, n_points):
@@ -231,7 +266,7 @@ def _merge(output, size, n_points):
     for key in parts[0]:
         if key not in ("z", "k"):
             merged[key] = np.concatenate([p[key] for p in parts])[order]
-    np.savez(os.path.join(output, "all.npz"), **merged)
+    _write_atomic(os.path.join(output, "all.npz"), lambda fh: np.savez(fh, **merged))
 
 
 def run(config, output=None, comm=None):
@@ -250,14 +285,16 @@ def run(config, output=None, comm=None):
     try:
         os.makedirs(output, exist_ok=True)
         arrays, meta = _rank_arrays(config, mine)
-        np.savez(os.path.join(output, f"rank{rank}.npz"), **arrays)
+        _write_atomic(os.path.join(output, f"rank{rank}.npz"), lambda fh: np.savez(fh, **arrays))
     except Exception as e:  # reported by every rank below, so that no rank waits forever
         error = f"rank {rank}: {type(e).__name__}: {e}"
         meta = {}
     errors = [error] if comm is None else comm.allgather(error)
     metas = [meta] if comm is None else comm.gather(meta, root=0)
     if any(errors):
-        raise RuntimeError("batch failed: " + "; ".join(e for e in errors if e))
+        # A refusal for memory (or a failed allocation) on any rank stays a MemoryError.
+        kind = MemoryError if any(": MemoryError: " in e for e in errors if e) else RuntimeError
+        raise kind("batch failed: " + "; ".join(e for e in errors if e))
     if rank != 0:
         return None
     meta = next(m for m in metas if m)
@@ -271,8 +308,8 @@ def run(config, output=None, comm=None):
     }
     _merge(output, size, n_points)
     index["seconds"] = time.perf_counter() - start
-    with open(os.path.join(output, "index.json"), "w") as fh:
-        json.dump(index, fh, indent=1)
+    text = json.dumps(index, indent=1).encode()
+    _write_atomic(os.path.join(output, "index.json"), lambda fh: fh.write(text))
     return index
 
 

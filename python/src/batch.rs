@@ -3,8 +3,9 @@
 //! `read_multipoles` (a likelihood's data file through the library's reader).
 
 use crate::{detached, value_error, RealPlan};
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
-use pt_spectra::jobs::real_batch_tables;
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyReadonlyArray2};
+use pt_spectra::jobs::{self, BatchRows};
 use pt_spectra::real::RealSelection;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -37,30 +38,26 @@ pub(crate) fn real_batch<'py>(
             k_lin.len()
         )));
     }
-    // Each row's spline, model and table on the threads (a bad row is an error naming it).
-    let rows: Vec<Vec<f64>> = p.rows().into_iter().map(|row| row.to_vec()).collect();
-    let (results, _) = detached(py, || {
-        Ok(real_batch_tables(&plan.plan, &k_lin, &rows, terms))
-    })?;
-    let tables = results
-        .into_iter()
-        .enumerate()
-        .map(|(i, r)| r.map_err(|e| PyValueError::new_err(format!("row {i} of P: {e}"))))
-        .collect::<PyResult<Vec<_>>>()?;
-    let out = PyDict::new(py);
-    out.set_item("k", plan.plan.k().to_vec().into_pyarray(py))?;
-    let Some(first) = tables.first() else {
-        return Ok(out);
+    // Planned against the memory limit ($PT_SPECTRA_MAX_MEMORY as now set, else the plan's) before
+    // anything per spectrum is allocated; each row is copied by its own task.
+    let max_memory = pt_spectra::memory::env_max_memory().map_err(value_error)?;
+    let (view, n_rows) = (&p, p.nrows());
+    let row = |i: usize| view.row(i).to_vec();
+    let rows = BatchRows {
+        k_lin: &k_lin,
+        spectra: n_rows,
+        row: &row,
+        name: "P",
     };
-    for name in first.names() {
-        if name == "k" {
-            continue;
-        }
-        let rows: Vec<Vec<f64>> = tables
-            .iter()
-            .map(|t| t.column(name).unwrap_or_default().to_vec())
-            .collect();
-        out.set_item(name, PyArray2::from_vec2(py, &rows).map_err(value_error)?)?;
+    let (columns, _) = detached(py, || {
+        jobs::real_batch(&plan.plan, &rows, terms, max_memory)
+    })?;
+    let out = PyDict::new(py);
+    out.set_item("k", columns.k.into_pyarray(py))?;
+    let n_k = plan.plan.k().len();
+    for (name, values) in columns.columns {
+        let array = Array2::from_shape_vec((n_rows, n_k), values).map_err(value_error)?;
+        out.set_item(name, array.into_pyarray(py))?;
     }
     Ok(out)
 }
@@ -89,4 +86,14 @@ pub(crate) fn read_multipoles<'py>(
             sigma.into_any(),
         ],
     )
+}
+
+/// Refuses `bytes` of arrays for `what` above the memory limit ($PT_SPECTRA_MAX_MEMORY, else half the
+/// machine's memory) or the address space the process has left (`ulimit -v`): `MemoryError` with
+/// both figures. For the grid runner (`pt_spectra.batch`), before it allocates its arrays.
+#[pyfunction]
+pub(crate) fn check_memory(bytes: f64, what: &str) -> PyResult<()> {
+    let mut precision = pt_spectra::precision::Precision::default();
+    precision.max_memory = pt_spectra::memory::env_max_memory().map_err(value_error)?;
+    pt_spectra::memory::check_allocation(bytes, &precision, what).map_err(crate::library_error)
 }

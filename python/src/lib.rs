@@ -135,7 +135,18 @@ pub(crate) fn detached<T: Send>(
         let result = f();
         (result, start.elapsed().as_secs_f64())
     });
-    Ok((result.map_err(value_error)?, seconds))
+    Ok((result.map_err(library_error)?, seconds))
+}
+
+/// A library error as a Python exception: `MemoryError` for a memory limit or a failed allocation
+/// (a plan or batch refused before it allocates), `ValueError` for everything else.
+pub(crate) fn library_error(e: pt_spectra::error::Error) -> PyErr {
+    match e {
+        pt_spectra::error::Error::MemoryLimit { .. } => {
+            pyo3::exceptions::PyMemoryError::new_err(e.to_string())
+        }
+        e => value_error(e),
+    }
 }
 
 /// A real-space model prepared for one k grid (cosmology-independent work done once); calling it
@@ -612,6 +623,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ept::fit_ept, m)?)?;
     m.add_function(wrap_pyfunction!(batch::real_batch, m)?)?;
     m.add_function(wrap_pyfunction!(batch::read_multipoles, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::check_memory, m)?)?;
     m.add_function(wrap_pyfunction!(real, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(growth, m)?)?;

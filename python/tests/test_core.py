@@ -135,7 +135,7 @@ def test_guards_name_the_problem(monkeypatch):
     with pytest.warns(RuntimeWarning, match="lengths differ"):
         pt.kernel("F", [[1e-6, 0, 0], [0, 1, 0]])
     monkeypatch.setenv("PT_SPECTRA_MAX_MEMORY", "1M")
-    with pytest.raises(ValueError, match=r"needs about .* of memory, above 1.0 MB"):
+    with pytest.raises(MemoryError, match=r"needs about .* of memory, above 1.0 MB"):
         pt.real(k=k)
 
 

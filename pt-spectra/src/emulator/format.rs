@@ -75,6 +75,12 @@ impl<'a> Reader<'a> {
         Ok(out)
     }
 
+    /// The bytes of `n` values of `width` bytes, if that does not overflow.
+    fn bytes_of(&self, n: usize, width: usize) -> Result<usize> {
+        n.checked_mul(width)
+            .ok_or_else(|| self.fail("a table size is implausibly large"))
+    }
+
     fn count(&mut self, max: usize) -> Result<usize> {
         let b = self.take(4)?;
         let v = u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize;
@@ -84,8 +90,10 @@ impl<'a> Reader<'a> {
         Ok(v)
     }
 
+    /// `n` values, `n` bounded by the counts of the header ([`Self::count`]) and checked against the
+    /// bytes left before anything is allocated.
     fn f64s(&mut self, n: usize) -> Result<Vec<f64>> {
-        let b = self.take(n * 8)?;
+        let b = self.take(self.bytes_of(n, 8)?)?;
         let v: Vec<f64> = b
             .chunks_exact(8)
             .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
@@ -97,7 +105,7 @@ impl<'a> Reader<'a> {
     }
 
     fn f32s(&mut self, n: usize) -> Result<Vec<f32>> {
-        let b = self.take(n * 4)?;
+        let b = self.take(self.bytes_of(n, 4)?)?;
         let v: Vec<f32> = b
             .chunks_exact(4)
             .map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes")))
@@ -145,12 +153,13 @@ pub fn parse(bytes: &[u8], what: &str) -> Result<Parsed> {
         return Err(r.fail("bad wavenumber range or early-dark-energy coordinate"));
     }
     let exponents = r
-        .take(n_terms * COORDINATES)?
+        .take(r.bytes_of(n_terms, COORDINATES)?)?
         .chunks_exact(COORDINATES)
         .map(|c| c.try_into().expect("seven exponents"))
         .collect();
     let mut target = |n_pc: usize| -> Result<Target> {
         Ok(Target {
+            // Products of counts each bounded by `count` (≤ 1e4 × 1e3 × 1e5): no overflow.
             mean: r.f64s(n_z * n_x)?,
             components: r.f32s(n_pc * n_z * n_x)?,
             coefficients: r.f64s(n_terms * n_pc)?,
@@ -174,4 +183,44 @@ pub fn parse(bytes: &[u8], what: &str) -> Result<Parsed> {
         targets,
         error,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A crafted header (the largest counts allowed, or a count beyond them) on a file too short for
+    /// them: an error naming the file and the byte offset, before any table is allocated.
+    #[test]
+    fn a_crafted_header_is_an_error_naming_the_file() {
+        let header = |counts: [u32; 3]| {
+            let mut b = MAGIC.to_vec();
+            for c in counts {
+                b.extend(c.to_le_bytes());
+            }
+            b.extend([0u8; 4]);
+            for c in [10_000u32, 10_000] {
+                b.extend(c.to_le_bytes());
+            }
+            for i in 0..8 {
+                b.extend((i as f64).to_le_bytes());
+                b.extend((i as f64 + 1.0).to_le_bytes());
+            }
+            b
+        };
+        let e = parse(&header([100_000, 1000, 100_000]), "crafted.bin")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("crafted.bin") && e.contains("file ends early"),
+            "{e}"
+        );
+        let e = parse(&header([u32::MAX, 1000, 100_000]), "crafted.bin")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("crafted.bin") && e.contains("implausibly large"),
+            "{e}"
+        );
+    }
 }

@@ -46,7 +46,7 @@ mod observe;
 mod report;
 mod rsd;
 mod spt2;
-pub use batch::real_batch_tables;
+pub use batch::{batch_memory, real_batch, BatchColumns, BatchMemory, BatchRows};
 pub use bias::BiasOutput;
 pub use ept::{
     ept_fit_table, ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest,

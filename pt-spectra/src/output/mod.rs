@@ -1,5 +1,6 @@
 //! Output tables: each column declared once (name, unit, values), written as text by the command line
-//! and handed to Python as arrays under the same names.
+//! and handed to Python as arrays under the same names; and [`write_atomic`], through which every file
+//! is written (whole or not at all).
 //!
 //! Text format: `#` header lines, then `# column i: name [unit]` for every column, then `# ` and the
 //! names, then one row per k with every value as `{:.9e}`, separated by single spaces.
@@ -18,7 +19,9 @@
 //!             an input outside what the model handles; please report it with the command)");
 //! ```
 
+mod atomic;
 mod written;
+pub use atomic::{replace_with, write_atomic, write_atomic_with};
 pub use written::WrittenTable;
 
 use crate::error::{number, Error, Result};

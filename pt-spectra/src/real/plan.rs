@@ -500,17 +500,39 @@ impl RealPlan {
 impl RealPlan {
     /// The model's spectra for each of `spectra` (each at the output redshift), spread over
     /// rayon's threads one spectrum per task: a batch of cosmologies. The results are those of
-    /// [`evaluate`](Self::evaluate), in order. Memory: the plan once, and per spectrum its table
-    /// and its [`RealSpectra`] (values and errors of every term: ~0.4 kB per k for 1-loop models
-    /// with terms).
-    pub fn evaluate_batch(&self, spectra: &[LinearSpectrum]) -> Vec<Result<RealSpectra>> {
+    /// [`evaluate`](Self::evaluate), in order. Memory: the plan once, and per spectrum its
+    /// [`RealSpectra`] (values and errors of every term: at most 1 kB per k),
+    /// checked against the plan's limit before any is evaluated.
+    ///
+    /// # Errors
+    /// [`crate::error::Error::MemoryLimit`] with the estimate and the limit if the results do not
+    /// fit; per spectrum as [`evaluate`](Self::evaluate).
+    pub fn evaluate_batch(&self, spectra: &[LinearSpectrum]) -> Result<Vec<Result<RealSpectra>>> {
         use rayon::prelude::*;
-        spectra
+        let nk = self.k.len();
+        let plan = crate::memory::plan_bytes(nk, self.model.plan_parts(), &self.precision);
+        let results = SPECTRA_BYTES_PER_K * nk as f64 * spectra.len() as f64;
+        crate::memory::check(
+            plan + results,
+            &self.precision,
+            &format!(
+                "a batch of {} spectra on {nk} k (the {} plan {}, the results {})",
+                spectra.len(),
+                self.model.name(),
+                crate::memory::size(plan),
+                crate::memory::size(results)
+            ),
+        )?;
+        Ok(spectra
             .par_iter()
             .map(|s| self.evaluate(s, &Silent))
-            .collect()
+            .collect())
     }
 }
+
+/// Bytes per k of one [`RealSpectra`] with every term: at most ~40 estimates (value and error,
+/// 16 bytes each) per k, and its vectors' overhead.
+const SPECTRA_BYTES_PER_K: f64 = 1e3;
 
 /// RegPT's vertex weights on `k` (seconds on long grids: reported as [`Stage::Gamma2Weights`]).
 fn gamma2_plan(k: &[f64], precision: &Precision, progress: &dyn Progress) -> Gamma2Plan {

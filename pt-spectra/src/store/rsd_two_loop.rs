@@ -14,7 +14,7 @@ impl TableStore {
     /// written. Without a directory they are built each time.
     ///
     /// # Errors
-    /// [`Error::Cache`](crate::error::Error::Cache) if the directory cannot be created or the file cannot be written or locked.
+    /// None from the cache (a cache that cannot be used means tensors built in memory, with a note).
     #[allow(clippy::too_many_arguments)]
     pub fn rsd_two_loop_basis(
         &self,

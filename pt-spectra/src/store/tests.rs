@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::progress::Silent;
+use std::fs::{File, TryLockError};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 fn scratch(name: &str) -> PathBuf {
@@ -240,19 +241,151 @@ fn a_table_that_cannot_be_written_is_used_from_memory() {
     assert!(left.is_empty(), "temporary files left: {left:?}");
 }
 
+/// `table` with notes, run on another thread so that a hang (a FIFO opened for reading) fails the
+/// test after two minutes instead of blocking the suite.
+fn table_with_notes(path: &Path, builds: &Arc<AtomicUsize>) -> (Vec<f64>, Vec<String>) {
+    let (path, builds) = (path.to_path_buf(), Arc::clone(builds));
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let notes = Notes(Mutex::new(Vec::new()));
+        let t = cached(
+            &path,
+            "test",
+            |v: &[f64]| (v.len() == 3).then(|| v.to_vec()),
+            || {
+                builds.fetch_add(1, Ordering::Relaxed);
+                vec![4.5; 3]
+            },
+            Clone::clone,
+            &notes,
+        )
+        .unwrap();
+        let _ = send.send((t, notes.0.into_inner().unwrap()));
+    });
+    receive
+        .recv_timeout(std::time::Duration::from_secs(120))
+        .expect("the cache hung")
+}
+
+/// A cache directory that cannot hold the table never fails the run: the table is built in memory
+/// and a note names the path and the reason. Tests run as root, which ignores permission bits, so
+/// the unwritable directories are ones no one can write: a path under a regular file (ENOTDIR) and,
+/// on Linux, `/proc/self`, an existing directory where no file can be created (the lock file fails
+/// there, as in a read-only directory).
 #[test]
-fn an_unwritable_directory_is_an_error_naming_it() {
+fn an_unusable_cache_directory_is_used_from_memory_with_a_note() {
     let dir = scratch("unwritable");
     std::fs::create_dir_all(&dir).unwrap();
     // A file where the cache directory should be.
     let blocker = dir.join("file");
     std::fs::write(&blocker, "x").unwrap();
-    let e = table(&blocker.join("t.bin"), &AtomicUsize::new(0), 1.0).unwrap_err();
-    let text = e.to_string();
+    let mut paths = vec![blocker.join("t.bin"), blocker.join("sub/t.bin")];
+    if Path::new("/proc/self/status").is_file() {
+        paths.push(PathBuf::from("/proc/self/pt-spectra-t.bin"));
+    }
+    for path in paths {
+        let builds = Arc::new(AtomicUsize::new(0));
+        let (t, notes) = table_with_notes(&path, &builds);
+        assert_eq!(t, vec![4.5; 3], "{}", path.display());
+        assert_eq!(builds.load(Ordering::Relaxed), 1);
+        let parent = path.parent().unwrap().display().to_string();
+        assert!(
+            notes.len() == 1
+                && notes[0].contains("from memory")
+                && (notes[0].contains(&parent)
+                    || notes[0].contains(&blocker.display().to_string())),
+            "{}: {notes:?}",
+            path.display()
+        );
+    }
+    assert_eq!(std::fs::read_to_string(&blocker).unwrap(), "x");
+}
+
+/// Makes a FIFO at `path` with `mkfifo`.
+#[cfg(unix)]
+fn mkfifo(path: &Path) {
+    let status = std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .expect("mkfifo");
+    assert!(status.success());
+}
+
+/// A FIFO in place of a table file is not read (that would wait for a writer forever): it is
+/// reported and replaced by the table; a FIFO in place of the lock file means a table built in
+/// memory, with a note.
+#[cfg(unix)]
+#[test]
+fn a_fifo_in_place_of_a_cache_file_never_hangs() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = scratch("fifo");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("t.bin");
+    mkfifo(&path);
+    let builds = Arc::new(AtomicUsize::new(0));
+    let (t, notes) = table_with_notes(&path, &builds);
+    assert_eq!(t, vec![4.5; 3]);
     assert!(
-        text.contains("file")
-            && text.contains("cache directory")
-            && text.contains("not a directory"),
-        "{text}"
+        notes.len() == 1 && notes[0].contains("not a regular file") && notes[0].contains("t.bin"),
+        "{notes:?}"
+    );
+    assert!(std::fs::metadata(&path).unwrap().is_file());
+    let (again, _) = table_with_notes(&path, &builds);
+    assert_eq!((again, builds.load(Ordering::Relaxed)), (vec![4.5; 3], 1));
+    // A FIFO as the lock file (and no table yet).
+    let other = dir.join("u.bin");
+    mkfifo(&other.with_extension("lock"));
+    let (t, notes) = table_with_notes(&other, &builds);
+    assert_eq!(t, vec![4.5; 3]);
+    assert!(
+        notes.len() == 1
+            && notes[0].contains("u.lock")
+            && notes[0].contains("not a regular file")
+            && notes[0].contains("from memory"),
+        "{notes:?}"
+    );
+    assert!(std::fs::metadata(other.with_extension("lock"))
+        .unwrap()
+        .file_type()
+        .is_fifo());
+    // The read-only path (cached tensors, never built) reports it too.
+    let notes = Notes(Mutex::new(Vec::new()));
+    let none = read_cached(&dir.join("u.lock"), "test tensors", &notes, |v| {
+        Some(v.to_vec())
+    });
+    assert!(none.is_none());
+    let notes = notes.0.into_inner().unwrap();
+    assert!(notes[0].contains("not a regular file"), "{notes:?}");
+}
+
+/// A tensor file with a valid checksum but a crafted basis size (one whose product with the lattice
+/// length wraps to 2048, which panicked when the basis was sliced) is rebuilt with a note naming the
+/// file, never a panic.
+#[test]
+fn a_crafted_basis_size_with_a_valid_checksum_is_rebuilt() {
+    use crate::loops::lattice::Lattice;
+    let dir = scratch("crafted");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("basis.bin");
+    let lattice = Lattice::new(1e-5, 1e3, 0.05);
+    let n = crate::loops::basis::wrapping_basis_size(lattice.len);
+    let mut values = vec![n];
+    values.extend(vec![1.0; lattice.len + 4096]);
+    file::write_f64s(&path, &values).unwrap();
+    let notes = Notes(Mutex::new(Vec::new()));
+    let n = cached(
+        &path,
+        "crafted basis",
+        |v: &[f64]| LinearBasis::from_f64s(lattice.clone(), v).map(|(b, _)| b.len()),
+        || 0,
+        |_| vec![0.0],
+        &notes,
+    )
+    .unwrap();
+    assert_eq!(n, 0, "built, not read");
+    let notes = notes.0.into_inner().unwrap();
+    assert!(
+        notes[0].contains("basis.bin") && notes[0].contains("consistency checks"),
+        "{notes:?}"
     );
 }

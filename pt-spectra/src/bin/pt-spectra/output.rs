@@ -58,11 +58,12 @@ fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
-/// Writes `table` as text to `out`, or to standard output, after checking that every value is finite.
+/// Writes `table` as text to `out` (atomically: an existing file is replaced only by the whole new
+/// table), or to standard output, after checking that every value is finite.
 pub fn write_output(out: Option<&PathBuf>, table: &Table) -> Result<()> {
     let text = table.checked()?.to_text();
     match out {
-        Some(path) => std::fs::write(path, text)
+        Some(path) => pt_spectra::output::write_atomic(path, text.as_bytes())
             .with_context(|| format!("cannot write `{}`", path.display()))?,
         None => std::io::stdout().write_all(text.as_bytes())?,
     }

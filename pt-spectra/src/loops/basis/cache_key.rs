@@ -31,7 +31,7 @@ pub(crate) fn cache_file_name(prefix: &str, version: u32, key: &[f64]) -> String
 /// then the key, equal to 12 significant digits: [`canonical`]) and every value is finite; `None` for
 /// a file made for other settings.
 pub(crate) fn after_key<'a>(values: &'a [f64], expected: &[f64]) -> Option<&'a [f64]> {
-    let len = *values.first()? as usize;
+    let len = stored_count(*values.first()?, expected.len())?;
     let stored = values.get(1..1 + len)?;
     if len != expected.len()
         || stored
@@ -45,6 +45,34 @@ pub(crate) fn after_key<'a>(values: &'a [f64], expected: &[f64]) -> Option<&'a [
         return None;
     }
     Some(&values[1 + len..])
+}
+
+/// The most basis functions a cache file may declare: the bases in use have [`BASIS_SIZE`]; a larger
+/// count is a corrupted or crafted header, refused before any size is computed from it (so that the
+/// n³-sized products of the tensors stay far from overflow).
+pub(crate) const MAX_STORED_BASIS: usize = 1024;
+
+/// `value`, a size read from a cache file, as a count if it is a whole number in `0..=max`; `None`
+/// (the file is not used) otherwise. Every size read from a file goes through this before it is used,
+/// with `max` a sane maximum or the number of values the file still holds.
+pub(crate) fn stored_count(value: f64, max: usize) -> Option<usize> {
+    (value.is_finite() && value >= 0.0 && value.fract() == 0.0 && value <= max as f64)
+        .then_some(value as usize)
+}
+
+/// The values after the points per k and the number of replicas of a tensor file, if they are
+/// `points` and `replicas` (those the settings give: a file that disagrees is not used).
+pub(crate) fn after_points<'a>(
+    values: &'a [f64],
+    points: &[usize],
+    replicas: usize,
+) -> Option<&'a [f64]> {
+    let stored = values.get(..=points.len())?;
+    let equal = stored[..points.len()]
+        .iter()
+        .zip(points)
+        .all(|(&s, &p)| s == p as f64);
+    (equal && stored[points.len()] == replicas as f64).then(|| &values[points.len() + 1..])
 }
 
 #[cfg(test)]

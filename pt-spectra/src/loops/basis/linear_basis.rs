@@ -313,9 +313,9 @@ impl LinearBasis {
     /// The basis on `lattice` from [`to_f64s`](Self::to_f64s) values (the rest of the slice
     /// returned), or `None` if they do not fit.
     pub(crate) fn from_f64s(lattice: Lattice, values: &[f64]) -> Option<(Self, &[f64])> {
-        let n = *values.first()? as usize;
+        let n = super::stored_count(*values.first()?, super::MAX_STORED_BASIS)?;
         let len = lattice.len;
-        let size = 1 + len + len * n;
+        let size = len.checked_mul(n)?.checked_add(1 + len)?;
         if n == 0 || values.len() < size {
             return None;
         }
@@ -327,6 +327,22 @@ impl LinearBasis {
         );
         Some((basis, &values[size..]))
     }
+}
+
+/// A crafted basis size for a lattice of `len` points (odd, as every [`Lattice`]) that an f64 holds
+/// exactly and whose product with `len` wraps to 2048 in 64 bits: n = 2^11 m with m·len ≡ 1 mod
+/// 2^53. Unchecked, such a file passes the length check and panics when the basis is sliced.
+#[cfg(test)]
+pub(crate) fn wrapping_basis_size(len: usize) -> f64 {
+    let len = len as u64;
+    // Newton's iteration for the inverse of an odd number modulo 2^64 (each step doubles the bits).
+    let mut inverse = len;
+    for _ in 0..6 {
+        inverse = inverse.wrapping_mul(2u64.wrapping_sub(len.wrapping_mul(inverse)));
+    }
+    let n = (inverse & ((1 << 53) - 1)) << 11;
+    assert_eq!(n.wrapping_mul(len), 2048);
+    n as f64
 }
 
 /// The smoothed residual is evaluated at every this many lattice points (0.4 of the smoothing width
@@ -413,6 +429,39 @@ mod tests {
         let mut out = vec![0.0; 2];
         basis.at_ln(lattice.x(100), &mut out);
         assert!((out[1] - basis.row(100)[1]).abs() < 1e-15);
+    }
+
+    /// A basis size read from a cache file (whose checksum is valid: a crafted or mis-written file) is
+    /// bounded before use: a huge, negative, non-integer or non-finite count, or one above
+    /// [`super::super::MAX_STORED_BASIS`], gives `None` (the file is rebuilt), never a panic or a
+    /// huge allocation ([`wrapping_basis_size`]: the size that panicked at the slicing of φ).
+    #[test]
+    fn a_crafted_basis_size_is_refused() {
+        let lattice = Lattice::new(1e-5, 1e3, 0.05);
+        let training: Vec<Vec<f64>> = [(1.0, 1.0), (0.9, 2.0)]
+            .iter()
+            .map(|&(n, a)| family(&lattice, n, a))
+            .collect();
+        let good = LinearBasis::greedy(lattice.clone(), &[], &training, 10).to_f64s();
+        let (back, rest) = LinearBasis::from_f64s(lattice.clone(), &good).unwrap();
+        assert!(back.len() == 2 && rest.is_empty());
+        let mut long = good.clone();
+        long.resize(good.len() + 4096, 0.5);
+        for n in [
+            wrapping_basis_size(lattice.len),
+            2f64.powi(63),
+            1e18,
+            1e300,
+            f64::INFINITY,
+            f64::NAN,
+            -1.0,
+            2.5,
+            1025.0,
+        ] {
+            let mut v = long.clone();
+            v[0] = n;
+            assert!(LinearBasis::from_f64s(lattice.clone(), &v).is_none(), "{n}");
+        }
     }
 
     #[test]

@@ -218,9 +218,14 @@ impl LowRank {
     /// The form from [`to_f64s`](Self::to_f64s) values (and the rest of the slice), if they fit.
     pub(crate) fn from_f64s(values: &[f64]) -> Option<(Self, &[f64])> {
         let head = values.get(..5)?;
-        let [rows, columns, rank, degree, n] = std::array::from_fn(|i| head[i] as usize);
-        let sizes = [n, rows, rows * rank, rank * columns];
-        let total = 5 + sizes.iter().sum::<usize>();
+        // Every size is at most the values the file holds (checked before any product is formed).
+        let mut counts = head.iter().map(|&v| super::stored_count(v, values.len()));
+        let [rows, columns, rank, degree, n] = std::array::from_fn(|_| counts.next().flatten());
+        let [rows, columns, rank, degree, n] = [rows?, columns?, rank?, degree?, n?];
+        let sizes = [n, rows, rows.checked_mul(rank)?, rank.checked_mul(columns)?];
+        let total = sizes
+            .iter()
+            .try_fold(5_usize, |total, &size| total.checked_add(size))?;
         if values.len() < total || !(2..=3).contains(&degree) {
             return None;
         }

@@ -47,7 +47,11 @@ mod tensors;
 mod tns;
 pub mod training;
 
-pub(crate) use cache_key::{after_key, cache_file_name};
+pub(crate) use cache_key::{
+    after_key, after_points, cache_file_name, stored_count, MAX_STORED_BASIS,
+};
+#[cfg(test)]
+pub(crate) use linear_basis::wrapping_basis_size;
 pub use linear_basis::{LinearBasis, Projection, SMOOTHING};
 pub use one_loop::{BasisOneLoop, OneLoopBasis};
 pub use redshift::{RedshiftBasis, RedshiftFamily, SpectrumFamily};
@@ -427,16 +431,20 @@ impl TwoLoopBasis {
     ) -> Option<Self> {
         let expected = key(k, precision, family);
         let rest = after_key(values, &expected)?;
-        let points: Vec<usize> = rest.get(..k.len())?.iter().map(|&p| p as usize).collect();
-        let replicas = *rest.get(k.len())? as usize;
-        let (basis, mut rest) =
-            LinearBasis::from_f64s(lattice_of(precision), &rest[k.len() + 1..])?;
+        // The stored points are those the settings give; the replicas are the settings' own.
+        let points: Vec<usize> = k
+            .iter()
+            .map(|&k| points_at(k, precision.two_loop_points))
+            .collect();
+        let replicas = precision.two_loop_replicas;
+        let rest = after_points(rest, &points, replicas)?;
+        let (basis, mut rest) = LinearBasis::from_f64s(lattice_of(precision), rest)?;
         let n = basis.len();
         let sizes = [
             3 * FORM_KERNELS * n * (n + 1) / 2,
-            replicas * ACC * triples(error_functions(n)),
+            replicas.checked_mul(ACC * triples(error_functions(n)))?,
         ];
-        let per_k = k.len() * sizes.iter().sum::<usize>();
+        let per_k = k.len().checked_mul(sizes[0].checked_add(sizes[1])?)?;
         if rest.len() < per_k {
             return None;
         }

@@ -519,7 +519,7 @@ mod plan_tests {
                 &crate::linear::LogGrid::default(),
             )
             .unwrap();
-        let batch = plan.evaluate_batch(&[camb.clone(), eh.clone()]);
+        let batch = plan.evaluate_batch(&[camb.clone(), eh.clone()]).unwrap();
         let (on_basis, fallback) = (batch[0].as_ref().unwrap(), batch[1].as_ref().unwrap());
         assert!(matches!(
             on_basis.terms.one_loop_source,

@@ -19,7 +19,9 @@ use super::{
 };
 use crate::linear::LinearSpectrum;
 use crate::loops::lattice::Lattice;
-use crate::loops::rsd_two_loop::{to_coefficients, RsdTwoLoopTerms, Sampling, COEFFICIENTS};
+use crate::loops::rsd_two_loop::{
+    rsd_points_at, to_coefficients, RsdTwoLoopTerms, Sampling, COEFFICIENTS,
+};
 use crate::loops::two_loop::integral_scale;
 use crate::loops::TwoLoopSettings;
 use crate::simd::{from_bf16, matvec_bf16, to_bf16};
@@ -331,13 +333,17 @@ impl RsdTwoLoopBasis {
     ) -> Option<Self> {
         let expected = key(k, q_range, lattice_step, settings, family);
         let rest = after_key(values, &expected)?;
-        let points: Vec<usize> = rest.get(..k.len())?.iter().map(|&p| p as usize).collect();
-        let replicas = *rest.get(k.len())? as usize;
-        let (basis, mut rest) =
-            LinearBasis::from_f64s(Self::lattice(q_range, lattice_step), &rest[k.len() + 1..])?;
+        // The stored points are those the settings give; the replicas are the settings' own.
+        let points: Vec<usize> = k
+            .iter()
+            .map(|&k| rsd_points_at(k, settings.points))
+            .collect();
+        let replicas = settings.replicas;
+        let rest = super::after_points(rest, &points, replicas)?;
+        let (basis, mut rest) = LinearBasis::from_f64s(Self::lattice(q_range, lattice_step), rest)?;
         let n = basis.len();
-        let size = replicas * COEFFICIENTS * triples(error_functions(n));
-        if rest.len() < k.len() * size {
+        let size = replicas.checked_mul(COEFFICIENTS * triples(error_functions(n)))?;
+        if rest.len() < k.len().checked_mul(size)? {
             return None;
         }
         let mut deviations = Vec::new();

@@ -206,13 +206,14 @@ fn pieces(points: Vec<(f64, f64)>) -> Vec<Vec<(f64, f64)>> {
     out
 }
 
-/// Draws `fig` on `root`.
+/// Draws `fig` on `root` and presents it (writes the file of a file backend).
 pub fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("drawing: {e:?}");
     root.fill(&WHITE).map_err(e)?;
+    let whole = root.clone();
     let root = root.titled(&fig.title, ("sans-serif", 22)).map_err(e)?;
     let (_, height) = root.dim_in_pixel();
     let n = fig.panels.len();
@@ -373,7 +374,8 @@ where
             }
         }
     }
-    Ok(())
+    // Written here, where a failure is an error (on drop, plotters would ignore it).
+    whole.present().map_err(e)
 }
 
 type Chart<'a, DB> = ChartContext<

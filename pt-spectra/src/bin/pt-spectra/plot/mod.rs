@@ -170,15 +170,21 @@ pub fn run(args: &Args) -> Result<()> {
         figure.title.clone_from(&args.title);
     }
     let size = (1000, figure.height);
-    if extension.as_deref() == Some("png") {
-        draw::draw(
-            BitMapBackend::new(&args.out, size).into_drawing_area(),
-            &figure,
-        )
-    } else {
-        draw::draw(
-            SVGBackend::new(&args.out, size).into_drawing_area(),
-            &figure,
-        )
-    }
+    // Drawn into a temporary file of the same extension, renamed over --out once whole.
+    let mut drawn = Ok(());
+    pt_spectra::output::replace_with(&args.out, |tmp| {
+        drawn = if extension.as_deref() == Some("png") {
+            draw::draw(BitMapBackend::new(tmp, size).into_drawing_area(), &figure)
+        } else {
+            draw::draw(SVGBackend::new(tmp, size).into_drawing_area(), &figure)
+        };
+        match &drawn {
+            Ok(()) => Ok(()),
+            Err(e) => Err(std::io::Error::other(e.to_string())),
+        }
+    })
+    .map_err(|e| match drawn {
+        Err(drawing) => drawing,
+        Ok(()) => anyhow::anyhow!("cannot write `{}`: {e}", args.out.display()),
+    })
 }
