@@ -10,7 +10,9 @@ DATA_DIR holds the npz files of make_emulator_neutrinos.py (train_*, corners_*, 
      cubic spline in ln k of CAMB's tables; principal components; each coefficient a polynomial
      (Legendre products of total degree --degree) of the base emulator's seven coordinates.
   2. The bound: the early dark-energy density q = rho_DE/rho_m at a = 0.1 (the emulator's seventh
-     coordinate) must not exceed --q-bound times q_max; beyond, the emulator refuses.
+     coordinate) must not exceed --q-bound times q_max, and the six shape parameters must lie in the
+     box shrunk about its centre by --shrink (the corners of the training box are beyond the stated
+     accuracy); beyond, the emulator refuses.
   3. The check: every spectrum of corners_*, edge_*, random_* inside the bounded prior (each at z = 0,
      0.5, 1, 2, 3) predicted as the Rust code does, |Delta ln P| of P_cb and P_m for 1e-3 <= k <= 1
      h/Mpc, per setting; the worst is written into the file (the header prints it) and the report.
@@ -28,7 +30,6 @@ from scipy.interpolate import CubicSpline
 sys.path.insert(0, str(Path(__file__).parent))
 from fit_emulator import (drag_horizon, early_dark_energy, exponents, features, growth_md,  # noqa: E402
                           interpolate_z, primordial)
-from make_emulator_training import K_GRID, Z_NODES  # noqa: E402
 
 HERE = Path(__file__).parent
 SETTING_ONE = 1  # the code of "one massive species" in the file
@@ -168,6 +169,10 @@ def main():
     ap.add_argument("--out")
     ap.add_argument("--report")
     ap.add_argument("--train-limit", type=int, default=None)
+    ap.add_argument("--kinds", default="corners,edge,random", help="check sets (file prefixes)")
+    ap.add_argument("--shrink", type=float, default=1.0,
+                    help="the stated box of the six shape parameters: centre +- shrink x half-width")
+    ap.add_argument("--no-head", action="store_true", help="write no neutrino head")
     args = ap.parse_args()
     emu = read_v1(args.inp)
     train = load(args.data, "train")
@@ -179,7 +184,7 @@ def main():
         print(f"head: {len(train['params'])} training cosmologies, {len(head[0])} terms, {args.pcs} PCs")
     lines = [f"q bound: q <= {args.q_bound} q_max (q_max = {emu['q_max']:.6g}, a = {emu['a_e']})"]
     worst = {}
-    for kind in ("corners", "edge", "random"):
+    for kind in args.kinds.split(","):
         d = load(args.data, kind)
         if d is None:
             continue
@@ -200,18 +205,26 @@ def main():
     print(text)
     if args.report:
         Path(args.report).write_text(text + "\n")
-    if args.out and head is not None:
-        write(args.out, emu, head, args.q_bound, worst)
+    if args.out:
+        write(args.out, emu, None if args.no_head else head, args.q_bound, args.shrink, worst)
 
 
-def write(path, emu, head, q_bound, worst):
-    """PTEMU002: the PTEMU001 body, then the bound, the measured worst errors and the head."""
-    h_exps, h_models = head
+def write(path, emu, head, q_bound, shrink, worst):
+    """PTEMU002: the PTEMU001 body, then the stated box, the bound, the measured worst errors and the
+    heads."""
+    centre, half = emu["prior"][:6].mean(1), (emu["prior"][:6, 1] - emu["prior"][:6, 0]) / 2
+    box = np.column_stack([centre - shrink * half, centre + shrink * half])
+    box[3, 0] = emu["prior"][3, 0]  # massless neutrinos stay inside (checked by the massless set)
     with open(path, "wb") as f:
         f.write(b"PTEMU002")
         f.write(emu["raw"][8:])
+        f.write(np.asarray(box, "<f8").tobytes())
         f.write(np.array([q_bound, *worst["degenerate"]], "<f8").tobytes())
-        f.write(struct.pack("<I", 1))  # one head
+        f.write(struct.pack("<I", 0 if head is None else 1))
+        if head is None:
+            print("wrote", path, Path(path).stat().st_size, "bytes")
+            return
+        h_exps, h_models = head
         f.write(struct.pack("<4I", SETTING_ONE, len(h_exps), h_models[0][1].shape[0],
                             h_models[1][1].shape[0]))
         f.write(np.array(h_exps, np.uint8).tobytes())

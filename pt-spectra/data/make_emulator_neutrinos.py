@@ -12,6 +12,7 @@ KIND:
            parameters of the prior, A_s = 2e-9, n_s = 1, at the base emulator's Z_NODES; fit_emulator.py
            --neutrinos fits ln(P_one/P_degenerate) (of P_cb and of P_m) to it.
   corners  the 64 corners of the six shape parameters' box (A_s = 2.1e-9, n_s = 0.965) at Z_CHECK.
+  massless the 32 corners of the box with Sigma m_nu = 0 (the lower end of m_nu is not shrunk).
   edge     the early-dark-energy edge: w0 + wa in EDGE_SUMS on its two ends (w0 = -0.7, or wa = 0.5),
            the other four shape parameters at the 16 corners of their box, at Z_CHECK.
   random   uniform draws (seed 17) over all eight parameters, each at Z_CHECK.
@@ -57,6 +58,10 @@ def cosmologies(kind, shrink=1.0):
         return np.hstack([x, np.tile([np.log(20.0), 1.0], (len(x), 1))]), Z_NODES
     if kind == "corners":
         x = np.array(list(itertools.product(*[box[p] for p in NAMES[:6]])))
+        return np.hstack([x, np.tile(PLANCK_AS, (len(x), 1))]), Z_CHECK
+    if kind == "massless":  # the 32 corners of the box with Sigma m_nu = 0 (its lower end, unshrunk)
+        b = dict(box, m_nu=(0.0,))
+        x = np.array(list(itertools.product(*[b[p] for p in NAMES[:6]])))
         return np.hstack([x, np.tile(PLANCK_AS, (len(x), 1))]), Z_CHECK
     if kind == "edge":
         rows = []

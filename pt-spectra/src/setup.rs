@@ -171,6 +171,7 @@ pub fn prepare(request: Request) -> Result<Prepared> {
         LinearSource::Embedded | LinearSource::Emulator => {
             let emulated = emulate(&c, z)?;
             description.extend(emulated.description);
+            warnings.extend(emulated.warning);
             if let Some((cb, f_cb)) = emulated.cb {
                 spectrum_cb = Some(cb);
                 f = f_cb;
@@ -241,6 +242,8 @@ struct Emulated {
     /// P_cb and f_cb(K_GROWTH_RATE) with massive neutrinos.
     cb: Option<(LinearSpectrum, f64)>,
     description: Vec<String>,
+    /// σ8(z = 0) outside the typical range for an A_s input (a likely mistyped A_s).
+    warning: Option<String>,
 }
 
 /// The emulated spectra of `c` at `z`, with the header lines that say so.
@@ -288,10 +291,22 @@ fn emulate(c: &Cosmology, z: f64) -> Result<Emulated> {
     } else {
         None
     };
+    let warning = match c.amplitude {
+        crate::cosmology::Amplitude::As { a_s, .. } => {
+            let today = if z == 0.0 {
+                e.sigma8
+            } else {
+                emulator.spectra(c, 0.0)?.sigma8
+            };
+            crate::cosmology::sigma8_warning(today, a_s)
+        }
+        crate::cosmology::Amplitude::Sigma8(_) => None,
+    };
     Ok(Emulated {
         spectrum,
         cb,
         description,
+        warning,
     })
 }
 
@@ -429,6 +444,33 @@ mod tests {
         .unwrap();
         assert!(p.warnings.is_empty(), "{:?}", p.warnings);
         assert!(p.description.iter().any(|l| l.contains("emulator")));
+        // the header states the measured worst case over the prior and the neutrino setting
+        let emulator = LinearEmulator::embedded().unwrap();
+        let worst = emulator
+            .worst(crate::cosmology::Neutrinos::ThreeDegenerate)
+            .unwrap();
+        let line = &p.description[0];
+        assert!(line.contains("worst |Delta ln P| measured against CAMB over the whole prior"));
+        assert!(line.contains(&format!("{:.1e}", worst[1])), "{line}");
+        assert!(p.description.iter().any(|l| l == "neutrinos: massless, N_eff = 3.046"));
+        // an accepted but mistyped A_s (σ8 = 5.7) is warned about
+        let big = NamedCosmology {
+            name: "big".into(),
+            cosmology: Cosmology::planck2018()
+                .with_amplitude(crate::cosmology::Amplitude::a_s(1e-7))
+                .unwrap(),
+        };
+        let p = prepare(Request {
+            source: LinearSource::Emulator,
+            cosmology: Some(big),
+            z: 0.5,
+        })
+        .unwrap();
+        assert!(
+            p.warnings.iter().any(|w| w.contains("A_s = 1e-07") && w.contains("sigma8")),
+            "{:?}",
+            p.warnings
+        );
         // The emulated spectrum is CAMB's to its error (1e-3 here, k in [0.01, 0.3]).
         let camb = planck(0.0);
         for k in LogGrid::new(0.01, 0.3, 30).unwrap().points() {
@@ -448,6 +490,13 @@ mod tests {
             z: 0.5,
         })
         .unwrap();
+        assert!(
+            p.description
+                .iter()
+                .any(|l| l.starts_with("neutrinos: three degenerate massive species")),
+            "{:?}",
+            p.description
+        );
         let cb = p.spectrum_cb.as_ref().unwrap();
         assert!(cb.eval(0.5) > p.spectrum.eval(0.5) * 1.02);
         assert!((p.growth_rate - c.growth_rate(0.5)).abs() < 0.02);

@@ -181,7 +181,7 @@ def test_warnings_for_defaults_that_may_not_fit():
     assert abs(t["P_lin"][0] / np.interp(0.1, kl, pl) - 1) < 2e-3
     with pytest.raises(ValueError, match="m_nu = 0.8"):
         pt.real(k=[0.1], model="linear", cosmology={"h": 0.67, "omega_b": 0.022, "omega_cdm": 0.12,
-                                                   "n_s": 0.96, "A_s": 2.1e-9, "m_ncdm": 0.8})
+                                                   "n_s": 0.96, "A_s": 2.1e-9, "m_nu": 0.8})
 
 
 def test_the_gil_is_released_during_a_computation():

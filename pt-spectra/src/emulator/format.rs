@@ -20,6 +20,8 @@
 //! Layout `PTEMU002` (`pt-spectra/data/fit_emulator_neutrinos.py`) is the same after its magic, then:
 //!
 //! ```text
+//! box          6 × (f64 min, f64 max): the stated prior of the six shape parameters (inside the
+//!                       training box of `prior`, which still maps them to [−1, 1])
 //! q_bound      f64      the prior's bound on the early dark energy: q/q_max ≤ q_bound (in (0, 1])
 //! worst        2 × f64  the measured worst |Δ ln P| of P_cb and P_m over the bounded prior
 //!                       (three degenerate neutrinos)
@@ -29,7 +31,7 @@
 //!              as above with this head's n_terms and n_pc), worst 2 × f64 (as above, this setting)
 //! ```
 //!
-//! A `PTEMU001` file reads as q_bound = 1, no heads, and the largest per-x error as the worst.
+//! A `PTEMU001` file reads as box = prior, q_bound = 1, no heads, and the largest per-x error as the worst.
 
 use super::prior::{PriorRange, COORDINATES, PARAMETER_NAMES};
 use crate::cosmology::Neutrinos;
@@ -86,6 +88,8 @@ pub struct Parsed {
     pub q_max: f64,
     pub targets: [Target; 2],
     pub error: [Vec<f64>; 2],
+    /// The stated prior of the six shape parameters (the training box for a `PTEMU001` file).
+    pub stated: Vec<PriorRange>,
     /// q/q_max ≤ q_bound (1 for a `PTEMU001` file).
     pub q_bound: f64,
     /// Measured worst |Δ ln P| of P_cb and P_m (three degenerate neutrinos).
@@ -241,7 +245,24 @@ pub fn parse(bytes: &[u8], what: &str) -> Result<Parsed> {
         r.target(n_z * n_x, n_terms, n_pc[1])?,
     ];
     let error = [r.f64s(n_x)?, r.f64s(n_x)?];
-    let (q_bound, worst, heads) = if version_2 {
+    let (stated, q_bound, worst, heads) = if version_2 {
+        let b = r.f64s(12)?;
+        let stated: Vec<PriorRange> = prior[..6]
+            .iter()
+            .enumerate()
+            .map(|(i, p)| PriorRange {
+                name: p.name,
+                min: b[2 * i],
+                max: b[2 * i + 1],
+            })
+            .collect();
+        if stated
+            .iter()
+            .zip(&prior)
+            .any(|(s, p)| !(s.min < s.max && s.min >= p.min && s.max <= p.max))
+        {
+            return Err(r.fail("the stated prior must be a non-empty box inside the training box"));
+        }
         let v = r.f64s(3)?;
         if !(v[0] > 0.0 && v[0] <= 1.0) || v[1] < 0.0 || v[2] < 0.0 {
             return Err(r.fail("the prior bound must be in (0, 1] and the errors non-negative"));
@@ -255,10 +276,11 @@ pub fn parse(bytes: &[u8], what: &str) -> Result<Parsed> {
         for _ in 0..n_heads {
             heads.push(r.head(n_z * n_x)?);
         }
-        (v[0], [v[1], v[2]], heads)
+        (stated, v[0], [v[1], v[2]], heads)
     } else {
         let largest = |e: &[f64]| e.iter().copied().fold(0.0, f64::max);
-        (1.0, [largest(&error[0]), largest(&error[1])], Vec::new())
+        let stated = prior[..6].to_vec();
+        (stated, 1.0, [largest(&error[0]), largest(&error[1])], Vec::new())
     };
     if r.at != bytes.len() {
         return Err(r.fail("bytes left after the last table"));
@@ -274,6 +296,7 @@ pub fn parse(bytes: &[u8], what: &str) -> Result<Parsed> {
         q_max: lx[3],
         targets,
         error,
+        stated,
         q_bound,
         worst,
         heads,

@@ -149,8 +149,10 @@ impl LinearEmulator {
 
     /// The prior: the range of each of the eight parameters it was trained or tested on. The six shape
     /// parameters must lie inside; A_s and n_s may lie outside (their dependence is exact).
-    pub fn prior(&self) -> &[PriorRange] {
-        &self.file.prior
+    pub fn prior(&self) -> Vec<PriorRange> {
+        let mut out = self.file.stated.clone();
+        out.extend_from_slice(&self.file.prior[SHAPE_PARAMETERS..]);
+        out
     }
 
     /// The redshift range, [z_min, z_max].
@@ -161,7 +163,7 @@ impl LinearEmulator {
 
     /// One line for output headers: what the emulator is and where it is valid.
     pub fn describe(&self) -> String {
-        let prior: Vec<String> = self.file.prior[..SHAPE_PARAMETERS]
+        let prior: Vec<String> = self.file.stated
             .iter()
             .map(|p| format!("{} in [{}, {}]", p.name, p.min, p.max))
             .collect();
@@ -213,6 +215,7 @@ impl LinearEmulator {
         let point = PriorPoint::of(cosmology)?;
         let u = point.coordinates(
             &self.file.prior,
+            &self.file.stated,
             self.file.a_early,
             self.file.q_max,
             self.file.q_bound,

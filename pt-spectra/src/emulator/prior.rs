@@ -99,6 +99,25 @@ impl PriorPoint {
     /// [`Error::InvalidParameter`] naming the first shape parameter outside the box, with the range in
     /// the message.
     pub fn unit(&self, prior: &[PriorRange]) -> Result<[f64; SHAPE_PARAMETERS]> {
+        self.unit_in(prior, prior)
+    }
+
+    /// [`unit`](Self::unit) with the range check against `stated` (a box inside `prior`, the prior
+    /// the emulator states) and the mapping by `prior` (the training box).
+    ///
+    /// # Errors
+    /// [`Error::OutsidePrior`] naming the first shape parameter outside `stated`.
+    pub fn unit_in(
+        &self,
+        prior: &[PriorRange],
+        stated: &[PriorRange],
+    ) -> Result<[f64; SHAPE_PARAMETERS]> {
+        for (range, &v) in stated.iter().zip(&self.values).take(SHAPE_PARAMETERS) {
+            let t = 2.0 * (v - range.min) / (range.max - range.min) - 1.0;
+            if t.is_nan() || t.abs() > 1.0 + 2.0 * EDGE_TOL {
+                return Err(outside(range, v));
+            }
+        }
         let mut u = [0.0; SHAPE_PARAMETERS];
         for (i, (range, &v)) in prior
             .iter()
@@ -125,16 +144,18 @@ impl PriorPoint {
     /// closest to 0 is beyond the emulator's accuracy).
     ///
     /// # Errors
-    /// As [`unit`](Self::unit); [`Error::OutsidePrior`] naming [`EARLY_DE_NAME`] and its bound for q
+    /// As [`unit_in`](Self::unit_in) (`stated`: the box the emulator states, inside the training box
+    /// `prior`); [`Error::OutsidePrior`] naming [`EARLY_DE_NAME`] and its bound for q
     /// beyond it.
     pub fn coordinates(
         &self,
         prior: &[PriorRange],
+        stated: &[PriorRange],
         a_early: f64,
         q_max: f64,
         q_bound: f64,
     ) -> Result<[f64; COORDINATES]> {
-        let u = self.unit(prior)?;
+        let u = self.unit_in(prior, stated)?;
         let [_, om, _, _, w0, wa, ..] = self.values;
         let q =
             (1.0 - om) / om * a_early.powf(-3.0 * (w0 + wa)) * (-3.0 * wa * (1.0 - a_early)).exp();
