@@ -449,8 +449,11 @@ mod tests {
         let worst = emulator
             .worst(crate::cosmology::Neutrinos::ThreeDegenerate)
             .unwrap();
-        let line = &p.description[0];
-        assert!(line.contains("worst |Delta ln P| measured against CAMB over the whole prior"));
+        let line = p
+            .description
+            .iter()
+            .find(|l| l.contains("worst |Delta ln P| measured against CAMB over the whole prior"))
+            .expect("the emulator's line");
         assert!(line.contains(&format!("{:.1e}", worst[1])), "{line}");
         assert!(p.description.iter().any(|l| l == "neutrinos: massless, N_eff = 3.046"));
         // an accepted but mistyped A_s (σ8 = 5.7) is warned about
@@ -467,7 +470,7 @@ mod tests {
         })
         .unwrap();
         assert!(
-            p.warnings.iter().any(|w| w.contains("A_s = 1e-07") && w.contains("sigma8")),
+            p.warnings.iter().any(|w| w.contains("A_s = 1e-7") && w.contains("sigma8(z = 0) = 5.668")),
             "{:?}",
             p.warnings
         );

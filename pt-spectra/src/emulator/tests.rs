@@ -45,6 +45,16 @@ fn heldout() -> Vec<Heldout> {
     out
 }
 
+/// The embedded emulator with its stated prior widened to the training box and no early dark-energy
+/// bound: the held-out sets below were drawn over the training box and check the fit there (its corners
+/// are beyond the stated accuracy and refused by the emulator itself, tested further below).
+fn on_the_training_box() -> LinearEmulator {
+    let mut e = LinearEmulator::embedded().unwrap();
+    e.file.stated = e.file.prior[..SHAPE_PARAMETERS].to_vec();
+    e.file.q_bound = 1.0;
+    e
+}
+
 fn cosmology(p: &[f64; 8]) -> Cosmology {
     let [ob, om, h, m_nu, w0, wa, ln_as, n_s] = *p;
     let mut c = Cosmology::planck2018();
@@ -63,7 +73,7 @@ fn cosmology(p: &[f64; 8]) -> Cosmology {
 
 #[test]
 fn held_out_camb_spectra_growth_rates_and_sigma8() {
-    let emulator = LinearEmulator::embedded().unwrap();
+    let emulator = on_the_training_box();
     let (mut worst_p, mut worst_f, mut worst_s8) = (0.0_f64, 0.0_f64, 0.0_f64);
     let mut checked = 0;
     for h in heldout() {
@@ -85,7 +95,7 @@ fn held_out_camb_spectra_growth_rates_and_sigma8() {
         worst_s8 = worst_s8.max((e.sigma8 / h.sigma8 - 1.0).abs());
     }
     eprintln!("held out ({checked}): P {worst_p:.2e}, f_cb {worst_f:.2e}, sigma8 {worst_s8:.2e}");
-    assert!(checked >= 3, "{checked}");
+    assert_eq!(checked, 16);
     assert!(worst_p < 2e-3, "P: {worst_p}");
     assert!(worst_f < 3e-3, "f_cb: {worst_f}");
     assert!(worst_s8 < 1e-3, "sigma8: {worst_s8}");
@@ -203,7 +213,7 @@ fn class_spectra_of_six_cosmologies_agree() {
     // differ on these by 0.7e-3 (Planck, massless) to 5.7e-3 (m_nu = 0.45 eV): the bound is theirs.
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/emulator_class.dat");
     let text = std::fs::read_to_string(path).expect("CLASS table");
-    let emulator = LinearEmulator::embedded().unwrap();
+    let emulator = on_the_training_box();
     let mut worst = 0.0_f64;
     let mut current: Option<(usize, EmulatedSpectra)> = None;
     for line in text.lines().filter(|l| !l.starts_with('#')) {
@@ -236,7 +246,7 @@ fn scale_dependent_growth_agrees_with_camb_transfer_functions() {
         "/tests/data/emulator_growth.dat"
     );
     let text = std::fs::read_to_string(path).expect("growth table");
-    let emulator = LinearEmulator::embedded().unwrap();
+    let emulator = on_the_training_box();
     let (mut worst, mut spread) = (0.0_f64, 0.0_f64);
     let mut current: Option<((usize, u64), ScaleDependentGrowth)> = None;
     for line in text.lines().filter(|l| !l.starts_with('#')) {
