@@ -455,7 +455,10 @@ mod tests {
             .find(|l| l.contains("worst |Delta ln P| measured against CAMB over the whole prior"))
             .expect("the emulator's line");
         assert!(line.contains(&format!("{:.1e}", worst[1])), "{line}");
-        assert!(p.description.iter().any(|l| l == "neutrinos: massless, N_eff = 3.046"));
+        assert!(p
+            .description
+            .iter()
+            .any(|l| l == "neutrinos: massless, N_eff = 3.046"));
         // an accepted but mistyped A_s (σ8 = 5.7) is warned about
         let big = NamedCosmology {
             name: "big".into(),
@@ -463,16 +466,19 @@ mod tests {
                 .with_amplitude(crate::cosmology::Amplitude::a_s(1e-7))
                 .unwrap(),
         };
-        let p = prepare(Request {
+        let mistyped = prepare(Request {
             source: LinearSource::Emulator,
             cosmology: Some(big),
             z: 0.5,
         })
         .unwrap();
         assert!(
-            p.warnings.iter().any(|w| w.contains("A_s = 1e-7") && w.contains("sigma8(z = 0) = 5.668")),
+            mistyped
+                .warnings
+                .iter()
+                .any(|w| w.contains("A_s = 1e-7") && w.contains("sigma8(z = 0) = 5.668")),
             "{:?}",
-            p.warnings
+            mistyped.warnings
         );
         // The emulated spectrum is CAMB's to its error (1e-3 here, k in [0.01, 0.3]).
         let camb = planck(0.0);

@@ -178,7 +178,6 @@ const KEYS: [(&str, Quantity, Unit); 29] = [
     ("m_nu", Quantity::NeutrinoMass, Unit::Same),
 ];
 
-
 /// One `key = value` of the input.
 #[derive(Debug, Clone, Copy)]
 struct Entry<'a> {

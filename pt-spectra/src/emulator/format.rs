@@ -280,7 +280,12 @@ pub fn parse(bytes: &[u8], what: &str) -> Result<Parsed> {
     } else {
         let largest = |e: &[f64]| e.iter().copied().fold(0.0, f64::max);
         let stated = prior[..6].to_vec();
-        (stated, 1.0, [largest(&error[0]), largest(&error[1])], Vec::new())
+        (
+            stated,
+            1.0,
+            [largest(&error[0]), largest(&error[1])],
+            Vec::new(),
+        )
     };
     if r.at != bytes.len() {
         return Err(r.fail("bytes left after the last table"));

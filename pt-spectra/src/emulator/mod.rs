@@ -163,7 +163,9 @@ impl LinearEmulator {
 
     /// One line for output headers: what the emulator is and where it is valid.
     pub fn describe(&self) -> String {
-        let prior: Vec<String> = self.file.stated
+        let prior: Vec<String> = self
+            .file
+            .stated
             .iter()
             .map(|p| format!("{} in [{}, {}]", p.name, p.min, p.max))
             .collect();
@@ -201,7 +203,11 @@ impl LinearEmulator {
         if neutrinos == Neutrinos::ThreeDegenerate {
             return Some(self.file.worst);
         }
-        self.file.heads.iter().find(|h| h.setting == neutrinos).map(|h| h.worst)
+        self.file
+            .heads
+            .iter()
+            .find(|h| h.setting == neutrinos)
+            .map(|h| h.worst)
     }
 
     /// P_m, P_cb and f_cb of `cosmology` at redshift `z`.
@@ -246,7 +252,12 @@ impl LinearEmulator {
             .take(n_x)
             .collect();
         let z = z.clamp(z0, z1);
-        let coefficients = coefficients(&self.file.exponents, &self.file.targets, &u, self.max_degree);
+        let coefficients = coefficients(
+            &self.file.exponents,
+            &self.file.targets,
+            &u,
+            self.max_degree,
+        );
         let head_coefficients = head.map(|h| {
             let c = coefficients_of(h, &u, self.max_degree);
             (h, c)
@@ -458,7 +469,11 @@ fn coefficients(
 }
 
 /// [`coefficients`] of a neutrino head.
-fn coefficients_of(head: &format::Head, u: &[f64; COORDINATES], max_degree: usize) -> [Vec<f64>; 2] {
+fn coefficients_of(
+    head: &format::Head,
+    u: &[f64; COORDINATES],
+    max_degree: usize,
+) -> [Vec<f64>; 2] {
     coefficients(&head.exponents, &head.targets, u, max_degree)
 }
 

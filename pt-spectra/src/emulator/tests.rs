@@ -283,14 +283,22 @@ const STATED_ACCURACY: f64 = 2e-3;
 #[test]
 fn corners_of_the_stated_prior_agree_with_camb() {
     // pt-spectra/tests/data/emulator_corners.dat: CAMB at three corners of the stated box
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/emulator_corners.dat");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/emulator_corners.dat"
+    );
     let text = std::fs::read_to_string(path).expect("corner table");
     let emulator = LinearEmulator::embedded().unwrap();
     let mut worst = 0.0_f64;
     let mut rows = 0;
     for line in text.lines().filter(|l| !l.starts_with('#')) {
-        let v: Vec<f64> = line.split_whitespace().map(|x| x.parse().unwrap()).collect();
-        let e = emulator.spectra(&cosmology(&v[1..9].try_into().unwrap()), v[9]).unwrap();
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        let e = emulator
+            .spectra(&cosmology(&v[1..9].try_into().unwrap()), v[9])
+            .unwrap();
         let (m, cb) = (e.matter().unwrap(), e.cb().unwrap());
         worst = worst
             .max((cb.eval(v[10]) / v[11]).ln().abs())
@@ -322,8 +330,15 @@ fn the_corners_beyond_the_stated_prior_are_refused() {
     c.omega_lambda = 0.74;
     c.omega_b_h2 = 0.05 * c.h * c.h;
     let e = emulator.spectra(&c, 0.0).unwrap_err().to_string();
-    assert!(e.contains("rho_DE/rho_m at a = 0.1") && e.contains("w0, wa"), "{e}");
-    assert!(emulator.describe().contains("rho_DE/rho_m at a = 0.1"), "{}", emulator.describe());
+    assert!(
+        e.contains("rho_DE/rho_m at a = 0.1") && e.contains("w0, wa"),
+        "{e}"
+    );
+    assert!(
+        emulator.describe().contains("rho_DE/rho_m at a = 0.1"),
+        "{}",
+        emulator.describe()
+    );
 }
 
 #[test]
@@ -362,12 +377,16 @@ fn a_file_of_layout_two_is_validated() {
     let mut bad = good.clone();
     let at = good.len() - 4 - 3 * 8 - 12 * 8; // the stated box, with no heads
     bad[at..at + 8].copy_from_slice(&0.0f64.to_le_bytes());
-    let e = LinearEmulator::from_bytes(&bad, "x").unwrap_err().to_string();
+    let e = LinearEmulator::from_bytes(&bad, "x")
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("stated prior"), "{e}");
     // a bound beyond (0, 1]
     let mut bad = good.clone();
     let at = good.len() - 4 - 3 * 8;
     bad[at..at + 8].copy_from_slice(&2.0f64.to_le_bytes());
-    let e = LinearEmulator::from_bytes(&bad, "x").unwrap_err().to_string();
+    let e = LinearEmulator::from_bytes(&bad, "x")
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("prior bound"), "{e}");
 }

@@ -162,7 +162,10 @@ fn camb(
             Err(refuse(
                 origin,
                 c,
-                format!("{} degenerate massive species are not emulated; {SUPPORTED}", c.value),
+                format!(
+                    "{} degenerate massive species are not emulated; {SUPPORTED}",
+                    c.value
+                ),
             ))
         }
     }
@@ -198,7 +201,12 @@ fn class(entries: &[Entry<'_>], origin: &str) -> Result<Option<Neutrinos>> {
         ));
     };
     let how = format!(" (N_ur + {species} x {N_EFF_PER_NCDM} for the massive species)");
-    check_n_eff(origin, n_ur.expect("read"), n_ur_value + N_EFF_PER_NCDM * species, &how)?;
+    check_n_eff(
+        origin,
+        n_ur.expect("read"),
+        n_ur_value + N_EFF_PER_NCDM * species,
+        &how,
+    )?;
     match masses.as_slice() {
         [_] => Ok(Some(Neutrinos::OneMassive)),
         [a, b, c] if a == b && b == c => Ok(Some(Neutrinos::ThreeDegenerate)),
@@ -336,27 +344,51 @@ mod tests {
         // CAMB: mnu or omnuh2 alone is CAMB's default, one massive species
         assert_eq!(setting(CAMB, "mnu = 0.06\n"), OneMassive);
         assert_eq!(setting(CAMB, "omnuh2 = 0.00064\n"), OneMassive);
-        assert_eq!(setting(CAMB, "mnu = 0.06\nnum_massive_neutrinos = 1\n"), OneMassive);
-        assert_eq!(setting(CAMB, "mnu = 0.06\nnum_massive_neutrinos = 3\n"), ThreeDegenerate);
+        assert_eq!(
+            setting(CAMB, "mnu = 0.06\nnum_massive_neutrinos = 1\n"),
+            OneMassive
+        );
+        assert_eq!(
+            setting(CAMB, "mnu = 0.06\nnum_massive_neutrinos = 3\n"),
+            ThreeDegenerate
+        );
         assert_eq!(
             setting(CAMB, "mnu = 0.06\nnum_massive_neutrinos = 3\nneutrino_hierarchy = degenerate\nnnu = 3.046\n"),
             ThreeDegenerate
         );
-        assert_eq!(setting(CAMB, "mnu = 0.1\nneutrino_hierarchy = normal\n"), NormalHierarchy);
-        assert_eq!(setting(CAMB, "mnu = 0.1\nneutrino_hierarchy = inverted\n"), InvertedHierarchy);
+        assert_eq!(
+            setting(CAMB, "mnu = 0.1\nneutrino_hierarchy = normal\n"),
+            NormalHierarchy
+        );
+        assert_eq!(
+            setting(CAMB, "mnu = 0.1\nneutrino_hierarchy = inverted\n"),
+            InvertedHierarchy
+        );
         // CAMB params.ini: massive_neutrinos, massless_neutrinos
         assert_eq!(
-            setting(CAMB, "omnuh2 = 0.00064\nmassless_neutrinos = 2.046\nmassive_neutrinos = 1\n"),
+            setting(
+                CAMB,
+                "omnuh2 = 0.00064\nmassless_neutrinos = 2.046\nmassive_neutrinos = 1\n"
+            ),
             OneMassive
         );
         assert_eq!(
-            setting(CAMB, "omnuh2 = 0.00064\nmassless_neutrinos = 0.046\nmassive_neutrinos = 3\n"),
+            setting(
+                CAMB,
+                "omnuh2 = 0.00064\nmassless_neutrinos = 0.046\nmassive_neutrinos = 3\n"
+            ),
             ThreeDegenerate
         );
         // pt-spectra's own: m_nu is three degenerate (as with_neutrinos), `neutrinos` sets it
         assert_eq!(setting(CLASS, "m_nu = 0.06\n"), ThreeDegenerate);
-        assert_eq!(setting(CLASS, "m_nu = 0.06\nneutrinos = one massive\n"), OneMassive);
-        assert_eq!(setting(CAMB, "mnu = 0.06\nneutrinos = three degenerate\n"), ThreeDegenerate);
+        assert_eq!(
+            setting(CLASS, "m_nu = 0.06\nneutrinos = one massive\n"),
+            OneMassive
+        );
+        assert_eq!(
+            setting(CAMB, "mnu = 0.06\nneutrinos = three degenerate\n"),
+            ThreeDegenerate
+        );
         // the same from key-value pairs (a Python dict)
         let pairs = [
             ("H0", "67"),
@@ -368,7 +400,11 @@ mod tests {
         ];
         let c = Cosmology::from_keys(pairs, "dict").unwrap().cosmology;
         assert_eq!(c.neutrinos, OneMassive);
-        assert!(c.describe().contains("m_nu = 0.06 eV (one massive)"), "{}", c.describe());
+        assert!(
+            c.describe().contains("m_nu = 0.06 eV (one massive)"),
+            "{}",
+            c.describe()
+        );
         // the default of the library's own constructor is unchanged
         let c = Cosmology::planck2018().with_neutrinos(0.06).unwrap();
         assert_eq!(c.neutrinos, ThreeDegenerate);
@@ -378,13 +414,36 @@ mod tests {
     fn unsupported_settings_and_n_eff_are_refused_naming_the_key() {
         // CLASS keeps N_ur = 3.044 when it is not given: N_eff = 4.057 with one massive species
         let e = refused(CLASS, "N_ncdm = 1\nm_ncdm = 0.39\n", "m_ncdm = 0.39");
-        assert!(e.contains("N_ur") && e.contains("4.057") && e.contains("nu.ini:7"), "{e}");
-        refused(CLASS, "N_ncdm = 1\nm_ncdm = 0.06\nN_ur = 3.046\n", "N_ur = 3.046");
-        refused(CLASS, "N_ncdm = 2\nm_ncdm = 0.03, 0.03\nN_ur = 1.02\n", "m_ncdm");
-        refused(CLASS, "N_ncdm = 3\nm_ncdm = 0.01, 0.02, 0.05\nN_ur = 0.00641\n", "m_ncdm");
-        refused(CAMB, "mnu = 0.06\nnum_massive_neutrinos = 2\n", "num_massive_neutrinos = 2");
+        assert!(
+            e.contains("N_ur") && e.contains("4.057") && e.contains("nu.ini:7"),
+            "{e}"
+        );
+        refused(
+            CLASS,
+            "N_ncdm = 1\nm_ncdm = 0.06\nN_ur = 3.046\n",
+            "N_ur = 3.046",
+        );
+        refused(
+            CLASS,
+            "N_ncdm = 2\nm_ncdm = 0.03, 0.03\nN_ur = 1.02\n",
+            "m_ncdm",
+        );
+        refused(
+            CLASS,
+            "N_ncdm = 3\nm_ncdm = 0.01, 0.02, 0.05\nN_ur = 0.00641\n",
+            "m_ncdm",
+        );
+        refused(
+            CAMB,
+            "mnu = 0.06\nnum_massive_neutrinos = 2\n",
+            "num_massive_neutrinos = 2",
+        );
         refused(CAMB, "mnu = 0.06\nnnu = 3.3\n", "nnu = 3.3");
-        refused(CAMB, "mnu = 0.06\nneutrino_hierarchy = sideways\n", "neutrino_hierarchy");
+        refused(
+            CAMB,
+            "mnu = 0.06\nneutrino_hierarchy = sideways\n",
+            "neutrino_hierarchy",
+        );
         refused(CAMB, "mnu = 0\nnnu = 4\n", "nnu = 4");
         refused(CLASS, "N_ur = 2.0328\n", "N_ur = 2.0328");
         refused(CLASS, "m_nu = 0.06\nneutrinos = two\n", "neutrinos = two");
@@ -397,8 +456,9 @@ mod tests {
         );
         assert!(e.contains("different neutrino settings"), "{e}");
         // massless: the species keys do not matter (listed as ignored), N_eff does
-        let p = Cosmology::from_ini_str(&format!("{CAMB}mnu = 0\nnum_massive_neutrinos = 1\n"), "x")
-            .unwrap();
+        let p =
+            Cosmology::from_ini_str(&format!("{CAMB}mnu = 0\nnum_massive_neutrinos = 1\n"), "x")
+                .unwrap();
         assert_eq!(p.ignored, ["num_massive_neutrinos"]);
         assert!(parse(CLASS, "N_ur = 3.046\n").is_ok());
         assert!(parse(CLASS, "N_ur = 3.044\n").is_ok());
