@@ -160,7 +160,7 @@ impl PriorPoint {
         let q =
             (1.0 - om) / om * a_early.powf(-3.0 * (w0 + wa)) * (-3.0 * wa * (1.0 - a_early)).exp();
         let limit = q_bound * q_max;
-        if !(q <= limit * (1.0 + EDGE_TOL)) {
+        if q.is_nan() || q > limit * (1.0 + EDGE_TOL) {
             return Err(Error::OutsidePrior {
                 name: EARLY_DE_NAME,
                 value: q,

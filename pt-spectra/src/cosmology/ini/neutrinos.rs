@@ -155,8 +155,8 @@ fn camb(
     }
     match count.map(|c| (c, number(origin, c))) {
         None => Ok(Some(Neutrinos::OneMassive)),
-        Some((_, Ok(n))) if n == 1.0 => Ok(Some(Neutrinos::OneMassive)),
-        Some((_, Ok(n))) if n == 3.0 => Ok(Some(Neutrinos::ThreeDegenerate)),
+        Some((_, Ok(1.0))) => Ok(Some(Neutrinos::OneMassive)),
+        Some((_, Ok(3.0))) => Ok(Some(Neutrinos::ThreeDegenerate)),
         Some((c, n)) => {
             n?;
             Err(refuse(
