@@ -66,15 +66,25 @@ def redshifts(kind, i):
     return np.concatenate([Z_NODES, extra])
 
 
-def camb_spectra(x, zs):
+# CAMB's neutrino settings by the names of pt_spectra::cosmology::Neutrinos: (num_massive_neutrinos,
+# neutrino_hierarchy); N_eff = 3.046 in all
+NEUTRINOS = {
+    "degenerate": (3, "degenerate"),  # three degenerate massive species (the emulator's base)
+    "one": (1, "degenerate"),  # one massive species and N_eff - 1.0153 massless (CAMB's default)
+    "normal": (3, "normal"),
+    "inverted": (3, "inverted"),
+}
+
+
+def camb_spectra(x, zs, neutrinos="degenerate"):
     ob, om, h, mnu, w0, wa, loga, ns = x
+    n_massive, hierarchy = NEUTRINOS[neutrinos]
+    nu = dict(mnu=mnu, num_massive_neutrinos=n_massive, neutrino_hierarchy=hierarchy, omk=0,
+              TCMB=2.7255, nnu=3.046)
     p = camb.CAMBparams()
-    p.set_cosmology(H0=100 * h, ombh2=ob * h * h, omch2=0.1, mnu=mnu, num_massive_neutrinos=3,
-                    neutrino_hierarchy="degenerate", omk=0, TCMB=2.7255, nnu=3.046)
+    p.set_cosmology(H0=100 * h, ombh2=ob * h * h, omch2=0.1, **nu)
     omnuh2 = p.omnuh2
-    p.set_cosmology(H0=100 * h, ombh2=ob * h * h, omch2=(om - ob) * h * h - omnuh2, mnu=mnu,
-                    num_massive_neutrinos=3, neutrino_hierarchy="degenerate", omk=0, TCMB=2.7255,
-                    nnu=3.046)
+    p.set_cosmology(H0=100 * h, ombh2=ob * h * h, omch2=(om - ob) * h * h - omnuh2, **nu)
     p.set_dark_energy(w=w0, wa=wa, dark_energy_model="ppf")
     p.InitPower.set_params(As=np.exp(loga) * 1e-10, ns=ns)
     order = np.argsort(zs)[::-1]

@@ -178,6 +178,7 @@ pub fn prepare(request: Request) -> Result<Prepared> {
         LinearSource::Embedded | LinearSource::Emulator => {
             let emulated = emulate(&c, z)?;
             description.extend(emulated.description);
+            warnings.extend(emulated.warning);
             if let Some((cb, f_cb)) = emulated.cb {
                 spectrum_cb = Some(cb);
                 f = f_cb;
@@ -262,6 +263,8 @@ struct Emulated {
     /// P_cb and f_cb(K_GROWTH_RATE) with massive neutrinos.
     cb: Option<(LinearSpectrum, f64)>,
     description: Vec<String>,
+    /// σ8(z = 0) outside the typical range for an A_s input (a likely mistyped A_s).
+    warning: Option<String>,
 }
 
 /// The emulated spectra of `c` at `z`, with the header lines that say so.
@@ -269,21 +272,23 @@ fn emulate(c: &Cosmology, z: f64) -> Result<Emulated> {
     let emulator = LinearEmulator::embedded()?;
     let e = emulator.spectra(c, z)?;
     let spectrum = e.matter()?;
-    let accuracy = |err: &[f64]| {
-        e.k.iter()
-            .zip(err)
-            .filter(|(k, _)| (1e-3..=1.0).contains(*k))
-            .map(|(_, v)| *v)
-            .fold(0.0, f64::max)
-    };
     let mut description = vec![
         format!(
             "linear spectrum: P_m at z = {z} from the {} (sigma8(z) = {:.6}, A_s = {:.6e}); error \
-             (99th percentile on held-out CAMB cosmologies, 1e-3 <= k <= 1 h/Mpc) {:.1e}",
+             (worst |Delta ln P| measured against CAMB over the whole prior, its corners included, \
+             1e-3 <= k <= 1 h/Mpc, 0 <= z <= 3) {:.1e}",
             emulator.describe(),
             e.sigma8,
             e.a_s,
-            accuracy(&e.error_m)
+            e.worst[1]
+        ),
+        format!(
+            "neutrinos: {}",
+            if c.m_nu > 0.0 {
+                c.neutrinos.describe()
+            } else {
+                "massless, N_eff = 3.046"
+            }
         ),
         format!(
             "linear spectrum: emulated for {:.4e} <= k <= {:.4e} h/Mpc, power laws beyond",
@@ -299,7 +304,7 @@ fn emulate(c: &Cosmology, z: f64) -> Result<Emulated> {
             "massive neutrinos: P_cb (cold dark matter + baryons) emulated too (error {:.1e}): the \
              redshift-space and galaxy models use P_cb, with the growth rate f = f_cb(k = \
              {K_GROWTH_RATE} h/Mpc, z) = {f:.6} (scale-dependent: {:.6} at k = 0.01, {:.6} at k = 0.3)",
-            accuracy(&e.error_cb),
+            e.worst[0],
             f_of_k.eval(0.01),
             f_of_k.eval(0.3)
         ));
@@ -307,10 +312,22 @@ fn emulate(c: &Cosmology, z: f64) -> Result<Emulated> {
     } else {
         None
     };
+    let warning = match c.amplitude {
+        crate::cosmology::Amplitude::As { a_s, .. } => {
+            let today = if z == 0.0 {
+                e.sigma8
+            } else {
+                emulator.spectra(c, 0.0)?.sigma8
+            };
+            crate::cosmology::sigma8_warning(today, a_s)
+        }
+        crate::cosmology::Amplitude::Sigma8(_) => None,
+    };
     Ok(Emulated {
         spectrum,
         cb,
         description,
+        warning,
     })
 }
 
@@ -485,6 +502,42 @@ mod tests {
         .unwrap();
         assert!(p.warnings.is_empty(), "{:?}", p.warnings);
         assert!(p.description.iter().any(|l| l.contains("emulator")));
+        // the header states the measured worst case over the prior and the neutrino setting
+        let emulator = LinearEmulator::embedded().unwrap();
+        let worst = emulator
+            .worst(crate::cosmology::Neutrinos::ThreeDegenerate)
+            .unwrap();
+        let line = p
+            .description
+            .iter()
+            .find(|l| l.contains("worst |Delta ln P| measured against CAMB over the whole prior"))
+            .expect("the emulator's line");
+        assert!(line.contains(&format!("{:.1e}", worst[1])), "{line}");
+        assert!(p
+            .description
+            .iter()
+            .any(|l| l == "neutrinos: massless, N_eff = 3.046"));
+        // an accepted but mistyped A_s (σ8 = 5.7) is warned about
+        let big = NamedCosmology {
+            name: "big".into(),
+            cosmology: Cosmology::planck2018()
+                .with_amplitude(crate::cosmology::Amplitude::a_s(1e-7))
+                .unwrap(),
+        };
+        let mistyped = prepare(Request {
+            source: LinearSource::Emulator,
+            cosmology: Some(big),
+            z: 0.5,
+        })
+        .unwrap();
+        assert!(
+            mistyped
+                .warnings
+                .iter()
+                .any(|w| w.contains("A_s = 1e-7") && w.contains("sigma8(z = 0) = 5.668")),
+            "{:?}",
+            mistyped.warnings
+        );
         // The emulated spectrum is CAMB's to its error (1e-3 here, k in [0.01, 0.3]).
         let camb = planck(0.0);
         for k in LogGrid::new(0.01, 0.3, 30).unwrap().points() {
@@ -504,6 +557,13 @@ mod tests {
             z: 0.5,
         })
         .unwrap();
+        assert!(
+            p.description
+                .iter()
+                .any(|l| l.starts_with("neutrinos: three degenerate massive species")),
+            "{:?}",
+            p.description
+        );
         let cb = p.spectrum_cb.as_ref().unwrap();
         assert!(cb.eval(0.5) > p.spectrum.eval(0.5) * 1.02);
         assert!((p.growth_rate - c.growth_rate(0.5)).abs() < 0.02);

@@ -63,8 +63,10 @@ Without a Boltzmann code (``emulator: true``): the theory takes the cosmological
 computes the linear spectrum with the library's emulator (:class:`pt_spectra.LinearEmulator`, 0.1 ms per
 redshift; see the documentation for its prior and accuracy). Parameters (cobaya/CAMB or CLASS names, each
 fixed or sampled in ``params``): ``ombh2``/``omega_b``, ``omch2``/``omega_cdm``, ``H0``/``h``,
-``logA``/``As``/``A_s``, ``ns``/``n_s`` (required), ``mnu``/``m_ncdm`` (Σm_ν in eV, three degenerate;
-default 0), ``w``/``w0_fld`` (-1), ``wa``/``wa_fld`` (0). The models use P_cb (cold dark matter +
+``logA``/``As``/``A_s``, ``ns``/``n_s`` (required), ``mnu``/``m_ncdm`` (Σm_ν in eV, read as CAMB's
+``mnu``: one massive species, CAMB's and cobaya's default, which the emulator refuses (it emulates three
+degenerate species only: set the theory's ``neutrinos: three degenerate`` to use it with massive
+neutrinos; see the documentation); default 0), ``w``/``w0_fld`` (-1), ``wa``/``wa_fld`` (0). The models use P_cb (cold dark matter +
 baryons), f = f_cb(k = 0.1 h/Mpc, z) and D = σ8(z)/σ8(0) of P_m; a cosmology outside the prior gets zero
 likelihood (logged). With ``ap_fiducial``, H(z) and D_M(z) of the sampled cosmology come from
 :func:`pt_spectra.distances` (radiation as CAMB closes the budget; massive neutrinos as matter: within
@@ -167,6 +169,9 @@ class PTMultipoles(Theory):
     ir: bool = True
     ap_fiducial: dict | None = None
     emulator: bool = False
+    #: with ``emulator: true``, how Σm_ν is shared: None (``mnu``'s own convention, CAMB's one massive
+    #: species) or "three degenerate" (the setting the emulator emulates)
+    neutrinos: str | None = None
 
     # ---- set-up ------------------------------------------------------------------------------
     def initialize(self):
@@ -354,6 +359,8 @@ class PTMultipoles(Theory):
         """({z: (k, P_cb, f, D, σ8)}, {z: (α∥, α⊥)}) from the emulator and the library's background,
         or None outside the emulator's prior (logged)."""
         keys = {COSMOLOGY[n][0]: params[n] for n in COSMOLOGY if n in params}
+        if self.neutrinos is not None:
+            keys["neutrinos"] = self.neutrinos
         try:
             today = self._emulator.spectra(keys, 0.0)
             out = {}

@@ -11,9 +11,13 @@ use pyo3::types::PyDict;
 /// ``LinearEmulator()`` parses the embedded file once; ``spectra(cosmology, z)`` then costs ~0.1 ms:
 /// a dict with ``k`` [h/Mpc], ``P_m`` and ``P_cb`` [(Mpc/h)^3] (all matter; cold dark matter +
 /// baryons), ``f_cb`` (the scale-dependent growth rate), ``err_P_m``, ``err_P_cb`` (relative errors
-/// per k), ``sigma8`` (of P_m at z) and ``A_s``. ``cosmology`` is a preset name, an ini path or a dict
-/// of CLASS/CAMB keys (``m_ncdm``/``mnu`` for massive neutrinos, ``w0_fld``, ``wa_fld``). A parameter
-/// outside the prior (``prior``) raises ValueError naming it.
+/// per k), ``sigma8`` (of P_m at z), ``A_s``, ``neutrinos`` (the setting emulated: "three degenerate" or
+/// "one massive") and ``worst_error`` (the measured worst |Δ ln P| of P_cb and P_m over the prior).
+/// ``cosmology`` is a preset name, an ini path or a dict of CLASS/CAMB keys (``m_ncdm`` with ``N_ur``,
+/// or ``mnu``, for massive neutrinos, each in its own code's convention: CAMB's ``mnu`` alone is one
+/// massive species; ``w0_fld``, ``wa_fld``); a dict key that sets nothing raises ValueError naming it.
+/// A parameter outside the prior (``prior``), or a neutrino setting that is not emulated, raises
+/// ValueError naming it.
 #[pyclass(name = "LinearEmulator", module = "pt_spectra._core")]
 pub struct LinearEmulator {
     inner: pt_spectra::emulator::LinearEmulator,
@@ -46,6 +50,8 @@ impl LinearEmulator {
         out.set_item("err_P_cb", s.error_cb.into_pyarray(py))?;
         out.set_item("sigma8", s.sigma8)?;
         out.set_item("A_s", s.a_s)?;
+        out.set_item("neutrinos", s.neutrinos.name())?;
+        out.set_item("worst_error", (s.worst[0], s.worst[1]))?;
         Ok(out)
     }
 

@@ -163,10 +163,26 @@ fn positive(values: Vec<f64>, what: &str) -> PyResult<Vec<f64>> {
     }
 }
 
-/// The cosmology of a Python argument (for the small helpers), gm2012 by default.
+/// The cosmology of a Python argument (for the small helpers and the emulator), gm2012 by default.
+///
+/// A dict is strict: a key that sets nothing (a misspelt `m_ncmd`, say) is a ValueError naming it,
+/// since it would otherwise change the result silently. An ini file's other keys (CLASS's `output`,
+/// ...) are normal there and are not an error.
 pub fn cosmology_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Cosmology> {
     let inputs = Inputs::extract(None, 0.0, 0.0, obj, None)?;
-    let (named, _) = inputs.cosmology().map_err(value_error)?;
+    let (named, ignored) = inputs.cosmology().map_err(value_error)?;
+    if matches!(inputs.cosmology, CosmologyArg::Keys(_)) && !ignored.is_empty() {
+        return Err(PyValueError::new_err(format!(
+            "cosmology dict: unknown key(s) {}: they set nothing (a misspelling?); the keys read are \
+             CLASS's and CAMB's names of h, omega_b, omega_cdm, n_s, A_s or sigma8, Omega_k, w0, wa, \
+             the neutrino masses and species (see the documentation of pt_spectra.cosmology ini keys)",
+            ignored
+                .iter()
+                .map(|k| format!("`{k}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
     Ok(named.map_or(Cosmology::gm2012(), |n| n.cosmology))
 }
 

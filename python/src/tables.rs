@@ -10,7 +10,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 /// A table of results: `t.columns` (names as the command line prints them), `t["P_dd"]` (a numpy
-/// array), `t.units`, `t.header`, `t.meta` (z, f, D, cosmology, precision, q range, model), and
+/// array), `t.units`, `t.header`, `t.meta` (z, f, D, cosmology, neutrinos, precision, q range, model), and
 /// `t.to_text()` (the command line's output).
 #[pyclass(module = "pt_spectra._core", frozen)]
 pub struct Table {
@@ -39,6 +39,13 @@ impl Table {
             "cosmology_parameters",
             prepared.cosmology.cosmology.describe(),
         )?;
+        let c = &prepared.cosmology.cosmology;
+        let neutrinos = if c.m_nu > 0.0 {
+            c.neutrinos.name()
+        } else {
+            "massless"
+        };
+        meta.set_item("neutrinos", neutrinos)?;
         meta.set_item("precision", precision.label())?;
         meta.set_item("q_range", (precision.q_min, precision.q_max))?;
         meta.set_item("model", model)?;

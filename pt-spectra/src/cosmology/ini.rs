@@ -19,10 +19,17 @@
 //! | w0 (default −1) | `w0_fld` | `w` |
 //! | wa (default 0) | `wa_fld` | `wa` |
 //! | Σm_ν in eV (default 0) | `m_ncdm` (list, eV per species; with `N_ncdm`, `deg_ncdm`) | `mnu`; `omnuh2` (ω_ν, Σm_ν = 93.14 eV ω_ν) |
+//! | Σm_ν in eV, pt-spectra's name | `m_nu` | |
+//!
+//! How Σm_ν is shared among the species ([`Neutrinos`](super::Neutrinos)) and N_eff follow the
+//! convention of the code whose keys are given (`N_ncdm`, `deg_ncdm`, `N_ur`; `num_massive_neutrinos`,
+//! `neutrino_hierarchy`, `nnu`; pt-spectra's `neutrinos`): CAMB's `mnu` alone is one massive species,
+//! as in CAMB; the table is in the private module `ini::neutrinos` (and in `docs/emulator.md`).
 //!
 //! h, ω_b, ω_cdm, n_s and one of σ8 or A_s are needed; σ8 and A_s together are a conflict. Derived:
 //! Ω_m = (ω_b + ω_cdm + ω_ν)/h² with ω_ν = Σm_ν/93.14 eV (all matter, as CLASS's `Omega_m`), and
-//! Ω_DE = 1 − Ω_m − Ω_k. Massless species (`N_ur`) are ignored, like the photons.
+//! Ω_DE = 1 − Ω_m − Ω_k. Massless species (`N_ur`) do not enter the background, like the photons; N_eff
+//! must be the standard one.
 //! Every key not in the table is ignored and listed in [`ParsedCosmology::ignored`], so that the caller
 //! can say once which were. Not followed: CAMB's `DEFAULT(file)` and `INCLUDE(file)` lines (syntax
 //! errors), CAMB's `use_physical = F` parameters, and CLASS's split of the dark energy into
@@ -135,7 +142,7 @@ enum Unit {
 }
 
 /// The keys that are read (see the module docs).
-const KEYS: [(&str, Quantity, Unit); 28] = [
+const KEYS: [(&str, Quantity, Unit); 29] = [
     ("h", Quantity::Hubble, Unit::Same),
     ("H0", Quantity::Hubble, Unit::KmPerSecPerMpc),
     ("hubble", Quantity::Hubble, Unit::KmPerSecPerMpc),
@@ -168,11 +175,8 @@ const KEYS: [(&str, Quantity, Unit); 28] = [
     ("m_ncdm", Quantity::NeutrinoMass, Unit::NcdmList),
     ("mnu", Quantity::NeutrinoMass, Unit::Same),
     ("omnuh2", Quantity::NeutrinoMass, Unit::OmegaNu),
+    ("m_nu", Quantity::NeutrinoMass, Unit::Same),
 ];
-
-/// CLASS keys read with `m_ncdm`: the number of species (checked against the list) and their
-/// degeneracies.
-const NCDM_KEYS: [&str; 2] = ["N_ncdm", "deg_ncdm"];
 
 /// One `key = value` of the input.
 #[derive(Debug, Clone, Copy)]
@@ -344,37 +348,6 @@ fn parse_number(text: &str) -> Option<f64> {
     value.is_finite().then_some(value)
 }
 
-/// Σm_ν of CLASS's `m_ncdm` list (eV per species) times `deg_ncdm` (a number for all species or a list,
-/// default 1); `None` if a number does not parse, or the lengths disagree with each other or with
-/// `N_ncdm`.
-fn ncdm_sum(m_ncdm: Entry<'_>, entries: &[Entry<'_>]) -> Option<f64> {
-    let list = |text: &str| -> Option<Vec<f64>> {
-        text.split(',').map(|v| parse_number(v.trim())).collect()
-    };
-    let masses = list(m_ncdm.value)?;
-    let find = |key: &str| entries.iter().find(|e| e.key == key).map(|e| e.value);
-    if let Some(n) = find("N_ncdm") {
-        if parse_number(n)? != masses.len() as f64 {
-            return None;
-        }
-    }
-    let degeneracy = match find("deg_ncdm").map(list) {
-        None => vec![1.0; masses.len()],
-        Some(d) => {
-            let d = d?;
-            match d.len() {
-                1 => vec![d[0]; masses.len()],
-                n if n == masses.len() => d,
-                _ => return None,
-            }
-        }
-    };
-    let sum: f64 = masses.iter().zip(&degeneracy).map(|(m, g)| m * g).sum();
-    // to 1e-12 eV: 3 × 0.1 is 0.3, not 0.30000000000000004
-    let sum = (sum * 1e12).round() / 1e12;
-    sum.is_finite().then_some(sum)
-}
-
 /// Whether two values of the same quantity agree to [`SYNONYM_TOL`].
 fn agree(x: f64, y: f64) -> bool {
     (x - y).abs() <= SYNONYM_TOL * x.abs().max(y.abs())
@@ -395,15 +368,15 @@ fn resolve(entries: &[Entry<'_>], origin: &str) -> Result<ParsedCosmology> {
             });
         }
         first_line.insert(entry.key, entry.line);
-        if NCDM_KEYS.contains(&entry.key) {
-            continue; // read with m_ncdm
+        if neutrinos::SPECIES_KEYS.contains(&entry.key) {
+            continue; // read with the masses
         }
         let Some((quantity, unit)) = lookup(entry.key) else {
             ignored.push((entry.line, entry.key));
             continue;
         };
         let parsed = if unit == Unit::NcdmList {
-            ncdm_sum(entry, entries)
+            neutrinos::ncdm_sum(entry, entries)
         } else {
             parse_number(entry.value)
         };
@@ -468,11 +441,15 @@ fn resolve(entries: &[Entry<'_>], origin: &str) -> Result<ParsedCosmology> {
         }
     };
     let m_nu = values.get(Quantity::NeutrinoMass, h2)?.unwrap_or(0.0);
+    let mass_key = (m_nu > 0.0).then(|| values.first(Quantity::NeutrinoMass).key);
+    let neutrinos = neutrinos::setting(entries, origin, mass_key)?;
     if m_nu == 0.0 {
+        // how a zero mass is shared does not matter (N_eff was checked)
+        let checked = ["N_eff", "nnu", "N_ur"];
         ignored.extend(
             entries
                 .iter()
-                .filter(|e| NCDM_KEYS.contains(&e.key))
+                .filter(|e| neutrinos::SPECIES_KEYS.contains(&e.key) && !checked.contains(&e.key))
                 .map(|e| (e.line, e.key)),
         );
     }
@@ -487,6 +464,7 @@ fn resolve(entries: &[Entry<'_>], origin: &str) -> Result<ParsedCosmology> {
         w0,
         wa,
         m_nu,
+        neutrinos,
     };
     cosmology
         .validate()
@@ -594,5 +572,6 @@ impl<'a> Values<'a> {
     }
 }
 
+mod neutrinos;
 #[cfg(test)]
 mod tests;

@@ -49,11 +49,13 @@ pub mod distance;
 mod eisenstein_hu;
 mod growth;
 pub mod ini;
+pub mod neutrinos;
 mod plausible;
 
 pub use eisenstein_hu::{EisensteinHu, TransferKind};
 pub use ini::ParsedCosmology;
-pub use plausible::{plausible, Plausible, PLAUSIBLE};
+pub use neutrinos::Neutrinos;
+pub use plausible::{plausible, sigma8_warning, Plausible, PLAUSIBLE, SIGMA8_TYPICAL};
 
 /// How the amplitude of the linear spectrum is fixed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -106,10 +108,14 @@ pub struct Cosmology {
     pub w0: f64,
     /// Dark-energy equation-of-state slope wa, w(a) = w0 + wa (1 − a) (0 for a cosmological constant).
     pub wa: f64,
-    /// Sum of the neutrino masses Σm_ν in eV (three degenerate neutrinos; 0: massless). Their density
-    /// ω_ν = Σm_ν/93.14 eV is part of Ω_m; the growth here treats them as matter (scale-independent),
-    /// the emulator ([`crate::emulator`]) gives the scale-dependent growth of CDM + baryons.
+    /// Sum of the neutrino masses Σm_ν in eV (0: massless). Their density ω_ν = Σm_ν/93.14 eV is part
+    /// of Ω_m; the growth here treats them as matter (scale-independent), the emulator
+    /// ([`crate::emulator`]) gives the scale-dependent growth of CDM + baryons.
     pub m_nu: f64,
+    /// How Σm_ν is shared among the species ([`Neutrinos::ThreeDegenerate`] unless set by
+    /// [`with_neutrino_species`](Self::with_neutrino_species) or a parameter file's keys, see
+    /// [`ini`]); N_eff is the standard 3.046.
+    pub neutrinos: Neutrinos,
 }
 
 impl Default for Cosmology {
@@ -133,6 +139,7 @@ impl Cosmology {
             w0: -1.0,
             wa: 0.0,
             m_nu: 0.0,
+            neutrinos: Neutrinos::ThreeDegenerate,
         }
     }
 
@@ -154,6 +161,7 @@ impl Cosmology {
             w0: -1.0,
             wa: 0.0,
             m_nu: 0.0,
+            neutrinos: Neutrinos::ThreeDegenerate,
         }
     }
 
@@ -195,6 +203,7 @@ impl Cosmology {
             w0: -1.0,
             wa: 0.0,
             m_nu: 0.0,
+            neutrinos: Neutrinos::ThreeDegenerate,
         };
         c.validate()?;
         Ok(c)
@@ -219,7 +228,8 @@ impl Cosmology {
         Ok(c)
     }
 
-    /// The same cosmology with neutrinos of total mass `m_nu` eV (three degenerate), at the same Ω_m:
+    /// The same cosmology with neutrinos of total mass `m_nu` eV (shared as [`neutrinos`](Self::neutrinos)
+    /// says: three degenerate species unless set otherwise), at the same Ω_m:
     /// the cold dark matter gives way to them, ω_cdm = Ω_m h² − ω_b − Σm_ν/93.14 eV.
     ///
     /// # Errors
@@ -228,6 +238,21 @@ impl Cosmology {
         let c = Self { m_nu, ..self };
         c.validate()?;
         Ok(c)
+    }
+
+    /// The same cosmology with Σm_ν shared among the neutrino species as `neutrinos` says (Σm_ν and Ω_m
+    /// unchanged). [`with_neutrinos`](Self::with_neutrinos) keeps the setting, three degenerate species
+    /// by default.
+    ///
+    /// ```
+    /// use pt_spectra::cosmology::{Cosmology, Neutrinos};
+    /// // Planck's and DESI's baseline (and CAMB's default): one massive species of 0.06 eV
+    /// let c = Cosmology::planck2018().with_neutrinos(0.06)?.with_neutrino_species(Neutrinos::OneMassive);
+    /// assert!(c.describe().contains("one massive"));
+    /// # Ok::<(), pt_spectra::error::Error>(())
+    /// ```
+    pub fn with_neutrino_species(self, neutrinos: Neutrinos) -> Self {
+        Self { neutrinos, ..self }
     }
 
     /// The same cosmology normalised by `amplitude` instead.
@@ -436,7 +461,7 @@ impl Cosmology {
         let omega_k = self.omega_k();
         let omega_k = if omega_k.abs() < 1e-12 { 0.0 } else { omega_k };
         let neutrinos = if self.m_nu > 0.0 {
-            format!(", m_nu = {} eV", number(self.m_nu))
+            format!(", m_nu = {} eV ({})", number(self.m_nu), self.neutrinos)
         } else {
             String::new()
         };

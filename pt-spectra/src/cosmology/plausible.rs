@@ -133,3 +133,22 @@ pub const PLAUSIBLE: [Plausible; 13] = [
 pub fn plausible(name: &str) -> Option<&'static Plausible> {
     PLAUSIBLE.iter().find(|p| p.name == name)
 }
+
+/// The range of σ8(z = 0) of all matter that cosmologies fitted to data have had (Planck, weak lensing,
+/// clusters: 0.6–1.0), widened: a σ8 outside it follows from an A_s that is accepted (within
+/// [`PLAUSIBLE`]) but most likely mistyped (A_s = 1e-7 gives σ8 = 5.7).
+pub const SIGMA8_TYPICAL: (f64, f64) = (0.4, 1.3);
+
+/// A warning for σ8(z = 0) = `sigma8` outside [`SIGMA8_TYPICAL`] when the amplitude was given as
+/// A_s = `a_s`; `None` inside.
+pub fn sigma8_warning(sigma8: f64, a_s: f64) -> Option<String> {
+    let (lo, hi) = SIGMA8_TYPICAL;
+    if (lo..=hi).contains(&sigma8) {
+        return None;
+    }
+    Some(format!(
+        "cosmology: A_s = {} gives sigma8(z = 0) = {sigma8:.3}, outside the range [{lo}, {hi}] of \
+         cosmologies fitted to data: check A_s (e.g. 2.1e-9)",
+        crate::error::number(&a_s)
+    ))
+}

@@ -16,12 +16,51 @@
 //! error        2 × n_x f64: |Δ ln P| of P_cb and of P_m on the test set (99th percentile over
 //!              cosmologies and redshifts, per x)
 //! ```
+//!
+//! Layout `PTEMU002` (`pt-spectra/data/fit_emulator_neutrinos.py`) is the same after its magic, then:
+//!
+//! ```text
+//! box          6 × (f64 min, f64 max): the stated prior of the six shape parameters (inside the
+//!                       training box of `prior`, which still maps them to [−1, 1])
+//! q_bound      f64      the prior's bound on the early dark energy: q/q_max ≤ q_bound (in (0, 1])
+//! worst        2 × f64  the measured worst |Δ ln P| of P_cb and P_m over the bounded prior
+//!                       (three degenerate neutrinos)
+//! n_heads      u32      neutrino heads (0 to 3)
+//! per head:    setting u32 (1: one massive species), n_terms u32, n_pc 2 × u32,
+//!              exponents n_terms × 7 u8, 2 × target (ln(P_setting/P_degenerate) of P_cb and of P_m,
+//!              as above with this head's n_terms and n_pc), worst 2 × f64 (as above, this setting)
+//! ```
+//!
+//! A `PTEMU001` file reads as box = prior, q_bound = 1, no heads, and the largest per-x error as the worst.
 
 use super::prior::{PriorRange, COORDINATES, PARAMETER_NAMES};
+use crate::cosmology::Neutrinos;
 use crate::error::{Error, Result};
 
-/// The magic bytes that open an emulator file of this layout.
+/// The magic bytes that open an emulator file of the first layout (no neutrino heads).
 pub const MAGIC: &[u8; 8] = b"PTEMU001";
+
+/// The magic bytes of the layout with the prior bound and the neutrino heads.
+pub const MAGIC_2: &[u8; 8] = b"PTEMU002";
+
+/// Largest Legendre degree a file may use (the Rust code builds P_0..P_max per coordinate).
+const MAX_DEGREE: u8 = 30;
+
+/// Most neutrino heads a file may hold.
+const MAX_HEADS: usize = 3;
+
+/// A neutrino head: ln(P_setting/P_degenerate) of P_cb and of P_m.
+#[derive(Debug, Clone)]
+pub struct Head {
+    /// The setting it emulates.
+    pub setting: Neutrinos,
+    /// Its polynomial terms.
+    pub exponents: Vec<[u8; COORDINATES]>,
+    /// ln(P_cb ratio) and ln(P_m ratio).
+    pub targets: [Target; 2],
+    /// Measured worst |Δ ln P| of P_cb and P_m with this setting.
+    pub worst: [f64; 2],
+}
 
 /// One emulated quantity (a function of x and z): mean + Σ_j c_j(θ) V_j, with c_j a polynomial in θ.
 #[derive(Debug, Clone)]
@@ -49,6 +88,13 @@ pub struct Parsed {
     pub q_max: f64,
     pub targets: [Target; 2],
     pub error: [Vec<f64>; 2],
+    /// The stated prior of the six shape parameters (the training box for a `PTEMU001` file).
+    pub stated: Vec<PriorRange>,
+    /// q/q_max ≤ q_bound (1 for a `PTEMU001` file).
+    pub q_bound: f64,
+    /// Measured worst |Δ ln P| of P_cb and P_m (three degenerate neutrinos).
+    pub worst: [f64; 2],
+    pub heads: Vec<Head>,
 }
 
 /// A cursor over the bytes that names the file and the offset in its errors.
@@ -104,6 +150,53 @@ impl<'a> Reader<'a> {
         Ok(v)
     }
 
+    /// One target of `nodes` = n_z·n_x values per component.
+    fn target(&mut self, nodes: usize, n_terms: usize, n_pc: usize) -> Result<Target> {
+        Ok(Target {
+            mean: self.f64s(nodes)?,
+            components: self.f32s(n_pc * nodes)?,
+            coefficients: self.f64s(n_terms * n_pc)?,
+            n_pc,
+        })
+    }
+
+    /// One neutrino head (layout PTEMU002).
+    fn head(&mut self, nodes: usize) -> Result<Head> {
+        let setting = match self.count(1)? {
+            1 => Neutrinos::OneMassive,
+            _ => unreachable!("count(1) is 1"),
+        };
+        let n_terms = self.count(100_000)?;
+        let n_pc = [self.count(10_000)?, self.count(10_000)?];
+        let exponents = self.exponents(n_terms)?;
+        let targets = [
+            self.target(nodes, n_terms, n_pc[0])?,
+            self.target(nodes, n_terms, n_pc[1])?,
+        ];
+        let w = self.f64s(2)?;
+        if w.iter().any(|&v| v < 0.0) {
+            return Err(self.fail("a measured error is negative"));
+        }
+        Ok(Head {
+            setting,
+            exponents,
+            targets,
+            worst: [w[0], w[1]],
+        })
+    }
+
+    /// `n_terms` rows of seven Legendre degrees.
+    fn exponents(&mut self, n_terms: usize) -> Result<Vec<[u8; COORDINATES]>> {
+        let bytes = self.take(self.bytes_of(n_terms, COORDINATES)?)?;
+        if bytes.iter().any(|&d| d > MAX_DEGREE) {
+            return Err(self.fail("a polynomial degree is implausibly large"));
+        }
+        Ok(bytes
+            .chunks_exact(COORDINATES)
+            .map(|c| c.try_into().expect("seven exponents"))
+            .collect())
+    }
+
     fn f32s(&mut self, n: usize) -> Result<Vec<f32>> {
         let b = self.take(self.bytes_of(n, 4)?)?;
         let v: Vec<f32> = b
@@ -123,8 +216,10 @@ impl<'a> Reader<'a> {
 /// [`Error::BadDataFile`] with the byte offset where the layout is broken.
 pub fn parse(bytes: &[u8], what: &str) -> Result<Parsed> {
     let mut r = Reader { bytes, at: 0, what };
-    if r.take(8)? != MAGIC {
-        return Err(r.fail("not an emulator file of layout PTEMU001"));
+    let magic = r.take(8)?;
+    let version_2 = magic == MAGIC_2;
+    if magic != MAGIC && !version_2 {
+        return Err(r.fail("not an emulator file of layout PTEMU001 or PTEMU002"));
     }
     let n_terms = r.count(100_000)?;
     let n_z = r.count(1000)?;
@@ -152,22 +247,54 @@ pub fn parse(bytes: &[u8], what: &str) -> Result<Parsed> {
     if !(lx[0] < lx[1] && lx[2] > 0.0 && lx[2] < 1.0 && lx[3] > 0.0) {
         return Err(r.fail("bad wavenumber range or early-dark-energy coordinate"));
     }
-    let exponents = r
-        .take(r.bytes_of(n_terms, COORDINATES)?)?
-        .chunks_exact(COORDINATES)
-        .map(|c| c.try_into().expect("seven exponents"))
-        .collect();
-    let mut target = |n_pc: usize| -> Result<Target> {
-        Ok(Target {
-            // Products of counts each bounded by `count` (≤ 1e4 × 1e3 × 1e5): no overflow.
-            mean: r.f64s(n_z * n_x)?,
-            components: r.f32s(n_pc * n_z * n_x)?,
-            coefficients: r.f64s(n_terms * n_pc)?,
-            n_pc,
-        })
-    };
-    let targets = [target(n_pc[0])?, target(n_pc[1])?];
+    let exponents = r.exponents(n_terms)?;
+    let targets = [
+        r.target(n_z * n_x, n_terms, n_pc[0])?,
+        r.target(n_z * n_x, n_terms, n_pc[1])?,
+    ];
     let error = [r.f64s(n_x)?, r.f64s(n_x)?];
+    let (stated, q_bound, worst, heads) = if version_2 {
+        let b = r.f64s(12)?;
+        let stated: Vec<PriorRange> = prior[..6]
+            .iter()
+            .enumerate()
+            .map(|(i, p)| PriorRange {
+                name: p.name,
+                min: b[2 * i],
+                max: b[2 * i + 1],
+            })
+            .collect();
+        if stated
+            .iter()
+            .zip(&prior)
+            .any(|(s, p)| !(s.min < s.max && s.min >= p.min && s.max <= p.max))
+        {
+            return Err(r.fail("the stated prior must be a non-empty box inside the training box"));
+        }
+        let v = r.f64s(3)?;
+        if !(v[0] > 0.0 && v[0] <= 1.0) || v[1] < 0.0 || v[2] < 0.0 {
+            return Err(r.fail("the prior bound must be in (0, 1] and the errors non-negative"));
+        }
+        let b = r.take(4)?;
+        let n_heads = u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize;
+        if n_heads > MAX_HEADS {
+            return Err(r.fail("too many neutrino heads"));
+        }
+        let mut heads = Vec::with_capacity(n_heads);
+        for _ in 0..n_heads {
+            heads.push(r.head(n_z * n_x)?);
+        }
+        (stated, v[0], [v[1], v[2]], heads)
+    } else {
+        let largest = |e: &[f64]| e.iter().copied().fold(0.0, f64::max);
+        let stated = prior[..6].to_vec();
+        (
+            stated,
+            1.0,
+            [largest(&error[0]), largest(&error[1])],
+            Vec::new(),
+        )
+    };
     if r.at != bytes.len() {
         return Err(r.fail("bytes left after the last table"));
     }
@@ -182,6 +309,10 @@ pub fn parse(bytes: &[u8], what: &str) -> Result<Parsed> {
         q_max: lx[3],
         targets,
         error,
+        stated,
+        q_bound,
+        worst,
+        heads,
     })
 }
 

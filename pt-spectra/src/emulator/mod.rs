@@ -32,7 +32,7 @@
 mod format;
 pub mod prior;
 
-use crate::cosmology::{Cosmology, EV_PER_OMEGA_NU};
+use crate::cosmology::{Cosmology, Neutrinos, EV_PER_OMEGA_NU};
 use crate::error::{Error, Result};
 use crate::linear::{top_hat, LinearSpectrum};
 pub use prior::{PriorPoint, PriorRange, COORDINATES, PARAMETER_NAMES, SHAPE_PARAMETERS};
@@ -75,6 +75,11 @@ pub struct EmulatedSpectra {
     pub error_cb: Vec<f64>,
     /// Estimated relative error of `p_m` per k.
     pub error_m: Vec<f64>,
+    /// The neutrino setting emulated (the cosmology's).
+    pub neutrinos: Neutrinos,
+    /// The measured worst |Δ ln P| of P_cb and of P_m against CAMB over the whole stated prior
+    /// (corners included, 1e-3 ≤ k ≤ 1 h/Mpc, 0 ≤ z ≤ 3) for this neutrino setting.
+    pub worst: [f64; 2],
     /// σ8 of all matter at `z`.
     pub sigma8: f64,
     /// A_s at the pivot (given, or set by σ8).
@@ -130,6 +135,7 @@ impl LinearEmulator {
         let max_degree = file
             .exponents
             .iter()
+            .chain(file.heads.iter().flat_map(|h| h.exponents.iter()))
             .flat_map(|e| e.iter())
             .map(|&d| usize::from(d))
             .max()
@@ -143,8 +149,10 @@ impl LinearEmulator {
 
     /// The prior: the range of each of the eight parameters it was trained or tested on. The six shape
     /// parameters must lie inside; A_s and n_s may lie outside (their dependence is exact).
-    pub fn prior(&self) -> &[PriorRange] {
-        &self.file.prior
+    pub fn prior(&self) -> Vec<PriorRange> {
+        let mut out = self.file.stated.clone();
+        out.extend_from_slice(&self.file.prior[SHAPE_PARAMETERS..]);
+        out
     }
 
     /// The redshift range, [z_min, z_max].
@@ -155,26 +163,70 @@ impl LinearEmulator {
 
     /// One line for output headers: what the emulator is and where it is valid.
     pub fn describe(&self) -> String {
-        let prior: Vec<String> = self.file.prior[..SHAPE_PARAMETERS]
+        let prior: Vec<String> = self
+            .file
+            .stated
             .iter()
             .map(|p| format!("{} in [{}, {}]", p.name, p.min, p.max))
             .collect();
         let (z0, z1) = self.z_range();
+        let settings: Vec<&str> = std::iter::once(Neutrinos::ThreeDegenerate)
+            .chain(self.file.heads.iter().map(|h| h.setting))
+            .map(Neutrinos::name)
+            .collect();
         format!(
-            "{} (trained on CAMB; prior {}; z in [{z0}, {z1}]; three degenerate neutrinos, PPF dark energy, flat)",
+            "{} (trained on CAMB; prior {}, {} <= {}; z in [{z0}, {z1}]; neutrinos: {}; N_eff 3.046, \
+             PPF dark energy, flat)",
             self.origin,
-            prior.join(", ")
+            prior.join(", "),
+            prior::EARLY_DE_NAME,
+            crate::error::number(&(self.file.q_bound * self.file.q_max)),
+            settings.join(" or ")
         )
+    }
+
+    /// The neutrino settings emulated: three degenerate species and those of the file's heads.
+    pub fn neutrino_settings(&self) -> Vec<Neutrinos> {
+        std::iter::once(Neutrinos::ThreeDegenerate)
+            .chain(self.file.heads.iter().map(|h| h.setting))
+            .collect()
+    }
+
+    /// The largest early dark-energy density q = ρ_DE/ρ_m at a = 0.1 of the prior
+    /// ([`PriorPoint::coordinates`]).
+    pub fn q_limit(&self) -> f64 {
+        self.file.q_bound * self.file.q_max
+    }
+
+    /// The measured worst |Δ ln P| of P_cb and of P_m over the prior with `neutrinos`, if emulated.
+    pub fn worst(&self, neutrinos: Neutrinos) -> Option<[f64; 2]> {
+        if neutrinos == Neutrinos::ThreeDegenerate {
+            return Some(self.file.worst);
+        }
+        self.file
+            .heads
+            .iter()
+            .find(|h| h.setting == neutrinos)
+            .map(|h| h.worst)
     }
 
     /// P_m, P_cb and f_cb of `cosmology` at redshift `z`.
     ///
     /// # Errors
-    /// [`Error::OutsidePrior`] naming a shape parameter outside the prior; [`Error::InvalidParameter`]
-    /// for a curved cosmology or a redshift outside [`z_range`](Self::z_range).
+    /// [`Error::OutsidePrior`] naming a shape parameter outside the prior, or the early dark-energy
+    /// density beyond its bound; [`Error::InvalidParameter`] for a curved cosmology or a redshift
+    /// outside [`z_range`](Self::z_range); [`Error::InvalidChoice`] for a neutrino setting that is not
+    /// emulated ([`neutrino_settings`](Self::neutrino_settings)).
     pub fn spectra(&self, cosmology: &Cosmology, z: f64) -> Result<EmulatedSpectra> {
         let point = PriorPoint::of(cosmology)?;
-        let u = point.coordinates(&self.file.prior, self.file.a_early, self.file.q_max)?;
+        let u = point.coordinates(
+            &self.file.prior,
+            &self.file.stated,
+            self.file.a_early,
+            self.file.q_max,
+            self.file.q_bound,
+        )?;
+        let head = self.head(cosmology)?;
         let (z0, z1) = self.z_range();
         if !(z >= z0 - 1e-12 && z <= z1 + 1e-12) {
             return Err(Error::InvalidParameter {
@@ -199,16 +251,33 @@ impl LinearEmulator {
         let k: Vec<f64> = std::iter::successors(Some(ln_k[0].exp()), |k| Some(k * ratio))
             .take(n_x)
             .collect();
-        let coefficients = self.coefficients(&u);
         let z = z.clamp(z0, z1);
-        let shape = self.at_redshift(&coefficients, z);
+        let coefficients = coefficients(
+            &self.file.exponents,
+            &self.file.targets,
+            &u,
+            self.max_degree,
+        );
+        let head_coefficients = head.map(|h| {
+            let c = coefficients_of(h, &u, self.max_degree);
+            (h, c)
+        });
+        let shape_at = |z: f64| {
+            let mut shape = self.at_redshift(&self.file.targets, &coefficients, z);
+            if let Some((h, c)) = &head_coefficients {
+                shape.add(&self.at_redshift(&h.targets, c, z));
+            }
+            shape
+        };
+        let shape = shape_at(z);
         // ln P_cb = G_cb + 2 ln(D_md/Ω_m) + ln A_s + (n_s − 1) ln(k h/k_pivot)
         let growth = |z: f64| {
             let (d_md, f) = cosmology.growth_md_and_rate(z);
             (2.0 * (d_md / om).ln(), f)
         };
         let (growth_z, f_ode) = growth(z);
-        // P_m = P_cb exactly for massless neutrinos (the emulated ratio is then its own error)
+        // P_m = P_cb exactly for massless neutrinos (the emulated ratio is then its own error; the
+        // neutrino head is 0 too: the settings differ only in how the mass is shared)
         let massive = if m_nu > 0.0 { 1.0 } else { 0.0 };
         let tilt: Vec<f64> = ln_k
             .iter()
@@ -217,7 +286,7 @@ impl LinearEmulator {
         let ln_as = match point.a_s {
             Some(a_s) => a_s.ln(),
             None => {
-                let today = self.at_redshift(&coefficients, z0);
+                let today = shape_at(z0);
                 let growth_0 = growth(z0).0;
                 let sigma8_unit = sigma8(&k, step, |i| {
                     (today.cb[i] + growth_0 + massive * today.ratio[i] + tilt[i]).exp()
@@ -244,6 +313,8 @@ impl LinearEmulator {
             f_cb: shape.d_cb_ds.iter().map(|d| f_ode - 0.5 * d).collect(),
             error_cb: self.file.error[0].clone(),
             error_m: self.file.error[1].clone(),
+            neutrinos: cosmology.neutrinos,
+            worst: head.map_or(self.file.worst, |h| h.worst),
             sigma8,
             a_s: ln_as.exp(),
         })
@@ -273,35 +344,42 @@ impl LinearEmulator {
         })
     }
 
-    /// The principal-component coefficients of both targets at the unit point `u`.
-    fn coefficients(&self, u: &[f64; COORDINATES]) -> [Vec<f64>; 2] {
-        let legendre: Vec<Vec<f64>> = u.iter().map(|&x| legendre(x, self.max_degree)).collect();
-        let features: Vec<f64> = self
-            .file
-            .exponents
-            .iter()
-            .map(|e| {
-                e.iter()
-                    .enumerate()
-                    .map(|(d, &n)| legendre[d][usize::from(n)])
-                    .product()
-            })
-            .collect();
-        [0, 1].map(|t| {
-            let t = &self.file.targets[t];
-            let mut c = vec![0.0; t.n_pc];
-            for (row, f) in t.coefficients.chunks_exact(t.n_pc).zip(&features) {
-                for (cj, r) in c.iter_mut().zip(row) {
-                    *cj += f * r;
-                }
-            }
-            c
-        })
+    /// The neutrino head of `cosmology`'s setting (`None`: three degenerate species, or massless).
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] for a setting the file does not emulate.
+    fn head(&self, cosmology: &Cosmology) -> Result<Option<&format::Head>> {
+        let setting = cosmology.neutrinos;
+        if setting == Neutrinos::ThreeDegenerate || cosmology.m_nu == 0.0 {
+            return Ok(None);
+        }
+        match self.file.heads.iter().find(|h| h.setting == setting) {
+            Some(h) => Ok(Some(h)),
+            None => Err(Error::InvalidChoice {
+                what: format!("neutrinos: {}", setting.describe()),
+                reason: format!(
+                    "the linear-spectrum emulator ({}) emulates {} only: give the neutrinos as one of \
+                     them (CAMB num_massive_neutrinos = 1 or 3 with neutrino_hierarchy = degenerate; \
+                     CLASS N_ncdm = 1 or three equal m_ncdm), or a linear spectrum (--linear FILE)",
+                    self.origin,
+                    self.neutrino_settings()
+                        .iter()
+                        .map(|s| s.describe())
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                ),
+            }),
+        }
     }
 
     /// Both targets at redshift `z` (four-node Lagrange interpolation in s = ln(1 + z)), and
-    /// ∂ ln P_cb/∂s.
-    fn at_redshift(&self, coefficients: &[Vec<f64>; 2], z: f64) -> Shape {
+    /// ∂(first target)/∂s.
+    fn at_redshift(
+        &self,
+        targets: &[format::Target; 2],
+        coefficients: &[Vec<f64>; 2],
+        z: f64,
+    ) -> Shape {
         let nodes: Vec<f64> = self.file.z_nodes.iter().map(|z| z.ln_1p()).collect();
         let s = z.ln_1p();
         let interval = nodes.partition_point(|&v| v <= s).saturating_sub(1);
@@ -313,7 +391,7 @@ impl LinearEmulator {
         // one node's Σ_p c_p V_p, accumulated in f32 (the components are f32; |sum| ≲ 10, so the
         // rounding is ~1e-6 in ln P)
         let mut row = vec![0.0_f32; n_x];
-        for (t, (target, c)) in self.file.targets.iter().zip(coefficients).enumerate() {
+        for (t, (target, c)) in targets.iter().zip(coefficients).enumerate() {
             let stride = target.mean.len();
             for j in 0..4 {
                 let node = first + j;
@@ -346,6 +424,57 @@ struct Shape {
     cb: Vec<f64>,
     ratio: Vec<f64>,
     d_cb_ds: Vec<f64>,
+}
+
+impl Shape {
+    /// Adds a neutrino head's ln(P_cb ratio) to ln P_cb and its ln(P_m ratio) − ln(P_cb ratio) to
+    /// ln(P_m/P_cb).
+    fn add(&mut self, head: &Shape) {
+        for i in 0..self.cb.len() {
+            self.cb[i] += head.cb[i];
+            self.ratio[i] += head.ratio[i] - head.cb[i];
+            self.d_cb_ds[i] += head.d_cb_ds[i];
+        }
+    }
+}
+
+/// The principal-component coefficients of two targets with polynomial terms `exponents` at the unit
+/// point `u` (Legendre polynomials to `max_degree`).
+fn coefficients(
+    exponents: &[[u8; COORDINATES]],
+    targets: &[format::Target; 2],
+    u: &[f64; COORDINATES],
+    max_degree: usize,
+) -> [Vec<f64>; 2] {
+    let legendre: Vec<Vec<f64>> = u.iter().map(|&x| legendre(x, max_degree)).collect();
+    let features: Vec<f64> = exponents
+        .iter()
+        .map(|e| {
+            e.iter()
+                .enumerate()
+                .map(|(d, &n)| legendre[d][usize::from(n)])
+                .product()
+        })
+        .collect();
+    [0, 1].map(|t| {
+        let t = &targets[t];
+        let mut c = vec![0.0; t.n_pc];
+        for (row, f) in t.coefficients.chunks_exact(t.n_pc).zip(&features) {
+            for (cj, r) in c.iter_mut().zip(row) {
+                *cj += f * r;
+            }
+        }
+        c
+    })
+}
+
+/// [`coefficients`] of a neutrino head.
+fn coefficients_of(
+    head: &format::Head,
+    u: &[f64; COORDINATES],
+    max_degree: usize,
+) -> [Vec<f64>; 2] {
+    coefficients(&head.exponents, &head.targets, u, max_degree)
 }
 
 /// Legendre polynomials P_0..P_n at x.

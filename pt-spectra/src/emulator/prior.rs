@@ -36,6 +36,10 @@ pub const SHAPE_PARAMETERS: usize = 6;
 /// dark-energy density (see [`PriorPoint::coordinates`]).
 pub const COORDINATES: usize = 7;
 
+/// The name of the early dark-energy density in errors and headers: q = ρ_DE/ρ_m at a = 0.1, a
+/// function of Ω_m, w0 and wa ([`PriorPoint::coordinates`]).
+pub const EARLY_DE_NAME: &str = "rho_DE/rho_m at a = 0.1 (from Omega_m, w0, wa)";
+
 /// Tolerance on the box edges, relative to the width: a value within it of an edge counts as inside
 /// (parameter files round to ~7 digits).
 const EDGE_TOL: f64 = 1e-9;
@@ -95,6 +99,25 @@ impl PriorPoint {
     /// [`Error::InvalidParameter`] naming the first shape parameter outside the box, with the range in
     /// the message.
     pub fn unit(&self, prior: &[PriorRange]) -> Result<[f64; SHAPE_PARAMETERS]> {
+        self.unit_in(prior, prior)
+    }
+
+    /// [`unit`](Self::unit) with the range check against `stated` (a box inside `prior`, the prior
+    /// the emulator states) and the mapping by `prior` (the training box).
+    ///
+    /// # Errors
+    /// [`Error::OutsidePrior`] naming the first shape parameter outside `stated`.
+    pub fn unit_in(
+        &self,
+        prior: &[PriorRange],
+        stated: &[PriorRange],
+    ) -> Result<[f64; SHAPE_PARAMETERS]> {
+        for (range, &v) in stated.iter().zip(&self.values).take(SHAPE_PARAMETERS) {
+            let t = 2.0 * (v - range.min) / (range.max - range.min) - 1.0;
+            if t.is_nan() || t.abs() > 1.0 + 2.0 * EDGE_TOL {
+                return Err(outside(range, v));
+            }
+        }
         let mut u = [0.0; SHAPE_PARAMETERS];
         for (i, (range, &v)) in prior
             .iter()
@@ -117,19 +140,34 @@ impl PriorPoint {
     /// The emulator's seven coordinates: [`unit`](Self::unit), and 2 √(q/q_max) − 1 with
     /// q = ρ_DE/ρ_m at a = `a_early` = (1 − Ω_m)/Ω_m a^{−3(w0+wa)} e^{−3wa(1−a)} (flat), on which the
     /// amplitude of large scales depends steeply as w0 + wa → 0; q_max is its largest value in the box.
+    /// The prior is bounded in q too: q ≤ `q_bound` q_max (the corner of the box where w0 + wa is
+    /// closest to 0 is beyond the emulator's accuracy).
     ///
     /// # Errors
-    /// As [`unit`](Self::unit).
+    /// As [`unit_in`](Self::unit_in) (`stated`: the box the emulator states, inside the training box
+    /// `prior`); [`Error::OutsidePrior`] naming [`EARLY_DE_NAME`] and its bound for q
+    /// beyond it.
     pub fn coordinates(
         &self,
         prior: &[PriorRange],
+        stated: &[PriorRange],
         a_early: f64,
         q_max: f64,
+        q_bound: f64,
     ) -> Result<[f64; COORDINATES]> {
-        let u = self.unit(prior)?;
+        let u = self.unit_in(prior, stated)?;
         let [_, om, _, _, w0, wa, ..] = self.values;
         let q =
             (1.0 - om) / om * a_early.powf(-3.0 * (w0 + wa)) * (-3.0 * wa * (1.0 - a_early)).exp();
+        let limit = q_bound * q_max;
+        if q.is_nan() || q > limit * (1.0 + EDGE_TOL) {
+            return Err(Error::OutsidePrior {
+                name: EARLY_DE_NAME,
+                value: q,
+                min: 0.0,
+                max: limit,
+            });
+        }
         let mut out = [0.0; COORDINATES];
         out[..SHAPE_PARAMETERS].copy_from_slice(&u);
         out[SHAPE_PARAMETERS] = (2.0 * (q / q_max).sqrt() - 1.0).clamp(-1.0, 1.0);

@@ -1,5 +1,5 @@
 use super::*;
-use crate::cosmology::Amplitude;
+use crate::cosmology::{Amplitude, Neutrinos};
 
 /// One held-out CAMB cosmology of `tests/data/emulator_heldout.dat`.
 struct Heldout {
@@ -45,6 +45,16 @@ fn heldout() -> Vec<Heldout> {
     out
 }
 
+/// The embedded emulator with its stated prior widened to the training box and no early dark-energy
+/// bound: the held-out sets below were drawn over the training box and check the fit there (its corners
+/// are beyond the stated accuracy and refused by the emulator itself, tested further below).
+fn on_the_training_box() -> LinearEmulator {
+    let mut e = LinearEmulator::embedded().unwrap();
+    e.file.stated = e.file.prior[..SHAPE_PARAMETERS].to_vec();
+    e.file.q_bound = 1.0;
+    e
+}
+
 fn cosmology(p: &[f64; 8]) -> Cosmology {
     let [ob, om, h, m_nu, w0, wa, ln_as, n_s] = *p;
     let mut c = Cosmology::planck2018();
@@ -63,10 +73,16 @@ fn cosmology(p: &[f64; 8]) -> Cosmology {
 
 #[test]
 fn held_out_camb_spectra_growth_rates_and_sigma8() {
-    let emulator = LinearEmulator::embedded().unwrap();
+    let emulator = on_the_training_box();
     let (mut worst_p, mut worst_f, mut worst_s8) = (0.0_f64, 0.0_f64, 0.0_f64);
+    let mut checked = 0;
     for h in heldout() {
-        let e = emulator.spectra(&cosmology(&h.params), h.z).unwrap();
+        // drawn over the training box: those outside the stated prior are refused (tested below)
+        let e = match emulator.spectra(&cosmology(&h.params), h.z) {
+            Err(Error::OutsidePrior { .. }) => continue,
+            e => e.unwrap(),
+        };
+        checked += 1;
         let (m, cb) = (e.matter().unwrap(), e.cb().unwrap());
         let f = LinearSpectrum::from_nodes(e.k.clone(), e.f_cb.iter().map(|v| v + 1.0).collect())
             .unwrap();
@@ -78,7 +94,8 @@ fn held_out_camb_spectra_growth_rates_and_sigma8() {
         }
         worst_s8 = worst_s8.max((e.sigma8 / h.sigma8 - 1.0).abs());
     }
-    eprintln!("held out: P {worst_p:.2e}, f_cb {worst_f:.2e}, sigma8 {worst_s8:.2e}");
+    eprintln!("held out ({checked}): P {worst_p:.2e}, f_cb {worst_f:.2e}, sigma8 {worst_s8:.2e}");
+    assert_eq!(checked, 16);
     assert!(worst_p < 2e-3, "P: {worst_p}");
     assert!(worst_f < 3e-3, "f_cb: {worst_f}");
     assert!(worst_s8 < 1e-3, "sigma8: {worst_s8}");
@@ -156,7 +173,7 @@ fn outside_the_prior_names_the_parameter() {
     let emulator = LinearEmulator::embedded().unwrap();
     let c = Cosmology::planck2018().with_neutrinos(0.7).unwrap();
     let e = emulator.spectra(&c, 0.0).unwrap_err().to_string();
-    assert!(e.contains("m_nu = 0.7") && e.contains("[0, 0.5]"), "{e}");
+    assert!(e.contains("m_nu = 0.7") && e.contains("[0, 0.45]"), "{e}");
     let curved = Cosmology::new(0.3, 0.65, 0.7, 0.022, 0.96, 0.8).unwrap();
     let e = emulator.spectra(&curved, 0.0).unwrap_err().to_string();
     assert!(e.contains("Omega_k"), "{e}");
@@ -196,7 +213,7 @@ fn class_spectra_of_six_cosmologies_agree() {
     // differ on these by 0.7e-3 (Planck, massless) to 5.7e-3 (m_nu = 0.45 eV): the bound is theirs.
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/emulator_class.dat");
     let text = std::fs::read_to_string(path).expect("CLASS table");
-    let emulator = LinearEmulator::embedded().unwrap();
+    let emulator = on_the_training_box();
     let mut worst = 0.0_f64;
     let mut current: Option<(usize, EmulatedSpectra)> = None;
     for line in text.lines().filter(|l| !l.starts_with('#')) {
@@ -229,7 +246,7 @@ fn scale_dependent_growth_agrees_with_camb_transfer_functions() {
         "/tests/data/emulator_growth.dat"
     );
     let text = std::fs::read_to_string(path).expect("growth table");
-    let emulator = LinearEmulator::embedded().unwrap();
+    let emulator = on_the_training_box();
     let (mut worst, mut spread) = (0.0_f64, 0.0_f64);
     let mut current: Option<((usize, u64), ScaleDependentGrowth)> = None;
     for line in text.lines().filter(|l| !l.starts_with('#')) {
@@ -257,4 +274,119 @@ fn scale_dependent_growth_agrees_with_camb_transfer_functions() {
     assert!(worst < 3e-3, "{worst}");
     // the scale dependence is resolved: since z, the small scales grew less (free streaming) by percents
     assert!(spread > 0.01, "{spread}");
+}
+
+/// |Δ ln P| allowed against CAMB at the corners of the stated prior with massive neutrinos (the
+/// accuracy the issue asks for; the massless corners reach 3.0e-3, docs/emulator.md).
+const STATED_ACCURACY: f64 = 2e-3;
+
+#[test]
+fn corners_of_the_stated_prior_agree_with_camb() {
+    // pt-spectra/tests/data/emulator_corners.dat: CAMB at three corners of the stated box
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/emulator_corners.dat"
+    );
+    let text = std::fs::read_to_string(path).expect("corner table");
+    let emulator = LinearEmulator::embedded().unwrap();
+    let mut worst = 0.0_f64;
+    let mut rows = 0;
+    for line in text.lines().filter(|l| !l.starts_with('#')) {
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        let e = emulator
+            .spectra(&cosmology(&v[1..9].try_into().unwrap()), v[9])
+            .unwrap();
+        let (m, cb) = (e.matter().unwrap(), e.cb().unwrap());
+        worst = worst
+            .max((cb.eval(v[10]) / v[11]).ln().abs())
+            .max((m.eval(v[10]) / v[12]).ln().abs());
+        rows += 1;
+    }
+    eprintln!("corners: worst |dln P| {worst:.2e} on {rows} rows");
+    assert!(rows >= 100, "{rows}");
+    assert!(worst <= STATED_ACCURACY, "{worst}");
+    // and the header's figure is the measured worst case, not below what this table shows (3.0e-3,
+    // at a massless corner: docs/emulator.md)
+    let w = emulator.worst(Neutrinos::ThreeDegenerate).unwrap();
+    assert!(w[0].max(w[1]) >= worst && w[1] < 3.1e-3, "{w:?}");
+}
+
+#[test]
+fn the_corners_beyond_the_stated_prior_are_refused() {
+    let emulator = LinearEmulator::embedded().unwrap();
+    // the issue's case: w0 = -0.7, wa = 0.5 (9.9e-3 off CAMB) is outside the stated box
+    let mut c = Cosmology::planck2018().with_neutrinos(0.06).unwrap();
+    c.w0 = -0.7;
+    c.wa = 0.5;
+    let e = emulator.spectra(&c, 0.0).unwrap_err().to_string();
+    assert!(e.contains("w0 = -0.7") && e.contains("prior"), "{e}");
+    // inside the box but with too much early dark energy: refused naming the bound
+    c.w0 = -0.76;
+    c.wa = 0.38;
+    c.omega_m = 0.26;
+    c.omega_lambda = 0.74;
+    c.omega_b_h2 = 0.05 * c.h * c.h;
+    let e = emulator.spectra(&c, 0.0).unwrap_err().to_string();
+    assert!(
+        e.contains("rho_DE/rho_m at a = 0.1") && e.contains("w0, wa"),
+        "{e}"
+    );
+    assert!(
+        emulator.describe().contains("rho_DE/rho_m at a = 0.1"),
+        "{}",
+        emulator.describe()
+    );
+}
+
+#[test]
+fn neutrino_settings_that_are_not_emulated_are_refused_naming_them() {
+    let emulator = LinearEmulator::embedded().unwrap();
+    let c = Cosmology::planck2018().with_neutrinos(0.39).unwrap();
+    assert!(emulator.spectra(&c, 0.0).is_ok());
+    for (setting, name) in [
+        (Neutrinos::OneMassive, "one massive species"),
+        (Neutrinos::NormalHierarchy, "normal hierarchy"),
+        (Neutrinos::InvertedHierarchy, "inverted hierarchy"),
+    ] {
+        let e = emulator
+            .spectra(&c.with_neutrino_species(setting), 0.0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(name) && e.contains("three degenerate"), "{e}");
+    }
+    // massless: how a zero mass is shared does not matter
+    let c = Cosmology::planck2018().with_neutrino_species(Neutrinos::OneMassive);
+    assert!(emulator.spectra(&c, 0.0).is_ok());
+    // the CLASS file of the issue, with its N_ur: refused, not emulated as three species
+    let text = "h = 0.67\nomega_b = 0.022445\nomega_cdm = 0.1207\nn_s = 0.965\nA_s = 2.1e-9\n\
+                N_ncdm = 1\nm_ncdm = 0.39\nN_ur = 2.0328\n";
+    let c = Cosmology::from_ini_str(text, "nu.ini").unwrap().cosmology;
+    assert_eq!(c.neutrinos, Neutrinos::OneMassive);
+    let e = emulator.spectra(&c, 0.0).unwrap_err().to_string();
+    assert!(e.contains("one massive species"), "{e}");
+}
+
+#[test]
+fn a_file_of_layout_two_is_validated() {
+    let good = EMBEDDED.to_vec();
+    assert!(LinearEmulator::from_bytes(&good, "x").is_ok());
+    // a stated box wider than the training box
+    let mut bad = good.clone();
+    let at = good.len() - 4 - 3 * 8 - 12 * 8; // the stated box, with no heads
+    bad[at..at + 8].copy_from_slice(&0.0f64.to_le_bytes());
+    let e = LinearEmulator::from_bytes(&bad, "x")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("stated prior"), "{e}");
+    // a bound beyond (0, 1]
+    let mut bad = good.clone();
+    let at = good.len() - 4 - 3 * 8;
+    bad[at..at + 8].copy_from_slice(&2.0f64.to_le_bytes());
+    let e = LinearEmulator::from_bytes(&bad, "x")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("prior bound"), "{e}");
 }

@@ -4,7 +4,7 @@
 use super::{column_names, fails_naming, rows, run, scratch};
 
 const NU_INI: &str = "h = 0.6766\nomega_b = 0.02242\nomega_cdm = 0.11933\nn_s = 0.9665\n\
-                      A_s = 2.105209e-9\nN_ncdm = 1\nm_ncdm = 0.1\ndeg_ncdm = 3\n";
+                      A_s = 2.105209e-9\nN_ncdm = 1\nm_ncdm = 0.1\ndeg_ncdm = 3\nN_ur = 0.00641\n";
 
 #[test]
 fn a_cosmology_with_massive_neutrinos_is_emulated_with_p_cb_and_the_prescription() {
@@ -88,7 +88,7 @@ fn outside_the_prior_is_an_error_naming_the_parameter() {
     fails_naming(&[
         (
             heavy,
-            "m_nu = 0.9 is outside the linear-spectrum emulator's prior [0, 0.5]",
+            "m_nu = 0.9 is outside the linear-spectrum emulator's prior [0, 0.45]",
         ),
         (high_z, "z = 4"),
     ]);

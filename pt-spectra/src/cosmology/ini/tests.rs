@@ -92,7 +92,7 @@ fn class_and_camb_files_give_the_planck2018_preset() {
     let tol = 1e-14;
     let class = Cosmology::from_ini_str(CLASS_PLANCK2018, "class.ini").unwrap();
     assert_same(&class.cosmology, &preset, tol);
-    assert_eq!(class.ignored, ["output", "P_k_max_h/Mpc", "N_ur"]);
+    assert_eq!(class.ignored, ["output", "P_k_max_h/Mpc"]);
     let camb = Cosmology::from_ini_str(CAMB_PLANCK2018, "camb.ini").unwrap();
     assert_same(&camb.cosmology, &preset, tol);
     // mnu = 0 is read (massless neutrinos, as the preset)
@@ -321,7 +321,7 @@ proptest! {
 fn neutrino_masses_from_class_lists_camb_mnu_and_omnuh2() {
     let base = "h = 0.67\nomega_b = 0.022\nomega_cdm = 0.12\nn_s = 0.96\nA_s = 2.1e-9\n";
     let class = |extra: &str| Cosmology::from_ini_str(&format!("{base}{extra}"), "nu.ini");
-    let c = class("N_ncdm = 3\nm_ncdm = 0.02, 0.02, 0.02\n")
+    let c = class("N_ncdm = 3\nm_ncdm = 0.02, 0.02, 0.02\nN_ur = 0.00641\n")
         .unwrap()
         .cosmology;
     assert_eq!(c.m_nu, 0.06);
@@ -329,7 +329,7 @@ fn neutrino_masses_from_class_lists_camb_mnu_and_omnuh2() {
     let expected = (0.022 + 0.12 + 0.06 / 93.14) / (0.67 * 0.67);
     assert!((c.omega_m / expected - 1.0).abs() < 1e-14);
     assert_eq!(
-        class("m_ncdm = 0.05\ndeg_ncdm = 3\n")
+        class("m_ncdm = 0.05\ndeg_ncdm = 3\nN_ur = 0.00641\n")
             .unwrap()
             .cosmology
             .m_nu,
