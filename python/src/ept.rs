@@ -10,7 +10,7 @@ use pt_spectra::progress::Silent;
 use pt_spectra::rsd::ap::Distortion;
 use pt_spectra::rsd::ept::{EptParams, EptPlan as LibEptPlan, EptTerms as LibEptTerms};
 use pt_spectra::setup::Prepared;
-use pt_spectra::survey::observe::{Bins, Observation, Window};
+use pt_spectra::survey::observe::{Bins, Observation};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Arc;

@@ -91,7 +91,7 @@ pub fn validate(
     // The RMS of each multipole's data, per element of the data vector.
     let scale: Vec<f64> = values
         .iter()
-        .flat_map(|v| std::iter::repeat(rms(v)).take(v.len()))
+        .flat_map(|v| std::iter::repeat_n(rms(v), v.len()))
         .collect();
     check(c, &scale, origin, &line)
 }
@@ -127,9 +127,10 @@ fn check(
         line: line(i),
         problem,
     };
-    for i in 0..n {
-        let v = c[i][i];
-        if !(v > 0.0) {
+    for (i, row) in c.iter().enumerate() {
+        let v = row[i];
+        // (Not `v <= 0.0`: a NaN must be refused too.)
+        if v.is_nan() || v <= 0.0 {
             return Err(bad(
                 i,
                 format!(
@@ -199,7 +200,7 @@ fn check(
         )
     })?;
     let (condition, row) = correlation_condition(&r, &l);
-    if !(condition <= MAX_CORRELATION_CONDITION) {
+    if condition.is_nan() || condition > MAX_CORRELATION_CONDITION {
         return Err(bad(
             row,
             format!(
@@ -299,11 +300,9 @@ mod tests {
         let six = |x: f64| format!("{x:.5e}").parse::<f64>().unwrap();
         // Row and column 8 (0-based 7) := 7 (0-based 6), written with 6 digits.
         let mut dup = base.clone();
-        for j in 0..30 {
-            dup[7][j] = dup[6][j];
-        }
-        for i in 0..30 {
-            dup[i][7] = dup[i][6];
+        dup[7] = dup[6].clone();
+        for row in dup.iter_mut() {
+            row[7] = row[6];
         }
         let dup: Vec<Vec<f64>> = dup
             .iter()
@@ -317,13 +316,11 @@ mod tests {
             "{e}"
         );
         let mut tiny = base.clone();
-        tiny[4][4] = 1e-10;
-        for j in 0..30 {
-            if j != 4 {
-                tiny[4][j] = 0.0;
-                tiny[j][4] = 0.0;
-            }
+        tiny[4] = vec![0.0; 30];
+        for row in tiny.iter_mut() {
+            row[4] = 0.0;
         }
+        tiny[4][4] = 1e-10;
         let scale = vec![1e4; 30];
         let e = check(tiny, &scale, "cov.dat", &line)
             .unwrap_err()

@@ -129,17 +129,15 @@ fn singular_or_absurd_covariances_are_refused() {
     let good = covariance(&p);
     // Row and column 6 := row and column 5.
     let mut equal = good.clone();
-    for j in 0..16 {
-        equal[5][j] = equal[4][j];
-    }
+    equal[5] = equal[4].clone();
     for row in equal.iter_mut() {
         row[5] = row[4];
     }
     let equal = write_matrix(&dir, "equal.dat", &equal);
     let mut tiny = good.clone();
-    for j in 0..16 {
-        tiny[3][j] = 0.0;
-        tiny[j][3] = 0.0;
+    tiny[3] = vec![0.0; 16];
+    for row in tiny.iter_mut() {
+        row[3] = 0.0;
     }
     tiny[3][3] = 1e-10;
     let tiny = write_matrix(&dir, "tiny.dat", &tiny);
