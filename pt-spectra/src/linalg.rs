@@ -11,6 +11,12 @@ pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
 /// Lower-triangular Cholesky factor of a symmetric positive-definite matrix, or `None` (also for NaN
 /// or infinite pivots: huge elements overflow the sums).
 pub(crate) fn cholesky(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
+    cholesky_pivot(a).ok()
+}
+
+/// As [`cholesky`], or the 0-based row and the value of the first pivot that is not finite and
+/// positive.
+pub(crate) fn cholesky_pivot(a: &[Vec<f64>]) -> std::result::Result<Vec<Vec<f64>>, (usize, f64)> {
     let n = a.len();
     let mut l = vec![vec![0.0; n]; n];
     for i in 0..n {
@@ -19,7 +25,7 @@ pub(crate) fn cholesky(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
             if i == j {
                 let d = a[i][i] - s;
                 if !(d > 0.0 && d.is_finite()) {
-                    return None;
+                    return Err((i, d));
                 }
                 l[i][i] = d.sqrt();
             } else {
@@ -27,7 +33,7 @@ pub(crate) fn cholesky(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
             }
         }
     }
-    Some(l)
+    Ok(l)
 }
 
 /// L⁻¹ for lower-triangular L (forward substitution on the identity).

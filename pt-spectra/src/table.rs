@@ -4,7 +4,7 @@
 //! Format (as for linear spectra): lines starting with `#` (after optional blanks) are header lines;
 //! text after a `#` on a data line is ignored; blank lines are skipped; fields are separated by commas
 //! and/or whitespace; a single row of column names with no number in it before the first data row is
-//! taken as a header line. Lines end with `\n`, `\r\n` or a lone `\r`; a leading byte-order mark is
+//! taken as a header line; every data row has as many fields as the first. Lines end with `\n`, `\r\n` or a lone `\r`; a leading byte-order mark is
 //! ignored.
 
 use crate::error::{Error, Result};
@@ -100,7 +100,8 @@ impl Table {
     /// (NaN and infinities included: callers check what they need, e.g. with [`Tabulated::new`]).
     ///
     /// # Errors
-    /// [`Error::Parse`] for a field that is not a number, [`Error::MissingColumn`] for a short row.
+    /// [`Error::Parse`] for a field that is not a number, [`Error::MissingColumn`] for a short row,
+    /// [`Error::BadRow`] for a row whose width differs from the first row's.
     pub fn parse(text: &str, origin: &str, columns: &[usize]) -> Result<Self> {
         Self::parse_rows(text, origin, columns, None)
     }
@@ -127,6 +128,7 @@ impl Table {
             columns: vec![Vec::new(); columns.len()],
         };
         let mut named_columns = false;
+        let mut first_width: Option<(usize, usize)> = None;
         for (line, raw) in numbered_lines(text) {
             let (data, comment) = raw.split_once('#').unwrap_or((raw, ""));
             let fields: Vec<&str> = data
@@ -168,6 +170,23 @@ impl Table {
                     line,
                     problem: format!("the row has {} columns, {width} expected", fields.len()),
                 });
+            }
+            // Every row as wide as the first: a field dropped or added in one row would shift the
+            // columns after it, and the columns asked for would take their neighbours' values.
+            match first_width {
+                None => first_width = Some((fields.len(), line)),
+                Some((w, first)) if fields.len() != w => {
+                    return Err(Error::BadRow {
+                        origin: origin.into(),
+                        line,
+                        problem: format!(
+                            "the row has {} columns, the first row (line {first}) has {w}: every row \
+                             must have as many (a field dropped or added shifts the columns after it)",
+                            fields.len()
+                        ),
+                    });
+                }
+                Some(_) => {}
             }
             for (values, &c) in table.columns.iter_mut().zip(columns) {
                 let field = fields[c];
@@ -300,7 +319,9 @@ impl Tabulated {
 
     /// Reads `name` from a file whose first column is k and whose value column is the one named
     /// `column` on a `# k …` names line (as every table of pt-spectra has: `halo` output feeds
-    /// `--bias-file` by its column `b` and `--noise-file` by `P_eps`), else the second column.
+    /// `--bias-file` by its column `b` and `--noise-file` by `P_eps`), else the second column of a file
+    /// of exactly two columns. A wider file without `column` on such a line is refused: its value
+    /// column is not guessed.
     ///
     /// ```
     /// use pt_spectra::table::Tabulated;
@@ -308,13 +329,16 @@ impl Tabulated {
     /// std::fs::write(&path, "# column 1: k [h/Mpc]\n# k b P_eps\n0.01 2.5 3e4\n0.1 2.6 2.9e4\n")?;
     /// let noise = Tabulated::read_column(&path, "P_eps(k)", "P_eps", true)?;
     /// assert_eq!(noise.eval(0.1)?, 2.9e4);
-    /// let bias = Tabulated::read_column(&path, "b(k)", "bias", true)?; // no such name: column 2
+    /// let bias = Tabulated::read_column(&path, "b(k)", "b", true)?;
     /// assert_eq!(bias.eval(0.01)?, 2.5);
+    /// // No column `bias` on the names line of a three-column file: refused, not column 2.
+    /// assert!(Tabulated::read_column(&path, "b(k)", "bias", true).is_err());
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     ///
     /// # Errors
-    /// As [`read`](Self::read).
+    /// As [`read`](Self::read); [`Error::InvalidChoice`] for a file of more than two columns without
+    /// `column` on its names line.
     pub fn read_column(
         path: impl AsRef<Path>,
         name: &'static str,
@@ -323,8 +347,20 @@ impl Tabulated {
     ) -> Result<Self> {
         let path = path.as_ref();
         let text = read_text(path)?;
-        let value_column = named_column(&text, column).unwrap_or(1);
-        let table = Table::parse(&text, &path.display().to_string(), &[0, value_column])?;
+        let origin = path.display().to_string();
+        let table = match named_column(&text, column) {
+            Some(c) => Table::parse(&text, &origin, &[0, c])?,
+            None => Table::parse_exact(&text, &origin, 2).map_err(|e| match e {
+                Error::BadRow { line, .. } => Error::InvalidChoice {
+                    what: format!("`{origin}` (line {line})"),
+                    reason: format!(
+                        "has more than 2 columns and no `# k …` names line with `{column}`: name \
+                         the columns (e.g. `# k {column} …`) so that {name} is read from the right one"
+                    ),
+                },
+                e => e,
+            })?,
+        };
         let [k, v]: [Vec<f64>; 2] = table.columns.try_into().expect("two columns");
         Self::new(name, &table.origin, k, v, positive, &table.lines)
     }

@@ -228,7 +228,8 @@ def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0,
             data_ells=(0, 2, 4), data_columns=None, covariance=None, k_min=0.0, ir=True, apar=None,
             aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision=_D["precision"],
             q_range=None, eh=None, n_mocks=None, k_ranges=None, window=None,
-            window_mixing="wilson", k_edges=None, box=None, xi=False, s_edges=None, **start) -> Table:
+            window_mixing="wilson", k_edges=None, box=None, xi=False, s_edges=None, window_format=None,
+            **start) -> Table:
     """Fits of the galaxy model ``ept`` (``pt-spectra fit --rsd ept``), one row per k_max.
 
     data, data_ells, data_columns, covariance, k_min as :func:`fit`; k_max: a list. free: any of
@@ -239,7 +240,8 @@ def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0,
     that many mocks. apar, aperp: the measurement's distortion (free with ``free=(…, "apar",
     "aperp")``). k_ranges: ``{4: (0.02, 0.1)}`` narrows the range of a multipole. window (a file of
     Q_ℓ(s) or a window matrix, as ``rsd --window``), window_mixing ("wilson" or "classpt-boss"),
-    k_edges [h/Mpc] (k²-weighted bins; with box [Mpc/h] the modes of a periodic box): the model
+    window_format (the columns of a Q_ℓ(s) file without a names line: ``"s,Q0,Q2,Q4"``, ``"boss"``,
+    as ``--window-format``; default: the file's names line ``# s Q0 Q2 Q4``), k_edges [h/Mpc] (k²-weighted bins; with box [Mpc/h] the modes of a periodic box): the model
     goes through them before the comparison. xi=True: the data are ξ_ℓ(s) (s [Mpc/h] in place of k;
     k_min, k_max, k_ranges in s), optionally averaged over s_edges. Columns: ``k_max`` (``s_max``)
     ``points chi2 minus_2_ln_L`` and each parameter with ``err_<p>`` for the free (Gaussian, from the
@@ -252,7 +254,7 @@ def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0,
                           None if k_ranges is None else {int(l): tuple(map(float, r))
                                                          for l, r in k_ranges.items()},
                           None if window is None else str(window), window_mixing,
-                          k_edges, box, bool(xi), s_edges, **_ept_params(start))
+                          k_edges, box, bool(xi), s_edges, window_format, **_ept_params(start))
     return _warn(table)
 
 

@@ -147,7 +147,8 @@ class SurveyMultipoles(Likelihood):
       narrowing the range of one multipole.
     - ``window``: a window file (Q_ℓ(s) multipoles ``s Q0 Q2 Q4 …`` or the BOSS format, or a window
       matrix, as ``pt-spectra rsd --window``), ``window_mixing`` ("wilson", default, or
-      "classpt-boss"); ``k_edges`` [h/Mpc]: the data are k²-weighted bin means over these edges (then
+      "classpt-boss"), ``window_format`` (the columns of a Q_ℓ(s) file without a names line:
+      ``"s,Q0,Q2,Q4"`` or ``"boss"``, as ``--window-format``; default: the file's names line); ``k_edges`` [h/Mpc]: the data are k²-weighted bin means over these edges (then
       the data's k column only labels the rows); ``box`` [Mpc/h] with ``k_edges``: the mean over the
       modes of a periodic box. Wide-angle terms are neglected.
     - ``xi: true``: the data are correlation-function multipoles; ``s_edges`` [Mpc/h]: s-bin means.
@@ -167,6 +168,7 @@ class SurveyMultipoles(Likelihood):
     n_mocks: int | None = None
     window: str | None = None
     window_mixing: str = "wilson"
+    window_format: str | None = None
     k_edges: list | None = None
     box: float | None = None
     xi: bool = False
@@ -189,7 +191,8 @@ class SurveyMultipoles(Likelihood):
         else:
             self.observation = pt.Observation(ells, k, window=self.window,
                                               window_mixing=self.window_mixing,
-                                              k_edges=self.k_edges, box=self.box)
+                                              k_edges=self.k_edges, box=self.box,
+                                              window_format=self.window_format)
         k_out = np.asarray(self.observation.k_out)
         if k_out.size != k.size:
             raise ValueError(f"SurveyMultipoles: the window and bins give {k_out.size} k, the data "
@@ -224,6 +227,10 @@ class SurveyMultipoles(Likelihood):
             if cov.shape != (n, n):
                 raise ValueError(f"SurveyMultipoles: covariance {path!r} is {cov.shape}, expected "
                                  f"({n}, {n}) (data_ells x every k of the data file)")
+            # The library's checks (as `fit --covariance`): symmetric, positive definite, not nearly
+            # singular, no variance absurdly small for its data; each refusal names the row.
+            cov = _core.check_covariance(np.ascontiguousarray(cov, dtype=float),
+                                         [values[ell] for ell in data_ells], path)
             cov = cov[np.ix_(index, index)]
         else:
             cov = np.diag(np.concatenate([sigma[ell][m]

@@ -97,3 +97,21 @@ pub(crate) fn check_memory(bytes: f64, what: &str) -> PyResult<()> {
     precision.max_memory = pt_spectra::memory::env_max_memory().map_err(value_error)?;
     pt_spectra::memory::check_allocation(bytes, &precision, what).map_err(crate::library_error)
 }
+
+/// The covariance `c` (2-D array) of the data vector made of the multipole blocks `values` (one array
+/// per ℓ, ℓ-major), checked as `fit` checks a covariance (`fit::covariance::validate`: finite,
+/// symmetric, positive definite, not nearly singular, no variance absurdly small for its data) and
+/// returned symmetrised; `origin` names it in the `ValueError`.
+#[pyfunction]
+#[pyo3(signature = (c, values, origin="covariance matrix"))]
+pub(crate) fn check_covariance<'py>(
+    py: Python<'py>,
+    c: &Bound<'py, PyAny>,
+    values: Vec<Vec<f64>>,
+    origin: &str,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    let rows = crate::covariance_rows(c)?;
+    let checked =
+        pt_spectra::fit::covariance::validate(rows, &values, origin, &[]).map_err(value_error)?;
+    numpy::PyArray2::from_vec2(py, &checked).map_err(value_error)
+}

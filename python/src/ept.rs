@@ -10,7 +10,7 @@ use pt_spectra::progress::Silent;
 use pt_spectra::rsd::ap::Distortion;
 use pt_spectra::rsd::ept::{EptParams, EptPlan as LibEptPlan, EptTerms as LibEptTerms};
 use pt_spectra::setup::Prepared;
-use pt_spectra::survey::observe::{Bins, Observation, Window};
+use pt_spectra::survey::observe::{Bins, Observation};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Arc;
@@ -171,7 +171,7 @@ impl EptTerms {
     priors=None, ells=vec![0, 2], data_ells=vec![0, 2, 4], data_columns=None, covariance=None, k_min=0.0,
     ir=true, apar=None, aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision=pt_spectra::jobs::defaults::PRECISION,
     q_range=None, eh=None, n_mocks=None, k_ranges=None, window=None, window_mixing="wilson",
-    k_edges=None, r#box=None, xi=false, s_edges=None, **kwargs))]
+    k_edges=None, r#box=None, xi=false, s_edges=None, window_format=None, **kwargs))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit_ept(
     py: Python<'_>,
@@ -203,6 +203,7 @@ pub(crate) fn fit_ept(
     r#box: Option<f64>,
     xi: bool,
     s_edges: Option<&Bound<'_, PyAny>>,
+    window_format: Option<&str>,
     kwargs: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Table> {
     let (mut data, name, layout) = crate::data(data, data_columns, &data_ells, &ells)?;
@@ -240,8 +241,13 @@ pub(crate) fn fit_ept(
         ));
     }
     let s_edges = s_edges.map(|e| floats(e, "s_edges")).transpose()?;
+    if window.is_none() && window_format.is_some() {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "window_format needs a window",
+        ));
+    }
     let window = window
-        .map(|path| Window::read(&path, crate::survey::mixing(window_mixing)?).map_err(value_error))
+        .map(|path| crate::survey::read_window(&path, window_mixing, window_format))
         .transpose()?;
     let bins = match (k_edges.map(|e| floats(e, "k_edges")).transpose()?, r#box) {
         (None, None) => None,

@@ -624,6 +624,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(batch::real_batch, m)?)?;
     m.add_function(wrap_pyfunction!(batch::read_multipoles, m)?)?;
     m.add_function(wrap_pyfunction!(batch::check_memory, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::check_covariance, m)?)?;
     m.add_function(wrap_pyfunction!(real, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(growth, m)?)?;

@@ -4,10 +4,26 @@
 use crate::{detached, floats, matrix_rows, value_error};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pt_spectra::survey::observe::{Bins, Observation as LibObservation, Window};
-use pt_spectra::survey::Mixing;
+use pt_spectra::survey::{Mixing, WindowFormat};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// The window file `path` mixed by `mixing` (a Python name) with its columns declared by `format`
+/// (`None`: the file's names line; `"s,Q0,Q2,Q4"`, `"boss"`: as `--window-format`).
+pub(crate) fn read_window(
+    path: &Path,
+    mixing_name: &str,
+    format: Option<&str>,
+) -> PyResult<Window> {
+    let format = match format {
+        None => WindowFormat::header(),
+        Some(f) => {
+            WindowFormat::parse(f).map_err(|e| value_error(format!("window_format: {e}")))?
+        }
+    };
+    Window::read(path, mixing(mixing_name)?, &format).map_err(value_error)
+}
 
 /// The chain from model multipoles to a measured data vector (`pt_spectra.survey.observe`).
 #[pyclass(module = "pt_spectra._core", frozen)]
@@ -32,9 +48,11 @@ impl Observation {
     /// with a window matrix: its own k), through the window file `window` (Q_ℓ(s) multipoles or a
     /// matrix, as `rsd --window`) mixed by `window_mixing` ('wilson' or 'classpt-boss'), and averaged
     /// over the bins of `k_edges` [h/Mpc] (k² weight) or over the modes of a periodic box of side
-    /// `box` [Mpc/h] in those bins.
+    /// `box` [Mpc/h] in those bins. `window_format`: the columns of a Q_ℓ(s) file without a names
+    /// line (`"s,Q0,Q2,Q4"`, `"boss"`), as `--window-format`.
     #[new]
-    #[pyo3(signature = (ells, k=None, window=None, window_mixing="wilson", k_edges=None, r#box=None))]
+    #[pyo3(signature = (ells, k=None, window=None, window_mixing="wilson", k_edges=None, r#box=None,
+        window_format=None))]
     fn new(
         ells: Vec<usize>,
         k: Option<&Bound<'_, PyAny>>,
@@ -42,13 +60,17 @@ impl Observation {
         window_mixing: &str,
         k_edges: Option<&Bound<'_, PyAny>>,
         r#box: Option<f64>,
+        window_format: Option<&str>,
     ) -> PyResult<Self> {
         let k = match k {
             Some(k) => crate::k_array(k, "k")?.into_vec(),
             None => Vec::new(),
         };
+        if window.is_none() && window_format.is_some() {
+            return Err(PyValueError::new_err("window_format needs a window"));
+        }
         let window = window
-            .map(|path| Window::read(&path, mixing(window_mixing)?).map_err(value_error))
+            .map(|path| read_window(&path, window_mixing, window_format))
             .transpose()?;
         let bins = match (k_edges.map(|e| floats(e, "k_edges")).transpose()?, r#box) {
             (None, None) => None,

@@ -51,7 +51,7 @@ def test_fit_ept_through_a_window_and_bins_recovers_its_own_model(tmp_path):
     q0 = np.exp(-(s / 400.0) ** 2)
     q2 = -0.1 * (s / 400.0) ** 2 * q0
     window = tmp_path / "window.txt"
-    np.savetxt(window, np.column_stack([s, q0, q2, 0.3 * q2]))
+    np.savetxt(window, np.column_stack([s, q0, q2, 0.3 * q2]), header="s Q0 Q2 Q4")
     edges = np.round(np.arange(0.0, 0.2001, 0.01), 10)
     obs = pt.Observation([0, 2, 4], window=window, k_edges=edges)
     truth = dict(b1=2.0, f=0.7, alpha0=5.0)
@@ -97,7 +97,8 @@ def test_survey_likelihood_with_window_covariance_and_ap(tmp_path):
     aperp = res.comoving_radial_distance(z) * h / dm_fid
     s = np.geomspace(0.01, 3000.0, 300)
     window = tmp_path / "window.txt"
-    np.savetxt(window, np.column_stack([s, np.exp(-(s / 500.0) ** 2), 0 * s, 0 * s]))
+    np.savetxt(window, np.column_stack([s, np.exp(-(s / 500.0) ** 2), 0 * s, 0 * s]),
+               header="s Q0 Q2 Q4")
     k = np.linspace(0.02, 0.18, 17)
     obs = pt.Observation([0, 2], k, window=window)
     nu = dict(b1=2.1, b2=0.4, alpha0=4.0, sn=500.0)

@@ -390,7 +390,7 @@ proptest! {
         let file = write_file(&rows, NAMES, &style, &spoil);
         match Table::parse(&file.text, ORIGIN, &[0, 2]) {
             Ok(t) => prop_assert!(t.lines.len() <= rows.len() + 1),
-            Err(e) => check_error(&e, &file.text, &file.allowed(0))?,
+            Err(e) => check_error(&e, &file.text, &file.allowed(1))?,
         }
     }
 

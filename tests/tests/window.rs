@@ -14,7 +14,10 @@ mod support;
 use pt_spectra::estimate::Estimate;
 use pt_spectra::integrate::GaussLegendre;
 use pt_spectra::linear::LinearSpectrum;
-use pt_spectra::survey::{legendre, BinAverage, Mixing, WindowMultipoles, WindowPlan};
+use pt_spectra::survey::window::BOSS_ROWS;
+use pt_spectra::survey::{
+    legendre, BinAverage, Mixing, WindowFormat, WindowMultipoles, WindowPlan,
+};
 use std::f64::consts::PI;
 use std::time::Instant;
 
@@ -187,7 +190,8 @@ fn windowed_binned_evaluation_is_fast() {
         env!("CARGO_MANIFEST_DIR"),
         "/data/window_boss_ellipsoid.dat"
     );
-    let window = WindowMultipoles::from_file(path).unwrap();
+    let window =
+        WindowMultipoles::from_file(path, &WindowFormat::boss(BOSS_ROWS).unwrap()).unwrap();
     let edges: Vec<f64> = (0..=48).map(|i| 0.005 * i as f64).collect();
     let p = LinearSpectrum::gm2012(0.0).unwrap();
     let t0 = Instant::now();
@@ -228,7 +232,8 @@ fn boss_format_window_matches_the_python_reference() {
         env!("CARGO_MANIFEST_DIR"),
         "/data/window_boss_ellipsoid.dat"
     );
-    let window = WindowMultipoles::from_file(path).unwrap();
+    let window =
+        WindowMultipoles::from_file(path, &WindowFormat::boss(BOSS_ROWS).unwrap()).unwrap();
     assert_eq!(window.ells(), &[0, 2, 4]);
     assert!((window.s()[127] - 1000.0).abs() < 1e-9);
     assert!(window.normalisation_warning().is_none());

@@ -1,6 +1,6 @@
 //! Measured multipoles: reading them from tables or arrays, with checks that name the bad row.
 
-use crate::error::{number, Error, Result};
+use crate::error::{Error, Result};
 use crate::table::Table;
 use std::path::Path;
 
@@ -159,17 +159,10 @@ impl MultipoleData {
     ///
     /// # Errors
     /// [`Error::LengthMismatch`] for a wrong size; [`Error::InvalidValue`] for a diagonal element that is
-    /// not finite and positive, [`Error::BadRow`] for a non-finite or asymmetric element (row numbers
-    /// 1-based, origin `covariance matrix`).
+    /// not finite and positive, [`Error::BadRow`] for a non-finite or asymmetric element, a matrix that
+    /// is not positive definite or nearly singular, or a variance absurdly small for its data (the rules
+    /// of [`crate::fit::covariance`]; row numbers 1-based, origin `covariance matrix`).
     pub fn with_covariance(self, c: Vec<Vec<f64>>) -> Result<Self> {
-        let n = self.ells.len() * self.k.len();
-        if c.len() != n || c.iter().any(|r| r.len() != n) {
-            return Err(Error::LengthMismatch {
-                what: "covariance rows and data vector",
-                left: c.len(),
-                right: n,
-            });
-        }
         self.checked_covariance(c, "covariance matrix", &[])
     }
 
@@ -189,8 +182,9 @@ impl MultipoleData {
     /// # Errors
     /// Each naming `origin` and the line: [`Error::Parse`], [`Error::MissingColumn`] and
     /// [`Error::BadRow`] for a row that is not n_ℓ·n_k numbers, [`Error::BadRow`] for a row too many or a
-    /// non-finite or asymmetric element, [`Error::InvalidValue`] for a diagonal element that is not finite
-    /// and positive; [`Error::TooFewPoints`] for too few rows.
+    /// non-finite or asymmetric element and the other faults of [`crate::fit::covariance`],
+    /// [`Error::InvalidValue`] for a diagonal element that is not finite and positive;
+    /// [`Error::TooFewPoints`] for too few rows.
     pub fn parse_covariance(self, text: &str, origin: &str) -> Result<Self> {
         let n = self.ells.len() * self.k.len();
         let table = Table::parse_exact(text, origin, n)?;
@@ -222,61 +216,16 @@ impl MultipoleData {
         self.checked_covariance(c, origin, &table.lines)
     }
 
-    /// Attaches the n×n matrix `c` after checking it; `lines` numbers its rows for messages (row numbers if
-    /// empty).
+    /// Attaches the n×n matrix `c` after checking it (finite, then the checks of
+    /// [`super::covariance`]: symmetric, positive definite, not nearly singular, no variance absurdly
+    /// small for its data); `lines` numbers its rows for messages (row numbers if empty).
     pub(super) fn checked_covariance(
         mut self,
         c: Vec<Vec<f64>>,
         origin: &str,
         lines: &[usize],
     ) -> Result<Self> {
-        let line = |i: usize| lines.get(i).copied().unwrap_or(i + 1);
-        for (i, row) in c.iter().enumerate() {
-            if let Some(j) = row.iter().position(|v| !v.is_finite()) {
-                return Err(Error::BadRow {
-                    origin: origin.into(),
-                    line: line(i),
-                    problem: format!(
-                        "covariance element ({}, {}) = {} is not finite (row, column 1-based)",
-                        i + 1,
-                        j + 1,
-                        number(&row[j])
-                    ),
-                });
-            }
-            // (Finite: checked above.)
-            if row[i] <= 0.0 {
-                return Err(Error::InvalidValue {
-                    origin: origin.into(),
-                    line: line(i),
-                    name: "covariance diagonal",
-                    value: row[i],
-                    reason: "must be finite and positive",
-                });
-            }
-            for j in 0..i {
-                // sqrt before the product: c_ii c_jj may overflow, and then any asymmetry would pass.
-                let tolerance = 1e-9 * c[i][i].sqrt() * c[j][j].sqrt();
-                // Both finite: the difference is finite or infinite, never NaN.
-                if (row[j] - c[j][i]).abs() > tolerance {
-                    return Err(Error::BadRow {
-                        origin: origin.into(),
-                        line: line(i),
-                        problem: format!(
-                            "covariance element ({}, {}) = {} differs from element ({}, {}) = {}: \
-                             the matrix must be symmetric (row, column 1-based)",
-                            i + 1,
-                            j + 1,
-                            number(&row[j]),
-                            j + 1,
-                            i + 1,
-                            number(&c[j][i])
-                        ),
-                    });
-                }
-            }
-        }
-        self.covariance = Some(c);
+        self.covariance = Some(super::covariance::validate(c, &self.values, origin, lines)?);
         Ok(self)
     }
 

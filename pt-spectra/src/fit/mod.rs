@@ -25,6 +25,7 @@ use std::fmt;
 use std::str::FromStr;
 
 mod contour;
+pub mod covariance;
 mod data;
 pub mod galaxy;
 mod layout;

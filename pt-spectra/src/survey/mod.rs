@@ -65,7 +65,8 @@ pub mod xi;
 
 pub use bins::{BinAverage, BoxModes, BoxModesPlan, ModeGroup};
 pub use window::{
-    mixing_coefficient, Mixing, WindowMatrix, WindowMultipoles, WindowOptions, WindowPlan,
+    mixing_coefficient, Mixing, WindowFormat, WindowMatrix, WindowMultipoles, WindowOptions,
+    WindowPlan,
 };
 pub use xi::XiPlan;
 

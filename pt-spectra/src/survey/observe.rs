@@ -7,7 +7,8 @@
 //! binning included); box modes alone (a periodic box has no window).
 
 use super::{
-    BinAverage, BoxModes, BoxModesPlan, Mixing, WindowMatrix, WindowMultipoles, WindowPlan, XiPlan,
+    BinAverage, BoxModes, BoxModesPlan, Mixing, WindowFormat, WindowMatrix, WindowMultipoles,
+    WindowPlan, XiPlan,
 };
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
@@ -25,20 +26,34 @@ pub enum Window {
 
 impl Window {
     /// Reads `path`: a `.npy` matrix (with its `.txt` sidecar) or a text matrix (its header names
-    /// `ells_out`), else Q_ℓ(s) multipoles mixed by `mixing`.
+    /// `ells_out`), else Q_ℓ(s) multipoles laid out as `format` declares, mixed by `mixing`.
     ///
     /// # Errors
-    /// As [`WindowMatrix::from_file`] and [`WindowMultipoles::from_file`].
-    pub fn read(path: &Path, mixing: Mixing) -> Result<Self> {
+    /// As [`WindowMatrix::from_file`] and [`WindowMultipoles::from_file`]; [`Error::InvalidChoice`] for
+    /// a `format` other than [`WindowFormat::header`] given with a matrix (it declares its own layout).
+    pub fn read(path: &Path, mixing: Mixing, format: &WindowFormat) -> Result<Self> {
         let is_npy = path.extension().is_some_and(|e| e == "npy");
         let text_matrix = !is_npy
             && crate::table::read_text(path)
                 .map(|t| t.lines().take(40).any(|l| l.contains("ells_out")))
                 .unwrap_or(false);
+        if (is_npy || text_matrix) && !format.is_header() {
+            return Err(Error::InvalidChoice {
+                what: format!("the window format {format}"),
+                reason: format!(
+                    "`{}` is a window matrix, which declares its own layout (`# ells_out` …): the \
+                     format is for Q_ell(s) files only",
+                    path.display()
+                ),
+            });
+        }
         if is_npy || text_matrix {
             Ok(Self::Matrix(WindowMatrix::from_file(path)?))
         } else {
-            Ok(Self::Multipoles(WindowMultipoles::from_file(path)?, mixing))
+            Ok(Self::Multipoles(
+                WindowMultipoles::from_file(path, format)?,
+                mixing,
+            ))
         }
     }
 }

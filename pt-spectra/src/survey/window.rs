@@ -55,12 +55,14 @@
 //! the midpoints of the three intervals of the model's grid nearest to the output k. It does not see
 //! spline errors far from the output k that the kernel's tails sample (a few 1e-6 of P̂0 for the sphere).
 
+mod format;
 mod matrix;
 mod multipoles;
 mod npy;
 mod transforms;
 mod wigner;
 
+pub use format::{WindowFormat, BOSS_ROWS, WINDOW_FORMAT_HELP};
 pub use matrix::WindowMatrix;
 pub use multipoles::{boss_s_grid, WindowMultipoles, BOSS_S_MAX, BOSS_S_MIN};
 

@@ -9,6 +9,7 @@ mod bias;
 mod counterterm;
 mod emulator;
 mod ept;
+mod faults;
 mod fit;
 mod fixtures;
 mod halo;

@@ -66,11 +66,22 @@ pub struct EptArgs {
     /// ept without IR resummation of the BAO: plain 1-loop SPT in redshift space.
     #[arg(long)]
     no_ir: bool,
-    /// Any model (fit: ept): convolve with a survey window: Q_ℓ(s) multipoles (`s Q0 Q2 Q4 …`, s in Mpc/h, or the BOSS
-    /// DR12 file of Q0 Q2 Q4 without s), or a window matrix (`.npy` with a `.npy.txt` sidecar, or text
-    /// with an `ells_out` header). Wide-angle terms are neglected.
+    /// Any model (fit: ept): convolve with a survey window: Q_ℓ(s) multipoles (columns declared by a
+    /// names line `# s Q0 Q2 Q4 …` in the file, s in Mpc/h, or by --window-format), or a window matrix
+    /// (`.npy` with a `.npy.txt` sidecar, or text with an `ells_out` header). Wide-angle terms are
+    /// neglected.
     #[arg(long, value_name = "FILE")]
     window: Option<std::path::PathBuf>,
+    /// The columns of a Q_ℓ(s) --window file that has no names line: `s,Q0,Q2,Q4` (file order), `boss`
+    /// (the CLASS-PT BOSS DR12 layout: Q0 Q2 Q4 without s on 128 log-uniform s from 0.01 to 1000
+    /// Mpc/h; `boss:N` for N rows) or `header` (the default: the file's names line).
+    #[arg(
+        long,
+        value_name = "LAYOUT",
+        requires = "window",
+        default_value = "header"
+    )]
+    window_format: String,
     /// How Q_ℓ mix the multipoles: wilson (Wilson et al. 2017, every Q_ℓ given; the default) or
     /// classpt-boss (the CLASS-PT BOSS likelihoods: Q ≤ 4, no ξ4 in ξ̂0, ξ̂2).
     #[arg(long, value_name = "M", default_value = "wilson")]
@@ -148,10 +159,13 @@ impl EptArgs {
             "classpt-boss" => pt_spectra::survey::Mixing::ClassPtBoss,
             other => bail!("--window-mixing {other}: expected wilson or classpt-boss"),
         };
+        let format = pt_spectra::survey::WindowFormat::parse(&self.window_format)
+            .map_err(|e| anyhow::anyhow!("--window-format: {e}"))?;
         let window = match &self.window {
-            Some(path) => {
-                Some(Window::read(path, mixing).map_err(|e| anyhow::anyhow!("--window: {e}"))?)
-            }
+            Some(path) => Some(
+                Window::read(path, mixing, &format)
+                    .map_err(|e| anyhow::anyhow!("--window: {e}"))?,
+            ),
             None => None,
         };
         let bins = match &self.k_edges {

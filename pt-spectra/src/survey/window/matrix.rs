@@ -254,9 +254,20 @@ impl Meta {
             what: format!("window matrix `{origin}`"),
             reason,
         };
+        let mut seen: Vec<&str> = Vec::new();
         for line in lines {
             let mut fields = line.split_whitespace();
             let Some(key) = fields.next() else { continue };
+            // A key given twice (two `# k_out` lines) would leave one of them unread: refused.
+            let is_key = ["ells_out", "ells_theory", "layout", "k_out", "k_theory"]
+                .iter()
+                .any(|k| key == *k || key.strip_prefix(k).is_some_and(|t| t.starts_with('_')));
+            if is_key {
+                if seen.contains(&key) {
+                    return Err(bad(format!("`{key}` is given twice: `{line}`")));
+                }
+                seen.push(key);
+            }
             let rest: Vec<&str> = fields.collect();
             let numbers = || {
                 rest.iter()
@@ -389,6 +400,17 @@ mod tests {
 
     const TEXT: &str = "# a window matrix\n# ells_out 0 2\n# k_out 0.1 0.2\n# ells_theory 0\n\
                         # k_theory_0 0.05 0.1 0.15\n1 0 0\n0 1 0\n0.5 0.5 0\n0 0 2\n";
+
+    /// A second `# k_out` line was read as nothing before (the first one won): refused.
+    #[test]
+    fn repeated_metadata_is_refused() {
+        let text = TEXT.replace("# k_out 0.1 0.2\n", "# k_out 0.1 0.2\n# k_out 0.1 0.3\n");
+        let e = WindowMatrix::parse(&text, "w.txt").unwrap_err().to_string();
+        assert!(
+            e.contains("`k_out` is given twice") && e.contains("w.txt"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn text_matrix_applies() {

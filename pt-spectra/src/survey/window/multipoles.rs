@@ -5,19 +5,16 @@
 //! tabulated s the Q_ℓ are a not-a-knot cubic spline in ln s, below the first s they keep their first
 //! value, beyond the last s they are zero.
 //!
-//! File layouts (plain text, `#` comments, white space or commas):
-//! * `s Q0 Q2 Q4 …` with s in Mpc/h, strictly increasing. A line of names before the data (as a comment
-//!   or not) may give the columns in any order: `s` (or `r`) and `Q0`, `Q2`, … (or `Q_0`, `W0`, …).
-//!   Without names, the columns after s are Q0, Q2, Q4, … in order.
-//! * The BOSS DR12 files as the CLASS-PT BOSS likelihoods read them (lss_montepython, `window.dat`):
-//!   columns Q0 Q2 Q4, no s column, one row per point of the log-uniform grid
-//!   s_i = 0.01 · (1000/0.01)^{i/(N−1)} Mpc/h, i = 0 … N−1 (N = 128 there), see [`boss_s_grid`].
-//!
-//! Without a names line, a file is read as having an s column if its first column is positive and
-//! strictly increasing (the Q0 of a window never is), as the BOSS layout otherwise.
+//! File layout (plain text, `#` comments, white space or commas): declared, never guessed from the
+//! numbers ([`WindowFormat`]): columns `s Q0 Q2 Q4 …` in any order named on a line before the data (or
+//! by the caller), s in Mpc/h, strictly increasing; or the BOSS DR12 files as the CLASS-PT BOSS
+//! likelihoods read them (lss_montepython, `window.dat`): columns Q0 Q2 Q4, no s column, one row per
+//! point of the log-uniform grid s_i = 0.01 · (1000/0.01)^{i/(N−1)} Mpc/h, i = 0 … N−1 (N = 128
+//! there), see [`boss_s_grid`], declared with [`WindowFormat::boss`].
 
+use super::super::check_ells;
 use super::super::text::parse_table;
-use super::super::{check_ells, MAX_ELL};
+use super::format::{check_has_s, column_names, Column, Layout, WindowFormat, WINDOW_FORMAT_HELP};
 use crate::error::{Error, Result};
 use crate::linear::spline::LogSpline;
 use crate::table::read_text;
@@ -64,74 +61,104 @@ impl WindowMultipoles {
         Self::build(s, ells, q, "window columns".into(), &lines)
     }
 
-    /// Reads a window file (module docs for the layouts).
+    /// Reads a window file laid out as `format` declares (module docs).
     ///
     /// # Errors
     /// [`Error::Io`] if the file cannot be read, and those of [`parse`](Self::parse).
-    pub fn from_file(path: impl AsRef<Path>) -> Result<Self> {
+    pub fn from_file(path: impl AsRef<Path>, format: &WindowFormat) -> Result<Self> {
         let path = path.as_ref();
-        Self::parse(&read_text(path)?, &path.display().to_string())
+        Self::parse(&read_text(path)?, &path.display().to_string(), format)
     }
 
-    /// Parses the text of a window file; `origin` names it in messages.
+    /// Parses the text of a window file laid out as `format` declares; `origin` names it in messages.
     ///
     /// # Errors
-    /// [`Error::Parse`] or [`Error::BadRow`] for a malformed row, [`Error::InvalidChoice`] for column
-    /// names that are not `s` and `Q<ℓ>` or a layout that cannot be read, and those of
-    /// [`from_columns`](Self::from_columns).
-    pub fn parse(text: &str, origin: &str) -> Result<Self> {
+    /// [`Error::Parse`] or [`Error::BadRow`] for a malformed row or a row count the BOSS layout does not
+    /// have, [`Error::InvalidChoice`] for a file that does not declare its columns (with the default
+    /// [`WindowFormat::header`]), column names that are not `s` and `Q<ℓ>`, names that disagree with
+    /// `format` or with the width of the rows, and those of [`from_columns`](Self::from_columns).
+    pub fn parse(text: &str, origin: &str, format: &WindowFormat) -> Result<Self> {
         let table = parse_table(text, origin)?;
-        let width = table.rows.first().map_or(0, Vec::len);
-        if table.rows.is_empty() {
+        let Some(&first_line) = table.lines.first() else {
             return Err(Error::TooFewPoints {
                 origin: origin.into(),
                 found: 0,
                 min: MIN_POINTS,
             });
-        }
+        };
+        let width = table.rows[0].len();
         let invalid = |reason: String| Error::InvalidChoice {
             what: format!("window file `{origin}`"),
             reason,
         };
-        // Names: a non-comment names line, or the last comment line made only of column names.
-        let names = match &table.names {
+        // Names in the file: a non-comment names line, or the last comment line made only of names.
+        let named = match &table.names {
             Some(n) => Some(column_names(n).ok_or_else(|| {
                 invalid(format!(
                     "the names line {n:?} is not made of `s` and `Q<ell>` names"
                 ))
             })?),
             None => table.comments.iter().rev().find_map(|(_, c)| {
-                let fields: Vec<String> = c.split_whitespace().map(String::from).collect();
+                let fields: Vec<&str> = c
+                    .split(|c: char| c == ',' || c.is_whitespace())
+                    .filter(|f| !f.is_empty())
+                    .collect();
                 column_names(&fields)
             }),
         };
-        let columns: Vec<Column> = match names {
-            Some(n) if n.len() != width => {
+        let boss_names = [Column::Q(0), Column::Q(2), Column::Q(4)];
+        let columns: Vec<Column> = match (&format.0, named) {
+            (Layout::Header, None) => {
                 return Err(invalid(format!(
-                    "{} column names for rows of {width} columns",
-                    n.len()
+                    "no names line declares its columns (they are not guessed from the \
+                     numbers): add a line such as `# s Q0 Q2 Q4` before the data, or give the \
+                     layout (`--window-format`, Python `window_format`): {WINDOW_FORMAT_HELP}"
                 )))
             }
-            Some(n) => n,
-            None => {
-                let first: Vec<f64> = table.rows.iter().map(|r| r[0]).collect();
-                let has_s = width >= 2
-                    && first.iter().all(|&v| v > 0.0)
-                    && first.windows(2).all(|w| w[1] > w[0]);
-                let n_q = if has_s { width - 1 } else { width };
-                if n_q > MAX_ELL / 2 + 1 {
-                    return Err(invalid(format!(
-                        "{width} columns: at most Q0 … Q8 (5 columns) after an optional s column"
-                    )));
+            (Layout::Header, Some(n)) => {
+                check_has_s(&n).map_err(|r| invalid(format!("its names line: {r}")))?;
+                n
+            }
+            (Layout::Columns(c), Some(n)) if *c != n => {
+                return Err(invalid(format!(
+                    "its names line ({}) disagrees with the format given ({format})",
+                    WindowFormat(Layout::Columns(n))
+                )))
+            }
+            (Layout::Columns(c), _) => c.clone(),
+            (Layout::Boss(_), Some(n)) if n != boss_names => {
+                return Err(invalid(format!(
+                    "its names line ({}) disagrees with the format given ({format}: Q0 Q2 Q4 \
+                     without s)",
+                    WindowFormat(Layout::Columns(n))
+                )))
+            }
+            (Layout::Boss(rows), _) => {
+                if table.rows.len() != *rows {
+                    return Err(Error::BadRow {
+                        origin: origin.into(),
+                        line: table.lines.last().copied().unwrap_or(first_line),
+                        problem: format!(
+                            "{} rows, but the layout {format} has exactly {rows} (one per point \
+                             of its s grid: a row missing or repeated would shift every s)",
+                            table.rows.len()
+                        ),
+                    });
                 }
-                let q = (0..n_q).map(|j| Column::Q(2 * j));
-                if has_s {
-                    std::iter::once(Column::S).chain(q).collect()
-                } else {
-                    q.collect()
-                }
+                boss_names.to_vec()
             }
         };
+        if columns.len() != width {
+            return Err(Error::BadRow {
+                origin: origin.into(),
+                line: first_line,
+                problem: format!(
+                    "the row has {width} columns, the declared layout ({}) has {}",
+                    WindowFormat(Layout::Columns(columns.clone())),
+                    columns.len()
+                ),
+            });
+        }
         let column = |j: usize| table.rows.iter().map(|r| r[j]).collect::<Vec<f64>>();
         let s = match columns.iter().position(|c| *c == Column::S) {
             Some(j) => column(j),
@@ -310,65 +337,107 @@ impl WindowMultipoles {
     }
 }
 
-/// A column of a window file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Column {
-    S,
-    Q(usize),
-}
-
-/// The columns named by `fields` (at least 2 names, at most one s), or `None` if they are not names.
-fn column_names(fields: &[String]) -> Option<Vec<Column>> {
-    if fields.len() < 2 {
-        return None;
-    }
-    let columns: Vec<Column> = fields
-        .iter()
-        .map(|f| {
-            let f = f.to_ascii_lowercase();
-            if f == "s" || f == "r" {
-                return Some(Column::S);
-            }
-            let rest = f.strip_prefix('q').or_else(|| f.strip_prefix('w'))?;
-            let rest = rest.strip_prefix('_').unwrap_or(rest);
-            rest.parse::<usize>().ok().map(Column::Q)
-        })
-        .collect::<Option<_>>()?;
-    (columns.iter().filter(|c| **c == Column::S).count() <= 1).then_some(columns)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    fn header() -> WindowFormat {
+        WindowFormat::header()
+    }
+
     #[test]
-    fn layouts_are_recognised() {
-        // An s column, detected from the numbers.
-        let text = "# sphere\n1 1 0\n2 0.9 0.01\n4 0.8 0.02\n8 0.5 0.03\n16 0.1 0.02\n";
-        let w = WindowMultipoles::parse(text, "t").unwrap();
-        assert_eq!(w.s(), &[1.0, 2.0, 4.0, 8.0, 16.0]);
-        assert_eq!(w.ells(), &[0, 2]);
-        assert_eq!(w.q(2, 4.0), 0.02);
-        assert_eq!(w.q(0, 0.5), 1.0);
-        assert_eq!(w.q(0, 17.0), 0.0);
-        assert_eq!(w.q(4, 4.0), 0.0);
-        // BOSS layout: three Q columns, no s.
+    fn layouts_are_declared_not_guessed() {
+        // An s column declared by a names line, or by the caller.
+        let rows = "1 1 0\n2 0.9 0.01\n4 0.8 0.02\n8 0.5 0.03\n16 0.1 0.02\n";
+        let given = WindowFormat::parse("s,Q0,Q2").unwrap();
+        for (text, format) in [
+            (format!("# sphere\n# s Q0 Q2\n{rows}"), header()),
+            (format!("# s, Q0, Q2\n{rows}"), header()),
+            (format!("# sphere\n{rows}"), given.clone()),
+            (format!("s Q0 Q2\n{rows}"), given),
+        ] {
+            let w = WindowMultipoles::parse(&text, "t", &format).unwrap();
+            assert_eq!(w.s(), &[1.0, 2.0, 4.0, 8.0, 16.0]);
+            assert_eq!(w.ells(), &[0, 2]);
+            assert_eq!(w.q(2, 4.0), 0.02);
+            assert_eq!(w.q(0, 0.5), 1.0);
+            assert_eq!(w.q(0, 17.0), 0.0);
+            assert_eq!(w.q(4, 4.0), 0.0);
+        }
+        // Nothing declared: refused, with how to declare it (the numbers are not looked at).
+        let e = WindowMultipoles::parse(&format!("# sphere\n{rows}"), "w.dat", &header());
+        let e = e.unwrap_err().to_string();
+        assert!(
+            e.contains("w.dat") && e.contains("# s Q0 Q2 Q4") && e.contains("--window-format"),
+            "{e}"
+        );
+        // BOSS layout: three Q columns, no s, declared with its row count.
         let rows: String = (0..8)
             .map(|i| format!("{} {} {}\n", 1.0 - 0.01 * i as f64, -0.001 * i as f64, 0.0))
             .collect();
-        let w = WindowMultipoles::parse(&rows, "boss").unwrap();
+        let w = WindowMultipoles::parse(&rows, "boss", &WindowFormat::boss(8).unwrap()).unwrap();
         assert_eq!(w.ells(), &[0, 2, 4]);
         assert_eq!(w.s(), boss_s_grid(8).as_slice());
         assert!((w.s()[7] - 1000.0).abs() < 1e-9 && (w.s()[0] - 0.01).abs() < 1e-15);
+        let e = WindowMultipoles::parse(&rows, "boss", &WindowFormat::boss(9).unwrap());
+        assert!(matches!(e, Err(Error::BadRow { line: 8, .. })), "{e:?}");
+        let e = WindowMultipoles::parse(&rows, "boss", &header()).unwrap_err();
+        assert!(e.to_string().contains("no names line"), "{e}");
+        let e = WindowMultipoles::parse(&format!("# Q0 Q2 Q4\n{rows}"), "b", &header());
+        assert!(e.unwrap_err().to_string().contains("no s column"));
         // Names, in any order, as a comment or a plain line.
         for text in [
             "# Q2 s Q0\n0 1 1\n0.1 2 0.9\n0.2 3 0.8\n0.3 4 0.7\n",
             "q_2 r W0\n0 1 1\n0.1 2 0.9\n0.2 3 0.8\n0.3 4 0.7\n",
         ] {
-            let w = WindowMultipoles::parse(text, "named").unwrap();
+            let w = WindowMultipoles::parse(text, "named", &header()).unwrap();
             assert_eq!(w.ells(), &[2, 0]);
             assert_eq!(w.s(), &[1.0, 2.0, 3.0, 4.0]);
             assert_eq!(w.column(0).unwrap(), &[1.0, 0.9, 0.8, 0.7]);
+        }
+        // A names line that disagrees with the format given, or with the rows' width.
+        let text = "# s Q0 Q2\n1 1 0\n2 1 0\n3 1 0\n4 1 0\n";
+        let other = WindowFormat::parse("s,Q0,Q4").unwrap();
+        let e = WindowMultipoles::parse(text, "n", &other)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("disagrees"), "{e}");
+        let e = WindowMultipoles::parse(text, "n", &WindowFormat::boss(4).unwrap());
+        assert!(e.unwrap_err().to_string().contains("disagrees"));
+        let e =
+            WindowMultipoles::parse("# s Q0 Q2 Q4\n1 1 0\n2 1 0\n3 1 0\n4 1 0\n", "n", &header());
+        assert!(matches!(e, Err(Error::BadRow { line: 2, .. })), "{e:?}");
+    }
+
+    /// The issue's case: a duplicated row (the s column is then not increasing) is refused naming the
+    /// line, whatever the layout declared, never read as another layout.
+    #[test]
+    fn a_duplicated_or_swapped_row_is_refused_with_its_line() {
+        let mut rows: Vec<String> = (1..=6)
+            .map(|i| format!("{i} {} 0", 1.0 / i as f64))
+            .collect();
+        let dup = {
+            let mut r = rows.clone();
+            r.insert(3, r[2].clone());
+            r
+        };
+        rows.swap(2, 3);
+        for (what, r) in [("duplicated", dup), ("swapped", rows)] {
+            for (text, format) in [
+                (format!("# s Q0 Q2\n{}\n", r.join("\n")), header()),
+                (
+                    format!("{}\n", r.join("\n")),
+                    WindowFormat::parse("s,Q0,Q2").unwrap(),
+                ),
+            ] {
+                let e = WindowMultipoles::parse(&text, "w.dat", &format).unwrap_err();
+                let line = if format.is_header() { 5 } else { 4 };
+                assert!(
+                    matches!(e, Error::InvalidValue { line: l, .. } if l == line),
+                    "{what}: {e}"
+                );
+                assert!(e.to_string().contains("strictly increasing"), "{e}");
+            }
         }
     }
 
@@ -409,16 +478,18 @@ mod tests {
         assert!(matches!(e, Error::InvalidValue { line: 3, .. }), "{e}");
         let e = WindowMultipoles::from_columns(s(), vec![0], vec![vec![1.0, f64::NAN, 1.0, 1.0]]);
         assert!(matches!(e, Err(Error::InvalidValue { line: 2, .. })));
-        let e = WindowMultipoles::parse("1 2\n3 4\n", "short").unwrap_err();
+        let e = WindowMultipoles::parse("s Q0\n1 2\n3 4\n", "short", &header()).unwrap_err();
         assert!(matches!(e, Error::TooFewPoints { found: 2, .. }), "{e}");
-        let e = WindowMultipoles::parse("s Q0 Q3\n1 1 0\n2 1 0\n3 1 0\n4 1 0\n", "odd");
+        let e = WindowMultipoles::parse("s Q0 Q3\n1 1 0\n2 1 0\n3 1 0\n4 1 0\n", "odd", &header());
         assert!(matches!(e, Err(Error::InvalidChoice { .. })));
-        let e = WindowMultipoles::parse("s Q0 x\n1 1 0\n", "names");
+        let e = WindowMultipoles::parse("s Q0 x\n1 1 0\n", "names", &header());
         assert!(matches!(e, Err(Error::InvalidChoice { .. })));
         let five: String = (1..5).map(|i| format!("{i} 1 0 0 0 0\n")).collect();
-        let w = WindowMultipoles::parse(&five, "s and five Q").unwrap();
+        let five = format!("s Q0 Q2 Q4 Q6 Q8\n{five}");
+        let w = WindowMultipoles::parse(&five, "s and five Q", &header()).unwrap();
         assert_eq!(w.ells(), &[0, 2, 4, 6, 8]);
         let six: String = (1..5).map(|i| format!("{i} 1 0 0 0 0 0\n")).collect();
-        assert!(WindowMultipoles::parse(&six, "s and six Q").is_err());
+        let six = format!("s Q0 Q2 Q4 Q6 Q8 Q10\n{six}");
+        assert!(WindowMultipoles::parse(&six, "s and six Q", &header()).is_err());
     }
 }

@@ -83,14 +83,14 @@ pub(super) fn parse_npy(bytes: &[u8], origin: &str) -> Result<Array2> {
         return Err(bad(format!("shape {shape}: a 2-D array is needed")));
     };
     let data = &bytes[start + len..];
-    let count = rows
+    let bytes_expected = rows
         .checked_mul(cols)
+        .and_then(|count| count.checked_mul(size))
         .ok_or_else(|| bad(format!("shape {shape} too large")))?;
-    if data.len() != count * size {
+    if data.len() != bytes_expected {
         return Err(bad(format!(
-            "{} data bytes for shape {shape} of {size}-byte values ({} expected)",
+            "{} data bytes for shape {shape} of {size}-byte values ({bytes_expected} expected)",
             data.len(),
-            count * size
         )));
     }
     let read = |c: &[u8]| -> f64 {
