@@ -377,6 +377,10 @@ class PTMultipoles(Theory):
                 alphas = self._alphas(background)
             return out, alphas
         except ValueError as e:
+            if str(e).startswith("neutrinos:"):
+                # A setting the emulator does not emulate is the same at every point of the chain: a
+                # zero likelihood everywhere would hide it, so it stops the run with the library's words.
+                raise ValueError(f"PTMultipoles (emulator: true): {e}") from e
             self.log.debug("emulator: %s", e)
             return None
 

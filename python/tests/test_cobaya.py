@@ -241,6 +241,21 @@ def test_without_a_boltzmann_code_the_emulator_gives_the_linear_spectrum(setup, 
         assert m.logposterior(bad).logpost == -np.inf
 
 
+def test_the_emulator_stops_on_a_neutrino_setting_it_does_not_emulate(setup):
+    """emulator: true with mnu and no `neutrinos` option: mnu is CAMB's one massive species, which the
+    emulator does not emulate; the run stops naming the setting (a zero likelihood at every point
+    would hide it)."""
+    info, point = setup
+    info = copy.deepcopy({k: v for k, v in info.items() if k != "sampler"})
+    info["theory"].pop("camb")
+    info["theory"]["pt"]["emulator"] = True
+    info["params"].pop("tau")
+    m = get_model(info)
+    sampled = {p: v for p, v in point.items() if p in m.parameterization.sampled_params()}
+    with pytest.raises(ValueError, match="one massive species.*three degenerate"):
+        m.logposterior(sampled)
+
+
 def test_emulator_with_ap_fiducial_gives_camb_distances_and_derived_fsigma8(setup):
     """emulator: true with ap_fiducial (rsd: ept): the α's of the library's background equal those of
     the CAMB run within 1e-4 (3.0e-5 measured: CAMB's run has one massive neutrino and two massless ones,

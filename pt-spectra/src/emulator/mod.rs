@@ -358,9 +358,11 @@ impl LinearEmulator {
             None => Err(Error::InvalidChoice {
                 what: format!("neutrinos: {}", setting.describe()),
                 reason: format!(
-                    "the linear-spectrum emulator ({}) emulates {} only: give the neutrinos as one of \
-                     them (CAMB num_massive_neutrinos = 1 or 3 with neutrino_hierarchy = degenerate; \
-                     CLASS N_ncdm = 1 or three equal m_ncdm), or a linear spectrum (--linear FILE)",
+                    "the linear-spectrum emulator ({}) emulates {} only: if that is what you mean, say \
+                     so (CAMB num_massive_neutrinos = 3 with neutrino_hierarchy = degenerate; CLASS \
+                     three equal m_ncdm, or N_ncdm = 1 with deg_ncdm = 3; the key `neutrinos = three \
+                     degenerate`; the cobaya theory's option `neutrinos: three degenerate`), else give \
+                     a linear spectrum (--linear FILE)",
                     self.origin,
                     self.neutrino_settings()
                         .iter()
