@@ -48,7 +48,7 @@ const EIGEN_ITERATIONS: usize = 200;
 /// # Errors
 /// [`Error::LengthMismatch`] unless `c` is square and as long as the data vector; [`Error::BadRow`]
 /// for a non-finite element; [`Error::InvalidValue`] for a diagonal element that is not positive; as
-/// [`check`] otherwise.
+/// the symmetry, positive-definiteness and condition checks of the module docs otherwise.
 pub fn validate(
     c: Vec<Vec<f64>>,
     values: &[Vec<f64>],
