@@ -323,7 +323,7 @@ mod tests {
 
     #[test]
     fn k_files_of_any_origin_are_read_or_refused_at_a_line() {
-        let windows = write("crlf", "\u{feff}# k\r\n0.01\r\n0.02, x\r\n");
+        let windows = write("crlf", "\u{feff}# k\r\n0.01, y\r\n0.02, x\r\n");
         assert_eq!(read_k_file(&windows).unwrap().into_vec(), vec![0.01, 0.02]);
         let mac = write("cr", "k\r0.01\r0.02\r0.03");
         assert_eq!(
