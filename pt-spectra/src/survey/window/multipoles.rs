@@ -422,7 +422,10 @@ mod tests {
         // A names line with a wrong ℓ (Q6 for Q4): refused naming the file and the missing Q4.
         let e = WindowMultipoles::parse("# s Q0 Q2 Q6\n1 1 0 0\n2 1 0 0\n", "w.dat", &header());
         let e = e.unwrap_err().to_string();
-        assert!(e.contains("w.dat") && e.contains("Q4 is missing below Q6"), "{e}");
+        assert!(
+            e.contains("w.dat") && e.contains("Q4 is missing below Q6"),
+            "{e}"
+        );
     }
 
     /// The case: a duplicated row (the s column is then not increasing) is refused naming the
