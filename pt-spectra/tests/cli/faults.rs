@@ -188,3 +188,28 @@ fn singular_or_absurd_covariances_are_refused() {
     );
     assert!(err.contains("row 5") || err.contains("row 6"), "{err}");
 }
+
+/// A names line with a wrong ℓ (`# s Q0 Q2 Q6` over the BOSS window's Q0 Q2 Q4 columns) once left Q4
+/// out of the mixing with exit 0 (P4 8% off, P2 0.2%); it is refused naming the file and the gap.
+#[test]
+fn a_window_names_line_with_a_wrong_ell_is_refused() {
+    let dir = scratch("faults_window_ell");
+    let text = boss_window().replace("# s Q0 Q2 Q4", "# s Q0 Q2 Q6");
+    let wrong = write(&dir, "wrong_ell.dat", &text);
+    let args = [
+        "rsd",
+        "--rsd",
+        "ept",
+        "--bias",
+        "2",
+        "--k-edges",
+        "0.02:0.2:0.02",
+        "--window",
+        &wrong,
+    ];
+    let needle = format!("window `{wrong}` with multipoles [0, 2, 6]");
+    fails_naming(&[
+        (args.to_vec(), needle.as_str()),
+        (args.to_vec(), "Q4 is missing below Q6"),
+    ]);
+}

@@ -1,5 +1,5 @@
 //! Inputs that once gave a wrong number or a wrong message with exit 0 (issue 45): the growth far
-//! in z, the separations of --xi.
+//! in z, the separations of --xi (rsd and fit).
 
 use super::{fails_naming, run};
 
@@ -45,6 +45,53 @@ fn separations_are_named_as_separations() {
     assert!(
         err.contains("invalid --s-min/--s-max/--ns")
             && err.contains("invalid s_max [Mpc/h] = 10: must exceed s_min"),
+        "{err}"
+    );
+    assert!(!err.contains("k_max") && !err.contains("k_min"), "{err}");
+}
+
+/// fit --xi with --s-min above --s-max names the separations (it once said `invalid k_max [h/Mpc] = 10`).
+#[test]
+fn fit_xi_separations_are_named_as_separations() {
+    let dir = super::scratch("seams_fit_xi");
+    let data: String = (1..=8)
+        .map(|i| {
+            let s = 20.0 * i as f64;
+            format!(
+                "{s} {} {} {} {}\n",
+                100.0 / (s * s),
+                1.0 / (s * s),
+                10.0 / (s * s),
+                0.1 / (s * s)
+            )
+        })
+        .collect();
+    let data = super::write(&dir, "xi.dat", &data);
+    let (ok, _, err) = run(&[
+        "fit",
+        "--data",
+        &data,
+        "--data-ells",
+        "0,2",
+        "--data-columns",
+        "1,2,3,4,5",
+        "--ells",
+        "0,2",
+        "--free",
+        "f",
+        "--rsd",
+        "ept",
+        "--bias",
+        "2",
+        "--xi",
+        "--s-min",
+        "200",
+        "--s-max",
+        "10",
+    ]);
+    assert!(!ok);
+    assert!(
+        err.contains("--s-max 10 Mpc/h must exceed --s-min 200 Mpc/h"),
         "{err}"
     );
     assert!(!err.contains("k_max") && !err.contains("k_min"), "{err}");

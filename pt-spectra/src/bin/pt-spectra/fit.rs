@@ -322,12 +322,20 @@ fn run_ept(args: &Args) -> Result<()> {
         &loaded.prepared,
         &loaded.precision,
     ));
+    let maxima = k_max_values(if args.xi { &args.s_max } else { &args.k_max })?;
+    // --s-max at or below --s-min: named as separations (it was reported as an invalid k_max).
+    if let Some(s_max) = maxima.iter().find(|&&s| args.xi && s <= args.s_min) {
+        bail!(
+            "--s-max {s_max} Mpc/h must exceed --s-min {} Mpc/h (the fitted s range is empty)",
+            args.s_min
+        );
+    }
     let table = pt_spectra::jobs::ept_fit_table(
         &plan,
         &terms,
         &data,
         &request,
-        &k_max_values(if args.xi { &args.s_max } else { &args.k_max })?,
+        &maxima,
         header,
         observation.as_ref(),
     )?;

@@ -188,6 +188,18 @@ impl WindowMultipoles {
                 reason: "Q0 is needed".into(),
             });
         }
+        // The multipoles must be 0, 2, …, ℓ_max without a gap: a names line with a wrong ℓ (`Q6` for
+        // `Q4`) would otherwise leave Q4 out of the mixing, silently.
+        let top = ells.iter().copied().max().unwrap_or(0);
+        if let Some(gap) = (0..=top).step_by(2).find(|l| !ells.contains(l)) {
+            return Err(Error::InvalidChoice {
+                what: format!("window `{origin}` with multipoles {ells:?}"),
+                reason: format!(
+                    "Q{gap} is missing below Q{top}: the multipoles must be 0, 2, …, ℓ_max \
+                     without a gap (a wrong ℓ in the names line or --window-format?)"
+                ),
+            });
+        }
         if ells.len() != q.len() {
             return Err(Error::LengthMismatch {
                 what: "window multipoles and their columns",
@@ -407,6 +419,13 @@ mod tests {
         let e =
             WindowMultipoles::parse("# s Q0 Q2 Q4\n1 1 0\n2 1 0\n3 1 0\n4 1 0\n", "n", &header());
         assert!(matches!(e, Err(Error::BadRow { line: 2, .. })), "{e:?}");
+        // A names line with a wrong ℓ (Q6 for Q4): refused naming the file and the missing Q4.
+        let e = WindowMultipoles::parse("# s Q0 Q2 Q6\n1 1 0 0\n2 1 0 0\n", "w.dat", &header());
+        let e = e.unwrap_err().to_string();
+        assert!(
+            e.contains("w.dat") && e.contains("Q4 is missing below Q6"),
+            "{e}"
+        );
     }
 
     /// The issue's case: a duplicated row (the s column is then not increasing) is refused naming the
