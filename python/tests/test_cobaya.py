@@ -277,6 +277,7 @@ def test_emulator_with_ap_fiducial_gives_camb_distances_and_derived_fsigma8(setu
             i["theory"].pop("camb")
             i["params"].pop("tau")
             i["theory"]["pt"]["emulator"] = True
+            i["theory"]["pt"]["neutrinos"] = "three degenerate"  # mnu alone: CAMB's one massive species
         m = get_model(i)
         m.add_requirements({"pt_ap": None, "pt_growth": None})
         sampled = {p: v for p, v in point.items() if p in m.parameterization.sampled_params()}
