@@ -38,6 +38,7 @@ use crate::setup::Prepared;
 
 mod batch;
 mod bias;
+mod bispectrum;
 pub mod defaults;
 mod ept;
 mod fit;
@@ -48,6 +49,7 @@ mod rsd;
 mod spt2;
 pub use batch::{batch_memory, real_batch, BatchColumns, BatchMemory, BatchRows};
 pub use bias::BiasOutput;
+pub use bispectrum::{bispectrum_table, BispectrumRequest};
 pub use ept::{
     ept_fit_table, ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest,
 };
