@@ -43,7 +43,7 @@ pub struct Args {
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     c1: f64,
     /// Number density n_bar [(h/Mpc)^3] of the stochastic terms (none without it).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
     n_bar: Option<f64>,
     /// B_shot of (1/n_bar) b1 B_shot Z1 P (Poisson: 1).
     #[arg(
@@ -73,16 +73,16 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true)]
     f: Option<f64>,
     /// AP scaling q_par = alpha_par (observed in a fiducial cosmology).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     q_par: f64,
     /// AP scaling q_perp = alpha_perp.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     q_perp: f64,
     /// Fingers of God: none, lorentzian or gaussian, with --sigma-fog.
     #[arg(long, default_value = "none")]
     fog: String,
     /// sigma_B of the Fingers of God [Mpc/h].
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     sigma_fog: f64,
     /// Switch off the IR resummation of the BAO in every leg.
     #[arg(long)]
