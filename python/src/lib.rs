@@ -23,6 +23,7 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 mod batch;
+mod bispectrum;
 mod emulator;
 mod ept;
 mod halo;
@@ -617,6 +618,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<redshift::RsdPlan>()?;
     m.add_class::<redshift::RsdTerms>()?;
     m.add_class::<ept::EptPlan>()?;
+    m.add_class::<bispectrum::BispectrumPlan>()?;
+    m.add_class::<bispectrum::BispectrumTerms>()?;
+    m.add_function(wrap_pyfunction!(bispectrum::bispectrum, m)?)?;
     m.add_class::<ept::EptTerms>()?;
     m.add_class::<two_loop_rsd::TwoLoopRsdPlan>()?;
     m.add_class::<survey::Observation>()?;

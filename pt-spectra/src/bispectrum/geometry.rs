@@ -16,6 +16,28 @@ pub enum LegendreSide {
     Index(usize),
 }
 
+impl LegendreSide {
+    /// The choices by name, as the CLI and Python take them (sides numbered from 1).
+    pub const NAMES: [&'static str; 4] = ["largest", "1", "2", "3"];
+
+    /// The side by name: `largest`, `1`, `2` or `3`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] listing [`LegendreSide::NAMES`].
+    pub fn by_name(name: &str) -> Result<Self> {
+        match name.trim().to_ascii_lowercase().as_str() {
+            "largest" => Ok(Self::Largest),
+            "1" => Ok(Self::Index(0)),
+            "2" => Ok(Self::Index(1)),
+            "3" => Ok(Self::Index(2)),
+            _ => Err(Error::InvalidChoice {
+                what: format!("legendre side = {name}"),
+                reason: format!("valid: {}", Self::NAMES.join(", ")),
+            }),
+        }
+    }
+}
+
 /// Relative tolerance of the triangle condition k_a ≤ k_b + k_c for triangles given as three numbers.
 const CLOSURE_TOLERANCE: f64 = 1e-9;
 

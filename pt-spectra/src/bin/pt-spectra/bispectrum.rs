@@ -125,13 +125,7 @@ pub fn run(args: &Args) -> Result<()> {
     let mut inputs = args.spectrum.files();
     inputs.push(("--triangles", args.triangles.as_deref()));
     check_outputs(&[("--out", args.out.as_deref())], &inputs)?;
-    let side = match args.legendre_side.to_ascii_lowercase().as_str() {
-        "largest" => LegendreSide::Largest,
-        "1" => LegendreSide::Index(0),
-        "2" => LegendreSide::Index(1),
-        "3" => LegendreSide::Index(2),
-        other => bail!("--legendre-side {other}: valid: largest, 1, 2, 3"),
-    };
+    let side = LegendreSide::by_name(&args.legendre_side).context("--legendre-side")?;
     let params = BispectrumParams {
         b1: args.b1,
         b2: args.b2,
