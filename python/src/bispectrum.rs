@@ -180,6 +180,9 @@ impl BispectrumPlan {
     }
 }
 
+/// B and its errors, (n, 3) arrays.
+type ValuesAndErrors<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
+
 /// The terms of one spectrum: `multipoles(...)` returns (B, err), (n, 3) arrays of B0, B2, B4.
 #[pyclass(module = "pt_spectra._core", frozen)]
 pub struct BispectrumTerms {
@@ -205,7 +208,7 @@ impl BispectrumTerms {
         b_shot: f64,
         p_shot: f64,
         a_shot: f64,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+    ) -> PyResult<ValuesAndErrors<'py>> {
         let b = self
             .terms
             .multipoles(&params(b1, b2, bs, c1, n_bar, b_shot, p_shot, a_shot))

@@ -133,7 +133,7 @@ impl TriangleSet {
     /// [`Error::InvalidChoice`] for fewer than two edges, edges not increasing or not uniform (to
     /// 1e-9 relative); as [`shells`](Self::shells).
     pub fn from_edges(edges: &[f64]) -> Result<Self> {
-        if edges.len() < 2 || edges.windows(2).any(|w| !(w[1] > w[0])) {
+        if edges.len() < 2 || !edges.windows(2).all(|w| w[1] > w[0]) {
             return Err(Error::InvalidChoice {
                 what: "k edges".into(),
                 reason: "need at least two strictly increasing edges [h/Mpc]".into(),

@@ -222,7 +222,7 @@ impl BispectrumParams {
                 });
             }
         }
-        if !(self.n_bar > 0.0) {
+        if self.n_bar.is_nan() || self.n_bar <= 0.0 {
             return Err(Error::InvalidChoice {
                 what: format!("n_bar = {}", self.n_bar),
                 reason: "the number density must be > 0 [(h/Mpc)^3] (inf for no shot noise)".into(),
