@@ -27,12 +27,13 @@ import warnings as _warnings
 import numpy as np
 
 from . import _core
-from ._core import (LinearEmulator, Observation, Table, distances, eisenstein_hu, growth, log_grid,
+from ._core import (LinearEmulator, Observation, Pipeline, Table, distances, eisenstein_hu, growth, log_grid,
                     num_threads, set_num_threads)
 
 __all__ = [
     "EptPlan",
     "Observation",
+    "Pipeline",
     "EptTerms",
     "LinearEmulator",
     "PtSpectraWarning",
