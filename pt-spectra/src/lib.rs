@@ -49,6 +49,7 @@ pub mod linear;
 pub mod loops;
 pub mod memory;
 pub mod output;
+pub mod pipeline;
 pub mod precision;
 pub mod progress;
 pub mod real;

@@ -27,14 +27,15 @@ import warnings as _warnings
 import numpy as np
 
 from . import _core
-from ._core import (BispectrumPlan, BispectrumTerms, LinearEmulator, Observation, Table, distances,
-                    eisenstein_hu, growth, log_grid, num_threads, set_num_threads)
+from ._core import (BispectrumPlan, BispectrumTerms, LinearEmulator, Observation, Pipeline, Table,
+                    distances, eisenstein_hu, growth, log_grid, num_threads, set_num_threads)
 
 __all__ = [
     "BispectrumPlan",
     "BispectrumTerms",
     "EptPlan",
     "Observation",
+    "Pipeline",
     "EptTerms",
     "LinearEmulator",
     "PtSpectraWarning",

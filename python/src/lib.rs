@@ -29,6 +29,7 @@ mod ept;
 mod halo;
 mod inputs;
 mod kernel;
+mod pipeline;
 mod redshift;
 mod survey;
 mod tables;
@@ -624,6 +625,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ept::EptTerms>()?;
     m.add_class::<two_loop_rsd::TwoLoopRsdPlan>()?;
     m.add_class::<survey::Observation>()?;
+    m.add_class::<pipeline::Pipeline>()?;
     m.add_function(wrap_pyfunction!(ept::fit_ept, m)?)?;
     m.add_function(wrap_pyfunction!(batch::real_batch, m)?)?;
     m.add_function(wrap_pyfunction!(batch::read_multipoles, m)?)?;

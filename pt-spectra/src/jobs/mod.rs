@@ -52,6 +52,7 @@ pub use bias::BiasOutput;
 pub use bispectrum::{bispectrum_table, BispectrumRequest};
 pub use ept::{
     ept_fit_table, ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest,
+    AP_FIT_RANGE,
 };
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use halo::{halo_table, HaloRequest};

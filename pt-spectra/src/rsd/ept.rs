@@ -170,6 +170,8 @@ pub struct EptPlan {
     split: Option<()>,
     /// The basis tensors of the loop terms, if they come from them ([`Self::with_basis`]).
     tensors: Option<basis::Tensors>,
+    /// The largest projection residual evaluated on the tensors ([`Self::with_max_residual`]).
+    max_residual: f64,
 }
 
 /// What the plan's loop grid is to its output k.
@@ -251,6 +253,7 @@ impl EptPlan {
             loops,
             split,
             tensors: None,
+            max_residual: crate::loops::basis::MAX_RESIDUAL,
         })
     }
 
