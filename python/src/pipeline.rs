@@ -16,12 +16,17 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Mutex;
 
+/// What a call did: the loop terms' source, f and the distortion (q∥, q⊥) if any.
+type LastCall = (TermsSource, f64, Option<(f64, f64)>);
+/// A data vector and, if asked for, its Jacobian (one row per nuisance parameter).
+type VectorAndJacobian = (Vec<f64>, Option<Vec<Vec<f64>>>);
+
 /// The chain step: observation, model, redshift and AP fiducial fixed at construction.
 #[pyclass(module = "pt_spectra._core", frozen)]
 pub(crate) struct Pipeline {
     inner: LibPipeline,
     /// What the last call did (the loop terms' source, f, the distortion).
-    last: Mutex<Option<(TermsSource, f64, Option<(f64, f64)>)>>,
+    last: Mutex<Option<LastCall>>,
 }
 
 /// The nuisance parameters of `kwargs` as (name, value) pairs.
@@ -64,7 +69,7 @@ impl Pipeline {
         prepared: &Prepared,
         params: &[(String, f64)],
         jacobian: bool,
-    ) -> PyResult<(Vec<f64>, Option<Vec<Vec<f64>>>)> {
+    ) -> PyResult<VectorAndJacobian> {
         let step = self.inner.step(prepared).map_err(value_error)?;
         if let TermsSource::DirectFallback { .. } = step.source {
             let text = step.source.describe(self.inner.settings().max_residual);

@@ -93,7 +93,7 @@ fn chain(max_residual: f64, c: &Cosmology) -> (Vec<f64>, Option<f64>) {
         source: LinearSource::Emulator,
         cosmology: Some(NamedCosmology {
             name: "test".into(),
-            cosmology: c.clone(),
+            cosmology: *c,
         }),
         z: Z,
     })
@@ -229,7 +229,7 @@ fn a_batch_gives_the_single_calls() {
     let other = Cosmology::flat(0.32, 0.66, 0.0221, 0.975, 0.78).unwrap();
     let sets = vec![
         (truth(), PARAMS.to_vec()),
-        (other.clone(), vec![("b1", 1.8), ("sn", 300.0)]),
+        (other, vec![("b1", 1.8), ("sn", 300.0)]),
     ];
     let batch = pl.evaluate_batch(&sets).unwrap();
     assert_eq!(batch[0], pl.evaluate(&truth(), &PARAMS).unwrap());

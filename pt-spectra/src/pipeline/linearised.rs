@@ -4,7 +4,7 @@
 
 use super::CosmologyStep;
 use crate::error::{Error, Result};
-use crate::rsd::ept::{EptParams, PARAM_NAMES};
+use crate::rsd::ept::{checked_param, EptParams, PARAM_NAMES};
 
 /// The nuisance parameters of the polynomial, in [`PARAM_NAMES`]' order (all but `f`, which the
 /// cosmology step fixes).
@@ -116,20 +116,17 @@ impl Linearised {
                 }
                 continue;
             }
+            let full = checked_param(name, value)?;
             let i = NUISANCE_NAMES
                 .iter()
-                .position(|&n| n == name)
+                .position(|&n| n == PARAM_NAMES[full])
                 .ok_or_else(|| Error::InvalidChoice {
                     what: format!("ept parameter `{name}`"),
-                    reason: format!("the parameters are {}", PARAM_NAMES.join(", ")),
+                    reason: format!(
+                        "not a nuisance parameter: they are {}",
+                        NUISANCE_NAMES.join(", ")
+                    ),
                 })?;
-            if !value.is_finite() {
-                return Err(Error::InvalidParameter {
-                    name: NUISANCE_NAMES[i],
-                    value,
-                    reason: "must be finite",
-                });
-            }
             v[i] = value;
         }
         Ok(v)

@@ -232,7 +232,7 @@ impl Pipeline {
             LinearSource::Emulator,
             Some(NamedCosmology {
                 name: "the pipeline's parameters".into(),
-                cosmology: cosmology.clone(),
+                cosmology: *cosmology,
             }),
         )
     }
