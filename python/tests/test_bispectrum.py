@@ -58,3 +58,10 @@ def test_the_plan_gives_the_table_and_parameter_steps_are_polynomial():
 def test_bad_input_raises_naming_the_problem(kwargs, needle):
     with pytest.raises(ValueError, match=needle):
         pt.bispectrum(**kwargs)
+
+
+def test_the_plan_refuses_an_implausible_growth_rate_as_the_function_does():
+    plan = pt.BispectrumPlan(TRIANGLES)
+    for call in (lambda: plan.terms(f=5.0), lambda: pt.bispectrum(TRIANGLES, bin_width=0.005, f=5.0)):
+        with pytest.raises(ValueError, match=r"f = 5.*\[0, 2\]"):
+            call()

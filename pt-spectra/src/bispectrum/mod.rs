@@ -257,17 +257,12 @@ pub struct Settings {
 }
 
 impl Settings {
-    /// Checks f, q∥, q⊥ are finite and q's > 0.
+    /// Checks f is finite and plausible ([`crate::cosmology::check_growth_rate`]), q∥, q⊥ finite and > 0.
     ///
     /// # Errors
-    /// [`Error::InvalidChoice`] naming the setting.
+    /// As [`crate::cosmology::check_growth_rate`]; [`Error::InvalidChoice`] naming q∥ or q⊥.
     pub fn validate(&self) -> Result<()> {
-        if !self.f.is_finite() {
-            return Err(Error::InvalidChoice {
-                what: format!("f = {}", self.f),
-                reason: "the growth rate must be finite".into(),
-            });
-        }
+        crate::cosmology::check_growth_rate(self.f)?;
         for (name, q) in [("q_par", self.q_par), ("q_perp", self.q_perp)] {
             if !(q.is_finite() && q > 0.0) {
                 return Err(Error::InvalidChoice {

@@ -6,7 +6,7 @@ use super::geometry::{orientations, LegendreSide, TriangleSet};
 use super::{BispectrumParams, Settings};
 use crate::error::Result;
 use crate::estimate::Estimate;
-use crate::ir::{delta_sigma2_bao, sigma2_bao, WiggleSplit};
+use crate::ir::{delta_sigma2_bao, sigma2_bao, sigma2_total, WiggleSplit};
 use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
 
@@ -50,12 +50,19 @@ impl PlanRules {
 /// the 1/n̄² term.
 const SLOTS: usize = 43;
 
-/// One quadrature node in the observed (fiducial) frame: sides, their dot products (k₀·k₁, k₁·k₂,
-/// k₂·k₀), line-of-sight components and the (2ℓ + 1)L_ℓ × weight of ℓ = 0, 2, 4.
-#[derive(Debug, Clone, Copy)]
-struct Node {
+/// One shape of a triangle or bin in the observed (fiducial) frame: sides, their dot products (k₀·k₁,
+/// k₁·k₂, k₂·k₀) and the orientation nodes of its average.
+#[derive(Debug, Clone)]
+struct Shape {
     k: [f64; 3],
     dots: [f64; 3],
+    orientations: Vec<Orientation>,
+}
+
+/// One orientation of a shape: the sides' line-of-sight components and the (2ℓ + 1)L_ℓ × weight of
+/// ℓ = 0, 2, 4 (the shape's bin weight included).
+#[derive(Debug, Clone, Copy)]
+struct Orientation {
     par: [f64; 3],
     lambda: [f64; 3],
 }
@@ -67,8 +74,8 @@ pub struct BispectrumPlan {
     set: TriangleSet,
     side: LegendreSide,
     rules: PlanRules,
-    fine: Vec<Vec<Node>>,
-    coarse: Vec<Vec<Node>>,
+    fine: Vec<Vec<Shape>>,
+    coarse: Vec<Vec<Shape>>,
     split: WiggleSplit,
     q_min: f64,
 }
@@ -94,25 +101,30 @@ impl BispectrumPlan {
                 });
             }
         }
-        let nodes = |r: PlanRules| -> Vec<Vec<Node>> {
+        let nodes = |r: PlanRules| -> Vec<Vec<Shape>> {
             (0..set.len())
                 .map(|i| {
                     let a = set.legendre_index(i, side);
-                    let mut out = Vec::new();
-                    for (k, w) in set.shapes(i, r.n_shell) {
-                        let sq = k.map(|k| k * k);
-                        let dots =
-                            [0, 1, 2].map(|i| 0.5 * (sq[(i + 2) % 3] - sq[i] - sq[(i + 1) % 3]));
-                        for o in orientations(k, a, r.n_mu, r.n_phi) {
-                            out.push(Node {
+                    set.shapes(i, r.n_shell)
+                        .into_iter()
+                        .map(|(k, w)| {
+                            let sq = k.map(|k| k * k);
+                            let dots = [0, 1, 2]
+                                .map(|i| 0.5 * (sq[(i + 2) % 3] - sq[i] - sq[(i + 1) % 3]));
+                            let orientations = orientations(k, a, r.n_mu, r.n_phi)
+                                .into_iter()
+                                .map(|o| Orientation {
+                                    par: [o[0], o[1], o[2]],
+                                    lambda: [o[3] * w, o[4] * w, o[5] * w],
+                                })
+                                .collect();
+                            Shape {
                                 k,
                                 dots,
-                                par: [o[0], o[1], o[2]],
-                                lambda: [o[3] * w, o[4] * w, o[5] * w],
-                            });
-                        }
-                    }
-                    out
+                                orientations,
+                            }
+                        })
+                        .collect()
                 })
                 .collect()
         };
@@ -157,31 +169,40 @@ impl BispectrumPlan {
         } else {
             None
         };
-        let power = |k: f64, mu: f64| -> f64 {
+        // P and P_nw at k (P_nw = P without IR resummation), and the resummed P at k, μ from them.
+        let legs = |k: f64| -> (f64, f64) {
             let p = spectrum.eval(k);
+            (p, ir.as_ref().map_or(p, |(nw, _, _)| nw.eval(k)))
+        };
+        let resummed = |(p, p_nw): (f64, f64), k: f64, mu: f64| -> f64 {
             match &ir {
                 None => p,
-                Some((nw, s2, ds2)) => {
-                    let f = settings.f;
-                    let mu2 = mu * mu;
-                    let sigma_tot =
-                        (1.0 + f * mu2 * (2.0 + f)) * s2 + f * f * mu2 * (mu2 - 1.0) * ds2;
-                    let p_nw = nw.eval(k);
-                    p_nw + (-k * k * sigma_tot).exp() * (p - p_nw)
+                Some((_, s2, ds2)) => {
+                    let x = k * k * sigma2_total(*s2, *ds2, settings.f, mu);
+                    p_nw + (-x).exp() * (p - p_nw)
                 }
             }
         };
-        let sum = |nodes: &Vec<Vec<Node>>| -> Vec<[[f64; SLOTS]; 3]> {
-            nodes
+        // Without an anisotropic distortion the true sides k/q do not depend on the orientation:
+        // the spectra are interpolated once per shape, not once per orientation.
+        let isotropic = settings.q_par == settings.q_perp;
+        let sum = |shapes: &Vec<Vec<Shape>>| -> Vec<[[f64; SLOTS]; 3]> {
+            shapes
                 .iter()
                 .map(|triangle| {
                     let mut acc = [[0.0; SLOTS]; 3];
-                    for node in triangle {
-                        let (slots, weight) = node_slots(node, settings, &power);
-                        for (l, acc) in acc.iter_mut().enumerate() {
-                            let g = weight * node.lambda[l];
-                            for (a, s) in acc.iter_mut().zip(&slots) {
-                                *a += g * s;
+                    for shape in triangle {
+                        let cached = isotropic.then(|| shape.k.map(|k| legs(k / settings.q_par)));
+                        let power = |i: usize, k: f64, mu: f64| {
+                            resummed(cached.map_or_else(|| legs(k), |c| c[i]), k, mu)
+                        };
+                        for o in &shape.orientations {
+                            let (slots, weight) = node_slots(shape, o, settings, &power);
+                            for (l, acc) in acc.iter_mut().enumerate() {
+                                let g = weight * o.lambda[l];
+                                for (a, s) in acc.iter_mut().zip(&slots) {
+                                    *a += g * s;
+                                }
                             }
                         }
                     }
@@ -197,23 +218,29 @@ impl BispectrumPlan {
     }
 }
 
-/// The monomial slots of one node (in the true frame after AP) and its overall weight (the AP volume
-/// factor; the FoG factor is already in the slots it damps).
-fn node_slots(node: &Node, s: &Settings, power: &dyn Fn(f64, f64) -> f64) -> ([f64; SLOTS], f64) {
+/// The monomial slots of one orientation of a shape (in the true frame after AP) and its overall weight
+/// (the AP volume factor; the FoG factor is already in the slots it damps). `power(i, k, μ)` is the
+/// (resummed) linear power of side i at its true k, μ.
+fn node_slots(
+    shape: &Shape,
+    o: &Orientation,
+    s: &Settings,
+    power: &dyn Fn(usize, f64, f64) -> f64,
+) -> ([f64; SLOTS], f64) {
     let (qp2, qt2) = (s.q_par * s.q_par, s.q_perp * s.q_perp);
-    let par = node.par.map(|p| p / s.q_par);
+    let par = o.par.map(|p| p / s.q_par);
     let k2: [f64; 3] = [0, 1, 2].map(|i| {
-        let perp2 = (node.k[i] * node.k[i] - node.par[i] * node.par[i]).max(0.0);
+        let perp2 = (shape.k[i] * shape.k[i] - o.par[i] * o.par[i]).max(0.0);
         par[i] * par[i] + perp2 / qt2
     });
     let k = k2.map(f64::sqrt);
     let mu = [0, 1, 2].map(|i| par[i] / k[i]);
     let dots = [0, 1, 2].map(|i| {
         let j = (i + 1) % 3;
-        let pp = node.par[i] * node.par[j];
-        pp / qp2 + (node.dots[i] - pp) / qt2
+        let pp = o.par[i] * o.par[j];
+        pp / qp2 + (shape.dots[i] - pp) / qt2
     });
-    let p = [0, 1, 2].map(|i| power(k[i], mu[i]));
+    let p = [0, 1, 2].map(|i| power(i, k[i], mu[i]));
     let fog = s.fog.factor(par.iter().map(|p| p * p).sum());
     let mut slots = tree_slots(k, dots, par, p, s.f);
     for v in &mut slots[..SLOTS - 1] {

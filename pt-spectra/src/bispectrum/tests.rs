@@ -426,3 +426,38 @@ fn bias_conventions_round_trip() {
     );
     assert!(Fog::by_name("lorentz", 1.0).is_err() && Fog::by_name("gaussian", -1.0).is_err());
 }
+
+#[test]
+fn a_chosen_legendre_side_is_the_same_side_wherever_it_is_listed() {
+    // the largest side of (0.04, 0.07, 0.1) is the same side as side 1 of (0.1, 0.04, 0.07) and side 2 of
+    // (0.07, 0.1, 0.04); side 1 of the first triangle is another side, with other B2, B4
+    let p_lin = spectrum();
+    let s = Settings {
+        ir: true,
+        ..settings(0.7)
+    };
+    let b = galaxy();
+    let run = |t: [f64; 3], side| {
+        BispectrumPlan::new(
+            TriangleSet::points(vec![t]).unwrap(),
+            side,
+            PlanRules::default(),
+        )
+        .unwrap()
+        .terms(&p_lin, &s)
+        .unwrap()
+        .multipoles(&b)
+        .unwrap()[0]
+    };
+    let largest = run([0.04, 0.07, 0.1], LegendreSide::Largest);
+    for (t, side) in [([0.1, 0.04, 0.07], 0), ([0.07, 0.1, 0.04], 1)] {
+        let chosen = run(t, LegendreSide::Index(side));
+        for l in 0..3 {
+            assert!((chosen[l].value - largest[l].value).abs() < 1e-10 * largest[0].value.abs());
+        }
+    }
+    let other = run([0.04, 0.07, 0.1], LegendreSide::Index(0));
+    assert!((other[0].value - largest[0].value).abs() < 1e-10 * largest[0].value.abs());
+    assert!((other[1].value - largest[1].value).abs() > 1e-3 * largest[1].value.abs());
+    assert!(LegendreSide::by_name("largest").is_ok() && LegendreSide::by_name("4").is_err());
+}

@@ -38,7 +38,6 @@ pub struct BispectrumRequest {
 /// As [`BispectrumPlan::new`], [`BispectrumPlan::terms`] and the parameters' validation.
 pub fn bispectrum_table(prepared: &Prepared, request: &BispectrumRequest) -> Result<Table> {
     let f = request.f.unwrap_or(prepared.growth_rate);
-    super::rsd::check_growth_rate(f)?;
     let settings = Settings {
         f,
         q_par: request.q.0,
