@@ -78,7 +78,7 @@ def header_value(lin, key):
 # ----------------------------------------------------------------------------------------------
 DEFAULTS = dict(b1=1.0, b2=0.0, bs=0.0, c1=0.0, f=0.0, b_shot=1.0, p_shot=0.0, a_shot=0.0,
                 n_bar=np.inf, fog="none", sigma_fog=0.0, q_par=1.0, q_perp=1.0,
-                fmu_shot=1.0, ir=None)
+                fmu_shot=1.0, ir=None, fog_on_shot=False)
 
 
 def model(**kw):
@@ -96,6 +96,8 @@ def describe(m):
     s = ", ".join(f"{k} = {m[k]}" for k in keys)
     if m["fmu_shot"] != 1.0:
         s += f", f mu^2 shot coefficient = {m['fmu_shot']}"
+    if m["fog_on_shot"]:
+        s += ", FoG also on the (1/n_bar) Z1 P terms"
     s += ", IR: " + ("none" if m["ir"] is None else m["ir"]["describe"])
     return s
 
@@ -161,8 +163,9 @@ def bispectrum(lin, m, k1, k2, k3, km1, km2, km3, d12, d23, d31):
     b = w * bdet
     if np.isfinite(m["n_bar"]):
         nb = m["n_bar"]
+        ws = w if m["fog_on_shot"] else 1.0
         for i in range(3):
-            b = b + (b1 * m["b_shot"] + m["fmu_shot"] * (1 + m["p_shot"]) * f * MU2[i]) * Z1e[i] * P[i] / nb
+            b = b + ws * (b1 * m["b_shot"] + m["fmu_shot"] * (1 + m["p_shot"]) * f * MU2[i]) * Z1e[i] * P[i] / nb
         b = b + (1 + m["a_shot"]) / nb**2
     return b / (qp * qt * qt) ** 2
 
@@ -422,6 +425,8 @@ def std_models(lin):
         ("tree_ap", model(**base, q_par=1.03, q_perp=0.98)),
         ("tree_all", model(**base, fog="lorentzian2", sigma_fog=4.0, c1=5.0, n_bar=3e-4, b_shot=1.1,
                            p_shot=0.2, a_shot=0.3, q_par=1.03, q_perp=0.98)),
+        ("tree_all_fogshot", model(**base, fog="lorentzian2", sigma_fog=4.0, c1=5.0, n_bar=3e-4, b_shot=1.1,
+                                   p_shot=0.2, a_shot=0.3, q_par=1.03, q_perp=0.98, fog_on_shot=True)),
     ]
 
 
@@ -460,7 +465,8 @@ def table_unbinned(lin):
         hdr.append(f"#   {name}: {describe(m)}")
     hdr += [
         "# fog: lorentzian2 = (1 + x s^2/2)^-2, lorentzian1 = (1 + x s^2/2)^-1 (FolpsD 'lor'),",
-        "#   gaussian = exp(-x s^2/2), x = sum_i k_i^2 mu_i^2 (true frame), s = sigma_fog [Mpc/h]; deterministic part only",
+        "#   gaussian = exp(-x s^2/2), x = sum_i k_i^2 mu_i^2 (true frame), s = sigma_fog [Mpc/h]; on the deterministic",
+        "#   part only (FolpsD), or also on the (1/n_bar) Z1 P terms where the model says so (pt-spectra c039246)",
         "# stochastic: (1/n_bar) sum_i [b1 b_shot + (1 + p_shot) f mu_i^2] Z1(k_i) P(k_i) + (1 + a_shot)/n_bar^2",
         "# c1 [(Mpc/h)^2]: Z1 -> Z1 - c1 k^2 mu^2 in the external legs; AP: q_par, q_perp, sides observed",
         "# quadrature: Gauss-Legendre 64 in mu3 x trapezoid 64 in phi; err_* = |64x64 - 32x32|",
@@ -551,7 +557,7 @@ def nseries_edges(code):
 
 def table_bins(lin):
     f, models = std_models(lin)
-    models = [(n, m) for n, m in models if n in ("tree", "tree_all")]
+    models = [(n, m) for n, m in models if n in ("tree", "tree_all", "tree_all_fogshot")]
     rows, errs = [], {}
     for name, m in models:
         err = 0.0
