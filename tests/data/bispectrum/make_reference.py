@@ -435,6 +435,12 @@ def lin_header(lin):
             "spline in (ln k, ln P), power-law ends"] + ["#   " + h.lstrip("# ") for h in lin.header[:3]]
 
 
+def models_header(lin, f, models):
+    """Header lines: the linear spectrum and every model's parameters."""
+    return [*lin_header(lin), f"# models (bias in velocileptors' convention; f = {f}):"] + [
+        f"#   {name}: {describe(m)}" for name, m in models]
+
+
 def write(path, lines, rows, fmt):
     with open(path, "w") as fh:
         for l in lines:
@@ -444,8 +450,9 @@ def write(path, lines, rows, fmt):
     print("wrote", os.path.relpath(path, ROOT), len(rows), "rows", file=sys.stderr)
 
 
-def table_unbinned(lin):
-    f, models = std_models(lin)
+def triangle_rows(lin, models):
+    """Rows (model, k1, k2, k3, B0, B2, B4, err x 3) at TRIANGLES, 64 x 64 orientation nodes, the error
+    the change from 32 x 32; and the largest error / |B0| per model."""
     tri = np.array(TRIANGLES)
     rows, errs = [], {}
     for name, m in models:
@@ -454,15 +461,17 @@ def table_unbinned(lin):
         errs[name] = np.max(np.abs(hi - lo) / np.abs(hi[0])[None, :])
         for i, t in enumerate(TRIANGLES):
             rows.append((name, *t, *hi[:, i], *np.abs(hi - lo)[:, i]))
+    return rows, errs
+
+
+def table_unbinned(lin):
+    f, models = std_models(lin)
+    rows, errs = triangle_rows(lin, models)
     hdr = [
         "# Tree-level redshift-space galaxy bispectrum multipoles B0, B2, B4 (Scoccimarro et al. 1999) at",
         "# single triangles, Legendre polynomial on the LARGEST side k3, average over all orientations",
         "# (DEFINITIONS.md (a)-(d), (f) in this folder). Independent numpy code: make_reference.py.",
-        *lin_header(lin),
-        f"# models (bias in velocileptors' convention; f = f(z) of the table = {f}):",
-    ]
-    for name, m in models:
-        hdr.append(f"#   {name}: {describe(m)}")
+        *models_header(lin, f, models)]
     hdr += [
         "# fog: lorentzian2 = (1 + x s^2/2)^-2, lorentzian1 = (1 + x s^2/2)^-1 (FolpsD 'lor'),",
         "#   gaussian = exp(-x s^2/2), x = sum_i k_i^2 mu_i^2 (true frame), s = sigma_fog [Mpc/h]; on the deterministic",
@@ -537,10 +546,7 @@ def table_sugiyama(lin):
            "# N = (2l1+1)(2l2+1)(2L+1); weights 000: 1, 110: 3x, 220: 5L2(x), 202: 5L2(mu1), 022: 5L2(mu2),",
            "# 112: 3(3 mu1 mu2 - x), x = k1^.k2^; B112F = 112 with FolpsD's azimuthal weight (2 sqrt3 instead of 3):",
            "# 3[(3mu1^2-1)x + 2 sqrt3 mu1 (1-mu1^2)^1/2 (1-x^2)^1/2 cos phi] (not the tripolar harmonic; for comparison).",
-           *lin_header(lin),
-           f"# models (velocileptors bias, f = {f}):"]
-    for name, m in models:
-        hdr.append(f"#   {name}: {describe(m)}")
+           *models_header(lin, f, models)]
     hdr += ["# quadrature: k3 on 48 Gauss-Legendre panels x 16 (quadratically clustered at |k1-k2|), mu1 GL 24,",
             "#   phi trapezoid 32; estimated error (vs 24x12, 16, 24) / |B000| <= "
             + ", ".join(f"{k} {v:.0e}" for k, v in errs.items()),
@@ -575,10 +581,7 @@ def table_bins(lin):
            "# Theta(closed) over k1 in shell a, k2 in b, k3 in c (DEFINITIONS.md (d)), Legendre on the side in",
            "# shell c (the largest); shells [k_c - 0.005, k_c + 0.005). B_l^(3) in the observed frame (AP, observed",
            "# shells). The Philcox (2021) estimator returns these (its Delta_abc normalisation, DEFINITIONS (d)).",
-           *lin_header(lin),
-           f"# models (velocileptors bias, f = {f}):"]
-    for name, m in models:
-        hdr.append(f"#   {name}: {describe(m)}")
+           *models_header(lin, f, models)]
     hdr += ["# quadrature: the closed part of the shell box split into tetrahedra, collapsed Gauss-Legendre 8^3",
             "#   per tetrahedron, orientations GL 20 x trapezoid 24; err_* = |that - (6^3, 12 x 16)|; max err/|B0|: "
             + ", ".join(f"{k} {v:.0e}" for k, v in errs.items()),
@@ -625,10 +628,7 @@ def table_box(lin):
            "#        [L(mu2)+L(mu3)]/(1 + N_l/N0) (a<b=c), 2[L(mu1)+L(mu2)+L(mu3)]/(2(1 + 2N_l/N0)) (a=b=c),",
            "#        q_l = sum T_l B, F_ll' = sum T_l T_l'; N_l = sum L_l(k2^.k3^) over the triples",
            "# cont:  the same shells as continuous shells (make_reference.bin_average, 8^3 nodes per tetrahedron)",
-           *lin_header(lin),
-           f"# models (velocileptors bias, f = {f}):"]
-    for name, m in models:
-        hdr.append(f"#   {name}: {describe(m)}")
+           *models_header(lin, f, models)]
     hdr += ["# accuracy: exact sums (double precision, ~1e-13 relative); est - plain differs by the discreteness",
             "#   of the fixed-LOS box: max |est - plain| / |B0| per l (0, 2, 4): "
             + "; ".join(f"{k} " + ", ".join(f"{v:.1e}" for v in d) for k, d in stats.items()),
@@ -696,21 +696,11 @@ def table_ir(lin):
     models = [("tree_ir", model(**base)),
               ("tree_ir_all", model(**base, fog="lorentzian2", sigma_fog=4.0, c1=5.0, n_bar=3e-4, b_shot=1.1,
                                     p_shot=0.2, a_shot=0.3, q_par=1.03, q_perp=0.98))]
-    tri = np.array(TRIANGLES)
-    rows, errs = [], {}
-    for name, m in models:
-        hi = multipoles_at(lin, m, tri[:, 0], tri[:, 1], tri[:, 2], n_mu=64, n_phi=64)
-        lo = multipoles_at(lin, m, tri[:, 0], tri[:, 1], tri[:, 2], n_mu=32, n_phi=32)
-        errs[name] = np.max(np.abs(hi - lo) / np.abs(hi[0])[None, :])
-        for i, t in enumerate(TRIANGLES):
-            rows.append((name, *t, *hi[:, i], *np.abs(hi - lo)[:, i]))
+    rows, errs = triangle_rows(lin, models)
     hdr = ["# Tree-level B0, B2, B4 with IR resummation in every leg (DEFINITIONS.md (c)): P(k_i) -> P_nw + e^{-k_i^2",
            "# Sigma_tot^2(mu_i)} (P - P_nw), Sigma_tot^2 = [1 + f mu^2 (2 + f)] Sigma^2 + f^2 mu^2 (mu^2 - 1) dSigma^2,",
            "# in the deterministic and stochastic terms; Legendre on k3; P_nw tabulated in linear_nw_gm2012_z0.5.txt",
-           *lin_header(lin),
-           f"# models (velocileptors bias, f = {f}):"]
-    for name, m in models:
-        hdr.append(f"#   {name}: {describe(m)}")
+           *models_header(lin, f, models)]
     hdr += ["# quadrature: GL 64 x trapezoid 64; err = |64x64 - 32x32|, max/|B0|: "
             + ", ".join(f"{k} {v:.0e}" for k, v in errs.items()),
             "# units: k [h/Mpc], B [(Mpc/h)^6]",
@@ -877,10 +867,7 @@ def table_nseries_grid(lin):
            "# sight varies; the exact fixed-LOS sum is what ref_box.txt does for a small box). Counts and mean |k_i|",
            "# per sub-shell triple of width 0.0005 (err = |w 0.0005 - w 0.001|/3, Richardson for the O(w^2) error).",
            "# d*_cont = (grid - continuous-shell average of ref_bins_nseries.txt)/|B0_cont|: the discreteness effect.",
-           *lin_header(lin),
-           f"# models (velocileptors bias, f = {f}):"]
-    for name, m in models:
-        hdr.append(f"#   {name}: {describe(m)}")
+           *models_header(lin, f, models)]
     hdr += ["# max err/|B0|: " + ", ".join(f"{k} {v:.0e}" for k, v in errs.items()),
             "# units: k [h/Mpc] (bin centres), B [(Mpc/h)^6]",
             "# columns: model k1 k2 k3 N_triangles B0 B2 B4 err_B0 err_B2 err_B4 dB0_cont dB2_cont dB4_cont"]
