@@ -239,6 +239,16 @@ fn shape_nodes(shells: &[[f64; 2]; 3], n: usize) -> Vec<([f64; 3], f64)> {
     for k2 in [lo2, hi2] {
         k1_breaks.extend([hi3 - k2, lo3 - k2, k2 + lo3, k2 - lo3, k2 + hi3, k2 - hi3]);
     }
+    // where a falling line k₂ = c − k₁ crosses a rising one k₂ = k₁ + d inside the k₂ shell, the pieces
+    // of the k₂ integrand change order: the k₂ integral has a kink there (at the shell centre of an
+    // equilateral bin, where an odd Gauss rule puts a node)
+    for c in [lo3, hi3] {
+        for d in [lo3, -lo3, hi3, -hi3] {
+            if (lo2..=hi2).contains(&(0.5 * (c + d))) {
+                k1_breaks.push(0.5 * (c - d));
+            }
+        }
+    }
     let mut nodes = Vec::new();
     for (k1, w1) in panels(lo1, hi1, &k1_breaks, &x, &w) {
         for (k2, w2) in panels(lo2, hi2, &k2_breaks(k1), &x, &w) {

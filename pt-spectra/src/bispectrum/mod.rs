@@ -43,6 +43,7 @@
 //! difference from a coarser rule (orientation and shells).
 
 mod geometry;
+mod sampled;
 mod terms;
 #[cfg(test)]
 mod tests;
