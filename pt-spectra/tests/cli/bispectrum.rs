@@ -150,3 +150,55 @@ fn bad_triangles_and_choices_are_refused() {
         ),
     ]);
 }
+
+#[test]
+fn sugiyama_multipoles_at_pairs_with_errors_and_refusals() {
+    let file = std::env::temp_dir().join(format!("pt-spectra-bk-pairs-{}", std::process::id()));
+    std::fs::write(&file, "# k1 k2\n0.05 0.05\n0.02 0.1\n").unwrap();
+    let f = file.to_str().unwrap();
+    let (ok, out, err) = run(&[
+        "bispectrum",
+        "--basis",
+        "sugiyama",
+        "--pairs",
+        f,
+        "--f",
+        "0",
+        "--no-ir",
+        "--b1",
+        "1.8",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("Sugiyama et al. (2019)") && out.contains("err_B*: difference"));
+    assert!(out.contains("# k1 k2 B000 B110 B202 B022 B112 B220 err_B000"));
+    for r in rows(&out) {
+        // f = 0: B does not depend on the line of sight, the L = 2 multipoles vanish
+        assert!(r[2] > 0.0 && r[8] <= 1e-4 * r[2], "{r:?}");
+        for m in [4, 5, 6] {
+            assert!(r[m].abs() <= 1e-10 * r[2], "{r:?}");
+        }
+    }
+    fails_naming(&[
+        (vec!["bispectrum", "--basis", "sugiyama"], "needs --pairs"),
+        (
+            vec!["bispectrum", "--basis", "bispec", "--pairs", f],
+            "valid: scoccimarro, sugiyama",
+        ),
+        (
+            vec!["bispectrum", "--pairs", f],
+            "--pairs is for --basis sugiyama",
+        ),
+        (
+            vec![
+                "bispectrum",
+                "--basis",
+                "sugiyama",
+                "--pairs",
+                f,
+                "--k-edges",
+                "0.01:0.05:0.01",
+            ],
+            "cannot be used with",
+        ),
+    ]);
+}
