@@ -42,13 +42,16 @@
 //! changes form. Every B_ℓ carries an error: the
 //! difference from a coarser rule (orientation and shells).
 
+mod box_modes;
 mod geometry;
+mod observed;
 mod resum;
 mod sugiyama;
 mod terms;
 #[cfg(test)]
 mod tests;
 
+pub use box_modes::BoxPlan;
 pub use geometry::{LegendreSide, TriangleSet};
 pub use resum::IrInputs;
 pub use sugiyama::{SugiyamaPlan, SugiyamaRules, SugiyamaTerms, SUGIYAMA_MULTIPOLES};

@@ -20,8 +20,9 @@
 //! [`SugiyamaRules::coarse`] as its error. AP, FoG, IR and the parameters as the Scoccimarro multipoles
 //! ([`crate::bispectrum`]): the sides, x and μ's are the observed ones.
 
+use super::observed::{accumulate, observed_slots};
 use super::resum::IrInputs;
-use super::terms::{contract, tree_slots, SLOTS};
+use super::terms::{contract, SLOTS};
 use super::{BispectrumParams, Settings};
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
@@ -281,41 +282,23 @@ impl Evaluator<'_> {
         orientations: &[Orientation],
     ) -> [[f64; SLOTS]; 6] {
         let s = self.settings;
-        let (qp, qt) = (s.q_par, s.q_perp);
-        let (qp2, qt2) = (qp * qp, qt * qt);
-        let volume = 1.0 / (qp2 * qt2 * qt2);
         // without anisotropic AP the true sides are k/q at every orientation: P interpolated per leg
-        let isotropic = qp == qt;
-        let fixed = isotropic.then(|| [self.legs(k1 / qp), self.legs(k2 / qp)]);
+        let fixed =
+            (s.q_par == s.q_perp).then(|| [self.legs(k1 / s.q_par), self.legs(k2 / s.q_par)]);
         let mut acc = [[0.0; SLOTS]; 6];
         for leg in legs {
-            let k_obs = [k1, k2, leg.k3];
             let d12 = k1 * k2 * leg.x;
-            let dots_obs = [d12, -(d12 + k2 * k2), -(k1 * k1 + d12)];
-            let cached = fixed.map(|[a, b]| [a, b, self.legs(leg.k3 / qp)]);
+            let dots = [d12, -(d12 + k2 * k2), -(k1 * k1 + d12)];
+            let cached = fixed.map(|[a, b]| [a, b, self.legs(leg.k3 / s.q_par)]);
+            let power = |i: usize, k: f64, mu: f64| {
+                let (p, p_nw) = cached.map_or_else(|| self.legs(k), |c| c[i]);
+                self.ir.map_or(p, |ir| ir.resum(p, p_nw, k, mu, s.f))
+            };
             for o in orientations {
                 let mu2 = o.mu1 * leg.x + o.sin1 * leg.sin_x * o.cos_phi;
-                let par_obs = [k1 * o.mu1, k2 * mu2, -(k1 * o.mu1 + k2 * mu2)];
-                let par = par_obs.map(|p| p / qp);
-                let k = [0, 1, 2].map(|i| {
-                    let perp2 = (k_obs[i] * k_obs[i] - par_obs[i] * par_obs[i]).max(0.0);
-                    (par[i] * par[i] + perp2 / qt2).sqrt()
-                });
-                let dots = [0, 1, 2].map(|i| {
-                    let pp = par_obs[i] * par_obs[(i + 1) % 3];
-                    pp / qp2 + (dots_obs[i] - pp) / qt2
-                });
-                let p = [0, 1, 2].map(|i| {
-                    let l = cached.map_or_else(|| self.legs(k[i]), |c| c[i]);
-                    self.ir
-                        .map_or(l.0, |ir| ir.resum(l.0, l.1, k[i], par[i] / k[i], s.f))
-                });
-                let mut slots = tree_slots(k, dots, par, p, s.f);
-                let fog = s.fog.factor(par.iter().map(|p| p * p).sum());
-                for v in &mut slots[..SLOTS - 1] {
-                    *v *= fog;
-                }
-                let w = leg.weight * o.weight * volume;
+                let par = [k1 * o.mu1, k2 * mu2, -(k1 * o.mu1 + k2 * mu2)];
+                let slots = observed_slots([k1, k2, leg.k3], dots, par, s, power);
+                let w = leg.weight * o.weight;
                 let l2 = |t: f64| 2.5 * (3.0 * t * t - 1.0);
                 let weights = [
                     w,
@@ -325,11 +308,7 @@ impl Evaluator<'_> {
                     3.0 * (3.0 * o.mu1 * mu2 - leg.x) * w,
                     l2(leg.x) * w,
                 ];
-                for (acc, g) in acc.iter_mut().zip(weights) {
-                    for (a, v) in acc.iter_mut().zip(&slots) {
-                        *a += g * v;
-                    }
-                }
+                accumulate(&mut acc, weights, &slots);
             }
         }
         acc

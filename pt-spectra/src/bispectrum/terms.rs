@@ -367,6 +367,15 @@ pub struct BispectrumTerms {
 }
 
 impl BispectrumTerms {
+    /// Terms of exact sums (no quadrature: the coarse rule is the rule itself, errors are zero).
+    pub(super) fn exact(slots: Vec<[[f64; SLOTS]; 3]>, triangles: Vec<[f64; 3]>) -> Self {
+        Self {
+            fine: slots.clone(),
+            coarse: slots,
+            triangles,
+        }
+    }
+
     /// The triangles (bin centres) [h/Mpc].
     pub fn triangles(&self) -> &[[f64; 3]] {
         &self.triangles
