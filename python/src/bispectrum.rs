@@ -160,6 +160,7 @@ pub fn bispectrum(
                 q: (q_par, q_perp),
                 fog,
                 ir,
+                box_size: None,
             })
         }
     };

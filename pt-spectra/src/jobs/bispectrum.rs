@@ -4,8 +4,8 @@
 
 use super::VERSION;
 use crate::bispectrum::{
-    BispectrumParams, BispectrumPlan, Fog, LegendreSide, PlanRules, Settings, SugiyamaPlan,
-    SugiyamaRules, TriangleSet, SUGIYAMA_MULTIPOLES,
+    BispectrumParams, BispectrumPlan, BoxPlan, Fog, LegendreSide, PlanRules, Settings,
+    SugiyamaPlan, SugiyamaRules, TriangleSet, SUGIYAMA_MULTIPOLES,
 };
 use crate::error::Result;
 use crate::estimate::Estimate;
@@ -31,6 +31,9 @@ pub struct BispectrumRequest {
     pub fog: Fog,
     /// IR resummation of the BAO.
     pub ir: bool,
+    /// Average the bins exactly over the discrete modes of a periodic box of this side [Mpc/h]
+    /// (line of sight z) instead of continuous shells.
+    pub box_size: Option<f64>,
 }
 
 /// The table `k1 k2 k3 B0 B2 B4 err_B0 err_B2 err_B4` of `request` for the linear spectrum of
@@ -40,8 +43,12 @@ pub struct BispectrumRequest {
 /// As [`BispectrumPlan::new`], [`BispectrumPlan::terms`] and the parameters' validation.
 pub fn bispectrum_table(prepared: &Prepared, request: &BispectrumRequest) -> Result<Table> {
     let settings = settings(prepared, request.f, request.q, request.fog, request.ir);
-    let plan = BispectrumPlan::new(request.triangles.clone(), request.side, request.rules)?;
-    let terms = plan.terms(prepared.tracer_spectrum(), &settings)?;
+    let terms = match request.box_size {
+        Some(l) => BoxPlan::new(request.triangles.clone(), request.side, l)?
+            .terms(prepared.tracer_spectrum(), &settings)?,
+        None => BispectrumPlan::new(request.triangles.clone(), request.side, request.rules)?
+            .terms(prepared.tracer_spectrum(), &settings)?,
+    };
     let b = terms.multipoles(&request.params)?;
     let rules = request.rules;
     let mut header = vec![format!(
@@ -60,13 +67,18 @@ pub fn bispectrum_table(prepared: &Prepared, request: &BispectrumRequest) -> Res
             rules.n_mu,
             rules.n_phi,
         ),
-        match request.triangles.width() {
-            Some(w) => format!(
+        match (request.box_size, request.triangles.width()) {
+            (Some(l), Some(w)) => format!(
+                "bin averages over the discrete modes of a periodic box of side {l} Mpc/h (k_f = 2 pi/L, line of \
+                 sight z): every ordered triple of modes in the three shells of width {w} h/Mpc around k1, k2, k3; \
+                 exact sums, err_B* = 0 (round-off ~1e-13)"
+            ),
+            (_, Some(w)) => format!(
                 "bin averages over all closed triangles of three shells of width {w} h/Mpc around k1, k2, k3 \
                  (weight k1 k2 k3, {} Gauss-Legendre nodes per shell panel)",
                 rules.n_shell
             ),
-            None => "at the given triangles (not averaged over bins)".into(),
+            (_, None) => "at the given triangles (not averaged over bins)".into(),
         },
         "err_B*: difference from a coarser rule (one node fewer per shell panel, in mu and in phi)".into(),
     ]);

@@ -202,3 +202,29 @@ fn sugiyama_multipoles_at_pairs_with_errors_and_refusals() {
         ),
     ]);
 }
+
+#[test]
+fn box_averages_from_edges_are_exact_sums() {
+    // L = 1000 Mpc/h, shells of width 3 k_f: the header says what was summed, errors are zero
+    let kf = 2.0 * std::f64::consts::PI / 1000.0;
+    let edges = format!("{},{},{}", 1.5 * kf, 4.5 * kf, 7.5 * kf);
+    let (ok, out, err) = run(&[
+        "bispectrum",
+        "--k-edges",
+        &edges,
+        "--box",
+        "1000",
+        "--no-ir",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("discrete modes of a periodic box of side 1000 Mpc/h"));
+    let rows = rows(&out);
+    assert!(!rows.is_empty());
+    for r in rows {
+        assert!(r[3] > 0.0 && r[6] == 0.0, "{r:?}");
+    }
+    fails_naming(&[(
+        vec!["bispectrum", "--k-edges", &edges, "--box", "-1"],
+        "side of the box",
+    )]);
+}

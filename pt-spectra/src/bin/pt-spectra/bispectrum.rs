@@ -37,6 +37,10 @@ pub struct Args {
     /// triangle, averaged over their closed triangles: `a,b,c,…` or `start:end:step`.
     #[arg(long, value_name = "EDGES")]
     k_edges: Option<String>,
+    /// Average the bins exactly over the discrete modes of a periodic box of side L [Mpc/h] (line of
+    /// sight z; the FFT box estimator) instead of continuous shells; needs bins.
+    #[arg(long = "box", value_name = "L", allow_hyphen_values = true)]
+    box_size: Option<f64>,
     /// Side whose cosine with the line of sight the Legendre polynomial takes: largest (the largest bin,
     /// as the window-free estimator), 1, 2 or 3.
     #[arg(long, value_name = "SIDE", default_value = "largest")]
@@ -170,6 +174,7 @@ pub fn run(args: &Args) -> Result<()> {
                 q: (args.q_par, args.q_perp),
                 fog,
                 ir: !args.no_ir,
+                box_size: args.box_size,
             };
             let loaded = args.spectrum.load()?;
             bispectrum_table(&loaded.prepared, &request)?
@@ -178,6 +183,9 @@ pub fn run(args: &Args) -> Result<()> {
             let Some(path) = &args.pairs else {
                 bail!("--basis sugiyama needs --pairs FILE (columns k1 k2 [h/Mpc])");
             };
+            if args.box_size.is_some() {
+                bail!("--box is for the Scoccimarro multipoles of triangle bins");
+            }
             if args.legendre_side != "largest" {
                 bail!("--legendre-side is for --basis scoccimarro (the Sugiyama multipoles have no Legendre side)");
             }
