@@ -75,7 +75,7 @@ impl BoxPlan {
     ///
     /// # Errors
     /// [`Error::InvalidChoice`] for a set of points, a box size not finite and > 0, or more than
-    /// [`MAX_PAIRS`] pairs of modes to visit; [`Error::InvalidValue`] naming the bin (1-based) with no
+    /// 2e10 pairs of modes to visit (about a minute); [`Error::InvalidValue`] naming the bin (1-based) with no
     /// triangle of modes; as [`WiggleSplit::new`].
     pub fn new(set: TriangleSet, side: LegendreSide, box_size: f64) -> Result<Self> {
         if !(box_size.is_finite() && box_size > 0.0) {
