@@ -27,8 +27,8 @@ import warnings as _warnings
 import numpy as np
 
 from . import _core
-from ._core import (BispectrumPlan, BispectrumTerms, LinearEmulator, Observation, Pipeline, Table,
-                    distances, eisenstein_hu, growth, log_grid, num_threads, set_num_threads)
+from ._core import (BispectrumPlan, BispectrumTerms, LinearEmulator, Observation, Pipeline,
+                    SugiyamaPlan, SugiyamaTerms, Table, distances, eisenstein_hu, growth, log_grid, num_threads, set_num_threads)
 
 __all__ = [
     "BispectrumPlan",
@@ -42,6 +42,8 @@ __all__ = [
     "RealPlan",
     "RsdPlan",
     "RsdTerms",
+    "SugiyamaPlan",
+    "SugiyamaTerms",
     "Table",
     "TwoLoopRsdPlan",
     "eisenstein_hu",
@@ -510,9 +512,10 @@ def kernel(which, vectors, exact=False, f=None, los=None):
                         None if los is None else list(los))
 
 
-def bispectrum(triangles, bin_width=None, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None,
+def bispectrum(triangles=None, bin_width=None, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None,
                b1=1.0, b2=0.0, bs=0.0, c1=0.0, n_bar=None, b_shot=1.0, p_shot=0.0, a_shot=0.0, f=None,
-               q_par=1.0, q_perp=1.0, fog="none", sigma_fog=0.0, ir=True, legendre_side="largest"):
+               q_par=1.0, q_perp=1.0, fog="none", sigma_fog=0.0, ir=True, legendre_side="largest",
+               basis="scoccimarro", pairs=None):
     """Tree-level galaxy bispectrum multipoles B0, B2, B4 [(Mpc/h)^6] in redshift space.
 
     ``triangles``: an (n, 3) array of k1, k2, k3 [h/Mpc]; with ``bin_width`` [h/Mpc] each row is a bin
@@ -523,10 +526,14 @@ def bispectrum(triangles, bin_width=None, linear=None, z=0.0, z_input=0.0, cosmo
     [Mpc/h], IR resummation, the Legendre polynomial on the largest side (or "1", "2", "3").
     Returns a ``Table``: k1 k2 k3 B0 B2 B4 err_B0 err_B2 err_B4, its header and ``meta``.
     For many parameter steps on one spectrum use ``BispectrumPlan(triangles).terms(...).multipoles(...)``.
+
+    ``basis="sugiyama"`` with ``pairs`` (an (n, 2) array of k1, k2 [h/Mpc]) gives instead the Sugiyama
+    et al. (2019) multipoles B000 B110 B202 B022 B112 B220 (the angle between k1 and k2 integrated;
+    B112 the tripolar one), columns k1 k2 B000 … err_B000 …; ``SugiyamaPlan(pairs)`` for many steps.
     """
-    if bin_width is None and np.ndim(triangles) == 2:
+    if triangles is not None and bin_width is None and np.ndim(triangles) == 2:
         _warnings.warn("bispectrum: triangles without bin_width are points; a measurement's bins need "
                        "bin_width (their shell width) to be averaged over", PtSpectraWarning, stacklevel=2)
     return _warn(_core.bispectrum(triangles, bin_width, linear, z, z_input, cosmology, eh, b1, b2, bs,
                                   c1, n_bar, b_shot, p_shot, a_shot, f, q_par, q_perp, fog, sigma_fog, ir,
-                                  legendre_side))
+                                  legendre_side, basis, pairs))

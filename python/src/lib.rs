@@ -621,6 +621,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ept::EptPlan>()?;
     m.add_class::<bispectrum::BispectrumPlan>()?;
     m.add_class::<bispectrum::BispectrumTerms>()?;
+    m.add_class::<bispectrum::SugiyamaPlan>()?;
+    m.add_class::<bispectrum::SugiyamaTerms>()?;
     m.add_function(wrap_pyfunction!(bispectrum::bispectrum, m)?)?;
     m.add_class::<ept::EptTerms>()?;
     m.add_class::<two_loop_rsd::TwoLoopRsdPlan>()?;

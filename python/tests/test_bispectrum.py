@@ -65,3 +65,40 @@ def test_the_plan_refuses_an_implausible_growth_rate_as_the_function_does():
     for call in (lambda: plan.terms(f=5.0), lambda: pt.bispectrum(TRIANGLES, bin_width=0.005, f=5.0)):
         with pytest.raises(ValueError, match=r"f = 5.*\[0, 2\]"):
             call()
+
+
+PAIRS = np.array([[0.05, 0.05], [0.02, 0.1]])
+
+
+def test_sugiyama_basis_in_real_space_and_the_plan():
+    t = pt.bispectrum(basis="sugiyama", pairs=PAIRS, f=0.0, ir=False, b1=1.8, b2=0.4)
+    assert t.meta["model"] == "bispectrum tree sugiyama"
+    for name in ("B202", "B022", "B112"):     # f = 0: no dependence on the line of sight
+        np.testing.assert_allclose(t[name], 0.0, atol=1e-10 * np.max(t["B000"]))
+    assert np.all(t["err_B000"] <= 1e-4 * t["B000"])
+    kwargs = dict(b1=2.0, b2=-0.5, bs=-0.3, c1=3.0, n_bar=4e-4)
+    table = pt.bispectrum(basis="sugiyama", pairs=PAIRS, z=0.5, fog="gaussian", sigma_fog=3.0, **kwargs)
+    terms = pt.SugiyamaPlan(PAIRS).terms(z=0.5, fog="gaussian", sigma_fog=3.0)
+    b, err = terms.multipoles(**kwargs)
+    assert b.shape == (2, 6) and err.shape == (2, 6)
+    assert pt.SugiyamaPlan.multipole_names == ["000", "110", "202", "022", "112", "220"]
+    for m, name in enumerate(pt.SugiyamaPlan.multipole_names):
+        np.testing.assert_allclose(b[:, m], table["B" + name], rtol=1e-9)
+        np.testing.assert_allclose(err[:, m], table["err_B" + name], rtol=1e-6, atol=1e-3)
+    b_lo = terms.multipoles(**{**kwargs, "bs": 0.0})[0]
+    b_hi = terms.multipoles(**{**kwargs, "bs": -0.6})[0]
+    np.testing.assert_allclose(b, 0.5 * (b_lo + b_hi), rtol=1e-12)
+
+
+@pytest.mark.filterwarnings("ignore::pt_spectra.PtSpectraWarning")
+@pytest.mark.parametrize("kwargs, needle", [
+    (dict(basis="sugiyama"), "needs pairs"),
+    (dict(basis="sugiyama", pairs=PAIRS, triangles=TRIANGLES), "not triangles"),
+    (dict(basis="sugiyama", pairs=[[0.05, 0.05, 0.1]]), "k1, k2"),
+    (dict(basis="sugiyama", pairs=[[0.05, -0.1]]), "finite and > 0"),
+    (dict(basis="tripolar", pairs=PAIRS), "valid: scoccimarro, sugiyama"),
+    (dict(), "give triangles"),
+])
+def test_bad_sugiyama_input_raises_naming_the_problem(kwargs, needle):
+    with pytest.raises(ValueError, match=needle):
+        pt.bispectrum(**kwargs)

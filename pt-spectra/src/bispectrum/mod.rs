@@ -42,13 +42,20 @@
 //! changes form. Every B_ℓ carries an error: the
 //! difference from a coarser rule (orientation and shells).
 
+mod box_modes;
 mod geometry;
+mod observed;
+mod resum;
 mod sampled;
+mod sugiyama;
 mod terms;
 #[cfg(test)]
 mod tests;
 
+pub use box_modes::BoxPlan;
 pub use geometry::{LegendreSide, TriangleSet};
+pub use resum::IrInputs;
+pub use sugiyama::{SugiyamaPlan, SugiyamaRules, SugiyamaTerms, SUGIYAMA_MULTIPOLES};
 pub use terms::{tree_level_at, BispectrumPlan, BispectrumTerms, PlanRules};
 
 use crate::error::{Error, Result};
@@ -273,5 +280,20 @@ impl Settings {
             }
         }
         Ok(())
+    }
+    /// Checks the IR resummation is on (for inputs given explicitly).
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] if `ir` is false.
+    pub(crate) fn require_ir(&self) -> Result<()> {
+        if self.ir {
+            Ok(())
+        } else {
+            Err(Error::InvalidChoice {
+                what: "IR inputs with ir = false".into(),
+                reason: "explicit IR inputs (no-wiggle spectrum, Sigma^2) need the resummation on"
+                    .into(),
+            })
+        }
     }
 }

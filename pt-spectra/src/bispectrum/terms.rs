@@ -3,11 +3,12 @@
 //! with the parameters (per step, microseconds).
 
 use super::geometry::{orientations, LegendreSide, TriangleSet};
+use super::resum::IrInputs;
 use super::sampled::Sampled;
 use super::{BispectrumParams, Settings};
 use crate::error::Result;
 use crate::estimate::Estimate;
-use crate::ir::{delta_sigma2_bao, sigma2_bao, sigma2_total, WiggleSplit};
+use crate::ir::WiggleSplit;
 use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
 
@@ -68,7 +69,7 @@ const SHORTCUT_REFERENCE: (f64, f64) = (0.72, 2.0);
 
 /// Number of monomial slots per triangle and ℓ: 36 of Z₁Z₁Z₂ (3 × 3 × 4), 3 + 3 of the 1/n̄ terms, 1 of
 /// the 1/n̄² term.
-const SLOTS: usize = 43;
+pub(super) const SLOTS: usize = 43;
 
 /// One shape of a triangle or bin in the observed (fiducial) frame: sides, their dot products (k₀·k₁,
 /// k₁·k₂, k₂·k₀) and the orientation nodes of its average, in groups of one μ of the Legendre side.
@@ -241,13 +242,36 @@ impl BispectrumPlan {
     pub fn terms(&self, spectrum: &LinearSpectrum, settings: &Settings) -> Result<BispectrumTerms> {
         settings.validate()?;
         let ir = if settings.ir {
-            let nw = self.split.no_wiggle(spectrum)?;
-            let s2 = sigma2_bao(&nw, self.q_min);
-            let ds2 = delta_sigma2_bao(&nw, self.q_min);
-            Some((nw, s2.value, ds2.value))
+            Some(IrInputs::split(spectrum, &self.split, self.q_min)?)
         } else {
             None
         };
+        self.terms_resummed(spectrum, settings, ir.as_ref())
+    }
+
+    /// As [`terms`](Self::terms), with the IR resummation's no-wiggle spectrum and Σ², δΣ² given
+    /// (`settings.ir` must be true), e.g. to compare with another code's split.
+    ///
+    /// # Errors
+    /// As [`terms`](Self::terms); [`crate::error::Error::InvalidChoice`] if `settings.ir` is false.
+    pub fn terms_with_ir(
+        &self,
+        spectrum: &LinearSpectrum,
+        settings: &Settings,
+        ir: &IrInputs,
+    ) -> Result<BispectrumTerms> {
+        settings.validate()?;
+        settings.require_ir()?;
+        self.terms_resummed(spectrum, settings, Some(ir))
+    }
+
+    /// The terms with IR resummation from `ir` (none for `None`).
+    fn terms_resummed(
+        &self,
+        spectrum: &LinearSpectrum,
+        settings: &Settings,
+        ir: Option<&IrInputs>,
+    ) -> Result<BispectrumTerms> {
         // P and P_nw (P_nw = P without IR resummation) sampled once over every true side a node can
         // have: k/q with q between q∥ and q⊥
         let (q_lo, q_hi) = (
@@ -256,19 +280,13 @@ impl BispectrumPlan {
         );
         let table = Sampled::new(
             spectrum,
-            ir.as_ref().map(|(nw, _, _)| nw),
+            ir.map(|ir| &ir.no_wiggle),
             self.k_range[0] / q_hi,
             self.k_range[1] / q_lo,
         )?;
         // the resummed P at k, μ from (P, P_nw)
         let resummed = |(p, p_nw): (f64, f64), k: f64, mu: f64| -> f64 {
-            match &ir {
-                None => p,
-                Some((_, s2, ds2)) => {
-                    let x = k * k * sigma2_total(*s2, *ds2, settings.f, mu);
-                    p_nw + (-x).exp() * (p - p_nw)
-                }
-            }
+            ir.map_or(p, |ir| ir.resum(p, p_nw, k, mu, settings.f))
         };
         // Without an anisotropic distortion the true sides k/q do not depend on the orientation:
         // the spectra are looked up once per shape, not once per orientation.
@@ -350,7 +368,13 @@ fn node_slots(
 /// The slots of B at one configuration with true sides of lengths `k`, dot products `dots`, line-of-sight
 /// components `par` and linear power `p` (see the module docs of [`crate::bispectrum`]):
 /// Z₁ = u·a with u = (1, b₁, c₁), a = (fμ², 1, −k²μ²); Z₂ = v·c with v = (1, b₁, b₂, b_s).
-fn tree_slots(k: [f64; 3], dots: [f64; 3], par: [f64; 3], p: [f64; 3], f: f64) -> [f64; SLOTS] {
+pub(super) fn tree_slots(
+    k: [f64; 3],
+    dots: [f64; 3],
+    par: [f64; 3],
+    p: [f64; 3],
+    f: f64,
+) -> [f64; SLOTS] {
     let mu = [0, 1, 2].map(|i| par[i] / k[i]);
     let a: [[f64; 3]; 3] = [0, 1, 2].map(|i| [f * mu[i] * mu[i], 1.0, -par[i] * par[i]]);
     let mut out = [0.0; SLOTS];
@@ -392,7 +416,7 @@ fn tree_slots(k: [f64; 3], dots: [f64; 3], par: [f64; 3], p: [f64; 3], f: f64) -
 }
 
 /// The contraction of slots with the parameters.
-fn contract(slots: &[f64; SLOTS], b: &BispectrumParams) -> f64 {
+pub(super) fn contract(slots: &[f64; SLOTS], b: &BispectrumParams) -> f64 {
     let u = [1.0, b.b1, b.c1];
     let v = [1.0, b.b1, b.b2, b.bs];
     let mut total = 0.0;
@@ -445,6 +469,17 @@ pub struct BispectrumTerms {
 }
 
 impl BispectrumTerms {
+    /// Terms of exact sums (no quadrature: the coarse rule is the rule itself, errors are zero).
+    pub(super) fn exact(slots: Vec<[[f64; SLOTS]; 3]>, triangles: Vec<[f64; 3]>) -> Self {
+        Self {
+            fine: slots.clone(),
+            coarse: slots,
+            interpolation: 0.0,
+            shortcut: Vec::new(),
+            triangles,
+        }
+    }
+
     /// The triangles (bin centres) [h/Mpc].
     pub fn triangles(&self) -> &[[f64; 3]] {
         &self.triangles

@@ -1,11 +1,13 @@
 //! `bispectrum`: the tree-level galaxy bispectrum multipoles B₀, B₂, B₄ at triangles or over triangle
-//! bins ([`crate::bispectrum`]) as a table with its header.
+//! bins, or the Sugiyama multipoles B_{ℓ₁ℓ₂L} at (k₁, k₂) pairs ([`crate::bispectrum`]), as a table with
+//! its header.
 
 use super::VERSION;
 use crate::bispectrum::{
-    BispectrumParams, BispectrumPlan, Fog, LegendreSide, PlanRules, Settings, TriangleSet,
+    BispectrumParams, BispectrumPlan, BoxPlan, Fog, LegendreSide, PlanRules, Settings,
+    SugiyamaPlan, SugiyamaRules, TriangleSet, SUGIYAMA_MULTIPOLES,
 };
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::estimate::Estimate;
 use crate::output::{Table, BISPECTRUM, WAVENUMBER};
 use crate::setup::Prepared;
@@ -29,6 +31,9 @@ pub struct BispectrumRequest {
     pub fog: Fog,
     /// IR resummation of the BAO.
     pub ir: bool,
+    /// Average the bins exactly over the discrete modes of a periodic box of this side [Mpc/h]
+    /// (line of sight z) instead of continuous shells.
+    pub box_size: Option<f64>,
 }
 
 /// The table `k1 k2 k3 B0 B2 B4 err_B0 err_B2 err_B4` of `request` for the linear spectrum of
@@ -37,42 +42,33 @@ pub struct BispectrumRequest {
 /// # Errors
 /// As [`BispectrumPlan::new`], [`BispectrumPlan::terms`] and the parameters' validation.
 pub fn bispectrum_table(prepared: &Prepared, request: &BispectrumRequest) -> Result<Table> {
-    let f = request.f.unwrap_or(prepared.growth_rate);
-    let settings = Settings {
-        f,
-        q_par: request.q.0,
-        q_perp: request.q.1,
-        fog: request.fog,
-        ir: request.ir,
+    let settings = settings(prepared, request.f, request.q, request.fog, request.ir);
+    if request.rules.effective
+        && (request.box_size.is_some() || request.triangles.width().is_none())
+    {
+        return Err(Error::InvalidChoice {
+            what: "the effective-triangle shortcut".into(),
+            reason:
+                "is for bins of continuous shells (--k-edges, or --triangles with --bin-width), \
+                     not for single triangles or --box"
+                    .into(),
+        });
+    }
+    let terms = match request.box_size {
+        Some(l) => BoxPlan::new(request.triangles.clone(), request.side, l)?
+            .terms(prepared.tracer_spectrum(), &settings)?,
+        None => BispectrumPlan::new(request.triangles.clone(), request.side, request.rules)?
+            .terms(prepared.tracer_spectrum(), &settings)?,
     };
-    let plan = BispectrumPlan::new(request.triangles.clone(), request.side, request.rules)?;
-    let terms = plan.terms(prepared.tracer_spectrum(), &settings)?;
     let b = terms.multipoles(&request.params)?;
     let rules = request.rules;
-    let mut header = vec![
-        format!(
-            "pt-spectra {VERSION} bispectrum: tree-level galaxy bispectrum in redshift space, multipoles B0, B2, B4 \
-             (Scoccimarro et al. 1999), z = {}",
-            prepared.z
-        ),
-        format!(
-            "B = 2 Z1 Z1 Z2 P P + cyclic + (1/n_bar)[b1 b_shot + f mu^2 (1 + p_shot)] Z1 P + cyclic + (1 + a_shot)/n_bar^2; \
-             Z1 = b1 + f mu^2 - c1 k^2 mu^2; bias as velocileptors ((b2/2) delta^2 + bs s^2; CLASS-PT: bs = b_G2, \
-             b2 = b2_CLASS-PT - (4/3) b_G2)"
-        ),
-        format!("parameters: {}", request.params.describe()),
-        format!(
-            "f = {f}{}; AP q_par = {}, q_perp = {} (B / (q_par^2 q_perp^4)); FoG {}; IR resummation {}",
-            if request.f.is_none() { " (f(z) of the cosmology)" } else { "" },
-            settings.q_par,
-            settings.q_perp,
-            request.fog.describe(),
-            if request.ir {
-                "of the BAO in every leg: P_nw + exp(-k^2 Sigma_tot^2(mu)) P_w"
-            } else {
-                "off"
-            }
-        ),
+    let mut header = vec![format!(
+        "pt-spectra {VERSION} bispectrum: tree-level galaxy bispectrum in redshift space, multipoles B0, B2, B4 \
+         (Scoccimarro et al. 1999), z = {}",
+        prepared.z
+    )];
+    header.extend(model_lines(&request.params, request.f, &settings));
+    header.extend([
         format!(
             "Legendre polynomial on {}; orientations {} x {} (Gauss-Legendre in mu in [0, 1] x trapezoid in phi)",
             match request.side {
@@ -82,16 +78,26 @@ pub fn bispectrum_table(prepared: &Prepared, request: &BispectrumRequest) -> Res
             rules.n_mu,
             rules.n_phi,
         ),
-        match request.triangles.width() {
-            Some(w) => format!(
+        match (request.box_size, request.triangles.width()) {
+            (Some(l), Some(w)) => format!(
+                "bin averages over the discrete modes of a periodic box of side {l} Mpc/h (k_f = 2 pi/L, line of \
+                 sight z): every ordered triple of modes in the three shells of width {w} h/Mpc around k1, k2, k3; \
+                 exact sums, err_B* = 0 (round-off ~1e-13)"
+            ),
+            (_, Some(w)) if rules.effective => format!(
+                "effective-triangle shortcut: each bin of width {w} h/Mpc evaluated at its mean sides over its closed \
+                 triangles (weight k1 k2 k3), not averaged; err_B* includes twice the shortcut's distance from the \
+                 bin average measured on the reference prediction (gm2012 z = 0.5, f = 0.72, b1 = 2, IR), relative to B0"
+            ),
+            (_, Some(w)) => format!(
                 "bin averages over all closed triangles of three shells of width {w} h/Mpc around k1, k2, k3 \
                  (weight k1 k2 k3, {} Gauss-Legendre nodes per shell panel)",
                 rules.n_shell
             ),
-            None => "at the given triangles (not averaged over bins)".into(),
+            (_, None) => "at the given triangles (not averaged over bins)".into(),
         },
         "err_B*: difference from a coarser rule (one node fewer per shell panel, in mu and in phi)".into(),
-    ];
+    ]);
     header.extend(prepared.description.iter().cloned());
     let mut t = Table::new(header);
     let tri = request.triangles.triangles();
@@ -112,6 +118,114 @@ pub fn bispectrum_table(prepared: &Prepared, request: &BispectrumRequest) -> Res
             BISPECTRUM,
             column(l).iter().map(|e| e.error).collect(),
         );
+    }
+    Ok(t)
+}
+
+/// The settings of a request: f defaults to f(z) of `prepared`'s cosmology.
+fn settings(prepared: &Prepared, f: Option<f64>, q: (f64, f64), fog: Fog, ir: bool) -> Settings {
+    Settings {
+        f: f.unwrap_or(prepared.growth_rate),
+        q_par: q.0,
+        q_perp: q.1,
+        fog,
+        ir,
+    }
+}
+
+/// The header lines of the model: formula, parameters, f, AP, FoG and IR.
+fn model_lines(params: &BispectrumParams, f: Option<f64>, settings: &Settings) -> [String; 3] {
+    [
+        "B = 2 Z1 Z1 Z2 P P + cyclic + (1/n_bar)[b1 b_shot + f mu^2 (1 + p_shot)] Z1 P + cyclic + (1 + a_shot)/n_bar^2; \
+         Z1 = b1 + f mu^2 - c1 k^2 mu^2; bias as velocileptors ((b2/2) delta^2 + bs s^2; CLASS-PT: bs = b_G2, \
+         b2 = b2_CLASS-PT - (4/3) b_G2)"
+            .to_string(),
+        format!("parameters: {}", params.describe()),
+        format!(
+            "f = {}{}; AP q_par = {}, q_perp = {} (B / (q_par^2 q_perp^4)); FoG {}; IR resummation {}",
+            settings.f,
+            if f.is_none() { " (f(z) of the cosmology)" } else { "" },
+            settings.q_par,
+            settings.q_perp,
+            settings.fog.describe(),
+            if settings.ir {
+                "of the BAO in every leg: P_nw + exp(-k^2 Sigma_tot^2(mu)) P_w"
+            } else {
+                "off"
+            }
+        ),
+    ]
+}
+
+/// What the Sugiyama multipoles are computed for beyond the linear spectrum.
+#[derive(Debug, Clone)]
+pub struct SugiyamaRequest {
+    /// The pairs (k₁, k₂) [h/Mpc].
+    pub pairs: Vec<[f64; 2]>,
+    /// The quadrature rules.
+    pub rules: SugiyamaRules,
+    /// Bias, counterterm and stochastic parameters.
+    pub params: BispectrumParams,
+    /// The growth rate; `None` is f(z) of the cosmology.
+    pub f: Option<f64>,
+    /// AP scalings q∥, q⊥.
+    pub q: (f64, f64),
+    /// Fingers of God.
+    pub fog: Fog,
+    /// IR resummation of the BAO.
+    pub ir: bool,
+}
+
+/// The table `k1 k2 B000 B110 B202 B022 B112 B220 err_B000 …` of `request` for the linear spectrum of
+/// `prepared` (tracer spectrum).
+///
+/// # Errors
+/// As [`SugiyamaPlan::new`], [`SugiyamaPlan::terms`] and the parameters' validation.
+pub fn sugiyama_table(prepared: &Prepared, request: &SugiyamaRequest) -> Result<Table> {
+    let settings = settings(prepared, request.f, request.q, request.fog, request.ir);
+    let plan = SugiyamaPlan::new(request.pairs.clone(), request.rules)?;
+    let b = plan
+        .terms(prepared.tracer_spectrum(), &settings)?
+        .multipoles(&request.params)?;
+    let r = request.rules;
+    let mut header = vec![format!(
+        "pt-spectra {VERSION} bispectrum: tree-level galaxy bispectrum in redshift space, Sugiyama et al. (2019) \
+         multipoles B_l1l2L(k1, k2) (angle between k1 and k2 integrated), z = {}",
+        prepared.z
+    )];
+    header.extend(model_lines(&request.params, request.f, &settings));
+    header.extend([
+        "B_l1l2L = (1/8pi) int dx dmu1 dphi w B, x = k1^.k2^, mu1 = k1^.n^, phi the azimuth of k2 about k1; \
+         w = 1 (000), 3x (110), 5 L2(mu1) (202), 5 L2(mu2) (022), 3(3 mu1 mu2 - x) (112, tripolar; FolpsD's \
+         B112 has 2 sqrt3 for the azimuthal 3), 5 L2(x) (220)"
+            .to_string(),
+        format!(
+            "quadrature: k3 = |k1 + k2| on {} Gauss-Legendre panels x {} (clustered at |k1 - k2|), mu1 {} x phi {}; \
+             err_B*: difference from the coarser rule {:?}",
+            r.n_panels,
+            r.n_k3,
+            r.n_mu,
+            r.n_phi,
+            r.coarse()
+        ),
+    ]);
+    header.extend(prepared.description.iter().cloned());
+    let mut t = Table::new(header);
+    for (i, name) in ["k1", "k2"].iter().enumerate() {
+        t.push(
+            *name,
+            WAVENUMBER,
+            request.pairs.iter().map(|p| p[i]).collect(),
+        );
+    }
+    let column = |m: usize| -> Vec<Estimate> { b.iter().map(|b| b[m]).collect() };
+    for (m, name) in SUGIYAMA_MULTIPOLES.iter().enumerate() {
+        let values = column(m).iter().map(|e| e.value).collect();
+        t.push(format!("B{name}"), BISPECTRUM, values);
+    }
+    for (m, name) in SUGIYAMA_MULTIPOLES.iter().enumerate() {
+        let errors = column(m).iter().map(|e| e.error).collect();
+        t.push(format!("err_B{name}"), BISPECTRUM, errors);
     }
     Ok(t)
 }

@@ -109,6 +109,61 @@ fn bins_from_edges_carry_errors_and_the_header_says_what_was_computed() {
 }
 
 #[test]
+fn the_effective_triangle_shortcut_states_its_error_and_needs_bins() {
+    let args = |effective: bool| {
+        let mut a = vec![
+            "bispectrum",
+            "--k-edges",
+            "0.01:0.05:0.01",
+            "--b1",
+            "2",
+            "--fog",
+            "lorentzian",
+            "--sigma-fog",
+            "4",
+        ];
+        if effective {
+            a.push("--effective");
+        }
+        run(&a)
+    };
+    let (ok, average, err) = args(false);
+    assert!(ok, "{err}");
+    let (ok, shortcut, err) = args(true);
+    assert!(ok, "{err}");
+    assert!(
+        shortcut.contains("effective-triangle shortcut"),
+        "{shortcut}"
+    );
+    let (a, s) = (rows(&average), rows(&shortcut));
+    assert_eq!(a.len(), s.len());
+    let mut off = false;
+    for (a, s) in a.iter().zip(&s) {
+        // columns k1 k2 k3 B0 B2 B4 err_B0 err_B2 err_B4: the shortcut's stated error covers its
+        // distance from the bin average, and that distance is not nothing
+        for l in 0..3 {
+            assert!(
+                (s[3 + l] - a[3 + l]).abs() <= s[6 + l] + a[6 + l],
+                "{a:?} {s:?}"
+            );
+        }
+        off |= (s[3] - a[3]).abs() > 10.0 * a[6];
+    }
+    assert!(off, "the shortcut differs from the average somewhere");
+    fails_naming(&[(
+        vec![
+            "bispectrum",
+            "--k-edges",
+            "0.01:0.05:0.01",
+            "--box",
+            "1000",
+            "--effective",
+        ],
+        "effective-triangle shortcut",
+    )]);
+}
+
+#[test]
 fn bad_triangles_and_choices_are_refused() {
     let file = std::env::temp_dir().join(format!("pt-spectra-bk-bad-{}", std::process::id()));
     std::fs::write(&file, "0.01 0.02 0.05\n").unwrap();
@@ -149,4 +204,82 @@ fn bad_triangles_and_choices_are_refused() {
             "q_par",
         ),
     ]);
+}
+
+#[test]
+fn sugiyama_multipoles_at_pairs_with_errors_and_refusals() {
+    let file = std::env::temp_dir().join(format!("pt-spectra-bk-pairs-{}", std::process::id()));
+    std::fs::write(&file, "# k1 k2\n0.05 0.05\n0.02 0.1\n").unwrap();
+    let f = file.to_str().unwrap();
+    let (ok, out, err) = run(&[
+        "bispectrum",
+        "--basis",
+        "sugiyama",
+        "--pairs",
+        f,
+        "--f",
+        "0",
+        "--no-ir",
+        "--b1",
+        "1.8",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("Sugiyama et al. (2019)") && out.contains("err_B*: difference"));
+    assert!(out.contains("# k1 k2 B000 B110 B202 B022 B112 B220 err_B000"));
+    for r in rows(&out) {
+        // f = 0: B does not depend on the line of sight, the L = 2 multipoles vanish
+        assert!(r[2] > 0.0 && r[8] <= 1e-4 * r[2], "{r:?}");
+        for m in [4, 5, 6] {
+            assert!(r[m].abs() <= 1e-10 * r[2], "{r:?}");
+        }
+    }
+    fails_naming(&[
+        (vec!["bispectrum", "--basis", "sugiyama"], "needs --pairs"),
+        (
+            vec!["bispectrum", "--basis", "bispec", "--pairs", f],
+            "valid: scoccimarro, sugiyama",
+        ),
+        (
+            vec!["bispectrum", "--pairs", f],
+            "--pairs is for --basis sugiyama",
+        ),
+        (
+            vec![
+                "bispectrum",
+                "--basis",
+                "sugiyama",
+                "--pairs",
+                f,
+                "--k-edges",
+                "0.01:0.05:0.01",
+            ],
+            "cannot be used with",
+        ),
+    ]);
+}
+
+#[test]
+fn box_averages_from_edges_are_exact_sums() {
+    // L = 1000 Mpc/h, shells of width 3 k_f: the header says what was summed, errors are zero
+    let kf = 2.0 * std::f64::consts::PI / 1000.0;
+    let edges = format!("{},{},{}", 1.5 * kf, 4.5 * kf, 7.5 * kf);
+    let (ok, out, err) = run(&[
+        "bispectrum",
+        "--k-edges",
+        &edges,
+        "--box",
+        "1000",
+        "--no-ir",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("discrete modes of a periodic box of side 1000 Mpc/h"));
+    let rows = rows(&out);
+    assert!(!rows.is_empty());
+    for r in rows {
+        assert!(r[3] > 0.0 && r[6] == 0.0, "{r:?}");
+    }
+    fails_naming(&[(
+        vec!["bispectrum", "--k-edges", &edges, "--box", "-1"],
+        "side of the box",
+    )]);
 }

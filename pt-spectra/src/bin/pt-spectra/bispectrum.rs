@@ -1,11 +1,14 @@
 //! `pt-spectra bispectrum`: the tree-level galaxy bispectrum multipoles B0, B2, B4 in redshift space at
-//! triangles or averaged over the triangle bins of a measurement.
+//! triangles or averaged over the triangle bins of a measurement, or the Sugiyama multipoles
+//! B_l1l2L(k1, k2) at pairs (`--basis sugiyama --pairs FILE`).
 
 use crate::input::SpectrumInput;
 use crate::output::{check_outputs, write_output};
 use anyhow::{bail, Context, Result};
-use pt_spectra::bispectrum::{BispectrumParams, Fog, LegendreSide, PlanRules, TriangleSet};
-use pt_spectra::jobs::{bispectrum_table, BispectrumRequest};
+use pt_spectra::bispectrum::{
+    BispectrumParams, Fog, LegendreSide, PlanRules, SugiyamaRules, TriangleSet,
+};
+use pt_spectra::jobs::{bispectrum_table, sugiyama_table, BispectrumRequest, SugiyamaRequest};
 use pt_spectra::table::Table;
 use std::path::PathBuf;
 
@@ -14,6 +17,14 @@ use std::path::PathBuf;
 pub struct Args {
     #[command(flatten)]
     spectrum: SpectrumInput,
+    /// Multipole basis: scoccimarro (B0, B2, B4 at triangles or bins) or sugiyama (B000, B110, B202,
+    /// B022, B112, B220 at the (k1, k2) pairs of --pairs).
+    #[arg(long, default_value = "scoccimarro")]
+    basis: String,
+    /// With --basis sugiyama: the pairs from the first two columns k1 k2 [h/Mpc] of this file
+    /// ('#' comments).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["triangles", "k_edges", "bin_width"])]
+    pairs: Option<PathBuf>,
     /// Triangles from the first three columns k1 k2 k3 [h/Mpc] of this file ('#' comments), e.g. the
     /// k1 k2 k3 columns of a measurement.
     #[arg(long, value_name = "FILE", conflicts_with = "k_edges")]
@@ -26,6 +37,14 @@ pub struct Args {
     /// triangle, averaged over their closed triangles: `a,b,c,…` or `start:end:step`.
     #[arg(long, value_name = "EDGES")]
     k_edges: Option<String>,
+    /// Average the bins exactly over the discrete modes of a periodic box of side L [Mpc/h] (line of
+    /// sight z; the FFT box estimator) instead of continuous shells; needs bins.
+    #[arg(long = "box", value_name = "L", allow_hyphen_values = true)]
+    box_size: Option<f64>,
+    /// The effective-triangle shortcut: each bin at its mean sides (weight k1 k2 k3) instead of the
+    /// bin average, about 10x faster; err_B* then includes the shortcut's error. Needs bins.
+    #[arg(long)]
+    effective: bool,
     /// Side whose cosine with the line of sight the Legendre polynomial takes: largest (the largest bin,
     /// as the window-free estimator), 1, 2 or 3.
     #[arg(long, value_name = "SIDE", default_value = "largest")]
@@ -120,12 +139,20 @@ fn triangles(args: &Args) -> Result<TriangleSet> {
     }
 }
 
+/// The pairs of `--pairs`.
+fn pairs(path: &std::path::Path) -> Result<Vec<[f64; 2]>> {
+    let t = Table::read(path, &[0, 1]).context("--pairs")?;
+    Ok((0..t.columns[0].len())
+        .map(|i| [t.columns[0][i], t.columns[1][i]])
+        .collect())
+}
+
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<()> {
     let mut inputs = args.spectrum.files();
     inputs.push(("--triangles", args.triangles.as_deref()));
+    inputs.push(("--pairs", args.pairs.as_deref()));
     check_outputs(&[("--out", args.out.as_deref())], &inputs)?;
-    let side = LegendreSide::by_name(&args.legendre_side).context("--legendre-side")?;
     let params = BispectrumParams {
         b1: args.b1,
         b2: args.b2,
@@ -136,17 +163,53 @@ pub fn run(args: &Args) -> Result<()> {
         a_shot: args.a_shot,
         n_bar: args.n_bar.unwrap_or(f64::INFINITY),
     };
-    let request = BispectrumRequest {
-        triangles: triangles(args)?,
-        side,
-        rules: PlanRules::default(),
-        params,
-        f: args.f,
-        q: (args.q_par, args.q_perp),
-        fog: Fog::by_name(&args.fog, args.sigma_fog)?,
-        ir: !args.no_ir,
+    let fog = Fog::by_name(&args.fog, args.sigma_fog)?;
+    let table = match args.basis.to_ascii_lowercase().as_str() {
+        "scoccimarro" => {
+            if args.pairs.is_some() {
+                bail!("--pairs is for --basis sugiyama; the Scoccimarro multipoles take --triangles or --k-edges");
+            }
+            let request = BispectrumRequest {
+                triangles: triangles(args)?,
+                side: LegendreSide::by_name(&args.legendre_side).context("--legendre-side")?,
+                rules: PlanRules {
+                    effective: args.effective,
+                    ..PlanRules::default()
+                },
+                params,
+                f: args.f,
+                q: (args.q_par, args.q_perp),
+                fog,
+                ir: !args.no_ir,
+                box_size: args.box_size,
+            };
+            let loaded = args.spectrum.load()?;
+            bispectrum_table(&loaded.prepared, &request)?
+        }
+        "sugiyama" => {
+            let Some(path) = &args.pairs else {
+                bail!("--basis sugiyama needs --pairs FILE (columns k1 k2 [h/Mpc])");
+            };
+            if args.box_size.is_some() {
+                bail!("--box is for the Scoccimarro multipoles of triangle bins");
+            }
+            if args.legendre_side != "largest" {
+                bail!("--legendre-side is for --basis scoccimarro (the Sugiyama multipoles have no Legendre side)");
+            }
+            let request = SugiyamaRequest {
+                pairs: pairs(path)?,
+                rules: SugiyamaRules::default(),
+                params,
+                f: args.f,
+                q: (args.q_par, args.q_perp),
+                fog,
+                ir: !args.no_ir,
+            };
+            let loaded = args.spectrum.load()?;
+            sugiyama_table(&loaded.prepared, &request)
+                .with_context(|| format!("--pairs {}", path.display()))?
+        }
+        other => bail!("--basis {other}: valid: scoccimarro, sugiyama"),
     };
-    let loaded = args.spectrum.load()?;
-    let table = bispectrum_table(&loaded.prepared, &request)?;
     write_output(args.out.as_ref(), &table)
 }
