@@ -40,6 +40,7 @@ mod batch;
 mod bias;
 pub mod defaults;
 mod ept;
+mod ept_fit;
 mod fit;
 mod halo;
 mod observe;
@@ -48,9 +49,8 @@ mod rsd;
 mod spt2;
 pub use batch::{batch_memory, real_batch, BatchColumns, BatchMemory, BatchRows};
 pub use bias::BiasOutput;
-pub use ept::{
-    ept_fit_table, ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest,
-};
+pub use ept::{ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest};
+pub use ept_fit::{ept_fit_table, ept_model_table, ept_profile_table, FitContext};
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use halo::{halo_table, HaloRequest};
 pub use observe::observed_table;
