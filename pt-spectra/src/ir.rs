@@ -141,6 +141,13 @@ pub fn delta_sigma2_bao(no_wiggle: &LinearSpectrum, q_min: f64) -> Estimate {
     Estimate::new(norm * value, norm * error)
 }
 
+/// Σ²_tot(μ) = [1 + fμ²(2 + f)]Σ² + f²μ²(μ² − 1)δΣ² [(Mpc/h)²], the damping of the wiggles in
+/// redshift space (see [`delta_sigma2_bao`]) from Σ² = `sigma2` and δΣ² = `delta_sigma2`.
+pub fn sigma2_total(sigma2: f64, delta_sigma2: f64, f: f64, mu: f64) -> f64 {
+    let m2 = mu * mu;
+    (1.0 + f * m2 * (2.0 + f)) * sigma2 + f * f * m2 * (m2 - 1.0) * delta_sigma2
+}
+
 /// Spherical Bessel j0(x) = sin x / x.
 fn j0(x: f64) -> f64 {
     if x.abs() < 1e-4 {

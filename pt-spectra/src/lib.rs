@@ -15,6 +15,8 @@
 //! * [`loops`], [`resum`], [`real`]: 1- and 2-loop SPT terms, the propagator terms P13, P15, P17 (angular
 //!   tables), and TNS terms, all with error estimates; RPT propagators N0..N3; real-space models.
 //! * [`rsd`]: Kaiser, Scoccimarro and TNS redshift-space models, Fingers of God, Legendre multipoles.
+//! * [`bispectrum`]: the tree-level galaxy bispectrum in redshift space, B₀, B₂, B₄ over the orientations
+//!   of a triangle and the triangle bins of a measurement, with AP, IR resummation, FoG and shot noise.
 //! * [`fit`]: χ² fits of f, σ0 and A_b to measured multipoles, with Δχ² contour errors, versus k_max.
 //! * [`halo`]: scale-dependent bias, stochasticity (shot noise) and signal-to-noise of haloes.
 //! * [`hankel`]: FFTLog Hankel transforms between power-spectrum multipoles P_ℓ(k) and correlation-function
@@ -31,6 +33,7 @@
 //! # Ok::<(), pt_spectra::error::Error>(())
 //! ```
 
+pub mod bispectrum;
 pub mod cosmology;
 pub mod emulator;
 pub mod error;
@@ -46,6 +49,7 @@ pub mod linear;
 pub mod loops;
 pub mod memory;
 pub mod output;
+pub mod pipeline;
 pub mod precision;
 pub mod progress;
 pub mod real;

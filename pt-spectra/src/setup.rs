@@ -138,6 +138,18 @@ fn check_z(name: &'static str, z: f64) -> Result<()> {
 /// [`radiation::REFUSE_ABOVE`] off (a warning above [`radiation::WARN_ABOVE`]); as
 /// [`Cosmology::eisenstein_hu_spectrum`] and [`LinearSpectrum::scaled`].
 pub fn prepare(request: Request) -> Result<Prepared> {
+    prepare_with_emulator(request, None)
+}
+
+/// [`prepare`] with an emulator parsed before (`None`: the embedded one, parsed at this call): what a
+/// chain step that emulates at every call uses, since parsing costs more than an evaluation.
+///
+/// # Errors
+/// As [`prepare`].
+pub fn prepare_with_emulator(
+    request: Request,
+    emulator: Option<&LinearEmulator>,
+) -> Result<Prepared> {
     check_z("z", request.z)?;
     let z = request.z;
     let defaulted = request.cosmology.is_none();
@@ -176,7 +188,10 @@ pub fn prepare(request: Request) -> Result<Prepared> {
             spectrum
         }
         LinearSource::Embedded | LinearSource::Emulator => {
-            let emulated = emulate(&c, z)?;
+            let emulated = match emulator {
+                Some(e) => emulate(e, &c, z)?,
+                None => emulate(&LinearEmulator::embedded()?, &c, z)?,
+            };
             description.extend(emulated.description);
             warnings.extend(emulated.warning);
             if let Some((cb, f_cb)) = emulated.cb {
@@ -268,8 +283,7 @@ struct Emulated {
 }
 
 /// The emulated spectra of `c` at `z`, with the header lines that say so.
-fn emulate(c: &Cosmology, z: f64) -> Result<Emulated> {
-    let emulator = LinearEmulator::embedded()?;
+fn emulate(emulator: &LinearEmulator, c: &Cosmology, z: f64) -> Result<Emulated> {
     let e = emulator.spectra(c, z)?;
     let spectrum = e.matter()?;
     let mut description = vec![

@@ -27,12 +27,15 @@ import warnings as _warnings
 import numpy as np
 
 from . import _core
-from ._core import (LinearEmulator, Observation, Table, distances, eisenstein_hu, growth, log_grid,
-                    num_threads, set_num_threads)
+from ._core import (BispectrumPlan, BispectrumTerms, LinearEmulator, Observation, Pipeline, Table,
+                    distances, eisenstein_hu, growth, log_grid, num_threads, set_num_threads)
 
 __all__ = [
+    "BispectrumPlan",
+    "BispectrumTerms",
     "EptPlan",
     "Observation",
+    "Pipeline",
     "EptTerms",
     "LinearEmulator",
     "PtSpectraWarning",
@@ -46,6 +49,7 @@ __all__ = [
     "fit",
     "fit_ept",
     "fit_tables",
+    "bispectrum",
     "distances",
     "growth",
     "halo",
@@ -526,3 +530,25 @@ def kernel(which, vectors, exact=False, f=None, los=None):
     """
     return _core.kernel(which, [list(v) for v in vectors], exact, f,
                         None if los is None else list(los))
+
+
+def bispectrum(triangles, bin_width=None, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None,
+               b1=1.0, b2=0.0, bs=0.0, c1=0.0, n_bar=None, b_shot=1.0, p_shot=0.0, a_shot=0.0, f=None,
+               q_par=1.0, q_perp=1.0, fog="none", sigma_fog=0.0, ir=True, legendre_side="largest"):
+    """Tree-level galaxy bispectrum multipoles B0, B2, B4 [(Mpc/h)^6] in redshift space.
+
+    ``triangles``: an (n, 3) array of k1, k2, k3 [h/Mpc]; with ``bin_width`` [h/Mpc] each row is a bin
+    of three shells averaged over all its closed triangles (what a measurement is), else a point.
+    Bias as velocileptors (b1, b2, bs; CLASS-PT's b_G2 = bs), counterterm c1 [(Mpc/h)^2], stochastic
+    terms (1/n_bar)[b1 b_shot + f mu^2 (1 + p_shot)] Z1 P + cyclic + (1 + a_shot)/n_bar^2 (none without
+    ``n_bar``), f (default f(z)), AP q_par, q_perp, FoG none | lorentzian | gaussian with ``sigma_fog``
+    [Mpc/h], IR resummation, the Legendre polynomial on the largest side (or "1", "2", "3").
+    Returns a ``Table``: k1 k2 k3 B0 B2 B4 err_B0 err_B2 err_B4, its header and ``meta``.
+    For many parameter steps on one spectrum use ``BispectrumPlan(triangles).terms(...).multipoles(...)``.
+    """
+    if bin_width is None and np.ndim(triangles) == 2:
+        _warnings.warn("bispectrum: triangles without bin_width are points; a measurement's bins need "
+                       "bin_width (their shell width) to be averaged over", PtSpectraWarning, stacklevel=2)
+    return _warn(_core.bispectrum(triangles, bin_width, linear, z, z_input, cosmology, eh, b1, b2, bs,
+                                  c1, n_bar, b_shot, p_shot, a_shot, f, q_par, q_perp, fog, sigma_fog, ir,
+                                  legendre_side))

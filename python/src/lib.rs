@@ -23,11 +23,13 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 mod batch;
+mod bispectrum;
 mod emulator;
 mod ept;
 mod halo;
 mod inputs;
 mod kernel;
+mod pipeline;
 mod redshift;
 mod survey;
 mod tables;
@@ -617,9 +619,13 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<redshift::RsdPlan>()?;
     m.add_class::<redshift::RsdTerms>()?;
     m.add_class::<ept::EptPlan>()?;
+    m.add_class::<bispectrum::BispectrumPlan>()?;
+    m.add_class::<bispectrum::BispectrumTerms>()?;
+    m.add_function(wrap_pyfunction!(bispectrum::bispectrum, m)?)?;
     m.add_class::<ept::EptTerms>()?;
     m.add_class::<two_loop_rsd::TwoLoopRsdPlan>()?;
     m.add_class::<survey::Observation>()?;
+    m.add_class::<pipeline::Pipeline>()?;
     m.add_function(wrap_pyfunction!(ept::fit_ept, m)?)?;
     m.add_function(wrap_pyfunction!(batch::real_batch, m)?)?;
     m.add_function(wrap_pyfunction!(batch::read_multipoles, m)?)?;

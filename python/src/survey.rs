@@ -28,7 +28,7 @@ pub(crate) fn read_window(
 /// The chain from model multipoles to a measured data vector (`pt_spectra.survey.observe`).
 #[pyclass(module = "pt_spectra._core", frozen)]
 pub(crate) struct Observation {
-    inner: LibObservation,
+    pub(crate) inner: LibObservation,
 }
 
 /// The window mixing of its Python name.

@@ -55,7 +55,9 @@ mod plausible;
 pub use eisenstein_hu::{EisensteinHu, TransferKind};
 pub use ini::ParsedCosmology;
 pub use neutrinos::Neutrinos;
-pub use plausible::{plausible, sigma8_warning, Plausible, PLAUSIBLE, SIGMA8_TYPICAL};
+pub use plausible::{
+    check_growth_rate, plausible, sigma8_warning, Plausible, PLAUSIBLE, SIGMA8_TYPICAL,
+};
 
 /// How the amplitude of the linear spectrum is fixed.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,5 +1,7 @@
 //! The ranges in which cosmological parameters are accepted ([`PLAUSIBLE`]).
 
+use crate::error::{Error, Result};
+
 /// The range in which a cosmological parameter is accepted, and what is said otherwise.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Plausible {
@@ -132,6 +134,22 @@ pub const PLAUSIBLE: [Plausible; 13] = [
 /// The [`PLAUSIBLE`] range of the parameter `name`.
 pub fn plausible(name: &str) -> Option<&'static Plausible> {
     PLAUSIBLE.iter().find(|p| p.name == name)
+}
+
+/// The growth rate `f` if finite and in its [`PLAUSIBLE`] range [0, 2].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming f, its value and the range.
+pub fn check_growth_rate(f: f64) -> Result<()> {
+    let range = plausible("f").expect("f has a plausible range");
+    if !(f.is_finite() && range.contains(f)) {
+        return Err(Error::InvalidParameter {
+            name: "f",
+            value: f,
+            reason: range.reason,
+        });
+    }
+    Ok(())
 }
 
 /// The range of σ8(z = 0) of all matter that cosmologies fitted to data have had (Planck, weak lensing,

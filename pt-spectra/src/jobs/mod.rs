@@ -38,6 +38,7 @@ use crate::setup::Prepared;
 
 mod batch;
 mod bias;
+mod bispectrum;
 pub mod defaults;
 mod ept;
 mod ept_fit;
@@ -49,7 +50,10 @@ mod rsd;
 mod spt2;
 pub use batch::{batch_memory, real_batch, BatchColumns, BatchMemory, BatchRows};
 pub use bias::BiasOutput;
-pub use ept::{ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest};
+pub use bispectrum::{bispectrum_table, BispectrumRequest};
+pub use ept::{
+    ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest, AP_FIT_RANGE,
+};
 pub use ept_fit::{ept_fit_table, ept_model_table, ept_profile_table, FitContext};
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use halo::{halo_table, HaloRequest};

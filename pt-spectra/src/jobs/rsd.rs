@@ -396,21 +396,7 @@ fn crossing_line(what: &str, k: &[f64], sn: &[f64]) -> String {
     text
 }
 
-/// The growth rate `f` if finite and in its [`PLAUSIBLE`](crate::cosmology::PLAUSIBLE) range [0, 2].
-///
-/// # Errors
-/// [`Error::InvalidParameter`] naming f, its value and the range.
-pub fn check_growth_rate(f: f64) -> Result<()> {
-    let range = crate::cosmology::plausible("f").expect("f has a plausible range");
-    if !(f.is_finite() && range.contains(f)) {
-        return Err(Error::InvalidParameter {
-            name: "f",
-            value: f,
-            reason: range.reason,
-        });
-    }
-    Ok(())
-}
+pub use crate::cosmology::check_growth_rate;
 
 /// `rsd --xi`: the correlation-function multipoles ξ_ℓ(s) of a multipole table `t` (columns `k`,
 /// `P<l>`, `err_P<l>` for each of `ells`) at `s` [Mpc/h], by FFTLog ([`crate::hankel::xi_from_pk`]:

@@ -29,6 +29,8 @@ use crate::estimate::Estimate;
 
 /// The unit of spectra.
 pub const POWER: &str = "(Mpc/h)^3";
+/// The unit of bispectra.
+pub const BISPECTRUM: &str = "(Mpc/h)^6";
 /// The unit of wavenumbers.
 pub const WAVENUMBER: &str = "h/Mpc";
 

@@ -39,7 +39,7 @@
 use super::spt2::{loop_terms, LoopTensors};
 use crate::error::{Error, Result};
 use crate::integrate::legendre_nodes;
-use crate::ir::{delta_sigma2_bao, sigma2_bao, WiggleSplit};
+use crate::ir::{delta_sigma2_bao, sigma2_bao, sigma2_total, WiggleSplit};
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::training::{camb_basis, transformed_basis};
 use crate::loops::basis::{LinearBasis, RsdTwoLoopBasis, SpectrumFamily, BASIS_SIZE};
@@ -353,10 +353,8 @@ impl Eft2Terms {
 
     /// k²Σ²(μ) at k index `i` (0 without IR resummation).
     fn x(&self, i: usize, f: f64, mu: f64) -> f64 {
-        let (s2, ds2) = (self.sigma2.0.value, self.sigma2.1.value);
-        let m2 = mu * mu;
         let k = self.k[i];
-        k * k * ((1.0 + f * m2 * (2.0 + f)) * s2 + f * f * m2 * (m2 - 1.0) * ds2)
+        k * k * sigma2_total(self.sigma2.0.value, self.sigma2.1.value, f, mu)
     }
 
     /// At k index `i` and μ: the model without its 2-loop terms, and the shapes P_IR, P^(1)_IR of the

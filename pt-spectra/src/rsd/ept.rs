@@ -81,21 +81,7 @@ impl EptParams {
     /// [`Error::InvalidChoice`] for a name not in [`PARAM_NAMES`]; [`Error::InvalidParameter`] for a
     /// value that is not finite.
     pub fn set(&mut self, name: &str, value: f64) -> Result<()> {
-        let i =
-            PARAM_NAMES
-                .iter()
-                .position(|&n| n == name)
-                .ok_or_else(|| Error::InvalidChoice {
-                    what: format!("ept parameter `{name}`"),
-                    reason: format!("the parameters are {}", PARAM_NAMES.join(", ")),
-                })?;
-        if !value.is_finite() {
-            return Err(Error::InvalidParameter {
-                name: PARAM_NAMES[i],
-                value,
-                reason: "must be finite",
-            });
-        }
+        let i = checked_param(name, value)?;
         self.values[i] = value;
         Ok(())
     }
@@ -170,6 +156,8 @@ pub struct EptPlan {
     split: Option<()>,
     /// The basis tensors of the loop terms, if they come from them ([`Self::with_basis`]).
     tensors: Option<basis::Tensors>,
+    /// The largest projection residual evaluated on the tensors ([`Self::with_max_residual`]).
+    max_residual: f64,
 }
 
 /// What the plan's loop grid is to its output k.
@@ -251,6 +239,7 @@ impl EptPlan {
             loops,
             split,
             tensors: None,
+            max_residual: crate::loops::basis::MAX_RESIDUAL,
         })
     }
 
@@ -477,6 +466,29 @@ fn sigma2_kernel(q: f64) -> f64 {
 
 mod basis;
 mod model;
+
+/// The index of parameter `name` in [`PARAM_NAMES`], its `value` checked finite.
+///
+/// # Errors
+/// [`Error::InvalidChoice`] for a name not in [`PARAM_NAMES`] (listing them);
+/// [`Error::InvalidParameter`] for a value that is not finite.
+pub fn checked_param(name: &str, value: f64) -> Result<usize> {
+    let i = PARAM_NAMES
+        .iter()
+        .position(|&n| n == name)
+        .ok_or_else(|| Error::InvalidChoice {
+            what: format!("ept parameter `{name}`"),
+            reason: format!("the parameters are {}", PARAM_NAMES.join(", ")),
+        })?;
+    if !value.is_finite() {
+        return Err(Error::InvalidParameter {
+            name: PARAM_NAMES[i],
+            value,
+            reason: "must be finite",
+        });
+    }
+    Ok(i)
+}
 
 #[cfg(test)]
 mod tests;

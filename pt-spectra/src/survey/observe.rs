@@ -72,11 +72,13 @@ pub enum Bins {
     },
 }
 
+#[derive(Clone)]
 enum WindowStage {
     Plan(WindowPlan),
     Matrix(WindowMatrix),
 }
 
+#[derive(Clone)]
 enum BinStage {
     Average(BinAverage),
     Box(BoxModesPlan),
@@ -85,6 +87,7 @@ enum BinStage {
 }
 
 /// The planned chain (module docs).
+#[derive(Clone)]
 pub struct Observation {
     ells: Vec<usize>,
     k_out: Vec<f64>,

@@ -6,6 +6,7 @@
 use std::process::Command;
 
 mod bias;
+mod bispectrum;
 mod counterterm;
 mod emulator;
 mod ept;

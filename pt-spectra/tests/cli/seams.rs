@@ -96,3 +96,16 @@ fn fit_xi_separations_are_named_as_separations() {
     );
     assert!(!err.contains("k_max") && !err.contains("k_min"), "{err}");
 }
+
+#[test]
+fn an_unknown_rsd_model_lists_every_model_the_help_lists() {
+    let (ok, _, err) = super::run(&["rsd", "--rsd", "foo"]);
+    assert!(!ok);
+    for name in ["kaiser", "scoccimarro", "tns", "ept", "spt2", "eft2"] {
+        assert!(err.contains(name), "{name} missing from: {err}");
+    }
+    let (_, help, _) = super::run(&["rsd", "--help"]);
+    for name in ["kaiser", "scoccimarro", "tns", "ept", "spt2", "eft2"] {
+        assert!(help.contains(name), "{name} missing from --help");
+    }
+}

@@ -23,6 +23,11 @@ pub enum RsdChoice {
     Eft2,
 }
 
+impl RsdChoice {
+    /// Every name `--rsd` takes, in the order of its help (one list for the help and the errors).
+    pub const NAMES: &'static str = "kaiser, scoccimarro, tns, ept, spt2, eft2";
+}
+
 impl FromStr for RsdChoice {
     type Err = pt_spectra::error::Error;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
@@ -35,7 +40,13 @@ impl FromStr for RsdChoice {
         if s.eq_ignore_ascii_case("eft2") {
             return Ok(Self::Eft2);
         }
-        s.parse().map(Self::Paper)
+        s.parse()
+            .map(Self::Paper)
+            .map_err(|_| pt_spectra::error::Error::UnknownName {
+                what: "RSD model",
+                name: s.to_string(),
+                available: Self::NAMES,
+            })
     }
 }
 

@@ -6,6 +6,7 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+mod bispectrum;
 mod common;
 mod ept;
 mod fit;
@@ -36,6 +37,8 @@ enum Command {
     Rsd(Box<rsd::Args>),
     /// Fit f, σ0 and the bias amplitude to measured multipoles, with Δχ² errors, versus k_max.
     Fit(Box<fit::Args>),
+    /// Tree-level galaxy bispectrum multipoles B0, B2, B4 in redshift space at triangles or triangle bins.
+    Bispectrum(Box<bispectrum::Args>),
     /// Halo bias b(k) = P_mh/P_mm and stochasticity P_εε = P_hh − P_mh²/P_mm from measured spectra.
     Halo(halo::Args),
     /// Draw the paper's kinds of figure (PNG or SVG) from the tables of the other subcommands.
@@ -50,6 +53,7 @@ fn main() -> ExitCode {
         Command::Rsd(args) => rsd::run(&args),
         Command::Fit(args) => fit::run(&args),
         Command::Halo(args) => halo::run(&args),
+        Command::Bispectrum(args) => bispectrum::run(&args),
         Command::Plot(args) => plot::run(&args),
     };
     match result {

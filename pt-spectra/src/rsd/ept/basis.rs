@@ -14,7 +14,7 @@ use super::{sigma2_kernel, EptPlan, EptTerms};
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::training::camb_basis;
-use crate::loops::basis::{LinearBasis, RedshiftBasis, RedshiftFamily, BASIS_SIZE, MAX_RESIDUAL};
+use crate::loops::basis::{LinearBasis, Projection, RedshiftBasis, RedshiftFamily, BASIS_SIZE};
 use crate::loops::Estimate;
 use crate::precision::TwoLoopMethod;
 use crate::progress::Progress;
@@ -172,9 +172,46 @@ impl EptPlan {
         Ok(self)
     }
 
+    /// This plan accepting spectra that project on the basis with a smoothed residual up to
+    /// `max_residual` (default [`crate::loops::basis::MAX_RESIDUAL`]); the terms' errors include the projection error
+    /// ([`EptTerms::describe_source`]) whatever the residual.
+    ///
+    /// # Errors
+    /// [`crate::error::Error::InvalidParameter`] unless 0 < `max_residual` < 0.1.
+    pub fn with_max_residual(mut self, max_residual: f64) -> Result<Self> {
+        if !(max_residual > 0.0 && max_residual < 0.1) {
+            return Err(crate::error::Error::InvalidParameter {
+                name: "max_residual",
+                value: max_residual,
+                reason: "the largest projection residual must lie in (0, 0.1)",
+            });
+        }
+        self.max_residual = max_residual;
+        Ok(self)
+    }
+
+    /// The largest projection residual evaluated on the tensors ([`Self::with_max_residual`]).
+    pub fn max_residual(&self) -> f64 {
+        self.max_residual
+    }
+
     /// Whether the loop terms come from basis tensors (for spectra the bases represent).
     pub fn has_basis(&self) -> bool {
         self.tensors.is_some()
+    }
+
+    /// The projection of `spectrum` on the linear basis of the tensors (`None` without tensors):
+    /// its coefficients and residual, whether or not [`Self::terms`] accepts it
+    /// ([`crate::loops::basis::MAX_RESIDUAL`]).
+    pub fn basis_projection(&self, spectrum: &LinearSpectrum) -> Option<Projection> {
+        let basis = self.tensors.as_ref()?.linear.basis();
+        let samples = basis.sample(spectrum);
+        Some(basis.project_spectrum_sampled(spectrum, &samples, self.max_residual))
+    }
+
+    /// The linear basis the spectra are projected on, if the loop terms come from basis tensors.
+    pub fn linear_basis(&self) -> Option<&LinearBasis> {
+        Some(self.tensors.as_ref()?.linear.basis())
     }
 
     /// The loop terms from the basis tensors, or `None` without tensors or for a spectrum its basis
@@ -185,8 +222,8 @@ impl EptPlan {
         };
         let basis = tensors.linear.basis();
         let samples = basis.sample(spectrum);
-        let projection = basis.project_spectrum_sampled(spectrum, &samples, MAX_RESIDUAL);
-        if projection.residual.is_nan() || projection.residual > MAX_RESIDUAL {
+        let projection = basis.project_spectrum_sampled(spectrum, &samples, self.max_residual);
+        if projection.residual.is_nan() || projection.residual > self.max_residual {
             return Ok(None);
         }
         let p_lin: Vec<f64> = self.grid.iter().map(|&k| spectrum.eval(k)).collect();
@@ -218,6 +255,11 @@ impl EptPlan {
 }
 
 impl EptTerms {
+    /// The projection residual if the terms come from basis tensors (`None`: the direct integrals).
+    pub fn basis_residual(&self) -> Option<f64> {
+        self.basis_residual
+    }
+
     /// One header line if the terms come from basis tensors: the projection residuals.
     pub fn describe_source(&self) -> Option<String> {
         let residual = self.basis_residual?;

@@ -1,0 +1,411 @@
+//! The chain step as one object: cosmological parameters (through the emulator) or a linear
+//! spectrum, and nuisance parameters by name, to the observed data vector (issue 47).
+//!
+//! A [`Pipeline`] is built once from the observation ([`Observation`]: window, bins or ξ, ℓ's), the
+//! model (`ept`: [`crate::rsd::ept`]; other models take the place of [`Model`]), the redshift and the
+//! Alcock–Paczynski fiducial. Everything that does not depend on the cosmology is done there:
+//! - the loop plan and its basis tensors on one fixed k grid (with a fiducial: the internal log grid
+//!   of every α∥, α⊥ in [`AP_FIT_RANGE`], [`crate::rsd::ept::EptSettings::ap_range`]), which the AP
+//!   projection interpolates at the true k, μ; no plan is made per cosmology;
+//! - the observation as one matrix `M` (rows: output ℓ then output k; columns: model ℓ then model k),
+//!   found by applying the (linear) window and bins to unit vectors, so that the stage is one
+//!   matrix–vector product and its derivative is `M` itself;
+//! - the parsed emulator.
+//!
+//! A call ([`Pipeline::step`] then [`CosmologyStep::data_vector`]) computes the loop terms of the
+//! spectrum (on the basis when it projects within [`PIPELINE_MAX_RESIDUAL`], else by the direct
+//! integrals, stated in [`CosmologyStep::source`]), the multipoles with the distortion of the
+//! cosmology against the fiducial, and `M` times them.
+//!
+//! The nuisance-only step: at fixed cosmology the data vector is a polynomial in the parameters,
+//! quadratic in u = (1, b1, b2, bs, b3) and linear in the counterterms and stochastic terms
+//! (α0, α2, α4, α6, sn, sn2, sn4; velocileptors' REPT), so
+//! D(θ) = Σ_{i≤j} u_i u_j A_ij + Σ_c θ_c C_c. [`CosmologyStep::linearise`] finds the 22 vectors
+//! A_ij, C_c from 22 evaluations (exact up to rounding: the model is that polynomial), after which
+//! [`Linearised::data_vector`] and its exact Jacobian [`Linearised::jacobian`] cost a few
+//! thousand multiplications.
+
+use crate::cosmology::Cosmology;
+use crate::emulator::LinearEmulator;
+use crate::error::{Error, Result};
+use crate::jobs::AP_FIT_RANGE;
+use crate::linear::LinearSpectrum;
+use crate::precision::Precision;
+use crate::progress::Progress;
+use crate::rsd::ap::Distortion;
+use crate::rsd::ept::{EptParams, EptPlan, EptSettings, EptTerms, PARAM_NAMES};
+use crate::setup::{LinearSource, NamedCosmology, Prepared, Request};
+use crate::store::TableStore;
+use crate::survey::observe::Observation;
+
+mod linearised;
+pub use linearised::{Linearised, NUISANCE_NAMES};
+
+/// The largest smoothed projection residual for which a [`Pipeline`] evaluates the loop terms on the
+/// basis: 2e-3, twice the emulator's own worst |Δ ln P| (~1e-3, [`LinearEmulator::describe`]).
+/// Emulated spectra project with 5e-4 to 7e-4 (the kink where the emulated table, ending at
+/// k ≈ 8.9 h/Mpc, meets its power-law extrapolation), above the 3e-4 of
+/// [`crate::loops::basis::MAX_RESIDUAL`], which sent them to the direct integrals (5–50 ms instead
+/// of < 1 ms). The terms' errors include ε|T| for a residual ε, whatever it is.
+pub const PIPELINE_MAX_RESIDUAL: f64 = 2e-3;
+
+/// The models a [`Pipeline`] can evaluate (the place of TNS, eft2 and the bispectrum later).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Model {
+    /// The 1-loop Eulerian galaxy model in redshift space ([`crate::rsd::ept`]).
+    Ept,
+}
+
+/// What a [`Pipeline`] is built from besides the observation.
+#[derive(Debug, Clone)]
+pub struct PipelineSettings {
+    /// The model.
+    pub model: Model,
+    /// The redshift of the observation.
+    pub z: f64,
+    /// The fiducial cosmology of the measurement's distances (`None`: no AP distortion).
+    pub fiducial: Option<Cosmology>,
+    /// IR resummation of the model.
+    pub ir: bool,
+    /// The largest projection residual evaluated on the basis ([`PIPELINE_MAX_RESIDUAL`]).
+    pub max_residual: f64,
+}
+
+impl PipelineSettings {
+    /// `ept` at `z` with IR resummation, the AP distortion against `fiducial`, and
+    /// [`PIPELINE_MAX_RESIDUAL`].
+    pub fn ept(z: f64, fiducial: Option<Cosmology>) -> Self {
+        Self {
+            model: Model::Ept,
+            z,
+            fiducial,
+            ir: true,
+            max_residual: PIPELINE_MAX_RESIDUAL,
+        }
+    }
+}
+
+/// The whole chain step, planned once (module docs).
+pub struct Pipeline {
+    settings: PipelineSettings,
+    plan: EptPlan,
+    observation: Observation,
+    /// The observation as a matrix, rows × columns = `rows` × `model_ells.len() · k_model.len()`.
+    matrix: Vec<f64>,
+    rows: usize,
+    emulator: LinearEmulator,
+}
+
+/// Where the loop terms of one spectrum came from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TermsSource {
+    /// The basis tensors, with the spectrum's smoothed projection residual.
+    Basis {
+        /// The residual.
+        residual: f64,
+    },
+    /// The direct integrals, since the residual exceeded the pipeline's largest (or was NaN).
+    DirectFallback {
+        /// The residual that was refused.
+        residual: f64,
+    },
+    /// The direct integrals (the plan has no basis tensors).
+    Direct,
+}
+
+impl TermsSource {
+    /// One line for a header, a `meta` entry or a warning.
+    pub fn describe(&self, max_residual: f64) -> String {
+        match self {
+            Self::Basis { residual } => format!(
+                "loop terms: basis (projection residual {residual:.1e} <= {max_residual:.1e}; its \
+                 error is in the terms' errors)"
+            ),
+            Self::DirectFallback { residual } => format!(
+                "loop terms: direct integrals (fallback: the spectrum projects on the basis with \
+                 residual {residual:.1e} > {max_residual:.1e}, outside its span; slower, same model)"
+            ),
+            Self::Direct => "loop terms: direct integrals (no basis tensors)".into(),
+        }
+    }
+}
+
+/// The cosmology-dependent part of one call: the loop terms, the growth rate and the distortion.
+pub struct CosmologyStep<'a> {
+    pipeline: &'a Pipeline,
+    terms: EptTerms,
+    /// f(z) of the spectrum's cosmology (the default of the nuisance `f`).
+    pub growth_rate: f64,
+    /// The AP distortion of the cosmology against the fiducial (`None` without fiducial).
+    pub ap: Option<Distortion>,
+    /// Where the loop terms came from.
+    pub source: TermsSource,
+}
+
+impl Pipeline {
+    /// The pipeline of `observation` (its model ℓ's and k are what the model is evaluated on) with
+    /// `settings`, the loop terms planned at `precision` with basis tensors read or built in
+    /// `store` (reporting to `progress`).
+    ///
+    /// # Errors
+    /// As [`crate::jobs::ept_plan`], [`EptPlan::with_max_residual`], [`Observation::apply_values`]
+    /// and [`LinearEmulator::embedded`]; [`Error::InvalidParameter`] for a bad redshift.
+    pub fn new(
+        observation: Observation,
+        settings: PipelineSettings,
+        precision: &Precision,
+        store: &TableStore,
+        progress: &dyn Progress,
+    ) -> Result<Self> {
+        if !(settings.z.is_finite() && settings.z > -1.0) {
+            return Err(Error::InvalidParameter {
+                name: "z",
+                value: settings.z,
+                reason: "a redshift must be finite and > -1",
+            });
+        }
+        let mut precision = precision.clone();
+        if precision.two_loop == crate::precision::TwoLoopMethod::Auto {
+            precision.two_loop = crate::precision::TwoLoopMethod::Basis;
+        }
+        let Model::Ept = settings.model;
+        let plan = EptPlan::new(
+            observation.k_model(),
+            EptSettings {
+                ir: settings.ir,
+                ap: None,
+                ap_range: settings.fiducial.as_ref().map(|_| AP_FIT_RANGE),
+            },
+            &precision,
+        )?
+        .with_basis(store, progress)?
+        .with_max_residual(settings.max_residual)?;
+        let (matrix, rows) = observation_matrix(&observation)?;
+        Ok(Self {
+            settings,
+            plan,
+            observation,
+            matrix,
+            rows,
+            emulator: LinearEmulator::embedded()?,
+        })
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &PipelineSettings {
+        &self.settings
+    }
+
+    /// The observation.
+    pub fn observation(&self) -> &Observation {
+        &self.observation
+    }
+
+    /// The length of the data vector: output ℓ's × output k.
+    pub fn len(&self) -> usize {
+        self.rows
+    }
+
+    /// Whether the data vector is empty (never for a built pipeline).
+    pub fn is_empty(&self) -> bool {
+        self.rows == 0
+    }
+
+    /// The observation's matrix (row-major, [`Self::len`] rows, model ℓ's × model k columns): the
+    /// derivative of the data vector with respect to the model multipoles.
+    pub fn observation_matrix(&self) -> &[f64] {
+        &self.matrix
+    }
+
+    /// Whether the loop terms can come from basis tensors.
+    pub fn has_basis(&self) -> bool {
+        self.plan.has_basis()
+    }
+
+    /// The prepared linear spectrum of `cosmology` at the pipeline's redshift from the emulator
+    /// parsed at build time (P_cb and f_cb with massive neutrinos, as [`crate::setup::prepare`]).
+    ///
+    /// # Errors
+    /// As [`crate::setup::prepare`] (a parameter outside the emulator's prior is named).
+    pub fn prepare(&self, cosmology: &Cosmology) -> Result<Prepared> {
+        self.prepare_source(
+            LinearSource::Emulator,
+            Some(NamedCosmology {
+                name: "the pipeline's parameters".into(),
+                cosmology: *cosmology,
+            }),
+        )
+    }
+
+    /// The prepared spectrum of any source (a table, the emulator, Eisenstein & Hu) with
+    /// `cosmology` (its growth and distances), at the pipeline's redshift.
+    ///
+    /// # Errors
+    /// As [`crate::setup::prepare`].
+    pub fn prepare_source(
+        &self,
+        source: LinearSource,
+        cosmology: Option<NamedCosmology>,
+    ) -> Result<Prepared> {
+        crate::setup::prepare_with_emulator(
+            Request {
+                source,
+                cosmology,
+                z: self.settings.z,
+            },
+            Some(&self.emulator),
+        )
+    }
+
+    /// The cosmology-dependent step of a prepared spectrum: its loop terms and, with a fiducial,
+    /// the distortion of its cosmology.
+    ///
+    /// # Errors
+    /// As [`EptPlan::terms`] and [`Distortion::from_cosmologies`].
+    pub fn step(&self, prepared: &Prepared) -> Result<CosmologyStep<'_>> {
+        let ap = match &self.settings.fiducial {
+            Some(fid) => Some(Distortion::from_cosmologies(
+                &prepared.cosmology.cosmology,
+                fid,
+                self.settings.z,
+            )?),
+            None => None,
+        };
+        self.step_with(prepared.tracer_spectrum(), prepared.growth_rate, ap)
+    }
+
+    /// The step of a linear spectrum at the pipeline's redshift with growth rate `growth_rate` and
+    /// distortion `ap` (given, not from a cosmology: `None` on a pipeline with a fiducial is no
+    /// distortion).
+    ///
+    /// # Errors
+    /// As [`EptPlan::terms`]; [`Error::InvalidChoice`] for a distortion without fiducial.
+    pub fn step_with(
+        &self,
+        spectrum: &LinearSpectrum,
+        growth_rate: f64,
+        ap: Option<Distortion>,
+    ) -> Result<CosmologyStep<'_>> {
+        let terms = self.plan.terms(spectrum)?;
+        let source = match (terms.basis_residual(), self.plan.has_basis()) {
+            (Some(residual), _) => TermsSource::Basis { residual },
+            (None, true) => TermsSource::DirectFallback {
+                residual: self
+                    .plan
+                    .basis_projection(spectrum)
+                    .map_or(f64::NAN, |p| p.residual),
+            },
+            (None, false) => TermsSource::Direct,
+        };
+        let ap = match (ap, &self.settings.fiducial) {
+            (Some(a), _) => Some(a),
+            (None, Some(_)) => Some(Distortion::new(1.0, 1.0)?),
+            (None, None) => None,
+        };
+        Ok(CosmologyStep {
+            pipeline: self,
+            terms,
+            growth_rate,
+            ap,
+            source,
+        })
+    }
+
+    /// The data vector of `cosmology` (through the emulator) with the nuisance parameters `params`
+    /// by name ([`NUISANCE_NAMES`]; `f` defaults to f(z) of the cosmology).
+    ///
+    /// # Errors
+    /// As [`Self::prepare`], [`Self::step`] and [`CosmologyStep::data_vector`].
+    pub fn evaluate(&self, cosmology: &Cosmology, params: &[(&str, f64)]) -> Result<Vec<f64>> {
+        let prepared = self.prepare(cosmology)?;
+        self.step(&prepared)?.data_vector(params)
+    }
+
+    /// [`Self::evaluate`] for many parameter sets (one data vector each, in order).
+    ///
+    /// # Errors
+    /// As [`Self::evaluate`], naming the set that failed.
+    pub fn evaluate_batch(&self, sets: &[(Cosmology, Vec<(&str, f64)>)]) -> Result<Vec<Vec<f64>>> {
+        sets.iter()
+            .enumerate()
+            .map(|(i, (c, p))| {
+                self.evaluate(c, p).map_err(|e| Error::InvalidChoice {
+                    what: format!("parameter set {i} of the batch"),
+                    reason: e.to_string(),
+                })
+            })
+            .collect()
+    }
+
+    /// `M` times the model multipoles (`model[j]`: model ℓ j on the model k).
+    fn observe(&self, model: &[Vec<f64>]) -> Vec<f64> {
+        let flat: Vec<f64> = model.iter().flatten().copied().collect();
+        self.matrix
+            .chunks_exact(flat.len())
+            .map(|row| crate::simd::dot(row, &flat))
+            .collect()
+    }
+}
+
+impl CosmologyStep<'_> {
+    /// The ept parameters of `params` by name, `f` defaulting to the step's growth rate.
+    fn params(&self, params: &[(&str, f64)]) -> Result<EptParams> {
+        let mut p = EptParams::new(0.0, self.growth_rate);
+        for &(name, value) in params {
+            p.set(name, value)?;
+        }
+        p.validate()?;
+        Ok(p)
+    }
+
+    /// The data vector at the nuisance parameters `params` (by name; any not given is 0, `f` is
+    /// f(z)): the model multipoles with the step's distortion, times the observation matrix.
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] naming the valid parameters for an unknown name; as
+    /// [`EptPlan::multipole_values_at`].
+    pub fn data_vector(&self, params: &[(&str, f64)]) -> Result<Vec<f64>> {
+        let p = self.params(params)?;
+        self.data_vector_of(&p)
+    }
+
+    fn data_vector_of(&self, p: &EptParams) -> Result<Vec<f64>> {
+        let pl = self.pipeline;
+        let model =
+            pl.plan
+                .multipole_values_at(&self.terms, p, pl.observation.model_ells(), self.ap)?;
+        Ok(pl.observe(&model))
+    }
+
+    /// The loop terms.
+    pub fn terms(&self) -> &EptTerms {
+        &self.terms
+    }
+}
+
+/// The observation's matrix by columns: the chain applied to each unit model vector.
+fn observation_matrix(observation: &Observation) -> Result<(Vec<f64>, usize)> {
+    let (ells, k) = (observation.model_ells(), observation.k_model());
+    let columns = ells.len() * k.len();
+    let mut unit = vec![vec![0.0; k.len()]; ells.len()];
+    let mut by_column: Vec<Vec<f64>> = Vec::with_capacity(columns);
+    for c in 0..columns {
+        unit[c / k.len()][c % k.len()] = 1.0;
+        let out = observation.apply_values(&unit)?;
+        unit[c / k.len()][c % k.len()] = 0.0;
+        by_column.push(out.into_iter().flatten().collect());
+    }
+    let rows = by_column.first().map_or(0, Vec::len);
+    let mut matrix = vec![0.0; rows * columns];
+    for (c, col) in by_column.iter().enumerate() {
+        for (r, v) in col.iter().enumerate() {
+            matrix[r * columns + c] = *v;
+        }
+    }
+    Ok((matrix, rows))
+}
+
+/// The names a call takes: [`PARAM_NAMES`] (`f` defaults to f(z) of the cosmology).
+pub fn parameter_names() -> &'static [&'static str] {
+    &PARAM_NAMES
+}

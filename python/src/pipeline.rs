@@ -1,0 +1,242 @@
+//! `pt_spectra.Pipeline`: the chain step planned once (`pt_spectra::pipeline`), called with
+//! cosmological parameters (through the emulator) or a linear spectrum and nuisance parameters by
+//! name, returning the data vector as a numpy array.
+
+use crate::inputs::Inputs;
+use crate::survey::Observation;
+use crate::value_error;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pt_spectra::pipeline::{
+    Pipeline as LibPipeline, PipelineSettings, TermsSource, NUISANCE_NAMES, PIPELINE_MAX_RESIDUAL,
+};
+use pt_spectra::progress::Silent;
+use pt_spectra::setup::{LinearSource, Prepared};
+use pyo3::exceptions::PyUserWarning;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::sync::Mutex;
+
+/// What a call did: the loop terms' source, f and the distortion (q∥, q⊥) if any.
+type LastCall = (TermsSource, f64, Option<(f64, f64)>);
+/// A data vector and, if asked for, its Jacobian (one row per nuisance parameter).
+type VectorAndJacobian = (Vec<f64>, Option<Vec<Vec<f64>>>);
+
+/// The chain step: observation, model, redshift and AP fiducial fixed at construction.
+#[pyclass(module = "pt_spectra._core", frozen)]
+pub(crate) struct Pipeline {
+    inner: LibPipeline,
+    /// What the last call did (the loop terms' source, f, the distortion).
+    last: Mutex<Option<LastCall>>,
+}
+
+/// The nuisance parameters of `kwargs` as (name, value) pairs.
+fn pairs(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<(String, f64)>> {
+    let mut out = Vec::new();
+    if let Some(kw) = kwargs {
+        for (k, v) in kw.iter() {
+            out.push((k.extract::<String>()?, v.extract::<f64>()?));
+        }
+    }
+    Ok(out)
+}
+
+impl Pipeline {
+    /// The prepared spectrum: `linear` (arrays or a file) with the growth of `cosmology`, else the
+    /// cosmology's spectrum through the pipeline's emulator (gm2012: its embedded CAMB table).
+    fn prepared(
+        &self,
+        linear: Option<&Bound<'_, PyAny>>,
+        z_input: Option<f64>,
+        cosmology: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Prepared> {
+        let z = self.inner.settings().z;
+        let inputs = Inputs::extract(linear, z, z_input.unwrap_or(z), cosmology, None)?;
+        if linear.is_some() {
+            return inputs
+                .prepare(self.inner.observation().k_model())
+                .map_err(value_error);
+        }
+        let (named, _) = inputs.cosmology().map_err(value_error)?;
+        self.inner
+            .prepare_source(LinearSource::Embedded, named)
+            .map_err(value_error)
+    }
+
+    /// The data vector (and with `jacobian` d/d of each nuisance parameter) of one parameter set.
+    fn one(
+        &self,
+        py: Python<'_>,
+        prepared: &Prepared,
+        params: &[(String, f64)],
+        jacobian: bool,
+    ) -> PyResult<VectorAndJacobian> {
+        let step = self.inner.step(prepared).map_err(value_error)?;
+        if let TermsSource::DirectFallback { .. } = step.source {
+            let text = step.source.describe(self.inner.settings().max_residual);
+            PyErr::warn(
+                py,
+                &py.get_type::<PyUserWarning>(),
+                &std::ffi::CString::new(text)?,
+                1,
+            )?;
+        }
+        *self.last.lock().expect("not poisoned") = Some((
+            step.source,
+            step.growth_rate,
+            step.ap.map(|d| (d.apar, d.aperp)),
+        ));
+        let named: Vec<(&str, f64)> = params.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+        let values = step.data_vector(&named).map_err(value_error)?;
+        let jac = if jacobian {
+            let f = named.iter().find(|(n, _)| *n == "f").map(|p| p.1);
+            let lin = step.linearise(f).map_err(value_error)?;
+            Some(lin.jacobian(&named).map_err(value_error)?)
+        } else {
+            None
+        };
+        Ok((values, jac))
+    }
+}
+
+#[pymethods]
+impl Pipeline {
+    #[new]
+    #[pyo3(signature = (observation, z, fiducial=None, ir=true, precision=pt_spectra::jobs::defaults::PRECISION,
+        max_residual=PIPELINE_MAX_RESIDUAL, cache_dir=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        observation: &Bound<'_, Observation>,
+        z: f64,
+        fiducial: Option<&Bound<'_, PyAny>>,
+        ir: bool,
+        precision: &str,
+        max_residual: f64,
+        cache_dir: Option<std::path::PathBuf>,
+    ) -> PyResult<Self> {
+        let fiducial = match fiducial {
+            Some(f) => Some(crate::inputs::cosmology_of(Some(f))?),
+            None => None,
+        };
+        let precision = crate::precision(precision, None, None, Some("basis"))?;
+        let observation = observation.get().inner.clone();
+        let store = crate::Store::new(cache_dir);
+        let settings = PipelineSettings {
+            ir,
+            max_residual,
+            ..PipelineSettings::ept(z, fiducial)
+        };
+        let (inner, _) = crate::detached(py, || {
+            LibPipeline::new(observation, settings, &precision, store.get(), &Silent)
+        })?;
+        Ok(Self {
+            inner,
+            last: Mutex::new(None),
+        })
+    }
+
+    /// The data vector (output ℓ's, then k) at `cosmology` (a preset, an ini file or a dict of
+    /// CLASS/CAMB names; through the emulator) or at the spectrum `linear` ((k, P) arrays or a file
+    /// at `z_input`, the growth and distances of `cosmology`), with the nuisance parameters by
+    /// name (`pt_spectra.Pipeline.parameters`; `f` defaults to f(z)). With `jacobian=True`:
+    /// (data vector, d data/d θ as an array of shape (11, n) in the order of `nuisance`).
+    #[pyo3(signature = (cosmology=None, linear=None, z_input=None, jacobian=false, **params))]
+    fn __call__<'py>(
+        &self,
+        py: Python<'py>,
+        cosmology: Option<&Bound<'py, PyAny>>,
+        linear: Option<&Bound<'py, PyAny>>,
+        z_input: Option<f64>,
+        jacobian: bool,
+        params: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let prepared = self.prepared(linear, z_input, cosmology)?;
+        let (values, jac) = self.one(py, &prepared, &pairs(params)?, jacobian)?;
+        let v = values.into_pyarray(py).into_any();
+        match jac {
+            None => Ok(v),
+            Some(j) => {
+                let j = PyArray2::from_vec2(py, &j)?;
+                Ok((v, j).into_pyobject(py)?.into_any())
+            }
+        }
+    }
+
+    /// Many parameter sets in one call: `cosmologies[i]` with the nuisance dict `params[i]`; an
+    /// array of shape (len, n).
+    fn batch<'py>(
+        &self,
+        py: Python<'py>,
+        cosmologies: Vec<Bound<'py, PyAny>>,
+        params: Vec<Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        if cosmologies.len() != params.len() {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "batch: {} cosmologies but {} parameter dicts",
+                cosmologies.len(),
+                params.len()
+            )));
+        }
+        let mut rows = Vec::with_capacity(params.len());
+        for (c, p) in cosmologies.iter().zip(&params) {
+            let prepared = self.prepared(None, None, Some(c))?;
+            rows.push(self.one(py, &prepared, &pairs(Some(p))?, false)?.0);
+        }
+        Ok(PyArray2::from_vec2(py, &rows)?)
+    }
+
+    /// The parameter names a call takes.
+    #[getter]
+    fn parameters(&self) -> Vec<&'static str> {
+        pt_spectra::pipeline::parameter_names().to_vec()
+    }
+
+    /// The nuisance parameters of the Jacobian, in its order.
+    #[getter]
+    fn nuisance(&self) -> Vec<&'static str> {
+        NUISANCE_NAMES.to_vec()
+    }
+
+    /// The output k [h/Mpc].
+    #[getter]
+    fn k<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.observation().k_out().to_vec().into_pyarray(py)
+    }
+
+    /// What the pipeline is and what its last call did: model, z, ells, k, the fiducial, the
+    /// largest projection residual, and the loop terms' source of the last call.
+    #[getter]
+    fn meta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = self.inner.settings();
+        let d = PyDict::new(py);
+        d.set_item("model", "ept")?;
+        d.set_item("z", s.z)?;
+        d.set_item("ells", self.inner.observation().ells().to_vec())?;
+        d.set_item("len", self.inner.len())?;
+        d.set_item("ap", s.fiducial.is_some())?;
+        d.set_item("ir", s.ir)?;
+        d.set_item("max_residual", s.max_residual)?;
+        d.set_item("basis", self.inner.has_basis())?;
+        d.set_item(
+            "observation",
+            self.inner.observation().description().to_vec(),
+        )?;
+        if let Some((source, f, ap)) = *self.last.lock().expect("not poisoned") {
+            d.set_item("loop_terms", source.describe(s.max_residual))?;
+            let residual = match source {
+                TermsSource::Basis { residual } | TermsSource::DirectFallback { residual } => {
+                    Some(residual)
+                }
+                TermsSource::Direct => None,
+            };
+            d.set_item("residual", residual)?;
+            d.set_item(
+                "fallback",
+                matches!(source, TermsSource::DirectFallback { .. }),
+            )?;
+            d.set_item("f", f)?;
+            d.set_item("apar_aperp", ap)?;
+        }
+        Ok(d)
+    }
+}

@@ -1,0 +1,67 @@
+"""pt.bispectrum and pt.BispectrumPlan: the real-space closed form, the plan against the function, errors."""
+
+import numpy as np
+import pytest
+
+import pt_spectra as pt
+
+TRIANGLES = np.array([[0.02, 0.03, 0.04], [0.05, 0.05, 0.05], [0.01, 0.1, 0.105]])
+
+
+def closed_form(t, p, b1, b2, bs):
+    total = 0.0
+    for i in range(3):
+        j, l = (i + 1) % 3, (i + 2) % 3
+        c = (t[l] ** 2 - t[i] ** 2 - t[j] ** 2) / (2 * t[i] * t[j])
+        f2 = 5 / 7 + 0.5 * c * (t[i] / t[j] + t[j] / t[i]) + 2 / 7 * c * c
+        total += 2 * b1 * b1 * (b1 * f2 + 0.5 * b2 + bs * (c * c - 1 / 3)) * p(t[i]) * p(t[j])
+    return total
+
+
+def test_real_space_limit_is_the_closed_form():
+    k = np.unique(TRIANGLES)
+    lin = pt.real(model="linear", k=k)
+    p = dict(zip(k, lin["P_lin"]))
+    with pytest.warns(pt.PtSpectraWarning, match="bin_width"):
+        t = pt.bispectrum(TRIANGLES, f=0.0, ir=False, b1=1.8, b2=0.4, bs=-0.2)
+    for row, b0, b2 in zip(TRIANGLES, t["B0"], t["B2"]):
+        assert b0 == pytest.approx(closed_form(row, p.__getitem__, 1.8, 0.4, -0.2), rel=1e-12)
+        assert abs(b2) < 1e-12 * b0
+    assert t.meta["model"] == "bispectrum tree"
+
+
+def test_the_plan_gives_the_table_and_parameter_steps_are_polynomial():
+    bins = np.array([[0.015, 0.025, 0.035], [0.045, 0.055, 0.065], [0.035, 0.035, 0.055]])
+    kwargs = dict(b1=2.0, b2=0.3, bs=-0.1, c1=2.0, n_bar=3e-4, b_shot=0.9, p_shot=0.1)
+    table = pt.bispectrum(bins, bin_width=0.01, z=0.5, fog="lorentzian", sigma_fog=4.0, **kwargs)
+    terms = pt.BispectrumPlan(bins, bin_width=0.01).terms(z=0.5, fog="lorentzian", sigma_fog=4.0)
+    b, err = terms.multipoles(**kwargs)
+    assert b.shape == (3, 3) and err.shape == (3, 3)
+    np.testing.assert_allclose(b[:, 0], table["B0"], rtol=1e-9)
+    np.testing.assert_allclose(err[:, 2], table["err_B4"], rtol=1e-6, atol=1e-3)
+    assert terms.f == pytest.approx(table.meta["f"])
+    # B is linear in b2: the midpoint of two steps is the step at the mid value
+    b_lo = terms.multipoles(**{**kwargs, "b2": 0.0})[0]
+    b_hi = terms.multipoles(**{**kwargs, "b2": 0.6})[0]
+    np.testing.assert_allclose(b, 0.5 * (b_lo + b_hi), rtol=1e-12)
+
+
+@pytest.mark.filterwarnings("ignore::pt_spectra.PtSpectraWarning")
+@pytest.mark.parametrize("kwargs, needle", [
+    (dict(triangles=[[0.01, 0.02, 0.05]]), "does not close"),
+    (dict(triangles=[[0.01, 0.02]]), "k1, k2, k3"),
+    (dict(triangles=TRIANGLES, fog="lorentz"), "valid: none, lorentzian, gaussian"),
+    (dict(triangles=TRIANGLES, legendre_side="4"), "valid: largest, 1, 2, 3"),
+    (dict(triangles=TRIANGLES, n_bar=-1.0), "n_bar"),
+    (dict(triangles=TRIANGLES, bin_width=0.0), "width"),
+])
+def test_bad_input_raises_naming_the_problem(kwargs, needle):
+    with pytest.raises(ValueError, match=needle):
+        pt.bispectrum(**kwargs)
+
+
+def test_the_plan_refuses_an_implausible_growth_rate_as_the_function_does():
+    plan = pt.BispectrumPlan(TRIANGLES)
+    for call in (lambda: plan.terms(f=5.0), lambda: pt.bispectrum(TRIANGLES, bin_width=0.005, f=5.0)):
+        with pytest.raises(ValueError, match=r"f = 5.*\[0, 2\]"):
+            call()

@@ -1,0 +1,72 @@
+"""pt.Pipeline (issue 47): equals pt.EptPlan + Observation, states the loop terms' source, names bad
+parameters, gives exact nuisance Jacobians."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pt_spectra as pt
+
+WINDOW = Path(__file__).resolve().parents[2] / "examples/data/boss_dr12_cmass_ngc/window_BOSS_CMASS_NGC_z057.dat"
+Z = 0.57
+PARAMS = dict(b1=2.1, b2=-0.4, bs=0.3, alpha0=12.0, sn=1500.0)
+COSMO = dict(h=0.69, omega_b=0.0224, omega_cdm=0.295 * 0.69**2 - 0.0224, n_s=0.955, sigma8=0.83)
+
+
+@pytest.fixture(scope="module")
+def setup(tmp_path_factory):
+    cache = tmp_path_factory.mktemp("store")
+    k = 0.015 * (0.38 / 0.015) ** (np.arange(20) / 19)
+    obs = pt.Observation([0, 2], k, window=str(WINDOW))
+    pipe = pt.Pipeline(obs, Z, precision="fast", cache_dir=cache)
+    return obs, pipe, cache
+
+
+def test_the_pipeline_equals_the_plan_and_the_observation(setup):
+    obs, pipe, cache = setup
+    got = pipe(COSMO, **PARAMS)
+    assert pipe.meta["loop_terms"].startswith("loop terms: basis")
+    assert not pipe.meta["fallback"] and pipe.meta["residual"] <= pipe.meta["max_residual"]
+    # the same without AP by the existing faces (plan on the observation's model k, same residual)
+    plan = pt.EptPlan(obs.k_model, precision="fast", two_loop="basis", cache_dir=cache)
+    table = plan(cosmology=COSMO, z=Z, ells=list(obs.model_ells), **PARAMS)
+    model = [np.asarray(table[f"P{l}"]) for l in obs.model_ells]
+    expected = np.asarray(obs.apply_values(model)).ravel()
+    # the plan's default residual (3e-4) sends the emulated spectrum to the direct integrals:
+    # the two agree within the projection error
+    assert np.max(np.abs(got - expected)) / np.max(np.abs(expected)) < 2e-3
+
+
+def test_a_bad_name_is_refused_naming_the_valid_ones(setup):
+    _, pipe, _ = setup
+    with pytest.raises(ValueError, match="alpha0"):
+        pipe(COSMO, c0=1.0)
+
+
+def test_a_spectrum_outside_the_span_falls_back_with_a_warning(setup):
+    obs, _, cache = setup
+    strict = pt.Pipeline(obs, Z, precision="fast", cache_dir=cache, max_residual=1e-6)
+    with pytest.warns(UserWarning, match="fallback"):
+        strict(COSMO, **PARAMS)
+    assert strict.meta["fallback"]
+
+
+def test_the_nuisance_jacobian_matches_differences(setup):
+    _, pipe, _ = setup
+    values, jac = pipe(COSMO, jacobian=True, **PARAMS)
+    assert jac.shape == (len(pipe.nuisance), values.size)
+    for i, name in enumerate(pipe.nuisance):
+        h = 0.5 * max(abs(PARAMS.get(name, 0.0)), 1.0)
+        at = lambda x: pipe(COSMO, **{**PARAMS, name: x})
+        x = PARAMS.get(name, 0.0)
+        fd = (8 * (at(x + h) - at(x - h)) - (at(x + 2 * h) - at(x - 2 * h))) / (12 * h)
+        assert np.max(np.abs(jac[i] - fd)) <= 1e-6 * np.max(np.abs(fd)) + 1e-12, name
+
+
+def test_a_batch_gives_the_single_calls(setup):
+    _, pipe, _ = setup
+    other = dict(COSMO, sigma8=0.78)
+    rows = pipe.batch([COSMO, other], [PARAMS, dict(b1=1.5)])
+    assert np.array_equal(rows[0], pipe(COSMO, **PARAMS))
+    assert np.array_equal(rows[1], pipe(other, b1=1.5))

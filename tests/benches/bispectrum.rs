@@ -1,0 +1,75 @@
+//! The tree-level bispectrum (issue 49: the 62 bin-averaged Nseries triangles, B0, B2, B4, for a new
+//! linear spectrum ≤ 0.2 ms; a parameter step ≤ 20 µs): the terms of a new spectrum (f, AP, FoG and IR
+//! resummation as a fit varies them) and the contraction with new bias and stochastic parameters.
+
+// `criterion_group!` defines an undocumented function.
+#![allow(missing_docs)]
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use pt_spectra::bispectrum::{
+    BispectrumParams, BispectrumPlan, Fog, LegendreSide, PlanRules, Settings, TriangleSet,
+};
+use pt_spectra::linear::LinearSpectrum;
+use std::hint::black_box;
+
+fn nseries() -> TriangleSet {
+    let text = include_str!("../data/bispectrum/nseries_triangles.txt");
+    let rows: Vec<[f64; 3]> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    TriangleSet::shells(rows, 0.01).unwrap()
+}
+
+fn bispectrum(crit: &mut Criterion) {
+    let plan = BispectrumPlan::new(nseries(), LegendreSide::Largest, PlanRules::default()).unwrap();
+    let p = LinearSpectrum::gm2012(0.5).unwrap();
+    let mut i = 0u32;
+    let settings = |i: u32| Settings {
+        f: 0.7 + 1e-3 * f64::from(i % 50),
+        q_par: 1.0 + 1e-3 * f64::from(i % 7),
+        q_perp: 1.0 - 1e-3 * f64::from(i % 5),
+        fog: Fog::Lorentzian { sigma: 3.0 },
+        ir: true,
+    };
+    crit.bench_function(
+        "bispectrum/terms of 62 Nseries bins, B0 B2 B4, new f and AP, IR",
+        |b| {
+            b.iter(|| {
+                i += 1;
+                black_box(plan.terms(&p, &settings(i)).unwrap())
+            })
+        },
+    );
+    let terms = plan.terms(&p, &settings(0)).unwrap();
+    crit.bench_function(
+        "bispectrum/parameter step (b1, b2, bs, c1, shot) of 62 bins",
+        |b| {
+            b.iter(|| {
+                i += 1;
+                let params = BispectrumParams {
+                    b1: 2.0 + 1e-3 * f64::from(i % 100),
+                    b2: 0.3,
+                    bs: -0.2,
+                    c1: 1.0,
+                    b_shot: 0.9,
+                    p_shot: 0.1,
+                    a_shot: 0.0,
+                    n_bar: 3e-4,
+                };
+                black_box(terms.multipoles(&params).unwrap())
+            })
+        },
+    );
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(10);
+    targets = bispectrum
+}
+criterion_main!(benches);

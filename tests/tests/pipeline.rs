@@ -1,0 +1,241 @@
+//! The chain-step `Pipeline` (issue 47) against the path it replaces: the ept plan's terms, its
+//! multipoles with the AP distortion, and the observation (BOSS CMASS NGC window, 38 k).
+
+use pt_spectra::cosmology::Cosmology;
+use pt_spectra::jobs::ept_plan;
+use pt_spectra::pipeline::{
+    Pipeline, PipelineSettings, TermsSource, NUISANCE_NAMES, PIPELINE_MAX_RESIDUAL,
+};
+use pt_spectra::precision::{Precision, TwoLoopMethod};
+use pt_spectra::progress::Silent;
+use pt_spectra::rsd::ap::Distortion;
+use pt_spectra::rsd::ept::EptParams;
+use pt_spectra::setup::{prepare, LinearSource, NamedCosmology, Request};
+use pt_spectra::store::TableStore;
+use pt_spectra::survey::observe::{Observation, Window};
+use pt_spectra::survey::{Mixing, WindowFormat};
+use std::sync::OnceLock;
+
+const Z: f64 = 0.57;
+/// The observation matrix against the window's own steps: 3.9e-8 of the largest element measured
+/// (the window's transform is linear up to its tail treatment, rounding aside); the brief's bound.
+const ROUNDING: f64 = 1e-6;
+
+fn observation() -> Observation {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../examples/data/boss_dr12_cmass_ngc/window_BOSS_CMASS_NGC_z057.dat"
+    );
+    let window = Window::read(path.as_ref(), Mixing::Wilson, &WindowFormat::header()).unwrap();
+    let k: Vec<f64> = (0..38)
+        .map(|i| 0.015 * (0.38f64 / 0.015).powf(i as f64 / 37.0))
+        .collect();
+    Observation::new(&[0, 2, 4], &k, Some(window), None).unwrap()
+}
+
+fn precision() -> Precision {
+    let mut p = Precision::preset("fast").unwrap();
+    p.two_loop = TwoLoopMethod::Basis;
+    p
+}
+
+fn store() -> TableStore {
+    TableStore::new(concat!(env!("CARGO_TARGET_TMPDIR"), "/pipeline-store"))
+}
+
+fn fiducial() -> Cosmology {
+    Cosmology::flat(0.31, 0.676, 0.022, 0.97, 0.80).unwrap()
+}
+
+fn truth() -> Cosmology {
+    Cosmology::flat(0.295, 0.69, 0.0226, 0.955, 0.83).unwrap()
+}
+
+fn pipeline() -> &'static Pipeline {
+    static P: OnceLock<Pipeline> = OnceLock::new();
+    P.get_or_init(|| {
+        let settings = PipelineSettings::ept(Z, Some(fiducial()));
+        Pipeline::new(observation(), settings, &precision(), &store(), &Silent).unwrap()
+    })
+}
+
+const PARAMS: [(&str, f64); 8] = [
+    ("b1", 2.1),
+    ("b2", -0.4),
+    ("bs", 0.3),
+    ("b3", 0.2),
+    ("alpha0", 12.0),
+    ("alpha2", -20.0),
+    ("sn", 1500.0),
+    ("sn2", -800.0),
+];
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |a, x| a.max(x.abs()))
+}
+
+fn assert_close(a: &[f64], b: &[f64], tol: f64, what: &str) {
+    assert_eq!(a.len(), b.len(), "{what}");
+    let scale = max_abs(b);
+    let worst = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs() / scale)
+        .fold(0.0, f64::max);
+    assert!(worst <= tol, "{what}: worst {worst:e} > {tol:e}");
+}
+
+/// The existing path: the prepared emulated spectrum, the plan on the AP range, its multipoles at
+/// the distortion of the cosmology, then the observation's own steps.
+fn chain(max_residual: f64, c: &Cosmology) -> (Vec<f64>, Option<f64>) {
+    let obs = observation();
+    let prepared = prepare(Request {
+        source: LinearSource::Emulator,
+        cosmology: Some(NamedCosmology {
+            name: "test".into(),
+            cosmology: *c,
+        }),
+        z: Z,
+    })
+    .unwrap();
+    let plan = ept_plan(
+        obs.k_model(),
+        true,
+        None,
+        true,
+        &precision(),
+        &store(),
+        &Silent,
+    )
+    .unwrap()
+    .with_max_residual(max_residual)
+    .unwrap();
+    let terms = plan.terms(prepared.tracer_spectrum()).unwrap();
+    let mut p = EptParams::new(0.0, prepared.growth_rate);
+    for (n, v) in PARAMS {
+        p.set(n, v).unwrap();
+    }
+    let ap = Distortion::from_cosmologies(c, &fiducial(), Z).unwrap();
+    let m = plan
+        .multipole_values_at(&terms, &p, obs.model_ells(), Some(ap))
+        .unwrap();
+    let d = obs.apply_values(&m).unwrap().concat();
+    (d, terms.basis_residual())
+}
+
+#[test]
+fn the_pipeline_equals_the_chain_of_plan_multipoles_and_observation() {
+    let pl = pipeline();
+    assert_eq!(pl.len(), 3 * 38);
+    let (expected, residual) = chain(PIPELINE_MAX_RESIDUAL, &truth());
+    // The emulated spectrum projects on the basis within the pipeline's residual (not within
+    // loops::basis::MAX_RESIDUAL = 3e-4, which sent it to the direct integrals).
+    let residual = residual.expect("an emulated spectrum is evaluated on the basis");
+    assert!(
+        residual > 0.0 && residual <= PIPELINE_MAX_RESIDUAL,
+        "{residual}"
+    );
+    let got = pl.evaluate(&truth(), &PARAMS).unwrap();
+    assert_close(&got, &expected, ROUNDING, "pipeline vs chain");
+    let step = pl.step(&pl.prepare(&truth()).unwrap()).unwrap();
+    assert_eq!(step.source, TermsSource::Basis { residual });
+}
+
+#[test]
+fn outside_the_span_the_pipeline_falls_back_to_direct_and_says_so() {
+    let mut settings = PipelineSettings::ept(Z, Some(fiducial()));
+    settings.max_residual = 1e-6;
+    let pl = Pipeline::new(observation(), settings, &precision(), &store(), &Silent).unwrap();
+    let step = pl.step(&pl.prepare(&truth()).unwrap()).unwrap();
+    let TermsSource::DirectFallback { residual } = step.source else {
+        panic!("{:?}", step.source);
+    };
+    assert!(residual > 1e-6, "{residual}");
+    assert!(step.source.describe(1e-6).contains("fallback"));
+    let direct = step.data_vector(&PARAMS).unwrap();
+    let (expected, r) = chain(1e-6, &truth());
+    assert!(r.is_none());
+    assert_close(&direct, &expected, ROUNDING, "fallback vs direct chain");
+    // The basis and the direct integrals agree within the projection error (≲ residual × terms).
+    let basis = pipeline().evaluate(&truth(), &PARAMS).unwrap();
+    assert_close(&basis, &direct, PIPELINE_MAX_RESIDUAL, "basis vs direct");
+}
+
+#[test]
+fn the_nuisance_polynomial_and_its_jacobian_are_exact() {
+    let pl = pipeline();
+    let step = pl.step(&pl.prepare(&truth()).unwrap()).unwrap();
+    let lin = step.linearise(None).unwrap();
+    let sets: [&[(&str, f64)]; 3] = [
+        &PARAMS,
+        &[
+            ("b1", 1.3),
+            ("b3", -1.1),
+            ("alpha4", 3.0),
+            ("alpha6", 1.5),
+            ("sn4", 40.0),
+        ],
+        &[("b2", 2.0), ("bs", -1.7)],
+    ];
+    for set in sets {
+        let direct = step.data_vector(set).unwrap();
+        assert_close(&lin.data_vector(set).unwrap(), &direct, 1e-9, "polynomial");
+        // Fourth-order central differences of the full step (exact for a quadratic up to rounding).
+        let jac = lin.jacobian(set).unwrap();
+        for (n, column) in NUISANCE_NAMES.iter().zip(&jac) {
+            let base = set.iter().find(|(m, _)| m == n).map_or(0.0, |p| p.1);
+            let h = 0.5 * base.abs().max(1.0);
+            let at = |x: f64| {
+                let mut s: Vec<(&str, f64)> = set.iter().filter(|(m, _)| m != n).copied().collect();
+                s.push((n, x));
+                step.data_vector(&s).unwrap()
+            };
+            let (p1, m1, p2, m2) = (
+                at(base + h),
+                at(base - h),
+                at(base + 2.0 * h),
+                at(base - 2.0 * h),
+            );
+            let fd: Vec<f64> = (0..p1.len())
+                .map(|r| (8.0 * (p1[r] - m1[r]) - (p2[r] - m2[r])) / (12.0 * h))
+                .collect();
+            assert_close(column, &fd, 1e-6, n);
+        }
+    }
+}
+
+#[test]
+fn bad_parameter_names_are_refused_naming_the_valid_ones() {
+    let pl = pipeline();
+    let err = pl
+        .evaluate(&truth(), &[("b1", 2.0), ("c0", 1.0)])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("c0") && err.contains("alpha0") && err.contains("sn4"),
+        "{err}"
+    );
+    let step = pl.step(&pl.prepare(&truth()).unwrap()).unwrap();
+    let lin = step.linearise(None).unwrap();
+    let err = lin.data_vector(&[("bias", 2.0)]).unwrap_err().to_string();
+    assert!(err.contains("bias") && err.contains("b1"), "{err}");
+    let err = lin.data_vector(&[("f", 0.3)]).unwrap_err().to_string();
+    assert!(err.contains("linearised"), "{err}");
+}
+
+#[test]
+fn a_batch_gives_the_single_calls() {
+    let pl = pipeline();
+    let other = Cosmology::flat(0.32, 0.66, 0.0221, 0.975, 0.78).unwrap();
+    let sets = vec![
+        (truth(), PARAMS.to_vec()),
+        (other, vec![("b1", 1.8), ("sn", 300.0)]),
+    ];
+    let batch = pl.evaluate_batch(&sets).unwrap();
+    assert_eq!(batch[0], pl.evaluate(&truth(), &PARAMS).unwrap());
+    assert_eq!(
+        batch[1],
+        pl.evaluate(&other, &[("b1", 1.8), ("sn", 300.0)]).unwrap()
+    );
+    assert_ne!(batch[0], batch[1]);
+}
