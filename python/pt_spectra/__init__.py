@@ -235,13 +235,17 @@ def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0,
             aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision=_D["precision"],
             q_range=None, eh=None, n_mocks=None, k_ranges=None, window=None,
             window_mixing="wilson", k_edges=None, box=None, xi=False, s_edges=None, window_format=None,
-            **start) -> Table:
+            starts=8, seed=1, profile_check=True, profile_linear=False, profile=None,
+            profile_points=21, profile_span=3.0, model_out=False, **start):
     """Fits of the galaxy model ``ept`` (``pt-spectra fit --rsd ept``), one row per k_max.
 
-    data, data_ells, data_columns, covariance, k_min as :func:`fit`; k_max: a list. free: any of
+    data, data_ells, data_columns, k_min as :func:`fit`; covariance: a path (as ``--covariance``)
+    or a 2-D array; k_max: a list. free: any of
     the model's parameters (see :class:`EptPlan`); marginalise: linear ones (alpha0, alpha2, alpha4,
     alpha6, sn, sn2, sn4) marginalised analytically; priors: ``{"b2": (0.0, 1.0), …}`` Gaussian
-    (mean, sigma). ``start``: start values of the free parameters and values of the fixed ones
+    (mean, sigma), ``{"f": ("flat", 0.0, 2.0)}`` or ``("lognormal", mu, sigma)`` (of ln x), or the
+    command line's text ``"flat,0,2"``. ``start``: start values of the free parameters and values of
+    the fixed ones
     (e.g. ``b1=2.0, f=0.7``; f defaults to f(z)). n_mocks: the Hartlap factor of a covariance from
     that many mocks. apar, aperp: the measurement's distortion (free with ``free=(…, "apar",
     "aperp")``). k_ranges: ``{4: (0.02, 0.1)}`` narrows the range of a multipole. window (a file of
@@ -249,18 +253,36 @@ def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0,
     window_format (the columns of a Q_ℓ(s) file without a names line: ``"s,Q0,Q2,Q4"``, ``"boss"``,
     as ``--window-format``; default: the file's names line ``# s Q0 Q2 Q4``), k_edges [h/Mpc] (k²-weighted bins; with box [Mpc/h] the modes of a periodic box): the model
     goes through them before the comparison. xi=True: the data are ξ_ℓ(s) (s [Mpc/h] in place of k;
-    k_min, k_max, k_ranges in s), optionally averaged over s_edges. Columns: ``k_max`` (``s_max``)
-    ``points chi2 minus_2_ln_L`` and each parameter with ``err_<p>`` for the free (Gaussian, from the
-    Hessian) and marginalised ones.
+    k_min, k_max, k_ranges in s), optionally averaged over s_edges.
+
+    The minimiser (as ``fit --starts --seed --no-profile-check --profile-linear``): ``starts``
+    starts (the start given, then seeded draws from the priors or the start box), the lowest
+    minimum taken; ``profile_check`` checks the Hessian errors on the profile likelihood;
+    ``profile_linear`` profiles the linear parameters instead of marginalising them.
+
+    Columns: ``k_max`` (``s_max``) ``points chi2 minus_2_ln_L``, each parameter with ``err_<p>``
+    for the free and marginalised ones; per free parameter ``err_<p>_hessian <p>_lo <p>_hi
+    err_<p>_from_profile`` (the Δ(−2 ln L) = 1 interval; err_<p> is its half-width where it differs
+    from the Hessian's by > 10%); ``starts starts_agree starts_spread``; the derived ``fsigma8
+    sigma8_z`` and, with a distortion, ``alpha_iso alpha_ap DM_over_DH DV_over_rd`` with errors.
+
+    ``profile="f"`` (one k_max): the profile likelihood of that free parameter instead, on
+    ``profile_points`` values over ± ``profile_span`` fitted errors (columns ``<p> minus_2_ln_L
+    delta_minus_2_ln_L chi2`` and the others there). ``model_out=True`` returns ``(table, model)``,
+    the model the best-fit multipoles of every k_max (``--model-out``).
     """
-    table = _core.fit_ept(data, list(k_max), list(free), list(marginalise), priors, list(ells),
-                          list(data_ells), None if data_columns is None else list(data_columns),
-                          covariance, k_min, ir, apar, aperp, linear, z, z_input, cosmology,
-                          precision, q_range, eh, n_mocks,
-                          None if k_ranges is None else {int(l): tuple(map(float, r))
-                                                         for l, r in k_ranges.items()},
-                          None if window is None else str(window), window_mixing,
-                          k_edges, box, bool(xi), s_edges, window_format, **_ept_params(start))
+    table, model = _core.fit_ept(data, list(k_max), list(free), list(marginalise), priors, list(ells),
+                                 list(data_ells), None if data_columns is None else list(data_columns),
+                                 covariance, k_min, ir, apar, aperp, linear, z, z_input, cosmology,
+                                 precision, q_range, eh, n_mocks,
+                                 None if k_ranges is None else {int(l): tuple(map(float, r))
+                                                                for l, r in k_ranges.items()},
+                                 None if window is None else str(window), window_mixing,
+                                 k_edges, box, bool(xi), s_edges, window_format, int(starts), int(seed),
+                                 bool(profile_check), bool(profile_linear), profile, int(profile_points),
+                                 float(profile_span), bool(model_out), **_ept_params(start))
+    if model_out:
+        return _warn(table), _warn(model)
     return _warn(table)
 
 

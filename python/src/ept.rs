@@ -171,7 +171,9 @@ impl EptTerms {
     priors=None, ells=vec![0, 2], data_ells=vec![0, 2, 4], data_columns=None, covariance=None, k_min=0.0,
     ir=true, apar=None, aperp=None, linear=None, z=0.0, z_input=0.0, cosmology=None, precision=pt_spectra::jobs::defaults::PRECISION,
     q_range=None, eh=None, n_mocks=None, k_ranges=None, window=None, window_mixing="wilson",
-    k_edges=None, r#box=None, xi=false, s_edges=None, window_format=None, **kwargs))]
+    k_edges=None, r#box=None, xi=false, s_edges=None, window_format=None, starts=pt_spectra::fit::galaxy::search::DEFAULT_STARTS,
+    seed=1, profile_check=true, profile_linear=false, profile=None, profile_points=21, profile_span=3.0,
+    model_out=false, **kwargs))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit_ept(
     py: Python<'_>,
@@ -204,27 +206,65 @@ pub(crate) fn fit_ept(
     xi: bool,
     s_edges: Option<&Bound<'_, PyAny>>,
     window_format: Option<&str>,
+    starts: usize,
+    seed: u64,
+    profile_check: bool,
+    profile_linear: bool,
+    profile: Option<String>,
+    profile_points: usize,
+    profile_span: f64,
+    model_out: bool,
     kwargs: Option<&Bound<'_, PyDict>>,
-) -> PyResult<Table> {
+) -> PyResult<(Table, Option<Table>)> {
     let (mut data, name, layout) = crate::data(data, data_columns, &data_ells, &ells)?;
     if let Some(c) = covariance {
-        data = layout
-            .attach_covariance(data, crate::covariance_rows(c)?)
-            .map_err(value_error)?;
+        // A path (as the command line's --covariance), or a 2-D array.
+        data = match c.extract::<std::path::PathBuf>() {
+            Ok(path) if !c.hasattr("shape")? => layout
+                .read_covariance(data, &path)
+                .map_err(|e| value_error(format!("covariance: {e}")))?,
+            _ => layout
+                .attach_covariance(data, crate::covariance_rows(c)?)
+                .map_err(value_error)?,
+        };
     }
+    if starts == 0 {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "starts = 0: the fit needs at least one start",
+        ));
+    }
+    let search = pt_spectra::fit::galaxy::Search {
+        starts,
+        seed,
+        profile_check,
+        linear: if profile_linear {
+            pt_spectra::fit::galaxy::Linear::Profiled
+        } else {
+            pt_spectra::fit::galaxy::Linear::Marginalised
+        },
+    };
     let mut prior_list = Vec::new();
     if let Some(p) = priors {
         for (key, value) in p.iter() {
-            let (mean, sigma): (f64, f64) = value.extract().map_err(|_| {
-                pyo3::exceptions::PyValueError::new_err(format!(
-                    "priors[{key}]: expected (mean, sigma)"
-                ))
-            })?;
-            prior_list.push(pt_spectra::fit::galaxy::Prior {
-                name: key.extract()?,
-                mean,
-                sigma,
-            });
+            let name: String = key.extract()?;
+            // (mean, sigma): Gaussian; ("flat", lo, hi) or ("lognormal", mu, sigma); or the
+            // command line's text after the colon, e.g. "flat,0,2".
+            let text = if let Ok((mean, sigma)) = value.extract::<(f64, f64)>() {
+                format!("{name}:{mean},{sigma}")
+            } else if let Ok((kind, a, b)) = value.extract::<(String, f64, f64)>() {
+                format!("{name}:{kind},{a},{b}")
+            } else if let Ok(t) = value.extract::<String>() {
+                format!("{name}:{t}")
+            } else {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "priors[{name}]: expected (mean, sigma), (\"flat\", lo, hi), \
+                     (\"lognormal\", mu, sigma) or a text such as \"flat,0,2\""
+                )));
+            };
+            prior_list
+                .push(pt_spectra::fit::galaxy::Prior::parse(&text).map_err(|e| {
+                    pyo3::exceptions::PyValueError::new_err(format!("priors: {e}"))
+                })?);
         }
     }
     let mut start = params(kwargs)?;
@@ -269,7 +309,7 @@ pub(crate) fn fit_ept(
         .map_or(data.k.clone(), |o| o.k_model().to_vec());
     let precision = crate::precision(precision, q_range, None, None)?;
     let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
-    let ((table, prepared), seconds) = detached(py, || {
+    let ((table, model, prepared), seconds) = detached(py, || {
         let prepared = inputs.prepare(&model_k)?;
         if start.values[11].is_nan() {
             start.values[11] = prepared.growth_rate;
@@ -299,16 +339,52 @@ pub(crate) fn fit_ept(
                 "no IR resummation"
             }
         )];
-        let table = jobs::ept_fit_table(
-            &plan,
-            &terms,
-            &data,
-            &request,
-            &k_max,
+        let context = jobs::FitContext {
+            observation: observation.as_ref(),
+            search,
+            template: Some(pt_spectra::fit::galaxy::Template {
+                sigma8_z: prepared.spectrum.sigma8(),
+                z: prepared.z,
+                cosmology: Some(prepared.cosmology.cosmology.clone()),
+            }),
             header,
-            observation.as_ref(),
-        )?;
-        Ok((table, prepared))
+        };
+        if let Some(name) = &profile {
+            let [k] = k_max[..] else {
+                return Err(pt_spectra::error::Error::InvalidChoice {
+                    what: format!("the profile of {name}"),
+                    reason: format!("needs one k_max, not {}", k_max.len()),
+                });
+            };
+            let mut r = request.clone();
+            r.k_max = k;
+            let grid = pt_spectra::fit::galaxy::ProfileGrid {
+                points: profile_points,
+                span: profile_span,
+            };
+            let table = jobs::ept_profile_table(&plan, &terms, &data, &r, &context, name, &grid)?;
+            return Ok((table, None, prepared));
+        }
+        let (table, fits) = jobs::ept_fit_table(&plan, &terms, &data, &request, &k_max, &context)?;
+        let model = if model_out {
+            Some(jobs::ept_model_table(
+                &plan, &terms, &data, &request, &fits, &k_max, &context,
+            )?)
+        } else {
+            None
+        };
+        Ok((table, model, prepared))
     })?;
-    Table::new(py, table, &prepared, &precision, "ept fit", seconds)
+    let what = if profile.is_some() {
+        "ept profile"
+    } else {
+        "ept fit"
+    };
+    let model = model
+        .map(|m| Table::new(py, m, &prepared, &precision, "ept fit model", seconds))
+        .transpose()?;
+    Ok((
+        Table::new(py, table, &prepared, &precision, what, seconds)?,
+        model,
+    ))
 }

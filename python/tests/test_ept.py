@@ -85,3 +85,39 @@ def test_rsd_and_fit_route_ept(reference):
         t = pt.fit(data, [0.3], free=("f", "b1"), ells=(0, 2), rsd="ept", linear=linear, bias=1.7,
                    f=0.7, b2=0.5, alpha0=3.0, ir=False, precision="fast")
     assert abs(t["f"][0] - 0.8) < 1e-3 and abs(t["b1"][0] - 1.8) < 1e-3
+
+
+def test_fit_ept_covariance_path_profile_model_and_derived(tmp_path):
+    """Issue 48's faces: a covariance path gives the fit of the same array; the search reports its
+    starts; the derived fsigma8 is f sigma8(z); profile="f" crosses delta = 1 at the fit's interval;
+    model_out gives the best-fit multipoles; flat priors bound the fit."""
+    k = np.geomspace(0.02, 0.2, 20)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pt.PtSpectraWarning)
+        truth = dict(b1=2.0, f=0.7, alpha0=5.0)
+        m = pt.ept(k=k, precision="fast", **truth)
+        s = 0.01 * m["P0"]
+        data = {"k": k, "P0": m["P0"], "s0": s, "P2": m["P2"], "s2": s}
+        cov = np.diag(np.concatenate([s, s]) ** 2)
+        path = tmp_path / "cov.txt"
+        np.savetxt(path, cov)
+        args = dict(free=("f", "b1"), marginalise=("alpha0",), precision="fast", b1=1.8, f=0.6)
+        a = pt.fit_ept(data, [0.2], covariance=cov, **args)
+        b = pt.fit_ept(data, [0.2], covariance=str(path), **args)
+        for name in ("f", "b1", "minus_2_ln_L", "err_f", "f_lo", "f_hi"):
+            assert a[name][0] == pytest.approx(b[name][0], rel=1e-12), name
+        assert a["starts"][0] == 8 and 1 <= a["starts_agree"][0] <= 8
+        assert a["fsigma8"][0] == pytest.approx(a["f"][0] * a["sigma8_z"][0], rel=1e-14)
+        assert a["err_fsigma8"][0] == pytest.approx(a["err_f"][0] * a["sigma8_z"][0], rel=1e-12)
+        p = pt.fit_ept(data, [0.2], profile="f", profile_points=5, profile_span=1.0, **args)
+        d = p["delta_minus_2_ln_L"]
+        assert abs(d[2]) < 1e-3 and all(d > -1e-3)
+        # Points 0 and 4 at -+1 fitted error: delta = 1 there (a near-Gaussian likelihood).
+        assert d[0] == pytest.approx(1.0, abs=0.15) and d[4] == pytest.approx(1.0, abs=0.15)
+        t, model = pt.fit_ept(data, [0.15, 0.2], model_out=True, **args)
+        best = pt.ept(k=k, precision="fast", b1=t["b1"][1], f=t["f"][1], alpha0=t["alpha0"][1])
+        assert np.allclose(model["P0_kmax0.2"], best["P0"], rtol=1e-10)
+        flat = pt.fit_ept(data, [0.2], priors={"f": ("flat", 0.5, 0.65)}, **args)
+        assert flat["f"][0] == 0.65
+        with pytest.raises(ValueError, match="lognormal|flat"):
+            pt.fit_ept(data, [0.2], priors={"f": ("beta", 0.5, 0.65)}, **args)

@@ -24,6 +24,7 @@ use minimise::{Residuals, Window};
 use std::fmt;
 use std::str::FromStr;
 
+pub mod bounded;
 mod contour;
 pub mod covariance;
 mod data;

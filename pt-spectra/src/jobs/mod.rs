@@ -41,6 +41,7 @@ mod bias;
 mod bispectrum;
 pub mod defaults;
 mod ept;
+mod ept_fit;
 mod fit;
 mod halo;
 mod observe;
@@ -51,9 +52,9 @@ pub use batch::{batch_memory, real_batch, BatchColumns, BatchMemory, BatchRows};
 pub use bias::BiasOutput;
 pub use bispectrum::{bispectrum_table, sugiyama_table, BispectrumRequest, SugiyamaRequest};
 pub use ept::{
-    ept_fit_table, ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest,
-    AP_FIT_RANGE,
+    ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest, AP_FIT_RANGE,
 };
+pub use ept_fit::{ept_fit_table, ept_model_table, ept_profile_table, FitContext};
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use halo::{halo_table, HaloRequest};
 pub use observe::observed_table;

@@ -58,8 +58,10 @@ pub struct Args {
     /// Hartlap factor (N − p − 2)/(N − 1), p the fitted points.
     #[arg(long, value_name = "N")]
     n_mocks: Option<usize>,
-    /// --rsd ept: a Gaussian prior NAME:MEAN,SIGMA (repeat the option for several).
-    #[arg(long, value_name = "NAME:MEAN,SIGMA")]
+    /// --rsd ept: a prior on a free or marginalised parameter (repeat the option for several):
+    /// Gaussian NAME:MEAN,SIGMA, flat NAME:flat,LO,HI (bounds the fit), or log-normal
+    /// NAME:lognormal,MU,SIGMA (of ln NAME). Marginalised parameters take Gaussian priors only.
+    #[arg(long, value_name = "NAME:MEAN,SIGMA|NAME:flat,LO,HI")]
     prior: Vec<String>,
     /// --rsd ept: second-order bias b2 (start or fixed value).
     #[arg(long, value_name = "B2", allow_hyphen_values = true)]
@@ -133,12 +135,38 @@ pub struct Args {
     /// the model is averaged with the pair-count weight s².
     #[arg(long, value_name = "EDGES", requires = "xi")]
     s_edges: Option<String>,
+    /// --rsd ept: starts of the minimiser (the start given, then draws from the priors or the start
+    /// box); the lowest minimum is taken and the table says how many agree with it.
+    #[arg(long, value_name = "N", default_value_t = pt_spectra::fit::galaxy::search::DEFAULT_STARTS)]
+    starts: usize,
+    /// --rsd ept: the seed of the starts' draws.
+    #[arg(long, value_name = "SEED", default_value_t = 1)]
+    seed: u64,
+    /// --rsd ept: skip the check of the Hessian errors by the profile likelihood (faster; no
+    /// <p>_lo, <p>_hi).
+    #[arg(long)]
+    no_profile_check: bool,
+    /// --rsd ept: profile the linear (--marginalise) parameters, at their best values, instead of
+    /// marginalising them (no ln det F term).
+    #[arg(long)]
+    profile_linear: bool,
+    /// --rsd ept: write the profile likelihood of this free parameter at the (single) --k-max instead
+    /// of the fit table: a row per value, the other free parameters re-minimised.
+    #[arg(long, value_name = "P")]
+    profile: Option<String>,
+    /// --profile: values on the grid (3 to 401).
+    #[arg(long, value_name = "N", default_value_t = 21, requires = "profile")]
+    profile_points: usize,
+    /// --profile: the grid's half-width in units of the parameter's fitted error.
+    #[arg(long, value_name = "S", default_value_t = 3.0, requires = "profile")]
+    profile_span: f64,
     /// Write the table to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
     /// Write the best-fit model multipoles of every k_max to this file: `k`, the fitted data
-    /// `P<l>_data err_P<l>_data`, the no-wiggle reference `P<l>_nw` and `P<l>_kmax<K>` (the model
-    /// curves of the paper's figures; `plot multipoles` draws them).
+    /// `P<l>_data err_P<l>_data`, the no-wiggle reference `P<l>_nw` (not with ept) and `P<l>_kmax<K>`
+    /// (the model curves of the paper's figures, windowed with ept's --window; `plot multipoles`
+    /// draws them).
     #[arg(long, value_name = "FILE")]
     model_out: Option<PathBuf>,
     /// Two free parameters, e.g. `f,sigma0`, `f,ab` or `f,cs2`: write their Δχ² surface at every k_max to
@@ -189,8 +217,7 @@ fn run_ept(args: &Args) -> Result<()> {
             "--shot-noise/--number-density/--noise-file (use --sn)",
             args.noise.is_set(),
         ),
-        ("--contour", args.contour.is_some()),
-        ("--model-out", args.model_out.is_some()),
+        ("--contour (use --profile)", args.contour.is_some()),
     ];
     if let Some((flag, _)) = refused.iter().find(|(_, given)| *given) {
         bail!("{flag} is not an option of fit --rsd ept");
@@ -330,16 +357,59 @@ fn run_ept(args: &Args) -> Result<()> {
             args.s_min
         );
     }
-    let table = pt_spectra::jobs::ept_fit_table(
-        &plan,
-        &terms,
-        &data,
-        &request,
-        &maxima,
+    let context = pt_spectra::jobs::FitContext {
+        observation: observation.as_ref(),
+        search: search(args)?,
+        template: Some(pt_spectra::fit::galaxy::Template {
+            sigma8_z: loaded.prepared.spectrum.sigma8(),
+            z: loaded.prepared.z,
+            cosmology: Some(loaded.prepared.cosmology.cosmology.clone()),
+        }),
         header,
-        observation.as_ref(),
-    )?;
+    };
+    if let Some(name) = &args.profile {
+        let [k_max] = maxima[..] else {
+            bail!(
+                "--profile needs one --k-max (or --s-max), not {}",
+                maxima.len()
+            );
+        };
+        let mut r = request.clone();
+        r.k_max = k_max;
+        let grid = pt_spectra::fit::galaxy::ProfileGrid {
+            points: args.profile_points,
+            span: args.profile_span,
+        };
+        let table =
+            pt_spectra::jobs::ept_profile_table(&plan, &terms, &data, &r, &context, name, &grid)?;
+        return write_output(args.out.as_ref(), &table);
+    }
+    let (table, fits) =
+        pt_spectra::jobs::ept_fit_table(&plan, &terms, &data, &request, &maxima, &context)?;
+    if let Some(path) = &args.model_out {
+        let model = pt_spectra::jobs::ept_model_table(
+            &plan, &terms, &data, &request, &fits, &maxima, &context,
+        )?;
+        write_output(Some(path), &model)?;
+    }
     write_output(args.out.as_ref(), &table)
+}
+
+/// The minimiser's settings of --starts, --seed, --no-profile-check, --profile-linear.
+fn search(args: &Args) -> Result<pt_spectra::fit::galaxy::Search> {
+    if args.starts == 0 {
+        bail!("--starts 0: the fit needs at least one start");
+    }
+    Ok(pt_spectra::fit::galaxy::Search {
+        starts: args.starts,
+        seed: args.seed,
+        profile_check: !args.no_profile_check,
+        linear: if args.profile_linear {
+            pt_spectra::fit::galaxy::Linear::Profiled
+        } else {
+            pt_spectra::fit::galaxy::Linear::Marginalised
+        },
+    })
 }
 
 /// L:KMIN,KMAX of --k-range-ell.
@@ -356,16 +426,9 @@ fn parse_ell_range(text: &str) -> Result<(usize, f64, f64)> {
     parse().ok_or_else(|| anyhow::anyhow!("--k-range-ell {text}: expected L:KMIN,KMAX"))
 }
 
-/// NAME:MEAN,SIGMA.
+/// NAME:MEAN,SIGMA, NAME:flat,LO,HI or NAME:lognormal,MU,SIGMA.
 fn parse_prior(text: &str) -> Result<Prior> {
-    let bad = || anyhow::anyhow!("--prior {text}: expected NAME:MEAN,SIGMA, e.g. b2:0,1");
-    let (name, rest) = text.split_once(':').ok_or_else(bad)?;
-    let (mean, sigma) = rest.split_once(',').ok_or_else(bad)?;
-    Ok(Prior {
-        name: name.trim().to_string(),
-        mean: mean.trim().parse().map_err(|_| bad())?,
-        sigma: sigma.trim().parse().map_err(|_| bad())?,
-    })
+    Prior::parse(text).map_err(|e| anyhow::anyhow!("--prior: {e}"))
 }
 
 /// `a:b:step` (inclusive, to rounding), a list, or one value.
@@ -419,6 +482,14 @@ pub fn run(args: &Args) -> Result<()> {
         ),
         ("--prior", !args.prior.is_empty()),
         ("--n-mocks", args.n_mocks.is_some()),
+        ("--profile", args.profile.is_some()),
+        (
+            "--starts/--seed/--no-profile-check/--profile-linear",
+            args.starts != pt_spectra::fit::galaxy::search::DEFAULT_STARTS
+                || args.seed != 1
+                || args.no_profile_check
+                || args.profile_linear,
+        ),
         (
             "--b2/--bs/--b3",
             args.b2.is_some() || args.bs.is_some() || args.b3.is_some(),

@@ -6,7 +6,7 @@ use crate::linear::{LinearSpectrum, LogGrid};
 use crate::precision::Precision;
 use crate::rsd::ept::EptSettings;
 
-fn setup() -> (EptPlan, EptTerms, EptParams, MultipoleData) {
+pub(super) fn setup() -> (EptPlan, EptTerms, EptParams, MultipoleData) {
     let k = LogGrid::new(0.02, 0.2, 24).unwrap().points();
     let plan = EptPlan::new(
         &k,
@@ -89,11 +89,7 @@ fn analytic_marginalisation_is_the_integral() {
     let (plan, terms, truth, data) = setup();
     let mut start = truth;
     start.set("alpha0", 0.0).unwrap();
-    let prior = Prior {
-        name: "alpha0".into(),
-        mean: 3.0,
-        sigma: 10.0,
-    };
+    let prior = Prior::gaussian("alpha0", 3.0, 10.0);
     let request = GalaxyFitRequest {
         start,
         ap: None,
@@ -121,7 +117,7 @@ fn analytic_marginalisation_is_the_integral() {
                 }
             }
         }
-        c + ((a - prior.mean) / prior.sigma).powi(2)
+        c + prior.shape.minus_two_log(a)
     };
     let (lo, hi, n) = (
         fit.best.get("alpha0").unwrap() - 8.0 * fit.marginalised_errors[0],
@@ -179,11 +175,7 @@ fn bad_requests_are_named() {
     r.marginalise = vec!["b2".into()];
     assert!(err(r).contains("b2"));
     let mut r = base.clone();
-    r.priors = vec![Prior {
-        name: "b1".into(),
-        mean: 2.0,
-        sigma: 0.0,
-    }];
+    r.priors = vec![Prior::gaussian("b1", 2.0, 0.0)];
     assert!(err(r).contains("sigma"));
     let mut r = base.clone();
     r.marginalise = vec!["f".into()];
@@ -290,11 +282,7 @@ fn priors_on_fixed_parameters_are_refused() {
         ap: None,
         free: vec!["f".into(), "b1".into()],
         marginalise: vec!["sn".into()],
-        priors: vec![Prior {
-            name: "b2".into(),
-            mean: 0.0,
-            sigma: 1.0,
-        }],
+        priors: vec![Prior::gaussian("b2", 0.0, 1.0)],
         ells: vec![0, 2],
         k_min: 0.0,
         k_max: 0.2,
@@ -310,14 +298,7 @@ fn priors_on_fixed_parameters_are_refused() {
          (free: f, b1; marginalised: sn)"
     );
     let mut twice = request.clone();
-    twice.priors = vec![
-        Prior {
-            name: "sn".into(),
-            mean: 0.0,
-            sigma: 1e3,
-        };
-        2
-    ];
+    twice.priors = vec![Prior::gaussian("sn", 0.0, 1e3); 2];
     let e = fit_galaxy(&plan, &terms, &data, &twice).unwrap_err();
     assert_eq!(e.to_string(), "the prior on sn: is given twice");
     let mut ok = request;

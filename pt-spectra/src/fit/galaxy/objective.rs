@@ -1,0 +1,478 @@
+//! The objective of a galaxy fit: −2 ln L of the free parameters with the linear ones marginalised
+//! analytically (the module docs of [`super`]), on one window of data.
+
+use super::{index, GalaxyFitRequest, PriorShape, LINEAR, SLOTS};
+use crate::error::{Error, Result};
+use crate::fit::MultipoleData;
+use crate::linalg::{cholesky, dot, invert_lower, solve_spd};
+use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
+use crate::survey::observe::Observation;
+use crate::table::{describe_grid, same_k};
+
+/// The slots of the biases b1, b2, bs, b3 ([`PARAM_NAMES`]).
+const BIASES: [usize; 4] = [0, 1, 2, 3];
+
+/// The largest change of a template, relative to the largest template value, that counts as none
+/// when the biases change (rounding of the model's sums: ~1e-15 relative).
+const TEMPLATE_TOLERANCE: f64 = 1e-10;
+
+/// Templates kept: a gradient's bias steps find those of its centre among the last few (the steps of
+/// f, α∥, α⊥ before them made their own).
+const CACHE_SIZE: usize = 8;
+
+/// The objective of one request on one data window.
+pub(super) struct Objective<'a> {
+    pub(super) plan: &'a EptPlan,
+    terms: &'a EptTerms,
+    /// The window and bins between the model and the data, if any.
+    observation: Option<&'a Observation>,
+    /// Every slot's start or fixed value (the model's parameters, α∥, α⊥).
+    pub(super) start: [f64; SLOTS],
+    /// Whether the measurement has a distortion.
+    pub(super) has_ap: bool,
+    ells: Vec<usize>,
+    pub(super) free: Vec<usize>,
+    pub(super) marg: Vec<usize>,
+    /// Per slot, its prior, if any.
+    pub(super) priors: Vec<Option<PriorShape>>,
+    /// Per fitted ℓ (in the order of `ells`), the k indices of its fitted points.
+    window: Vec<Vec<usize>>,
+    /// Whether the marginalised templates are independent of the biases (checked at construction).
+    bias_free_templates: bool,
+    /// The last [`CACHE_SIZE`] templates and the slots they were made at ([`Self::template_key`]).
+    cache: std::cell::RefCell<Vec<(Vec<u64>, Vec<Vec<f64>>)>>,
+    /// Whether −2 ln L holds ln det F (the linear parameters marginalised), or not (profiled).
+    pub(super) log_det: bool,
+    /// L⁻¹ of the Cholesky factor of the window's covariance.
+    whiten: Vec<Vec<f64>>,
+    /// L⁻¹ d.
+    data: Vec<f64>,
+}
+
+impl Objective<'_> {
+    pub(super) fn slots(&self, x: &[f64]) -> [f64; SLOTS] {
+        let mut v = self.start;
+        for (&i, &value) in self.free.iter().zip(x) {
+            v[i] = value;
+        }
+        v
+    }
+
+    pub(super) fn split(
+        &self,
+        v: &[f64; SLOTS],
+    ) -> Result<(EptParams, Option<crate::rsd::ap::Distortion>)> {
+        let n = PARAM_NAMES.len();
+        let mut p = EptParams::new(0.0, 0.0);
+        p.values.copy_from_slice(&v[..n]);
+        let ap = if self.has_ap {
+            Some(crate::rsd::ap::Distortion::new(v[n], v[n + 1])?)
+        } else {
+            None
+        };
+        Ok((p, ap))
+    }
+
+    /// The whitened model at `p` with distortion `ap` (L⁻¹ m).
+    pub(super) fn model(
+        &self,
+        p: &EptParams,
+        ap: Option<crate::rsd::ap::Distortion>,
+    ) -> Result<Vec<f64>> {
+        let m = match self.observation {
+            None => self
+                .plan
+                .multipole_values_at(self.terms, p, &self.ells, ap)?,
+            Some(o) => {
+                let model = self
+                    .plan
+                    .multipole_values_at(self.terms, p, o.model_ells(), ap)?;
+                o.apply_values(&model)?
+            }
+        };
+        let raw: Vec<f64> = m
+            .iter()
+            .zip(&self.window)
+            .flat_map(|(l, window)| window.iter().map(move |&i| l[i]))
+            .collect();
+        Ok(self
+            .whiten
+            .iter()
+            .map(|row| row.iter().zip(&raw).map(|(a, b)| a * b).sum())
+            .collect())
+    }
+
+    /// The whitened templates Tᵢ = m(p, aᵢ = 1) − m(p, aᵢ = 0) of the marginalised parameters at `p`
+    /// (theirs at 0), `m0` the model at `p`.
+    fn templates(
+        &self,
+        p: &EptParams,
+        ap: Option<crate::rsd::ap::Distortion>,
+        m0: &[f64],
+    ) -> Result<Vec<Vec<f64>>> {
+        self.marg
+            .iter()
+            .map(|&i| {
+                let mut q = *p;
+                q.values[i] = 1.0;
+                self.model(&q, ap)
+                    .map(|m| m.iter().zip(m0).map(|(a, b)| a - b).collect())
+            })
+            .collect()
+    }
+
+    /// The slots the templates can depend on: all but the biases and the marginalised ones.
+    fn template_key(&self, v: &[f64; SLOTS]) -> Vec<u64> {
+        (0..SLOTS)
+            .filter(|i| !BIASES.contains(i) && !self.marg.contains(i))
+            .map(|i| v[i].to_bits())
+            .collect()
+    }
+
+    /// Whether the templates at the start are those at other biases (to [`TEMPLATE_TOLERANCE`]):
+    /// the counterterms and stochastic terms of the model do not multiply a bias, so that a step
+    /// of b1, b2, bs, b3 alone reuses them (module docs of [`super`]). Checked, not assumed.
+    fn check_bias_free_templates(&mut self) -> Result<()> {
+        if self.marg.is_empty() {
+            return Ok(());
+        }
+        let (mut p, ap) = self.split(&self.start)?;
+        for &i in &self.marg {
+            p.values[i] = 0.0;
+        }
+        let t0 = self.templates(&p, ap, &self.model(&p, ap)?)?;
+        for (&i, shift) in BIASES.iter().zip([0.37, -0.41, 0.23, 0.11]) {
+            p.values[i] += shift;
+        }
+        let t1 = self.templates(&p, ap, &self.model(&p, ap)?)?;
+        let scale = t0.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+        self.bias_free_templates = t0
+            .iter()
+            .flatten()
+            .zip(t1.iter().flatten())
+            .all(|(a, b)| (a - b).abs() <= TEMPLATE_TOLERANCE * scale);
+        Ok(())
+    }
+
+    /// −2 ln L at the free values `x`; +∞ outside the model's domain (e.g. f < 0).
+    pub(super) fn cost(&self, x: &[f64]) -> f64 {
+        self.evaluate(x).map_or(f64::INFINITY, |e| e.0)
+    }
+
+    /// The number of fitted data points.
+    pub(super) fn points(&self) -> usize {
+        self.data.len()
+    }
+
+    /// (−2 ln L, χ², the slots with â, the errors of â) at the free values `x`.
+    ///
+    /// # Errors
+    /// As the model's evaluation (e.g. f or α outside the plan's range).
+    pub(super) fn evaluate(&self, x: &[f64]) -> Result<(f64, f64, [f64; SLOTS], Vec<f64>)> {
+        let mut v = self.slots(x);
+        let (mut p, ap) = self.split(&v)?;
+        for &i in &self.marg {
+            p.values[i] = 0.0;
+        }
+        let m0 = self.model(&p, ap)?;
+        let key = self.template_key(&v);
+        let cached = if self.bias_free_templates {
+            self.cache
+                .borrow()
+                .iter()
+                .find(|(k, _)| *k == key)
+                .map(|(_, t)| t.clone())
+        } else {
+            None
+        };
+        let templates = match cached {
+            Some(t) => t,
+            None => {
+                let t = self.templates(&p, ap, &m0)?;
+                let mut cache = self.cache.borrow_mut();
+                if cache.len() == CACHE_SIZE {
+                    cache.remove(0);
+                }
+                cache.push((key, t.clone()));
+                t
+            }
+        };
+        let r0: Vec<f64> = self.data.iter().zip(&m0).map(|(d, m)| d - m).collect();
+        let n = self.marg.len();
+        let mut f = vec![vec![0.0; n]; n];
+        let mut b = vec![0.0; n];
+        for a in 0..n {
+            let (mean, precision) = self.priors[self.marg[a]]
+                .as_ref()
+                .and_then(PriorShape::gaussian)
+                .unwrap_or((0.0, 0.0));
+            b[a] = dot(&templates[a], &r0) + precision * mean;
+            for c in 0..n {
+                f[a][c] = dot(&templates[a], &templates[c]);
+            }
+            f[a][a] += precision;
+        }
+        let (ahat, inverse, log_det) = solve_spd(&f, &b)?;
+        let mut chi2 = 0.0;
+        for (j, r) in r0.iter().enumerate() {
+            let fit: f64 = (0..n).map(|a| ahat[a] * templates[a][j]).sum();
+            chi2 += (r - fit).powi(2);
+        }
+        let mut total = chi2 + if self.log_det { log_det } else { 0.0 };
+        for (a, &i) in self.marg.iter().enumerate() {
+            v[i] = ahat[a];
+            if let Some((mean, precision)) = self.priors[i].as_ref().and_then(PriorShape::gaussian)
+            {
+                total += precision * (ahat[a] - mean).powi(2);
+            }
+        }
+        for &i in &self.free {
+            if let Some(prior) = &self.priors[i] {
+                total += prior.minus_two_log(v[i]);
+            }
+        }
+        let errors = (0..n).map(|a| inverse[a][a].sqrt()).collect();
+        Ok((total, chi2, v, errors))
+    }
+}
+
+/// The objective of `request` on `data` (through `observation`, if any).
+///
+/// # Errors
+/// As [`super::fit_galaxy_observed`].
+pub(super) fn objective<'a>(
+    plan: &'a EptPlan,
+    terms: &'a EptTerms,
+    data: &MultipoleData,
+    request: &GalaxyFitRequest,
+    observation: Option<&'a Observation>,
+) -> Result<Objective<'a>> {
+    let (free, marg, priors) = validate(request)?;
+    if request.ap.is_none() && free.iter().any(|&i| i >= PARAM_NAMES.len()) {
+        return Err(Error::InvalidChoice {
+            what: "free apar/aperp".into(),
+            reason: "the fit needs a distortion to start from (the measurement's AP)".into(),
+        });
+    }
+    let k = match observation {
+        None => plan.k(),
+        Some(o) => {
+            if plan.k() != o.k_model() || !same_k(o.k_out(), &data.k) || o.ells() != request.ells {
+                return Err(Error::InvalidChoice {
+                    what: "the fit's window and bins".into(),
+                    reason: format!(
+                        "the plan must be on their model k and their output ({}, l {:?}) on the \
+                         data's ({}, l {:?})",
+                        describe_grid(o.k_out()),
+                        o.ells(),
+                        describe_grid(&data.k),
+                        request.ells
+                    ),
+                });
+            }
+            data.k.as_slice()
+        }
+    };
+    if observation.is_none() && !same_k(k, &data.k) {
+        return Err(Error::InvalidChoice {
+            what: "the fit's model grid".into(),
+            reason: "the plan must be built on the data's k".into(),
+        });
+    }
+    let mut rows = Vec::new();
+    for &l in &request.ells {
+        let j = data
+            .ells
+            .iter()
+            .position(|&d| d == l)
+            .ok_or(Error::InvalidParameter {
+                name: "fitted multipole ell",
+                value: l as f64,
+                reason: "is not in the data",
+            })?;
+        rows.push(j);
+    }
+    let mut window = Vec::with_capacity(rows.len());
+    for &l in &request.ells {
+        let (mut lo, mut hi) = (request.k_min, request.k_max);
+        for &(_, a, b) in request.ell_ranges.iter().filter(|r| r.0 == l) {
+            lo = lo.max(a);
+            hi = hi.min(b);
+        }
+        window.push(
+            (0..k.len())
+                .filter(|&i| (lo..=hi).contains(&k[i]))
+                .collect::<Vec<usize>>(),
+        );
+    }
+    let points: usize = window.iter().map(Vec::len).sum();
+    if points <= free.len() + marg.len() {
+        return Err(Error::InvalidParameter {
+            name: "k_max [h/Mpc]",
+            value: request.k_max,
+            reason: "the fitted window holds no more points than parameters",
+        });
+    }
+    // The window's covariance: the data's full covariance (ℓ-major over the data's ells), or σ².
+    let position = |r: usize, i: usize| r * k.len() + i;
+    // The fitted points (data row, k index), ℓ-major.
+    let fitted: Vec<(usize, usize)> = rows
+        .iter()
+        .zip(&window)
+        .flat_map(|(&r, w)| w.iter().map(move |&i| (r, i)))
+        .collect();
+    let cov: Vec<Vec<f64>> = fitted
+        .iter()
+        .map(|&(r, i)| {
+            fitted
+                .iter()
+                .map(|&(s, j)| match &data.covariance {
+                    Some(c) => c[position(r, i)][position(s, j)],
+                    None if (r, i) == (s, j) => data.sigma[r][i].powi(2),
+                    None => 0.0,
+                })
+                .collect()
+        })
+        .collect();
+    let mut cov = cov;
+    if let Some(n) = request.n_mocks {
+        if n < points + 3 {
+            return Err(Error::InvalidParameter {
+                name: "number of mocks",
+                value: n as f64,
+                reason: "the Hartlap factor needs more mocks than fitted points + 2",
+            });
+        }
+        // C⁻¹ → h C⁻¹ is C → C/h.
+        let h = (n - points - 2) as f64 / (n - 1) as f64;
+        for row in cov.iter_mut() {
+            for v in row.iter_mut() {
+                *v /= h;
+            }
+        }
+    }
+    let l = cholesky(&cov).ok_or_else(|| Error::InvalidChoice {
+        what: format!("the covariance of the {points} fitted points"),
+        reason: "is not positive definite".into(),
+    })?;
+    let whiten = invert_lower(&l);
+    let raw: Vec<f64> = fitted.iter().map(|&(r, i)| data.values[r][i]).collect();
+    let data_vector = whiten.iter().map(|row| dot(row, &raw)).collect();
+    let mut start = [0.0; SLOTS];
+    start[..PARAM_NAMES.len()].copy_from_slice(&request.start.values);
+    if let Some(d) = request.ap {
+        start[PARAM_NAMES.len()] = d.apar;
+        start[PARAM_NAMES.len() + 1] = d.aperp;
+    }
+    let mut objective = Objective {
+        plan,
+        terms,
+        observation,
+        start,
+        has_ap: request.ap.is_some(),
+        ells: request.ells.clone(),
+        free,
+        marg,
+        priors,
+        window,
+        log_det: true,
+        bias_free_templates: false,
+        cache: std::cell::RefCell::new(Vec::new()),
+        whiten,
+        data: data_vector,
+    };
+    objective.check_bias_free_templates()?;
+    Ok(objective)
+}
+
+/// The free and marginalised parameter indices, and per parameter its prior (mean, 1/σ²).
+type Validated = (Vec<usize>, Vec<usize>, Vec<Option<PriorShape>>);
+
+/// Checks the request's names and values.
+pub(super) fn validate(request: &GalaxyFitRequest) -> Result<Validated> {
+    let free = request
+        .free
+        .iter()
+        .map(|n| index(n))
+        .collect::<Result<Vec<_>>>()?;
+    let mut marg = Vec::new();
+    for name in &request.marginalise {
+        if !LINEAR.contains(&name.as_str()) {
+            return Err(Error::InvalidChoice {
+                what: format!("--marginalise {name}"),
+                reason: format!(
+                    "only parameters that enter linearly can be marginalised: {}",
+                    LINEAR.join(", ")
+                ),
+            });
+        }
+        marg.push(index(name)?);
+    }
+    let mut seen = std::collections::HashSet::new();
+    for name in request.free.iter().chain(&request.marginalise) {
+        if !seen.insert(name.as_str()) {
+            return Err(Error::InvalidChoice {
+                what: format!("fit parameter `{name}`"),
+                reason: "is listed twice (free and marginalised are exclusive)".into(),
+            });
+        }
+    }
+    if free.is_empty() {
+        return Err(Error::InvalidChoice {
+            what: "--free".into(),
+            reason: "name at least one free parameter".into(),
+        });
+    }
+    for &(l, lo, hi) in &request.ell_ranges {
+        if !request.ells.contains(&l) {
+            return Err(Error::InvalidChoice {
+                what: format!("the k range of multipole {l}"),
+                reason: format!("{l} is not a fitted multipole ({:?})", request.ells),
+            });
+        }
+        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            return Err(Error::InvalidParameter {
+                name: "per-multipole k_max [h/Mpc]",
+                value: hi,
+                reason: "a multipole's range needs finite k_min < k_max",
+            });
+        }
+    }
+    let mut priors = vec![None; SLOTS];
+    for p in &request.priors {
+        let i = index(&p.name)?;
+        p.shape.check(&p.name)?;
+        if !free.contains(&i) && !marg.contains(&i) {
+            return Err(Error::InvalidChoice {
+                what: format!("the prior on {}", p.name),
+                reason: format!(
+                    "{} is fixed, and a prior acts only on a free or marginalised parameter \
+                     (free: {}; marginalised: {})",
+                    p.name,
+                    request.free.join(", "),
+                    if request.marginalise.is_empty() {
+                        "none".to_string()
+                    } else {
+                        request.marginalise.join(", ")
+                    }
+                ),
+            });
+        }
+        if marg.contains(&i) && p.shape.gaussian().is_none() {
+            return Err(Error::InvalidChoice {
+                what: format!("the prior {} on {}", p.shape, p.name),
+                reason: "a marginalised parameter takes a Gaussian prior (or none): the analytic \
+                         marginalisation integrates a Gaussian"
+                    .into(),
+            });
+        }
+        if priors[i].is_some() {
+            return Err(Error::InvalidChoice {
+                what: format!("the prior on {}", p.name),
+                reason: "is given twice".into(),
+            });
+        }
+        priors[i] = Some(p.shape.clone());
+    }
+    Ok((free, marg, priors))
+}

@@ -1,0 +1,534 @@
+//! The search of a galaxy fit: the bounds and start box of each parameter, several starts, the
+//! Hessian errors and their check by the profile likelihood, and the 1-D profile of a parameter.
+//!
+//! * Bounds ([`RANGES`]): wide physical ranges (f in [0, 2], b1 in [0.05, 10], …), narrowed by a flat
+//!   or log-normal prior's support; α∥, α⊥ within the plan's AP range.
+//! * Starts: the request's start, then [`Search::starts`] − 1 points drawn with a seeded generator
+//!   (ChaCha8, [`Search::seed`]): a parameter with a prior from its prior (a Gaussian's draws within
+//!   ±2σ), the others uniformly in their start box ([`RANGES`]), all moved into the bounds. Each start
+//!   is minimised ([`crate::fit::bounded`]) and the lowest minimum taken; the fit reports how many
+//!   reached it to Δχ² < 0.01 and the spread of the minima.
+//! * Errors: √diag(2H⁻¹), H the central-difference Hessian of −2 ln L with steps of
+//!   [`HESSIAN_STEP`] times each parameter's conditional σ at the minimum. Then the likelihood checks
+//!   it: the profile −2 ln L (the others re-minimised, started on the Hessian's regression line) at
+//!   best ± σ_H, and the crossing of Δ = 1 found by the secant in √Δ (exact for a Gaussian likelihood,
+//!   where √Δ is linear in the distance) to [`CROSSING_TOLERANCE`]. A profile point below the minimum
+//!   by more than 0.01 means the starts missed the global minimum: the search restarts there.
+
+use super::objective::Objective;
+use super::{index, GalaxyFit, GalaxyFitRequest, MultipoleData, Observation, SLOTS};
+use crate::error::{Error, Result};
+use crate::fit::bounded::{multistart, Minimum, Problem, AGREEMENT, EXPECTED_DECREASE};
+use crate::linalg::solve_spd;
+use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
+use rand::{Rng, SeedableRng};
+
+/// The starts of a fit by default.
+pub const DEFAULT_STARTS: usize = 8;
+
+/// The Hessian's step in units of each parameter's conditional σ at the minimum.
+pub const HESSIAN_STEP: f64 = 0.5;
+
+/// The relative difference between the profile's half-width and the Hessian's σ above which the
+/// profile's is the error given.
+pub const PROFILE_AGREEMENT: f64 = 0.1;
+
+/// The tolerance on √Δ(−2 ln L) at a crossing of Δ = 1 (0.5% of the interval).
+pub const CROSSING_TOLERANCE: f64 = 0.005;
+
+/// The convergence of a profile point's minimisation: Δ(−2 ln L) to 1e-4, √Δ at Δ = 1 to 5e-5.
+pub const PROFILE_DECREASE: f64 = 1e-4;
+
+/// Re-searches after a profile found a lower minimum, at most.
+const RESTARTS: usize = 3;
+
+/// Per slot ([`PARAM_NAMES`], then α∥, α⊥): (lower bound, upper bound, start box lower, upper,
+/// typical σ). The bounds are wide physical ranges (f: the plausible range [0, 2]); the start box is
+/// where galaxy samples' best fits lie (b1 1–3, |b2| ≲ 2 in velocileptors' units; counterterms tens
+/// of (Mpc/h)², shot noise ~1/n̄ ~ 10³ (Mpc/h)³).
+pub const RANGES: [(f64, f64, f64, f64, f64); SLOTS] = [
+    (0.05, 10.0, 1.0, 3.0, 0.1),
+    (-50.0, 50.0, -2.0, 2.0, 1.0),
+    (-50.0, 50.0, -1.0, 1.0, 1.0),
+    (-50.0, 50.0, -1.0, 1.0, 1.0),
+    (-1e4, 1e4, -30.0, 30.0, 10.0),
+    (-1e4, 1e4, -30.0, 30.0, 10.0),
+    (-1e4, 1e4, -30.0, 30.0, 10.0),
+    (-1e4, 1e4, -30.0, 30.0, 10.0),
+    (-1e5, 1e5, -1e3, 1e3, 300.0),
+    (-1e7, 1e7, -1e4, 1e4, 3e3),
+    (-1e9, 1e9, -1e5, 1e5, 3e4),
+    (0.0, 2.0, 0.4, 1.0, 0.05),
+    (0.5, 2.0, 0.9, 1.1, 0.03),
+    (0.5, 2.0, 0.9, 1.1, 0.03),
+];
+
+/// The linear parameters in −2 ln L.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Linear {
+    /// Marginalised analytically (the ln det F term).
+    Marginalised,
+    /// Profiled: set to their best values â, without ln det F.
+    Profiled,
+}
+
+/// How a fit searches for its minimum.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Search {
+    /// Starts minimised (≥ 1; the first is the request's start).
+    pub starts: usize,
+    /// The seed of the starts' draws.
+    pub seed: u64,
+    /// Whether the Hessian errors are checked by (and the intervals found on) the profile likelihood.
+    pub profile_check: bool,
+    /// Marginalise or profile the linear parameters.
+    pub linear: Linear,
+}
+
+impl Default for Search {
+    fn default() -> Self {
+        Self {
+            starts: DEFAULT_STARTS,
+            seed: 1,
+            profile_check: true,
+            linear: Linear::Marginalised,
+        }
+    }
+}
+
+/// The bounds (lower, upper) and typical σ of the free parameters of `objective`.
+fn bounds(objective: &Objective) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let ap = objective.plan.settings().ap_range;
+    let mut lo = Vec::new();
+    let mut hi = Vec::new();
+    let mut scale = Vec::new();
+    for &i in &objective.free {
+        let (mut a, mut b, _, _, s) = RANGES[i];
+        if let (true, Some((x, y))) = (i >= PARAM_NAMES.len(), ap) {
+            (a, b) = (x, y);
+        }
+        if let Some(p) = &objective.priors[i] {
+            let (x, y) = p.support();
+            (a, b) = (a.max(x), b.min(y));
+        }
+        lo.push(a);
+        hi.push(b);
+        scale.push(s);
+    }
+    (lo, hi, scale)
+}
+
+/// A standard normal draw (Box–Muller) and a uniform one.
+fn draws(rng: &mut rand_chacha::ChaCha8Rng) -> (f64, f64) {
+    let (u1, u2): (f64, f64) = (rng.gen(), rng.gen());
+    let z = (-2.0 * (1.0 - u1).ln()).sqrt() * (std::f64::consts::TAU * u2).cos();
+    (z, rng.gen())
+}
+
+/// The starts: `x0`, then draws from the priors or the start box, within [lo, hi].
+fn starts(
+    objective: &Objective,
+    x0: &[f64],
+    lo: &[f64],
+    hi: &[f64],
+    search: &Search,
+) -> Vec<Vec<f64>> {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(search.seed);
+    let mut all = vec![x0.to_vec()];
+    while all.len() < search.starts {
+        let x = objective
+            .free
+            .iter()
+            .enumerate()
+            .map(|(j, &i)| {
+                let (z, u) = draws(&mut rng);
+                let v = match &objective.priors[i] {
+                    Some(p) => p.draw(z.clamp(-2.0, 2.0), u),
+                    None => RANGES[i].2 + (RANGES[i].3 - RANGES[i].2) * u,
+                };
+                v.clamp(lo[j], hi[j])
+            })
+            .collect();
+        all.push(x);
+    }
+    all
+}
+
+/// `y` (every free parameter but the i-th) with `v` put in at i.
+fn insert(y: &[f64], i: usize, v: f64) -> Vec<f64> {
+    let mut x = y.to_vec();
+    x.insert(i, v);
+    x
+}
+
+/// The minimum of `problem` with parameter i held at `v`, the others started at `guess` (full
+/// length; its i-th entry ignored).
+fn profile_at(problem: &Problem, sigma: &[f64], i: usize, v: f64, guess: &[f64]) -> Minimum {
+    let drop = |x: &[f64]| -> Vec<f64> {
+        x.iter()
+            .enumerate()
+            .filter(|&(j, _)| j != i)
+            .map(|(_, &a)| a)
+            .collect()
+    };
+    let g = |y: &[f64]| (problem.f)(&insert(y, i, v));
+    let reduced = Problem {
+        f: &g,
+        lo: drop(&problem.lo),
+        hi: drop(&problem.hi),
+        scale: drop(sigma),
+        tolerance: PROFILE_DECREASE,
+    };
+    let m = reduced.minimise(&drop(guess));
+    Minimum {
+        x: insert(&m.x, i, v),
+        sigma: insert(&m.sigma, i, sigma[i]),
+        ..m
+    }
+}
+
+/// The start of the others for the profile at x_i = `v`: on the Hessian's regression line through
+/// the best fit (x_j + C_ji/C_ii Δx_i), or the best fit where the covariance is undefined.
+fn regression(best: &[f64], cov: Option<&[Vec<f64>]>, i: usize, v: f64) -> Vec<f64> {
+    let d = v - best[i];
+    best.iter()
+        .enumerate()
+        .map(|(j, &b)| match cov {
+            Some(c) if j != i => b + c[j][i] / c[i][i] * d,
+            _ => b,
+        })
+        .collect()
+}
+
+/// The Gaussian errors √diag(2H⁻¹) at `best` and the covariance 2H⁻¹ (`None` if H is not positive
+/// definite; the errors NaN then), and the evaluations used.
+fn hessian_errors(problem: &Problem, best: &Minimum) -> (Vec<f64>, Option<Vec<Vec<f64>>>, usize) {
+    let n = best.x.len();
+    let count = std::cell::Cell::new(0);
+    let f = |x: &[f64]| {
+        count.set(count.get() + 1);
+        (problem.f)(x)
+    };
+    let h: Vec<f64> = best.sigma.iter().map(|s| HESSIAN_STEP * s).collect();
+    let hess = crate::fit::bounded::hessian(&f, &best.x, best.value, &h, &problem.lo, &problem.hi);
+    match solve_spd(&hess, &vec![0.0; n]) {
+        Ok((_, inverse, _)) => {
+            let cov: Vec<Vec<f64>> = inverse
+                .iter()
+                .map(|r| r.iter().map(|v| 2.0 * v).collect())
+                .collect();
+            let errors = (0..n).map(|i| cov[i][i].sqrt()).collect();
+            (errors, Some(cov), count.get())
+        }
+        Err(_) => (vec![f64::NAN; n], None, count.get()),
+    }
+}
+
+/// The profile crossings of Δ = 1 of every parameter: (lower, upper) per parameter and the
+/// evaluations used; `Err` with a profile point that is lower than `best` by more than 0.01.
+fn intervals(
+    problem: &Problem,
+    best: &Minimum,
+    errors: &[f64],
+    cov: Option<&[Vec<f64>]>,
+) -> std::result::Result<(Vec<(f64, f64)>, usize), Minimum> {
+    let n = best.x.len();
+    let mut used = 0;
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let start = if errors[i].is_finite() && errors[i] > 0.0 {
+            errors[i]
+        } else {
+            best.sigma[i]
+        };
+        let mut ends = [f64::NAN; 2];
+        for (side, end) in [-1.0, 1.0].into_iter().zip(ends.iter_mut()) {
+            let bound = if side < 0.0 {
+                problem.lo[i]
+            } else {
+                problem.hi[i]
+            };
+            let mut d = start;
+            for _ in 0..8 {
+                let v = best.x[i] + side * d;
+                let at_bound = (v - bound) * side >= 0.0;
+                let v = if at_bound { bound } else { v };
+                let guess = regression(&best.x, cov, i, v);
+                let m = profile_at(problem, &best.sigma, i, v, &guess);
+                used += m.evaluations;
+                let delta = m.value - best.value;
+                if delta < -AGREEMENT {
+                    return Err(m);
+                }
+                let root = delta.max(0.0).sqrt();
+                if (root - 1.0).abs() < CROSSING_TOLERANCE {
+                    *end = v;
+                    break;
+                }
+                if at_bound && root < 1.0 {
+                    break;
+                }
+                // √Δ ∝ distance for a Gaussian likelihood; at most 4× further per step.
+                let reach = (v - best.x[i]).abs();
+                d = reach / root.max(0.25);
+            }
+        }
+        out.push((ends[0], ends[1]));
+    }
+    Ok((out, used))
+}
+
+/// The fit of `objective` (module docs).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for no start or no start with a finite −2 ln L; as the model's
+/// evaluation.
+pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit> {
+    if search.starts == 0 {
+        return Err(Error::InvalidParameter {
+            name: "number of starts",
+            value: 0.0,
+            reason: "the fit needs at least one start",
+        });
+    }
+    let (lo, hi, scale) = bounds(objective);
+    let mut x0: Vec<f64> = objective.free.iter().map(|&i| objective.start[i]).collect();
+    for (j, v) in x0.iter_mut().enumerate() {
+        *v = v.clamp(lo[j], hi[j]);
+    }
+    // Errors of the model at the start are the user's: reported as they are.
+    objective.evaluate(&x0)?;
+    let f = |x: &[f64]| objective.cost(x);
+    let problem = Problem {
+        f: &f,
+        lo: lo.clone(),
+        hi: hi.clone(),
+        scale,
+        tolerance: EXPECTED_DECREASE,
+    };
+    let multi = multistart(&problem, &starts(objective, &x0, &lo, &hi, search));
+    let mut best = multi.best().clone();
+    if !best.value.is_finite() {
+        return Err(Error::InvalidParameter {
+            name: "number of starts with a finite -2 ln L",
+            value: 0.0,
+            reason: "no start gave a finite likelihood (every one outside the model's domain)",
+        });
+    }
+    let mut evaluations = multi.evaluations();
+    if std::env::var_os("PT_FIT_DEBUG").is_some() {
+        for m in &multi.minima {
+            eprintln!(
+                "start: {} evals, value {}, converged {}",
+                m.evaluations, m.value, m.converged
+            );
+        }
+    }
+    let mut moved = false;
+    let n = best.x.len();
+    let mut restarts = 0;
+    let (hessian, covariance, intervals) = loop {
+        let (errors, cov, used) = hessian_errors(&problem, &best);
+        evaluations += used;
+        if !search.profile_check {
+            break (errors, cov, vec![(f64::NAN, f64::NAN); n]);
+        }
+        match intervals(&problem, &best, &errors, cov.as_deref()) {
+            Ok((found, used)) => {
+                evaluations += used;
+                break (errors, cov, found);
+            }
+            Err(lower) if restarts < RESTARTS => {
+                restarts += 1;
+                moved = true;
+                best = problem.minimise(&lower.x);
+                evaluations += best.evaluations + lower.evaluations;
+            }
+            Err(_) => break (errors, cov, vec![(f64::NAN, f64::NAN); n]),
+        }
+    };
+    if std::env::var_os("PT_FIT_DEBUG").is_some() {
+        eprintln!("total {evaluations} evals");
+    }
+    let (minus_two_log_l, chi2, slots, marginalised_errors) = objective.evaluate(&best.x)?;
+    let (params, ap) = objective.split(&slots)?;
+    let mut errors = hessian.clone();
+    let mut from_profile = vec![false; n];
+    for j in 0..n {
+        let (a, b) = intervals[j];
+        let half = 0.5 * (b - a);
+        if half.is_finite() && !(((half / hessian[j]) - 1.0).abs() <= PROFILE_AGREEMENT) {
+            errors[j] = half;
+            from_profile[j] = true;
+        }
+    }
+    Ok(GalaxyFit {
+        best: params,
+        ap,
+        errors,
+        hessian_errors: hessian,
+        covariance,
+        intervals,
+        from_profile,
+        marginalised_errors,
+        chi2,
+        minus_two_log_l,
+        points: objective.points(),
+        starts: multi.minima.len(),
+        agree: multi.agree,
+        spread: multi.worst_value() - multi.best().value,
+        moved_by_profile: moved,
+        evaluations,
+    })
+}
+
+/// The grid of a profile: `points` values over ± `span` times the fitted error around the best fit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProfileGrid {
+    /// Values (≥ 3).
+    pub points: usize,
+    /// The half-width in units of the fitted error (> 0).
+    pub span: f64,
+}
+
+/// One point of a profile.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProfilePoint {
+    /// The profiled parameter's value.
+    pub value: f64,
+    /// −2 ln L with the others re-minimised.
+    pub minus_two_log_l: f64,
+    /// χ² there.
+    pub chi2: f64,
+    /// Every parameter there (the marginalised ones at â).
+    pub best: EptParams,
+    /// The distortion there.
+    pub ap: Option<crate::rsd::ap::Distortion>,
+}
+
+/// The profile likelihood of one free parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GalaxyProfile {
+    /// The parameter.
+    pub name: String,
+    /// The best fit (with the Δ = 1 interval of every free parameter).
+    pub fit: GalaxyFit,
+    /// The profile, in increasing value.
+    pub points: Vec<ProfilePoint>,
+}
+
+/// The profile of the free parameter `name` of `request` on `grid` around the best fit: at each
+/// value the other free parameters re-minimised (started from the neighbouring point's), the linear
+/// ones marginalised or profiled as `search` says. Δ(−2 ln L) = 1 bounds the 68.3% interval
+/// ([`GalaxyFit::intervals`]), 4 the 95.4% one.
+///
+/// # Errors
+/// [`Error::InvalidChoice`] if `name` is not free; [`Error::InvalidParameter`] for a grid of fewer
+/// than 3 or more than 401 points or a span that is not finite and positive; as
+/// [`super::fit_galaxy_search`].
+#[allow(clippy::too_many_arguments)]
+pub fn profile_galaxy(
+    plan: &EptPlan,
+    terms: &EptTerms,
+    data: &MultipoleData,
+    request: &GalaxyFitRequest,
+    observation: Option<&Observation>,
+    search: &Search,
+    name: &str,
+    grid: &ProfileGrid,
+) -> Result<GalaxyProfile> {
+    let slot = index(name)?;
+    if !(3..=401).contains(&grid.points) {
+        return Err(Error::InvalidParameter {
+            name: "profile grid points",
+            value: grid.points as f64,
+            reason: "must be between 3 and 401",
+        });
+    }
+    if !(grid.span.is_finite() && grid.span > 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "profile span (in fitted errors)",
+            value: grid.span,
+            reason: "must be finite and positive",
+        });
+    }
+    let mut objective = super::objective::objective(plan, terms, data, request, observation)?;
+    objective.log_det = search.linear == Linear::Marginalised;
+    let Some(i) = objective.free.iter().position(|&s| s == slot) else {
+        return Err(Error::InvalidChoice {
+            what: format!("the profile of {name}"),
+            reason: format!(
+                "{name} is not free (free: {}): only a free parameter has a profile",
+                request.free.join(", ")
+            ),
+        });
+    };
+    let fit = solve(&objective, search)?;
+    let (lo, hi, _) = bounds(&objective);
+    let f = |x: &[f64]| objective.cost(x);
+    let problem = Problem {
+        f: &f,
+        lo,
+        hi,
+        scale: vec![],
+        tolerance: EXPECTED_DECREASE,
+    };
+    let value_of = |s: usize| match s.checked_sub(PARAM_NAMES.len()) {
+        None => fit.best.values[s],
+        Some(0) => fit.ap.map_or(f64::NAN, |d| d.apar),
+        Some(_) => fit.ap.map_or(f64::NAN, |d| d.aperp),
+    };
+    let best: Vec<f64> = objective.free.iter().map(|&s| value_of(s)).collect();
+    let sigma: Vec<f64> = fit
+        .errors
+        .iter()
+        .zip(objective.free.iter())
+        .map(|(&e, &s)| {
+            if e.is_finite() && e > 0.0 {
+                e
+            } else {
+                RANGES[s].4
+            }
+        })
+        .collect();
+    let n = grid.points;
+    let values: Vec<f64> = (0..n)
+        .map(|j| best[i] + grid.span * sigma[i] * (2.0 * j as f64 / (n - 1) as f64 - 1.0))
+        .map(|v| v.clamp(problem.lo[i], problem.hi[i]))
+        .collect();
+    // From the centre outwards, each point started from its inner neighbour's optimum.
+    let mut found: Vec<Option<Minimum>> = vec![None; n];
+    let centre = values
+        .iter()
+        .enumerate()
+        .min_by(|a, b| (a.1 - best[i]).abs().total_cmp(&(b.1 - best[i]).abs()))
+        .map_or(0, |(j, _)| j);
+    let order: Vec<usize> = (centre..n).chain((0..centre).rev()).collect();
+    for j in order {
+        let guess = if j >= centre && j > centre {
+            found[j - 1].as_ref().map_or(best.clone(), |m| m.x.clone())
+        } else if j < centre {
+            found[j + 1].as_ref().map_or(best.clone(), |m| m.x.clone())
+        } else {
+            best.clone()
+        };
+        found[j] = Some(profile_at(&problem, &sigma, i, values[j], &guess));
+    }
+    let mut points = Vec::with_capacity(n);
+    for m in found.into_iter().flatten() {
+        let (total, chi2, slots, _) = objective.evaluate(&m.x)?;
+        let (params, ap) = objective.split(&slots)?;
+        points.push(ProfilePoint {
+            value: m.x[i],
+            minus_two_log_l: total,
+            chi2,
+            best: params,
+            ap,
+        });
+    }
+    Ok(GalaxyProfile {
+        name: name.to_string(),
+        fit,
+        points,
+    })
+}

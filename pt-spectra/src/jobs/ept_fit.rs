@@ -1,0 +1,459 @@
+//! `fit --rsd ept`: the best fits of the galaxy model versus k_max, and the profile likelihood of a
+//! parameter, as tables.
+
+use super::ept::AP_FIT_RANGE;
+use crate::error::Result;
+use crate::fit::bounded::{AGREEMENT, EXPECTED_DECREASE};
+use crate::fit::galaxy::search::{CROSSING_TOLERANCE, HESSIAN_STEP, PROFILE_AGREEMENT};
+use crate::fit::galaxy::{
+    derived, fit_galaxy_search, profile_galaxy, Derived, GalaxyFit, GalaxyFitRequest, Linear,
+    ProfileGrid, Search, Template,
+};
+use crate::fit::MultipoleData;
+use crate::output::{Table, WAVENUMBER};
+use crate::rsd::ept::{EptPlan, EptTerms, PARAM_NAMES};
+use crate::survey::observe::Observation;
+
+/// What a fit's table needs besides the plan, data and request.
+#[derive(Clone)]
+pub struct FitContext<'a> {
+    /// The window and bins between the model and the data, if any.
+    pub observation: Option<&'a Observation>,
+    /// How the minimum is searched for.
+    pub search: Search,
+    /// The template of the derived parameters (fσ8, …); `None`: no derived columns.
+    pub template: Option<Template>,
+    /// The caller's header lines (the command, the inputs).
+    pub header: Vec<String>,
+}
+
+/// The header lines of the search and the errors.
+fn search_lines(request: &GalaxyFitRequest, context: &FitContext) -> Vec<String> {
+    let s = &context.search;
+    let mut lines = vec![format!(
+        "minimiser: bounded quasi-Newton (BFGS, central-difference gradients) from {} starts (the \
+         start given, then draws from the priors or the start box, seed {}), converged to an \
+         expected decrease < {EXPECTED_DECREASE:e}; the lowest minimum is taken; starts_agree: the \
+         starts within {AGREEMENT} of it in -2 ln L, starts_spread: the highest start's minimum minus \
+         the lowest",
+        s.starts, s.seed
+    )];
+    lines.push(if s.profile_check {
+        format!(
+            "errors of the free parameters: err_<p>_hessian = sqrt(diag 2 H^-1), H the Hessian of -2 ln \
+             L by central differences of {HESSIAN_STEP} conditional sigma; <p>_lo, <p>_hi: where the \
+             profile -2 ln L (the others re-minimised) is 1 above the minimum (sqrt(delta) to \
+             {CROSSING_TOLERANCE}); err_<p> is the Hessian's unless the profile's half-width differs \
+             from it by more than {:.0}% (err_<p>_from_profile = 1: then the half-width)",
+            100.0 * PROFILE_AGREEMENT
+        )
+    } else {
+        "errors of the free parameters: sqrt(diag 2 H^-1) (Gaussian; the profile check is off)".into()
+    });
+    if s.linear == Linear::Profiled {
+        lines.push(
+            "linear parameters profiled (at their best values, no ln det F term), not marginalised"
+                .into(),
+        );
+    }
+    if let Some(t) = &context.template {
+        lines.push(format!(
+            "derived: fsigma8 = f sigma8_z, sigma8_z = {} (the template's linear matter spectrum at z = \
+             {}); errors propagated linearly with the Hessian's correlations{}",
+            t.sigma8_z,
+            t.z,
+            if request.ap.is_some() {
+                "; alpha_iso = apar^(1/3) aperp^(2/3), alpha_ap = apar/aperp (relative to the \
+                 fiducial the data were measured in); DM_over_DH = D_M/D_H and DV_over_rd = D_V/r_d \
+                 from the template's distances times the fitted alphas over their start values, \
+                 r_d of the template by Aubourg et al. 2015 eq. 16"
+            } else {
+                " (no distortion: no alpha or distance columns)"
+            }
+        ));
+    }
+    lines
+}
+
+/// `fit --rsd ept`: one best fit per k_max of `request` (its k_max replaced), a row each: `k_max
+/// points chi2 minus_2_ln_L starts starts_agree starts_spread`; per parameter its best value and (free
+/// or marginalised) `err_<p>`; per free parameter `err_<p>_hessian <p>_lo <p>_hi
+/// err_<p>_from_profile`; the derived parameters and their errors ([`crate::fit::galaxy::derived`]).
+///
+/// Returns the table and the fits.
+///
+/// # Errors
+/// As [`crate::fit::galaxy::fit_galaxy_search`].
+pub fn ept_fit_table(
+    plan: &EptPlan,
+    terms: &EptTerms,
+    data: &MultipoleData,
+    request: &GalaxyFitRequest,
+    k_max: &[f64],
+    context: &FitContext,
+) -> Result<(Table, Vec<GalaxyFit>)> {
+    let mut fits = Vec::with_capacity(k_max.len());
+    for &k in k_max {
+        let mut r = request.clone();
+        r.k_max = k;
+        fits.push(fit_galaxy_search(
+            plan,
+            terms,
+            data,
+            &r,
+            context.observation,
+            &context.search,
+        )?);
+    }
+    let mut t = Table::new(fit_header(terms, request, context));
+    if context.observation.is_some_and(Observation::is_xi) {
+        t.push("s_max", "Mpc/h", k_max.to_vec());
+    } else {
+        t.push("k_max", WAVENUMBER, k_max.to_vec());
+    }
+    fit_columns(&mut t, &fits, request, context);
+    Ok((t, fits))
+}
+
+/// `fit --rsd ept --model-out`: `k`, the data `P<l>_data err_P<l>_data` and the best-fit model
+/// `P<l>_kmax<K>` of each fit (of [`ept_fit_table`], at `k_max`; the marginalised parameters at â;
+/// through the observation, if any) on every k of the data.
+///
+/// # Errors
+/// As [`EptPlan::multipole_values_at`] and [`Observation::apply_values`].
+pub fn ept_model_table(
+    plan: &EptPlan,
+    terms: &EptTerms,
+    data: &MultipoleData,
+    request: &GalaxyFitRequest,
+    fits: &[GalaxyFit],
+    k_max: &[f64],
+    context: &FitContext,
+) -> Result<Table> {
+    let mut header = fit_header(terms, request, context);
+    header.push(
+        "P<l>_data, err_P<l>_data: the data (sqrt of the covariance's diagonal); P<l>_kmax<K>: the \
+         best-fit model of the fit up to k_max = K (marginalised parameters at their best values), \
+         through the window and bins if any, on every k"
+            .into(),
+    );
+    let mut t = Table::new(header);
+    t.push("k", WAVENUMBER, data.k.clone());
+    for &l in &request.ells {
+        if let Some(j) = data.ells.iter().position(|&d| d == l) {
+            t.push(
+                format!("P{l}_data"),
+                crate::output::POWER,
+                data.values[j].clone(),
+            );
+            t.push(
+                format!("err_P{l}_data"),
+                crate::output::POWER,
+                data.sigma[j].clone(),
+            );
+        }
+    }
+    for (fit, &k) in fits.iter().zip(k_max) {
+        let m = match context.observation {
+            None => plan.multipole_values_at(terms, &fit.best, &request.ells, fit.ap)?,
+            Some(o) => {
+                let model = plan.multipole_values_at(terms, &fit.best, o.model_ells(), fit.ap)?;
+                o.apply_values(&model)?
+            }
+        };
+        let suffix = format!("{k:.4}");
+        let suffix = suffix.trim_end_matches('0').trim_end_matches('.');
+        for (l, p) in request.ells.iter().zip(m) {
+            t.push(format!("P{l}_kmax{suffix}"), crate::output::POWER, p);
+        }
+    }
+    Ok(t)
+}
+
+/// The header of a fit's table: the caller's lines, the terms' source, the observation, the AP,
+/// the fitted data, the search and the errors.
+fn fit_header(terms: &EptTerms, request: &GalaxyFitRequest, context: &FitContext) -> Vec<String> {
+    let observation = context.observation;
+    let mut header = context.header.clone();
+    header.extend(terms.describe_source());
+    if let Some(o) = observation {
+        header.extend(o.description().iter().cloned());
+    }
+    let xi = observation.is_some_and(Observation::is_xi);
+    if let Some(d) = request.ap {
+        header.push(format!(
+            "Alcock-Paczynski: the data measured with apar = {}, aperp = {}{}",
+            d.apar,
+            d.aperp,
+            if request.free.iter().any(|n| n == "apar" || n == "aperp") {
+                format!(
+                    " (start values; free ones searched in [{}, {}])",
+                    AP_FIT_RANGE.0, AP_FIT_RANGE.1
+                )
+            } else {
+                String::new()
+            }
+        ));
+    }
+    let (var, unit_of_var) = if xi { ("s", "Mpc/h") } else { ("k", "h/Mpc") };
+    let ranges: String = request
+        .ell_ranges
+        .iter()
+        .map(|(l, a, b)| format!(" (l = {l}: within [{a}, {b}] {unit_of_var})"))
+        .collect();
+    header.push(format!(
+        "fit of ept to {} multipoles {:?} for {var} in [{}, {var}_max] {unit_of_var}{ranges}: free {}, marginalised analytically {} (errors sqrt((F^-1)_ii) at the best fit), \
+         priors {}; -2 ln L = chi2 + priors + ln det F",
+        if xi { "correlation-function" } else { "power-spectrum" },
+        request.ells,
+        request.k_min,
+        request.free.join(","),
+        if request.marginalise.is_empty() {
+            "none".to_string()
+        } else {
+            request.marginalise.join(",")
+        },
+        if request.priors.is_empty() {
+            "none".to_string()
+        } else {
+            request
+                .priors
+                .iter()
+                .map(|p| format!("{}: {}", p.name, p.shape))
+                .collect::<Vec<_>>()
+                .join(", ")
+        }
+    ));
+    header.extend(search_lines(request, context));
+    header
+}
+
+/// The columns of `fits` after the first (k_max or s_max).
+fn fit_columns(
+    t: &mut Table,
+    fits: &[GalaxyFit],
+    request: &GalaxyFitRequest,
+    context: &FitContext,
+) {
+    t.push(
+        "points",
+        "1",
+        fits.iter().map(|f| f.points as f64).collect(),
+    );
+    t.push("chi2", "1", fits.iter().map(|f| f.chi2).collect());
+    t.push(
+        "minus_2_ln_L",
+        "1",
+        fits.iter().map(|f| f.minus_two_log_l).collect(),
+    );
+    let ap_names: &[&str] = if request.ap.is_some() {
+        &crate::fit::galaxy::AP_NAMES
+    } else {
+        &[]
+    };
+    let value = |i: usize, f: &GalaxyFit| match (i.checked_sub(12), f.ap) {
+        (None, _) => f.best.values[i],
+        (Some(0), Some(d)) => d.apar,
+        (Some(_), Some(d)) => d.aperp,
+        (Some(_), None) => f64::NAN,
+    };
+    for (i, name) in PARAM_NAMES.iter().chain(ap_names).enumerate() {
+        t.push(
+            *name,
+            unit(name),
+            fits.iter().map(|f| value(i, f)).collect(),
+        );
+        let err = |f: &GalaxyFit| {
+            if let Some(j) = request.free.iter().position(|n| n == name) {
+                Some(f.errors[j])
+            } else {
+                request
+                    .marginalise
+                    .iter()
+                    .position(|n| n == name)
+                    .map(|j| f.marginalised_errors[j])
+            }
+        };
+        if fits.first().and_then(err).is_some() {
+            let values: Vec<f64> = fits.iter().map(|f| err(f).unwrap_or(f64::NAN)).collect();
+            t.push_undefined_as(
+                format!("err_{name}"),
+                unit(name),
+                values,
+                "NaN where the Hessian of -2 ln L is not positive definite and the profile has \
+                 no crossing",
+            );
+        }
+        if let Some(j) = request.free.iter().position(|n| n == name) {
+            free_columns(t, fits, name, j);
+        }
+    }
+    t.push(
+        "starts",
+        "1",
+        fits.iter().map(|f| f.starts as f64).collect(),
+    );
+    t.push(
+        "starts_agree",
+        "1",
+        fits.iter().map(|f| f.agree as f64).collect(),
+    );
+    t.push(
+        "starts_spread",
+        "1",
+        fits.iter().map(|f| f.spread).collect(),
+    );
+    if let Some(template) = &context.template {
+        let all: Vec<Vec<Derived>> = fits.iter().map(|f| derived(f, request, template)).collect();
+        for (j, d) in all.first().map_or(&[][..], |d| &d[..]).iter().enumerate() {
+            t.push(d.name, "1", all.iter().map(|d| d[j].value).collect());
+            if d.name != "sigma8_z" {
+                t.push(
+                    format!("err_{}", d.name),
+                    "1",
+                    all.iter().map(|d| d[j].error).collect(),
+                );
+            }
+        }
+    }
+}
+
+/// The error columns of the free parameter `name` (the j-th free).
+fn free_columns(t: &mut Table, fits: &[GalaxyFit], name: &str, j: usize) {
+    t.push_undefined_as(
+        format!("err_{name}_hessian"),
+        unit(name),
+        fits.iter().map(|f| f.hessian_errors[j]).collect(),
+        "NaN where the Hessian of -2 ln L is not positive definite",
+    );
+    let none = "NaN where the profile does not reach delta = 1 inside the parameter's bounds";
+    t.push_undefined_as(
+        format!("{name}_lo"),
+        unit(name),
+        fits.iter().map(|f| f.intervals[j].0).collect(),
+        none,
+    );
+    t.push_undefined_as(
+        format!("{name}_hi"),
+        unit(name),
+        fits.iter().map(|f| f.intervals[j].1).collect(),
+        none,
+    );
+    t.push(
+        format!("err_{name}_from_profile"),
+        "1",
+        fits.iter()
+            .map(|f| f64::from(u8::from(f.from_profile[j])))
+            .collect(),
+    );
+}
+
+/// The unit of an ept parameter.
+fn unit(name: &str) -> &'static str {
+    match name {
+        "alpha0" | "alpha2" | "alpha4" | "alpha6" => "(Mpc/h)^2",
+        "sn" => "(Mpc/h)^3",
+        "sn2" => "(Mpc/h)^5",
+        "sn4" => "(Mpc/h)^7",
+        _ => "1",
+    }
+}
+
+/// `fit --rsd ept --profile P`: the profile likelihood of the free parameter `name` at `request`'s
+/// k_max on `grid`, a row per value: `<P> minus_2_ln_L delta_minus_2_ln_L chi2` and every other
+/// free parameter (and marginalised one, at â) there. The header gives the best fit and the
+/// Δ(−2 ln L) = 1 interval of `name` and its Hessian error.
+///
+/// # Errors
+/// As [`crate::fit::galaxy::profile_galaxy`].
+pub fn ept_profile_table(
+    plan: &EptPlan,
+    terms: &EptTerms,
+    data: &MultipoleData,
+    request: &GalaxyFitRequest,
+    context: &FitContext,
+    name: &str,
+    grid: &ProfileGrid,
+) -> Result<Table> {
+    let profile = profile_galaxy(
+        plan,
+        terms,
+        data,
+        request,
+        context.observation,
+        &context.search,
+        name,
+        grid,
+    )?;
+    let fit = &profile.fit;
+    let j = request
+        .free
+        .iter()
+        .position(|n| n == name)
+        .expect("profile_galaxy checked that the parameter is free");
+    let mut header = fit_header(terms, request, context);
+    header.push(format!(
+        "profile of {name} at k_max = {}: {} points over +- {} times its error around the best fit \
+         {name} = {}, -2 ln L = {}; the other free parameters re-minimised at each point{}; \
+         delta_minus_2_ln_L = 1 (4) bounds the 68.3% (95.4%) interval: [{}, {}] (Hessian error {})",
+        request.k_max,
+        grid.points,
+        grid.span,
+        value_of(fit, name),
+        fit.minus_two_log_l,
+        if context.search.linear == Linear::Profiled {
+            ", the linear ones profiled"
+        } else if request.marginalise.is_empty() {
+            ""
+        } else {
+            ", the linear ones marginalised analytically"
+        },
+        fit.intervals[j].0,
+        fit.intervals[j].1,
+        fit.hessian_errors[j]
+    ));
+    let mut t = Table::new(header);
+    let points = &profile.points;
+    let at = |p: &crate::fit::galaxy::ProfilePoint, n: &str| match n {
+        "apar" => p.ap.map_or(f64::NAN, |d| d.apar),
+        "aperp" => p.ap.map_or(f64::NAN, |d| d.aperp),
+        n => p.best.get(n).unwrap_or(f64::NAN),
+    };
+    t.push(name, unit(name), points.iter().map(|p| p.value).collect());
+    t.push(
+        "minus_2_ln_L",
+        "1",
+        points.iter().map(|p| p.minus_two_log_l).collect(),
+    );
+    t.push(
+        "delta_minus_2_ln_L",
+        "1",
+        points
+            .iter()
+            .map(|p| p.minus_two_log_l - fit.minus_two_log_l)
+            .collect(),
+    );
+    t.push("chi2", "1", points.iter().map(|p| p.chi2).collect());
+    for n in request
+        .free
+        .iter()
+        .chain(&request.marginalise)
+        .filter(|n| *n != name)
+    {
+        t.push(
+            n.as_str(),
+            unit(n),
+            points.iter().map(|p| at(p, n)).collect(),
+        );
+    }
+    Ok(t)
+}
+
+/// The best-fit value of the parameter `name` (α∥, α⊥ from the distortion).
+fn value_of(fit: &GalaxyFit, name: &str) -> f64 {
+    match name {
+        "apar" => fit.ap.map_or(f64::NAN, |d| d.apar),
+        "aperp" => fit.ap.map_or(f64::NAN, |d| d.aperp),
+        n => fit.best.get(n).unwrap_or(f64::NAN),
+    }
+}
