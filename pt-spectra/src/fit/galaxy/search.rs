@@ -375,8 +375,14 @@ pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit>
         minus_two_log_l,
         points: objective.points(),
         starts: multi.minima.len(),
-        agree: multi.agree,
-        spread: multi.worst_value() - multi.best().value,
+        // counted against the final minimum: after a profile found a lower one, the starts that
+        // reached it (possibly none)
+        agree: multi
+            .minima
+            .iter()
+            .filter(|m| m.value - best.value < AGREEMENT)
+            .count(),
+        spread: multi.worst_value() - best.value,
         moved_by_profile: moved,
         evaluations,
     })
