@@ -345,7 +345,7 @@ pub(crate) fn fit_ept(
             template: Some(pt_spectra::fit::galaxy::Template {
                 sigma8_z: prepared.spectrum.sigma8(),
                 z: prepared.z,
-                cosmology: Some(prepared.cosmology.cosmology.clone()),
+                cosmology: Some(prepared.cosmology.cosmology),
             }),
             header,
         };

@@ -46,6 +46,19 @@ def test_the_plan_gives_the_table_and_parameter_steps_are_polynomial():
     np.testing.assert_allclose(b, 0.5 * (b_lo + b_hi), rtol=1e-12)
 
 
+def test_the_effective_triangle_shortcut_states_its_error():
+    bins = np.array([[0.015, 0.015, 0.015], [0.015, 0.025, 0.035], [0.045, 0.055, 0.065]])
+    kwargs = dict(b1=1.8, b2=0.2, bs=-0.1)
+    average = pt.BispectrumPlan(bins, bin_width=0.01).terms(z=0.5, q_par=1.02, q_perp=0.99)
+    shortcut = pt.BispectrumPlan(bins, bin_width=0.01, effective=True).terms(
+        z=0.5, q_par=1.02, q_perp=0.99)
+    (a, ea), (s, es) = average.multipoles(**kwargs), shortcut.multipoles(**kwargs)
+    assert np.all(np.abs(s - a) <= es + ea)
+    assert np.any(np.abs(s[:, 0] - a[:, 0]) > 10 * ea[:, 0])
+    with pytest.raises(ValueError, match="bin_width"):
+        pt.BispectrumPlan(bins, effective=True)
+
+
 @pytest.mark.filterwarnings("ignore::pt_spectra.PtSpectraWarning")
 @pytest.mark.parametrize("kwargs, needle", [
     (dict(triangles=[[0.01, 0.02, 0.05]]), "does not close"),

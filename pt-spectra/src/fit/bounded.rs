@@ -222,13 +222,13 @@ impl Problem<'_> {
             };
             let mut d = direction(&inverse);
             let mut slope: f64 = d.iter().zip(&g).map(|(a, b)| a * b).sum();
-            if !(slope < 0.0) {
+            if slope.is_nan() || slope >= 0.0 {
                 inverse = diagonal(&sigma);
                 d = direction(&inverse);
                 slope = d.iter().zip(&g).map(|(a, b)| a * b).sum();
             }
             // ½ gᵀH⁻¹g over the free variables: the decrease still expected.
-            if !(slope < 0.0) || -0.5 * slope < self.tolerance {
+            if slope.is_nan() || slope >= 0.0 || -0.5 * slope < self.tolerance {
                 converged = true;
                 break;
             }
@@ -251,7 +251,7 @@ impl Problem<'_> {
                     break;
                 }
             }
-            if !(f_new < f0) {
+            if f_new.is_nan() || f_new >= f0 {
                 // No decrease to rounding along the quasi-Newton direction.
                 converged = -0.5 * slope < 1e3 * self.tolerance;
                 break;
@@ -282,7 +282,7 @@ fn bfgs_update(h: &mut [Vec<f64>], s: &[f64], y: &[f64]) {
     let sy: f64 = s.iter().zip(y).map(|(a, b)| a * b).sum();
     let norm =
         s.iter().map(|v| v * v).sum::<f64>().sqrt() * y.iter().map(|v| v * v).sum::<f64>().sqrt();
-    if !(sy > 1e-10 * norm) {
+    if sy.is_nan() || sy <= 1e-10 * norm {
         return;
     }
     let rho = 1.0 / sy;

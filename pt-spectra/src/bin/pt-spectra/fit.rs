@@ -363,7 +363,7 @@ fn run_ept(args: &Args) -> Result<()> {
         template: Some(pt_spectra::fit::galaxy::Template {
             sigma8_z: loaded.prepared.spectrum.sigma8(),
             z: loaded.prepared.z,
-            cosmology: Some(loaded.prepared.cosmology.cosmology.clone()),
+            cosmology: Some(loaded.prepared.cosmology.cosmology),
         }),
         header,
     };

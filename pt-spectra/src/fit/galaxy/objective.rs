@@ -20,6 +20,9 @@ const TEMPLATE_TOLERANCE: f64 = 1e-10;
 /// f, α∥, α⊥ before them made their own).
 const CACHE_SIZE: usize = 8;
 
+/// A cached template: the key of the slots it was made at and its rows.
+type CachedTemplate = (Vec<u64>, Vec<Vec<f64>>);
+
 /// The objective of one request on one data window.
 pub(super) struct Objective<'a> {
     pub(super) plan: &'a EptPlan,
@@ -40,7 +43,7 @@ pub(super) struct Objective<'a> {
     /// Whether the marginalised templates are independent of the biases (checked at construction).
     bias_free_templates: bool,
     /// The last [`CACHE_SIZE`] templates and the slots they were made at ([`Self::template_key`]).
-    cache: std::cell::RefCell<Vec<(Vec<u64>, Vec<Vec<f64>>)>>,
+    cache: std::cell::RefCell<Vec<CachedTemplate>>,
     /// Whether −2 ln L holds ln det F (the linear parameters marginalised), or not (profiled).
     pub(super) log_det: bool,
     /// L⁻¹ of the Cholesky factor of the window's covariance.

@@ -235,6 +235,7 @@ fn intervals(
     let n = best.x.len();
     let mut used = 0;
     let mut out = Vec::with_capacity(n);
+    #[allow(clippy::needless_range_loop)] // i indexes the bounds, the best fit and its errors alike
     for i in 0..n {
         let start = if errors[i].is_finite() && errors[i] > 0.0 {
             errors[i]
@@ -357,7 +358,7 @@ pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit>
     for j in 0..n {
         let (a, b) = intervals[j];
         let half = 0.5 * (b - a);
-        if half.is_finite() && !(((half / hessian[j]) - 1.0).abs() <= PROFILE_AGREEMENT) {
+        if half.is_finite() && ((half / hessian[j]) - 1.0).abs() > PROFILE_AGREEMENT {
             errors[j] = half;
             from_profile[j] = true;
         }

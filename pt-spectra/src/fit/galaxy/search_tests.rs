@@ -347,7 +347,7 @@ fn derived_parameters_from_their_definitions() {
     let template = Template {
         sigma8_z: spectrum.sigma8(),
         z: 0.5,
-        cosmology: Some(c.clone()),
+        cosmology: Some(c),
     };
     let d = derived(&fit, &request, &template);
     let get = |n: &str| d.iter().find(|x| x.name == n).unwrap();
