@@ -17,7 +17,8 @@ Settings (stated in the report too):
 - P: P0, P2 at 0.02 <= k <= 0.15 h/Mpc, parameters b1, b2, bs, alpha0, alpha2, sn (velocileptors' names);
 - B: B0 of the bins with largest side <= k_max(B), averaged over their closed triangles (width 0.01),
   IR-resummed, no FoG, counterterm c1 and the stochastic terms b_shot, a_shot at n_bar = 3e-4 (h/Mpc)^3
-  free (p_shot = 0); B2, B4 are not fitted (B2 of some isosceles bins is not yet understood: docs/bispectrum.md);
+  free (p_shot = 0); B2, B4 are not fitted (the tree-level B2 without FoG is 10-25% off the mocks by
+  bin class: docs/bispectrum.md);
 - covariance: the Patchy P + B covariance of one NGC volume (so the errors are those of one BOSS-like
   volume, not of the mean of 84 mocks), Hartlap-corrected; B enters through the joint covariance;
 - B depends on f beyond a polynomial only through the IR damping: its terms are computed at 7 values of f

@@ -3,6 +3,7 @@
 //! with the parameters (per step, microseconds).
 
 use super::geometry::{orientations, LegendreSide, TriangleSet};
+use super::observed::{accumulate, observed_slots};
 use super::resum::IrInputs;
 use super::sampled::Sampled;
 use super::{BispectrumParams, Settings};
@@ -291,7 +292,6 @@ impl BispectrumPlan {
         // Without an anisotropic distortion the true sides k/q do not depend on the orientation:
         // the spectra are looked up once per shape, not once per orientation.
         let isotropic = settings.q_par == settings.q_perp;
-        let volume = 1.0 / (settings.q_par * settings.q_perp.powi(2)).powi(2);
         let sum = |shapes: &Vec<Vec<Shape>>| -> Vec<[[f64; SLOTS]; 3]> {
             shapes
                 .iter()
@@ -307,17 +307,13 @@ impl BispectrumPlan {
                             // the azimuths first (λ depends on μ only), then ℓ
                             let mut azimuths = [0.0; SLOTS];
                             for par in &group.par {
-                                let slots = node_slots(shape, par, settings, &power);
+                                let slots =
+                                    observed_slots(shape.k, shape.dots, *par, settings, &power);
                                 for (a, s) in azimuths.iter_mut().zip(&slots) {
                                     *a += s;
                                 }
                             }
-                            for (acc, lambda) in acc.iter_mut().zip(group.lambda) {
-                                let g = volume * lambda;
-                                for (a, s) in acc.iter_mut().zip(&azimuths) {
-                                    *a += g * s;
-                                }
-                            }
+                            accumulate(&mut acc, group.lambda, &azimuths);
                         }
                     }
                     acc
@@ -332,37 +328,6 @@ impl BispectrumPlan {
             triangles: self.set.triangles().to_vec(),
         })
     }
-}
-
-/// The monomial slots of one orientation of a shape (sides' line-of-sight components `par` in the
-/// observed frame), in the true frame after AP, the FoG factor in the slots it damps. `power(i, k, μ)`
-/// is the (resummed) linear power of side i at its true k, μ.
-fn node_slots(
-    shape: &Shape,
-    par: &[f64; 3],
-    s: &Settings,
-    power: &dyn Fn(usize, f64, f64) -> f64,
-) -> [f64; SLOTS] {
-    let (qp2, qt2) = (s.q_par * s.q_par, s.q_perp * s.q_perp);
-    let par_true = par.map(|p| p / s.q_par);
-    let k2: [f64; 3] = [0, 1, 2].map(|i| {
-        let perp2 = (shape.k[i] * shape.k[i] - par[i] * par[i]).max(0.0);
-        par_true[i] * par_true[i] + perp2 / qt2
-    });
-    let k = k2.map(f64::sqrt);
-    let mu = [0, 1, 2].map(|i| par_true[i] / k[i]);
-    let dots = [0, 1, 2].map(|i| {
-        let j = (i + 1) % 3;
-        let pp = par[i] * par[j];
-        pp / qp2 + (shape.dots[i] - pp) / qt2
-    });
-    let p = [0, 1, 2].map(|i| power(i, k[i], mu[i]));
-    let fog = s.fog.factor(par_true.iter().map(|p| p * p).sum());
-    let mut slots = tree_slots(k, dots, par_true, p, s.f);
-    for v in &mut slots[..SLOTS - 1] {
-        *v *= fog;
-    }
-    slots
 }
 
 /// The slots of B at one configuration with true sides of lengths `k`, dot products `dots`, line-of-sight

@@ -548,3 +548,62 @@ fn the_effective_triangle_is_the_bins_mean_triangle_and_its_error_covers_the_bin
         assert!((e[0].value - a[0].value).abs() > a[0].error);
     }
 }
+
+#[test]
+fn on_a_bin_with_two_equal_shells_either_equal_side_may_carry_the_legendre_polynomial() {
+    // The window-free estimator (Philcox 2021) attaches L_ℓ to the field of the third bin and divides
+    // by the symmetry factor Δ_abc (2 for two equal bins, 6 for three): on a bin with two equal shells
+    // it averages L_ℓ over both equal sides. The bin average is symmetric under the exchange of the
+    // two sides, so that average is the plan's value with L_ℓ on either one: the model needs no extra
+    // factor on isosceles or equilateral bins. Checked with anisotropic AP, IR and FoG, which break
+    // every other symmetry of the orientation average.
+    let p_lin = spectrum();
+    let s = Settings {
+        q_par: 1.04,
+        q_perp: 0.97,
+        fog: Fog::Lorentzian { sigma: 4.0 },
+        ir: true,
+        ..settings(0.75)
+    };
+    let b = galaxy();
+    let run = |t: [f64; 3], side| {
+        BispectrumPlan::new(
+            TriangleSet::shells(vec![t], 0.01).unwrap(),
+            side,
+            PlanRules::default(),
+        )
+        .unwrap()
+        .terms(&p_lin, &s)
+        .unwrap()
+        .multipoles(&b)
+        .unwrap()[0]
+    };
+    let equal_sides: [([f64; 3], [usize; 2]); 4] = [
+        ([0.015, 0.035, 0.035], [1, 2]),
+        ([0.035, 0.035, 0.055], [0, 1]),
+        ([0.045, 0.045, 0.045], [0, 2]),
+        ([0.045, 0.045, 0.045], [1, 2]),
+    ];
+    for (t, [i, j]) in equal_sides {
+        let (a, c) = (
+            run(t, LegendreSide::Index(i)),
+            run(t, LegendreSide::Index(j)),
+        );
+        for l in 1..3 {
+            let tol = a[l].error + c[l].error + 1e-12 * a[0].value.abs();
+            assert!(
+                (a[l].value - c[l].value).abs() <= tol,
+                "{t:?} ℓ{}: side {i} {} side {j} {}",
+                ELLS[l],
+                a[l].value,
+                c[l].value
+            );
+        }
+    }
+    // and a side of another shell carries another multipole (the test can tell sides apart)
+    let (a, c) = (
+        run([0.015, 0.035, 0.035], LegendreSide::Index(0)),
+        run([0.015, 0.035, 0.035], LegendreSide::Index(2)),
+    );
+    assert!((a[1].value - c[1].value).abs() > 1e-2 * c[1].value.abs());
+}

@@ -58,7 +58,7 @@ pub use ept_fit::{ept_fit_table, ept_model_table, ept_profile_table, FitContext}
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use halo::{halo_table, HaloRequest};
 pub use observe::observed_table;
-pub use report::{contour_table, real_spectra_table, rsd_multipoles_table};
+pub use report::{contour_table, push_spectrum_errors, real_spectra_table, rsd_multipoles_table};
 pub use rsd::{
     describe_sigma0, no_wiggle_multipoles, rsd_table, rsd_table_from_terms,
     rsd_table_from_terms_memo, rsd_table_with_bias_terms, xi_table, NonlinearBias, RsdRequest,
@@ -119,7 +119,8 @@ pub fn two_loop_line(precision: &Precision) -> String {
 }
 
 /// `pt-spectra real`: the spectra of the selected model (or P_dd/P_nw of every model) for the
-/// prepared linear spectrum, with the loop terms if `terms`, and the EFT `counterterms` added (c_s²
+/// prepared linear spectrum (each with its error `err_P_xx`, the last columns without `terms`), with the
+/// loop terms if `terms`, and the EFT `counterterms` added (c_s²
 /// to every model, [`crate::real::counterterm`](mod@crate::real::counterterm); the 2-loop set to
 /// `2l-eft`, `2l-eft-ir`, [`crate::real::eft`]). The header states them; with `terms`, the columns
 /// `P_ct_dd P_ct_dt P_ct_tt` give their sum and, for the EFT models, `T_dd_X T_dt_X T_tt_X` the
@@ -230,6 +231,10 @@ pub fn real_table_with_bias(
             }
             if let Some(b) = bias_terms {
                 bias::push_columns(&mut t, &spectra, &b, bias);
+            }
+            if !terms {
+                // every number with its error (the `--terms` table has them after the spectra)
+                push_spectrum_errors(&mut t, &spectra);
             }
             Ok(t)
         }

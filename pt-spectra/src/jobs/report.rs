@@ -8,6 +8,14 @@ use crate::output::{Table, POWER, WAVENUMBER};
 use crate::real::{RealModel, RealSpectra};
 use crate::rsd::RsdMultipoles;
 
+/// The error columns `err_P_dd err_P_dt err_P_tt` of the spectra (after the spectra with `--terms`;
+/// at the end of the default table, so that the columns before them keep their places).
+pub fn push_spectrum_errors(t: &mut Table, r: &RealSpectra) {
+    for (pair, s) in r.spectra.iter() {
+        t.push(format!("err_P_{}", pair.suffix()), POWER, errors(s));
+    }
+}
+
 /// The spectra as a table with `header` lines: `k P_lin P_dd P_dt P_tt`, and with `terms` also
 /// their errors, every loop term the model uses with its error (`P22_xx`, `P13_xx`, then `P15_xx`,
 /// `P17_xx`, `P24_xx P33_xx P33_2L_xx P2loop_xx` as the model needs them), σ_v² and, for RPT, the
@@ -23,9 +31,7 @@ pub fn real_spectra_table(r: &RealSpectra, header: Vec<String>, terms: bool) -> 
     if !terms {
         return t;
     }
-    for (pair, s) in r.spectra.iter() {
-        t.push(format!("err_P_{}", pair.suffix()), POWER, errors(s));
-    }
+    push_spectrum_errors(&mut t, r);
     let one = &r.terms.one_loop;
     for pair in Pair::ALL {
         t.push_estimates(&format!("P22_{}", pair.suffix()), POWER, &one.p22[pair]);
