@@ -537,7 +537,7 @@ def kernel(which, vectors, exact=False, f=None, los=None):
 def bispectrum(triangles=None, bin_width=None, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None,
                b1=1.0, b2=0.0, bs=0.0, c1=0.0, n_bar=None, b_shot=1.0, p_shot=0.0, a_shot=0.0, f=None,
                q_par=1.0, q_perp=1.0, fog="none", sigma_fog=0.0, ir=True, legendre_side="largest",
-               basis="scoccimarro", pairs=None):
+               basis="scoccimarro", pairs=None, box_size=None):
     """Tree-level galaxy bispectrum multipoles B0, B2, B4 [(Mpc/h)^6] in redshift space.
 
     ``triangles``: an (n, 3) array of k1, k2, k3 [h/Mpc]; with ``bin_width`` [h/Mpc] each row is a bin
@@ -548,6 +548,8 @@ def bispectrum(triangles=None, bin_width=None, linear=None, z=0.0, z_input=0.0, 
     [Mpc/h], IR resummation, the Legendre polynomial on the largest side (or "1", "2", "3").
     Returns a ``Table``: k1 k2 k3 B0 B2 B4 err_B0 err_B2 err_B4, its header and ``meta``.
     For many parameter steps on one spectrum use ``BispectrumPlan(triangles).terms(...).multipoles(...)``.
+    ``box_size`` L [Mpc/h] (with ``bin_width``): the bins averaged exactly over the discrete modes
+    k = (2 pi/L) n of a periodic box, line of sight z, as the FFT box estimator measures them (errors 0).
 
     ``basis="sugiyama"`` with ``pairs`` (an (n, 2) array of k1, k2 [h/Mpc]) gives instead the Sugiyama
     et al. (2019) multipoles B000 B110 B202 B022 B112 B220 (the angle between k1 and k2 integrated;
@@ -558,4 +560,4 @@ def bispectrum(triangles=None, bin_width=None, linear=None, z=0.0, z_input=0.0, 
                        "bin_width (their shell width) to be averaged over", PtSpectraWarning, stacklevel=2)
     return _warn(_core.bispectrum(triangles, bin_width, linear, z, z_input, cosmology, eh, b1, b2, bs,
                                   c1, n_bar, b_shot, p_shot, a_shot, f, q_par, q_perp, fog, sigma_fog, ir,
-                                  legendre_side, basis, pairs))
+                                  legendre_side, basis, pairs, box_size))

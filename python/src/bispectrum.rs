@@ -75,12 +75,13 @@ fn params(
 /// B0, B2, B4 [(Mpc/h)^6] of the triangles (an (n, 3) array of k1 k2 k3 [h/Mpc]; bins of `bin_width`
 /// if given) as a `Table` with columns k1 k2 k3 B0 B2 B4 err_B0 err_B2 err_B4, its header and `meta`;
 /// with `basis="sugiyama"` the Sugiyama multipoles at `pairs` (an (n, 2) array of k1 k2 [h/Mpc]),
-/// columns k1 k2 B000 B110 B202 B022 B112 B220 err_B000 ….
+/// columns k1 k2 B000 B110 B202 B022 B112 B220 err_B000 …. With `box_size` L [Mpc/h] the bins are
+/// averaged exactly over the discrete modes of a periodic box of side L (line of sight z).
 #[pyfunction]
 #[pyo3(signature = (triangles=None, bin_width=None, linear=None, z=0.0, z_input=0.0, cosmology=None,
     eh=None, b1=1.0, b2=0.0, bs=0.0, c1=0.0, n_bar=None, b_shot=1.0, p_shot=0.0, a_shot=0.0, f=None,
     q_par=1.0, q_perp=1.0, fog="none", sigma_fog=0.0, ir=true, legendre_side="largest",
-    basis="scoccimarro", pairs=None))]
+    basis="scoccimarro", pairs=None, box_size=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn bispectrum(
     py: Python<'_>,
@@ -108,15 +109,21 @@ pub fn bispectrum(
     legendre_side: &str,
     basis: &str,
     pairs: Option<&Bound<'_, PyAny>>,
+    box_size: Option<f64>,
 ) -> PyResult<Table> {
     let params = params(b1, b2, bs, c1, n_bar, b_shot, p_shot, a_shot);
     let fog = Fog::by_name(fog, sigma_fog).map_err(library_error)?;
     let sugiyama = match basis.to_ascii_lowercase().as_str() {
         "scoccimarro" => None,
         "sugiyama" => {
-            if triangles.is_some() || bin_width.is_some() || legendre_side != "largest" {
+            if triangles.is_some()
+                || bin_width.is_some()
+                || legendre_side != "largest"
+                || box_size.is_some()
+            {
                 return Err(crate::value_error(
-                    "basis='sugiyama' takes pairs (k1, k2), not triangles, bin_width or legendre_side",
+                    "basis='sugiyama' takes pairs (k1, k2), not triangles, bin_width, legendre_side or \
+                     box_size",
                 ));
             }
             let Some(pairs) = pairs else {
@@ -160,7 +167,7 @@ pub fn bispectrum(
                 q: (q_par, q_perp),
                 fog,
                 ir,
-                box_size: None,
+                box_size,
             })
         }
     };
