@@ -39,7 +39,10 @@ fn fixed_rows<const N: usize>(
 }
 
 /// The triangle set of a (n, 3) array of k1 k2 k3 [h/Mpc], bins of `bin_width` if given.
-fn triangle_set(triangles: &Bound<'_, PyAny>, bin_width: Option<f64>) -> PyResult<TriangleSet> {
+pub(crate) fn triangle_set(
+    triangles: &Bound<'_, PyAny>,
+    bin_width: Option<f64>,
+) -> PyResult<TriangleSet> {
     let t = fixed_rows::<3>(triangles, "triangles", "k1, k2, k3")?;
     match bin_width {
         Some(w) => TriangleSet::shells(t, w),

@@ -6,8 +6,10 @@ use crate::inputs::Inputs;
 use crate::survey::Observation;
 use crate::value_error;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pt_spectra::bispectrum::Fog;
 use pt_spectra::pipeline::{
-    Pipeline as LibPipeline, PipelineSettings, TermsSource, NUISANCE_NAMES, PIPELINE_MAX_RESIDUAL,
+    BispectrumBlock, Pipeline as LibPipeline, PipelineSettings, TermsSource, NUISANCE_NAMES,
+    PIPELINE_MAX_RESIDUAL,
 };
 use pt_spectra::progress::Silent;
 use pt_spectra::setup::{LinearSource, Prepared};
@@ -21,7 +23,11 @@ type LastCall = (TermsSource, f64, Option<(f64, f64)>);
 /// A data vector and, if asked for, its Jacobian (one row per nuisance parameter).
 type VectorAndJacobian = (Vec<f64>, Option<Vec<Vec<f64>>>);
 
-/// The chain step: observation, model, redshift and AP fiducial fixed at construction.
+/// The chain step: observation, model, redshift and AP fiducial fixed at construction. With
+/// `triangles` (an (n, 3) array of k1 k2 k3 [h/Mpc]; bins with `bin_width`) the data vector goes on
+/// with the tree-level bispectrum multipoles `b_ells` (default (0,)) of those triangles (multipole,
+/// then triangle) from the same spectrum, f, distortion and IR, sharing b1, b2, bs and adding c1,
+/// b_shot, p_shot, a_shot (stochastic terms at `n_bar`; FoG `fog`, `sigma_fog` [Mpc/h]).
 #[pyclass(module = "pt_spectra._core", frozen)]
 pub(crate) struct Pipeline {
     inner: LibPipeline,
@@ -70,7 +76,14 @@ impl Pipeline {
         params: &[(String, f64)],
         jacobian: bool,
     ) -> PyResult<VectorAndJacobian> {
-        let step = self.inner.step(prepared).map_err(value_error)?;
+        // with a bispectrum block a given f makes the step at that f (its IR damping is not a
+        // polynomial in f)
+        let f_given = params.iter().find(|(n, _)| n == "f").map(|p| p.1);
+        let step = match f_given {
+            Some(f) if self.inner.has_bispectrum() => self.inner.step_at_growth_rate(prepared, f),
+            _ => self.inner.step(prepared),
+        }
+        .map_err(value_error)?;
         if let TermsSource::DirectFallback { .. } = step.source {
             let text = step.source.describe(self.inner.settings().max_residual);
             PyErr::warn(
@@ -102,7 +115,8 @@ impl Pipeline {
 impl Pipeline {
     #[new]
     #[pyo3(signature = (observation, z, fiducial=None, ir=true, precision=pt_spectra::jobs::defaults::PRECISION,
-        max_residual=PIPELINE_MAX_RESIDUAL, cache_dir=None))]
+        max_residual=PIPELINE_MAX_RESIDUAL, cache_dir=None, triangles=None, bin_width=None,
+        b_ells=vec![0], n_bar=None, fog="none", sigma_fog=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -113,7 +127,29 @@ impl Pipeline {
         precision: &str,
         max_residual: f64,
         cache_dir: Option<std::path::PathBuf>,
+        triangles: Option<&Bound<'_, PyAny>>,
+        bin_width: Option<f64>,
+        b_ells: Vec<usize>,
+        n_bar: Option<f64>,
+        fog: &str,
+        sigma_fog: f64,
     ) -> PyResult<Self> {
+        let bispectrum = match triangles {
+            Some(t) => Some(BispectrumBlock {
+                ells: b_ells,
+                fog: Fog::by_name(fog, sigma_fog).map_err(value_error)?,
+                n_bar: n_bar.unwrap_or(f64::INFINITY),
+                ..BispectrumBlock::monopole(crate::bispectrum::triangle_set(t, bin_width)?)
+            }),
+            None => {
+                if bin_width.is_some() || n_bar.is_some() || fog != "none" {
+                    return Err(value_error(
+                        "bin_width, n_bar and fog are for the bispectrum block: give triangles",
+                    ));
+                }
+                None
+            }
+        };
         let fiducial = match fiducial {
             Some(f) => Some(crate::inputs::cosmology_of(Some(f))?),
             None => None,
@@ -124,6 +160,7 @@ impl Pipeline {
         let settings = PipelineSettings {
             ir,
             max_residual,
+            bispectrum,
             ..PipelineSettings::ept(z, fiducial)
         };
         let (inner, _) = crate::detached(py, || {
@@ -188,7 +225,7 @@ impl Pipeline {
     /// The parameter names a call takes.
     #[getter]
     fn parameters(&self) -> Vec<&'static str> {
-        pt_spectra::pipeline::parameter_names().to_vec()
+        self.inner.parameters()
     }
 
     /// The nuisance parameters of the Jacobian, in its order.
@@ -213,6 +250,8 @@ impl Pipeline {
         d.set_item("z", s.z)?;
         d.set_item("ells", self.inner.observation().ells().to_vec())?;
         d.set_item("len", self.inner.len())?;
+        d.set_item("power_len", self.inner.power_len())?;
+        d.set_item("bispectrum", self.inner.has_bispectrum())?;
         d.set_item("ap", s.fiducial.is_some())?;
         d.set_item("ir", s.ir)?;
         d.set_item("max_residual", s.max_residual)?;

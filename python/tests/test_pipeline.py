@@ -70,3 +70,30 @@ def test_a_batch_gives_the_single_calls(setup):
     rows = pipe.batch([COSMO, other], [PARAMS, dict(b1=1.5)])
     assert np.array_equal(rows[0], pipe(COSMO, **PARAMS))
     assert np.array_equal(rows[1], pipe(other, b1=1.5))
+
+
+def test_a_bispectrum_block_follows_the_power_spectrum(setup):
+    obs, pipe, cache = setup
+    bins = np.array([[0.015, 0.025, 0.035], [0.045, 0.055, 0.065]])
+    joint = pt.Pipeline(obs, Z, precision="fast", cache_dir=cache, triangles=bins, bin_width=0.01,
+                        b_ells=[0, 2], n_bar=3e-4)
+    b = dict(c1=1.0, b_shot=0.8)
+    got = joint(COSMO, **PARAMS, **b)
+    n = joint.meta["power_len"]
+    assert len(got) == n + 4 and joint.meta["bispectrum"]
+    np.testing.assert_array_equal(got[:n], pipe(COSMO, **PARAMS))
+    # the block is the bispectrum plan on the same spectrum at f(z) (no AP: no fiducial)
+    f = joint.meta["f"]
+    terms = pt.BispectrumPlan(bins, bin_width=0.01).terms(cosmology=COSMO, z=Z, f=f)
+    ref, _ = terms.multipoles(b1=2.1, b2=-0.4, bs=0.3, n_bar=3e-4, **b)
+    np.testing.assert_allclose(got[n:], np.concatenate([ref[:, 0], ref[:, 1]]), rtol=1e-6)
+    # a given f is the step at that f
+    at_f = joint(COSMO, f=f + 0.05, **PARAMS, **b)
+    ref_f, _ = pt.BispectrumPlan(bins, bin_width=0.01).terms(cosmology=COSMO, z=Z, f=f + 0.05).multipoles(
+        b1=2.1, b2=-0.4, bs=0.3, n_bar=3e-4, **b)
+    np.testing.assert_allclose(at_f[n:], np.concatenate([ref_f[:, 0], ref_f[:, 1]]), rtol=1e-6)
+    assert "b_shot" in joint.parameters
+    with pytest.raises(ValueError, match="bispectrum"):
+        joint(COSMO, jacobian=True, **PARAMS)
+    with pytest.raises(ValueError, match="triangles"):
+        pt.Pipeline(obs, Z, precision="fast", cache_dir=cache, n_bar=3e-4)

@@ -1,10 +1,12 @@
 //! The chain-step `Pipeline` (issue 47) against the path it replaces: the ept plan's terms, its
-//! multipoles with the AP distortion, and the observation (BOSS CMASS NGC window, 38 k).
+//! multipoles with the AP distortion, and the observation (BOSS CMASS NGC window, 38 k); with a
+//! bispectrum block, against the bispectrum plan on the same spectrum.
 
+use pt_spectra::bispectrum::{BispectrumParams, BispectrumPlan, Fog, Settings, TriangleSet};
 use pt_spectra::cosmology::Cosmology;
 use pt_spectra::jobs::ept_plan;
 use pt_spectra::pipeline::{
-    Pipeline, PipelineSettings, TermsSource, NUISANCE_NAMES, PIPELINE_MAX_RESIDUAL,
+    BispectrumBlock, Pipeline, PipelineSettings, TermsSource, NUISANCE_NAMES, PIPELINE_MAX_RESIDUAL,
 };
 use pt_spectra::precision::{Precision, TwoLoopMethod};
 use pt_spectra::progress::Silent;
@@ -238,4 +240,99 @@ fn a_batch_gives_the_single_calls() {
         pl.evaluate(&other, &[("b1", 1.8), ("sn", 300.0)]).unwrap()
     );
     assert_ne!(batch[0], batch[1]);
+}
+
+/// Four bins of width 0.01 h/Mpc (Nseries-like), B0 and B2, Lorentzian FoG, n̄ = 3e-4.
+fn bispectrum_block() -> BispectrumBlock {
+    let bins = vec![
+        [0.015, 0.025, 0.035],
+        [0.035, 0.035, 0.055],
+        [0.045, 0.055, 0.065],
+        [0.055, 0.065, 0.075],
+    ];
+    BispectrumBlock {
+        ells: vec![0, 2],
+        fog: Fog::Lorentzian { sigma: 4.0 },
+        n_bar: 3e-4,
+        ..BispectrumBlock::monopole(TriangleSet::shells(bins, 0.01).unwrap())
+    }
+}
+
+#[test]
+fn a_bispectrum_block_follows_the_power_spectrum_with_the_same_spectrum_f_and_distortion() {
+    let mut settings = PipelineSettings::ept(Z, Some(fiducial()));
+    settings.bispectrum = Some(bispectrum_block());
+    let pl = Pipeline::new(observation(), settings, &precision(), &store(), &Silent).unwrap();
+    assert_eq!((pl.len(), pl.power_len()), (3 * 38 + 2 * 4, 3 * 38));
+    let b_params = [("c1", 2.0), ("b_shot", 0.9), ("a_shot", 0.1)];
+    let params: Vec<(&str, f64)> = PARAMS.iter().chain(&b_params).copied().collect();
+    let prepared = pl.prepare(&truth()).unwrap();
+    let got = pl.step(&prepared).unwrap().data_vector(&params).unwrap();
+    // the power spectrum part is the pipeline without the block
+    let p_only = pipeline().evaluate(&truth(), &PARAMS).unwrap();
+    assert_eq!(&got[..pl.power_len()], &p_only[..]);
+    // the block: the bispectrum plan on the same spectrum at f(z), the cosmology's distortion, IR
+    let ap = Distortion::from_cosmologies(&truth(), &fiducial(), Z).unwrap();
+    assert!((ap.apar - 1.0).abs() > 1e-3, "the test needs a distortion");
+    let block = bispectrum_block();
+    let direct = |f: f64| {
+        BispectrumPlan::new(block.triangles.clone(), block.side, block.rules)
+            .unwrap()
+            .terms(
+                prepared.tracer_spectrum(),
+                &Settings {
+                    f,
+                    q_par: ap.apar,
+                    q_perp: ap.aperp,
+                    fog: block.fog,
+                    ir: true,
+                },
+            )
+            .unwrap()
+            .multipoles(&BispectrumParams {
+                b1: 2.1,
+                b2: -0.4,
+                bs: 0.3,
+                c1: 2.0,
+                b_shot: 0.9,
+                p_shot: 0.0,
+                a_shot: 0.1,
+                n_bar: 3e-4,
+            })
+            .unwrap()
+    };
+    let flat = |m: Vec<[pt_spectra::estimate::Estimate; 3]>| -> Vec<f64> {
+        [0, 1]
+            .iter()
+            .flat_map(|&l| m.iter().map(move |r| r[l].value).collect::<Vec<_>>())
+            .collect()
+    };
+    assert_close(
+        &got[pl.power_len()..],
+        &flat(direct(prepared.growth_rate)),
+        1e-12,
+        "block vs bispectrum plan",
+    );
+    // another f: refused on the step at f(z), given by a step at that f
+    let f = prepared.growth_rate + 0.05;
+    let mut with_f = params.clone();
+    with_f.push(("f", f));
+    let step = pl.step(&prepared).unwrap();
+    let err = step.data_vector(&with_f).unwrap_err().to_string();
+    assert!(err.contains("step_at_growth_rate"), "{err}");
+    let at_f = pl
+        .step_at_growth_rate(&prepared, f)
+        .unwrap()
+        .data_vector(&with_f)
+        .unwrap();
+    assert_close(&at_f[pl.power_len()..], &flat(direct(f)), 1e-12, "at f");
+    // the nuisance polynomial is the power spectrum's: refused with a block
+    assert!(step.linearise(None).is_err());
+    assert!(pl.parameters().contains(&"b_shot"));
+    // without a block a bispectrum name is refused, saying why
+    let err = pipeline()
+        .evaluate(&truth(), &[("b1", 2.0), ("c1", 1.0)])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("no bispectrum block"), "{err}");
 }

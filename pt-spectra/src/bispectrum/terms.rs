@@ -308,7 +308,7 @@ impl BispectrumPlan {
                             let mut azimuths = [0.0; SLOTS];
                             for par in &group.par {
                                 let slots =
-                                    observed_slots(shape.k, shape.dots, *par, settings, &power);
+                                    observed_slots(shape.k, shape.dots, *par, settings, power);
                                 for (a, s) in azimuths.iter_mut().zip(&slots) {
                                     *a += s;
                                 }

@@ -41,8 +41,17 @@ impl CosmologyStep<'_> {
     /// step is a few thousand multiplications ([`Linearised::data_vector`]).
     ///
     /// # Errors
-    /// As [`CosmologyStep::data_vector`].
+    /// As [`CosmologyStep::data_vector`]; [`Error::InvalidChoice`] with a bispectrum block.
     pub fn linearise(&self, f: Option<f64>) -> Result<Linearised> {
+        if self.has_bispectrum() {
+            return Err(Error::InvalidChoice {
+                what: "the nuisance polynomial of a pipeline with a bispectrum block".into(),
+                reason:
+                    "it is the power spectrum's (quadratic in b1, b2, bs, b3); the bispectrum is \
+                         cubic in b1: evaluate the data vector instead"
+                        .into(),
+            });
+        }
         let f = f.unwrap_or(self.growth_rate);
         let at = |set: &[(usize, f64)]| -> Result<Vec<f64>> {
             let mut p = EptParams::new(0.0, f);

@@ -38,7 +38,10 @@ use crate::setup::{LinearSource, NamedCosmology, Prepared, Request};
 use crate::store::TableStore;
 use crate::survey::observe::Observation;
 
+mod bispectrum;
 mod linearised;
+use bispectrum::{bispectrum_params, PlannedBispectrum};
+pub use bispectrum::{BispectrumBlock, BISPECTRUM_NAMES};
 pub use linearised::{Linearised, NUISANCE_NAMES};
 
 /// The largest smoothed projection residual for which a [`Pipeline`] evaluates the loop terms on the
@@ -69,6 +72,9 @@ pub struct PipelineSettings {
     pub ir: bool,
     /// The largest projection residual evaluated on the basis ([`PIPELINE_MAX_RESIDUAL`]).
     pub max_residual: f64,
+    /// The tree-level bispectrum multipoles after the power spectrum in the data vector (`None`:
+    /// the power spectrum alone).
+    pub bispectrum: Option<BispectrumBlock>,
 }
 
 impl PipelineSettings {
@@ -81,6 +87,7 @@ impl PipelineSettings {
             fiducial,
             ir: true,
             max_residual: PIPELINE_MAX_RESIDUAL,
+            bispectrum: None,
         }
     }
 }
@@ -94,6 +101,8 @@ pub struct Pipeline {
     matrix: Vec<f64>,
     rows: usize,
     emulator: LinearEmulator,
+    /// The bispectrum block, planned.
+    bispectrum: Option<PlannedBispectrum>,
 }
 
 /// Where the loop terms of one spectrum came from.
@@ -140,6 +149,8 @@ pub struct CosmologyStep<'a> {
     pub ap: Option<Distortion>,
     /// Where the loop terms came from.
     pub source: TermsSource,
+    /// The bispectrum block's terms at [`Self::growth_rate`] (with a block).
+    bispectrum: Option<crate::bispectrum::BispectrumTerms>,
 }
 
 impl Pipeline {
@@ -181,6 +192,11 @@ impl Pipeline {
         .with_basis(store, progress)?
         .with_max_residual(settings.max_residual)?;
         let (matrix, rows) = observation_matrix(&observation)?;
+        let bispectrum = settings
+            .bispectrum
+            .clone()
+            .map(PlannedBispectrum::new)
+            .transpose()?;
         Ok(Self {
             settings,
             plan,
@@ -188,6 +204,7 @@ impl Pipeline {
             matrix,
             rows,
             emulator: LinearEmulator::embedded()?,
+            bispectrum,
         })
     }
 
@@ -201,14 +218,25 @@ impl Pipeline {
         &self.observation
     }
 
-    /// The length of the data vector: output ℓ's × output k.
+    /// The length of the data vector: output ℓ's × output k, then with a bispectrum block its
+    /// multipoles × triangles.
     pub fn len(&self) -> usize {
+        self.rows + self.bispectrum.as_ref().map_or(0, PlannedBispectrum::len)
+    }
+
+    /// The length of the power-spectrum part of the data vector (output ℓ's × output k).
+    pub fn power_len(&self) -> usize {
         self.rows
     }
 
     /// Whether the data vector is empty (never for a built pipeline).
     pub fn is_empty(&self) -> bool {
-        self.rows == 0
+        self.len() == 0
+    }
+
+    /// Whether the data vector has a bispectrum block.
+    pub fn has_bispectrum(&self) -> bool {
+        self.bispectrum.is_some()
     }
 
     /// The observation's matrix (row-major, [`Self::len`] rows, model ℓ's × model k columns): the
@@ -263,6 +291,15 @@ impl Pipeline {
     /// # Errors
     /// As [`EptPlan::terms`] and [`Distortion::from_cosmologies`].
     pub fn step(&self, prepared: &Prepared) -> Result<CosmologyStep<'_>> {
+        self.step_at_growth_rate(prepared, prepared.growth_rate)
+    }
+
+    /// [`Self::step`] at the growth rate `f` instead of the cosmology's f(z) (a template fit's free
+    /// f; with a bispectrum block the only way to change f, whose IR damping is not a polynomial in it).
+    ///
+    /// # Errors
+    /// As [`Self::step`].
+    pub fn step_at_growth_rate(&self, prepared: &Prepared, f: f64) -> Result<CosmologyStep<'_>> {
         let ap = match &self.settings.fiducial {
             Some(fid) => Some(Distortion::from_cosmologies(
                 &prepared.cosmology.cosmology,
@@ -271,7 +308,7 @@ impl Pipeline {
             )?),
             None => None,
         };
-        self.step_with(prepared.tracer_spectrum(), prepared.growth_rate, ap)
+        self.step_with(prepared.tracer_spectrum(), f, ap)
     }
 
     /// The step of a linear spectrum at the pipeline's redshift with growth rate `growth_rate` and
@@ -302,12 +339,17 @@ impl Pipeline {
             (None, Some(_)) => Some(Distortion::new(1.0, 1.0)?),
             (None, None) => None,
         };
+        let bispectrum = match &self.bispectrum {
+            Some(b) => Some(b.terms(spectrum, growth_rate, ap, self.settings.ir)?),
+            None => None,
+        };
         Ok(CosmologyStep {
             pipeline: self,
             terms,
             growth_rate,
             ap,
             source,
+            bispectrum,
         })
     }
 
@@ -351,8 +393,31 @@ impl CosmologyStep<'_> {
     /// The ept parameters of `params` by name, `f` defaulting to the step's growth rate.
     fn params(&self, params: &[(&str, f64)]) -> Result<EptParams> {
         let mut p = EptParams::new(0.0, self.growth_rate);
+        let with_b = self.bispectrum.is_some();
         for &(name, value) in params {
-            p.set(name, value)?;
+            if with_b && BISPECTRUM_NAMES.contains(&name) {
+                continue;
+            }
+            if with_b && name == "f" && value != self.growth_rate {
+                return Err(Error::InvalidChoice {
+                    what: format!("f = {value} with a bispectrum block"),
+                    reason: format!(
+                        "the step's bispectrum terms are at f = {}: make the step at this f \
+                         (Pipeline::step_at_growth_rate; in Python, f is passed there)",
+                        self.growth_rate
+                    ),
+                });
+            }
+            p.set(name, value).map_err(|e| match (with_b, e) {
+                (
+                    false,
+                    Error::InvalidChoice { what, reason },
+                ) if BISPECTRUM_NAMES.contains(&name) => Error::InvalidChoice {
+                    what,
+                    reason: format!("{reason} ({name} is a bispectrum parameter: this pipeline has no bispectrum block)"),
+                },
+                (_, e) => e,
+            })?;
         }
         p.validate()?;
         Ok(p)
@@ -366,7 +431,11 @@ impl CosmologyStep<'_> {
     /// [`EptPlan::multipole_values_at`].
     pub fn data_vector(&self, params: &[(&str, f64)]) -> Result<Vec<f64>> {
         let p = self.params(params)?;
-        self.data_vector_of(&p)
+        let mut out = self.data_vector_of(&p)?;
+        if let (Some(block), Some(terms)) = (&self.pipeline.bispectrum, &self.bispectrum) {
+            out.extend(block.values(terms, bispectrum_params(params))?);
+        }
+        Ok(out)
     }
 
     fn data_vector_of(&self, p: &EptParams) -> Result<Vec<f64>> {
@@ -380,6 +449,11 @@ impl CosmologyStep<'_> {
     /// The loop terms.
     pub fn terms(&self) -> &EptTerms {
         &self.terms
+    }
+
+    /// Whether the step has the terms of a bispectrum block.
+    pub fn has_bispectrum(&self) -> bool {
+        self.bispectrum.is_some()
     }
 }
 
@@ -408,4 +482,16 @@ fn observation_matrix(observation: &Observation) -> Result<(Vec<f64>, usize)> {
 /// The names a call takes: [`PARAM_NAMES`] (`f` defaults to f(z) of the cosmology).
 pub fn parameter_names() -> &'static [&'static str] {
     &PARAM_NAMES
+}
+
+impl Pipeline {
+    /// The names a call of this pipeline takes: [`PARAM_NAMES`], and with a bispectrum block
+    /// [`BISPECTRUM_NAMES`].
+    pub fn parameters(&self) -> Vec<&'static str> {
+        let mut names = PARAM_NAMES.to_vec();
+        if self.bispectrum.is_some() {
+            names.extend(BISPECTRUM_NAMES);
+        }
+        names
+    }
 }
