@@ -16,7 +16,7 @@
 //!   by more than 0.01 means the starts missed the global minimum: the search restarts there.
 
 use super::objective::Objective;
-use super::{index, GalaxyFit, GalaxyFitRequest, MultipoleData, Observation, SLOTS};
+use super::{index, GalaxyFit, GalaxyFitRequest, MultipoleData, Observation, PriorShape, SLOTS};
 use crate::error::{Error, Result};
 use crate::fit::bounded::{multistart, Minimum, Problem, AGREEMENT, EXPECTED_DECREASE};
 use crate::linalg::solve_spd;
@@ -96,6 +96,24 @@ impl Default for Search {
     }
 }
 
+/// The bounds (lower, upper) and typical σ of slot `i` with `prior`, on a plan of AP range `ap`:
+/// [`RANGES`], α∥, α⊥ within the AP range, narrowed by the prior's support.
+pub(super) fn bound(
+    i: usize,
+    prior: Option<&PriorShape>,
+    ap: Option<(f64, f64)>,
+) -> (f64, f64, f64) {
+    let (mut a, mut b, _, _, s) = RANGES[i];
+    if let (true, Some((x, y))) = (i >= PARAM_NAMES.len(), ap) {
+        (a, b) = (x, y);
+    }
+    if let Some(p) = prior {
+        let (x, y) = p.support();
+        (a, b) = (a.max(x), b.min(y));
+    }
+    (a, b, s)
+}
+
 /// The bounds (lower, upper) and typical σ of the free parameters of `objective`.
 fn bounds(objective: &Objective) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let ap = objective.plan.settings().ap_range;
@@ -103,14 +121,7 @@ fn bounds(objective: &Objective) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let mut hi = Vec::new();
     let mut scale = Vec::new();
     for &i in &objective.free {
-        let (mut a, mut b, _, _, s) = RANGES[i];
-        if let (true, Some((x, y))) = (i >= PARAM_NAMES.len(), ap) {
-            (a, b) = (x, y);
-        }
-        if let Some(p) = &objective.priors[i] {
-            let (x, y) = p.support();
-            (a, b) = (a.max(x), b.min(y));
-        }
+        let (a, b, s) = bound(i, objective.priors[i].as_ref(), ap);
         lo.push(a);
         hi.push(b);
         scale.push(s);
@@ -125,9 +136,10 @@ fn draws(rng: &mut rand_chacha::ChaCha8Rng) -> (f64, f64) {
     (z, rng.gen())
 }
 
-/// The starts: `x0`, then draws from the priors or the start box, within [lo, hi].
+/// The starts: `x0`, then draws from the priors or the start box, within [lo, hi]; `params` the
+/// slot and prior of each free parameter.
 fn starts(
-    objective: &Objective,
+    params: &[(usize, Option<&PriorShape>)],
     x0: &[f64],
     lo: &[f64],
     hi: &[f64],
@@ -136,13 +148,12 @@ fn starts(
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(search.seed);
     let mut all = vec![x0.to_vec()];
     while all.len() < search.starts {
-        let x = objective
-            .free
+        let x = params
             .iter()
             .enumerate()
-            .map(|(j, &i)| {
+            .map(|(j, &(i, prior))| {
                 let (z, u) = draws(&mut rng);
-                let v = match &objective.priors[i] {
+                let v = match prior {
                     Some(p) => p.draw(z.clamp(-2.0, 2.0), u),
                     None => RANGES[i].2 + (RANGES[i].3 - RANGES[i].2) * u,
                 };
@@ -279,19 +290,78 @@ fn intervals(
     Ok((out, used))
 }
 
+/// The free parameters of a search: per parameter its slot and prior, its bounds and typical σ, and
+/// its start (inside the bounds).
+pub(super) struct Space<'p> {
+    /// Per parameter: its slot and prior.
+    pub(super) params: Vec<(usize, Option<&'p PriorShape>)>,
+    /// Lower bounds.
+    pub(super) lo: Vec<f64>,
+    /// Upper bounds.
+    pub(super) hi: Vec<f64>,
+    /// Typical σ.
+    pub(super) scale: Vec<f64>,
+    /// The start.
+    pub(super) x0: Vec<f64>,
+}
+
+/// The errors of a search's free parameters (or of a selection of them: [`Errors::select`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Errors {
+    /// The errors given (the Hessian's, or the profile's half-width).
+    pub(super) given: Vec<f64>,
+    /// √diag(2H⁻¹).
+    pub(super) hessian: Vec<f64>,
+    /// 2H⁻¹.
+    pub(super) covariance: Option<Vec<Vec<f64>>>,
+    /// The profile's Δ = 1 crossings.
+    pub(super) intervals: Vec<(f64, f64)>,
+    /// Whether the error given is the profile's.
+    pub(super) from_profile: Vec<bool>,
+}
+
+impl Errors {
+    /// The errors of the parameters `indices` (their covariance the block of those rows and columns).
+    pub(super) fn select(&self, indices: &[usize]) -> Self {
+        Self {
+            given: indices.iter().map(|&i| self.given[i]).collect(),
+            hessian: indices.iter().map(|&i| self.hessian[i]).collect(),
+            covariance: self.covariance.as_ref().map(|c| {
+                indices
+                    .iter()
+                    .map(|&i| indices.iter().map(|&j| c[i][j]).collect())
+                    .collect()
+            }),
+            intervals: indices.iter().map(|&i| self.intervals[i]).collect(),
+            from_profile: indices.iter().map(|&i| self.from_profile[i]).collect(),
+        }
+    }
+}
+
+/// What a search found: the minimum, the errors and their profile check, the starts' agreement.
+pub(super) struct Found {
+    /// The minimum.
+    pub(super) best: Minimum,
+    /// The free parameters' errors.
+    pub(super) errors: Errors,
+    /// Starts minimised.
+    pub(super) starts: usize,
+    /// Starts that reached the minimum to [`AGREEMENT`].
+    pub(super) agree: usize,
+    /// The highest start's minimum minus the lowest.
+    pub(super) spread: f64,
+    /// Whether the profile check moved the minimum.
+    pub(super) moved: bool,
+    /// Objective evaluations used.
+    pub(super) evaluations: usize,
+}
+
 /// The fit of `objective` (module docs).
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for no start or no start with a finite −2 ln L; as the model's
 /// evaluation.
 pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit> {
-    if search.starts == 0 {
-        return Err(Error::InvalidParameter {
-            name: "number of starts",
-            value: 0.0,
-            reason: "the fit needs at least one start",
-        });
-    }
     let (lo, hi, scale) = bounds(objective);
     let mut x0: Vec<f64> = objective.free.iter().map(|&i| objective.start[i]).collect();
     for (j, v) in x0.iter_mut().enumerate() {
@@ -299,15 +369,76 @@ pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit>
     }
     // Errors of the model at the start are the user's: reported as they are.
     objective.evaluate(&x0)?;
-    let f = |x: &[f64]| objective.cost(x);
+    let space = Space {
+        params: objective
+            .free
+            .iter()
+            .map(|&i| (i, objective.priors[i].as_ref()))
+            .collect(),
+        lo,
+        hi,
+        scale,
+        x0,
+    };
+    let found = find(&|x: &[f64]| objective.cost(x), &space, search)?;
+    package(objective, &found.best.x, &found, found.errors.clone())
+}
+
+/// The [`GalaxyFit`] of `objective` at its free values `x`, with `errors` (of its free parameters)
+/// and the search's report `found`.
+///
+/// # Errors
+/// As the model's evaluation.
+pub(super) fn package(
+    objective: &Objective,
+    x: &[f64],
+    found: &Found,
+    errors: Errors,
+) -> Result<GalaxyFit> {
+    let (minus_two_log_l, chi2, slots, marginalised_errors) = objective.evaluate(x)?;
+    let (params, ap) = objective.split(&slots)?;
+    Ok(GalaxyFit {
+        best: params,
+        ap,
+        errors: errors.given,
+        hessian_errors: errors.hessian,
+        covariance: errors.covariance,
+        intervals: errors.intervals,
+        from_profile: errors.from_profile,
+        marginalised_errors,
+        chi2,
+        minus_two_log_l,
+        points: objective.points(),
+        starts: found.starts,
+        agree: found.agree,
+        spread: found.spread,
+        moved_by_profile: found.moved,
+        evaluations: found.evaluations,
+    })
+}
+
+/// The minimum of `cost` over `space` from the starts of `search`, its errors and their profile
+/// check (module docs).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for no start or no start with a finite −2 ln L.
+pub(super) fn find(cost: &dyn Fn(&[f64]) -> f64, space: &Space, search: &Search) -> Result<Found> {
+    if search.starts == 0 {
+        return Err(Error::InvalidParameter {
+            name: "number of starts",
+            value: 0.0,
+            reason: "the fit needs at least one start",
+        });
+    }
+    let (lo, hi) = (&space.lo, &space.hi);
     let problem = Problem {
-        f: &f,
+        f: cost,
         lo: lo.clone(),
         hi: hi.clone(),
-        scale,
+        scale: space.scale.clone(),
         tolerance: EXPECTED_DECREASE,
     };
-    let multi = multistart(&problem, &starts(objective, &x0, &lo, &hi, search));
+    let multi = multistart(&problem, &starts(&space.params, &space.x0, lo, hi, search));
     let mut best = multi.best().clone();
     if !best.value.is_finite() {
         return Err(Error::InvalidParameter {
@@ -351,8 +482,6 @@ pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit>
     if std::env::var_os("PT_FIT_DEBUG").is_some() {
         eprintln!("total {evaluations} evals");
     }
-    let (minus_two_log_l, chi2, slots, marginalised_errors) = objective.evaluate(&best.x)?;
-    let (params, ap) = objective.split(&slots)?;
     let mut errors = hessian.clone();
     let mut from_profile = vec![false; n];
     for j in 0..n {
@@ -363,18 +492,7 @@ pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit>
             from_profile[j] = true;
         }
     }
-    Ok(GalaxyFit {
-        best: params,
-        ap,
-        errors,
-        hessian_errors: hessian,
-        covariance,
-        intervals,
-        from_profile,
-        marginalised_errors,
-        chi2,
-        minus_two_log_l,
-        points: objective.points(),
+    Ok(Found {
         starts: multi.minima.len(),
         // counted against the final minimum: after a profile found a lower one, the starts that
         // reached it (possibly none)
@@ -384,7 +502,15 @@ pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit>
             .filter(|m| m.value - best.value < AGREEMENT)
             .count(),
         spread: multi.worst_value() - best.value,
-        moved_by_profile: moved,
+        best,
+        errors: Errors {
+            given: errors,
+            hessian,
+            covariance,
+            intervals,
+            from_profile,
+        },
+        moved,
         evaluations,
     })
 }
