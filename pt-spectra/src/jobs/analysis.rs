@@ -249,6 +249,19 @@ fn file(origin: &str, key: &str, base: &Path, v: &Value) -> Result<PathBuf> {
     Ok(p)
 }
 
+/// The value of the optional `key` of `t` (at `at`) read by `read`.
+fn optional<T>(
+    origin: &str,
+    at: &str,
+    t: &Map,
+    key: &str,
+    read: impl Fn(&str, &str, &Value) -> Result<T>,
+) -> Result<Option<T>> {
+    t.get(key)
+        .map(|v| read(origin, &format!("{at}{key}"), v))
+        .transpose()
+}
+
 fn data_set(origin: &str, base: &Path, n: usize, t: &Map) -> Result<SetSpec> {
     let at = format!("dataset[{n}].");
     known(origin, &at, t, &SET)?;
@@ -336,57 +349,32 @@ fn data_set(origin: &str, base: &Path, n: usize, t: &Map) -> Result<SetSpec> {
     Ok(SetSpec {
         label,
         z,
-        tracer: opt("tracer")
-            .map(|v| string(origin, &key("tracer"), v))
-            .transpose()?
-            .unwrap_or_default(),
+        tracer: optional(origin, &at, t, "tracer", string)?.unwrap_or_default(),
         data: file(origin, &key("data"), base, need("data")?)?,
         data_ells: match opt("data_ells") {
             Some(v) => counts(origin, &key("data_ells"), v)?,
             None => vec![0, 2, 4],
         },
-        data_columns: opt("data_columns")
-            .map(|v| counts(origin, &key("data_columns"), v))
-            .transpose()?,
-        covariance: opt("covariance")
-            .map(|v| file(origin, &key("covariance"), base, v))
-            .transpose()?,
-        n_mocks: opt("n_mocks")
-            .map(|v| count(origin, &key("n_mocks"), v))
-            .transpose()?,
+        data_columns: optional(origin, &at, t, "data_columns", counts)?,
+        covariance: optional(origin, &at, t, "covariance", |o, k, v| file(o, k, base, v))?,
+        n_mocks: optional(origin, &at, t, "n_mocks", count)?,
         ells,
-        k_min: opt("k_min")
-            .map(|v| number(origin, &key("k_min"), v))
-            .transpose()?
-            .unwrap_or(0.0),
+        k_min: optional(origin, &at, t, "k_min", number)?.unwrap_or(0.0),
         k_max: number(origin, &key("k_max"), need("k_max")?)?,
         ell_ranges,
         free: strings(origin, &key("free"), need("free")?)?,
-        marginalise: opt("marginalise")
-            .map(|v| strings(origin, &key("marginalise"), v))
-            .transpose()?
-            .unwrap_or_default(),
+        marginalise: optional(origin, &at, t, "marginalise", strings)?.unwrap_or_default(),
         priors,
         start,
         ap,
-        fiducial: opt("fiducial")
-            .map(|v| string(origin, &key("fiducial"), v))
-            .transpose()?,
-        window: opt("window")
-            .map(|v| file(origin, &key("window"), base, v))
-            .transpose()?,
-        window_format: opt("window_format")
-            .map(|v| string(origin, &key("window_format"), v))
-            .transpose()?
+        fiducial: optional(origin, &at, t, "fiducial", string)?,
+        window: optional(origin, &at, t, "window", |o, k, v| file(o, k, base, v))?,
+        window_format: optional(origin, &at, t, "window_format", string)?
             .unwrap_or_else(|| "header".into()),
-        window_mixing: opt("window_mixing")
-            .map(|v| string(origin, &key("window_mixing"), v))
-            .transpose()?
+        window_mixing: optional(origin, &at, t, "window_mixing", string)?
             .unwrap_or_else(|| "wilson".into()),
         k_edges,
-        box_side: opt("box")
-            .map(|v| number(origin, &key("box"), v))
-            .transpose()?,
+        box_side: optional(origin, &at, t, "box", number)?,
         ir: opt("ir")
             .map(|v| {
                 v.as_bool()
