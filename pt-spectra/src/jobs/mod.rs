@@ -61,7 +61,7 @@ pub use ept::{
 pub use ept_fit::{ept_fit_table, ept_model_table, ept_profile_table, FitContext};
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use halo::{halo_table, HaloRequest};
-pub use joint_fit::{joint_fit_table, Analysis, Inputs, SetSpec};
+pub use joint_fit::{joint_fit_table, Analysis, Inputs, SetSpec, DEFAULT_B1};
 pub use observe::observed_table;
 pub use report::{contour_table, real_spectra_table, rsd_multipoles_table};
 pub use rsd::{
