@@ -159,6 +159,13 @@ fn recovers_two_biases_and_the_shared_growth_rate() {
         set("high", &plan, &terms, &high, &r),
     ];
     assert_eq!(default_shared(&sets), vec!["f".to_string()]);
+    // Another redshift or another tracer: nothing shared by default.
+    let mut other = sets.clone();
+    other[1].z = 0.8;
+    assert!(default_shared(&other).is_empty());
+    other[1].z = 0.5;
+    other[1].tracer = "ELG".into();
+    assert!(default_shared(&other).is_empty());
     let joint = fit_joint(&sets, &default_shared(&sets), &search).unwrap();
     assert_eq!(
         joint.names,
