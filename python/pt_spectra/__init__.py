@@ -50,6 +50,7 @@ __all__ = [
     "ept",
     "fit",
     "fit_ept",
+    "fit_joint",
     "fit_tables",
     "bispectrum",
     "distances",
@@ -285,6 +286,23 @@ def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0,
         return _warn(table), _warn(model)
     return _warn(table)
 
+
+
+def fit_joint(analysis, linear=None, z_input=0.0, cosmology=None, precision=_D["precision"],
+              q_range=None, eh=None):
+    """The joint fit of the galaxy model ``ept`` to several data sets (``pt-spectra fit --analysis``).
+
+    analysis: the path of a TOML analysis file (docs/analysis.md): per ``[[dataset]]`` its data,
+    covariance, window, z, multipoles, k range, free and marginalised parameters, priors and start;
+    ``shared``: the parameters with one value across the sets (default f, apar, aperp when every set
+    has the same z and tracer); ``[search]``: the minimiser (starts, seed, profile_check, linear).
+    linear, z_input, cosmology, precision, q_range, eh as :func:`fit_ept`; each set is at its own z.
+
+    Returns a :class:`Table` with a row per data set: ``set z`` then the columns of :func:`fit_ept`
+    for that set at the joint best fit (a shared parameter has the same value and error in every
+    row); the header states every set and the sharing.
+    """
+    return _warn(_core.fit_joint(str(analysis), linear, z_input, cosmology, precision, q_range, eh))
 
 class RsdPlan:
     """The loop terms of a redshift-space model prepared for one k grid.

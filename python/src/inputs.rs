@@ -128,6 +128,11 @@ impl Inputs {
     /// The linear spectrum at z with the growth of the cosmology, the warnings (ignored keys and
     /// output k beyond the linear table included).
     pub fn prepare(&self, k: &[f64]) -> pt_spectra::error::Result<Prepared> {
+        self.prepare_at(k, self.z)
+    }
+
+    /// [`Self::prepare`] at the output redshift `z` in place of the arguments' (a joint fit's sets).
+    pub fn prepare_at(&self, k: &[f64], z: f64) -> pt_spectra::error::Result<Prepared> {
         let source = match &self.linear {
             Linear::Default(None) => LinearSource::Embedded,
             Linear::Default(Some(kind)) => LinearSource::EisensteinHu(*kind),
@@ -144,7 +149,7 @@ impl Inputs {
         let mut prepared = setup::prepare(Request {
             source,
             cosmology,
-            z: self.z,
+            z,
         })?;
         let extra = setup::input_warnings(&prepared, &ignored, k);
         prepared.warnings.extend(extra);

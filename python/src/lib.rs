@@ -28,6 +28,7 @@ mod emulator;
 mod ept;
 mod halo;
 mod inputs;
+mod joint;
 mod kernel;
 mod pipeline;
 mod redshift;
@@ -629,6 +630,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<survey::Observation>()?;
     m.add_class::<pipeline::Pipeline>()?;
     m.add_function(wrap_pyfunction!(ept::fit_ept, m)?)?;
+    m.add_function(wrap_pyfunction!(joint::fit_joint, m)?)?;
     m.add_function(wrap_pyfunction!(batch::real_batch, m)?)?;
     m.add_function(wrap_pyfunction!(batch::read_multipoles, m)?)?;
     m.add_function(wrap_pyfunction!(batch::check_memory, m)?)?;

@@ -31,10 +31,12 @@ use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
 use crate::survey::observe::Observation;
 
 mod derived;
+pub mod joint;
 mod objective;
 mod priors;
 pub mod search;
 pub use derived::{derived, sound_horizon, Derived, Template};
+pub use joint::{default_shared, fit_joint, DataSet, JointFit};
 pub use priors::{Prior, PriorShape};
 pub use search::{profile_galaxy, GalaxyProfile, Linear, ProfileGrid, ProfilePoint, Search};
 
@@ -179,6 +181,8 @@ pub fn fit_galaxy_search(
     search::solve(&objective, search)
 }
 
+#[cfg(test)]
+mod joint_tests;
 #[cfg(test)]
 mod search_tests;
 #[cfg(test)]

@@ -228,6 +228,14 @@ fn fit_header(terms: &EptTerms, request: &GalaxyFitRequest, context: &FitContext
     header
 }
 
+/// One row of a fit table: a fit, its request and the template of its derived parameters.
+#[derive(Clone, Copy)]
+pub(super) struct Row<'a> {
+    pub(super) fit: &'a GalaxyFit,
+    pub(super) request: &'a GalaxyFitRequest,
+    pub(super) template: Option<&'a Template>,
+}
+
 /// The columns of `fits` after the first (k_max or s_max).
 fn fit_columns(
     t: &mut Table,
@@ -235,18 +243,32 @@ fn fit_columns(
     request: &GalaxyFitRequest,
     context: &FitContext,
 ) {
+    let rows: Vec<Row> = fits
+        .iter()
+        .map(|fit| Row {
+            fit,
+            request,
+            template: context.template.as_ref(),
+        })
+        .collect();
+    row_columns(t, &rows);
+}
+
+/// The columns of `rows` (each its own request: a parameter free in one row and not another has
+/// NaN errors in the other; a derived parameter a row does not have is NaN there).
+pub(super) fn row_columns(t: &mut Table, rows: &[Row]) {
     t.push(
         "points",
         "1",
-        fits.iter().map(|f| f.points as f64).collect(),
+        rows.iter().map(|r| r.fit.points as f64).collect(),
     );
-    t.push("chi2", "1", fits.iter().map(|f| f.chi2).collect());
+    t.push("chi2", "1", rows.iter().map(|r| r.fit.chi2).collect());
     t.push(
         "minus_2_ln_L",
         "1",
-        fits.iter().map(|f| f.minus_two_log_l).collect(),
+        rows.iter().map(|r| r.fit.minus_two_log_l).collect(),
     );
-    let ap_names: &[&str] = if request.ap.is_some() {
+    let ap_names: &[&str] = if rows.iter().any(|r| r.request.ap.is_some()) {
         &crate::fit::galaxy::AP_NAMES
     } else {
         &[]
@@ -261,90 +283,95 @@ fn fit_columns(
         t.push(
             *name,
             unit(name),
-            fits.iter().map(|f| value(i, f)).collect(),
+            rows.iter().map(|r| value(i, r.fit)).collect(),
         );
-        let err = |f: &GalaxyFit| {
-            if let Some(j) = request.free.iter().position(|n| n == name) {
-                Some(f.errors[j])
+        let free = |r: &Row| r.request.free.iter().position(|n| n == name);
+        let err = |r: &Row| {
+            if let Some(j) = free(r) {
+                Some(r.fit.errors[j])
             } else {
-                request
+                r.request
                     .marginalise
                     .iter()
                     .position(|n| n == name)
-                    .map(|j| f.marginalised_errors[j])
+                    .map(|j| r.fit.marginalised_errors[j])
             }
         };
-        if fits.first().and_then(err).is_some() {
-            let values: Vec<f64> = fits.iter().map(|f| err(f).unwrap_or(f64::NAN)).collect();
+        if rows.iter().any(|r| err(r).is_some()) {
+            let values: Vec<f64> = rows.iter().map(|r| err(r).unwrap_or(f64::NAN)).collect();
             t.push_undefined_as(
                 format!("err_{name}"),
                 unit(name),
                 values,
                 "NaN where the Hessian of -2 ln L is not positive definite and the profile has \
-                 no crossing",
+                 no crossing, or where the parameter is neither free nor marginalised",
             );
         }
-        if let Some(j) = request.free.iter().position(|n| n == name) {
-            free_columns(t, fits, name, j);
+        if rows.iter().any(|r| free(r).is_some()) {
+            let js: Vec<Option<usize>> = rows.iter().map(free).collect();
+            free_columns(t, rows, name, &js);
         }
     }
-    t.push(
-        "starts",
-        "1",
-        fits.iter().map(|f| f.starts as f64).collect(),
-    );
-    t.push(
-        "starts_agree",
-        "1",
-        fits.iter().map(|f| f.agree as f64).collect(),
-    );
-    t.push(
-        "starts_spread",
-        "1",
-        fits.iter().map(|f| f.spread).collect(),
-    );
-    if let Some(template) = &context.template {
-        let all: Vec<Vec<Derived>> = fits.iter().map(|f| derived(f, request, template)).collect();
-        for (j, d) in all.first().map_or(&[][..], |d| &d[..]).iter().enumerate() {
-            t.push(d.name, "1", all.iter().map(|d| d[j].value).collect());
-            if d.name != "sigma8_z" {
-                t.push(
-                    format!("err_{}", d.name),
-                    "1",
-                    all.iter().map(|d| d[j].error).collect(),
-                );
-            }
+    let count = |g: fn(&GalaxyFit) -> f64| rows.iter().map(|r| g(r.fit)).collect();
+    t.push("starts", "1", count(|f| f.starts as f64));
+    t.push("starts_agree", "1", count(|f| f.agree as f64));
+    t.push("starts_spread", "1", count(|f| f.spread));
+    let all: Vec<Vec<Derived>> = rows
+        .iter()
+        .map(|r| r.template.map_or(vec![], |t| derived(r.fit, r.request, t)))
+        .collect();
+    let mut names: Vec<&'static str> = Vec::new();
+    for d in all.iter().flatten() {
+        if !names.contains(&d.name) {
+            names.push(d.name);
+        }
+    }
+    for name in names {
+        let find = |d: &[Derived]| d.iter().find(|x| x.name == name).cloned();
+        let of = |g: fn(&Derived) -> f64| -> Vec<f64> {
+            all.iter()
+                .map(|d| find(d).map_or(f64::NAN, |x| g(&x)))
+                .collect()
+        };
+        t.push(name, "1", of(|d| d.value));
+        if name != "sigma8_z" {
+            t.push(format!("err_{name}"), "1", of(|d| d.error));
         }
     }
 }
 
-/// The error columns of the free parameter `name` (the j-th free).
-fn free_columns(t: &mut Table, fits: &[GalaxyFit], name: &str, j: usize) {
+/// The error columns of the free parameter `name` (the `js[r]`-th free of row r, if free there).
+fn free_columns(t: &mut Table, rows: &[Row], name: &str, js: &[Option<usize>]) {
+    let of = |g: &dyn Fn(&GalaxyFit, usize) -> f64| -> Vec<f64> {
+        rows.iter()
+            .zip(js)
+            .map(|(r, j)| j.map_or(f64::NAN, |j| g(r.fit, j)))
+            .collect()
+    };
     t.push_undefined_as(
         format!("err_{name}_hessian"),
         unit(name),
-        fits.iter().map(|f| f.hessian_errors[j]).collect(),
-        "NaN where the Hessian of -2 ln L is not positive definite",
+        of(&|f, j| f.hessian_errors[j]),
+        "NaN where the Hessian of -2 ln L is not positive definite (or the parameter is not free)",
     );
     let none = "NaN where the profile does not reach delta = 1 inside the parameter's bounds";
     t.push_undefined_as(
         format!("{name}_lo"),
         unit(name),
-        fits.iter().map(|f| f.intervals[j].0).collect(),
+        of(&|f, j| f.intervals[j].0),
         none,
     );
     t.push_undefined_as(
         format!("{name}_hi"),
         unit(name),
-        fits.iter().map(|f| f.intervals[j].1).collect(),
+        of(&|f, j| f.intervals[j].1),
         none,
     );
-    t.push(
+    t.push_undefined_as(
         format!("err_{name}_from_profile"),
         "1",
-        fits.iter()
-            .map(|f| f64::from(u8::from(f.from_profile[j])))
-            .collect(),
+        of(&|f, j| f64::from(u8::from(f.from_profile[j]))),
+        "NaN where the parameter is not free",
     );
 }
 

@@ -36,6 +36,9 @@ pub use crate::real::counterterm::counterterm_line;
 use crate::real::{Counterterms, RealModel, RealPlan, RealSelection, RealSpectra};
 use crate::setup::Prepared;
 
+/// The TOML analysis file of a joint fit (feature `analysis`).
+#[cfg(feature = "analysis")]
+pub mod analysis;
 mod batch;
 mod bias;
 mod bispectrum;
@@ -44,6 +47,7 @@ mod ept;
 mod ept_fit;
 mod fit;
 mod halo;
+mod joint_fit;
 mod observe;
 mod report;
 mod rsd;
@@ -57,6 +61,7 @@ pub use ept::{
 pub use ept_fit::{ept_fit_table, ept_model_table, ept_profile_table, FitContext};
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use halo::{halo_table, HaloRequest};
+pub use joint_fit::{joint_fit_table, Analysis, Inputs, SetSpec, DEFAULT_B1};
 pub use observe::observed_table;
 pub use report::{contour_table, push_spectrum_errors, real_spectra_table, rsd_multipoles_table};
 pub use rsd::{

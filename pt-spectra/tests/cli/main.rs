@@ -5,6 +5,7 @@
 
 use std::process::Command;
 
+mod analysis;
 mod bias;
 mod bispectrum;
 mod counterterm;

@@ -19,8 +19,18 @@ pub struct Args {
     #[command(flatten)]
     spectrum: SpectrumInput,
     /// Measured multipoles: a table with k [h/Mpc] and, per multipole, P_l and its 1σ error [(Mpc/h)^3].
-    #[arg(long, value_name = "FILE")]
-    data: PathBuf,
+    #[arg(long, value_name = "FILE", required_unless_present = "analysis")]
+    data: Option<PathBuf>,
+    /// A joint fit of the galaxy model `ept` to several data sets described by a TOML analysis file
+    /// (each set's data, covariance, window, z, k ranges, multipoles, free and marginalised parameters,
+    /// priors; the shared parameters; docs/analysis.md). The cosmology and linear spectrum come from
+    /// the options (--cosmology, --linear, …), the redshifts from the file.
+    #[arg(long, value_name = "FILE.toml", conflicts_with_all = [
+        "data", "covariance", "data_columns", "data_ells", "ells", "free", "marginalise", "prior",
+        "n_mocks", "k_min", "k_max", "k_range_ell", "xi", "apar", "aperp", "fiducial", "starts",
+        "seed", "no_profile_check", "profile_linear", "profile", "model_out", "contour", "z",
+    ])]
+    analysis: Option<PathBuf>,
     /// 1-based columns of the data: k, then P_l and σ_l for each of --data-ells.
     #[arg(long, value_name = "K,P,S,…", default_value = "1,2,3,4,5,6,7")]
     data_columns: String,
@@ -190,6 +200,13 @@ pub struct Args {
 /// The default scan of --k-max.
 const K_MAX_SCAN: &str = "0.05:0.25:0.01";
 
+/// The path of --data (required unless --analysis is given).
+fn data_path(args: &Args) -> Result<&std::path::Path> {
+    args.data
+        .as_deref()
+        .ok_or_else(|| anyhow::anyhow!("fit needs --data FILE (or --analysis FILE.toml)"))
+}
+
 /// The data of --data (the multipoles of --ells) and --covariance, and the fitted ells.
 fn read_data(args: &Args) -> Result<(MultipoleData, Vec<usize>)> {
     let data_ells: Vec<usize> = list(&args.data_ells, "--data-ells")?;
@@ -198,7 +215,7 @@ fn read_data(args: &Args) -> Result<(MultipoleData, Vec<usize>)> {
     let layout = pt_spectra::fit::DataLayout::new(&data_ells, Some(&cols))
         .map_err(|e| anyhow::anyhow!("--data-columns/--data-ells: {e}"))?;
     let mut data = layout
-        .read(&args.data, &ells)
+        .read(data_path(args)?, &ells)
         .map_err(|e| anyhow::anyhow!("--ells/--data: {e}"))?;
     if let Some(path) = &args.covariance {
         data = layout.read_covariance(data, path).context("--covariance")?;
@@ -343,7 +360,7 @@ fn run_ept(args: &Args) -> Result<()> {
         } else {
             ", IR resummed"
         },
-        args.data.display()
+        data_path(args)?.display()
     )];
     header.extend(pt_spectra::jobs::describe_inputs(
         &loaded.prepared,
@@ -455,8 +472,11 @@ fn k_max_values(s: &str) -> Result<Vec<f64>> {
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<()> {
+    if let Some(path) = &args.analysis {
+        return crate::analysis::run(path, &args.spectrum, args.rsd, args.out.as_deref());
+    }
     let mut inputs = args.spectrum.files();
-    inputs.push(("--data", Some(args.data.as_path())));
+    inputs.push(("--data", Some(data_path(args)?)));
     inputs.push(("--covariance", args.covariance.as_deref()));
     inputs.extend(args.bias.files());
     inputs.extend(args.noise.files());
@@ -535,7 +555,7 @@ pub fn run(args: &Args) -> Result<()> {
         free,
         k_min: args.k_min,
         k_max: k_max_values(&args.k_max)?,
-        data_name: args.data.display().to_string(),
+        data_name: data_path(args)?.display().to_string(),
     };
     for (name, v) in [("--amplitude", args.bias.amplitude)]
         .into_iter()

@@ -163,7 +163,12 @@ impl SpectrumInput {
 
     /// Parses the cosmology and reads the spectrum; warnings go to standard error.
     pub fn load(&self) -> Result<Loaded> {
-        for (name, z) in [("--z", self.z), ("--z-input", self.z_input)] {
+        self.load_at(self.z, "--z")
+    }
+
+    /// [`Self::load`] at the output redshift `z` (given by `origin`) in place of --z.
+    pub fn load_at(&self, z: f64, origin: &str) -> Result<Loaded> {
+        for (name, z) in [(origin, z), ("--z-input", self.z_input)] {
             if !(z.is_finite() && z > -1.0) {
                 bail!("{name} {z}: a redshift must be finite and > -1");
             }
@@ -192,7 +197,7 @@ impl SpectrumInput {
         let prepared = setup::prepare(Request {
             source,
             cosmology,
-            z: self.z,
+            z,
         })?;
         // Ignored keys are a note (the file may hold a Boltzmann code's other settings).
         for w in setup::input_warnings(&prepared, &ignored, &[]) {

@@ -6,6 +6,7 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+mod analysis;
 mod bispectrum;
 mod common;
 mod ept;

@@ -16,12 +16,15 @@
 //!   by more than 0.01 means the starts missed the global minimum: the search restarts there.
 
 use super::objective::Objective;
-use super::{index, GalaxyFit, GalaxyFitRequest, MultipoleData, Observation, SLOTS};
+use super::{GalaxyFit, PriorShape, SLOTS};
 use crate::error::{Error, Result};
 use crate::fit::bounded::{multistart, Minimum, Problem, AGREEMENT, EXPECTED_DECREASE};
 use crate::linalg::solve_spd;
-use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
+use crate::rsd::ept::PARAM_NAMES;
 use rand::{Rng, SeedableRng};
+
+mod profile;
+pub use profile::{profile_galaxy, GalaxyProfile, ProfileGrid, ProfilePoint};
 
 /// The starts of a fit by default.
 pub const DEFAULT_STARTS: usize = 8;
@@ -96,6 +99,24 @@ impl Default for Search {
     }
 }
 
+/// The bounds (lower, upper) and typical σ of slot `i` with `prior`, on a plan of AP range `ap`:
+/// [`RANGES`], α∥, α⊥ within the AP range, narrowed by the prior's support.
+pub(super) fn bound(
+    i: usize,
+    prior: Option<&PriorShape>,
+    ap: Option<(f64, f64)>,
+) -> (f64, f64, f64) {
+    let (mut a, mut b, _, _, s) = RANGES[i];
+    if let (true, Some((x, y))) = (i >= PARAM_NAMES.len(), ap) {
+        (a, b) = (x, y);
+    }
+    if let Some(p) = prior {
+        let (x, y) = p.support();
+        (a, b) = (a.max(x), b.min(y));
+    }
+    (a, b, s)
+}
+
 /// The bounds (lower, upper) and typical σ of the free parameters of `objective`.
 fn bounds(objective: &Objective) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let ap = objective.plan.settings().ap_range;
@@ -103,14 +124,7 @@ fn bounds(objective: &Objective) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let mut hi = Vec::new();
     let mut scale = Vec::new();
     for &i in &objective.free {
-        let (mut a, mut b, _, _, s) = RANGES[i];
-        if let (true, Some((x, y))) = (i >= PARAM_NAMES.len(), ap) {
-            (a, b) = (x, y);
-        }
-        if let Some(p) = &objective.priors[i] {
-            let (x, y) = p.support();
-            (a, b) = (a.max(x), b.min(y));
-        }
+        let (a, b, s) = bound(i, objective.priors[i].as_ref(), ap);
         lo.push(a);
         hi.push(b);
         scale.push(s);
@@ -125,9 +139,10 @@ fn draws(rng: &mut rand_chacha::ChaCha8Rng) -> (f64, f64) {
     (z, rng.gen())
 }
 
-/// The starts: `x0`, then draws from the priors or the start box, within [lo, hi].
+/// The starts: `x0`, then draws from the priors or the start box, within [lo, hi]; `params` the
+/// slot and prior of each free parameter.
 fn starts(
-    objective: &Objective,
+    params: &[(usize, Option<&PriorShape>)],
     x0: &[f64],
     lo: &[f64],
     hi: &[f64],
@@ -136,13 +151,12 @@ fn starts(
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(search.seed);
     let mut all = vec![x0.to_vec()];
     while all.len() < search.starts {
-        let x = objective
-            .free
+        let x = params
             .iter()
             .enumerate()
-            .map(|(j, &i)| {
+            .map(|(j, &(i, prior))| {
                 let (z, u) = draws(&mut rng);
-                let v = match &objective.priors[i] {
+                let v = match prior {
                     Some(p) => p.draw(z.clamp(-2.0, 2.0), u),
                     None => RANGES[i].2 + (RANGES[i].3 - RANGES[i].2) * u,
                 };
@@ -279,19 +293,78 @@ fn intervals(
     Ok((out, used))
 }
 
+/// The free parameters of a search: per parameter its slot and prior, its bounds and typical σ, and
+/// its start (inside the bounds).
+pub(super) struct Space<'p> {
+    /// Per parameter: its slot and prior.
+    pub(super) params: Vec<(usize, Option<&'p PriorShape>)>,
+    /// Lower bounds.
+    pub(super) lo: Vec<f64>,
+    /// Upper bounds.
+    pub(super) hi: Vec<f64>,
+    /// Typical σ.
+    pub(super) scale: Vec<f64>,
+    /// The start.
+    pub(super) x0: Vec<f64>,
+}
+
+/// The errors of a search's free parameters (or of a selection of them: [`Errors::select`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Errors {
+    /// The errors given (the Hessian's, or the profile's half-width).
+    pub(super) given: Vec<f64>,
+    /// √diag(2H⁻¹).
+    pub(super) hessian: Vec<f64>,
+    /// 2H⁻¹.
+    pub(super) covariance: Option<Vec<Vec<f64>>>,
+    /// The profile's Δ = 1 crossings.
+    pub(super) intervals: Vec<(f64, f64)>,
+    /// Whether the error given is the profile's.
+    pub(super) from_profile: Vec<bool>,
+}
+
+impl Errors {
+    /// The errors of the parameters `indices` (their covariance the block of those rows and columns).
+    pub(super) fn select(&self, indices: &[usize]) -> Self {
+        Self {
+            given: indices.iter().map(|&i| self.given[i]).collect(),
+            hessian: indices.iter().map(|&i| self.hessian[i]).collect(),
+            covariance: self.covariance.as_ref().map(|c| {
+                indices
+                    .iter()
+                    .map(|&i| indices.iter().map(|&j| c[i][j]).collect())
+                    .collect()
+            }),
+            intervals: indices.iter().map(|&i| self.intervals[i]).collect(),
+            from_profile: indices.iter().map(|&i| self.from_profile[i]).collect(),
+        }
+    }
+}
+
+/// What a search found: the minimum, the errors and their profile check, the starts' agreement.
+pub(super) struct Found {
+    /// The minimum.
+    pub(super) best: Minimum,
+    /// The free parameters' errors.
+    pub(super) errors: Errors,
+    /// Starts minimised.
+    pub(super) starts: usize,
+    /// Starts that reached the minimum to [`AGREEMENT`].
+    pub(super) agree: usize,
+    /// The highest start's minimum minus the lowest.
+    pub(super) spread: f64,
+    /// Whether the profile check moved the minimum.
+    pub(super) moved: bool,
+    /// Objective evaluations used.
+    pub(super) evaluations: usize,
+}
+
 /// The fit of `objective` (module docs).
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for no start or no start with a finite −2 ln L; as the model's
 /// evaluation.
 pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit> {
-    if search.starts == 0 {
-        return Err(Error::InvalidParameter {
-            name: "number of starts",
-            value: 0.0,
-            reason: "the fit needs at least one start",
-        });
-    }
     let (lo, hi, scale) = bounds(objective);
     let mut x0: Vec<f64> = objective.free.iter().map(|&i| objective.start[i]).collect();
     for (j, v) in x0.iter_mut().enumerate() {
@@ -299,15 +372,76 @@ pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit>
     }
     // Errors of the model at the start are the user's: reported as they are.
     objective.evaluate(&x0)?;
-    let f = |x: &[f64]| objective.cost(x);
+    let space = Space {
+        params: objective
+            .free
+            .iter()
+            .map(|&i| (i, objective.priors[i].as_ref()))
+            .collect(),
+        lo,
+        hi,
+        scale,
+        x0,
+    };
+    let found = find(&|x: &[f64]| objective.cost(x), &space, search)?;
+    package(objective, &found.best.x, &found, found.errors.clone())
+}
+
+/// The [`GalaxyFit`] of `objective` at its free values `x`, with `errors` (of its free parameters)
+/// and the search's report `found`.
+///
+/// # Errors
+/// As the model's evaluation.
+pub(super) fn package(
+    objective: &Objective,
+    x: &[f64],
+    found: &Found,
+    errors: Errors,
+) -> Result<GalaxyFit> {
+    let (minus_two_log_l, chi2, slots, marginalised_errors) = objective.evaluate(x)?;
+    let (params, ap) = objective.split(&slots)?;
+    Ok(GalaxyFit {
+        best: params,
+        ap,
+        errors: errors.given,
+        hessian_errors: errors.hessian,
+        covariance: errors.covariance,
+        intervals: errors.intervals,
+        from_profile: errors.from_profile,
+        marginalised_errors,
+        chi2,
+        minus_two_log_l,
+        points: objective.points(),
+        starts: found.starts,
+        agree: found.agree,
+        spread: found.spread,
+        moved_by_profile: found.moved,
+        evaluations: found.evaluations,
+    })
+}
+
+/// The minimum of `cost` over `space` from the starts of `search`, its errors and their profile
+/// check (module docs).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for no start or no start with a finite −2 ln L.
+pub(super) fn find(cost: &dyn Fn(&[f64]) -> f64, space: &Space, search: &Search) -> Result<Found> {
+    if search.starts == 0 {
+        return Err(Error::InvalidParameter {
+            name: "number of starts",
+            value: 0.0,
+            reason: "the fit needs at least one start",
+        });
+    }
+    let (lo, hi) = (&space.lo, &space.hi);
     let problem = Problem {
-        f: &f,
+        f: cost,
         lo: lo.clone(),
         hi: hi.clone(),
-        scale,
+        scale: space.scale.clone(),
         tolerance: EXPECTED_DECREASE,
     };
-    let multi = multistart(&problem, &starts(objective, &x0, &lo, &hi, search));
+    let multi = multistart(&problem, &starts(&space.params, &space.x0, lo, hi, search));
     let mut best = multi.best().clone();
     if !best.value.is_finite() {
         return Err(Error::InvalidParameter {
@@ -351,8 +485,6 @@ pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit>
     if std::env::var_os("PT_FIT_DEBUG").is_some() {
         eprintln!("total {evaluations} evals");
     }
-    let (minus_two_log_l, chi2, slots, marginalised_errors) = objective.evaluate(&best.x)?;
-    let (params, ap) = objective.split(&slots)?;
     let mut errors = hessian.clone();
     let mut from_profile = vec![false; n];
     for j in 0..n {
@@ -363,18 +495,7 @@ pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit>
             from_profile[j] = true;
         }
     }
-    Ok(GalaxyFit {
-        best: params,
-        ap,
-        errors,
-        hessian_errors: hessian,
-        covariance,
-        intervals,
-        from_profile,
-        marginalised_errors,
-        chi2,
-        minus_two_log_l,
-        points: objective.points(),
+    Ok(Found {
         starts: multi.minima.len(),
         // counted against the final minimum: after a profile found a lower one, the starts that
         // reached it (possibly none)
@@ -384,158 +505,15 @@ pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit>
             .filter(|m| m.value - best.value < AGREEMENT)
             .count(),
         spread: multi.worst_value() - best.value,
-        moved_by_profile: moved,
+        best,
+        errors: Errors {
+            given: errors,
+            hessian,
+            covariance,
+            intervals,
+            from_profile,
+        },
+        moved,
         evaluations,
-    })
-}
-
-/// The grid of a profile: `points` values over ± `span` times the fitted error around the best fit.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ProfileGrid {
-    /// Values (≥ 3).
-    pub points: usize,
-    /// The half-width in units of the fitted error (> 0).
-    pub span: f64,
-}
-
-/// One point of a profile.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ProfilePoint {
-    /// The profiled parameter's value.
-    pub value: f64,
-    /// −2 ln L with the others re-minimised.
-    pub minus_two_log_l: f64,
-    /// χ² there.
-    pub chi2: f64,
-    /// Every parameter there (the marginalised ones at â).
-    pub best: EptParams,
-    /// The distortion there.
-    pub ap: Option<crate::rsd::ap::Distortion>,
-}
-
-/// The profile likelihood of one free parameter.
-#[derive(Debug, Clone, PartialEq)]
-pub struct GalaxyProfile {
-    /// The parameter.
-    pub name: String,
-    /// The best fit (with the Δ = 1 interval of every free parameter).
-    pub fit: GalaxyFit,
-    /// The profile, in increasing value.
-    pub points: Vec<ProfilePoint>,
-}
-
-/// The profile of the free parameter `name` of `request` on `grid` around the best fit: at each
-/// value the other free parameters re-minimised (started from the neighbouring point's), the linear
-/// ones marginalised or profiled as `search` says. Δ(−2 ln L) = 1 bounds the 68.3% interval
-/// ([`GalaxyFit::intervals`]), 4 the 95.4% one.
-///
-/// # Errors
-/// [`Error::InvalidChoice`] if `name` is not free; [`Error::InvalidParameter`] for a grid of fewer
-/// than 3 or more than 401 points or a span that is not finite and positive; as
-/// [`super::fit_galaxy_search`].
-#[allow(clippy::too_many_arguments)]
-pub fn profile_galaxy(
-    plan: &EptPlan,
-    terms: &EptTerms,
-    data: &MultipoleData,
-    request: &GalaxyFitRequest,
-    observation: Option<&Observation>,
-    search: &Search,
-    name: &str,
-    grid: &ProfileGrid,
-) -> Result<GalaxyProfile> {
-    let slot = index(name)?;
-    if !(3..=401).contains(&grid.points) {
-        return Err(Error::InvalidParameter {
-            name: "profile grid points",
-            value: grid.points as f64,
-            reason: "must be between 3 and 401",
-        });
-    }
-    if !(grid.span.is_finite() && grid.span > 0.0) {
-        return Err(Error::InvalidParameter {
-            name: "profile span (in fitted errors)",
-            value: grid.span,
-            reason: "must be finite and positive",
-        });
-    }
-    let mut objective = super::objective::objective(plan, terms, data, request, observation)?;
-    objective.log_det = search.linear == Linear::Marginalised;
-    let Some(i) = objective.free.iter().position(|&s| s == slot) else {
-        return Err(Error::InvalidChoice {
-            what: format!("the profile of {name}"),
-            reason: format!(
-                "{name} is not free (free: {}): only a free parameter has a profile",
-                request.free.join(", ")
-            ),
-        });
-    };
-    let fit = solve(&objective, search)?;
-    let (lo, hi, _) = bounds(&objective);
-    let f = |x: &[f64]| objective.cost(x);
-    let problem = Problem {
-        f: &f,
-        lo,
-        hi,
-        scale: vec![],
-        tolerance: EXPECTED_DECREASE,
-    };
-    let value_of = |s: usize| match s.checked_sub(PARAM_NAMES.len()) {
-        None => fit.best.values[s],
-        Some(0) => fit.ap.map_or(f64::NAN, |d| d.apar),
-        Some(_) => fit.ap.map_or(f64::NAN, |d| d.aperp),
-    };
-    let best: Vec<f64> = objective.free.iter().map(|&s| value_of(s)).collect();
-    let sigma: Vec<f64> = fit
-        .errors
-        .iter()
-        .zip(objective.free.iter())
-        .map(|(&e, &s)| {
-            if e.is_finite() && e > 0.0 {
-                e
-            } else {
-                RANGES[s].4
-            }
-        })
-        .collect();
-    let n = grid.points;
-    let values: Vec<f64> = (0..n)
-        .map(|j| best[i] + grid.span * sigma[i] * (2.0 * j as f64 / (n - 1) as f64 - 1.0))
-        .map(|v| v.clamp(problem.lo[i], problem.hi[i]))
-        .collect();
-    // From the centre outwards, each point started from its inner neighbour's optimum.
-    let mut found: Vec<Option<Minimum>> = vec![None; n];
-    let centre = values
-        .iter()
-        .enumerate()
-        .min_by(|a, b| (a.1 - best[i]).abs().total_cmp(&(b.1 - best[i]).abs()))
-        .map_or(0, |(j, _)| j);
-    let order: Vec<usize> = (centre..n).chain((0..centre).rev()).collect();
-    for j in order {
-        let guess = if j >= centre && j > centre {
-            found[j - 1].as_ref().map_or(best.clone(), |m| m.x.clone())
-        } else if j < centre {
-            found[j + 1].as_ref().map_or(best.clone(), |m| m.x.clone())
-        } else {
-            best.clone()
-        };
-        found[j] = Some(profile_at(&problem, &sigma, i, values[j], &guess));
-    }
-    let mut points = Vec::with_capacity(n);
-    for m in found.into_iter().flatten() {
-        let (total, chi2, slots, _) = objective.evaluate(&m.x)?;
-        let (params, ap) = objective.split(&slots)?;
-        points.push(ProfilePoint {
-            value: m.x[i],
-            minus_two_log_l: total,
-            chi2,
-            best: params,
-            ap,
-        });
-    }
-    Ok(GalaxyProfile {
-        name: name.to_string(),
-        fit,
-        points,
     })
 }

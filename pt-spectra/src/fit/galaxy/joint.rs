@@ -1,0 +1,301 @@
+//! Joint fits of several data sets: −2 ln L the sum of each set's (independent covariances), with
+//! the parameters declared shared taking one value in every set and the others one per set.
+//!
+//! Each data set has its own data vector, covariance, window and bins, fitted multipoles and k ranges,
+//! plan (its redshift's spectrum and AP range), start, free and marginalised parameters and priors:
+//! a [`GalaxyFitRequest`] as for a single fit. Its −2 ln L is the single fit's objective (the module
+//! docs of [`super`]), the linear parameters marginalised analytically per set (each set its own
+//! counterterms and stochastic terms, and its own ln det F). The joint free vector holds every shared
+//! parameter once and every other free parameter once per set; the sum is minimised by the single
+//! fit's search ([`super::search`]: the same bounds, starts, minimiser, Hessian errors and profile
+//! check), so that one data set gives exactly the single fit.
+//!
+//! A shared parameter must be free in every set and not marginalised (a marginalised parameter is
+//! a set's own); its prior, given in one set or identically in several, counts once; its bounds are
+//! the intersection of the sets'. [`default_shared`]: f, α∥, α⊥ (those free in every set) when the
+//! sets have the same redshift and tracer, none otherwise.
+//!
+//! Two copies of one data set with covariance C each are one copy with C/2 when every free parameter
+//! is shared and the linear ones are profiled (with them marginalised, each copy has its own ln det F
+//! and prior terms, which C/2 counts once).
+
+use super::objective::{objective, Objective};
+use super::search::{bound, find, package, Space};
+use super::{index, GalaxyFit, GalaxyFitRequest, Linear, MultipoleData, Observation, Search};
+use crate::error::{Error, Result};
+use crate::rsd::ept::{EptPlan, EptTerms};
+
+/// The parameters shared by default when every data set has the same redshift and tracer.
+pub const DEFAULT_SHARED: [&str; 3] = ["f", "apar", "aperp"];
+
+/// Redshifts closer than this are the same (the default sharing).
+pub const SAME_REDSHIFT: f64 = 1e-6;
+
+/// One data set of a joint fit.
+#[derive(Clone)]
+pub struct DataSet<'a> {
+    /// Its name in the output (`b1[<label>]`, …): unique among the sets.
+    pub label: String,
+    /// Its redshift (the default sharing; the plan is the spectrum's at this redshift).
+    pub z: f64,
+    /// Its tracer (the default sharing; empty: not stated).
+    pub tracer: String,
+    /// The plan on its model k.
+    pub plan: &'a EptPlan,
+    /// The terms of its spectrum.
+    pub terms: &'a EptTerms,
+    /// Its multipoles and covariance.
+    pub data: &'a MultipoleData,
+    /// What to fit (its start, free, marginalised, priors, ℓ and k ranges).
+    pub request: GalaxyFitRequest,
+    /// Its window and bins, if any.
+    pub observation: Option<&'a Observation>,
+}
+
+/// The result of a joint fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointFit {
+    /// The joint free parameters: a shared one by its name, a set's own as `name[label]`.
+    pub names: Vec<String>,
+    /// The shared parameters.
+    pub shared: Vec<String>,
+    /// Per data set its fit: its parameters at the joint best fit, its free parameters' errors (and
+    /// their covariance block) from the joint Hessian and profiles, its χ² and −2 ln L (its term of
+    /// the sum), its points; the search's report (starts, agreement, evaluations) is the joint one.
+    pub sets: Vec<GalaxyFit>,
+    /// The joint free parameters' errors (as [`GalaxyFit::errors`]), in the order of [`Self::names`].
+    pub errors: Vec<f64>,
+    /// Their covariance 2H⁻¹ (`None` where H is not positive definite).
+    pub covariance: Option<Vec<Vec<f64>>>,
+    /// Σ χ² of the sets.
+    pub chi2: f64,
+    /// Σ −2 ln L of the sets (the shared priors once).
+    pub minus_two_log_l: f64,
+    /// Σ fitted points.
+    pub points: usize,
+}
+
+/// The default shared parameters of `sets`: [`DEFAULT_SHARED`] free in every set when all have the
+/// same redshift (to [`SAME_REDSHIFT`]) and tracer; none otherwise.
+pub fn default_shared(sets: &[DataSet]) -> Vec<String> {
+    let Some(first) = sets.first() else {
+        return Vec::new();
+    };
+    let same = sets
+        .iter()
+        .all(|s| (s.z - first.z).abs() <= SAME_REDSHIFT && s.tracer == first.tracer);
+    if !same {
+        return Vec::new();
+    }
+    DEFAULT_SHARED
+        .iter()
+        .filter(|n| sets.iter().all(|s| s.request.free.iter().any(|f| f == *n)))
+        .map(|n| n.to_string())
+        .collect()
+}
+
+/// The joint objective: every set's objective and, per set, the joint index of each of its free
+/// parameters.
+struct Joint<'o, 'a> {
+    objectives: &'o [Objective<'a>],
+    map: Vec<Vec<usize>>,
+}
+
+impl Joint<'_, '_> {
+    /// Set `s`'s free values in the joint vector `x`.
+    fn part(&self, s: usize, x: &[f64]) -> Vec<f64> {
+        self.map[s].iter().map(|&g| x[g]).collect()
+    }
+
+    fn cost(&self, x: &[f64]) -> f64 {
+        self.objectives
+            .iter()
+            .enumerate()
+            .map(|(s, o)| o.cost(&self.part(s, x)))
+            .sum()
+    }
+}
+
+/// The error of a sharing rule broken.
+fn sharing(name: &str, reason: String) -> Error {
+    Error::InvalidChoice {
+        what: format!("the shared parameter `{name}`"),
+        reason,
+    }
+}
+
+/// The joint best fit of `sets` with the parameters `shared` (module docs), searched as `search`.
+///
+/// # Errors
+/// [`Error::InvalidChoice`] for no set, repeated labels, a shared name that is not a parameter,
+/// that no set frees, that a set does not free or marginalises, or with different priors in two
+/// sets; as [`super::fit_galaxy_search`] for each set.
+pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result<JointFit> {
+    if sets.is_empty() {
+        return Err(Error::InvalidChoice {
+            what: "a joint fit".into(),
+            reason: "needs at least one data set".into(),
+        });
+    }
+    for (i, s) in sets.iter().enumerate() {
+        if sets[..i].iter().any(|t| t.label == s.label) {
+            return Err(Error::InvalidChoice {
+                what: format!("the data set label `{}`", s.label),
+                reason: "is given twice: labels name the sets' own parameters".into(),
+            });
+        }
+    }
+    let mut objectives = Vec::with_capacity(sets.len());
+    for s in sets {
+        let mut o = objective(s.plan, s.terms, s.data, &s.request, s.observation).map_err(|e| {
+            Error::InvalidChoice {
+                what: format!("data set `{}`", s.label),
+                reason: e.to_string(),
+            }
+        })?;
+        o.log_det = search.linear == Linear::Marginalised;
+        objectives.push(o);
+    }
+    for (n, name) in shared.iter().enumerate() {
+        let slot = index(name)?;
+        if shared[..n].contains(name) {
+            return Err(sharing(name, "is declared shared twice".into()));
+        }
+        let frees: Vec<bool> = objectives.iter().map(|o| o.free.contains(&slot)).collect();
+        if let Some(s) = sets.iter().find(|s| s.request.marginalise.contains(name)) {
+            return Err(sharing(
+                name,
+                format!(
+                    "is marginalised in data set `{}`: a marginalised parameter is a set's own (free \
+                     it in every set to share it)",
+                    s.label
+                ),
+            ));
+        }
+        if !frees.iter().any(|&f| f) {
+            return Err(sharing(
+                name,
+                "no data set has it free: a shared parameter must be free in every set".into(),
+            ));
+        }
+        if let Some(s) = frees.iter().position(|&f| !f) {
+            return Err(sharing(
+                name,
+                format!(
+                    "is not free in data set `{}`: a shared parameter must be free in every set",
+                    sets[s].label
+                ),
+            ));
+        }
+        // Its prior: one, counted once (kept in the first set that gives it).
+        let mut prior = None;
+        for (o, s) in objectives.iter_mut().zip(sets) {
+            match (prior.as_ref(), o.priors[slot].take()) {
+                (_, None) => {}
+                (None, Some(p)) => {
+                    o.priors[slot] = Some(p.clone());
+                    prior = Some(p);
+                }
+                (Some(q), Some(p)) if *q == p => {}
+                (Some(q), Some(p)) => {
+                    return Err(sharing(
+                        name,
+                        format!(
+                            "has the prior {q} in one set and {p} in data set `{}`: a shared \
+                             parameter has one prior",
+                            s.label
+                        ),
+                    ))
+                }
+            }
+        }
+    }
+    // The joint parameters, in the sets' order of their free ones; a shared one at its first.
+    let slots_shared: Vec<usize> = shared.iter().map(|n| index(n)).collect::<Result<_>>()?;
+    let mut names = Vec::new();
+    let mut params = Vec::new();
+    let (mut lo, mut hi, mut scale, mut x0) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut map = Vec::with_capacity(sets.len());
+    for (s, o) in objectives.iter().enumerate() {
+        let ap = o.plan.settings().ap_range;
+        let mut own = Vec::with_capacity(o.free.len());
+        for (j, &slot) in o.free.iter().enumerate() {
+            let (a, b, sc) = bound(slot, o.priors[slot].as_ref(), ap);
+            let is_shared = slots_shared.contains(&slot);
+            if let Some(g) = (is_shared && s > 0).then(|| map_of(&map, slot, &objectives)) {
+                let g = g.expect("a shared parameter is free in the first set");
+                lo[g] = f64::max(lo[g], a);
+                hi[g] = f64::min(hi[g], b);
+                own.push(g);
+                continue;
+            }
+            own.push(names.len());
+            names.push(if is_shared {
+                sets[s].request.free[j].clone()
+            } else {
+                format!("{}[{}]", sets[s].request.free[j], sets[s].label)
+            });
+            params.push((slot, o.priors[slot].as_ref()));
+            lo.push(a);
+            hi.push(b);
+            scale.push(sc);
+            x0.push(o.start[slot]);
+        }
+        map.push(own);
+    }
+    for (j, v) in x0.iter_mut().enumerate() {
+        if lo[j] > hi[j] {
+            return Err(sharing(
+                &names[j],
+                "the sets' bounds (priors, AP ranges) do not overlap".into(),
+            ));
+        }
+        *v = v.clamp(lo[j], hi[j]);
+    }
+    let joint = Joint {
+        objectives: &objectives,
+        map,
+    };
+    // Errors of the model at the start are the user's: reported as they are, naming the set.
+    for (s, o) in joint.objectives.iter().enumerate() {
+        o.evaluate(&joint.part(s, &x0))
+            .map_err(|e| Error::InvalidChoice {
+                what: format!("data set `{}` at the start", sets[s].label),
+                reason: e.to_string(),
+            })?;
+    }
+    let space = Space {
+        params,
+        lo,
+        hi,
+        scale,
+        x0,
+    };
+    let found = find(&|x: &[f64]| joint.cost(x), &space, search)?;
+    let x = &found.best.x;
+    let mut fits = Vec::with_capacity(sets.len());
+    for (s, o) in joint.objectives.iter().enumerate() {
+        fits.push(package(
+            o,
+            &joint.part(s, x),
+            &found,
+            found.errors.select(&joint.map[s]),
+        )?);
+    }
+    Ok(JointFit {
+        names,
+        shared: shared.to_vec(),
+        chi2: fits.iter().map(|f| f.chi2).sum(),
+        minus_two_log_l: fits.iter().map(|f| f.minus_two_log_l).sum(),
+        points: fits.iter().map(|f| f.points).sum(),
+        sets: fits,
+        errors: found.errors.given.clone(),
+        covariance: found.errors.covariance.clone(),
+    })
+}
+
+/// The joint index of the shared `slot`: its index in the first set's map.
+fn map_of(map: &[Vec<usize>], slot: usize, objectives: &[Objective]) -> Option<usize> {
+    let j = objectives[0].free.iter().position(|&i| i == slot)?;
+    map.first().map(|m| m[j])
+}

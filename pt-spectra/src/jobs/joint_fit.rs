@@ -1,0 +1,403 @@
+//! `fit --analysis FILE`: the joint fit of the galaxy model `ept` to several data sets
+//! ([`crate::fit::galaxy::joint`]), from an analysis (the parsed file, [`Analysis`]), as a table with
+//! a row per data set.
+
+use super::ept_fit::{row_columns, Row};
+use crate::error::{Error, Result};
+use crate::fit::galaxy::search::{CROSSING_TOLERANCE, HESSIAN_STEP};
+use crate::fit::galaxy::{
+    default_shared, fit_joint, DataSet, GalaxyFitRequest, JointFit, Linear, Prior, Search, Template,
+};
+use crate::fit::{DataLayout, MultipoleData};
+use crate::output::Table;
+use crate::precision::Precision;
+use crate::rsd::ap::Distortion;
+use crate::rsd::ept::{EptParams, EptPlan, EptTerms};
+use crate::setup::Prepared;
+use crate::store::TableStore;
+use crate::survey::observe::{Bins, Observation, Window};
+use std::path::PathBuf;
+
+/// The start of b1 when a data set gives none (the middle of the start box, [`crate::fit::galaxy::search::RANGES`]).
+pub const DEFAULT_B1: f64 = 2.0;
+
+/// One data set of an analysis (paths already resolved against the analysis file's directory).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SetSpec {
+    /// Its label (unique; names its own parameters).
+    pub label: String,
+    /// Its redshift.
+    pub z: f64,
+    /// Its tracer (empty: not stated).
+    pub tracer: String,
+    /// The multipoles file: k, then P_ℓ and σ_ℓ per multipole of `data_ells`.
+    pub data: PathBuf,
+    /// The multipoles in the data file, in column order.
+    pub data_ells: Vec<usize>,
+    /// 1-based columns of k, then P_ℓ, σ_ℓ (default 1, 2, 3, …).
+    pub data_columns: Option<Vec<usize>>,
+    /// The covariance file, if any (else diagonal σ²).
+    pub covariance: Option<PathBuf>,
+    /// The mocks the covariance was estimated from (the Hartlap factor).
+    pub n_mocks: Option<usize>,
+    /// The fitted multipoles.
+    pub ells: Vec<usize>,
+    /// The fitted range [h/Mpc].
+    pub k_min: f64,
+    /// The fitted range [h/Mpc].
+    pub k_max: f64,
+    /// Per-multipole ranges (ℓ, k_min, k_max) [h/Mpc].
+    pub ell_ranges: Vec<(usize, f64, f64)>,
+    /// The free parameters.
+    pub free: Vec<String>,
+    /// The marginalised parameters.
+    pub marginalise: Vec<String>,
+    /// The priors.
+    pub priors: Vec<Prior>,
+    /// Start (or fixed) values by name; b1 defaults to [`DEFAULT_B1`], f to f(z) of the cosmology.
+    pub start: Vec<(String, f64)>,
+    /// The measurement's distortion (α∥, α⊥), if given.
+    pub ap: Option<(f64, f64)>,
+    /// The fiducial cosmology of the measurement (preset or .ini), for the distortion, if given.
+    pub fiducial: Option<String>,
+    /// The window file, if any.
+    pub window: Option<PathBuf>,
+    /// The window file's layout ([`crate::survey::WindowFormat::parse`]).
+    pub window_format: String,
+    /// The window's mixing: `wilson` or `classpt-boss`.
+    pub window_mixing: String,
+    /// k bin edges [h/Mpc], if any.
+    pub k_edges: Option<Vec<f64>>,
+    /// The side of the periodic box [Mpc/h] whose modes are averaged in the bins, if any.
+    pub box_side: Option<f64>,
+    /// IR resummation.
+    pub ir: bool,
+}
+
+/// A joint analysis: its data sets, the shared parameters and the search.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Analysis {
+    /// The file it was read from (for the header and the errors).
+    pub origin: String,
+    /// The shared parameters; `None`: [`default_shared`].
+    pub shared: Option<Vec<String>>,
+    /// The minimiser's settings.
+    pub search: Search,
+    /// The data sets.
+    pub sets: Vec<SetSpec>,
+}
+
+/// What the analysis needs from the face: the spectrum at a redshift, the loop settings, the cache.
+pub struct Inputs<'a> {
+    /// The prepared spectrum and growth at z (the face's cosmology and linear spectrum).
+    pub prepare: &'a dyn Fn(f64) -> Result<Prepared>,
+    /// The loop-integral settings.
+    pub precision: &'a Precision,
+    /// The angular-table cache.
+    pub store: &'a TableStore,
+    /// Progress of the plans.
+    pub progress: &'a dyn crate::progress::Progress,
+}
+
+/// An error of data set `label` of `origin`.
+fn in_set(origin: &str, label: &str, e: impl std::fmt::Display) -> Error {
+    Error::InvalidChoice {
+        what: format!("{origin}: data set `{label}`"),
+        reason: e.to_string(),
+    }
+}
+
+/// What one data set loads: its data, observation, plan, terms, request and template.
+struct Loaded {
+    data: MultipoleData,
+    observation: Option<Observation>,
+    plan: EptPlan,
+    terms: EptTerms,
+    request: GalaxyFitRequest,
+    template: Template,
+    description: Vec<String>,
+}
+
+/// Loads data set `s` of `analysis`.
+fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded> {
+    let err = |e: Error| in_set(origin, &s.label, e);
+    let prepared = (inputs.prepare)(s.z).map_err(err)?;
+    let layout = DataLayout::new(&s.data_ells, s.data_columns.as_deref()).map_err(err)?;
+    let mut data = layout.read(&s.data, &s.ells).map_err(err)?;
+    if let Some(path) = &s.covariance {
+        data = layout.read_covariance(data, path).map_err(err)?;
+    }
+    let mixing = match s.window_mixing.as_str() {
+        "wilson" => crate::survey::Mixing::Wilson,
+        "classpt-boss" => crate::survey::Mixing::ClassPtBoss,
+        other => {
+            return Err(err(Error::InvalidChoice {
+                what: format!("window_mixing = \"{other}\""),
+                reason: "expected wilson or classpt-boss".into(),
+            }))
+        }
+    };
+    let window = match &s.window {
+        Some(path) => {
+            let format = crate::survey::WindowFormat::parse(&s.window_format).map_err(err)?;
+            Some(Window::read(path, mixing, &format).map_err(err)?)
+        }
+        None => None,
+    };
+    let bins = s.k_edges.as_ref().map(|edges| match s.box_side {
+        Some(side) => Bins::Box {
+            side,
+            edges: edges.clone(),
+        },
+        None => Bins::Edges(edges.clone()),
+    });
+    let observation = if window.is_some() || bins.is_some() {
+        Some(Observation::new(&s.ells, &data.k, window, bins).map_err(err)?)
+    } else {
+        None
+    };
+    let cosmology = prepared.cosmology.cosmology;
+    let ap = match (s.ap, &s.fiducial) {
+        (Some((a, p)), _) => Some(Distortion::new(a, p).map_err(err)?),
+        (None, Some(name)) => {
+            let fiducial = crate::setup::NamedCosmology::parse(name).map_err(err)?.0;
+            Some(Distortion::from_cosmologies(&cosmology, &fiducial.cosmology, s.z).map_err(err)?)
+        }
+        (None, None) => None,
+    };
+    let free_ap = s.free.iter().any(|n| n == "apar" || n == "aperp");
+    if free_ap && ap.is_none() {
+        return Err(err(Error::InvalidChoice {
+            what: "free apar/aperp".into(),
+            reason: "need the measurement's distortion: apar and aperp, or fiducial".into(),
+        }));
+    }
+    let model_k = observation
+        .as_ref()
+        .map_or(data.k.as_slice(), |o| o.k_model());
+    let plan = super::ept_plan(
+        model_k,
+        s.ir,
+        ap,
+        free_ap,
+        inputs.precision,
+        inputs.store,
+        inputs.progress,
+    )
+    .map_err(err)?;
+    let terms = plan.terms(prepared.tracer_spectrum()).map_err(err)?;
+    let mut start = EptParams::new(DEFAULT_B1, prepared.growth_rate);
+    for (name, v) in &s.start {
+        match name.as_str() {
+            "apar" | "aperp" => {
+                return Err(err(Error::InvalidChoice {
+                    what: format!("start.{name}"),
+                    reason: "the distortion's start is the data set's apar, aperp (or fiducial)"
+                        .into(),
+                }))
+            }
+            _ => start.set(name, *v).map_err(err)?,
+        }
+    }
+    let request = GalaxyFitRequest {
+        start,
+        ap,
+        free: s.free.clone(),
+        marginalise: s.marginalise.clone(),
+        priors: s.priors.clone(),
+        ells: s.ells.clone(),
+        k_min: s.k_min,
+        k_max: s.k_max,
+        ell_ranges: s.ell_ranges.clone(),
+        n_mocks: s.n_mocks,
+    };
+    let mut description =
+        vec![format!(
+        "data set {}: {} (z = {}, tracer {}{}{}), multipoles {:?} for k in [{}, {}] h/Mpc{}; free \
+         {}, marginalised {}, priors {}; start {}",
+        s.label,
+        s.data.display(),
+        s.z,
+        if s.tracer.is_empty() { "not stated" } else { &s.tracer },
+        s.covariance
+            .as_ref()
+            .map_or(", diagonal errors".into(), |c| format!(
+                ", covariance {}",
+                c.display()
+            )),
+        s.n_mocks
+            .map_or(String::new(), |n| format!(" from {n} mocks (Hartlap)")),
+        s.ells,
+        s.k_min,
+        s.k_max,
+        s.ell_ranges
+            .iter()
+            .map(|(l, a, b)| format!(" (l = {l}: within [{a}, {b}])"))
+            .collect::<String>(),
+        s.free.join(","),
+        list_or_none(&s.marginalise),
+        list_or_none(
+            &s.priors
+                .iter()
+                .map(|p| format!("{}: {}", p.name, p.shape))
+                .collect::<Vec<_>>()
+        ),
+        describe_start(&request),
+    )];
+    if let Some(d) = ap {
+        description.push(format!(
+            "data set {}: measured with apar = {}, aperp = {}",
+            s.label, d.apar, d.aperp
+        ));
+    }
+    if let Some(o) = &observation {
+        description.extend(
+            o.description()
+                .iter()
+                .map(|l| format!("data set {}: {l}", s.label)),
+        );
+    }
+    description.extend(
+        prepared
+            .description
+            .iter()
+            .map(|l| format!("data set {}: {l}", s.label)),
+    );
+    let template = Template {
+        sigma8_z: prepared.spectrum.sigma8(),
+        z: s.z,
+        cosmology: Some(cosmology),
+    };
+    Ok(Loaded {
+        data,
+        observation,
+        plan,
+        terms,
+        request,
+        template,
+        description,
+    })
+}
+
+/// `a,b,c` or `none`.
+fn list_or_none(v: &[String]) -> String {
+    if v.is_empty() {
+        "none".into()
+    } else {
+        v.join(", ")
+    }
+}
+
+/// The start values of the free parameters of `request`.
+fn describe_start(request: &GalaxyFitRequest) -> String {
+    request
+        .free
+        .iter()
+        .filter_map(|n| request.start.get(n).map(|v| format!("{n} = {v}")))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The joint fit of `analysis`: a row per data set (`set` its 1-based number, `z`, then the columns
+/// of [`super::ept_fit_table`] for that set at the joint best fit: a shared parameter has the same
+/// value and error in every row). The header states every data set, the sharing and the search.
+///
+/// # Errors
+/// As [`fit_joint`]; each data set's loading errors name the analysis file and the set.
+pub fn joint_fit_table(
+    analysis: &Analysis,
+    inputs: &Inputs,
+    header: Vec<String>,
+) -> Result<(Table, JointFit)> {
+    let origin = &analysis.origin;
+    let loaded = analysis
+        .sets
+        .iter()
+        .map(|s| load(s, origin, inputs))
+        .collect::<Result<Vec<_>>>()?;
+    let sets: Vec<DataSet> = analysis
+        .sets
+        .iter()
+        .zip(&loaded)
+        .map(|(s, l)| DataSet {
+            label: s.label.clone(),
+            z: s.z,
+            tracer: s.tracer.clone(),
+            plan: &l.plan,
+            terms: &l.terms,
+            data: &l.data,
+            request: l.request.clone(),
+            observation: l.observation.as_ref(),
+        })
+        .collect();
+    let (shared, sharing) = match &analysis.shared {
+        Some(v) => (v.clone(), "declared in the analysis file"),
+        None => (
+            default_shared(&sets),
+            "the default: f, apar, aperp (those free in every set) when every set has the same z \
+             and tracer, none otherwise",
+        ),
+    };
+    let fit = fit_joint(&sets, &shared, &analysis.search).map_err(|e| Error::InvalidChoice {
+        what: origin.clone(),
+        reason: e.to_string(),
+    })?;
+    let mut h = header;
+    h.push(format!(
+        "joint fit of ept to {} data set(s) of {origin}: -2 ln L = the sum of the sets' (independent \
+         covariances; each set's linear parameters {} with its own ln det F); shared parameters ({sharing}): {}; \
+         every other free parameter is fitted per set; joint free parameters: {}",
+        sets.len(),
+        if analysis.search.linear == Linear::Profiled {
+            "profiled"
+        } else {
+            "marginalised analytically"
+        },
+        list_or_none(&shared),
+        fit.names.join(", ")
+    ));
+    for l in &loaded {
+        h.extend(l.terms.describe_source());
+        h.extend(l.description.iter().cloned());
+    }
+    h.push(format!(
+        "joint: points {}, chi2 {}, -2 ln L {} (the sums over the sets; each row's chi2 and \
+         minus_2_ln_L are its set's term)",
+        fit.points, fit.chi2, fit.minus_two_log_l
+    ));
+    h.push(format!(
+        "minimiser: bounded quasi-Newton from {} starts (seed {}), the lowest minimum taken; errors \
+         sqrt(diag 2 H^-1) of the joint -2 ln L (steps of {HESSIAN_STEP} sigma){}",
+        analysis.search.starts,
+        analysis.search.seed,
+        if analysis.search.profile_check {
+            format!(
+                ", checked by the profile likelihood (the half-width where they differ by more \
+                 than 10%, sqrt(delta) to {CROSSING_TOLERANCE})"
+            )
+        } else {
+            ", not checked by the profile likelihood".into()
+        }
+    ));
+    h.push(
+        "derived (per set): fsigma8 = f sigma8_z with the set's sigma8_z, alpha_iso, alpha_ap, \
+         DM_over_DH, DV_over_rd with a distortion; errors propagated with the joint Hessian's \
+         correlations"
+            .into(),
+    );
+    let mut t = Table::new(h);
+    t.push("set", "1", (1..=sets.len()).map(|i| i as f64).collect());
+    t.push("z", "1", analysis.sets.iter().map(|s| s.z).collect());
+    let rows: Vec<Row> = fit
+        .sets
+        .iter()
+        .zip(&loaded)
+        .map(|(f, l)| Row {
+            fit: f,
+            request: &l.request,
+            template: Some(&l.template),
+        })
+        .collect();
+    row_columns(&mut t, &rows);
+    Ok((t, fit))
+}

@@ -1,0 +1,160 @@
+//! `fit --analysis FILE.toml`: the joint fit of two data sets made by `rsd --rsd ept` with
+//! different b1 and the same f, and the file's errors.
+
+use super::{column_names_of, fails_naming, rows, run, scratch, write};
+
+/// Noise-free ept multipoles ℓ = 0, 2, 4 with b1 = `b1`, f = 0.7, as `k P0 σ P2 σ P4 σ` (σ = 1% of
+/// P0) on 25 k in [0.02, 0.2] h/Mpc.
+fn model(b1: &str) -> String {
+    let (ok, out, err) = run(&[
+        "rsd",
+        "--rsd",
+        "ept",
+        "--bias",
+        b1,
+        "--b2",
+        "-0.4",
+        "--alpha0",
+        "8",
+        "--sn",
+        "900",
+        "--f",
+        "0.7",
+        "--k-min",
+        "0.02",
+        "--k-max",
+        "0.2",
+        "--nk",
+        "25",
+        "--precision",
+        "fast",
+    ]);
+    assert!(ok, "{err}");
+    rows(&out)
+        .iter()
+        .map(|r| {
+            let s = 0.01 * r[1];
+            format!("{} {} {s} {} {s} {} {s}\n", r[0], r[1], r[2], r[3])
+        })
+        .collect()
+}
+
+/// The body of a data set of the analysis file.
+fn set(label: &str, data: &str) -> String {
+    format!(
+        "[[dataset]]\nlabel = \"{label}\"\ndata = \"{data}\"\nz = 0.0\nells = [0, 2]\nk_max = 0.2\n\
+         free = [\"f\", \"b1\"]\nmarginalise = [\"alpha0\", \"sn\"]\n\
+         [dataset.start]\nb1 = 2.0\nb2 = -0.4\nf = 0.6\n\n"
+    )
+}
+
+const SEARCH: &str = "[search]\nstarts = 4\nprofile_check = false\n\n";
+
+/// Two sets with b1 = 1.8 and 2.2 and f = 0.7 shared by default (same z, same tracer): a row per
+/// set, each b1 recovered, one f (the same value and error in both rows); the header states the sets
+/// and the sharing.
+#[test]
+fn analysis_file_fits_two_sets_with_a_shared_f() {
+    let dir = scratch("analysis_two_sets");
+    write(&dir, "low.dat", &model("1.8"));
+    write(&dir, "high.dat", &model("2.2"));
+    let file = write(
+        &dir,
+        "joint.toml",
+        &format!(
+            "{SEARCH}{}{}",
+            set("low", "low.dat"),
+            set("high", "high.dat")
+        ),
+    );
+    let (ok, out, err) = run(&["fit", "--analysis", &file, "--precision", "fast"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("data set low: "), "{out}");
+    assert!(out.contains("data set high: "), "{out}");
+    assert!(
+        out.contains("shared parameters (the default") && out.contains("): f;"),
+        "{out}"
+    );
+    assert!(
+        out.contains("joint free parameters: f, b1[low], b1[high]"),
+        "{out}"
+    );
+    let names = column_names_of(&out, "# set ");
+    let table = rows(&out);
+    assert_eq!(table.len(), 2);
+    let get = |r: usize, n: &str| table[r][names.iter().position(|c| *c == n).unwrap()];
+    for (r, b1) in [(0, 1.8), (1, 2.2)] {
+        let (v, e) = (get(r, "b1"), get(r, "err_b1"));
+        assert!((v - b1).abs() < 0.1 * e, "b1 of set {r}: {v} ± {e}");
+        let (f, ef) = (get(r, "f"), get(r, "err_f"));
+        assert!((f - 0.7).abs() < 0.1 * ef, "f: {f} ± {ef}");
+    }
+    assert_eq!(get(0, "f"), get(1, "f"));
+    assert_eq!(get(0, "err_f"), get(1, "err_f"));
+    assert!(names.contains(&"fsigma8"));
+}
+
+/// Every mistake in the file is an error naming the file, the key and the rule.
+#[test]
+fn analysis_file_errors_name_the_file_key_and_rule() {
+    let dir = scratch("analysis_errors");
+    write(&dir, "low.dat", "0.05 1 0.1 1 0.1 1 0.1\n");
+    let case = |name: &str, text: &str| write(&dir, name, text);
+    let good = set("low", "low.dat");
+    let unknown = case("unknown.toml", &good.replace("k_max", "kmax"));
+    let missing = case("missing.toml", &set("low", "nowhere.dat"));
+    let shared = case("shared.toml", &format!("shared = [\"apar\"]\n{good}"));
+    let syntax = case("syntax.toml", "[[dataset]\nlabel = 1\n");
+    let top = case("top.toml", &format!("share = [\"f\"]\n{good}"));
+    let twice = case("twice.toml", &format!("{good}{good}"));
+    let prior = case(
+        "prior.toml",
+        &good.replace("k_max = 0.2", "k_max = 0.2\npriors = [\"b2:0\"]"),
+    );
+    fails_naming(&[
+        (
+            vec!["fit", "--analysis", &unknown],
+            "unknown.toml: `dataset[1].kmax`: unknown key",
+        ),
+        (
+            vec!["fit", "--analysis", &missing],
+            "missing.toml: `dataset[1].data`: the file",
+        ),
+        (
+            vec!["fit", "--analysis", &missing],
+            "nowhere.dat does not exist",
+        ),
+        (
+            vec!["fit", "--analysis", &shared],
+            "shared.toml: `shared`: `apar` is declared shared but no data set has it free",
+        ),
+        (
+            vec!["fit", "--analysis", &syntax],
+            "syntax.toml: is not valid TOML",
+        ),
+        (
+            vec!["fit", "--analysis", &top],
+            "top.toml: `share`: unknown key",
+        ),
+        (
+            vec!["fit", "--analysis", &twice],
+            "twice.toml: `dataset[2].label`: `low` is given twice",
+        ),
+        (
+            vec!["fit", "--analysis", &prior],
+            "prior.toml: `dataset[1].priors`",
+        ),
+        (
+            vec!["fit", "--analysis", &unknown, "--data", &unknown],
+            "cannot be used with",
+        ),
+        (
+            vec!["fit", "--analysis", "/nonexistent/a.toml"],
+            "/nonexistent/a.toml",
+        ),
+        (
+            vec!["fit", "--analysis", &unknown, "--rsd", "kaiser"],
+            "--analysis fits the galaxy model",
+        ),
+    ]);
+}

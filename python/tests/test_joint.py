@@ -1,0 +1,68 @@
+"""Joint fits of several data sets from Python (``pt.fit_joint``, an analysis file): one set is
+``fit_ept`` exactly; two sets with different b1 and one f recover both b1 and the shared f; the file's
+mistakes are ValueErrors naming the key."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+import pt_spectra as pt
+
+K = np.geomspace(0.02, 0.2, 25)
+
+
+def _data(tmp_path, name, b1):
+    m = pt.ept(k=K, precision="fast", b1=b1, b2=-0.4, alpha0=8.0, sn=900.0, f=0.7)
+    s = 0.01 * m["P0"]
+    rows = np.column_stack([K, m["P0"], s, m["P2"], s, m["P4"], s])
+    path = tmp_path / name
+    np.savetxt(path, rows, fmt="%.17g")
+    return path
+
+
+def _set(label, path):
+    return (f'[[dataset]]\nlabel = "{label}"\ndata = "{path.name}"\nz = 0.0\nells = [0, 2]\n'
+            'k_max = 0.2\nfree = ["f", "b1"]\nmarginalise = ["alpha0", "sn"]\n'
+            '[dataset.start]\nb1 = 1.9\nb2 = -0.4\nf = 0.6\n\n')
+
+
+SEARCH = "[search]\nstarts = 4\nprofile_check = false\n\n"
+
+
+def test_one_set_is_fit_ept(tmp_path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pt.PtSpectraWarning)
+        path = _data(tmp_path, "a.dat", 2.0)
+        (tmp_path / "one.toml").write_text(SEARCH + _set("a", path))
+        joint = pt.fit_joint(tmp_path / "one.toml", precision="fast")
+        single = pt.fit_ept(str(path), [0.2], free=("f", "b1"), marginalise=("alpha0", "sn"),
+                            precision="fast", b1=1.9, b2=-0.4, f=0.6, starts=4,
+                            profile_check=False)
+    assert len(joint["f"]) == 1
+    for name in ("f", "err_f", "b1", "err_b1", "alpha0", "err_sn", "chi2", "minus_2_ln_L",
+                 "fsigma8", "err_fsigma8"):
+        assert joint[name][0] == single[name][0], name
+
+
+def test_two_sets_recover_their_b1_and_the_shared_f(tmp_path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pt.PtSpectraWarning)
+        low, high = _data(tmp_path, "low.dat", 1.8), _data(tmp_path, "high.dat", 2.2)
+        (tmp_path / "two.toml").write_text(SEARCH + _set("low", low) + _set("high", high))
+        t = pt.fit_joint(tmp_path / "two.toml", precision="fast")
+    assert list(t["set"]) == [1, 2]
+    for row, b1 in ((0, 1.8), (1, 2.2)):
+        assert abs(t["b1"][row] - b1) < 0.1 * t["err_b1"][row]
+        assert abs(t["f"][row] - 0.7) < 0.1 * t["err_f"][row]
+    assert t["f"][0] == t["f"][1] and t["err_f"][0] == t["err_f"][1]
+
+
+def test_analysis_file_mistakes_name_the_key(tmp_path):
+    path = _data(tmp_path, "a.dat", 2.0)
+    (tmp_path / "bad.toml").write_text(_set("a", path).replace("k_max", "kmax"))
+    with pytest.raises(ValueError, match=r"bad.toml: `dataset\[1\].kmax`: unknown key"):
+        pt.fit_joint(tmp_path / "bad.toml")
+    (tmp_path / "shared.toml").write_text('shared = ["bs"]\n' + _set("a", path))
+    with pytest.raises(ValueError, match="`bs` is declared shared but no data set has it free"):
+        pt.fit_joint(tmp_path / "shared.toml")
