@@ -53,11 +53,13 @@ brute_force_property!(order_6_equals_brute_force_exactly, 6, 4);
 brute_force_property!(order_7_equals_brute_force_exactly, 7, 2);
 
 /// Configurations with exactly cancelling pairs (k, q1, −q1, …): the generated kernel at the singular point
-/// against the brute force moved off it by ε = 10⁻³⁰ (−q → −q + εd). The symmetrised kernel is continuous
-/// there, so the exact difference must be O(ε).
+/// against the brute force moved off it by ε = 10⁻⁶ (−q → −q + εd). The symmetrised kernel is continuous
+/// there, so the exact difference must be O(ε): measured ≤ 0.09ε for n = 2…7 (and the same multiple of ε
+/// at ε = 10⁻¹⁵ and 10⁻³⁰, so it is the linear term), bound 100ε; a wrong limit is off by O(1). ε = 10⁻⁶
+/// rather than 10⁻³⁰ keeps the rationals of the n = 7 brute force small (43 s instead of 215 s).
 #[test]
 fn zero_momentum_pairs_give_the_limit() {
-    let eps = ten_to_minus(30);
+    let eps = ten_to_minus(6);
     let k = v(3, -1, 2, 2);
     let qs = [v(1, 2, -1, 1), v(-2, 1, 1, 3), v(1, 1, 4, 2)];
     let d = v(1, -2, 3, 1);
@@ -80,7 +82,7 @@ fn zero_momentum_pairs_give_the_limit() {
         for (g, b) in generated.iter().zip(&brute) {
             let diff = f(&(g - b));
             assert!(
-                diff.abs() < 1e-20,
+                diff.abs() < 100.0 * f(&eps),
                 "n = {n}: generated {} vs brute force {} (diff {diff:e})",
                 f(g),
                 f(b)
