@@ -1,8 +1,7 @@
-//! The monomial slots of B at one configuration given in the observed (fiducial) frame: the
-//! Alcock–Paczynski map to the true frame, the linear power of each side, the FoG factor and the
-//! volume factor (module docs of [`crate::bispectrum`]).
+//! The monomial slots of B at one configuration: in the true frame ([`tree_slots`]), and given in the
+//! observed (fiducial) frame ([`observed_slots`]: the Alcock–Paczynski map to the true frame, the linear
+//! power of each side, the FoG factor and the volume factor; module docs of [`crate::bispectrum`]).
 
-use super::terms::{tree_slots, SLOTS};
 use super::Settings;
 
 /// The slots at observed sides of lengths `k`, dot products `dots` (k₀·k₁, k₁·k₂, k₂·k₀) and
@@ -47,4 +46,58 @@ pub(super) fn accumulate<const N: usize>(
             *a += g * v;
         }
     }
+}
+
+/// Number of monomial slots per triangle and ℓ: 36 of Z₁Z₁Z₂ (3 × 3 × 4), 3 + 3 of the 1/n̄ terms, 1 of
+/// the 1/n̄² term.
+pub(super) const SLOTS: usize = 43;
+
+/// The slots of B at one configuration with true sides of lengths `k`, dot products `dots`, line-of-sight
+/// components `par` and linear power `p` (see the module docs of [`crate::bispectrum`]):
+/// Z₁ = u·a with u = (1, b₁, c₁), a = (fμ², 1, −k²μ²); Z₂ = v·c with v = (1, b₁, b₂, b_s).
+pub(super) fn tree_slots(
+    k: [f64; 3],
+    dots: [f64; 3],
+    par: [f64; 3],
+    p: [f64; 3],
+    f: f64,
+) -> [f64; SLOTS] {
+    let mu = [0, 1, 2].map(|i| par[i] / k[i]);
+    let a: [[f64; 3]; 3] = [0, 1, 2].map(|i| [f * mu[i] * mu[i], 1.0, -par[i] * par[i]]);
+    let mut out = [0.0; SLOTS];
+    for i in 0..3 {
+        let (j, l) = ((i + 1) % 3, (i + 2) % 3);
+        let cos = dots[i] / (k[i] * k[j]);
+        let ratio = k[i] / k[j] + k[j] / k[i];
+        let f2 = 5.0 / 7.0 + 0.5 * cos * ratio + 2.0 / 7.0 * cos * cos;
+        let g2 = 3.0 / 7.0 + 0.5 * cos * ratio + 4.0 / 7.0 * cos * cos;
+        let k_par = par[i] + par[j]; // n̂·(kᵢ + kⱼ) = −n̂·k_l
+        let mu12_sq = k_par * k_par / (k[l] * k[l]);
+        let c = [
+            f * mu12_sq * g2
+                + 0.5
+                    * f
+                    * f
+                    * k_par
+                    * (mu[i] * mu[j] * mu[j] / k[i] + mu[j] * mu[i] * mu[i] / k[j]),
+            f2 + 0.5 * f * k_par * (mu[i] / k[i] + mu[j] / k[j]),
+            0.5,
+            cos * cos - 1.0 / 3.0,
+        ];
+        let pp = 2.0 * p[i] * p[j];
+        for al in 0..3 {
+            for be in 0..3 {
+                let ab = pp * a[i][al] * a[j][be];
+                for (g, cg) in c.iter().enumerate() {
+                    out[(al * 3 + be) * 4 + g] += ab * cg;
+                }
+            }
+        }
+        for be in 0..3 {
+            out[36 + be] += p[i] * a[i][be];
+            out[39 + be] += p[i] * a[i][0] * a[i][be];
+        }
+    }
+    out[42] = 1.0;
+    out
 }

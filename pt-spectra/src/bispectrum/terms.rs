@@ -4,6 +4,7 @@
 
 use super::geometry::{orientations, LegendreSide, TriangleSet};
 use super::observed::{accumulate, observed_slots};
+pub(super) use super::observed::{tree_slots, SLOTS};
 use super::resum::IrInputs;
 use super::sampled::Sampled;
 use super::{BispectrumParams, Settings};
@@ -67,10 +68,6 @@ impl PlanRules {
 /// shortcut's error is measured when a plan is made (the embedded gm2012 spectrum at z = 0.5, IR
 /// resummed, no AP, no FoG, b₂ = b_s = 0, no shot noise).
 const SHORTCUT_REFERENCE: (f64, f64) = (0.72, 2.0);
-
-/// Number of monomial slots per triangle and ℓ: 36 of Z₁Z₁Z₂ (3 × 3 × 4), 3 + 3 of the 1/n̄ terms, 1 of
-/// the 1/n̄² term.
-pub(super) const SLOTS: usize = 43;
 
 /// One shape of a triangle or bin in the observed (fiducial) frame: sides, their dot products (k₀·k₁,
 /// k₁·k₂, k₂·k₀) and the orientation nodes of its average, in groups of one μ of the Legendre side.
@@ -328,56 +325,6 @@ impl BispectrumPlan {
             triangles: self.set.triangles().to_vec(),
         })
     }
-}
-
-/// The slots of B at one configuration with true sides of lengths `k`, dot products `dots`, line-of-sight
-/// components `par` and linear power `p` (see the module docs of [`crate::bispectrum`]):
-/// Z₁ = u·a with u = (1, b₁, c₁), a = (fμ², 1, −k²μ²); Z₂ = v·c with v = (1, b₁, b₂, b_s).
-pub(super) fn tree_slots(
-    k: [f64; 3],
-    dots: [f64; 3],
-    par: [f64; 3],
-    p: [f64; 3],
-    f: f64,
-) -> [f64; SLOTS] {
-    let mu = [0, 1, 2].map(|i| par[i] / k[i]);
-    let a: [[f64; 3]; 3] = [0, 1, 2].map(|i| [f * mu[i] * mu[i], 1.0, -par[i] * par[i]]);
-    let mut out = [0.0; SLOTS];
-    for i in 0..3 {
-        let (j, l) = ((i + 1) % 3, (i + 2) % 3);
-        let cos = dots[i] / (k[i] * k[j]);
-        let ratio = k[i] / k[j] + k[j] / k[i];
-        let f2 = 5.0 / 7.0 + 0.5 * cos * ratio + 2.0 / 7.0 * cos * cos;
-        let g2 = 3.0 / 7.0 + 0.5 * cos * ratio + 4.0 / 7.0 * cos * cos;
-        let k_par = par[i] + par[j]; // n̂·(kᵢ + kⱼ) = −n̂·k_l
-        let mu12_sq = k_par * k_par / (k[l] * k[l]);
-        let c = [
-            f * mu12_sq * g2
-                + 0.5
-                    * f
-                    * f
-                    * k_par
-                    * (mu[i] * mu[j] * mu[j] / k[i] + mu[j] * mu[i] * mu[i] / k[j]),
-            f2 + 0.5 * f * k_par * (mu[i] / k[i] + mu[j] / k[j]),
-            0.5,
-            cos * cos - 1.0 / 3.0,
-        ];
-        let pp = 2.0 * p[i] * p[j];
-        for al in 0..3 {
-            for be in 0..3 {
-                let ab = pp * a[i][al] * a[j][be];
-                for (g, cg) in c.iter().enumerate() {
-                    out[(al * 3 + be) * 4 + g] += ab * cg;
-                }
-            }
-        }
-        for be in 0..3 {
-            out[36 + be] += p[i] * a[i][be];
-            out[39 + be] += p[i] * a[i][0] * a[i][be];
-        }
-    }
-    out[42] = 1.0;
-    out
 }
 
 /// The contraction of slots with the parameters.
