@@ -45,6 +45,7 @@
 mod box_modes;
 mod geometry;
 mod observed;
+pub mod one_loop;
 mod resum;
 mod sampled;
 mod sugiyama;
