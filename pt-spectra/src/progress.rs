@@ -39,6 +39,8 @@ pub enum Stage {
     TnsBasis,
     /// The basis tensors of the galaxy model's loop terms on a k grid (once; cached).
     RedshiftBasis,
+    /// The one-loop bispectrum's integrals (per triangle).
+    OneLoopBispectrum,
 }
 
 impl fmt::Display for Stage {
@@ -53,6 +55,7 @@ impl fmt::Display for Stage {
             Stage::OneLoopBasis => "1-loop basis tensors (once per k grid; cached)",
             Stage::TnsBasis => "TNS basis tensors (once per k grid; cached)",
             Stage::RedshiftBasis => "galaxy-model basis tensors (once per k grid; cached)",
+            Stage::OneLoopBispectrum => "one-loop bispectrum (per triangle)",
         })
     }
 }

@@ -283,3 +283,67 @@ fn box_averages_from_edges_are_exact_sums() {
         "side of the box",
     )]);
 }
+
+/// `--loop 1`: the one-loop matter terms at triangles, the tree column the closed form, the total the
+/// sum of the terms, a header that says what was computed; galaxy options, bins and other orders refused.
+#[test]
+fn one_loop_matter_terms_at_triangles_and_refusals() {
+    let file = std::env::temp_dir().join(format!("pt-spectra-bk1-{}", std::process::id()));
+    std::fs::write(&file, "# k1 k2 k3\n0.05 0.1 0.12\n0.1 0.1 0.1\n").unwrap();
+    let path = file.to_str().unwrap();
+    let (ok, out, err) = run(&["bispectrum", "--loop", "1", "--triangles", path]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("one-loop matter bispectrum in real space"),
+        "{out}"
+    );
+    assert!(out.contains("no counterterms"), "{out}");
+    assert!(out.contains("0.0001 <= |q| <= 10 h/Mpc"), "{out}");
+    let names =
+        "# k1 k2 k3 B_tree B222 B321_I B321_II B411 B_1loop err_B_tree err_B222 err_B321_I \
+                 err_B321_II err_B411 err_B_1loop";
+    assert!(out.lines().any(|l| l == names), "{out}");
+    for (t, r) in [[0.05, 0.1, 0.12], [0.1, 0.1, 0.1]].iter().zip(rows(&out)) {
+        let mut closed = 0.0;
+        for i in 0..3 {
+            let (j, l) = ((i + 1) % 3, (i + 2) % 3);
+            let c = (t[l] * t[l] - t[i] * t[i] - t[j] * t[j]) / (2.0 * t[i] * t[j]);
+            let f2 = 5.0 / 7.0 + 0.5 * c * (t[i] / t[j] + t[j] / t[i]) + 2.0 / 7.0 * c * c;
+            closed += 2.0 * f2 * p_lin(t[i]) * p_lin(t[j]);
+        }
+        assert!(
+            (r[3] - closed).abs() < 1e-8 * closed,
+            "{t:?}: {} vs {closed}",
+            r[3]
+        );
+        let sum: f64 = r[3..8].iter().sum();
+        assert!(
+            (r[8] - sum).abs() < 1e-8 * sum.abs(),
+            "{t:?}: total {} vs {sum}",
+            r[8]
+        );
+        assert!(
+            r[14] > 0.0 && r[14] < 1e-3 * r[8].abs(),
+            "{t:?}: err {}",
+            r[14]
+        );
+    }
+    let with = |extra: &[&'static str]| {
+        let mut a = vec!["bispectrum", "--loop", "1", "--triangles", path];
+        a.extend(extra);
+        a
+    };
+    fails_naming(&[
+        (with(&["--b1", "2"]), "--b1"),
+        (with(&["--f", "0.5"]), "--f"),
+        (with(&["--bin-width", "0.01"]), "not built yet"),
+        (
+            vec!["bispectrum", "--loop", "1", "--k-edges", "0.02:0.1:0.02"],
+            "--k-edges",
+        ),
+        (
+            vec!["bispectrum", "--loop", "2", "--triangles", path],
+            "--loop 2: valid",
+        ),
+    ]);
+}

@@ -1,14 +1,18 @@
 //! `pt-spectra bispectrum`: the tree-level galaxy bispectrum multipoles B0, B2, B4 in redshift space at
 //! triangles or averaged over the triangle bins of a measurement, or the Sugiyama multipoles
-//! B_l1l2L(k1, k2) at pairs (`--basis sugiyama --pairs FILE`).
+//! B_l1l2L(k1, k2) at pairs (`--basis sugiyama --pairs FILE`); with `--loop 1` the one-loop matter
+//! bispectrum in real space at triangles.
 
 use crate::input::SpectrumInput;
 use crate::output::{check_outputs, write_output};
 use anyhow::{bail, Context, Result};
+use pt_spectra::bispectrum::one_loop::OneLoopRule;
 use pt_spectra::bispectrum::{
     BispectrumParams, Fog, LegendreSide, PlanRules, SugiyamaRules, TriangleSet,
 };
-use pt_spectra::jobs::{bispectrum_table, sugiyama_table, BispectrumRequest, SugiyamaRequest};
+use pt_spectra::jobs::{
+    bispectrum_table, one_loop_bispectrum_table, sugiyama_table, BispectrumRequest, SugiyamaRequest,
+};
 use pt_spectra::table::Table;
 use std::path::PathBuf;
 
@@ -106,9 +110,65 @@ pub struct Args {
     /// Switch off the IR resummation of the BAO in every leg.
     #[arg(long)]
     no_ir: bool,
+    /// Loop order: 0 (the tree-level galaxy model in redshift space) or 1 (the one-loop matter
+    /// bispectrum in real space, SPT: B_tree, B222, B321_I, B321_II, B411 at the points of --triangles;
+    /// no bias, redshift space, bins or counterterms yet).
+    #[arg(long = "loop", value_name = "N", default_value_t = 0)]
+    loop_order: u32,
     /// Write the table to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
+}
+
+/// The options that the one-loop matter bispectrum does not take, set away from their defaults.
+fn galaxy_options_given(args: &Args) -> Vec<&'static str> {
+    let mut given = Vec::new();
+    let mut flag = |set: bool, name: &'static str| {
+        if set {
+            given.push(name);
+        }
+    };
+    flag(args.basis != "scoccimarro", "--basis");
+    flag(args.pairs.is_some(), "--pairs");
+    flag(args.bin_width.is_some(), "--bin-width");
+    flag(args.k_edges.is_some(), "--k-edges");
+    flag(args.box_size.is_some(), "--box");
+    flag(args.effective, "--effective");
+    flag(args.legendre_side != "largest", "--legendre-side");
+    flag(args.b1 != 1.0, "--b1");
+    flag(args.b2 != 0.0, "--b2");
+    flag(args.bs != 0.0, "--bs");
+    flag(args.c1 != 0.0, "--c1");
+    flag(args.n_bar.is_some(), "--n-bar");
+    flag(args.f.is_some(), "--f");
+    flag(args.q_par != 1.0 || args.q_perp != 1.0, "--q-par/--q-perp");
+    flag(args.fog != "none", "--fog");
+    flag(args.sigma_fog != 0.0, "--sigma-fog");
+    flag(args.no_ir, "--no-ir");
+    given
+}
+
+/// `--loop 1`: the one-loop matter bispectrum at the triangles of --triangles.
+fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
+    let given = galaxy_options_given(args);
+    if !given.is_empty() {
+        bail!(
+            "--loop 1 is the one-loop matter bispectrum in real space at single triangles; it does not take {} \
+             (bias, redshift space, AP and bin averages of the one-loop bispectrum are not built yet)",
+            given.join(", ")
+        );
+    }
+    let Some(path) = &args.triangles else {
+        bail!("--loop 1 needs --triangles FILE (columns k1 k2 k3 [h/Mpc])");
+    };
+    let t = Table::read(path, &[0, 1, 2]).context("--triangles")?;
+    let rows: Vec<[f64; 3]> = (0..t.columns[0].len())
+        .map(|i| [t.columns[0][i], t.columns[1][i], t.columns[2][i]])
+        .collect();
+    let loaded = args.spectrum.load()?;
+    let bars = crate::progress::Bars::default();
+    one_loop_bispectrum_table(&loaded.prepared, &rows, &OneLoopRule::default(), &bars)
+        .with_context(|| format!("--triangles {}", path.display()))
 }
 
 /// The triangle set of the options.
@@ -164,6 +224,11 @@ pub fn run(args: &Args) -> Result<()> {
         n_bar: args.n_bar.unwrap_or(f64::INFINITY),
     };
     let fog = Fog::by_name(&args.fog, args.sigma_fog)?;
+    match args.loop_order {
+        0 => {}
+        1 => return write_output(args.out.as_ref(), &one_loop(args)?),
+        n => bail!("--loop {n}: valid: 0 (tree level), 1 (one-loop matter, real space)"),
+    }
     let table = match args.basis.to_ascii_lowercase().as_str() {
         "scoccimarro" => {
             if args.pairs.is_some() {
