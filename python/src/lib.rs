@@ -625,6 +625,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<bispectrum::SugiyamaPlan>()?;
     m.add_class::<bispectrum::SugiyamaTerms>()?;
     m.add_function(wrap_pyfunction!(bispectrum::bispectrum, m)?)?;
+    m.add_function(wrap_pyfunction!(bispectrum::one_loop_bispectrum, m)?)?;
     m.add_class::<ept::EptTerms>()?;
     m.add_class::<two_loop_rsd::TwoLoopRsdPlan>()?;
     m.add_class::<survey::Observation>()?;

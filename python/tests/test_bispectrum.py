@@ -138,3 +138,32 @@ def test_box_averages_are_the_exact_sums_over_the_modes_of_a_periodic_box():
     assert np.max(np.abs(shells["B0"] / t["B0"] - 1)) > 1e-3
     with pytest.raises(ValueError, match="box"):
         pt.bispectrum(bins[:1], box_size=1000.0, z=0.5)
+
+
+def test_one_loop_matter_bispectrum_terms_sum_and_errors():
+    tri = np.array([[0.1, 0.1, 0.1], [0.05, 0.1, 0.12]])
+    k = np.unique(tri)
+    lin = pt.real(model="linear", k=k)
+    p = dict(zip(k, lin["P_lin"]))
+    t = pt.one_loop_bispectrum(tri)
+    assert t.meta["model"] == "bispectrum one-loop matter"
+    for row, tree in zip(tri, t["B_tree"]):
+        assert tree == pytest.approx(closed_form(row, p.__getitem__, 1.0, 0.0, 0.0), rel=1e-10)
+    terms = sum(t[c] for c in ["B_tree", "B222", "B321_I", "B321_II", "B411"])
+    np.testing.assert_allclose(t["B_1loop"], terms, rtol=1e-12)
+    assert np.all(t["err_B_1loop"] > 0) and np.all(t["err_B_1loop"] < 1e-3 * np.abs(t["B_1loop"]))
+    # the equilateral k = 0.1 terms of the independent Monte Carlo (tests/data/bispectrum), within 3 sigma
+    mc = {"B222": (2.1708e7, 3.2e5), "B321_I": (1.94134e7, 1.8e5), "B321_II": (-1.37937e7, 2.4e4),
+          "B411": (-5.9212e6, 1.5e4)}
+    for name, (value, sigma) in mc.items():
+        assert abs(t[name][0] - value) < 3 * sigma, name
+
+
+@pytest.mark.parametrize("kwargs, needle", [
+    (dict(triangles=[[0.1, 0.1, 0.3]]), "do not close"),
+    (dict(triangles=[[0.1, 0.1]]), "k1, k2, k3"),
+    (dict(triangles=[[0.1, 0.1, 0.1]], mu=1), "at least 2 nodes"),
+])
+def test_one_loop_bad_input_raises_naming_the_problem(kwargs, needle):
+    with pytest.raises(ValueError, match=needle):
+        pt.one_loop_bispectrum(**kwargs)
