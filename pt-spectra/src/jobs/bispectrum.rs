@@ -3,14 +3,16 @@
 //! its header.
 
 use super::VERSION;
-use crate::bispectrum::one_loop::{one_loop_matter, OneLoopMatter, OneLoopRule, PARTITION_POWER};
+use crate::bispectrum::one_loop::{
+    one_loop_matter, OneLoopMatter, OneLoopRule, COUNTERTERMS, PARTITION_POWER,
+};
 use crate::bispectrum::{
     BispectrumParams, BispectrumPlan, BoxPlan, Fog, LegendreSide, PlanRules, Settings,
     SugiyamaPlan, SugiyamaRules, TriangleSet, SUGIYAMA_MULTIPOLES,
 };
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
-use crate::output::{Table, BISPECTRUM, WAVENUMBER};
+use crate::output::{Table, BISPECTRUM, BISPECTRUM_SHAPE, WAVENUMBER};
 use crate::progress::{Progress, Stage};
 use crate::setup::Prepared;
 
@@ -260,7 +262,8 @@ pub fn one_loop_bispectrum_table(
             prepared.z
         ),
         "B_1loop = B_tree + B222 + B321_I + B321_II + B411 (Scoccimarro 1997; Sefusatti et al. 2010 eqs. 17-21), \
-         exact generated kernels F2..F4; no counterterms (not yet built)"
+         exact generated kernels F2..F4; no counterterms in B_1loop: the columns shape_ct_* are the four EFT \
+         counterterm shapes, B_ct = sum_c ct_c shape_ct_c with coefficients ct_c in (Mpc/h)^2 (docs/bispectrum.md)"
             .into(),
         format!(
             "loop integrals over {} <= |q| <= {} h/Mpc about each cusp (smooth partition of unity, power {}); \
@@ -295,6 +298,13 @@ pub fn one_loop_bispectrum_table(
             format!("err_{name}"),
             BISPECTRUM,
             rows.iter().map(|b| terms(b)[j].error).collect(),
+        );
+    }
+    for (j, name) in COUNTERTERMS.iter().enumerate() {
+        t.push(
+            format!("shape_{name}"),
+            BISPECTRUM_SHAPE,
+            rows.iter().map(|b| b.counterterm_shapes[j]).collect(),
         );
     }
     Ok(t)

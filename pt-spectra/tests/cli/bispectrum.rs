@@ -301,7 +301,7 @@ fn one_loop_matter_terms_at_triangles_and_refusals() {
     assert!(out.contains("0.0001 <= |q| <= 10 h/Mpc"), "{out}");
     let names =
         "# k1 k2 k3 B_tree B222 B321_I B321_II B411 B_1loop err_B_tree err_B222 err_B321_I \
-                 err_B321_II err_B411 err_B_1loop";
+                 err_B321_II err_B411 err_B_1loop shape_ct_f2 shape_ct_k3 shape_ct_tidal shape_ct_f2k3";
     assert!(out.lines().any(|l| l == names), "{out}");
     for (t, r) in [[0.05, 0.1, 0.12], [0.1, 0.1, 0.1]].iter().zip(rows(&out)) {
         let mut closed = 0.0;
