@@ -304,13 +304,20 @@ fn one_loop_matter_terms_at_triangles_and_refusals() {
                  err_B321_II err_B411 err_B_1loop shape_ct_f2 shape_ct_k3 shape_ct_tidal shape_ct_f2k3";
     assert!(out.lines().any(|l| l == names), "{out}");
     for (t, r) in [[0.05, 0.1, 0.12], [0.1, 0.1, 0.1]].iter().zip(rows(&out)) {
-        let mut closed = 0.0;
+        // the tree 2 F2 P P + cyclic, and the c_s²-type counterterm shape: each term times k_i² + k_j²
+        let (mut closed, mut shape) = (0.0, 0.0);
         for i in 0..3 {
             let (j, l) = ((i + 1) % 3, (i + 2) % 3);
             let c = (t[l] * t[l] - t[i] * t[i] - t[j] * t[j]) / (2.0 * t[i] * t[j]);
             let f2 = 5.0 / 7.0 + 0.5 * c * (t[i] / t[j] + t[j] / t[i]) + 2.0 / 7.0 * c * c;
             closed += 2.0 * f2 * p_lin(t[i]) * p_lin(t[j]);
+            shape += 2.0 * f2 * p_lin(t[i]) * p_lin(t[j]) * (t[i] * t[i] + t[j] * t[j]);
         }
+        assert!(
+            (r[15] - shape).abs() < 1e-8 * shape,
+            "{t:?}: shape {} vs {shape}",
+            r[15]
+        );
         assert!(
             (r[3] - closed).abs() < 1e-8 * closed,
             "{t:?}: {} vs {closed}",
