@@ -103,10 +103,12 @@ pub fn ept_table_from_terms(
             .into(),
     ];
     header.push(if settings.ir {
-        "IR resummation: no-wiggle P by velocileptors' Savitzky-Golay filter (quartic, ln 7 in ln k), \
-         wiggles damped by exp(-k^2 Sigma^2 (1 + f (2 + f) mu^2)), Sigma^2 = (1/6pi^2) int P_nw (1 - \
-         j0(q 110 Mpc/h)) dq, (1 + k^2 Sigma^2(mu)) on the linear wiggles; --no-ir for plain SPT"
-            .into()
+        format!(
+            "IR resummation: no-wiggle P by velocileptors' Savitzky-Golay filter (quartic, ln 7 in ln k), \
+             wiggles damped by exp(-k^2 Sigma^2 (1 + f (2 + f) mu^2)), Sigma^2 = (1/6pi^2) int P_nw (1 - \
+             j0(q {} Mpc/h)) dq, (1 + k^2 Sigma^2(mu)) on the linear wiggles; --no-ir for plain SPT",
+            crate::rsd::ept::R_BAO
+        )
     } else {
         "no IR resummation (--no-ir): plain 1-loop SPT in redshift space".into()
     });

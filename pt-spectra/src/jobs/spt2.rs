@@ -103,8 +103,11 @@ pub fn eft2_table(
             "IR resummation: P_nw + loops of P_nw + exp(-k^2 Sigma^2(mu)) [(1 + x + x^2/2)(1 + f mu^2)^2 P_w \
              + (1 + x) P1_w + P2_w], x = k^2 Sigma^2(mu) = k^2 [(1 + f mu^2 (2 + f)) Sigma^2 + f^2 mu^2 \
              (mu^2 - 1) dSigma^2], Sigma^2 = {:.4} (Mpc/h)^2, dSigma^2 = {:.4} (Mpc/h)^2 (CLASS-PT's, \
-             BAO scale 110 Mpc/h, k_s = 0.2); P_IR = P_nw + exp(-x) P_w; --no-ir for plain SPT",
-            terms.sigma2.0.value, terms.sigma2.1.value
+             BAO scale {} Mpc/h, k_s = {}); P_IR = P_nw + exp(-x) P_w; --no-ir for plain SPT",
+            terms.sigma2.0.value,
+            terms.sigma2.1.value,
+            crate::ir::BAO_SCALE,
+            crate::ir::SIGMA_CUTOFF
         )
     } else {
         "no IR resummation (--no-ir): P_IR = P_lin, P1_IR = P1".into()

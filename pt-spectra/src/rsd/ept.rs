@@ -43,8 +43,8 @@ use std::f64::consts::PI;
 
 /// Gauss–Legendre nodes of the μ integral on [0, 1].
 pub const MU_NODES: usize = 24;
-/// The BAO scale of Σ² [Mpc/h] (velocileptors' `rbao`).
-pub const R_BAO: f64 = 110.0;
+/// The BAO scale of Σ² [Mpc/h] (velocileptors' `rbao`): the IR resummation's one ([`crate::ir::BAO_SCALE`]).
+pub const R_BAO: f64 = crate::ir::BAO_SCALE;
 
 /// The parameter names, in velocileptors' order (then f).
 pub const PARAM_NAMES: [&str; 12] = [
