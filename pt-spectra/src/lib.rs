@@ -61,6 +61,7 @@ mod simd;
 pub mod store;
 pub mod survey;
 pub mod table;
+mod vec3;
 
 /// The README's library example, compiled and run as a doctest.
 #[doc = include_str!("../../README.md")]

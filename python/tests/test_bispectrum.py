@@ -160,7 +160,7 @@ def test_one_loop_matter_bispectrum_terms_sum_and_errors():
 
 
 @pytest.mark.parametrize("kwargs, needle", [
-    (dict(triangles=[[0.1, 0.1, 0.3]]), "do not close"),
+    (dict(triangles=[[0.1, 0.1, 0.3]]), "does not close"),
     (dict(triangles=[[0.1, 0.1]]), "k1, k2, k3"),
     (dict(triangles=[[0.1, 0.1, 0.1]], mu=1), "at least 2 nodes"),
 ])

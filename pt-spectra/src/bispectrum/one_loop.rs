@@ -32,10 +32,12 @@
 //! integrals over [q_min, q_max] are what is computed (stated in [`OneLoopRule`]), with the same
 //! cut in the independent Monte Carlo reference of the tests.
 
+use super::TriangleSet;
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
 use crate::integrate::legendre_nodes;
 use crate::linear::LinearSpectrum;
+use crate::vec3::{add, neg, norm, sub};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -166,22 +168,6 @@ impl OneLoopMatter {
 
 type Vec3 = [f64; 3];
 
-fn add(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-fn sub(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn neg(a: Vec3) -> Vec3 {
-    [-a[0], -a[1], -a[2]]
-}
-
-fn norm(a: Vec3) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
-}
-
 /// F_n^s of the vectors; 0 where a vector is zero (a node never is: the rules avoid the centres).
 fn f_n(q: &[Vec3]) -> f64 {
     pt_kernels::kernels(q).map_or(0.0, |[f, _]| f)
@@ -190,24 +176,12 @@ fn f_n(q: &[Vec3]) -> f64 {
 /// The sides as vectors: k₁ along z, k₂ in the x–z plane, k₃ = −k₁ − k₂.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] for a side that is not finite and positive or sides that do not close.
+/// As [`TriangleSet::points`] (the one check of sides): a side that is not finite and > 0, or sides
+/// that do not close.
 pub fn triangle_vectors(k: [f64; 3]) -> Result<[Vec3; 3]> {
-    if let Some(&bad) = k.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
-        return Err(Error::InvalidParameter {
-            name: "triangle side [h/Mpc]",
-            value: bad,
-            reason: "sides must be finite and positive",
-        });
-    }
+    TriangleSet::points(vec![k])?;
     let [k1, k2, k3] = k;
     let cos12 = (k3 * k3 - k1 * k1 - k2 * k2) / (2.0 * k1 * k2);
-    if !(-1.0 - 1e-12..=1.0 + 1e-12).contains(&cos12) {
-        return Err(Error::InvalidParameter {
-            name: "triangle side k3 [h/Mpc]",
-            value: k3,
-            reason: "the sides do not close a triangle (|k1 - k2| <= k3 <= k1 + k2)",
-        });
-    }
     let c = cos12.clamp(-1.0, 1.0);
     let s = (1.0 - c * c).sqrt();
     let v1 = [0.0, 0.0, k1];
@@ -285,14 +259,15 @@ fn loop_integrals(p: &LinearSpectrum, kv: &[Vec3; 3], rule: &OneLoopRule) -> [f6
                 8.0 * partition(&r, j) * kern * p.eval(r[0]) * p.eval(r[1]) * p.eval(r[2])
             };
             out[0] = b222(v, 0) + b222(sub(v, k1), 1) + b222(sub(k2, v), 2);
-            // B321ᴵ: ordered pairs (a outer, b in the loop), twice the piece about q = 0.
+            // B321ᴵ: ordered pairs (a outer, b in the loop), twice the piece about q = 0; the loop
+            // leg's F₂, spectra and partition weight depend on b only.
             let pq = p.eval(norm(v));
-            for a in 0..3 {
-                for b in (0..3).filter(|&b| b != a) {
-                    let d = sub(kv[b], v);
-                    let r = [norm(v), norm(d)];
-                    let kern = f_n(&[neg(v), neg(d), neg(kv[a])]) * f_n(&[v, d]);
-                    out[1] += 2.0 * 6.0 * pk[a] * partition(&r, 0) * kern * pq * p.eval(r[1]);
+            for b in 0..3 {
+                let d = sub(kv[b], v);
+                let r = [norm(v), norm(d)];
+                let leg = 2.0 * 6.0 * partition(&r, 0) * f_n(&[v, d]) * pq * p.eval(r[1]);
+                for a in (0..3).filter(|&a| a != b) {
+                    out[1] += leg * pk[a] * f_n(&[neg(v), neg(d), neg(kv[a])]);
                 }
             }
             // B411 and the P13-type integrals J_a = ∫ F₃(k_a, q, −q) P(q).
@@ -311,7 +286,7 @@ fn loop_integrals(p: &LinearSpectrum, kv: &[Vec3; 3], rule: &OneLoopRule) -> [f6
 /// `p` (at the redshift of `p`: the terms scale as D⁴ and D⁶ of the tree), with `rule`.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] for sides that do not close; [`Error::InvalidChoice`] for a bad rule.
+/// As [`triangle_vectors`] for sides that do not close; [`Error::InvalidChoice`] for a bad rule.
 pub fn one_loop_matter(
     p: &LinearSpectrum,
     k: [f64; 3],

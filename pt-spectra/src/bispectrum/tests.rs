@@ -1,5 +1,6 @@
 use super::terms::tree_level_at;
 use super::*;
+use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
 use crate::survey::legendre;
 
@@ -40,6 +41,22 @@ fn shape_vectors(k: [f64; 3]) -> [[f64; 3]; 3] {
     let k1 = [0, 1, 2].map(|i| k[1] * (cos01 * e1[i] + sin01 * e2[i]));
     let k2 = [0, 1, 2].map(|i| -k0[i] - k1[i]);
     [k0, k1, k2]
+}
+
+/// B0, B2, B4 of the one triangle or bin of `set` with the Legendre polynomial on `side`.
+fn first_multipoles(
+    set: TriangleSet,
+    side: LegendreSide,
+    p_lin: &LinearSpectrum,
+    s: &Settings,
+    b: &BispectrumParams,
+) -> [Estimate; 3] {
+    BispectrumPlan::new(set, side, PlanRules::default())
+        .unwrap()
+        .terms(p_lin, s)
+        .unwrap()
+        .multipoles(b)
+        .unwrap()[0]
 }
 
 const TRIANGLES: [[f64; 3]; 4] = [
@@ -439,16 +456,7 @@ fn a_chosen_legendre_side_is_the_same_side_wherever_it_is_listed() {
     };
     let b = galaxy();
     let run = |t: [f64; 3], side| {
-        BispectrumPlan::new(
-            TriangleSet::points(vec![t]).unwrap(),
-            side,
-            PlanRules::default(),
-        )
-        .unwrap()
-        .terms(&p_lin, &s)
-        .unwrap()
-        .multipoles(&b)
-        .unwrap()[0]
+        first_multipoles(TriangleSet::points(vec![t]).unwrap(), side, &p_lin, &s, &b)
     };
     let largest = run([0.04, 0.07, 0.1], LegendreSide::Largest);
     for (t, side) in [([0.1, 0.04, 0.07], 0), ([0.07, 0.1, 0.04], 1)] {
@@ -567,16 +575,13 @@ fn on_a_bin_with_two_equal_shells_either_equal_side_may_carry_the_legendre_polyn
     };
     let b = galaxy();
     let run = |t: [f64; 3], side| {
-        BispectrumPlan::new(
+        first_multipoles(
             TriangleSet::shells(vec![t], 0.01).unwrap(),
             side,
-            PlanRules::default(),
+            &p_lin,
+            &s,
+            &b,
         )
-        .unwrap()
-        .terms(&p_lin, &s)
-        .unwrap()
-        .multipoles(&b)
-        .unwrap()[0]
     };
     let equal_sides: [([f64; 3], [usize; 2]); 4] = [
         ([0.015, 0.035, 0.035], [1, 2]),

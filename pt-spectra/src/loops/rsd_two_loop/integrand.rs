@@ -7,6 +7,7 @@ use super::{mu2_nodes, NodeIntegrals, MU_NODES};
 use crate::loops::mode_coupling::{Point, Sampled, Sampler};
 use crate::loops::two_loop::{points_at, random_shifts, sobol_sequence};
 use crate::loops::TwoLoopSettings;
+use crate::vec3::{neg, norm2, sub};
 use std::f64::consts::PI;
 
 /// The points, shifts and maps of one integration on a k grid.
@@ -81,21 +82,6 @@ impl Sampling {
             mode_coupling_legs(k, &samplers[1].point(&point, &head), &los),
         ]
     }
-}
-
-#[inline]
-fn neg(v: [f64; 3]) -> [f64; 3] {
-    v.map(|x| -x)
-}
-
-#[inline]
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline]
-fn norm2(a: [f64; 3]) -> f64 {
-    a[0] * a[0] + a[1] * a[1] + a[2] * a[2]
 }
 
 /// The line of sight at each node for the azimuth `phi_n`.

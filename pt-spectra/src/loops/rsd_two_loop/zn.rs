@@ -19,17 +19,14 @@
 //! Z_n = (1/n!) Σ_{S₀≠∅} |S₀|! D(S₀) E(rest): every U carries one f, so E(R) is a polynomial in f
 //! whose degree is its number of blocks, and Z_n one of degree n.
 
+use crate::vec3::dot;
+
 /// Most vectors in a configuration.
 pub(crate) const MAX_VECTORS: usize = 5;
 const SUBSETS: usize = 1 << MAX_VECTORS;
 /// Coefficients of f⁰ … f⁵ of a kernel (f⁶ for products of two).
 pub(crate) type FPoly = [f64; 7];
 const FACTORIAL: [f64; 6] = [1.0, 1.0, 2.0, 6.0, 24.0, 120.0];
-
-#[inline]
-fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
 
 /// F_S, G_S of every subset S (a bitmask) of up to [`MAX_VECTORS`] vectors.
 pub(crate) struct SubsetKernels {
