@@ -111,7 +111,10 @@ impl Fog {
     pub(crate) fn factor(&self, x: f64) -> f64 {
         match *self {
             Self::None => 1.0,
-            Self::Lorentzian { sigma } => (1.0 + 0.5 * x * sigma * sigma).powi(-2),
+            Self::Lorentzian { sigma } => {
+                let d = 1.0 + 0.5 * x * sigma * sigma;
+                1.0 / (d * d)
+            }
             Self::Gaussian { sigma } => (-0.5 * x * sigma * sigma).exp(),
         }
     }

@@ -14,25 +14,52 @@ pub(super) fn observed_slots(
     s: &Settings,
     power: impl Fn(usize, f64, f64) -> f64,
 ) -> [f64; SLOTS] {
-    let (qp2, qt2) = (s.q_par * s.q_par, s.q_perp * s.q_perp);
-    let par_true = par.map(|p| p / s.q_par);
-    let k_true = [0, 1, 2].map(|i| {
+    let mut out = [0.0; SLOTS];
+    add_observed_slots(&mut out, k, dots, par, s, power);
+    out
+}
+
+/// Adds the slots of [`observed_slots`] to `out` (the inner loop of the orientation and bin averages:
+/// no array of slots is made per node).
+#[inline]
+pub(super) fn add_observed_slots(
+    out: &mut [f64; SLOTS],
+    k: [f64; 3],
+    dots: [f64; 3],
+    par: [f64; 3],
+    s: &Settings,
+    power: impl Fn(usize, f64, f64) -> f64,
+) {
+    let (inv_qp2, inv_qt2) = (1.0 / (s.q_par * s.q_par), 1.0 / (s.q_perp * s.q_perp));
+    let inv_qp = 1.0 / s.q_par;
+    let mut par_true = [0.0; 3];
+    let mut k_true = [0.0; 3];
+    let mut p = [0.0; 3];
+    let mut x = 0.0;
+    for i in 0..3 {
+        par_true[i] = par[i] * inv_qp;
         let perp2 = (k[i] * k[i] - par[i] * par[i]).max(0.0);
-        (par_true[i] * par_true[i] + perp2 / qt2).sqrt()
-    });
-    let dots_true = [0, 1, 2].map(|i| {
-        let pp = par[i] * par[(i + 1) % 3];
-        pp / qp2 + (dots[i] - pp) / qt2
-    });
-    let p = [0, 1, 2].map(|i| power(i, k_true[i], par_true[i] / k_true[i]));
-    let mut slots = tree_slots(k_true, dots_true, par_true, p, s.f);
-    let fog = s.fog.factor(par_true.iter().map(|p| p * p).sum());
-    let volume = 1.0 / (qp2 * qt2 * qt2);
-    for v in &mut slots[..SLOTS - 1] {
-        *v *= fog * volume;
+        k_true[i] = (par_true[i] * par_true[i] + perp2 * inv_qt2).sqrt();
+        p[i] = power(i, k_true[i], par_true[i] / k_true[i]);
+        x += par_true[i] * par_true[i];
     }
-    slots[SLOTS - 1] *= volume;
-    slots
+    let mut dots_true = [0.0; 3];
+    for i in 0..3 {
+        let pp = par[i] * par[(i + 1) % 3];
+        dots_true[i] = pp * inv_qp2 + (dots[i] - pp) * inv_qt2;
+    }
+    let volume = inv_qp2 * inv_qt2 * inv_qt2;
+    let fog = s.fog.factor(x);
+    add_tree_slots(
+        out,
+        k_true,
+        dots_true,
+        par_true,
+        p,
+        s.f,
+        fog * volume,
+        volume,
+    );
 }
 
 /// Adds `slots` times each weight to the matching accumulator.
@@ -62,42 +89,67 @@ pub(super) fn tree_slots(
     p: [f64; 3],
     f: f64,
 ) -> [f64; SLOTS] {
-    let mu = [0, 1, 2].map(|i| par[i] / k[i]);
-    let a: [[f64; 3]; 3] = [0, 1, 2].map(|i| [f * mu[i] * mu[i], 1.0, -par[i] * par[i]]);
     let mut out = [0.0; SLOTS];
+    add_tree_slots(&mut out, k, dots, par, p, f, 1.0, 1.0);
+    out
+}
+
+/// Adds the slots of [`tree_slots`] to `out`, those of the P-dependent terms times `scale` and the
+/// constant 1/n̄² slot as `constant`.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn add_tree_slots(
+    out: &mut [f64; SLOTS],
+    k: [f64; 3],
+    dots: [f64; 3],
+    par: [f64; 3],
+    p: [f64; 3],
+    f: f64,
+    scale: f64,
+    constant: f64,
+) {
+    let inv_k = [1.0 / k[0], 1.0 / k[1], 1.0 / k[2]];
+    let mu = [par[0] * inv_k[0], par[1] * inv_k[1], par[2] * inv_k[2]];
+    let a: [[f64; 3]; 3] = [
+        [f * mu[0] * mu[0], 1.0, -par[0] * par[0]],
+        [f * mu[1] * mu[1], 1.0, -par[1] * par[1]],
+        [f * mu[2] * mu[2], 1.0, -par[2] * par[2]],
+    ];
     for i in 0..3 {
         let (j, l) = ((i + 1) % 3, (i + 2) % 3);
-        let cos = dots[i] / (k[i] * k[j]);
-        let ratio = k[i] / k[j] + k[j] / k[i];
+        let cos = dots[i] * inv_k[i] * inv_k[j];
+        let ratio = k[i] * inv_k[j] + k[j] * inv_k[i];
         let f2 = 5.0 / 7.0 + 0.5 * cos * ratio + 2.0 / 7.0 * cos * cos;
         let g2 = 3.0 / 7.0 + 0.5 * cos * ratio + 4.0 / 7.0 * cos * cos;
         let k_par = par[i] + par[j]; // n̂·(kᵢ + kⱼ) = −n̂·k_l
-        let mu12_sq = k_par * k_par / (k[l] * k[l]);
+        let mu12_sq = k_par * k_par * inv_k[l] * inv_k[l];
         let c = [
             f * mu12_sq * g2
                 + 0.5
                     * f
                     * f
                     * k_par
-                    * (mu[i] * mu[j] * mu[j] / k[i] + mu[j] * mu[i] * mu[i] / k[j]),
-            f2 + 0.5 * f * k_par * (mu[i] / k[i] + mu[j] / k[j]),
+                    * (mu[i] * mu[j] * mu[j] * inv_k[i] + mu[j] * mu[i] * mu[i] * inv_k[j]),
+            f2 + 0.5 * f * k_par * (mu[i] * inv_k[i] + mu[j] * inv_k[j]),
             0.5,
             cos * cos - 1.0 / 3.0,
         ];
-        let pp = 2.0 * p[i] * p[j];
+        let pp = 2.0 * p[i] * p[j] * scale;
         for al in 0..3 {
+            let pa = pp * a[i][al];
             for be in 0..3 {
-                let ab = pp * a[i][al] * a[j][be];
-                for (g, cg) in c.iter().enumerate() {
-                    out[(al * 3 + be) * 4 + g] += ab * cg;
+                let ab = pa * a[j][be];
+                let base = (al * 3 + be) * 4;
+                for g in 0..4 {
+                    out[base + g] += ab * c[g];
                 }
             }
         }
+        let ps = p[i] * scale;
         for be in 0..3 {
-            out[36 + be] += p[i] * a[i][be];
-            out[39 + be] += p[i] * a[i][0] * a[i][be];
+            out[36 + be] += ps * a[i][be];
+            out[39 + be] += ps * a[i][0] * a[i][be];
         }
     }
-    out[42] = 1.0;
-    out
+    out[42] += constant;
 }

@@ -19,8 +19,8 @@ const PROBE_STRIDE: usize = 3;
 pub(crate) struct Sampled {
     k0: f64,
     inv_h: f64,
-    p: Vec<f64>,
-    p_nw: Vec<f64>,
+    /// (P, P_nw) at each node, side by side (one cache line per lookup).
+    pairs: Vec<[f64; 2]>,
     /// Largest relative interpolation error measured (P or P_nw).
     pub(crate) relative_error: f64,
 }
@@ -59,8 +59,7 @@ impl Sampled {
         let mut table = Self {
             k0,
             inv_h: 1.0 / h,
-            p,
-            p_nw,
+            pairs: p.into_iter().zip(p_nw).map(|(p, nw)| [p, nw]).collect(),
             relative_error: 0.0,
         };
         let mut worst = 0.0_f64;
@@ -80,7 +79,8 @@ impl Sampled {
     #[inline]
     pub(crate) fn eval(&self, k: f64) -> (f64, f64) {
         let t = (k - self.k0) * self.inv_h;
-        let i = (t.floor().max(1.0) as usize).min(self.p.len() - 3);
+        // truncation, not floor: they differ only at t < 0, which the clamp to 1 maps alike
+        let i = (t as usize).clamp(1, self.pairs.len() - 3);
         let u = t - i as f64;
         let w = [
             -u * (u - 1.0) * (u - 2.0) / 6.0,
@@ -88,10 +88,10 @@ impl Sampled {
             -(u + 1.0) * u * (u - 2.0) / 2.0,
             (u + 1.0) * u * (u - 1.0) / 6.0,
         ];
-        let (p, nw) = (&self.p[i - 1..i + 3], &self.p_nw[i - 1..i + 3]);
+        let s = &self.pairs[i - 1..i + 3];
         (
-            w[0] * p[0] + w[1] * p[1] + w[2] * p[2] + w[3] * p[3],
-            w[0] * nw[0] + w[1] * nw[1] + w[2] * nw[2] + w[3] * nw[3],
+            w[0] * s[0][0] + w[1] * s[1][0] + w[2] * s[2][0] + w[3] * s[3][0],
+            w[0] * s[0][1] + w[1] * s[1][1] + w[2] * s[2][1] + w[3] * s[3][1],
         )
     }
 }

@@ -3,7 +3,7 @@
 //! with the parameters (per step, microseconds).
 
 use super::geometry::{orientations, LegendreSide, TriangleSet};
-use super::observed::{accumulate, observed_slots};
+use super::observed::{accumulate, add_observed_slots};
 pub(super) use super::observed::{tree_slots, SLOTS};
 use super::resum::IrInputs;
 use super::sampled::Sampled;
@@ -304,11 +304,14 @@ impl BispectrumPlan {
                             // the azimuths first (λ depends on μ only), then ℓ
                             let mut azimuths = [0.0; SLOTS];
                             for par in &group.par {
-                                let slots =
-                                    observed_slots(shape.k, shape.dots, *par, settings, power);
-                                for (a, s) in azimuths.iter_mut().zip(&slots) {
-                                    *a += s;
-                                }
+                                add_observed_slots(
+                                    &mut azimuths,
+                                    shape.k,
+                                    shape.dots,
+                                    *par,
+                                    settings,
+                                    power,
+                                );
                             }
                             accumulate(&mut acc, group.lambda, &azimuths);
                         }
