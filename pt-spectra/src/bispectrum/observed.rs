@@ -137,8 +137,8 @@ fn add_tree_slots(
         let pp = 2.0 * p[i] * p[j] * scale;
         for al in 0..3 {
             let pa = pp * a[i][al];
-            for be in 0..3 {
-                let ab = pa * a[j][be];
+            for (be, a_jb) in a[j].iter().enumerate() {
+                let ab = pa * a_jb;
                 let base = (al * 3 + be) * 4;
                 for g in 0..4 {
                     out[base + g] += ab * c[g];
