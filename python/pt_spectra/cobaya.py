@@ -49,6 +49,19 @@ E_fid(z)/E(z) and α⊥ = D_M(z)/D_M,fid(z) (distances in Mpc/h; E, D_M of the B
 model (plan built for 0.8 ≤ α ≤ 1.25; a step outside has zero likelihood, with a log message), and
 ``get_pt_ap(z)`` returns them.
 
+The tree-level bispectrum (``bispectrum: true``, ``rsd: ept`` only): the theory also provides
+``pt_bk_ell``, the bin-averaged B_ℓ(k₁, k₂, k₃) [(Mpc/h)^6] of :class:`pt_spectra.BispectrumPlan` at the
+triangles a likelihood requests (``pt_bk_ell: {z, triangles, bin_width, ells}``; one triangle set per
+redshift), with the spectrum, f and α∥, α⊥ of the multipoles, IR resummation as ``ir``, and b1, b2, bs
+shared with them (velocileptors' convention in both). Its own parameters per redshift: ``c1_i``
+[(Mpc/h)^2] (the k²μ² counterterm of every leg, default 0), ``b_shot_i`` (1), ``p_shot_i`` (0),
+``a_shot_i`` (0) (the stochastic terms in units of 1/n̄, Ivanov et al. 2021; Poisson: 1, 0, 0); the
+options ``n_bar`` [(h/Mpc)^3] (default none: no stochastic terms, logged), ``b_fog`` ("none",
+"lorentzian", "gaussian") and ``b_sigma_fog`` [Mpc/h]. Each new spectrum, f or α costs the bispectrum
+terms (about 11 ms for 62 bins on one core); a step in the biases or the B parameters alone costs
+microseconds. ``get_pt_bk_ell(z)`` is an array [len(ells), n_triangles], ``get_pt_bk_ell_err(z)`` its
+quadrature errors.
+
 The multipoles requested by a likelihood (``pt_pk_ell: {ells: [...]}``, e.g. 0 … 8 for a window) are
 added to ``ells``.
 
@@ -97,7 +110,7 @@ except ImportError as e:  # pragma: no cover - depends on the environment
 
 import pt_spectra as pt
 
-__all__ = ["PTMultipoles", "NUISANCE", "EPT_NUISANCE"]
+__all__ = ["PTMultipoles", "NUISANCE", "EPT_NUISANCE", "BISPECTRUM_NUISANCE"]
 
 #: The nuisance parameters of one redshift: name -> (required, default, unit).
 NUISANCE = {
@@ -131,6 +144,14 @@ EPT_NUISANCE = {"b1": (True, None, "")} | {
         ("alpha4", "(Mpc/h)^2"), ("alpha6", "(Mpc/h)^2"), ("sn", "(Mpc/h)^3"), ("sn2", "(Mpc/h)^5"),
         ("sn4", "(Mpc/h)^7"))
 }
+
+#: The bispectrum's own parameters per redshift with ``bispectrum: true`` (b1, b2, bs are shared with
+#: the galaxy model): name -> (required, default, unit).
+BISPECTRUM_NUISANCE = {"c1": (False, 0.0, "(Mpc/h)^2"), "b_shot": (False, 1.0, ""),
+                       "p_shot": (False, 0.0, ""), "a_shot": (False, 0.0, "")}
+
+#: The bispectrum multipoles a plan computes, in the order of its columns.
+B_ELLS = (0, 2, 4)
 
 # The library warns that without a cosmology the growth of its gm2012 cosmology is used. It does
 # not apply here: z_input = z (the spectrum is used as given, rescaling factor 1), f is passed, and
@@ -172,6 +193,11 @@ class PTMultipoles(Theory):
     #: with ``emulator: true``, how Σm_ν is shared: None (``mnu``'s own convention, CAMB's one massive
     #: species) or "three degenerate" (the setting the emulator emulates)
     neutrinos: str | None = None
+    #: provide ``pt_bk_ell``, the tree-level bispectrum multipoles (rsd: ept only; module docs)
+    bispectrum: bool = False
+    n_bar: float | None = None
+    b_fog: str = "none"
+    b_sigma_fog: float = 0.0
 
     # ---- set-up ------------------------------------------------------------------------------
     def initialize(self):
@@ -201,6 +227,24 @@ class PTMultipoles(Theory):
                 raise ValueError("PTMultipoles: `ap_fiducial` needs Omega_m in (0, 1) of the flat "
                                  f"fiducial, got {self.ap_fiducial}")
             self._ap_omega_m = float(om)
+        if self.bispectrum:
+            if not self._ept:
+                raise ValueError("PTMultipoles: `bispectrum: true` needs rsd: ept (its bias convention)")
+            if self.b_fog not in ("none", "lorentzian", "gaussian"):
+                raise ValueError(f"PTMultipoles: unknown `b_fog` {self.b_fog!r}; "
+                                 "available: none, lorentzian, gaussian")
+            if not (np.isfinite(self.b_sigma_fog) and self.b_sigma_fog >= 0):
+                raise ValueError(f"PTMultipoles: `b_sigma_fog` must be >= 0 [Mpc/h], got "
+                                 f"{self.b_sigma_fog}")
+            if self.n_bar is not None and not (np.isfinite(self.n_bar) and self.n_bar > 0):
+                raise ValueError(f"PTMultipoles: `n_bar` must be > 0 [(h/Mpc)^3], got {self.n_bar}")
+            if self.n_bar is None:
+                self.log.info("bispectrum: no n_bar, so no stochastic terms (b_shot, p_shot, "
+                              "a_shot have no effect)")
+        # per z: the requested (triangles, bin_width, ells), its plan, and the cached terms
+        self._b_requests = {}
+        self._b_plans = {}
+        self._b_terms = {}
         self._k = self._option_grid()
         self._requested_k: list[float] = []
         self._plan = None
@@ -235,6 +279,8 @@ class PTMultipoles(Theory):
 
     def _table(self):
         """The nuisance parameters of the model: name -> (required, default, unit)."""
+        if self._ept and self.bispectrum:
+            return EPT_NUISANCE | BISPECTRUM_NUISANCE
         return EPT_NUISANCE if self._ept else NUISANCE
 
     def _make_plan(self, k):
@@ -331,6 +377,7 @@ class PTMultipoles(Theory):
                 raise ValueError(f"PTMultipoles: requested multipole {ell} is not even and <= 8")
             if ell not in self.ells:
                 self.ells = sorted(self.ells + [ell])
+        self._request_bispectrum(requirements.get("pt_bk_ell"))
         k = np.atleast_1d(options.get("k", [])).astype(float)
         if k.size and self._k is not None:
             for ki in k:
@@ -338,6 +385,37 @@ class PTMultipoles(Theory):
         elif k.size:
             self._requested_k = sorted(set(self._requested_k) | set(k.tolist()))
         return None
+
+    def _request_bispectrum(self, options):
+        """Records a likelihood's ``pt_bk_ell: {z, triangles, bin_width, ells}`` (one set per z)."""
+        if options is None:
+            return
+        if not self.bispectrum:
+            raise ValueError("PTMultipoles: a likelihood requires pt_bk_ell: set the theory's "
+                             "`bispectrum: true` (with rsd: ept)")
+        if "z" not in options or "triangles" not in options:
+            raise ValueError("PTMultipoles: pt_bk_ell needs `z` and `triangles` (rows k1 k2 k3 "
+                             "[h/Mpc])")
+        z = self.zs[_close_index(self.zs, float(options["z"]), "requested pt_bk_ell z")]
+        triangles = np.asarray(options["triangles"], dtype=float)
+        if triangles.ndim != 2 or triangles.shape[1] != 3 or triangles.shape[0] == 0:
+            raise ValueError(f"PTMultipoles: pt_bk_ell triangles must be rows of k1 k2 k3, got "
+                             f"shape {triangles.shape}")
+        width = options.get("bin_width")
+        width = None if width is None else float(width)
+        ells = [int(ell) for ell in options.get("ells", B_ELLS)]
+        if not ells or any(ell not in B_ELLS for ell in ells):
+            raise ValueError(f"PTMultipoles: pt_bk_ell ells must be among {list(B_ELLS)}, got {ells}")
+        request = (triangles, width, ells)
+        old = self._b_requests.get(z)
+        if old is not None and not (np.array_equal(old[0], triangles) and old[1] == width):
+            raise ValueError(f"PTMultipoles: two different triangle sets requested at z = {z}: "
+                             "one bispectrum per redshift (give both likelihoods the same triangles)")
+        if old is not None:
+            request = (triangles, width, sorted(set(old[2]) | set(ells)))
+        self._b_requests[z] = request
+        # the plan (its nodes) depends only on the triangles and the width: made here, once
+        self._b_plans[z] = pt.BispectrumPlan(triangles, bin_width=width)
 
     def initialize_with_provider(self, provider):
         super().initialize_with_provider(provider)
@@ -413,11 +491,14 @@ class PTMultipoles(Theory):
     def _multipoles(self, state, params_values_dict, linear, alphas, want_derived=True):
         """The multipoles of each z from {z: (k [h/Mpc], P_lin [(Mpc/h)^3], f, D, σ8(z))}."""
         spectra, errors, growth, derived = {}, {}, {}, {}
+        b_spectra, b_errors = {}, {}
         for i, z in enumerate(self.zs):
             k_lin, p_lin, f, d, s8 = linear[z]
             derived[self.param_name("fsigma8", i)] = f * s8
             derived[self.param_name("sigma8", i)] = s8
             nu = self._nuisance(params_values_dict, i)
+            # the galaxy model's own parameters (the bispectrum's are used by _bispectrum only)
+            nu_p = {n: v for n, v in nu.items() if n not in BISPECTRUM_NUISANCE}
             digest = hashlib.sha1(k_lin.tobytes() + p_lin.tobytes()).digest()
             with warnings.catch_warnings():
                 # The spectrum is given at z (no rescaling), f and D come from the Boltzmann code:
@@ -431,17 +512,21 @@ class PTMultipoles(Theory):
                 if self._ept and z in alphas:
                     apar, aperp = alphas[z]
                     try:
-                        t = cached[1].multipoles(ells=self.ells, f=f, apar=apar, aperp=aperp, **nu)
+                        t = cached[1].multipoles(ells=self.ells, f=f, apar=apar, aperp=aperp, **nu_p)
                     except ValueError as e:
                         self.log.debug("z = %g: alpha_par %.4f, alpha_perp %.4f outside the plan: %s",
                                        z, apar, aperp, e)
                         return False
                 elif self._ept:
-                    t = cached[1].multipoles(ells=self.ells, f=f, **nu)
+                    t = cached[1].multipoles(ells=self.ells, f=f, **nu_p)
                 else:
                     t = cached[1].multipoles(f=f, bias=nu["b"], amplitude=nu["A_b"], fog=self.fog,
                                              sigma0=nu["sigma0"], ells=self.ells,
                                              growth_factor=d, cs2=nu["cs2"])
+            if z in self._b_requests:
+                ap = alphas.get(z, (1.0, 1.0))
+                bk = self._bispectrum(z, digest, (k_lin, p_lin), f, ap, nu)
+                b_spectra[z], b_errors[z] = bk
             p = np.array([t[f"P{ell}"] for ell in self.ells])
             if 0 in self.ells and not self._ept:
                 p[self.ells.index(0)] += nu["P_shot"]
@@ -452,8 +537,31 @@ class PTMultipoles(Theory):
         state["pt_pk_ell_err"] = errors
         state["pt_growth"] = growth
         state["pt_ap"] = alphas
+        state["pt_bk_ell"] = b_spectra
+        state["pt_bk_ell_err"] = b_errors
         if want_derived:
             state["derived"] = derived
+
+    def _bispectrum(self, z, digest, linear, f, ap, nu):
+        """(B, err) [len(ells), n_triangles] of the requested triangles at z: the terms are kept while
+        the spectrum, f and the α's are unchanged, so a step in the biases alone costs microseconds."""
+        _, _, ells = self._b_requests[z]
+        key = (digest, float(f), float(ap[0]), float(ap[1]))
+        cached = self._b_terms.get(z)
+        if cached is None or cached[0] != key:
+            with warnings.catch_warnings():
+                warnings.filterwarnings("ignore", message=_NO_COSMOLOGY,
+                                        category=pt.PtSpectraWarning)
+                terms = self._b_plans[z].terms(linear=linear, z=z, z_input=z, f=f, q_par=ap[0],
+                                               q_perp=ap[1], fog=self.b_fog,
+                                               sigma_fog=float(self.b_sigma_fog), ir=bool(self.ir))
+            cached = (key, terms)
+            self._b_terms[z] = cached
+        b, err = cached[1].multipoles(b1=nu["b1"], b2=nu["b2"], bs=nu["bs"], c1=nu["c1"],
+                                      n_bar=self.n_bar, b_shot=nu["b_shot"], p_shot=nu["p_shot"],
+                                      a_shot=nu["a_shot"])
+        columns = [B_ELLS.index(ell) for ell in ells]
+        return np.asarray(b)[:, columns].T, np.asarray(err)[:, columns].T
 
     # ---- products ----------------------------------------------------------------------------
     def _at(self, name, z):
@@ -476,6 +584,20 @@ class PTMultipoles(Theory):
         """{z: (α∥, α⊥)} against ``ap_fiducial`` (empty without it), or the pair of one z."""
         values = self.current_state["pt_ap"]
         return values if z is None else values[self.zs[_close_index(self.zs, z, "z")]]
+
+    def get_pt_bk_ell(self, z=None):
+        """{z: array [len(ells), n_triangles]} of the bispectrum multipoles B_ℓ [(Mpc/h)^6] at the
+        requested triangles (``bispectrum: true``), or the array of one z; rows in the order of
+        :meth:`get_pt_bk_ells`."""
+        return self._at("pt_bk_ell", z)
+
+    def get_pt_bk_ell_err(self, z=None):
+        """The quadrature errors of :meth:`get_pt_bk_ell`."""
+        return self._at("pt_bk_ell_err", z)
+
+    def get_pt_bk_ells(self, z):
+        """The bispectrum multipoles ℓ at z, in the order of the rows of :meth:`get_pt_bk_ell`."""
+        return list(self._b_requests[self.zs[_close_index(self.zs, z, "z")]][2])
 
     def get_pt_k(self):
         """The k grid [h/Mpc] of the multipoles."""

@@ -6,6 +6,10 @@ multipoles P_ℓ(k) (or ξ_ℓ(s)) with a full covariance (its inverse scaled by
 and, with the theory's ``ap_fiducial``, distorted by AP; a k range per multipole. Below it,
 ``MultipoleGaussian``, the simplest case (diagonal errors, the model at the data's k).
 
+``PowerBispectrum``: the joint likelihood of window-free power-spectrum and bispectrum multipoles with
+one covariance (P + B analyses: BOSS, DESI), the bispectrum from the theory's ``pt_bk_ell``
+(``bispectrum: true``), sharing its spectrum, f, α's and b1, b2, bs with the power spectrum.
+
 ``MultipoleGaussian``: a Gaussian likelihood with diagonal errors of measured multipoles at one
 redshift, logp = -χ²/2 with χ² = Σ_ℓ Σ_k [(P_ℓ^model - P_ℓ^data) / σ_ℓ]². The model is
 ``pt_pk_ell`` of a :class:`pt_spectra.cobaya.PTMultipoles` theory at the same k.
@@ -37,7 +41,8 @@ try:
 except ImportError as e:  # pragma: no cover - depends on the environment
     raise ImportError("pt_spectra.likelihoods needs cobaya: pip install cobaya camb") from e
 
-__all__ = ["MultipoleGaussian", "SurveyMultipoles", "read_multipoles"]
+__all__ = ["MultipoleGaussian", "PowerBispectrum", "SurveyMultipoles", "read_multipoles",
+           "read_columns"]
 
 
 def read_multipoles(path, data_ells=(0, 2, 4)):
@@ -278,6 +283,190 @@ class SurveyMultipoles(Likelihood):
         p = np.asarray(self.provider.get_pt_pk_ell(z=self.z))[self._rows][:, self._cols]
         observed = np.asarray(self.observation.apply_values(np.ascontiguousarray(p)))
         return np.concatenate([observed[j][m] for j, m in enumerate(self._mask)])
+
+    def logp(self, **params_values):
+        r = self._whiten @ (self.data - self.model())
+        return -0.5 * float(r @ r)
+
+
+def read_columns(path, names, what):
+    """The columns `names` of a whitespace text table (``#`` comments), as float arrays; every error
+    names the file, the line and the value."""
+    path = os.fspath(path)
+    if not os.path.isfile(path):
+        raise ValueError(f"{what}: no file {path!r}")
+    rows = []
+    with open(path, encoding="utf-8") as handle:
+        for line_no, line in enumerate(handle, start=1):
+            text = line.split("#", 1)[0].strip()
+            if not text:
+                continue
+            fields = text.split()
+            if len(fields) != len(names):
+                raise ValueError(f"{what} {path!r} line {line_no}: {len(fields)} columns, expected "
+                                 f"{len(names)} ({' '.join(names)})")
+            try:
+                values = [float(x) for x in fields]
+            except ValueError as e:
+                raise ValueError(f"{what} {path!r} line {line_no}: {e}") from e
+            if not np.all(np.isfinite(values)):
+                raise ValueError(f"{what} {path!r} line {line_no}: a value is not finite")
+            rows.append(values)
+    if not rows:
+        raise ValueError(f"{what} {path!r}: no data rows")
+    table = np.array(rows)
+    return {name: table[:, j] for j, name in enumerate(names)}
+
+
+class PowerBispectrum(Likelihood):
+    """Joint Gaussian likelihood of window-free P_ℓ(k) and B_ℓ(k₁, k₂, k₃) with one covariance.
+
+    Options:
+
+    - ``p_file``: text columns ``k P_ℓ …`` for the multipoles ``p_data_ells`` (default [0, 2, 4]; the
+      layout of the window-free estimators' files, e.g. the Nseries ``pk_*.txt``), k [h/Mpc], P
+      [(Mpc/h)^3]; ``b_file``: columns ``k1 k2 k3 B_ℓ …`` for ``b_data_ells`` (default [0, 2, 4]), the
+      bin centres [h/Mpc] and B [(Mpc/h)^6].
+    - ``covariance_file`` (required; text or ``.npy``): the joint covariance in one declared layout:
+      the P block ℓ-major over ``p_data_ells`` and every k of ``p_file``, then the B block ℓ-major over
+      ``b_data_ells`` and every triangle of ``b_file`` (the layout of the Patchy P + B covariance).
+      ``covariance_scale`` (1): the covariance is divided by it (e.g. the effective number of volumes
+      of a mean of mocks); ``n_mocks``: C⁻¹ is scaled by the Hartlap factor (N − p − 2)/(N − 1), p the
+      fitted points. It is whitened through its correlation matrix (the P and B blocks differ by ~1e5
+      in scale).
+    - ``z``; ``p_ells`` ([0, 2]) and ``k_min``, ``k_max`` [h/Mpc]: the fitted P points;
+      ``b_ells`` ([0]) and ``b_k_min``, ``b_k_max`` [h/Mpc]: the fitted triangles, all of whose sides
+      lie in [b_k_min, b_k_max].
+    - ``bin_width`` [h/Mpc]: the shell width of the measured triangle bins, whose closed triangles the
+      model averages (the Nseries and Patchy files: 0.01); ``null`` evaluates the model at the
+      triangles themselves, which is logged (the bin average changes B by up to ~10% at low k).
+
+    The theory (``pt_spectra.cobaya.PTMultipoles`` with ``rsd: ept`` and ``bispectrum: true``) is asked
+    for P_ℓ at the fitted k and B_ℓ at the fitted triangles. ``logp = −χ²/2``, χ² = rᵀ C⁻¹ r over the
+    fitted P then B points.
+    """
+
+    p_file: str | None = None
+    b_file: str | None = None
+    covariance_file: str | None = None
+    covariance_scale: float = 1.0
+    n_mocks: int | None = None
+    z: float | None = None
+    p_data_ells: list = [0, 2, 4]
+    b_data_ells: list = [0, 2, 4]
+    p_ells: list = [0, 2]
+    b_ells: list = [0]
+    k_min: float = 0.0
+    k_max: float = np.inf
+    b_k_min: float = 0.0
+    b_k_max: float = np.inf
+    bin_width: float | None = None
+
+    def initialize(self):
+        name = "PowerBispectrum"
+        for option in ("p_file", "b_file", "covariance_file", "z"):
+            if getattr(self, option) is None:
+                raise ValueError(f"{name}: option `{option}` is required")
+        self.z = float(self.z)
+        p_data_ells = [int(ell) for ell in self.p_data_ells]
+        b_data_ells = [int(ell) for ell in self.b_data_ells]
+        p_ells = [int(ell) for ell in self.p_ells]
+        b_ells = [int(ell) for ell in self.b_ells]
+        for fitted, data, what in ((p_ells, p_data_ells, "p_ells"), (b_ells, b_data_ells, "b_ells")):
+            absent = [ell for ell in fitted if ell not in data]
+            if absent or not fitted:
+                raise ValueError(f"{name}: `{what}` {fitted} must be a non-empty subset of the "
+                                 f"file's multipoles {data}")
+        p = read_columns(self.p_file, ["k"] + [f"P{ell}" for ell in p_data_ells], f"{name} p_file")
+        b = read_columns(self.b_file, ["k1", "k2", "k3"] + [f"B{ell}" for ell in b_data_ells],
+                         f"{name} b_file")
+        k = p["k"]
+        if np.any(k <= 0) or np.any(np.diff(k) <= 0):
+            raise ValueError(f"{name} p_file {self.p_file!r}: k must be positive and increasing")
+        triangles = np.column_stack([b["k1"], b["k2"], b["k3"]])
+        if np.any(triangles <= 0):
+            raise ValueError(f"{name} b_file {self.b_file!r}: every side must be > 0")
+        p_keep = (k >= float(self.k_min)) & (k <= float(self.k_max))
+        b_keep = ((triangles.min(axis=1) >= float(self.b_k_min))
+                  & (triangles.max(axis=1) <= float(self.b_k_max)))
+        if not p_keep.any():
+            raise ValueError(f"{name}: no P point in [k_min, k_max] = [{self.k_min}, {self.k_max}]")
+        if not b_keep.any():
+            raise ValueError(f"{name}: no triangle with all sides in [b_k_min, b_k_max] = "
+                             f"[{self.b_k_min}, {self.b_k_max}] h/Mpc")
+        n_k, n_t = k.size, triangles.shape[0]
+        index = np.concatenate(
+            [p_data_ells.index(ell) * n_k + np.flatnonzero(p_keep) for ell in p_ells]
+            + [len(p_data_ells) * n_k + b_data_ells.index(ell) * n_t + np.flatnonzero(b_keep)
+               for ell in b_ells])
+        path = str(self.covariance_file)
+        if not os.path.isfile(path):
+            raise ValueError(f"{name}: no covariance file {path!r}")
+        cov = np.load(path) if path.endswith(".npy") else np.loadtxt(path)
+        n = len(p_data_ells) * n_k + len(b_data_ells) * n_t
+        if cov.shape != (n, n):
+            raise ValueError(f"{name}: covariance {path!r} is {cov.shape}, expected ({n}, {n}): P "
+                             f"{p_data_ells} x {n_k} k, then B {b_data_ells} x {n_t} triangles")
+        if not (np.isfinite(self.covariance_scale) and self.covariance_scale > 0):
+            raise ValueError(f"{name}: `covariance_scale` must be > 0, got {self.covariance_scale}")
+        values = ([p[f"P{ell}"] for ell in p_data_ells] + [b[f"B{ell}"] for ell in b_data_ells])
+        cov = _core.check_covariance(np.ascontiguousarray(cov, dtype=float), values, path)
+        cov = np.asarray(cov)[np.ix_(index, index)] / float(self.covariance_scale)
+        points = index.size
+        if self.n_mocks is not None:
+            n_mocks = int(self.n_mocks)
+            if n_mocks < points + 3:
+                raise ValueError(f"{name}: n_mocks = {n_mocks} needs to exceed the {points} fitted "
+                                 "points + 2 (Hartlap factor)")
+            cov = cov * (n_mocks - 1) / (n_mocks - points - 2)
+        scale = np.sqrt(np.diag(cov))
+        try:
+            chol = np.linalg.cholesky(cov / np.outer(scale, scale))
+        except np.linalg.LinAlgError as e:
+            raise ValueError(f"{name}: the fitted covariance block is not positive definite") from e
+        self._whiten = np.linalg.inv(chol) / scale
+        self.p_ells, self.b_ells, self.points = p_ells, b_ells, points
+        self.k_data = k[p_keep]
+        self.triangles = triangles[b_keep]
+        self.data = np.concatenate([p[f"P{ell}"][p_keep] for ell in p_ells]
+                                   + [b[f"B{ell}"][b_keep] for ell in b_ells])
+        self._cols = None
+        if self.bin_width is None:
+            self.log.warning("bin_width not given: B is evaluated at the triangles, not averaged over "
+                             "the measurement's bins (up to ~10%% off at low k)")
+        self.log.info("%d P points (multipoles %s, %g <= k <= %g h/Mpc) and %d B points "
+                      "(multipoles %s, %d triangles) at z = %g", p_keep.sum() * len(p_ells), p_ells,
+                      self.k_data[0], self.k_data[-1], b_keep.sum() * len(b_ells), b_ells,
+                      self.triangles.shape[0], self.z)
+
+    def get_requirements(self):
+        return {"pt_pk_ell": {"z": [self.z], "k": self.k_data.tolist(), "ells": list(self.p_ells)},
+                "pt_bk_ell": {"z": self.z, "triangles": self.triangles.tolist(),
+                              "bin_width": self.bin_width, "ells": list(self.b_ells)},
+                "pt_k": None, "pt_ells": None, "pt_bk_ells": None}
+
+    def _select(self):
+        theory_k = np.asarray(self.provider.get_pt_k())
+        cols = []
+        for kd in self.k_data:
+            hit = np.flatnonzero(np.isclose(theory_k, kd, rtol=1e-8, atol=0.0))
+            if hit.size == 0:
+                raise ValueError(f"PowerBispectrum: data k = {kd} h/Mpc is not on the theory's k "
+                                 "grid (give the theory no `k` option: it takes the requested k)")
+            cols.append(int(hit[0]))
+        theory_ells = list(self.provider.get_pt_ells())
+        self._rows = [theory_ells.index(ell) for ell in self.p_ells]
+        b_ells = list(self.provider.get_pt_bk_ells(self.z))
+        self._b_rows = [b_ells.index(ell) for ell in self.b_ells]
+        self._cols = np.array(cols)
+
+    def model(self):
+        """The model at the fitted points: P_ℓ at the fitted k, then B_ℓ at the fitted triangles."""
+        if self._cols is None:
+            self._select()
+        p = np.asarray(self.provider.get_pt_pk_ell(z=self.z))[self._rows][:, self._cols]
+        b = np.asarray(self.provider.get_pt_bk_ell(z=self.z))[self._b_rows]
+        return np.concatenate([p.ravel(), b.ravel()])
 
     def logp(self, **params_values):
         r = self._whiten @ (self.data - self.model())
