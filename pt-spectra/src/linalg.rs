@@ -3,7 +3,8 @@
 
 use crate::error::{Error, Result};
 
-/// Σ aᵢbᵢ.
+/// Σ aᵢbᵢ over the common length, summed in order (the same rounding on every machine: the small
+/// solves and fits); the loop integrals' long sums use the vectorised [`crate::simd::dot`].
 pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }

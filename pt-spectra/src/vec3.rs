@@ -1,4 +1,4 @@
-//! Arithmetic of 3-vectors of wavenumbers [h/Mpc], `[f64; 3]`, for the loop integrands that build
+//! Arithmetic of 3-vectors of wavenumbers [h/Mpc], `[f64; 3]`, for the integrands that build
 //! their kernels' arguments (the 2-loop redshift-space integrand, the one-loop bispectrum).
 
 /// a + b.

@@ -362,7 +362,7 @@ pub fn tree_level_at(
     f: f64,
     params: &BispectrumParams,
 ) -> f64 {
-    let dot = |a: &[f64; 3], b: &[f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    use crate::vec3::dot;
     let n = dot(&los, &los).sqrt();
     let k = sides.map(|s| dot(&s, &s).sqrt());
     let dots = [0, 1, 2].map(|i| dot(&sides[i], &sides[(i + 1) % 3]));

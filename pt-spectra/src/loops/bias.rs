@@ -33,6 +33,7 @@ use super::p22::{f2_g2, Layout, PairNodes};
 use super::Estimate;
 use crate::error::Result;
 use crate::integrate::legendre_nodes;
+use crate::linalg::dot;
 use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
 use rayon::prelude::*;
@@ -200,10 +201,6 @@ impl Rule {
         }
         total
     }
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// The plan of the bias terms on a fixed k grid: all weights, independent of the linear spectrum.

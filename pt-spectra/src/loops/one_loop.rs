@@ -8,6 +8,7 @@ use crate::error::{Error, Result};
 use crate::integrate::legendre_nodes;
 use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
+use crate::simd::dot;
 use rayon::prelude::*;
 
 /// The half-resolution rule of the error estimates lowers every P22 Gauss–Legendre order by this.
@@ -64,20 +65,6 @@ impl Rule {
         let [a, b, c] = self.p22.evaluate(i, &self.lattice, samples);
         [dot(&w.f, samples), dot(&w.g, samples), a, b, c]
     }
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    // Four partial sums: lets the compiler vectorise; fixed order, so results are reproducible.
-    let mut s = [0.0; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for j in 0..4 {
-            s[j] += x[j] * y[j];
-        }
-    }
-    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
-    (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
 /// Checks `precision` and that `k` is a grid ([`crate::table::check_k_values`]: non-empty, finite,

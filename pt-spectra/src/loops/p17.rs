@@ -91,7 +91,7 @@ pub fn p17_angular_kernel(r: [f64; 3]) -> [Estimate; 2] {
                 let phi = if i == 0 { 0.0 } else { 2.0 * PI * t[2 + i] };
                 dirs[i] = [r[i] * s * phi.cos(), r[i] * s * phi.sin(), r[i] * x];
             }
-            let dot = |a: &[f64; 3], b: &[f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+            use crate::vec3::dot;
             let [q1, q2, q3] = &dirs;
             let gram = [
                 1.0,

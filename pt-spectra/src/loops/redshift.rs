@@ -42,6 +42,7 @@ mod kernels;
 use super::Estimate;
 use crate::error::Result;
 use crate::integrate::legendre_nodes;
+use crate::linalg::dot;
 use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
 #[cfg(test)]
@@ -209,10 +210,6 @@ impl Rule {
 
 /// The pair columns and the lattice-weight terms of one k.
 pub(crate) type Row = ([Estimate; NPAIR], [Estimate; 6]);
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
 
 /// One term of the table: `monomial` · μ^{2n} · `values[i]` at the i-th k.
 #[derive(Debug, Clone, PartialEq)]

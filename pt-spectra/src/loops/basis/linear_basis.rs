@@ -14,6 +14,7 @@
 //! worst, so the first n functions of a basis are the basis of size n, and its worst training residual
 //! falls step by step.
 
+use crate::linalg::dot;
 use crate::loops::lattice::Lattice;
 
 /// Width (standard deviation in ln q) of the Gaussian with which the relative residual is smoothed.
@@ -238,7 +239,10 @@ impl LinearBasis {
             .map(|(p, w)| w * p)
             .collect();
         let columns = self.columns.chunks_exact(len);
-        let c: Vec<f64> = columns.clone().map(|phi| super::dot(phi, &wp)).collect();
+        let c: Vec<f64> = columns
+            .clone()
+            .map(|phi| crate::simd::dot(phi, &wp))
+            .collect();
         let mut projected = vec![0.0; len];
         for (phi, &ca) in columns.zip(&c) {
             crate::simd::axpy(&mut projected, ca, phi);
@@ -366,7 +370,7 @@ fn smoothed(values: &[f64], width: f64, stride: usize) -> Vec<f64> {
         .chain((len > 0 && !(len - 1).is_multiple_of(stride)).then(|| len - 1))
         .map(|j| {
             if j >= reach && j + reach < len {
-                return norm * super::dot(&values[j - reach..=j + reach], &kernel);
+                return norm * crate::simd::dot(&values[j - reach..=j + reach], &kernel);
             }
             let (lo, hi) = (j.saturating_sub(reach), (j + reach).min(len - 1));
             let (mut s, mut w) = (0.0, 0.0);
@@ -378,10 +382,6 @@ fn smoothed(values: &[f64], width: f64, stride: usize) -> Vec<f64> {
             s / w
         })
         .collect()
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 fn norm2(a: &[f64]) -> f64 {

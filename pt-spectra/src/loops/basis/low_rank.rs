@@ -18,6 +18,7 @@
 //! to the errors. On held-out CAMB and CLASS tables it is ≤ 3e-5 of each galaxy-model column
 //! (median 6e-7), against a projection error of ~1e-4.
 
+use crate::linalg::dot;
 use crate::simd::{dot32, matvec_f32};
 use rand::Rng;
 use rand::SeedableRng;
@@ -342,10 +343,6 @@ fn range(b: &[f64], rows: usize, columns: usize, tolerance: f64) -> Vec<Vec<f64>
         }
     }
     q
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 #[cfg(test)]

@@ -69,7 +69,7 @@ use super::{
 };
 use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
-use crate::simd::dot32;
+use crate::simd::{dot, dot32};
 use low_rank::{LowRank, TRIPLE_TOLERANCE};
 use p15_forms::{p15_forms, FORM_KERNELS};
 use rayon::prelude::*;
@@ -554,9 +554,4 @@ pub(crate) fn replica_contractions<const Q: usize>(
 /// The lattice of the loop integrals of `precision`.
 fn lattice_of(precision: &Precision) -> Lattice {
     Lattice::new(precision.q_min, precision.q_max, precision.lattice_step)
-}
-
-/// Σ a_i b_i, vectorised for the processor ([`crate::simd`]).
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    crate::simd::dot(a, b)
 }

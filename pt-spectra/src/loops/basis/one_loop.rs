@@ -32,6 +32,7 @@ use crate::loops::lattice::{add_product_weights, Lattice};
 use crate::loops::one_loop::Rule;
 use crate::loops::{ByPair, Estimate, OneLoopPlan, OneLoopTerms};
 use crate::precision::Precision;
+use crate::simd::dot;
 use std::f64::consts::PI;
 
 /// Version of the tensor layout and rules, part of the cache file name.
@@ -336,11 +337,6 @@ fn sigma_d2_forms(k: &[f64], rows: &Rows<'_>) -> Vec<f64> {
             linear_form(&w[0], rows)
         })
         .collect()
-}
-
-/// Σ a_i b_i with four partial sums (so that it vectorises).
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    super::dot(a, b)
 }
 
 #[cfg(test)]

@@ -255,8 +255,8 @@ impl RedshiftBasis {
                 (pair, lw)
             })
             .collect();
-        let sv = super::dot(&self.sigma_v2[..n], c);
-        let sv_diff = super::dot(&self.sigma_v2[n..], c);
+        let sv = crate::simd::dot(&self.sigma_v2[..n], c);
+        let sv_diff = crate::simd::dot(&self.sigma_v2[n..], c);
         (rows, Estimate::new(sv, sv_diff.abs() + eps * sv.abs()))
     }
 

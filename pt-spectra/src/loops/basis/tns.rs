@@ -157,7 +157,7 @@ impl TnsBasis {
                 let l = &self.linear[i * 2 * LINEAR * n..][..2 * LINEAR * n];
                 let form = |rule: usize, m: usize| {
                     let at = (rule * LINEAR + m) * n;
-                    super::dot(&l[at..at + n], c)
+                    crate::simd::dot(&l[at..at + n], c)
                 };
                 let value = |m: usize| -> Estimate {
                     let bilinear = dot_f32(&t[m * pairs..(m + 1) * pairs], &s2_single);
