@@ -50,6 +50,11 @@ pub fn drag_horizon(omega_b: f64, omega_m: f64, h: f64, m_nu: f64) -> f64 {
     55.154 * (-72.3 * (w_nu + 0.0006).powi(2)).exp() / (w_cb.powf(0.25351) * w_b.powf(0.12807)) * h
 }
 
+/// Below this Σm_ν [eV] the emulated ln(P_m/P_cb) is tapered to 0 at Σm_ν = 0 (continuity of P_m;
+/// [`LinearEmulator::spectra`]): a tenth of the smallest mass the oscillations allow (0.059 eV), so
+/// no physical cosmology is touched.
+pub const RATIO_TAPER: f64 = 0.005;
+
 /// The emulator: parsed once, then [`spectra`](Self::spectra) per cosmology.
 #[derive(Debug, Clone)]
 pub struct LinearEmulator {
@@ -269,6 +274,54 @@ impl LinearEmulator {
             }
             shape
         };
+        // The emulated ln(P_m/P_cb), continuous as Σm_ν → 0: P_m = P_cb exactly without massive
+        // neutrinos (the emulated ratio is then its own error, and the neutrino head is 0 too: the
+        // settings differ only in how the mass is shared); below RATIO_TAPER the ratio's value at
+        // Σm_ν = 0 (its polynomial's offset, 7e-4 to 1.2e-3) is removed in proportion, so that P_m
+        // meets P_cb at 0 instead of jumping by the offset at 0⁺.
+        let taper = (1.0 - m_nu / RATIO_TAPER).max(0.0);
+        let offset_at = |z: f64| -> Option<Vec<f64>> {
+            if m_nu <= 0.0 || taper == 0.0 {
+                return None;
+            }
+            let mut massless = point;
+            massless.values[3] = 0.0;
+            let u0 = massless
+                .coordinates(
+                    &self.file.prior,
+                    &self.file.stated,
+                    self.file.a_early,
+                    self.file.q_max,
+                    self.file.q_bound,
+                )
+                .ok()?;
+            let c0 = self::coefficients(
+                &self.file.exponents,
+                &self.file.targets,
+                &u0,
+                self.max_degree,
+            );
+            let mut shape = self.at_redshift(&self.file.targets, &c0, z);
+            if let Some(h) = head {
+                shape.add(&self.at_redshift(
+                    &h.targets,
+                    &coefficients_of(h, &u0, self.max_degree),
+                    z,
+                ));
+            }
+            Some(shape.ratio)
+        };
+        let ln_ratio = |shape: &Shape, z: f64| -> Vec<f64> {
+            if m_nu <= 0.0 {
+                return vec![0.0; shape.ratio.len()];
+            }
+            match offset_at(z) {
+                Some(offset) => (shape.ratio.iter().zip(&offset))
+                    .map(|(r, o)| r - taper * o)
+                    .collect(),
+                None => shape.ratio.clone(),
+            }
+        };
         let shape = shape_at(z);
         // ln P_cb = G_cb + 2 ln(D_md/Ω_m) + ln A_s + (n_s − 1) ln(k h/k_pivot)
         let growth = |z: f64| {
@@ -276,9 +329,6 @@ impl LinearEmulator {
             (2.0 * (d_md / om).ln(), f)
         };
         let (growth_z, f_ode) = growth(z);
-        // P_m = P_cb exactly for massless neutrinos (the emulated ratio is then its own error; the
-        // neutrino head is 0 too: the settings differ only in how the mass is shared)
-        let massive = if m_nu > 0.0 { 1.0 } else { 0.0 };
         let tilt: Vec<f64> = ln_k
             .iter()
             .map(|&lk| (n_s - 1.0) * (lk + (h / point.k_pivot).ln()))
@@ -287,9 +337,10 @@ impl LinearEmulator {
             Some(a_s) => a_s.ln(),
             None => {
                 let today = shape_at(z0);
+                let today_ratio = ln_ratio(&today, z0);
                 let growth_0 = growth(z0).0;
                 let sigma8_unit = sigma8(&k, step, |i| {
-                    (today.cb[i] + growth_0 + massive * today.ratio[i] + tilt[i]).exp()
+                    (today.cb[i] + growth_0 + today_ratio[i] + tilt[i]).exp()
                 });
                 let crate::cosmology::Amplitude::Sigma8(target) = cosmology.amplitude else {
                     unreachable!("a_s is None only for a σ8 amplitude")
@@ -301,9 +352,8 @@ impl LinearEmulator {
             .map(|i| shape.cb[i] + growth_z + ln_as + tilt[i])
             .collect();
         let p_cb: Vec<f64> = ln_p_cb.iter().map(|v| v.exp()).collect();
-        let p_m: Vec<f64> = (0..n_x)
-            .map(|i| (ln_p_cb[i] + massive * shape.ratio[i]).exp())
-            .collect();
+        let ratio = ln_ratio(&shape, z);
+        let p_m: Vec<f64> = (0..n_x).map(|i| (ln_p_cb[i] + ratio[i]).exp()).collect();
         let sigma8 = sigma8(&k, step, |i| p_m[i]);
         Ok(EmulatedSpectra {
             z,
