@@ -28,6 +28,9 @@ type VectorAndJacobian = (Vec<f64>, Option<Vec<Vec<f64>>>);
 /// with the tree-level bispectrum multipoles `b_ells` (default (0,)) of those triangles (multipole,
 /// then triangle) from the same spectrum, f, distortion and IR, sharing b1, b2, bs and adding c1,
 /// b_shot, p_shot, a_shot (stochastic terms at `n_bar`; FoG `fog`, `sigma_fog` [Mpc/h]).
+/// `restrict_loops` (default True): the loop terms only where the observation weighs them, the range
+/// chosen by measurement at construction (`meta["loop_range"]`: the range and the change it made,
+/// at most 1e-5 of each multipole's largest value); False computes them on the whole window grid.
 #[pyclass(module = "pt_spectra._core", frozen)]
 pub(crate) struct Pipeline {
     inner: LibPipeline,
@@ -116,7 +119,7 @@ impl Pipeline {
     #[new]
     #[pyo3(signature = (observation, z, fiducial=None, ir=true, precision=pt_spectra::jobs::defaults::PRECISION,
         max_residual=PIPELINE_MAX_RESIDUAL, cache_dir=None, triangles=None, bin_width=None,
-        b_ells=vec![0], n_bar=None, fog="none", sigma_fog=0.0))]
+        b_ells=vec![0], n_bar=None, fog="none", sigma_fog=0.0, restrict_loops=true))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -133,6 +136,7 @@ impl Pipeline {
         n_bar: Option<f64>,
         fog: &str,
         sigma_fog: f64,
+        restrict_loops: bool,
     ) -> PyResult<Self> {
         let bispectrum = match triangles {
             Some(t) => Some(BispectrumBlock {
@@ -161,6 +165,7 @@ impl Pipeline {
             ir,
             max_residual,
             bispectrum,
+            restrict_loops,
             ..PipelineSettings::ept(z, fiducial)
         };
         let (inner, _) = crate::detached(py, || {
@@ -241,7 +246,8 @@ impl Pipeline {
     }
 
     /// What the pipeline is and what its last call did: model, z, ells, k, the fiducial, the
-    /// largest projection residual, and the loop terms' source of the last call.
+    /// largest projection residual, the loop range (``((lo, hi), change)`` or None: where the loop
+    /// terms are computed and what that changed at build), and the loop terms' source of the last call.
     #[getter]
     fn meta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = self.inner.settings();
@@ -256,6 +262,9 @@ impl Pipeline {
         d.set_item("ir", s.ir)?;
         d.set_item("max_residual", s.max_residual)?;
         d.set_item("basis", self.inner.has_basis())?;
+        // where the loop terms are computed: the true k range and its measured change, or None
+        d.set_item("loop_range", self.inner.loop_range())?;
+        d.set_item("loop_range_note", self.inner.describe_loop_range())?;
         d.set_item(
             "observation",
             self.inner.observation().description().to_vec(),

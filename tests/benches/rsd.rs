@@ -256,6 +256,7 @@ fn ept(c: &mut Criterion) {
         ir: true,
         ap: Some(Distortion::new(1.03, 0.98).expect("valid alphas")),
         ap_range: None,
+        loop_range: None,
     };
     let plan = EptPlan::new(&k, ap, &Precision::default()).expect("valid plan");
     let terms = plan.terms(&p).expect("valid spectrum");

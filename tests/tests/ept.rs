@@ -38,6 +38,7 @@ fn worst_at(z: &str, f: f64, variant: usize, set: usize, precision: &Precision) 
         ir: variant == 1,
         ap: (variant == 2).then(|| Distortion::new(1.03, 0.98).unwrap()),
         ap_range: None,
+        loop_range: None,
     };
     let plan = EptPlan::new(&k, settings, precision).unwrap();
     let terms = plan.terms(&spectrum).unwrap();

@@ -47,6 +47,7 @@ pub fn ept_plan(
             ir,
             ap,
             ap_range: free_ap.then_some(AP_FIT_RANGE),
+            loop_range: None,
         },
         precision,
     )?

@@ -40,6 +40,7 @@ use crate::survey::observe::Observation;
 
 mod bispectrum;
 mod linearised;
+pub mod loop_range;
 use bispectrum::{bispectrum_params, PlannedBispectrum};
 pub use bispectrum::{BispectrumBlock, BISPECTRUM_NAMES};
 pub use linearised::{Linearised, NUISANCE_NAMES};
@@ -75,6 +76,9 @@ pub struct PipelineSettings {
     /// The tree-level bispectrum multipoles after the power spectrum in the data vector (`None`:
     /// the power spectrum alone).
     pub bispectrum: Option<BispectrumBlock>,
+    /// Whether the loop terms are computed only where the observation weighs them, the range chosen
+    /// by measurement at build time ([`loop_range`]; default true). False: everywhere.
+    pub restrict_loops: bool,
 }
 
 impl PipelineSettings {
@@ -88,6 +92,7 @@ impl PipelineSettings {
             ir: true,
             max_residual: PIPELINE_MAX_RESIDUAL,
             bispectrum: None,
+            restrict_loops: true,
         }
     }
 }
@@ -103,6 +108,9 @@ pub struct Pipeline {
     emulator: LinearEmulator,
     /// The bispectrum block, planned.
     bispectrum: Option<PlannedBispectrum>,
+    /// The measured change of the reference data vector by the loop range, if restricted
+    /// ([`loop_range`]).
+    loop_truncation: Option<f64>,
 }
 
 /// Where the loop terms of one spectrum came from.
@@ -180,12 +188,22 @@ impl Pipeline {
             precision.two_loop = crate::precision::TwoLoopMethod::Basis;
         }
         let Model::Ept = settings.model;
+        let ept = EptSettings {
+            ir: settings.ir,
+            ap: None,
+            ap_range: settings.fiducial.as_ref().map(|_| AP_FIT_RANGE),
+            loop_range: None,
+        };
+        let chosen = if settings.restrict_loops {
+            loop_range::choose(&observation, &ept, settings.z)?
+        } else {
+            None
+        };
         let plan = EptPlan::new(
             observation.k_model(),
             EptSettings {
-                ir: settings.ir,
-                ap: None,
-                ap_range: settings.fiducial.as_ref().map(|_| AP_FIT_RANGE),
+                loop_range: chosen.map(|(range, _)| range),
+                ..ept
             },
             &precision,
         )?
@@ -205,6 +223,7 @@ impl Pipeline {
             rows,
             emulator: LinearEmulator::embedded()?,
             bispectrum,
+            loop_truncation: chosen.map(|(_, change)| change),
         })
     }
 
@@ -243,6 +262,29 @@ impl Pipeline {
     /// derivative of the data vector with respect to the model multipoles.
     pub fn observation_matrix(&self) -> &[f64] {
         &self.matrix
+    }
+
+    /// The true k range [h/Mpc] of the loop terms (the first and last points of their grid) and the
+    /// change of the reference data vector this range measured at build time, relative to each
+    /// multipole's largest |value| ([`loop_range::LOOP_RANGE_TOLERANCE`]); `None` if the loops cover the
+    /// whole grid.
+    pub fn loop_range(&self) -> Option<((f64, f64), f64)> {
+        self.loop_truncation
+            .map(|change| (self.plan.loop_k_range(), change))
+    }
+
+    /// One line for a header, a `meta` entry or a log: where the loop terms are computed.
+    pub fn describe_loop_range(&self) -> String {
+        match self.loop_range() {
+            Some(((lo, hi), change)) => format!(
+                "loop terms on true k in [{lo:.3e}, {hi:.3e}] h/Mpc only (the observation weighs \
+                 the rest by little: the reference data vector changes by {change:.1e} of each \
+                 multipole's largest value, <= {:.0e}); linear, counterterm and stochastic terms \
+                 everywhere",
+                loop_range::LOOP_RANGE_TOLERANCE
+            ),
+            None => "loop terms on the whole grid of the observation's model k".into(),
+        }
     }
 
     /// Whether the loop terms can come from basis tensors.

@@ -129,6 +129,11 @@ pub struct EptSettings {
     /// The range [lo, hi] of α∥ and α⊥ the plan must serve (fits with free AP parameters): the
     /// internal grid then covers every distortion in it ([`EptPlan::multipole_values_at`]).
     pub ap_range: Option<(f64, f64)>,
+    /// The true k [h/Mpc] outside of which the loop terms are taken as 0 (the linear, counterterm
+    /// and stochastic terms are kept): for an observation whose far window columns weigh nothing
+    /// ([`crate::pipeline::Pipeline`] measures the range it sets and what it changes). `None`:
+    /// the loops everywhere.
+    pub loop_range: Option<(f64, f64)>,
 }
 
 impl Default for EptSettings {
@@ -137,6 +142,7 @@ impl Default for EptSettings {
             ir: true,
             ap: None,
             ap_range: None,
+            loop_range: None,
         }
     }
 }
@@ -152,6 +158,8 @@ pub struct EptPlan {
     /// the plan was built, never by comparing lengths (an output grid may have the AP grid's length).
     grid_use: GridUse,
     settings: EptSettings,
+    /// The indices of `grid` where the loop terms are computed ([`EptSettings::loop_range`]).
+    loop_span: std::ops::Range<usize>,
     loops: RedshiftPlan,
     split: Option<()>,
     /// The basis tensors of the loop terms, if they come from them ([`Self::with_basis`]).
@@ -214,7 +222,8 @@ impl EptPlan {
             (Some(ap), None) => ap.internal_grid(k)?,
             (None, None) => k.to_vec(),
         };
-        let loops = RedshiftPlan::new(&grid, precision)?;
+        let loop_span = range::loop_span(&grid, settings.loop_range)?;
+        let loops = RedshiftPlan::new(&grid[loop_span.clone()], precision)?;
         let split = settings.ir.then_some(());
         let legendre: Vec<Vec<f64>> = (0..=MAX_ELL).map(legendre_coefficients).collect();
         let rules = [MU_NODES, MU_NODES / 2].map(|n| {
@@ -236,6 +245,7 @@ impl EptPlan {
             grid,
             grid_use,
             settings,
+            loop_span,
             loops,
             split,
             tensors: None,
@@ -261,14 +271,19 @@ impl EptPlan {
         if let Some(terms) = self.terms_on_basis(spectrum)? {
             return Ok(terms);
         }
+        let at_grid =
+            |p: &LinearSpectrum| -> Vec<f64> { self.grid.iter().map(|&k| p.eval(k)).collect() };
+        let p_lin = at_grid(spectrum);
         let (full, nw) = match &self.split {
             Some(()) => {
                 let p_nw = savitzky_golay_no_wiggle(spectrum)?;
                 let (full, t) = self.loops.evaluate_with_no_wiggle(spectrum, &p_nw);
+                let t = self.padded(t, &at_grid(&p_nw));
                 (full, Some((t, sigma2(&p_nw))))
             }
             None => (self.loops.evaluate(spectrum), None),
         };
+        let full = self.padded(full, &p_lin);
         Ok(EptTerms {
             grid: self.grid.clone(),
             full,
@@ -466,6 +481,7 @@ fn sigma2_kernel(q: f64) -> f64 {
 
 mod basis;
 mod model;
+mod range;
 
 /// The index of parameter `name` in [`PARAM_NAMES`], its `value` checked finite.
 ///

@@ -50,6 +50,7 @@ fn boss() -> (EptPlan, EptTerms, MultipoleData, GalaxyFitRequest) {
             ir: true,
             ap: None,
             ap_range: None,
+            loop_range: None,
         },
         &Precision::fast(),
     )
@@ -313,6 +314,7 @@ fn derived_parameters_from_their_definitions() {
         ir: false,
         ap: Some(crate::rsd::ap::Distortion::new(1.0, 1.0).unwrap()),
         ap_range: Some((0.8, 1.25)),
+        loop_range: None,
     };
     let plan = EptPlan::new(&k, settings, &Precision::fast()).unwrap();
     let spectrum = crate::linear::LinearSpectrum::gm2012(0.5).unwrap();

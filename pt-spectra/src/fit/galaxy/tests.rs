@@ -14,6 +14,7 @@ pub(super) fn setup() -> (EptPlan, EptTerms, EptParams, MultipoleData) {
             ir: false,
             ap: None,
             ap_range: None,
+            loop_range: None,
         },
         &Precision::fast(),
     )
@@ -193,6 +194,7 @@ fn recovers_the_distortion() {
         ir: true,
         ap: Some(crate::rsd::ap::Distortion::new(1.0, 1.0).unwrap()),
         ap_range: Some((0.8, 1.25)),
+        loop_range: None,
     };
     let plan = EptPlan::new(&k, settings, &Precision::fast()).unwrap();
     let terms = plan.terms(&LinearSpectrum::gm2012(0.5).unwrap()).unwrap();
@@ -324,6 +326,7 @@ fn an_observation_on_other_k_of_the_same_length_is_refused() {
         ir: false,
         ap: None,
         ap_range: None,
+        loop_range: None,
     };
     let plan = EptPlan::new(observation.k_model(), settings, &Precision::fast()).unwrap();
     let terms = plan.terms(&LinearSpectrum::gm2012(0.5).unwrap()).unwrap();

@@ -144,7 +144,7 @@ impl EptPlan {
                     Some(store.redshift_basis(&self.loops, family, &linear_basis, progress)?)
                 }
                 TwoLoopMethod::Auto => {
-                    store.cached_redshift_basis(&self.grid, &precision, family, progress)
+                    store.cached_redshift_basis(self.loop_grid(), &precision, family, progress)
                 }
                 TwoLoopMethod::Direct => None,
             })
@@ -226,24 +226,29 @@ impl EptPlan {
         if projection.residual.is_nan() || projection.residual > self.max_residual {
             return Ok(None);
         }
+        // P_lin and P_nw on the whole grid; the loop terms on the loop grid, padded
         let p_lin: Vec<f64> = self.grid.iter().map(|&k| spectrum.eval(k)).collect();
+        let span = self.loop_span.clone();
         let (full, nw) = match (&self.split, &tensors.no_wiggle) {
             (Some(()), Some((nw_tensors, forms))) => {
                 let c = &projection.coefficients;
                 let (p_nw, sigma2) = forms.evaluate(&samples, c, projection.residual);
                 let (full, t) = tensors.linear.evaluate_with_no_wiggle(
                     &self.loops,
-                    (&p_lin, &projection),
+                    (&p_lin[span.clone()], &projection),
                     nw_tensors,
-                    (&p_nw, &projection),
+                    (&p_nw[span], &projection),
                 );
-                (full, Some((t, sigma2)))
+                (full, Some((self.padded(t, &p_nw), sigma2)))
             }
             _ => (
-                tensors.linear.evaluate(&self.loops, &p_lin, &projection),
+                tensors
+                    .linear
+                    .evaluate(&self.loops, &p_lin[span], &projection),
                 None,
             ),
         };
+        let full = self.padded(full, &p_lin);
         Ok(Some(EptTerms {
             grid: self.grid.clone(),
             full,

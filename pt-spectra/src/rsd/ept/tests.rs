@@ -17,6 +17,7 @@ fn large_scales_are_kaiser_plus_noise() {
             ir: false,
             ap: None,
             ap_range: None,
+            loop_range: None,
         },
     );
     let mut params = EptParams::new(2.0, 0.7);
@@ -52,6 +53,7 @@ fn counterterms_and_noise_have_their_mu_powers() {
             ir: false,
             ap: None,
             ap_range: None,
+            loop_range: None,
         },
     );
     let base = EptParams::new(1.5, 0.6);
@@ -78,6 +80,7 @@ fn resummation_changes_little_on_large_scales() {
             ir: false,
             ap: None,
             ap_range: None,
+            loop_range: None,
         },
     );
     let (pb, tb) = plan(&k, EptSettings::default());
@@ -98,6 +101,7 @@ fn values_are_the_multipoles_values() {
                 ir: true,
                 ap,
                 ap_range: None,
+                loop_range: None,
             },
         );
         let params = EptParams::new(1.7, 0.6);
@@ -140,6 +144,7 @@ fn the_basis_gives_the_direct_multipoles_and_falls_back_outside_its_span() {
             ir,
             ap: None,
             ap_range: None,
+            loop_range: None,
         };
         let mut precision = Precision::fast();
         let direct = EptPlan::new(&k, settings, &precision).unwrap();
@@ -202,6 +207,7 @@ fn an_output_grid_of_the_internal_length_is_not_the_internal_grid() {
         ir: true,
         ap: None,
         ap_range: Some((0.8, 1.25)),
+        loop_range: None,
     };
     let (pa, ta) = plan(&k, free_ap);
     assert_eq!(
@@ -227,4 +233,72 @@ fn an_output_grid_of_the_internal_length_is_not_the_internal_grid() {
     }
     let e = pa.multipoles(&tb, &params, &[0]).unwrap_err().to_string();
     assert!(e.contains("ept terms and plan"), "{e}");
+}
+
+/// A loop range: the plan's loops on the grid points inside it only, the terms padded with zeros,
+/// equal to the whole grid's terms with the loops cut outside it (direct integrals; with IR and AP),
+/// and a range with fewer than 4 grid points refused naming it.
+#[test]
+fn a_loop_range_computes_the_loops_inside_it_only() {
+    let k: Vec<f64> = (0..40).map(|i| 0.002 * 1.15_f64.powi(i)).collect();
+    let settings = EptSettings {
+        ap_range: Some((0.9, 1.1)),
+        ..EptSettings::default()
+    };
+    let (whole, terms) = plan(&k, settings);
+    let (lo, hi) = (0.01, 0.2);
+    let (cut, cut_terms) = plan(
+        &k,
+        EptSettings {
+            loop_range: Some((lo, hi)),
+            ..settings
+        },
+    );
+    let (a, b) = cut.loop_k_range();
+    assert!(
+        a >= lo && b <= hi && a < 1.02 * lo && b > 0.98 * hi,
+        "{a} {b}"
+    );
+    let expected = terms.with_loops_only_in(lo, hi);
+    let mut params = EptParams::new(1.9, 0.75);
+    params.set("b2", 0.4).unwrap();
+    params.set("alpha0", 10.0).unwrap();
+    let ap = Some(Distortion::new(1.04, 0.97).unwrap());
+    let got = cut
+        .multipole_values_at(&cut_terms, &params, &[0, 2, 4], ap)
+        .unwrap();
+    let want = whole
+        .multipole_values_at(&expected, &params, &[0, 2, 4], ap)
+        .unwrap();
+    let full = whole
+        .multipole_values_at(&terms, &params, &[0, 2, 4], ap)
+        .unwrap();
+    for l in 0..3 {
+        for i in 0..k.len() {
+            let scale = full[0][i].abs();
+            assert!(
+                (got[l][i] - want[l][i]).abs() <= 1e-12 * scale,
+                "ℓ {} k {}",
+                2 * l,
+                k[i]
+            );
+        }
+    }
+    // inside the range, away from its ends, the loops are there (the cut changes P0 by < 1e-9)
+    let mid = k.iter().position(|&x| x > 0.05).unwrap();
+    assert!((got[0][mid] / full[0][mid] - 1.0).abs() < 1e-9);
+    // outside, they are not: at k = 0.45 the loops are a large part of P0
+    let far = k.iter().position(|&x| x > 0.4).unwrap();
+    assert!((got[0][far] / full[0][far] - 1.0).abs() > 1e-2);
+    let e = EptPlan::new(
+        &k,
+        EptSettings {
+            loop_range: Some((0.05, 0.051)),
+            ..settings
+        },
+        &Precision::fast(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("loop range") && e.contains("at least 4"), "{e}");
 }
