@@ -50,7 +50,7 @@ pub fn drag_horizon(omega_b: f64, omega_m: f64, h: f64, m_nu: f64) -> f64 {
     55.154 * (-72.3 * (w_nu + 0.0006).powi(2)).exp() / (w_cb.powf(0.25351) * w_b.powf(0.12807)) * h
 }
 
-/// Below this Σm_ν [eV] the emulated ln(P_m/P_cb) is tapered to 0 at Σm_ν = 0 (continuity of P_m;
+/// Below this Σm_ν (eV) the emulated ln(P_m/P_cb) is tapered to 0 at Σm_ν = 0 (continuity of P_m;
 /// [`LinearEmulator::spectra`]): a tenth of the smallest mass the oscillations allow (0.059 eV), so
 /// no physical cosmology is touched.
 pub const RATIO_TAPER: f64 = 0.005;

@@ -8,9 +8,9 @@
 //! pipeline's z, b1 = 2, f = f(z), AP at the fiducial) with the loops everywhere is compared with the
 //! loops inside each candidate range only, and the narrowest candidate whose largest change is at most
 //! [`LOOP_RANGE_TOLERANCE`] of the largest |value| of its multipole's block is taken. The candidates are
-//! the measured k span widened by factors [`LOW_FACTORS`] below and [`HIGH_FACTORS`] above, in observed
+//! the measured k span widened by factors 1/16 … 1/2 below and 2 … 1.25 above, in observed
 //! k, then divided by the AP range's extremes (the loops are in true k). The measured change is kept
-//! ([`super::Pipeline::loop_truncation`]) and stated.
+//! ([`super::Pipeline::loop_range`]) and stated.
 
 use super::observation_matrix;
 use crate::error::Result;
