@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 use crate::integrate::legendre_nodes;
 use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
-use crate::simd::dot;
+use crate::simd::dot_fixed as dot;
 use rayon::prelude::*;
 
 /// The half-resolution rule of the error estimates lowers every P22 Gauss–Legendre order by this.
