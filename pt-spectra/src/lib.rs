@@ -39,6 +39,7 @@ pub mod emulator;
 pub mod error;
 pub mod estimate;
 pub mod fit;
+pub mod forecast;
 pub mod halo;
 pub mod hankel;
 pub mod integrate;

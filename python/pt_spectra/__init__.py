@@ -28,7 +28,8 @@ import numpy as np
 
 from . import _core
 from ._core import (BispectrumPlan, BispectrumTerms, LinearEmulator, Observation, Pipeline,
-                    SugiyamaPlan, SugiyamaTerms, Table, distances, eisenstein_hu, growth, log_grid, num_threads, set_num_threads)
+                    SugiyamaPlan, SugiyamaTerms, Table, distances, eisenstein_hu, fisher, growth, log_grid,
+                    num_threads, set_num_threads)
 
 __all__ = [
     "BispectrumPlan",
@@ -51,6 +52,7 @@ __all__ = [
     "fit",
     "fit_ept",
     "fit_joint",
+    "fisher",
     "fit_tables",
     "bispectrum",
     "one_loop_bispectrum",

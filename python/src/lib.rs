@@ -26,6 +26,7 @@ mod batch;
 mod bispectrum;
 mod emulator;
 mod ept;
+mod forecast;
 mod halo;
 mod inputs;
 mod joint;
@@ -632,6 +633,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<pipeline::Pipeline>()?;
     m.add_function(wrap_pyfunction!(ept::fit_ept, m)?)?;
     m.add_function(wrap_pyfunction!(joint::fit_joint, m)?)?;
+    m.add_function(wrap_pyfunction!(forecast::fisher, m)?)?;
     m.add_function(wrap_pyfunction!(batch::real_batch, m)?)?;
     m.add_function(wrap_pyfunction!(batch::read_multipoles, m)?)?;
     m.add_function(wrap_pyfunction!(batch::check_memory, m)?)?;
