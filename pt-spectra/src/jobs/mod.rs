@@ -46,6 +46,7 @@ pub mod defaults;
 mod ept;
 mod ept_fit;
 mod fit;
+mod forecast;
 mod halo;
 mod joint_fit;
 mod observe;
@@ -62,6 +63,7 @@ pub use ept::{
 };
 pub use ept_fit::{ept_fit_table, ept_model_table, ept_profile_table, FitContext};
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
+pub use forecast::{forecast_table, parse_bin};
 pub use halo::{halo_table, HaloRequest};
 pub use joint_fit::{joint_fit_table, Analysis, Inputs, SetSpec, DEFAULT_B1};
 pub use observe::observed_table;

@@ -12,6 +12,7 @@ mod counterterm;
 mod emulator;
 mod ept;
 mod faults;
+mod fisher;
 mod fit;
 mod fixtures;
 mod halo;

@@ -10,6 +10,7 @@ mod analysis;
 mod bispectrum;
 mod common;
 mod ept;
+mod fisher;
 mod fit;
 mod halo;
 mod input;
@@ -40,6 +41,8 @@ enum Command {
     Fit(Box<fit::Args>),
     /// Tree-level galaxy bispectrum multipoles B0, B2, B4 in redshift space at triangles or triangle bins.
     Bispectrum(Box<bispectrum::Args>),
+    /// Fisher forecast of a redshift survey (volume, n̄, k range per bin) with the galaxy model ept.
+    Fisher(Box<fisher::Args>),
     /// Halo bias b(k) = P_mh/P_mm and stochasticity P_εε = P_hh − P_mh²/P_mm from measured spectra.
     Halo(halo::Args),
     /// Draw the paper's kinds of figure (PNG or SVG) from the tables of the other subcommands.
@@ -54,6 +57,7 @@ fn main() -> ExitCode {
         Command::Rsd(args) => rsd::run(&args),
         Command::Fit(args) => fit::run(&args),
         Command::Halo(args) => halo::run(&args),
+        Command::Fisher(args) => fisher::run(&args),
         Command::Bispectrum(args) => bispectrum::run(&args),
         Command::Plot(args) => plot::run(&args),
     };
