@@ -311,8 +311,8 @@ pub(crate) fn fit_ept(
     let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
     let ((table, model, prepared), seconds) = detached(py, || {
         let prepared = inputs.prepare(&model_k)?;
-        if start.values[11].is_nan() {
-            start.values[11] = prepared.growth_rate;
+        if start.f().is_nan() {
+            start.set_f(prepared.growth_rate);
         }
         let free_ap = free.iter().any(|n| n == "apar" || n == "aperp");
         let request = pt_spectra::fit::galaxy::GalaxyFitRequest {

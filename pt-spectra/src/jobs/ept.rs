@@ -80,8 +80,8 @@ pub fn ept_table_from_terms(
     precision: &Precision,
 ) -> Result<Table> {
     let mut params = request.params;
-    if params.values[11].is_nan() {
-        params.values[11] = prepared.growth_rate;
+    if params.f().is_nan() {
+        params.set_f(prepared.growth_rate);
     }
     let settings = plan.settings();
     let ap = request.ap.or(settings.ap);

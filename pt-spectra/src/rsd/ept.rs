@@ -51,6 +51,11 @@ pub const PARAM_NAMES: [&str; 12] = [
     "b1", "b2", "bs", "b3", "alpha0", "alpha2", "alpha4", "alpha6", "sn", "sn2", "sn4", "f",
 ];
 
+/// The index of `b1` in [`PARAM_NAMES`] and [`EptParams::values`].
+const B1: usize = 0;
+/// The index of the growth rate `f` in [`PARAM_NAMES`] and [`EptParams::values`].
+const F: usize = 11;
+
 /// The parameters of the model (velocileptors' names and units; module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EptParams {
@@ -62,9 +67,19 @@ impl EptParams {
     /// Linear bias `b1`, growth rate `f`, every other parameter 0.
     pub fn new(b1: f64, f: f64) -> Self {
         let mut values = [0.0; 12];
-        values[0] = b1;
-        values[11] = f;
+        values[B1] = b1;
+        values[F] = f;
         Self { values }
+    }
+
+    /// The growth rate f.
+    pub fn f(&self) -> f64 {
+        self.values[F]
+    }
+
+    /// Sets the growth rate f (unchecked: [`Self::validate`] checks it).
+    pub fn set_f(&mut self, f: f64) {
+        self.values[F] = f;
     }
 
     /// The value of parameter `name`.
@@ -89,7 +104,7 @@ impl EptParams {
     /// (b1, b2, bs, b3, f) for the loop terms.
     fn bias(&self) -> [f64; 5] {
         let v = &self.values;
-        [v[0], v[1], v[2], v[3], v[11]]
+        [v[B1], v[1], v[2], v[3], v[F]]
     }
 
     /// Checks the growth rate is physical (0 ≤ f ≤ 2) and every value finite.
@@ -106,7 +121,7 @@ impl EptParams {
                 });
             }
         }
-        let f = self.values[11];
+        let f = self.f();
         let range = crate::cosmology::plausible("f").expect("f has a plausible range");
         if !range.contains(f) {
             return Err(Error::InvalidParameter {

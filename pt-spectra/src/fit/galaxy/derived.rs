@@ -77,7 +77,7 @@ pub fn derived(fit: &GalaxyFit, request: &GalaxyFitRequest, template: &Template)
         }
         v.max(0.0).sqrt()
     };
-    let f = fit.best.values[11];
+    let f = fit.best.f();
     let s8 = template.sigma8_z;
     let mut out = vec![
         Derived {

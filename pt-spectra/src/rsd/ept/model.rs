@@ -71,7 +71,7 @@ impl EptTerms {
             grid: &self.grid,
             parts,
             sigma2: s2,
-            f: params.values[11],
+            f: params.f(),
         }
     }
 }
