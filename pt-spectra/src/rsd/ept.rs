@@ -425,16 +425,27 @@ impl EptPlan {
                     .collect()
             })
             .collect();
+        // per μ node, the distortion's k'/k and μ' (Distortion::true_coordinates): ln(k'/k),
+        // (k'/k)² and μ', the same at every k
+        let nodes: Vec<(f64, f64, f64)> = self.rules[0]
+            .iter()
+            .map(|(mu, _, _)| match &ap {
+                None => (0.0, 1.0, *mu),
+                Some(ap) => {
+                    let (ratio, mt) = ap.true_coordinates(1.0, *mu);
+                    (ratio.ln(), ratio * ratio, mt)
+                }
+            })
+            .collect();
         let mut out = vec![vec![0.0; self.k_out.len()]; ells.len()];
         for (i, &k) in self.k_out.iter().enumerate() {
-            for ((mu, _, _), c) in self.rules[0].iter().zip(&weights) {
+            let (ln_k, k2) = (k.ln(), k * k);
+            for (((mu, _, _), c), &(ln_ratio, ratio2, mt)) in
+                self.rules[0].iter().zip(&weights).zip(&nodes)
+            {
                 let p = match &ap {
                     None if self.grid_use == GridUse::Output => model.value_at(i, k, *mu),
-                    None => model.interpolated_value(k, *mu)?,
-                    Some(ap) => {
-                        let (kt, mt) = ap.true_coordinates(k, *mu);
-                        model.interpolated_value(kt, mt)?
-                    }
+                    _ => model.interpolated_value_ln(ln_k + ln_ratio, k2 * ratio2, mt)?,
                 };
                 for (o, c) in out.iter_mut().zip(c) {
                     o[i] += c * p;

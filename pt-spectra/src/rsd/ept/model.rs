@@ -13,6 +13,9 @@ type Poly = ([f64; MAX_MU_POWER + 1], [f64; MAX_MU_POWER + 1]);
 /// The model at fixed parameters on the terms' grid: P = N(μ²) + e^{−k²Σ²(1 + f(2+f)μ²)} W(μ²).
 pub(super) struct Model<'a> {
     grid: &'a [f64],
+    /// ln of the first grid point and the grid's step in ln k (log-uniform).
+    ln_k0: f64,
+    ln_step: f64,
     parts: Vec<(Poly, Poly)>,
     sigma2: f64,
     f: f64,
@@ -67,8 +70,11 @@ impl EptTerms {
                 (n, w)
             })
             .collect();
+        let g = &self.grid;
         Model {
-            grid: &self.grid,
+            grid: g,
+            ln_k0: g[0].ln(),
+            ln_step: (g[g.len() - 1] / g[0]).ln() / (g.len() - 1) as f64,
             parts,
             sigma2: s2,
             f: params.f(),
@@ -119,9 +125,10 @@ impl Model<'_> {
         Ok(self.combine(&n, &w, k, mu))
     }
 
-    /// The value only of [`Self::interpolated`].
-    pub(super) fn interpolated_value(&self, k: f64, mu: f64) -> Result<f64> {
-        let (b, l) = self.stencil(k)?;
+    /// The value only of [`Self::interpolated`], at k given as ln k and k² (the AP projection has
+    /// them per μ node without a logarithm or a square root per point).
+    pub(super) fn interpolated_value_ln(&self, ln_k: f64, k2: f64, mu: f64) -> Result<f64> {
+        let (b, l) = self.stencil_ln(ln_k)?;
         let m2 = mu * mu;
         let (mut n, mut w) = (0.0, 0.0);
         for (j, lj) in l.iter().enumerate() {
@@ -129,23 +136,25 @@ impl Model<'_> {
             n += lj * pn.0.iter().rev().fold(0.0, |a, c| a * m2 + c);
             w += lj * pw.0.iter().rev().fold(0.0, |a, c| a * m2 + c);
         }
-        let damping = (-k * k * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
+        let damping = (-k2 * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
         Ok(n + damping * w)
     }
 
     /// The first grid index and the Lagrange weights of the four-point stencil of k.
     fn stencil(&self, k: f64) -> Result<(usize, [f64; 4])> {
+        self.stencil_ln(k.ln())
+    }
+
+    /// [`Self::stencil`] of ln k.
+    fn stencil_ln(&self, ln_k: f64) -> Result<(usize, [f64; 4])> {
         let g = self.grid;
-        let (x0, step) = (
-            g[0].ln(),
-            (g[g.len() - 1] / g[0]).ln() / (g.len() - 1) as f64,
-        );
-        let u = (k.ln() - x0) / step;
+        let (x0, step) = (self.ln_k0, self.ln_step);
+        let u = (ln_k - x0) / step;
         let last = (g.len() - 1) as f64;
         if !(1.0 - 1e-9..=last - 1.0 + 1e-9).contains(&u) {
             return Err(Error::OutOfRange {
                 what: "the true spectrum of the Alcock-Paczynski projection".into(),
-                k,
+                k: ln_k.exp(),
                 min: g[1],
                 max: g[g.len() - 2],
             });
