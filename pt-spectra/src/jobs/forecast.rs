@@ -62,7 +62,8 @@ pub fn parse_bin(text: &str, ells: &[usize], free: &[String]) -> Result<SurveyBi
 }
 
 /// The forecast of `bins` in `fiducial` as a table: with template parameters one row per bin (z,
-/// fsigma8, sigma_fsigma8, sigma_apar, sigma_aperp, sigma_f), with cosmological ones one row of the
+/// fsigma8, sigma_fsigma8, sigma_f, sigma_apar, sigma_aperp and the correlations corr_f_apar,
+/// corr_f_aperp, corr_apar_aperp), with cosmological ones one row of the
 /// fiducial values and errors of [`COSMOLOGY_NAMES`]; the header states the survey, the model, the
 /// covariance, the free parameters, the priors and the derivatives' error.
 ///
@@ -173,6 +174,23 @@ pub fn forecast_table(
                     (1..=bins.len())
                         .map(|i| sigma_of(&format!("{name}_{i}")))
                         .collect(),
+                );
+            }
+            // the correlations of f (so of fσ8: σ8(z) is fixed), α∥, α⊥ within each bin (for the
+            // ellipses of `pt-spectra plot ellipses`)
+            let at = |name: &str| f.names.iter().position(|n| n == name);
+            let corr = |a: &str, b: &str, i: usize| match (
+                at(&format!("{a}_{i}")),
+                at(&format!("{b}_{i}")),
+            ) {
+                (Some(p), Some(q)) => f.covariance[p][q] / (f.sigma[p] * f.sigma[q]),
+                _ => f64::NAN,
+            };
+            for (a, b) in [("f", "apar"), ("f", "aperp"), ("apar", "aperp")] {
+                table.push(
+                    format!("corr_{a}_{b}"),
+                    "",
+                    (1..=bins.len()).map(|i| corr(a, b, i)).collect(),
                 );
             }
         }

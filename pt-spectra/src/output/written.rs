@@ -27,7 +27,7 @@ impl WrittenTable {
     }
 
     /// Parses a table: the names are on the last `#` line before the first row, which must start with
-    /// `# k` (`k`, `k_max`, …).
+    /// `# k` (`k`, `k_max`, …) or, for the tables of redshift bins (`fisher`), `# z `.
     ///
     /// # Errors
     /// [`Error::InvalidChoice`] without such a names line, [`Error::BadRow`] for a row that is not
@@ -40,7 +40,7 @@ impl WrittenTable {
             .collect();
         let names: Vec<String> = header
             .last()
-            .filter(|l| l.starts_with('k'))
+            .filter(|l| l.starts_with('k') || l.starts_with("z "))
             .ok_or_else(|| Error::InvalidChoice {
                 what: format!("`{origin}`"),
                 reason: "has no `# k …` names line (not a pt-spectra table?)".into(),

@@ -39,6 +39,26 @@ fn a_two_bin_template_forecast_states_its_survey_and_scales_with_the_volume() {
     }
     let rows = columns(&out);
     assert_eq!(rows.len(), 2);
+    // the correlations are in [-1, 1] and the table draws as ellipses
+    for r in &rows {
+        for c in ["corr_f_apar", "corr_f_aperp", "corr_apar_aperp"] {
+            assert!(r[c].abs() < 1.0, "{c} = {}", r[c]);
+        }
+    }
+    let dir = super::scratch("fisher");
+    let (table, png) = (dir.join("fisher.txt"), dir.join("ellipses.png"));
+    std::fs::write(&table, &out).unwrap();
+    let (ok, _, err) = run(&[
+        "plot",
+        "ellipses",
+        table.to_str().unwrap(),
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert!(
+        ok && std::fs::metadata(&png).unwrap().len() > 10_000,
+        "{err}"
+    );
     let s = rows[1]["sigma_fsigma8"] / rows[1]["fsigma8"];
     assert!(s > 0.03 && s < 0.3, "{s}");
     let (ok, out4, err) = run(&["fisher", "--bin", &four, "--cache-dir", cache]);

@@ -3,14 +3,15 @@
 //! an embedded DejaVu Sans font.
 //!
 //! Modules: [`table`] reads the inputs, [`draw`] draws a [`draw::Figure`]; the kinds are built in
-//! [`real`] (models, propagators), [`rsd`] (multipoles, sn, tns-terms), [`fit`] (fit, contour) and
-//! [`halo`] (bias-noise).
+//! [`real`] (models, propagators), [`rsd`] (multipoles, sn, tns-terms), [`fit`] (fit, contour),
+//! [`halo`] (bias-noise) and [`fisher`] (ellipses).
 
 use anyhow::{bail, Result};
 use plotters::prelude::*;
 use std::path::PathBuf;
 
 mod draw;
+mod fisher;
 mod fit;
 mod halo;
 mod real;
@@ -46,6 +47,8 @@ pub enum Kind {
     TnsTerms,
     /// The Δχ² = 2.3 and 6.17 contours of a `fit --contour-out` table at one k_max, with the best fit.
     Contour,
+    /// The 68% ellipses of α∥ and α⊥ against fσ8 of each bin of a `pt-spectra fisher` table.
+    Ellipses,
 }
 
 /// Arguments of `pt-spectra plot`.
@@ -165,6 +168,7 @@ pub fn run(args: &Args) -> Result<()> {
         Kind::Sn => rsd::signal_to_noise(args)?,
         Kind::TnsTerms => rsd::tns_terms(args)?,
         Kind::Contour => fit::contour(args)?,
+        Kind::Ellipses => fisher::ellipses(args)?,
     };
     if !args.title.is_empty() {
         figure.title.clone_from(&args.title);
