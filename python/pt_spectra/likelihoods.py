@@ -74,6 +74,20 @@ def read_multipoles(path, data_ells=(0, 2, 4)):
     return k, values, sigma
 
 
+def _columns_of(theory_k, data_k, who):
+    """The index of each data k [h/Mpc] on the theory's k grid (relative tolerance 1e-8), or a
+    ValueError naming the likelihood and the k."""
+    theory_k = np.asarray(theory_k)
+    cols = []
+    for kd in data_k:
+        hit = np.flatnonzero(np.isclose(theory_k, kd, rtol=1e-8, atol=0.0))
+        if hit.size == 0:
+            raise ValueError(f"{who}: data k = {kd} h/Mpc is not on the theory's k grid (give the "
+                             "theory no `k` option: it takes the requested k)")
+        cols.append(int(hit[0]))
+    return np.array(cols)
+
+
 class MultipoleGaussian(Likelihood):
     """Gaussian likelihood of measured multipoles with diagonal errors: see the module docs."""
 
@@ -112,17 +126,9 @@ class MultipoleGaussian(Likelihood):
                 "pt_k": None, "pt_ells": None}
 
     def _select(self):
-        theory_k = np.asarray(self.provider.get_pt_k())
+        self._cols = _columns_of(self.provider.get_pt_k(), self.k_data, "MultipoleGaussian")
         theory_ells = list(self.provider.get_pt_ells())
-        cols = []
-        for kd in self.k_data:
-            hit = np.flatnonzero(np.isclose(theory_k, kd, rtol=1e-8, atol=0.0))
-            if hit.size == 0:
-                raise ValueError(f"MultipoleGaussian: data k = {kd} h/Mpc is not on the "
-                                 "theory's k grid")
-            cols.append(int(hit[0]))
         self._rows = [theory_ells.index(ell) for ell in self.ells]
-        self._cols = np.array(cols)
 
     def model(self):
         """The model multipoles at the data's (ℓ, k), shape [len(ells), len(k)], (Mpc/h)^3."""
@@ -446,19 +452,12 @@ class PowerBispectrum(Likelihood):
                 "pt_k": None, "pt_ells": None, "pt_bk_ells": None}
 
     def _select(self):
-        theory_k = np.asarray(self.provider.get_pt_k())
-        cols = []
-        for kd in self.k_data:
-            hit = np.flatnonzero(np.isclose(theory_k, kd, rtol=1e-8, atol=0.0))
-            if hit.size == 0:
-                raise ValueError(f"PowerBispectrum: data k = {kd} h/Mpc is not on the theory's k "
-                                 "grid (give the theory no `k` option: it takes the requested k)")
-            cols.append(int(hit[0]))
+        cols = _columns_of(self.provider.get_pt_k(), self.k_data, "PowerBispectrum")
         theory_ells = list(self.provider.get_pt_ells())
         self._rows = [theory_ells.index(ell) for ell in self.p_ells]
         b_ells = list(self.provider.get_pt_bk_ells(self.z))
         self._b_rows = [b_ells.index(ell) for ell in self.b_ells]
-        self._cols = np.array(cols)
+        self._cols = cols
 
     def model(self):
         """The model at the fitted points: P_ℓ at the fitted k, then B_ℓ at the fitted triangles."""

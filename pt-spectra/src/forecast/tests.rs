@@ -6,6 +6,19 @@ fn store() -> TableStore {
     TableStore::new(std::env::temp_dir().join("pt-spectra-forecast-tests"))
 }
 
+/// The template forecast of `bins` in Planck 2018, no shared priors.
+fn template(bins: &[SurveyBin]) -> Forecast {
+    fisher(
+        bins,
+        &Cosmology::planck2018(),
+        Parameters::Template,
+        &[],
+        &store(),
+        &Silent,
+    )
+    .unwrap()
+}
+
 /// The Kaiser model's Fisher matrix of (b1, f) from P0, P2 with the Gaussian covariance, in closed
 /// form: P_ℓ and their derivatives are polynomials in b, f times P_lin, and the covariance's μ
 /// integrals are exact moments of μ (written here independently of the module's quadrature).
@@ -88,15 +101,7 @@ fn on_large_scales_the_forecast_is_the_kaiser_fisher_matrix() {
     bin.k_min = 0.004;
     bin.dk = 0.002;
     bin.free = vec!["b1".into()];
-    let got = fisher(
-        std::slice::from_ref(&bin),
-        &fiducial,
-        Parameters::Template,
-        &[],
-        &store(),
-        &Silent,
-    )
-    .unwrap();
+    let got = template(std::slice::from_ref(&bin));
     let (f_at, b_at) = (
         got.names.iter().position(|n| n == "f_1").unwrap(),
         got.names.iter().position(|n| n == "b1_1").unwrap(),
@@ -135,28 +140,11 @@ fn on_large_scales_the_forecast_is_the_kaiser_fisher_matrix() {
 
 #[test]
 fn errors_scale_as_one_over_the_square_root_of_the_volume_and_priors_shrink_them() {
-    let fiducial = Cosmology::planck2018();
     let bin = SurveyBin::new(0.6, 1e9, 4e-4, 0.15, 2.0);
-    let one = fisher(
-        std::slice::from_ref(&bin),
-        &fiducial,
-        Parameters::Template,
-        &[],
-        &store(),
-        &Silent,
-    )
-    .unwrap();
+    let one = template(std::slice::from_ref(&bin));
     let mut big = bin.clone();
     big.volume *= 4.0;
-    let four = fisher(
-        &[big],
-        &fiducial,
-        Parameters::Template,
-        &[],
-        &store(),
-        &Silent,
-    )
-    .unwrap();
+    let four = template(&[big]);
     for (a, b) in one.sigma.iter().zip(&four.sigma) {
         assert!((a / b - 2.0).abs() < 1e-9, "{a} {b}");
     }
@@ -164,29 +152,13 @@ fn errors_scale_as_one_over_the_square_root_of_the_volume_and_priors_shrink_them
     let (s, fs8) = one.fsigma8[0];
     assert!(s > 0.01 * fs8 && s < 0.2 * fs8, "{s} {fs8}");
     // two identical bins: errors of the shared-nothing template parameters unchanged per bin
-    let two = fisher(
-        &[bin.clone(), bin.clone()],
-        &fiducial,
-        Parameters::Template,
-        &[],
-        &store(),
-        &Silent,
-    )
-    .unwrap();
+    let two = template(&[bin.clone(), bin.clone()]);
     assert_eq!(two.names.len(), 2 * one.names.len());
     assert!((two.sigma[0] / one.sigma[0] - 1.0).abs() < 1e-12);
     // a prior on b2 lowers σ(f)
     let mut with_prior = bin.clone();
     with_prior.priors = vec![("b2".into(), 0.1)];
-    let p = fisher(
-        &[with_prior],
-        &fiducial,
-        Parameters::Template,
-        &[],
-        &store(),
-        &Silent,
-    )
-    .unwrap();
+    let p = template(&[with_prior]);
     assert!(p.sigma[0] < one.sigma[0]);
 }
 
