@@ -1,6 +1,9 @@
 //! The tree-level bispectrum (issue 49: the 62 bin-averaged Nseries triangles, B0, B2, B4, for a new
 //! linear spectrum ≤ 0.2 ms; a parameter step ≤ 20 µs): the terms of a new spectrum (f, AP, FoG and IR
 //! resummation as a fit varies them) and the contraction with new bias and stochastic parameters.
+//!
+//! Run with `RAYON_NUM_THREADS=1 cargo bench -p pt-spectra-tests --bench bispectrum` for one core (the
+//! terms are computed triangle by triangle in parallel otherwise).
 
 // `criterion_group!` defines an undocumented function.
 #![allow(missing_docs)]

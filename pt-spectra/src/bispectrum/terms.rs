@@ -13,6 +13,7 @@ use crate::estimate::Estimate;
 use crate::ir::WiggleSplit;
 use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
+use rayon::prelude::*;
 
 /// Quadrature orders of a plan: Gauss–Legendre nodes per shell (bins), in μ of the Legendre side and
 /// trapezoid nodes in the azimuth. The error estimate is the difference from [`PlanRules::coarse`].
@@ -289,9 +290,10 @@ impl BispectrumPlan {
         // Without an anisotropic distortion the true sides k/q do not depend on the orientation:
         // the spectra are looked up once per shape, not once per orientation.
         let isotropic = settings.q_par == settings.q_perp;
+        // triangles in parallel (rayon; RAYON_NUM_THREADS=1 for one core)
         let sum = |shapes: &Vec<Vec<Shape>>| -> Vec<[[f64; SLOTS]; 3]> {
             shapes
-                .iter()
+                .par_iter()
                 .map(|triangle| {
                     let mut acc = [[0.0; SLOTS]; 3];
                     for shape in triangle {
