@@ -8,8 +8,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 /// The keys of a bin dict besides the nuisance parameters.
-const BIN_KEYS: [&str; 9] = [
-    "z", "volume", "n_bar", "k_min", "k_max", "dk", "ells", "free", "priors",
+const BIN_KEYS: [&str; 10] = [
+    "z", "volume", "n_bar", "k_min", "k_max", "dk", "ells", "free", "priors", "b_k_max",
 ];
 
 fn bin_of(i: usize, d: &Bound<'_, PyDict>) -> PyResult<SurveyBin> {
@@ -36,6 +36,9 @@ fn bin_of(i: usize, d: &Bound<'_, PyDict>) -> PyResult<SurveyBin> {
     if let Some(v) = d.get_item("ells")? {
         bin.ells = v.extract()?;
     }
+    if let Some(v) = get("b_k_max")? {
+        bin = bin.with_bispectrum(v);
+    }
     if let Some(v) = d.get_item("free")? {
         bin.free = v.extract()?;
     }
@@ -50,7 +53,9 @@ fn bin_of(i: usize, d: &Bound<'_, PyDict>) -> PyResult<SurveyBin> {
         if BIN_KEYS.contains(&key.as_str()) || key == "b1" {
             continue;
         }
-        if !pt_spectra::pipeline::NUISANCE_NAMES.contains(&key.as_str()) {
+        let bispectrum =
+            bin.b_k_max.is_some() && pt_spectra::pipeline::BISPECTRUM_NAMES.contains(&key.as_str());
+        if !pt_spectra::pipeline::NUISANCE_NAMES.contains(&key.as_str()) && !bispectrum {
             return Err(value_error(format!(
                 "survey bin {}: unknown key `{key}` (valid: {}, and the nuisance parameters {})",
                 i + 1,
@@ -65,8 +70,9 @@ fn bin_of(i: usize, d: &Bound<'_, PyDict>) -> PyResult<SurveyBin> {
 
 /// The Fisher forecast of a survey: `bins` a list of dicts (z, volume [(Mpc/h)^3], n_bar
 /// [(h/Mpc)^3], k_max [h/Mpc], b1, and optionally k_min (0.01), dk (0.01), ells ([0, 2]), free
-/// (["b1", "b2", "bs", "alpha0", "alpha2", "sn"]), priors ({name: sigma}), other nuisance values by
-/// name); `parameters` "template" (f, apar, aperp per bin) or "cosmology" (omega_cdm, omega_b, h,
+/// (["b1", "b2", "bs", "alpha0", "alpha2", "sn"], and "c1", "b_shot", "a_shot" with B0), priors
+/// ({name: sigma}), b_k_max (the bispectrum monopole of the shells' triangle bins up to it, Gaussian
+/// variance, no P-B cross-covariance), other nuisance values by name); `parameters` "template" (f, apar, aperp per bin) or "cosmology" (omega_cdm, omega_b, h,
 /// logA, n_s shared, with `priors` {name: sigma} on them, e.g. {"omega_b": 0.00037}); the fiducial
 /// `cosmology` (a preset or dict; default planck2018). Returns a dict: names, fiducial, sigma,
 /// covariance, fisher, fsigma8 ([(sigma, fsigma8)] per bin), derivative_error, points.

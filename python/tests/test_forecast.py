@@ -29,6 +29,13 @@ def test_cosmological_parameters_with_a_bbn_prior(tmp_path):
     assert all(np.isfinite(got["sigma"])) and got["sigma"][2] < 0.05 * 0.6766
 
 
+def test_the_bispectrum_monopole_narrows_the_errors(tmp_path):
+    p = pt.fisher([BOSS], cache_dir=tmp_path)
+    pb = pt.fisher([dict(BOSS, b_k_max=0.08)], cache_dir=tmp_path)
+    assert {"c1_1", "b_shot_1", "a_shot_1"} <= set(pb["names"])
+    assert pb["fsigma8"][0][0] < p["fsigma8"][0][0]
+
+
 def test_bad_input_is_named(tmp_path):
     with pytest.raises(ValueError, match="survey bin 1: `n_bar` is required"):
         pt.fisher([dict(z=0.5, volume=1e9, k_max=0.2, b1=2.0)], cache_dir=tmp_path)

@@ -81,7 +81,14 @@ pub struct SurveyBin {
     pub free: Vec<String>,
     /// Gaussian priors (name, σ) on free nuisance parameters, centred on the fiducial.
     pub priors: Vec<(String, f64)>,
+    /// With the bispectrum monopole B0: the largest side [h/Mpc] of its triangle bins (the bins of
+    /// the power spectrum's shells, all closed triangles up to it); `None`: P alone.
+    pub b_k_max: Option<f64>,
 }
+
+/// The bispectrum's own parameters in a forecast with B0 (c1 [(Mpc/h)²], the stochastic amplitudes in
+/// units of 1/n̄; fiducial 0, 1 (Poisson), 0, 0): free by default, p_shot fixed.
+pub const BISPECTRUM_FREE: [&str; 3] = ["c1", "b_shot", "a_shot"];
 
 impl SurveyBin {
     /// A bin with k from 0.01 to `k_max` in shells of 0.01 h/Mpc, P0 and P2, b1, the
@@ -101,7 +108,20 @@ impl SurveyBin {
                 .map(|s| s.to_string())
                 .collect(),
             priors: Vec::new(),
+            b_k_max: None,
         }
+    }
+
+    /// With the bispectrum monopole of the triangle bins up to `b_k_max` [h/Mpc], and its
+    /// [`BISPECTRUM_FREE`] parameters free.
+    pub fn with_bispectrum(mut self, b_k_max: f64) -> Self {
+        self.b_k_max = Some(b_k_max);
+        for name in BISPECTRUM_FREE {
+            if !self.free.iter().any(|n| n == name) {
+                self.free.push(name.into());
+            }
+        }
+        self
     }
 
     /// The shell centres [h/Mpc] and their lower and upper edges.
@@ -113,6 +133,28 @@ impl SurveyBin {
                 (lo + 0.5 * self.dk, lo, lo + self.dk)
             })
             .collect()
+    }
+
+    /// The nuisance parameters of the bin's data vector: the power spectrum's, and with B0 the
+    /// bispectrum's ([`crate::pipeline::BISPECTRUM_NAMES`]).
+    fn parameter_names(&self) -> Vec<&'static str> {
+        let mut names = NUISANCE_NAMES.to_vec();
+        if self.b_k_max.is_some() {
+            names.extend(crate::pipeline::BISPECTRUM_NAMES);
+        }
+        names
+    }
+
+    /// The triangle bins of B0: all closed bins of the power spectrum's shells up to `b_k_max`.
+    fn triangles(&self) -> Result<Option<crate::bispectrum::TriangleSet>> {
+        let Some(b_max) = self.b_k_max else {
+            return Ok(None);
+        };
+        let edges: Vec<f64> = std::iter::once(self.k_min)
+            .chain(self.shells().iter().map(|s| s.2))
+            .filter(|&e| e <= b_max + 1e-12)
+            .collect();
+        Ok(Some(crate::bispectrum::TriangleSet::from_edges(&edges)?))
     }
 
     /// Checks the values and names; the error names the bin (1-based) and the value.
@@ -140,17 +182,26 @@ impl SurveyBin {
                 "must reach at least one shell above k_min",
             ));
         }
+        if let Some(b) = self.b_k_max {
+            if !(b.is_finite() && b >= self.k_min + self.dk && b <= self.k_max + 1e-12) {
+                return Err(bad(
+                    format!("b_k_max = {b}"),
+                    "the bispectrum's bins are the power spectrum's shells: k_min + dk <= b_k_max <= k_max",
+                ));
+            }
+        }
         if self.ells.is_empty() || self.ells.iter().any(|&l| l % 2 == 1 || l > 4) {
             return Err(bad(
                 format!("ells = {:?}", self.ells),
                 "must be among 0, 2, 4",
             ));
         }
+        let valid = self.parameter_names();
         for (name, _) in &self.nuisance {
-            if !NUISANCE_NAMES.contains(&name.as_str()) {
+            if !valid.contains(&name.as_str()) {
                 return Err(bad(
                     format!("nuisance parameter `{name}`"),
-                    &format!("valid: {}", NUISANCE_NAMES.join(", ")),
+                    &format!("valid: {}", valid.join(", ")),
                 ));
             }
         }
@@ -158,12 +209,12 @@ impl SurveyBin {
             return Err(bad("b1".into(), "the fiducial linear bias is required"));
         }
         for name in self.free.iter().chain(self.priors.iter().map(|p| &p.0)) {
-            if !NUISANCE_NAMES.contains(&name.as_str()) {
+            if !valid.contains(&name.as_str()) {
                 return Err(bad(
                     format!("free parameter `{name}`"),
                     &format!(
                         "the free nuisance parameters are among {}",
-                        NUISANCE_NAMES.join(", ")
+                        valid.join(", ")
                     ),
                 ));
             }
@@ -265,7 +316,14 @@ pub fn fisher(
         let shells = bin.shells();
         let k: Vec<f64> = shells.iter().map(|s| s.0).collect();
         let observation = Observation::new(&[0, 2, 4, 6, 8], &k, None, None)?;
-        let settings = PipelineSettings::ept(bin.z, Some(*fiducial));
+        let triangles = bin.triangles()?;
+        let settings = PipelineSettings {
+            bispectrum: triangles.clone().map(|t| crate::pipeline::BispectrumBlock {
+                n_bar: bin.n_bar,
+                ..crate::pipeline::BispectrumBlock::monopole(t)
+            }),
+            ..PipelineSettings::ept(bin.z, Some(*fiducial))
+        };
         let pipeline = Pipeline::new(observation, settings, &precision, store, progress)?;
         let prepared = pipeline.prepare(fiducial)?;
         let step = pipeline.step(&prepared)?;
@@ -281,14 +339,23 @@ pub fn fisher(
                 (0..n_k).map(move |j| (l / 2) * n_k + j)
             })
             .collect();
+        // and with B0, its rows after the power spectrum's ℓ = 0 … 8
+        let n_p = 5 * k.len();
+        let rows: Vec<usize> = rows.into_iter().chain(n_p..all.len()).collect();
         let select = |d: &[f64]| -> Vec<f64> { rows.iter().map(|&r| d[r]).collect() };
+        let with_b = triangles.is_some();
         let mut jacobian: Vec<Vec<f64>> = Vec::new();
         let f0 = step.growth_rate;
         let ap0 = step.ap.unwrap_or(Distortion::new(1.0, 1.0)?);
         match parameters {
             Parameters::Template => {
-                // f: the data vector at f ± h (the terms do not depend on f)
+                // f: the data vector at f ± h (the power spectrum's terms do not depend on f; the
+                // bispectrum's, through the IR damping, do: a step at that f)
                 let with_f = |f: f64| -> Result<Vec<f64>> {
+                    if with_b {
+                        let s = pipeline.step_with(prepared.tracer_spectrum(), f, Some(ap0))?;
+                        return Ok(select(&s.data_vector(&nuisance)?));
+                    }
                     let mut p = nuisance.clone();
                     p.push(("f", f));
                     Ok(select(&step.data_vector(&p)?))
@@ -332,25 +399,52 @@ pub fn fisher(
                 fsigma8.push((f64::NAN, f64::NAN));
             }
         }
-        // the free nuisance parameters: exact
-        let exact = step.linearise(None)?.jacobian(&nuisance)?;
+        // the free nuisance parameters: exact (P alone: the linearised polynomial; with B0, which is
+        // quartic in them, Richardson-extrapolated central differences, exact for a polynomial of
+        // degree ≤ 4 up to rounding)
+        let exact = if with_b {
+            None
+        } else {
+            Some(step.linearise(None)?.jacobian(&nuisance)?)
+        };
         for name in &bin.free {
-            let j = NUISANCE_NAMES
+            let default = if name == "b_shot" { 1.0 } else { 0.0 };
+            let x0 = nuisance
                 .iter()
-                .position(|n| n == name)
-                .expect("validated");
-            jacobian.push(select(&exact[j]));
+                .find(|(n, _)| n == name)
+                .map_or(default, |p| p.1);
+            let d = match &exact {
+                Some(j) => {
+                    let at = NUISANCE_NAMES
+                        .iter()
+                        .position(|n| n == name)
+                        .expect("validated");
+                    select(&j[at])
+                }
+                None => {
+                    let at = |x: f64| -> Result<Vec<f64>> {
+                        let mut p: Vec<(&str, f64)> = nuisance
+                            .iter()
+                            .filter(|(n, _)| n != name)
+                            .copied()
+                            .collect();
+                        p.push((name.as_str(), x));
+                        Ok(select(&step.data_vector(&p)?))
+                    };
+                    richardson(x0, STEP * x0.abs().max(1.0), at)?.0
+                }
+            };
+            jacobian.push(d);
             names.push(format!("{name}_{}", i + 1));
-            values.push(
-                nuisance
-                    .iter()
-                    .find(|(n, _)| n == name)
-                    .map_or(0.0, |p| p.1),
-            );
+            values.push(x0);
         }
         let covariances = covariance::shell_covariances(&all, &shells, bin)?;
+        let b_variance = match &triangles {
+            Some(t) => covariance::bispectrum_variances(&all[..k.len()], t, bin),
+            None => Vec::new(),
+        };
         points += rows.len();
-        blocks.push((jacobian, covariances, bin.ells.len(), k.len()));
+        blocks.push((jacobian, covariances, b_variance, bin.ells.len(), k.len()));
     }
     let n = names.len();
     let mut fisher = vec![vec![0.0; n]; n];
@@ -360,11 +454,12 @@ pub fn fisher(
         0
     };
     let mut offset = shared;
-    for (b, (jacobian, covariances, n_ell, n_k)) in blocks.iter().enumerate() {
+    for (b, (jacobian, covariances, b_variance, n_ell, n_k)) in blocks.iter().enumerate() {
         // the columns of this bin's parameters in the global matrix
         let own = jacobian.len() - shared;
         let index: Vec<usize> = (0..shared).chain(offset..offset + own).collect();
         covariance::add_fisher(&mut fisher, &index, jacobian, covariances, *n_ell, *n_k);
+        covariance::add_bispectrum_fisher(&mut fisher, &index, jacobian, b_variance, n_ell * n_k);
         for (name, sigma) in &bins[b].priors {
             let at = names
                 .iter()

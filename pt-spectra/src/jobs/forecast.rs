@@ -38,18 +38,30 @@ pub fn parse_bin(text: &str, ells: &[usize], free: &[String]) -> Result<SurveyBi
         required("k_max")?,
         required("b1")?,
     );
+    if let Some(b) = get("b_k_max") {
+        bin = bin.with_bispectrum(b);
+    }
     bin.k_min = get("k_min").unwrap_or(bin.k_min);
     bin.dk = get("dk").unwrap_or(bin.dk);
     bin.ells = ells.to_vec();
     if !free.is_empty() {
         bin.free = free.to_vec();
+        if bin.b_k_max.is_some() {
+            bin.free.extend(
+                crate::forecast::BISPECTRUM_FREE
+                    .iter()
+                    .map(|s| s.to_string()),
+            );
+        }
     }
-    const KEYS: [&str; 6] = ["z", "volume", "n_bar", "k_max", "k_min", "dk"];
+    const KEYS: [&str; 7] = ["z", "volume", "n_bar", "k_max", "k_min", "dk", "b_k_max"];
     for (key, value) in pairs {
         if KEYS.contains(&key.as_str()) || key == "b1" {
             continue;
         }
-        if !crate::pipeline::NUISANCE_NAMES.contains(&key.as_str()) {
+        let bispectrum =
+            bin.b_k_max.is_some() && crate::pipeline::BISPECTRUM_NAMES.contains(&key.as_str());
+        if !crate::pipeline::NUISANCE_NAMES.contains(&key.as_str()) && !bispectrum {
             return Err(bad(format!(
                 "unknown key `{key}` (valid: {}, and the nuisance parameters {})",
                 KEYS.join(", "),
@@ -103,8 +115,9 @@ pub fn forecast_table(
             .map(|(n, v)| format!("{n} = {v}"))
             .collect();
         header.push(format!(
-            "bin {}: z = {}, V = {:e} (Mpc/h)^3, n_bar = {:e} (h/Mpc)^3, shells of {} h/Mpc from {} to \
-             {} h/Mpc, multipoles {:?}; fiducial {} (others 0); free nuisance {} (marginalised){}",
+                        "bin {}: z = {}, V = {:e} (Mpc/h)^3, n_bar = {:e} (h/Mpc)^3, shells of {} h/Mpc from {} to \
+             {} h/Mpc, multipoles {:?}{}; fiducial {} (others 0; b_shot 1); free nuisance {} \
+             (marginalised){}",
             i + 1,
             b.z,
             b.volume,
@@ -112,7 +125,12 @@ pub fn forecast_table(
             b.dk,
             b.k_min,
             b.k_max,
-            b.ells,
+                        b.ells,
+            b.b_k_max.map_or(String::new(), |m| format!(
+                " and the bispectrum monopole B0 of every closed triangle bin of these shells up to \
+                 {m} h/Mpc (tree level, IR resummed; Gaussian variance s123 k_f^3 P_t P_t P_t / V_B \
+                 with the monopole, no P-B cross-covariance: an optimistic bound on what B adds)"
+            )),
             fixed.join(", "),
             b.free.join(", "),
             if b.priors.is_empty() {

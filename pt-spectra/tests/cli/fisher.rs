@@ -78,6 +78,24 @@ fn a_two_bin_template_forecast_states_its_survey_and_scales_with_the_volume() {
 }
 
 #[test]
+fn the_bispectrum_monopole_narrows_the_forecast_and_is_stated() {
+    let cache = std::env::temp_dir().join("pt-spectra-cli-fisher");
+    let cache = cache.to_str().unwrap();
+    let p = "z=0.57,volume=2.6e9,n_bar=3e-4,k_max=0.15,b1=2";
+    let pb = format!("{p},b_k_max=0.08,c1=1");
+    let (ok, out_p, err) = run(&["fisher", "--bin", p, "--cache-dir", cache]);
+    assert!(ok, "{err}");
+    let (ok, out_pb, err) = run(&["fisher", "--bin", &pb, "--cache-dir", cache]);
+    assert!(ok, "{err}");
+    assert!(out_pb.contains("bispectrum monopole B0") && out_pb.contains("c1 = 1"));
+    assert!(out_pb.contains("b_shot, a_shot (marginalised)"), "{out_pb}");
+    let (a, b) = (&columns(&out_p)[0], &columns(&out_pb)[0]);
+    for name in ["sigma_fsigma8", "sigma_apar", "sigma_aperp"] {
+        assert!(b[name] < a[name], "{name}: {} vs {}", b[name], a[name]);
+    }
+}
+
+#[test]
 fn bad_forecast_input_is_named() {
     let good = "z=0.5,volume=1e9,n_bar=3e-4,k_max=0.15,b1=2";
     fails_naming(&[
@@ -114,5 +132,21 @@ fn bad_forecast_input_is_named() {
             "prior on `omega_b`",
         ),
         (vec!["fisher", "--bin", good, "--free", "b1,b7"], "b7"),
+        (
+            vec![
+                "fisher",
+                "--bin",
+                "z=0.5,volume=1e9,n_bar=3e-4,k_max=0.15,b1=2,c1=1",
+            ],
+            "unknown key `c1`",
+        ),
+        (
+            vec![
+                "fisher",
+                "--bin",
+                "z=0.5,volume=1e9,n_bar=3e-4,k_max=0.15,b1=2,b_k_max=0.3",
+            ],
+            "b_k_max",
+        ),
     ]);
 }

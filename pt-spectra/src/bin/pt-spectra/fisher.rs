@@ -14,8 +14,9 @@ use std::path::PathBuf;
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// A redshift bin, `z=0.57,volume=2.6e9,n_bar=3e-4,k_max=0.15,b1=2` (volume [(Mpc/h)^3], n_bar
-    /// [(h/Mpc)^3], k [h/Mpc]; optionally k_min (0.01), dk (0.01) and fiducial nuisance values b2, bs,
-    /// b3, alpha0 … sn4, else 0); repeat for several bins.
+    /// [(h/Mpc)^3], k [h/Mpc]; optionally k_min (0.01), dk (0.01), b_k_max (the bispectrum monopole of
+    /// the shells' triangle bins up to it, with c1, b_shot, a_shot free) and fiducial nuisance values
+    /// b2, bs, b3, alpha0 … sn4, c1, b_shot, p_shot, a_shot, else 0 (b_shot 1)); repeat for several bins.
     #[arg(long = "bin", value_name = "KEY=VALUE,...", required = true)]
     bins: Vec<String>,
     /// `template`: f, apar, aperp per bin (and sigma(fsigma8)); `cosmology`: omega_cdm, omega_b, h,
