@@ -137,7 +137,7 @@ impl SurveyBin {
 
     /// The nuisance parameters of the bin's data vector: the power spectrum's, and with B0 the
     /// bispectrum's ([`crate::pipeline::BISPECTRUM_NAMES`]).
-    fn parameter_names(&self) -> Vec<&'static str> {
+    pub fn parameter_names(&self) -> Vec<&'static str> {
         let mut names = NUISANCE_NAMES.to_vec();
         if self.b_k_max.is_some() {
             names.extend(crate::pipeline::BISPECTRUM_NAMES);

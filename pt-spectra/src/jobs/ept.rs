@@ -21,8 +21,7 @@ pub struct EptRequest {
     pub ap: Option<Distortion>,
 }
 
-/// The range of α∥, α⊥ of fits that free them: [`AP_FIT_RANGE`].0 … .1.
-pub const AP_FIT_RANGE: (f64, f64) = (0.8, 1.25);
+pub use crate::rsd::ap::AP_FIT_RANGE;
 
 /// The plan of a request on the output `k`, with IR resummation `ir`, the distortion `ap`, and with
 /// `free_ap` the internal grid of every α∥, α⊥ in `AP_FIT_RANGE` (0.8 … 1.25).

@@ -59,13 +59,12 @@ pub fn parse_bin(text: &str, ells: &[usize], free: &[String]) -> Result<SurveyBi
         if KEYS.contains(&key.as_str()) || key == "b1" {
             continue;
         }
-        let bispectrum =
-            bin.b_k_max.is_some() && crate::pipeline::BISPECTRUM_NAMES.contains(&key.as_str());
-        if !crate::pipeline::NUISANCE_NAMES.contains(&key.as_str()) && !bispectrum {
+        let valid = bin.parameter_names();
+        if !valid.contains(&key.as_str()) {
             return Err(bad(format!(
                 "unknown key `{key}` (valid: {}, and the nuisance parameters {})",
                 KEYS.join(", "),
-                crate::pipeline::NUISANCE_NAMES.join(", ")
+                valid.join(", ")
             )));
         }
         bin.nuisance.push((key, value));

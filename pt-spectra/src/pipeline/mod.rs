@@ -28,11 +28,10 @@
 use crate::cosmology::Cosmology;
 use crate::emulator::LinearEmulator;
 use crate::error::{Error, Result};
-use crate::jobs::AP_FIT_RANGE;
 use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
 use crate::progress::Progress;
-use crate::rsd::ap::Distortion;
+use crate::rsd::ap::{Distortion, AP_FIT_RANGE};
 use crate::rsd::ept::{EptParams, EptPlan, EptSettings, EptTerms, PARAM_NAMES};
 use crate::setup::{LinearSource, NamedCosmology, Prepared, Request};
 use crate::store::TableStore;

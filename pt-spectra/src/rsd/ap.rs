@@ -26,6 +26,9 @@ use crate::integrate::{lagrange4, legendre_nodes};
 pub const POINTS_PER_DECADE: f64 = 100.0;
 /// Gauss–Legendre nodes of the μ integral on [0, 1] (the error estimate uses half as many).
 pub const MU_NODES: usize = 32;
+/// The range of α∥, α⊥ of fits and pipelines that free them: [`AP_FIT_RANGE`].0 … .1 (their plans'
+/// internal grids cover every distortion in it).
+pub const AP_FIT_RANGE: (f64, f64) = (0.8, 1.25);
 /// The accepted range of α∥ and α⊥.
 pub const ALPHA_RANGE: (f64, f64) = (0.5, 2.0);
 
