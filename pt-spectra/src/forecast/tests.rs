@@ -215,33 +215,29 @@ fn cosmological_forecasts_share_the_parameters_and_bad_input_is_named() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("omega_b"), "{e}");
+    let refused = |bad: SurveyBin| -> String {
+        fisher(
+            &[bad],
+            &fiducial,
+            Parameters::Template,
+            &[],
+            &store(),
+            &Silent,
+        )
+        .unwrap_err()
+        .to_string()
+    };
     let mut bad = bins[0].clone();
     bad.volume = -1.0;
-    let e = fisher(
-        &[bad],
-        &fiducial,
-        Parameters::Template,
-        &[],
-        &store(),
-        &Silent,
-    )
-    .unwrap_err();
-    assert!(
-        e.to_string().contains("survey bin 1") && e.to_string().contains("volume"),
-        "{e}"
-    );
+    let e = refused(bad);
+    assert!(e.contains("survey bin 1") && e.contains("volume"), "{e}");
     let mut bad = bins[0].clone();
     bad.free.push("b9".into());
-    let e = fisher(
-        &[bad],
-        &fiducial,
-        Parameters::Template,
-        &[],
-        &store(),
-        &Silent,
-    )
-    .unwrap_err();
-    assert!(e.to_string().contains("b9"), "{e}");
+    let e = refused(bad);
+    assert!(e.contains("b9"), "{e}");
+    let mut bad = bins[0].clone();
+    bad.b_k_max = Some(0.3);
+    assert!(refused(bad).contains("b_k_max"));
     let sigma8 = Cosmology::gm2012();
     let e = fisher(
         &bins,
