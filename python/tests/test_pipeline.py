@@ -68,8 +68,9 @@ def test_a_batch_gives_the_single_calls(setup):
     _, pipe, _ = setup
     other = dict(COSMO, sigma8=0.78)
     rows = pipe.batch([COSMO, other], [PARAMS, dict(b1=1.5)])
-    assert np.array_equal(rows[0], pipe(COSMO, **PARAMS))
-    assert np.array_equal(rows[1], pipe(other, b1=1.5))
+    # a call repeating the last cosmology is its nuisance polynomial: equal to rounding (~1e-13)
+    np.testing.assert_allclose(rows[0], pipe(COSMO, **PARAMS), rtol=1e-12)
+    np.testing.assert_allclose(rows[1], pipe(other, b1=1.5), rtol=1e-12)
 
 
 def test_a_bispectrum_block_follows_the_power_spectrum(setup):
@@ -81,7 +82,7 @@ def test_a_bispectrum_block_follows_the_power_spectrum(setup):
     got = joint(COSMO, **PARAMS, **b)
     n = joint.meta["power_len"]
     assert len(got) == n + 4 and joint.meta["bispectrum"]
-    np.testing.assert_array_equal(got[:n], pipe(COSMO, **PARAMS))
+    np.testing.assert_allclose(got[:n], pipe(COSMO, **PARAMS), rtol=1e-12)
     # the block is the bispectrum plan on the same spectrum at f(z) (no AP: no fiducial)
     f = joint.meta["f"]
     terms = pt.BispectrumPlan(bins, bin_width=0.01).terms(cosmology=COSMO, z=Z, f=f)
@@ -113,3 +114,22 @@ def test_the_loop_range_is_stated_and_can_be_switched_off(setup):
     n = len(a) // 2
     for block in (slice(0, n), slice(n, 2 * n)):
         assert np.max(np.abs(a[block] - b[block])) <= 3e-5 * np.max(np.abs(b[block]))
+
+
+def test_a_repeated_cosmology_is_the_nuisance_polynomial(setup):
+    """The same cosmology again with new nuisance parameters: the step's nuisance polynomial (exact to
+    rounding) instead of the step; the same numbers as a fresh call, and its Jacobian too."""
+    obs, pipe, cache = setup
+    other = dict(COSMO, n_s=0.96)
+    sets = [PARAMS, dict(PARAMS, b1=1.7, b2=0.5, sn2=-300.0), dict(PARAMS, alpha2=4.0, b3=0.3)]
+    got = [pipe(other, **p) for p in sets]
+    _, jac = pipe(other, jacobian=True, **sets[1])
+    for p, g in zip(sets, got):
+        fresh = pt.Pipeline(obs, Z, precision="fast", cache_dir=cache)(other, **p)
+        np.testing.assert_allclose(g, fresh, rtol=1e-9, atol=1e-9 * np.max(np.abs(fresh)))
+    fresh_jac = pt.Pipeline(obs, Z, precision="fast", cache_dir=cache)(other, jacobian=True, **sets[1])[1]
+    np.testing.assert_allclose(jac, fresh_jac, rtol=1e-9, atol=1e-9 * np.max(np.abs(fresh_jac)))
+    # a given f different from f(z) is its own polynomial
+    with_f = pipe(other, f=0.7, **PARAMS)
+    np.testing.assert_allclose(with_f, pt.Pipeline(obs, Z, precision="fast", cache_dir=cache)(
+        other, f=0.7, **PARAMS), rtol=1e-9)
