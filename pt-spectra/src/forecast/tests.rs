@@ -19,6 +19,18 @@ fn template(bins: &[SurveyBin]) -> Forecast {
     .unwrap()
 }
 
+/// [P(k, μ) + 1/n̄]² of the Kaiser model P(k, μ) = (b + fμ²)²P as coefficients of μ⁰ … μ⁸.
+fn kaiser_noise_squared(b: f64, f: f64, p: f64, n_bar: f64) -> [f64; 5] {
+    let (a0, a1, a2) = (b * b * p + 1.0 / n_bar, 2.0 * b * f * p, f * f * p);
+    [
+        a0 * a0,
+        2.0 * a0 * a1,
+        a1 * a1 + 2.0 * a0 * a2,
+        2.0 * a1 * a2,
+        a2 * a2,
+    ]
+}
+
 /// The Kaiser model's Fisher matrix of (b1, f) from P0, P2 with the Gaussian covariance, in closed
 /// form: P_ℓ and their derivatives are polynomials in b, f times P_lin, and the covariance's μ
 /// integrals are exact moments of μ (written here independently of the module's quadrature).
@@ -44,15 +56,7 @@ fn kaiser_fisher(
     let mut fisher = [[0.0; 2]; 2];
     for &(_, lo, hi, p) in shells {
         let modes = volume * 4.0 * PI / 3.0 * (hi.powi(3) - lo.powi(3)) / (2.0 * PI).powi(3);
-        // [P(k, μ) + 1/n]² as a polynomial in μ²: (a0 + a1 μ² + a2 μ⁴)²
-        let (a0, a1, a2) = (b * b * p + 1.0 / n_bar, 2.0 * b * f * p, f * f * p);
-        let sq = [
-            a0 * a0,
-            2.0 * a0 * a1,
-            a1 * a1 + 2.0 * a0 * a2,
-            2.0 * a1 * a2,
-            a2 * a2,
-        ];
+        let sq = kaiser_noise_squared(b, f, p, n_bar);
         // L0 L0 = 1, L0 L2 = L2, L2 L2 = (9μ⁴ − 6μ² + 1)/4: times sq, truncated at μ⁸
         let c00 = integral(sq) / modes;
         let c02 = 5.0 * integral(l2(sq)) / modes;
@@ -265,14 +269,7 @@ fn the_gaussian_covariance_is_the_closed_form_of_kaiser_multipoles() {
     ];
     let c = gaussian_covariance(&[0, 2, 4], &ell, n_bar, modes);
     let m = |n: usize| 2.0 / (2.0 * n as f64 + 1.0);
-    let (a0, a1, a2) = (b * b * p + 1.0 / n_bar, 2.0 * b * f * p, f * f * p);
-    let sq = [
-        a0 * a0,
-        2.0 * a0 * a1,
-        a1 * a1 + 2.0 * a0 * a2,
-        2.0 * a1 * a2,
-        a2 * a2,
-    ];
+    let sq = kaiser_noise_squared(b, f, p, n_bar);
     // L0 = 1, L2 = (3μ² − 1)/2, L4 = (35μ⁴ − 30μ² + 3)/8 as coefficients of μ^0, μ^2, μ^4
     let legendre = [
         [1.0, 0.0, 0.0],
