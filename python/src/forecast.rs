@@ -7,37 +7,22 @@ use pt_spectra::progress::Silent;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-/// The keys of a bin dict besides the nuisance parameters.
-const BIN_KEYS: [&str; 10] = [
-    "z", "volume", "n_bar", "k_min", "k_max", "dk", "ells", "free", "priors", "b_k_max",
-];
+/// The keys of a bin dict that are not numbers (the numbers: `SurveyBin::KEYS` and the nuisance
+/// parameters).
+const LIST_KEYS: [&str; 3] = ["ells", "free", "priors"];
 
 fn bin_of(i: usize, d: &Bound<'_, PyDict>) -> PyResult<SurveyBin> {
-    let get = |key: &str| -> PyResult<Option<f64>> {
-        d.get_item(key)?.map(|v| v.extract::<f64>()).transpose()
-    };
-    let required = |key: &str| -> PyResult<f64> {
-        get(key)?.ok_or_else(|| value_error(format!("survey bin {}: `{key}` is required", i + 1)))
-    };
-    let b1 = required("b1")?;
-    let mut bin = SurveyBin::new(
-        required("z")?,
-        required("volume")?,
-        required("n_bar")?,
-        required("k_max")?,
-        b1,
-    );
-    if let Some(v) = get("k_min")? {
-        bin.k_min = v;
+    let mut values = Vec::new();
+    for (key, value) in d.iter() {
+        let key: String = key.extract()?;
+        if !LIST_KEYS.contains(&key.as_str()) {
+            values.push((key, value.extract::<f64>()?));
+        }
     }
-    if let Some(v) = get("dk")? {
-        bin.dk = v;
-    }
+    let mut bin =
+        SurveyBin::from_values(&format!("survey bin {}", i + 1), &values).map_err(value_error)?;
     if let Some(v) = d.get_item("ells")? {
         bin.ells = v.extract()?;
-    }
-    if let Some(v) = get("b_k_max")? {
-        bin = bin.with_bispectrum(v);
     }
     if let Some(v) = d.get_item("free")? {
         bin.free = v.extract()?;
@@ -47,23 +32,6 @@ fn bin_of(i: usize, d: &Bound<'_, PyDict>) -> PyResult<SurveyBin> {
             .extract::<std::collections::BTreeMap<String, f64>>()?
             .into_iter()
             .collect();
-    }
-    for (key, value) in d.iter() {
-        let key: String = key.extract()?;
-        if BIN_KEYS.contains(&key.as_str()) || key == "b1" {
-            continue;
-        }
-        let bispectrum =
-            bin.b_k_max.is_some() && pt_spectra::pipeline::BISPECTRUM_NAMES.contains(&key.as_str());
-        if !pt_spectra::pipeline::NUISANCE_NAMES.contains(&key.as_str()) && !bispectrum {
-            return Err(value_error(format!(
-                "survey bin {}: unknown key `{key}` (valid: {}, and the nuisance parameters {})",
-                i + 1,
-                BIN_KEYS.join(", "),
-                pt_spectra::pipeline::NUISANCE_NAMES.join(", ")
-            )));
-        }
-        bin.nuisance.push((key, value.extract()?));
     }
     Ok(bin)
 }

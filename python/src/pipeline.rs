@@ -42,9 +42,12 @@ pub(crate) struct Pipeline {
     repeat: Mutex<Option<Repeat>>,
 }
 
-/// The cache of [`Pipeline::repeat`]: (cosmology, f given), the prepared spectrum, the polynomial.
+/// The key of [`Pipeline::repeat`]: the cosmology and the bits of a given f.
+type RepeatKey = (pt_spectra::cosmology::Cosmology, Option<u64>);
+
+/// The cache of [`Pipeline::repeat`]: its key, the prepared spectrum, the polynomial.
 type Repeat = (
-    (pt_spectra::cosmology::Cosmology, Option<u64>),
+    RepeatKey,
     Prepared,
     Option<pt_spectra::pipeline::Linearised>,
 );
@@ -132,7 +135,7 @@ impl Pipeline {
         z_input: Option<f64>,
         cosmology: Option<&Bound<'_, PyAny>>,
         params: &[(String, f64)],
-    ) -> PyResult<Option<(pt_spectra::cosmology::Cosmology, Option<u64>)>> {
+    ) -> PyResult<Option<RepeatKey>> {
         if linear.is_some() || z_input.is_some() || self.inner.has_bispectrum() {
             return Ok(None);
         }
@@ -145,33 +148,31 @@ impl Pipeline {
     }
 
     /// The data vector (and Jacobian) of a call repeating the last cosmology, from its nuisance
-    /// polynomial (made on the first repeat: the same numbers to rounding, ~1e-12); `None` otherwise.
+    /// polynomial (made on the first repeat: the same numbers to rounding, ~1e-13); `None` otherwise.
     fn repeated(
         &self,
-        linear: Option<&Bound<'_, PyAny>>,
-        z_input: Option<f64>,
-        cosmology: Option<&Bound<'_, PyAny>>,
+        key: Option<&RepeatKey>,
         params: &[(String, f64)],
         jacobian: bool,
     ) -> PyResult<Option<VectorAndJacobian>> {
-        let Some(key) = self.repeat_key(linear, z_input, cosmology, params)? else {
+        let Some(key) = key else {
             return Ok(None);
         };
         let mut cache = self.repeat.lock().expect("not poisoned");
         let Some((cached, prepared, lin)) = cache.as_mut() else {
             return Ok(None);
         };
-        if *cached != key {
+        if cached != key {
             return Ok(None);
         }
         if lin.is_none() {
-            let f = key.1.map(f64::from_bits);
-            let step = match f {
-                Some(f) => self.inner.step_at_growth_rate(prepared, f),
-                None => self.inner.step(prepared),
-            }
-            .map_err(value_error)?;
-            *lin = Some(step.linearise(f).map_err(value_error)?);
+            // the power spectrum's terms do not depend on f (no bispectrum block here): the step of
+            // the cosmology, linearised at the given f
+            let step = self.inner.step(prepared).map_err(value_error)?;
+            *lin = Some(
+                step.linearise(key.1.map(f64::from_bits))
+                    .map_err(value_error)?,
+            );
         }
         let lin = lin.as_ref().expect("made above");
         let named: Vec<(&str, f64)> = params.iter().map(|(n, v)| (n.as_str(), *v)).collect();
@@ -182,20 +183,6 @@ impl Pipeline {
             None
         };
         Ok(Some((values, jac)))
-    }
-
-    /// Keeps the prepared spectrum of a cosmology call for [`Self::repeated`].
-    fn remember(
-        &self,
-        linear: Option<&Bound<'_, PyAny>>,
-        z_input: Option<f64>,
-        cosmology: Option<&Bound<'_, PyAny>>,
-        params: &[(String, f64)],
-        prepared: Prepared,
-    ) -> PyResult<()> {
-        let key = self.repeat_key(linear, z_input, cosmology, params)?;
-        *self.repeat.lock().expect("not poisoned") = key.map(|k| (k, prepared, None));
-        Ok(())
     }
 }
 
@@ -282,12 +269,13 @@ impl Pipeline {
         params: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let params = pairs(params)?;
-        let (values, jac) = match self.repeated(linear, z_input, cosmology, &params, jacobian)? {
+        let key = self.repeat_key(linear, z_input, cosmology, &params)?;
+        let (values, jac) = match self.repeated(key.as_ref(), &params, jacobian)? {
             Some(result) => result,
             None => {
                 let prepared = self.prepared(linear, z_input, cosmology)?;
                 let result = self.one(py, &prepared, &params, jacobian)?;
-                self.remember(linear, z_input, cosmology, &params, prepared)?;
+                *self.repeat.lock().expect("not poisoned") = key.map(|k| (k, prepared, None));
                 result
             }
         };

@@ -224,13 +224,7 @@ impl LinearEmulator {
     /// emulated ([`neutrino_settings`](Self::neutrino_settings)).
     pub fn spectra(&self, cosmology: &Cosmology, z: f64) -> Result<EmulatedSpectra> {
         let point = PriorPoint::of(cosmology)?;
-        let u = point.coordinates(
-            &self.file.prior,
-            &self.file.stated,
-            self.file.a_early,
-            self.file.q_max,
-            self.file.q_bound,
-        )?;
+        let u = self.coordinates(&point)?;
         let head = self.head(cosmology)?;
         let (z0, z1) = self.z_range();
         if !(z >= z0 - 1e-12 && z <= z1 + 1e-12) {
@@ -257,66 +251,28 @@ impl LinearEmulator {
             .take(n_x)
             .collect();
         let z = z.clamp(z0, z1);
-        let coefficients = coefficients(
-            &self.file.exponents,
-            &self.file.targets,
-            &u,
-            self.max_degree,
-        );
-        let head_coefficients = head.map(|h| {
-            let c = coefficients_of(h, &u, self.max_degree);
-            (h, c)
-        });
-        let shape_at = |z: f64| {
-            let mut shape = self.at_redshift(&self.file.targets, &coefficients, z);
-            if let Some((h, c)) = &head_coefficients {
-                shape.add(&self.at_redshift(&h.targets, c, z));
-            }
-            shape
-        };
+        let point_coefficients = self.point_coefficients(&u, head);
+        let shape_at = |z: f64| self.shape(&point_coefficients, head, z);
         // The emulated ln(P_m/P_cb), continuous as Σm_ν → 0: P_m = P_cb exactly without massive
         // neutrinos (the emulated ratio is then its own error, and the neutrino head is 0 too: the
         // settings differ only in how the mass is shared); below RATIO_TAPER the ratio's value at
         // Σm_ν = 0 (its polynomial's offset, 7e-4 to 1.2e-3) is removed in proportion, so that P_m
         // meets P_cb at 0 instead of jumping by the offset at 0⁺.
         let taper = (1.0 - m_nu / RATIO_TAPER).max(0.0);
-        let offset_at = |z: f64| -> Option<Vec<f64>> {
-            if m_nu <= 0.0 || taper == 0.0 {
-                return None;
-            }
-            let mut massless = point;
-            massless.values[3] = 0.0;
-            let u0 = massless
-                .coordinates(
-                    &self.file.prior,
-                    &self.file.stated,
-                    self.file.a_early,
-                    self.file.q_max,
-                    self.file.q_bound,
-                )
-                .ok()?;
-            let c0 = self::coefficients(
-                &self.file.exponents,
-                &self.file.targets,
-                &u0,
-                self.max_degree,
-            );
-            let mut shape = self.at_redshift(&self.file.targets, &c0, z);
-            if let Some(h) = head {
-                shape.add(&self.at_redshift(
-                    &h.targets,
-                    &coefficients_of(h, &u0, self.max_degree),
-                    z,
-                ));
-            }
-            Some(shape.ratio)
+        // the coefficients of the same point with Σm_ν = 0, if the taper applies
+        let massless = if m_nu > 0.0 && taper > 0.0 {
+            let mut p = point;
+            p.values[3] = 0.0;
+            Some(self.point_coefficients(&self.coordinates(&p)?, head))
+        } else {
+            None
         };
         let ln_ratio = |shape: &Shape, z: f64| -> Vec<f64> {
             if m_nu <= 0.0 {
                 return vec![0.0; shape.ratio.len()];
             }
-            match offset_at(z) {
-                Some(offset) => (shape.ratio.iter().zip(&offset))
+            match &massless {
+                Some(c) => (shape.ratio.iter().zip(&self.shape(c, head, z).ratio))
                     .map(|(r, o)| r - taper * o)
                     .collect(),
                 None => shape.ratio.clone(),
@@ -392,6 +348,43 @@ impl LinearEmulator {
             d_cb,
             f_cb: at_z.f_cb,
         })
+    }
+
+    /// The prior coordinates of `point` (the file's box, stated prior and early dark-energy bound).
+    fn coordinates(&self, point: &PriorPoint) -> Result<[f64; COORDINATES]> {
+        point.coordinates(
+            &self.file.prior,
+            &self.file.stated,
+            self.file.a_early,
+            self.file.q_max,
+            self.file.q_bound,
+        )
+    }
+
+    /// The polynomial coefficients of the targets (and of the neutrino `head`'s) at coordinates `u`.
+    fn point_coefficients(
+        &self,
+        u: &[f64; COORDINATES],
+        head: Option<&format::Head>,
+    ) -> ([Vec<f64>; 2], Option<[Vec<f64>; 2]>) {
+        (
+            coefficients(&self.file.exponents, &self.file.targets, u, self.max_degree),
+            head.map(|h| coefficients_of(h, u, self.max_degree)),
+        )
+    }
+
+    /// The targets at redshift `z` of a point's coefficients ([`Self::point_coefficients`]).
+    fn shape(
+        &self,
+        (c, head_c): &([Vec<f64>; 2], Option<[Vec<f64>; 2]>),
+        head: Option<&format::Head>,
+        z: f64,
+    ) -> Shape {
+        let mut shape = self.at_redshift(&self.file.targets, c, z);
+        if let (Some(h), Some(hc)) = (head, head_c) {
+            shape.add(&self.at_redshift(&h.targets, hc, z));
+        }
+        shape
     }
 
     /// The neutrino head of `cosmology`'s setting (`None`: three degenerate species, or massless).

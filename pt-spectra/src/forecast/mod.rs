@@ -30,10 +30,11 @@
 //! ([`Forecast::derivative_error`]). Exact cosmological derivatives are not built yet.
 
 mod covariance;
+mod parameters;
 #[cfg(test)]
 mod tests;
 
-use crate::cosmology::{Amplitude, Cosmology, EV_PER_OMEGA_NU};
+use crate::cosmology::Cosmology;
 use crate::error::{Error, Result};
 use crate::pipeline::{Pipeline, PipelineSettings, NUISANCE_NAMES};
 use crate::precision::Precision;
@@ -42,6 +43,7 @@ use crate::rsd::ap::Distortion;
 use crate::store::TableStore;
 use crate::survey::observe::Observation;
 pub use covariance::gaussian_covariance;
+use parameters::{check_cosmology, cosmology_value, with_cosmology_value};
 
 /// The cosmological parameters a forecast can vary: ω_cdm, ω_b, h, ln(10¹⁰A_s), n_s (flat, the
 /// fiducial's neutrinos and dark energy kept).
@@ -110,6 +112,53 @@ impl SurveyBin {
             priors: Vec::new(),
             b_k_max: None,
         }
+    }
+
+    /// The numeric keys of a bin besides the nuisance parameters ([`Self::from_values`]).
+    pub const KEYS: [&'static str; 8] = [
+        "z", "volume", "n_bar", "k_max", "b1", "k_min", "dk", "b_k_max",
+    ];
+
+    /// A bin from its values by name, as the faces take them: `z`, `volume`, `n_bar`, `k_max`, `b1`
+    /// (required), `k_min`, `dk`, `b_k_max` ([`Self::with_bispectrum`]) and fiducial nuisance values
+    /// by name; `what` names the bin in errors.
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] naming a missing or unknown key.
+    pub fn from_values(what: &str, values: &[(String, f64)]) -> Result<Self> {
+        let bad = |reason: String| Error::InvalidChoice {
+            what: what.to_string(),
+            reason,
+        };
+        let get = |key: &str| values.iter().find(|(k, _)| k == key).map(|p| p.1);
+        let required = |key: &str| get(key).ok_or_else(|| bad(format!("`{key}` is required")));
+        let mut bin = Self::new(
+            required("z")?,
+            required("volume")?,
+            required("n_bar")?,
+            required("k_max")?,
+            required("b1")?,
+        );
+        if let Some(b) = get("b_k_max") {
+            bin = bin.with_bispectrum(b);
+        }
+        bin.k_min = get("k_min").unwrap_or(bin.k_min);
+        bin.dk = get("dk").unwrap_or(bin.dk);
+        let valid = bin.parameter_names();
+        for (key, value) in values {
+            if Self::KEYS.contains(&key.as_str()) {
+                continue;
+            }
+            if !valid.contains(&key.as_str()) {
+                return Err(bad(format!(
+                    "unknown key `{key}` (valid: {}, and the nuisance parameters {})",
+                    Self::KEYS.join(", "),
+                    valid.join(", ")
+                )));
+            }
+            bin.nuisance.push((key.clone(), *value));
+        }
+        Ok(bin)
     }
 
     /// With the bispectrum monopole of the triangle bins up to `b_k_max` [h/Mpc], and its
@@ -347,14 +396,18 @@ pub fn fisher(
         let mut jacobian: Vec<Vec<f64>> = Vec::new();
         let f0 = step.growth_rate;
         let ap0 = step.ap.unwrap_or(Distortion::new(1.0, 1.0)?);
+        // the measured data vector of a step at growth rate f and distortion ap
+        let step_at = |f: f64, ap: Distortion| -> Result<Vec<f64>> {
+            let s = pipeline.step_with(prepared.tracer_spectrum(), f, Some(ap))?;
+            Ok(select(&s.data_vector(&nuisance)?))
+        };
         match parameters {
             Parameters::Template => {
                 // f: the data vector at f ± h (the power spectrum's terms do not depend on f; the
                 // bispectrum's, through the IR damping, do: a step at that f)
                 let with_f = |f: f64| -> Result<Vec<f64>> {
                     if with_b {
-                        let s = pipeline.step_with(prepared.tracer_spectrum(), f, Some(ap0))?;
-                        return Ok(select(&s.data_vector(&nuisance)?));
+                        return step_at(f, ap0);
                     }
                     let mut p = nuisance.clone();
                     p.push(("f", f));
@@ -371,8 +424,7 @@ pub fn fisher(
                         } else {
                             Distortion::new(ap0.apar, a)?
                         };
-                        let s = pipeline.step_with(prepared.tracer_spectrum(), f0, Some(ap))?;
-                        Ok(select(&s.data_vector(&nuisance)?))
+                        step_at(f0, ap)
                     };
                     let (d, e) = richardson(base, STEP, with_alpha)?;
                     worst = worst.max(e);
@@ -408,7 +460,12 @@ pub fn fisher(
             Some(step.linearise(None)?.jacobian(&nuisance)?)
         };
         for name in &bin.free {
-            let default = if name == "b_shot" { 1.0 } else { 0.0 };
+            // unset: 0, but the bispectrum's Poisson b_shot
+            let default = if name == "b_shot" {
+                crate::bispectrum::BispectrumParams::default().b_shot
+            } else {
+                0.0
+            };
             let x0 = nuisance
                 .iter()
                 .find(|(n, _)| n == name)
@@ -542,82 +599,9 @@ fn richardson(x: f64, h: f64, g: impl Fn(f64) -> Result<Vec<f64>>) -> Result<(Ve
     Ok((d, if scale > 0.0 { error / scale } else { 0.0 }))
 }
 
-fn check_cosmology(c: &Cosmology) -> Result<()> {
-    if (c.omega_m + c.omega_lambda - 1.0).abs() > 1e-9 {
-        return Err(Error::InvalidChoice {
-            what: "the forecast's fiducial cosmology".into(),
-            reason: "cosmological forecasts vary a flat cosmology (Omega_k = 0)".into(),
-        });
-    }
-    if !matches!(c.amplitude, Amplitude::As { .. }) {
-        return Err(Error::InvalidChoice {
-            what: "the forecast's fiducial cosmology".into(),
-            reason:
-                "cosmological forecasts vary ln(10^10 A_s): give the fiducial by A_s, not sigma8"
-                    .into(),
-        });
-    }
-    Ok(())
-}
-
-/// ω_ν of the fiducial's neutrinos.
-fn omega_nu(c: &Cosmology) -> f64 {
-    c.m_nu / EV_PER_OMEGA_NU
-}
-
-/// The value of cosmological parameter `name` ([`COSMOLOGY_NAMES`]) of `c`.
-fn cosmology_value(c: &Cosmology, name: &str) -> f64 {
-    let h2 = c.h * c.h;
-    match name {
-        "omega_cdm" => c.omega_m * h2 - c.omega_b_h2 - omega_nu(c),
-        "omega_b" => c.omega_b_h2,
-        "h" => c.h,
-        "logA" => match c.amplitude {
-            Amplitude::As { a_s, .. } => (1e10 * a_s).ln(),
-            Amplitude::Sigma8(_) => f64::NAN,
-        },
-        _ => c.n_s,
-    }
-}
-
-/// `c` with cosmological parameter `name` set to `x`, ω_cdm, ω_b and ω_ν kept where not varied (flat).
-fn with_cosmology_value(c: &Cosmology, name: &str, x: f64) -> Result<Cosmology> {
-    let mut out = *c;
-    let (mut w_cdm, mut w_b, mut h) = (cosmology_value(c, "omega_cdm"), c.omega_b_h2, c.h);
-    match name {
-        "omega_cdm" => w_cdm = x,
-        "omega_b" => w_b = x,
-        "h" => h = x,
-        "logA" => {
-            if let Amplitude::As { k_pivot, .. } = c.amplitude {
-                out.amplitude = Amplitude::As {
-                    a_s: x.exp() * 1e-10,
-                    k_pivot,
-                };
-            }
-        }
-        _ => out.n_s = x,
-    }
-    out.h = h;
-    out.omega_b_h2 = w_b;
-    out.omega_m = (w_cdm + w_b + omega_nu(c)) / (h * h);
-    out.omega_lambda = 1.0 - out.omega_m;
-    out.validate()?;
-    Ok(out)
-}
-
-/// The inverse of a symmetric positive-definite matrix (Cholesky), or `None`.
+/// The inverse of a symmetric positive-definite matrix ([`crate::linalg::solve_spd`]), or `None`.
 fn invert_spd(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
-    let l = crate::linalg::cholesky(a)?;
-    let li = crate::linalg::invert_lower(&l);
-    let n = a.len();
-    Some(
-        (0..n)
-            .map(|i| {
-                (0..n)
-                    .map(|j| (i.max(j)..n).map(|m| li[m][i] * li[m][j]).sum())
-                    .collect()
-            })
-            .collect(),
-    )
+    crate::linalg::solve_spd(a, &vec![0.0; a.len()])
+        .ok()
+        .map(|(_, inverse, _)| inverse)
 }

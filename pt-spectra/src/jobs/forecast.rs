@@ -9,7 +9,8 @@ use crate::setup::NamedCosmology;
 use crate::store::TableStore;
 
 /// Parses a bin given as `z=0.57,volume=2.6e9,n_bar=3e-4,k_max=0.15,b1=2` (and optionally k_min,
-/// dk, and nuisance values by name); `ells` and `free` apply to it.
+/// dk, b_k_max and nuisance values by name: [`SurveyBin::from_values`]); `ells` and `free` apply to
+/// it.
 ///
 /// # Errors
 /// [`crate::error::Error::InvalidChoice`] naming a key that is missing, unknown or not a number.
@@ -29,20 +30,7 @@ pub fn parse_bin(text: &str, ells: &[usize], free: &[String]) -> Result<SurveyBi
             .map_err(|_| bad(format!("{key} = `{value}` is not a number")))?;
         pairs.push((key.trim().to_string(), value));
     }
-    let get = |key: &str| pairs.iter().find(|(k, _)| k == key).map(|p| p.1);
-    let required = |key: &str| get(key).ok_or_else(|| bad(format!("`{key}` is required")));
-    let mut bin = SurveyBin::new(
-        required("z")?,
-        required("volume")?,
-        required("n_bar")?,
-        required("k_max")?,
-        required("b1")?,
-    );
-    if let Some(b) = get("b_k_max") {
-        bin = bin.with_bispectrum(b);
-    }
-    bin.k_min = get("k_min").unwrap_or(bin.k_min);
-    bin.dk = get("dk").unwrap_or(bin.dk);
+    let mut bin = SurveyBin::from_values(&format!("survey bin `{text}`"), &pairs)?;
     bin.ells = ells.to_vec();
     if !free.is_empty() {
         bin.free = free.to_vec();
@@ -53,21 +41,6 @@ pub fn parse_bin(text: &str, ells: &[usize], free: &[String]) -> Result<SurveyBi
                     .map(|s| s.to_string()),
             );
         }
-    }
-    const KEYS: [&str; 7] = ["z", "volume", "n_bar", "k_max", "k_min", "dk", "b_k_max"];
-    for (key, value) in pairs {
-        if KEYS.contains(&key.as_str()) || key == "b1" {
-            continue;
-        }
-        let valid = bin.parameter_names();
-        if !valid.contains(&key.as_str()) {
-            return Err(bad(format!(
-                "unknown key `{key}` (valid: {}, and the nuisance parameters {})",
-                KEYS.join(", "),
-                valid.join(", ")
-            )));
-        }
-        bin.nuisance.push((key, value));
     }
     Ok(bin)
 }

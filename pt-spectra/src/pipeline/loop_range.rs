@@ -12,7 +12,7 @@
 //! k, then divided by the AP range's extremes (the loops are in true k). The measured change is kept
 //! ([`super::Pipeline::loop_range`]) and stated.
 
-use super::observation_matrix;
+use super::apply_matrix;
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
@@ -29,11 +29,12 @@ const LOW_FACTORS: [f64; 4] = [1.0 / 16.0, 1.0 / 8.0, 1.0 / 4.0, 1.0 / 2.0];
 /// The upper ends tried: the largest measured k times these (widest first).
 const HIGH_FACTORS: [f64; 3] = [2.0, 1.5, 1.25];
 
-/// The chosen range in true k [h/Mpc] and its measured change of the reference data vector
+/// The chosen range, for the observation's `matrix` ([`super::Pipeline::observation_matrix`]), in true k [h/Mpc] and its measured change of the reference data vector
 /// (relative, as [`LOOP_RANGE_TOLERANCE`]); `None` if no candidate is narrower than the model's grid
 /// or none passes.
 pub(super) fn choose(
     observation: &Observation,
+    matrix: &[f64],
     settings: &EptSettings,
     z: f64,
 ) -> Result<Option<((f64, f64), f64)>> {
@@ -48,7 +49,7 @@ pub(super) fn choose(
     // observed k to true k: the loops must cover k/α for every α of the plan's AP range
     let (a_lo, a_hi) = settings.ap_range.unwrap_or((1.0, 1.0));
     let spectrum = reference_spectrum(z)?;
-    let (matrix, rows) = observation_matrix(observation)?;
+
     let ells = observation.model_ells();
     let f = crate::cosmology::Cosmology::gm2012().growth_rate(z);
     let ap = settings
@@ -66,16 +67,14 @@ pub(super) fn choose(
             lo.map_or(0.0, |l| l / a_hi),
             hi.map_or(f64::INFINITY, |h| h / a_lo),
         );
-        let model = plan.multipole_values_at(&cut, &params, ells, ap)?;
-        let flat: Vec<f64> = model.into_iter().flatten().collect();
-        Ok(matrix
-            .chunks_exact(flat.len())
-            .map(|row| crate::linalg::dot(row, &flat))
-            .collect())
+        Ok(apply_matrix(
+            matrix,
+            &plan.multipole_values_at(&cut, &params, ells, ap)?,
+        ))
     };
     let full = data(None, None)?;
     // per row, the largest |value| of its output multipole's block
-    let block = rows / observation.ells().len();
+    let block = full.len() / observation.ells().len();
     let scale: Vec<f64> = full
         .chunks(block)
         .flat_map(|b| {

@@ -193,8 +193,9 @@ impl Pipeline {
             ap_range: settings.fiducial.as_ref().map(|_| AP_FIT_RANGE),
             loop_range: None,
         };
+        let (matrix, rows) = observation_matrix(&observation)?;
         let chosen = if settings.restrict_loops {
-            loop_range::choose(&observation, &ept, settings.z)?
+            loop_range::choose(&observation, &matrix, &ept, settings.z)?
         } else {
             None
         };
@@ -208,7 +209,6 @@ impl Pipeline {
         )?
         .with_basis(store, progress)?
         .with_max_residual(settings.max_residual)?;
-        let (matrix, rows) = observation_matrix(&observation)?;
         let bispectrum = settings
             .bispectrum
             .clone()
@@ -422,11 +422,7 @@ impl Pipeline {
 
     /// `M` times the model multipoles (`model[j]`: model ℓ j on the model k).
     fn observe(&self, model: &[Vec<f64>]) -> Vec<f64> {
-        let flat: Vec<f64> = model.iter().flatten().copied().collect();
-        self.matrix
-            .chunks_exact(flat.len())
-            .map(|row| crate::simd::dot(row, &flat))
-            .collect()
+        apply_matrix(&self.matrix, model)
     }
 }
 
@@ -496,6 +492,16 @@ impl CosmologyStep<'_> {
     pub fn has_bispectrum(&self) -> bool {
         self.bispectrum.is_some()
     }
+}
+
+/// `matrix` (row-major, model ℓ's × model k columns) times the model multipoles (`model[j]`: model
+/// ℓ j on the model k).
+fn apply_matrix(matrix: &[f64], model: &[Vec<f64>]) -> Vec<f64> {
+    let flat: Vec<f64> = model.iter().flatten().copied().collect();
+    matrix
+        .chunks_exact(flat.len())
+        .map(|row| crate::simd::dot(row, &flat))
+        .collect()
 }
 
 /// The observation's matrix by columns: the chain applied to each unit model vector.
