@@ -41,6 +41,8 @@ pub enum Stage {
     RedshiftBasis,
     /// The one-loop bispectrum's integrals (per triangle).
     OneLoopBispectrum,
+    /// The one-loop bispectrum's basis tensors of a triangle set (once; cached).
+    OneLoopBispectrumBasis,
 }
 
 impl fmt::Display for Stage {
@@ -56,6 +58,9 @@ impl fmt::Display for Stage {
             Stage::TnsBasis => "TNS basis tensors (once per k grid; cached)",
             Stage::RedshiftBasis => "galaxy-model basis tensors (once per k grid; cached)",
             Stage::OneLoopBispectrum => "one-loop bispectrum (per triangle)",
+            Stage::OneLoopBispectrumBasis => {
+                "one-loop bispectrum basis tensors (once per triangle set; cached)"
+            }
         })
     }
 }

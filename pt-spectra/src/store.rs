@@ -396,6 +396,7 @@ fn load<T>(
     Ok(t)
 }
 
+mod bispectrum;
 mod file;
 mod rsd_two_loop;
 

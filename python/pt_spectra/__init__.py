@@ -585,7 +585,7 @@ def bispectrum(triangles=None, bin_width=None, linear=None, z=0.0, z_input=0.0, 
 
 
 def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, q_min=1e-4,
-                        q_max=10.0, radial=12, mu=32, phi=24):
+                        q_max=10.0, radial=12, mu=32, phi=24, two_loop="auto", cache_dir=None):
     """One-loop matter bispectrum in real space (SPT) [(Mpc/h)^6] at single triangles.
 
     ``triangles``: an (n, 3) array of k1, k2, k3 [h/Mpc] (points, not bins). The linear spectrum as in
@@ -595,6 +595,13 @@ def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=No
     B_1loop, their err_ columns, and the four EFT counterterm shapes shape_ct_f2, shape_ct_k3,
     shape_ct_tidal, shape_ct_f2k3 [(Mpc/h)^8] (B_ct = sum of ct_c * shape_ct_c, ct_c in (Mpc/h)^2, not
     included in B_1loop). No bias or redshift space yet (docs/bispectrum.md).
+
+    ``two_loop`` says how the loop terms are computed, as for the power spectra: ``"basis"`` (tensors
+    built once per triangle set and rule, ~0.7 s per triangle and core, cached in ``cache_dir``
+    (default: $PT_SPECTRA_CACHE, else ~/.cache/pt-spectra); then ~10 us per triangle for any linear
+    spectrum, their projection error included in the errors; a spectrum the basis does not represent
+    is integrated directly, as the header says), ``"direct"`` or ``"auto"`` (the tensors if cached,
+    else direct). The header line ``loop terms: ...`` says which was used.
     """
     return _warn(_core.one_loop_bispectrum(triangles, linear, z, z_input, cosmology, eh, q_min, q_max,
-                                           radial, mu, phi))
+                                           radial, mu, phi, two_loop, cache_dir))

@@ -447,10 +447,15 @@ impl SugiyamaTerms {
 /// [h/Mpc], points, not bins) as a `Table` with columns k1 k2 k3 B_tree B222 B321_I B321_II B411
 /// B_1loop and their `err_` columns [(Mpc/h)^6], for the all-matter linear spectrum of the inputs
 /// (as `pt.bispectrum`). The loop integrals run over q_min <= |q| <= q_max [h/Mpc] with `radial`
-/// x `mu` x `phi` nodes per panel; each error is the difference from half the nodes.
+/// x `mu` x `phi` nodes per panel; each error is the difference from half the nodes. `two_loop`
+/// says how the loop terms are computed, as everywhere: "basis" (tensors built once per triangle
+/// set and rule, ~0.7 s per triangle and core, cached in `cache_dir`; then ~10 us per triangle;
+/// their projection error is in the errors), "direct" (~0.5 s per triangle), "auto" (the tensors if
+/// cached, else direct). The header says which was used (its line `loop terms: ...`).
 #[pyfunction]
 #[pyo3(signature = (triangles, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None,
-    q_min=1e-4, q_max=10.0, radial=12, mu=32, phi=24))]
+    q_min=1e-4, q_max=10.0, radial=12, mu=32, phi=24,
+    two_loop=pt_spectra::jobs::defaults::TWO_LOOP, cache_dir=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn one_loop_bispectrum(
     py: Python<'_>,
@@ -465,8 +470,12 @@ pub fn one_loop_bispectrum(
     radial: usize,
     mu: usize,
     phi: usize,
+    two_loop: &str,
+    cache_dir: Option<std::path::PathBuf>,
 ) -> PyResult<Table> {
     let rows = fixed_rows::<3>(triangles, "triangles", "k1, k2, k3")?;
+    let method: pt_spectra::precision::TwoLoopMethod = two_loop.parse().map_err(library_error)?;
+    let store = crate::Store::new(cache_dir);
     let rule = bk::one_loop::OneLoopRule {
         radial,
         mu,
@@ -481,6 +490,8 @@ pub fn one_loop_bispectrum(
             &prepared,
             &rows,
             &rule,
+            method,
+            store.get(),
             &pt_spectra::progress::Silent,
         )?;
         Ok((prepared, table))

@@ -2,6 +2,8 @@
 //! linear spectrum ≤ 0.2 ms; a parameter step ≤ 20 µs): the terms of a new spectrum (f, AP, FoG and IR
 //! resummation as a fit varies them) and the contraction with new bias and stochastic parameters.
 //!
+//! The one-loop matter bispectrum (issue 50) through its basis tensors and directly.
+//!
 //! Run with `RAYON_NUM_THREADS=1 cargo bench -p pt-spectra-tests --bench bispectrum` for one core (the
 //! terms are computed triangle by triangle in parallel otherwise).
 
@@ -70,9 +72,52 @@ fn bispectrum(crit: &mut Criterion) {
     );
 }
 
+/// The one-loop matter bispectrum (issue 50: ≤ 10 ms per new spectrum through the basis) at the 62
+/// Nseries triangles (their centres: the bins' averages are not built for the one-loop terms yet),
+/// the default rule, through the basis tensors (built once, cached in `$PT_SPECTRA_CACHE`), and one
+/// triangle directly for comparison.
+fn one_loop(crit: &mut Criterion) {
+    use pt_spectra::bispectrum::one_loop::{one_loop_matter, OneLoopRule};
+    use pt_spectra::bispectrum::one_loop_basis::OneLoopMatterPlan;
+    let triangles: Vec<[f64; 3]> = nseries().triangles().to_vec();
+    let rule = OneLoopRule::default();
+    let store = pt_spectra::store::TableStore::from_env();
+    let start = std::time::Instant::now();
+    let tensors = store
+        .one_loop_bispectrum_basis(&triangles, &rule, &pt_spectra::progress::Silent)
+        .unwrap();
+    eprintln!(
+        "one-loop bispectrum tensors of {} triangles: {:.1} s (or read from the cache)",
+        triangles.len(),
+        start.elapsed().as_secs_f64()
+    );
+    let plan = OneLoopMatterPlan::new(triangles, rule)
+        .unwrap()
+        .with_basis(tensors)
+        .unwrap();
+    let spectra: Vec<LinearSpectrum> = [0.0, 0.5, 1.0, 1.5]
+        .iter()
+        .map(|&z| LinearSpectrum::gm2012(z).unwrap())
+        .collect();
+    let mut i = 0;
+    crit.bench_function(
+        "bispectrum/one-loop matter B of 62 Nseries triangles, new spectrum, basis",
+        |b| {
+            b.iter(|| {
+                i += 1;
+                black_box(plan.evaluate(&spectra[i % spectra.len()]).unwrap())
+            })
+        },
+    );
+    crit.bench_function(
+        "bispectrum/one-loop matter B of one triangle, direct",
+        |b| b.iter(|| black_box(one_loop_matter(&spectra[0], [0.1, 0.1, 0.1], &rule).unwrap())),
+    );
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(10);
-    targets = bispectrum
+    targets = bispectrum, one_loop
 }
 criterion_main!(benches);

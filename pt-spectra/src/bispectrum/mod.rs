@@ -46,6 +46,7 @@ mod box_modes;
 mod geometry;
 mod observed;
 pub mod one_loop;
+pub mod one_loop_basis;
 mod resum;
 mod sampled;
 mod sugiyama;

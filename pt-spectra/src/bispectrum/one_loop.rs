@@ -75,7 +75,7 @@ impl Default for OneLoopRule {
 }
 
 impl OneLoopRule {
-    fn validate(&self) -> Result<()> {
+    pub(super) fn validate(&self) -> Result<()> {
         if self.radial < 2 || self.mu < 2 || self.phi < 2 {
             return Err(Error::InvalidChoice {
                 what: format!(
@@ -97,7 +97,7 @@ impl OneLoopRule {
     }
 
     /// The rule with half as many nodes in each dimension (the error's comparison).
-    fn half(&self) -> Self {
+    pub(super) fn half(&self) -> Self {
         Self {
             radial: (self.radial / 2).max(1),
             mu: (self.mu / 2).max(1),
@@ -166,10 +166,10 @@ impl OneLoopMatter {
     }
 }
 
-type Vec3 = [f64; 3];
+pub(super) type Vec3 = [f64; 3];
 
 /// F_n^s of the vectors; 0 where a vector is zero (a node never is: the rules avoid the centres).
-fn f_n(q: &[Vec3]) -> f64 {
+pub(super) fn f_n(q: &[Vec3]) -> f64 {
     pt_kernels::kernels(q).map_or(0.0, |[f, _]| f)
 }
 
@@ -189,8 +189,9 @@ pub fn triangle_vectors(k: [f64; 3]) -> Result<[Vec3; 3]> {
     Ok([v1, v2, neg(add(v1, v2))])
 }
 
-/// The nodes p and weights of one piece's rule (weights include p² dp dΩ/(2π)³ and the φ symmetry).
-fn nodes(rule: &OneLoopRule, breaks: &[f64]) -> Vec<(Vec3, f64)> {
+/// The radial nodes (q, weight) of one piece's rule: Gauss–Legendre in ln q on panels of at most a
+/// factor 3 in q, broken at `breaks` inside [q_min, q_max]; the weight includes q³ (q² dq = q³ d ln q).
+pub(super) fn radial_nodes(rule: &OneLoopRule, breaks: &[f64]) -> Vec<(f64, f64)> {
     let mut edges: Vec<f64> = breaks
         .iter()
         .copied()
@@ -198,41 +199,63 @@ fn nodes(rule: &OneLoopRule, breaks: &[f64]) -> Vec<(Vec3, f64)> {
         .chain([rule.q_min, rule.q_max])
         .map(f64::ln)
         .collect();
-    // Panels of at most a factor 3 in q.
     edges.sort_by(f64::total_cmp);
-    let mut panels = Vec::new();
+    let (xr, wr) = legendre_nodes(rule.radial);
+    let mut out = Vec::new();
     for w in edges.windows(2) {
         let n = ((w[1] - w[0]) / 3f64.ln()).ceil().max(1.0) as usize;
+        let h = (w[1] - w[0]) / n as f64;
         for i in 0..n {
-            let h = (w[1] - w[0]) / n as f64;
-            panels.push((w[0] + i as f64 * h, w[0] + (i + 1) as f64 * h));
-        }
-    }
-    let (xr, wr) = legendre_nodes(rule.radial);
-    let (xm, wm) = legendre_nodes(rule.mu);
-    let dphi = PI / rule.phi as f64;
-    let mut out = Vec::with_capacity(panels.len() * rule.radial * rule.mu * rule.phi);
-    let norm = 2.0 / (2.0 * PI).powi(3); // φ ∈ [0, π] counted twice; d³q/(2π)³
-    for (a, b) in panels {
-        let half = 0.5 * (b - a);
-        for (x, w) in xr.iter().zip(&wr) {
-            let p = (a + half * (x + 1.0)).exp();
-            let radial = w * half * p.powi(3); // p² dp = p³ d ln p
-            for (mu, wmu) in xm.iter().zip(&wm) {
-                let s = (1.0 - mu * mu).sqrt();
-                for j in 0..rule.phi {
-                    let phi = (j as f64 + 0.5) * dphi;
-                    let v = [p * s * phi.cos(), p * s * phi.sin(), p * mu];
-                    out.push((v, norm * radial * wmu * dphi));
-                }
+            let (a, half) = (w[0] + i as f64 * h, 0.5 * h);
+            for (x, wx) in xr.iter().zip(&wr) {
+                let q = (a + half * (x + 1.0)).exp();
+                out.push((q, wx * half * q.powi(3)));
             }
         }
     }
     out
 }
 
+/// The angular nodes (unit vector, weight) of one piece's rule: Gauss–Legendre in cos θ, midpoints
+/// in φ ∈ [0, π] (counted twice: the integrands are even in φ); the weights include 1/(2π)³.
+pub(super) fn angular_nodes(rule: &OneLoopRule) -> Vec<(Vec3, f64)> {
+    let (xm, wm) = legendre_nodes(rule.mu);
+    let dphi = PI / rule.phi as f64;
+    let norm = 2.0 / (2.0 * PI).powi(3);
+    let mut out = Vec::with_capacity(rule.mu * rule.phi);
+    for (mu, wmu) in xm.iter().zip(&wm) {
+        let s = (1.0 - mu * mu).sqrt();
+        for j in 0..rule.phi {
+            let phi = (j as f64 + 0.5) * dphi;
+            out.push(([s * phi.cos(), s * phi.sin(), *mu], norm * wmu * dphi));
+        }
+    }
+    out
+}
+
+/// The panel breaks of a triangle: every side, half side and double side.
+pub(super) fn breaks(k: &[f64; 3]) -> Vec<f64> {
+    let mut b: Vec<f64> = k.iter().flat_map(|&v| [v, 0.5 * v, 2.0 * v]).collect();
+    b.sort_by(f64::total_cmp);
+    b
+}
+
+/// The nodes q and weights of one piece's rule (weights include q² dq dΩ/(2π)³ and the φ symmetry):
+/// the product of [`radial_nodes`] and [`angular_nodes`].
+fn nodes(rule: &OneLoopRule, breaks: &[f64]) -> Vec<(Vec3, f64)> {
+    let angular = angular_nodes(rule);
+    radial_nodes(rule, breaks)
+        .into_iter()
+        .flat_map(|(q, wq)| angular.iter().map(move |&(u, wu)| (scale(u, q), wq * wu)))
+        .collect()
+}
+
+fn scale(u: Vec3, q: f64) -> Vec3 {
+    u.map(|x| x * q)
+}
+
 /// The partition weight of the point at distance `r[j]` among the distances `r`.
-fn partition(r: &[f64], j: usize) -> f64 {
+pub(super) fn partition(r: &[f64], j: usize) -> f64 {
     let rj = r[j];
     1.0 / r
         .iter()
@@ -242,11 +265,9 @@ fn partition(r: &[f64], j: usize) -> f64 {
 
 /// The loop terms [b222, b321_i, b411, J_a (3)] on one rule.
 fn loop_integrals(p: &LinearSpectrum, kv: &[Vec3; 3], rule: &OneLoopRule) -> [f64; 6] {
-    let k: Vec<f64> = kv.iter().map(|v| norm(*v)).collect();
-    let pk: Vec<f64> = k.iter().map(|&v| p.eval(v)).collect();
-    let mut breaks: Vec<f64> = k.iter().flat_map(|&v| [v, 0.5 * v, 2.0 * v]).collect();
-    breaks.sort_by(f64::total_cmp);
-    let grid = nodes(rule, &breaks);
+    let k = kv.map(norm);
+    let pk = k.map(|v| p.eval(v));
+    let grid = nodes(rule, &breaks(&k));
     let (k1, k2) = (kv[0], kv[1]);
     grid.par_iter()
         .map(|&(v, w)| {
@@ -282,6 +303,27 @@ fn loop_integrals(p: &LinearSpectrum, kv: &[Vec3; 3], rule: &OneLoopRule) -> [f6
         .reduce(|| [0.0; 6], |a, b| std::array::from_fn(|i| a[i] + b[i]))
 }
 
+/// The tree level B₁₁₂ and the four counterterm shapes of [`COUNTERTERMS`] of the triangle `kv` with
+/// the spectrum `pk` at its sides.
+pub(super) fn tree_and_counterterms(kv: &[Vec3; 3], pk: &[f64; 3]) -> (f64, [f64; 4]) {
+    let k = kv.map(norm);
+    let f2 = |a: usize, b: usize| f_n(&[kv[a], kv[b]]);
+    let tree =
+        2.0 * (f2(0, 1) * pk[0] * pk[1] + f2(1, 2) * pk[1] * pk[2] + f2(2, 0) * pk[2] * pk[0]);
+    let mut shapes = [0.0; 4];
+    for i in 0..3 {
+        let (j, l) = ((i + 1) % 3, (i + 2) % 3);
+        let pp = 2.0 * pk[i] * pk[j];
+        let mu = (k[l] * k[l] - k[i] * k[i] - k[j] * k[j]) / (2.0 * k[i] * k[j]);
+        let (f, kl2, kij2) = (f2(i, j), k[l] * k[l], k[i] * k[i] + k[j] * k[j]);
+        shapes[0] += pp * f * kij2;
+        shapes[1] += pp * kl2;
+        shapes[2] += pp * kl2 * (mu * mu - 1.0 / 3.0);
+        shapes[3] += pp * f * kl2;
+    }
+    (tree, shapes)
+}
+
 /// The one-loop matter bispectrum terms of the triangle of sides `k` [h/Mpc] of the linear spectrum
 /// `p` (at the redshift of `p`: the terms scale as D⁴ and D⁶ of the tree), with `rule`.
 ///
@@ -296,19 +338,7 @@ pub fn one_loop_matter(
     let kv = triangle_vectors(k)?;
     let pk = k.map(|v| p.eval(v));
     let f2 = |a: usize, b: usize| f_n(&[kv[a], kv[b]]);
-    let tree =
-        2.0 * (f2(0, 1) * pk[0] * pk[1] + f2(1, 2) * pk[1] * pk[2] + f2(2, 0) * pk[2] * pk[0]);
-    let mut counterterm_shapes = [0.0; 4];
-    for i in 0..3 {
-        let (j, l) = ((i + 1) % 3, (i + 2) % 3);
-        let pp = 2.0 * pk[i] * pk[j];
-        let mu = (k[l] * k[l] - k[i] * k[i] - k[j] * k[j]) / (2.0 * k[i] * k[j]);
-        let (f, kl2, kij2) = (f2(i, j), k[l] * k[l], k[i] * k[i] + k[j] * k[j]);
-        counterterm_shapes[0] += pp * f * kij2;
-        counterterm_shapes[1] += pp * kl2;
-        counterterm_shapes[2] += pp * kl2 * (mu * mu - 1.0 / 3.0);
-        counterterm_shapes[3] += pp * f * kl2;
-    }
+    let (tree, counterterm_shapes) = tree_and_counterterms(&kv, &pk);
     let fine = loop_integrals(p, &kv, rule);
     let coarse = loop_integrals(p, &kv, &rule.half());
     let estimate = |i: usize| Estimate::new(fine[i], (fine[i] - coarse[i]).abs());

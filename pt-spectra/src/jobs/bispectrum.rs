@@ -3,9 +3,8 @@
 //! its header.
 
 use super::VERSION;
-use crate::bispectrum::one_loop::{
-    one_loop_matter, OneLoopMatter, OneLoopRule, COUNTERTERMS, PARTITION_POWER,
-};
+use crate::bispectrum::one_loop::{OneLoopMatter, OneLoopRule, COUNTERTERMS, PARTITION_POWER};
+use crate::bispectrum::one_loop_basis::{OneLoopMatterPlan, OneLoopSource};
 use crate::bispectrum::{
     BispectrumParams, BispectrumPlan, BoxPlan, Fog, LegendreSide, PlanRules, Settings,
     SugiyamaPlan, SugiyamaRules, TriangleSet, SUGIYAMA_MULTIPOLES,
@@ -13,8 +12,10 @@ use crate::bispectrum::{
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
 use crate::output::{Table, BISPECTRUM, BISPECTRUM_SHAPE, WAVENUMBER};
+use crate::precision::TwoLoopMethod;
 use crate::progress::{Progress, Stage};
 use crate::setup::Prepared;
+use crate::store::TableStore;
 
 /// What `bispectrum` computes beyond the linear spectrum.
 #[derive(Debug, Clone)]
@@ -236,25 +237,35 @@ pub fn sugiyama_table(prepared: &Prepared, request: &SugiyamaRequest) -> Result<
 
 /// The table `k1 k2 k3 B_tree B222 B321_I B321_II B411 B_1loop` and their `err_` columns of the one-loop
 /// matter bispectrum in real space at `triangles` (points) for the all-matter linear spectrum of
-/// `prepared` ([`crate::bispectrum::one_loop`]), reporting each triangle to `progress`.
+/// `prepared` ([`crate::bispectrum::one_loop`]), the loop terms computed by `method`: `direct`, `basis`
+/// (the tensors of [`crate::bispectrum::one_loop_basis`] from `store`, built once and cached) or `auto`
+/// (the tensors if cached, else direct); direct integrals report each triangle to `progress`.
 ///
 /// # Errors
-/// As [`one_loop_matter`] (sides that do not close, a bad rule), naming the triangle.
+/// As [`OneLoopMatterPlan::new`] (sides that do not close, naming the triangle; a bad rule).
 pub fn one_loop_bispectrum_table(
     prepared: &Prepared,
     triangles: &[[f64; 3]],
     rule: &OneLoopRule,
+    method: TwoLoopMethod,
+    store: &TableStore,
     progress: &dyn Progress,
 ) -> Result<Table> {
-    let mut rows = Vec::with_capacity(triangles.len());
-    for (i, k) in triangles.iter().enumerate() {
-        let b =
-            one_loop_matter(&prepared.spectrum, *k, rule).map_err(|e| Error::InvalidChoice {
-                what: format!("triangle {} ({}, {}, {})", i + 1, k[0], k[1], k[2]),
-                reason: e.to_string(),
-            })?;
-        rows.push(b);
-        progress.update(Stage::OneLoopBispectrum, i + 1, triangles.len());
+    let mut plan = OneLoopMatterPlan::new(triangles.to_vec(), *rule)?;
+    let tensors = match method {
+        TwoLoopMethod::Direct => None,
+        TwoLoopMethod::Basis => Some(store.one_loop_bispectrum_basis(triangles, rule, progress)?),
+        TwoLoopMethod::Auto => store.cached_one_loop_bispectrum_basis(triangles, rule, progress),
+    };
+    let uncached = method == TwoLoopMethod::Auto && tensors.is_none();
+    if let Some(t) = tensors {
+        plan = plan.with_basis(t)?;
+    }
+    let (rows, mut source) = plan.evaluate_reporting(&prepared.spectrum, &|d, t| {
+        progress.update(Stage::OneLoopBispectrum, d, t);
+    })?;
+    if uncached {
+        source = OneLoopSource::DirectUncached;
     }
     let mut header = vec![
         format!(
@@ -270,6 +281,7 @@ pub fn one_loop_bispectrum_table(
              {} ln q x {} cos(theta) x {} phi nodes per panel; err_: difference from the rule with half the nodes",
             rule.q_min, rule.q_max, PARTITION_POWER, rule.radial, rule.mu, rule.phi
         ),
+        source.describe(),
         "at the given triangles (not averaged over bins); linear spectrum: all matter".into(),
     ];
     if prepared.spectrum_cb.is_some() {

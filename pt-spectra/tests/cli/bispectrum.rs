@@ -335,6 +335,41 @@ fn one_loop_matter_terms_at_triangles_and_refusals() {
             r[14]
         );
     }
+    // Through the basis tensors (built in a private cache, then read back): every column within the
+    // direct run's and its own errors, and the header says how the loop terms were computed.
+    assert!(out.contains("loop terms: direct integration"), "{out}");
+    let cache = std::env::temp_dir().join(format!("pt-spectra-bk1-cache-{}", std::process::id()));
+    let cache_arg = cache.to_str().unwrap();
+    for _ in 0..2 {
+        let (ok, basis, err) = run(&[
+            "bispectrum",
+            "--loop",
+            "1",
+            "--triangles",
+            path,
+            "--two-loop",
+            "basis",
+            "--cache-dir",
+            cache_arg,
+        ]);
+        assert!(ok, "{err}");
+        assert!(
+            basis.contains("loop terms: basis tensors on 36 functions"),
+            "{basis}"
+        );
+        for (b, d) in rows(&basis).iter().zip(rows(&out)) {
+            for j in 3..9 {
+                let tol = b[j + 6] + d[j + 6];
+                assert!(
+                    (b[j] - d[j]).abs() <= tol,
+                    "column {j}: {} vs {} (+- {tol})",
+                    b[j],
+                    d[j]
+                );
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&cache);
     let with = |extra: &[&'static str]| {
         let mut a = vec!["bispectrum", "--loop", "1", "--triangles", path];
         a.extend(extra);

@@ -123,9 +123,10 @@ pub struct SpectrumInput {
     /// Default: $PT_SPECTRA_MAX_MEMORY, else half of the machine's memory.
     #[arg(long, value_name = "SIZE", value_parser = parse_max_memory)]
     max_memory: Option<f64>,
-    /// How the loop terms are computed (1-loop, TNS, the galaxy model `ept`, 2-loop): `basis`
-    /// (precomputed tensors contracted with the spectrum's projection on a basis of linear spectra;
-    /// built and cached once per k grid, seconds, minutes for 2-loop, then a fraction of a millisecond
+    /// How the loop terms are computed (1-loop, TNS, the galaxy model `ept`, 2-loop, the one-loop
+    /// bispectrum): `basis` (precomputed tensors contracted with the spectrum's projection on a basis
+    /// of linear spectra; built and cached once per k grid or triangle set, seconds, minutes for
+    /// 2-loop and ~0.7 s per triangle for the bispectrum, then a fraction of a millisecond
     /// to milliseconds per spectrum; a spectrum the basis does not represent is computed directly,
     /// with a note), `direct` (integrals for every spectrum), or `auto` (basis if the tensors of this
     /// grid are already cached, else direct). The header says which was used.
