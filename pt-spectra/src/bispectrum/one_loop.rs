@@ -217,15 +217,22 @@ pub(super) fn radial_nodes(rule: &OneLoopRule, breaks: &[f64]) -> Vec<(f64, f64)
 }
 
 /// The angular nodes (unit vector, weight) of one piece's rule: Gauss–Legendre in cos θ, midpoints
-/// in φ ∈ [0, π] (counted twice: the integrands are even in φ); the weights include 1/(2π)³.
-pub(super) fn angular_nodes(rule: &OneLoopRule) -> Vec<(Vec3, f64)> {
+/// in φ ∈ [0, π] (counted twice) if the integrands are even in φ (`mirror`: the triangle's plane is a
+/// mirror of the integrand, as in real space), else `2 phi` midpoints in φ ∈ [0, 2π); the weights
+/// include 1/(2π)³.
+pub(super) fn angular_nodes(rule: &OneLoopRule, mirror: bool) -> Vec<(Vec3, f64)> {
     let (xm, wm) = legendre_nodes(rule.mu);
+    let (n_phi, copies) = if mirror {
+        (rule.phi, 2.0)
+    } else {
+        (2 * rule.phi, 1.0)
+    };
     let dphi = PI / rule.phi as f64;
-    let norm = 2.0 / (2.0 * PI).powi(3);
-    let mut out = Vec::with_capacity(rule.mu * rule.phi);
+    let norm = copies / (2.0 * PI).powi(3);
+    let mut out = Vec::with_capacity(rule.mu * n_phi);
     for (mu, wmu) in xm.iter().zip(&wm) {
         let s = (1.0 - mu * mu).sqrt();
-        for j in 0..rule.phi {
+        for j in 0..n_phi {
             let phi = (j as f64 + 0.5) * dphi;
             out.push(([s * phi.cos(), s * phi.sin(), *mu], norm * wmu * dphi));
         }
@@ -242,8 +249,8 @@ pub(super) fn breaks(k: &[f64; 3]) -> Vec<f64> {
 
 /// The nodes q and weights of one piece's rule (weights include q² dq dΩ/(2π)³ and the φ symmetry):
 /// the product of [`radial_nodes`] and [`angular_nodes`].
-fn nodes(rule: &OneLoopRule, breaks: &[f64]) -> Vec<(Vec3, f64)> {
-    let angular = angular_nodes(rule);
+fn nodes(rule: &OneLoopRule, breaks: &[f64], mirror: bool) -> Vec<(Vec3, f64)> {
+    let angular = angular_nodes(rule, mirror);
     radial_nodes(rule, breaks)
         .into_iter()
         .flat_map(|(q, wq)| angular.iter().map(move |&(u, wu)| (scale(u, q), wq * wu)))
@@ -263,11 +270,56 @@ pub(super) fn partition(r: &[f64], j: usize) -> f64 {
         .sum::<f64>()
 }
 
-/// The loop terms [b222, b321_i, b411, J_a (3)] on one rule.
-fn loop_integrals(p: &LinearSpectrum, kv: &[Vec3; 3], rule: &OneLoopRule) -> [f64; 6] {
+/// The kernels of the loop terms: F_n in real space (1 on a linear leg), or Z_n(f, n̂) of the
+/// redshift-space mapping ([`pt_kernels::redshift`]; Z₁ = 1 + fμ² on a linear leg).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Kernels {
+    /// F_n.
+    Real,
+    /// Z_n at growth rate `f` and line of sight `los` (a unit vector in the triangle's frame).
+    Redshift {
+        /// The growth rate.
+        f: f64,
+        /// The line of sight.
+        los: Vec3,
+    },
+}
+
+impl Kernels {
+    /// The kernel of order `q.len()` at the vectors `q` (0 where a vector is zero).
+    pub(super) fn eval(&self, q: &[Vec3]) -> f64 {
+        match *self {
+            Kernels::Real if q.len() == 1 => 1.0,
+            Kernels::Real => f_n(q),
+            Kernels::Redshift { f, los } => {
+                pt_kernels::redshift::redshift_kernel(q, &f, &los).unwrap_or(0.0)
+            }
+        }
+    }
+
+    /// Whether the triangle's plane (x–z) is a mirror of the integrands: in real space, and in
+    /// redshift space for a line of sight in that plane.
+    pub(super) fn mirror(&self) -> bool {
+        match *self {
+            Kernels::Real => true,
+            Kernels::Redshift { los, .. } => los[1] == 0.0,
+        }
+    }
+}
+
+/// The loop terms [b222, b321_i, b411, J_a (3)] on one rule, with `kernels` (module docs; in redshift
+/// space with Z₁ on the linear legs of B₃₂₁ᴵ and B₄₁₁).
+pub(super) fn loop_integrals(
+    p: &LinearSpectrum,
+    kv: &[Vec3; 3],
+    rule: &OneLoopRule,
+    kernels: &Kernels,
+) -> [f64; 6] {
     let k = kv.map(norm);
     let pk = k.map(|v| p.eval(v));
-    let grid = nodes(rule, &breaks(&k));
+    let z1 = kv.map(|v| kernels.eval(&[v]));
+    let z = |q: &[Vec3]| kernels.eval(q);
+    let grid = nodes(rule, &breaks(&k), kernels.mirror());
     let (k1, k2) = (kv[0], kv[1]);
     grid.par_iter()
         .map(|&(v, w)| {
@@ -276,7 +328,7 @@ fn loop_integrals(p: &LinearSpectrum, kv: &[Vec3; 3], rule: &OneLoopRule) -> [f6
             let b222 = |q: Vec3, j: usize| {
                 let (a, b) = (add(q, k1), sub(k2, q));
                 let r = [norm(q), norm(a), norm(b)];
-                let kern = f_n(&[neg(q), a]) * f_n(&[neg(a), neg(b)]) * f_n(&[b, q]);
+                let kern = z(&[neg(q), a]) * z(&[neg(a), neg(b)]) * z(&[b, q]);
                 8.0 * partition(&r, j) * kern * p.eval(r[0]) * p.eval(r[1]) * p.eval(r[2])
             };
             out[0] = b222(v, 0) + b222(sub(v, k1), 1) + b222(sub(k2, v), 2);
@@ -286,17 +338,17 @@ fn loop_integrals(p: &LinearSpectrum, kv: &[Vec3; 3], rule: &OneLoopRule) -> [f6
             for b in 0..3 {
                 let d = sub(kv[b], v);
                 let r = [norm(v), norm(d)];
-                let leg = 2.0 * 6.0 * partition(&r, 0) * f_n(&[v, d]) * pq * p.eval(r[1]);
+                let leg = 2.0 * 6.0 * partition(&r, 0) * z(&[v, d]) * pq * p.eval(r[1]);
                 for a in (0..3).filter(|&a| a != b) {
-                    out[1] += leg * pk[a] * f_n(&[neg(v), neg(d), neg(kv[a])]);
+                    out[1] += leg * z1[a] * pk[a] * z(&[neg(v), neg(d), neg(kv[a])]);
                 }
             }
             // B411 and the P13-type integrals J_a = ∫ F₃(k_a, q, −q) P(q).
             for a in 0..3 {
                 let (b, c) = ((a + 1) % 3, (a + 2) % 3);
-                let kern = f_n(&[v, neg(v), neg(kv[b]), neg(kv[c])]);
-                out[2] += 12.0 * pk[b] * pk[c] * kern * pq;
-                out[3 + a] = f_n(&[kv[a], v, neg(v)]) * pq;
+                let kern = z(&[v, neg(v), neg(kv[b]), neg(kv[c])]);
+                out[2] += 12.0 * z1[b] * z1[c] * pk[b] * pk[c] * kern * pq;
+                out[3 + a] = z(&[kv[a], v, neg(v)]) * pq;
             }
             out.map(|x| x * w)
         })
@@ -339,8 +391,8 @@ pub fn one_loop_matter(
     let pk = k.map(|v| p.eval(v));
     let f2 = |a: usize, b: usize| f_n(&[kv[a], kv[b]]);
     let (tree, counterterm_shapes) = tree_and_counterterms(&kv, &pk);
-    let fine = loop_integrals(p, &kv, rule);
-    let coarse = loop_integrals(p, &kv, &rule.half());
+    let fine = loop_integrals(p, &kv, rule, &Kernels::Real);
+    let coarse = loop_integrals(p, &kv, &rule.half(), &Kernels::Real);
     let estimate = |i: usize| Estimate::new(fine[i], (fine[i] - coarse[i]).abs());
     // B321ᴵᴵ from J_a: 6 F₂(k_a, k_b) P(k_a) P(k_b) J_a over the ordered pairs.
     let b321_ii = |j: &[f64; 6]| {

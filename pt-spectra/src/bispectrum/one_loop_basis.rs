@@ -308,7 +308,7 @@ fn rule_tensors(basis: &LinearBasis, kv: &[Vec3; 3], rule: &OneLoopRule) -> Vec<
     let n = basis.len();
     let k = kv.map(norm);
     let radial = radial_nodes(rule, &breaks(&k));
-    let angular = angular_nodes(rule);
+    let angular = angular_nodes(rule, true);
     let (k1, k2) = (kv[0], kv[1]);
     let mut t222 = vec![0.0; n * n * n];
     let mut m321 = vec![0.0; 6 * n * n];
