@@ -60,10 +60,13 @@ impl Orientation {
         }
         let s = (1.0 - self.mu1 * self.mu1).sqrt();
         // An exact zero for φ = 0 or π (sin π is 1.2e-16): the mirror symmetry is then used.
-        let (sin, cos) = match self.phi.rem_euclid(2.0 * std::f64::consts::PI) {
-            x if x == 0.0 => (0.0, 1.0),
-            x if x == std::f64::consts::PI => (0.0, -1.0),
-            x => x.sin_cos(),
+        let x = self.phi.rem_euclid(2.0 * std::f64::consts::PI);
+        let (sin, cos) = if x == 0.0 {
+            (0.0, 1.0)
+        } else if x == std::f64::consts::PI {
+            (0.0, -1.0)
+        } else {
+            x.sin_cos()
         };
         Ok([s * cos, s * sin, self.mu1])
     }
