@@ -326,6 +326,7 @@ pub(crate) fn fit_ept(
             k_max: 0.0,
             ell_ranges,
             n_mocks,
+            basis: None,
         };
         let store = crate::Store::new(None);
         let plan = jobs::ept_plan(&model_k, ir, ap, free_ap, &precision, store.get(), &Silent)?;

@@ -27,6 +27,9 @@
 
 use super::MultipoleData;
 use crate::error::{Error, Result};
+use crate::rsd::ept::physical::{
+    check_physical_name, PhysicalBasis, PHYSICAL_LINEAR, PHYSICAL_NAMES,
+};
 use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
 use crate::survey::observe::Observation;
 
@@ -37,7 +40,7 @@ mod priors;
 pub mod search;
 pub use derived::{derived, sound_horizon, Derived, Template};
 pub use joint::{default_shared, fit_joint, DataSet, JointFit};
-pub use priors::{Prior, PriorShape};
+pub use priors::{desi_priors, Prior, PriorShape};
 pub use search::{profile_galaxy, GalaxyProfile, Linear, ProfileGrid, ProfilePoint, Search};
 
 /// The parameters that enter the model linearly and can be marginalised analytically.
@@ -76,6 +79,10 @@ pub struct GalaxyFitRequest {
     /// The number of mocks the covariance was estimated from: C⁻¹ is scaled by the Hartlap factor
     /// (N − p − 2)/(N − 1), p the number of fitted points (Hartlap, Simon & Schneider 2007).
     pub n_mocks: Option<usize>,
+    /// The parameter basis of `free`, `marginalise` and `priors`: `None` velocileptors' (the
+    /// model's), or the DESI physical basis ([`crate::rsd::ept::physical`]; the start is still
+    /// given as the model's parameters and converted).
+    pub basis: Option<PhysicalBasis>,
 }
 
 /// The result of a fit.
@@ -117,19 +124,56 @@ pub struct GalaxyFit {
     pub moved_by_profile: bool,
     /// Objective evaluations used (every start, the Hessian and the profiles).
     pub evaluations: usize,
+    /// With the physical basis: every parameter at the best fit in it (the order of
+    /// [`PHYSICAL_NAMES`]; [`Self::best`] holds the model's parameters they map to).
+    pub physical: Option<[f64; 12]>,
 }
 
-fn index(name: &str) -> Result<usize> {
-    PARAM_NAMES
+/// The names of the model's slots: velocileptors' (the model's own), or of the DESI physical
+/// basis.
+pub fn slot_names(physical: bool) -> &'static [&'static str; 12] {
+    if physical {
+        &PHYSICAL_NAMES
+    } else {
+        &PARAM_NAMES
+    }
+}
+
+/// The parameters that enter the model linearly, in the basis of [`slot_names`].
+pub fn linear_names(physical: bool) -> &'static [&'static str] {
+    if physical {
+        &PHYSICAL_LINEAR
+    } else {
+        &LINEAR
+    }
+}
+
+/// The slot of parameter `name` in the basis of [`slot_names`] (its model parameters, then apar,
+/// aperp).
+pub(crate) fn slot_index(name: &str, physical: bool) -> Result<usize> {
+    if physical {
+        check_physical_name(name)?;
+    }
+    let names = slot_names(physical);
+    names
         .iter()
         .chain(&AP_NAMES)
         .position(|&n| n == name)
-        .ok_or_else(|| Error::InvalidChoice {
-            what: format!("fit parameter `{name}`"),
-            reason: format!(
-                "the ept parameters are {} (and apar, aperp)",
-                PARAM_NAMES.join(", ")
-            ),
+        .ok_or_else(|| {
+            let hint = match (slot_names(!physical).contains(&name), physical) {
+                (true, false) => {
+                    " (a name of the DESI physical basis: choose that basis to use it)"
+                }
+                (true, true) => " (a velocileptors name: the physical basis's names end in p)",
+                _ => "",
+            };
+            Error::InvalidChoice {
+                what: format!("fit parameter `{name}`"),
+                reason: format!(
+                    "the parameters are {} (and apar, aperp){hint}",
+                    names.join(", ")
+                ),
+            }
         })
 }
 

@@ -210,6 +210,7 @@ fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded> {
         k_max: s.k_max,
         ell_ranges: s.ell_ranges.clone(),
         n_mocks: s.n_mocks,
+        basis: None,
     };
     let mut description =
         vec![format!(

@@ -507,6 +507,7 @@ fn sigma2_kernel(q: f64) -> f64 {
 
 mod basis;
 mod model;
+pub mod physical;
 mod range;
 
 /// The index of parameter `name` in [`PARAM_NAMES`], its `value` checked finite.

@@ -316,6 +316,7 @@ fn run_ept(args: &Args) -> Result<()> {
             .map(|t| parse_ell_range(t))
             .collect::<Result<_>>()?,
         n_mocks: args.n_mocks,
+        basis: None,
     };
     let (window, bins) = args.ept.observation()?;
     let observation = if args.xi {

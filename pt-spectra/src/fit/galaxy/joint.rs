@@ -21,7 +21,7 @@
 
 use super::objective::{objective, Objective};
 use super::search::{bound, find, package, Space};
-use super::{index, GalaxyFit, GalaxyFitRequest, Linear, MultipoleData, Observation, Search};
+use super::{slot_index, GalaxyFit, GalaxyFitRequest, Linear, MultipoleData, Observation, Search};
 use crate::error::{Error, Result};
 use crate::rsd::ept::{EptPlan, EptTerms};
 
@@ -156,8 +156,18 @@ pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result
         o.log_det = search.linear == Linear::Marginalised;
         objectives.push(o);
     }
+    let physical = sets.first().is_some_and(|s| s.request.basis.is_some());
+    if let Some(s) = sets.iter().find(|s| s.request.basis.is_some() != physical) {
+        return Err(Error::InvalidChoice {
+            what: format!("the parameter basis of data set `{}`", s.label),
+            reason:
+                "every data set of a joint fit takes the same basis (velocileptors' or the DESI \
+                     physical one), so that a shared name means one parameter"
+                    .into(),
+        });
+    }
     for (n, name) in shared.iter().enumerate() {
-        let slot = index(name)?;
+        let slot = slot_index(name, physical)?;
         if shared[..n].contains(name) {
             return Err(sharing(name, "is declared shared twice".into()));
         }
@@ -211,7 +221,10 @@ pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result
         }
     }
     // The joint parameters, in the sets' order of their free ones; a shared one at its first.
-    let slots_shared: Vec<usize> = shared.iter().map(|n| index(n)).collect::<Result<_>>()?;
+    let slots_shared: Vec<usize> = shared
+        .iter()
+        .map(|n| slot_index(n, physical))
+        .collect::<Result<_>>()?;
     let mut names = Vec::new();
     let mut params = Vec::new();
     let (mut lo, mut hi, mut scale, mut x0) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -220,7 +233,7 @@ pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result
         let ap = o.plan.settings().ap_range;
         let mut own = Vec::with_capacity(o.free.len());
         for (j, &slot) in o.free.iter().enumerate() {
-            let (a, b, sc) = bound(slot, o.priors[slot].as_ref(), ap);
+            let (a, b, sc) = bound(slot, o.priors[slot].as_ref(), ap, physical);
             let is_shared = slots_shared.contains(&slot);
             if let Some(g) = (is_shared && s > 0).then(|| map_of(&map, slot, &objectives)) {
                 let g = g.expect("a shared parameter is free in the first set");
@@ -270,6 +283,7 @@ pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result
         hi,
         scale,
         x0,
+        physical,
     };
     let found = find(&|x: &[f64]| joint.cost(x), &space, search)?;
     let x = &found.best.x;

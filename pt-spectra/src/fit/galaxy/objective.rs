@@ -1,10 +1,11 @@
 //! The objective of a galaxy fit: −2 ln L of the free parameters with the linear ones marginalised
 //! analytically (the module docs of [`super`]), on one window of data.
 
-use super::{index, GalaxyFitRequest, PriorShape, LINEAR, SLOTS};
+use super::{linear_names, slot_index, GalaxyFitRequest, PriorShape, SLOTS};
 use crate::error::{Error, Result};
 use crate::fit::MultipoleData;
 use crate::linalg::{cholesky, dot, invert_lower, solve_spd};
+use crate::rsd::ept::physical::PhysicalBasis;
 use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
 use crate::survey::observe::Observation;
 use crate::table::{describe_grid, same_k};
@@ -33,6 +34,9 @@ pub(super) struct Objective<'a> {
     pub(super) start: [f64; SLOTS],
     /// Whether the measurement has a distortion.
     pub(super) has_ap: bool,
+    /// The parameter basis of the slots: `None` velocileptors' (the model's own), else the DESI
+    /// physical basis, converted to the model's at every evaluation.
+    pub(super) basis: Option<PhysicalBasis>,
     ells: Vec<usize>,
     pub(super) free: Vec<usize>,
     pub(super) marg: Vec<usize>,
@@ -66,8 +70,12 @@ impl Objective<'_> {
         v: &[f64; SLOTS],
     ) -> Result<(EptParams, Option<crate::rsd::ap::Distortion>)> {
         let n = PARAM_NAMES.len();
-        let mut p = EptParams::new(0.0, 0.0);
-        p.values.copy_from_slice(&v[..n]);
+        let mut model = [0.0; PARAM_NAMES.len()];
+        model.copy_from_slice(&v[..n]);
+        let p = match &self.basis {
+            None => EptParams { values: model },
+            Some(b) => b.to_ept(&model),
+        };
         let ap = if self.has_ap {
             Some(crate::rsd::ap::Distortion::new(v[n], v[n + 1])?)
         } else {
@@ -105,19 +113,15 @@ impl Objective<'_> {
             .collect())
     }
 
-    /// The whitened templates Tᵢ = m(p, aᵢ = 1) − m(p, aᵢ = 0) of the marginalised parameters at `p`
-    /// (theirs at 0), `m0` the model at `p`.
-    fn templates(
-        &self,
-        p: &EptParams,
-        ap: Option<crate::rsd::ap::Distortion>,
-        m0: &[f64],
-    ) -> Result<Vec<Vec<f64>>> {
+    /// The whitened templates Tᵢ = m(v, aᵢ = 1) − m(v, aᵢ = 0) of the marginalised parameters at the
+    /// slots `v` (theirs at 0), `m0` the model at `v` (the model is linear in them in either basis).
+    fn templates(&self, v: &[f64; SLOTS], m0: &[f64]) -> Result<Vec<Vec<f64>>> {
         self.marg
             .iter()
             .map(|&i| {
-                let mut q = *p;
-                q.values[i] = 1.0;
+                let mut w = *v;
+                w[i] = 1.0;
+                let (q, ap) = self.split(&w)?;
                 self.model(&q, ap)
                     .map(|m| m.iter().zip(m0).map(|(a, b)| a - b).collect())
             })
@@ -139,15 +143,19 @@ impl Objective<'_> {
         if self.marg.is_empty() {
             return Ok(());
         }
-        let (mut p, ap) = self.split(&self.start)?;
+        let mut v = self.start;
         for &i in &self.marg {
-            p.values[i] = 0.0;
+            v[i] = 0.0;
         }
-        let t0 = self.templates(&p, ap, &self.model(&p, ap)?)?;
+        let at = |v: &[f64; SLOTS]| -> Result<Vec<Vec<f64>>> {
+            let (p, ap) = self.split(v)?;
+            self.templates(v, &self.model(&p, ap)?)
+        };
+        let t0 = at(&v)?;
         for (&i, shift) in BIASES.iter().zip([0.37, -0.41, 0.23, 0.11]) {
-            p.values[i] += shift;
+            v[i] += shift * if self.basis.is_some() { 0.5 } else { 1.0 };
         }
-        let t1 = self.templates(&p, ap, &self.model(&p, ap)?)?;
+        let t1 = at(&v)?;
         let scale = t0.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
         self.bias_free_templates = t0
             .iter()
@@ -173,10 +181,10 @@ impl Objective<'_> {
     /// As the model's evaluation (e.g. f or α outside the plan's range).
     pub(super) fn evaluate(&self, x: &[f64]) -> Result<(f64, f64, [f64; SLOTS], Vec<f64>)> {
         let mut v = self.slots(x);
-        let (mut p, ap) = self.split(&v)?;
         for &i in &self.marg {
-            p.values[i] = 0.0;
+            v[i] = 0.0;
         }
+        let (p, ap) = self.split(&v)?;
         let m0 = self.model(&p, ap)?;
         let key = self.template_key(&v);
         let cached = if self.bias_free_templates {
@@ -191,7 +199,7 @@ impl Objective<'_> {
         let templates = match cached {
             Some(t) => t,
             None => {
-                let t = self.templates(&p, ap, &m0)?;
+                let t = self.templates(&v, &m0)?;
                 let mut cache = self.cache.borrow_mut();
                 if cache.len() == CACHE_SIZE {
                     cache.remove(0);
@@ -362,7 +370,20 @@ pub(super) fn objective<'a>(
     let raw: Vec<f64> = fitted.iter().map(|&(r, i)| data.values[r][i]).collect();
     let data_vector = whiten.iter().map(|row| dot(row, &raw)).collect();
     let mut start = [0.0; SLOTS];
-    start[..PARAM_NAMES.len()].copy_from_slice(&request.start.values);
+    match &request.basis {
+        None => start[..PARAM_NAMES.len()].copy_from_slice(&request.start.values),
+        Some(b) => {
+            let physical = b.from_ept(&request.start);
+            if let Some(i) = physical.iter().position(|v| !v.is_finite()) {
+                return Err(Error::InvalidParameter {
+                    name: "start value in the physical basis",
+                    value: physical[i],
+                    reason: "the start (b1, f) cannot be expressed in the physical basis",
+                });
+            }
+            start[..PARAM_NAMES.len()].copy_from_slice(&physical);
+        }
+    }
     if let Some(d) = request.ap {
         start[PARAM_NAMES.len()] = d.apar;
         start[PARAM_NAMES.len() + 1] = d.aperp;
@@ -373,6 +394,7 @@ pub(super) fn objective<'a>(
         observation,
         start,
         has_ap: request.ap.is_some(),
+        basis: request.basis,
         ells: request.ells.clone(),
         free,
         marg,
@@ -393,23 +415,25 @@ type Validated = (Vec<usize>, Vec<usize>, Vec<Option<PriorShape>>);
 
 /// Checks the request's names and values.
 pub(super) fn validate(request: &GalaxyFitRequest) -> Result<Validated> {
+    let physical = request.basis.is_some();
     let free = request
         .free
         .iter()
-        .map(|n| index(n))
+        .map(|n| slot_index(n, physical))
         .collect::<Result<Vec<_>>>()?;
     let mut marg = Vec::new();
+    let linear = linear_names(physical);
     for name in &request.marginalise {
-        if !LINEAR.contains(&name.as_str()) {
+        if !linear.contains(&name.as_str()) {
             return Err(Error::InvalidChoice {
                 what: format!("--marginalise {name}"),
                 reason: format!(
                     "only parameters that enter linearly can be marginalised: {}",
-                    LINEAR.join(", ")
+                    linear.join(", ")
                 ),
             });
         }
-        marg.push(index(name)?);
+        marg.push(slot_index(name, physical)?);
     }
     let mut seen = std::collections::HashSet::new();
     for name in request.free.iter().chain(&request.marginalise) {
@@ -443,7 +467,7 @@ pub(super) fn validate(request: &GalaxyFitRequest) -> Result<Validated> {
     }
     let mut priors = vec![None; SLOTS];
     for p in &request.priors {
-        let i = index(&p.name)?;
+        let i = slot_index(&p.name, physical)?;
         p.shape.check(&p.name)?;
         if !free.contains(&i) && !marg.contains(&i) {
             return Err(Error::InvalidChoice {

@@ -178,6 +178,27 @@ impl fmt::Display for PriorShape {
     }
 }
 
+/// The priors of the DESI DR1 full-shape analysis in the physical basis (desilike's defaults for
+/// velocileptors): b1p flat on [0, 3]; b2p, bsp N(0, 5²); α₀p, α₂p, α₄p N(0, 12.5²) (50% of linear
+/// theory at k = 0.2 h/Mpc); sn0p N(0, 2²); sn2p, sn4p N(0, 5²). b3p is fixed at 0 there.
+pub fn desi_priors() -> Vec<Prior> {
+    let gaussian = |name: &str, sigma: f64| Prior::gaussian(name, 0.0, sigma);
+    vec![
+        Prior {
+            name: "b1p".into(),
+            shape: PriorShape::Flat { lo: 0.0, hi: 3.0 },
+        },
+        gaussian("b2p", 5.0),
+        gaussian("bsp", 5.0),
+        gaussian("alpha0p", 12.5),
+        gaussian("alpha2p", 12.5),
+        gaussian("alpha4p", 12.5),
+        gaussian("sn0p", 2.0),
+        gaussian("sn2p", 5.0),
+        gaussian("sn4p", 5.0),
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

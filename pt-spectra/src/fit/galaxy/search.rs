@@ -66,6 +66,35 @@ pub const RANGES: [(f64, f64, f64, f64, f64); SLOTS] = [
     (0.5, 2.0, 0.9, 1.1, 0.03),
 ];
 
+/// [`RANGES`] for the slots of the DESI physical basis ([`crate::rsd::ept::physical`]): b1p = b1 σ₈(z)
+/// (start box 0.6–1.8), b2p, bsp, b3p in σ₈²-scaled units, the counterterms as fractions of linear
+/// theory per (h/Mpc)² (tens), the stochastic terms in units of 1/n̄ (of order one).
+pub const PHYSICAL_RANGES: [(f64, f64, f64, f64, f64); SLOTS] = [
+    (0.01, 10.0, 0.6, 1.8, 0.05),
+    (-50.0, 50.0, -1.0, 1.0, 0.5),
+    (-50.0, 50.0, -0.5, 0.5, 0.5),
+    (-50.0, 50.0, -0.5, 0.5, 0.5),
+    (-1e3, 1e3, -20.0, 20.0, 5.0),
+    (-1e3, 1e3, -20.0, 20.0, 5.0),
+    (-1e3, 1e3, -20.0, 20.0, 5.0),
+    (0.0, 0.0, 0.0, 0.0, 1.0),
+    (-1e3, 1e3, -2.0, 2.0, 0.5),
+    (-1e3, 1e3, -5.0, 5.0, 1.0),
+    (-1e3, 1e3, -5.0, 5.0, 1.0),
+    (0.0, 2.0, 0.4, 1.0, 0.05),
+    (0.5, 2.0, 0.9, 1.1, 0.03),
+    (0.5, 2.0, 0.9, 1.1, 0.03),
+];
+
+/// [`RANGES`] or [`PHYSICAL_RANGES`].
+fn ranges(physical: bool) -> &'static [(f64, f64, f64, f64, f64); SLOTS] {
+    if physical {
+        &PHYSICAL_RANGES
+    } else {
+        &RANGES
+    }
+}
+
 /// The linear parameters in −2 ln L.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Linear {
@@ -105,8 +134,9 @@ pub(super) fn bound(
     i: usize,
     prior: Option<&PriorShape>,
     ap: Option<(f64, f64)>,
+    physical: bool,
 ) -> (f64, f64, f64) {
-    let (mut a, mut b, _, _, s) = RANGES[i];
+    let (mut a, mut b, _, _, s) = ranges(physical)[i];
     if let (true, Some((x, y))) = (i >= PARAM_NAMES.len(), ap) {
         (a, b) = (x, y);
     }
@@ -124,7 +154,12 @@ fn bounds(objective: &Objective) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let mut hi = Vec::new();
     let mut scale = Vec::new();
     for &i in &objective.free {
-        let (a, b, s) = bound(i, objective.priors[i].as_ref(), ap);
+        let (a, b, s) = bound(
+            i,
+            objective.priors[i].as_ref(),
+            ap,
+            objective.basis.is_some(),
+        );
         lo.push(a);
         hi.push(b);
         scale.push(s);
@@ -141,13 +176,9 @@ fn draws(rng: &mut rand_chacha::ChaCha8Rng) -> (f64, f64) {
 
 /// The starts: `x0`, then draws from the priors or the start box, within [lo, hi]; `params` the
 /// slot and prior of each free parameter.
-fn starts(
-    params: &[(usize, Option<&PriorShape>)],
-    x0: &[f64],
-    lo: &[f64],
-    hi: &[f64],
-    search: &Search,
-) -> Vec<Vec<f64>> {
+fn starts(space: &Space, search: &Search) -> Vec<Vec<f64>> {
+    let (params, x0, lo, hi) = (&space.params, &space.x0, &space.lo, &space.hi);
+    let box_of = ranges(space.physical);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(search.seed);
     let mut all = vec![x0.to_vec()];
     while all.len() < search.starts {
@@ -158,7 +189,7 @@ fn starts(
                 let (z, u) = draws(&mut rng);
                 let v = match prior {
                     Some(p) => p.draw(z.clamp(-2.0, 2.0), u),
-                    None => RANGES[i].2 + (RANGES[i].3 - RANGES[i].2) * u,
+                    None => box_of[i].2 + (box_of[i].3 - box_of[i].2) * u,
                 };
                 v.clamp(lo[j], hi[j])
             })
@@ -306,6 +337,8 @@ pub(super) struct Space<'p> {
     pub(super) scale: Vec<f64>,
     /// The start.
     pub(super) x0: Vec<f64>,
+    /// Whether the slots are those of the DESI physical basis (the start box of [`PHYSICAL_RANGES`]).
+    pub(super) physical: bool,
 }
 
 /// The errors of a search's free parameters (or of a selection of them: [`Errors::select`]).
@@ -382,6 +415,7 @@ pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit>
         hi,
         scale,
         x0,
+        physical: objective.basis.is_some(),
     };
     let found = find(&|x: &[f64]| objective.cost(x), &space, search)?;
     package(objective, &found.best.x, &found, found.errors.clone())
@@ -417,6 +451,7 @@ pub(super) fn package(
         spread: found.spread,
         moved_by_profile: found.moved,
         evaluations: found.evaluations,
+        physical: objective.basis.map(|_| std::array::from_fn(|i| slots[i])),
     })
 }
 
@@ -441,7 +476,7 @@ pub(super) fn find(cost: &dyn Fn(&[f64]) -> f64, space: &Space, search: &Search)
         scale: space.scale.clone(),
         tolerance: EXPECTED_DECREASE,
     };
-    let multi = multistart(&problem, &starts(&space.params, &space.x0, lo, hi, search));
+    let multi = multistart(&problem, &starts(space, search));
     let mut best = multi.best().clone();
     if !best.value.is_finite() {
         return Err(Error::InvalidParameter {

@@ -61,6 +61,7 @@ fn recovers_the_truth_with_marginalised_counterterms() {
         k_max: 0.2,
         ell_ranges: vec![],
         n_mocks: None,
+        basis: None,
     };
     let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
     // ln det F is nearly flat in θ, so the maximum of the marginal likelihood sits within a small
@@ -102,6 +103,7 @@ fn analytic_marginalisation_is_the_integral() {
         k_max: 0.15,
         ell_ranges: vec![],
         n_mocks: None,
+        basis: None,
     };
     let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
     // χ² at fixed a (alpha0 fixed, nothing marginalised) on a grid, integrated by Simpson.
@@ -163,6 +165,7 @@ fn bad_requests_are_named() {
         k_max: 0.2,
         ell_ranges: vec![],
         n_mocks: None,
+        basis: None,
     };
     let err = |r: GalaxyFitRequest| {
         fit_galaxy(&plan, &terms, &data, &r)
@@ -219,6 +222,7 @@ fn recovers_the_distortion() {
         k_max: 0.2,
         ell_ranges: vec![],
         n_mocks: None,
+        basis: None,
     };
     let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
     let ap = fit.ap.unwrap();
@@ -255,6 +259,7 @@ fn hartlap_factor_scales_chi2() {
         k_max: 0.2,
         ell_ranges: vec![],
         n_mocks: None,
+        basis: None,
     };
     let plain = fit_galaxy(&plan, &terms, &data, &base).unwrap();
     let mut with = base.clone();
@@ -290,6 +295,7 @@ fn priors_on_fixed_parameters_are_refused() {
         k_max: 0.2,
         ell_ranges: vec![],
         n_mocks: None,
+        basis: None,
     };
     let e = fit_galaxy(&plan, &terms, &data, &request)
         .unwrap_err()
@@ -341,6 +347,7 @@ fn an_observation_on_other_k_of_the_same_length_is_refused() {
         k_max: 0.2,
         ell_ranges: vec![],
         n_mocks: None,
+        basis: None,
     };
     let e = fit_galaxy_observed(&plan, &terms, &data, &request, Some(&observation))
         .unwrap_err()
@@ -351,4 +358,176 @@ fn an_observation_on_other_k_of_the_same_length_is_refused() {
         "{e}"
     );
     assert!(!e.contains("  "), "stray spaces: {e:?}");
+}
+
+mod physical {
+    //! Fits in the DESI physical basis ([`crate::rsd::ept::physical`]).
+    use super::*;
+    use crate::fit::galaxy::search::{Linear, Search};
+    use crate::rsd::ept::physical::PhysicalBasis;
+
+    fn basis() -> PhysicalBasis {
+        PhysicalBasis::new(0.62, 3e-4, 0.1, 5.0).unwrap()
+    }
+
+    fn request(free: &[&str], marginalise: &[&str], start: EptParams) -> GalaxyFitRequest {
+        GalaxyFitRequest {
+            start,
+            ap: None,
+            free: free.iter().map(|s| s.to_string()).collect(),
+            marginalise: marginalise.iter().map(|s| s.to_string()).collect(),
+            priors: vec![],
+            ells: vec![0, 2, 4],
+            k_min: 0.0,
+            k_max: 0.2,
+            ell_ranges: vec![],
+            n_mocks: None,
+            basis: None,
+        }
+    }
+
+    /// Free b1, b2, bs, f and a profiled sn are a one-to-one map of b1p, b2p, bsp, f and sn0p: the
+    /// same minimum of −2 ln L (without priors and ln det F, a change of variables leaves it), the same
+    /// best fit and the same error on f, which both bases share.
+    #[test]
+    fn the_physical_basis_is_a_change_of_variables() {
+        let (plan, terms, truth, data) = setup();
+        let mut start = truth;
+        for (n, v) in [("f", 0.68), ("b1", 1.9), ("alpha0", 0.0), ("alpha2", 0.0)] {
+            start.set(n, v).unwrap();
+        }
+        let search = Search {
+            starts: 3,
+            linear: Linear::Profiled,
+            ..Search::default()
+        };
+        let vel = request(&["f", "b1", "b2", "bs"], &["sn"], start);
+        let mut phys = request(&["f", "b1p", "b2p", "bsp"], &["sn0p"], start);
+        phys.basis = Some(basis());
+        let a = fit_galaxy_search(&plan, &terms, &data, &vel, None, &search).unwrap();
+        let b = fit_galaxy_search(&plan, &terms, &data, &phys, None, &search).unwrap();
+        assert!(
+            (a.minus_two_log_l - b.minus_two_log_l).abs() < 1e-6 * a.minus_two_log_l.max(1.0),
+            "{} vs {}",
+            a.minus_two_log_l,
+            b.minus_two_log_l
+        );
+        for (j, name) in ["f", "b1", "b2", "bs"].iter().enumerate() {
+            let (x, y) = (a.best.get(name).unwrap(), b.best.get(name).unwrap());
+            assert!(
+                (x - y).abs() < 0.01 * a.errors[j],
+                "{name}: {x} vs {y} (σ {})",
+                a.errors[j]
+            );
+        }
+        let (x, y) = (a.best.get("sn").unwrap(), b.best.get("sn").unwrap());
+        assert!(
+            (x - y).abs() < 0.01 * a.marginalised_errors[0],
+            "sn: {x} vs {y}"
+        );
+        assert!(
+            (a.errors[0] / b.errors[0] - 1.0).abs() < 0.01,
+            "{:?} vs {:?}",
+            a.errors,
+            b.errors
+        );
+        let physical = b.physical.expect("the physical values are reported");
+        assert!((physical[0] - b.best.get("b1").unwrap() * 0.62).abs() < 1e-12);
+        assert!((physical[8] - b.best.get("sn").unwrap() * 3e-4).abs() < 1e-12);
+        assert!(a.physical.is_none());
+    }
+
+    /// Data made in the physical basis (counterterms α₀p, α₂p, α₄p and sn0p, hence α₆ = f²α₄p) are
+    /// recovered by a fit in it: exactly (0.01σ) with the linear ones profiled and no priors, and
+    /// within 0.3σ with them marginalised under the DESI DR1 priors (centred on 0, not on the truth,
+    /// and with ln det F, which depends on b1p and f in this basis: the projection effects of the
+    /// DESI analyses).
+    #[test]
+    fn recovers_the_truth_in_the_physical_basis_with_desi_priors() {
+        let (plan, terms, _, _) = setup();
+        let truth = [
+            1.24, -0.1, 0.05, 0.0, 2.0, -3.0, 1.0, 0.0, 0.3, 0.0, 0.0, 0.75,
+        ];
+        let model = basis().to_ept(&truth);
+        let m = plan.multipoles(&terms, &model, &[0, 2, 4]).unwrap();
+        let values: Vec<Vec<f64>> = m
+            .iter()
+            .map(|l| l.iter().map(|e| e.value).collect())
+            .collect();
+        let sigma: Vec<Vec<f64>> = (0..3)
+            .map(|_| values[0].iter().map(|p| 0.01 * p).collect())
+            .collect();
+        let data =
+            MultipoleData::from_arrays(plan.k().to_vec(), &[0, 2, 4], values, sigma, "model")
+                .unwrap();
+        let mut start = model;
+        start.set("f", 0.65).unwrap();
+        start.set("b1", 1.8).unwrap();
+        let free = ["f", "b1p", "b2p", "bsp"];
+        let marg = ["alpha0p", "alpha2p", "alpha4p", "sn0p"];
+        let mut r = request(&free, &marg, start);
+        r.basis = Some(basis());
+        r.priors = desi_priors()
+            .into_iter()
+            .filter(|p| free.contains(&p.name.as_str()) || marg.contains(&p.name.as_str()))
+            .collect();
+        let profiled = Search {
+            starts: 3,
+            linear: Linear::Profiled,
+            ..Search::default()
+        };
+        let exact = GalaxyFitRequest {
+            priors: vec![],
+            ..r.clone()
+        };
+        // χ² of the marginalised fit: the priors and ln det F move its maximum off χ² = 0 (0.018 here).
+        for (request, search, tolerance, chi2) in [
+            (&exact, &profiled, 0.01, 1e-4),
+            (&r, &Search::default(), 0.3, 0.1),
+        ] {
+            let fit = fit_galaxy_search(&plan, &terms, &data, request, None, search).unwrap();
+            let got = fit.physical.unwrap();
+            for (j, &slot) in [11, 0, 1, 2].iter().enumerate() {
+                let sigma = fit.errors[j];
+                assert!(
+                    (got[slot] - truth[slot]).abs() < tolerance * sigma,
+                    "{}: {} vs {} (σ {sigma})",
+                    free[j],
+                    got[slot],
+                    truth[slot]
+                );
+            }
+            assert!(fit.chi2 < chi2, "{}", fit.chi2);
+        }
+    }
+
+    /// Names of the other basis, and alpha6p (not a parameter of the physical basis), are refused by
+    /// name.
+    #[test]
+    fn names_of_the_other_basis_are_refused_with_a_hint() {
+        let (plan, terms, truth, data) = setup();
+        let mut r = request(&["f", "b1"], &[], truth);
+        r.basis = Some(basis());
+        let e = fit_galaxy(&plan, &terms, &data, &r)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("velocileptors name"), "{e}");
+        let r = request(&["f", "b1p"], &[], truth);
+        let e = fit_galaxy(&plan, &terms, &data, &r)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("DESI physical"), "{e}");
+        let mut r = request(&["f", "alpha6p"], &[], truth);
+        r.basis = Some(basis());
+        let e = fit_galaxy(&plan, &terms, &data, &r)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("alpha4p"), "{e}");
+        let mut r = request(&["f"], &["alpha0"], truth);
+        r.basis = Some(basis());
+        let e = fit_galaxy(&plan, &terms, &data, &r)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("alpha0p"), "{e}");
+    }
 }

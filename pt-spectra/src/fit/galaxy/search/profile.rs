@@ -4,7 +4,7 @@
 use super::{bounds, profile_at, solve, Linear, Search, RANGES};
 use crate::error::{Error, Result};
 use crate::fit::bounded::{Minimum, Problem, EXPECTED_DECREASE};
-use crate::fit::galaxy::{index, GalaxyFit, GalaxyFitRequest, MultipoleData, Observation};
+use crate::fit::galaxy::{slot_index, GalaxyFit, GalaxyFitRequest, MultipoleData, Observation};
 use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
 
 /// The grid of a profile: `points` values over ± `span` times the fitted error around the best fit.
@@ -62,7 +62,7 @@ pub fn profile_galaxy(
     name: &str,
     grid: &ProfileGrid,
 ) -> Result<GalaxyProfile> {
-    let slot = index(name)?;
+    let slot = slot_index(name, request.basis.is_some())?;
     if !(3..=401).contains(&grid.points) {
         return Err(Error::InvalidParameter {
             name: "profile grid points",
