@@ -240,7 +240,8 @@ def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0,
             q_range=None, eh=None, n_mocks=None, k_ranges=None, window=None,
             window_mixing="wilson", k_edges=None, box=None, xi=False, s_edges=None, window_format=None,
             starts=8, seed=1, profile_check=True, profile_linear=False, profile=None,
-            profile_points=21, profile_span=3.0, model_out=False, **start):
+            profile_points=21, profile_span=3.0, model_out=False, basis="velocileptors", n_bar=None,
+            satellites=None, desi_priors=False, **start):
     """Fits of the galaxy model ``ept`` (``pt-spectra fit --rsd ept``), one row per k_max.
 
     data, data_ells, data_columns, k_min as :func:`fit`; covariance: a path (as ``--covariance``)
@@ -264,6 +265,12 @@ def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0,
     minimum taken; ``profile_check`` checks the Hessian errors on the profile likelihood;
     ``profile_linear`` profiles the linear parameters instead of marginalising them.
 
+    ``basis="desi"`` (with ``n_bar`` [(h/Mpc)^3], optionally ``satellites=(f_sat, sigma_v)``, default
+    (0.1, 5 Mpc/h)): free, marginalise and priors name the DESI DR1 physical basis (b1p = b1 sigma8(z),
+    b2p, bsp, b3p, alpha0p, alpha2p, alpha4p, sn0p, sn2p, sn4p; docs/reference.md) and the table gives
+    them, then the model's parameters they map to; ``desi_priors=True`` adds the DR1 priors of the
+    free and marginalised ones that have none. The start keywords stay the model's (b1=, f=, ...).
+
     Columns: ``k_max`` (``s_max``) ``points chi2 minus_2_ln_L``, each parameter with ``err_<p>``
     for the free and marginalised ones; per free parameter ``err_<p>_hessian <p>_lo <p>_hi
     err_<p>_from_profile`` (the Δ(−2 ln L) = 1 interval; err_<p> is its half-width where it differs
@@ -284,7 +291,10 @@ def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0,
                                  None if window is None else str(window), window_mixing,
                                  k_edges, box, bool(xi), s_edges, window_format, int(starts), int(seed),
                                  bool(profile_check), bool(profile_linear), profile, int(profile_points),
-                                 float(profile_span), bool(model_out), **_ept_params(start))
+                                 float(profile_span), bool(model_out), str(basis),
+                                 None if n_bar is None else float(n_bar),
+                                 None if satellites is None else tuple(map(float, satellites)),
+                                 bool(desi_priors), **_ept_params(start))
     if model_out:
         return _warn(table), _warn(model)
     return _warn(table)

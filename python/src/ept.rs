@@ -173,7 +173,7 @@ impl EptTerms {
     q_range=None, eh=None, n_mocks=None, k_ranges=None, window=None, window_mixing="wilson",
     k_edges=None, r#box=None, xi=false, s_edges=None, window_format=None, starts=pt_spectra::fit::galaxy::search::DEFAULT_STARTS,
     seed=1, profile_check=true, profile_linear=false, profile=None, profile_points=21, profile_span=3.0,
-    model_out=false, **kwargs))]
+    model_out=false, basis="velocileptors", n_bar=None, satellites=None, desi_priors=false, **kwargs))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit_ept(
     py: Python<'_>,
@@ -214,6 +214,10 @@ pub(crate) fn fit_ept(
     profile_points: usize,
     profile_span: f64,
     model_out: bool,
+    basis: &str,
+    n_bar: Option<f64>,
+    satellites: Option<(f64, f64)>,
+    desi_priors: bool,
     kwargs: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<(Table, Option<Table>)> {
     let (mut data, name, layout) = crate::data(data, data_columns, &data_ells, &ells)?;
@@ -315,6 +319,16 @@ pub(crate) fn fit_ept(
             start.set_f(prepared.growth_rate);
         }
         let free_ap = free.iter().any(|n| n == "apar" || n == "aperp");
+        let basis = jobs::fit_basis(
+            basis,
+            prepared.spectrum.sigma8(),
+            n_bar,
+            satellites,
+            desi_priors,
+        )?;
+        if desi_priors {
+            jobs::add_desi_priors(&mut prior_list, &free, &marginalise);
+        }
         let request = pt_spectra::fit::galaxy::GalaxyFitRequest {
             start,
             ap,
@@ -326,7 +340,7 @@ pub(crate) fn fit_ept(
             k_max: 0.0,
             ell_ranges,
             n_mocks,
-            basis: None,
+            basis,
         };
         let store = crate::Store::new(None);
         let plan = jobs::ept_plan(&model_k, ir, ap, free_ap, &precision, store.get(), &Silent)?;

@@ -66,6 +66,33 @@ def test_fit_ept_recovers_its_own_multipoles():
         pt.fit_ept(data, [0.2], priors={"b2": (0.0, -1.0)}, precision="fast")
 
 
+def test_fit_ept_in_the_desi_physical_basis():
+    # A change of variables of b1, b2, sn (the rest fixed): the same f and error as velocileptors'.
+    k = np.geomspace(0.02, 0.2, 25)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pt.PtSpectraWarning)
+        m = pt.ept(k=k, precision="fast", b1=2.0, b2=-0.4, sn=900.0, f=0.7)
+        s = 0.01 * m["P0"]
+        data = {"k": k, "P0": m["P0"], "s0": s, "P2": m["P2"], "s2": s}
+        kw = dict(precision="fast", b1=1.8, f=0.6, starts=2)
+        vel = pt.fit_ept(data, [0.2], free=("f", "b1", "b2"), marginalise=("sn",), **kw)
+        phys = pt.fit_ept(data, [0.2], free=("f", "b1p", "b2p"), marginalise=("sn0p",), basis="desi",
+                          n_bar=3e-4, **kw)
+    assert abs(vel["f"][0] - phys["f"][0]) < 0.01 * vel["err_f"][0]
+    assert phys["b1p"][0] == pytest.approx(phys["b1"][0] * phys["sigma8_z"][0], rel=1e-9)
+    assert phys["sn0p"][0] == pytest.approx(phys["sn"][0] * 3e-4, rel=1e-9)
+    assert any("DESI DR1 physical" in line for line in phys.header)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pt.PtSpectraWarning)
+        t = pt.fit_ept(data, [0.2], free=("f", "b1p"), marginalise=("sn0p",), basis="desi",
+                       n_bar=3e-4, desi_priors=True, **kw)
+    assert any("b1p: U[0, 3]" in line and "sn0p: N(0, 2^2)" in line for line in t.header)
+    with pytest.raises(ValueError, match="n_bar"):
+        pt.fit_ept(data, [0.2], free=("f", "b1p"), basis="desi", precision="fast")
+    with pytest.raises(ValueError, match="velocileptors name"):
+        pt.fit_ept(data, [0.2], free=("f", "b1"), basis="desi", n_bar=3e-4, precision="fast")
+
+
 def test_rsd_and_fit_route_ept(reference):
     ref, linear = reference
     with warnings.catch_warnings():

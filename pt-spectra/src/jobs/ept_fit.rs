@@ -2,15 +2,16 @@
 //! parameter, as tables.
 
 use super::ept::AP_FIT_RANGE;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::fit::bounded::{AGREEMENT, EXPECTED_DECREASE};
 use crate::fit::galaxy::search::{CROSSING_TOLERANCE, HESSIAN_STEP, PROFILE_AGREEMENT};
 use crate::fit::galaxy::{
-    derived, fit_galaxy_search, profile_galaxy, Derived, GalaxyFit, GalaxyFitRequest, Linear,
-    ProfileGrid, Search, Template,
+    derived, fit_galaxy_search, profile_galaxy, slot_names, Derived, GalaxyFit, GalaxyFitRequest,
+    Linear, Prior, ProfileGrid, Search, Template,
 };
 use crate::fit::MultipoleData;
 use crate::output::{Table, WAVENUMBER};
+use crate::rsd::ept::physical::{PhysicalBasis, DEFAULT_F_SAT, DEFAULT_SIGMA_V};
 use crate::rsd::ept::{EptPlan, EptTerms, PARAM_NAMES};
 use crate::survey::observe::Observation;
 
@@ -25,6 +26,57 @@ pub struct FitContext<'a> {
     pub template: Option<Template>,
     /// The caller's header lines (the command, the inputs).
     pub header: Vec<String>,
+}
+
+/// The parameter basis of a fit by name: `velocileptors` (`None`: the model's own) or `desi` (the
+/// DESI DR1 physical basis at σ₈(z) `sigma8` of the template, number density `n_bar` [(h/Mpc)³],
+/// satellites (f_sat, σ_v [Mpc/h]), default desilike's 0.1 and 5). `desi_priors`: whether the DESI
+/// priors are asked for (only in that basis).
+///
+/// # Errors
+/// [`Error::InvalidChoice`] for another name, `desi` without `n_bar`, or `n_bar`, satellites or
+/// the DESI priors with `velocileptors`; as [`PhysicalBasis::new`].
+pub fn fit_basis(
+    name: &str,
+    sigma8: f64,
+    n_bar: Option<f64>,
+    satellites: Option<(f64, f64)>,
+    desi_priors: bool,
+) -> Result<Option<PhysicalBasis>> {
+    let bad = |reason: &str| Error::InvalidChoice {
+        what: format!("parameter basis `{name}`"),
+        reason: reason.into(),
+    };
+    match name {
+        "velocileptors" => {
+            if n_bar.is_some() || satellites.is_some() || desi_priors {
+                return Err(bad(
+                    "n_bar (--n-bar), the satellites (--satellites) and the DESI priors \
+                     (--desi-priors) belong to the basis desi",
+                ));
+            }
+            Ok(None)
+        }
+        "desi" => {
+            let n_bar = n_bar.ok_or_else(|| {
+                bad("the basis desi needs n_bar (--n-bar): the unit 1/n_bar of sn0p, sn2p, sn4p")
+            })?;
+            let (f_sat, sigma_v) = satellites.unwrap_or((DEFAULT_F_SAT, DEFAULT_SIGMA_V));
+            Ok(Some(PhysicalBasis::new(sigma8, n_bar, f_sat, sigma_v)?))
+        }
+        _ => Err(bad("valid: velocileptors, desi")),
+    }
+}
+
+/// Adds the DESI DR1 priors ([`crate::fit::galaxy::desi_priors`]) of the `free` and `marginalise`d
+/// parameters that have none in `priors`.
+pub fn add_desi_priors(priors: &mut Vec<Prior>, free: &[String], marginalise: &[String]) {
+    for p in crate::fit::galaxy::desi_priors() {
+        let used = free.contains(&p.name) || marginalise.contains(&p.name);
+        if used && !priors.iter().any(|q| q.name == p.name) {
+            priors.push(p);
+        }
+    }
 }
 
 /// The header lines of the search and the errors.
@@ -180,6 +232,9 @@ fn fit_header(terms: &EptTerms, request: &GalaxyFitRequest, context: &FitContext
         header.extend(o.description().iter().cloned());
     }
     let xi = observation.is_some_and(Observation::is_xi);
+    if let Some(b) = &request.basis {
+        header.push(b.describe());
+    }
     if let Some(d) = request.ap {
         header.push(format!(
             "Alcock-Paczynski: the data measured with apar = {}, aperp = {}{}",
@@ -273,13 +328,20 @@ pub(super) fn row_columns(t: &mut Table, rows: &[Row]) {
     } else {
         &[]
     };
+    // In the physical basis its parameters (with their errors), then the model's they map to.
+    let physical = rows.iter().any(|r| r.request.basis.is_some());
     let value = |i: usize, f: &GalaxyFit| match (i.checked_sub(12), f.ap) {
+        (None, _) if physical => f.physical.map_or(f64::NAN, |v| v[i]),
         (None, _) => f.best.values[i],
         (Some(0), Some(d)) => d.apar,
         (Some(_), Some(d)) => d.aperp,
         (Some(_), None) => f64::NAN,
     };
-    for (i, name) in PARAM_NAMES.iter().chain(ap_names).enumerate() {
+    let names = slot_names(physical)
+        .iter()
+        .filter(|&&n| !(physical && n == "alpha6p"));
+    for (i, name) in names.chain(ap_names).enumerate() {
+        let i = if physical && i >= 7 { i + 1 } else { i };
         t.push(
             *name,
             unit(name),
@@ -310,6 +372,15 @@ pub(super) fn row_columns(t: &mut Table, rows: &[Row]) {
         if rows.iter().any(|r| free(r).is_some()) {
             let js: Vec<Option<usize>> = rows.iter().map(free).collect();
             free_columns(t, rows, name, &js);
+        }
+    }
+    if physical {
+        for (i, name) in PARAM_NAMES.iter().enumerate().take(11) {
+            t.push(
+                *name,
+                unit(name),
+                rows.iter().map(|r| r.fit.best.values[i]).collect(),
+            );
         }
     }
     let count = |g: fn(&GalaxyFit) -> f64| rows.iter().map(|r| g(r.fit)).collect();
@@ -378,7 +449,9 @@ fn free_columns(t: &mut Table, rows: &[Row], name: &str, js: &[Option<usize>]) {
 /// The unit of an ept parameter.
 fn unit(name: &str) -> &'static str {
     match name {
-        "alpha0" | "alpha2" | "alpha4" | "alpha6" => "(Mpc/h)^2",
+        "alpha0" | "alpha2" | "alpha4" | "alpha6" | "alpha0p" | "alpha2p" | "alpha4p" => {
+            "(Mpc/h)^2"
+        }
         "sn" => "(Mpc/h)^3",
         "sn2" => "(Mpc/h)^5",
         "sn4" => "(Mpc/h)^7",

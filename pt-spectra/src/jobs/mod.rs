@@ -61,7 +61,9 @@ pub use bispectrum::{
 pub use ept::{
     ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest, AP_FIT_RANGE,
 };
-pub use ept_fit::{ept_fit_table, ept_model_table, ept_profile_table, FitContext};
+pub use ept_fit::{
+    add_desi_priors, ept_fit_table, ept_model_table, ept_profile_table, fit_basis, FitContext,
+};
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use forecast::{forecast_table, parse_bin};
 pub use halo::{halo_table, HaloRequest};

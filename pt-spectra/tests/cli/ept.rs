@@ -172,6 +172,139 @@ fn ept_fit_recovers_the_parameters_of_its_own_multipoles() {
     ]);
 }
 
+/// `fit --rsd ept --basis desi`: the DESI physical basis is a change of variables of the model's
+/// b1, b2 and sn (with the other parameters fixed), so f and its error are those of the
+/// velocileptors fit; the table has the physical parameters (b1p = b1 sigma8_z), then the model's
+/// they map to; the DESI priors are stated; bad combinations are refused by name.
+#[test]
+fn ept_fit_in_the_desi_physical_basis() {
+    let dir = super::scratch("ept_fit_desi");
+    let (ok, out, err) = run(&[
+        "rsd",
+        "--rsd",
+        "ept",
+        "--bias",
+        "2",
+        "--b2",
+        "-0.4",
+        "--sn",
+        "900",
+        "--f",
+        "0.7",
+        "--k-min",
+        "0.02",
+        "--k-max",
+        "0.2",
+        "--nk",
+        "25",
+        "--precision",
+        "fast",
+    ]);
+    assert!(ok, "{err}");
+    let mut text = String::new();
+    for r in rows(&out) {
+        let s = 0.01 * r[1];
+        text += &format!("{} {} {s} {} {s} {} {s}\n", r[0], r[1], r[2], r[3]);
+    }
+    let data = super::write(&dir, "data.txt", &text);
+    let fit = |extra: &[&str]| {
+        let mut a = vec![
+            "fit",
+            "--rsd",
+            "ept",
+            "--data",
+            &data,
+            "--ells",
+            "0,2,4",
+            "--k-max",
+            "0.2",
+            "--precision",
+            "fast",
+            "--bias",
+            "1.8",
+            "--f",
+            "0.6",
+            "--starts",
+            "2",
+        ];
+        a.extend(extra);
+        let (ok, out, err) = run(&a);
+        assert!(ok, "{err}");
+        let names: Vec<String> = column_names_of(&out, "# k_max ")
+            .iter()
+            .map(|c| c.to_string())
+            .collect();
+        let row = rows(&out)[0].clone();
+        let get = move |n: &str| {
+            row[names
+                .iter()
+                .position(|c| c == n)
+                .unwrap_or_else(|| panic!("no column {n}"))]
+        };
+        (out, get)
+    };
+    let (_, vel) = fit(&["--free", "f,b1,b2", "--marginalise", "sn"]);
+    let (out, phys) = fit(&[
+        "--basis",
+        "desi",
+        "--n-bar",
+        "3e-4",
+        "--free",
+        "f,b1p,b2p",
+        "--marginalise",
+        "sn0p",
+    ]);
+    assert!(out.contains("parameter basis: DESI DR1 physical"), "{out}");
+    assert!(
+        (vel("f") - phys("f")).abs() < 0.01 * vel("err_f"),
+        "{} vs {}",
+        vel("f"),
+        phys("f")
+    );
+    assert!((vel("err_f") / phys("err_f") - 1.0).abs() < 0.02);
+    assert!((phys("b1p") - phys("b1") * phys("sigma8_z")).abs() < 1e-6 * phys("b1p"));
+    assert!((phys("sn0p") - phys("sn") * 3e-4).abs() < 1e-6 * phys("sn0p").abs());
+    assert!((phys("b1") - vel("b1")).abs() < 0.01 * vel("err_b1"));
+    let (out, _) = fit(&[
+        "--basis",
+        "desi",
+        "--n-bar",
+        "3e-4",
+        "--free",
+        "f,b1p,b2p",
+        "--marginalise",
+        "sn0p,alpha0p",
+        "--desi-priors",
+    ]);
+    assert!(
+        out.contains("b2p") && out.contains("N(0, 5)") || out.contains("b2p:"),
+        "{out}"
+    );
+    fails_naming(&[
+        (
+            vec![
+                "fit", "--rsd", "ept", "--data", &data, "--basis", "desi", "--free", "f,b1p",
+            ],
+            "--n-bar",
+        ),
+        (
+            vec!["fit", "--rsd", "ept", "--data", &data, "--n-bar", "3e-4"],
+            "--basis desi",
+        ),
+        (
+            vec!["fit", "--rsd", "ept", "--data", &data, "--basis", "lpt"],
+            "velocileptors, desi",
+        ),
+        (
+            vec![
+                "fit", "--rsd", "ept", "--data", &data, "--basis", "desi", "--n-bar", "3e-4",
+                "--free", "f,b1",
+            ],
+            "velocileptors name",
+        ),
+    ]);
+}
+
 /// With a distortion, the fit table has `apar aperp` (and their errors when free).
 #[test]
 fn ept_fit_prints_the_distortion() {

@@ -29,6 +29,7 @@ pub struct Args {
         "data", "covariance", "data_columns", "data_ells", "ells", "free", "marginalise", "prior",
         "n_mocks", "k_min", "k_max", "k_range_ell", "xi", "apar", "aperp", "fiducial", "starts",
         "seed", "no_profile_check", "profile_linear", "profile", "model_out", "contour", "z",
+        "basis", "n_bar", "satellites", "desi_priors",
     ])]
     analysis: Option<PathBuf>,
     /// 1-based columns of the data: k, then P_l and σ_l for each of --data-ells.
@@ -73,6 +74,24 @@ pub struct Args {
     /// NAME:lognormal,MU,SIGMA (of ln NAME). Marginalised parameters take Gaussian priors only.
     #[arg(long, value_name = "NAME:MEAN,SIGMA|NAME:flat,LO,HI")]
     prior: Vec<String>,
+    /// --rsd ept: the basis of --free, --marginalise and --prior: `velocileptors` (the model's own
+    /// b1, b2, bs, b3, alpha0..6, sn, sn2, sn4) or `desi` (the DESI DR1 physical basis b1p = b1
+    /// sigma8(z), b2p, bsp, b3p, alpha0p, alpha2p, alpha4p, sn0p, sn2p, sn4p in units of 1/n_bar;
+    /// needs --n-bar; docs/reference.md). Start values stay the model's (--bias, --b2, ...).
+    #[arg(long, value_name = "BASIS", default_value = "velocileptors")]
+    basis: String,
+    /// --basis desi: the sample's number density [(h/Mpc)^3] (the unit of sn0p, sn2p, sn4p).
+    #[arg(long, value_name = "N")]
+    n_bar: Option<f64>,
+    /// --basis desi: satellite fraction and velocity dispersion [Mpc/h] of sn2p, sn4p (desilike's
+    /// generic 0.1 and 5).
+    #[arg(long, value_name = "FSAT,SIGV", value_parser = parse_pair)]
+    satellites: Option<(f64, f64)>,
+    /// --basis desi: add the DESI DR1 priors (b1p flat [0, 3]; b2p, bsp N(0, 5); alpha0p, alpha2p,
+    /// alpha4p N(0, 12.5); sn0p N(0, 2); sn2p, sn4p N(0, 5)) to the free and marginalised parameters
+    /// that have no --prior.
+    #[arg(long)]
+    desi_priors: bool,
     /// --rsd ept: second-order bias b2 (start or fixed value).
     #[arg(long, value_name = "B2", allow_hyphen_values = true)]
     b2: Option<f64>,
@@ -274,7 +293,7 @@ fn run_ept(args: &Args) -> Result<()> {
             .filter(|n| !n.is_empty())
             .collect()
     };
-    let priors = args
+    let mut priors = args
         .prior
         .iter()
         .map(|text| parse_prior(text))
@@ -301,11 +320,16 @@ fn run_ept(args: &Args) -> Result<()> {
     if free_ap && distortion.is_none() {
         bail!("free apar/aperp need the measurement's distortion: --apar/--aperp or --fiducial");
     }
+    let marginalise = names(args.marginalise.as_deref(), "");
+    let basis = physical_basis(args, loaded.prepared.spectrum.sigma8())?;
+    if args.desi_priors {
+        pt_spectra::jobs::add_desi_priors(&mut priors, &free, &marginalise);
+    }
     let request = GalaxyFitRequest {
         start,
         ap: distortion,
         free,
-        marginalise: names(args.marginalise.as_deref(), ""),
+        marginalise,
         priors,
         ells,
         k_min: if args.xi { args.s_min } else { args.k_min },
@@ -316,7 +340,7 @@ fn run_ept(args: &Args) -> Result<()> {
             .map(|t| parse_ell_range(t))
             .collect::<Result<_>>()?,
         n_mocks: args.n_mocks,
-        basis: None,
+        basis,
     };
     let (window, bins) = args.ept.observation()?;
     let observation = if args.xi {
@@ -445,6 +469,32 @@ fn parse_ell_range(text: &str) -> Result<(usize, f64, f64)> {
 }
 
 /// NAME:MEAN,SIGMA, NAME:flat,LO,HI or NAME:lognormal,MU,SIGMA.
+/// The parameter basis of the options ([`pt_spectra::jobs::fit_basis`]) at σ₈(z) `sigma8`.
+fn physical_basis(
+    args: &Args,
+    sigma8: f64,
+) -> Result<Option<pt_spectra::rsd::ept::physical::PhysicalBasis>> {
+    Ok(pt_spectra::jobs::fit_basis(
+        &args.basis,
+        sigma8,
+        args.n_bar,
+        args.satellites,
+        args.desi_priors,
+    )?)
+}
+
+/// `A,B` as two numbers.
+fn parse_pair(text: &str) -> std::result::Result<(f64, f64), String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    match parts[..] {
+        [a, b] => match (a.parse(), b.parse()) {
+            (Ok(a), Ok(b)) => Ok((a, b)),
+            _ => Err(format!("`{text}`: expected two numbers A,B")),
+        },
+        _ => Err(format!("`{text}`: expected two numbers A,B")),
+    }
+}
+
 fn parse_prior(text: &str) -> Result<Prior> {
     Prior::parse(text).map_err(|e| anyhow::anyhow!("--prior: {e}"))
 }
@@ -502,6 +552,13 @@ pub fn run(args: &Args) -> Result<()> {
             args.ept.has_window() || args.ept.has_bins(),
         ),
         ("--prior", !args.prior.is_empty()),
+        (
+            "--basis/--n-bar/--satellites/--desi-priors",
+            args.basis != "velocileptors"
+                || args.n_bar.is_some()
+                || args.satellites.is_some()
+                || args.desi_priors,
+        ),
         ("--n-mocks", args.n_mocks.is_some()),
         ("--profile", args.profile.is_some()),
         (
