@@ -17,7 +17,7 @@ const TOP: [&str; 3] = ["shared", "search", "dataset"];
 /// The keys of `[search]`.
 const SEARCH: [&str; 4] = ["starts", "seed", "profile_check", "linear"];
 /// The keys of a `[[dataset]]`.
-const SET: [&str; 25] = [
+const SET: [&str; 29] = [
     "label",
     "z",
     "tracer",
@@ -43,6 +43,10 @@ const SET: [&str; 25] = [
     "k_edges",
     "box",
     "ir",
+    "basis",
+    "n_bar",
+    "satellites",
+    "desi_priors",
 ];
 
 /// The error at `key` of `origin`.
@@ -337,6 +341,14 @@ fn data_set(origin: &str, base: &Path, n: usize, t: &Map) -> Result<SetSpec> {
             })
             .collect::<Result<_>>()?,
     };
+    let flag = |name: &str| -> Result<Option<bool>> {
+        opt(name)
+            .map(|v| {
+                v.as_bool()
+                    .ok_or_else(|| bad(origin, &key(name), "must be true or false"))
+            })
+            .transpose()
+    };
     let k_edges = match opt("k_edges") {
         None => None,
         Some(v) => Some(
@@ -375,12 +387,25 @@ fn data_set(origin: &str, base: &Path, n: usize, t: &Map) -> Result<SetSpec> {
             .unwrap_or_else(|| "wilson".into()),
         k_edges,
         box_side: optional(origin, &at, t, "box", number)?,
-        ir: opt("ir")
-            .map(|v| {
-                v.as_bool()
-                    .ok_or_else(|| bad(origin, &key("ir"), "must be true or false"))
-            })
-            .transpose()?
-            .unwrap_or(true),
+        ir: flag("ir")?.unwrap_or(true),
+        basis: optional(origin, &at, t, "basis", string)?.unwrap_or_else(|| "velocileptors".into()),
+        n_bar: optional(origin, &at, t, "n_bar", number)?,
+        satellites: match opt("satellites") {
+            None => None,
+            Some(v) => match &array(origin, &key("satellites"), v)?[..] {
+                [a, b] => Some((
+                    number(origin, &key("satellites"), a)?,
+                    number(origin, &key("satellites"), b)?,
+                )),
+                _ => {
+                    return Err(bad(
+                        origin,
+                        &key("satellites"),
+                        "is [f_sat, sigma_v], e.g. [0.1, 5.0]",
+                    ))
+                }
+            },
+        },
+        desi_priors: flag("desi_priors")?.unwrap_or(false),
     })
 }

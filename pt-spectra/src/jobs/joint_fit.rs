@@ -68,6 +68,14 @@ pub struct SetSpec {
     pub window_mixing: String,
     /// k bin edges [h/Mpc], if any.
     pub k_edges: Option<Vec<f64>>,
+    /// The parameter basis: `velocileptors` or `desi` ([`super::fit_basis`]).
+    pub basis: String,
+    /// The number density of the `desi` basis [(h/Mpc)³].
+    pub n_bar: Option<f64>,
+    /// The satellites (f_sat, σ_v [Mpc/h]) of the `desi` basis.
+    pub satellites: Option<(f64, f64)>,
+    /// Whether the DESI DR1 priors are added ([`super::add_desi_priors`]).
+    pub desi_priors: bool,
     /// The side of the periodic box [Mpc/h] whose modes are averaged in the bins, if any.
     pub box_side: Option<f64>,
     /// IR resummation.
@@ -199,18 +207,30 @@ fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded> {
             _ => start.set(name, *v).map_err(err)?,
         }
     }
+    let basis = super::fit_basis(
+        &s.basis,
+        prepared.spectrum.sigma8(),
+        s.n_bar,
+        s.satellites,
+        s.desi_priors,
+    )
+    .map_err(err)?;
+    let mut priors = s.priors.clone();
+    if s.desi_priors {
+        super::add_desi_priors(&mut priors, &s.free, &s.marginalise);
+    }
     let request = GalaxyFitRequest {
         start,
         ap,
         free: s.free.clone(),
         marginalise: s.marginalise.clone(),
-        priors: s.priors.clone(),
+        priors,
         ells: s.ells.clone(),
         k_min: s.k_min,
         k_max: s.k_max,
         ell_ranges: s.ell_ranges.clone(),
         n_mocks: s.n_mocks,
-        basis: None,
+        basis,
     };
     let mut description =
         vec![format!(
@@ -238,13 +258,17 @@ fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded> {
         s.free.join(","),
         list_or_none(&s.marginalise),
         list_or_none(
-            &s.priors
+            &request
+                .priors
                 .iter()
                 .map(|p| format!("{}: {}", p.name, p.shape))
                 .collect::<Vec<_>>()
         ),
         describe_start(&request),
     )];
+    if let Some(b) = &request.basis {
+        description.push(format!("data set {}: {}", s.label, b.describe()));
+    }
     if let Some(d) = ap {
         description.push(format!(
             "data set {}: measured with apar = {}, aperp = {}",

@@ -94,6 +94,100 @@ fn analysis_file_fits_two_sets_with_a_shared_f() {
     assert!(names.contains(&"fsigma8"));
 }
 
+/// The same two sets in the DESI physical basis (`basis = "desi"`, `n_bar`): b1p, b2p free per set,
+/// f shared, sn0p marginalised, against b1, b2 and sn in the model's basis (the counterterm fixed at 0
+/// in both): a change of variables, so the same b1 (= b1p/sigma8_z) and f; `desi_priors` puts the DESI
+/// priors in the header; a set without n_bar, or sets in two bases, refused by name.
+#[test]
+fn analysis_file_in_the_desi_physical_basis() {
+    let dir = scratch("analysis_desi");
+    write(&dir, "low.dat", &model("1.8"));
+    write(&dir, "high.dat", &model("2.2"));
+    // b2 free in both: a fixed b2p is not a fixed b2 (b2 = b2p/sigma8^2 + (8/21)(b1 - 1)).
+    let vel = |label: &str, data: &str| {
+        set(label, data)
+            .replace("free = [\"f\", \"b1\"]", "free = [\"f\", \"b1\", \"b2\"]")
+            .replace(
+                "marginalise = [\"alpha0\", \"sn\"]",
+                "marginalise = [\"sn\"]",
+            )
+    };
+    let desi = |label: &str, data: &str| {
+        set(label, data)
+            .replace("free = [\"f\", \"b1\"]", "free = [\"f\", \"b1p\", \"b2p\"]")
+            .replace(
+                "marginalise = [\"alpha0\", \"sn\"]",
+                "marginalise = [\"sn0p\"]\nbasis = \"desi\"\nn_bar = 3e-4",
+            )
+    };
+    let fit = |name: &str, body: String| {
+        let file = write(&dir, name, &format!("{SEARCH}{body}"));
+        let (ok, out, err) = run(&["fit", "--analysis", &file, "--precision", "fast"]);
+        assert!(ok, "{err}");
+        out
+    };
+    let a = fit("vel.toml", vel("low", "low.dat") + &vel("high", "high.dat"));
+    let b = fit(
+        "desi.toml",
+        desi("low", "low.dat") + &desi("high", "high.dat"),
+    );
+    assert!(
+        b.contains("data set low: parameter basis: DESI DR1 physical"),
+        "{b}"
+    );
+    let column = |out: &str, r: usize, n: &str| {
+        let names = column_names_of(out, "# set ");
+        rows(out)[r][names
+            .iter()
+            .position(|c| *c == n)
+            .unwrap_or_else(|| panic!("{n}"))]
+    };
+    for r in 0..2 {
+        let (x, y, e) = (
+            column(&a, r, "b1"),
+            column(&b, r, "b1"),
+            column(&a, r, "err_b1"),
+        );
+        assert!((x - y).abs() < 0.01 * e, "b1 of set {r}: {x} vs {y} ± {e}");
+        let b1p = column(&b, r, "b1p");
+        assert!((b1p - y * column(&b, r, "sigma8_z")).abs() < 1e-9 * b1p);
+        let (x, y, e) = (
+            column(&a, r, "f"),
+            column(&b, r, "f"),
+            column(&a, r, "err_f"),
+        );
+        assert!((x - y).abs() < 0.01 * e, "f: {x} vs {y} ± {e}");
+    }
+    let with_priors =
+        |l: &str, d: &str| desi(l, d).replace("n_bar = 3e-4", "n_bar = 3e-4\ndesi_priors = true");
+    let c = fit(
+        "priors.toml",
+        with_priors("low", "low.dat") + &with_priors("high", "high.dat"),
+    );
+    assert!(
+        c.contains("b1p: U[0, 3]") && c.contains("sn0p: N(0, 2^2)"),
+        "{c}"
+    );
+    let mixed = write(
+        &dir,
+        "mixed.toml",
+        &format!(
+            "{SEARCH}{}{}",
+            desi("low", "low.dat"),
+            set("high", "high.dat")
+        ),
+    );
+    let no_n_bar = write(
+        &dir,
+        "no_n_bar.toml",
+        &desi("low", "low.dat").replace("n_bar = 3e-4", ""),
+    );
+    fails_naming(&[
+        (vec!["fit", "--analysis", &mixed], "same basis"),
+        (vec!["fit", "--analysis", &no_n_bar], "needs n_bar"),
+    ]);
+}
+
 /// Every mistake in the file is an error naming the file, the key and the rule.
 #[test]
 fn analysis_file_errors_name_the_file_key_and_rule() {
