@@ -27,12 +27,14 @@ import warnings as _warnings
 import numpy as np
 
 from . import _core
-from ._core import (BispectrumPlan, BispectrumTerms, LinearEmulator, Observation, Pipeline,
+from ._core import (BispectrumPlan, BispectrumTerms, LinearEmulator, Observation, OneLoopBispectrumPlan,
+                    Pipeline,
                     SugiyamaPlan, SugiyamaTerms, Table, distances, eisenstein_hu, fisher, growth, log_grid,
                     num_threads, set_num_threads)
 
 __all__ = [
     "BispectrumPlan",
+    "OneLoopBispectrumPlan",
     "BispectrumTerms",
     "EptPlan",
     "Observation",

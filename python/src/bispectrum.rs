@@ -16,7 +16,7 @@ use pt_spectra::precision::Precision;
 use pyo3::prelude::*;
 
 /// The rows of an (n, N) array `what` of `columns` [h/Mpc].
-fn fixed_rows<const N: usize>(
+pub(crate) fn fixed_rows<const N: usize>(
     array: &Bound<'_, PyAny>,
     what: &str,
     columns: &str,
@@ -441,67 +441,4 @@ impl SugiyamaTerms {
             .map_err(library_error)?;
         values_and_errors(py, &b)
     }
-}
-
-/// The one-loop matter bispectrum in real space (SPT) at the triangles (an (n, 3) array of k1 k2 k3
-/// [h/Mpc], points, not bins) as a `Table` with columns k1 k2 k3 B_tree B222 B321_I B321_II B411
-/// B_1loop and their `err_` columns [(Mpc/h)^6], for the all-matter linear spectrum of the inputs
-/// (as `pt.bispectrum`). The loop integrals run over q_min <= |q| <= q_max [h/Mpc] with `radial`
-/// x `mu` x `phi` nodes per panel; each error is the difference from half the nodes. `two_loop`
-/// says how the loop terms are computed, as everywhere: "basis" (tensors built once per triangle
-/// set and rule, ~0.7 s per triangle and core, cached in `cache_dir`; then ~10 us per triangle;
-/// their projection error is in the errors), "direct" (~0.5 s per triangle), "auto" (the tensors if
-/// cached, else direct). The header says which was used (its line `loop terms: ...`).
-#[pyfunction]
-#[pyo3(signature = (triangles, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None,
-    q_min=1e-4, q_max=10.0, radial=12, mu=32, phi=24,
-    two_loop=pt_spectra::jobs::defaults::TWO_LOOP, cache_dir=None))]
-#[allow(clippy::too_many_arguments)]
-pub fn one_loop_bispectrum(
-    py: Python<'_>,
-    triangles: &Bound<'_, PyAny>,
-    linear: Option<&Bound<'_, PyAny>>,
-    z: f64,
-    z_input: f64,
-    cosmology: Option<&Bound<'_, PyAny>>,
-    eh: Option<&str>,
-    q_min: f64,
-    q_max: f64,
-    radial: usize,
-    mu: usize,
-    phi: usize,
-    two_loop: &str,
-    cache_dir: Option<std::path::PathBuf>,
-) -> PyResult<Table> {
-    let rows = fixed_rows::<3>(triangles, "triangles", "k1, k2, k3")?;
-    let method: pt_spectra::precision::TwoLoopMethod = two_loop.parse().map_err(library_error)?;
-    let store = crate::Store::new(cache_dir);
-    let rule = bk::one_loop::OneLoopRule {
-        radial,
-        mu,
-        phi,
-        q_min,
-        q_max,
-    };
-    let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
-    let ((prepared, table), seconds) = detached(py, || {
-        let prepared = inputs.prepare(&[])?;
-        let table = pt_spectra::jobs::one_loop_bispectrum_table(
-            &prepared,
-            &rows,
-            &rule,
-            method,
-            store.get(),
-            &pt_spectra::progress::Silent,
-        )?;
-        Ok((prepared, table))
-    })?;
-    Table::new(
-        py,
-        table,
-        &prepared,
-        &Precision::default(),
-        "bispectrum one-loop matter",
-        seconds,
-    )
 }

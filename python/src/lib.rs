@@ -24,6 +24,7 @@ use std::sync::OnceLock;
 
 mod batch;
 mod bispectrum;
+mod bispectrum_one_loop;
 mod emulator;
 mod ept;
 mod forecast;
@@ -626,7 +627,11 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<bispectrum::SugiyamaPlan>()?;
     m.add_class::<bispectrum::SugiyamaTerms>()?;
     m.add_function(wrap_pyfunction!(bispectrum::bispectrum, m)?)?;
-    m.add_function(wrap_pyfunction!(bispectrum::one_loop_bispectrum, m)?)?;
+    m.add_function(wrap_pyfunction!(
+        bispectrum_one_loop::one_loop_bispectrum,
+        m
+    )?)?;
+    m.add_class::<bispectrum_one_loop::OneLoopBispectrumPlan>()?;
     m.add_class::<ept::EptTerms>()?;
     m.add_class::<two_loop_rsd::TwoLoopRsdPlan>()?;
     m.add_class::<survey::Observation>()?;

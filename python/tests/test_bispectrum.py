@@ -170,6 +170,17 @@ def test_one_loop_bispectrum_through_the_basis_tensors_agrees_with_direct(tmp_pa
         for name in ["B222", "B321_I", "B321_II", "B411", "B_1loop"]:
             assert np.all(np.abs(basis[name] - direct[name]) <= basis["err_" + name]), name
         np.testing.assert_allclose(basis["B_1loop"], direct["B_1loop"], rtol=1e-3)
+    # The plan keeps its tensors: a call per spectrum returns the same numbers as the table.
+    plan = pt.OneLoopBispectrumPlan(tri, two_loop="basis", cache_dir=tmp_path, **rule)
+    out = plan(z=0.5)
+    assert "basis tensors" in out["loop_terms"]
+    at_z = pt.one_loop_bispectrum(tri, z=0.5, two_loop="basis", cache_dir=tmp_path, **rule)
+    for name in ["B_tree", "B222", "B_1loop", "err_B_1loop"]:
+        np.testing.assert_allclose(out[name], at_z[name], rtol=1e-12)
+    np.testing.assert_array_equal(out["k3"], tri[:, 2])
+    direct = pt.OneLoopBispectrumPlan(tri, two_loop="direct", **rule)(z=0.5)
+    assert direct["loop_terms"].startswith("loop terms: direct")
+    np.testing.assert_allclose(direct["B_1loop"], out["B_1loop"], rtol=1e-3)
     auto = pt.one_loop_bispectrum(tri, two_loop="auto", cache_dir=tmp_path, **rule)
     assert any("basis tensors" in line for line in auto.header)
     with pytest.raises(ValueError, match="two_loop|method|valid"):

@@ -235,6 +235,32 @@ pub fn sugiyama_table(prepared: &Prepared, request: &SugiyamaRequest) -> Result<
     Ok(t)
 }
 
+/// The one-loop matter bispectrum plan of `triangles` and `rule` whose loop terms are computed by
+/// `method`: `direct`, `basis` (the tensors from `store`, built once, reporting to `progress`, and
+/// cached) or `auto` (the tensors if cached, else direct); and whether `auto` found none.
+///
+/// # Errors
+/// As [`OneLoopMatterPlan::new`] (sides that do not close, naming the triangle; a bad rule).
+pub fn one_loop_bispectrum_plan(
+    triangles: &[[f64; 3]],
+    rule: &OneLoopRule,
+    method: TwoLoopMethod,
+    store: &TableStore,
+    progress: &dyn Progress,
+) -> Result<(OneLoopMatterPlan, bool)> {
+    let plan = OneLoopMatterPlan::new(triangles.to_vec(), *rule)?;
+    let tensors = match method {
+        TwoLoopMethod::Direct => None,
+        TwoLoopMethod::Basis => Some(store.one_loop_bispectrum_basis(triangles, rule, progress)?),
+        TwoLoopMethod::Auto => store.cached_one_loop_bispectrum_basis(triangles, rule, progress),
+    };
+    let uncached = method == TwoLoopMethod::Auto && tensors.is_none();
+    Ok(match tensors {
+        Some(t) => (plan.with_basis(t)?, false),
+        None => (plan, uncached),
+    })
+}
+
 /// The table `k1 k2 k3 B_tree B222 B321_I B321_II B411 B_1loop` and their `err_` columns of the one-loop
 /// matter bispectrum in real space at `triangles` (points) for the all-matter linear spectrum of
 /// `prepared` ([`crate::bispectrum::one_loop`]), the loop terms computed by `method`: `direct`, `basis`
@@ -251,16 +277,7 @@ pub fn one_loop_bispectrum_table(
     store: &TableStore,
     progress: &dyn Progress,
 ) -> Result<Table> {
-    let mut plan = OneLoopMatterPlan::new(triangles.to_vec(), *rule)?;
-    let tensors = match method {
-        TwoLoopMethod::Direct => None,
-        TwoLoopMethod::Basis => Some(store.one_loop_bispectrum_basis(triangles, rule, progress)?),
-        TwoLoopMethod::Auto => store.cached_one_loop_bispectrum_basis(triangles, rule, progress),
-    };
-    let uncached = method == TwoLoopMethod::Auto && tensors.is_none();
-    if let Some(t) = tensors {
-        plan = plan.with_basis(t)?;
-    }
+    let (plan, uncached) = one_loop_bispectrum_plan(triangles, rule, method, store, progress)?;
     let (rows, mut source) = plan.evaluate_reporting(&prepared.spectrum, &|d, t| {
         progress.update(Stage::OneLoopBispectrum, d, t);
     })?;

@@ -1,0 +1,159 @@
+//! `pt.one_loop_bispectrum`, `pt.OneLoopBispectrumPlan`: the one-loop matter bispectrum in real
+//! space ([`pt_spectra::bispectrum::one_loop`], its basis tensors
+//! [`pt_spectra::bispectrum::one_loop_basis`]) from Python.
+
+use crate::bispectrum::fixed_rows;
+use crate::inputs::Inputs;
+use crate::tables::Table;
+use crate::{detached, library_error};
+use numpy::IntoPyArray;
+use pt_spectra::bispectrum::one_loop::{OneLoopMatter, OneLoopRule};
+use pt_spectra::bispectrum::one_loop_basis::{OneLoopMatterPlan, OneLoopSource};
+use pt_spectra::precision::{Precision, TwoLoopMethod};
+use pt_spectra::progress::Silent;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// The one-loop matter bispectrum in real space (SPT) at the triangles (an (n, 3) array of k1 k2 k3
+/// [h/Mpc], points, not bins) as a `Table` with columns k1 k2 k3 B_tree B222 B321_I B321_II B411
+/// B_1loop and their `err_` columns [(Mpc/h)^6], for the all-matter linear spectrum of the inputs
+/// (as `pt.bispectrum`). The loop integrals run over q_min <= |q| <= q_max [h/Mpc] with `radial`
+/// x `mu` x `phi` nodes per panel; each error is the difference from half the nodes. `two_loop`
+/// says how the loop terms are computed, as everywhere: "basis" (tensors built once per triangle
+/// set and rule, ~0.7 s per triangle and core, cached in `cache_dir`; then ~10 us per triangle;
+/// their projection error is in the errors), "direct" (~0.5 s per triangle), "auto" (the tensors if
+/// cached, else direct). The header says which was used (its line `loop terms: ...`).
+#[pyfunction]
+#[pyo3(signature = (triangles, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None,
+    q_min=1e-4, q_max=10.0, radial=12, mu=32, phi=24,
+    two_loop=pt_spectra::jobs::defaults::TWO_LOOP, cache_dir=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn one_loop_bispectrum(
+    py: Python<'_>,
+    triangles: &Bound<'_, PyAny>,
+    linear: Option<&Bound<'_, PyAny>>,
+    z: f64,
+    z_input: f64,
+    cosmology: Option<&Bound<'_, PyAny>>,
+    eh: Option<&str>,
+    q_min: f64,
+    q_max: f64,
+    radial: usize,
+    mu: usize,
+    phi: usize,
+    two_loop: &str,
+    cache_dir: Option<std::path::PathBuf>,
+) -> PyResult<Table> {
+    let rows = fixed_rows::<3>(triangles, "triangles", "k1, k2, k3")?;
+    let method: TwoLoopMethod = two_loop.parse().map_err(library_error)?;
+    let store = crate::Store::new(cache_dir);
+    let rule = OneLoopRule {
+        radial,
+        mu,
+        phi,
+        q_min,
+        q_max,
+    };
+    let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
+    let ((prepared, table), seconds) = detached(py, || {
+        let prepared = inputs.prepare(&[])?;
+        let table = pt_spectra::jobs::one_loop_bispectrum_table(
+            &prepared,
+            &rows,
+            &rule,
+            method,
+            store.get(),
+            &Silent,
+        )?;
+        Ok((prepared, table))
+    })?;
+    Table::new(
+        py,
+        table,
+        &prepared,
+        &Precision::default(),
+        "bispectrum one-loop matter",
+        seconds,
+    )
+}
+
+/// A one-loop matter bispectrum planned for a set of triangles (points): the plan and, with
+/// `two_loop="basis"`, its basis tensors (built once, ~0.7 s per triangle and core, cached in
+/// `cache_dir`), so that a call per linear spectrum costs ~10 us per triangle.
+#[pyclass(module = "pt_spectra._core", frozen)]
+pub struct OneLoopBispectrumPlan {
+    plan: OneLoopMatterPlan,
+    uncached: bool,
+}
+
+#[pymethods]
+impl OneLoopBispectrumPlan {
+    #[new]
+    #[pyo3(signature = (triangles, q_min=1e-4, q_max=10.0, radial=12, mu=32, phi=24,
+        two_loop="basis", cache_dir=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        triangles: &Bound<'_, PyAny>,
+        q_min: f64,
+        q_max: f64,
+        radial: usize,
+        mu: usize,
+        phi: usize,
+        two_loop: &str,
+        cache_dir: Option<std::path::PathBuf>,
+    ) -> PyResult<Self> {
+        let rows = fixed_rows::<3>(triangles, "triangles", "k1, k2, k3")?;
+        let rule = OneLoopRule {
+            radial,
+            mu,
+            phi,
+            q_min,
+            q_max,
+        };
+        let method: TwoLoopMethod = two_loop.parse().map_err(library_error)?;
+        let store = crate::Store::new(cache_dir);
+        let ((plan, uncached), _) = detached(py, || {
+            pt_spectra::jobs::one_loop_bispectrum_plan(&rows, &rule, method, store.get(), &Silent)
+        })?;
+        Ok(Self { plan, uncached })
+    }
+
+    /// The terms at every triangle for the linear spectrum of the inputs (as `pt.bispectrum`: all
+    /// matter), as a dict of arrays: k1 k2 k3, B_tree B222 B321_I B321_II B411 B_1loop and their
+    /// err_ [(Mpc/h)^6], and `loop_terms` (how they were computed: basis, or direct and why).
+    #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None))]
+    fn __call__<'py>(
+        &self,
+        py: Python<'py>,
+        linear: Option<&Bound<'py, PyAny>>,
+        z: f64,
+        z_input: f64,
+        cosmology: Option<&Bound<'py, PyAny>>,
+        eh: Option<&str>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
+        let ((rows, mut source), _) = detached(py, || {
+            let prepared = inputs.prepare(&[])?;
+            self.plan.evaluate(&prepared.spectrum)
+        })?;
+        if self.uncached && source == OneLoopSource::Direct {
+            source = OneLoopSource::DirectUncached;
+        }
+        let out = PyDict::new(py);
+        for (i, name) in ["k1", "k2", "k3"].iter().enumerate() {
+            let v: Vec<f64> = rows.iter().map(|b| b.k[i]).collect();
+            out.set_item(*name, v.into_pyarray(py))?;
+        }
+        let terms = |b: &OneLoopMatter| [b.tree, b.b222, b.b321_i, b.b321_ii, b.b411, b.total()];
+        let names = ["B_tree", "B222", "B321_I", "B321_II", "B411", "B_1loop"];
+        for (j, name) in names.iter().enumerate() {
+            let v: Vec<f64> = rows.iter().map(|b| terms(b)[j].value).collect();
+            let e: Vec<f64> = rows.iter().map(|b| terms(b)[j].error).collect();
+            out.set_item(*name, v.into_pyarray(py))?;
+            out.set_item(format!("err_{name}"), e.into_pyarray(py))?;
+        }
+        out.set_item("loop_terms", source.describe())?;
+        Ok(out)
+    }
+}
