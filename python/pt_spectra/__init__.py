@@ -597,7 +597,8 @@ def bispectrum(triangles=None, bin_width=None, linear=None, z=0.0, z_input=0.0, 
 
 
 def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, q_min=1e-4,
-                        q_max=10.0, radial=12, mu=32, phi=24, two_loop="auto", cache_dir=None):
+                        q_max=10.0, radial=12, mu=32, phi=24, two_loop="auto", cache_dir=None, mu1=None,
+                        phi_los=0.0, f=None):
     """One-loop matter bispectrum in real space (SPT) [(Mpc/h)^6] at single triangles.
 
     ``triangles``: an (n, 3) array of k1, k2, k3 [h/Mpc] (points, not bins). The linear spectrum as in
@@ -614,6 +615,11 @@ def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=No
     spectrum, their projection error included in the errors; a spectrum the basis does not represent
     is integrated directly, as the header says), ``"direct"`` or ``"auto"`` (the tensors if cached,
     else direct). The header line ``loop terms: ...`` says which was used.
+
+    ``mu1`` (and ``phi_los`` [rad], ``f``, default f(z)): the matter bispectrum in redshift space at one
+    orientation of the triangles to the line of sight (the cosine between k1 and it, its azimuth about
+    k1 from the triangle's plane), with the exact redshift-space kernels Z1..Z4, directly (about 1.3 s
+    per triangle on 2 cores; no counterterm shapes, bias or multipoles yet).
     """
     return _warn(_core.one_loop_bispectrum(triangles, linear, z, z_input, cosmology, eh, q_min, q_max,
-                                           radial, mu, phi, two_loop, cache_dir))
+                                           radial, mu, phi, two_loop, cache_dir, mu1, phi_los, f))

@@ -26,7 +26,7 @@ use pyo3::types::PyDict;
 #[pyfunction]
 #[pyo3(signature = (triangles, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None,
     q_min=1e-4, q_max=10.0, radial=12, mu=32, phi=24,
-    two_loop=pt_spectra::jobs::defaults::TWO_LOOP, cache_dir=None))]
+    two_loop=pt_spectra::jobs::defaults::TWO_LOOP, cache_dir=None, mu1=None, phi_los=0.0, f=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn one_loop_bispectrum(
     py: Python<'_>,
@@ -43,6 +43,9 @@ pub fn one_loop_bispectrum(
     phi: usize,
     two_loop: &str,
     cache_dir: Option<std::path::PathBuf>,
+    mu1: Option<f64>,
+    phi_los: f64,
+    f: Option<f64>,
 ) -> PyResult<Table> {
     let rows = fixed_rows::<3>(triangles, "triangles", "k1, k2, k3")?;
     let method: TwoLoopMethod = two_loop.parse().map_err(library_error)?;
@@ -55,8 +58,31 @@ pub fn one_loop_bispectrum(
         q_max,
     };
     let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
+    if mu1.is_none() && f.is_some() {
+        return Err(crate::value_error(
+            "f is the growth rate of the redshift-space one-loop bispectrum: give mu1 too",
+        ));
+    }
+    if mu1.is_some() && method == TwoLoopMethod::Basis {
+        return Err(crate::value_error(
+            "two_loop=\"basis\": the one-loop bispectrum's tensors are built for real space only",
+        ));
+    }
     let ((prepared, table), seconds) = detached(py, || {
         let prepared = inputs.prepare(&[])?;
+        if let Some(mu1) = mu1 {
+            let orientation =
+                pt_spectra::bispectrum::one_loop_rsd::Orientation { mu1, phi: phi_los };
+            let table = pt_spectra::jobs::one_loop_redshift_table(
+                &prepared,
+                &rows,
+                f,
+                orientation,
+                &rule,
+                &Silent,
+            )?;
+            return Ok((prepared, table));
+        }
         let table = pt_spectra::jobs::one_loop_bispectrum_table(
             &prepared,
             &rows,

@@ -187,6 +187,22 @@ def test_one_loop_bispectrum_through_the_basis_tensors_agrees_with_direct(tmp_pa
         pt.one_loop_bispectrum(tri, two_loop="fast", **rule)
 
 
+def test_one_loop_bispectrum_in_redshift_space_at_one_orientation():
+    tri = np.array([[0.1, 0.1, 0.1], [0.05, 0.1, 0.12]])
+    rule = dict(radial=6, mu=12, phi=8)
+    real = pt.one_loop_bispectrum(tri, two_loop="direct", **rule)
+    zero = pt.one_loop_bispectrum(tri, mu1=0.4, f=0.0, **rule)  # f = 0 is real space
+    for name in ["B_tree", "B222", "B321_I", "B321_II", "B411"]:
+        np.testing.assert_allclose(zero[name], real[name], rtol=1e-10)
+    rsd = pt.one_loop_bispectrum(tri, mu1=0.4, phi_los=0.3, f=0.7, **rule)
+    assert any("redshift space" in line and "mu1 = 0.4" in line for line in rsd.header)
+    assert np.all(rsd["B_tree"] > real["B_tree"])
+    with pytest.raises(ValueError, match="real space only"):
+        pt.one_loop_bispectrum(tri, mu1=0.4, two_loop="basis", **rule)
+    with pytest.raises(ValueError, match="give mu1"):
+        pt.one_loop_bispectrum(tri, f=0.7, **rule)
+
+
 @pytest.mark.parametrize("kwargs, needle", [
     (dict(triangles=[[0.1, 0.1, 0.3]]), "does not close"),
     (dict(triangles=[[0.1, 0.1]]), "k1, k2, k3"),

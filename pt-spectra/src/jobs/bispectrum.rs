@@ -5,6 +5,7 @@
 use super::VERSION;
 use crate::bispectrum::one_loop::{OneLoopMatter, OneLoopRule, COUNTERTERMS, PARTITION_POWER};
 use crate::bispectrum::one_loop_basis::{OneLoopMatterPlan, OneLoopSource};
+use crate::bispectrum::one_loop_rsd::{one_loop_matter_redshift, Orientation};
 use crate::bispectrum::{
     BispectrumParams, BispectrumPlan, BoxPlan, Fog, LegendreSide, PlanRules, Settings,
     SugiyamaPlan, SugiyamaRules, TriangleSet, SUGIYAMA_MULTIPOLES,
@@ -310,25 +311,11 @@ pub fn one_loop_bispectrum_table(
     }
     header.extend(prepared.description.iter().cloned());
     let mut t = Table::new(header);
-    for (i, name) in ["k1", "k2", "k3"].iter().enumerate() {
-        t.push(*name, WAVENUMBER, rows.iter().map(|b| b.k[i]).collect());
-    }
     let terms = |b: &OneLoopMatter| [b.tree, b.b222, b.b321_i, b.b321_ii, b.b411, b.total()];
-    let names = ["B_tree", "B222", "B321_I", "B321_II", "B411", "B_1loop"];
-    for (j, name) in names.iter().enumerate() {
-        t.push(
-            *name,
-            BISPECTRUM,
-            rows.iter().map(|b| terms(b)[j].value).collect(),
-        );
-    }
-    for (j, name) in names.iter().enumerate() {
-        t.push(
-            format!("err_{name}"),
-            BISPECTRUM,
-            rows.iter().map(|b| terms(b)[j].error).collect(),
-        );
-    }
+    one_loop_columns(
+        &mut t,
+        &rows.iter().map(|b| (b.k, terms(b))).collect::<Vec<_>>(),
+    );
     for (j, name) in COUNTERTERMS.iter().enumerate() {
         t.push(
             format!("shape_{name}"),
@@ -336,5 +323,82 @@ pub fn one_loop_bispectrum_table(
             rows.iter().map(|b| b.counterterm_shapes[j]).collect(),
         );
     }
+    Ok(t)
+}
+
+/// The columns `k1 k2 k3 B_tree B222 B321_I B321_II B411 B_1loop` and their `err_` of one-loop terms,
+/// per triangle its sides and (tree, B222, B321_I, B321_II, B411, total).
+fn one_loop_columns(t: &mut Table, rows: &[([f64; 3], [Estimate; 6])]) {
+    for (i, name) in ["k1", "k2", "k3"].iter().enumerate() {
+        t.push(*name, WAVENUMBER, rows.iter().map(|r| r.0[i]).collect());
+    }
+    let names = ["B_tree", "B222", "B321_I", "B321_II", "B411", "B_1loop"];
+    for (j, name) in names.iter().enumerate() {
+        t.push(
+            *name,
+            BISPECTRUM,
+            rows.iter().map(|r| r.1[j].value).collect(),
+        );
+    }
+    for (j, name) in names.iter().enumerate() {
+        t.push(
+            format!("err_{name}"),
+            BISPECTRUM,
+            rows.iter().map(|r| r.1[j].error).collect(),
+        );
+    }
+}
+
+/// The table `k1 k2 k3 B_tree B222 B321_I B321_II B411 B_1loop` and their `err_` columns of the one-loop
+/// matter bispectrum in redshift space ([`crate::bispectrum::one_loop_rsd`]) at `triangles` (points)
+/// at growth rate `f` (default f(z)) and `orientation` to the line of sight, for the all-matter
+/// linear spectrum of `prepared`, directly, reporting each triangle to `progress`.
+///
+/// # Errors
+/// As [`one_loop_matter_redshift`], naming the triangle.
+pub fn one_loop_redshift_table(
+    prepared: &Prepared,
+    triangles: &[[f64; 3]],
+    f: Option<f64>,
+    orientation: Orientation,
+    rule: &OneLoopRule,
+    progress: &dyn Progress,
+) -> Result<Table> {
+    let f = f.unwrap_or(prepared.growth_rate);
+    let mut rows = Vec::with_capacity(triangles.len());
+    for (i, &k) in triangles.iter().enumerate() {
+        let b =
+            one_loop_matter_redshift(&prepared.spectrum, k, f, orientation, rule).map_err(|e| {
+                Error::InvalidChoice {
+                    what: format!("triangle {} ({}, {}, {})", i + 1, k[0], k[1], k[2]),
+                    reason: e.to_string(),
+                }
+            })?;
+        rows.push((k, [b.tree, b.b222, b.b321_i, b.b321_ii, b.b411, b.total()]));
+        progress.update(Stage::OneLoopBispectrum, i + 1, triangles.len());
+    }
+    let mut header = vec![
+        format!(
+            "pt-spectra {VERSION} bispectrum --loop 1: one-loop matter bispectrum in redshift space (SPT), z = {}, \
+             f = {f}, line of sight at mu1 = {} (cosine to k1), phi = {} rad (azimuth about k1 from the \
+             triangle's plane, on the side of k2)",
+            prepared.z, orientation.mu1, orientation.phi
+        ),
+        "B_1loop = B_tree + B222 + B321_I + B321_II + B411 with the exact generated redshift-space kernels Z1..Z4 \
+         (Scoccimarro, Couchman & Frieman 1999) in place of F_n and Z1 on the linear legs; no counterterms, \
+         bias, IR resummation or average over orientations yet (docs/bispectrum.md)"
+            .into(),
+        format!(
+            "loop integrals over {} <= |q| <= {} h/Mpc about each cusp (smooth partition of unity, power {}); \
+             {} ln q x {} cos(theta) x {} phi nodes per half circle and panel (phi over the whole circle unless the line of \
+             sight lies in the triangle's plane); err_: difference from the rule with half the nodes; \
+             loop terms: direct integration",
+            rule.q_min, rule.q_max, PARTITION_POWER, rule.radial, rule.mu, rule.phi
+        ),
+        "at the given triangles (not averaged over bins); linear spectrum: all matter".into(),
+    ];
+    header.extend(prepared.description.iter().cloned());
+    let mut t = Table::new(header);
+    one_loop_columns(&mut t, &rows);
     Ok(t)
 }

@@ -56,8 +56,8 @@ mod spt2;
 pub use batch::{batch_memory, real_batch, BatchColumns, BatchMemory, BatchRows};
 pub use bias::BiasOutput;
 pub use bispectrum::{
-    bispectrum_table, one_loop_bispectrum_plan, one_loop_bispectrum_table, sugiyama_table,
-    BispectrumRequest, SugiyamaRequest,
+    bispectrum_table, one_loop_bispectrum_plan, one_loop_bispectrum_table, one_loop_redshift_table,
+    sugiyama_table, BispectrumRequest, SugiyamaRequest,
 };
 pub use ept::{
     ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest, AP_FIT_RANGE,

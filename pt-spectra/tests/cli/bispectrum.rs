@@ -370,6 +370,53 @@ fn one_loop_matter_terms_at_triangles_and_refusals() {
         }
     }
     let _ = std::fs::remove_dir_all(&cache);
+    // Redshift space at one orientation (--mu1, --phi-los, --f): at f = 0 the real-space terms (the
+    // line of sight in the triangle's plane: the same nodes), the header states f and the orientation.
+    let (ok, rsd, err) = run(&[
+        "bispectrum",
+        "--loop",
+        "1",
+        "--triangles",
+        path,
+        "--mu1",
+        "0.5",
+        "--f",
+        "0",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        rsd.contains("in redshift space (SPT)")
+            && rsd.contains("f = 0, line of sight at mu1 = 0.5"),
+        "{rsd}"
+    );
+    for (b, d) in rows(&rsd).iter().zip(rows(&out)) {
+        for j in 3..9 {
+            assert!(
+                (b[j] - d[j]).abs() <= 1e-10 * d[j].abs(),
+                "column {j}: {} vs {}",
+                b[j],
+                d[j]
+            );
+        }
+    }
+    let (ok, rsd, err) = run(&[
+        "bispectrum",
+        "--loop",
+        "1",
+        "--triangles",
+        path,
+        "--mu1",
+        "0.5",
+        "--phi-los",
+        "0.3",
+        "--f",
+        "0.7",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        rows(&rsd)[1][3] > 1.5 * rows(&out)[1][3],
+        "Kaiser-like boost of the tree: {rsd}"
+    );
     let with = |extra: &[&'static str]| {
         let mut a = vec!["bispectrum", "--loop", "1", "--triangles", path];
         a.extend(extra);
@@ -386,6 +433,36 @@ fn one_loop_matter_terms_at_triangles_and_refusals() {
         (
             vec!["bispectrum", "--loop", "2", "--triangles", path],
             "--loop 2: valid",
+        ),
+        (
+            vec!["bispectrum", "--triangles", path, "--mu1", "0.5"],
+            "give --loop 1",
+        ),
+        (
+            vec![
+                "bispectrum",
+                "--loop",
+                "1",
+                "--triangles",
+                path,
+                "--mu1",
+                "1.5",
+            ],
+            "mu1",
+        ),
+        (
+            vec![
+                "bispectrum",
+                "--loop",
+                "1",
+                "--triangles",
+                path,
+                "--mu1",
+                "0.5",
+                "--two-loop",
+                "basis",
+            ],
+            "real space only",
         ),
     ]);
 }

@@ -116,6 +116,19 @@ pub struct Args {
     /// triangle after a one-off ~0.7 s per triangle).
     #[arg(long = "loop", value_name = "N", default_value_t = 0)]
     loop_order: u32,
+    /// --loop 1 in redshift space: the cosine between k1 and the line of sight (with --f, default
+    /// f(z); the matter bispectrum at this one orientation, directly).
+    #[arg(
+        long,
+        value_name = "MU1",
+        allow_hyphen_values = true,
+        requires = "triangles"
+    )]
+    mu1: Option<f64>,
+    /// --loop 1 with --mu1: the azimuth of the line of sight about k1 from the triangle's plane, on
+    /// the side of k2 [rad] (default 0: in the plane).
+    #[arg(long, value_name = "PHI", allow_hyphen_values = true, requires = "mu1")]
+    phi_los: Option<f64>,
     /// Write the table to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
@@ -151,7 +164,11 @@ fn galaxy_options_given(args: &Args) -> Vec<&'static str> {
 
 /// `--loop 1`: the one-loop matter bispectrum at the triangles of --triangles.
 fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
-    let given = galaxy_options_given(args);
+    let redshift = args.mu1.is_some();
+    let given: Vec<&str> = galaxy_options_given(args)
+        .into_iter()
+        .filter(|&o| !(redshift && o == "--f"))
+        .collect();
     if !given.is_empty() {
         bail!(
             "--loop 1 is the one-loop matter bispectrum in real space at single triangles; it does not take {} \
@@ -168,6 +185,26 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
         .collect();
     let loaded = args.spectrum.load()?;
     let bars = crate::progress::Bars::default();
+    if let Some(mu1) = args.mu1 {
+        if loaded.precision.two_loop == pt_spectra::precision::TwoLoopMethod::Basis {
+            bail!(
+                "--two-loop basis: the one-loop bispectrum's tensors are built for real space only"
+            );
+        }
+        let orientation = pt_spectra::bispectrum::one_loop_rsd::Orientation {
+            mu1,
+            phi: args.phi_los.unwrap_or(0.0),
+        };
+        return pt_spectra::jobs::one_loop_redshift_table(
+            &loaded.prepared,
+            &rows,
+            args.f,
+            orientation,
+            &OneLoopRule::default(),
+            &bars,
+        )
+        .with_context(|| format!("--triangles {}", path.display()));
+    }
     one_loop_bispectrum_table(
         &loaded.prepared,
         &rows,
@@ -233,9 +270,16 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let fog = Fog::by_name(&args.fog, args.sigma_fog)?;
     match args.loop_order {
+        0 if args.mu1.is_some() => {
+            bail!("--mu1 is the orientation of the one-loop matter bispectrum: give --loop 1 (the tree \
+                   level averages over orientations: B0, B2, B4)")
+        }
         0 => {}
         1 => return write_output(args.out.as_ref(), &one_loop(args)?),
-        n => bail!("--loop {n}: valid: 0 (tree level), 1 (one-loop matter, real space)"),
+        n => bail!(
+            "--loop {n}: valid: 0 (tree level), 1 (one-loop matter, real space, or redshift space at \
+             one orientation with --mu1)"
+        ),
     }
     let table = match args.basis.to_ascii_lowercase().as_str() {
         "scoccimarro" => {
