@@ -50,13 +50,7 @@ pub fn one_loop_bispectrum(
     let rows = fixed_rows::<3>(triangles, "triangles", "k1, k2, k3")?;
     let method: TwoLoopMethod = two_loop.parse().map_err(library_error)?;
     let store = crate::Store::new(cache_dir);
-    let rule = OneLoopRule {
-        radial,
-        mu,
-        phi,
-        q_min,
-        q_max,
-    };
+    let rule = rule_of(q_min, q_max, radial, mu, phi);
     let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
     if mu1.is_none() && f.is_some() {
         return Err(crate::value_error(
@@ -101,6 +95,17 @@ pub fn one_loop_bispectrum(
         "bispectrum one-loop matter",
         seconds,
     )
+}
+
+/// The rule of the keyword arguments (checked where it is used).
+fn rule_of(q_min: f64, q_max: f64, radial: usize, mu: usize, phi: usize) -> OneLoopRule {
+    OneLoopRule {
+        radial,
+        mu,
+        phi,
+        q_min,
+        q_max,
+    }
 }
 
 /// A one-loop matter bispectrum planned for a set of triangles (points): the plan and, with

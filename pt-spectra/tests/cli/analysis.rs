@@ -6,37 +6,9 @@ use super::{column_names_of, fails_naming, rows, run, scratch, write};
 /// Noise-free ept multipoles ℓ = 0, 2, 4 with b1 = `b1`, f = 0.7, as `k P0 σ P2 σ P4 σ` (σ = 1% of
 /// P0) on 25 k in [0.02, 0.2] h/Mpc.
 fn model(b1: &str) -> String {
-    let (ok, out, err) = run(&[
-        "rsd",
-        "--rsd",
-        "ept",
-        "--bias",
-        b1,
-        "--b2",
-        "-0.4",
-        "--alpha0",
-        "8",
-        "--sn",
-        "900",
-        "--f",
-        "0.7",
-        "--k-min",
-        "0.02",
-        "--k-max",
-        "0.2",
-        "--nk",
-        "25",
-        "--precision",
-        "fast",
-    ]);
-    assert!(ok, "{err}");
-    rows(&out)
-        .iter()
-        .map(|r| {
-            let s = 0.01 * r[1];
-            format!("{} {} {s} {} {s} {} {s}\n", r[0], r[1], r[2], r[3])
-        })
-        .collect()
+    super::ept_multipoles(&[
+        "--bias", b1, "--b2", "-0.4", "--alpha0", "8", "--sn", "900", "--f", "0.7",
+    ])
 }
 
 /// The body of a data set of the analysis file.

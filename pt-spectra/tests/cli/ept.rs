@@ -67,35 +67,9 @@ fn ept_refuses_other_models_options_and_bad_values() {
 #[test]
 fn ept_fit_recovers_the_parameters_of_its_own_multipoles() {
     let dir = super::scratch("ept_fit");
-    let (ok, out, err) = run(&[
-        "rsd",
-        "--rsd",
-        "ept",
-        "--bias",
-        "2",
-        "--b2",
-        "-0.4",
-        "--alpha0",
-        "8",
-        "--sn",
-        "900",
-        "--f",
-        "0.7",
-        "--k-min",
-        "0.02",
-        "--k-max",
-        "0.2",
-        "--nk",
-        "25",
-        "--precision",
-        "fast",
+    let text = super::ept_multipoles(&[
+        "--bias", "2", "--b2", "-0.4", "--alpha0", "8", "--sn", "900", "--f", "0.7",
     ]);
-    assert!(ok, "{err}");
-    let mut text = String::new();
-    for r in rows(&out) {
-        let s = 0.01 * r[1];
-        text += &format!("{} {} {s} {} {s} {} {s}\n", r[0], r[1], r[2], r[3]);
-    }
     let data = super::write(&dir, "data.txt", &text);
     let (ok, out, err) = run(&[
         "fit",
@@ -179,33 +153,7 @@ fn ept_fit_recovers_the_parameters_of_its_own_multipoles() {
 #[test]
 fn ept_fit_in_the_desi_physical_basis() {
     let dir = super::scratch("ept_fit_desi");
-    let (ok, out, err) = run(&[
-        "rsd",
-        "--rsd",
-        "ept",
-        "--bias",
-        "2",
-        "--b2",
-        "-0.4",
-        "--sn",
-        "900",
-        "--f",
-        "0.7",
-        "--k-min",
-        "0.02",
-        "--k-max",
-        "0.2",
-        "--nk",
-        "25",
-        "--precision",
-        "fast",
-    ]);
-    assert!(ok, "{err}");
-    let mut text = String::new();
-    for r in rows(&out) {
-        let s = 0.01 * r[1];
-        text += &format!("{} {} {s} {} {s} {} {s}\n", r[0], r[1], r[2], r[3]);
-    }
+    let text = super::ept_multipoles(&["--bias", "2", "--b2", "-0.4", "--sn", "900", "--f", "0.7"]);
     let data = super::write(&dir, "data.txt", &text);
     let fit = |extra: &[&str]| {
         let mut a = vec![
@@ -289,7 +237,7 @@ fn ept_fit_in_the_desi_physical_basis() {
         ),
         (
             vec!["fit", "--rsd", "ept", "--data", &data, "--n-bar", "3e-4"],
-            "--basis desi",
+            "belong to the basis desi",
         ),
         (
             vec!["fit", "--rsd", "ept", "--data", &data, "--basis", "lpt"],
