@@ -135,13 +135,7 @@ impl OneLoopBispectrumPlan {
         cache_dir: Option<std::path::PathBuf>,
     ) -> PyResult<Self> {
         let rows = fixed_rows::<3>(triangles, "triangles", "k1, k2, k3")?;
-        let rule = OneLoopRule {
-            radial,
-            mu,
-            phi,
-            q_min,
-            q_max,
-        };
+        let rule = rule_of(q_min, q_max, radial, mu, phi);
         let method: TwoLoopMethod = two_loop.parse().map_err(library_error)?;
         let store = crate::Store::new(cache_dir);
         let ((plan, uncached), _) = detached(py, || {
