@@ -11,7 +11,7 @@ use crate::fit::galaxy::{
 };
 use crate::fit::MultipoleData;
 use crate::output::{Table, WAVENUMBER};
-use crate::rsd::ept::physical::{PhysicalBasis, DEFAULT_F_SAT, DEFAULT_SIGMA_V};
+use crate::rsd::ept::physical::{PhysicalBasis, DEFAULT_F_SAT, DEFAULT_SIGMA_V, PHYSICAL_NAMES};
 use crate::rsd::ept::{EptPlan, EptTerms, PARAM_NAMES};
 use crate::survey::observe::Observation;
 
@@ -517,7 +517,10 @@ pub fn ept_profile_table(
     let at = |p: &crate::fit::galaxy::ProfilePoint, n: &str| match n {
         "apar" => p.ap.map_or(f64::NAN, |d| d.apar),
         "aperp" => p.ap.map_or(f64::NAN, |d| d.aperp),
-        n => p.best.get(n).unwrap_or(f64::NAN),
+        n => match (p.physical, PHYSICAL_NAMES.iter().position(|&m| m == n)) {
+            (Some(v), Some(i)) => v[i],
+            _ => p.best.get(n).unwrap_or(f64::NAN),
+        },
     };
     t.push(name, unit(name), points.iter().map(|p| p.value).collect());
     t.push(

@@ -501,6 +501,42 @@ mod physical {
         }
     }
 
+    /// The profile of b1p in the physical basis runs through the best fit (its lowest point at the
+    /// fitted b1p, Δ(−2 ln L) = 0 there) and reports the physical values at each point.
+    #[test]
+    fn profiles_in_the_physical_basis_start_from_its_best_fit() {
+        let (plan, terms, truth, data) = setup();
+        let mut r = request(&["f", "b1p", "b2p"], &["sn0p"], truth);
+        r.basis = Some(basis());
+        let search = Search {
+            starts: 2,
+            profile_check: false,
+            ..Search::default()
+        };
+        let grid = ProfileGrid {
+            points: 5,
+            span: 2.0,
+        };
+        let p = profile_galaxy(&plan, &terms, &data, &r, None, &search, "b1p", &grid).unwrap();
+        let best = p.fit.physical.unwrap()[0];
+        let low = p
+            .points
+            .iter()
+            .min_by(|a, b| a.minus_two_log_l.total_cmp(&b.minus_two_log_l))
+            .unwrap();
+        assert!(
+            (low.value - best).abs() < 1e-9 * best,
+            "{} vs {best}",
+            low.value
+        );
+        assert!((low.minus_two_log_l - p.fit.minus_two_log_l).abs() < 1e-6);
+        for point in &p.points {
+            let v = point.physical.unwrap();
+            assert!((v[0] - point.value).abs() < 1e-12 * point.value);
+            assert!((point.best.get("b1").unwrap() - point.value / 0.62).abs() < 1e-12);
+        }
+    }
+
     /// Names of the other basis, and alpha6p (not a parameter of the physical basis), are refused by
     /// name.
     #[test]

@@ -29,6 +29,8 @@ pub struct ProfilePoint {
     pub best: EptParams,
     /// The distortion there.
     pub ap: Option<crate::rsd::ap::Distortion>,
+    /// With the physical basis: every parameter there in it ([`GalaxyFit::physical`]).
+    pub physical: Option<[f64; 12]>,
 }
 
 /// The profile likelihood of one free parameter.
@@ -100,7 +102,7 @@ pub fn profile_galaxy(
         tolerance: EXPECTED_DECREASE,
     };
     let value_of = |s: usize| match s.checked_sub(PARAM_NAMES.len()) {
-        None => fit.best.values[s],
+        None => fit.physical.map_or(fit.best.values[s], |v| v[s]),
         Some(0) => fit.ap.map_or(f64::NAN, |d| d.apar),
         Some(_) => fit.ap.map_or(f64::NAN, |d| d.aperp),
     };
@@ -150,6 +152,7 @@ pub fn profile_galaxy(
             chi2,
             best: params,
             ap,
+            physical: objective.basis.map(|_| std::array::from_fn(|k| slots[k])),
         });
     }
     Ok(GalaxyProfile {
