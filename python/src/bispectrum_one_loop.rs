@@ -8,7 +8,7 @@ use crate::tables::Table;
 use crate::{detached, library_error};
 use numpy::IntoPyArray;
 use pt_spectra::bispectrum::one_loop::{OneLoopMatter, OneLoopRule};
-use pt_spectra::bispectrum::one_loop_basis::{OneLoopMatterPlan, OneLoopSource};
+use pt_spectra::bispectrum::one_loop_basis::{BispectrumLoopSource, OneLoopMatterPlan};
 use pt_spectra::precision::{Precision, TwoLoopMethod};
 use pt_spectra::progress::Silent;
 use pyo3::prelude::*;
@@ -162,8 +162,8 @@ impl OneLoopBispectrumPlan {
             let prepared = inputs.prepare(&[])?;
             self.plan.evaluate(&prepared.spectrum)
         })?;
-        if self.uncached && source == OneLoopSource::Direct {
-            source = OneLoopSource::DirectUncached;
+        if self.uncached && source == BispectrumLoopSource::Direct {
+            source = BispectrumLoopSource::DirectUncached;
         }
         let out = PyDict::new(py);
         for (i, name) in ["k1", "k2", "k3"].iter().enumerate() {

@@ -332,7 +332,7 @@ fn the_counterterms_absorb_the_change_of_the_cut_off() {
 /// thing.
 #[test]
 fn basis_terms_match_the_direct_integrals_for_spectra_not_in_the_training_set() {
-    use pt_spectra::bispectrum::one_loop_basis::{OneLoopMatterPlan, OneLoopSource};
+    use pt_spectra::bispectrum::one_loop_basis::{BispectrumLoopSource, OneLoopMatterPlan};
     use pt_spectra::cosmology::{Cosmology, TransferKind};
     use pt_spectra::linear::LogGrid;
     use pt_spectra::progress::Silent;
@@ -382,7 +382,7 @@ fn basis_terms_match_the_direct_integrals_for_spectra_not_in_the_training_set() 
     for (name, p) in &spectra {
         let (b, source) = plan.evaluate(p).unwrap();
         assert!(
-            matches!(source, OneLoopSource::Basis { .. }),
+            matches!(source, BispectrumLoopSource::Basis { .. }),
             "{name}: {source:?}"
         );
         let (d, _) = direct.evaluate(p).unwrap();
@@ -418,7 +418,7 @@ fn basis_terms_match_the_direct_integrals_for_spectra_not_in_the_training_set() 
         .unwrap();
     let (_, source) = plan.evaluate(&eh).unwrap();
     assert!(
-        matches!(source, OneLoopSource::Fallback { .. }),
+        matches!(source, BispectrumLoopSource::Fallback { .. }),
         "{source:?}"
     );
     assert!(

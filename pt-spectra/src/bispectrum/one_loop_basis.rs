@@ -430,7 +430,7 @@ fn pack_pairs(m: &[f64], n: usize) -> Vec<f64> {
 
 /// How the loop terms of an evaluation were computed.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum OneLoopSource {
+pub enum BispectrumLoopSource {
     /// Directly (no basis given to the plan).
     Direct,
     /// Directly, since no tensors were cached for the triangles and rule and the method `auto`
@@ -452,7 +452,7 @@ pub enum OneLoopSource {
     },
 }
 
-impl OneLoopSource {
+impl BispectrumLoopSource {
     /// One line for table headers.
     pub fn describe(&self) -> String {
         match *self {
@@ -540,7 +540,10 @@ impl OneLoopMatterPlan {
     ///
     /// # Errors
     /// None for a plan made by [`Self::new`] (its triangles and rule are checked there).
-    pub fn evaluate(&self, p: &LinearSpectrum) -> Result<(Vec<OneLoopMatter>, OneLoopSource)> {
+    pub fn evaluate(
+        &self,
+        p: &LinearSpectrum,
+    ) -> Result<(Vec<OneLoopMatter>, BispectrumLoopSource)> {
         self.evaluate_reporting(p, &|_, _| {})
     }
 
@@ -553,7 +556,7 @@ impl OneLoopMatterPlan {
         &self,
         p: &LinearSpectrum,
         progress: &dyn Fn(usize, usize),
-    ) -> Result<(Vec<OneLoopMatter>, OneLoopSource)> {
+    ) -> Result<(Vec<OneLoopMatter>, BispectrumLoopSource)> {
         let direct = || -> Result<Vec<OneLoopMatter>> {
             let n = self.triangles.len();
             let mut out = Vec::with_capacity(n);
@@ -564,17 +567,17 @@ impl OneLoopMatterPlan {
             Ok(out)
         };
         let Some(basis) = &self.basis else {
-            return Ok((direct()?, OneLoopSource::Direct));
+            return Ok((direct()?, BispectrumLoopSource::Direct));
         };
         let projection = basis.project(p);
         if projection.residual.is_nan() || projection.residual > self.max_residual {
-            let source = OneLoopSource::Fallback {
+            let source = BispectrumLoopSource::Fallback {
                 residual: projection.residual,
                 max_residual: self.max_residual,
             };
             return Ok((direct()?, source));
         }
-        let source = OneLoopSource::Basis {
+        let source = BispectrumLoopSource::Basis {
             functions: basis.functions(),
             residual: projection.residual,
         };

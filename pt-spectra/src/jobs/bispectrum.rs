@@ -4,7 +4,7 @@
 
 use super::VERSION;
 use crate::bispectrum::one_loop::{OneLoopMatter, OneLoopRule, COUNTERTERMS, PARTITION_POWER};
-use crate::bispectrum::one_loop_basis::{OneLoopMatterPlan, OneLoopSource};
+use crate::bispectrum::one_loop_basis::{BispectrumLoopSource, OneLoopMatterPlan};
 use crate::bispectrum::one_loop_rsd::{one_loop_matter_redshift, Orientation};
 use crate::bispectrum::{
     BispectrumParams, BispectrumPlan, BoxPlan, Fog, LegendreSide, PlanRules, Settings,
@@ -283,7 +283,7 @@ pub fn one_loop_bispectrum_table(
         progress.update(Stage::OneLoopBispectrum, d, t);
     })?;
     if uncached {
-        source = OneLoopSource::DirectUncached;
+        source = BispectrumLoopSource::DirectUncached;
     }
     let mut header = vec![
         format!(
