@@ -38,6 +38,7 @@ use crate::error::Result;
 use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::{after_key, cache_file_name, training, LinearBasis, Projection};
+use crate::loops::basis::{pair_index, pair_products, triple_index, triple_products, triples};
 use crate::loops::basis::{BASIS_SIZE, MAX_RESIDUAL};
 use crate::loops::lattice::Lattice;
 use crate::simd::{axpy, dot};
@@ -47,7 +48,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
 /// Version of the tensor layout and rules, part of the cache file name.
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 /// The projection error of each loop term is this × ε × Σ|T| (ε: the smoothed residual; Σ|T| the
 /// sum of the four loop terms' sizes). Each term is cubic in P̂, so a uniform relative residual ε
@@ -70,11 +71,6 @@ fn lattice(rule: &OneLoopRule, k_max: f64) -> Lattice {
 
 fn k_max(triangles: &[[f64; 3]]) -> f64 {
     triangles.iter().flatten().copied().fold(0.0, f64::max)
-}
-
-/// The number of index triples a ≤ b ≤ c of n functions.
-fn triples(n: usize) -> usize {
-    n * (n + 1) * (n + 2) / 6
 }
 
 /// The number of index pairs a ≤ b of n functions.
@@ -184,16 +180,8 @@ impl OneLoopMatterBasis {
     pub fn evaluate(&self, p: &LinearSpectrum, projection: &Projection) -> Vec<OneLoopMatter> {
         let c = &projection.coefficients;
         let n = c.len();
-        let mut c3 = Vec::with_capacity(triples(n));
-        let mut c2 = Vec::with_capacity(pairs(n));
-        for a in 0..n {
-            for b in a..n {
-                c2.push(c[a] * c[b]);
-                for cc in &c[b..] {
-                    c3.push(c[a] * c[b] * cc);
-                }
-            }
-        }
+        // The products on the packed pairs and triples of the power-spectrum tensors' layout.
+        let (c2, c3) = (pair_products(c), triple_products(c));
         let eps = PROJECTION_FACTOR * projection.residual;
         self.triangles
             .iter()
@@ -386,14 +374,14 @@ fn rule_tensors(basis: &LinearBasis, kv: &[Vec3; 3], rule: &OneLoopRule) -> Vec<
     out
 }
 
-/// The symmetric form of a full n³ tensor on the triples a ≤ b ≤ c: Σ over the distinct
-/// permutations, so that Σ_{a≤b≤c} packed c_a c_b c_c = Σ_{abc} T_abc c_a c_b c_c.
+/// The symmetric form of a full n³ tensor on the triples a ≤ b ≤ c (at [`triple_index`]): Σ over
+/// the distinct permutations, so that Σ_{a≤b≤c} packed c_a c_b c_c = Σ_{abc} T_abc c_a c_b c_c.
 fn pack_triples(t: &[f64], n: usize) -> Vec<f64> {
     let at = |a: usize, b: usize, c: usize| t[(a * n + b) * n + c];
-    let mut out = Vec::with_capacity(triples(n));
-    for a in 0..n {
-        for b in a..n {
-            for c in b..n {
+    let mut out = vec![0.0; triples(n)];
+    for c in 0..n {
+        for b in 0..=c {
+            for a in 0..=b {
                 let all = at(a, b, c)
                     + at(a, c, b)
                     + at(b, a, c)
@@ -406,23 +394,23 @@ fn pack_triples(t: &[f64], n: usize) -> Vec<f64> {
                     (false, false) if a != c => 1.0,
                     _ => 2.0,
                 };
-                out.push(all / repeats);
+                out[triple_index(a, b, c)] = all / repeats;
             }
         }
     }
     out
 }
 
-/// The symmetric form of an n × n matrix on the pairs a ≤ b.
+/// The symmetric form of an n × n matrix on the pairs a ≤ b (at [`pair_index`]).
 fn pack_pairs(m: &[f64], n: usize) -> Vec<f64> {
-    let mut out = Vec::with_capacity(pairs(n));
-    for a in 0..n {
-        for b in a..n {
-            out.push(if a == b {
+    let mut out = vec![0.0; pairs(n)];
+    for b in 0..n {
+        for a in 0..=b {
+            out[pair_index(a, b)] = if a == b {
                 m[a * n + a]
             } else {
                 m[a * n + b] + m[b * n + a]
-            });
+            };
         }
     }
     out

@@ -50,6 +50,7 @@ pub mod training;
 pub(crate) use cache_key::{
     after_key, after_points, cache_file_name, stored_count, MAX_STORED_BASIS,
 };
+pub(crate) use forms::pair_products;
 #[cfg(test)]
 pub(crate) use linear_basis::wrapping_basis_size;
 pub use linear_basis::{LinearBasis, Projection, SMOOTHING};
@@ -115,7 +116,8 @@ fn error_functions(n: usize) -> usize {
     ERROR_FUNCTIONS.min(n)
 }
 
-fn triples(n: usize) -> usize {
+/// The number of triples a ≤ b ≤ c of n functions.
+pub(crate) fn triples(n: usize) -> usize {
     n * (n + 1) * (n + 2) / 6
 }
 
