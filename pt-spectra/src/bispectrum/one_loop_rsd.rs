@@ -34,7 +34,7 @@ pub struct Orientation {
     /// μ₁: the cosine between k₁ and the line of sight.
     pub mu1: f64,
     /// φ: the azimuth of the line of sight about k₁, from the triangle's plane (on the side of k₂)
-    /// [rad].
+    /// (radians).
     pub phi: f64,
 }
 
