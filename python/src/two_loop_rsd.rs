@@ -105,6 +105,10 @@ impl TwoLoopRsdPlan {
             Plan::Eft2(p) => (p.k().to_vec(), "eft2"),
         };
         pt_spectra::rsd::MultipoleRule::new(&ells).map_err(value_error)?;
+        // f is checked before the loop terms are computed (seconds without the basis).
+        if let Some(f) = f {
+            pt_spectra::cosmology::check_growth_rate(f).map_err(value_error)?;
+        }
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
         let ((table, prepared), seconds) = detached(py, || {
             let prepared = inputs.prepare(&k)?;

@@ -137,6 +137,7 @@ fn two_loop_regpt_and_its_vertex_terms_match_pyregpt() {
 /// spectrum not trained on, P24 and PΓ2 equal the direct integrals to 5e-5 of their size and within
 /// the errors, and the terms say so (their projection residual), as does the table's header.
 #[test]
+#[ignore = "slow exhaustive check: `cargo test --release --workspace -- --ignored` (CI runs it)"]
 fn two_loop_regpt_vertex_terms_through_the_basis_match_the_integrals() {
     use pt_spectra::precision::TwoLoopMethod;
     let k = [0.03, 0.12, 0.25];

@@ -451,6 +451,7 @@ fn the_counterterms_absorb_the_loop_cut_off() {
 }
 
 #[test]
+#[ignore = "slow exhaustive check: `cargo test --release --workspace -- --ignored` (CI runs it)"]
 fn basis_tensors_reproduce_direct_on_held_out_spectra() {
     // The tensors on the direct path's points: for CAMB and CLASS spectra not in the training set,
     // every multipole of the 2-loop correction within 1e-3 of direct and within the reported error
@@ -567,6 +568,7 @@ fn eft2_with_ir_on_the_basis_tensors_matches_direct() {
 }
 
 #[test]
+#[ignore = "slow exhaustive check: `cargo test --release --workspace -- --ignored` (CI runs it)"]
 fn spt2_one_loop_terms_on_the_basis_match_their_integrals() {
     // The 1-loop terms of the 2-loop models come from the galaxy model's basis tensors with the
     // 2-loop projection: their multipoles of a held-out CAMB spectrum agree with the plan's own

@@ -265,6 +265,10 @@ pub fn run(args: &Args) -> Result<()> {
             )?)
         }
     };
+    // f is checked before any loop integral runs (a 2-loop plan takes seconds).
+    if let Some(f) = args.f {
+        pt_spectra::cosmology::check_growth_rate(f)?;
+    }
     if !args.ct.is_empty() && args.rsd != RsdChoice::Eft2 {
         bail!("--ct is an option of --rsd eft2 (the paper's models take --cs2; ept --alpha0..6)");
     }
