@@ -58,6 +58,7 @@ __all__ = [
     "fit_tables",
     "bispectrum",
     "one_loop_bispectrum",
+    "from_desi_physical",
     "distances",
     "growth",
     "halo",
@@ -623,3 +624,15 @@ def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=No
     """
     return _warn(_core.one_loop_bispectrum(triangles, linear, z, z_input, cosmology, eh, q_min, q_max,
                                            radial, mu, phi, two_loop, cache_dir, mu1, phi_los, f))
+
+
+def from_desi_physical(physical, sigma8, n_bar, satellites=None):
+    """The ``ept`` model's parameters (velocileptors' names, a dict) of values in the DESI DR1 physical
+    basis (``fit_ept(basis="desi")``; docs/reference.md): ``physical`` a dict of b1p, b2p, bsp, b3p,
+    alpha0p, alpha2p, alpha4p, sn0p, sn2p, sn4p (missing ones 0) and f (required), at ``sigma8`` =
+    sigma8(z), number density ``n_bar`` [(h/Mpc)^3] and ``satellites`` = (f_sat, sigma_v [Mpc/h])
+    (default (0.1, 5)). E.g. a cobaya likelihood sampling the physical basis passes the result to
+    ``ept(...)`` or ``Pipeline``.
+    """
+    return _core.from_desi_physical(dict(physical), float(sigma8), float(n_bar),
+                                    None if satellites is None else tuple(map(float, satellites)))

@@ -403,3 +403,50 @@ pub(crate) fn fit_ept(
         model,
     ))
 }
+
+/// The model's parameters (velocileptors' names) of values in the DESI DR1 physical basis
+/// (`rsd::ept::physical`): `physical` a dict of b1p, b2p, bsp, b3p, alpha0p, alpha2p, alpha4p, sn0p,
+/// sn2p, sn4p and f (missing ones 0; f required), at σ8(z) `sigma8`, number density `n_bar`
+/// [(h/Mpc)^3] and satellites (f_sat, σ_v [Mpc/h]).
+#[pyfunction]
+#[pyo3(signature = (physical, sigma8, n_bar, satellites=None))]
+pub(crate) fn from_desi_physical(
+    physical: &Bound<'_, PyDict>,
+    sigma8: f64,
+    n_bar: f64,
+    satellites: Option<(f64, f64)>,
+) -> PyResult<std::collections::HashMap<String, f64>> {
+    use pt_spectra::rsd::ept::physical::{
+        check_physical_name, PhysicalBasis, DEFAULT_F_SAT, DEFAULT_SIGMA_V, PHYSICAL_NAMES,
+    };
+    let (f_sat, sigma_v) = satellites.unwrap_or((DEFAULT_F_SAT, DEFAULT_SIGMA_V));
+    let basis = PhysicalBasis::new(sigma8, n_bar, f_sat, sigma_v).map_err(value_error)?;
+    let mut v = [0.0; 12];
+    let mut has_f = false;
+    for (key, value) in physical.iter() {
+        let name: String = key.extract()?;
+        check_physical_name(&name).map_err(value_error)?;
+        let i = PHYSICAL_NAMES
+            .iter()
+            .position(|&n| n == name)
+            .ok_or_else(|| {
+                value_error(format!(
+                    "`{name}` is not a parameter of the physical basis: {}",
+                    PHYSICAL_NAMES.join(", ")
+                ))
+            })?;
+        v[i] = value.extract()?;
+        has_f |= name == "f";
+    }
+    if !has_f {
+        return Err(value_error(
+            "the physical basis's counterterms need f (the growth rate)",
+        ));
+    }
+    let p = basis.to_ept(&v);
+    Ok(pt_spectra::rsd::ept::PARAM_NAMES
+        .iter()
+        .zip(p.values)
+        .map(|(n, v)| (n.to_string(), v))
+        .collect())
+}

@@ -93,6 +93,27 @@ def test_fit_ept_in_the_desi_physical_basis():
         pt.fit_ept(data, [0.2], free=("f", "b1"), basis="desi", n_bar=3e-4, precision="fast")
 
 
+def test_from_desi_physical_is_the_documented_map():
+    p = pt.from_desi_physical(dict(b1p=1.2, b2p=0.3, bsp=-0.4, alpha0p=5.0, alpha2p=-3.0, alpha4p=2.0,
+                                   sn0p=0.7, sn2p=-1.5, f=0.75), sigma8=0.6, n_bar=3e-4)
+    b, f = 2.0, 0.75
+    assert p["b1"] == pytest.approx(b)
+    assert p["b2"] == pytest.approx(0.3 / 0.36 + 8 / 21 * (b - 1))
+    assert p["bs"] == pytest.approx(-0.4 / 0.36)
+    assert p["alpha0"] == pytest.approx(b * b * 5.0)
+    assert p["alpha2"] == pytest.approx(f * b * (5.0 - 3.0))
+    assert p["alpha4"] == pytest.approx(f * (f * -3.0 + b * 2.0))
+    assert p["alpha6"] == pytest.approx(f * f * 2.0)
+    assert p["sn"] == pytest.approx(0.7 / 3e-4)
+    assert p["sn2"] == pytest.approx(-1.5 * 0.1 * 25 / 3e-4)
+    with pytest.raises(ValueError, match="alpha4p"):
+        pt.from_desi_physical(dict(alpha6p=1.0, f=0.7), 0.6, 3e-4)
+    with pytest.raises(ValueError, match="need f"):
+        pt.from_desi_physical(dict(b1p=1.2), 0.6, 3e-4)
+    with pytest.raises(ValueError, match="physical basis"):
+        pt.from_desi_physical(dict(b1=1.2, f=0.7), 0.6, 3e-4)
+
+
 def test_rsd_and_fit_route_ept(reference):
     ref, linear = reference
     with warnings.catch_warnings():
