@@ -153,7 +153,7 @@ impl Objective<'_> {
         };
         let t0 = at(&v)?;
         for (&i, shift) in BIASES.iter().zip([0.37, -0.41, 0.23, 0.11]) {
-            v[i] += shift * if self.basis.is_some() { 0.5 } else { 1.0 };
+            v[i] += shift;
         }
         let t1 = at(&v)?;
         let scale = t0.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
