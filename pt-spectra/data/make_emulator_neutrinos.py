@@ -13,6 +13,13 @@ KIND:
            --neutrinos fits ln(P_one/P_degenerate) (of P_cb and of P_m) to it.
   corners  the 64 corners of the six shape parameters' box (A_s = 2.1e-9, n_s = 0.965) at Z_CHECK.
   massless the 32 corners of the box with Sigma m_nu = 0 (the lower end of m_nu is not shrunk).
+  light    the 64 corners of the box (SHRINK applies) with Sigma m_nu = 0.01 or 0.03 eV: light masses
+           between the massless set and the box's lower end.
+  massless_train  a scrambled Sobol sequence (seed 2028) over the five shape parameters other than m_nu
+           (the training box), Sigma m_nu = 0, A_s = 2e-9, n_s = 1, at Z_NODES: fit_emulator_massless.py
+           fits the massless head (CAMB's massless spectrum over the base emulator's at Sigma m_nu = 0).
+  massless_random  uniform draws (seed 19) over the box (SHRINK applies) with Sigma m_nu = 0 and A_s,
+           n_s drawn too, at Z_CHECK.
   edge     the early-dark-energy edge: w0 + wa in EDGE_SUMS on its two ends (w0 = -0.7, or wa = 0.5),
            the other four shape parameters at the 16 corners of their box, at Z_CHECK.
   random   uniform draws (seed 17) over all eight parameters, each at Z_CHECK.
@@ -63,6 +70,22 @@ def cosmologies(kind, shrink=1.0):
         b = dict(box, m_nu=(0.0,))
         x = np.array(list(itertools.product(*[b[p] for p in NAMES[:6]])))
         return np.hstack([x, np.tile(PLANCK_AS, (len(x), 1))]), Z_CHECK
+    if kind == "light":
+        b = dict(box, m_nu=(0.01, 0.03))
+        x = np.array(list(itertools.product(*[b[p] for p in NAMES[:6]])))
+        return np.hstack([x, np.tile(PLANCK_AS, (len(x), 1))]), Z_CHECK
+    if kind == "massless_train":
+        u = qmc.Sobol(d=5, scramble=True, seed=2028).random(1024)
+        five = [0, 1, 2, 4, 5]
+        x = np.zeros((len(u), 8))
+        x[:, five] = LO[five] + u * (HI[five] - LO[five])
+        x[:, 6:] = [np.log(20.0), 1.0]
+        return x, Z_NODES
+    if kind == "massless_random":
+        rng = np.random.default_rng(19)
+        x = lo + rng.random((256, 8)) * (hi - lo)
+        x[:, 3] = 0.0
+        return x, Z_CHECK
     if kind == "edge":
         rows = []
         for s in EDGE_SUMS:
@@ -73,7 +96,8 @@ def cosmologies(kind, shrink=1.0):
     if kind == "random":
         rng = np.random.default_rng(17)
         return lo + rng.random((256, 8)) * (hi - lo), Z_CHECK
-    raise SystemExit(f"unknown kind {kind!r}: train, corners, edge or random")
+    raise SystemExit(f"unknown kind {kind!r}: train, corners, massless, light, massless_train, "
+                     "massless_random, edge or random")
 
 
 def main():
@@ -82,7 +106,7 @@ def main():
     settings = sys.argv[6].split(",") if len(sys.argv) > 6 else SETTINGS
     params, zs = cosmologies(kind, shrink)
     params = params[start:stop]
-    if kind != "train":
+    if kind not in ("train", "massless_train"):
         make_emulator_training.K_GRID = K_GRID[K_GRID <= K_CHECK_MAX]
     out = {f"pk_{t}_{s}": [] for t in ("cb", "m") for s in settings}
     t0 = time.time()

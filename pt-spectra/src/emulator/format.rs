@@ -25,10 +25,13 @@
 //! q_bound      f64      the prior's bound on the early dark energy: q/q_max ≤ q_bound (in (0, 1])
 //! worst        2 × f64  the measured worst |Δ ln P| of P_cb and P_m over the bounded prior
 //!                       (three degenerate neutrinos)
-//! n_heads      u32      neutrino heads (0 to 3)
-//! per head:    setting u32 (1: one massive species), n_terms u32, n_pc 2 × u32,
-//!              exponents n_terms × 7 u8, 2 × target (ln(P_setting/P_degenerate) of P_cb and of P_m,
-//!              as above with this head's n_terms and n_pc), worst 2 × f64 (as above, this setting)
+//! n_heads      u32      heads (0 to 4: one per neutrino setting, and the massless head)
+//! per head:    setting u32, n_terms u32, n_pc 2 × u32, exponents n_terms × 7 u8, 2 × target (as
+//!              above with this head's n_terms and n_pc), worst 2 × f64 (as above, this head's
+//!              cosmologies); setting 1: one massive species, the targets ln(P_setting/P_degenerate)
+//!              of P_cb and of P_m (`fit_emulator_neutrinos.py`); setting 2: Σm_ν = 0, the targets
+//!              ln P(CAMB, massless) − ln P(base emulator at Σm_ν = 0), the same for P_cb and P_m
+//!              (`fit_emulator_massless.py`)
 //! ```
 //!
 //! A `PTEMU001` file reads as box = prior, q_bound = 1, no heads, and the largest per-x error as the worst.
@@ -46,19 +49,29 @@ pub const MAGIC_2: &[u8; 8] = b"PTEMU002";
 /// Largest Legendre degree a file may use (the Rust code builds P_0..P_max per coordinate).
 const MAX_DEGREE: u8 = 30;
 
-/// Most neutrino heads a file may hold.
-const MAX_HEADS: usize = 3;
+/// Most heads a file may hold.
+const MAX_HEADS: usize = 4;
 
-/// A neutrino head: ln(P_setting/P_degenerate) of P_cb and of P_m.
+/// What a head corrects.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HeadOf {
+    /// A neutrino setting other than three degenerate species: ln(P_setting/P_degenerate).
+    Setting(Neutrinos),
+    /// Σm_ν = 0: CAMB's massless spectrum over the base emulator's at Σm_ν = 0 (the edge of its
+    /// training box, and CAMB's massless run is not the limit of its massive runs).
+    Massless,
+}
+
+/// A head: a correction to ln P_cb and ln P_m, emulated as the base targets are.
 #[derive(Debug, Clone)]
 pub struct Head {
-    /// The setting it emulates.
-    pub setting: Neutrinos,
+    /// What it corrects.
+    pub of: HeadOf,
     /// Its polynomial terms.
     pub exponents: Vec<[u8; COORDINATES]>,
     /// ln(P_cb ratio) and ln(P_m ratio).
     pub targets: [Target; 2],
-    /// Measured worst |Δ ln P| of P_cb and P_m with this setting.
+    /// Measured worst |Δ ln P| of P_cb and P_m with this head's cosmologies.
     pub worst: [f64; 2],
 }
 
@@ -160,11 +173,12 @@ impl<'a> Reader<'a> {
         })
     }
 
-    /// One neutrino head (layout PTEMU002).
+    /// One head (layout PTEMU002).
     fn head(&mut self, nodes: usize) -> Result<Head> {
-        let setting = match self.count(1)? {
-            1 => Neutrinos::OneMassive,
-            _ => unreachable!("count(1) is 1"),
+        let of = match self.count(2)? {
+            1 => HeadOf::Setting(Neutrinos::OneMassive),
+            2 => HeadOf::Massless,
+            _ => unreachable!("count(2) is 1 or 2"),
         };
         let n_terms = self.count(100_000)?;
         let n_pc = [self.count(10_000)?, self.count(10_000)?];
@@ -178,7 +192,7 @@ impl<'a> Reader<'a> {
             return Err(self.fail("a measured error is negative"));
         }
         Ok(Head {
-            setting,
+            of,
             exponents,
             targets,
             worst: [w[0], w[1]],
@@ -278,11 +292,15 @@ pub fn parse(bytes: &[u8], what: &str) -> Result<Parsed> {
         let b = r.take(4)?;
         let n_heads = u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize;
         if n_heads > MAX_HEADS {
-            return Err(r.fail("too many neutrino heads"));
+            return Err(r.fail("too many heads"));
         }
-        let mut heads = Vec::with_capacity(n_heads);
+        let mut heads: Vec<Head> = Vec::with_capacity(n_heads);
         for _ in 0..n_heads {
-            heads.push(r.head(n_z * n_x)?);
+            let head = r.head(n_z * n_x)?;
+            if heads.iter().any(|h| h.of == head.of) {
+                return Err(r.fail("two heads correct the same thing"));
+            }
+            heads.push(head);
         }
         (stated, v[0], [v[1], v[2]], heads)
     } else {

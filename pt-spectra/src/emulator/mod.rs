@@ -30,6 +30,7 @@
 //! ```
 
 mod format;
+use format::HeadOf;
 pub mod prior;
 
 use crate::cosmology::{Cosmology, Neutrinos, EV_PER_OMEGA_NU};
@@ -50,9 +51,9 @@ pub fn drag_horizon(omega_b: f64, omega_m: f64, h: f64, m_nu: f64) -> f64 {
     55.154 * (-72.3 * (w_nu + 0.0006).powi(2)).exp() / (w_cb.powf(0.25351) * w_b.powf(0.12807)) * h
 }
 
-/// Below this Σm_ν (eV) the emulated ln(P_m/P_cb) is tapered to 0 at Σm_ν = 0 (continuity of P_m;
-/// [`LinearEmulator::spectra`]): a tenth of the smallest mass the oscillations allow (0.059 eV), so
-/// no physical cosmology is touched.
+/// Below this Σm_ν (eV) the emulated ln(P_m/P_cb) is tapered to 0 at Σm_ν = 0 and the massless head
+/// tapered in (continuity of P_m and P_cb; [`LinearEmulator::spectra`]): a tenth of the smallest mass
+/// the oscillations allow (0.059 eV), so no physical cosmology is touched.
 pub const RATIO_TAPER: f64 = 0.005;
 
 /// The emulator: parsed once, then [`spectra`](Self::spectra) per cosmology.
@@ -175,8 +176,9 @@ impl LinearEmulator {
             .map(|p| format!("{} in [{}, {}]", p.name, p.min, p.max))
             .collect();
         let (z0, z1) = self.z_range();
-        let settings: Vec<&str> = std::iter::once(Neutrinos::ThreeDegenerate)
-            .chain(self.file.heads.iter().map(|h| h.setting))
+        let settings: Vec<&str> = self
+            .neutrino_settings()
+            .into_iter()
             .map(Neutrinos::name)
             .collect();
         format!(
@@ -193,7 +195,10 @@ impl LinearEmulator {
     /// The neutrino settings emulated: three degenerate species and those of the file's heads.
     pub fn neutrino_settings(&self) -> Vec<Neutrinos> {
         std::iter::once(Neutrinos::ThreeDegenerate)
-            .chain(self.file.heads.iter().map(|h| h.setting))
+            .chain(self.file.heads.iter().filter_map(|h| match h.of {
+                HeadOf::Setting(s) => Some(s),
+                HeadOf::Massless => None,
+            }))
             .collect()
     }
 
@@ -203,16 +208,20 @@ impl LinearEmulator {
         self.file.q_bound * self.file.q_max
     }
 
-    /// The measured worst |Δ ln P| of P_cb and of P_m over the prior with `neutrinos`, if emulated.
+    /// The measured worst |Δ ln P| of P_cb and of P_m over the prior with massless neutrinos (Σm_ν =
+    /// 0), if the file has a massless head (else the spectra at Σm_ν = 0 carry [`Self::worst`]'s
+    /// figure of three degenerate species).
+    pub fn worst_massless(&self) -> Option<[f64; 2]> {
+        self.head_of(HeadOf::Massless).map(|h| h.worst)
+    }
+
+    /// The measured worst |Δ ln P| of P_cb and of P_m over the prior with Σm_ν > 0 shared as
+    /// `neutrinos`, if emulated.
     pub fn worst(&self, neutrinos: Neutrinos) -> Option<[f64; 2]> {
         if neutrinos == Neutrinos::ThreeDegenerate {
             return Some(self.file.worst);
         }
-        self.file
-            .heads
-            .iter()
-            .find(|h| h.setting == neutrinos)
-            .map(|h| h.worst)
+        self.head_of(HeadOf::Setting(neutrinos)).map(|h| h.worst)
     }
 
     /// P_m, P_cb and f_cb of `cosmology` at redshift `z`.
@@ -226,6 +235,16 @@ impl LinearEmulator {
         let point = PriorPoint::of(cosmology)?;
         let u = self.coordinates(&point)?;
         let head = self.head(cosmology)?;
+        let m_nu = point.values[3];
+        // The massless head: CAMB's massless spectrum over the base's at Σm_ν = 0 (the edge of the
+        // training box; CAMB's massless run is not the limit of its massive runs). Tapered in below
+        // RATIO_TAPER, as the ratio's offset is tapered out, so P_cb and P_m are continuous in Σm_ν;
+        // nothing changes from RATIO_TAPER up.
+        let taper = (1.0 - m_nu / RATIO_TAPER).max(0.0);
+        let mut heads: Vec<(&format::Head, f64)> = head.map(|h| (h, 1.0)).into_iter().collect();
+        if taper > 0.0 {
+            heads.extend(self.head_of(HeadOf::Massless).map(|h| (h, taper)));
+        }
         let (z0, z1) = self.z_range();
         if !(z >= z0 - 1e-12 && z <= z1 + 1e-12) {
             return Err(Error::InvalidParameter {
@@ -234,7 +253,7 @@ impl LinearEmulator {
                 reason: "outside the linear-spectrum emulator's redshift range [0, 3]",
             });
         }
-        let [ob, om, h, m_nu, ..] = point.values;
+        let [ob, om, h, ..] = point.values;
         let n_s = point.values[7];
         let r_d = if self.file.rescale {
             drag_horizon(ob, om, h, m_nu)
@@ -251,19 +270,19 @@ impl LinearEmulator {
             .take(n_x)
             .collect();
         let z = z.clamp(z0, z1);
-        let point_coefficients = self.point_coefficients(&u, head);
-        let shape_at = |z: f64| self.shape(&point_coefficients, head, z);
+        let point_coefficients = self.point_coefficients(&u, &heads);
+        let shape_at = |z: f64| self.shape(&point_coefficients, &heads, z);
         // The emulated ln(P_m/P_cb), continuous as Σm_ν → 0: P_m = P_cb exactly without massive
         // neutrinos (the emulated ratio is then its own error, and the neutrino head is 0 too: the
         // settings differ only in how the mass is shared); below RATIO_TAPER the ratio's value at
         // Σm_ν = 0 (its polynomial's offset, 7e-4 to 1.2e-3) is removed in proportion, so that P_m
         // meets P_cb at 0 instead of jumping by the offset at 0⁺.
-        let taper = (1.0 - m_nu / RATIO_TAPER).max(0.0);
-        // the coefficients of the same point with Σm_ν = 0, if the taper applies
+        // the coefficients of the same point with Σm_ν = 0, if the taper applies (the massless head
+        // adds nothing to the ratio)
         let massless = if m_nu > 0.0 && taper > 0.0 {
             let mut p = point;
             p.values[3] = 0.0;
-            Some(self.point_coefficients(&self.coordinates(&p)?, head))
+            Some(self.point_coefficients(&self.coordinates(&p)?, &heads))
         } else {
             None
         };
@@ -272,7 +291,7 @@ impl LinearEmulator {
                 return vec![0.0; shape.ratio.len()];
             }
             match &massless {
-                Some(c) => (shape.ratio.iter().zip(&self.shape(c, head, z).ratio))
+                Some(c) => (shape.ratio.iter().zip(&self.shape(c, &heads, z).ratio))
                     .map(|(r, o)| r - taper * o)
                     .collect(),
                 None => shape.ratio.clone(),
@@ -320,7 +339,7 @@ impl LinearEmulator {
             error_cb: self.file.error[0].clone(),
             error_m: self.file.error[1].clone(),
             neutrinos: cosmology.neutrinos,
-            worst: head.map_or(self.file.worst, |h| h.worst),
+            worst: self.worst_of(cosmology.neutrinos, m_nu),
             sigma8,
             a_s: ln_as.exp(),
         })
@@ -361,30 +380,48 @@ impl LinearEmulator {
         )
     }
 
-    /// The polynomial coefficients of the targets (and of the neutrino `head`'s) at coordinates `u`.
+    /// The polynomial coefficients of the targets and of the `heads`' at coordinates `u`.
     fn point_coefficients(
         &self,
         u: &[f64; COORDINATES],
-        head: Option<&format::Head>,
-    ) -> ([Vec<f64>; 2], Option<[Vec<f64>; 2]>) {
+        heads: &[(&format::Head, f64)],
+    ) -> ([Vec<f64>; 2], Vec<[Vec<f64>; 2]>) {
         (
             coefficients(&self.file.exponents, &self.file.targets, u, self.max_degree),
-            head.map(|h| coefficients_of(h, u, self.max_degree)),
+            heads
+                .iter()
+                .map(|(h, _)| coefficients(&h.exponents, &h.targets, u, self.max_degree))
+                .collect(),
         )
     }
 
-    /// The targets at redshift `z` of a point's coefficients ([`Self::point_coefficients`]).
+    /// The targets at redshift `z` of a point's coefficients ([`Self::point_coefficients`]), each
+    /// head added with its weight.
     fn shape(
         &self,
-        (c, head_c): &([Vec<f64>; 2], Option<[Vec<f64>; 2]>),
-        head: Option<&format::Head>,
+        (c, head_c): &([Vec<f64>; 2], Vec<[Vec<f64>; 2]>),
+        heads: &[(&format::Head, f64)],
         z: f64,
     ) -> Shape {
         let mut shape = self.at_redshift(&self.file.targets, c, z);
-        if let (Some(h), Some(hc)) = (head, head_c) {
-            shape.add(&self.at_redshift(&h.targets, hc, z));
+        for ((h, weight), hc) in heads.iter().zip(head_c) {
+            shape.add(&self.at_redshift(&h.targets, hc, z), *weight);
         }
         shape
+    }
+
+    /// The file's head that corrects `of`, if it has one.
+    fn head_of(&self, of: HeadOf) -> Option<&format::Head> {
+        self.file.heads.iter().find(|h| h.of == of)
+    }
+
+    /// The measured worst error of a cosmology's spectra: the massless head's at Σm_ν = 0, else
+    /// that of its neutrino setting.
+    fn worst_of(&self, setting: Neutrinos, m_nu: f64) -> [f64; 2] {
+        let massless = (m_nu == 0.0).then(|| self.worst_massless()).flatten();
+        massless
+            .or_else(|| self.worst(setting))
+            .unwrap_or(self.file.worst)
     }
 
     /// The neutrino head of `cosmology`'s setting (`None`: three degenerate species, or massless).
@@ -396,7 +433,7 @@ impl LinearEmulator {
         if setting == Neutrinos::ThreeDegenerate || cosmology.m_nu == 0.0 {
             return Ok(None);
         }
-        match self.file.heads.iter().find(|h| h.setting == setting) {
+        match self.head_of(HeadOf::Setting(setting)) {
             Some(h) => Ok(Some(h)),
             None => Err(Error::InvalidChoice {
                 what: format!("neutrinos: {}", setting.describe()),
@@ -472,13 +509,13 @@ struct Shape {
 }
 
 impl Shape {
-    /// Adds a neutrino head's ln(P_cb ratio) to ln P_cb and its ln(P_m ratio) − ln(P_cb ratio) to
-    /// ln(P_m/P_cb).
-    fn add(&mut self, head: &Shape) {
+    /// Adds `weight` times a head's correction of ln P_cb to ln P_cb and of ln P_m − ln P_cb to
+    /// ln(P_m/P_cb) (0 for the massless head, whose two targets are equal).
+    fn add(&mut self, head: &Shape, weight: f64) {
         for i in 0..self.cb.len() {
-            self.cb[i] += head.cb[i];
-            self.ratio[i] += head.ratio[i] - head.cb[i];
-            self.d_cb_ds[i] += head.d_cb_ds[i];
+            self.cb[i] += weight * head.cb[i];
+            self.ratio[i] += weight * (head.ratio[i] - head.cb[i]);
+            self.d_cb_ds[i] += weight * head.d_cb_ds[i];
         }
     }
 }
@@ -511,15 +548,6 @@ fn coefficients(
         }
         c
     })
-}
-
-/// [`coefficients`] of a neutrino head.
-fn coefficients_of(
-    head: &format::Head,
-    u: &[f64; COORDINATES],
-    max_degree: usize,
-) -> [Vec<f64>; 2] {
-    coefficients(&head.exponents, &head.targets, u, max_degree)
 }
 
 /// Legendre polynomials P_0..P_n at x.

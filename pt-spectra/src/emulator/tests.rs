@@ -276,8 +276,8 @@ fn scale_dependent_growth_agrees_with_camb_transfer_functions() {
     assert!(spread > 0.01, "{spread}");
 }
 
-/// |Δ ln P| allowed against CAMB at the corners of the stated prior with massive neutrinos (the
-/// accuracy the issue asks for; the massless corners reach 3.0e-3, docs/emulator.md).
+/// |Δ ln P| allowed against CAMB over the stated prior (the accuracy the issue asks for; measured
+/// worst 1.3e-3 with massive neutrinos, 1.1e-3 massless, docs/emulator.md).
 const STATED_ACCURACY: f64 = 2e-3;
 
 #[test]
@@ -308,10 +308,58 @@ fn corners_of_the_stated_prior_agree_with_camb() {
     eprintln!("corners: worst |dln P| {worst:.2e} on {rows} rows");
     assert!(rows >= 100, "{rows}");
     assert!(worst <= STATED_ACCURACY, "{worst}");
-    // and the header's figure is the measured worst case, not below what this table shows (3.0e-3,
-    // at a massless corner: docs/emulator.md)
+    // and the header's figure is the measured worst case, not below what this table shows
     let w = emulator.worst(Neutrinos::ThreeDegenerate).unwrap();
-    assert!(w[0].max(w[1]) >= worst && w[1] < 3.1e-3, "{w:?}");
+    assert!(w[0].max(w[1]) >= worst && w[1] <= STATED_ACCURACY, "{w:?}");
+}
+
+#[test]
+fn massless_and_light_neutrinos_at_the_worst_points_agree_with_camb() {
+    // pt-spectra/tests/data/emulator_massless.dat (make_emulator_massless.py): CAMB at the massless
+    // corner where the emulator without its massless head was 3.0e-3 off, the massless random draw
+    // where it was 2.75e-3 off, the worst points with the head, and two light corners (0.01, 0.03 eV)
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/emulator_massless.dat"
+    );
+    let text = std::fs::read_to_string(path).expect("massless table");
+    let emulator = LinearEmulator::embedded().unwrap();
+    let (mut massless, mut light, mut rows) = (0.0_f64, 0.0_f64, 0);
+    for line in text.lines().filter(|l| !l.starts_with('#')) {
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        let e = emulator
+            .spectra(&cosmology(&v[1..9].try_into().unwrap()), v[9])
+            .unwrap();
+        let d = (e.cb().unwrap().eval(v[10]) / v[11])
+            .ln()
+            .abs()
+            .max((e.matter().unwrap().eval(v[10]) / v[12]).ln().abs());
+        if v[4] == 0.0 {
+            massless = massless.max(d);
+            // the spectra carry the massless head's measured worst case
+            assert_eq!(e.worst, emulator.worst_massless().unwrap());
+        } else {
+            light = light.max(d);
+        }
+        rows += 1;
+    }
+    eprintln!("massless: worst |dln P| {massless:.2e}, light {light:.2e} on {rows} rows");
+    assert_eq!(rows, 6 * 4 * 12);
+    assert!(
+        massless <= STATED_ACCURACY && light <= STATED_ACCURACY,
+        "{massless} {light}"
+    );
+    // the stated figures are the measured worst cases, not below what this table shows
+    let w = emulator.worst_massless().unwrap();
+    assert!(
+        w[0].max(w[1]) >= massless && w[1] <= STATED_ACCURACY,
+        "{w:?}"
+    );
+    let w = emulator.worst(Neutrinos::ThreeDegenerate).unwrap();
+    assert!(w[0].max(w[1]) >= light && w[1] <= STATED_ACCURACY, "{w:?}");
 }
 
 #[test]
@@ -372,10 +420,25 @@ fn neutrino_settings_that_are_not_emulated_are_refused_naming_them() {
 #[test]
 fn a_file_of_layout_two_is_validated() {
     let good = EMBEDDED.to_vec();
-    assert!(LinearEmulator::from_bytes(&good, "x").is_ok());
+    let parsed = LinearEmulator::from_bytes(&good, "x").unwrap().file;
+    // the end of the PTEMU001 body (layout in format.rs), where the PTEMU002 tail begins
+    let (n_x, n_terms) = (parsed.n_x, parsed.exponents.len());
+    let nodes = parsed.z_nodes.len() * n_x;
+    let body = 8
+        + 6 * 4
+        + 16 * 8
+        + 8 * parsed.z_nodes.len()
+        + 4 * 8
+        + 7 * n_terms
+        + parsed
+            .targets
+            .iter()
+            .map(|t| 8 * nodes + 4 * t.n_pc * nodes + 8 * n_terms * t.n_pc)
+            .sum::<usize>()
+        + 2 * 8 * n_x;
     // a stated box wider than the training box
     let mut bad = good.clone();
-    let at = good.len() - 4 - 3 * 8 - 12 * 8; // the stated box, with no heads
+    let at = body; // the stated box
     bad[at..at + 8].copy_from_slice(&0.0f64.to_le_bytes());
     let e = LinearEmulator::from_bytes(&bad, "x")
         .unwrap_err()
@@ -383,12 +446,33 @@ fn a_file_of_layout_two_is_validated() {
     assert!(e.contains("stated prior"), "{e}");
     // a bound beyond (0, 1]
     let mut bad = good.clone();
-    let at = good.len() - 4 - 3 * 8;
+    let at = body + 12 * 8;
     bad[at..at + 8].copy_from_slice(&2.0f64.to_le_bytes());
     let e = LinearEmulator::from_bytes(&bad, "x")
         .unwrap_err()
         .to_string();
     assert!(e.contains("prior bound"), "{e}");
+    // the massless head given twice (the count of heads raised, the head's bytes repeated)
+    let heads = body + 15 * 8;
+    let mut twice = good[..heads].to_vec();
+    twice.extend(2u32.to_le_bytes());
+    twice.extend(&good[heads + 4..]);
+    twice.extend(&good[heads + 4..]);
+    assert_eq!(
+        u32::from_le_bytes(good[heads..heads + 4].try_into().unwrap()),
+        1
+    );
+    let e = LinearEmulator::from_bytes(&twice, "x")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("two heads"), "{e}");
+    // a head of an unknown kind
+    let mut bad = good.clone();
+    bad[heads + 4..heads + 8].copy_from_slice(&7u32.to_le_bytes());
+    let e = LinearEmulator::from_bytes(&bad, "x")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("x") && e.contains("implausibly large"), "{e}");
 }
 
 /// The rows of `pt-spectra/tests/data/emulator_small_masses.dat` (CAMB, three degenerate species of
@@ -442,8 +526,8 @@ fn p_m_is_continuous_as_the_neutrino_mass_goes_to_zero() {
 #[test]
 fn small_neutrino_masses_agree_with_camb() {
     // CAMB at Σm_ν = 0, 0.005, …, 0.1 eV (make_emulator_small_masses.py). Measured: ≤ 6.3e-4 for
-    // Σm_ν ≥ 0.005 eV; 1.0e-3 to 2.1e-3 at exactly 0, where CAMB's massless run itself lies up to 9e-4
-    // from the limit of its massive runs (the emulator, trained on Σm_ν > 0, follows that limit)
+    // Σm_ν ≥ 0.005 eV; 2.5e-4 at exactly 0 (1.0e-3 to 2.1e-3 before the massless head: CAMB's
+    // massless run lies up to 9e-4 from the limit of its massive runs, which the base follows)
     let emulator = LinearEmulator::embedded().unwrap();
     let (mut massive, mut massless) = (0.0_f64, 0.0_f64);
     for (params, z, k, p_cb, p_m) in small_masses() {
@@ -460,6 +544,5 @@ fn small_neutrino_masses_agree_with_camb() {
     }
     eprintln!("small masses: worst |dln P| {massive:.2e} (massive), {massless:.2e} (massless)");
     assert!(massive < 8e-4, "{massive}");
-    // within the worst figure stated in the header (3.0e-3, a massless corner)
-    assert!(massless < 2.5e-3, "{massless}");
+    assert!(massless < 5e-4, "{massless}");
 }
