@@ -109,23 +109,29 @@ def template(out):
     return path, ini, dict(sigma8_z=s8[round(Z, 6)], camb=camb.__version__, A_s=a_s)
 
 
-def data_files(out):
-    """The stacked data and covariance in the layout of `fit`: k P0 s0 P2 s2 P4 s4, and the covariance
-    blocks of l = (0, 2) and (0, 2, 4)."""
-    d = np.loadtxt(DATA / "ps1D_highzNGC.dat")
-    cov = np.loadtxt(DATA / "Cov_highzNGC.dat")
-    k = d[:N_K, 0]
-    p = d[:, 1].reshape(3, N_K)
-    sig = np.sqrt(np.diag(cov)).reshape(3, N_K)
+def data_files(out, cap="NGC", k_floor=0.0):
+    """The stacked data and covariance of a cap (NGC, or SGC from ../boss_dr12_cmass_sgc) in the layout
+    of `fit`: k P0 s0 P2 s2 P4 s4, and the covariance blocks of l = (0, 2) and (0, 2, 4); rows below
+    `k_floor` [h/Mpc] left out."""
+    folder = DATA.parent / f"boss_dr12_cmass_{cap.lower()}"
+    d = np.loadtxt(folder / f"ps1D_highz{cap}.dat")
+    cov = np.loadtxt(folder / f"Cov_highz{cap}.dat")
+    keep = np.flatnonzero(d[:N_K, 0] >= k_floor)
+    rows = np.concatenate([keep + l * N_K for l in range(3)])
+    d, cov = d[rows], cov[np.ix_(rows, rows)]
+    n_k = len(keep)
+    k = d[:n_k, 0]
+    p = d[:, 1].reshape(3, n_k)
+    sig = np.sqrt(np.diag(cov)).reshape(3, n_k)
     table = np.column_stack([k] + [c for l in range(3) for c in (p[l], sig[l])])
-    path = out / "boss_cmass_ngc_pk.dat"
+    path = out / f"boss_cmass_{cap.lower()}_pk.dat"
     np.savetxt(path, table, fmt="%.10e",
-               header="BOSS DR12 CMASS NGC z_eff = 0.57 (Gil-Marin et al. 2016; via PyBird, MIT)\n"
+               header=f"BOSS DR12 CMASS {cap} z_eff = 0.57 (Gil-Marin et al. 2016; via PyBird, MIT)\n"
                       "k [h/Mpc]  P0 s0 P2 s2 P4 s4 [(Mpc/h)^3] (s = sqrt of the covariance's diagonal)")
     covs = {}
     for n in (2, 3):
-        c = cov[: n * N_K, : n * N_K]
-        covs[n] = out / f"boss_cmass_ngc_cov_l{'024'[:n]}.dat"
+        c = cov[: n * n_k, : n * n_k]
+        covs[n] = out / f"boss_cmass_{cap.lower()}_cov_l{'024'[:n]}.dat"
         np.savetxt(covs[n], 0.5 * (c + c.T), fmt="%.10e")
     return path, covs, k, p, sig
 
