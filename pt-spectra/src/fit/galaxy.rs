@@ -33,11 +33,13 @@ use crate::rsd::ept::physical::{
 use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
 use crate::survey::observe::Observation;
 
+mod bispectrum;
 mod derived;
 pub mod joint;
 mod objective;
 mod priors;
 pub mod search;
+pub use bispectrum::{BispectrumFit, BISPECTRUM_LINEAR, BISPECTRUM_NAMES};
 pub use derived::{derived, sound_horizon, Derived, Template};
 pub use joint::{default_shared, fit_joint, DataSet, JointFit};
 pub use priors::{desi_priors, Prior, PriorShape};
@@ -50,8 +52,14 @@ pub const LINEAR: [&str; 7] = ["alpha0", "alpha2", "alpha4", "alpha6", "sn", "sn
 /// model's [`PARAM_NAMES`].
 pub const AP_NAMES: [&str; 2] = ["apar", "aperp"];
 
-/// Slots of the fitted vector: the model's parameters, then α∥, α⊥.
-const SLOTS: usize = PARAM_NAMES.len() + AP_NAMES.len();
+/// The slot of α∥ (α⊥ the next).
+const AP_SLOT: usize = PARAM_NAMES.len();
+
+/// The first slot of the bispectrum's own parameters ([`BISPECTRUM_NAMES`]).
+const B_SLOT: usize = AP_SLOT + AP_NAMES.len();
+
+/// Slots of the fitted vector: the model's parameters, then α∥, α⊥, then the bispectrum's own.
+const SLOTS: usize = B_SLOT + BISPECTRUM_NAMES.len();
 
 /// What to fit.
 #[derive(Debug, Clone, PartialEq)]
@@ -127,6 +135,8 @@ pub struct GalaxyFit {
     /// With the physical basis: every parameter at the best fit in it (the order of
     /// [`PHYSICAL_NAMES`]; [`Self::best`] holds the model's parameters they map to).
     pub physical: Option<[f64; 12]>,
+    /// With a bispectrum: its own parameters at the best fit ([`BISPECTRUM_NAMES`]).
+    pub bispectrum: Option<[f64; 4]>,
 }
 
 /// The names of the model's slots: velocileptors' (the model's own), or of the DESI physical
@@ -139,7 +149,8 @@ pub fn slot_names(physical: bool) -> &'static [&'static str; 12] {
     }
 }
 
-/// The parameters that enter the model linearly, in the basis of [`slot_names`].
+/// The parameters of the power spectrum's model that enter it linearly, in the basis of
+/// [`slot_names`] (and [`BISPECTRUM_LINEAR`] with a bispectrum).
 pub fn linear_names(physical: bool) -> &'static [&'static str] {
     if physical {
         &PHYSICAL_LINEAR
@@ -149,15 +160,16 @@ pub fn linear_names(physical: bool) -> &'static [&'static str] {
 }
 
 /// The slot of parameter `name` in the basis of [`slot_names`] (its model parameters, then apar,
-/// aperp).
+/// aperp, then the bispectrum's own, which no basis changes).
 pub(crate) fn slot_index(name: &str, physical: bool) -> Result<usize> {
-    if physical {
+    if physical && !BISPECTRUM_NAMES.contains(&name) {
         check_physical_name(name)?;
     }
     let names = slot_names(physical);
     names
         .iter()
         .chain(&AP_NAMES)
+        .chain(&BISPECTRUM_NAMES)
         .position(|&n| n == name)
         .ok_or_else(|| {
             let hint = match (slot_names(!physical).contains(&name), physical) {
@@ -170,8 +182,9 @@ pub(crate) fn slot_index(name: &str, physical: bool) -> Result<usize> {
             Error::InvalidChoice {
                 what: format!("fit parameter `{name}`"),
                 reason: format!(
-                    "the parameters are {} (and apar, aperp){hint}",
-                    names.join(", ")
+                    "the parameters are {} (and apar, aperp; with a bispectrum {}){hint}",
+                    names.join(", "),
+                    BISPECTRUM_NAMES.join(", ")
                 ),
             }
         })
@@ -220,11 +233,13 @@ pub fn fit_galaxy_search(
     observation: Option<&Observation>,
     search: &Search,
 ) -> Result<GalaxyFit> {
-    let mut objective = objective::objective(plan, terms, data, request, observation)?;
+    let mut objective = objective::objective(plan, terms, data, request, observation, None)?;
     objective.log_det = search.linear == Linear::Marginalised;
     search::solve(&objective, search)
 }
 
+#[cfg(test)]
+mod bispectrum_tests;
 #[cfg(test)]
 mod joint_tests;
 #[cfg(test)]

@@ -153,7 +153,7 @@ impl DataLayout {
     }
 
     /// The positions in the full (all the file's multipoles) data vector of the fitted ones.
-    fn block_index(&self, data: &MultipoleData) -> Result<Vec<usize>> {
+    pub(crate) fn block_index(&self, data: &MultipoleData) -> Result<Vec<usize>> {
         let n_k = data.k.len();
         Ok(data
             .ells

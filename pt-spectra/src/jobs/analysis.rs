@@ -6,6 +6,7 @@
 //! analysis file's directory.
 
 use super::joint_fit::{Analysis, SetSpec};
+use super::BispectrumSpec;
 use crate::error::{Error, Result};
 use crate::fit::galaxy::{Linear, Prior, Search};
 use std::path::{Path, PathBuf};
@@ -17,7 +18,7 @@ const TOP: [&str; 3] = ["shared", "search", "dataset"];
 /// The keys of `[search]`.
 const SEARCH: [&str; 4] = ["starts", "seed", "profile_check", "linear"];
 /// The keys of a `[[dataset]]`.
-const SET: [&str; 29] = [
+const SET: [&str; 30] = [
     "label",
     "z",
     "tracer",
@@ -47,6 +48,19 @@ const SET: [&str; 29] = [
     "n_bar",
     "satellites",
     "desi_priors",
+    "bispectrum",
+];
+
+/// The keys of a `[dataset.bispectrum]`.
+const BISPECTRUM: [&str; 8] = [
+    "data",
+    "data_ells",
+    "ells",
+    "k_min",
+    "k_max",
+    "bin_width",
+    "covariance",
+    "n_bar",
 ];
 
 /// The error at `key` of `origin`.
@@ -407,5 +421,71 @@ fn data_set(origin: &str, base: &Path, n: usize, t: &Map) -> Result<SetSpec> {
             },
         },
         desi_priors: flag("desi_priors")?.unwrap_or(false),
+        bispectrum: match opt("bispectrum") {
+            None => None,
+            Some(Value::Table(b)) => Some(bispectrum(origin, base, &key("bispectrum."), b, t)?),
+            Some(_) => {
+                return Err(bad(
+                    origin,
+                    &key("bispectrum"),
+                    "must be a table `[dataset.bispectrum]`",
+                ))
+            }
+        },
+    })
+}
+
+/// A data set's `[dataset.bispectrum]` table `b` (at key prefix `at`; `set` the data set's table, whose
+/// n_bar is the default).
+fn bispectrum(origin: &str, base: &Path, at: &str, b: &Map, set: &Map) -> Result<BispectrumSpec> {
+    known(origin, at, b, &BISPECTRUM)?;
+    let key = |k: &str| format!("{at}{k}");
+    let need = |k: &str| {
+        b.get(k)
+            .ok_or_else(|| bad(origin, &key(k), "is required (missing)"))
+    };
+    let ells_of = |k: &str, default: Vec<usize>| -> Result<Vec<usize>> {
+        let v = match b.get(k) {
+            Some(v) => counts(origin, &key(k), v)?,
+            None => default,
+        };
+        if v.is_empty() || v.iter().any(|l| ![0, 2, 4].contains(l)) {
+            return Err(bad(
+                origin,
+                &key(k),
+                "the bispectrum multipoles are 0, 2, 4",
+            ));
+        }
+        Ok(v)
+    };
+    let n_bar = match b.get("n_bar").or_else(|| set.get("n_bar")) {
+        Some(v) => Some(number(origin, &key("n_bar"), v)?),
+        None => None,
+    };
+    if let Some(n) = n_bar {
+        if !(n.is_finite() && n > 0.0) {
+            return Err(bad(origin, &key("n_bar"), "must be > 0 [(h/Mpc)^3]"));
+        }
+    }
+    let k_min = match b.get("k_min") {
+        Some(v) => number(origin, &key("k_min"), v)?,
+        None => 0.0,
+    };
+    let k_max = number(origin, &key("k_max"), need("k_max")?)?;
+    if k_max <= k_min {
+        return Err(bad(origin, &key("k_max"), "must exceed k_min"));
+    }
+    Ok(BispectrumSpec {
+        data: file(origin, &key("data"), base, need("data")?)?,
+        data_ells: ells_of("data_ells", vec![0, 2, 4])?,
+        ells: ells_of("ells", vec![0])?,
+        k_min,
+        k_max,
+        bin_width: match b.get("bin_width") {
+            Some(v) => Some(number(origin, &key("bin_width"), v)?),
+            None => None,
+        },
+        covariance: file(origin, &key("covariance"), base, need("covariance")?)?,
+        n_bar,
     })
 }

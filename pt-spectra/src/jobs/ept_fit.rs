@@ -330,7 +330,14 @@ pub(super) fn row_columns(t: &mut Table, rows: &[Row]) {
     };
     // In the physical basis its parameters (with their errors), then the model's they map to.
     let physical = rows.iter().any(|r| r.request.basis.is_some());
+    // with a bispectrum, its own parameters after the distortion's
+    let b_names: &[&str] = if rows.iter().any(|r| r.fit.bispectrum.is_some()) {
+        &crate::fit::galaxy::BISPECTRUM_NAMES
+    } else {
+        &[]
+    };
     let value = |i: usize, f: &GalaxyFit| match (i.checked_sub(12), f.ap) {
+        (Some(b), _) if b >= 2 => f.bispectrum.map_or(f64::NAN, |v| v[b - 2]),
         (None, _) if physical => f.physical.map_or(f64::NAN, |v| v[i]),
         (None, _) => f.best.values[i],
         (Some(0), Some(d)) => d.apar,
@@ -340,8 +347,14 @@ pub(super) fn row_columns(t: &mut Table, rows: &[Row]) {
     let names = slot_names(physical)
         .iter()
         .filter(|&&n| !(physical && n == "alpha6p"));
-    for (i, name) in names.chain(ap_names).enumerate() {
-        let i = if physical && i >= 7 { i + 1 } else { i };
+    // the columns in slot order: the model's parameters, α∥, α⊥ (if any), the bispectrum's (if any)
+    let ap_slots = [12, 13];
+    let b_slots = [14, 15, 16, 17];
+    let model_slots = (0..12).filter(|&i| !(physical && i == 7));
+    let slots = model_slots
+        .chain(ap_slots.into_iter().take(ap_names.len()))
+        .chain(b_slots.into_iter().take(b_names.len()));
+    for (i, name) in slots.zip(names.chain(ap_names).chain(b_names)) {
         t.push(
             *name,
             unit(name),
@@ -453,6 +466,7 @@ fn unit(name: &str) -> &'static str {
             "(Mpc/h)^2"
         }
         "sn" => "(Mpc/h)^3",
+        "c1" => "(Mpc/h)^2",
         "sn2" => "(Mpc/h)^5",
         "sn4" => "(Mpc/h)^7",
         _ => "1",

@@ -6,7 +6,8 @@ use super::ept_fit::{row_columns, Row};
 use crate::error::{Error, Result};
 use crate::fit::galaxy::search::{CROSSING_TOLERANCE, HESSIAN_STEP};
 use crate::fit::galaxy::{
-    default_shared, fit_joint, DataSet, GalaxyFitRequest, JointFit, Linear, Prior, Search, Template,
+    default_shared, fit_joint, BispectrumFit, DataSet, GalaxyFitRequest, JointFit, Linear, Prior,
+    Search, Template, BISPECTRUM_NAMES,
 };
 use crate::fit::{DataLayout, MultipoleData};
 use crate::output::Table;
@@ -80,6 +81,9 @@ pub struct SetSpec {
     pub box_side: Option<f64>,
     /// IR resummation.
     pub ir: bool,
+    /// The bispectrum beside the power spectrum, with their joint covariance (then `covariance`
+    /// is not given), if any.
+    pub bispectrum: Option<super::BispectrumSpec>,
 }
 
 /// A joint analysis: its data sets, the shared parameters and the search.
@@ -124,6 +128,7 @@ struct Loaded {
     request: GalaxyFitRequest,
     template: Template,
     description: Vec<String>,
+    bispectrum: Option<BispectrumFit>,
 }
 
 /// Loads data set `s` of `analysis`.
@@ -133,7 +138,29 @@ fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded> {
     let layout = DataLayout::new(&s.data_ells, s.data_columns.as_deref()).map_err(err)?;
     let mut data = layout.read(&s.data, &s.ells).map_err(err)?;
     if let Some(path) = &s.covariance {
+        if s.bispectrum.is_some() {
+            return Err(err(Error::InvalidChoice {
+                what: "covariance with a bispectrum".into(),
+                reason: "the power spectrum's covariance is the joint one's block: give only \
+                         bispectrum.covariance"
+                    .into(),
+            }));
+        }
         data = layout.read_covariance(data, path).map_err(err)?;
+    }
+    let mut bispectrum = None;
+    if let Some(spec) = &s.bispectrum {
+        let (with_cov, fit, line) = super::joint_bispectrum::load_bispectrum(
+            spec,
+            &layout,
+            &s.data,
+            data,
+            prepared.tracer_spectrum(),
+            s.ir,
+        )
+        .map_err(err)?;
+        data = with_cov;
+        bispectrum = Some((fit, line));
     }
     let mixing = match s.window_mixing.as_str() {
         "wilson" => crate::survey::Mixing::Wilson,
@@ -197,6 +224,16 @@ fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded> {
     let mut start = EptParams::new(DEFAULT_B1, prepared.growth_rate);
     for (name, v) in &s.start {
         match name.as_str() {
+            b if BISPECTRUM_NAMES.contains(&b) => match bispectrum.take() {
+                Some((fit, line)) => bispectrum = Some((fit.with_start(b, *v).map_err(err)?, line)),
+                None => {
+                    return Err(err(Error::InvalidChoice {
+                        what: format!("start.{name}"),
+                        reason: "is a bispectrum parameter, and this data set has no bispectrum"
+                            .into(),
+                    }))
+                }
+            },
             "apar" | "aperp" => {
                 return Err(err(Error::InvalidChoice {
                     what: format!("start.{name}"),
@@ -269,6 +306,9 @@ fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded> {
     if let Some(b) = &request.basis {
         description.push(format!("data set {}: {}", s.label, b.describe()));
     }
+    if let Some((_, line)) = &bispectrum {
+        description.push(format!("data set {}: {line}", s.label));
+    }
     if let Some(d) = ap {
         description.push(format!(
             "data set {}: measured with apar = {}, aperp = {}",
@@ -301,6 +341,7 @@ fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded> {
         request,
         template,
         description,
+        bispectrum: bispectrum.map(|b| b.0),
     })
 }
 
@@ -353,6 +394,7 @@ pub fn joint_fit_table(
             data: &l.data,
             request: l.request.clone(),
             observation: l.observation.as_ref(),
+            bispectrum: l.bispectrum.as_ref(),
         })
         .collect();
     let (shared, sharing) = match &analysis.shared {

@@ -37,11 +37,10 @@ use crate::setup::{LinearSource, NamedCosmology, Prepared, Request};
 use crate::store::TableStore;
 use crate::survey::observe::Observation;
 
-mod bispectrum;
 mod linearised;
 pub mod loop_range;
-use bispectrum::{bispectrum_params, PlannedBispectrum};
-pub use bispectrum::{BispectrumBlock, BISPECTRUM_NAMES};
+use crate::bispectrum::block::{bispectrum_params, PlannedBispectrum};
+pub use crate::bispectrum::block::{BispectrumBlock, BISPECTRUM_NAMES};
 pub use linearised::{Linearised, NUISANCE_NAMES};
 
 /// The largest smoothed projection residual for which a [`Pipeline`] evaluates the loop terms on the
@@ -381,7 +380,12 @@ impl Pipeline {
             (None, None) => None,
         };
         let bispectrum = match &self.bispectrum {
-            Some(b) => Some(b.terms(spectrum, growth_rate, ap, self.settings.ir)?),
+            Some(b) => Some(b.terms(
+                spectrum,
+                growth_rate,
+                ap.map(|d| (d.apar, d.aperp)),
+                self.settings.ir,
+            )?),
             None => None,
         };
         Ok(CosmologyStep {

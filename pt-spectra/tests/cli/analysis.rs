@@ -224,3 +224,129 @@ fn analysis_file_errors_name_the_file_key_and_rule() {
         ),
     ]);
 }
+
+/// A data set with its bispectrum (`[dataset.bispectrum]`): noise-free P (`rsd --rsd ept`) and B0, B2
+/// (`bispectrum`) of one truth (b1 = 2, b2 = −0.4, f = 0.7, c1 = 4, b_shot = 1.3, n̄ = 3e-4), a
+/// diagonal joint covariance (1% of P0, 2% of |B0|): f, b1, b2, c1 free, b_shot marginalised, the
+/// truth recovered; the header states the bispectrum and the table has its parameters; a joint file
+/// of the wrong size and a `covariance` beside it refused by name.
+#[test]
+fn analysis_file_fits_the_power_spectrum_with_its_bispectrum() {
+    let dir = scratch("analysis_bispectrum");
+    let p = super::ept_multipoles(&[
+        "--bias", "2", "--b2", "-0.4", "--alpha0", "8", "--sn", "900", "--f", "0.7",
+    ]);
+    write(&dir, "p.dat", &p);
+    let tri = "0.03 0.03 0.03\n0.05 0.05 0.05\n0.08 0.08 0.08\n0.04 0.05 0.06\n0.06 0.08 0.1\n\
+               0.02 0.08 0.09\n0.05 0.1 0.1\n0.03 0.06 0.08\n";
+    let triangles = write(&dir, "tri.dat", tri);
+    let (ok, out, err) = run(&[
+        "bispectrum",
+        "--triangles",
+        &triangles,
+        "--b1",
+        "2",
+        "--b2",
+        "-0.4",
+        "--f",
+        "0.7",
+        "--c1",
+        "4",
+        "--n-bar",
+        "3e-4",
+        "--b-shot",
+        "1.3",
+    ]);
+    assert!(ok, "{err}");
+    let b: Vec<Vec<f64>> = rows(&out);
+    let names = column_names_of(&out, "# k1 ");
+    let col = |n: &str| names.iter().position(|c| *c == n).unwrap();
+    let b_text: String = b
+        .iter()
+        .map(|r| {
+            format!(
+                "{} {} {} {} {} {}\n",
+                r[0],
+                r[1],
+                r[2],
+                r[col("B0")],
+                r[col("B2")],
+                r[col("B4")]
+            )
+        })
+        .collect();
+    write(&dir, "b.dat", &b_text);
+    // the diagonal joint covariance: P0, P2, P4 (25 k each, sigma of the data file), then B0, B2, B4
+    let mut variances: Vec<f64> = Vec::new();
+    let p_rows = rows(&p);
+    for j in 0..3 {
+        variances.extend(p_rows.iter().map(|r| r[2 + 2 * j].powi(2)));
+    }
+    for _ in 0..3 {
+        variances.extend(b.iter().map(|r| (0.02 * r[col("B0")]).powi(2)));
+    }
+    let n = variances.len();
+    let matrix = |n: usize| -> String {
+        (0..n)
+            .map(|i| {
+                let row: Vec<String> = (0..n)
+                    .map(|j| {
+                        if i == j {
+                            variances[i].to_string()
+                        } else {
+                            "0".into()
+                        }
+                    })
+                    .collect();
+                row.join(" ") + "\n"
+            })
+            .collect()
+    };
+    write(&dir, "joint.dat", &matrix(n));
+    let analysis = |covariance: &str, extra: &str| {
+        format!(
+            "{SEARCH}[[dataset]]\nlabel = \"pb\"\ndata = \"p.dat\"\nz = 0.0\nells = [0, 2]\n\
+             k_max = 0.2\nfree = [\"f\", \"b1\", \"b2\", \"c1\"]\n\
+             marginalise = [\"alpha0\", \"sn\", \"b_shot\"]\n{extra}\
+             [dataset.start]\nb1 = 1.9\nb2 = 0.0\nf = 0.6\n\
+             [dataset.bispectrum]\ndata = \"b.dat\"\nells = [0, 2]\nk_max = 0.1\n\
+             covariance = \"{covariance}\"\nn_bar = 3e-4\n"
+        )
+    };
+    let file = write(&dir, "pb.toml", &analysis("joint.dat", ""));
+    let (ok, out, err) = run(&["fit", "--analysis", &file, "--precision", "fast"]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("data set pb: bispectrum: B_l for l in [0, 2] of 8 triangles"),
+        "{out}"
+    );
+    let names = column_names_of(&out, "# set ");
+    let table = rows(&out);
+    let get = |n: &str| table[0][names.iter().position(|c| *c == n).unwrap()];
+    for (name, want) in [
+        ("f", 0.7),
+        ("b1", 2.0),
+        ("b2", -0.4),
+        ("c1", 4.0),
+        ("b_shot", 1.3),
+    ] {
+        let (v, e) = (get(name), get(&format!("err_{name}")));
+        assert!((v - want).abs() < 0.1 * e, "{name}: {v} ± {e}");
+    }
+    assert_eq!(get("points"), 50.0 + 16.0);
+    // refused: a joint file of the wrong size; a covariance beside the joint one
+    write(&dir, "small.dat", &matrix(n - 1));
+    let small = write(&dir, "small.toml", &analysis("small.dat", ""));
+    let both = write(
+        &dir,
+        "both.toml",
+        &analysis("joint.dat", "covariance = \"joint.dat\"\n"),
+    );
+    let (ok, _, err) = run(&["fit", "--analysis", &small, "--precision", "fast"]);
+    assert!(
+        !ok && err.contains("small.dat") && err.contains("the joint covariance is square"),
+        "{err}"
+    );
+    let (ok, _, err) = run(&["fit", "--analysis", &both, "--precision", "fast"]);
+    assert!(!ok && err.contains("covariance with a bispectrum"), "{err}");
+}

@@ -21,7 +21,10 @@
 
 use super::objective::{objective, Objective};
 use super::search::{bound, find, package, Space};
-use super::{slot_index, GalaxyFit, GalaxyFitRequest, Linear, MultipoleData, Observation, Search};
+use super::{
+    slot_index, BispectrumFit, GalaxyFit, GalaxyFitRequest, Linear, MultipoleData, Observation,
+    Search,
+};
 use crate::error::{Error, Result};
 use crate::rsd::ept::{EptPlan, EptTerms};
 
@@ -50,6 +53,8 @@ pub struct DataSet<'a> {
     pub request: GalaxyFitRequest,
     /// Its window and bins, if any.
     pub observation: Option<&'a Observation>,
+    /// Its bispectrum beside the power spectrum, if any (fitted with one covariance).
+    pub bispectrum: Option<&'a BispectrumFit>,
 }
 
 /// The result of a joint fit.
@@ -147,11 +152,17 @@ pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result
     }
     let mut objectives = Vec::with_capacity(sets.len());
     for s in sets {
-        let mut o = objective(s.plan, s.terms, s.data, &s.request, s.observation).map_err(|e| {
-            Error::InvalidChoice {
-                what: format!("data set `{}`", s.label),
-                reason: e.to_string(),
-            }
+        let mut o = objective(
+            s.plan,
+            s.terms,
+            s.data,
+            &s.request,
+            s.observation,
+            s.bispectrum,
+        )
+        .map_err(|e| Error::InvalidChoice {
+            what: format!("data set `{}`", s.label),
+            reason: e.to_string(),
         })?;
         o.log_det = search.linear == Linear::Marginalised;
         objectives.push(o);

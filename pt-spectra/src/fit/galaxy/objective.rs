@@ -1,7 +1,8 @@
 //! The objective of a galaxy fit: −2 ln L of the free parameters with the linear ones marginalised
 //! analytically (the module docs of [`super`]), on one window of data.
 
-use super::{linear_names, slot_index, GalaxyFitRequest, PriorShape, SLOTS};
+use super::bispectrum::{BispectrumFit, BispectrumModel, BISPECTRUM_LINEAR, BISPECTRUM_NAMES};
+use super::{linear_names, slot_index, GalaxyFitRequest, PriorShape, AP_SLOT, B_SLOT, SLOTS};
 use crate::error::{Error, Result};
 use crate::fit::MultipoleData;
 use crate::linalg::{cholesky, dot, invert_lower, solve_spd};
@@ -54,6 +55,9 @@ pub(super) struct Objective<'a> {
     whiten: Vec<Vec<f64>>,
     /// L⁻¹ d.
     data: Vec<f64>,
+    /// The bispectrum beside the power spectrum, if the data set has one: its entries follow the
+    /// power spectrum's in the model and data vectors.
+    bispectrum: Option<BispectrumModel<'a>>,
 }
 
 impl Objective<'_> {
@@ -84,12 +88,16 @@ impl Objective<'_> {
         Ok((p, ap))
     }
 
-    /// The whitened model at `p` with distortion `ap` (L⁻¹ m).
-    pub(super) fn model(
-        &self,
-        p: &EptParams,
-        ap: Option<crate::rsd::ap::Distortion>,
-    ) -> Result<Vec<f64>> {
+    /// Whether the data set has a bispectrum.
+    pub(super) fn has_bispectrum(&self) -> bool {
+        self.bispectrum.is_some()
+    }
+
+    /// The whitened model at the slots `v` (L⁻¹ m): the power spectrum's fitted points, then the
+    /// bispectrum's entries.
+    pub(super) fn model(&self, v: &[f64; SLOTS]) -> Result<Vec<f64>> {
+        let (p, ap) = self.split(v)?;
+        let p = &p;
         let m = match self.observation {
             None => self
                 .plan
@@ -101,11 +109,15 @@ impl Objective<'_> {
                 o.apply_values(&model)?
             }
         };
-        let raw: Vec<f64> = m
+        let mut raw: Vec<f64> = m
             .iter()
             .zip(&self.window)
             .flat_map(|(l, window)| window.iter().map(move |&i| l[i]))
             .collect();
+        if let Some(b) = &self.bispectrum {
+            let own: [f64; 4] = std::array::from_fn(|i| v[B_SLOT + i]);
+            raw.extend(b.values(p, ap, &own)?);
+        }
         Ok(self
             .whiten
             .iter()
@@ -121,8 +133,7 @@ impl Objective<'_> {
             .map(|&i| {
                 let mut w = *v;
                 w[i] = 1.0;
-                let (q, ap) = self.split(&w)?;
-                self.model(&q, ap)
+                self.model(&w)
                     .map(|m| m.iter().zip(m0).map(|(a, b)| a - b).collect())
             })
             .collect()
@@ -147,10 +158,7 @@ impl Objective<'_> {
         for &i in &self.marg {
             v[i] = 0.0;
         }
-        let at = |v: &[f64; SLOTS]| -> Result<Vec<Vec<f64>>> {
-            let (p, ap) = self.split(v)?;
-            self.templates(v, &self.model(&p, ap)?)
-        };
+        let at = |v: &[f64; SLOTS]| -> Result<Vec<Vec<f64>>> { self.templates(v, &self.model(v)?) };
         let t0 = at(&v)?;
         for (&i, shift) in BIASES.iter().zip([0.37, -0.41, 0.23, 0.11]) {
             v[i] += shift;
@@ -184,8 +192,7 @@ impl Objective<'_> {
         for &i in &self.marg {
             v[i] = 0.0;
         }
-        let (p, ap) = self.split(&v)?;
-        let m0 = self.model(&p, ap)?;
+        let m0 = self.model(&v)?;
         let key = self.template_key(&v);
         let cached = if self.bias_free_templates {
             self.cache
@@ -257,9 +264,20 @@ pub(super) fn objective<'a>(
     data: &MultipoleData,
     request: &GalaxyFitRequest,
     observation: Option<&'a Observation>,
+    bispectrum: Option<&'a BispectrumFit>,
 ) -> Result<Objective<'a>> {
     let (free, marg, priors) = validate(request)?;
-    if request.ap.is_none() && free.iter().any(|&i| i >= PARAM_NAMES.len()) {
+    if bispectrum.is_none() {
+        let with_prior = (0..SLOTS).filter(|&i| priors[i].is_some());
+        let used = free.iter().chain(&marg).copied().chain(with_prior);
+        if let Some(i) = used.into_iter().find(|&i| i >= B_SLOT) {
+            return Err(Error::InvalidChoice {
+                what: format!("fit parameter `{}`", BISPECTRUM_NAMES[i - B_SLOT]),
+                reason: "is a bispectrum parameter, and this data set has no bispectrum".into(),
+            });
+        }
+    }
+    if request.ap.is_none() && free.iter().any(|&i| (AP_SLOT..B_SLOT).contains(&i)) {
         return Err(Error::InvalidChoice {
             what: "free apar/aperp".into(),
             reason: "the fit needs a distortion to start from (the measurement's AP)".into(),
@@ -316,7 +334,8 @@ pub(super) fn objective<'a>(
                 .collect::<Vec<usize>>(),
         );
     }
-    let points: usize = window.iter().map(Vec::len).sum();
+    let points: usize =
+        window.iter().map(Vec::len).sum::<usize>() + bispectrum.map_or(0, BispectrumFit::len);
     if points <= free.len() + marg.len() {
         return Err(Error::InvalidParameter {
             name: "k_max [h/Mpc]",
@@ -332,7 +351,7 @@ pub(super) fn objective<'a>(
         .zip(&window)
         .flat_map(|(&r, w)| w.iter().map(move |&i| (r, i)))
         .collect();
-    let cov: Vec<Vec<f64>> = fitted
+    let mut cov: Vec<Vec<f64>> = fitted
         .iter()
         .map(|&(r, i)| {
             fitted
@@ -345,7 +364,30 @@ pub(super) fn objective<'a>(
                 .collect()
         })
         .collect();
-    let mut cov = cov;
+    // With a bispectrum: its entries after the power spectrum's, with the cross terms.
+    if let Some(b) = bispectrum {
+        if data.covariance.is_none() {
+            return Err(Error::InvalidChoice {
+                what: "a fit of the power spectrum and the bispectrum".into(),
+                reason: "needs their joint covariance (the cross terms), not diagonal errors"
+                    .into(),
+            });
+        }
+        let nb = b.len();
+        for (row, &(r, i)) in cov.iter_mut().zip(&fitted) {
+            for j in 0..nb {
+                row.push(b.cross(position(r, i), j)?);
+            }
+        }
+        for j in 0..nb {
+            let mut row = Vec::with_capacity(fitted.len() + nb);
+            for &(r, i) in &fitted {
+                row.push(b.cross(position(r, i), j)?);
+            }
+            row.extend((0..nb).map(|m| b.covariance(j, m)));
+            cov.push(row);
+        }
+    }
     if let Some(n) = request.n_mocks {
         if n < points + 3 {
             return Err(Error::InvalidParameter {
@@ -367,7 +409,8 @@ pub(super) fn objective<'a>(
         reason: "is not positive definite".into(),
     })?;
     let whiten = invert_lower(&l);
-    let raw: Vec<f64> = fitted.iter().map(|&(r, i)| data.values[r][i]).collect();
+    let mut raw: Vec<f64> = fitted.iter().map(|&(r, i)| data.values[r][i]).collect();
+    raw.extend(bispectrum.map_or(&[][..], BispectrumFit::values));
     let data_vector = whiten.iter().map(|row| dot(row, &raw)).collect();
     let mut start = [0.0; SLOTS];
     match &request.basis {
@@ -385,8 +428,11 @@ pub(super) fn objective<'a>(
         }
     }
     if let Some(d) = request.ap {
-        start[PARAM_NAMES.len()] = d.apar;
-        start[PARAM_NAMES.len() + 1] = d.aperp;
+        start[AP_SLOT] = d.apar;
+        start[AP_SLOT + 1] = d.aperp;
+    }
+    if let Some(b) = bispectrum {
+        start[B_SLOT..].copy_from_slice(b.start());
     }
     let mut objective = Objective {
         plan,
@@ -405,6 +451,7 @@ pub(super) fn objective<'a>(
         cache: std::cell::RefCell::new(Vec::new()),
         whiten,
         data: data_vector,
+        bispectrum: bispectrum.map(BispectrumModel::new),
     };
     objective.check_bias_free_templates()?;
     Ok(objective)
@@ -422,7 +469,11 @@ pub(super) fn validate(request: &GalaxyFitRequest) -> Result<Validated> {
         .map(|n| slot_index(n, physical))
         .collect::<Result<Vec<_>>>()?;
     let mut marg = Vec::new();
-    let linear = linear_names(physical);
+    let linear: Vec<&str> = linear_names(physical)
+        .iter()
+        .chain(&BISPECTRUM_LINEAR)
+        .copied()
+        .collect();
     for name in &request.marginalise {
         if !linear.contains(&name.as_str()) {
             return Err(Error::InvalidChoice {

@@ -16,11 +16,10 @@
 //!   by more than 0.01 means the starts missed the global minimum: the search restarts there.
 
 use super::objective::Objective;
-use super::{GalaxyFit, PriorShape, SLOTS};
+use super::{GalaxyFit, PriorShape, AP_SLOT, B_SLOT, SLOTS};
 use crate::error::{Error, Result};
 use crate::fit::bounded::{multistart, Minimum, Problem, AGREEMENT, EXPECTED_DECREASE};
 use crate::linalg::solve_spd;
-use crate::rsd::ept::PARAM_NAMES;
 use rand::{Rng, SeedableRng};
 
 mod profile;
@@ -45,10 +44,11 @@ pub const PROFILE_DECREASE: f64 = 1e-4;
 /// Re-searches after a profile found a lower minimum, at most.
 const RESTARTS: usize = 3;
 
-/// Per slot ([`PARAM_NAMES`], then α∥, α⊥): (lower bound, upper bound, start box lower, upper,
-/// typical σ). The bounds are wide physical ranges (f: the plausible range [0, 2]); the start box is
-/// where galaxy samples' best fits lie (b1 1–3, |b2| ≲ 2 in velocileptors' units; counterterms tens
-/// of (Mpc/h)², shot noise ~1/n̄ ~ 10³ (Mpc/h)³).
+/// Per slot ([`crate::rsd::ept::PARAM_NAMES`], then α∥, α⊥, then the bispectrum's c1, b_shot,
+/// p_shot, a_shot): (lower bound, upper bound, start box lower, upper, typical σ). The bounds are
+/// wide physical ranges (f: the plausible range [0, 2]); the start box is where galaxy samples' best
+/// fits lie (b1 1–3, |b2| ≲ 2 in velocileptors' units; counterterms tens of (Mpc/h)², shot noise
+/// ~1/n̄ ~ 10³ (Mpc/h)³; the bispectrum's stochastic amplitudes of order one in units of 1/n̄).
 pub const RANGES: [(f64, f64, f64, f64, f64); SLOTS] = [
     (0.05, 10.0, 1.0, 3.0, 0.1),
     (-50.0, 50.0, -2.0, 2.0, 1.0),
@@ -64,6 +64,10 @@ pub const RANGES: [(f64, f64, f64, f64, f64); SLOTS] = [
     (0.0, 2.0, 0.4, 1.0, 0.05),
     (0.5, 2.0, 0.9, 1.1, 0.03),
     (0.5, 2.0, 0.9, 1.1, 0.03),
+    (-1e3, 1e3, -10.0, 10.0, 3.0),
+    (-20.0, 20.0, 0.0, 2.0, 0.3),
+    (-20.0, 20.0, -1.0, 1.0, 0.3),
+    (-20.0, 20.0, -1.0, 1.0, 0.3),
 ];
 
 /// [`RANGES`] for the slots of the DESI physical basis ([`crate::rsd::ept::physical`]): b1p = b1 σ₈(z)
@@ -84,6 +88,10 @@ pub const PHYSICAL_RANGES: [(f64, f64, f64, f64, f64); SLOTS] = [
     (0.0, 2.0, 0.4, 1.0, 0.05),
     (0.5, 2.0, 0.9, 1.1, 0.03),
     (0.5, 2.0, 0.9, 1.1, 0.03),
+    (-1e3, 1e3, -10.0, 10.0, 3.0),
+    (-20.0, 20.0, 0.0, 2.0, 0.3),
+    (-20.0, 20.0, -1.0, 1.0, 0.3),
+    (-20.0, 20.0, -1.0, 1.0, 0.3),
 ];
 
 /// [`RANGES`] or [`PHYSICAL_RANGES`].
@@ -137,7 +145,7 @@ pub(super) fn bound(
     physical: bool,
 ) -> (f64, f64, f64) {
     let (mut a, mut b, _, _, s) = ranges(physical)[i];
-    if let (true, Some((x, y))) = (i >= PARAM_NAMES.len(), ap) {
+    if let (true, Some((x, y))) = ((AP_SLOT..B_SLOT).contains(&i), ap) {
         (a, b) = (x, y);
     }
     if let Some(p) = prior {
@@ -452,6 +460,9 @@ pub(super) fn package(
         moved_by_profile: found.moved,
         evaluations: found.evaluations,
         physical: objective.basis.map(|_| std::array::from_fn(|i| slots[i])),
+        bispectrum: objective
+            .has_bispectrum()
+            .then(|| std::array::from_fn(|i| slots[B_SLOT + i])),
     })
 }
 

@@ -80,7 +80,7 @@ pub fn profile_galaxy(
         });
     }
     let mut objective =
-        crate::fit::galaxy::objective::objective(plan, terms, data, request, observation)?;
+        crate::fit::galaxy::objective::objective(plan, terms, data, request, observation, None)?;
     objective.log_det = search.linear == Linear::Marginalised;
     let Some(i) = objective.free.iter().position(|&s| s == slot) else {
         return Err(Error::InvalidChoice {

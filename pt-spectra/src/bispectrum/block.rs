@@ -1,20 +1,19 @@
-//! The bispectrum block of a pipeline's data vector (issue 49, item 4): the tree-level galaxy
-//! bispectrum multipoles ([`crate::bispectrum`]) of a triangle set, after the power-spectrum rows, from
-//! the same linear spectrum, growth rate, Alcock–Paczynski distortion and IR setting, sharing b1, b2,
-//! bs with the galaxy model and adding its own counterterm and stochastic parameters
-//! ([`BISPECTRUM_NAMES`]).
+//! The bispectrum block of a data vector (issue 49, items 4 and 5): the tree-level galaxy bispectrum
+//! multipoles of a triangle set beside the power spectrum's, from the same linear spectrum, growth
+//! rate, Alcock–Paczynski distortion and IR setting, sharing b1, b2, bs with the galaxy model and
+//! adding its own counterterm and stochastic parameters ([`BISPECTRUM_NAMES`]); used by the pipeline
+//! ([`crate::pipeline`]) and the galaxy fits ([`crate::fit::galaxy`]).
 //!
-//! The block's terms are computed once per cosmology step at the step's growth rate: the IR damping
-//! makes B depend on f beyond a polynomial, so a call with another `f` needs a step at that f
-//! ([`super::Pipeline::step_at_growth_rate`]); a parameter step is then a contraction (microseconds).
+//! The block's terms are computed once per growth rate and distortion: the IR damping makes B depend
+//! on f beyond a polynomial, so another `f` needs new terms (the pipeline's
+//! `step_at_growth_rate`); a parameter step is then a contraction (microseconds).
 
-use crate::bispectrum::{
+use super::{
     BispectrumParams, BispectrumPlan, BispectrumTerms, Fog, LegendreSide, PlanRules, Settings,
     TriangleSet, ELLS,
 };
 use crate::error::{Error, Result};
 use crate::linear::LinearSpectrum;
-use crate::rsd::ap::Distortion;
 
 /// The parameters of the bispectrum block besides the shared b1, b2, bs (velocileptors' convention):
 /// the counterterm c1 [(Mpc/h)²] and the stochastic amplitudes of [`BispectrumParams`].
@@ -54,7 +53,7 @@ impl BispectrumBlock {
 
 /// The block planned: the bispectrum plan and where each multipole sits in [`ELLS`].
 #[derive(Debug, Clone)]
-pub(super) struct PlannedBispectrum {
+pub(crate) struct PlannedBispectrum {
     plan: BispectrumPlan,
     /// Indices into [`ELLS`] of the block's multipoles.
     ells: Vec<usize>,
@@ -68,7 +67,7 @@ impl PlannedBispectrum {
     /// # Errors
     /// [`Error::InvalidChoice`] for multipoles that are not an increasing subset of 0, 2, 4, or a bad
     /// n̄; as [`BispectrumPlan::new`].
-    pub(super) fn new(block: BispectrumBlock) -> Result<Self> {
+    pub(crate) fn new(block: BispectrumBlock) -> Result<Self> {
         let bad = |reason: &str| Error::InvalidChoice {
             what: format!("bispectrum multipoles {:?}", block.ells),
             reason: reason.into(),
@@ -98,22 +97,22 @@ impl PlannedBispectrum {
     }
 
     /// The number of entries: multipoles × triangles.
-    pub(super) fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.ells.len() * self.plan.triangles().len()
     }
 
-    /// The terms of `spectrum` at growth rate `f` with the distortion `ap` (none: q = 1).
+    /// The terms of `spectrum` at growth rate `f` with the distortion `ap` = (α∥, α⊥) (none: 1).
     ///
     /// # Errors
     /// As [`BispectrumPlan::terms`].
-    pub(super) fn terms(
+    pub(crate) fn terms(
         &self,
         spectrum: &LinearSpectrum,
         f: f64,
-        ap: Option<Distortion>,
+        ap: Option<(f64, f64)>,
         ir: bool,
     ) -> Result<BispectrumTerms> {
-        let (q_par, q_perp) = ap.map_or((1.0, 1.0), |d| (d.apar, d.aperp));
+        let (q_par, q_perp) = ap.unwrap_or((1.0, 1.0));
         self.plan.terms(
             spectrum,
             &Settings {
@@ -130,7 +129,7 @@ impl PlannedBispectrum {
     ///
     /// # Errors
     /// As [`BispectrumTerms::multipoles`].
-    pub(super) fn values(&self, terms: &BispectrumTerms, b: BispectrumParams) -> Result<Vec<f64>> {
+    pub(crate) fn values(&self, terms: &BispectrumTerms, b: BispectrumParams) -> Result<Vec<f64>> {
         let b = BispectrumParams {
             n_bar: self.n_bar,
             ..b
@@ -147,7 +146,7 @@ impl PlannedBispectrum {
 /// The bispectrum's parameters of `params`: b1, b2, bs (shared; 0 when not given, as the galaxy
 /// model's) and [`BISPECTRUM_NAMES`] (not given: c1 = 0, Poisson b_shot = 1, p_shot = a_shot = 0, as
 /// [`BispectrumParams::default`]); other names are the galaxy model's and are skipped here.
-pub(super) fn bispectrum_params(params: &[(&str, f64)]) -> BispectrumParams {
+pub(crate) fn bispectrum_params(params: &[(&str, f64)]) -> BispectrumParams {
     let mut b = BispectrumParams {
         b1: 0.0,
         ..BispectrumParams::default()
