@@ -66,3 +66,29 @@ def test_analysis_file_mistakes_name_the_key(tmp_path):
     (tmp_path / "shared.toml").write_text('shared = ["bs"]\n' + _set("a", path))
     with pytest.raises(ValueError, match="`bs` is declared shared but no data set has it free"):
         pt.fit_joint(tmp_path / "shared.toml")
+
+
+def test_a_set_with_its_bispectrum_recovers_the_truth(tmp_path):
+    """``[dataset.bispectrum]`` from Python: noise-free P (``pt.ept``) and B0, B2 (``pt.bispectrum``) of
+    one truth with a diagonal joint covariance; f, b1, b2, c1 free, b_shot marginalised, all recovered
+    within 0.1 sigma; the bispectrum's parameters are columns of the result."""
+    tri = np.array([[0.03, 0.03, 0.03], [0.05, 0.05, 0.05], [0.08, 0.08, 0.08], [0.04, 0.05, 0.06],
+                    [0.06, 0.08, 0.1], [0.02, 0.08, 0.09], [0.05, 0.1, 0.1], [0.03, 0.06, 0.08]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pt.PtSpectraWarning)
+        p = _data(tmp_path, "p.dat", 2.0)
+        b = pt.bispectrum(tri, b1=2.0, b2=-0.4, f=0.7, c1=4.0, n_bar=3e-4, b_shot=1.3)
+        np.savetxt(tmp_path / "b.dat", np.column_stack([tri, b["B0"], b["B2"], b["B4"]]), fmt="%.17g")
+        sigma_p = np.loadtxt(p)[:, 2]
+        variances = np.concatenate([np.tile(sigma_p ** 2, 3), np.tile((0.02 * b["B0"]) ** 2, 3)])
+        np.savetxt(tmp_path / "joint.dat", np.diag(variances), fmt="%.17g")
+        (tmp_path / "pb.toml").write_text(
+            SEARCH + '[[dataset]]\nlabel = "pb"\ndata = "p.dat"\nz = 0.0\nells = [0, 2]\nk_max = 0.2\n'
+            'free = ["f", "b1", "b2", "c1"]\nmarginalise = ["alpha0", "sn", "b_shot"]\n'
+            '[dataset.start]\nb1 = 1.9\nb2 = 0.0\nf = 0.6\n'
+            '[dataset.bispectrum]\ndata = "b.dat"\nells = [0, 2]\nk_max = 0.1\n'
+            'covariance = "joint.dat"\nn_bar = 3e-4\n')
+        t = pt.fit_joint(tmp_path / "pb.toml", precision="fast")
+    for name, truth in (("f", 0.7), ("b1", 2.0), ("b2", -0.4), ("c1", 4.0), ("b_shot", 1.3)):
+        assert abs(t[name][0] - truth) < 0.1 * t[f"err_{name}"][0], name
+    assert t["points"][0] == 50 + 16

@@ -208,11 +208,12 @@ impl<'a> BispectrumModel<'a> {
         let terms = match cached {
             Some(t) => t,
             None => {
-                let t = Rc::new(
-                    self.fit
-                        .block
-                        .terms(&self.fit.spectrum, f, Some((a, b)), self.fit.ir)?,
-                );
+                let t = Rc::new(self.fit.block.terms(
+                    &self.fit.spectrum,
+                    f,
+                    Some((a, b)),
+                    self.fit.ir,
+                )?);
                 let mut cache = self.cache.borrow_mut();
                 if cache.len() == TERMS_CACHE {
                     cache.remove(0);

@@ -111,15 +111,22 @@ impl PhysicalBasis {
 
     /// The physical values of the model's parameters `p` (the inverse of [`Self::to_ept`] where one
     /// exists: α₆ is not free in this basis, so its value in `p` is dropped, and α₀p, α₂p, α₄p are
-    /// solved from α₀, α₂, α₄; b = 0 or f = 0 leaves the counterterms undetermined and gives NaN).
+    /// solved from α₀, α₂, α₄). With b = 0 or f = 0 a counterterm the map leaves undetermined is 0
+    /// where that reproduces α₀, α₂, α₄ (e.g. all zero: a start at f = 0), and NaN where no value does.
     pub fn from_ept(&self, p: &EptParams) -> [f64; 12] {
         let s = self.sigma8;
         let v = &p.values;
         let (b, f) = (v[0], v[11]);
         let sat = self.f_sat / self.n_bar;
-        let a0 = v[4] / (b * b);
-        let a2 = v[5] / (f * b) - a0;
-        let a4 = (v[6] / f - f * a2) / b;
+        // x = (α − rest)/scale, or 0 where the scale vanishes and α − rest does too (NaN otherwise)
+        let solve = |num: f64, scale: f64| match (scale == 0.0, num == 0.0) {
+            (false, _) => num / scale,
+            (true, true) => 0.0,
+            (true, false) => f64::NAN,
+        };
+        let a0 = solve(v[4], b * b);
+        let a2 = solve(v[5] - f * b * a0, f * b);
+        let a4 = solve(v[6] - f * f * a2, f * b);
         let mut out = [0.0; 12];
         out[0] = b * s;
         out[1] = (v[1] - 8.0 / 21.0 * (b - 1.0)) * s * s;
@@ -212,6 +219,30 @@ mod tests {
                 "{v:?} vs {back:?}"
             );
         }
+    }
+
+    /// At f = 0 or b1 = 0 the counterterms the map leaves undetermined are 0 where that reproduces
+    /// the model's (a start with no counterterms: finite, and back to it), NaN where nothing does.
+    #[test]
+    fn f_or_b_zero_is_finite_where_the_map_allows_it() {
+        for (b1p, f) in [(1.2, 0.0), (0.0, 0.75)] {
+            let v = [b1p, 0.3, -0.4, 0.1, 0.0, 0.0, 0.0, 0.0, 0.7, -1.5, 2.5, f];
+            let p = basis().to_ept(&v);
+            let back = basis().from_ept(&p);
+            assert!(back.iter().all(|x| x.is_finite()), "{back:?}");
+            let again = basis().to_ept(&back).values;
+            for (a, b) in again.iter().zip(&p.values) {
+                assert!(
+                    (a - b).abs() <= 1e-12 * b.abs(),
+                    "{again:?} vs {:?}",
+                    p.values
+                );
+            }
+        }
+        // α2 ≠ 0 at f = 0 is not a point of the physical basis (α2 = f b1 (α0p + α2p))
+        let mut p = EptParams::new(2.0, 0.0);
+        p.values[5] = 3.0;
+        assert!(basis().from_ept(&p)[5].is_nan());
     }
 
     #[test]
