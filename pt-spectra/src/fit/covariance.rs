@@ -93,7 +93,8 @@ pub fn validate(
         .iter()
         .flat_map(|v| std::iter::repeat_n(rms(v), v.len()))
         .collect();
-    check(c, &scale, origin, &line)
+    let blocks: Vec<usize> = values.iter().map(Vec::len).collect();
+    check(c, &scale, &blocks, origin, &line)
 }
 
 /// The root mean square of `v`, scaled by its largest |x| (the squares of values near f64::MAX would
@@ -108,8 +109,8 @@ fn rms(v: &[f64]) -> f64 {
 }
 
 /// Checks the n×n matrix `c` (finite, as the readers ensure) as the covariance of a data vector whose
-/// element i belongs to the multipole block with data RMS `scale[i]`; returns it symmetrised. `origin`
-/// names it and `line(i)` the line of row i in messages.
+/// element i belongs to the multipole block with data RMS `scale[i]` (the blocks' lengths `blocks`);
+/// returns it symmetrised. `origin` names it and `line(i)` the line of row i in messages.
 ///
 /// # Errors
 /// [`Error::BadRow`] naming the row (and column) and the rule: an asymmetric pair, a variance that is
@@ -118,6 +119,7 @@ fn rms(v: &[f64]) -> f64 {
 fn check(
     mut c: Vec<Vec<f64>>,
     scale: &[f64],
+    blocks: &[usize],
     origin: &str,
     line: &dyn Fn(usize) -> usize,
 ) -> Result<Vec<Vec<f64>>> {
@@ -201,15 +203,26 @@ fn check(
     })?;
     let (condition, row) = correlation_condition(&r, &l);
     if condition.is_nan() || condition > MAX_CORRELATION_CONDITION {
+        // where the row sits in the data vector: (block, point), 1-based
+        let (mut block, mut point) = (0, row);
+        while block < blocks.len() && point >= blocks[block] {
+            point -= blocks[block];
+            block += 1;
+        }
         return Err(bad(
             row,
             format!(
                 "the covariance is nearly singular: its correlation matrix has condition number {} \
                  > {MAX_CORRELATION_CONDITION:e} (the real BOSS and Patchy covariances have ≤ 6.1e4); \
-                 row {} weighs most on its most degenerate direction (two rows equal to the digits \
-                 written? a row of another matrix?)",
+                 row {} (point {} of block {} of the data vector: the multipoles in order, then any \
+                 bispectrum) weighs most on its most degenerate direction (two rows equal to the \
+                 digits written? a row of another matrix? The check is on the whole file: points the \
+                 fit does not use, e.g. the few-mode bins at the lowest k of a small survey cap, can \
+                 be left out of the data and covariance files)",
                 number(&condition),
-                row + 1
+                row + 1,
+                point + 1,
+                block + 1
             ),
         ));
     }
@@ -289,7 +302,7 @@ mod tests {
         let (cond, _) = correlation_condition(&r, &l);
         let want = 354.407_134_234_794_6;
         assert!((cond / want - 1.0).abs() < 0.01, "{cond} {want}");
-        assert!(check(c, &[], "c", &line).is_ok());
+        assert!(check(c, &[], &[], "c", &line).is_ok());
     }
 
     /// The issue's faults: two rows equal to 6 digits, one variance of 1e-10, an asymmetric pair, a
@@ -308,13 +321,23 @@ mod tests {
             .iter()
             .map(|r| r.iter().map(|&x| six(x)).collect())
             .collect();
-        let e = check(dup, &[], "cov.dat", &line).unwrap_err().to_string();
+        let e = check(dup, &[], &[20, 10], "cov.dat", &line)
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("cov.dat:1"), "{e}");
         assert!(
             (e.contains("row 8") || e.contains("row 7"))
                 && (e.contains("condition number") || e.contains("positive definite")),
             "{e}"
         );
+        // a nearly singular matrix names where the row sits in the data vector (blocks of 20, 10)
+        if e.contains("condition number") {
+            assert!(
+                (e.contains("point 8 of block 1") || e.contains("point 7 of block 1"))
+                    && e.contains("whole file"),
+                "{e}"
+            );
+        }
         let mut tiny = base.clone();
         tiny[4] = vec![0.0; 30];
         for row in tiny.iter_mut() {
@@ -322,7 +345,7 @@ mod tests {
         }
         tiny[4][4] = 1e-10;
         let scale = vec![1e4; 30];
-        let e = check(tiny, &scale, "cov.dat", &line)
+        let e = check(tiny, &scale, &[], "cov.dat", &line)
             .unwrap_err()
             .to_string();
         assert!(
@@ -331,11 +354,13 @@ mod tests {
         );
         let mut asym = base.clone();
         asym[3][1] *= 1.001;
-        let e = check(asym, &[], "cov.dat", &line).unwrap_err().to_string();
+        let e = check(asym, &[], &[], "cov.dat", &line)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("(4, 2)") && e.contains("symmetric"), "{e}");
         let mut negative = base.clone();
         negative[2][2] = -1.0;
-        let e = check(negative, &[], "cov.dat", &line)
+        let e = check(negative, &[], &[], "cov.dat", &line)
             .unwrap_err()
             .to_string();
         assert!(
@@ -348,7 +373,7 @@ mod tests {
             .map(|r| r.iter().map(|&x| six(x)).collect())
             .collect();
         rounded[5][2] = rounded[2][5] * (1.0 + 2e-6);
-        let c = check(rounded, &scale, "cov.dat", &line).unwrap();
+        let c = check(rounded, &scale, &[], "cov.dat", &line).unwrap();
         assert_eq!(c[5][2], c[2][5]);
     }
 }
