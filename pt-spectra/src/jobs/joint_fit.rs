@@ -319,6 +319,7 @@ fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded> {
         description.extend(
             o.description()
                 .iter()
+                .chain([&crate::fit::galaxy::OBSERVATION_IN_FITS.to_string()])
                 .map(|l| format!("data set {}: {l}", s.label)),
         );
     }

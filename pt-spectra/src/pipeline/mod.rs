@@ -35,7 +35,7 @@ use crate::rsd::ap::{Distortion, AP_FIT_RANGE};
 use crate::rsd::ept::{EptParams, EptPlan, EptSettings, EptTerms, PARAM_NAMES};
 use crate::setup::{LinearSource, NamedCosmology, Prepared, Request};
 use crate::store::TableStore;
-use crate::survey::observe::Observation;
+use crate::survey::observe::{apply_matrix, Observation};
 
 mod linearised;
 pub mod loop_range;
@@ -192,7 +192,7 @@ impl Pipeline {
             ap_range: settings.fiducial.as_ref().map(|_| AP_FIT_RANGE),
             loop_range: None,
         };
-        let (matrix, rows) = observation_matrix(&observation)?;
+        let (matrix, rows) = observation.matrix().map(|(m, r)| (m.to_vec(), r))?;
         let chosen = if settings.restrict_loops {
             loop_range::choose(&observation, &matrix, &ept, settings.z)?
         } else {
@@ -496,38 +496,6 @@ impl CosmologyStep<'_> {
     pub fn has_bispectrum(&self) -> bool {
         self.bispectrum.is_some()
     }
-}
-
-/// `matrix` (row-major, model ℓ's × model k columns) times the model multipoles (`model[j]`: model
-/// ℓ j on the model k).
-fn apply_matrix(matrix: &[f64], model: &[Vec<f64>]) -> Vec<f64> {
-    let flat: Vec<f64> = model.iter().flatten().copied().collect();
-    matrix
-        .chunks_exact(flat.len())
-        .map(|row| crate::simd::dot(row, &flat))
-        .collect()
-}
-
-/// The observation's matrix by columns: the chain applied to each unit model vector.
-fn observation_matrix(observation: &Observation) -> Result<(Vec<f64>, usize)> {
-    let (ells, k) = (observation.model_ells(), observation.k_model());
-    let columns = ells.len() * k.len();
-    let mut unit = vec![vec![0.0; k.len()]; ells.len()];
-    let mut by_column: Vec<Vec<f64>> = Vec::with_capacity(columns);
-    for c in 0..columns {
-        unit[c / k.len()][c % k.len()] = 1.0;
-        let out = observation.apply_values(&unit)?;
-        unit[c / k.len()][c % k.len()] = 0.0;
-        by_column.push(out.into_iter().flatten().collect());
-    }
-    let rows = by_column.first().map_or(0, Vec::len);
-    let mut matrix = vec![0.0; rows * columns];
-    for (c, col) in by_column.iter().enumerate() {
-        for (r, v) in col.iter().enumerate() {
-            matrix[r * columns + c] = *v;
-        }
-    }
-    Ok((matrix, rows))
 }
 
 /// The names a call takes: [`PARAM_NAMES`] (`f` defaults to f(z) of the cosmology).

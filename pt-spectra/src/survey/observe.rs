@@ -96,6 +96,8 @@ pub struct Observation {
     window: Option<WindowStage>,
     bins: Option<BinStage>,
     description: Vec<String>,
+    /// [`Self::matrix`], made on first use.
+    matrix: std::sync::OnceLock<(Vec<f64>, usize)>,
 }
 
 /// Model multipoles 0, 2, …, 8: what a window or the box modes need of a model with μ⁸ terms.
@@ -162,6 +164,7 @@ impl Observation {
                     window: None,
                     bins: Some(BinStage::Box(plan)),
                     description,
+                    matrix: std::sync::OnceLock::new(),
                 });
             }
         };
@@ -227,6 +230,7 @@ impl Observation {
             window,
             bins,
             description,
+            matrix: std::sync::OnceLock::new(),
         })
     }
 
@@ -263,6 +267,7 @@ impl Observation {
             window: None,
             bins: Some(BinStage::Xi(plan)),
             description,
+            matrix: std::sync::OnceLock::new(),
         })
     }
 
@@ -294,6 +299,47 @@ impl Observation {
     /// Header lines saying what the chain does.
     pub fn description(&self) -> &[String] {
         &self.description
+    }
+
+    /// The chain as one matrix, row-major, with its number of rows (output ℓ then output k) and
+    /// columns (model ℓ then model k): the chain applied to each unit model vector, so that applying
+    /// it is one matrix–vector product ([`apply_matrix`]) and its derivative is the matrix itself.
+    /// The chain is linear in the model but for the resampling of a one-signed multipole, whose
+    /// spline is of ln|P| ([`Self::apply_values`]); a unit vector takes the linear spline, so the
+    /// matrix is the chain with a spline of P (the pipeline's tests bound the difference).
+    ///
+    /// # Errors
+    /// As [`Self::apply_values`].
+    pub fn matrix(&self) -> Result<(&[f64], usize)> {
+        if self.matrix.get().is_none() {
+            let made = self.make_matrix()?;
+            // another thread may have set it meanwhile: the same matrix
+            let _ = self.matrix.set(made);
+        }
+        let (m, rows) = self.matrix.get().expect("set above");
+        Ok((m, *rows))
+    }
+
+    /// [`Self::matrix`], made.
+    fn make_matrix(&self) -> Result<(Vec<f64>, usize)> {
+        let (ells, k) = (self.model_ells(), self.k_model());
+        let columns = ells.len() * k.len();
+        let mut unit = vec![vec![0.0; k.len()]; ells.len()];
+        let mut by_column: Vec<Vec<f64>> = Vec::with_capacity(columns);
+        for c in 0..columns {
+            unit[c / k.len()][c % k.len()] = 1.0;
+            let out = self.apply_values(&unit)?;
+            unit[c / k.len()][c % k.len()] = 0.0;
+            by_column.push(out.into_iter().flatten().collect());
+        }
+        let rows = by_column.first().map_or(0, Vec::len);
+        let mut matrix = vec![0.0; rows * columns];
+        for (c, col) in by_column.iter().enumerate() {
+            for (r, v) in col.iter().enumerate() {
+                matrix[r * columns + c] = *v;
+            }
+        }
+        Ok((matrix, rows))
     }
 
     /// The values of [`Self::apply`] without the error estimates of the window and the ξ transform
@@ -369,4 +415,14 @@ impl Observation {
             _ => Ok(windowed),
         }
     }
+}
+
+/// `matrix` ([`Observation::matrix`]: row-major, model ℓ's × model k columns) times the model
+/// multipoles (`model[j]`: model ℓ j on the model k): the observed data vector, output ℓ then k.
+pub fn apply_matrix(matrix: &[f64], model: &[Vec<f64>]) -> Vec<f64> {
+    let flat: Vec<f64> = model.iter().flatten().copied().collect();
+    matrix
+        .chunks_exact(flat.len())
+        .map(|row| crate::simd::dot(row, &flat))
+        .collect()
 }

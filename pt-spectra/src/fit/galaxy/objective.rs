@@ -103,10 +103,13 @@ impl Objective<'_> {
                 .plan
                 .multipole_values_at(self.terms, p, &self.ells, ap)?,
             Some(o) => {
+                // the chain as its matrix (made once per observation): one product per model
                 let model = self
                     .plan
                     .multipole_values_at(self.terms, p, o.model_ells(), ap)?;
-                o.apply_values(&model)?
+                let (matrix, _) = o.matrix()?;
+                let flat = crate::survey::observe::apply_matrix(matrix, &model);
+                flat.chunks(o.k_out().len()).map(<[f64]>::to_vec).collect()
             }
         };
         let mut raw: Vec<f64> = m
