@@ -125,6 +125,38 @@ impl PlannedBispectrum {
         )
     }
 
+    /// The IR resummation's inputs of `spectrum` ([`BispectrumPlan::ir_inputs`]).
+    ///
+    /// # Errors
+    /// As [`BispectrumPlan::ir_inputs`].
+    pub(crate) fn ir_inputs(&self, spectrum: &LinearSpectrum) -> Result<super::IrInputs> {
+        self.plan.ir_inputs(spectrum)
+    }
+
+    /// [`Self::terms`] with the IR inputs given (`None`: no resummation).
+    ///
+    /// # Errors
+    /// As [`BispectrumPlan::terms_with_ir`].
+    pub(crate) fn terms_resummed(
+        &self,
+        spectrum: &LinearSpectrum,
+        f: f64,
+        (q_par, q_perp): (f64, f64),
+        ir: Option<&super::IrInputs>,
+    ) -> Result<BispectrumTerms> {
+        let settings = Settings {
+            f,
+            q_par,
+            q_perp,
+            fog: self.fog,
+            ir: ir.is_some(),
+        };
+        match ir {
+            Some(ir) => self.plan.terms_with_ir(spectrum, &settings, ir),
+            None => self.plan.terms(spectrum, &settings),
+        }
+    }
+
     /// The block's entries (multipole, then triangle) at the parameters `b` (its n̄ set here).
     ///
     /// # Errors

@@ -241,11 +241,22 @@ impl BispectrumPlan {
     pub fn terms(&self, spectrum: &LinearSpectrum, settings: &Settings) -> Result<BispectrumTerms> {
         settings.validate()?;
         let ir = if settings.ir {
-            Some(IrInputs::split(spectrum, &self.split, self.q_min)?)
+            Some(self.ir_inputs(spectrum)?)
         } else {
             None
         };
         self.terms_resummed(spectrum, settings, ir.as_ref())
+    }
+
+    /// The IR resummation's inputs of `spectrum` with this plan's no-wiggle split (what
+    /// [`terms`](Self::terms) makes; they depend on the spectrum alone, not on f or AP, so a caller
+    /// evaluating many f or α of one spectrum makes them once and passes them to
+    /// [`terms_with_ir`](Self::terms_with_ir)).
+    ///
+    /// # Errors
+    /// As the no-wiggle split.
+    pub fn ir_inputs(&self, spectrum: &LinearSpectrum) -> Result<IrInputs> {
+        IrInputs::split(spectrum, &self.split, self.q_min)
     }
 
     /// As [`terms`](Self::terms), with the IR resummation's no-wiggle spectrum and Σ², δΣ² given

@@ -12,7 +12,7 @@
 
 pub use crate::bispectrum::block::BISPECTRUM_NAMES;
 use crate::bispectrum::block::{BispectrumBlock, PlannedBispectrum};
-use crate::bispectrum::{BispectrumParams, BispectrumTerms};
+use crate::bispectrum::{BispectrumParams, BispectrumTerms, IrInputs};
 use crate::error::{Error, Result};
 use crate::linear::LinearSpectrum;
 use crate::rsd::ap::Distortion;
@@ -32,7 +32,8 @@ const TERMS_CACHE: usize = 4;
 pub struct BispectrumFit {
     block: PlannedBispectrum,
     spectrum: LinearSpectrum,
-    ir: bool,
+    /// The IR resummation's inputs of the spectrum, made once (`None`: no resummation).
+    ir: Option<IrInputs>,
     values: Vec<f64>,
     cross: Vec<Vec<f64>>,
     covariance: Vec<Vec<f64>>,
@@ -70,6 +71,11 @@ impl BispectrumFit {
             block.n_bar
         );
         let block = PlannedBispectrum::new(block)?;
+        let ir = if ir {
+            Some(block.ir_inputs(&spectrum)?)
+        } else {
+            None
+        };
         let n = block.len();
         let bad = |what: &str| Error::InvalidChoice {
             what: format!("the bispectrum data ({what})"),
@@ -103,7 +109,10 @@ impl BispectrumFit {
             cross,
             covariance,
             description,
-            start: [0.0, 1.0, 0.0, 0.0],
+            start: {
+                let d = BispectrumParams::default();
+                [d.c1, d.b_shot, d.p_shot, d.a_shot]
+            },
         })
     }
 
@@ -208,11 +217,11 @@ impl<'a> BispectrumModel<'a> {
         let terms = match cached {
             Some(t) => t,
             None => {
-                let t = Rc::new(self.fit.block.terms(
+                let t = Rc::new(self.fit.block.terms_resummed(
                     &self.fit.spectrum,
                     f,
-                    Some((a, b)),
-                    self.fit.ir,
+                    (a, b),
+                    self.fit.ir.as_ref(),
                 )?);
                 let mut cache = self.cache.borrow_mut();
                 if cache.len() == TERMS_CACHE {
