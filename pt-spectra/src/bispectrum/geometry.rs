@@ -296,8 +296,10 @@ fn panels(a: f64, b: f64, breaks: &[f64], x: &[f64], w: &[f64]) -> Vec<(f64, f64
 /// The line-of-sight components n̂·kᵢ [h/Mpc] of the three sides of `k` for the orientations of a rule
 /// about side `a`, with the weights (2ℓ + 1) L_ℓ(μ_a) w for ℓ = 0, 2, 4 (w summing to 1 over the rule):
 /// `[par₀, par₁, par₂, λ₀, λ₂, λ₄]` per orientation. B is even in n̂ and in the azimuth φ about k_a (the
-/// sides lie in a plane through k_a), so the rule covers μ_a ∈ [0, 1] (`n_mu` Gauss–Legendre nodes) and
-/// φ ∈ (0, π) (the `n_phi` nodes of the 2n_phi-point trapezoid rule there).
+/// sides lie in a plane through k_a), so the rule covers μ_a ∈ [0, 1] and φ ∈ (0, π). In μ_a: the `n_mu`
+/// positive nodes of the 2n_mu-point Gauss–Legendre rule on [−1, 1] (the azimuthal average is even in
+/// μ_a, so the half rule is exact for its polynomials of degree ≤ 4n_mu − 1); in φ: the `n_phi` nodes of
+/// the 2n_phi-point trapezoid rule there.
 pub(crate) fn orientations(k: [f64; 3], a: usize, n_mu: usize, n_phi: usize) -> Vec<[f64; 6]> {
     let (b, c) = ((a + 1) % 3, (a + 2) % 3);
     // k_a along z, k_b in the xz plane, k_c = −k_a − k_b
@@ -307,16 +309,16 @@ pub(crate) fn orientations(k: [f64; 3], a: usize, n_mu: usize, n_phi: usize) -> 
     side[a] = [0.0, k[a]];
     side[b] = [k[b] * sin_ab, k[b] * cos_ab];
     side[c] = [-side[a][0] - side[b][0], -side[a][1] - side[b][1]];
-    let (x, w_x) = legendre_nodes(n_mu);
+    let (x, w_x) = legendre_nodes(2 * n_mu);
     let mut out = Vec::with_capacity(n_mu * n_phi);
-    for (&x, &w) in x.iter().zip(&w_x) {
-        let mu = 0.5 * (1.0 + x);
+    // the positive half (nodes symmetric about 0, weights summing to 1 on it)
+    for (&mu, &w) in x.iter().zip(&w_x).filter(|(&x, _)| x > 0.0) {
         let sin = (1.0 - mu * mu).max(0.0).sqrt();
         let lambda = crate::bispectrum::ELLS.map(|l| (2 * l + 1) as f64 * legendre(l, mu));
         for m in 0..n_phi {
             let phi = PI * (m as f64 + 0.5) / n_phi as f64;
             let nx = sin * phi.cos();
-            let weight = 0.5 * w / n_phi as f64;
+            let weight = w / n_phi as f64;
             let par = side.map(|s| s[0] * nx + s[1] * mu);
             out.push([
                 par[0],
