@@ -30,11 +30,10 @@ from boss_cmass_fit import (DATA, DEFAULT_BIN, DEFAULT_OUT, FREE, K_MIN, MARG, N
 
 K_MAX = 0.2
 STARTS = 8
-# The data files start at k = 0.005 h/Mpc (the fit at K_MIN = 0.01): the SGC covariance's first bins
-# (k < 0.005, a few modes each, 0.99 correlated through the smaller cap's window) make its ell = 0, 2
-# block nearly singular (correlation condition number 2.0e7), which `fit` refuses; from 0.005 on it is
-# 2.9e3 (NGC: 4.1e4 with every bin, 4.6e2 from 0.005).
-K_FLOOR = 0.005
+# The data files hold every bin. The SGC covariance's first bins (k < 0.005, a few modes each, 0.99
+# correlated through the smaller cap's window) make its ell = 0, 2 block nearly singular as a whole
+# (correlation condition number 2.0e7); `fit` checks the degeneracy of the points it fits (K_MIN = 0.01
+# to K_MAX: 8.4e2), so the file is used as it is.
 
 
 def dataset(cap, data, cov, ini):
@@ -90,7 +89,7 @@ def main():
     plin, ini, truth = template(args.out)
     files = {}
     for cap in ("NGC", "SGC"):
-        data, covs, *_ = data_files(args.out, cap, k_floor=K_FLOOR)
+        data, covs, *_ = data_files(args.out, cap)
         files[cap] = (data, covs)
     fits = {
         "NGC": analysis(args.out, "boss_cmass_ngc.toml", ["NGC"], files, ini),
@@ -132,10 +131,10 @@ def write_report(args, rows, outputs, truth, version, seconds):
         "[the NGC fit](boss_cmass_fit.md) (BOSS DR12 fiducial cosmology; CAMB "
         f"{truth['camb']}; σ8(z = {Z}) = {s8:.5f}; fσ8 = f × σ8(z)).",
         f"- Each cap: P0, P2, {K_MIN} ≤ k ≤ {K_MAX} h/Mpc, its full covariance with the Hartlap factor "
-        f"for {N_MOCKS} mocks, its window (Wilson et al. mixing). The data files start at k = {K_FLOOR} "
-        "h/Mpc: below, the SGC covariance's first bins are 0.99 correlated (the smaller cap's window), "
-        "its correlation matrix's condition number 2.0e7, which `fit` refuses as nearly singular (from "
-        f"{K_FLOOR} on: 2.9e3).",
+        f"for {N_MOCKS} mocks, its window (Wilson et al. mixing). The files hold every bin: the SGC "
+        "covariance's first bins (k < 0.005 h/Mpc) are 0.99 correlated (the smaller cap's window), its "
+        "ℓ = 0, 2 correlation matrix's condition number 2.0e7 as a whole; `fit` checks the points it "
+        f"fits ({K_MIN} ≤ k ≤ {K_MAX}: 8.4e2).",
         f"- Free: {FREE}; marginalised analytically per cap: {MARG}.",
         "- Joint: one likelihood, the sum of the caps' (independent: no cross-covariance). f, α∥, α⊥ "
         "are shared (the default for data sets of one z and tracer); b1, b2, bs are free per cap "

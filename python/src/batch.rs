@@ -99,9 +99,10 @@ pub(crate) fn check_memory(bytes: f64, what: &str) -> PyResult<()> {
 }
 
 /// The covariance `c` (2-D array) of the data vector made of the multipole blocks `values` (one array
-/// per ℓ, ℓ-major), checked as `fit` checks a covariance (`fit::covariance::validate`: finite,
-/// symmetric, positive definite, not nearly singular, no variance absurdly small for its data) and
-/// returned symmetrised; `origin` names it in the `ValueError`.
+/// per ℓ, ℓ-major), checked as a whole (`fit::covariance::validate_whole`: finite, symmetric,
+/// positive definite, not nearly singular, no variance absurdly small for its data; a fit checks the
+/// degeneracy on the points it fits only) and returned symmetrised; `origin` names it in the
+/// `ValueError`.
 #[pyfunction]
 #[pyo3(signature = (c, values, origin="covariance matrix"))]
 pub(crate) fn check_covariance<'py>(
@@ -111,7 +112,7 @@ pub(crate) fn check_covariance<'py>(
     origin: &str,
 ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
     let rows = crate::covariance_rows(c)?;
-    let checked =
-        pt_spectra::fit::covariance::validate(rows, &values, origin, &[]).map_err(value_error)?;
+    let checked = pt_spectra::fit::covariance::validate_whole(rows, &values, origin, &[])
+        .map_err(value_error)?;
     numpy::PyArray2::from_vec2(py, &checked).map_err(value_error)
 }

@@ -101,6 +101,20 @@ impl PlannedBispectrum {
         self.ells.len() * self.plan.triangles().len()
     }
 
+    /// Entry `j` (multipole, then triangle) in words, e.g. "B2 of the triangle (0.015, 0.025, 0.035)
+    /// h/Mpc" (for messages).
+    pub(crate) fn entry(&self, j: usize) -> String {
+        let triangles = self.plan.triangles().triangles();
+        let n = triangles.len().max(1);
+        match (self.ells.get(j / n), triangles.get(j % n)) {
+            (Some(&l), Some(t)) => format!(
+                "B{} of the triangle ({}, {}, {}) h/Mpc",
+                ELLS[l], t[0], t[1], t[2]
+            ),
+            _ => format!("bispectrum entry {}", j + 1),
+        }
+    }
+
     /// The terms of `spectrum` at growth rate `f` with the distortion `ap` = (α∥, α⊥) (none: 1).
     ///
     /// # Errors

@@ -4,6 +4,14 @@
 //! the digits a file keeps, one variance of 1e-10) gives a χ² whose minimum the minimiser does not
 //! find and NaN errors, with exit 0: each is refused naming the origin, the row and the rule.
 //!
+//! Where: a file is checked when it is read ([`validate`]: finite, symmetric, positive definite, the
+//! scale of each variance), and the degeneracy of the rows a fit inverts when the fit is set up
+//! ([`check_conditioning`]: the fitted points only). A real covariance can be nearly degenerate in
+//! points no fit uses: the BOSS DR12 SGC file's first bins (k < 0.005 h/Mpc, correlated 0.99 through the
+//! small cap's window) make its ℓ = 0, 2 correlation matrix's condition number 2.0e7, while the fitted
+//! points of any k_min ≥ 0.005 have ≤ 3e3. [`validate_whole`] applies every rule to the whole matrix
+//! (Python's `check_covariance`).
+//!
 //! Bounds, and why:
 //! * Symmetry: |C_ij − C_ji| ≤ [`SYMMETRY_TOLERANCE`] · √(C_ii C_jj). A matrix written with 6
 //!   significant digits from a symmetric one that differs in its last bits (e.g. a sample covariance
@@ -42,19 +50,114 @@ const EIGEN_ITERATIONS: usize = 200;
 
 /// Checks the square matrix `c` as the covariance of the data vector made of the blocks `values`
 /// (ℓ-major: `values[j]` the data of multipole j): every element finite, the diagonal positive, then
-/// the rules of the module docs. Returns it symmetrised. `origin` names it in messages and `lines[i]`
-/// the line of row i (row numbers where `lines` is shorter).
+/// the rules of the module docs but the condition number (a fit checks that on the points it fits:
+/// [`check_conditioning`]). Returns it symmetrised. `origin` names it in messages and `lines[i]` the
+/// line of row i (row numbers where `lines` is shorter).
 ///
 /// # Errors
 /// [`Error::LengthMismatch`] unless `c` is square and as long as the data vector; [`Error::BadRow`]
 /// for a non-finite element; [`Error::InvalidValue`] for a diagonal element that is not positive; as
-/// the symmetry, positive-definiteness and condition checks of the module docs otherwise.
+/// the symmetry and positive-definiteness checks of the module docs otherwise.
 pub fn validate(
     c: Vec<Vec<f64>>,
     values: &[Vec<f64>],
     origin: &str,
     lines: &[usize],
 ) -> Result<Vec<Vec<f64>>> {
+    let (c, _) = validate_rows(c, values, origin, lines)?;
+    Ok(c)
+}
+
+/// [`validate`] and the condition number of the whole matrix ([`check_conditioning`]), the row of a
+/// nearly singular matrix named by its line and its place (point, block) in the data vector.
+///
+/// # Errors
+/// As [`validate`]; [`Error::BadRow`] for a condition number above [`MAX_CORRELATION_CONDITION`].
+pub fn validate_whole(
+    c: Vec<Vec<f64>>,
+    values: &[Vec<f64>],
+    origin: &str,
+    lines: &[usize],
+) -> Result<Vec<Vec<f64>>> {
+    let (c, blocks) = validate_rows(c, values, origin, lines)?;
+    if let Err((condition, row)) = conditioning(&c) {
+        // where the row sits in the data vector: (block, point), 1-based
+        let (mut block, mut point) = (0, row);
+        while block < blocks.len() && point >= blocks[block] {
+            point -= blocks[block];
+            block += 1;
+        }
+        return Err(Error::BadRow {
+            origin: origin.into(),
+            line: lines.get(row).copied().unwrap_or(row + 1),
+            problem: nearly_singular(
+                condition,
+                &format!(
+                    "row {} (point {} of block {} of the data vector: the multipoles in order, then \
+                     any bispectrum)",
+                    row + 1,
+                    point + 1,
+                    block + 1
+                ),
+            ),
+        });
+    }
+    Ok(c)
+}
+
+/// The message of a nearly singular matrix whose most degenerate direction weighs most on `row`.
+fn nearly_singular(condition: f64, row: &str) -> String {
+    format!(
+        "the covariance is nearly singular: its correlation matrix has condition number {} > \
+         {MAX_CORRELATION_CONDITION:e} (the real BOSS and Patchy covariances have ≤ 6.1e4 on their \
+         fitted points); {row} weighs most on its most degenerate direction (two rows equal to the \
+         digits written? a row of another matrix?)",
+        number(&condition)
+    )
+}
+
+/// Checks that the covariance `c` of the points a fit inverts (symmetric and positive definite: a
+/// block of a matrix [`validate`] passed) is not nearly singular: the condition number of its
+/// correlation matrix at most [`MAX_CORRELATION_CONDITION`] (module docs). `what` names the points
+/// ("the 72 fitted points") and `row(i)` point i in the message (e.g. "P2 at k = 0.105 h/Mpc").
+///
+/// # Errors
+/// [`Error::InvalidChoice`] naming the condition number, the bound and the row that weighs most on
+/// the most degenerate direction.
+pub fn check_conditioning(c: &[Vec<f64>], what: &str, row: &dyn Fn(usize) -> String) -> Result<()> {
+    conditioning(c)
+        .map(|_| ())
+        .map_err(|(condition, i)| Error::InvalidChoice {
+            what: format!("the covariance of {what}"),
+            reason: nearly_singular(condition, &row(i)),
+        })
+}
+
+/// The condition number of the correlation matrix of the SPD matrix `c` if within the bound, else
+/// (it, the row of the largest component of the most degenerate direction); a matrix that is not
+/// positive definite (a block of a checked one cannot be) is (NaN, its failing row).
+fn conditioning(c: &[Vec<f64>]) -> std::result::Result<f64, (f64, usize)> {
+    let n = c.len();
+    let sigma: Vec<f64> = (0..n).map(|i| c[i][i].sqrt()).collect();
+    let r: Vec<Vec<f64>> = (0..n)
+        .map(|i| (0..n).map(|j| c[i][j] / sigma[i] / sigma[j]).collect())
+        .collect();
+    let l = cholesky_pivot(&r).map_err(|(i, _)| (f64::NAN, i))?;
+    let (condition, row) = correlation_condition(&r, &l);
+    if condition.is_nan() || condition > MAX_CORRELATION_CONDITION {
+        Err((condition, row))
+    } else {
+        Ok(condition)
+    }
+}
+
+/// [`validate`]'s checks; also returns the blocks' lengths.
+fn validate_rows(
+    c: Vec<Vec<f64>>,
+    values: &[Vec<f64>],
+    origin: &str,
+    lines: &[usize],
+) -> Result<(Vec<Vec<f64>>, Vec<usize>)> {
     let n: usize = values.iter().map(Vec::len).sum();
     if c.len() != n || c.iter().any(|r| r.len() != n) {
         return Err(Error::LengthMismatch {
@@ -94,7 +197,7 @@ pub fn validate(
         .flat_map(|v| std::iter::repeat_n(rms(v), v.len()))
         .collect();
     let blocks: Vec<usize> = values.iter().map(Vec::len).collect();
-    check(c, &scale, &blocks, origin, &line)
+    Ok((check(c, &scale, origin, &line)?, blocks))
 }
 
 /// The root mean square of `v`, scaled by its largest |x| (the squares of values near f64::MAX would
@@ -109,17 +212,15 @@ fn rms(v: &[f64]) -> f64 {
 }
 
 /// Checks the n×n matrix `c` (finite, as the readers ensure) as the covariance of a data vector whose
-/// element i belongs to the multipole block with data RMS `scale[i]` (the blocks' lengths `blocks`);
-/// returns it symmetrised. `origin` names it and `line(i)` the line of row i in messages.
+/// element i belongs to the multipole block with data RMS `scale[i]`; returns it symmetrised. `origin`
+/// names it and `line(i)` the line of row i in messages.
 ///
 /// # Errors
 /// [`Error::BadRow`] naming the row (and column) and the rule: an asymmetric pair, a variance that is
-/// not positive or too small for its data, a row that makes the matrix not positive definite, or a
-/// condition number of the correlation matrix above [`MAX_CORRELATION_CONDITION`].
+/// not positive or too small for its data, or a row that makes the matrix not positive definite.
 fn check(
     mut c: Vec<Vec<f64>>,
     scale: &[f64],
-    blocks: &[usize],
     origin: &str,
     line: &dyn Fn(usize) -> usize,
 ) -> Result<Vec<Vec<f64>>> {
@@ -189,7 +290,7 @@ fn check(
     let r: Vec<Vec<f64>> = (0..n)
         .map(|i| (0..n).map(|j| c[i][j] / sigma[i] / sigma[j]).collect())
         .collect();
-    let l = cholesky_pivot(&r).map_err(|(i, pivot)| {
+    cholesky_pivot(&r).map_err(|(i, pivot)| {
         bad(
             i,
             format!(
@@ -201,31 +302,6 @@ fn check(
             ),
         )
     })?;
-    let (condition, row) = correlation_condition(&r, &l);
-    if condition.is_nan() || condition > MAX_CORRELATION_CONDITION {
-        // where the row sits in the data vector: (block, point), 1-based
-        let (mut block, mut point) = (0, row);
-        while block < blocks.len() && point >= blocks[block] {
-            point -= blocks[block];
-            block += 1;
-        }
-        return Err(bad(
-            row,
-            format!(
-                "the covariance is nearly singular: its correlation matrix has condition number {} \
-                 > {MAX_CORRELATION_CONDITION:e} (the real BOSS and Patchy covariances have ≤ 6.1e4); \
-                 row {} (point {} of block {} of the data vector: the multipoles in order, then any \
-                 bispectrum) weighs most on its most degenerate direction (two rows equal to the \
-                 digits written? a row of another matrix? The check is on the whole file: points the \
-                 fit does not use, e.g. the few-mode bins at the lowest k of a small survey cap, can \
-                 be left out of the data and covariance files)",
-                number(&condition),
-                row + 1,
-                point + 1,
-                block + 1
-            ),
-        ));
-    }
     Ok(c)
 }
 
@@ -302,7 +378,8 @@ mod tests {
         let (cond, _) = correlation_condition(&r, &l);
         let want = 354.407_134_234_794_6;
         assert!((cond / want - 1.0).abs() < 0.01, "{cond} {want}");
-        assert!(check(c, &[], &[], "c", &line).is_ok());
+        assert!(check(c.clone(), &[], "c", &line).is_ok());
+        assert!(check_conditioning(&c, "c", &|i| format!("point {i}")).is_ok());
     }
 
     /// The issue's faults: two rows equal to 6 digits, one variance of 1e-10, an asymmetric pair, a
@@ -321,7 +398,11 @@ mod tests {
             .iter()
             .map(|r| r.iter().map(|&x| six(x)).collect())
             .collect();
-        let e = check(dup, &[], &[20, 10], "cov.dat", &line)
+        // the whole matrix (Python's check_covariance): refused naming the line and the place in
+        // the data vector (blocks of 20, 10)
+        let values = [vec![1e3; 20], vec![1e3; 10]];
+        let lines: Vec<usize> = (0..30).map(line).collect();
+        let e = validate_whole(dup.clone(), &values, "cov.dat", &lines)
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("cov.dat:1"), "{e}");
@@ -330,13 +411,29 @@ mod tests {
                 && (e.contains("condition number") || e.contains("positive definite")),
             "{e}"
         );
-        // a nearly singular matrix names where the row sits in the data vector (blocks of 20, 10)
         if e.contains("condition number") {
             assert!(
-                (e.contains("point 8 of block 1") || e.contains("point 7 of block 1"))
-                    && e.contains("whole file"),
+                e.contains("point 8 of block 1") || e.contains("point 7 of block 1"),
                 "{e}"
             );
+            // read as a fit's file it passes; the fit's check of its points refuses it, naming
+            // the point, unless the fit leaves one of the two rows out
+            let c = validate(dup, &values, "cov.dat", &lines).unwrap();
+            let e = check_conditioning(&c, "the 30 fitted points", &|i| format!("P0 point {i}"))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("the 30 fitted points")
+                    && (e.contains("P0 point 7") || e.contains("P0 point 6"))
+                    && e.contains("condition number"),
+                "{e}"
+            );
+            let keep: Vec<usize> = (0..30).filter(|&i| i != 7).collect();
+            let sub: Vec<Vec<f64>> = keep
+                .iter()
+                .map(|&i| keep.iter().map(|&j| c[i][j]).collect())
+                .collect();
+            assert!(check_conditioning(&sub, "29", &|i| i.to_string()).is_ok());
         }
         let mut tiny = base.clone();
         tiny[4] = vec![0.0; 30];
@@ -345,7 +442,7 @@ mod tests {
         }
         tiny[4][4] = 1e-10;
         let scale = vec![1e4; 30];
-        let e = check(tiny, &scale, &[], "cov.dat", &line)
+        let e = check(tiny, &scale, "cov.dat", &line)
             .unwrap_err()
             .to_string();
         assert!(
@@ -354,13 +451,11 @@ mod tests {
         );
         let mut asym = base.clone();
         asym[3][1] *= 1.001;
-        let e = check(asym, &[], &[], "cov.dat", &line)
-            .unwrap_err()
-            .to_string();
+        let e = check(asym, &[], "cov.dat", &line).unwrap_err().to_string();
         assert!(e.contains("(4, 2)") && e.contains("symmetric"), "{e}");
         let mut negative = base.clone();
         negative[2][2] = -1.0;
-        let e = check(negative, &[], &[], "cov.dat", &line)
+        let e = check(negative, &[], "cov.dat", &line)
             .unwrap_err()
             .to_string();
         assert!(
@@ -373,7 +468,7 @@ mod tests {
             .map(|r| r.iter().map(|&x| six(x)).collect())
             .collect();
         rounded[5][2] = rounded[2][5] * (1.0 + 2e-6);
-        let c = check(rounded, &scale, &[], "cov.dat", &line).unwrap();
+        let c = check(rounded, &scale, "cov.dat", &line).unwrap();
         assert_eq!(c[5][2], c[2][5]);
     }
 }

@@ -160,8 +160,9 @@ impl MultipoleData {
     /// # Errors
     /// [`Error::LengthMismatch`] for a wrong size; [`Error::InvalidValue`] for a diagonal element that is
     /// not finite and positive, [`Error::BadRow`] for a non-finite or asymmetric element, a matrix that
-    /// is not positive definite or nearly singular, or a variance absurdly small for its data (the rules
-    /// of [`crate::fit::covariance`]; row numbers 1-based, origin `covariance matrix`).
+    /// is not positive definite, or a variance absurdly small for its data (the rules of
+    /// [`crate::fit::covariance`]; row numbers 1-based, origin `covariance matrix`). Whether the rows a
+    /// fit inverts are nearly degenerate is checked by the fit, on those rows.
     pub fn with_covariance(self, c: Vec<Vec<f64>>) -> Result<Self> {
         self.checked_covariance(c, "covariance matrix", &[])
     }
@@ -217,8 +218,8 @@ impl MultipoleData {
     }
 
     /// Attaches the n×n matrix `c` after checking it (finite, then the checks of
-    /// [`super::covariance`]: symmetric, positive definite, not nearly singular, no variance absurdly
-    /// small for its data); `lines` numbers its rows for messages (row numbers if empty).
+    /// [`super::covariance::validate`]: symmetric, positive definite, no variance absurdly small for its
+    /// data); `lines` numbers its rows for messages (row numbers if empty).
     pub(super) fn checked_covariance(
         mut self,
         c: Vec<Vec<f64>>,

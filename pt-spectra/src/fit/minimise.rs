@@ -59,6 +59,14 @@ impl<'a> Residuals<'a> {
                     .iter()
                     .map(|&a| ids.iter().map(|&b| c[a][b]).collect())
                     .collect();
+                crate::fit::covariance::check_conditioning(
+                    &sub,
+                    &format!("the {} fitted points", ids.len()),
+                    &|r| {
+                        let (j, i) = (ids[r] / n_all, ids[r] % n_all);
+                        format!("P{} at k = {} h/Mpc", data.ells[j], data.k[i])
+                    },
+                )?;
                 let l = cholesky(&sub).ok_or(Error::InvalidParameter {
                     name: "k_max [h/Mpc]",
                     value: k_max,

@@ -167,7 +167,7 @@ fn singular_or_absurd_covariances_are_refused() {
     let (ok, _, err) = run(&fit(&good).iter().map(String::as_str).collect::<Vec<_>>());
     assert!(ok, "the valid covariance is refused: {err}");
     let cases: Vec<(Vec<String>, String)> = vec![
-        (fit(&equal), format!("{equal}:")),
+        (fit(&equal), "the covariance of the 16 fitted points".into()),
         (
             fit(&tiny),
             format!("{tiny}:4: covariance row 4: the variance 1e-10"),
@@ -179,14 +179,22 @@ fn singular_or_absurd_covariances_are_refused() {
         .map(|(a, n)| (a.iter().map(String::as_str).collect(), n.as_str()))
         .collect();
     fails_naming(&cases);
-    // The rule is stated: not positive definite, or the condition-number bound.
+    // The rule is stated (the condition-number bound, checked on the fitted points) and the point
+    // of the repeated row (P0 at k = 0.1 or 0.12: rows 5, 6).
     let (ok, _, err) = run(&fit(&equal).iter().map(String::as_str).collect::<Vec<_>>());
     assert!(!ok);
+    assert!(err.contains("condition number"), "{err}");
     assert!(
-        err.contains("not positive definite") || err.contains("condition number"),
+        err.contains("P0 at k = 0.1 h/Mpc") || err.contains("P0 at k = 0.12 h/Mpc"),
         "{err}"
     );
-    assert!(err.contains("row 5") || err.contains("row 6"), "{err}");
+    // The file is read (its rows are finite, symmetric, positive definite); the fit leaving the
+    // repeated rows out (k < 0.1) is not refused: the check is on the points a fit inverts.
+    let mut below = fit(&equal);
+    let at = below.iter().position(|a| a == "0.16").expect("k-max");
+    below[at] = "0.09".into();
+    let (ok, _, err) = run(&below.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(ok, "a fit without the repeated rows is refused: {err}");
 }
 
 /// A names line with a wrong ℓ (`# s Q0 Q2 Q6` over the BOSS window's Q0 Q2 Q4 columns) once left Q4

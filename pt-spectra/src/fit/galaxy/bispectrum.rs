@@ -181,6 +181,11 @@ impl BispectrumFit {
     pub(super) fn covariance(&self, i: usize, j: usize) -> f64 {
         self.covariance[i][j]
     }
+
+    /// Entry `j` in words (for messages).
+    pub(super) fn entry(&self, j: usize) -> String {
+        self.block.entry(j)
+    }
 }
 
 /// The bispectrum of an objective: the data set's and its terms cache.

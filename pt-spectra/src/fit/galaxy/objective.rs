@@ -391,6 +391,17 @@ pub(super) fn objective<'a>(
             cov.push(row);
         }
     }
+    // the degeneracy of the rows inverted (the file's other rows may be nearly degenerate: few-mode
+    // bins the fit leaves out; fit::covariance)
+    crate::fit::covariance::check_conditioning(
+        &cov,
+        &format!("the {points} fitted points"),
+        &|i| match (fitted.get(i), bispectrum) {
+            (Some(&(r, j)), _) => format!("P{} at k = {} h/Mpc", data.ells[r], k[j]),
+            (None, Some(b)) => b.entry(i - fitted.len()),
+            (None, None) => format!("point {}", i + 1),
+        },
+    )?;
     if let Some(n) = request.n_mocks {
         if n < points + 3 {
             return Err(Error::InvalidParameter {
