@@ -116,15 +116,15 @@ impl Pipeline {
             step.ap.map(|d| (d.apar, d.aperp)),
         ));
         let named: Vec<(&str, f64)> = params.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-        let values = step.data_vector(&named).map_err(value_error)?;
-        let jac = if jacobian {
+        if jacobian {
+            // the data vector from the nuisance polynomial too (the same numbers to rounding): one
+            // projection of the multipoles for both
             let f = named.iter().find(|(n, _)| *n == "f").map(|p| p.1);
             let lin = step.linearise(f).map_err(value_error)?;
-            Some(lin.jacobian(&named).map_err(value_error)?)
-        } else {
-            None
-        };
-        Ok((values, jac))
+            let values = lin.data_vector(&named).map_err(value_error)?;
+            return Ok((values, Some(lin.jacobian(&named).map_err(value_error)?)));
+        }
+        Ok((step.data_vector(&named).map_err(value_error)?, None))
     }
 
     /// The cache key of a call: (cosmology, f given) when it names a cosmology without a table and

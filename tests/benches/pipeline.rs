@@ -6,6 +6,8 @@
 //!   window matrix);
 //! * `pipeline/table`: the same from a given linear table (the embedded gm2012 CAMB spectrum);
 //! * `pipeline/terms`, `pipeline/multipoles`: the two cosmology-dependent stages alone;
+//! * `pipeline/linearise`: a cosmology's data vector as a polynomial in the nuisance parameters
+//!   (what a new cosmology's nuisance Jacobian costs beyond the step);
 //! * `pipeline/nuisance`: the nuisance-only step on a linearised cosmology, and
 //!   `pipeline/nuisance-jacobian` its exact Jacobian.
 //!
@@ -87,6 +89,9 @@ fn benches(c: &mut Criterion) {
     let step = pl.step(&prepared).unwrap();
     c.bench_function("pipeline/multipoles", |b| {
         b.iter(|| black_box(step.data_vector(&PARAMS).unwrap()))
+    });
+    c.bench_function("pipeline/linearise", |b| {
+        b.iter(|| black_box(step.linearise(None).unwrap().f()))
     });
     let lin = step.linearise(None).unwrap();
     c.bench_function("pipeline/nuisance", |b| {

@@ -248,6 +248,21 @@ impl RedshiftTerms {
         self.terms.iter().map(|t| t.monomial.eval(params)).collect()
     }
 
+    /// The values only of [`Self::loop_polynomial_with`] at every grid point (the fast path of the
+    /// multipoles' values): term by term, the terms of zero coefficient skipped (most, for the unit
+    /// parameter sets of a nuisance polynomial).
+    pub fn loop_values_all(&self, coefficients: &[f64]) -> Vec<[f64; 5]> {
+        let mut v = vec![[0.0; 5]; self.terms.first().map_or(0, |t| t.values.len())];
+        for (t, &c) in self.terms.iter().zip(coefficients) {
+            if c != 0.0 {
+                for (v, x) in v.iter_mut().zip(&t.values) {
+                    v[t.n] += c * x.value;
+                }
+            }
+        }
+        v
+    }
+
     /// [`Self::loop_polynomial`] from the monomials' values `coefficients`.
     pub fn loop_polynomial_with(&self, i: usize, coefficients: &[f64]) -> ([f64; 5], [f64; 5]) {
         let (mut v, mut e) = ([0.0; 5], [0.0; 5]);

@@ -37,8 +37,9 @@ fn pair(i: usize, j: usize) -> usize {
 
 impl CosmologyStep<'_> {
     /// This step's data vector as a polynomial in the nuisance parameters at growth rate `f`
-    /// (`None`: f(z) of the cosmology): 22 evaluations of the model, after which every nuisance
-    /// step is a few thousand multiplications ([`Linearised::data_vector`]).
+    /// (`None`: f(z) of the cosmology): 22 evaluations of the model (their projection onto the
+    /// multipoles made once, [`crate::rsd::ept::EptPlan::multipole_values_many`]), after which every
+    /// nuisance step is a few thousand multiplications ([`Linearised::data_vector`]).
     ///
     /// # Errors
     /// As [`CosmologyStep::data_vector`]; [`Error::InvalidChoice`] with a bispectrum block.
@@ -53,20 +54,37 @@ impl CosmologyStep<'_> {
             });
         }
         let f = f.unwrap_or(self.growth_rate);
-        let at = |set: &[(usize, f64)]| -> Result<Vec<f64>> {
-            let mut p = EptParams::new(0.0, f);
-            for &(i, v) in set {
-                p.values[i] = v;
+        // the 22 parameter sets: none, ±1 of each bias, each pair of biases at 1, each linear one at 1
+        let mut sets: Vec<Vec<(usize, f64)>> = vec![Vec::new()];
+        for i in 0..BIASES {
+            sets.push(vec![(i, 1.0)]);
+            sets.push(vec![(i, -1.0)]);
+        }
+        for i in 0..BIASES {
+            for j in i + 1..BIASES {
+                sets.push(vec![(i, 1.0), (j, 1.0)]);
             }
-            self.data_vector_of(&p)
-        };
+        }
+        sets.extend((0..LINEAR).map(|c| vec![(BIASES + c, 1.0)]));
+        let params: Vec<EptParams> = sets
+            .iter()
+            .map(|set| {
+                let mut p = EptParams::new(0.0, f);
+                for &(i, v) in set {
+                    p.values[i] = v;
+                }
+                p
+            })
+            .collect();
+        // their data vectors, the projection onto the multipoles made once for all
+        let mut vectors = self.data_vectors_of(&params)?.into_iter();
+        let mut next = || vectors.next().expect("one per set");
         let sub = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x - y).collect::<Vec<_>>();
-        let a00 = at(&[])?;
+        let a00 = next();
         let mut a0 = vec![Vec::new(); BIASES + 1];
         let mut aa = vec![Vec::new(); BIASES + 1];
         for i in 1..=BIASES {
-            let plus = at(&[(i - 1, 1.0)])?;
-            let minus = at(&[(i - 1, -1.0)])?;
+            let (plus, minus) = (next(), next());
             a0[i] = plus
                 .iter()
                 .zip(&minus)
@@ -84,16 +102,16 @@ impl CosmologyStep<'_> {
         for i in 1..=BIASES {
             quadratic[pair(0, i)] = a0[i].clone();
             quadratic[pair(i, i)] = aa[i].clone();
+        }
+        for i in 1..=BIASES {
             for j in i + 1..=BIASES {
-                let both = at(&[(i - 1, 1.0), (j - 1, 1.0)])?;
+                let both = next();
                 quadratic[pair(i, j)] = (0..both.len())
                     .map(|r| both[r] - a00[r] - a0[i][r] - a0[j][r] - aa[i][r] - aa[j][r])
                     .collect();
             }
         }
-        let linear = (0..LINEAR)
-            .map(|c| Ok(sub(&at(&[(BIASES + c, 1.0)])?, &a00)))
-            .collect::<Result<Vec<_>>>()?;
+        let linear = (0..LINEAR).map(|_| sub(&next(), &a00)).collect();
         Ok(Linearised {
             quadratic,
             linear,

@@ -479,6 +479,18 @@ impl CosmologyStep<'_> {
         Ok(out)
     }
 
+    /// The power spectrum's data vectors of several parameter sets of one f.
+    fn data_vectors_of(&self, params: &[EptParams]) -> Result<Vec<Vec<f64>>> {
+        let pl = self.pipeline;
+        let models = pl.plan.multipole_values_many(
+            &self.terms,
+            params,
+            pl.observation.model_ells(),
+            self.ap,
+        )?;
+        Ok(models.iter().map(|m| pl.observe(m)).collect())
+    }
+
     fn data_vector_of(&self, p: &EptParams) -> Result<Vec<f64>> {
         let pl = self.pipeline;
         let model =

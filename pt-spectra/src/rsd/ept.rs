@@ -405,7 +405,68 @@ impl EptPlan {
         ells: &[usize],
         ap: Option<Distortion>,
     ) -> Result<Vec<Vec<f64>>> {
-        params.validate()?;
+        let (weights, nodes) =
+            self.projection_nodes(terms, std::slice::from_ref(params), ells, ap)?;
+        let model = terms.model_values(params);
+        let mut out = vec![vec![0.0; self.k_out.len()]; ells.len()];
+        for (i, &k) in self.k_out.iter().enumerate() {
+            let (ln_k, k2) = (k.ln(), k * k);
+            for (((mu, _, _), c), &(ln_ratio, ratio2, mt)) in
+                self.rules[0].iter().zip(&weights).zip(&nodes)
+            {
+                let p = match &ap {
+                    None if self.grid_use == GridUse::Output => model.value_at(i, k, *mu),
+                    _ => model.interpolated_value_ln(ln_k + ln_ratio, k2 * ratio2, mt)?,
+                };
+                for (o, c) in out.iter_mut().zip(c) {
+                    o[i] += c * p;
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// [`Self::multipole_values_at`] of several parameter sets of one growth rate f (e.g. the
+    /// nuisance polynomial's 22 sets, [`crate::pipeline::CosmologyStep::linearise`]): the projection
+    /// onto the multipoles is linear in the model's μ² polynomials on the grid, so it is made once per
+    /// output k as weights on the grid points its stencils reach and applied to each set's
+    /// polynomials (`out[s][j][i]`: set s, j-th ℓ, i-th k; the same numbers to rounding).
+    ///
+    /// # Errors
+    /// As [`Self::multipole_values_at`]; [`Error::InvalidChoice`] for sets of different f.
+    pub fn multipole_values_many(
+        &self,
+        terms: &EptTerms,
+        params: &[EptParams],
+        ells: &[usize],
+        ap: Option<Distortion>,
+    ) -> Result<Vec<Vec<Vec<f64>>>> {
+        if let Some(p) = params.iter().find(|p| p.f() != params[0].f()) {
+            return Err(Error::InvalidChoice {
+                what: format!("parameter sets with f = {} and {}", params[0].f(), p.f()),
+                reason: "a batch of multipoles shares one growth rate (its damping)".into(),
+            });
+        }
+        let (weights, nodes) = self.projection_nodes(terms, params, ells, ap)?;
+        let models: Vec<_> = params.iter().map(|p| terms.model_values(p)).collect();
+        let on_grid = ap.is_none() && self.grid_use == GridUse::Output;
+        model::project_many(&models, &self.k_out, &nodes, &weights, on_grid)
+    }
+
+    /// The checks of a projection onto the multipoles `ells` with distortion `ap`, and per μ node
+    /// of the rule the weights (2ℓ + 1) w L_ℓ(μ) × the AP volume factor, and the distortion's
+    /// ln(k'/k), (k'/k)² and μ' (the same at every k).
+    #[allow(clippy::type_complexity)]
+    fn projection_nodes(
+        &self,
+        terms: &EptTerms,
+        params: &[EptParams],
+        ells: &[usize],
+        ap: Option<Distortion>,
+    ) -> Result<(Vec<Vec<f64>>, Vec<(f64, f64, f64)>)> {
+        for p in params {
+            p.validate()?;
+        }
         self.check_ap(ap)?;
         self.check_terms(terms)?;
         if let Some(&bad) = ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
@@ -415,7 +476,6 @@ impl EptPlan {
                 reason: "must be even and at most 8",
             });
         }
-        let model = terms.model(params);
         let volume = ap.map_or(1.0, |d| d.volume());
         let weights: Vec<Vec<f64>> = self.rules[0]
             .iter()
@@ -437,22 +497,7 @@ impl EptPlan {
                 }
             })
             .collect();
-        let mut out = vec![vec![0.0; self.k_out.len()]; ells.len()];
-        for (i, &k) in self.k_out.iter().enumerate() {
-            let (ln_k, k2) = (k.ln(), k * k);
-            for (((mu, _, _), c), &(ln_ratio, ratio2, mt)) in
-                self.rules[0].iter().zip(&weights).zip(&nodes)
-            {
-                let p = match &ap {
-                    None if self.grid_use == GridUse::Output => model.value_at(i, k, *mu),
-                    _ => model.interpolated_value_ln(ln_k + ln_ratio, k2 * ratio2, mt)?,
-                };
-                for (o, c) in out.iter_mut().zip(c) {
-                    o[i] += c * p;
-                }
-            }
-        }
-        Ok(out)
+        Ok((weights, nodes))
     }
 }
 

@@ -22,7 +22,17 @@ pub(super) struct Model<'a> {
 }
 
 impl EptTerms {
+    /// The model with the errors of its polynomials.
     pub(super) fn model(&self, params: &EptParams) -> Model<'_> {
+        self.model_with(params, true)
+    }
+
+    /// The model without the errors of its polynomials (zero; the multipoles' values).
+    pub(super) fn model_values(&self, params: &EptParams) -> Model<'_> {
+        self.model_with(params, false)
+    }
+
+    fn model_with(&self, params: &EptParams, errors: bool) -> Model<'_> {
         let v = &params.values;
         let [b1, _, _, _, f] = params.bias();
         let z1 = [b1 * b1, 2.0 * b1 * f, f * f];
@@ -30,17 +40,30 @@ impl EptTerms {
         let s2 = self.nw.as_ref().map_or(0.0, |(_, s)| s.value);
         // The terms of the full and no-wiggle spectra are in the same order.
         let coefficients = self.full.coefficients(params.bias());
+        let values_only = |t: &crate::loops::redshift::RedshiftTerms| {
+            (!errors).then(|| t.loop_values_all(&coefficients))
+        };
+        let (full_values, nw_values) = (
+            values_only(&self.full),
+            self.nw.as_ref().and_then(|(t, _)| values_only(t)),
+        );
         let parts = (0..self.grid.len())
             .map(|i| {
                 let k = self.grid[i];
                 let k2 = k * k;
                 let p = self.full.p_lin[i];
-                let (lv, le) = self.full.loop_polynomial_with(i, &coefficients);
+                let with = |t: &crate::loops::redshift::RedshiftTerms,
+                            values: &Option<Vec<[f64; 5]>>| match values
+                {
+                    Some(v) => (v[i], [0.0; 5]),
+                    None => t.loop_polynomial_with(i, &coefficients),
+                };
+                let (lv, le) = with(&self.full, &full_values);
                 let mut n: Poly = (lv, le);
                 let mut w: Poly = ([0.0; 5], [0.0; 5]);
                 let (p_nw, p_w) = match &self.nw {
                     Some((t, _)) => {
-                        let (nv, ne) = t.loop_polynomial_with(i, &coefficients);
+                        let (nv, ne) = with(t, &nw_values);
                         n = (nv, ne);
                         for j in 0..5 {
                             w.0[j] = lv[j] - nv[j];
@@ -80,6 +103,83 @@ impl EptTerms {
             f: params.f(),
         }
     }
+}
+
+/// The multipoles of several models of one f and Σ² (those of one terms' set) at the output `k_out`:
+/// `nodes` per μ node (ln(k'/k), (k'/k)², μ'), `weights[m][j]` the weight of the j-th ℓ at μ node
+/// m; `on_grid`: k_out is the models' grid and undistorted (each k its own grid point), else
+/// P(k', μ') is interpolated (four-point Lagrange in ln k). Per k, the projection is made once as
+/// weights on the μ² coefficients of the grid points its stencils reach, then applied to each model:
+/// `out[s][j][i]`.
+pub(super) fn project_many(
+    models: &[Model<'_>],
+    k_out: &[f64],
+    nodes: &[(f64, f64, f64)],
+    weights: &[Vec<f64>],
+    on_grid: bool,
+) -> Result<Vec<Vec<Vec<f64>>>> {
+    let Some(first) = models.first() else {
+        return Ok(Vec::new());
+    };
+    let n_ell = weights.first().map_or(0, Vec::len);
+    let mut out = vec![vec![vec![0.0; k_out.len()]; n_ell]; models.len()];
+    // the weights of the no-wiggle (N) and wiggle (W) coefficients: [ℓ][grid point − lo][μ² power]
+    let (mut on, mut ow) = (Vec::new(), Vec::new());
+    let mut stencils = Vec::with_capacity(nodes.len());
+    for (i, &k) in k_out.iter().enumerate() {
+        let (ln_k, k2) = (k.ln(), k * k);
+        stencils.clear();
+        let (mut lo, mut hi) = (usize::MAX, 0);
+        for &(ln_ratio, ratio2, mt) in nodes {
+            let (b, l, width) = if on_grid {
+                (i, [1.0, 0.0, 0.0, 0.0], 1)
+            } else {
+                let (b, l) = first.stencil_ln(ln_k + ln_ratio)?;
+                (b, l, 4)
+            };
+            let m2 = mt * mt;
+            let damping =
+                (-k2 * ratio2 * first.sigma2 * (1.0 + first.f * (2.0 + first.f) * m2)).exp();
+            stencils.push((b, l, width, m2, damping));
+            lo = lo.min(b);
+            hi = hi.max(b + width);
+        }
+        let span = hi - lo;
+        on.clear();
+        on.resize(n_ell * span * 5, 0.0);
+        ow.clear();
+        ow.resize(n_ell * span * 5, 0.0);
+        for (&(b, l, width, m2, damping), c) in stencils.iter().zip(weights) {
+            let mut powers = [1.0; 5];
+            for q in 1..5 {
+                powers[q] = powers[q - 1] * m2;
+            }
+            for (j, lj) in l.iter().enumerate().take(width) {
+                for (e, ce) in c.iter().enumerate() {
+                    let base = (e * span + b + j - lo) * 5;
+                    let (wn, ww) = (ce * lj, ce * lj * damping);
+                    for q in 0..5 {
+                        on[base + q] += wn * powers[q];
+                        ow[base + q] += ww * powers[q];
+                    }
+                }
+            }
+        }
+        for (model, o) in models.iter().zip(out.iter_mut()) {
+            for (e, oe) in o.iter_mut().enumerate() {
+                let mut sum = 0.0;
+                for g in 0..span {
+                    let (n, w) = &model.parts[lo + g];
+                    let base = (e * span + g) * 5;
+                    for q in 0..5 {
+                        sum += on[base + q] * n.0[q] + ow[base + q] * w.0[q];
+                    }
+                }
+                oe[i] = sum;
+            }
+        }
+    }
+    Ok(out)
 }
 
 impl Model<'_> {

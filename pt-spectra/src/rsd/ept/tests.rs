@@ -119,6 +119,70 @@ fn values_are_the_multipoles_values() {
     }
 }
 
+/// The batched projection gives each set's single projection to rounding: on the output grid
+/// (no distortion), and interpolated with the plan's distortion and with one inside an AP range; sets
+/// of different f are refused.
+#[test]
+fn a_batch_of_parameter_sets_gives_the_single_projections() {
+    let k = [0.02, 0.05, 0.11, 0.15, 0.19];
+    let sets = [
+        EptParams::new(1.7, 0.6),
+        {
+            let mut p = EptParams::new(2.2, 0.6);
+            for (i, v) in [
+                (1, 0.4),
+                (2, -0.3),
+                (3, 0.2),
+                (4, 10.0),
+                (5, -5.0),
+                (8, 900.0),
+            ] {
+                p.values[i] = v;
+            }
+            p
+        },
+        EptParams::new(0.0, 0.6),
+    ];
+    let distorted = Distortion::new(1.03, 0.98).unwrap();
+    for (ap, ap_range, at) in [
+        (None, None, None),
+        (Some(distorted), None, Some(distorted)),
+        (None, Some((0.9, 1.1)), Some(distorted)),
+    ] {
+        let (plan, terms) = plan(
+            &k,
+            EptSettings {
+                ir: true,
+                ap,
+                ap_range,
+                loop_range: None,
+            },
+        );
+        let ells = [0, 2, 4];
+        let batch = plan
+            .multipole_values_many(&terms, &sets, &ells, at)
+            .unwrap();
+        for (p, got) in sets.iter().zip(&batch) {
+            let want = plan.multipole_values_at(&terms, p, &ells, at).unwrap();
+            for (g, w) in got.iter().zip(&want) {
+                let scale = w.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                for (x, y) in g.iter().zip(w) {
+                    assert!(
+                        (x - y).abs() <= 1e-12 * scale,
+                        "{ap:?} {ap_range:?}: {x} vs {y}"
+                    );
+                }
+            }
+        }
+    }
+    let (plan, terms) = plan(&k, EptSettings::default());
+    let e = plan
+        .multipole_values_many(&terms, &[sets[0], EptParams::new(1.7, 0.7)], &[0], None)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("one growth rate"), "{e}");
+}
+
 /// With basis tensors (method basis) two CAMB spectra, a flat w0–wa one, a curved one (projected cut
 /// below the soft modes: loops::basis::soft) and a CLASS one not trained on give the direct
 /// multipoles within 3e-4 of P0 and inside the errors, with and without IR; an Eisenstein–Hu
