@@ -8,7 +8,7 @@ use crate::value_error;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pt_spectra::bispectrum::Fog;
 use pt_spectra::pipeline::{
-    BispectrumBlock, Pipeline as LibPipeline, PipelineSettings, TermsSource, NUISANCE_NAMES,
+    BispectrumBlock, Pipeline as LibPipeline, PipelineSettings, TermsSource, JACOBIAN_NAMES,
     PIPELINE_MAX_RESIDUAL,
 };
 use pt_spectra::progress::Silent;
@@ -117,12 +117,9 @@ impl Pipeline {
         ));
         let named: Vec<(&str, f64)> = params.iter().map(|(n, v)| (n.as_str(), *v)).collect();
         if jacobian {
-            // the data vector from the nuisance polynomial too (the same numbers to rounding): one
-            // projection of the multipoles for both
-            let f = named.iter().find(|(n, _)| *n == "f").map(|p| p.1);
-            let lin = step.linearise(f).map_err(value_error)?;
-            let values = lin.data_vector(&named).map_err(value_error)?;
-            return Ok((values, Some(lin.jacobian(&named).map_err(value_error)?)));
+            // the data vector from the nuisance polynomial too (the same numbers to rounding)
+            let (values, rows) = step.jacobian(&named).map_err(value_error)?;
+            return Ok((values, Some(rows)));
         }
         Ok((step.data_vector(&named).map_err(value_error)?, None))
     }
@@ -165,13 +162,21 @@ impl Pipeline {
         if cached != key {
             return Ok(None);
         }
-        if lin.is_none() {
+        if lin
+            .as_ref()
+            .is_none_or(|l| jacobian && l.names().len() < JACOBIAN_NAMES.len())
+        {
             // the power spectrum's terms do not depend on f (no bispectrum block here): the step of
-            // the cosmology, linearised at the given f
+            // the cosmology, linearised at the given f (with the f-derivative for a Jacobian)
             let step = self.inner.step(prepared).map_err(value_error)?;
+            let f = key.1.map(f64::from_bits);
             *lin = Some(
-                step.linearise(key.1.map(f64::from_bits))
-                    .map_err(value_error)?,
+                if jacobian {
+                    step.linearise_with_df(f)
+                } else {
+                    step.linearise(f)
+                }
+                .map_err(value_error)?,
             );
         }
         let lin = lin.as_ref().expect("made above");
@@ -254,10 +259,10 @@ impl Pipeline {
     /// CLASS/CAMB names; through the emulator) or at the spectrum `linear` ((k, P) arrays or a file
     /// at `z_input`, the growth and distances of `cosmology`), with the nuisance parameters by
     /// name (`pt_spectra.Pipeline.parameters`; `f` defaults to f(z)). With `jacobian=True`:
-    /// (data vector, d data/d θ as an array of shape (11, n) in the order of `nuisance`). A call that
-    /// repeats the last call's cosmology (no `linear`, no bispectrum block) evaluates that cosmology's
-    /// nuisance polynomial (made at the first repeat, ~5 ms; then microseconds): the same numbers to
-    /// rounding (~1e-13 relative).
+    /// (data vector, d data/d θ as an array of shape (12, n) in the order of `nuisance`: the 11
+    /// nuisance parameters, then f; all exact). A call that repeats the last call's cosmology (no
+    /// `linear`, no bispectrum block) evaluates that cosmology's nuisance polynomial (made at the
+    /// first repeat, ~1.5 ms; then microseconds): the same numbers to rounding (~1e-13 relative).
     #[pyo3(signature = (cosmology=None, linear=None, z_input=None, jacobian=false, **params))]
     fn __call__<'py>(
         &self,
@@ -318,10 +323,10 @@ impl Pipeline {
         self.inner.parameters()
     }
 
-    /// The nuisance parameters of the Jacobian, in its order.
+    /// The parameters of the Jacobian's rows, in order: the nuisance parameters, then f.
     #[getter]
     fn nuisance(&self) -> Vec<&'static str> {
-        NUISANCE_NAMES.to_vec()
+        JACOBIAN_NAMES.to_vec()
     }
 
     /// The output k [h/Mpc].

@@ -7,7 +7,8 @@
 //! * `pipeline/table`: the same from a given linear table (the embedded gm2012 CAMB spectrum);
 //! * `pipeline/terms`, `pipeline/multipoles`: the two cosmology-dependent stages alone;
 //! * `pipeline/linearise`: a cosmology's data vector as a polynomial in the nuisance parameters
-//!   (what a new cosmology's nuisance Jacobian costs beyond the step);
+//!   (what a new cosmology's nuisance Jacobian costs beyond the step), and `pipeline/jacobian` the
+//!   step's full exact Jacobian (the nuisance parameters and f) with the data vector;
 //! * `pipeline/nuisance`: the nuisance-only step on a linearised cosmology, and
 //!   `pipeline/nuisance-jacobian` its exact Jacobian.
 //!
@@ -92,6 +93,9 @@ fn benches(c: &mut Criterion) {
     });
     c.bench_function("pipeline/linearise", |b| {
         b.iter(|| black_box(step.linearise(None).unwrap().f()))
+    });
+    c.bench_function("pipeline/jacobian", |b| {
+        b.iter(|| black_box(step.jacobian(&PARAMS).unwrap().1.len()))
     });
     let lin = step.linearise(None).unwrap();
     c.bench_function("pipeline/nuisance", |b| {

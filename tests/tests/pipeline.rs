@@ -7,7 +7,8 @@ use pt_spectra::cosmology::Cosmology;
 use pt_spectra::jobs::ept_plan;
 use pt_spectra::pipeline::loop_range::LOOP_RANGE_TOLERANCE;
 use pt_spectra::pipeline::{
-    BispectrumBlock, Pipeline, PipelineSettings, TermsSource, NUISANCE_NAMES, PIPELINE_MAX_RESIDUAL,
+    BispectrumBlock, Pipeline, PipelineSettings, TermsSource, JACOBIAN_NAMES, NUISANCE_NAMES,
+    PIPELINE_MAX_RESIDUAL,
 };
 use pt_spectra::precision::{Precision, TwoLoopMethod};
 use pt_spectra::progress::Silent;
@@ -169,7 +170,9 @@ fn outside_the_span_the_pipeline_falls_back_to_direct_and_says_so() {
 fn the_nuisance_polynomial_and_its_jacobian_are_exact() {
     let pl = pipeline();
     let step = pl.step(&pl.prepare(&truth()).unwrap()).unwrap();
-    let lin = step.linearise(None).unwrap();
+    let lin = step.linearise_with_df(None).unwrap();
+    assert_eq!(lin.names(), &JACOBIAN_NAMES);
+    assert_eq!(step.linearise(None).unwrap().names(), &NUISANCE_NAMES);
     let sets: [&[(&str, f64)]; 3] = [
         &PARAMS,
         &[
@@ -204,6 +207,33 @@ fn the_nuisance_polynomial_and_its_jacobian_are_exact() {
                 .map(|r| (8.0 * (p1[r] - m1[r]) - (p2[r] - m2[r])) / (12.0 * h))
                 .collect();
             assert_close(column, &fd, 1e-6, n);
+        }
+        // ∂/∂f (not a polynomial: the BAO damping's exponential): against fourth-order central
+        // differences of the full step with step control (h and h/2 agree to 1e-8 of the largest
+        // element before the comparison)
+        assert_eq!(jac.len(), JACOBIAN_NAMES.len());
+        assert_eq!(JACOBIAN_NAMES[NUISANCE_NAMES.len()], "f");
+        let f0 = step.growth_rate;
+        let at = |x: f64| {
+            let mut s: Vec<(&str, f64)> = set.to_vec();
+            s.push(("f", x));
+            step.data_vector(&s).unwrap()
+        };
+        let fd = |h: f64| -> Vec<f64> {
+            let (p1, m1, p2, m2) = (at(f0 + h), at(f0 - h), at(f0 + 2.0 * h), at(f0 - 2.0 * h));
+            (0..p1.len())
+                .map(|r| (8.0 * (p1[r] - m1[r]) - (p2[r] - m2[r])) / (12.0 * h))
+                .collect()
+        };
+        let (coarse, fine) = (fd(2e-3 * f0), fd(1e-3 * f0));
+        assert_close(&coarse, &fine, 1e-8, "f: step control");
+        assert_close(&jac[NUISANCE_NAMES.len()], &fine, 1e-6, "f");
+        // the step's Jacobian: the same rows, its f row from the one set
+        let (values, rows) = step.jacobian(set).unwrap();
+        assert_close(&values, &direct, 1e-9, "step: values");
+        assert_eq!(rows.len(), JACOBIAN_NAMES.len());
+        for (a, b) in rows.iter().zip(&jac) {
+            assert_close(a, b, 1e-9, "step: rows");
         }
     }
 }

@@ -248,6 +248,15 @@ impl RedshiftTerms {
         self.terms.iter().map(|t| t.monomial.eval(params)).collect()
     }
 
+    /// ∂/∂f of [`Self::coefficients`] (the loop part is linear in them: its f-derivative is
+    /// [`Self::loop_values_all`] of these).
+    pub fn coefficients_df(&self, params: [f64; 5]) -> Vec<f64> {
+        self.terms
+            .iter()
+            .map(|t| t.monomial.eval_df(params))
+            .collect()
+    }
+
     /// The values only of [`Self::loop_polynomial_with`] at every grid point (the fast path of the
     /// multipoles' values): term by term, the terms of zero coefficient skipped (most, for the unit
     /// parameter sets of a nuisance polynomial).

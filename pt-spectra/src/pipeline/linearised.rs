@@ -12,6 +12,13 @@ pub const NUISANCE_NAMES: [&str; 11] = [
     "b1", "b2", "bs", "b3", "alpha0", "alpha2", "alpha4", "alpha6", "sn", "sn2", "sn4",
 ];
 
+/// The parameters of the full Jacobian ([`CosmologyStep::jacobian`], and [`Linearised::jacobian`]
+/// with the f-derivative), in its order: the nuisance parameters, then the growth rate f (its
+/// derivative exact too: of the μ² polynomials and of the BAO damping).
+pub const JACOBIAN_NAMES: [&str; 12] = [
+    "b1", "b2", "bs", "b3", "alpha0", "alpha2", "alpha4", "alpha6", "sn", "sn2", "sn4", "f",
+];
+
 /// Bias parameters (u_1 … u_4 = b1, b2, bs, b3; u_0 = 1).
 const BIASES: usize = 4;
 /// Parameters entering linearly (α0, α2, α4, α6, sn, sn2, sn4).
@@ -24,6 +31,9 @@ pub struct Linearised {
     quadratic: Vec<Vec<f64>>,
     /// C_c of the linear parameters.
     linear: Vec<Vec<f64>>,
+    /// With the f-derivative ([`CosmologyStep::linearise_with_df`]): ∂A_ij/∂f (as `quadratic`)
+    /// and ∂C_c/∂f.
+    df: Option<Polynomial>,
     /// The growth rate f the polynomial is at.
     f: f64,
 }
@@ -44,6 +54,45 @@ impl CosmologyStep<'_> {
     /// # Errors
     /// As [`CosmologyStep::data_vector`]; [`Error::InvalidChoice`] with a bispectrum block.
     pub fn linearise(&self, f: Option<f64>) -> Result<Linearised> {
+        self.polynomial(f, false)
+    }
+
+    /// [`Self::linearise`] with the polynomial of the data vector's exact f-derivative as well, so
+    /// that [`Linearised::jacobian`] has the row of f (twice the cost: the f-derivatives of the 22
+    /// sets' μ² polynomials and BAO damping, projected by the same weights).
+    ///
+    /// # Errors
+    /// As [`Self::linearise`].
+    pub fn linearise_with_df(&self, f: Option<f64>) -> Result<Linearised> {
+        self.polynomial(f, true)
+    }
+
+    /// The exact Jacobian of the data vector at `params` by name: one row per name of
+    /// [`JACOBIAN_NAMES`] (the nuisance parameters from the polynomial of [`Self::linearise`], f from
+    /// one f-derivative at `params`), with the data vector itself (from the polynomial: the same
+    /// numbers as [`Self::data_vector`] to rounding).
+    ///
+    /// # Errors
+    /// As [`Self::linearise`] and [`Linearised::jacobian`].
+    pub fn jacobian(&self, params: &[(&str, f64)]) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+        self.refuse_bispectrum()?;
+        let p = self.params(params)?;
+        let (vectors, df) =
+            self.data_vectors_and_df_of(&unit_sets(p.f()), std::slice::from_ref(&p))?;
+        let (quadratic, linear) = polynomial(vectors);
+        let lin = Linearised {
+            quadratic,
+            linear,
+            df: None,
+            f: p.f(),
+        };
+        let mut rows = lin.jacobian(params)?;
+        rows.extend(df);
+        Ok((lin.data_vector(params)?, rows))
+    }
+
+    /// The polynomial is the power spectrum's.
+    fn refuse_bispectrum(&self) -> Result<()> {
         if self.has_bispectrum() {
             return Err(Error::InvalidChoice {
                 what: "the nuisance polynomial of a pipeline with a bispectrum block".into(),
@@ -53,71 +102,99 @@ impl CosmologyStep<'_> {
                         .into(),
             });
         }
+        Ok(())
+    }
+
+    fn polynomial(&self, f: Option<f64>, with_df: bool) -> Result<Linearised> {
+        self.refuse_bispectrum()?;
         let f = f.unwrap_or(self.growth_rate);
-        // the 22 parameter sets: none, ±1 of each bias, each pair of biases at 1, each linear one at 1
-        let mut sets: Vec<Vec<(usize, f64)>> = vec![Vec::new()];
-        for i in 0..BIASES {
-            sets.push(vec![(i, 1.0)]);
-            sets.push(vec![(i, -1.0)]);
-        }
-        for i in 0..BIASES {
-            for j in i + 1..BIASES {
-                sets.push(vec![(i, 1.0), (j, 1.0)]);
-            }
-        }
-        sets.extend((0..LINEAR).map(|c| vec![(BIASES + c, 1.0)]));
-        let params: Vec<EptParams> = sets
-            .iter()
-            .map(|set| {
-                let mut p = EptParams::new(0.0, f);
-                for &(i, v) in set {
-                    p.values[i] = v;
-                }
-                p
-            })
-            .collect();
-        // their data vectors, the projection onto the multipoles made once for all
-        let mut vectors = self.data_vectors_of(&params)?.into_iter();
-        let mut next = || vectors.next().expect("one per set");
-        let sub = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x - y).collect::<Vec<_>>();
-        let a00 = next();
-        let mut a0 = vec![Vec::new(); BIASES + 1];
-        let mut aa = vec![Vec::new(); BIASES + 1];
-        for i in 1..=BIASES {
-            let (plus, minus) = (next(), next());
-            a0[i] = plus
-                .iter()
-                .zip(&minus)
-                .map(|(p, m)| 0.5 * (p - m))
-                .collect();
-            aa[i] = plus
-                .iter()
-                .zip(&minus)
-                .zip(&a00)
-                .map(|((p, m), c)| 0.5 * (p + m) - c)
-                .collect();
-        }
-        let mut quadratic = vec![Vec::new(); pair(BIASES, BIASES) + 1];
-        quadratic[pair(0, 0)] = a00.clone();
-        for i in 1..=BIASES {
-            quadratic[pair(0, i)] = a0[i].clone();
-            quadratic[pair(i, i)] = aa[i].clone();
-        }
-        for i in 1..=BIASES {
-            for j in i + 1..=BIASES {
-                let both = next();
-                quadratic[pair(i, j)] = (0..both.len())
-                    .map(|r| both[r] - a00[r] - a0[i][r] - a0[j][r] - aa[i][r] - aa[j][r])
-                    .collect();
-            }
-        }
-        let linear = (0..LINEAR).map(|_| sub(&next(), &a00)).collect();
+        let params = unit_sets(f);
+        // their data vectors (and f-derivatives), the projection onto the multipoles made once
+        let (quadratic, linear, df) = if with_df {
+            let (vectors, df) = self.data_vectors_and_df_of(&params, &params)?;
+            let (q, l) = polynomial(vectors);
+            (q, l, Some(polynomial(df)))
+        } else {
+            let (q, l) = polynomial(self.data_vectors_of(&params)?);
+            (q, l, None)
+        };
         Ok(Linearised {
             quadratic,
             linear,
+            df,
             f,
         })
     }
+}
+
+/// The vectors of a polynomial: A_ij (i ≤ j, [`pair`] order) and C_c.
+type Polynomial = (Vec<Vec<f64>>, Vec<Vec<f64>>);
+
+/// The 22 parameter sets of the polynomial at growth rate f: none, ±1 of each bias, each pair of
+/// biases at 1, each linear parameter at 1.
+fn unit_sets(f: f64) -> Vec<EptParams> {
+    let mut sets: Vec<Vec<(usize, f64)>> = vec![Vec::new()];
+    for i in 0..BIASES {
+        sets.push(vec![(i, 1.0)]);
+        sets.push(vec![(i, -1.0)]);
+    }
+    for i in 0..BIASES {
+        for j in i + 1..BIASES {
+            sets.push(vec![(i, 1.0), (j, 1.0)]);
+        }
+    }
+    sets.extend((0..LINEAR).map(|c| vec![(BIASES + c, 1.0)]));
+    sets.iter()
+        .map(|set| {
+            let mut p = EptParams::new(0.0, f);
+            for &(i, v) in set {
+                p.values[i] = v;
+            }
+            p
+        })
+        .collect()
+}
+
+/// The vectors A_ij (i ≤ j, [`pair`] order) and C_c of the polynomial from its values at the 22
+/// parameter sets of [`CosmologyStep::linearise`], in their order (the same extraction gives the
+/// f-derivatives' polynomial from the sets' f-derivatives).
+fn polynomial(vectors: Vec<Vec<f64>>) -> Polynomial {
+    let mut vectors = vectors.into_iter();
+    let mut next = || vectors.next().expect("one per set");
+    let sub = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x - y).collect::<Vec<_>>();
+    let a00 = next();
+    let mut a0 = vec![Vec::new(); BIASES + 1];
+    let mut aa = vec![Vec::new(); BIASES + 1];
+    for i in 1..=BIASES {
+        let (plus, minus) = (next(), next());
+        a0[i] = plus
+            .iter()
+            .zip(&minus)
+            .map(|(p, m)| 0.5 * (p - m))
+            .collect();
+        aa[i] = plus
+            .iter()
+            .zip(&minus)
+            .zip(&a00)
+            .map(|((p, m), c)| 0.5 * (p + m) - c)
+            .collect();
+    }
+    let mut quadratic = vec![Vec::new(); pair(BIASES, BIASES) + 1];
+    for i in 1..=BIASES {
+        quadratic[pair(0, i)] = a0[i].clone();
+        quadratic[pair(i, i)] = aa[i].clone();
+    }
+    for i in 1..=BIASES {
+        for j in i + 1..=BIASES {
+            let both = next();
+            quadratic[pair(i, j)] = (0..both.len())
+                .map(|r| both[r] - a00[r] - a0[i][r] - a0[j][r] - aa[i][r] - aa[j][r])
+                .collect();
+        }
+    }
+    let linear = (0..LINEAR).map(|_| sub(&next(), &a00)).collect();
+    quadratic[pair(0, 0)] = a00;
+    (quadratic, linear)
 }
 
 impl Linearised {
@@ -171,21 +248,36 @@ impl Linearised {
     /// other than the polynomial's; [`Error::InvalidParameter`] for a value that is not finite.
     pub fn data_vector(&self, params: &[(&str, f64)]) -> Result<Vec<f64>> {
         let v = self.values(params)?;
-        let u = Self::u(&v);
-        let mut out = vec![0.0; self.quadratic[0].len()];
+        Ok(Self::evaluate(&self.quadratic, &self.linear, &v))
+    }
+
+    /// Σ_{i≤j} u_i u_j A_ij + Σ_c θ_c C_c.
+    fn evaluate(quadratic: &[Vec<f64>], linear: &[Vec<f64>], v: &[f64; 11]) -> Vec<f64> {
+        let u = Self::u(v);
+        let mut out = vec![0.0; quadratic[0].len()];
         for i in 0..=BIASES {
             for j in i..=BIASES {
-                crate::simd::axpy(&mut out, u[i] * u[j], &self.quadratic[pair(i, j)]);
+                crate::simd::axpy(&mut out, u[i] * u[j], &quadratic[pair(i, j)]);
             }
         }
-        for (c, vector) in self.linear.iter().enumerate() {
+        for (c, vector) in linear.iter().enumerate() {
             crate::simd::axpy(&mut out, v[BIASES + c], vector);
         }
-        Ok(out)
+        out
+    }
+
+    /// The names of the rows of [`Self::jacobian`]: [`NUISANCE_NAMES`], and f if the polynomial has
+    /// its f-derivative ([`CosmologyStep::linearise_with_df`]: [`JACOBIAN_NAMES`]).
+    pub fn names(&self) -> &'static [&'static str] {
+        if self.df.is_some() {
+            &JACOBIAN_NAMES
+        } else {
+            &NUISANCE_NAMES
+        }
     }
 
     /// The exact Jacobian d(data vector)/d(parameter) at `params`: one vector per name of
-    /// [`NUISANCE_NAMES`], in that order.
+    /// [`Self::names`], in that order.
     ///
     /// # Errors
     /// As [`Self::data_vector`].
@@ -204,6 +296,10 @@ impl Linearised {
             out.push(d);
         }
         out.extend(self.linear.iter().cloned());
+        // ∂/∂f: the polynomial of the f-derivatives at the same parameters
+        if let Some((quadratic, linear)) = &self.df {
+            out.push(Self::evaluate(quadratic, linear, &v));
+        }
         Ok(out)
     }
 }

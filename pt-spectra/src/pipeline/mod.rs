@@ -41,7 +41,7 @@ mod linearised;
 pub mod loop_range;
 use crate::bispectrum::block::{bispectrum_params, PlannedBispectrum};
 pub use crate::bispectrum::block::{BispectrumBlock, BISPECTRUM_NAMES};
-pub use linearised::{Linearised, NUISANCE_NAMES};
+pub use linearised::{Linearised, JACOBIAN_NAMES, NUISANCE_NAMES};
 
 /// The largest smoothed projection residual for which a [`Pipeline`] evaluates the loop terms on the
 /// basis: 2e-3, twice the emulator's own worst |Δ ln P| (~1e-3, [`LinearEmulator::describe`]).
@@ -489,6 +489,26 @@ impl CosmologyStep<'_> {
             self.ap,
         )?;
         Ok(models.iter().map(|m| pl.observe(m)).collect())
+    }
+
+    /// [`Self::data_vectors_of`] of the sets `params`, and the exact f-derivatives of those of the
+    /// sets `df` (one projection).
+    #[allow(clippy::type_complexity)]
+    fn data_vectors_and_df_of(
+        &self,
+        params: &[EptParams],
+        df: &[EptParams],
+    ) -> Result<(Vec<Vec<f64>>, Vec<Vec<f64>>)> {
+        let pl = self.pipeline;
+        let (models, df) = pl.plan.multipole_values_and_df_many(
+            &self.terms,
+            params,
+            df,
+            pl.observation.model_ells(),
+            self.ap,
+        )?;
+        let observe = |m: &Vec<Vec<Vec<f64>>>| m.iter().map(|m| pl.observe(m)).collect();
+        Ok((observe(&models), observe(&df)))
     }
 
     fn data_vector_of(&self, p: &EptParams) -> Result<Vec<f64>> {

@@ -441,16 +441,50 @@ impl EptPlan {
         ells: &[usize],
         ap: Option<Distortion>,
     ) -> Result<Vec<Vec<Vec<f64>>>> {
-        if let Some(p) = params.iter().find(|p| p.f() != params[0].f()) {
+        Ok(self.many(terms, params, &[], ells, ap)?.0)
+    }
+
+    /// [`Self::multipole_values_many`] of the sets `params`, and the exact f-derivatives of the
+    /// multipoles of the sets `df` (of the same f; their μ² polynomials' and the BAO damping's, no
+    /// finite differences), with one projection: `(values, d/df)`.
+    ///
+    /// # Errors
+    /// As [`Self::multipole_values_many`].
+    #[allow(clippy::type_complexity)]
+    pub fn multipole_values_and_df_many(
+        &self,
+        terms: &EptTerms,
+        params: &[EptParams],
+        df: &[EptParams],
+        ells: &[usize],
+        ap: Option<Distortion>,
+    ) -> Result<(Vec<Vec<Vec<f64>>>, Vec<Vec<Vec<f64>>>)> {
+        self.many(terms, params, df, ells, ap)
+    }
+
+    fn many(
+        &self,
+        terms: &EptTerms,
+        params: &[EptParams],
+        df: &[EptParams],
+        ells: &[usize],
+        ap: Option<Distortion>,
+    ) -> Result<model::Multipoles> {
+        let all: Vec<EptParams> = params.iter().chain(df).copied().collect();
+        if let Some(p) = all.iter().find(|p| p.f() != all[0].f()) {
             return Err(Error::InvalidChoice {
-                what: format!("parameter sets with f = {} and {}", params[0].f(), p.f()),
+                what: format!("parameter sets with f = {} and {}", all[0].f(), p.f()),
                 reason: "a batch of multipoles shares one growth rate (its damping)".into(),
             });
         }
-        let (weights, nodes) = self.projection_nodes(terms, params, ells, ap)?;
+        let (weights, nodes) = self.projection_nodes(terms, &all, ells, ap)?;
         let models: Vec<_> = params.iter().map(|p| terms.model_values(p)).collect();
+        let df: Vec<_> = df
+            .iter()
+            .map(|p| (terms.model_values(p), terms.parts_df(p)))
+            .collect();
         let on_grid = ap.is_none() && self.grid_use == GridUse::Output;
-        model::project_many(&models, &self.k_out, &nodes, &weights, on_grid)
+        model::project_many(&models, &df, &self.k_out, &nodes, &weights, on_grid)
     }
 
     /// The checks of a projection onto the multipoles `ells` with distortion `ap`, and per μ node

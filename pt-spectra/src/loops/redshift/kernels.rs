@@ -43,6 +43,19 @@ impl Monomial {
             * f.powi(self.f.into())
     }
 
+    /// ∂/∂f of [`Self::eval`] (exact: the power of f lowered by one, times it).
+    pub fn eval_df(self, [b1, b2, bs, b3, f]: [f64; 5]) -> f64 {
+        if self.f == 0 {
+            return 0.0;
+        }
+        f64::from(self.f)
+            * b1.powi(self.b1.into())
+            * b2.powi(self.b2.into())
+            * bs.powi(self.bs.into())
+            * b3.powi(self.b3.into())
+            * f.powi(i32::from(self.f) - 1)
+    }
+
     /// A readable name, e.g. `b1^2 f`.
     pub fn name(self) -> String {
         let mut parts = Vec::new();

@@ -105,26 +105,78 @@ impl EptTerms {
     }
 }
 
+/// ∂/∂f of a model's μ² polynomials (values) at every grid point, (N, W) as in [`Model`], with the
+/// damping held: the loop part through its monomials' f-derivatives ([`crate::loops::redshift::RedshiftTerms::coefficients_df`]),
+/// Z₁² = (b₁ + fμ²)² and the resummation's (1 + k²Σ²[1 + f(2 + f)μ²]) Z₁² P_w by the product rule.
+pub(super) type PartsDf = Vec<([f64; 5], [f64; 5])>;
+
+impl EptTerms {
+    /// The f-derivative of the model of `params` ([`PartsDf`]).
+    pub(super) fn parts_df(&self, params: &EptParams) -> PartsDf {
+        let [b1, _, _, _, f] = params.bias();
+        let (z1, dz1) = ([b1 * b1, 2.0 * b1 * f, f * f], [0.0, 2.0 * b1, 2.0 * f]);
+        let s2 = self.nw.as_ref().map_or(0.0, |(_, s)| s.value);
+        let dc = self.full.coefficients_df(params.bias());
+        let full = self.full.loop_values_all(&dc);
+        let nw = self.nw.as_ref().map(|(t, _)| (t, t.loop_values_all(&dc)));
+        (0..self.grid.len())
+            .map(|i| {
+                let k2 = self.grid[i] * self.grid[i];
+                let p = self.full.p_lin[i];
+                let (mut dn, mut dw) = (full[i], [0.0; 5]);
+                let (p_nw, p_w) = match &nw {
+                    Some((t, values)) => {
+                        dn = values[i];
+                        for j in 0..5 {
+                            dw[j] = full[i][j] - values[i][j];
+                        }
+                        (t.p_lin[i], p - t.p_lin[i])
+                    }
+                    None => (p, 0.0),
+                };
+                for j in 0..3 {
+                    dn[j] += dz1[j] * p_nw;
+                }
+                let (c0, c1, dc1) = (
+                    1.0 + k2 * s2,
+                    k2 * s2 * f * (2.0 + f),
+                    k2 * s2 * (2.0 + 2.0 * f),
+                );
+                for j in 0..3 {
+                    dw[j] += c0 * dz1[j] * p_w;
+                    dw[j + 1] += (dc1 * z1[j] + c1 * dz1[j]) * p_w;
+                }
+                (dn, dw)
+            })
+            .collect()
+    }
+}
+
 /// The multipoles of several models of one f and Σ² (those of one terms' set) at the output `k_out`:
 /// `nodes` per μ node (ln(k'/k), (k'/k)², μ'), `weights[m][j]` the weight of the j-th ℓ at μ node
 /// m; `on_grid`: k_out is the models' grid and undistorted (each k its own grid point), else
 /// P(k', μ') is interpolated (four-point Lagrange in ln k). Per k, the projection is made once as
 /// weights on the μ² coefficients of the grid points its stencils reach, then applied to each model:
-/// `out[s][j][i]`.
+/// `out[s][j][i]`. With `df` (models of the same f and Σ² with their [`PartsDf`]), also the
+/// f-derivatives of their multipoles: those of the polynomials, projected, and that of the damping
+/// e^{−k'²Σ²[1 + f(2 + f)μ'²]}.
 pub(super) fn project_many(
     models: &[Model<'_>],
+    df: &[(Model<'_>, PartsDf)],
     k_out: &[f64],
     nodes: &[(f64, f64, f64)],
     weights: &[Vec<f64>],
     on_grid: bool,
-) -> Result<Vec<Vec<Vec<f64>>>> {
-    let Some(first) = models.first() else {
-        return Ok(Vec::new());
+) -> Result<Multipoles> {
+    let Some(first) = models.first().or(df.first().map(|d| &d.0)) else {
+        return Ok((Vec::new(), Vec::new()));
     };
     let n_ell = weights.first().map_or(0, Vec::len);
     let mut out = vec![vec![vec![0.0; k_out.len()]; n_ell]; models.len()];
-    // the weights of the no-wiggle (N) and wiggle (W) coefficients: [ℓ][grid point − lo][μ² power]
-    let (mut on, mut ow) = (Vec::new(), Vec::new());
+    let mut out_df = vec![vec![vec![0.0; k_out.len()]; n_ell]; df.len()];
+    // the weights of the no-wiggle (N) and wiggle (W) coefficients: [ℓ][grid point − lo][μ² power],
+    // and of W in the damping's f-derivative
+    let (mut on, mut ow, mut owf) = (Vec::new(), Vec::new(), Vec::new());
     let mut stencils = Vec::with_capacity(nodes.len());
     for (i, &k) in k_out.iter().enumerate() {
         let (ln_k, k2) = (k.ln(), k * k);
@@ -138,9 +190,10 @@ pub(super) fn project_many(
                 (b, l, 4)
             };
             let m2 = mt * mt;
-            let damping =
-                (-k2 * ratio2 * first.sigma2 * (1.0 + first.f * (2.0 + first.f) * m2)).exp();
-            stencils.push((b, l, width, m2, damping));
+            let x = k2 * ratio2 * first.sigma2;
+            let damping = (-x * (1.0 + first.f * (2.0 + first.f) * m2)).exp();
+            let damping_df = -x * (2.0 + 2.0 * first.f) * m2 * damping;
+            stencils.push((b, l, width, m2, damping, damping_df));
             lo = lo.min(b);
             hi = hi.max(b + width);
         }
@@ -149,7 +202,9 @@ pub(super) fn project_many(
         on.resize(n_ell * span * 5, 0.0);
         ow.clear();
         ow.resize(n_ell * span * 5, 0.0);
-        for (&(b, l, width, m2, damping), c) in stencils.iter().zip(weights) {
+        owf.clear();
+        owf.resize(if df.is_empty() { 0 } else { n_ell * span * 5 }, 0.0);
+        for (&(b, l, width, m2, damping, damping_df), c) in stencils.iter().zip(weights) {
             let mut powers = [1.0; 5];
             for q in 1..5 {
                 powers[q] = powers[q - 1] * m2;
@@ -161,6 +216,12 @@ pub(super) fn project_many(
                     for q in 0..5 {
                         on[base + q] += wn * powers[q];
                         ow[base + q] += ww * powers[q];
+                    }
+                    if !df.is_empty() {
+                        let wf = ce * lj * damping_df;
+                        for q in 0..5 {
+                            owf[base + q] += wf * powers[q];
+                        }
                     }
                 }
             }
@@ -178,9 +239,26 @@ pub(super) fn project_many(
                 oe[i] = sum;
             }
         }
+        for ((model, d), o) in df.iter().zip(out_df.iter_mut()) {
+            for (e, oe) in o.iter_mut().enumerate() {
+                let mut sum = 0.0;
+                for g in 0..span {
+                    let (dn, dw) = &d[lo + g];
+                    let w = &model.parts[lo + g].1 .0;
+                    let base = (e * span + g) * 5;
+                    for q in 0..5 {
+                        sum += on[base + q] * dn[q] + ow[base + q] * dw[q] + owf[base + q] * w[q];
+                    }
+                }
+                oe[i] = sum;
+            }
+        }
     }
-    Ok(out)
+    Ok((out, out_df))
 }
+
+/// Multipoles of several sets, `[s][j][i]`, and the f-derivatives of others.
+pub(super) type Multipoles = (Vec<Vec<Vec<f64>>>, Vec<Vec<Vec<f64>>>);
 
 impl Model<'_> {
     /// P(k, μ) at grid index `i` (k = grid[i]).
