@@ -4,7 +4,7 @@
     RAYON_NUM_THREADS=1 python3 examples/chain_step_timing.py [--calls 300]
 
 Prints the median time per call of: a new cosmology through the emulator; the same with the nuisance
-Jacobian (jacobian=True, 11 nuisance parameters); the same cosmology again with new nuisance parameters
+Jacobian (jacobian=True: the 11 nuisance parameters and f); the same cosmology again with new nuisance parameters
 (a nuisance-only step through Python); a new cosmology from a given linear table (the emulator's own
 spectrum, passed as arrays). Needs numpy and the Python module (`pip install ./python`); the basis tensors
 are built on the first run (minutes) and cached. The issue's targets: 0.5 ms per call through Python
