@@ -24,10 +24,12 @@
 //! and each bin's free nuisance parameters.
 //!
 //! **Derivatives.** The nuisance parameters': exact (the data vector is a polynomial in them,
-//! [`crate::pipeline::Linearised::jacobian`]). f, α∥, α⊥ and the cosmological parameters': central
-//! differences at steps h and h/2 combined by Richardson extrapolation, (4D(h/2) − D(h))/3, whose
-//! error, |D(h/2) − D(h)|/3, is reported relative to each derivative's largest element
-//! ([`Forecast::derivative_error`]). Exact cosmological derivatives are not built yet.
+//! [`crate::pipeline::Linearised::jacobian`]). f, α∥, α⊥ of the power spectrum alone: exact
+//! ([`crate::pipeline::CosmologyStep::template_jacobian`]). With the bispectrum, f, α∥, α⊥, and the
+//! cosmological parameters: central differences at steps h and h/2 combined by Richardson
+//! extrapolation, (4D(h/2) − D(h))/3, whose error, |D(h/2) − D(h)|/3, is reported relative to each
+//! derivative's largest element ([`Forecast::derivative_error`]). Exact cosmological derivatives
+//! are not built yet.
 
 mod covariance;
 mod parameters;
@@ -402,6 +404,17 @@ pub fn fisher(
             Ok(select(&s.data_vector(&nuisance)?))
         };
         match parameters {
+            Parameters::Template if !with_b => {
+                // the power spectrum alone: exact derivatives (of the μ² polynomials, the BAO
+                // damping, the interpolant in ln k', the volume factor)
+                jacobian.extend(step.template_jacobian(&nuisance)?.map(|d| select(&d)));
+                for (n, v) in TEMPLATE_NAMES.iter().zip([f0, ap0.apar, ap0.aperp]) {
+                    names.push(format!("{n}_{}", i + 1));
+                    values.push(v);
+                }
+                let s8 = prepared.spectrum.sigma8();
+                fsigma8.push((s8, f0 * s8));
+            }
             Parameters::Template => {
                 // f: the data vector at f ± h (the power spectrum's terms do not depend on f; the
                 // bispectrum's, through the IR damping, do: a step at that f)

@@ -91,6 +91,29 @@ impl CosmologyStep<'_> {
         Ok((lin.data_vector(params)?, rows))
     }
 
+    /// The exact derivatives of the data vector at `params` by name with respect to the template
+    /// parameters f, α∥, α⊥ (in that order; f's as in [`Self::jacobian`], α's through
+    /// [`crate::rsd::ept::EptPlan::multipole_ap_derivatives`], then the observation matrix).
+    ///
+    /// At a step without distortion, the derivatives at α∥ = α⊥ = 1.
+    ///
+    /// # Errors
+    /// As [`Self::jacobian`]; [`Error::InvalidChoice`] for a pipeline whose plan has no AP grid.
+    pub fn template_jacobian(&self, params: &[(&str, f64)]) -> Result<[Vec<f64>; 3]> {
+        self.refuse_bispectrum()?;
+        let ap = match self.ap {
+            Some(ap) => ap,
+            None => crate::rsd::ap::Distortion::new(1.0, 1.0)?,
+        };
+        let p = self.params(params)?;
+        let pl = self.pipeline;
+        let (_, mut df) = self.data_vectors_and_df_of(&[], std::slice::from_ref(&p))?;
+        let [dpar, dperp] =
+            pl.plan
+                .multipole_ap_derivatives(&self.terms, &p, pl.observation.model_ells(), ap)?;
+        Ok([df.remove(0), pl.observe(&dpar), pl.observe(&dperp)])
+    }
+
     /// The polynomial is the power spectrum's.
     fn refuse_bispectrum(&self) -> Result<()> {
         if self.has_bispectrum() {

@@ -487,6 +487,30 @@ impl EptPlan {
         model::project_many(&models, &df, &self.k_out, &nodes, &weights, on_grid)
     }
 
+    /// The exact derivatives of [`Self::multipole_values_at`] with respect to α∥ and α⊥ at the
+    /// distortion `ap` (of the interpolant in ln k of the true spectrum, the BAO damping and the
+    /// volume factor; no finite differences): `[d/dα∥, d/dα⊥]`, each `[j][i]` as the values.
+    ///
+    /// # Errors
+    /// As [`Self::multipole_values_at`] (the plan must have an AP grid: [`EptSettings::ap`] or
+    /// [`EptSettings::ap_range`]).
+    pub fn multipole_ap_derivatives(
+        &self,
+        terms: &EptTerms,
+        params: &EptParams,
+        ells: &[usize],
+        ap: Distortion,
+    ) -> Result<[Vec<Vec<f64>>; 2]> {
+        let (weights, nodes) =
+            self.projection_nodes(terms, std::slice::from_ref(params), ells, Some(ap))?;
+        terms.model_values(params).ap_derivatives(
+            &self.k_out,
+            &nodes,
+            &weights,
+            (ap.apar, ap.aperp),
+        )
+    }
+
     /// The checks of a projection onto the multipoles `ells` with distortion `ap`, and per μ node
     /// of the rule the weights (2ℓ + 1) w L_ℓ(μ) × the AP volume factor, and the distortion's
     /// ln(k'/k), (k'/k)² and μ' (the same at every k).

@@ -183,6 +183,88 @@ fn a_batch_of_parameter_sets_gives_the_single_projections() {
     assert!(e.contains("one growth rate"), "{e}");
 }
 
+/// The exact α∥, α⊥ derivatives of the multipoles against fourth-order central differences of the
+/// values, with step control (steps h and 2h agree to 1e-9 of the largest element first), with IR
+/// (the damping's k' and μ' dependence) and without.
+#[test]
+fn the_ap_derivatives_are_the_differences_of_the_values() {
+    let k = [0.02, 0.05, 0.08, 0.11, 0.15, 0.19];
+    let ells = [0, 2, 4];
+    let mut params = EptParams::new(2.1, 0.7);
+    for (i, v) in [
+        (1, 0.4),
+        (2, -0.3),
+        (4, 10.0),
+        (5, -5.0),
+        (8, 900.0),
+        (9, 300.0),
+    ] {
+        params.values[i] = v;
+    }
+    for ir in [true, false] {
+        let (plan, terms) = plan(
+            &k,
+            EptSettings {
+                ir,
+                ap: None,
+                ap_range: Some((0.9, 1.1)),
+                loop_range: None,
+            },
+        );
+        let at = Distortion::new(1.03, 0.98).unwrap();
+        let exact = plan
+            .multipole_ap_derivatives(&terms, &params, &ells, at)
+            .unwrap();
+        for (which, exact) in exact.iter().enumerate() {
+            let value = |x: f64| {
+                let d = if which == 0 {
+                    Distortion::new(x, at.aperp).unwrap()
+                } else {
+                    Distortion::new(at.apar, x).unwrap()
+                };
+                plan.multipole_values_at(&terms, &params, &ells, Some(d))
+                    .unwrap()
+            };
+            let x0 = if which == 0 { at.apar } else { at.aperp };
+            let fd = |h: f64| -> Vec<Vec<f64>> {
+                let (p1, m1, p2, m2) = (
+                    value(x0 + h),
+                    value(x0 - h),
+                    value(x0 + 2.0 * h),
+                    value(x0 - 2.0 * h),
+                );
+                (0..ells.len())
+                    .map(|j| {
+                        (0..k.len())
+                            .map(|i| {
+                                (8.0 * (p1[j][i] - m1[j][i]) - (p2[j][i] - m2[j][i])) / (12.0 * h)
+                            })
+                            .collect()
+                    })
+                    .collect()
+            };
+            let (fine, coarse) = (fd(1e-5), fd(2e-5));
+            for j in 0..ells.len() {
+                let scale = fine[j].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                for i in 0..k.len() {
+                    assert!(
+                        (fine[j][i] - coarse[j][i]).abs() <= 1e-8 * scale,
+                        "step control"
+                    );
+                    assert!(
+                        (exact[j][i] - fine[j][i]).abs() <= 1e-6 * scale,
+                        "ir {ir}, alpha {which}, l{} k {}: {} vs {}",
+                        ells[j],
+                        k[i],
+                        exact[j][i],
+                        fine[j][i]
+                    );
+                }
+            }
+        }
+    }
+}
+
 /// With basis tensors (method basis) two CAMB spectra, a flat w0–wa one, a curved one (projected cut
 /// below the soft modes: loops::basis::soft) and a CLASS one not trained on give the direct
 /// multipoles within 3e-4 of P0 and inside the errors, with and without IR; an Eisenstein–Hu
