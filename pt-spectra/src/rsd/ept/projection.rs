@@ -1,0 +1,142 @@
+//! The ept multipoles beyond one parameter set: several sets of one f with one projection (the
+//! nuisance polynomial's), their exact f-derivatives, and the exact derivatives with respect to α∥,
+//! α⊥ ([`EptPlan::multipole_ap_derivatives`]).
+
+use super::{model, EptParams, EptPlan, EptTerms, GridUse};
+use crate::error::{Error, Result};
+use crate::rsd::ap::Distortion;
+use crate::rsd::MAX_ELL;
+
+impl EptPlan {
+    /// [`Self::multipole_values_at`] of several parameter sets of one growth rate f (e.g. the
+    /// nuisance polynomial's 22 sets, [`crate::pipeline::CosmologyStep::linearise`]): the projection
+    /// onto the multipoles is linear in the model's μ² polynomials on the grid, so it is made once per
+    /// output k as weights on the grid points its stencils reach and applied to each set's
+    /// polynomials (`out[s][j][i]`: set s, j-th ℓ, i-th k; the same numbers to rounding).
+    ///
+    /// # Errors
+    /// As [`Self::multipole_values_at`]; [`Error::InvalidChoice`] for sets of different f.
+    pub fn multipole_values_many(
+        &self,
+        terms: &EptTerms,
+        params: &[EptParams],
+        ells: &[usize],
+        ap: Option<Distortion>,
+    ) -> Result<Vec<Vec<Vec<f64>>>> {
+        Ok(self.many(terms, params, &[], ells, ap)?.0)
+    }
+
+    /// [`Self::multipole_values_many`] of the sets `params`, and the exact f-derivatives of the
+    /// multipoles of the sets `df` (of the same f; their μ² polynomials' and the BAO damping's, no
+    /// finite differences), with one projection: `(values, d/df)`.
+    ///
+    /// # Errors
+    /// As [`Self::multipole_values_many`].
+    #[allow(clippy::type_complexity)]
+    pub fn multipole_values_and_df_many(
+        &self,
+        terms: &EptTerms,
+        params: &[EptParams],
+        df: &[EptParams],
+        ells: &[usize],
+        ap: Option<Distortion>,
+    ) -> Result<(Vec<Vec<Vec<f64>>>, Vec<Vec<Vec<f64>>>)> {
+        self.many(terms, params, df, ells, ap)
+    }
+
+    fn many(
+        &self,
+        terms: &EptTerms,
+        params: &[EptParams],
+        df: &[EptParams],
+        ells: &[usize],
+        ap: Option<Distortion>,
+    ) -> Result<model::Multipoles> {
+        let all: Vec<EptParams> = params.iter().chain(df).copied().collect();
+        if let Some(p) = all.iter().find(|p| p.f() != all[0].f()) {
+            return Err(Error::InvalidChoice {
+                what: format!("parameter sets with f = {} and {}", all[0].f(), p.f()),
+                reason: "a batch of multipoles shares one growth rate (its damping)".into(),
+            });
+        }
+        let (weights, nodes) = self.projection_nodes(terms, &all, ells, ap)?;
+        let models: Vec<_> = params.iter().map(|p| terms.model_values(p)).collect();
+        let df: Vec<_> = df
+            .iter()
+            .map(|p| (terms.model_values(p), terms.parts_df(p)))
+            .collect();
+        let on_grid = ap.is_none() && self.grid_use == GridUse::Output;
+        model::project_many(&models, &df, &self.k_out, &nodes, &weights, on_grid)
+    }
+
+    /// The exact derivatives of [`Self::multipole_values_at`] with respect to α∥ and α⊥ at the
+    /// distortion `ap` (of the interpolant in ln k of the true spectrum, the BAO damping and the
+    /// volume factor; no finite differences): `[d/dα∥, d/dα⊥]`, each `[j][i]` as the values.
+    ///
+    /// # Errors
+    /// As [`Self::multipole_values_at`] (the plan must have an AP grid: [`super::EptSettings::ap`] or
+    /// [`super::EptSettings::ap_range`]).
+    pub fn multipole_ap_derivatives(
+        &self,
+        terms: &EptTerms,
+        params: &EptParams,
+        ells: &[usize],
+        ap: Distortion,
+    ) -> Result<[Vec<Vec<f64>>; 2]> {
+        let (weights, nodes) =
+            self.projection_nodes(terms, std::slice::from_ref(params), ells, Some(ap))?;
+        terms.model_values(params).ap_derivatives(
+            &self.k_out,
+            &nodes,
+            &weights,
+            (ap.apar, ap.aperp),
+        )
+    }
+
+    /// The checks of a projection onto the multipoles `ells` with distortion `ap`, and per μ node
+    /// of the rule the weights (2ℓ + 1) w L_ℓ(μ) × the AP volume factor, and the distortion's
+    /// ln(k'/k), (k'/k)² and μ' (the same at every k).
+    #[allow(clippy::type_complexity)]
+    pub(super) fn projection_nodes(
+        &self,
+        terms: &EptTerms,
+        params: &[EptParams],
+        ells: &[usize],
+        ap: Option<Distortion>,
+    ) -> Result<(Vec<Vec<f64>>, Vec<(f64, f64, f64)>)> {
+        for p in params {
+            p.validate()?;
+        }
+        self.check_ap(ap)?;
+        self.check_terms(terms)?;
+        if let Some(&bad) = ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
+            return Err(Error::InvalidParameter {
+                name: "multipole ell",
+                value: bad as f64,
+                reason: "must be even and at most 8",
+            });
+        }
+        let volume = ap.map_or(1.0, |d| d.volume());
+        let weights: Vec<Vec<f64>> = self.rules[0]
+            .iter()
+            .map(|(_, w, legendre)| {
+                ells.iter()
+                    .map(|&l| w * (2 * l + 1) as f64 * legendre[l] * volume)
+                    .collect()
+            })
+            .collect();
+        // per μ node, the distortion's k'/k and μ' (Distortion::true_coordinates): ln(k'/k),
+        // (k'/k)² and μ', the same at every k
+        let nodes: Vec<(f64, f64, f64)> = self.rules[0]
+            .iter()
+            .map(|(mu, _, _)| match &ap {
+                None => (0.0, 1.0, *mu),
+                Some(ap) => {
+                    let (ratio, mt) = ap.true_coordinates(1.0, *mu);
+                    (ratio.ln(), ratio * ratio, mt)
+                }
+            })
+            .collect();
+        Ok((weights, nodes))
+    }
+}
