@@ -317,6 +317,28 @@ impl Pipeline {
         Ok(PyArray2::from_vec2(py, &rows)?)
     }
 
+    /// The exact derivatives of the data vector with respect to the template parameters f, apar,
+    /// aperp (rows in that order; an array of shape (3, n)) at `cosmology` or `linear` as a call
+    /// takes them, with the nuisance parameters by name (`f` defaults to f(z); the distortion is the
+    /// cosmology's against the fiducial, none without one: the derivatives at apar = aperp = 1). For
+    /// template fits and forecasts: the power spectrum only (no bispectrum block).
+    #[pyo3(signature = (cosmology=None, linear=None, z_input=None, **params))]
+    fn template_jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        cosmology: Option<&Bound<'py, PyAny>>,
+        linear: Option<&Bound<'py, PyAny>>,
+        z_input: Option<f64>,
+        params: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let params = pairs(params)?;
+        let prepared = self.prepared(linear, z_input, cosmology)?;
+        let step = self.inner.step(&prepared).map_err(value_error)?;
+        let named: Vec<(&str, f64)> = params.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+        let rows = step.template_jacobian(&named).map_err(value_error)?;
+        Ok(PyArray2::from_vec2(py, &rows)?)
+    }
+
     /// The parameter names a call takes.
     #[getter]
     fn parameters(&self) -> Vec<&'static str> {

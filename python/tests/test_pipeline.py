@@ -140,3 +140,20 @@ def test_a_repeated_cosmology_is_the_nuisance_polynomial(setup):
     with_f = pipe(other, f=0.7, **PARAMS)
     np.testing.assert_allclose(with_f, pt.Pipeline(obs, Z, precision="fast", cache_dir=cache)(
         other, f=0.7, **PARAMS), rtol=1e-9)
+
+
+def test_the_template_jacobian_matches_differences(setup):
+    """d(data vector)/d(f, apar, aperp), exact: f's against fourth-order differences (the alpha rows
+    are tested against differences in Rust, tests/tests/pipeline.rs, where alpha can be set)."""
+    obs, _, cache = setup
+    fiducial = dict(h=0.676, omega_b=0.022, omega_cdm=0.31 * 0.676**2 - 0.022, n_s=0.97, sigma8=0.8)
+    pipe = pt.Pipeline(obs, Z, fiducial=fiducial, precision="fast", cache_dir=cache)
+    jac = pipe.template_jacobian(COSMO, **PARAMS)
+    values = pipe(COSMO, **PARAMS)
+    assert jac.shape == (3, values.size)
+    f0 = pipe.meta["f"]
+    h = 1e-4 * f0
+    at = lambda f: pipe(COSMO, **{**PARAMS, "f": f})
+    fd = (8 * (at(f0 + h) - at(f0 - h)) - (at(f0 + 2 * h) - at(f0 - 2 * h))) / (12 * h)
+    assert np.max(np.abs(jac[0] - fd)) <= 1e-6 * np.max(np.abs(fd))
+    assert np.all(np.isfinite(jac)) and np.max(np.abs(jac[1])) > 0 and np.max(np.abs(jac[2])) > 0
