@@ -334,16 +334,7 @@ impl EptPlan {
         ells: &[usize],
         ap: Option<Distortion>,
     ) -> Result<Vec<Vec<Estimate>>> {
-        params.validate()?;
-        self.check_ap(ap)?;
-        self.check_terms(terms)?;
-        if let Some(&bad) = ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
-            return Err(Error::InvalidParameter {
-                name: "multipole ell",
-                value: bad as f64,
-                reason: "must be even and at most 8",
-            });
-        }
+        self.check_projection(terms, std::slice::from_ref(params), ells, ap)?;
         let model = terms.model(params);
         let volume = ap.map_or(1.0, |d| d.volume());
         let mut out = vec![Vec::with_capacity(self.k_out.len()); ells.len()];

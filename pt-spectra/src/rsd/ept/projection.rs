@@ -23,7 +23,9 @@ impl EptPlan {
         ells: &[usize],
         ap: Option<Distortion>,
     ) -> Result<Vec<Vec<Vec<f64>>>> {
-        Ok(self.many(terms, params, &[], ells, ap)?.0)
+        Ok(self
+            .multipole_values_and_df_many(terms, params, &[], ells, ap)?
+            .0)
     }
 
     /// [`Self::multipole_values_many`] of the sets `params`, and the exact f-derivatives of the
@@ -41,17 +43,6 @@ impl EptPlan {
         ells: &[usize],
         ap: Option<Distortion>,
     ) -> Result<(Vec<Vec<Vec<f64>>>, Vec<Vec<Vec<f64>>>)> {
-        self.many(terms, params, df, ells, ap)
-    }
-
-    fn many(
-        &self,
-        terms: &EptTerms,
-        params: &[EptParams],
-        df: &[EptParams],
-        ells: &[usize],
-        ap: Option<Distortion>,
-    ) -> Result<model::Multipoles> {
         let all: Vec<EptParams> = params.iter().chain(df).copied().collect();
         if let Some(p) = all.iter().find(|p| p.f() != all[0].f()) {
             return Err(Error::InvalidChoice {
@@ -93,17 +84,15 @@ impl EptPlan {
         )
     }
 
-    /// The checks of a projection onto the multipoles `ells` with distortion `ap`, and per μ node
-    /// of the rule the weights (2ℓ + 1) w L_ℓ(μ) × the AP volume factor, and the distortion's
-    /// ln(k'/k), (k'/k)² and μ' (the same at every k).
-    #[allow(clippy::type_complexity)]
-    pub(super) fn projection_nodes(
+    /// The checks of a projection: each parameter set, the distortion against the plan's AP grid,
+    /// the terms' grid, the multipoles (even, ≤ 8).
+    pub(super) fn check_projection(
         &self,
         terms: &EptTerms,
         params: &[EptParams],
         ells: &[usize],
         ap: Option<Distortion>,
-    ) -> Result<(Vec<Vec<f64>>, Vec<(f64, f64, f64)>)> {
+    ) -> Result<()> {
         for p in params {
             p.validate()?;
         }
@@ -116,6 +105,21 @@ impl EptPlan {
                 reason: "must be even and at most 8",
             });
         }
+        Ok(())
+    }
+
+    /// The checks of a projection onto the multipoles `ells` with distortion `ap`
+    /// ([`Self::check_projection`]), and per μ node of the rule the weights (2ℓ + 1) w L_ℓ(μ) × the
+    /// AP volume factor, and the distortion's ln(k'/k), (k'/k)² and μ' (the same at every k).
+    #[allow(clippy::type_complexity)]
+    pub(super) fn projection_nodes(
+        &self,
+        terms: &EptTerms,
+        params: &[EptParams],
+        ells: &[usize],
+        ap: Option<Distortion>,
+    ) -> Result<(Vec<Vec<f64>>, Vec<(f64, f64, f64)>)> {
+        self.check_projection(terms, params, ells, ap)?;
         let volume = ap.map_or(1.0, |d| d.volume());
         let weights: Vec<Vec<f64>> = self.rules[0]
             .iter()
