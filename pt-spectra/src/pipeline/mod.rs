@@ -24,6 +24,11 @@
 //! A_ij, C_c from 22 evaluations (exact up to rounding: the model is that polynomial), after which
 //! [`Linearised::data_vector`] and its exact Jacobian [`Linearised::jacobian`] cost a few
 //! thousand multiplications.
+//!
+//! Derivatives, all exact (no finite differences): [`CosmologyStep::jacobian`] with respect to the
+//! nuisance parameters and f ([`JACOBIAN_NAMES`]; f through the model's μ² polynomials and the BAO
+//! damping), [`CosmologyStep::template_jacobian`] with respect to f, α∥, α⊥ (the AP projection's
+//! interpolant, damping and volume factor). The cosmological parameters' are not built.
 
 use crate::cosmology::Cosmology;
 use crate::emulator::LinearEmulator;
