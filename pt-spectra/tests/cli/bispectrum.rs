@@ -3,9 +3,12 @@
 use super::{fails_naming, rows, run};
 
 /// The embedded gm2012 spectrum at z = 0 (the default input), read back from `real --model linear`.
+/// Each call writes its own k file: tests run in parallel threads of one process, and two calls at
+/// the same k once shared a file name, so that one read the file while the other truncated it.
 fn p_lin(k: f64) -> f64 {
-    let ks = format!("{k}");
-    let file = std::env::temp_dir().join(format!("pt-spectra-bk-k-{}-{ks}", std::process::id()));
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let file = std::env::temp_dir().join(format!("pt-spectra-bk-k-{}-{call}", std::process::id()));
     std::fs::write(&file, format!("{k}\n")).unwrap();
     let (ok, out, err) = run(&[
         "real",
