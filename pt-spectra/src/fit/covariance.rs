@@ -137,11 +137,7 @@ pub fn check_conditioning(c: &[Vec<f64>], what: &str, row: &dyn Fn(usize) -> Str
 /// (it, the row of the largest component of the most degenerate direction); a matrix that is not
 /// positive definite (a block of a checked one cannot be) is (NaN, its failing row).
 fn conditioning(c: &[Vec<f64>]) -> std::result::Result<f64, (f64, usize)> {
-    let n = c.len();
-    let sigma: Vec<f64> = (0..n).map(|i| c[i][i].sqrt()).collect();
-    let r: Vec<Vec<f64>> = (0..n)
-        .map(|i| (0..n).map(|j| c[i][j] / sigma[i] / sigma[j]).collect())
-        .collect();
+    let r = correlation(c);
     let l = cholesky_pivot(&r).map_err(|(i, _)| (f64::NAN, i))?;
     let (condition, row) = correlation_condition(&r, &l);
     if condition.is_nan() || condition > MAX_CORRELATION_CONDITION {
@@ -149,6 +145,15 @@ fn conditioning(c: &[Vec<f64>]) -> std::result::Result<f64, (f64, usize)> {
     } else {
         Ok(condition)
     }
+}
+
+/// The correlation matrix R = D^{-1/2} C D^{-1/2} of `c` (D its diagonal).
+fn correlation(c: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let sigma: Vec<f64> = (0..c.len()).map(|i| c[i][i].sqrt()).collect();
+    c.iter()
+        .zip(&sigma)
+        .map(|(row, si)| row.iter().zip(&sigma).map(|(x, sj)| x / si / sj).collect())
+        .collect()
 }
 
 /// [`validate`]'s checks; also returns the blocks' lengths.
@@ -285,12 +290,7 @@ fn check(
             c[j][i] = mean;
         }
     }
-    // The correlation matrix.
-    let sigma: Vec<f64> = (0..n).map(|i| c[i][i].sqrt()).collect();
-    let r: Vec<Vec<f64>> = (0..n)
-        .map(|i| (0..n).map(|j| c[i][j] / sigma[i] / sigma[j]).collect())
-        .collect();
-    cholesky_pivot(&r).map_err(|(i, pivot)| {
+    cholesky_pivot(&correlation(&c)).map_err(|(i, pivot)| {
         bad(
             i,
             format!(

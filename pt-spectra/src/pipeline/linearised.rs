@@ -6,18 +6,22 @@ use super::CosmologyStep;
 use crate::error::{Error, Result};
 use crate::rsd::ept::{checked_param, EptParams, PARAM_NAMES};
 
-/// The nuisance parameters of the polynomial, in [`PARAM_NAMES`]' order (all but `f`, which the
-/// cosmology step fixes).
-pub const NUISANCE_NAMES: [&str; 11] = [
-    "b1", "b2", "bs", "b3", "alpha0", "alpha2", "alpha4", "alpha6", "sn", "sn2", "sn4",
-];
+/// The nuisance parameters of the polynomial, in [`PARAM_NAMES`]' order (all but `f`, the last,
+/// which the cosmology step fixes).
+pub const NUISANCE_NAMES: [&str; 11] = {
+    let mut names = [""; 11];
+    let mut i = 0;
+    while i < names.len() {
+        names[i] = PARAM_NAMES[i];
+        i += 1;
+    }
+    names
+};
 
 /// The parameters of the full Jacobian ([`CosmologyStep::jacobian`], and [`Linearised::jacobian`]
-/// with the f-derivative), in its order: the nuisance parameters, then the growth rate f (its
-/// derivative exact too: of the μ² polynomials and of the BAO damping).
-pub const JACOBIAN_NAMES: [&str; 12] = [
-    "b1", "b2", "bs", "b3", "alpha0", "alpha2", "alpha4", "alpha6", "sn", "sn2", "sn4", "f",
-];
+/// with the f-derivative), in its order: [`PARAM_NAMES`], the nuisance parameters then the growth
+/// rate f (its derivative exact too: of the μ² polynomials and of the BAO damping).
+pub const JACOBIAN_NAMES: [&str; 12] = PARAM_NAMES;
 
 /// Bias parameters (u_1 … u_4 = b1, b2, bs, b3; u_0 = 1).
 const BIASES: usize = 4;
