@@ -1,7 +1,9 @@
 //! Bounded minimisation of a smooth objective of a few parameters (−2 ln L of a fit): a projected
 //! quasi-Newton method with several starts.
 //!
-//! * Gradient: central differences inside the minimiser only, with a step per parameter of
+//! * Gradient: the objective's own exact gradient where it gives one ([`Problem::grad`], with an
+//!   approximation of the diagonal curvature such as Gauss–Newton's), else central differences inside
+//!   the minimiser, with a step per parameter of
 //!   [`GRADIENT_STEP`] times its current error scale √(2/∂²f/∂x²) (the diagonal curvature comes free
 //!   with the central differences), one-sided at a bound. For −2 ln L that is a step of 1e-3 σ: the
 //!   truncation error of the gradient is ~1e-6 of its 1σ scale and the rounding error of a χ² of
@@ -38,10 +40,17 @@ pub const AGREEMENT: f64 = 0.01;
 /// Armijo's sufficient-decrease constant.
 const ARMIJO: f64 = 1e-4;
 
+/// An objective's value, exact gradient and an approximation of its diagonal curvature ∂²f/∂xᵢ²
+/// (Gauss–Newton's, say; NaN where unknown) at a point, or `None` where it cannot give them there
+/// (the minimiser then differences the objective at that point).
+pub type ValueGradient<'a> = dyn Fn(&[f64]) -> Option<(f64, Vec<f64>, Vec<f64>)> + 'a;
+
 /// A box-bounded objective of n parameters.
 pub struct Problem<'a> {
     /// The objective; +∞ (or NaN) outside its domain.
     pub f: &'a dyn Fn(&[f64]) -> f64,
+    /// The objective with its exact gradient, if it has one (module docs).
+    pub grad: Option<&'a ValueGradient<'a>>,
     /// Lower bounds.
     pub lo: Vec<f64>,
     /// Upper bounds.
@@ -112,6 +121,22 @@ impl Problem<'_> {
         }
     }
 
+    /// The objective at `x` and, where the problem has an exact gradient, the gradient and the
+    /// diagonal curvature there (one evaluation either way).
+    #[allow(clippy::type_complexity)]
+    fn trial(&self, x: &[f64], count: &mut usize) -> (f64, Option<(Vec<f64>, Vec<f64>)>) {
+        if let Some(grad) = self.grad {
+            if let Some((v, g, c)) = grad(x) {
+                *count += 1;
+                if v.is_finite() && g.iter().all(|g| g.is_finite()) {
+                    return (v, Some((g, c)));
+                }
+                return (f64::INFINITY, None);
+            }
+        }
+        (self.value(x, count), None)
+    }
+
     /// The central-difference gradient and diagonal curvature at `x` (value `f0`), steps of
     /// [`GRADIENT_STEP`] × `sigma`, one-sided where a bound is nearer than the step.
     fn gradient(
@@ -178,8 +203,8 @@ impl Problem<'_> {
         let mut count = 0;
         let mut x = x0.to_vec();
         self.clamp(&mut x);
-        let mut f0 = self.value(&x, &mut count);
         let mut sigma = self.scale.clone();
+        let (mut f0, mut exact) = self.trial(&x, &mut count);
         if !f0.is_finite() {
             return Minimum {
                 x,
@@ -189,7 +214,9 @@ impl Problem<'_> {
                 sigma,
             };
         }
-        let (mut g, c) = self.gradient(&x, f0, &sigma, &mut count);
+        let (mut g, c) = exact
+            .take()
+            .unwrap_or_else(|| self.gradient(&x, f0, &sigma, &mut count));
         sigma = Self::sigma_from(&c, &sigma);
         let diagonal = |sigma: &[f64]| -> Vec<Vec<f64>> {
             (0..n)
@@ -241,7 +268,7 @@ impl Problem<'_> {
                     .map(|(a, b)| a + t * b)
                     .collect::<Vec<f64>>();
                 self.clamp(&mut x_new);
-                f_new = self.value(&x_new, &mut count);
+                (f_new, exact) = self.trial(&x_new, &mut count);
                 let moved: f64 = (0..n).map(|i| g[i] * (x_new[i] - x[i])).sum();
                 if f_new <= f0 + ARMIJO * moved.min(0.0) && f_new.is_finite() {
                     break;
@@ -256,7 +283,9 @@ impl Problem<'_> {
                 converged = -0.5 * slope < 1e3 * self.tolerance;
                 break;
             }
-            let (g_new, c) = self.gradient(&x_new, f_new, &sigma, &mut count);
+            let (g_new, c) = exact
+                .take()
+                .unwrap_or_else(|| self.gradient(&x_new, f_new, &sigma, &mut count));
             sigma = Self::sigma_from(&c, &sigma);
             let s: Vec<f64> = x_new.iter().zip(&x).map(|(a, b)| a - b).collect();
             let y: Vec<f64> = g_new.iter().zip(&g).map(|(a, b)| a - b).collect();
@@ -303,6 +332,7 @@ fn bfgs_update(h: &mut [Vec<f64>], s: &[f64], y: &[f64]) {
 pub fn multistart(problem: &Problem, starts: &[Vec<f64>]) -> MultiStart {
     let coarse = Problem {
         f: problem.f,
+        grad: problem.grad,
         lo: problem.lo.clone(),
         hi: problem.hi.clone(),
         scale: problem.scale.clone(),
@@ -319,6 +349,7 @@ pub fn multistart(problem: &Problem, starts: &[Vec<f64>]) -> MultiStart {
     {
         let polished = Problem {
             f: problem.f,
+            grad: problem.grad,
             lo: problem.lo.clone(),
             hi: problem.hi.clone(),
             scale: m.sigma.clone(),
@@ -412,6 +443,7 @@ mod tests {
         };
         let p = Problem {
             f: &f,
+            grad: None,
             lo: vec![-10.0, -10.0],
             hi: vec![10.0, 10.0],
             scale: vec![1.0, 1.0],
@@ -442,6 +474,7 @@ mod tests {
         let f = |v: &[f64]| 100.0 * (v[1] - v[0] * v[0]).powi(2) + (1.0 - v[0]).powi(2);
         let p = Problem {
             f: &f,
+            grad: None,
             lo: vec![-5.0, -5.0],
             hi: vec![5.0, 5.0],
             scale: vec![0.1, 0.1],
@@ -452,6 +485,48 @@ mod tests {
         assert!((m.x[0] - 1.0).abs() < 2e-3, "{m:?}");
     }
 
+    /// With the exact gradient (and no curvature: NaN) the same minima are found, inside and on a
+    /// bound, in fewer evaluations than with central differences.
+    #[test]
+    fn exact_gradients_find_the_same_minima_in_fewer_evaluations() {
+        let f = |v: &[f64]| 100.0 * (v[1] - v[0] * v[0]).powi(2) + (1.0 - v[0]).powi(2);
+        let grad = |v: &[f64]| {
+            let r = v[1] - v[0] * v[0];
+            Some((
+                f(v),
+                vec![-400.0 * r * v[0] - 2.0 * (1.0 - v[0]), 200.0 * r],
+                vec![f64::NAN; 2],
+            ))
+        };
+        for lo in [-5.0, 1.2] {
+            let differences = Problem {
+                f: &f,
+                grad: None,
+                lo: vec![-5.0, lo],
+                hi: vec![5.0, 5.0],
+                scale: vec![0.1, 0.1],
+                tolerance: EXPECTED_DECREASE,
+            };
+            let exact = Problem {
+                grad: Some(&grad),
+                lo: vec![-5.0, lo],
+                hi: vec![5.0, 5.0],
+                scale: vec![0.1, 0.1],
+                ..differences
+            };
+            let (a, b) = (
+                differences.minimise(&[-1.2, 1.3]),
+                exact.minimise(&[-1.2, 1.3]),
+            );
+            assert!(
+                b.converged && (a.value - b.value).abs() < 1e-6,
+                "{a:?} {b:?}"
+            );
+            assert!((a.x[0] - b.x[0]).abs() < 3e-3, "{a:?} {b:?}");
+            assert!(b.evaluations < a.evaluations, "{a:?} {b:?}");
+        }
+    }
+
     /// Two valleys: the start near the higher one stays there, the multistart takes the lower one
     /// and counts the starts that reached it.
     #[test]
@@ -460,6 +535,7 @@ mod tests {
         let f = |v: &[f64]| (v[0] * v[0] - 1.0).powi(2) + 0.3 * v[0];
         let p = Problem {
             f: &f,
+            grad: None,
             lo: vec![-3.0],
             hi: vec![3.0],
             scale: vec![0.1],

@@ -35,6 +35,7 @@ use crate::survey::observe::Observation;
 
 mod bispectrum;
 mod derived;
+mod gradient;
 pub mod joint;
 mod objective;
 mod priors;
@@ -130,6 +131,9 @@ pub struct GalaxyFit {
     pub spread: f64,
     /// Whether the profile check found a lower minimum than the starts did (then taken).
     pub moved_by_profile: bool,
+    /// Whether the minimiser used the exact gradient of −2 ln L (the velocileptors basis without a
+    /// bispectrum), or central differences of it.
+    pub exact_gradient: bool,
     /// Objective evaluations used (every start, the Hessian and the profiles).
     pub evaluations: usize,
     /// With the physical basis: every parameter at the best fit in it (the order of

@@ -80,15 +80,21 @@ pub fn add_desi_priors(priors: &mut Vec<Prior>, free: &[String], marginalise: &[
 }
 
 /// The header lines of the search and the errors.
-fn search_lines(request: &GalaxyFitRequest, context: &FitContext) -> Vec<String> {
+fn search_lines(
+    request: &GalaxyFitRequest,
+    fits: &[GalaxyFit],
+    context: &FitContext,
+) -> Vec<String> {
     let s = &context.search;
     let mut lines = vec![format!(
-        "minimiser: bounded quasi-Newton (BFGS, central-difference gradients) from {} starts (the \
+        "minimiser: bounded quasi-Newton (BFGS, {}) from {} starts (the \
          start given, then draws from the priors or the start box, seed {}), converged to an \
          expected decrease < {EXPECTED_DECREASE:e}; the lowest minimum is taken; starts_agree: the \
          starts within {AGREEMENT} of it in -2 ln L, starts_spread: the highest start's minimum minus \
          the lowest",
-        s.starts, s.seed
+        gradient_source(fits.iter().map(|f| f.exact_gradient)),
+        s.starts,
+        s.seed
     )];
     lines.push(if s.profile_check {
         format!(
@@ -157,7 +163,7 @@ pub fn ept_fit_table(
             &context.search,
         )?);
     }
-    let mut t = Table::new(fit_header(terms, request, context));
+    let mut t = Table::new(fit_header(terms, request, &fits, context));
     if context.observation.is_some_and(Observation::is_xi) {
         t.push("s_max", "Mpc/h", k_max.to_vec());
     } else {
@@ -182,7 +188,7 @@ pub fn ept_model_table(
     k_max: &[f64],
     context: &FitContext,
 ) -> Result<Table> {
-    let mut header = fit_header(terms, request, context);
+    let mut header = fit_header(terms, request, fits, context);
     header.push(
         "P<l>_data, err_P<l>_data: the data (sqrt of the covariance's diagonal); P<l>_kmax<K>: the \
          best-fit model of the fit up to k_max = K (marginalised parameters at their best values), \
@@ -224,7 +230,12 @@ pub fn ept_model_table(
 
 /// The header of a fit's table: the caller's lines, the terms' source, the observation, the AP,
 /// the fitted data, the search and the errors.
-fn fit_header(terms: &EptTerms, request: &GalaxyFitRequest, context: &FitContext) -> Vec<String> {
+fn fit_header(
+    terms: &EptTerms,
+    request: &GalaxyFitRequest,
+    fits: &[GalaxyFit],
+    context: &FitContext,
+) -> Vec<String> {
     let observation = context.observation;
     let mut header = context.header.clone();
     header.extend(terms.describe_source());
@@ -280,8 +291,29 @@ fn fit_header(terms: &EptTerms, request: &GalaxyFitRequest, context: &FitContext
                 .join(", ")
         }
     ));
-    header.extend(search_lines(request, context));
+    header.extend(search_lines(request, fits, context));
     header
+}
+
+/// How the minimiser's gradients of the fits `exact` (one per fit) were made, for a header.
+pub(super) fn gradient_source(exact: impl Iterator<Item = bool>) -> &'static str {
+    let (mut any, mut all) = (false, true);
+    for e in exact {
+        any |= e;
+        all &= e;
+    }
+    match (any, all) {
+        (true, true) => {
+            "exact gradients: the model's derivatives in f, apar, aperp and the bias, counterterm \
+             and stochastic parameters, the marginalised ones through the envelope theorem and \
+             d ln det F"
+        }
+        (false, _) => {
+            "central-difference gradients (no exact gradient in the physical basis or with a \
+             bispectrum)"
+        }
+        (true, false) => "exact gradients for some fits, central differences for the others",
+    }
 }
 
 /// One row of a fit table: a fit, its request and the template of its derived parameters.
@@ -506,7 +538,7 @@ pub fn ept_profile_table(
         .iter()
         .position(|n| n == name)
         .expect("profile_galaxy checked that the parameter is free");
-    let mut header = fit_header(terms, request, context);
+    let mut header = fit_header(terms, request, std::slice::from_ref(fit), context);
     header.push(format!(
         "profile of {name} at k_max = {}: {} points over +- {} times its error around the best fit \
          {name} = {}, -2 ln L = {}; the other free parameters re-minimised at each point{}; \

@@ -434,8 +434,9 @@ pub fn joint_fit_table(
         fit.points, fit.chi2, fit.minus_two_log_l
     ));
     h.push(format!(
-        "minimiser: bounded quasi-Newton from {} starts (seed {}), the lowest minimum taken; errors \
-         sqrt(diag 2 H^-1) of the joint -2 ln L (steps of {HESSIAN_STEP} sigma){}",
+        "minimiser: bounded quasi-Newton ({}) from {} starts (seed {}), the lowest minimum taken; \
+         errors sqrt(diag 2 H^-1) of the joint -2 ln L (steps of {HESSIAN_STEP} sigma){}",
+        super::ept_fit::gradient_source(fit.sets.iter().map(|f| f.exact_gradient)),
         analysis.search.starts,
         analysis.search.seed,
         if analysis.search.profile_check {

@@ -119,6 +119,28 @@ impl Joint<'_, '_> {
             .map(|(s, o)| o.cost(&self.part(s, x)))
             .sum()
     }
+
+    /// The sum of the sets' −2 ln L with its exact gradient and Gauss–Newton curvature (each set's
+    /// scattered onto the joint parameters), if every set has one.
+    #[allow(clippy::type_complexity)]
+    fn cost_and_gradient(&self, x: &[f64]) -> Option<(f64, Vec<f64>, Vec<f64>)> {
+        let (mut value, mut gradient, mut curvature) =
+            (0.0, vec![0.0; x.len()], vec![0.0; x.len()]);
+        for (s, o) in self.objectives.iter().enumerate() {
+            let (v, g, c) = o.cost_and_gradient(&self.part(s, x))?;
+            value += v;
+            for ((&j, g), c) in self.map[s].iter().zip(g).zip(c) {
+                gradient[j] += g;
+                curvature[j] += c;
+            }
+        }
+        Some((value, gradient, curvature))
+    }
+
+    /// Whether every set's objective has an exact gradient.
+    fn exact_gradient(&self) -> bool {
+        self.objectives.iter().all(|o| o.exact_gradient)
+    }
 }
 
 /// The error of a sharing rule broken.
@@ -296,7 +318,11 @@ pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result
         x0,
         physical,
     };
-    let found = find(&|x: &[f64]| joint.cost(x), &space, search)?;
+    let exact = |x: &[f64]| joint.cost_and_gradient(x);
+    let grad = joint
+        .exact_gradient()
+        .then_some(&exact as &crate::fit::bounded::ValueGradient);
+    let found = find(&|x: &[f64]| joint.cost(x), grad, &space, search)?;
     let x = &found.best.x;
     let mut fits = Vec::with_capacity(sets.len());
     for (s, o) in joint.objectives.iter().enumerate() {

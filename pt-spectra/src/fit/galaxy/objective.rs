@@ -28,9 +28,9 @@ type CachedTemplate = (Vec<u64>, Vec<Vec<f64>>);
 /// The objective of one request on one data window.
 pub(super) struct Objective<'a> {
     pub(super) plan: &'a EptPlan,
-    terms: &'a EptTerms,
+    pub(super) terms: &'a EptTerms,
     /// The window and bins between the model and the data, if any.
-    observation: Option<&'a Observation>,
+    pub(super) observation: Option<&'a Observation>,
     /// Every slot's start or fixed value (the model's parameters, α∥, α⊥).
     pub(super) start: [f64; SLOTS],
     /// Whether the measurement has a distortion.
@@ -38,26 +38,28 @@ pub(super) struct Objective<'a> {
     /// The parameter basis of the slots: `None` velocileptors' (the model's own), else the DESI
     /// physical basis, converted to the model's at every evaluation.
     pub(super) basis: Option<PhysicalBasis>,
-    ells: Vec<usize>,
+    pub(super) ells: Vec<usize>,
     pub(super) free: Vec<usize>,
     pub(super) marg: Vec<usize>,
     /// Per slot, its prior, if any.
     pub(super) priors: Vec<Option<PriorShape>>,
     /// Per fitted ℓ (in the order of `ells`), the k indices of its fitted points.
-    window: Vec<Vec<usize>>,
+    pub(super) window: Vec<Vec<usize>>,
     /// Whether the marginalised templates are independent of the biases (checked at construction).
-    bias_free_templates: bool,
+    pub(super) bias_free_templates: bool,
+    /// Whether [`Self::value_and_gradient`] gives the exact gradient (checked at construction).
+    pub(super) exact_gradient: bool,
     /// The last [`CACHE_SIZE`] templates and the slots they were made at ([`Self::template_key`]).
-    cache: std::cell::RefCell<Vec<CachedTemplate>>,
+    pub(super) cache: std::cell::RefCell<Vec<CachedTemplate>>,
     /// Whether −2 ln L holds ln det F (the linear parameters marginalised), or not (profiled).
     pub(super) log_det: bool,
     /// L⁻¹ of the Cholesky factor of the window's covariance.
-    whiten: Vec<Vec<f64>>,
+    pub(super) whiten: Vec<Vec<f64>>,
     /// L⁻¹ d.
-    data: Vec<f64>,
+    pub(super) data: Vec<f64>,
     /// The bispectrum beside the power spectrum, if the data set has one: its entries follow the
     /// power spectrum's in the model and data vectors.
-    bispectrum: Option<BispectrumModel<'a>>,
+    pub(super) bispectrum: Option<BispectrumModel<'a>>,
 }
 
 impl Objective<'_> {
@@ -93,39 +95,50 @@ impl Objective<'_> {
         self.bispectrum.is_some()
     }
 
+    /// The multipoles the plan evaluates: the window's model multipoles, or the fitted ones.
+    pub(super) fn plan_ells(&self) -> &[usize] {
+        self.observation.map_or(&self.ells, |o| o.model_ells())
+    }
+
+    /// The power spectrum's fitted points (not whitened) of the plan's multipoles `m` over
+    /// [`Self::plan_ells`]: through the window and bins, if any (linear in `m`).
+    pub(super) fn fitted_points(&self, m: Vec<Vec<f64>>) -> Result<Vec<f64>> {
+        let m = match self.observation {
+            None => m,
+            Some(o) => {
+                // the chain as its matrix (made once per observation): one product per model
+                let (matrix, _) = o.matrix()?;
+                let flat = crate::survey::observe::apply_matrix(matrix, &m);
+                flat.chunks(o.k_out().len()).map(<[f64]>::to_vec).collect()
+            }
+        };
+        Ok(m.iter()
+            .zip(&self.window)
+            .flat_map(|(l, window)| window.iter().map(move |&i| l[i]))
+            .collect())
+    }
+
+    /// L⁻¹ `raw`: a vector of the fitted entries whitened.
+    pub(super) fn whitened(&self, raw: &[f64]) -> Vec<f64> {
+        self.whiten
+            .iter()
+            .map(|row| row.iter().zip(raw).map(|(a, b)| a * b).sum())
+            .collect()
+    }
+
     /// The whitened model at the slots `v` (L⁻¹ m): the power spectrum's fitted points, then the
     /// bispectrum's entries.
     pub(super) fn model(&self, v: &[f64; SLOTS]) -> Result<Vec<f64>> {
         let (p, ap) = self.split(v)?;
-        let p = &p;
-        let m = match self.observation {
-            None => self
-                .plan
-                .multipole_values_at(self.terms, p, &self.ells, ap)?,
-            Some(o) => {
-                // the chain as its matrix (made once per observation): one product per model
-                let model = self
-                    .plan
-                    .multipole_values_at(self.terms, p, o.model_ells(), ap)?;
-                let (matrix, _) = o.matrix()?;
-                let flat = crate::survey::observe::apply_matrix(matrix, &model);
-                flat.chunks(o.k_out().len()).map(<[f64]>::to_vec).collect()
-            }
-        };
-        let mut raw: Vec<f64> = m
-            .iter()
-            .zip(&self.window)
-            .flat_map(|(l, window)| window.iter().map(move |&i| l[i]))
-            .collect();
+        let m = self
+            .plan
+            .multipole_values_at(self.terms, &p, self.plan_ells(), ap)?;
+        let mut raw = self.fitted_points(m)?;
         if let Some(b) = &self.bispectrum {
             let own: [f64; 4] = std::array::from_fn(|i| v[B_SLOT + i]);
-            raw.extend(b.values(p, ap, &own)?);
+            raw.extend(b.values(&p, ap, &own)?);
         }
-        Ok(self
-            .whiten
-            .iter()
-            .map(|row| row.iter().zip(&raw).map(|(a, b)| a * b).sum())
-            .collect())
+        Ok(self.whitened(&raw))
     }
 
     /// The whitened templates Tᵢ = m(v, aᵢ = 1) − m(v, aᵢ = 0) of the marginalised parameters at the
@@ -181,6 +194,16 @@ impl Objective<'_> {
         self.evaluate(x).map_or(f64::INFINITY, |e| e.0)
     }
 
+    /// [`Self::value_and_gradient`] for the minimiser: `None` without an exact gradient, +∞
+    /// outside the model's domain.
+    #[allow(clippy::type_complexity)]
+    pub(super) fn cost_and_gradient(&self, x: &[f64]) -> Option<(f64, Vec<f64>, Vec<f64>)> {
+        match self.value_and_gradient(x) {
+            Ok(found) => found,
+            Err(_) => Some((f64::INFINITY, vec![0.0; x.len()], vec![f64::NAN; x.len()])),
+        }
+    }
+
     /// The number of fitted data points.
     pub(super) fn points(&self) -> usize {
         self.data.len()
@@ -218,7 +241,22 @@ impl Objective<'_> {
                 t
             }
         };
-        let r0: Vec<f64> = self.data.iter().zip(&m0).map(|(d, m)| d - m).collect();
+        let m = self.marginalise(&mut v, &m0, &templates)?;
+        let errors = (0..m.ahat.len()).map(|a| m.inverse[a][a].sqrt()).collect();
+        Ok((m.total, m.chi2, v, errors))
+    }
+
+    /// The linear parameters marginalised at the slots `v` (set to their best values â here), the
+    /// whitened model `m0` without them and their templates: −2 ln L (with ln det F if
+    /// [`Self::log_det`], the priors of the marginalised and the free parameters), χ², â, F⁻¹ and
+    /// the residual L⁻¹(d − m0) − Σ âₐTₐ.
+    pub(super) fn marginalise(
+        &self,
+        v: &mut [f64; SLOTS],
+        m0: &[f64],
+        templates: &[Vec<f64>],
+    ) -> Result<Marginal> {
+        let r0: Vec<f64> = self.data.iter().zip(m0).map(|(d, m)| d - m).collect();
         let n = self.marg.len();
         let mut f = vec![vec![0.0; n]; n];
         let mut b = vec![0.0; n];
@@ -234,11 +272,12 @@ impl Objective<'_> {
             f[a][a] += precision;
         }
         let (ahat, inverse, log_det) = solve_spd(&f, &b)?;
-        let mut chi2 = 0.0;
-        for (j, r) in r0.iter().enumerate() {
-            let fit: f64 = (0..n).map(|a| ahat[a] * templates[a][j]).sum();
-            chi2 += (r - fit).powi(2);
-        }
+        let residual: Vec<f64> = r0
+            .iter()
+            .enumerate()
+            .map(|(j, r)| r - (0..n).map(|a| ahat[a] * templates[a][j]).sum::<f64>())
+            .collect();
+        let chi2 = dot(&residual, &residual);
         let mut total = chi2 + if self.log_det { log_det } else { 0.0 };
         for (a, &i) in self.marg.iter().enumerate() {
             v[i] = ahat[a];
@@ -252,9 +291,28 @@ impl Objective<'_> {
                 total += prior.minus_two_log(v[i]);
             }
         }
-        let errors = (0..n).map(|a| inverse[a][a].sqrt()).collect();
-        Ok((total, chi2, v, errors))
+        Ok(Marginal {
+            total,
+            chi2,
+            ahat,
+            inverse,
+            residual,
+        })
     }
+}
+
+/// The linear parameters marginalised at one point ([`Objective::marginalise`]).
+pub(super) struct Marginal {
+    /// −2 ln L.
+    pub(super) total: f64,
+    /// χ² at â.
+    pub(super) chi2: f64,
+    /// The best values â of the marginalised parameters.
+    pub(super) ahat: Vec<f64>,
+    /// F⁻¹, the inverse of their Fisher matrix (with their priors).
+    pub(super) inverse: Vec<Vec<f64>>,
+    /// L⁻¹(d − m0) − Σ âₐTₐ.
+    pub(super) residual: Vec<f64>,
 }
 
 /// The objective of `request` on `data` (through `observation`, if any).
@@ -462,12 +520,15 @@ pub(super) fn objective<'a>(
         window,
         log_det: true,
         bias_free_templates: false,
+        exact_gradient: false,
         cache: std::cell::RefCell::new(Vec::new()),
         whiten,
         data: data_vector,
         bispectrum: bispectrum.map(BispectrumModel::new),
     };
     objective.check_bias_free_templates()?;
+    // (a model the checks cannot evaluate falls back to differences; its errors surface at the start)
+    objective.exact_gradient = objective.check_exact_gradient().unwrap_or(false);
     Ok(objective)
 }
 

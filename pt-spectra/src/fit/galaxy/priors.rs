@@ -124,6 +124,21 @@ impl PriorShape {
         }
     }
 
+    /// The first and second derivatives of [`Self::minus_two_log`] at `x` inside the support (0 for
+    /// a flat prior; with y = ln x, a log-normal's −2 ln p = ((y − μ)/σ)² + 2y).
+    pub fn minus_two_log_derivatives(&self, x: f64) -> (f64, f64) {
+        match *self {
+            PriorShape::Gaussian { mean, sigma } => {
+                (2.0 * (x - mean) / (sigma * sigma), 2.0 / (sigma * sigma))
+            }
+            PriorShape::Flat { .. } => (0.0, 0.0),
+            PriorShape::LogNormal { mu, sigma } => {
+                let dy = 2.0 * (x.ln() - mu) / (sigma * sigma) + 2.0;
+                (dy / x, (2.0 / (sigma * sigma) - dy) / (x * x))
+            }
+        }
+    }
+
     /// The range the prior allows: a flat prior's, (0, ∞) for a log-normal one, ℝ for a Gaussian.
     pub fn support(&self) -> (f64, f64) {
         match *self {
@@ -234,6 +249,31 @@ mod tests {
                 e.contains(bad) || e.contains("b2") || e.contains("f"),
                 "{bad}: {e}"
             );
+        }
+    }
+
+    /// The derivatives against central differences of the density itself.
+    #[test]
+    fn minus_two_log_derivatives_match_differences() {
+        for shape in [
+            PriorShape::Gaussian {
+                mean: 0.3,
+                sigma: 2.0,
+            },
+            PriorShape::LogNormal {
+                mu: 0.2,
+                sigma: 0.7,
+            },
+            PriorShape::Flat { lo: -1.0, hi: 4.0 },
+        ] {
+            let x = 1.3;
+            let h = 1e-4;
+            let f = |x: f64| shape.minus_two_log(x);
+            let (d1, d2) = shape.minus_two_log_derivatives(x);
+            let fd1 = (f(x + h) - f(x - h)) / (2.0 * h);
+            let fd2 = (f(x + h) - 2.0 * f(x) + f(x - h)) / (h * h);
+            assert!((d1 - fd1).abs() < 1e-7, "{shape}: {d1} {fd1}");
+            assert!((d2 - fd2).abs() < 1e-5, "{shape}: {d2} {fd2}");
         }
     }
 

@@ -18,7 +18,9 @@
 use super::objective::Objective;
 use super::{GalaxyFit, PriorShape, AP_SLOT, B_SLOT, SLOTS};
 use crate::error::{Error, Result};
-use crate::fit::bounded::{multistart, Minimum, Problem, AGREEMENT, EXPECTED_DECREASE};
+use crate::fit::bounded::{
+    multistart, Minimum, Problem, ValueGradient, AGREEMENT, EXPECTED_DECREASE,
+};
 use crate::linalg::solve_spd;
 use rand::{Rng, SeedableRng};
 
@@ -225,8 +227,13 @@ fn profile_at(problem: &Problem, sigma: &[f64], i: usize, v: f64, guess: &[f64])
             .collect()
     };
     let g = |y: &[f64]| (problem.f)(&insert(y, i, v));
+    let exact = |y: &[f64]| {
+        let (value, gradient, curvature) = (problem.grad?)(&insert(y, i, v))?;
+        Some((value, drop(&gradient), drop(&curvature)))
+    };
     let reduced = Problem {
         f: &g,
+        grad: problem.grad.map(|_| &exact as &ValueGradient),
         lo: drop(&problem.lo),
         hi: drop(&problem.hi),
         scale: drop(sigma),
@@ -398,6 +405,8 @@ pub(super) struct Found {
     pub(super) moved: bool,
     /// Objective evaluations used.
     pub(super) evaluations: usize,
+    /// Whether the minimiser had the exact gradient.
+    pub(super) exact_gradient: bool,
 }
 
 /// The fit of `objective` (module docs).
@@ -425,7 +434,9 @@ pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit>
         x0,
         physical: objective.basis.is_some(),
     };
-    let found = find(&|x: &[f64]| objective.cost(x), &space, search)?;
+    let exact = |x: &[f64]| objective.cost_and_gradient(x);
+    let grad = objective.exact_gradient.then_some(&exact as &ValueGradient);
+    let found = find(&|x: &[f64]| objective.cost(x), grad, &space, search)?;
     package(objective, &found.best.x, &found, found.errors.clone())
 }
 
@@ -458,6 +469,7 @@ pub(super) fn package(
         agree: found.agree,
         spread: found.spread,
         moved_by_profile: found.moved,
+        exact_gradient: found.exact_gradient,
         evaluations: found.evaluations,
         physical: objective.basis.map(|_| std::array::from_fn(|i| slots[i])),
         bispectrum: objective
@@ -471,7 +483,12 @@ pub(super) fn package(
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for no start or no start with a finite −2 ln L.
-pub(super) fn find(cost: &dyn Fn(&[f64]) -> f64, space: &Space, search: &Search) -> Result<Found> {
+pub(super) fn find(
+    cost: &dyn Fn(&[f64]) -> f64,
+    grad: Option<&ValueGradient>,
+    space: &Space,
+    search: &Search,
+) -> Result<Found> {
     if search.starts == 0 {
         return Err(Error::InvalidParameter {
             name: "number of starts",
@@ -482,6 +499,7 @@ pub(super) fn find(cost: &dyn Fn(&[f64]) -> f64, space: &Space, search: &Search)
     let (lo, hi) = (&space.lo, &space.hi);
     let problem = Problem {
         f: cost,
+        grad,
         lo: lo.clone(),
         hi: hi.clone(),
         scale: space.scale.clone(),
@@ -561,5 +579,6 @@ pub(super) fn find(cost: &dyn Fn(&[f64]) -> f64, space: &Space, search: &Search)
         },
         moved,
         evaluations,
+        exact_gradient: grad.is_some(),
     })
 }

@@ -89,8 +89,7 @@ fn boss() -> (EptPlan, EptTerms, MultipoleData, GalaxyFitRequest) {
 }
 
 /// The reported minimum is the lowest of 8 single-start minimisations from spread starts to
-/// Δχ² < 0.01, one of which stops in a local minimum more than 1 above it (with the old search the
-/// default start did too); the error given follows the 10% rule between the Hessian and the profile.
+/// Δχ² < 0.01, some of which stop in a local minimum more than 1 above it; the error given follows the 10% rule between the Hessian and the profile.
 #[test]
 fn boss_minimum_is_the_lowest_of_eight_starts() {
     let (plan, terms, data, request) = boss();
@@ -126,8 +125,12 @@ fn boss_minimum_is_the_lowest_of_eight_starts() {
         "{} vs the single starts {single:?}",
         fit.minus_two_log_l
     );
-    // The first start (f 0.6, b2 1) ends in a local minimum (measured 24.54 against 22.16).
-    assert!(single[0] > fit.minus_two_log_l + 1.0, "{single:?}");
+    // Some starts end in a local minimum (measured 24.54 against 22.16: with the exact gradient the
+    // 2nd, 4th and 7th, with central differences the 1st): one start alone is not enough.
+    assert!(
+        single.iter().any(|&v| v > fit.minus_two_log_l + 1.0),
+        "{single:?}"
+    );
     for j in 0..request.free.len() {
         let (lo, hi) = fit.intervals[j];
         let half = 0.5 * (hi - lo);

@@ -271,66 +271,74 @@ fn lagrange4_derivative(t: f64) -> [f64; 4] {
     ]
 }
 
-impl Model<'_> {
-    /// The exact derivatives of the multipoles with respect to α∥ and α⊥ at (`apar`, `aperp`):
-    /// `nodes` and `weights` (the volume factor included) as [`project_many`]'s at that distortion.
-    /// With A = μ²/α∥², B = (1 − μ²)/α⊥², k'² = k²(A + B) and μ'² = A/(A + B), so
-    /// ∂ln k'/∂α∥ = −μ'²/α∥, ∂ln k'/∂α⊥ = −(1 − μ'²)/α⊥, ∂μ'²/∂α∥ = −2μ'²(1 − μ'²)/α∥ = −(α⊥/α∥)
-    /// ∂μ'²/∂α⊥, and the volume 1/(α∥α⊥²) gives −1/α∥, −2/α⊥ times the value. P(k', μ') is the
-    /// four-point Lagrange interpolant in ln k' of the μ² polynomials with the BAO damping: its
-    /// derivative is that of the interpolant (the weights' derivatives) and of the damping.
-    pub(super) fn ap_derivatives(
-        &self,
-        k_out: &[f64],
-        nodes: &[(f64, f64, f64)],
-        weights: &[Vec<f64>],
-        (apar, aperp): (f64, f64),
-    ) -> Result<[Vec<Vec<f64>>; 2]> {
-        let n_ell = weights.first().map_or(0, Vec::len);
-        let mut out = [
+/// The exact derivatives of the multipoles of every model of `models` (one growth rate f, one
+/// Σ²: the sets of one spectrum and f) with respect to α∥ and α⊥ at (`apar`, `aperp`): `nodes` and
+/// `weights` (the volume factor included) as [`project_many`]'s at that distortion, the stencils and
+/// the damping made once for all models. With A = μ²/α∥², B = (1 − μ²)/α⊥², k'² = k²(A + B) and
+/// μ'² = A/(A + B), so ∂ln k'/∂α∥ = −μ'²/α∥, ∂ln k'/∂α⊥ = −(1 − μ'²)/α⊥, ∂μ'²/∂α∥ = −2μ'²(1 − μ'²)/α∥
+/// = −(α⊥/α∥) ∂μ'²/∂α⊥, and the volume 1/(α∥α⊥²) gives −1/α∥, −2/α⊥ times the value. P(k', μ') is
+/// the four-point Lagrange interpolant in ln k' of the μ² polynomials with the BAO damping: its
+/// derivative is that of the interpolant (the weights' derivatives) and of the damping.
+pub(super) fn ap_derivatives_many(
+    models: &[Model<'_>],
+    k_out: &[f64],
+    nodes: &[(f64, f64, f64)],
+    weights: &[Vec<f64>],
+    (apar, aperp): (f64, f64),
+) -> Result<Vec<[Vec<Vec<f64>>; 2]>> {
+    let Some(first) = models.first() else {
+        return Ok(Vec::new());
+    };
+    let n_ell = weights.first().map_or(0, Vec::len);
+    let mut out = vec![
+        [
             vec![vec![0.0; k_out.len()]; n_ell],
             vec![vec![0.0; k_out.len()]; n_ell],
         ];
-        let horner = |c: &[f64; 5], m2: f64| c.iter().rev().fold(0.0, |a, c| a * m2 + c);
-        let horner_d =
-            |c: &[f64; 5], m2: f64| (1..5).rev().fold(0.0, |a, q| a * m2 + q as f64 * c[q]);
-        let growth = self.f * (2.0 + self.f);
-        for (i, &k) in k_out.iter().enumerate() {
-            let (ln_k, k2) = (k.ln(), k * k);
-            for (&(ln_ratio, ratio2, mt), c) in nodes.iter().zip(weights) {
-                let ln_kt = ln_k + ln_ratio;
-                let (b, l) = self.stencil_ln(ln_kt)?;
-                let t = (ln_kt - self.ln_k0) / self.ln_step - b as f64;
-                let dl = lagrange4_derivative(t).map(|d| d / self.ln_step);
-                let m2 = mt * mt;
-                let x = k2 * ratio2 * self.sigma2;
-                let damping = (-x * (1.0 + growth * m2)).exp();
-                let d_lnk = -2.0 * x * (1.0 + growth * m2) * damping;
-                let d_m2 = -x * growth * damping;
+        models.len()
+    ];
+    let horner = |c: &[f64; 5], m2: f64| c.iter().rev().fold(0.0, |a, c| a * m2 + c);
+    let horner_d = |c: &[f64; 5], m2: f64| (1..5).rev().fold(0.0, |a, q| a * m2 + q as f64 * c[q]);
+    let growth = first.f * (2.0 + first.f);
+    for (i, &k) in k_out.iter().enumerate() {
+        let (ln_k, k2) = (k.ln(), k * k);
+        for (&(ln_ratio, ratio2, mt), c) in nodes.iter().zip(weights) {
+            let ln_kt = ln_k + ln_ratio;
+            let (b, l) = first.stencil_ln(ln_kt)?;
+            let t = (ln_kt - first.ln_k0) / first.ln_step - b as f64;
+            let dl = lagrange4_derivative(t).map(|d| d / first.ln_step);
+            let m2 = mt * mt;
+            let x = k2 * ratio2 * first.sigma2;
+            let damping = (-x * (1.0 + growth * m2)).exp();
+            let d_lnk = -2.0 * x * (1.0 + growth * m2) * damping;
+            let d_m2 = -x * growth * damping;
+            let dm2 = 2.0 * m2 * (1.0 - m2);
+            for (model, o) in models.iter().zip(out.iter_mut()) {
                 // P, ∂P/∂ln k', ∂P/∂μ'²
                 let (mut p, mut p_lnk, mut p_m2) = (0.0, 0.0, 0.0);
                 for j in 0..4 {
-                    let (n, w) = &self.parts[b + j];
+                    let (n, w) = &model.parts[b + j];
                     let (nv, wv) = (horner(&n.0, m2), horner(&w.0, m2));
                     p += l[j] * (nv + damping * wv);
                     p_lnk += dl[j] * (nv + damping * wv) + l[j] * d_lnk * wv;
                     p_m2 += l[j] * (horner_d(&n.0, m2) + damping * horner_d(&w.0, m2) + d_m2 * wv);
                 }
-                let dm2 = 2.0 * m2 * (1.0 - m2);
                 let derivatives = [
                     -p_lnk * m2 / apar - p_m2 * dm2 / apar - p / apar,
                     -p_lnk * (1.0 - m2) / aperp + p_m2 * dm2 / aperp - 2.0 * p / aperp,
                 ];
-                for (o, d) in out.iter_mut().zip(derivatives) {
+                for (o, d) in o.iter_mut().zip(derivatives) {
                     for (oe, ce) in o.iter_mut().zip(c) {
                         oe[i] += ce * d;
                     }
                 }
             }
         }
-        Ok(out)
     }
+    Ok(out)
+}
 
+impl Model<'_> {
     /// P(k, μ) at grid index `i` (k = grid[i]).
     pub(super) fn at(&self, i: usize, k: f64, mu: f64) -> Estimate {
         let (n, w) = &self.parts[i];

@@ -74,14 +74,32 @@ impl EptPlan {
         ells: &[usize],
         ap: Distortion,
     ) -> Result<[Vec<Vec<f64>>; 2]> {
-        let (weights, nodes) =
-            self.projection_nodes(terms, std::slice::from_ref(params), ells, Some(ap))?;
-        terms.model_values(params).ap_derivatives(
-            &self.k_out,
-            &nodes,
-            &weights,
-            (ap.apar, ap.aperp),
-        )
+        let mut all =
+            self.multipole_ap_derivatives_many(terms, std::slice::from_ref(params), ells, ap)?;
+        Ok(all.remove(0))
+    }
+
+    /// [`Self::multipole_ap_derivatives`] of several parameter sets of one growth rate f, with one
+    /// projection (its stencils and damping made once): one `[d/dα∥, d/dα⊥]` per set.
+    ///
+    /// # Errors
+    /// As [`Self::multipole_values_many`].
+    pub fn multipole_ap_derivatives_many(
+        &self,
+        terms: &EptTerms,
+        params: &[EptParams],
+        ells: &[usize],
+        ap: Distortion,
+    ) -> Result<Vec<[Vec<Vec<f64>>; 2]>> {
+        if let Some(p) = params.iter().find(|p| p.f() != params[0].f()) {
+            return Err(Error::InvalidChoice {
+                what: format!("parameter sets with f = {} and {}", params[0].f(), p.f()),
+                reason: "a batch of multipoles shares one growth rate (its damping)".into(),
+            });
+        }
+        let (weights, nodes) = self.projection_nodes(terms, params, ells, Some(ap))?;
+        let models: Vec<_> = params.iter().map(|p| terms.model_values(p)).collect();
+        model::ap_derivatives_many(&models, &self.k_out, &nodes, &weights, (ap.apar, ap.aperp))
     }
 
     /// The checks of a projection: each parameter set, the distortion against the plan's AP grid,

@@ -94,8 +94,12 @@ pub fn profile_galaxy(
     let fit = solve(&objective, search)?;
     let (lo, hi, _) = bounds(&objective);
     let f = |x: &[f64]| objective.cost(x);
+    let exact = |x: &[f64]| objective.cost_and_gradient(x);
     let problem = Problem {
         f: &f,
+        grad: objective
+            .exact_gradient
+            .then_some(&exact as &crate::fit::bounded::ValueGradient),
         lo,
         hi,
         scale: vec![],
