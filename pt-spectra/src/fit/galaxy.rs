@@ -131,7 +131,7 @@ pub struct GalaxyFit {
     pub spread: f64,
     /// Whether the profile check found a lower minimum than the starts did (then taken).
     pub moved_by_profile: bool,
-    /// Whether the minimiser used the exact gradient of −2 ln L (the velocileptors basis without a
+    /// Whether the minimiser used the exact gradient of −2 ln L (a power spectrum without a
     /// bispectrum), or central differences of it.
     pub exact_gradient: bool,
     /// Objective evaluations used (every start, the Hessian and the profiles).

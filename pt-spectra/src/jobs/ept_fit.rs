@@ -308,10 +308,7 @@ pub(super) fn gradient_source(exact: impl Iterator<Item = bool>) -> &'static str
              and stochastic parameters, the marginalised ones through the envelope theorem and \
              d ln det F"
         }
-        (false, _) => {
-            "central-difference gradients (no exact gradient in the physical basis or with a \
-             bispectrum)"
-        }
+        (false, _) => "central-difference gradients (no exact gradient with a bispectrum)",
         (true, false) => "exact gradients for some fits, central differences for the others",
     }
 }

@@ -10,107 +10,112 @@
 //! ∂Φ/∂θⱼ = −2 rᵀ(∂m₀/∂θⱼ + Σₐ âₐ ∂Tₐ/∂θⱼ) + 2 Σₐ꜀ (F⁻¹)ₐ꜀ T꜀ᵀ ∂Tₐ/∂θⱼ + ∂priors/∂θⱼ,
 //! ```
 //!
-//! r = d − m₀ − Σ âₐTₐ. The model's derivatives are exact:
-//! * f, α∥, α⊥: those of the projection ([`crate::rsd::ept::EptPlan::multipole_values_and_df_many`],
-//!   [`crate::rsd::ept::EptPlan::multipole_ap_derivatives_many`]), at the point and at each template's
-//!   set, so ∂Tₐ/∂θ is their difference;
-//! * the polynomial parameters (biases, counterterms, stochastic terms held free): the model is at
-//!   most quadratic in each, so ∂m/∂θⱼ = [m(θ + eⱼ) − m(θ − eⱼ)]/2 exactly (checked when the
-//!   objective is made, as is ∂Tₐ/∂θⱼ = 0: the templates do not multiply them).
+//! r = d − m₀ − Σ âₐTₐ. The model's derivatives are exact. With p(v) the model's parameters of the
+//! slots v (the DESI physical basis maps them, [`crate::rsd::ept::physical::PhysicalBasis::jacobian`];
+//! the identity in velocileptors' basis) and Mᵢ = ∂m/∂pᵢ:
+//! * the polynomial parameters (biases, counterterms, stochastic terms): the model is at most
+//!   quadratic in each, so Mᵢ = [m(p + eᵢ) − m(p − eᵢ)]/2 exactly; and Mᵢ does not depend on the
+//!   linear ones (no product of a bias with a counterterm or stochastic term), so one Mᵢ at the point
+//!   serves every template's set (both checked when the objective is made);
+//! * f, α∥, α⊥: the projection's exact derivatives ([`crate::rsd::ept::EptPlan::multipole_values_and_df_many`],
+//!   [`crate::rsd::ept::EptPlan::multipole_ap_derivatives_many`]) at the point and at each template's set;
+//! * ∂m/∂vⱼ = Σᵢ Mᵢ ∂pᵢ/∂vⱼ (+ ∂m/∂f for f) at each set, and ∂Tₐ/∂vⱼ the difference of a template's
+//!   set and the point.
 //!
 //! The curvature handed to the minimiser with it is Gauss–Newton's, 2(|Jⱼ|² − (TᵀJⱼ)ᵀF⁻¹(TᵀJⱼ)) plus
 //! the prior's, with Jⱼ the column above: the diagonal of the profiled χ²'s Hessian without the
 //! model's second derivatives.
 //!
-//! Not covered (the minimiser differences the objective there, and the output says so): the DESI
-//! physical basis (its map mixes the counterterms with b₁ and f), a bispectrum beside the power
-//! spectrum, and a model that fails the checks above.
+//! Not covered (the minimiser differences the objective there, and the output says so): a bispectrum
+//! beside the power spectrum, and a model that fails the checks above.
 
 use super::objective::Objective;
 use super::{AP_SLOT, SLOTS};
 use crate::error::Result;
 use crate::linalg::dot;
+use crate::rsd::ap::Distortion;
 use crate::rsd::ept::{EptParams, PARAM_NAMES};
 
-/// The slot of the growth rate f.
+/// The slot (and model parameter index) of the growth rate f.
 const F_SLOT: usize = PARAM_NAMES.len() - 1;
 
-/// The relative size, against the model, of a third difference (or of a template's change) that
-/// counts as none: rounding of the model's sums.
+/// The model's parameters that enter linearly: counterterms and stochastic terms.
+const LINEAR: std::ops::Range<usize> = 4..F_SLOT;
+
+/// The relative size, against the model, of a third or mixed difference that counts as none:
+/// rounding of the model's sums.
 const EXACTNESS_TOLERANCE: f64 = 1e-9;
 
-/// What the gradient needs to know of one free parameter.
-#[derive(Clone, Copy)]
-enum Kind {
-    /// A polynomial parameter: its index among the ± sets.
-    Polynomial(usize),
-    /// The growth rate.
-    Growth,
-    /// α∥ (0) or α⊥ (1).
-    Distortion(usize),
-}
+/// ∂p/∂v of a parameter basis: row i a model parameter, column j a slot (both in [`PARAM_NAMES`]'
+/// order).
+type Jacobian = [[f64; F_SLOT + 1]; F_SLOT + 1];
 
 impl Objective<'_> {
-    /// Whether [`Self::value_and_gradient`] is exact for this objective (module docs): the
-    /// velocileptors basis, no bispectrum, the model at most quadratic in each free polynomial
-    /// parameter and the templates independent of them, both checked at the start.
+    /// ∂p/∂v at the slots `v`: the physical basis's Jacobian, or the identity.
+    fn basis_jacobian(&self, v: &[f64; SLOTS]) -> Jacobian {
+        match &self.basis {
+            Some(b) => {
+                let mut u = [0.0; F_SLOT + 1];
+                u.copy_from_slice(&v[..=F_SLOT]);
+                b.jacobian(&u)
+            }
+            None => std::array::from_fn(|i| std::array::from_fn(|j| f64::from(u8::from(i == j)))),
+        }
+    }
+
+    /// The whitened power-spectrum points of each parameter set of `sets` (one f) at `ap`.
+    fn models_of(&self, sets: &[EptParams], ap: Option<Distortion>) -> Result<Vec<Vec<f64>>> {
+        self.plan
+            .multipole_values_many(self.terms, sets, self.plan_ells(), ap)?
+            .into_iter()
+            .map(|m| Ok(self.whitened(&self.fitted_points(m)?)))
+            .collect()
+    }
+
+    /// Whether [`Self::value_and_gradient`] is exact for this objective (module docs): no
+    /// bispectrum, the model at most quadratic in each polynomial parameter and none of their
+    /// derivatives changed by the linear ones, checked at the start.
     pub(super) fn check_exact_gradient(&self) -> Result<bool> {
-        if self.basis.is_some() || self.bispectrum.is_some() {
+        if self.bispectrum.is_some() {
             return Ok(false);
         }
         let mut v = self.start;
         for &i in &self.marg {
             v[i] = 0.0;
         }
-        let polynomial: Vec<usize> = self.free.iter().copied().filter(|&j| j < F_SLOT).collect();
-        let m = self.model(&v)?;
-        let scale = m
-            .iter()
-            .fold(0.0f64, |s, x| s.max(x.abs()))
-            .max(f64::MIN_POSITIVE);
-        for &j in &polynomial {
-            let at = |d: f64| {
-                let mut w = v;
-                w[j] += d;
-                self.model(&w)
-            };
-            let (a, b, c) = (at(2.0)?, at(1.0)?, at(-1.0)?);
-            let third = (0..m.len()).map(|i| a[i] - 3.0 * b[i] + 3.0 * m[i] - c[i]);
-            if third.fold(0.0f64, |s, x| s.max(x.abs())) > EXACTNESS_TOLERANCE * scale {
-                return Ok(false);
-            }
-        }
-        if self.marg.is_empty() || polynomial.is_empty() {
-            return Ok(true);
-        }
-        let templates = |v: &[f64; SLOTS]| -> Result<Vec<Vec<f64>>> {
-            let m0 = self.model(v)?;
-            self.marg
-                .iter()
-                .map(|&a| {
-                    let mut w = *v;
-                    w[a] = 1.0;
-                    Ok(self
-                        .model(&w)?
-                        .iter()
-                        .zip(&m0)
-                        .map(|(x, y)| x - y)
-                        .collect())
-                })
-                .collect()
+        let (p, ap) = self.split(&v)?;
+        let shift = |p: &EptParams, i: usize, d: f64| {
+            let mut q = *p;
+            q.values[i] += d;
+            q
         };
-        let t0 = templates(&v)?;
-        let mut w = v;
-        for (n, &j) in polynomial.iter().enumerate() {
-            w[j] += 0.37 - 0.11 * n as f64;
+        let mut shifted = p;
+        for k in LINEAR {
+            shifted.values[k] += 0.3 + 0.1 * k as f64;
         }
-        let t1 = templates(&w)?;
-        let t_scale = t0.iter().flatten().fold(0.0f64, |s, x| s.max(x.abs()));
-        Ok(t0
-            .iter()
-            .flatten()
-            .zip(t1.iter().flatten())
-            .all(|(a, b)| (a - b).abs() <= EXACTNESS_TOLERANCE * t_scale))
+        // per polynomial parameter: p + 2eᵢ, p + eᵢ, p − eᵢ, then shifted + eᵢ; p and shifted last
+        let mut sets = Vec::new();
+        for i in 0..F_SLOT {
+            sets.extend([
+                shift(&p, i, 2.0),
+                shift(&p, i, 1.0),
+                shift(&p, i, -1.0),
+                shift(&shifted, i, 1.0),
+            ]);
+        }
+        sets.extend([p, shifted]);
+        let m = self.models_of(&sets, ap)?;
+        let (m0, s0) = (&m[4 * F_SLOT], &m[4 * F_SLOT + 1]);
+        let scale = m0.iter().fold(f64::MIN_POSITIVE, |s, x| s.max(x.abs()));
+        Ok((0..F_SLOT).all(|i| {
+            let [a, b, c, d] = [&m[4 * i], &m[4 * i + 1], &m[4 * i + 2], &m[4 * i + 3]];
+            let third = |n: usize| a[n] - 3.0 * b[n] + 3.0 * m0[n] - c[n];
+            let mixed = |n: usize| (d[n] - s0[n]) - (b[n] - m0[n]);
+            let none = |e: &dyn Fn(usize) -> f64| {
+                (0..m0.len()).all(|n| e(n).abs() <= EXACTNESS_TOLERANCE * scale)
+            };
+            none(&third) && none(&mixed)
+        }))
     }
 
     /// −2 ln L, its exact gradient in the free values `x` and the Gauss–Newton diagonal curvature
@@ -130,42 +135,41 @@ impl Objective<'_> {
         for &i in &self.marg {
             v[i] = 0.0;
         }
-        let (p, ap) = self.split(&v)?;
-        let kinds: Vec<Kind> = {
-            let mut n = 0;
-            self.free
-                .iter()
-                .map(|&j| match j {
-                    F_SLOT => Kind::Growth,
-                    j if j >= AP_SLOT => Kind::Distortion(j - AP_SLOT),
-                    _ => {
-                        n += 1;
-                        Kind::Polynomial(n - 1)
-                    }
-                })
-                .collect()
-        };
-        // The sets: the point, each template's (aₐ = 1), then ± 1 in each polynomial parameter.
+        // The base sets: the point, then each template's (its slot at 1).
         let nm = self.marg.len();
-        let mut sets = vec![p];
+        let mut base = vec![v];
         for &a in &self.marg {
-            let mut q = p;
-            q.values[a] = 1.0;
-            sets.push(q);
+            let mut w = v;
+            w[a] = 1.0;
+            base.push(w);
         }
-        for (&j, _) in self
-            .free
-            .iter()
-            .zip(&kinds)
-            .filter(|(_, k)| matches!(k, Kind::Polynomial(_)))
-        {
+        let jacobians: Vec<Jacobian> = base.iter().map(|w| self.basis_jacobian(w)).collect();
+        let mut sets = Vec::with_capacity(nm + 1);
+        let mut ap = None;
+        for w in &base {
+            let (p, d) = self.split(w)?;
+            sets.push(p);
+            ap = d;
+        }
+        let p = sets[0];
+        // The polynomial parameters a free slot reaches, and ± 1 in each at the point.
+        let model_slots: Vec<usize> = self.free.iter().copied().filter(|&j| j <= F_SLOT).collect();
+        let reached: Vec<usize> = (0..F_SLOT)
+            .filter(|&i| {
+                model_slots
+                    .iter()
+                    .any(|&j| jacobians.iter().any(|jac| jac[i][j] != 0.0))
+            })
+            .collect();
+        for &i in &reached {
             for d in [1.0, -1.0] {
-                let mut q: EptParams = p;
-                q.values[j] += d;
+                let mut q = p;
+                q.values[i] += d;
                 sets.push(q);
             }
         }
-        let with_growth = kinds.iter().any(|k| matches!(k, Kind::Growth));
+        let with_growth = self.free.contains(&F_SLOT);
+        let with_ap = self.free.iter().any(|&j| j >= AP_SLOT);
         let ells = self.plan_ells();
         let (values, df) = self.plan.multipole_values_and_df_many(
             self.terms,
@@ -179,7 +183,7 @@ impl Objective<'_> {
         let w: Vec<Vec<f64>> = values.into_iter().map(observe).collect::<Result<_>>()?;
         let df: Vec<Vec<f64>> = df.into_iter().map(observe).collect::<Result<_>>()?;
         let da: Vec<[Vec<f64>; 2]> = match ap {
-            Some(d) if kinds.iter().any(|k| matches!(k, Kind::Distortion(_))) => self
+            Some(d) if with_ap => self
                 .plan
                 .multipole_ap_derivatives_many(self.terms, &sets[..=nm], ells, d)?
                 .into_iter()
@@ -187,6 +191,13 @@ impl Objective<'_> {
                 .collect::<Result<_>>()?,
             _ => Vec::new(),
         };
+        // Mᵢ = ∂m/∂pᵢ of the reached parameters
+        let derivative: Vec<Vec<f64>> = (0..reached.len())
+            .map(|r| {
+                let (up, down) = (&w[nm + 1 + 2 * r], &w[nm + 2 + 2 * r]);
+                up.iter().zip(down).map(|(a, b)| 0.5 * (a - b)).collect()
+            })
+            .collect();
         let m0 = &w[0];
         let diff =
             |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(x, y)| x - y).collect() };
@@ -194,27 +205,33 @@ impl Objective<'_> {
         let marginal = self.marginalise(&mut v, m0, &templates)?;
         let n = self.free.len();
         let (mut gradient, mut curvature) = (vec![0.0; n], vec![0.0; n]);
-        for (col, (&j, kind)) in self.free.iter().zip(&kinds).enumerate() {
-            // ∂m₀/∂θ and ∂Tₐ/∂θ
-            let (dm0, dt): (Vec<f64>, Vec<Vec<f64>>) = match *kind {
-                Kind::Polynomial(q) => {
-                    let (up, down) = (&w[1 + nm + 2 * q], &w[2 + nm + 2 * q]);
-                    (
-                        up.iter().zip(down).map(|(a, b)| 0.5 * (a - b)).collect(),
-                        Vec::new(),
-                    )
-                }
-                Kind::Growth => (
-                    df[0].clone(),
-                    (1..=nm).map(|a| diff(&df[a], &df[0])).collect(),
-                ),
-                Kind::Distortion(c) => (
-                    da[0][c].clone(),
-                    (1..=nm).map(|a| diff(&da[a][c], &da[0][c])).collect(),
-                ),
+        for (col, &j) in self.free.iter().enumerate() {
+            // ∂m/∂vⱼ at each base set
+            let at: Vec<Vec<f64>> = if j <= F_SLOT {
+                (0..=nm)
+                    .map(|s| {
+                        let mut d = if j == F_SLOT {
+                            df[s].clone()
+                        } else {
+                            vec![0.0; m0.len()]
+                        };
+                        for (r, &i) in reached.iter().enumerate() {
+                            let c = jacobians[s][i][j];
+                            if c != 0.0 {
+                                d.iter_mut()
+                                    .zip(&derivative[r])
+                                    .for_each(|(x, y)| *x += c * y);
+                            }
+                        }
+                        d
+                    })
+                    .collect()
+            } else {
+                da.iter().map(|d| d[j - AP_SLOT].clone()).collect()
             };
-            // J = ∂m/∂θ at â
-            let mut jac = dm0;
+            // ∂Tₐ/∂vⱼ, and J = ∂m/∂vⱼ at â
+            let dt: Vec<Vec<f64>> = (1..=nm).map(|a| diff(&at[a], &at[0])).collect();
+            let mut jac = at[0].clone();
             for (t, a) in dt.iter().zip(&marginal.ahat) {
                 jac.iter_mut().zip(t).for_each(|(x, y)| *x += a * y);
             }
@@ -342,16 +359,39 @@ mod tests {
                 c[i]
             );
         }
-        // The physical basis has no exact gradient here (the minimiser differences it).
+        // The physical basis: the same check through its map (b1p, f and the counterterms mix).
         let basis = crate::rsd::ept::physical::PhysicalBasis::new(0.6, 3e-4, 0.1, 5.0).unwrap();
         let physical = GalaxyFitRequest {
-            free: ["f", "b1p"].map(String::from).to_vec(),
-            marginalise: vec![],
-            priors: vec![],
+            free: ["f", "b1p", "b2p", "apar", "aperp"]
+                .map(String::from)
+                .to_vec(),
+            marginalise: ["alpha0p", "alpha2p", "alpha4p", "sn0p", "sn2p"]
+                .map(String::from)
+                .to_vec(),
+            priors: [("alpha0p", 12.5), ("alpha2p", 12.5), ("sn0p", 2.0)]
+                .map(|(n, s)| Prior::gaussian(n, 0.0, s))
+                .to_vec(),
             basis: Some(basis),
             ..request
         };
         let o = objective(&plan, &terms, &data, &physical, None, None).unwrap();
-        assert!(!o.exact_gradient && o.value_and_gradient(&[0.7, 1.1]).unwrap().is_none());
+        assert!(o.exact_gradient);
+        let x = [0.72, 1.15, 0.3, 1.02, 0.99];
+        let (value, g, _) = o.value_and_gradient(&x).unwrap().unwrap();
+        assert!((value - o.cost(&x)).abs() < 1e-9 * value.abs(), "{value}");
+        for (i, h) in [1e-3, 1e-3, 1e-2, 1e-4, 1e-4].into_iter().enumerate() {
+            let at = |d: f64| {
+                let mut y = x;
+                y[i] += d;
+                o.cost(&y)
+            };
+            let fd = (8.0 * (at(h) - at(-h)) - (at(2.0 * h) - at(-2.0 * h))) / (12.0 * h);
+            assert!(
+                (g[i] - fd).abs() < 1e-5 * g[i].abs().max(1.0),
+                "{}: exact {} differences {fd}",
+                physical.free[i],
+                g[i]
+            );
+        }
     }
 }

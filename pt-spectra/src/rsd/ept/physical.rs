@@ -109,6 +109,43 @@ impl PhysicalBasis {
         p
     }
 
+    /// The Jacobian ∂p_i/∂v_j of [`Self::to_ept`] at the physical values `v` (row i: the model's
+    /// parameter in the order of [`PARAM_NAMES`], column j: the physical one).
+    pub fn jacobian(&self, v: &[f64; 12]) -> [[f64; 12]; 12] {
+        let s = self.sigma8;
+        let (f, b) = (v[11], v[0] / s);
+        let (a0, a2, a4) = (v[4], v[5], v[6]);
+        let sat = self.f_sat / self.n_bar;
+        let db = 1.0 / s;
+        let mut j = [[0.0; 12]; 12];
+        j[0][0] = db;
+        j[1][1] = 1.0 / (s * s);
+        j[1][0] = 8.0 / 21.0 * db;
+        j[2][2] = 1.0 / (s * s);
+        j[3][3] = 1.0 / (s * s * s);
+        // α₀ = b² α₀p
+        j[4][0] = 2.0 * b * a0 * db;
+        j[4][4] = b * b;
+        // α₂ = f b (α₀p + α₂p)
+        j[5][0] = f * (a0 + a2) * db;
+        j[5][4] = f * b;
+        j[5][5] = f * b;
+        j[5][11] = b * (a0 + a2);
+        // α₄ = f (f α₂p + b α₄p)
+        j[6][0] = f * a4 * db;
+        j[6][5] = f * f;
+        j[6][6] = f * b;
+        j[6][11] = 2.0 * f * a2 + b * a4;
+        // α₆ = f² α₄p
+        j[7][6] = f * f;
+        j[7][11] = 2.0 * f * a4;
+        j[8][8] = 1.0 / self.n_bar;
+        j[9][9] = sat * self.sigma_v.powi(2);
+        j[10][10] = sat * self.sigma_v.powi(4);
+        j[11][11] = 1.0;
+        j
+    }
+
     /// The physical values of the model's parameters `p` (the inverse of [`Self::to_ept`] where one
     /// exists: α₆ is not free in this basis, so its value in `p` is dropped, and α₀p, α₂p, α₄p are
     /// solved from α₀, α₂, α₄). With b = 0 or f = 0 a counterterm the map leaves undetermined is 0
@@ -179,6 +216,33 @@ mod tests {
 
     fn basis() -> PhysicalBasis {
         PhysicalBasis::new(0.6, 3e-4, DEFAULT_F_SAT, DEFAULT_SIGMA_V).unwrap()
+    }
+
+    /// The Jacobian against central differences of the map (which is a polynomial of degree ≤ 3
+    /// in each value: the differences are exact to rounding).
+    #[test]
+    fn jacobian_is_the_derivative_of_the_map() {
+        let b = basis();
+        let v = [
+            1.3, 0.4, -0.2, 0.1, 2.0, -1.5, 0.7, 0.0, 0.3, 1.1, -0.6, 0.78,
+        ];
+        let jac = b.jacobian(&v);
+        for j in 0..12 {
+            let h = 1e-3;
+            let (mut up, mut down) = (v, v);
+            up[j] += h;
+            down[j] -= h;
+            let (pu, pd) = (b.to_ept(&up).values, b.to_ept(&down).values);
+            for i in 0..12 {
+                let fd = (pu[i] - pd[i]) / (2.0 * h);
+                let scale = 1.0 + fd.abs();
+                assert!(
+                    (jac[i][j] - fd).abs() < 1e-6 * scale,
+                    "d{i}/d{j}: {} {fd}",
+                    jac[i][j]
+                );
+            }
+        }
     }
 
     /// The counterterms are (b + fμ²)(b α₀p + f α₂p μ² + f α₄p μ⁴): the polynomial in μ² expanded
