@@ -428,6 +428,59 @@ pub fn hessian(
     hess
 }
 
+/// The Hessian at `x` by differences of the exact gradient `grad` with steps `h` (central where the
+/// box allows, else one-sided of second order, as [`hessian`]), symmetrised: exact for a quadratic,
+/// from 2n gradients where [`hessian`] takes 2n² values. `None` where a gradient is not available.
+pub fn hessian_from_gradient(
+    grad: &ValueGradient,
+    x: &[f64],
+    h: &[f64],
+    lo: &[f64],
+    hi: &[f64],
+) -> Option<Vec<Vec<f64>>> {
+    let n = x.len();
+    let at = |i: usize, d: f64| -> Option<Vec<f64>> {
+        let mut y = x.to_vec();
+        y[i] += d;
+        grad(&y).map(|(_, g, _)| g)
+    };
+    let mut at_x: Option<Vec<f64>> = None;
+    let mut columns = Vec::with_capacity(n);
+    for i in 0..n {
+        let (up, down) = (hi[i] - x[i], x[i] - lo[i]);
+        let room = up.min(down);
+        let column: Vec<f64> = if room >= 0.05 * h[i] {
+            let a = h[i].min(room);
+            let (p, m) = (at(i, a)?, at(i, -a)?);
+            p.iter().zip(&m).map(|(p, m)| (p - m) / (2.0 * a)).collect()
+        } else {
+            let a = if up >= down {
+                h[i].min(0.5 * up)
+            } else {
+                -h[i].min(0.5 * down)
+            };
+            if at_x.is_none() {
+                at_x = Some(grad(x)?.1);
+            }
+            let g0 = at_x.as_ref()?;
+            let (g1, g2) = (at(i, a)?, at(i, 2.0 * a)?);
+            (0..n)
+                .map(|j| (-3.0 * g0[j] + 4.0 * g1[j] - g2[j]) / (2.0 * a))
+                .collect()
+        };
+        columns.push(column);
+    }
+    Some(
+        (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| 0.5 * (columns[i][j] + columns[j][i]))
+                    .collect()
+            })
+            .collect(),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -549,6 +602,33 @@ mod tests {
         let x = m.best().x[0];
         assert!((4.0 * x * x * x - 4.0 * x + 0.3).abs() < 1e-3, "{x}");
         assert_eq!(m.agree, 2, "{m:?}");
+    }
+
+    /// The Hessian from differences of the exact gradient of a quadratic is exact to rounding, also
+    /// at a bound.
+    #[test]
+    fn hessian_from_the_gradient_of_a_quadratic() {
+        let grad = |v: &[f64]| {
+            Some((
+                0.0,
+                vec![4.0 * v[0] + 3.0 * v[1], 3.0 * v[0] + 10.0 * v[1]],
+                vec![f64::NAN; 2],
+            ))
+        };
+        for (x, lo) in [([0.3, -0.2], [-1.0, -1.0]), ([0.3, -0.2], [0.3, -1.0])] {
+            let h = hessian_from_gradient(&grad, &x, &[1e-2, 1e-2], &lo, &[1.0, 1.0]).unwrap();
+            for (got, want) in [
+                (h[0][0], 4.0),
+                (h[0][1], 3.0),
+                (h[1][0], 3.0),
+                (h[1][1], 10.0),
+            ] {
+                assert!((got - want).abs() < 1e-9, "{h:?}");
+            }
+        }
+        assert!(
+            hessian_from_gradient(&|_: &[f64]| None, &[0.0], &[1e-2], &[-1.0], &[1.0]).is_none()
+        );
     }
 
     /// The central-difference Hessian of a quadratic is exact to rounding, also at a bound.

@@ -99,7 +99,8 @@ fn search_lines(
     lines.push(if s.profile_check {
         format!(
             "errors of the free parameters: err_<p>_hessian = sqrt(diag 2 H^-1), H the Hessian of -2 ln \
-             L by central differences of {HESSIAN_STEP} conditional sigma; <p>_lo, <p>_hi: where the \
+             L by central differences (of its exact gradient where the minimiser has it, else of -2 ln L) \
+             of {HESSIAN_STEP} conditional sigma; <p>_lo, <p>_hi: where the \
              profile -2 ln L (the others re-minimised) is 1 above the minimum (sqrt(delta) to \
              {CROSSING_TOLERANCE}); err_<p> is the Hessian's unless the profile's half-width differs \
              from it by more than {:.0}% (err_<p>_from_profile = 1: then the half-width)",

@@ -435,7 +435,8 @@ pub fn joint_fit_table(
     ));
     h.push(format!(
         "minimiser: bounded quasi-Newton ({}) from {} starts (seed {}), the lowest minimum taken; \
-         errors sqrt(diag 2 H^-1) of the joint -2 ln L (steps of {HESSIAN_STEP} sigma){}",
+         errors sqrt(diag 2 H^-1) of the joint -2 ln L (differences of its gradient, steps of \
+         {HESSIAN_STEP} sigma){}",
         super::ept_fit::gradient_source(fit.sets.iter().map(|f| f.exact_gradient)),
         analysis.search.starts,
         analysis.search.seed,

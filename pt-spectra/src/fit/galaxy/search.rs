@@ -19,7 +19,8 @@ use super::objective::Objective;
 use super::{GalaxyFit, PriorShape, AP_SLOT, B_SLOT, SLOTS};
 use crate::error::{Error, Result};
 use crate::fit::bounded::{
-    multistart, Minimum, Problem, ValueGradient, AGREEMENT, EXPECTED_DECREASE,
+    hessian_from_gradient, multistart, Minimum, Problem, ValueGradient, AGREEMENT,
+    EXPECTED_DECREASE,
 };
 use crate::linalg::solve_spd;
 use rand::{Rng, SeedableRng};
@@ -270,7 +271,17 @@ fn hessian_errors(problem: &Problem, best: &Minimum) -> (Vec<f64>, Option<Vec<Ve
         (problem.f)(x)
     };
     let h: Vec<f64> = best.sigma.iter().map(|s| HESSIAN_STEP * s).collect();
-    let hess = crate::fit::bounded::hessian(&f, &best.x, best.value, &h, &problem.lo, &problem.hi);
+    // from the exact gradient where the objective has one (2n gradients), else from −2 ln L
+    let from_gradient = problem.grad.and_then(|grad| {
+        let counted = |x: &[f64]| {
+            count.set(count.get() + 1);
+            grad(x)
+        };
+        hessian_from_gradient(&counted, &best.x, &h, &problem.lo, &problem.hi)
+    });
+    let hess = from_gradient.unwrap_or_else(|| {
+        crate::fit::bounded::hessian(&f, &best.x, best.value, &h, &problem.lo, &problem.hi)
+    });
     match solve_spd(&hess, &vec![0.0; n]) {
         Ok((_, inverse, _)) => {
             let cov: Vec<Vec<f64>> = inverse
