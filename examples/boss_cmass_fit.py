@@ -11,7 +11,7 @@ best-fit model, residuals in sigma) and the inputs it makes (boss_cmass_*.dat, b
 
 --bin is the pt-spectra binary (default target/release/pt-spectra; `cargo build --release -p
 pt-spectra`). Needs numpy, matplotlib and camb (`pip install camb`: the template's linear spectrum and
-sigma8(z)). About 1 minute on 2 cores (61 s measured). The report goes to standard output and
+sigma8(z)). About 15 s on 2 cores (measured). The report goes to standard output and
 the .md file, progress to standard error.
 """
 

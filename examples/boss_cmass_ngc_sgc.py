@@ -12,7 +12,7 @@ Writes examples/out/boss_cmass_ngc_sgc.md (settings, table, comparison) and the 
 
 --bin is the pt-spectra binary (default target/release/pt-spectra; `cargo build --release -p
 pt-spectra`). Needs numpy and camb (`pip install camb`: the template, as in boss_cmass_fit.py).
-About 1.5 minutes on 2 cores. The report goes to standard output and the .md file, progress to
+About 20 s on 2 cores (measured). The report goes to standard output and the .md file, progress to
 standard error.
 """
 
