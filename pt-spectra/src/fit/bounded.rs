@@ -382,20 +382,7 @@ pub fn hessian(
     hi: &[f64],
 ) -> Vec<Vec<f64>> {
     let n = x.len();
-    // Per parameter: the step a and whether it is central (±a) or one-sided (a, 2a; a < 0 backward).
-    let stencil: Vec<(f64, bool)> = (0..n)
-        .map(|i| {
-            let (up, down) = (hi[i] - x[i], x[i] - lo[i]);
-            let room = up.min(down);
-            if room >= 0.05 * h[i] {
-                (h[i].min(room), true)
-            } else if up >= down {
-                (h[i].min(0.5 * up), false)
-            } else {
-                (-h[i].min(0.5 * down), false)
-            }
-        })
-        .collect();
+    let stencil = stencil(x, h, lo, hi);
     let at = |d: &[(usize, f64)]| {
         let mut y = x.to_vec();
         for &(i, v) in d {
@@ -428,6 +415,25 @@ pub fn hessian(
     hess
 }
 
+/// Per parameter of `x`, the step of a difference of size `h` inside the box [`lo`, `hi`] and
+/// whether it is central (±a) or one-sided (a, 2a; a < 0 backward, where a bound is nearer than
+/// 0.05 h).
+fn stencil(x: &[f64], h: &[f64], lo: &[f64], hi: &[f64]) -> Vec<(f64, bool)> {
+    (0..x.len())
+        .map(|i| {
+            let (up, down) = (hi[i] - x[i], x[i] - lo[i]);
+            let room = up.min(down);
+            if room >= 0.05 * h[i] {
+                (h[i].min(room), true)
+            } else if up >= down {
+                (h[i].min(0.5 * up), false)
+            } else {
+                (-h[i].min(0.5 * down), false)
+            }
+        })
+        .collect()
+}
+
 /// The Hessian at `x` by differences of the exact gradient `grad` with steps `h` (central where the
 /// box allows, else one-sided of second order, as [`hessian`]), symmetrised: exact for a quadratic,
 /// from 2n gradients where [`hessian`] takes 2n² values. `None` where a gradient is not available.
@@ -439,28 +445,22 @@ pub fn hessian_from_gradient(
     hi: &[f64],
 ) -> Option<Vec<Vec<f64>>> {
     let n = x.len();
+    // the gradient where the objective is finite (a point outside the model's domain: none)
+    let gradient_at = |y: &[f64]| grad(y).and_then(|(v, g, _)| v.is_finite().then_some(g));
     let at = |i: usize, d: f64| -> Option<Vec<f64>> {
         let mut y = x.to_vec();
         y[i] += d;
-        grad(&y).map(|(_, g, _)| g)
+        gradient_at(&y)
     };
     let mut at_x: Option<Vec<f64>> = None;
     let mut columns = Vec::with_capacity(n);
-    for i in 0..n {
-        let (up, down) = (hi[i] - x[i], x[i] - lo[i]);
-        let room = up.min(down);
-        let column: Vec<f64> = if room >= 0.05 * h[i] {
-            let a = h[i].min(room);
+    for (i, (a, central)) in stencil(x, h, lo, hi).into_iter().enumerate() {
+        let column: Vec<f64> = if central {
             let (p, m) = (at(i, a)?, at(i, -a)?);
             p.iter().zip(&m).map(|(p, m)| (p - m) / (2.0 * a)).collect()
         } else {
-            let a = if up >= down {
-                h[i].min(0.5 * up)
-            } else {
-                -h[i].min(0.5 * down)
-            };
             if at_x.is_none() {
-                at_x = Some(grad(x)?.1);
+                at_x = Some(gradient_at(x)?);
             }
             let g0 = at_x.as_ref()?;
             let (g1, g2) = (at(i, a)?, at(i, 2.0 * a)?);
@@ -629,6 +629,9 @@ mod tests {
         assert!(
             hessian_from_gradient(&|_: &[f64]| None, &[0.0], &[1e-2], &[-1.0], &[1.0]).is_none()
         );
+        // a point outside the objective's domain (+∞) gives no Hessian, not one of its zero gradient
+        let outside = |_: &[f64]| Some((f64::INFINITY, vec![0.0], vec![f64::NAN]));
+        assert!(hessian_from_gradient(&outside, &[0.0], &[1e-2], &[-1.0], &[1.0]).is_none());
     }
 
     /// The central-difference Hessian of a quadratic is exact to rounding, also at a bound.
