@@ -268,26 +268,14 @@ impl Objective<'_> {
 mod tests {
     use super::super::objective::objective;
     use super::super::{GalaxyFitRequest, Prior, PriorShape};
-    use crate::fit::MultipoleData;
-    use crate::linear::{LinearSpectrum, LogGrid};
-    use crate::precision::Precision;
     use crate::rsd::ap::Distortion;
-    use crate::rsd::ept::{EptParams, EptPlan, EptSettings};
+    use crate::rsd::ept::EptParams;
 
     /// The exact gradient of −2 ln L (free f, b1, b2, bs, α∥, α⊥ and α₄, a log-normal prior on b1;
     /// α₀, α₂, sn marginalised with Gaussian priors, ln det F included) against fourth-order central
     /// differences of the objective, away from the minimum; the Gauss–Newton curvature is positive.
     #[test]
     fn gradient_matches_differences_of_the_objective() {
-        let k = LogGrid::new(0.02, 0.2, 20).unwrap().points();
-        let settings = EptSettings {
-            ir: true,
-            ap: Some(Distortion::new(1.0, 1.0).unwrap()),
-            ap_range: Some((0.8, 1.25)),
-            loop_range: None,
-        };
-        let plan = EptPlan::new(&k, settings, &Precision::fast()).unwrap();
-        let terms = plan.terms(&LinearSpectrum::gm2012(0.5).unwrap()).unwrap();
         let mut truth = EptParams::new(2.0, 0.75);
         for (n, v) in [
             ("b2", -0.4),
@@ -298,13 +286,7 @@ mod tests {
             truth.set(n, v).unwrap();
         }
         let d = Distortion::new(1.03, 0.98).unwrap();
-        let m = plan
-            .multipole_values_at(&terms, &truth, &[0, 2, 4], Some(d))
-            .unwrap();
-        let sigma: Vec<Vec<f64>> = (0..3)
-            .map(|_| m[0].iter().map(|p| 0.02 * p).collect())
-            .collect();
-        let data = MultipoleData::from_arrays(k, &[0, 2, 4], m, sigma, "model").unwrap();
+        let (plan, terms, data) = super::super::tests::ap_setup(20, &truth, d, 0.02);
         let mut priors: Vec<Prior> = [("alpha0", 30.0), ("alpha2", 30.0), ("sn", 2000.0)]
             .map(|(n, s)| Prior::gaussian(n, 0.0, s))
             .to_vec();

@@ -189,10 +189,16 @@ fn bad_requests_are_named() {
     assert!(err(r).contains("ell"));
 }
 
-/// Free α∥, α⊥ on a plan built for an AP range: the injected distortion is recovered.
-#[test]
-fn recovers_the_distortion() {
-    let k = LogGrid::new(0.02, 0.2, 24).unwrap().points();
+/// A plan on `nk` k in [0.02, 0.2] with IR and an AP range [0.8, 1.25], its terms of the gm2012
+/// spectrum at z = 0.5, and noise-free P0, P2, P4 of `truth` at the distortion `d` with errors
+/// `relative` × P0.
+pub(super) fn ap_setup(
+    nk: usize,
+    truth: &EptParams,
+    d: crate::rsd::ap::Distortion,
+    relative: f64,
+) -> (EptPlan, EptTerms, MultipoleData) {
+    let k = LogGrid::new(0.02, 0.2, nk).unwrap().points();
     let settings = EptSettings {
         ir: true,
         ap: Some(crate::rsd::ap::Distortion::new(1.0, 1.0).unwrap()),
@@ -201,16 +207,23 @@ fn recovers_the_distortion() {
     };
     let plan = EptPlan::new(&k, settings, &Precision::fast()).unwrap();
     let terms = plan.terms(&LinearSpectrum::gm2012(0.5).unwrap()).unwrap();
+    let m = plan
+        .multipole_values_at(&terms, truth, &[0, 2, 4], Some(d))
+        .unwrap();
+    let sigma: Vec<Vec<f64>> = (0..3)
+        .map(|_| m[0].iter().map(|p| relative * p).collect())
+        .collect();
+    let data = MultipoleData::from_arrays(k, &[0, 2, 4], m, sigma, "model").unwrap();
+    (plan, terms, data)
+}
+
+/// Free α∥, α⊥ on a plan built for an AP range: the injected distortion is recovered.
+#[test]
+fn recovers_the_distortion() {
     let truth = crate::rsd::ap::Distortion::new(1.04, 0.97).unwrap();
     let mut params = EptParams::new(2.0, 0.75);
     params.set("sn", 900.0).unwrap();
-    let m = plan
-        .multipole_values_at(&terms, &params, &[0, 2, 4], Some(truth))
-        .unwrap();
-    let sigma: Vec<Vec<f64>> = (0..3)
-        .map(|_| m[0].iter().map(|p| 0.005 * p).collect())
-        .collect();
-    let data = MultipoleData::from_arrays(k, &[0, 2, 4], m, sigma, "model").unwrap();
+    let (plan, terms, data) = ap_setup(24, &params, truth, 0.005);
     let request = GalaxyFitRequest {
         start: EptParams::new(1.9, 0.7),
         ap: Some(crate::rsd::ap::Distortion::new(1.0, 1.0).unwrap()),
