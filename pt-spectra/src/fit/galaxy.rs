@@ -39,6 +39,7 @@ mod gradient;
 pub mod joint;
 mod objective;
 mod priors;
+mod request;
 pub mod search;
 pub use bispectrum::{BispectrumFit, BISPECTRUM_LINEAR, BISPECTRUM_NAMES};
 pub use derived::{derived, sound_horizon, Derived, Template};
