@@ -15,6 +15,8 @@
 //! * [`loops`], [`resum`], [`real`]: 1- and 2-loop SPT terms, the propagator terms P13, P15, P17 (angular
 //!   tables), and TNS terms, all with error estimates; RPT propagators N0..N3; real-space models.
 //! * [`rsd`]: Kaiser, Scoccimarro and TNS redshift-space models, Fingers of God, Legendre multipoles.
+//! * [`bias`]: the galaxy bias parameters in one convention (velocileptors') and the exact maps to
+//!   FAST-PT's and CLASS-PT's.
 //! * [`bispectrum`]: the tree-level galaxy bispectrum in redshift space, B₀, B₂, B₄ over the orientations
 //!   of a triangle and the triangle bins of a measurement, with AP, IR resummation, FoG and shot noise.
 //! * [`fit`]: χ² fits of f, σ0 and A_b to measured multipoles, with Δχ² contour errors, versus k_max.
@@ -33,6 +35,7 @@
 //! # Ok::<(), pt_spectra::error::Error>(())
 //! ```
 
+pub mod bias;
 pub mod bispectrum;
 pub mod cosmology;
 pub mod emulator;

@@ -225,3 +225,62 @@ fn tns_with_nonlinear_bias_moves_the_multipoles_by_the_bias_terms() {
         .iter()
         .any(|h| h.contains("Beutler et al. 2017")));
 }
+
+/// One bias, two implementations: the `ept` model (velocileptors' bs s² and b1 b3 sig3nl, checked
+/// against velocileptors in `ept.rs`) at f = 0 without IR against FAST-PT's expansion
+/// (`GalaxyBias`, checked against FAST-PT above) with the bias mapped by
+/// [`pt_spectra::bias::BiasConvention::FastPt`]. The parts linear in b2, bs and b3 are compared
+/// (halves of P(+b) − P(−b)): they carry no k → 0 constant, which the two subtract differently.
+#[test]
+fn ept_and_fastpt_expansions_agree_through_the_bias_map() {
+    use pt_spectra::bias::{BiasConvention, BiasParams};
+    use pt_spectra::rsd::ept::{EptParams, EptPlan, EptSettings};
+    let spectrum = LinearSpectrum::gm2012(0.5).unwrap();
+    let k: Vec<f64> = (0..12).map(|i| 0.02 + 0.025 * i as f64).collect();
+    let precision = Precision::default();
+    let settings = EptSettings {
+        ir: false,
+        ..EptSettings::default()
+    };
+    let plan = EptPlan::new(&k, settings, &precision).unwrap();
+    let terms = plan.terms(&spectrum).unwrap();
+    let fast = BiasPlan::new(&k, &precision).unwrap().evaluate(&spectrum);
+    let b1 = 1.7;
+    let p0 = |b: BiasParams| {
+        let mut p = EptParams::new(b.b1, 0.0);
+        p.values[1..4].copy_from_slice(&b.values()[1..]);
+        plan.multipoles(&terms, &p, &[0]).unwrap().remove(0)
+    };
+    for slot in 1..4 {
+        let mut values = [b1, 0.0, 0.0, 0.0];
+        values[slot] = 0.6;
+        let up = BiasParams::from_convention(BiasConvention::Velocileptors, values);
+        values[slot] = -0.6;
+        let down = BiasParams::from_convention(BiasConvention::Velocileptors, values);
+        let (pu, pd) = (p0(up), p0(down));
+        let gg = |b: &BiasParams| {
+            let [b1, b2, bs, b3nl] = b.in_convention(BiasConvention::FastPt);
+            let g = GalaxyBias { b1, b2, bs, b3nl };
+            (0..k.len())
+                .map(|i| g.spectra(i, Estimate::new(0.0, 0.0), &fast)[0].value)
+                .collect::<Vec<_>>()
+        };
+        let (fu, fd) = (gg(&up), gg(&down));
+        let ours: Vec<f64> = (0..k.len())
+            .map(|i| 0.5 * (pu[i].value - pd[i].value))
+            .collect();
+        let theirs: Vec<f64> = (0..k.len()).map(|i| 0.5 * (fu[i] - fd[i])).collect();
+        let scale = theirs.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        assert!(scale > 0.0);
+        for i in 0..k.len() {
+            let d = (ours[i] - theirs[i]).abs() / scale;
+            assert!(
+                d < 2e-4,
+                "slot {slot} k = {}: {} vs {}",
+                k[i],
+                ours[i],
+                theirs[i]
+            );
+        }
+    }
+}

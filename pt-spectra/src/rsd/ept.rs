@@ -7,7 +7,7 @@
 //!             + sn + sn2 k²μ² + sn4 k⁴μ⁴,
 //!
 //! with Z₁ = b1 + fμ², P^{1L}\[P\] = Z₁²P + the 1-loop terms of [`crate::loops::redshift`] (bias b1, b2, bs,
-//! b3 as velocileptors: (b2/2)δ², bs s², b3 FAST-PT's b3nl — see the map below), P_nw the no-wiggle
+//! b3 as velocileptors: (b2/2)δ², bs s², b3 = 2 b3nl of FAST-PT; [`crate::bias`]), P_nw the no-wiggle
 //! spectrum of velocileptors' Savitzky–Golay filter ([`crate::ir::savitzky_golay_no_wiggle`]), P_w = P − P_nw, P^{1L}_w = P^{1L}\[P\] − P^{1L}\[P_nw\], and
 //!   Σ²(μ) = [1 + fμ²(2 + f)] Σ²,   Σ² = (1/6π²) ∫ dq P_nw(q) [1 − j₀(q r_BAO)],   r_BAO = 110 Mpc/h
 //! (velocileptors' ½(X + Y/3) at r_BAO). Without IR resummation (`--no-ir`) P_nw = P: plain 1-loop SPT in
@@ -16,10 +16,9 @@
 //! Counterterms α_n [(Mpc/h)²], stochastic sn [(Mpc/h)³], sn2 [(Mpc/h)⁵], sn4 [(Mpc/h)⁷].
 //!
 //! Map to other bases:
-//! * CLASS-PT (Ivanov et al. 2019; Chudaykin et al. 2020): its δ_g ⊃ (b2/2)δ² + b_G2 G₂ with
-//!   G₂ = s² − (2/3)δ² in these normalisations (kernel μ₁₂² − 1 = S₂ − 2/3), so exactly
-//!   bs = b_G2 and b2 = b2^CLASS-PT − (4/3) b_G2. The cubic terms (b_Γ3 and the cubic part of b_G2)
-//!   share the one 1-loop shape of sig3nl, which b3 multiplies. Counterterms at the level of P(k, μ):
+//! * CLASS-PT (Ivanov et al. 2019; Chudaykin et al. 2020): the biases exactly as [`crate::bias`]
+//!   maps them, bs = b_G2, b2 = b2^CLASS-PT − (4/3) b_G2, b3 = −15 b_G2 − 6 b_Γ3 (the cubic parts
+//!   of G₂ and Γ₃ have sig3nl's shape, which b3 multiplies). Counterterms at the level of P(k, μ):
 //!   α_{2n} k²μ^{2n}P ↔ −2 c̃_{2n} f^n k²μ^{2n}P; stochastic sn = P_shot, sn2 = a2/k_NL² (k_NL = 0.45 h/Mpc);
 //!   CLASS-PT's isotropic a0 (k/k_NL)² has no counterpart here.
 //! * The paper's TNS (b, A_b, σ0, P_εε): b1 = b and sn = P_εε at large scales; its scale-dependent
