@@ -102,20 +102,31 @@ impl BiasParams {
 
     /// One header line: the values in velocileptors' convention and, if `given` is another, as given.
     pub fn describe(&self, given: BiasConvention) -> String {
+        self.line(given, 0)
+    }
+
+    /// [`Self::describe`] without b1 (the nonlinear bias of a model whose b1 is given apart).
+    pub fn describe_nonlinear(&self, given: BiasConvention) -> String {
+        self.line(given, 1)
+    }
+
+    fn line(&self, given: BiasConvention, from: usize) -> String {
         let list = |c: BiasConvention| {
             c.names()
                 .iter()
                 .zip(self.in_convention(c))
-                .map(|(n, v)| format!("{n} = {v}"))
+                .skip(from)
+                .map(|(n, v)| format!("{n} = {}", tidy(v)))
                 .collect::<Vec<_>>()
                 .join(", ")
         };
         let ours = list(BiasConvention::Velocileptors);
+        let what = "bias (velocileptors' convention, as every model takes it: (b2/2)d^2 + bs s^2 + b3 O3, b3 = 2 b3nl)";
         if given == BiasConvention::Velocileptors {
-            format!("bias (velocileptors' convention: (b2/2)d^2 + bs s^2 + b3 O3): {ours}")
+            format!("{what}: {ours}")
         } else {
             format!(
-                "bias (velocileptors' convention: (b2/2)d^2 + bs s^2 + b3 O3): {ours}; given in {}'s: {}",
+                "{what}: {ours}; given in {}'s: {}",
                 given.label(),
                 list(given)
             )
@@ -188,6 +199,17 @@ impl BiasConvention {
     /// The choices as `--help` and the error messages list them.
     pub fn choices() -> String {
         Self::ALL.map(Self::name).join(", ")
+    }
+}
+
+/// `v` to 12 decimals without trailing zeros: the maps' rounding (0.30000000000000004) left out of
+/// headers.
+fn tidy(v: f64) -> String {
+    let s = format!("{v:.12}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    match s {
+        "-0" | "" => "0".into(),
+        _ => s.into(),
     }
 }
 

@@ -102,7 +102,8 @@ class RealPlan:
     spectrum (seconds), ``"auto"`` uses the tensors if they are already cached. A spectrum the basis
     does not represent (e.g. Eisenstein & Hu) is integrated directly, with a warning.
     ``plan(linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False, eh=None, cs2=0.0,
-    bias_terms=False, bias=None, b2=0.0, bs=0.0, b3=0.0, ct=None)`` returns a :class:`Table` with no
+    bias_terms=False, bias=None, b2=0.0, bs=0.0, b3=0.0, ct=None, bias_convention=None)`` returns a
+    :class:`Table` with no
     set-up cost beyond the computation itself (``cs2``, ``ct``: the EFT counterterms; the bias
     arguments: the galaxy bias terms and spectra; all as in :func:`real`).
     """
@@ -119,9 +120,10 @@ class RealPlan:
         return self._plan.k
 
     def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False, eh=None,
-                 cs2=0.0, bias_terms=False, bias=None, b2=0.0, bs=0.0, b3=0.0, ct=None):
+                 cs2=0.0, bias_terms=False, bias=None, b2=0.0, bs=0.0, b3=0.0, ct=None,
+                 bias_convention=None):
         return _warn(self._plan(linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2,
-                                bs, b3, ct))
+                                bs, b3, ct, bias_convention))
 
     def batch(self, k_lin, P, terms=False):
         """The model for many linear spectra at once, spread over the threads
@@ -143,8 +145,10 @@ EPT_PARAMETERS = ("b1", "b2", "bs", "b3", "alpha0", "alpha2", "alpha4", "alpha6"
 
 
 def _ept_params(params):
-    """The model parameters of ``params`` that are not None (velocileptors' names)."""
-    return {name: float(v) for name, v in params.items() if v is not None}
+    """The model parameters of ``params`` that are not None (velocileptors' names, or those of
+    ``bias_convention``)."""
+    return {name: v if name == "bias_convention" else float(v) for name, v in params.items()
+            if v is not None}
 
 
 class EptPlan:
@@ -158,7 +162,9 @@ class EptPlan:
     takes the linear spectrum (``linear``, ``z``, ``z_input``, ``cosmology``, ``eh`` as in
     :func:`real`), ``ells`` and the parameters by name: b1, b2, bs, b3, alpha0, alpha2, alpha4,
     alpha6 [(Mpc/h)^2], sn [(Mpc/h)^3], sn2 [(Mpc/h)^5], sn4 [(Mpc/h)^7], f (default f(z)); an
-    unknown name is an error. ``terms(...)`` returns the loop terms of one spectrum
+    unknown name is an error. ``bias_convention="classpt"`` takes the bias as CLASS-PT names it
+    (b1, b2, bG2, bGamma3), ``"fastpt"`` as FAST-PT does (b1, b2, bs, b3nl); it is mapped exactly
+    to velocileptors' (docs/reference.md, "Bias conventions") and the header gives both. ``terms(...)`` returns the loop terms of one spectrum
     (:class:`EptTerms`), after which each parameter step costs microseconds. ``free_ap=True`` builds
     the plan for any distortion with 0.8 <= apar, aperp <= 1.25, given per call to
     :meth:`EptTerms.multipoles` (a chain that varies the cosmology against a fiducial).
@@ -345,15 +351,16 @@ class RsdPlan:
     def __call__(self, linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=1.0,
                  amplitude=1.0, fog="none", sigma0=0.0, shot_noise=None, number_density=None,
                  noise_table=None, ells=(0, 2, 4), terms=False, eh=None, growth_factor=None,
-                 no_wiggle=False, cs2=0.0, b2=None, bs=None, b3=None, **ept_params):
+                 no_wiggle=False, cs2=0.0, b2=None, bs=None, b3=None, bias_convention=None,
+                 **ept_params):
         if self._ept is not None:
-            return self._ept(linear, z, z_input, cosmology, eh, ells, b1=bias, b2=b2, bs=bs, b3=b3,
-                             f=f, **ept_params)
+            return self._ept(linear, z, z_input, cosmology, eh, ells, f=f, **ept_params,
+                             **_bias_kwargs(bias, b2, bs, b3, bias_convention))
         if ept_params:
             raise ValueError(f"{', '.join(ept_params)}: parameters of rsd='ept'")
         return _warn(self._plan(linear, z, z_input, cosmology, f, bias, amplitude, fog, sigma0,
                                 shot_noise, number_density, noise_table, list(ells), terms, eh,
-                                growth_factor, no_wiggle, cs2, b2, bs, b3))
+                                growth_factor, no_wiggle, cs2, b2, bs, b3, bias_convention))
 
     def terms(self, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None):
         """The loop terms of one linear spectrum (the expensive part), as :class:`RsdTerms`
@@ -385,10 +392,27 @@ class RsdTerms:
                                             growth_factor, no_wiggle, cs2))
 
 
+_BIAS_NAMES = {None: ("b1", "b2", "bs", "b3"), "velocileptors": ("b1", "b2", "bs", "b3"),
+               "fastpt": ("b1", "b2", "bs", "b3nl"), "classpt": ("b1", "b2", "bG2", "bGamma3")}
+
+
+def _bias_kwargs(b1, b2, bs, b3, bias_convention):
+    """The ``ept`` keyword arguments of b1 and the b2, bs, b3 slots of :func:`rsd`, named as
+    ``bias_convention`` names them."""
+    key = None if bias_convention is None else str(bias_convention).lower().replace("-", "").replace("_", "")
+    if key not in _BIAS_NAMES:
+        raise ValueError(f"bias convention {bias_convention!r}: the conventions are velocileptors, "
+                         "fastpt, classpt")
+    out = {name: v for name, v in zip(_BIAS_NAMES[key], (b1, b2, bs, b3)) if v is not None}
+    if bias_convention is not None:
+        out["bias_convention"] = key
+    return out
+
+
 def real(model=_D["real_model"], k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=False,
          precision=_D["precision"], q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None,
          k_min=1e-3, k_max=1.0, nk=100, cs2=0.0, two_loop=_D["two_loop"], bias_terms=False, bias=None,
-         b2=0.0, bs=0.0, b3=0.0, ct=None) -> Table:
+         b2=0.0, bs=0.0, b3=0.0, ct=None, bias_convention=None) -> Table:
     """Real-space P_dd, P_dt, P_tt of a model (``pt-spectra real``).
 
     model: ``linear``, ``1l-spt``, ``2l-spt``, ``1l-rpt-n0`` … ``1l-rpt-n3``, ``2l-rpt-n0`` …
@@ -416,11 +440,16 @@ def real(model=_D["real_model"], k=None, linear=None, z=0.0, z_input=0.0, cosmol
     bias_terms: add the 1-loop bias terms ``Pd1d2 Pd2d2 Pd1s2 Pd2s2 Ps2s2`` (FAST-PT's names and
     normalisation, no constant subtracted), ``Pt1d2 Pt1s2`` (their velocity counterparts) and
     ``sig3nl``, each with ``err_``. bias: b1; with it, ``P_gg`` and ``P_gm`` of the bias expansion
-    (b2, bs = b_s^2, b3 = b3nl; Saito et al. 2014, FAST-PT's convention) on the model's P_dd.
+    (Saito et al. 2014, evaluated with FAST-PT's terms) on the model's P_dd. b2, bs, b3 mean one
+    thing for every model: velocileptors' (b2/2)delta^2 + bs s^2 + b3 O3 (FAST-PT's bs is 2 bs, its
+    b3nl b3/2), unless ``bias_convention`` is ``"fastpt"`` (b2, bs, b3 are then FAST-PT's b2, bs,
+    b3nl) or ``"classpt"`` (CLASS-PT's b2, b_G2, b_Gamma3); the header gives both. bs or b3 without
+    a ``bias_convention`` warns once that they are no longer FAST-PT's.
     """
     plan = RealPlan(_grid(k, k_min, k_max, nk), model, precision, q_range, two_loop_tolerance,
                     cache_dir, two_loop)
-    return plan(linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2, bs, b3, ct)
+    return plan(linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2, bs, b3, ct,
+                bias_convention)
 
 
 def rsd(rsd=_D["rsd_model"], real=_D["rsd_real_model"], k=None, linear=None, z=0.0, z_input=0.0,
@@ -428,7 +457,8 @@ def rsd(rsd=_D["rsd_model"], real=_D["rsd_real_model"], k=None, linear=None, z=0
         f=None, bias=1.0, amplitude=1.0, fog=_D["rsd_fog"], sigma0=0.0, shot_noise=None,
         number_density=None, noise_table=None, ells=(0, 2, 4), terms=False, precision=_D["precision"],
         q_range=None, cache_dir=None, eh=None, k_min=1e-3, k_max=1.0, nk=100,
-        no_wiggle=False, cs2=0.0, b2=None, bs=None, b3=None, **ept_params) -> Table:
+        no_wiggle=False, cs2=0.0, b2=None, bs=None, b3=None, bias_convention=None,
+        **ept_params) -> Table:
     """Redshift-space multipoles (``pt-spectra rsd``): columns ``k P0 P2 P4 … err_P0 …``.
 
     ``rsd="ept"`` is the galaxy model (:func:`ept`): ``bias`` is b1, ``b2``, ``bs``, ``b3`` and the
@@ -449,13 +479,14 @@ def rsd(rsd=_D["rsd_model"], real=_D["rsd_real_model"], k=None, linear=None, z=0
     the linear Kaiser multipoles of the no-wiggle spectrum. cs2: the EFT counterterm added to the
     real-space spectra before the RSD model (as in :func:`real`). b2, bs, b3: the nonlinear galaxy
     bias of the ``scoccimarro`` and ``tns`` models (the BOSS DR12 model of Beutler et al. 2017, with
-    the bias terms of :func:`real`'s ``bias_terms``; ``bias`` is b1, a number). The other arguments
-    are those of :func:`real`.
+    the bias terms of :func:`real`'s ``bias_terms``; ``bias`` is b1, a number), in velocileptors'
+    convention as for every model unless ``bias_convention`` says otherwise (see :func:`real`). The
+    other arguments are those of :func:`real`.
     """
     if str(rsd).lower() == "ept":
         return ept(k=_grid(k, k_min, k_max, nk), linear=linear, z=z, z_input=z_input,
                    cosmology=cosmology, eh=eh, ells=ells, precision=precision, q_range=q_range,
-                   b1=bias, b2=b2, bs=bs, b3=b3, f=f, **ept_params)
+                   f=f, **ept_params, **_bias_kwargs(bias, b2, bs, b3, bias_convention))
     if str(rsd).lower() in ("spt2", "eft2"):
         given = [name for name, value, default in [
             ("real", real, _D["rsd_real_model"]), ("bias", bias, 1.0), ("amplitude", amplitude, 1.0),
@@ -476,7 +507,7 @@ def rsd(rsd=_D["rsd_model"], real=_D["rsd_real_model"], k=None, linear=None, z=0
     plan = RsdPlan(_grid(k, k_min, k_max, nk), real, rsd, precision, q_range, cache_dir)
     return plan(linear, z, z_input, cosmology, f, bias, amplitude, fog, sigma0, shot_noise,
                 number_density, noise_table, ells, terms, eh, no_wiggle=no_wiggle, cs2=cs2, b2=b2,
-                bs=bs, b3=b3)
+                bs=bs, b3=b3, bias_convention=bias_convention)
 
 
 def fit(data, k_max, free=("f", "sigma0"), ells=(0,), data_ells=(0, 2, 4), data_columns=None,

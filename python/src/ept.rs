@@ -5,12 +5,14 @@
 use crate::inputs::Inputs;
 use crate::tables::Table;
 use crate::{detached, floats, value_error};
+use pt_spectra::bias::{BiasConvention, BiasParams};
 use pt_spectra::jobs::{self, EptRequest};
 use pt_spectra::progress::Silent;
 use pt_spectra::rsd::ap::Distortion;
 use pt_spectra::rsd::ept::{EptParams, EptPlan as LibEptPlan, EptTerms as LibEptTerms};
 use pt_spectra::setup::Prepared;
 use pt_spectra::survey::observe::{Bins, Observation};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Arc;
@@ -28,11 +30,53 @@ fn distortion(apar: Option<f64>, aperp: Option<f64>) -> PyResult<Option<Distorti
 
 /// The parameters of `kwargs` (velocileptors' names; f may be absent: f(z) of the cosmology).
 fn params(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<EptParams> {
+    Ok(params_given(kwargs)?.0)
+}
+
+/// The model's parameters of `kwargs` and the bias convention they were given in: with
+/// `bias_convention=` the bias is named as that convention names it (classpt: b1, b2, bG2, bGamma3;
+/// fastpt: b1, b2, bs, b3nl) and mapped to velocileptors' ([`pt_spectra::bias`]).
+fn params_given(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<(EptParams, BiasConvention)> {
     let mut p = EptParams::new(1.0, f64::NAN);
-    for (name, v) in crate::number_kwargs(kwargs)? {
+    let numbers = match kwargs {
+        Some(kw) if kw.contains("bias_convention")? => {
+            let kw = kw.copy()?;
+            let name: String = kw
+                .get_item("bias_convention")?
+                .map(|v| v.extract())
+                .transpose()
+                .map_err(|_| PyValueError::new_err("bias_convention: expected a name"))?
+                .unwrap_or_default();
+            kw.del_item("bias_convention")?;
+            let convention: BiasConvention = name.parse().map_err(value_error)?;
+            let names = convention.names();
+            let mut bias = [1.0, 0.0, 0.0, 0.0];
+            let mut rest = Vec::new();
+            for (key, v) in crate::number_kwargs(Some(&kw))? {
+                match names.iter().position(|n| *n == key) {
+                    Some(i) => bias[i] = v,
+                    None if ["b2", "bs", "b3"].contains(&key.as_str()) => {
+                        return Err(PyValueError::new_err(format!(
+                            "{key} is not a bias parameter of bias_convention='{convention}': its names are {}",
+                            names.join(", ")
+                        )))
+                    }
+                    None => rest.push((key, v)),
+                }
+            }
+            let b = BiasParams::from_convention(convention, bias);
+            p.values[..4].copy_from_slice(&b.values());
+            for (key, v) in rest {
+                p.set(&key, v).map_err(value_error)?;
+            }
+            return Ok((p, convention));
+        }
+        _ => crate::number_kwargs(kwargs)?,
+    };
+    for (name, v) in numbers {
         p.set(&name, v).map_err(value_error)?;
     }
-    Ok(p)
+    Ok((p, BiasConvention::Velocileptors))
 }
 
 /// The 1-loop galaxy model in redshift space planned for one k grid.
@@ -86,10 +130,12 @@ impl EptPlan {
         ells: Vec<usize>,
         kwargs: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Table> {
+        let (params, bias_given) = params_given(kwargs)?;
         let request = EptRequest {
-            params: params(kwargs)?,
+            params,
             ells,
             ap: None,
+            bias_given,
         };
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
         let ((table, prepared), seconds) = detached(py, || {
@@ -147,10 +193,12 @@ impl EptTerms {
         aperp: Option<f64>,
         kwargs: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Table> {
+        let (params, bias_given) = params_given(kwargs)?;
         let request = EptRequest {
-            params: params(kwargs)?,
+            params,
             ells,
             ap: distortion(apar, aperp)?,
+            bias_given,
         };
         let (table, seconds) = detached(py, || {
             jobs::ept_table_from_terms(

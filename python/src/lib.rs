@@ -6,11 +6,12 @@
 //! `ValueError` with its message. The pure-Python package `pt_spectra` wraps these (warnings, docs).
 
 use numpy::{IntoPyArray, PyArray1};
+use pt_spectra::bias::BiasParams;
 use pt_spectra::cosmology::TransferKind;
 use pt_spectra::fit::{ContourGrid, MultipoleData, Parameter};
 use pt_spectra::jobs::{self, BiasOutput, FitRequest, RsdRequest};
 use pt_spectra::linear::LogGrid;
-use pt_spectra::loops::bias::{BiasPlan, GalaxyBias};
+use pt_spectra::loops::bias::BiasPlan;
 use pt_spectra::precision::Precision;
 use pt_spectra::progress::Silent;
 use pt_spectra::real::{Counterterms, RealPlan as LibRealPlan, RealSelection};
@@ -23,6 +24,7 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 mod batch;
+mod bias;
 mod bispectrum;
 mod bispectrum_one_loop;
 mod emulator;
@@ -202,7 +204,7 @@ impl RealPlan {
     /// The spectra of `linear` (None: the embedded gm2012 spectrum; a path; or (k, P)) at z, with the
     /// EFT counterterm c_s² = `cs2` [(Mpc/h)²], and the galaxy bias terms and spectra if asked for.
     #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false, eh=None, cs2=0.0,
-        bias_terms=false, bias=None, b2=0.0, bs=0.0, b3=0.0, ct=None))]
+        bias_terms=false, bias=None, b2=0.0, bs=0.0, b3=0.0, ct=None, bias_convention=None))]
     #[allow(clippy::too_many_arguments)]
     fn __call__(
         &self,
@@ -220,7 +222,9 @@ impl RealPlan {
         bs: f64,
         b3: f64,
         ct: Option<std::collections::BTreeMap<String, f64>>,
+        bias_convention: Option<&str>,
     ) -> PyResult<Table> {
+        let given = bias::convention(py, bias_convention, Some(bs), Some(b3), Some("real"))?;
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
         let assignments = ct
             .iter()
@@ -231,12 +235,8 @@ impl RealPlan {
             .map_err(value_error)?;
         let output = BiasOutput {
             terms: bias_terms,
-            galaxy: bias.map(|b1| GalaxyBias {
-                b1,
-                b2,
-                bs,
-                b3nl: b3,
-            }),
+            galaxy: bias.map(|b1| BiasParams::from_convention(given, [b1, b2, bs, b3])),
+            given,
         };
         if bias.is_none() && (b2 != 0.0 || bs != 0.0 || b3 != 0.0) {
             return Err(PyValueError::new_err(
@@ -287,7 +287,7 @@ impl RealPlan {
 #[pyo3(signature = (model=pt_spectra::jobs::defaults::REAL_MODEL, k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, terms=false,
     precision=pt_spectra::jobs::defaults::PRECISION, q_range=None, two_loop_tolerance=None, cache_dir=None, eh=None, k_min=1e-3,
     k_max=1.0, nk=100, cs2=0.0, two_loop=pt_spectra::jobs::defaults::TWO_LOOP, bias_terms=false, bias=None, b2=0.0, bs=0.0, b3=0.0,
-    ct=None))]
+    ct=None, bias_convention=None))]
 #[allow(clippy::too_many_arguments)]
 fn real(
     py: Python<'_>,
@@ -314,6 +314,7 @@ fn real(
     bs: f64,
     b3: f64,
     ct: Option<std::collections::BTreeMap<String, f64>>,
+    bias_convention: Option<&str>,
 ) -> PyResult<Table> {
     let k = k_grid(k, k_min, k_max, nk)?;
     let plan = RealPlan::new(
@@ -327,7 +328,21 @@ fn real(
         two_loop,
     )?;
     plan.__call__(
-        py, linear, z, z_input, cosmology, terms, eh, cs2, bias_terms, bias, b2, bs, b3, ct,
+        py,
+        linear,
+        z,
+        z_input,
+        cosmology,
+        terms,
+        eh,
+        cs2,
+        bias_terms,
+        bias,
+        b2,
+        bs,
+        b3,
+        ct,
+        bias_convention,
     )
 }
 

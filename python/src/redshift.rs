@@ -112,7 +112,8 @@ impl RsdPlan {
     /// The multipoles of the prepared spectrum: see the Python wrapper `pt_spectra.rsd`.
     #[pyo3(signature = (linear=None, z=0.0, z_input=0.0, cosmology=None, f=None, bias=None, amplitude=1.0,
         fog="none", sigma0=None, shot_noise=None, number_density=None, noise_table=None, ells=vec![0, 2, 4],
-        terms=false, eh=None, growth_factor=None, no_wiggle=false, cs2=0.0, b2=None, bs=None, b3=None))]
+        terms=false, eh=None, growth_factor=None, no_wiggle=false, cs2=0.0, b2=None, bs=None, b3=None,
+        bias_convention=None))]
     #[allow(clippy::too_many_arguments)]
     fn __call__(
         &self,
@@ -138,7 +139,10 @@ impl RsdPlan {
         b2: Option<f64>,
         bs: Option<f64>,
         b3: Option<f64>,
+        bias_convention: Option<&str>,
     ) -> PyResult<Table> {
+        let model = format!("rsd='{}'", self.rsd);
+        let given = crate::bias::convention(py, bias_convention, bs, b3, Some(&model))?;
         let settings = (
             f,
             amplitude,
@@ -152,11 +156,12 @@ impl RsdPlan {
         );
         let mut request = rsd_request(py, self.rsd, bias, sigma0, noise_table, settings)?;
         if b2.is_some() || bs.is_some() || b3.is_some() {
-            request.galaxy = Some(jobs::NonlinearBias {
-                b2: b2.unwrap_or(0.0),
-                bs: bs.unwrap_or(0.0),
-                b3nl: b3.unwrap_or(0.0),
-            });
+            request.galaxy = Some(jobs::NonlinearBias::new(
+                given,
+                b2.unwrap_or(0.0),
+                bs.unwrap_or(0.0),
+                b3.unwrap_or(0.0),
+            ));
         }
         request.validate_galaxy().map_err(value_error)?;
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;

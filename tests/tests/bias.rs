@@ -195,24 +195,22 @@ fn tns_with_nonlinear_bias_moves_the_multipoles_by_the_bias_terms() {
     };
     let silent = &pt_spectra::progress::Silent;
     let linear = rsd_table(&plan, &request, &prepared, silent).unwrap();
-    let g = NonlinearBias {
-        b2: 0.6,
-        bs: -0.4,
-        b3nl: 0.25,
-    };
+    // FAST-PT's values, as the formulas below write them
+    let g = NonlinearBias::new(pt_spectra::bias::BiasConvention::FastPt, 0.6, -0.4, 0.25);
     request.galaxy = Some(g);
     let galaxy = rsd_table(&plan, &request, &prepared, silent).unwrap();
     let t = plan.bias_terms(&prepared.spectrum).unwrap();
     let v = |name: &str, i: usize| t.pair(name).unwrap()[i].value;
+    let (b2, bs, b3nl) = (0.6, -0.4, 0.25);
     for (i, ki) in k.iter().enumerate() {
         let s3 = t.sig3nl[i].value;
-        let d_gg = b1 * g.b2 * v("Pd1d2", i)
-            + 0.25 * g.b2 * g.b2 * v("Pd2d2", i)
-            + b1 * g.bs * v("Pd1s2", i)
-            + 0.5 * g.b2 * g.bs * v("Pd2s2", i)
-            + 0.25 * g.bs * g.bs * v("Ps2s2", i)
-            + 2.0 * b1 * g.b3nl * s3;
-        let d_gt = 0.5 * g.b2 * v("Pt1d2", i) + 0.5 * g.bs * v("Pt1s2", i) + g.b3nl * s3;
+        let d_gg = b1 * b2 * v("Pd1d2", i)
+            + 0.25 * b2 * b2 * v("Pd2d2", i)
+            + b1 * bs * v("Pd1s2", i)
+            + 0.5 * b2 * bs * v("Pd2s2", i)
+            + 0.25 * bs * bs * v("Ps2s2", i)
+            + 2.0 * b1 * b3nl * s3;
+        let d_gt = 0.5 * b2 * v("Pt1d2", i) + 0.5 * bs * v("Pt1s2", i) + b3nl * s3;
         let want = [d_gg + 2.0 * f / 3.0 * d_gt, 4.0 * f / 3.0 * d_gt, 0.0];
         for (l, w) in ["P0", "P2", "P4"].iter().zip(want) {
             let d = galaxy.column(l).unwrap()[i] - linear.column(l).unwrap()[i];
@@ -224,6 +222,21 @@ fn tns_with_nonlinear_bias_moves_the_multipoles_by_the_bias_terms() {
         .header
         .iter()
         .any(|h| h.contains("Beutler et al. 2017")));
+    // the same bias in velocileptors' convention (bs/2, 2 b3nl): the same table
+    request.galaxy = Some(NonlinearBias::new(
+        pt_spectra::bias::BiasConvention::Velocileptors,
+        0.6,
+        -0.2,
+        0.5,
+    ));
+    let ours = rsd_table(&plan, &request, &prepared, silent).unwrap();
+    for l in ["P0", "P2", "P4"] {
+        assert_eq!(ours.column(l), galaxy.column(l), "{l}");
+    }
+    assert!(galaxy
+        .header
+        .iter()
+        .any(|h| h.contains("given in FAST-PT's")));
 }
 
 /// One bias, two implementations: the `ept` model (velocileptors' bs s² and b1 b3 sig3nl, checked

@@ -1,5 +1,6 @@
 //! The galaxy bias expansion in `real` tables: the bias terms and P_gg, P_gm.
 
+use crate::bias::{BiasConvention, BiasParams};
 use crate::error::{Error, Result};
 use crate::loops::bias::{BiasPlan, BiasTerms, GalaxyBias, PAIR_NAMES};
 use crate::loops::{Estimate, Pair};
@@ -12,8 +13,11 @@ use crate::setup::Prepared;
 pub struct BiasOutput {
     /// The bias terms Pd1d2 … sig3nl as columns, with their errors.
     pub terms: bool,
-    /// P_gg and P_gm of these bias parameters.
-    pub galaxy: Option<GalaxyBias>,
+    /// P_gg and P_gm of these bias parameters (velocileptors' convention, as every model takes
+    /// them: [`crate::bias`]; evaluated through FAST-PT's expansion with the mapped values).
+    pub galaxy: Option<BiasParams>,
+    /// The convention the user wrote the bias in (for the header).
+    pub given: BiasConvention,
 }
 
 impl BiasOutput {
@@ -34,12 +38,9 @@ impl BiasOutput {
                 reason: "the galaxy spectra need one matter model: choose it with --model".into(),
             });
         }
-        match self.galaxy {
-            Some(b) => {
-                super::check_finite(&[("b1", b.b1), ("b2", b.b2), ("bs", b.bs), ("b3nl", b.b3nl)])
-            }
-            None => Ok(()),
-        }
+        self.galaxy
+            .as_ref()
+            .map_or(Ok(()), BiasParams::check_finite)
     }
 }
 
@@ -94,9 +95,11 @@ pub(super) fn push_columns(
         }
         t.push_estimates("sig3nl", POWER, &b.sig3nl);
     }
-    if let Some(g) = output.galaxy {
+    if let Some(bias) = output.galaxy {
+        let g = GalaxyBias::from(bias);
+        t.header.push(bias.describe(output.given));
         t.header.push(format!(
-            "galaxies: b1 = {}, b2 = {}, bs = {}, b3nl = {}; P_gg = b1^2 P_dd + b1 b2 Pd1d2 + 1/4 b2^2 \
+            "galaxies, in FAST-PT's convention: b1 = {}, b2 = {}, bs = {}, b3nl = {}; P_gg = b1^2 P_dd + b1 b2 Pd1d2 + 1/4 b2^2 \
              Pd2d2 + b1 bs Pd1s2 + 1/2 b2 bs Pd2s2 + 1/4 bs^2 Ps2s2 + 2 b1 b3nl sig3nl, P_gm = b1 P_dd + \
              1/2 b2 Pd1d2 + 1/2 bs Pd1s2 + b3nl sig3nl (P_dd of the model above; no shot noise)",
             g.b1, g.b2, g.bs, g.b3nl

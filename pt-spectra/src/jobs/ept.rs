@@ -1,6 +1,7 @@
 //! `rsd --rsd ept`: the multipoles of the galaxy model ([`crate::rsd::ept`]) as a table.
 
 use super::{describe_inputs, VERSION};
+use crate::bias::{BiasConvention, BiasParams};
 use crate::error::Result;
 use crate::output::{Table, POWER, WAVENUMBER};
 use crate::precision::Precision;
@@ -19,6 +20,9 @@ pub struct EptRequest {
     /// A distortion replacing the plan's (on a plan built with an AP range, [`ept_plan`]'s
     /// `free_ap`); `None`: the plan's own.
     pub ap: Option<Distortion>,
+    /// The convention the user wrote the bias in (the header then gives it as written too); the
+    /// params are velocileptors' ([`crate::bias`]).
+    pub bias_given: BiasConvention,
 }
 
 pub use crate::rsd::ap::AP_FIT_RANGE;
@@ -102,6 +106,10 @@ pub fn ept_table_from_terms(
          mu^2 + sn4 k^4 mu^4; k->0 constants of the b2, bs terms not subtracted"
             .into(),
     ];
+    if request.bias_given != BiasConvention::Velocileptors {
+        let [b1, b2, bs, b3] = std::array::from_fn(|i| params.values[i]);
+        header.push(BiasParams { b1, b2, bs, b3 }.describe(request.bias_given));
+    }
     header.push(if settings.ir {
         format!(
             "IR resummation: no-wiggle P by velocileptors' Savitzky-Golay filter (quartic, ln 7 in ln k), \

@@ -2,6 +2,7 @@
 //! reference of the paper's figures.
 
 use super::{counterterm_line, describe_inputs, VERSION};
+use crate::bias::{BiasConvention, BiasParams};
 use crate::error::{Error, Result};
 use crate::halo::{crossings, Bias, Noise};
 use crate::linear::LinearSpectrum;
@@ -46,7 +47,7 @@ pub struct RsdRequest {
     /// The EFT counterterm c_s² [(Mpc/h)²] added to the real-space spectra ([`crate::real::counterterm`](mod@crate::real::counterterm);
     /// 0: none); in `fit` its start value if free, else its value.
     pub cs2: f64,
-    /// The nonlinear galaxy bias b2, bs, b3nl of the Scoccimarro and TNS models (the plan needs
+    /// The nonlinear galaxy bias b2, bs, b3 of the Scoccimarro and TNS models (the plan needs
     /// [`RsdPlan::with_bias_terms`]; b1 is the constant bias); `None`: linear bias.
     pub galaxy: Option<NonlinearBias>,
     /// The Alcock–Paczynski projection onto observed k ([`crate::rsd::ap`]): the plan must then be
@@ -54,15 +55,44 @@ pub struct RsdRequest {
     pub ap: Option<Observed>,
 }
 
-/// The nonlinear galaxy bias of an [`RsdRequest`] ([`crate::rsd::GalaxyTerms`] without its terms).
+/// The nonlinear galaxy bias of an [`RsdRequest`], in velocileptors' convention as every model
+/// takes it ([`crate::bias`]: (b2/2)δ², bs s², b3 = 2 b3nl), and the convention the user wrote it in
+/// (for the header). The Scoccimarro and TNS models evaluate FAST-PT's expansion with the mapped
+/// values ([`crate::rsd::GalaxyTerms`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NonlinearBias {
     /// Second-order local bias b2.
     pub b2: f64,
-    /// Tidal bias b_s².
+    /// Tidal bias bs (bs s²).
     pub bs: f64,
-    /// Non-local cubic bias b3nl.
-    pub b3nl: f64,
+    /// Cubic bias b3 (b1 b3 sig3nl in P_gg).
+    pub b3: f64,
+    /// The convention the values were given in.
+    pub given: BiasConvention,
+}
+
+impl NonlinearBias {
+    /// The bias of `b2`, `third` and `fourth` written in `convention` (bs and b3, b_G2 and b_Γ3, …:
+    /// [`BiasConvention::names`]).
+    pub fn new(convention: BiasConvention, b2: f64, third: f64, fourth: f64) -> Self {
+        let b = BiasParams::from_convention(convention, [0.0, b2, third, fourth]);
+        Self {
+            b2: b.b2,
+            bs: b.bs,
+            b3: b.b3,
+            given: convention,
+        }
+    }
+
+    /// The bias with linear bias `b1`.
+    pub fn with_b1(&self, b1: f64) -> BiasParams {
+        BiasParams {
+            b1,
+            b2: self.b2,
+            bs: self.bs,
+            b3: self.b3,
+        }
+    }
 }
 
 impl RsdRequest {
@@ -87,7 +117,7 @@ impl RsdRequest {
                 reason: "the bias expansion has a constant b1: give it with --bias".into(),
             });
         }
-        super::check_finite(&[("b2", g.b2), ("bs", g.bs), ("b3nl", g.b3nl)])
+        super::check_finite(&[("b2", g.b2), ("bs", g.bs), ("b3", g.b3)])
     }
 
     /// A description of the bias for headers.
@@ -266,12 +296,15 @@ fn rsd_table_memo(
                 hint: " (RsdPlan::with_bias_terms)",
             })
         }
-        (Some(g), Some(terms)) => Some(GalaxyTerms {
-            b2: g.b2,
-            bs: g.bs,
-            b3nl: g.b3nl,
-            terms,
-        }),
+        (Some(g), Some(terms)) => {
+            let [_, b2, bs, b3nl] = g.with_b1(0.0).in_convention(BiasConvention::FastPt);
+            Some(GalaxyTerms {
+                b2,
+                bs,
+                b3nl,
+                terms,
+            })
+        }
     };
     let settings = RsdSettings {
         model: request.rsd,
@@ -319,13 +352,15 @@ fn rsd_table_memo(
         }
     }
     if let Some(g) = request.galaxy {
+        let [_, b2, bs, b3nl] = g.with_b1(0.0).in_convention(BiasConvention::FastPt);
+        header.push(g.with_b1(0.0).describe_nonlinear(g.given));
         header.push(format!(
-            "nonlinear galaxy bias (Beutler et al. 2017): b1 = A_b b, b2 = {}, bs = {}, b3nl = {}; \
-             P^s = P_gg + 2 f mu^2 P_gt + f^2 mu^4 P_tt (+ A, B of b1), P_gg = b1^2 P_dd + b1 b2 Pd1d2 \
+            "nonlinear galaxy bias (Beutler et al. 2017) in FAST-PT's convention: b1 = A_b b, b2 = {}, \
+             bs = {}, b3nl = {}; P^s = P_gg + 2 f mu^2 P_gt + f^2 mu^4 P_tt (+ A, B of b1), P_gg = b1^2 P_dd + b1 b2 Pd1d2 \
              + 1/4 b2^2 Pd2d2 + b1 bs Pd1s2 + 1/2 b2 bs Pd2s2 + 1/4 bs^2 Ps2s2 + 2 b1 b3nl sig3nl, P_gt \
              = b1 P_dt + 1/2 b2 Pt1d2 + 1/2 bs Pt1s2 + b3nl sig3nl (FAST-PT's bias terms, no constant \
              subtracted: the k -> 0 constant 1/4 b2^2 Pd2d2 + ... acts as a shot noise)",
-            g.b2, g.bs, g.b3nl
+            b2, bs, b3nl
         ));
     }
     header.push(

@@ -298,7 +298,9 @@ impl BiasPlan {
     }
 }
 
-/// The bias parameters of the real-space galaxy spectra (module docs): b1, b2, bs (= b_s²) and b3nl.
+/// The bias parameters of the real-space galaxy spectra in FAST-PT's convention (module docs): b1,
+/// b2, bs (= b_s², (bs/2)s²) and b3nl. The faces take velocileptors' ([`crate::bias::BiasParams`],
+/// converted by `From`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GalaxyBias {
     /// Linear bias b1.
@@ -309,6 +311,14 @@ pub struct GalaxyBias {
     pub bs: f64,
     /// Non-local cubic bias b3nl.
     pub b3nl: f64,
+}
+
+impl From<crate::bias::BiasParams> for GalaxyBias {
+    /// FAST-PT's values of a bias given in velocileptors' convention ([`crate::bias`]).
+    fn from(b: crate::bias::BiasParams) -> Self {
+        let [b1, b2, bs, b3nl] = b.in_convention(crate::bias::BiasConvention::FastPt);
+        Self { b1, b2, bs, b3nl }
+    }
 }
 
 impl GalaxyBias {

@@ -33,8 +33,43 @@ fn bias_columns_and_galaxy_spectra() {
         "-0.3",
         "--b3",
         "0.2",
+        "--bias-convention",
+        "fastpt",
     ]));
     assert!(ok, "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    // The same bias in velocileptors' convention (the default: bs s², b1 b3 sig3nl), and in
+    // CLASS-PT's (b2 + (4/3)bs, b_G2 = bs, b_Γ3 = −(b3 + 15 bs)/6): the same table but its header.
+    for (extra, note) in [
+        (
+            vec!["--b2", "0.5", "--bs", "-0.15", "--b3", "0.4"],
+            "warning: --bs and --b3 of real",
+        ),
+        (
+            vec![
+                "--b2",
+                "0.3",
+                "--bs",
+                "-0.15",
+                "--b3",
+                "0.30833333333333335",
+                "--bias-convention",
+                "classpt",
+            ],
+            "given in CLASS-PT's: b1 = 2, b2 = 0.3",
+        ),
+    ] {
+        let mut a = args(&["--bias-terms", "--bias", "2"]);
+        a.extend(extra);
+        let (ok, same, err) = run(&a);
+        assert!(ok, "{err}");
+        assert!(err.contains(note) || same.contains(note), "{note}: {err}");
+        for (x, y) in rows(&same).iter().zip(rows(&out)) {
+            for (u, v) in x.iter().zip(&y) {
+                assert!((u - v).abs() <= 1e-12 * v.abs(), "{x:?} vs {y:?}");
+            }
+        }
+    }
     let names = column_names(&out);
     for name in [
         "Pd1d2",

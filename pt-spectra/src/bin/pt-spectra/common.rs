@@ -132,3 +132,71 @@ pub fn list<T: std::str::FromStr>(s: &str, what: &str) -> Result<Vec<T>> {
         })
         .collect()
 }
+
+/// The nonlinear galaxy bias, one meaning for every model: velocileptors' convention unless
+/// --bias-convention says which other the values are written in (`pt_spectra::bias`).
+#[derive(clap::Args, Debug)]
+pub struct GalaxyBiasArgs {
+    /// Second-order local bias b2: (b2/2)δ² (with --bias-convention classpt, CLASS-PT's b2).
+    #[arg(long, value_name = "B2", allow_hyphen_values = true)]
+    pub b2: Option<f64>,
+    /// Tidal bias bs: bs s², velocileptors' (with --bias-convention fastpt FAST-PT's (bs/2)s², with
+    /// classpt CLASS-PT's b_G2).
+    #[arg(long, value_name = "BS", allow_hyphen_values = true)]
+    pub bs: Option<f64>,
+    /// Cubic bias b3: b1 b3 sig3nl in P_gg, velocileptors' (with --bias-convention fastpt FAST-PT's
+    /// b3nl = b3/2, with classpt CLASS-PT's b_Γ3).
+    #[arg(long, value_name = "B3", allow_hyphen_values = true)]
+    pub b3: Option<f64>,
+    /// The convention --b2, --bs, --b3 are written in: velocileptors (the default, for every model),
+    /// fastpt (b2, bs, b3nl of FAST-PT, McDonald & Roy 2009, Beutler et al. 2017), classpt (b2, b_G2,
+    /// b_Γ3 of CLASS-PT). The header gives the values in velocileptors' convention and as given.
+    #[arg(long, value_name = "NAME", value_parser = parsed::<pt_spectra::bias::BiasConvention>)]
+    pub bias_convention: Option<pt_spectra::bias::BiasConvention>,
+}
+
+impl GalaxyBiasArgs {
+    /// Whether any of --b2, --bs, --b3 is given.
+    pub fn any(&self) -> bool {
+        self.b2.is_some() || self.bs.is_some() || self.b3.is_some()
+    }
+
+    /// The convention of the values.
+    pub fn convention(&self) -> pt_spectra::bias::BiasConvention {
+        self.bias_convention.unwrap_or_default()
+    }
+
+    /// The bias with linear bias `b1`, in velocileptors' convention.
+    pub fn params(&self, b1: f64) -> pt_spectra::bias::BiasParams {
+        let v = |x: Option<f64>| x.unwrap_or(0.0);
+        pt_spectra::bias::BiasParams::from_convention(
+            self.convention(),
+            [b1, v(self.b2), v(self.bs), v(self.b3)],
+        )
+    }
+
+    /// The nonlinear bias of --b2, --bs, --b3, if any is given.
+    pub fn nonlinear(&self) -> Option<pt_spectra::jobs::NonlinearBias> {
+        let v = |x: Option<f64>| x.unwrap_or(0.0);
+        self.any().then(|| {
+            pt_spectra::jobs::NonlinearBias::new(
+                self.convention(),
+                v(self.b2),
+                v(self.bs),
+                v(self.b3),
+            )
+        })
+    }
+
+    /// A warning for `model`, whose --bs and --b3 were FAST-PT's before they meant one thing for every
+    /// model, when they are given without --bias-convention.
+    pub fn warn_if_implicit(&self, model: &str) {
+        if self.bias_convention.is_none() && (self.bs.is_some() || self.b3.is_some()) {
+            eprintln!(
+                "warning: --bs and --b3 of {model} are velocileptors' bs (bs s^2) and b3 (b1 b3 sig3nl), as \
+                 for every model; FAST-PT's bs is twice this bs and its b3nl half this b3: give \
+                 --bias-convention fastpt to write FAST-PT's values (the header states both)"
+            );
+        }
+    }
+}

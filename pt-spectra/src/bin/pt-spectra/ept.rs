@@ -222,9 +222,8 @@ pub fn edges(text: &str, flag: &str) -> Result<Vec<f64>> {
 pub struct Shared {
     pub bias: Bias,
     pub f: Option<f64>,
-    pub b2: Option<f64>,
-    pub bs: Option<f64>,
-    pub b3: Option<f64>,
+    /// --b2, --bs, --b3 in velocileptors' convention, and the one they were given in.
+    pub galaxy: Option<pt_spectra::jobs::NonlinearBias>,
     pub ells: Vec<usize>,
     pub distortion: Option<Distortion>,
     /// --xi: the s [Mpc/h] of the correlation-function multipoles.
@@ -244,9 +243,9 @@ pub fn table(
     };
     let mut params = EptParams::new(b1, shared.f.unwrap_or(f64::NAN));
     for (name, value) in [
-        ("b2", shared.b2),
-        ("bs", shared.bs),
-        ("b3", shared.b3),
+        ("b2", shared.galaxy.map(|g| g.b2)),
+        ("bs", shared.galaxy.map(|g| g.bs)),
+        ("b3", shared.galaxy.map(|g| g.b3)),
         ("alpha0", args.alpha0),
         ("alpha2", args.alpha2),
         ("alpha4", args.alpha4),
@@ -263,6 +262,7 @@ pub fn table(
         params,
         ells: shared.ells,
         ap: None,
+        bias_given: shared.galaxy.map(|g| g.given).unwrap_or_default(),
     };
     let (window, bins) = args.observation()?;
     if shared.xi.is_some() && (window.is_some() || bins.is_some()) {

@@ -1,12 +1,12 @@
 //! `pt-spectra real`: real-space P_δδ, P_δθ, P_θθ of a model on a k grid, as a whitespace table.
 
-use crate::common::{parse_cs2, parsed};
+use crate::common::{parse_cs2, parsed, GalaxyBiasArgs};
 use crate::input::Input;
 use crate::output::{check_outputs, write_output};
 use crate::progress::Bars;
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use pt_spectra::jobs::{real_table_with_bias, BiasOutput};
-use pt_spectra::loops::bias::{BiasPlan, GalaxyBias};
+use pt_spectra::loops::bias::BiasPlan;
 use pt_spectra::real::{Counterterms, RealPlan, RealSelection};
 use std::path::PathBuf;
 
@@ -43,15 +43,8 @@ pub struct Args {
     /// with --b2, --bs, --b3 (default 0).
     #[arg(long, value_name = "B1", allow_hyphen_values = true)]
     bias: Option<f64>,
-    /// Second-order local bias b2 (needs --bias).
-    #[arg(long, value_name = "B2", allow_hyphen_values = true, requires = "bias")]
-    b2: Option<f64>,
-    /// Tidal bias b_s² (FAST-PT's bs; needs --bias).
-    #[arg(long, value_name = "BS", allow_hyphen_values = true, requires = "bias")]
-    bs: Option<f64>,
-    /// Non-local cubic bias b3nl (Saito et al. 2014; needs --bias).
-    #[arg(long, value_name = "B3", allow_hyphen_values = true, requires = "bias")]
-    b3: Option<f64>,
+    #[command(flatten)]
+    galaxy: GalaxyBiasArgs,
     /// Write the table to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
@@ -76,13 +69,15 @@ pub fn run(args: &Args) -> Result<()> {
     let bars = Bars::default();
     let bias = BiasOutput {
         terms: args.bias_terms,
-        galaxy: args.bias.map(|b1| GalaxyBias {
-            b1,
-            b2: args.b2.unwrap_or(0.0),
-            bs: args.bs.unwrap_or(0.0),
-            b3nl: args.b3.unwrap_or(0.0),
-        }),
+        galaxy: args.bias.map(|b1| args.galaxy.params(b1)),
+        given: args.galaxy.convention(),
     };
+    if args.bias.is_none() && (args.galaxy.any() || args.galaxy.bias_convention.is_some()) {
+        bail!("--b2, --bs, --b3 and --bias-convention need --bias (b1): the galaxy spectra are those of the bias expansion");
+    }
+    if args.bias.is_some() {
+        args.galaxy.warn_if_implicit("real");
+    }
     bias.validate(args.model)?;
     let counterterms = Counterterms::from_assignments(&args.ct)?.with_cs2(args.cs2)?;
     if let RealSelection::One(model) = args.model {

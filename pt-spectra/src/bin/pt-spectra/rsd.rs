@@ -1,6 +1,6 @@
 //! `pt-spectra rsd`: redshift-space multipoles P_ℓ(k) of a real-space model through an RSD model.
 
-use crate::common::{list, parse_cs2, parsed, BiasArgs, NoiseArgs};
+use crate::common::{list, parse_cs2, parsed, BiasArgs, GalaxyBiasArgs, NoiseArgs};
 use crate::ept::{self, EptArgs, RsdChoice};
 use crate::input::Input;
 use crate::output::{check_outputs, write_output};
@@ -54,17 +54,10 @@ pub struct Args {
     sigma0: Sigma0,
     #[command(flatten)]
     bias: BiasArgs,
-    /// Nonlinear galaxy bias b2 (scoccimarro, tns: the BOSS DR12 model of Beutler et al. 2017, with
-    /// the bias terms of `real --bias-terms`; b1 is --bias, constant; ept: velocileptors' b2, (b2/2)δ²).
-    #[arg(long, value_name = "B2", allow_hyphen_values = true)]
-    b2: Option<f64>,
-    /// Tidal bias of the nonlinear galaxy bias: FAST-PT's bs, (bs/2)s² (scoccimarro, tns); ept:
-    /// velocileptors' bs, bs s².
-    #[arg(long, value_name = "BS", allow_hyphen_values = true)]
-    bs: Option<f64>,
-    /// Non-local cubic bias: b3nl (scoccimarro, tns); ept: velocileptors' b3 = 2 b3nl.
-    #[arg(long, value_name = "B3", allow_hyphen_values = true)]
-    b3: Option<f64>,
+    /// The nonlinear galaxy bias (scoccimarro, tns: the BOSS DR12 model of Beutler et al. 2017 with
+    /// the bias terms of `real --bias-terms`, b1 is --bias, constant; ept: velocileptors' REPT).
+    #[command(flatten)]
+    galaxy: GalaxyBiasArgs,
     #[command(flatten)]
     noise: NoiseArgs,
     #[command(flatten)]
@@ -205,11 +198,7 @@ impl Args {
 
     /// The nonlinear bias of --b2, --bs, --b3, if any is given.
     fn galaxy(&self) -> Option<NonlinearBias> {
-        (self.b2.is_some() || self.bs.is_some() || self.b3.is_some()).then(|| NonlinearBias {
-            b2: self.b2.unwrap_or(0.0),
-            bs: self.bs.unwrap_or(0.0),
-            b3nl: self.b3.unwrap_or(0.0),
-        })
+        self.galaxy.nonlinear()
     }
 
     /// The redshift-space settings of the options.
@@ -320,9 +309,7 @@ pub fn run(args: &Args) -> Result<()> {
         let shared = ept::Shared {
             bias: args.bias.bias()?,
             f: args.f,
-            b2: args.b2,
-            bs: args.bs,
-            b3: args.b3,
+            galaxy: args.galaxy(),
             ells: ells.clone(),
             distortion,
             xi: if args.xi { Some(s_grid(args)?) } else { None },
@@ -331,6 +318,9 @@ pub fn run(args: &Args) -> Result<()> {
         // table at --k-min..--k-max.
         let table = ept::table(shared, &args.ept, k, &loaded)?;
         return write_output(args.out.as_ref(), &table);
+    }
+    if let (Some(_), RsdChoice::Paper(model)) = (args.galaxy(), args.rsd) {
+        args.galaxy.warn_if_implicit(&format!("--rsd {model}"));
     }
     let request = args.request()?;
     request.validate_galaxy()?;

@@ -1,0 +1,32 @@
+//! The bias convention of the Python faces (`bias_convention=`): one meaning of b2, bs, b3 for every
+//! model ([`pt_spectra::bias`]).
+
+use crate::value_error;
+use pt_spectra::bias::BiasConvention;
+use pyo3::prelude::*;
+
+/// The convention named `name` (None: velocileptors'). With `warn_for` (a model whose bs and b3 were
+/// FAST-PT's before they meant one thing), a `UserWarning` when bs or b3 is given without a name.
+pub(crate) fn convention(
+    py: Python<'_>,
+    name: Option<&str>,
+    bs: Option<f64>,
+    b3: Option<f64>,
+    warn_for: Option<&str>,
+) -> PyResult<BiasConvention> {
+    let given = |x: Option<f64>| x.is_some_and(|v| v != 0.0);
+    if let (None, Some(model)) = (name, warn_for) {
+        if given(bs) || given(b3) {
+            let note = format!(
+                "bs and b3 of {model} are velocileptors' bs (bs s^2) and b3 (b1 b3 sig3nl), as for every \
+                 model; FAST-PT's bs is twice this bs and its b3nl half this b3: pass \
+                 bias_convention='fastpt' to give FAST-PT's values (the header states both)"
+            );
+            let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+            PyErr::warn(py, &category, &std::ffi::CString::new(note)?, 2)?;
+        }
+    }
+    name.map_or(Ok(BiasConvention::default()), |n| {
+        n.parse().map_err(value_error)
+    })
+}

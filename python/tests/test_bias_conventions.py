@@ -1,0 +1,49 @@
+"""One meaning of b2, bs, b3 for every model (velocileptors' convention), and the exact maps of the
+other conventions (``bias_convention``): the same spectra whichever way the bias is written."""
+import warnings
+
+import numpy as np
+import pytest
+
+import pt_spectra as pt
+
+K = np.array([0.05, 0.1, 0.2])
+# one bias in the three conventions: velocileptors (b2, bs, b3), FAST-PT (b2, 2 bs, b3/2),
+# CLASS-PT (b2 + 4/3 bs, bs, -(b3 + 15 bs)/6)
+OURS = dict(b2=0.5, bs=-0.15, b3=0.4)
+FAST = dict(b2=0.5, bs=-0.3, b3=0.2)
+CLASS = dict(b2=0.3, bs=-0.15, b3=-(0.4 - 15 * 0.15) / 6)
+
+
+def test_real_galaxy_spectra_agree_across_conventions():
+    ours = pt.real(model="1l-spt", k=K, precision="fast", bias=2.0, bias_convention="velocileptors",
+                   **OURS)
+    for conv, b in (("fastpt", FAST), ("classpt", CLASS)):
+        t = pt.real(model="1l-spt", k=K, precision="fast", bias=2.0, bias_convention=conv, **b)
+        np.testing.assert_allclose(t["P_gg"], ours["P_gg"], rtol=1e-12)
+        assert any("given in" in h for h in t.header)
+
+
+def test_tns_and_ept_take_the_same_convention():
+    fast = pt.rsd(rsd="tns", real="1l-spt", k=K, precision="fast", bias=2.0, bias_convention="fastpt",
+                  **FAST)
+    ours = pt.rsd(rsd="tns", real="1l-spt", k=K, precision="fast", bias=2.0,
+                  bias_convention="velocileptors", **OURS)
+    np.testing.assert_allclose(fast["P0"], ours["P0"], rtol=1e-12)
+    a = pt.ept(k=K, b1=2.0, **OURS)
+    b = pt.ept(k=K, b1=2.0, b2=CLASS["b2"], bG2=CLASS["bs"], bGamma3=CLASS["b3"],
+               bias_convention="classpt")
+    c = pt.rsd(rsd="ept", k=K, bias=2.0, bias_convention="classpt", **CLASS)
+    np.testing.assert_allclose(b["P0"], a["P0"], rtol=1e-12)
+    np.testing.assert_allclose(c["P2"], a["P2"], rtol=1e-12)
+
+
+def test_an_implicit_convention_warns_and_bad_names_are_refused():
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        pt.real(model="1l-spt", k=K, precision="fast", bias=2.0, bs=-0.15)
+    assert any("bias_convention='fastpt'" in str(x.message) for x in w)
+    with pytest.raises(ValueError, match="velocileptors, fastpt, classpt"):
+        pt.real(k=K, bias=2.0, bias_convention="pybird")
+    with pytest.raises(ValueError, match="bG2, bGamma3"):
+        pt.ept(k=K, b1=2.0, bs=0.1, bias_convention="classpt")
