@@ -16,7 +16,7 @@ cores (the 2-loop spectra at --precision fast dominate). --keep DIR keeps the in
 The three models (the markdown states every setting):
 * ept: `fit --rsd ept` (velocileptors' REPT), f, b1, b2, bs free, alpha0, alpha2 and sn marginalised
   analytically (sn, a constant, absorbs the shot noise that the measurements do not subtract);
-* TNS + nonlinear bias (Beutler et al. 2017, `rsd --rsd tns --b2 --bs --b3`, real-space 2L-RPT-N1):
+* TNS + nonlinear bias (Beutler et al. 2017, `rsd --rsd tns --b2 --bs --b3 --bias-convention fastpt`, real-space 2L-RPT-N1):
   b1, b2 and a constant noise N from the real-space P_hh (bs, b3nl on the coevolution relations), then f
   and the Lorentzian sigma0 fitted to P0 - N and P2. `fit` does not take --b2/--bs with --rsd tns, so the
   no-FoG multipoles P0..P8 from `rsd` at five f (the model is a polynomial of degree 4 in f and 8 in mu)
@@ -166,12 +166,13 @@ def write_data(path, k, p0, p2, cov):
 
 # ----------------------------------------------------------------------------------------------------
 # Real-space bias: P_hh = b1^2 P_dd + b1 b2 Pd1d2 + b2^2/4 Pd2d2 + b1 bs Pd1s2 + b2 bs/2 Pd2s2 + bs^2/4 Ps2s2
-# + 2 b1 b3nl sig3nl + N (FAST-PT's terms as `real --bias-terms` prints them), bs = -4/7 (b1 - 1) and
-# b3nl = 32/315 (b1 - 1) (coevolution, Saito et al. 2014), b1, b2, N free.
+# + 2 b1 b3nl sig3nl + N (FAST-PT's terms and convention as `real --bias-terms` prints them), bs = -4/7 (b1 - 1)
+# and b3nl = (b1 - 1)/2 (coevolution, Saito et al. 2014: their b3nl = 32/315 (b1 - 1) multiplies
+# sigma3^2 P_lin = (315/64) sig3nl; docs/reference.md, "Bias conventions"), b1, b2, N free.
 
 
 def coevolution(b1):
-    return -4.0 / 7.0 * (b1 - 1.0), 32.0 / 315.0 * (b1 - 1.0)
+    return -4.0 / 7.0 * (b1 - 1.0), 0.5 * (b1 - 1.0)
 
 
 def bias_model(c, b1, b2, n):
@@ -356,7 +357,8 @@ def main():
         # Stage 2 inputs: TNS + nonlinear bias without FoG at each f of F_NODES.
         for f in F_NODES:
             jobs.append(["rsd", "--rsd", "tns", "--real", REAL, "--precision", "fast", "--bias", bias["b1"],
-                         "--b2", bias["b2"], "--bs", bias["bs"], "--b3", bias["b3"], "--f", f, "--fog", "none",
+                         "--b2", bias["b2"], "--bs", bias["bs"], "--b3", bias["b3"], "--bias-convention", "fastpt",
+                         "--f", f, "--fog", "none",
                          "--ells", "0,2,4,6,8", "--k-file", work / f"k_z{zk}.txt",
                          "--out", work / f"tns_nlb_f{f}_z{zk}.dat"] + spectrum(zk))
         # Diagnostic: ept with b2, bs, b3 fixed to the real-space values (velocileptors' bs s^2 and b3 =
@@ -403,7 +405,8 @@ def main():
         b = next(x for x in r["tns_nlb"] if abs(x["k_max"] - 0.2) < 1e-9)
         bias = r["bias"]
         jobs.append(["rsd", "--rsd", "tns", "--real", REAL, "--precision", "fast", "--bias", bias["b1"],
-                     "--b2", bias["b2"], "--bs", bias["bs"], "--b3", bias["b3"], "--f", b["f"], "--fog", "lorentzian",
+                     "--b2", bias["b2"], "--bs", bias["bs"], "--b3", bias["b3"], "--bias-convention", "fastpt",
+                     "--f", b["f"], "--fog", "lorentzian",
                      "--sigma0", b["sigma0"], "--ells", "0,2", "--k-file", work / f"k_z{zk}.txt",
                      "--out", work / f"tns_nlb_check_z{zk}.dat"] + spectrum(zk))
         for tag in r["p_eps"]:
@@ -518,10 +521,11 @@ def write_outputs(args, res, seconds):
         bl.append(f"z = {zk}: b1 = {b['b1']:.3f} ± {b['err']['b1']:.3f}, b2 = {b['b2']:.2f} ± {b['err']['b2']:.2f}, "
                   f"bs = {b['bs']:.3f}, b3nl = {b['b3']:.3f}, N = {b['N']:.0f} ± {b['err']['N']:.0f} (Mpc/h)³, "
                   f"χ² = {b['chi2']:.0f} for {b['points']} points")
-    w("- **TNS + nonlinear bias** (Beutler et al. 2017 as `rsd --rsd tns --b2 --bs --b3`, real space "
+    w("- **TNS + nonlinear bias** (Beutler et al. 2017 as `rsd --rsd tns --b2 --bs --b3 --bias-convention fastpt`, real space "
       "2L-RPT-N1 as the paper's TNS below, `--precision fast`): b1, b2 and a constant N fitted to the real-space P_hh for k ≤ "
-      f"{K_REAL} (P_gg of `real --bias-terms` + N, Var P_hh = 2P_hh²/N_k; bs = −4/7 (b1 − 1), b3nl = "
-      "32/315 (b1 − 1), the coevolution values, because P_hh alone does not separate bs from b2): "
+      f"{K_REAL} (P_gg of `real --bias-terms` + N, Var P_hh = 2P_hh²/N_k; in FAST-PT's convention bs = "
+      "−4/7 (b1 − 1), b3nl = (b1 − 1)/2 (Saito et al.'s 32/315 (b1 − 1) of σ₃² = (315/64) sig3nl/P_lin), "
+      "the coevolution values, because P_hh alone does not separate bs from b2): "
       + "; ".join(bl) + ". Then f and the Lorentzian σ0 (σ = σ0 D(z) f, as `rsd`) fitted to P0 − N and P2 "
       "with b1, b2, bs, b3nl, N fixed. `fit` refuses --b2/--bs with --rsd tns, so the script takes the "
       f"no-FoG multipoles P0…P8 from `rsd` at f = {', '.join(map(str, F_NODES))} (the model is a "
