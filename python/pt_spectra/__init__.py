@@ -278,7 +278,9 @@ def fit_ept(data, k_max, free=("f", "b1"), marginalise=(), priors=None, ells=(0,
     (0.1, 5 Mpc/h)): free, marginalise and priors name the DESI DR1 physical basis (b1p = b1 sigma8(z),
     b2p, bsp, b3p, alpha0p, alpha2p, alpha4p, sn0p, sn2p, sn4p; docs/reference.md) and the table gives
     them, then the model's parameters they map to; ``desi_priors=True`` adds the DR1 priors of the
-    free and marginalised ones that have none. The start keywords stay the model's (b1=, f=, ...).
+    free and marginalised ones that have none. ``basis="classpt"``: the bias as CLASS-PT names it
+    (b1, b2, bG2, bGamma3, mapped exactly: docs/reference.md, "Bias conventions"), the counterterms
+    and stochastic terms velocileptors'. The start keywords stay the model's (b1=, f=, ...).
 
     Columns: ``k_max`` (``s_max``) ``points chi2 minus_2_ln_L``, each parameter with ``err_<p>``
     for the free and marginalised ones; per free parameter ``err_<p>_hessian <p>_lo <p>_hi

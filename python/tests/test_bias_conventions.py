@@ -47,3 +47,20 @@ def test_an_implicit_convention_warns_and_bad_names_are_refused():
         pt.real(k=K, bias=2.0, bias_convention="pybird")
     with pytest.raises(ValueError, match="bG2, bGamma3"):
         pt.ept(k=K, b1=2.0, bs=0.1, bias_convention="classpt")
+
+
+def test_fit_ept_in_the_class_pt_basis(tmp_path):
+    """basis="classpt": free/marginalise name CLASS-PT's bias; the table maps it to the model's."""
+    k = np.linspace(0.02, 0.2, 10)
+    t = pt.ept(k=k, b1=2.0, b2=0.4, bs=-0.3, f=0.7, sn=500.0)
+    path = tmp_path / "d.txt"
+    np.savetxt(path, np.column_stack([k, t["P0"], 0.02 * t["P0"], t["P2"], 0.02 * np.abs(t["P0"])]),
+               header="k P0 err_P0 P2 err_P2")
+    r = pt.fit_ept(str(path), [0.2], free=("f", "b1", "b2", "bG2"), marginalise=("sn",),
+                   basis="classpt", ells=(0, 2), data_ells=(0, 2), b1=1.8, f=0.6)
+    assert r["bG2"][0] == pytest.approx(r["bs"][0], abs=1e-12)
+    # bGamma3 stays at its start, 0: then b3 = -15 bG2 (not b3 = 0, the velocileptors fit's default)
+    assert r["b3"][0] == pytest.approx(-15 * r["bG2"][0], rel=1e-9, abs=1e-12)
+    assert r["b2_velocileptors"][0] == pytest.approx(r["b2"][0] - 4 / 3 * r["bG2"][0], rel=1e-9)
+    with pytest.raises(ValueError, match="bG2 and bGamma3"):
+        pt.fit_ept(str(path), [0.2], free=("f", "bs"), basis="classpt", ells=(0, 2), data_ells=(0, 2))

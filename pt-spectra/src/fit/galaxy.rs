@@ -27,12 +27,10 @@
 
 use super::MultipoleData;
 use crate::error::{Error, Result};
-use crate::rsd::ept::physical::{
-    check_physical_name, PhysicalBasis, PHYSICAL_LINEAR, PHYSICAL_NAMES,
-};
 use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
 use crate::survey::observe::Observation;
 
+mod basis;
 mod bispectrum;
 mod derived;
 mod gradient;
@@ -41,6 +39,7 @@ mod objective;
 mod priors;
 mod request;
 pub mod search;
+pub use basis::{FitBasis, CLASSPT_NAMES};
 pub use bispectrum::{BispectrumFit, BISPECTRUM_LINEAR, BISPECTRUM_NAMES};
 pub use derived::{derived, sound_horizon, Derived, Template};
 pub use joint::{default_shared, fit_joint, DataSet, JointFit};
@@ -89,10 +88,10 @@ pub struct GalaxyFitRequest {
     /// The number of mocks the covariance was estimated from: C⁻¹ is scaled by the Hartlap factor
     /// (N − p − 2)/(N − 1), p the number of fitted points (Hartlap, Simon & Schneider 2007).
     pub n_mocks: Option<usize>,
-    /// The parameter basis of `free`, `marginalise` and `priors`: `None` velocileptors' (the
-    /// model's), or the DESI physical basis ([`crate::rsd::ept::physical`]; the start is still
-    /// given as the model's parameters and converted).
-    pub basis: Option<PhysicalBasis>,
+    /// The parameter basis of `free`, `marginalise` and `priors` ([`FitBasis`]: velocileptors' (the
+    /// model's), CLASS-PT's bias, or the DESI physical basis; the start is still given as the
+    /// model's parameters and converted).
+    pub basis: FitBasis,
 }
 
 /// The result of a fit.
@@ -137,61 +136,42 @@ pub struct GalaxyFit {
     pub exact_gradient: bool,
     /// Objective evaluations used (every start, the Hessian and the profiles).
     pub evaluations: usize,
-    /// With the physical basis: every parameter at the best fit in it (the order of
-    /// [`PHYSICAL_NAMES`]; [`Self::best`] holds the model's parameters they map to).
-    pub physical: Option<[f64; 12]>,
+    /// In a basis other than the model's: every parameter at the best fit in it (the order of its
+    /// [`FitBasis::names`]; [`Self::best`] holds the model's parameters they map to).
+    pub in_basis: Option<[f64; 12]>,
     /// With a bispectrum: its own parameters at the best fit ([`BISPECTRUM_NAMES`]).
     pub bispectrum: Option<[f64; 4]>,
 }
 
-/// The names of the model's slots: velocileptors' (the model's own), or of the DESI physical
-/// basis.
-pub fn slot_names(physical: bool) -> &'static [&'static str; 12] {
-    if physical {
-        &PHYSICAL_NAMES
-    } else {
-        &PARAM_NAMES
-    }
+/// The names of the model's slots in `basis`.
+pub fn slot_names(basis: &FitBasis) -> &'static [&'static str; 12] {
+    basis.names()
 }
 
-/// The parameters of the power spectrum's model that enter it linearly, in the basis of
-/// [`slot_names`] (and [`BISPECTRUM_LINEAR`] with a bispectrum).
-pub fn linear_names(physical: bool) -> &'static [&'static str] {
-    if physical {
-        &PHYSICAL_LINEAR
-    } else {
-        &LINEAR
-    }
+/// The parameters of the power spectrum's model that enter it linearly, in `basis` (and
+/// [`BISPECTRUM_LINEAR`] with a bispectrum).
+pub fn linear_names(basis: &FitBasis) -> &'static [&'static str] {
+    basis.linear_names()
 }
 
-/// The slot of parameter `name` in the basis of [`slot_names`] (its model parameters, then apar,
-/// aperp, then the bispectrum's own, which no basis changes).
-pub(crate) fn slot_index(name: &str, physical: bool) -> Result<usize> {
-    if physical && !BISPECTRUM_NAMES.contains(&name) {
-        check_physical_name(name)?;
-    }
-    let names = slot_names(physical);
+/// The slot of parameter `name` in `basis` (its model parameters, then apar, aperp, then the
+/// bispectrum's own, which no basis changes).
+pub(crate) fn slot_index(name: &str, basis: &FitBasis) -> Result<usize> {
+    basis.check_name(name)?;
+    let names = slot_names(basis);
     names
         .iter()
         .chain(&AP_NAMES)
         .chain(&BISPECTRUM_NAMES)
         .position(|&n| n == name)
-        .ok_or_else(|| {
-            let hint = match (slot_names(!physical).contains(&name), physical) {
-                (true, false) => {
-                    " (a name of the DESI physical basis: choose that basis to use it)"
-                }
-                (true, true) => " (a velocileptors name: the physical basis's names end in p)",
-                _ => "",
-            };
-            Error::InvalidChoice {
-                what: format!("fit parameter `{name}`"),
-                reason: format!(
-                    "the parameters are {} (and apar, aperp; with a bispectrum {}){hint}",
-                    names.join(", "),
-                    BISPECTRUM_NAMES.join(", ")
-                ),
-            }
+        .ok_or_else(|| Error::InvalidChoice {
+            what: format!("fit parameter `{name}`"),
+            reason: format!(
+                "the parameters are {} (and apar, aperp; with a bispectrum {}){}",
+                names.join(", "),
+                BISPECTRUM_NAMES.join(", "),
+                basis.hint(name)
+            ),
         })
 }
 

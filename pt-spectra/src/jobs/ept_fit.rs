@@ -6,12 +6,12 @@ use crate::error::{Error, Result};
 use crate::fit::bounded::{AGREEMENT, EXPECTED_DECREASE};
 use crate::fit::galaxy::search::{CROSSING_TOLERANCE, HESSIAN_STEP, PROFILE_AGREEMENT};
 use crate::fit::galaxy::{
-    derived, fit_galaxy_search, profile_galaxy, slot_names, Derived, GalaxyFit, GalaxyFitRequest,
-    Linear, Prior, ProfileGrid, Search, Template,
+    derived, fit_galaxy_search, profile_galaxy, slot_names, Derived, FitBasis, GalaxyFit,
+    GalaxyFitRequest, Linear, Prior, ProfileGrid, Search, Template,
 };
 use crate::fit::MultipoleData;
 use crate::output::{Table, WAVENUMBER};
-use crate::rsd::ept::physical::{PhysicalBasis, DEFAULT_F_SAT, DEFAULT_SIGMA_V, PHYSICAL_NAMES};
+use crate::rsd::ept::physical::{PhysicalBasis, DEFAULT_F_SAT, DEFAULT_SIGMA_V};
 use crate::rsd::ept::{EptPlan, EptTerms, PARAM_NAMES};
 use crate::survey::observe::Observation;
 
@@ -28,43 +28,50 @@ pub struct FitContext<'a> {
     pub header: Vec<String>,
 }
 
-/// The parameter basis of a fit by name: `velocileptors` (`None`: the model's own) or `desi` (the
-/// DESI DR1 physical basis at σ₈(z) `sigma8` of the template, number density `n_bar` [(h/Mpc)³],
-/// satellites (f_sat, σ_v [Mpc/h]), default desilike's 0.1 and 5). `desi_priors`: whether the DESI
-/// priors are asked for (only in that basis).
+/// The parameter basis of a fit by name: `velocileptors` (the model's own), `classpt` (CLASS-PT's
+/// bias b1, b2, bG2, bGamma3: [`FitBasis::ClassPt`]) or `desi` (the DESI DR1 physical basis at
+/// σ₈(z) `sigma8` of the template, number density `n_bar` [(h/Mpc)³], satellites (f_sat, σ_v
+/// [Mpc/h]), default desilike's 0.1 and 5). `desi_priors`: whether the DESI priors are asked for
+/// (only in that basis).
 ///
 /// # Errors
 /// [`Error::InvalidChoice`] for another name, `desi` without `n_bar`, or `n_bar`, satellites or
-/// the DESI priors with `velocileptors`; as [`PhysicalBasis::new`].
+/// the DESI priors with another basis; as [`PhysicalBasis::new`].
 pub fn fit_basis(
     name: &str,
     sigma8: f64,
     n_bar: Option<f64>,
     satellites: Option<(f64, f64)>,
     desi_priors: bool,
-) -> Result<Option<PhysicalBasis>> {
+) -> Result<FitBasis> {
     let bad = |reason: &str| Error::InvalidChoice {
         what: format!("parameter basis `{name}`"),
         reason: reason.into(),
     };
     match name {
-        "velocileptors" => {
+        "velocileptors" | "classpt" => {
             if n_bar.is_some() || satellites.is_some() || desi_priors {
                 return Err(bad(
                     "n_bar (--n-bar), the satellites (--satellites) and the DESI priors \
                      (--desi-priors) belong to the basis desi",
                 ));
             }
-            Ok(None)
+            Ok(if name == "classpt" {
+                FitBasis::ClassPt
+            } else {
+                FitBasis::Velocileptors
+            })
         }
         "desi" => {
             let n_bar = n_bar.ok_or_else(|| {
                 bad("the basis desi needs n_bar (--n-bar): the unit 1/n_bar of sn0p, sn2p, sn4p")
             })?;
             let (f_sat, sigma_v) = satellites.unwrap_or((DEFAULT_F_SAT, DEFAULT_SIGMA_V));
-            Ok(Some(PhysicalBasis::new(sigma8, n_bar, f_sat, sigma_v)?))
+            Ok(FitBasis::Desi(PhysicalBasis::new(
+                sigma8, n_bar, f_sat, sigma_v,
+            )?))
         }
-        _ => Err(bad("valid: velocileptors, desi")),
+        _ => Err(bad("valid: velocileptors, classpt, desi")),
     }
 }
 
@@ -245,9 +252,7 @@ fn fit_header(
         header.push(crate::fit::galaxy::OBSERVATION_IN_FITS.into());
     }
     let xi = observation.is_some_and(Observation::is_xi);
-    if let Some(b) = &request.basis {
-        header.push(b.describe());
-    }
+    header.extend(request.basis.describe());
     if let Some(d) = request.ap {
         header.push(format!(
             "Alcock-Paczynski: the data measured with apar = {}, aperp = {}{}",
@@ -359,8 +364,13 @@ pub(super) fn row_columns(t: &mut Table, rows: &[Row]) {
     } else {
         &[]
     };
-    // In the physical basis its parameters (with their errors), then the model's they map to.
-    let physical = rows.iter().any(|r| r.request.basis.is_some());
+    // In another basis its parameters (with their errors), then the model's they map to.
+    let basis = rows
+        .iter()
+        .map(|r| r.request.basis)
+        .find(|b| !b.is_model())
+        .unwrap_or_default();
+    let physical = matches!(basis, FitBasis::Desi(_));
     // with a bispectrum, its own parameters after the distortion's
     let b_names: &[&str] = if rows.iter().any(|r| r.fit.bispectrum.is_some()) {
         &crate::fit::galaxy::BISPECTRUM_NAMES
@@ -369,13 +379,13 @@ pub(super) fn row_columns(t: &mut Table, rows: &[Row]) {
     };
     let value = |i: usize, f: &GalaxyFit| match (i.checked_sub(12), f.ap) {
         (Some(b), _) if b >= 2 => f.bispectrum.map_or(f64::NAN, |v| v[b - 2]),
-        (None, _) if physical => f.physical.map_or(f64::NAN, |v| v[i]),
+        (None, _) if !basis.is_model() => f.in_basis.map_or(f64::NAN, |v| v[i]),
         (None, _) => f.best.values[i],
         (Some(0), Some(d)) => d.apar,
         (Some(_), Some(d)) => d.aperp,
         (Some(_), None) => f64::NAN,
     };
-    let names = slot_names(physical)
+    let names = slot_names(&basis)
         .iter()
         .filter(|&&n| !(physical && n == "alpha6p"));
     // the columns in slot order: the model's parameters, α∥, α⊥ (if any), the bispectrum's (if any)
@@ -418,10 +428,22 @@ pub(super) fn row_columns(t: &mut Table, rows: &[Row]) {
             free_columns(t, rows, name, &js);
         }
     }
-    if physical {
+    if !basis.is_model() {
+        // the model's parameters that differ from the basis's slot of that index; a name the basis
+        // also uses (CLASS-PT's b2) gets the suffix _velocileptors
+        let unit_rows = basis.jacobian(&[1.0; 12]);
         for (i, name) in PARAM_NAMES.iter().enumerate().take(11) {
+            let same = (0..12).all(|j| unit_rows[i][j] == f64::from(u8::from(i == j)));
+            if basis.names()[i] == *name && same {
+                continue;
+            }
+            let column = if basis.names().contains(name) {
+                format!("{name}_velocileptors")
+            } else {
+                (*name).to_string()
+            };
             t.push(
-                *name,
+                column,
                 unit(name),
                 rows.iter().map(|r| r.fit.best.values[i]).collect(),
             );
@@ -544,7 +566,7 @@ pub fn ept_profile_table(
         request.k_max,
         grid.points,
         grid.span,
-        value_of(fit, name),
+        value_of(fit, &request.basis, name),
         fit.minus_two_log_l,
         if context.search.linear == Linear::Profiled {
             ", the linear ones profiled"
@@ -562,7 +584,10 @@ pub fn ept_profile_table(
     let at = |p: &crate::fit::galaxy::ProfilePoint, n: &str| match n {
         "apar" => p.ap.map_or(f64::NAN, |d| d.apar),
         "aperp" => p.ap.map_or(f64::NAN, |d| d.aperp),
-        n => match (p.physical, PHYSICAL_NAMES.iter().position(|&m| m == n)) {
+        n => match (
+            p.in_basis,
+            request.basis.names().iter().position(|&m| m == n),
+        ) {
             (Some(v), Some(i)) => v[i],
             _ => p.best.get(n).unwrap_or(f64::NAN),
         },
@@ -598,10 +623,13 @@ pub fn ept_profile_table(
 }
 
 /// The best-fit value of the parameter `name` (α∥, α⊥ from the distortion).
-fn value_of(fit: &GalaxyFit, name: &str) -> f64 {
+fn value_of(fit: &GalaxyFit, basis: &FitBasis, name: &str) -> f64 {
     match name {
         "apar" => fit.ap.map_or(f64::NAN, |d| d.apar),
         "aperp" => fit.ap.map_or(f64::NAN, |d| d.aperp),
-        n => fit.best.get(n).unwrap_or(f64::NAN),
+        n => match (fit.in_basis, basis.names().iter().position(|&m| m == n)) {
+            (Some(v), Some(i)) => v[i],
+            _ => fit.best.get(n).unwrap_or(f64::NAN),
+        },
     }
 }

@@ -303,8 +303,8 @@ fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded> {
         ),
         describe_start(&request),
     )];
-    if let Some(b) = &request.basis {
-        description.push(format!("data set {}: {}", s.label, b.describe()));
+    if let Some(line) = request.basis.describe() {
+        description.push(format!("data set {}: {line}", s.label));
     }
     if let Some((_, line)) = &bispectrum {
         description.push(format!("data set {}: {line}", s.label));

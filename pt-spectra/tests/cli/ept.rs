@@ -213,6 +213,21 @@ fn ept_fit_in_the_desi_physical_basis() {
     assert!((phys("b1p") - phys("b1") * phys("sigma8_z")).abs() < 1e-6 * phys("b1p"));
     assert!((phys("sn0p") - phys("sn") * 3e-4).abs() < 1e-6 * phys("sn0p").abs());
     assert!((phys("b1") - vel("b1")).abs() < 0.01 * vel("err_b1"));
+    // CLASS-PT's bias: b2 = b2^CLASS-PT - (4/3) bG2 with bG2 = bs (here fixed at 0 in both fits)
+    let (out, cpt) = fit(&[
+        "--basis",
+        "classpt",
+        "--free",
+        "f,b1,b2",
+        "--marginalise",
+        "sn",
+        "--bs",
+        "0",
+    ]);
+    assert!(out.contains("parameter basis: CLASS-PT's bias"), "{out}");
+    assert!((cpt("f") - vel("f")).abs() < 0.01 * vel("err_f"));
+    assert!((cpt("b2") - cpt("b2_velocileptors")).abs() < 1e-9 * cpt("b2").abs().max(1.0));
+    assert!((cpt("bG2") - cpt("bs")).abs() < 1e-12);
     let (out, _) = fit(&[
         "--basis",
         "desi",
@@ -241,7 +256,7 @@ fn ept_fit_in_the_desi_physical_basis() {
         ),
         (
             vec!["fit", "--rsd", "ept", "--data", &data, "--basis", "lpt"],
-            "velocileptors, desi",
+            "velocileptors, classpt, desi",
         ),
         (
             vec![

@@ -75,9 +75,10 @@ pub struct Args {
     #[arg(long, value_name = "NAME:MEAN,SIGMA|NAME:flat,LO,HI")]
     prior: Vec<String>,
     /// --rsd ept: the basis of --free, --marginalise and --prior: `velocileptors` (the model's own
-    /// b1, b2, bs, b3, alpha0..6, sn, sn2, sn4) or `desi` (the DESI DR1 physical basis b1p = b1
-    /// sigma8(z), b2p, bsp, b3p, alpha0p, alpha2p, alpha4p, sn0p, sn2p, sn4p in units of 1/n_bar;
-    /// needs --n-bar; docs/reference.md). Start values stay the model's (--bias, --b2, ...).
+    /// b1, b2, bs, b3, alpha0..6, sn, sn2, sn4), `classpt` (CLASS-PT's bias b1, b2, bG2, bGamma3, the
+    /// rest velocileptors') or `desi` (the DESI DR1 physical basis b1p = b1 sigma8(z), b2p, bsp, b3p,
+    /// alpha0p, alpha2p, alpha4p, sn0p, sn2p, sn4p in units of 1/n_bar; needs --n-bar;
+    /// docs/reference.md). Start values stay the model's (--bias, --b2, ...).
     #[arg(long, value_name = "BASIS", default_value = "velocileptors")]
     basis: String,
     /// --basis desi: the sample's number density [(h/Mpc)^3] (the unit of sn0p, sn2p, sn4p).
@@ -321,7 +322,7 @@ fn run_ept(args: &Args) -> Result<()> {
         bail!("free apar/aperp need the measurement's distortion: --apar/--aperp or --fiducial");
     }
     let marginalise = names(args.marginalise.as_deref(), "");
-    let basis = physical_basis(args, loaded.prepared.spectrum.sigma8())?;
+    let basis = fit_basis(args, loaded.prepared.spectrum.sigma8())?;
     if args.desi_priors {
         pt_spectra::jobs::add_desi_priors(&mut priors, &free, &marginalise);
     }
@@ -468,12 +469,8 @@ fn parse_ell_range(text: &str) -> Result<(usize, f64, f64)> {
     parse().ok_or_else(|| anyhow::anyhow!("--k-range-ell {text}: expected L:KMIN,KMAX"))
 }
 
-/// NAME:MEAN,SIGMA, NAME:flat,LO,HI or NAME:lognormal,MU,SIGMA.
 /// The parameter basis of the options ([`pt_spectra::jobs::fit_basis`]) at σ₈(z) `sigma8`.
-fn physical_basis(
-    args: &Args,
-    sigma8: f64,
-) -> Result<Option<pt_spectra::rsd::ept::physical::PhysicalBasis>> {
+fn fit_basis(args: &Args, sigma8: f64) -> Result<pt_spectra::fit::galaxy::FitBasis> {
     Ok(pt_spectra::jobs::fit_basis(
         &args.basis,
         sigma8,

@@ -11,7 +11,7 @@
 //! ```
 //!
 //! r = d − m₀ − Σ âₐTₐ. The model's derivatives are exact. With p(v) the model's parameters of the
-//! slots v (the DESI physical basis maps them, [`crate::rsd::ept::physical::PhysicalBasis::jacobian`];
+//! slots v (the fit's basis maps them, [`super::FitBasis::jacobian`];
 //! the identity in velocileptors' basis) and Mᵢ = ∂m/∂pᵢ:
 //! * the polynomial parameters (biases, counterterms, stochastic terms): the model is at most
 //!   quadratic in each, so Mᵢ = [m(p + eᵢ) − m(p − eᵢ)]/2 exactly; and Mᵢ does not depend on the
@@ -51,16 +51,11 @@ const EXACTNESS_TOLERANCE: f64 = 1e-9;
 type Jacobian = [[f64; F_SLOT + 1]; F_SLOT + 1];
 
 impl Objective<'_> {
-    /// ∂p/∂v at the slots `v`: the physical basis's Jacobian, or the identity.
+    /// ∂p/∂v at the slots `v`: the basis's Jacobian (the identity in the model's).
     fn basis_jacobian(&self, v: &[f64; SLOTS]) -> Jacobian {
-        match &self.basis {
-            Some(b) => {
-                let mut u = [0.0; F_SLOT + 1];
-                u.copy_from_slice(&v[..=F_SLOT]);
-                b.jacobian(&u)
-            }
-            None => std::array::from_fn(|i| std::array::from_fn(|j| f64::from(u8::from(i == j)))),
-        }
+        let mut u = [0.0; F_SLOT + 1];
+        u.copy_from_slice(&v[..=F_SLOT]);
+        self.basis.jacobian(&u)
     }
 
     /// The whitened power-spectrum points of each parameter set of `sets` (one f) at `ap`.
@@ -267,7 +262,7 @@ impl Objective<'_> {
 #[cfg(test)]
 mod tests {
     use super::super::objective::objective;
-    use super::super::{GalaxyFitRequest, Prior, PriorShape};
+    use super::super::{FitBasis, GalaxyFitRequest, Prior, PriorShape};
     use crate::rsd::ap::Distortion;
     use crate::rsd::ept::EptParams;
 
@@ -310,7 +305,7 @@ mod tests {
             k_max: 0.2,
             ell_ranges: vec![],
             n_mocks: None,
-            basis: None,
+            basis: FitBasis::Velocileptors,
         };
         let o = objective(&plan, &terms, &data, &request, None, None).unwrap();
         assert!(o.exact_gradient);
@@ -341,6 +336,33 @@ mod tests {
                 c[i]
             );
         }
+        // The CLASS-PT bias basis: b2, bG2, bGamma3 mix into b2, bs, b3 linearly.
+        let class_pt = GalaxyFitRequest {
+            free: ["f", "b1", "b2", "bG2", "bGamma3"]
+                .map(String::from)
+                .to_vec(),
+            basis: FitBasis::ClassPt,
+            ..request.clone()
+        };
+        let o = objective(&plan, &terms, &data, &class_pt, None, None).unwrap();
+        assert!(o.exact_gradient);
+        let x = [0.72, 1.9, 0.3, -0.2, 0.1];
+        let (_, g, _) = o.value_and_gradient(&x).unwrap().unwrap();
+        for i in 0..x.len() {
+            let h = 1e-3;
+            let at = |d: f64| {
+                let mut y = x;
+                y[i] += d;
+                o.cost(&y)
+            };
+            let fd = (8.0 * (at(h) - at(-h)) - (at(2.0 * h) - at(-2.0 * h))) / (12.0 * h);
+            assert!(
+                (g[i] - fd).abs() < 1e-5 * g[i].abs().max(1.0),
+                "{}: exact {} differences {fd}",
+                class_pt.free[i],
+                g[i]
+            );
+        }
         // The physical basis: the same check through its map (b1p, f and the counterterms mix).
         let basis = crate::rsd::ept::physical::PhysicalBasis::new(0.6, 3e-4, 0.1, 5.0).unwrap();
         let physical = GalaxyFitRequest {
@@ -353,7 +375,7 @@ mod tests {
             priors: [("alpha0p", 12.5), ("alpha2p", 12.5), ("sn0p", 2.0)]
                 .map(|(n, s)| Prior::gaussian(n, 0.0, s))
                 .to_vec(),
-            basis: Some(basis),
+            basis: FitBasis::Desi(basis),
             ..request
         };
         let o = objective(&plan, &terms, &data, &physical, None, None).unwrap();

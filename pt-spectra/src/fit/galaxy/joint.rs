@@ -189,18 +189,24 @@ pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result
         o.log_det = search.linear == Linear::Marginalised;
         objectives.push(o);
     }
-    let physical = sets.first().is_some_and(|s| s.request.basis.is_some());
-    if let Some(s) = sets.iter().find(|s| s.request.basis.is_some() != physical) {
+    let basis = sets.first().map(|s| s.request.basis).unwrap_or_default();
+    if let Some(s) = sets
+        .iter()
+        .find(|s| s.request.basis.names() != basis.names())
+    {
         return Err(Error::InvalidChoice {
             what: format!("the parameter basis of data set `{}`", s.label),
-            reason:
-                "every data set of a joint fit takes the same basis (velocileptors' or the DESI \
-                     physical one), so that a shared name means one parameter"
-                    .into(),
+            reason: format!(
+                "every data set of a joint fit takes the same basis ({} here, {} in `{}`), so that \
+                 a shared name means one parameter",
+                s.request.basis.label(),
+                basis.label(),
+                sets[0].label
+            ),
         });
     }
     for (n, name) in shared.iter().enumerate() {
-        let slot = slot_index(name, physical)?;
+        let slot = slot_index(name, &basis)?;
         if shared[..n].contains(name) {
             return Err(sharing(name, "is declared shared twice".into()));
         }
@@ -256,7 +262,7 @@ pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result
     // The joint parameters, in the sets' order of their free ones; a shared one at its first.
     let slots_shared: Vec<usize> = shared
         .iter()
-        .map(|n| slot_index(n, physical))
+        .map(|n| slot_index(n, &basis))
         .collect::<Result<_>>()?;
     let mut names = Vec::new();
     let mut params = Vec::new();
@@ -266,7 +272,7 @@ pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result
         let ap = o.plan.settings().ap_range;
         let mut own = Vec::with_capacity(o.free.len());
         for (j, &slot) in o.free.iter().enumerate() {
-            let (a, b, sc) = bound(slot, o.priors[slot].as_ref(), ap, physical);
+            let (a, b, sc) = bound(slot, o.priors[slot].as_ref(), ap, &o.basis);
             let is_shared = slots_shared.contains(&slot);
             if let Some(g) = (is_shared && s > 0).then(|| map_of(&map, slot, &objectives)) {
                 let g = g.expect("a shared parameter is free in the first set");
@@ -316,7 +322,7 @@ pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result
         hi,
         scale,
         x0,
-        physical,
+        basis,
     };
     let exact = |x: &[f64]| joint.cost_and_gradient(x);
     let grad = joint

@@ -41,7 +41,7 @@ fn request(truth: &EptParams) -> GalaxyFitRequest {
         k_max: 0.2,
         ell_ranges: vec![],
         n_mocks: None,
-        basis: None,
+        basis: FitBasis::Velocileptors,
     }
 }
 

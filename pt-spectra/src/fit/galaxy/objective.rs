@@ -6,7 +6,6 @@ use super::{GalaxyFitRequest, PriorShape, AP_SLOT, B_SLOT, SLOTS};
 use crate::error::{Error, Result};
 use crate::fit::MultipoleData;
 use crate::linalg::{cholesky, dot, invert_lower, solve_spd};
-use crate::rsd::ept::physical::PhysicalBasis;
 use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
 use crate::survey::observe::Observation;
 use crate::table::{describe_grid, same_k};
@@ -35,9 +34,8 @@ pub(super) struct Objective<'a> {
     pub(super) start: [f64; SLOTS],
     /// Whether the measurement has a distortion.
     pub(super) has_ap: bool,
-    /// The parameter basis of the slots: `None` velocileptors' (the model's own), else the DESI
-    /// physical basis, converted to the model's at every evaluation.
-    pub(super) basis: Option<PhysicalBasis>,
+    /// The parameter basis of the slots, converted to the model's at every evaluation.
+    pub(super) basis: super::FitBasis,
     pub(super) ells: Vec<usize>,
     pub(super) free: Vec<usize>,
     pub(super) marg: Vec<usize>,
@@ -78,10 +76,7 @@ impl Objective<'_> {
         let n = PARAM_NAMES.len();
         let mut model = [0.0; PARAM_NAMES.len()];
         model.copy_from_slice(&v[..n]);
-        let p = match &self.basis {
-            None => EptParams { values: model },
-            Some(b) => b.to_ept(&model),
-        };
+        let p = self.basis.to_ept(&model);
         let ap = if self.has_ap {
             Some(crate::rsd::ap::Distortion::new(v[n], v[n + 1])?)
         } else {
@@ -485,20 +480,15 @@ pub(super) fn objective<'a>(
     raw.extend(bispectrum.map_or(&[][..], BispectrumFit::values));
     let data_vector = whiten.iter().map(|row| dot(row, &raw)).collect();
     let mut start = [0.0; SLOTS];
-    match &request.basis {
-        None => start[..PARAM_NAMES.len()].copy_from_slice(&request.start.values),
-        Some(b) => {
-            let physical = b.from_ept(&request.start);
-            if let Some(i) = physical.iter().position(|v| !v.is_finite()) {
-                return Err(Error::InvalidParameter {
-                    name: "start value in the physical basis",
-                    value: physical[i],
-                    reason: "the start (b1, f) cannot be expressed in the physical basis",
-                });
-            }
-            start[..PARAM_NAMES.len()].copy_from_slice(&physical);
-        }
+    let in_basis = request.basis.from_ept(&request.start);
+    if let Some(i) = in_basis.iter().position(|v| !v.is_finite()) {
+        return Err(Error::InvalidParameter {
+            name: "start value in the fit's basis",
+            value: in_basis[i],
+            reason: "the start (b1, f) cannot be expressed in the fit's parameter basis",
+        });
     }
+    start[..PARAM_NAMES.len()].copy_from_slice(&in_basis);
     if let Some(d) = request.ap {
         start[AP_SLOT] = d.apar;
         start[AP_SLOT + 1] = d.aperp;

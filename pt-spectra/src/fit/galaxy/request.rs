@@ -10,14 +10,14 @@ type Validated = (Vec<usize>, Vec<usize>, Vec<Option<PriorShape>>);
 
 /// Checks the request's names and values.
 pub(super) fn validate(request: &GalaxyFitRequest) -> Result<Validated> {
-    let physical = request.basis.is_some();
+    let basis = &request.basis;
     let free = request
         .free
         .iter()
-        .map(|n| slot_index(n, physical))
+        .map(|n| slot_index(n, basis))
         .collect::<Result<Vec<_>>>()?;
     let mut marg = Vec::new();
-    let linear: Vec<&str> = linear_names(physical)
+    let linear: Vec<&str> = linear_names(basis)
         .iter()
         .chain(&BISPECTRUM_LINEAR)
         .copied()
@@ -32,7 +32,7 @@ pub(super) fn validate(request: &GalaxyFitRequest) -> Result<Validated> {
                 ),
             });
         }
-        marg.push(slot_index(name, physical)?);
+        marg.push(slot_index(name, basis)?);
     }
     let mut seen = std::collections::HashSet::new();
     for name in request.free.iter().chain(&request.marginalise) {
@@ -66,7 +66,7 @@ pub(super) fn validate(request: &GalaxyFitRequest) -> Result<Validated> {
     }
     let mut priors = vec![None; SLOTS];
     for p in &request.priors {
-        let i = slot_index(&p.name, physical)?;
+        let i = slot_index(&p.name, basis)?;
         p.shape.check(&p.name)?;
         if !free.contains(&i) && !marg.contains(&i) {
             return Err(Error::InvalidChoice {

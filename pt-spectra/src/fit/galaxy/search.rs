@@ -16,7 +16,7 @@
 //!   by more than 0.01 means the starts missed the global minimum: the search restarts there.
 
 use super::objective::Objective;
-use super::{GalaxyFit, PriorShape, AP_SLOT, B_SLOT, SLOTS};
+use super::{FitBasis, GalaxyFit, PriorShape, AP_SLOT, B_SLOT, SLOTS};
 use crate::error::{Error, Result};
 use crate::fit::bounded::{
     hessian_from_gradient, multistart, Minimum, Problem, ValueGradient, AGREEMENT,
@@ -97,12 +97,11 @@ pub const PHYSICAL_RANGES: [(f64, f64, f64, f64, f64); SLOTS] = [
     (-20.0, 20.0, -1.0, 1.0, 0.3),
 ];
 
-/// [`RANGES`] or [`PHYSICAL_RANGES`].
-fn ranges(physical: bool) -> &'static [(f64, f64, f64, f64, f64); SLOTS] {
-    if physical {
-        &PHYSICAL_RANGES
-    } else {
-        &RANGES
+/// [`PHYSICAL_RANGES`] in the DESI basis, else [`RANGES`].
+fn ranges(basis: &FitBasis) -> &'static [(f64, f64, f64, f64, f64); SLOTS] {
+    match basis {
+        FitBasis::Desi(_) => &PHYSICAL_RANGES,
+        _ => &RANGES,
     }
 }
 
@@ -145,9 +144,9 @@ pub(super) fn bound(
     i: usize,
     prior: Option<&PriorShape>,
     ap: Option<(f64, f64)>,
-    physical: bool,
+    basis: &FitBasis,
 ) -> (f64, f64, f64) {
-    let (mut a, mut b, _, _, s) = ranges(physical)[i];
+    let (mut a, mut b, _, _, s) = ranges(basis)[i];
     if let (true, Some((x, y))) = ((AP_SLOT..B_SLOT).contains(&i), ap) {
         (a, b) = (x, y);
     }
@@ -165,12 +164,7 @@ fn bounds(objective: &Objective) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let mut hi = Vec::new();
     let mut scale = Vec::new();
     for &i in &objective.free {
-        let (a, b, s) = bound(
-            i,
-            objective.priors[i].as_ref(),
-            ap,
-            objective.basis.is_some(),
-        );
+        let (a, b, s) = bound(i, objective.priors[i].as_ref(), ap, &objective.basis);
         lo.push(a);
         hi.push(b);
         scale.push(s);
@@ -189,7 +183,7 @@ fn draws(rng: &mut rand_chacha::ChaCha8Rng) -> (f64, f64) {
 /// slot and prior of each free parameter.
 fn starts(space: &Space, search: &Search) -> Vec<Vec<f64>> {
     let (params, x0, lo, hi) = (&space.params, &space.x0, &space.lo, &space.hi);
-    let box_of = ranges(space.physical);
+    let box_of = ranges(&space.basis);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(search.seed);
     let mut all = vec![x0.to_vec()];
     while all.len() < search.starts {
@@ -363,8 +357,8 @@ pub(super) struct Space<'p> {
     pub(super) scale: Vec<f64>,
     /// The start.
     pub(super) x0: Vec<f64>,
-    /// Whether the slots are those of the DESI physical basis (the start box of [`PHYSICAL_RANGES`]).
-    pub(super) physical: bool,
+    /// The basis of the slots (the DESI one has the start box of [`PHYSICAL_RANGES`]).
+    pub(super) basis: FitBasis,
 }
 
 /// The errors of a search's free parameters (or of a selection of them: [`Errors::select`]).
@@ -443,7 +437,7 @@ pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit>
         hi,
         scale,
         x0,
-        physical: objective.basis.is_some(),
+        basis: objective.basis,
     };
     let exact = |x: &[f64]| objective.cost_and_gradient(x);
     let grad = objective.exact_gradient.then_some(&exact as &ValueGradient);
@@ -482,7 +476,7 @@ pub(super) fn package(
         moved_by_profile: found.moved,
         exact_gradient: found.exact_gradient,
         evaluations: found.evaluations,
-        physical: objective.basis.map(|_| std::array::from_fn(|i| slots[i])),
+        in_basis: (!objective.basis.is_model()).then(|| std::array::from_fn(|i| slots[i])),
         bispectrum: objective
             .has_bispectrum()
             .then(|| std::array::from_fn(|i| slots[B_SLOT + i])),

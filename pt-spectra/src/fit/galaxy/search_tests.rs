@@ -83,7 +83,7 @@ fn boss() -> (EptPlan, EptTerms, MultipoleData, GalaxyFitRequest) {
         k_max: 0.18,
         ell_ranges: vec![],
         n_mocks: Some(2048),
-        basis: None,
+        basis: FitBasis::Velocileptors,
     };
     (plan, terms, data, request)
 }
@@ -197,7 +197,7 @@ fn profile_of_f_agrees_with_the_fit() {
         k_max: 0.15,
         ell_ranges: vec![],
         n_mocks: None,
-        basis: None,
+        basis: FitBasis::Velocileptors,
     };
     let grid = ProfileGrid {
         points: 9,
@@ -283,7 +283,7 @@ fn flat_and_log_normal_priors() {
         k_max: 0.15,
         ell_ranges: vec![],
         n_mocks: None,
-        basis: None,
+        basis: FitBasis::Velocileptors,
     };
     let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
     assert_eq!(fit.best.get("f").unwrap(), 0.7);
@@ -345,7 +345,7 @@ fn derived_parameters_from_their_definitions() {
         k_max: 0.2,
         ell_ranges: vec![],
         n_mocks: None,
-        basis: None,
+        basis: FitBasis::Velocileptors,
     };
     let search = Search {
         starts: 2,

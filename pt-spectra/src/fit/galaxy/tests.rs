@@ -61,7 +61,7 @@ fn recovers_the_truth_with_marginalised_counterterms() {
         k_max: 0.2,
         ell_ranges: vec![],
         n_mocks: None,
-        basis: None,
+        basis: FitBasis::Velocileptors,
     };
     let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
     // ln det F is nearly flat in θ, so the maximum of the marginal likelihood sits within a small
@@ -103,7 +103,7 @@ fn analytic_marginalisation_is_the_integral() {
         k_max: 0.15,
         ell_ranges: vec![],
         n_mocks: None,
-        basis: None,
+        basis: FitBasis::Velocileptors,
     };
     let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
     // χ² at fixed a (alpha0 fixed, nothing marginalised) on a grid, integrated by Simpson.
@@ -165,7 +165,7 @@ fn bad_requests_are_named() {
         k_max: 0.2,
         ell_ranges: vec![],
         n_mocks: None,
-        basis: None,
+        basis: FitBasis::Velocileptors,
     };
     let err = |r: GalaxyFitRequest| {
         fit_galaxy(&plan, &terms, &data, &r)
@@ -235,7 +235,7 @@ fn recovers_the_distortion() {
         k_max: 0.2,
         ell_ranges: vec![],
         n_mocks: None,
-        basis: None,
+        basis: FitBasis::Velocileptors,
     };
     let fit = fit_galaxy(&plan, &terms, &data, &request).unwrap();
     let ap = fit.ap.unwrap();
@@ -272,7 +272,7 @@ fn hartlap_factor_scales_chi2() {
         k_max: 0.2,
         ell_ranges: vec![],
         n_mocks: None,
-        basis: None,
+        basis: FitBasis::Velocileptors,
     };
     let plain = fit_galaxy(&plan, &terms, &data, &base).unwrap();
     let mut with = base.clone();
@@ -308,7 +308,7 @@ fn priors_on_fixed_parameters_are_refused() {
         k_max: 0.2,
         ell_ranges: vec![],
         n_mocks: None,
-        basis: None,
+        basis: FitBasis::Velocileptors,
     };
     let e = fit_galaxy(&plan, &terms, &data, &request)
         .unwrap_err()
@@ -360,7 +360,7 @@ fn an_observation_on_other_k_of_the_same_length_is_refused() {
         k_max: 0.2,
         ell_ranges: vec![],
         n_mocks: None,
-        basis: None,
+        basis: FitBasis::Velocileptors,
     };
     let e = fit_galaxy_observed(&plan, &terms, &data, &request, Some(&observation))
         .unwrap_err()
@@ -395,7 +395,7 @@ mod physical {
             k_max: 0.2,
             ell_ranges: vec![],
             n_mocks: None,
-            basis: None,
+            basis: FitBasis::Velocileptors,
         }
     }
 
@@ -416,7 +416,7 @@ mod physical {
         };
         let vel = request(&["f", "b1", "b2", "bs"], &["sn"], start);
         let mut phys = request(&["f", "b1p", "b2p", "bsp"], &["sn0p"], start);
-        phys.basis = Some(basis());
+        phys.basis = FitBasis::Desi(basis());
         let a = fit_galaxy_search(&plan, &terms, &data, &vel, None, &search).unwrap();
         let b = fit_galaxy_search(&plan, &terms, &data, &phys, None, &search).unwrap();
         assert!(
@@ -444,10 +444,75 @@ mod physical {
             a.errors,
             b.errors
         );
-        let physical = b.physical.expect("the physical values are reported");
+        let physical = b.in_basis.expect("the physical values are reported");
         assert!((physical[0] - b.best.get("b1").unwrap() * 0.62).abs() < 1e-12);
         assert!((physical[8] - b.best.get("sn").unwrap() * 3e-4).abs() < 1e-12);
-        assert!(a.physical.is_none());
+        assert!(a.in_basis.is_none());
+    }
+
+    /// The CLASS-PT bias basis is a linear change of variables of b2, bs, b3: the same minimum, the
+    /// same best fit, and the reported bG2, bGamma3 map back to it ([`crate::bias`]).
+    #[test]
+    fn the_class_pt_basis_is_a_change_of_variables() {
+        let (plan, terms, truth, data) = setup();
+        let mut start = truth;
+        for (n, v) in [("f", 0.68), ("b1", 1.9), ("alpha0", 0.0), ("alpha2", 0.0)] {
+            start.set(n, v).unwrap();
+        }
+        let search = Search {
+            starts: 3,
+            linear: Linear::Profiled,
+            ..Search::default()
+        };
+        let vel = request(&["f", "b1", "b2", "bs", "b3"], &["sn"], start);
+        let mut cpt = request(&["f", "b1", "b2", "bG2", "bGamma3"], &["sn"], start);
+        cpt.basis = FitBasis::ClassPt;
+        let a = fit_galaxy_search(&plan, &terms, &data, &vel, None, &search).unwrap();
+        let b = fit_galaxy_search(&plan, &terms, &data, &cpt, None, &search).unwrap();
+        assert!(a.exact_gradient && b.exact_gradient);
+        assert!(
+            (a.minus_two_log_l - b.minus_two_log_l).abs() < 1e-6 * a.minus_two_log_l.max(1.0),
+            "{} vs {}",
+            a.minus_two_log_l,
+            b.minus_two_log_l
+        );
+        for (j, name) in ["f", "b1", "b2", "bs", "b3"].iter().enumerate() {
+            let (x, y) = (a.best.get(name).unwrap(), b.best.get(name).unwrap());
+            assert!((x - y).abs() < 0.02 * a.errors[j], "{name}: {x} vs {y}");
+        }
+        let v = b.in_basis.expect("the basis's values are reported");
+        let mapped = crate::bias::BiasParams::from_convention(
+            crate::bias::BiasConvention::ClassPt,
+            [v[0], v[1], v[2], v[3]],
+        );
+        for (i, name) in ["b1", "b2", "bs", "b3"].iter().enumerate() {
+            let want = b.best.get(name).unwrap();
+            assert!(
+                (mapped.values()[i] - want).abs() < 1e-12 * want.abs().max(1.0),
+                "{name}"
+            );
+        }
+        // the error of f, a parameter both bases share, is the same
+        assert!(
+            (a.errors[0] / b.errors[0] - 1.0).abs() < 0.01,
+            "{:?} vs {:?}",
+            a.errors,
+            b.errors
+        );
+        let e = fit_galaxy_search(
+            &plan,
+            &terms,
+            &data,
+            &GalaxyFitRequest {
+                free: vec!["bs".into()],
+                ..cpt.clone()
+            },
+            None,
+            &search,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("bG2 and bGamma3"), "{e}");
     }
 
     /// Data made in the physical basis (counterterms α₀p, α₂p, α₄p and sn0p, hence α₆ = f²α₄p) are
@@ -479,7 +544,7 @@ mod physical {
         let free = ["f", "b1p", "b2p", "bsp"];
         let marg = ["alpha0p", "alpha2p", "alpha4p", "sn0p"];
         let mut r = request(&free, &marg, start);
-        r.basis = Some(basis());
+        r.basis = FitBasis::Desi(basis());
         r.priors = desi_priors()
             .into_iter()
             .filter(|p| free.contains(&p.name.as_str()) || marg.contains(&p.name.as_str()))
@@ -499,7 +564,7 @@ mod physical {
             (&r, &Search::default(), 0.3, 0.1),
         ] {
             let fit = fit_galaxy_search(&plan, &terms, &data, request, None, search).unwrap();
-            let got = fit.physical.unwrap();
+            let got = fit.in_basis.unwrap();
             for (j, &slot) in [11, 0, 1, 2].iter().enumerate() {
                 let sigma = fit.errors[j];
                 assert!(
@@ -520,7 +585,7 @@ mod physical {
     fn profiles_in_the_physical_basis_start_from_its_best_fit() {
         let (plan, terms, truth, data) = setup();
         let mut r = request(&["f", "b1p", "b2p"], &["sn0p"], truth);
-        r.basis = Some(basis());
+        r.basis = FitBasis::Desi(basis());
         let search = Search {
             starts: 2,
             profile_check: false,
@@ -531,7 +596,7 @@ mod physical {
             span: 2.0,
         };
         let p = profile_galaxy(&plan, &terms, &data, &r, None, &search, "b1p", &grid).unwrap();
-        let best = p.fit.physical.unwrap()[0];
+        let best = p.fit.in_basis.unwrap()[0];
         let low = p
             .points
             .iter()
@@ -544,7 +609,7 @@ mod physical {
         );
         assert!((low.minus_two_log_l - p.fit.minus_two_log_l).abs() < 1e-6);
         for point in &p.points {
-            let v = point.physical.unwrap();
+            let v = point.in_basis.unwrap();
             assert!((v[0] - point.value).abs() < 1e-12 * point.value);
             assert!((point.best.get("b1").unwrap() - point.value / 0.62).abs() < 1e-12);
         }
@@ -556,7 +621,7 @@ mod physical {
     fn names_of_the_other_basis_are_refused_with_a_hint() {
         let (plan, terms, truth, data) = setup();
         let mut r = request(&["f", "b1"], &[], truth);
-        r.basis = Some(basis());
+        r.basis = FitBasis::Desi(basis());
         let e = fit_galaxy(&plan, &terms, &data, &r)
             .unwrap_err()
             .to_string();
@@ -567,13 +632,13 @@ mod physical {
             .to_string();
         assert!(e.contains("DESI physical"), "{e}");
         let mut r = request(&["f", "alpha6p"], &[], truth);
-        r.basis = Some(basis());
+        r.basis = FitBasis::Desi(basis());
         let e = fit_galaxy(&plan, &terms, &data, &r)
             .unwrap_err()
             .to_string();
         assert!(e.contains("alpha4p"), "{e}");
         let mut r = request(&["f"], &["alpha0"], truth);
-        r.basis = Some(basis());
+        r.basis = FitBasis::Desi(basis());
         let e = fit_galaxy(&plan, &terms, &data, &r)
             .unwrap_err()
             .to_string();

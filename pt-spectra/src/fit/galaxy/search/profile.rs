@@ -30,7 +30,7 @@ pub struct ProfilePoint {
     /// The distortion there.
     pub ap: Option<crate::rsd::ap::Distortion>,
     /// With the physical basis: every parameter there in it ([`GalaxyFit::physical`]).
-    pub physical: Option<[f64; 12]>,
+    pub in_basis: Option<[f64; 12]>,
 }
 
 /// The profile likelihood of one free parameter.
@@ -64,7 +64,7 @@ pub fn profile_galaxy(
     name: &str,
     grid: &ProfileGrid,
 ) -> Result<GalaxyProfile> {
-    let slot = slot_index(name, request.basis.is_some())?;
+    let slot = slot_index(name, &request.basis)?;
     if !(3..=401).contains(&grid.points) {
         return Err(Error::InvalidParameter {
             name: "profile grid points",
@@ -106,7 +106,7 @@ pub fn profile_galaxy(
         tolerance: EXPECTED_DECREASE,
     };
     let value_of = |s: usize| match s.checked_sub(PARAM_NAMES.len()) {
-        None => fit.physical.map_or(fit.best.values[s], |v| v[s]),
+        None => fit.in_basis.map_or(fit.best.values[s], |v| v[s]),
         Some(0) => fit.ap.map_or(f64::NAN, |d| d.apar),
         Some(_) => fit.ap.map_or(f64::NAN, |d| d.aperp),
     };
@@ -156,7 +156,7 @@ pub fn profile_galaxy(
             chi2,
             best: params,
             ap,
-            physical: objective.basis.map(|_| std::array::from_fn(|k| slots[k])),
+            in_basis: (!objective.basis.is_model()).then(|| std::array::from_fn(|k| slots[k])),
         });
     }
     Ok(GalaxyProfile {
