@@ -42,7 +42,7 @@ pub mod search;
 pub use basis::{FitBasis, CLASSPT_NAMES};
 pub use bispectrum::{BispectrumFit, BISPECTRUM_LINEAR, BISPECTRUM_NAMES};
 pub use derived::{derived, sound_horizon, Derived, Template};
-pub use joint::{default_shared, fit_joint, DataSet, JointFit};
+pub use joint::{default_shared, fit_joint, DataSet, JointFit, JointLikelihood};
 pub use priors::{desi_priors, Prior, PriorShape};
 pub use search::{profile_galaxy, GalaxyProfile, Linear, ProfileGrid, ProfilePoint, Search};
 

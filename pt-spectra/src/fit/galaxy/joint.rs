@@ -22,8 +22,8 @@
 use super::objective::{objective, Objective};
 use super::search::{bound, find, package, Space};
 use super::{
-    slot_index, BispectrumFit, GalaxyFit, GalaxyFitRequest, Linear, MultipoleData, Observation,
-    Search,
+    slot_index, BispectrumFit, FitBasis, GalaxyFit, GalaxyFitRequest, Linear, MultipoleData,
+    Observation, Search,
 };
 use crate::error::{Error, Result};
 use crate::rsd::ept::{EptPlan, EptTerms};
@@ -99,14 +99,44 @@ pub fn default_shared(sets: &[DataSet]) -> Vec<String> {
         .collect()
 }
 
-/// The joint objective: every set's objective and, per set, the joint index of each of its free
-/// parameters.
-struct Joint<'o, 'a> {
-    objectives: &'o [Objective<'a>],
+/// The joint −2 ln L of data sets (the sum of theirs, the shared parameters once, each set's linear
+/// parameters marginalised analytically or profiled): what [`fit_joint`] minimises and what a sampler
+/// calls (cobaya's likelihood, an MCMC or HMC on its exact gradient). Its parameters are
+/// [`Self::names`] (a shared one by its name, a set's own as `name[label]`) within
+/// [`Self::lower`], [`Self::upper`] (the fit's bounds: wide ranges narrowed by flat priors and the
+/// plans' AP range); its value includes every prior of the requests.
+pub struct JointLikelihood<'a> {
+    objectives: Vec<Objective<'a>>,
+    /// Per set, the joint index of each of its free parameters.
     map: Vec<Vec<usize>>,
+    /// The joint free parameters.
+    pub names: Vec<String>,
+    /// Their lower bounds.
+    pub lower: Vec<f64>,
+    /// Their upper bounds.
+    pub upper: Vec<f64>,
+    /// Their start values (the requests', within the bounds).
+    pub start: Vec<f64>,
+    /// Their typical σ (the start box of the fit's search).
+    scale: Vec<f64>,
+    /// Per joint parameter: its slot (in its first set).
+    slots: Vec<usize>,
+    /// The basis of every set.
+    basis: FitBasis,
+    /// The sets' labels.
+    labels: Vec<String>,
 }
 
-impl Joint<'_, '_> {
+impl<'a> JointLikelihood<'a> {
+    /// The likelihood of `sets` with the parameters `shared` (module docs of [`fit_joint`]), the
+    /// linear parameters as `linear` says.
+    ///
+    /// # Errors
+    /// As [`fit_joint`].
+    pub fn new(sets: &[DataSet<'a>], shared: &[String], linear: Linear) -> Result<Self> {
+        build(sets, shared, linear)
+    }
+
     /// Set `s`'s free values in the joint vector `x`.
     fn part(&self, s: usize, x: &[f64]) -> Vec<f64> {
         self.map[s].iter().map(|&g| x[g]).collect()
@@ -120,8 +150,48 @@ impl Joint<'_, '_> {
             .sum()
     }
 
+    /// −2 ln L at the joint free values `x` (in the order of [`Self::names`]).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a wrong length or a value outside the bounds; as the model
+    /// (naming the set) where it cannot be evaluated.
+    pub fn minus_two_log_l(&self, x: &[f64]) -> Result<f64> {
+        self.check(x)?;
+        let mut sum = 0.0;
+        for (s, o) in self.objectives.iter().enumerate() {
+            sum += o
+                .evaluate(&self.part(s, x))
+                .map_err(|e| self.in_set(s, e))?
+                .0;
+        }
+        Ok(sum)
+    }
+
+    /// −2 ln L and its exact gradient at `x`; `None` where a set has no exact gradient (a
+    /// bispectrum: [`Self::exact_gradient`]).
+    ///
+    /// # Errors
+    /// As [`Self::minus_two_log_l`].
+    pub fn value_and_gradient(&self, x: &[f64]) -> Result<Option<(f64, Vec<f64>)>> {
+        self.check(x)?;
+        let (mut value, mut gradient) = (0.0, vec![0.0; x.len()]);
+        for (s, o) in self.objectives.iter().enumerate() {
+            let Some((v, g, _)) = o
+                .value_and_gradient(&self.part(s, x))
+                .map_err(|e| self.in_set(s, e))?
+            else {
+                return Ok(None);
+            };
+            value += v;
+            for (&j, g) in self.map[s].iter().zip(g) {
+                gradient[j] += g;
+            }
+        }
+        Ok(Some((value, gradient)))
+    }
+
     /// The sum of the sets' −2 ln L with its exact gradient and Gauss–Newton curvature (each set's
-    /// scattered onto the joint parameters), if every set has one.
+    /// scattered onto the joint parameters), if every set has one; +∞ outside the model's domain.
     #[allow(clippy::type_complexity)]
     fn cost_and_gradient(&self, x: &[f64]) -> Option<(f64, Vec<f64>, Vec<f64>)> {
         let (mut value, mut gradient, mut curvature) =
@@ -138,8 +208,66 @@ impl Joint<'_, '_> {
     }
 
     /// Whether every set's objective has an exact gradient.
-    fn exact_gradient(&self) -> bool {
+    pub fn exact_gradient(&self) -> bool {
         self.objectives.iter().all(|o| o.exact_gradient)
+    }
+
+    /// The number of fitted points (all sets).
+    pub fn points(&self) -> usize {
+        self.objectives.iter().map(Objective::points).sum()
+    }
+
+    fn check(&self, x: &[f64]) -> Result<()> {
+        if x.len() != self.names.len() {
+            return Err(Error::InvalidParameter {
+                name: "number of likelihood parameters",
+                value: x.len() as f64,
+                reason: "must equal the number of the likelihood's free parameters (its names)",
+            });
+        }
+        for (j, &v) in x.iter().enumerate() {
+            if !(v >= self.lower[j] && v <= self.upper[j]) {
+                return Err(Error::InvalidChoice {
+                    what: format!("{} = {v}", self.names[j]),
+                    reason: format!(
+                        "is outside the likelihood's range [{}, {}] (the fit's bounds: its flat \
+                         priors and the plan's AP range)",
+                        self.lower[j], self.upper[j]
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn in_set(&self, s: usize, e: Error) -> Error {
+        Error::InvalidChoice {
+            what: format!("data set `{}`", self.labels[s]),
+            reason: e.to_string(),
+        }
+    }
+
+    /// The search space of the fit: per parameter its slot and prior, the bounds, σ and start.
+    fn space(&self) -> Space<'_> {
+        let params = self
+            .slots
+            .iter()
+            .enumerate()
+            .map(|(j, &slot)| {
+                let s = (0..self.map.len())
+                    .find(|&s| self.map[s].contains(&j))
+                    .expect("every joint parameter is some set's");
+                (slot, self.objectives[s].priors[slot].as_ref())
+            })
+            .collect();
+        Space {
+            params,
+            lo: self.lower.clone(),
+            hi: self.upper.clone(),
+            scale: self.scale.clone(),
+            x0: self.start.clone(),
+            basis: self.basis,
+        }
     }
 }
 
@@ -158,6 +286,49 @@ fn sharing(name: &str, reason: String) -> Error {
 /// that no set frees, that a set does not free or marginalises, or with different priors in two
 /// sets; as [`super::fit_galaxy_search`] for each set.
 pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result<JointFit> {
+    let joint = build(sets, shared, search.linear)?;
+    // Errors of the model at the start are the user's: reported as they are, naming the set.
+    for (s, o) in joint.objectives.iter().enumerate() {
+        o.evaluate(&joint.part(s, &joint.start))
+            .map_err(|e| Error::InvalidChoice {
+                what: format!("data set `{}` at the start", sets[s].label),
+                reason: e.to_string(),
+            })?;
+    }
+    let space = joint.space();
+    let exact = |x: &[f64]| joint.cost_and_gradient(x);
+    let grad = joint
+        .exact_gradient()
+        .then_some(&exact as &crate::fit::bounded::ValueGradient);
+    let found = find(&|x: &[f64]| joint.cost(x), grad, &space, search)?;
+    let x = &found.best.x;
+    let mut fits = Vec::with_capacity(sets.len());
+    for (s, o) in joint.objectives.iter().enumerate() {
+        fits.push(package(
+            o,
+            &joint.part(s, x),
+            &found,
+            found.errors.select(&joint.map[s]),
+        )?);
+    }
+    Ok(JointFit {
+        names: joint.names.clone(),
+        shared: shared.to_vec(),
+        chi2: fits.iter().map(|f| f.chi2).sum(),
+        minus_two_log_l: fits.iter().map(|f| f.minus_two_log_l).sum(),
+        points: fits.iter().map(|f| f.points).sum(),
+        sets: fits,
+        errors: found.errors.given.clone(),
+        covariance: found.errors.covariance.clone(),
+    })
+}
+
+/// The [`JointLikelihood`] of `sets` (as [`fit_joint`] checks them).
+fn build<'a>(
+    sets: &[DataSet<'a>],
+    shared: &[String],
+    linear: Linear,
+) -> Result<JointLikelihood<'a>> {
     if sets.is_empty() {
         return Err(Error::InvalidChoice {
             what: "a joint fit".into(),
@@ -186,7 +357,7 @@ pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result
             what: format!("data set `{}`", s.label),
             reason: e.to_string(),
         })?;
-        o.log_det = search.linear == Linear::Marginalised;
+        o.log_det = linear == Linear::Marginalised;
         objectives.push(o);
     }
     let basis = sets.first().map(|s| s.request.basis).unwrap_or_default();
@@ -265,7 +436,7 @@ pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result
         .map(|n| slot_index(n, &basis))
         .collect::<Result<_>>()?;
     let mut names = Vec::new();
-    let mut params = Vec::new();
+    let mut slots = Vec::new();
     let (mut lo, mut hi, mut scale, mut x0) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut map = Vec::with_capacity(sets.len());
     for (s, o) in objectives.iter().enumerate() {
@@ -287,7 +458,7 @@ pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result
             } else {
                 format!("{}[{}]", sets[s].request.free[j], sets[s].label)
             });
-            params.push((slot, o.priors[slot].as_ref()));
+            slots.push(slot);
             lo.push(a);
             hi.push(b);
             scale.push(sc);
@@ -304,50 +475,17 @@ pub fn fit_joint(sets: &[DataSet], shared: &[String], search: &Search) -> Result
         }
         *v = v.clamp(lo[j], hi[j]);
     }
-    let joint = Joint {
-        objectives: &objectives,
+    Ok(JointLikelihood {
+        objectives,
         map,
-    };
-    // Errors of the model at the start are the user's: reported as they are, naming the set.
-    for (s, o) in joint.objectives.iter().enumerate() {
-        o.evaluate(&joint.part(s, &x0))
-            .map_err(|e| Error::InvalidChoice {
-                what: format!("data set `{}` at the start", sets[s].label),
-                reason: e.to_string(),
-            })?;
-    }
-    let space = Space {
-        params,
-        lo,
-        hi,
-        scale,
-        x0,
-        basis,
-    };
-    let exact = |x: &[f64]| joint.cost_and_gradient(x);
-    let grad = joint
-        .exact_gradient()
-        .then_some(&exact as &crate::fit::bounded::ValueGradient);
-    let found = find(&|x: &[f64]| joint.cost(x), grad, &space, search)?;
-    let x = &found.best.x;
-    let mut fits = Vec::with_capacity(sets.len());
-    for (s, o) in joint.objectives.iter().enumerate() {
-        fits.push(package(
-            o,
-            &joint.part(s, x),
-            &found,
-            found.errors.select(&joint.map[s]),
-        )?);
-    }
-    Ok(JointFit {
         names,
-        shared: shared.to_vec(),
-        chi2: fits.iter().map(|f| f.chi2).sum(),
-        minus_two_log_l: fits.iter().map(|f| f.minus_two_log_l).sum(),
-        points: fits.iter().map(|f| f.points).sum(),
-        sets: fits,
-        errors: found.errors.given.clone(),
-        covariance: found.errors.covariance.clone(),
+        lower: lo,
+        upper: hi,
+        start: x0,
+        scale,
+        slots,
+        basis,
+        labels: sets.iter().map(|s| s.label.clone()).collect(),
     })
 }
 

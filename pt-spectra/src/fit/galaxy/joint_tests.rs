@@ -237,3 +237,68 @@ fn sharing_rules_are_checked() {
     let e = fit_joint(&[], &[], &search).unwrap_err().to_string();
     assert!(e.contains("at least one data set"), "{e}");
 }
+
+/// The likelihood a sampler calls is the fit's: at the joint best fit its value is the fit's
+/// −2 ln L; its gradient matches differences of it; a value outside the bounds is refused.
+#[test]
+fn the_joint_likelihood_is_what_the_fit_minimises() {
+    let (plan, terms, truth, _) = setup();
+    let (d1, d2) = (
+        model_data(&plan, &terms, &truth, 0.01),
+        model_data(&plan, &terms, &truth, -0.01),
+    );
+    let r = request(&truth);
+    let sets = [
+        set("a", &plan, &terms, &d1, &r),
+        set("b", &plan, &terms, &d2, &r),
+    ];
+    let shared = vec!["f".to_string()];
+    let fit = fit_joint(&sets, &shared, &Search::default()).unwrap();
+    let like = JointLikelihood::new(&sets, &shared, Linear::Marginalised).unwrap();
+    assert_eq!(like.names, fit.names);
+    assert!(like.exact_gradient());
+    let best: Vec<f64> = like
+        .names
+        .iter()
+        .map(|n| {
+            let (name, s) = match n.split_once('[') {
+                Some((name, label)) => (name, usize::from(label.starts_with('b'))),
+                None => (n.as_str(), 0),
+            };
+            fit.sets[s].best.get(name).unwrap()
+        })
+        .collect();
+    let v = like.minus_two_log_l(&best).unwrap();
+    assert!(
+        (v - fit.minus_two_log_l).abs() < 1e-9 * v.abs(),
+        "{v} vs {}",
+        fit.minus_two_log_l
+    );
+    let x: Vec<f64> = best.iter().map(|b| b * 1.02).collect();
+    let (value, g) = like.value_and_gradient(&x).unwrap().unwrap();
+    let direct = like.minus_two_log_l(&x).unwrap();
+    assert!(
+        (value - direct).abs() < 1e-9 * direct,
+        "{value} vs {direct}"
+    );
+    for j in 0..x.len() {
+        let h = 1e-4 * x[j].abs().max(1.0);
+        let at = |d: f64| {
+            let mut y = x.clone();
+            y[j] += d;
+            like.minus_two_log_l(&y).unwrap()
+        };
+        let fd = (8.0 * (at(h) - at(-h)) - (at(2.0 * h) - at(-2.0 * h))) / (12.0 * h);
+        assert!(
+            (g[j] - fd).abs() < 1e-5 * fd.abs().max(1.0),
+            "{}: {} vs {fd}",
+            like.names[j],
+            g[j]
+        );
+    }
+    let mut out = best.clone();
+    out[0] = like.upper[0] + 1.0;
+    let e = like.minus_two_log_l(&out).unwrap_err().to_string();
+    assert!(e.contains("outside the likelihood's range"), "{e}");
+    assert!(like.minus_two_log_l(&best[1..]).is_err());
+}
