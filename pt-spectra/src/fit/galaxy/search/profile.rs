@@ -29,7 +29,7 @@ pub struct ProfilePoint {
     pub best: EptParams,
     /// The distortion there.
     pub ap: Option<crate::rsd::ap::Distortion>,
-    /// With the physical basis: every parameter there in it ([`GalaxyFit::physical`]).
+    /// In a basis other than the model's: every parameter there in it ([`GalaxyFit::in_basis`]).
     pub in_basis: Option<[f64; 12]>,
 }
 
