@@ -59,6 +59,7 @@ __all__ = [
     "bispectrum",
     "one_loop_bispectrum",
     "from_desi_physical",
+    "AnalysisLikelihood",
     "distances",
     "growth",
     "halo",
@@ -327,6 +328,64 @@ def fit_joint(analysis, linear=None, z_input=0.0, cosmology=None, precision=_D["
     row); the header states every set and the sharing.
     """
     return _warn(_core.fit_joint(str(analysis), linear, z_input, cosmology, precision, q_range, eh))
+
+class AnalysisLikelihood:
+    """The likelihood of an analysis file (docs/analysis.md), kept between calls: the function
+    :func:`fit_joint` minimises, for samplers (cobaya, an MCMC, HMC/NUTS on its exact gradient).
+
+    ``AnalysisLikelihood(analysis, linear=None, z_input=0.0, cosmology=None, precision="default",
+    q_range=None, eh=None)`` loads every data set once (arguments as :func:`fit_joint`). Then:
+
+    - ``names``: the free parameters (a shared one by its name, a set's own as ``name[label]``);
+      ``bounds``: their (lower, upper) ranges, the fit's (a value outside raises ``ValueError``);
+      ``start``: the file's start values; ``sigma8_z``: ``{label: sigma8(z)}`` of each set's template
+      (f sigma8 = f sigma8(z)); ``header``: what it is; ``exact_gradient``, ``points``.
+    - ``lik(x)`` or ``lik(**params)``: -2 ln L (the sets' sum; linear parameters marginalised
+      analytically with their ln det F, or profiled, as the file's ``[search] linear``; every prior
+      of the file included), x in the order of ``names``.
+    - ``lik.loglike(params)``: ln L = -(-2 ln L)/2 of a dict by name, for cobaya's external
+      likelihoods (ln L up to the constant the fit also omits).
+    - ``lik.gradient(x)``: (-2 ln L, its exact gradient as an array) (``ValueError`` for a
+      likelihood with a bispectrum, whose gradient is not exact).
+    """
+
+    def __init__(self, analysis, linear=None, z_input=0.0, cosmology=None, precision=_D["precision"],
+                 q_range=None, eh=None):
+        self._lik = _core.AnalysisLikelihood(str(analysis), linear, z_input, cosmology, precision,
+                                             q_range, eh)
+        self.names = list(self._lik.names)
+        self.bounds = [tuple(b) for b in self._lik.bounds]
+        self.start = np.array(self._lik.start)
+        self.sigma8_z = dict(self._lik.sigma8_z)
+        self.header = list(self._lik.header)
+        self.exact_gradient = self._lik.exact_gradient
+        self.points = self._lik.points
+
+    def _vector(self, x, params):
+        if x is not None and params:
+            raise ValueError("give the values either as a sequence or by name, not both")
+        if x is None:
+            unknown = sorted(set(params) - set(self.names))
+            missing = [n for n in self.names if n not in params]
+            if unknown or missing:
+                raise ValueError(f"the likelihood's parameters are {', '.join(self.names)}"
+                                 + (f"; unknown: {', '.join(unknown)}" if unknown else "")
+                                 + (f"; missing: {', '.join(missing)}" if missing else ""))
+            x = [params[n] for n in self.names]
+        return [float(v) for v in np.asarray(x, dtype=float).ravel()]
+
+    def __call__(self, x=None, **params):
+        return self._lik.minus_two_log_l(self._vector(x, params))
+
+    def loglike(self, params):
+        return -0.5 * self._lik.minus_two_log_l(self._vector(None, dict(params)))
+
+    def gradient(self, x=None, **params):
+        found = self._lik.value_and_gradient(self._vector(x, params))
+        if found is None:
+            raise ValueError("this likelihood has no exact gradient (a data set with a bispectrum)")
+        return found[0], np.array(found[1])
+
 
 class RsdPlan:
     """The loop terms of a redshift-space model prepared for one k grid.

@@ -48,3 +48,108 @@ pub(crate) fn fit_joint(
     })?;
     Table::new(py, table, &prepared, &precision, "ept joint fit", seconds)
 }
+
+/// The likelihood of an analysis file, kept between calls: see the Python wrapper
+/// `pt_spectra.AnalysisLikelihood`.
+#[pyclass(module = "pt_spectra._core", frozen)]
+pub(crate) struct AnalysisLikelihood {
+    inner: std::sync::Mutex<pt_spectra::jobs::AnalysisLikelihood>,
+}
+
+impl AnalysisLikelihood {
+    fn with<T>(&self, f: impl FnOnce(&pt_spectra::jobs::AnalysisLikelihood) -> T) -> T {
+        let guard = self
+            .inner
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        f(&guard)
+    }
+}
+
+#[pymethods]
+impl AnalysisLikelihood {
+    #[new]
+    #[pyo3(signature = (analysis, linear=None, z_input=0.0, cosmology=None,
+        precision=pt_spectra::jobs::defaults::PRECISION, q_range=None, eh=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        analysis: std::path::PathBuf,
+        linear: Option<&Bound<'_, PyAny>>,
+        z_input: f64,
+        cosmology: Option<&Bound<'_, PyAny>>,
+        precision: &str,
+        q_range: Option<(f64, f64)>,
+        eh: Option<&str>,
+    ) -> PyResult<Self> {
+        let parsed = pt_spectra::jobs::analysis::read_analysis(&analysis).map_err(value_error)?;
+        let precision = crate::precision(precision, q_range, None, None)?;
+        let inputs = Inputs::extract(linear, parsed.sets[0].z, z_input, cosmology, eh)?;
+        let (inner, _) = detached(py, || {
+            let prepare = |z: f64| inputs.prepare_at(&[], z);
+            let store = crate::Store::new(None);
+            let job_inputs = pt_spectra::jobs::Inputs {
+                prepare: &prepare,
+                precision: &precision,
+                store: store.get(),
+                progress: &Silent,
+            };
+            pt_spectra::jobs::AnalysisLikelihood::new(&parsed, &job_inputs)
+        })?;
+        Ok(Self {
+            inner: std::sync::Mutex::new(inner),
+        })
+    }
+
+    /// The free parameters, in the order of the values the calls take.
+    #[getter]
+    fn names(&self) -> Vec<String> {
+        self.with(|l| l.names())
+    }
+
+    /// Their (lower, upper) bounds.
+    #[getter]
+    fn bounds(&self) -> Vec<(f64, f64)> {
+        self.with(|l| l.bounds())
+    }
+
+    /// Their start values.
+    #[getter]
+    fn start(&self) -> Vec<f64> {
+        self.with(|l| l.start())
+    }
+
+    /// Whether the exact gradient is available.
+    #[getter]
+    fn exact_gradient(&self) -> bool {
+        self.with(|l| l.exact_gradient())
+    }
+
+    /// The fitted points of all sets.
+    #[getter]
+    fn points(&self) -> usize {
+        self.with(|l| l.points())
+    }
+
+    /// Per data set label: σ8(z) of its template.
+    #[getter]
+    fn sigma8_z(&self) -> Vec<(String, f64)> {
+        self.with(|l| l.sigma8_z())
+    }
+
+    /// What the likelihood is.
+    #[getter]
+    fn header(&self) -> Vec<String> {
+        self.with(|l| l.header().to_vec())
+    }
+
+    /// −2 ln L at the values `x`.
+    fn minus_two_log_l(&self, py: Python<'_>, x: Vec<f64>) -> PyResult<f64> {
+        Ok(detached(py, || self.with(|l| l.minus_two_log_l(&x)))?.0)
+    }
+
+    /// (−2 ln L, its gradient) at `x`, or None without an exact gradient.
+    fn value_and_gradient(&self, py: Python<'_>, x: Vec<f64>) -> PyResult<Option<(f64, Vec<f64>)>> {
+        Ok(detached(py, || self.with(|l| l.value_and_gradient(&x)))?.0)
+    }
+}

@@ -92,3 +92,36 @@ def test_a_set_with_its_bispectrum_recovers_the_truth(tmp_path):
     for name, truth in (("f", 0.7), ("b1", 2.0), ("b2", -0.4), ("c1", 4.0), ("b_shot", 1.3)):
         assert abs(t[name][0] - truth) < 0.1 * t[f"err_{name}"][0], name
     assert t["points"][0] == 50 + 16
+
+
+def test_the_analysis_likelihood_is_what_fit_joint_minimises(tmp_path):
+    """``pt.AnalysisLikelihood``: at the joint best fit its -2 ln L is the fit's sum; loglike is -1/2
+    of it by name; its gradient matches differences; values outside the bounds and unknown names are
+    ValueErrors."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pt.PtSpectraWarning)
+        low, high = _data(tmp_path, "low.dat", 1.8), _data(tmp_path, "high.dat", 2.2)
+        (tmp_path / "two.toml").write_text(SEARCH + _set("low", low) + _set("high", high))
+        t = pt.fit_joint(tmp_path / "two.toml", precision="fast")
+        lik = pt.AnalysisLikelihood(tmp_path / "two.toml", precision="fast")
+    assert lik.names == ["f", "b1[low]", "b1[high]"] and lik.exact_gradient
+    best = [t["f"][0], t["b1"][0], t["b1"][1]]
+    total = t["minus_2_ln_L"][0] + t["minus_2_ln_L"][1]
+    assert lik(best) == pytest.approx(total, rel=1e-9)
+    by_name = dict(zip(lik.names, best))
+    assert lik.loglike(by_name) == pytest.approx(-0.5 * total, rel=1e-9)
+    assert lik(**by_name) == lik(best)
+    x = np.array(best) * 1.01
+    value, g = lik.gradient(x)
+    assert value == pytest.approx(lik(x), rel=1e-9)
+    for j in range(3):
+        h = 1e-4
+        up, down = x.copy(), x.copy()
+        up[j] += h
+        down[j] -= h
+        assert g[j] == pytest.approx((lik(up) - lik(down)) / (2 * h), rel=1e-4, abs=1e-3)
+    assert set(lik.sigma8_z) == {"low", "high"}
+    with pytest.raises(ValueError, match="outside the likelihood's range"):
+        lik([5.0, 2.0, 2.0])
+    with pytest.raises(ValueError, match="unknown: b2"):
+        lik(**by_name, b2=0.0)

@@ -120,19 +120,52 @@ fn in_set(origin: &str, label: &str, e: impl std::fmt::Display) -> Error {
 }
 
 /// What one data set loads: its data, observation, plan, terms, request and template.
-struct Loaded {
+pub(super) struct Loaded {
     data: MultipoleData,
     observation: Option<Observation>,
     plan: EptPlan,
     terms: EptTerms,
     request: GalaxyFitRequest,
-    template: Template,
-    description: Vec<String>,
+    pub(super) template: Template,
+    pub(super) description: Vec<String>,
     bispectrum: Option<BispectrumFit>,
 }
 
+/// The data sets of `analysis` on their `loaded` data.
+pub(super) fn data_sets<'a>(analysis: &Analysis, loaded: &'a [Loaded]) -> Vec<DataSet<'a>> {
+    analysis
+        .sets
+        .iter()
+        .zip(loaded)
+        .map(|(s, l)| DataSet {
+            label: s.label.clone(),
+            z: s.z,
+            tracer: s.tracer.clone(),
+            plan: &l.plan,
+            terms: &l.terms,
+            data: &l.data,
+            request: l.request.clone(),
+            observation: l.observation.as_ref(),
+            bispectrum: l.bispectrum.as_ref(),
+        })
+        .collect()
+}
+
+/// The shared parameters of `analysis` (declared, or [`default_shared`] of `sets`) and how they
+/// were chosen.
+pub(super) fn shared_of(analysis: &Analysis, sets: &[DataSet]) -> (Vec<String>, &'static str) {
+    match &analysis.shared {
+        Some(v) => (v.clone(), "declared in the analysis file"),
+        None => (
+            default_shared(sets),
+            "the default: f, apar, aperp (those free in every set) when every set has the same z \
+             and tracer, none otherwise",
+        ),
+    }
+}
+
 /// Loads data set `s` of `analysis`.
-fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded> {
+pub(super) fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded> {
     let err = |e: Error| in_set(origin, &s.label, e);
     let prepared = (inputs.prepare)(s.z).map_err(err)?;
     let layout = DataLayout::new(&s.data_ells, s.data_columns.as_deref()).map_err(err)?;
@@ -382,30 +415,8 @@ pub fn joint_fit_table(
         .iter()
         .map(|s| load(s, origin, inputs))
         .collect::<Result<Vec<_>>>()?;
-    let sets: Vec<DataSet> = analysis
-        .sets
-        .iter()
-        .zip(&loaded)
-        .map(|(s, l)| DataSet {
-            label: s.label.clone(),
-            z: s.z,
-            tracer: s.tracer.clone(),
-            plan: &l.plan,
-            terms: &l.terms,
-            data: &l.data,
-            request: l.request.clone(),
-            observation: l.observation.as_ref(),
-            bispectrum: l.bispectrum.as_ref(),
-        })
-        .collect();
-    let (shared, sharing) = match &analysis.shared {
-        Some(v) => (v.clone(), "declared in the analysis file"),
-        None => (
-            default_shared(&sets),
-            "the default: f, apar, aperp (those free in every set) when every set has the same z \
-             and tracer, none otherwise",
-        ),
-    };
+    let sets = data_sets(analysis, &loaded);
+    let (shared, sharing) = shared_of(analysis, &sets);
     let fit = fit_joint(&sets, &shared, &analysis.search).map_err(|e| Error::InvalidChoice {
         what: origin.clone(),
         reason: e.to_string(),

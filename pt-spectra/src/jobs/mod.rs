@@ -39,6 +39,8 @@ use crate::setup::Prepared;
 /// The TOML analysis file of a joint fit (feature `analysis`).
 #[cfg(feature = "analysis")]
 pub mod analysis;
+#[cfg(feature = "analysis")]
+mod analysis_likelihood;
 mod batch;
 mod bias;
 mod bispectrum;
@@ -54,6 +56,8 @@ mod observe;
 mod report;
 mod rsd;
 mod spt2;
+#[cfg(feature = "analysis")]
+pub use analysis_likelihood::AnalysisLikelihood;
 pub use batch::{batch_memory, real_batch, BatchColumns, BatchMemory, BatchRows};
 pub use bias::BiasOutput;
 pub use bispectrum::{

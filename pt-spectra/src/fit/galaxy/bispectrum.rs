@@ -18,7 +18,7 @@ use crate::linear::LinearSpectrum;
 use crate::rsd::ap::Distortion;
 use crate::rsd::ept::EptParams;
 use std::cell::RefCell;
-use std::rc::Rc;
+use std::sync::Arc;
 
 /// The bispectrum parameters that enter B linearly (affinely): the objective marginalises them as
 /// it does the power spectrum's counterterms.
@@ -191,7 +191,7 @@ impl BispectrumFit {
 /// The bispectrum of an objective: the data set's and its terms cache.
 pub(super) struct BispectrumModel<'a> {
     pub(super) fit: &'a BispectrumFit,
-    cache: RefCell<Vec<([u64; 3], Rc<BispectrumTerms>)>>,
+    cache: RefCell<Vec<([u64; 3], Arc<BispectrumTerms>)>>,
 }
 
 impl<'a> BispectrumModel<'a> {
@@ -218,11 +218,11 @@ impl<'a> BispectrumModel<'a> {
             .borrow()
             .iter()
             .find(|(k, _)| *k == key)
-            .map(|(_, t)| Rc::clone(t));
+            .map(|(_, t)| Arc::clone(t));
         let terms = match cached {
             Some(t) => t,
             None => {
-                let t = Rc::new(self.fit.block.terms_resummed(
+                let t = Arc::new(self.fit.block.terms_resummed(
                     &self.fit.spectrum,
                     f,
                     (a, b),
@@ -232,7 +232,7 @@ impl<'a> BispectrumModel<'a> {
                 if cache.len() == TERMS_CACHE {
                     cache.remove(0);
                 }
-                cache.push((key, Rc::clone(&t)));
+                cache.push((key, Arc::clone(&t)));
                 t
             }
         };
