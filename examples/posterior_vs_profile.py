@@ -219,7 +219,7 @@ def main():
         m, s, plo, phi, peak = weighted_stats(chain[n], w)
         rows.append((n, best[j] * scale, sig[j] * scale, lo, hi, m, s, plo, phi, peak))
 
-    write_report(args, lik, rows, fit, m_best, m_lib, truth, s8, len(w), n_eff,
+    write_report(args, lik, rows, profiles, fit, m_best, m_lib, truth, s8, len(w), n_eff,
                  dict(fit=t_fit, profile=t_profile, chain=t_chain, total=time.time() - t0))
     plot(args, profiles, chain, w, rows)
 
@@ -249,7 +249,7 @@ def plot(args, profiles, chain, w, rows):
     fig.savefig(args.out / "posterior_vs_profile.png", dpi=120)
 
 
-def write_report(args, lik, rows, fit, m_best, m_lib, truth, s8, n_points, n_eff, times):
+def write_report(args, lik, rows, profiles, fit, m_best, m_lib, truth, s8, n_points, n_eff, times):
     out = []
     w = out.append
     w("# Posterior against profile likelihood: BOSS DR12 CMASS NGC\n")
@@ -272,8 +272,10 @@ def write_report(args, lik, rows, fit, m_best, m_lib, truth, s8, n_points, n_eff
       f"own priors are already in it; the first 30% of the chain dropped: {n_points} distinct points, "
       f"effective sample size {n_eff:.0f} (of the weights).")
     w("- Profile: per parameter 21 points over ±3.5σ (Hessian σ), each re-minimised over the other five "
-      "(L-BFGS-B on the exact gradient), walking out from the best fit on either side; the interval where "
-      "Δ(−2 ln L) ≤ 1. The library's interval is that of `fit --analysis` (its own minimiser).")
+      "(L-BFGS-B on the exact gradient) from three starts, the lowest kept: the inner neighbour's "
+      "minimum (walking out from the best fit), the best fit, and the chain's most likely sample near "
+      "that value; the interval where Δ(−2 ln L) ≤ 1. The library's interval is that of "
+      "`fit --analysis` (its own minimiser and profile).")
     w(f"- The minimum: −2 ln L = {m_best:.4f} (the library's {m_lib:.4f}; "
       f"{int(fit['starts'][0]) if 'starts' in fit.columns else 8} starts).\n")
     w("## The table\n")
@@ -309,6 +311,13 @@ def write_report(args, lik, rows, fit, m_best, m_lib, truth, s8, n_points, n_eff
     else:
         w("- Every marginal posterior mean is within 0.3σ of the best fit: no projection effect of "
           "note in this template fit.")
+    for n, (g, d) in profiles.items():
+        inner = [i for i in range(1, len(d) - 1) if d[i] < d[i - 1] and d[i] < d[i + 1] and d[i] > 0.1]
+        for i in inner:
+            w(f"- {LABELS.get(n, n)} has a second minimum of the profile at {g[i]:.3g} with Δ(−2 ln L) = "
+              f"{d[i]:.2f} (the best fit at {g[int(np.argmin(d))]:.3g}): the likelihood is not one Gaussian "
+              "there, the posterior's mass on that side is that mode's. The minimiser's starts (8, from the "
+              "priors) and this profile find the global minimum all the same.")
     gaps = []
     for n, b, s, lo, hi, *_ in rows:
         col = "f" if n == "fsigma8" else n.split("[")[0]
