@@ -60,6 +60,7 @@ __all__ = [
     "one_loop_bispectrum",
     "from_desi_physical",
     "AnalysisLikelihood",
+    "convert_bias",
     "distances",
     "growth",
     "halo",
@@ -328,6 +329,17 @@ def fit_joint(analysis, linear=None, z_input=0.0, cosmology=None, precision=_D["
     row); the header states every set and the sharing.
     """
     return _warn(_core.fit_joint(str(analysis), linear, z_input, cosmology, precision, q_range, eh))
+
+def convert_bias(values, from_convention, to_convention="velocileptors"):
+    """The galaxy bias ``values`` (a dict, named as ``from_convention`` names them; a missing one is
+    0) in ``to_convention``: ``"velocileptors"`` (b1, b2, bs, b3: the convention of every function
+    here), ``"fastpt"`` (b1, b2, bs, b3nl: (bs/2)s^2, b3nl = b3/2) or ``"classpt"`` (b1, b2, bG2,
+    bGamma3: bs = bG2, b2 = b2^CLASS-PT - (4/3) bG2, b3 = -15 bG2 - 6 bGamma3). Exact (linear maps;
+    docs/reference.md, "Bias conventions"). E.g. CLASS-PT's values for :func:`bispectrum`:
+    ``pt.convert_bias({"b1": 2, "b2": 0.1, "bG2": -0.3, "bGamma3": 0.5}, "classpt")``."""
+    return dict(_core.convert_bias({k: float(v) for k, v in dict(values).items()}, from_convention,
+                                   to_convention))
+
 
 class AnalysisLikelihood:
     """The likelihood of an analysis file (docs/analysis.md), kept between calls: the function

@@ -30,3 +30,31 @@ pub(crate) fn convention(
         n.parse().map_err(value_error)
     })
 }
+
+/// The bias `values` (a dict named as `from_convention` names them; a missing one is 0) in
+/// `to_convention`, as a dict of its names.
+#[pyfunction]
+#[pyo3(signature = (values, from_convention, to_convention="velocileptors"))]
+pub(crate) fn convert_bias(
+    values: std::collections::BTreeMap<String, f64>,
+    from_convention: &str,
+    to_convention: &str,
+) -> PyResult<Vec<(String, f64)>> {
+    let from: BiasConvention = from_convention.parse().map_err(value_error)?;
+    let to: BiasConvention = to_convention.parse().map_err(value_error)?;
+    let names = from.names();
+    if let Some(bad) = values.keys().find(|k| !names.contains(&k.as_str())) {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "`{bad}` is not a bias parameter of the {from} convention: its names are {}",
+            names.join(", ")
+        )));
+    }
+    let v = names.map(|n| values.get(n).copied().unwrap_or(0.0));
+    let b = pt_spectra::bias::BiasParams::from_convention(from, v);
+    Ok(to
+        .names()
+        .iter()
+        .zip(b.in_convention(to))
+        .map(|(n, x)| ((*n).to_string(), x))
+        .collect())
+}

@@ -655,6 +655,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ept::from_desi_physical, m)?)?;
     m.add_function(wrap_pyfunction!(joint::fit_joint, m)?)?;
     m.add_class::<joint::AnalysisLikelihood>()?;
+    m.add_function(wrap_pyfunction!(bias::convert_bias, m)?)?;
     m.add_function(wrap_pyfunction!(forecast::fisher, m)?)?;
     m.add_function(wrap_pyfunction!(batch::real_batch, m)?)?;
     m.add_function(wrap_pyfunction!(batch::read_multipoles, m)?)?;

@@ -64,3 +64,14 @@ def test_fit_ept_in_the_class_pt_basis(tmp_path):
     assert r["b2_velocileptors"][0] == pytest.approx(r["b2"][0] - 4 / 3 * r["bG2"][0], rel=1e-9)
     with pytest.raises(ValueError, match="bG2 and bGamma3"):
         pt.fit_ept(str(path), [0.2], free=("f", "bs"), basis="classpt", ells=(0, 2), data_ells=(0, 2))
+
+
+def test_convert_bias_maps_and_inverts():
+    ours = dict(b1=2.0, b2=0.5, bs=-0.15, b3=0.4)
+    classpt = pt.convert_bias(ours, "velocileptors", "classpt")
+    assert classpt == pytest.approx(dict(b1=2.0, b2=0.3, bG2=-0.15, bGamma3=CLASS["b3"]))
+    assert pt.convert_bias(classpt, "classpt") == pytest.approx(ours)
+    assert pt.convert_bias(ours, "velocileptors", "fastpt") == pytest.approx(
+        dict(b1=2.0, b2=0.5, bs=-0.3, b3nl=0.2))
+    with pytest.raises(ValueError, match="b1, b2, bG2, bGamma3"):
+        pt.convert_bias(dict(bs=1.0), "classpt")

@@ -75,6 +75,40 @@ fn real_space_b0_is_the_closed_form_and_b2_b4_vanish() {
             "{r:?}"
         );
     }
+    // The same bias in CLASS-PT's convention (b2 + (4/3) bs, b_G2 = bs) and FAST-PT's (2 bs): the
+    // same bispectrum, and the header says how it was given.
+    for extra in [
+        [
+            "--b2",
+            "0.13333333333333336",
+            "--bs",
+            "-0.2",
+            "--bias-convention",
+            "classpt",
+        ],
+        ["--b2", "0.4", "--bs", "-0.4", "--bias-convention", "fastpt"],
+    ] {
+        let mut a = vec![
+            "bispectrum",
+            "--triangles",
+            file.to_str().unwrap(),
+            "--f",
+            "0",
+            "--no-ir",
+            "--b1",
+            "1.8",
+        ];
+        a.extend(extra);
+        let (ok, same, err) = run(&a);
+        assert!(ok, "{err}");
+        assert!(same.contains("given in"), "{same}");
+        for (x, y) in rows(&same).iter().zip(rows(&out)) {
+            assert!(
+                (x[3] / y[3] - 1.0).abs() < 1e-9,
+                "{extra:?}: {x:?} vs {y:?}"
+            );
+        }
+    }
 }
 
 #[test]

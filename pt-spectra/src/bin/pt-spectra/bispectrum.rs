@@ -62,6 +62,11 @@ pub struct Args {
     /// Tidal bias bs (bs s^2, velocileptors; CLASS-PT's b_G2 = bs).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     bs: f64,
+    /// The convention --b2 and --bs are written in: velocileptors (the default, as every command),
+    /// fastpt (FAST-PT's (bs/2) s^2) or classpt (CLASS-PT's b2 and b_G2); docs/reference.md, "Bias
+    /// conventions". The header gives both.
+    #[arg(long, value_name = "NAME", value_parser = crate::common::parsed::<pt_spectra::bias::BiasConvention>)]
+    bias_convention: Option<pt_spectra::bias::BiasConvention>,
     /// Counterterm c1 [(Mpc/h)^2]: Z1 -> Z1 - c1 k^2 mu^2.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     c1: f64,
@@ -152,6 +157,7 @@ fn galaxy_options_given(args: &Args) -> Vec<&'static str> {
     flag(args.b1 != 1.0, "--b1");
     flag(args.b2 != 0.0, "--b2");
     flag(args.bs != 0.0, "--bs");
+    flag(args.bias_convention.is_some(), "--bias-convention");
     flag(args.c1 != 0.0, "--c1");
     flag(args.n_bar.is_some(), "--n-bar");
     flag(args.f.is_some(), "--f");
@@ -258,10 +264,14 @@ pub fn run(args: &Args) -> Result<()> {
     inputs.push(("--triangles", args.triangles.as_deref()));
     inputs.push(("--pairs", args.pairs.as_deref()));
     check_outputs(&[("--out", args.out.as_deref())], &inputs)?;
+    let convention = args.bias_convention.unwrap_or_default();
+    // the cubic slot does not enter the tree level: given as 0 in the convention
+    let bias =
+        pt_spectra::bias::BiasParams::from_convention(convention, [args.b1, args.b2, args.bs, 0.0]);
     let params = BispectrumParams {
-        b1: args.b1,
-        b2: args.b2,
-        bs: args.bs,
+        b1: bias.b1,
+        b2: bias.b2,
+        bs: bias.bs,
         c1: args.c1,
         b_shot: args.b_shot,
         p_shot: args.p_shot,
@@ -328,5 +338,16 @@ pub fn run(args: &Args) -> Result<()> {
         }
         other => bail!("--basis {other}: valid: scoccimarro, sugiyama"),
     };
+    let mut table = table;
+    if convention != pt_spectra::bias::BiasConvention::Velocileptors {
+        table.header.push(format!(
+            "--b2 {} --bs {} given in {}'s convention: b2 = {}, bs = {} in velocileptors' (the parameters above)",
+            args.b2,
+            args.bs,
+            convention.label(),
+            bias.b2,
+            bias.bs
+        ));
+    }
     write_output(args.out.as_ref(), &table)
 }
