@@ -111,26 +111,21 @@ def crossing(grid, delta, level=1.0):
     return lo, hi
 
 
-def sample(lik, best, cov, s8, rminus1, seed):
-    """cobaya's MCMC on ln L of `lik` (flat priors on the likelihood's bounds: its own priors are in
-    -2 ln L already), f sigma8 derived."""
+def sample(lik, best, cov, likelihood, rminus1, seed):
+    """cobaya's MCMC with the likelihood class `pt_spectra.likelihoods.AnalysisFile` (the options
+    `likelihood`: the same file and template as `lik`), flat priors on the likelihood's bounds (its own
+    priors are in -2 ln L already), f sigma8 derived by it."""
     from cobaya.run import run
+    from pt_spectra.likelihoods import cobaya_name
 
-    key = {n: n.replace("[", "_").replace("]", "") for n in lik.names}
-
-    def loglike(**p):
-        try:
-            return -0.5 * lik([p[key[n]] for n in lik.names])
-        except ValueError:
-            return -np.inf
-
+    key = {n: cobaya_name(n) for n in lik.names}
     params = {}
     for n, (a, b), x, s in zip(lik.names, lik.bounds, best, np.sqrt(np.diag(cov))):
         params[key[n]] = {"prior": {"min": a, "max": b}, "ref": {"dist": "norm", "loc": x, "scale": 0.3 * s},
                           "proposal": s, "latex": LABELS.get(n, n)}
-    params["fsigma8"] = {"derived": lambda f: f * s8, "latex": r"f\sigma_8"}
+    params["fsigma8_ngc"] = {"latex": r"f\sigma_8"}
     info = {
-        "likelihood": {"boss_ngc": {"external": loglike, "input_params": [key[n] for n in lik.names]}},
+        "likelihood": {"boss_ngc": {"class": "pt_spectra.likelihoods.AnalysisFile", **likelihood}},
         "params": params,
         "sampler": {"mcmc": {"covmat": cov, "covmat_params": [key[n] for n in lik.names],
                              "Rminus1_stop": rminus1, "Rminus1_cl_stop": 0.1, "max_tries": 10000,
@@ -140,13 +135,12 @@ def sample(lik, best, cov, s8, rminus1, seed):
     }
     _, sampler = run(info)
     samples = sampler.products()["sample"]
-    samples.burn_in = 0
     table = samples.data
-    names = [key[n] for n in lik.names] + ["fsigma8"]
     burn = int(0.3 * len(table))
     chain = table.iloc[burn:]
+    key["fsigma8"] = "fsigma8_ngc"
     return chain["weight"].to_numpy(), chain["minuslogpost"].to_numpy(), \
-        {n: chain[key.get(n, n)].to_numpy() for n in lik.names + ["fsigma8"]}, names
+        {n: chain[key[n]].to_numpy() for n in lik.names + ["fsigma8"]}
 
 
 def weighted_stats(x, w):
@@ -192,7 +186,7 @@ def main():
 
     # The posterior.
     t = time.time()
-    w, mlp, chain, _ = sample(lik, best, cov, s8, args.rminus1, args.seed)
+    w, mlp, chain = sample(lik, best, cov, dict(analysis=str(path), **common), args.rminus1, args.seed)
     t_chain = time.time() - t
     n_eff = w.sum() ** 2 / (w ** 2).sum()
     log(f"chain: {len(w)} distinct points after burn-in, weight {w.sum():.0f}, {t_chain:.0f} s")
@@ -258,7 +252,8 @@ def write_report(args, lik, rows, profiles, fit, m_best, m_lib, truth, s8, n_poi
       f"the library's fit {times['fit']:.1f} s, the profiles {times['profile']:.0f} s, the chain "
       f"{times['chain']:.0f} s). One likelihood, three uses: the minimum and profiles `fit --analysis` "
       "reports, the same function's profiles re-minimised here with scipy's L-BFGS-B on its exact "
-      "gradient, and cobaya's MCMC on it (`pt.AnalysisLikelihood`, the external likelihood of the run).\n")
+      "gradient, and cobaya's MCMC on it (`pt.AnalysisLikelihood` inside the cobaya likelihood class "
+      "`pt_spectra.likelihoods.AnalysisFile`).\n")
     w("![posterior and profile](posterior_vs_profile.png)\n")
     w("## Settings\n")
     w("- Data, covariance, window, template and priors: those of `examples/boss_cmass_ngc_sgc.py` "
@@ -267,7 +262,8 @@ def write_report(args, lik, rows, profiles, fit, m_best, m_lib, truth, s8, n_poi
       f"from the BOSS fiducial; σ8(z = 0.57) = {s8:.4f} of the template.")
     w("- Free: f, b1, b2, bs, α∥, α⊥; marginalised analytically: α0, α2, sn, sn2 (with ln det F); "
       "priors N(0, 5²) on b2, bs and the file's on the marginalised ones, inside −2 ln L.")
-    w("- Posterior: cobaya's `mcmc` (covariance from the Hessian, learned proposal, R − 1 < "
+    w("- Posterior: cobaya's `mcmc` with the likelihood class `pt_spectra.likelihoods.AnalysisFile` on the "
+      "same file and template (covariance from the Hessian, learned proposal, R − 1 < "
       f"{args.rminus1} on the means and 0.1 on the 68% bounds, seed {args.seed}), flat priors on the "
       "likelihood's bounds (f ∈ [0, 2], b1 ∈ [0.05, 10], b2, bs ∈ [−50, 50], α ∈ [0.8, 1.25]) since its "
       f"own priors are already in it; the first 30% of the chain dropped: {n_points} distinct points, "

@@ -6,6 +6,10 @@ multipoles P_ℓ(k) (or ξ_ℓ(s)) with a full covariance (its inverse scaled by
 and, with the theory's ``ap_fiducial``, distorted by AP; a k range per multipole. Below it,
 ``MultipoleGaussian``, the simplest case (diagonal errors, the model at the data's k).
 
+``AnalysisFile``: the likelihood of a TOML analysis file (docs/analysis.md) with its template spectrum
+fixed, the function ``fit --analysis`` minimises (linear parameters marginalised analytically, every
+prior of the file included), needing no theory: posteriors beside the fit's profile likelihoods.
+
 ``PowerBispectrum``: the joint likelihood of window-free power-spectrum and bispectrum multipoles with
 one covariance (P + B analyses: BOSS, DESI), the bispectrum from the theory's ``pt_bk_ell``
 (``bispectrum: true``), sharing its spectrum, f, α's and b1, b2, bs with the power spectrum.
@@ -41,8 +45,8 @@ try:
 except ImportError as e:  # pragma: no cover - depends on the environment
     raise ImportError("pt_spectra.likelihoods needs cobaya: pip install cobaya camb") from e
 
-__all__ = ["MultipoleGaussian", "PowerBispectrum", "SurveyMultipoles", "read_multipoles",
-           "read_columns"]
+__all__ = ["AnalysisFile", "MultipoleGaussian", "PowerBispectrum", "SurveyMultipoles",
+           "read_multipoles", "read_columns", "cobaya_name"]
 
 
 def read_multipoles(path, data_ells=(0, 2, 4)):
@@ -470,3 +474,63 @@ class PowerBispectrum(Likelihood):
     def logp(self, **params_values):
         r = self._whiten @ (self.data - self.model())
         return -0.5 * float(r @ r)
+
+
+def cobaya_name(name):
+    """A likelihood parameter's name as cobaya takes it: ``b1[ngc]`` → ``b1_ngc``."""
+    return name.replace("[", "_").replace("]", "")
+
+
+class AnalysisFile(Likelihood):
+    """The likelihood of a TOML analysis file (docs/analysis.md): the very function ``pt-spectra fit
+    --analysis`` minimises (:class:`pt_spectra.AnalysisLikelihood`), with its template spectrum fixed
+    (f, α∥, α⊥, the biases free; each set's linear parameters marginalised analytically with their
+    ln det F, or profiled, as the file says), as a cobaya likelihood that needs no theory.
+
+    Options: ``analysis`` (the file, required), ``linear``, ``z_input``, ``cosmology``, ``precision``,
+    ``q_range`` as :func:`pt_spectra.fit_joint`. Its input parameters are the file's free ones with
+    cobaya's names: ``f``, ``b1_ngc`` for ``b1[ngc]``, … (declare each in ``params`` with a flat prior
+    inside the fit's bounds, :attr:`bounds`: the file's own priors are already in the likelihood).
+    Derived: ``fsigma8_<label>`` = f σ8(z) of each data set whose f is free. A point outside the
+    bounds has zero likelihood.
+    """
+
+    analysis: str | None = None
+    linear = None
+    z_input: float = 0.0
+    cosmology = None
+    precision: str = "default"
+    q_range = None
+
+    def initialize(self):
+        if not self.analysis:
+            raise ValueError("AnalysisFile: option `analysis` (a TOML analysis file) is required")
+        self.lik = pt.AnalysisLikelihood(self.analysis, linear=self.linear, z_input=float(self.z_input),
+                                         cosmology=self.cosmology, precision=self.precision,
+                                         q_range=None if self.q_range is None else tuple(self.q_range))
+        self.names = [cobaya_name(n) for n in self.lik.names]
+        self.bounds = dict(zip(self.names, self.lik.bounds))
+        self._fsigma8 = {}
+        for label, s8 in self.lik.sigma8_z.items():
+            for n in ("f", f"f[{label}]"):
+                if n in self.lik.names:
+                    self._fsigma8[f"fsigma8_{label}"] = (self.lik.names.index(n), s8)
+        self.log.info("%s: %s; %d points", self.analysis, ", ".join(self.names), self.lik.points)
+
+    def get_can_support_params(self):
+        return self.names
+
+    def get_can_provide_params(self):
+        return list(self._fsigma8)
+
+    def logp(self, **params_values):
+        x = [params_values[n] for n in self.names]
+        derived = params_values.get("_derived")
+        if derived is not None:
+            for name, (j, s8) in self._fsigma8.items():
+                derived[name] = x[j] * s8
+        try:
+            return -0.5 * self.lik(x)
+        except ValueError as e:
+            self.log.debug("zero likelihood: %s", e)
+            return -np.inf

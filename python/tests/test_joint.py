@@ -125,3 +125,29 @@ def test_the_analysis_likelihood_is_what_fit_joint_minimises(tmp_path):
         lik([5.0, 2.0, 2.0])
     with pytest.raises(ValueError, match="unknown: b2"):
         lik(**by_name, b2=0.0)
+
+
+def test_the_cobaya_likelihood_of_an_analysis_file(tmp_path):
+    """``pt_spectra.likelihoods.AnalysisFile``: cobaya's log-likelihood at the joint best fit is -1/2
+    of the fit's -2 ln L, fσ8 is derived, and a point outside the bounds has zero likelihood."""
+    from cobaya.model import get_model
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pt.PtSpectraWarning)
+        low, high = _data(tmp_path, "low.dat", 1.8), _data(tmp_path, "high.dat", 2.2)
+        (tmp_path / "two.toml").write_text(SEARCH + _set("low", low) + _set("high", high))
+        t = pt.fit_joint(tmp_path / "two.toml", precision="fast")
+        info = {"likelihood": {"joint": {"class": "pt_spectra.likelihoods.AnalysisFile",
+                                         "analysis": str(tmp_path / "two.toml"), "precision": "fast"}},
+                "params": {"f": {"prior": {"min": 0.0, "max": 2.0}},
+                           "b1_low": {"prior": {"min": 0.5, "max": 4.0}},
+                           "b1_high": {"prior": {"min": 0.5, "max": 4.0}},
+                           "fsigma8_low": None, "fsigma8_high": None}}
+        model = get_model(info)
+    point = {"f": t["f"][0], "b1_low": t["b1"][0], "b1_high": t["b1"][1]}
+    total = t["minus_2_ln_L"][0] + t["minus_2_ln_L"][1]
+    loglike, derived = model.loglike(point, return_derived=True)
+    assert loglike == pytest.approx(-0.5 * total, rel=1e-9)
+    s8 = dict(zip(t["set"], t["sigma8_z"]))
+    assert derived[0] == pytest.approx(t["f"][0] * s8[1], rel=1e-12)
+    assert model.loglike({**point, "b1_low": 0.5})[0] < -0.5 * total
