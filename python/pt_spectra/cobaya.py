@@ -70,7 +70,10 @@ conventions; ``ir`` (true) switches the BAO resummation) and its nuisance parame
 velocileptors' names with the suffix: ``b1_i`` (required), ``b2_i``, ``bs_i``, ``b3_i``,
 ``alpha0_i``, ``alpha2_i``, ``alpha4_i``, ``alpha6_i`` [(Mpc/h)^2], ``sn_i``, ``sn2_i``, ``sn4_i``
 (default 0; sn is the constant stochastic term, so no separate P_shot); ``real``, ``fog``, ``two_loop``
-do not apply.
+do not apply. Bias conventions: ``bias_convention: classpt`` names the bias as CLASS-PT does,
+``b1_i``, ``b2_i``, ``bG2_i``, ``bGamma3_i`` (CLASS-PT's b2, b_G2, b_Γ3), ``fastpt`` as FAST-PT does
+(``bs_i`` its (bs/2)s², ``b3nl_i``); each step maps them exactly to velocileptors' (docs/reference.md,
+"Bias conventions"), so priors are written as those codes' analyses publish them.
 
 Without a Boltzmann code (``emulator: true``): the theory takes the cosmological parameters itself and
 computes the linear spectrum with the library's emulator (:class:`pt_spectra.LinearEmulator`, 0.1 ms per
@@ -145,6 +148,10 @@ EPT_NUISANCE = {"b1": (True, None, "")} | {
         ("sn4", "(Mpc/h)^7"))
 }
 
+#: The bias parameters' names in each ``bias_convention`` (velocileptors' first: the model's own).
+_BIAS_NAMES = {"velocileptors": ("b1", "b2", "bs", "b3"), "fastpt": ("b1", "b2", "bs", "b3nl"),
+               "classpt": ("b1", "b2", "bG2", "bGamma3")}
+
 #: The bispectrum's own parameters per redshift with ``bispectrum: true`` (b1, b2, bs are shared with
 #: the galaxy model): name -> (required, default, unit).
 BISPECTRUM_NUISANCE = {"c1": (False, 0.0, "(Mpc/h)^2"), "b_shot": (False, 1.0, ""),
@@ -198,6 +205,8 @@ class PTMultipoles(Theory):
     n_bar: float | None = None
     b_fog: str = "none"
     b_sigma_fog: float = 0.0
+    #: rsd: ept: the names of the bias parameters (module docs, "Bias conventions")
+    bias_convention: str = "velocileptors"
 
     # ---- set-up ------------------------------------------------------------------------------
     def initialize(self):
@@ -210,6 +219,14 @@ class PTMultipoles(Theory):
         if not self.ells or any(ell < 0 or ell % 2 or ell > 8 for ell in self.ells):
             raise ValueError(f"PTMultipoles: `ells` must be even multipoles <= 8, got {self.ells}")
         self._ept = str(self.rsd).lower() == "ept"
+        convention = str(self.bias_convention).lower().replace("-", "").replace("_", "")
+        if convention not in _BIAS_NAMES:
+            raise ValueError(f"PTMultipoles: unknown `bias_convention` {self.bias_convention!r}; "
+                             f"available: {', '.join(_BIAS_NAMES)}")
+        if convention != "velocileptors" and not self._ept:
+            raise ValueError("PTMultipoles: `bias_convention` is an option of rsd: ept (the paper's "
+                             "models take b, sigma0, A_b)")
+        self._convention = convention
         if self.fog not in ("none", "lorentzian", "gaussian"):
             raise ValueError(f"PTMultipoles: unknown `fog` {self.fog!r}; "
                              "available: none, lorentzian, gaussian")
@@ -278,10 +295,13 @@ class PTMultipoles(Theory):
         return float(self.k_max_linear)
 
     def _table(self):
-        """The nuisance parameters of the model: name -> (required, default, unit)."""
-        if self._ept and self.bispectrum:
-            return EPT_NUISANCE | BISPECTRUM_NUISANCE
-        return EPT_NUISANCE if self._ept else NUISANCE
+        """The nuisance parameters of the model: name -> (required, default, unit); the bias named as
+        `bias_convention` names it."""
+        if not self._ept:
+            return NUISANCE
+        rename = dict(zip(_BIAS_NAMES["velocileptors"], _BIAS_NAMES[self._convention]))
+        table = {rename.get(n, n): v for n, v in EPT_NUISANCE.items()}
+        return table | BISPECTRUM_NUISANCE if self.bispectrum else table
 
     def _make_plan(self, k):
         if self._ept:
@@ -429,9 +449,13 @@ class PTMultipoles(Theory):
     # ---- computation -------------------------------------------------------------------------
     def _nuisance(self, params, i):
         # the required ones are in `params` (checked in initialize_with_params), except sigma0
-        # with fog: none, where it has no effect
-        return {name: float(params.get(self.param_name(name, i), 0.0 if d is None else d))
-                for name, (_, d, _) in self._table().items()}
+        # with fog: none, where it has no effect; the bias in velocileptors' convention
+        values = {name: float(params.get(self.param_name(name, i), 0.0 if d is None else d))
+                  for name, (_, d, _) in self._table().items()}
+        if self._ept and self._convention != "velocileptors":
+            given = {n: values.pop(n) for n in _BIAS_NAMES[self._convention]}
+            values.update(pt.convert_bias(given, self._convention))
+        return values
 
     def _emulated(self, params):
         """({z: (k, P_cb, f, D, σ8)}, {z: (α∥, α⊥)}) from the emulator and the library's background,

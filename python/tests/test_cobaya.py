@@ -198,6 +198,21 @@ def test_the_galaxy_model_takes_velocileptors_names(setup):
                  alpha0=5.0, sn=700.0)
     want = np.array([t["P0"], t["P2"], t["P4"]])
     np.testing.assert_allclose(got, want, rtol=1e-6, atol=0)
+    # bias_convention: classpt: the same bias (bs = 0.2, b3 = 0) named as CLASS-PT names it
+    theory["bias_convention"] = "classpt"
+    params.update(b2_0=0.3 + 4 / 3 * 0.2, bG2_0=0.2, bGamma3_0=-15 * 0.2 / 6)
+    m = get_model(info)
+    m.add_requirements({"pt_pk_ell": None})
+    m.logposterior(point)
+    classpt = np.asarray(m.provider.get_pt_pk_ell(z=Z))
+    theory["bias_convention"] = "velocileptors"
+    for n in ("bG2_0", "bGamma3_0"):
+        params.pop(n)
+    params.update(b2_0=0.3, bs_0=0.2)
+    m = get_model(info)
+    m.add_requirements({"pt_pk_ell": None})
+    m.logposterior(point)
+    np.testing.assert_allclose(classpt, np.asarray(m.provider.get_pt_pk_ell(z=Z)), rtol=1e-12)
 
 
 def test_without_a_boltzmann_code_the_emulator_gives_the_linear_spectrum(setup, model):
