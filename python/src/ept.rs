@@ -65,7 +65,7 @@ fn params_given(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<(EptParams, Bias
                 }
             }
             let b = BiasParams::from_convention(convention, bias);
-            p.values[..4].copy_from_slice(&b.values());
+            p.set_bias(&b);
             for (key, v) in rest {
                 p.set(&key, v).map_err(value_error)?;
             }

@@ -1,7 +1,7 @@
 //! `rsd --rsd ept`: the multipoles of the galaxy model ([`crate::rsd::ept`]) as a table.
 
 use super::{describe_inputs, VERSION};
-use crate::bias::{BiasConvention, BiasParams};
+use crate::bias::BiasConvention;
 use crate::error::Result;
 use crate::output::{Table, POWER, WAVENUMBER};
 use crate::precision::Precision;
@@ -107,8 +107,7 @@ pub fn ept_table_from_terms(
             .into(),
     ];
     if request.bias_given != BiasConvention::Velocileptors {
-        let [b1, b2, bs, b3] = std::array::from_fn(|i| params.values[i]);
-        header.push(BiasParams { b1, b2, bs, b3 }.describe(request.bias_given));
+        header.push(params.bias().describe(request.bias_given));
     }
     header.push(if settings.ir {
         format!(

@@ -31,6 +31,7 @@
 
 use super::ap::Distortion;
 use super::{legendre_coefficients, MAX_ELL};
+use crate::bias::BiasParams;
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
 use crate::integrate::legendre_nodes;
@@ -100,10 +101,26 @@ impl EptParams {
         Ok(())
     }
 
-    /// (b1, b2, bs, b3, f) for the loop terms.
-    fn bias(&self) -> [f64; 5] {
+    /// The bias b1, b2, bs, b3 ([`crate::bias`]: the model's convention is velocileptors').
+    pub fn bias(&self) -> BiasParams {
         let v = &self.values;
-        [v[B1], v[1], v[2], v[3], v[F]]
+        BiasParams {
+            b1: v[B1],
+            b2: v[B1 + 1],
+            bs: v[B1 + 2],
+            b3: v[B1 + 3],
+        }
+    }
+
+    /// Sets the bias b1, b2, bs, b3.
+    pub fn set_bias(&mut self, bias: &BiasParams) {
+        self.values[B1..B1 + 4].copy_from_slice(&bias.values());
+    }
+
+    /// (b1, b2, bs, b3, f) for the loop terms.
+    fn monomial_params(&self) -> [f64; 5] {
+        let [b1, b2, bs, b3] = self.bias().values();
+        [b1, b2, bs, b3, self.f()]
     }
 
     /// Checks the growth rate is physical (0 ≤ f ≤ 2) and every value finite.

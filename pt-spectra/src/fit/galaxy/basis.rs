@@ -69,11 +69,12 @@ impl FitBasis {
         match self {
             Self::Velocileptors => EptParams { values: *v },
             Self::ClassPt => {
-                let mut values = *v;
-                let b =
-                    BiasParams::from_convention(BiasConvention::ClassPt, [v[0], v[1], v[2], v[3]]);
-                values[..4].copy_from_slice(&b.values());
-                EptParams { values }
+                let mut p = EptParams { values: *v };
+                p.set_bias(&BiasParams::from_convention(
+                    BiasConvention::ClassPt,
+                    [v[0], v[1], v[2], v[3]],
+                ));
+                p
             }
             Self::Desi(b) => b.to_ept(v),
         }
@@ -86,9 +87,7 @@ impl FitBasis {
             Self::Velocileptors => p.values,
             Self::ClassPt => {
                 let mut v = p.values;
-                let [b1, b2, bs, b3] = [v[0], v[1], v[2], v[3]];
-                let b = BiasParams { b1, b2, bs, b3 };
-                v[..4].copy_from_slice(&b.in_convention(BiasConvention::ClassPt));
+                v[..4].copy_from_slice(&p.bias().in_convention(BiasConvention::ClassPt));
                 v
             }
             Self::Desi(b) => b.from_ept(p),

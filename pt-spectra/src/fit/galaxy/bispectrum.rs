@@ -237,10 +237,11 @@ impl<'a> BispectrumModel<'a> {
             }
         };
         let [c1, b_shot, p_shot, a_shot] = *own;
+        let bias = p.bias();
         let params = BispectrumParams {
-            b1: p.values[0],
-            b2: p.values[1],
-            bs: p.values[2],
+            b1: bias.b1,
+            b2: bias.b2,
+            bs: bias.bs,
             c1,
             b_shot,
             p_shot,

@@ -34,12 +34,12 @@ impl EptTerms {
 
     fn model_with(&self, params: &EptParams, errors: bool) -> Model<'_> {
         let v = &params.values;
-        let [b1, _, _, _, f] = params.bias();
+        let [b1, _, _, _, f] = params.monomial_params();
         let z1 = [b1 * b1, 2.0 * b1 * f, f * f];
         let (alpha, [sn, sn2, sn4]) = ([v[4], v[5], v[6], v[7]], [v[8], v[9], v[10]]);
         let s2 = self.nw.as_ref().map_or(0.0, |(_, s)| s.value);
         // The terms of the full and no-wiggle spectra are in the same order.
-        let coefficients = self.full.coefficients(params.bias());
+        let coefficients = self.full.coefficients(params.monomial_params());
         let values_only = |t: &crate::loops::redshift::RedshiftTerms| {
             (!errors).then(|| t.loop_values_all(&coefficients))
         };
@@ -113,10 +113,10 @@ pub(super) type PartsDf = Vec<([f64; 5], [f64; 5])>;
 impl EptTerms {
     /// The f-derivative of the model of `params` ([`PartsDf`]).
     pub(super) fn parts_df(&self, params: &EptParams) -> PartsDf {
-        let [b1, _, _, _, f] = params.bias();
+        let [b1, _, _, _, f] = params.monomial_params();
         let (z1, dz1) = ([b1 * b1, 2.0 * b1 * f, f * f], [0.0, 2.0 * b1, 2.0 * f]);
         let s2 = self.nw.as_ref().map_or(0.0, |(_, s)| s.value);
-        let dc = self.full.coefficients_df(params.bias());
+        let dc = self.full.coefficients_df(params.monomial_params());
         let full = self.full.loop_values_all(&dc);
         let nw = self.nw.as_ref().map(|(t, _)| (t, t.loop_values_all(&dc)));
         (0..self.grid.len())
