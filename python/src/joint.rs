@@ -7,6 +7,44 @@ use crate::{detached, value_error};
 use pt_spectra::progress::Silent;
 use pyo3::prelude::*;
 
+/// The analysis file `analysis`, the precision and the spectrum's inputs of the arguments (at the
+/// first set's z; each set is prepared at its own).
+fn read(
+    analysis: &std::path::Path,
+    linear: Option<&Bound<'_, PyAny>>,
+    z_input: f64,
+    cosmology: Option<&Bound<'_, PyAny>>,
+    precision: &str,
+    q_range: Option<(f64, f64)>,
+    eh: Option<&str>,
+) -> PyResult<(
+    pt_spectra::jobs::Analysis,
+    pt_spectra::precision::Precision,
+    Inputs,
+)> {
+    let parsed = pt_spectra::jobs::analysis::read_analysis(analysis).map_err(value_error)?;
+    let precision = crate::precision(precision, q_range, None, None)?;
+    let inputs = Inputs::extract(linear, parsed.sets[0].z, z_input, cosmology, eh)?;
+    Ok((parsed, precision, inputs))
+}
+
+/// `f` with the library's inputs of an analysis: the spectrum at each set's z, `precision`, the
+/// cache, no progress.
+fn with_job_inputs<T>(
+    inputs: &Inputs,
+    precision: &pt_spectra::precision::Precision,
+    f: impl FnOnce(&pt_spectra::jobs::Inputs) -> pt_spectra::error::Result<T>,
+) -> pt_spectra::error::Result<T> {
+    let prepare = |z: f64| inputs.prepare_at(&[], z);
+    let store = crate::Store::new(None);
+    f(&pt_spectra::jobs::Inputs {
+        prepare: &prepare,
+        precision,
+        store: store.get(),
+        progress: &Silent,
+    })
+}
+
 /// The joint fit of the analysis file `analysis` (TOML: the data sets and the shared parameters)
 /// with the cosmology and linear spectrum of the arguments, each set at its own z: a table with a
 /// row per data set, as `pt-spectra fit --analysis`.
@@ -24,26 +62,20 @@ pub(crate) fn fit_joint(
     q_range: Option<(f64, f64)>,
     eh: Option<&str>,
 ) -> PyResult<Table> {
-    let parsed = pt_spectra::jobs::analysis::read_analysis(&analysis).map_err(value_error)?;
-    let precision = crate::precision(precision, q_range, None, None)?;
-    let inputs = Inputs::extract(linear, parsed.sets[0].z, z_input, cosmology, eh)?;
+    let (parsed, precision, inputs) = read(
+        &analysis, linear, z_input, cosmology, precision, q_range, eh,
+    )?;
     let ((table, prepared), seconds) = detached(py, || {
         let first = inputs.prepare(&[])?;
-        let prepare = |z: f64| inputs.prepare_at(&[], z);
-        let store = crate::Store::new(None);
-        let job_inputs = pt_spectra::jobs::Inputs {
-            prepare: &prepare,
-            precision: &precision,
-            store: store.get(),
-            progress: &Silent,
-        };
         let header = vec![format!(
             "pt-spectra {} fit_joint {}: ept (velocileptors' REPT conventions) jointly to every \
              data set of the file",
             pt_spectra::jobs::VERSION,
             analysis.display()
         )];
-        let (table, _) = pt_spectra::jobs::joint_fit_table(&parsed, &job_inputs, header)?;
+        let (table, _) = with_job_inputs(&inputs, &precision, |job_inputs| {
+            pt_spectra::jobs::joint_fit_table(&parsed, job_inputs, header)
+        })?;
         Ok((table, first))
     })?;
     Table::new(py, table, &prepared, &precision, "ept joint fit", seconds)
@@ -82,19 +114,13 @@ impl AnalysisLikelihood {
         q_range: Option<(f64, f64)>,
         eh: Option<&str>,
     ) -> PyResult<Self> {
-        let parsed = pt_spectra::jobs::analysis::read_analysis(&analysis).map_err(value_error)?;
-        let precision = crate::precision(precision, q_range, None, None)?;
-        let inputs = Inputs::extract(linear, parsed.sets[0].z, z_input, cosmology, eh)?;
+        let (parsed, precision, inputs) = read(
+            &analysis, linear, z_input, cosmology, precision, q_range, eh,
+        )?;
         let (inner, _) = detached(py, || {
-            let prepare = |z: f64| inputs.prepare_at(&[], z);
-            let store = crate::Store::new(None);
-            let job_inputs = pt_spectra::jobs::Inputs {
-                prepare: &prepare,
-                precision: &precision,
-                store: store.get(),
-                progress: &Silent,
-            };
-            pt_spectra::jobs::AnalysisLikelihood::new(&parsed, &job_inputs)
+            with_job_inputs(&inputs, &precision, |job_inputs| {
+                pt_spectra::jobs::AnalysisLikelihood::new(&parsed, job_inputs)
+            })
         })?;
         Ok(Self {
             inner: std::sync::Mutex::new(inner),
