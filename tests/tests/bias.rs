@@ -243,7 +243,9 @@ fn tns_with_nonlinear_bias_moves_the_multipoles_by_the_bias_terms() {
 /// against velocileptors in `ept.rs`) at f = 0 without IR against FAST-PT's expansion
 /// (`GalaxyBias`, checked against FAST-PT above) with the bias mapped by
 /// [`pt_spectra::bias::BiasConvention::FastPt`]. The parts linear in b2, bs and b3 are compared
-/// (halves of P(+b) − P(−b)): they carry no k → 0 constant, which the two subtract differently.
+/// (halves of P(+b) − P(−b)): they carry no k → 0 constant, which the two subtract differently. Both
+/// evaluate the same integrals (measured: equal to 8e-14), so the test pins the normalisations, which
+/// the two comparisons above tie to velocileptors and FAST-PT: a factor 2 in bs or b3 is O(1) here.
 #[test]
 fn ept_and_fastpt_expansions_agree_through_the_bias_map() {
     use pt_spectra::bias::{BiasConvention, BiasParams};
@@ -285,15 +287,18 @@ fn ept_and_fastpt_expansions_agree_through_the_bias_map() {
         let theirs: Vec<f64> = (0..k.len()).map(|i| 0.5 * (fu[i] - fd[i])).collect();
         let scale = theirs.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         assert!(scale > 0.0);
+        let mut worst = 0.0_f64;
         for i in 0..k.len() {
             let d = (ours[i] - theirs[i]).abs() / scale;
+            worst = worst.max(d);
             assert!(
-                d < 2e-4,
+                d < 1e-10,
                 "slot {slot} k = {}: {} vs {}",
                 k[i],
                 ours[i],
                 theirs[i]
             );
         }
+        println!("slot {slot}: worst |ept - FAST-PT| / max = {worst:.1e}");
     }
 }
