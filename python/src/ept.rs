@@ -11,7 +11,7 @@ use pt_spectra::progress::Silent;
 use pt_spectra::rsd::ap::Distortion;
 use pt_spectra::rsd::ept::{EptParams, EptPlan as LibEptPlan, EptTerms as LibEptTerms};
 use pt_spectra::setup::Prepared;
-use pt_spectra::survey::observe::{Bins, Observation};
+use pt_spectra::survey::observe::{Bins, ObservationSpec};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -341,21 +341,15 @@ pub(crate) fn fit_ept(
     let window = window
         .map(|path| crate::survey::read_window(&path, window_mixing, window_format))
         .transpose()?;
-    let bins = match (k_edges.map(|e| floats(e, "k_edges")).transpose()?, r#box) {
-        (None, None) => None,
-        (Some(edges), None) => Some(Bins::Edges(edges)),
-        (Some(edges), Some(side)) => Some(Bins::Box { side, edges }),
-        (None, Some(_)) => {
-            return Err(pyo3::exceptions::PyValueError::new_err("box needs k_edges"))
-        }
+    let bins =
+        Bins::of(k_edges.map(|e| floats(e, "k_edges")).transpose()?, r#box).map_err(value_error)?;
+    let spec = ObservationSpec {
+        window,
+        bins,
+        xi,
+        s_edges,
     };
-    let observation = match (xi, window, bins) {
-        (true, _, _) => Some(Observation::xi(&ells, &data.k, s_edges.as_deref())),
-        (false, None, None) => None,
-        (false, window, bins) => Some(Observation::new(&ells, &data.k, window, bins)),
-    }
-    .transpose()
-    .map_err(value_error)?;
+    let observation = spec.build(&ells, &data.k).map_err(value_error)?;
     let model_k = observation
         .as_ref()
         .map_or(data.k.clone(), |o| o.k_model().to_vec());

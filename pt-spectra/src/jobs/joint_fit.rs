@@ -16,7 +16,7 @@ use crate::rsd::ap::Distortion;
 use crate::rsd::ept::{EptParams, EptPlan, EptTerms};
 use crate::setup::Prepared;
 use crate::store::TableStore;
-use crate::survey::observe::{Bins, Observation, Window};
+use crate::survey::observe::{Bins, Observation, ObservationSpec, Window};
 use std::path::PathBuf;
 
 /// The start of b1 when a data set gives none (the middle of the start box, [`crate::fit::galaxy::search::RANGES`]).
@@ -212,18 +212,12 @@ pub(super) fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded>
         }
         None => None,
     };
-    let bins = s.k_edges.as_ref().map(|edges| match s.box_side {
-        Some(side) => Bins::Box {
-            side,
-            edges: edges.clone(),
-        },
-        None => Bins::Edges(edges.clone()),
-    });
-    let observation = if window.is_some() || bins.is_some() {
-        Some(Observation::new(&s.ells, &data.k, window, bins).map_err(err)?)
-    } else {
-        None
+    let spec = ObservationSpec {
+        window,
+        bins: Bins::of(s.k_edges.clone(), s.box_side).map_err(err)?,
+        ..ObservationSpec::default()
     };
+    let observation = spec.build(&s.ells, &data.k).map_err(err)?;
     let cosmology = prepared.cosmology.cosmology;
     let ap = match (s.ap, &s.fiducial) {
         (Some((a, p)), _) => Some(Distortion::new(a, p).map_err(err)?),

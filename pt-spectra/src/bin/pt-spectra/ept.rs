@@ -1,7 +1,7 @@
 //! `pt-spectra rsd --rsd ept`: the galaxy model's options and run.
 
 use crate::progress::Bars;
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use pt_spectra::halo::Bias;
 use pt_spectra::jobs::{ept_plan, ept_table, EptRequest};
 use pt_spectra::output::Table;
@@ -179,16 +179,12 @@ impl EptArgs {
             ),
             None => None,
         };
-        let bins = match &self.k_edges {
-            None => None,
-            Some(text) => {
-                let edges = edges(text, "--k-edges")?;
-                Some(match self.r#box {
-                    Some(side) => Bins::Box { side, edges },
-                    None => Bins::Edges(edges),
-                })
-            }
-        };
+        let edges = self
+            .k_edges
+            .as_deref()
+            .map(|text| edges(text, "--k-edges"))
+            .transpose()?;
+        let bins = Bins::of(edges, self.r#box).context("--box")?;
         Ok((window, bins))
     }
 }
@@ -265,10 +261,17 @@ pub fn table(
         bias_given: shared.galaxy.map(|g| g.given).unwrap_or_default(),
     };
     let (window, bins) = args.observation()?;
-    if shared.xi.is_some() && (window.is_some() || bins.is_some()) {
-        bail!("--xi takes no --window or --k-edges (a Landy-Szalay xi has the window divided out)");
-    }
-    if window.is_none() && bins.is_none() && shared.xi.is_none() {
+    let spec = pt_spectra::survey::observe::ObservationSpec {
+        window,
+        bins,
+        xi: shared.xi.is_some(),
+        s_edges: None,
+    };
+    let at = shared.xi.as_deref().unwrap_or(&k);
+    let Some(observation) = spec
+        .build(&request.ells, at)
+        .context("--xi/--window/--k-edges")?
+    else {
         let plan = ept_plan(
             &k,
             !args.no_ir,
@@ -284,10 +287,6 @@ pub fn table(
             &loaded.prepared,
             &loaded.precision,
         )?);
-    }
-    let observation = match &shared.xi {
-        Some(s) => pt_spectra::survey::observe::Observation::xi(&request.ells, s, None)?,
-        None => pt_spectra::survey::observe::Observation::new(&request.ells, &k, window, bins)?,
     };
     let plan = ept_plan(
         observation.k_model(),

@@ -344,27 +344,19 @@ fn run_ept(args: &Args) -> Result<()> {
         basis,
     };
     let (window, bins) = args.ept.observation()?;
-    let observation = if args.xi {
-        let edges = args
+    let spec = pt_spectra::survey::observe::ObservationSpec {
+        window,
+        bins,
+        xi: args.xi,
+        s_edges: args
             .s_edges
             .as_deref()
             .map(|t| crate::ept::edges(t, "--s-edges"))
-            .transpose()?;
-        Some(pt_spectra::survey::observe::Observation::xi(
-            &request.ells,
-            &data.k,
-            edges.as_deref(),
-        )?)
-    } else if window.is_some() || bins.is_some() {
-        Some(pt_spectra::survey::observe::Observation::new(
-            &request.ells,
-            &data.k,
-            window,
-            bins,
-        )?)
-    } else {
-        None
+            .transpose()?,
     };
+    let observation = spec
+        .build(&request.ells, &data.k)
+        .context("--xi/--s-edges/--window/--k-edges")?;
     let model_k = observation
         .as_ref()
         .map_or(data.k.as_slice(), |o| o.k_model());

@@ -14,7 +14,6 @@ use pt_spectra::rsd::eft2::{Eft2Plan, RsdCounterterms};
 use pt_spectra::rsd::spt2::Spt2Plan;
 use pt_spectra::rsd::{Fog, Observed, RsdModel, RsdPlan, Sigma0};
 use pt_spectra::setup::NamedCosmology;
-use pt_spectra::survey::observe::Observation;
 use std::path::PathBuf;
 
 /// Arguments of `pt-spectra rsd`.
@@ -327,14 +326,15 @@ pub fn run(args: &Args) -> Result<()> {
     let mut request = request;
     // A window or bins: the model on their model k, with every multipole they need.
     let (window, bins) = args.ept.observation()?;
-    let observation = if window.is_some() || bins.is_some() {
-        if args.xi || args.terms {
-            bail!("--window/--k-edges/--box take neither --xi nor --terms (the observed table has the multipoles only)");
-        }
-        Some(Observation::new(&request.ells, &k, window, bins)?)
-    } else {
-        None
+    if (window.is_some() || bins.is_some()) && (args.xi || args.terms) {
+        bail!("--window/--k-edges/--box take neither --xi nor --terms (the observed table has the multipoles only)");
+    }
+    let spec = pt_spectra::survey::observe::ObservationSpec {
+        window,
+        bins,
+        ..Default::default()
     };
+    let observation = spec.build(&request.ells, &k)?;
     let k = match &observation {
         Some(o) => {
             request.ells = o.model_ells().to_vec();
