@@ -496,7 +496,10 @@ mod spec_tests {
     #[test]
     fn the_spec_decides_the_observation_and_refuses_what_has_no_meaning() {
         let k: Vec<f64> = (1..=20).map(|i| 0.01 * f64::from(i)).collect();
-        assert!(ObservationSpec::default().build(&[0, 2], &k).unwrap().is_none());
+        assert!(ObservationSpec::default()
+            .build(&[0, 2], &k)
+            .unwrap()
+            .is_none());
         let binned = ObservationSpec {
             bins: Bins::of(Some(vec![0.02, 0.06, 0.1]), None).unwrap(),
             ..ObservationSpec::default()
