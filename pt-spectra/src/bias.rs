@@ -134,6 +134,18 @@ impl BiasParams {
     }
 }
 
+/// The warning for a model whose bs and b3 were FAST-PT's before they meant one thing for every model
+/// (`real`, `scoccimarro`, `tns`), given without a convention; `options` is how the face spells bs
+/// and b3 (`--bs and --b3`, `bs and b3`), `fastpt` that convention (`--bias-convention fastpt`,
+/// `bias_convention='fastpt'`).
+pub fn implicit_convention_warning(model: &str, options: &str, fastpt: &str) -> String {
+    format!(
+        "{options} of {model} are velocileptors' bs (bs s^2) and b3 (b1 b3 sig3nl), as for every \
+         model; FAST-PT's bs is twice this bs and its b3nl half this b3: give {fastpt} to write \
+         FAST-PT's values (the header states both)"
+    )
+}
+
 /// A convention of the bias parameters (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum BiasConvention {

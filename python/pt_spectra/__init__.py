@@ -465,14 +465,17 @@ class RsdTerms:
                                             growth_factor, no_wiggle, cs2))
 
 
-_BIAS_NAMES = {None: ("b1", "b2", "bs", "b3"), "velocileptors": ("b1", "b2", "bs", "b3"),
-               "fastpt": ("b1", "b2", "bs", "b3nl"), "classpt": ("b1", "b2", "bG2", "bGamma3")}
+#: The bias parameters' names in each convention, as the library names them (velocileptors' first:
+#: the model's own).
+_BIAS_NAMES = {c: tuple(n for n, _ in _core.convert_bias({}, c, c))
+               for c in ("velocileptors", "fastpt", "classpt")}
 
 
 def _bias_kwargs(b1, b2, bs, b3, bias_convention):
     """The ``ept`` keyword arguments of b1 and the b2, bs, b3 slots of :func:`rsd`, named as
     ``bias_convention`` names them."""
-    key = None if bias_convention is None else str(bias_convention).lower().replace("-", "").replace("_", "")
+    key = "velocileptors" if bias_convention is None else \
+        str(bias_convention).lower().replace("-", "").replace("_", "")
     if key not in _BIAS_NAMES:
         raise ValueError(f"bias convention {bias_convention!r}: the conventions are velocileptors, "
                          "fastpt, classpt")

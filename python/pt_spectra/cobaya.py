@@ -148,9 +148,8 @@ EPT_NUISANCE = {"b1": (True, None, "")} | {
         ("sn4", "(Mpc/h)^7"))
 }
 
-#: The bias parameters' names in each ``bias_convention`` (velocileptors' first: the model's own).
-_BIAS_NAMES = {"velocileptors": ("b1", "b2", "bs", "b3"), "fastpt": ("b1", "b2", "bs", "b3nl"),
-               "classpt": ("b1", "b2", "bG2", "bGamma3")}
+#: The bias parameters' names in each ``bias_convention`` (the library's table).
+_BIAS_NAMES = pt._BIAS_NAMES
 
 #: The bispectrum's own parameters per redshift with ``bispectrum: true`` (b1, b2, bs are shared with
 #: the galaxy model): name -> (required, default, unit).

@@ -17,10 +17,10 @@ pub(crate) fn convention(
     let given = |x: Option<f64>| x.is_some_and(|v| v != 0.0);
     if let (None, Some(model)) = (name, warn_for) {
         if given(bs) || given(b3) {
-            let note = format!(
-                "bs and b3 of {model} are velocileptors' bs (bs s^2) and b3 (b1 b3 sig3nl), as for every \
-                 model; FAST-PT's bs is twice this bs and its b3nl half this b3: pass \
-                 bias_convention='fastpt' to give FAST-PT's values (the header states both)"
+            let note = pt_spectra::bias::implicit_convention_warning(
+                model,
+                "bs and b3",
+                "bias_convention='fastpt'",
             );
             let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
             PyErr::warn(py, &category, &std::ffi::CString::new(note)?, 2)?;

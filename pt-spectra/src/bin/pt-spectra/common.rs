@@ -193,9 +193,12 @@ impl GalaxyBiasArgs {
     pub fn warn_if_implicit(&self, model: &str) {
         if self.bias_convention.is_none() && (self.bs.is_some() || self.b3.is_some()) {
             eprintln!(
-                "warning: --bs and --b3 of {model} are velocileptors' bs (bs s^2) and b3 (b1 b3 sig3nl), as \
-                 for every model; FAST-PT's bs is twice this bs and its b3nl half this b3: give \
-                 --bias-convention fastpt to write FAST-PT's values (the header states both)"
+                "warning: {}",
+                pt_spectra::bias::implicit_convention_warning(
+                    model,
+                    "--bs and --b3",
+                    "--bias-convention fastpt"
+                )
             );
         }
     }
