@@ -1,0 +1,158 @@
+"""The JAX face of pt-spectra: its likelihoods and data vectors as JAX functions with exact derivatives.
+
+Gradient samplers (numpyro's or blackjax's NUTS, HMC, MCLMC) and gradient minimisers need d/dθ of
+the log-likelihood. The library computes it exactly (no finite differences); this module hands it
+to JAX, so that the functions below work under ``jax.jit``, ``jax.grad``, ``jax.jvp``,
+``jax.vjp`` and ``jax.vmap``:
+
+- :func:`log_likelihood`: ln L(x) of a :class:`pt_spectra.AnalysisLikelihood` (the likelihood of an
+  analysis file: data sets summed, the linear parameters marginalised analytically, every prior of
+  the file included), x in the order of its ``names``; the gradient is the library's exact one.
+- :func:`data_vector`: the data vector of a :class:`pt_spectra.Pipeline` at one cosmology or linear
+  spectrum as a function of its nuisance parameters and f (by name); the Jacobian is the pipeline's
+  exact one (``pipeline(..., jacobian=True)``).
+
+Each is a ``jax.custom_jvp`` around ``jax.pure_callback``: the value and the derivative are computed
+by the library on the host (one core; not traced, not on an accelerator), the tangent is linear in
+the input tangent, so JAX transposes it for reverse mode. ``vmap`` calls the library once per batch
+member. The library computes in float64: enable JAX's 64-bit mode first
+(``jax.config.update("jax_enable_x64", True)``, or ``numpyro.enable_x64()``); building a function
+without it raises ``ValueError``.
+
+Not yet differentiable here: the cosmological parameters through the emulator (the pipeline's
+Jacobian covers the nuisance parameters and f; ``Pipeline.template_jacobian`` gives f, α∥, α⊥), and
+likelihoods with a bispectrum (their gradient is not exact; :func:`log_likelihood` refuses them).
+
+JAX is an optional dependency: ``pip install "./python[jax]"`` (jax; numpyro for the example
+``examples/nuts_vs_cobaya.py``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+try:
+    import jax
+    import jax.numpy as jnp
+except ImportError as error:  # pragma: no cover - exercised only without jax
+    raise ImportError(
+        "pt_spectra.jax needs JAX: pip install jax (or the extra: pip install './python[jax]')"
+    ) from error
+
+__all__ = ["log_likelihood", "data_vector"]
+
+
+def _require_x64():
+    if not jax.config.jax_enable_x64:
+        raise ValueError(
+            "pt_spectra.jax computes in float64 and JAX's 64-bit mode is off: call "
+            "jax.config.update('jax_enable_x64', True) (numpyro: numpyro.enable_x64()) first"
+        )
+
+
+def _checked(x, n, what):
+    """x as a float64 vector of length n (a trace-time error naming `what` otherwise)."""
+    x = jnp.asarray(x, dtype=jnp.float64)
+    if x.shape != (n,):
+        raise ValueError(f"{what}: expected a vector of {n} values, got shape {x.shape}")
+    return x
+
+
+def log_likelihood(likelihood):
+    """ln L(x) = -(-2 ln L)/2 of ``likelihood`` (a :class:`pt_spectra.AnalysisLikelihood`) as a JAX
+    function of x, a vector in the order of ``likelihood.names``, with its exact gradient.
+
+    The value is the likelihood's (up to the constant the fit also omits); a point outside
+    ``likelihood.bounds`` raises ``ValueError`` from the library when evaluated (sample inside the
+    bounds: a uniform prior on them, as the cobaya likelihood has).
+
+    Raises ``ValueError`` if JAX's 64-bit mode is off or the likelihood has no exact gradient (a data
+    set with a bispectrum).
+    """
+    _require_x64()
+    if not likelihood.exact_gradient:
+        raise ValueError("this likelihood has no exact gradient (a data set with a bispectrum): "
+                         "pt_spectra.jax differentiates only exact gradients")
+    n = len(likelihood.names)
+    scalar = jax.ShapeDtypeStruct((), jnp.float64)
+    vector = jax.ShapeDtypeStruct((n,), jnp.float64)
+
+    def value(x):
+        return np.float64(-0.5 * likelihood(np.asarray(x, dtype=float)))
+
+    def value_and_gradient(x):
+        v, g = likelihood.gradient(np.asarray(x, dtype=float))
+        return np.float64(-0.5 * v), -0.5 * np.asarray(g, dtype=np.float64)
+
+    @jax.custom_jvp
+    def ln_l(x):
+        return jax.pure_callback(value, scalar, x, vmap_method="sequential")
+
+    @ln_l.defjvp
+    def _(primals, tangents):
+        (x,), (t,) = primals, tangents
+        v, g = jax.pure_callback(value_and_gradient, (scalar, vector), x, vmap_method="sequential")
+        return v, jnp.dot(g, t)
+
+    def function(x):
+        return ln_l(_checked(x, n, "log_likelihood"))
+
+    function.names = list(likelihood.names)
+    function.bounds = list(likelihood.bounds)
+    return function
+
+
+def data_vector(pipeline, names, cosmology=None, linear=None, z_input=None, **fixed):
+    """The data vector of ``pipeline`` (a :class:`pt_spectra.Pipeline` without a bispectrum block)
+    at one cosmology or linear spectrum (``cosmology``, ``linear``, ``z_input`` as a call takes them)
+    as a JAX function of the values of ``names`` (a vector in that order; names from
+    ``pipeline.nuisance``: the nuisance parameters and f), the other parameters fixed by ``fixed``
+    (by name; unset nuisance parameters are 0, f defaults to f(z)), with its exact Jacobian.
+
+    Raises ``ValueError`` if JAX's 64-bit mode is off, a name is not one of ``pipeline.nuisance`` or
+    repeated, or a name is both free and fixed.
+    """
+    _require_x64()
+    allowed = list(pipeline.nuisance)
+    names = list(names)
+    unknown = [n for n in names if n not in allowed]
+    if unknown or len(set(names)) != len(names):
+        raise ValueError(f"data_vector: names must be distinct, from {', '.join(allowed)}"
+                         + (f"; unknown: {', '.join(unknown)}" if unknown else ""))
+    both = sorted(set(names) & set(fixed))
+    if both:
+        raise ValueError(f"data_vector: {', '.join(both)} both free (names) and fixed")
+    if pipeline.meta["bispectrum"]:
+        raise ValueError("data_vector: the pipeline has a bispectrum block, whose Jacobian is not "
+                         "exact; build the pipeline without triangles")
+    rows = [allowed.index(n) for n in names]
+    where = dict(cosmology=cosmology, linear=linear, z_input=z_input)
+    m = len(pipeline(**where, **fixed))
+    out = jax.ShapeDtypeStruct((m,), jnp.float64)
+    jac = jax.ShapeDtypeStruct((len(names), m), jnp.float64)
+
+    def params(x):
+        return {**fixed, **{n: float(v) for n, v in zip(names, np.asarray(x, dtype=float))}}
+
+    def value(x):
+        return np.asarray(pipeline(**where, **params(x)), dtype=np.float64)
+
+    def value_and_jacobian(x):
+        v, j = pipeline(**where, jacobian=True, **params(x))
+        return np.asarray(v, dtype=np.float64), np.asarray(j, dtype=np.float64)[rows]
+
+    @jax.custom_jvp
+    def vector(x):
+        return jax.pure_callback(value, out, x, vmap_method="sequential")
+
+    @vector.defjvp
+    def _(primals, tangents):
+        (x,), (t,) = primals, tangents
+        v, j = jax.pure_callback(value_and_jacobian, (out, jac), x, vmap_method="sequential")
+        return v, t @ j
+
+    def function(x):
+        return vector(_checked(x, len(names), "data_vector"))
+
+    function.names = names
+    return function
