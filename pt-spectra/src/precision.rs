@@ -168,6 +168,81 @@ impl Default for Precision {
     }
 }
 
+/// The fields of a [`Precision`] that shape cached tensors, in the two groups the tensors' cache keys
+/// take ([`Precision::one_loop_key`], [`Precision::two_loop_key`]).
+struct TensorFields {
+    one_loop: [f64; 12],
+    two_loop: [f64; 6],
+}
+
+impl Precision {
+    /// Every field placed in a group of the cache keys, or named as not shaping any tensor. The
+    /// destructuring names every field: a field added to [`Precision`] does not compile until it is
+    /// placed here, so no cache key can miss it and reuse stale tensors.
+    fn tensor_fields(&self) -> TensorFields {
+        let Self {
+            // not tensors' settings: the label, how the terms are computed (basis or direct), the
+            // direct 2-loop integral's adaptive target (the 2-loop tensors use the fixed points),
+            // the memory limit
+            preset: _,
+            two_loop_tolerance: _,
+            two_loop: _,
+            max_memory: _,
+            q_min,
+            q_max,
+            lattice_step,
+            p13_cell_order,
+            p22_order,
+            p22_narrow_order,
+            p22_narrow_width,
+            p22_ln_width,
+            p22_tail_growth,
+            p22_linear_width,
+            p22_band_end,
+            p22_error_floor,
+            two_loop_points,
+            two_loop_replicas,
+            two_loop_seed,
+        } = *self;
+        TensorFields {
+            one_loop: [
+                q_min,
+                q_max,
+                lattice_step,
+                p13_cell_order as f64,
+                p22_order as f64,
+                p22_narrow_order as f64,
+                p22_narrow_width,
+                p22_ln_width,
+                p22_tail_growth,
+                p22_linear_width,
+                p22_band_end,
+                p22_error_floor,
+            ],
+            two_loop: [
+                q_min,
+                q_max,
+                lattice_step,
+                two_loop_points as f64,
+                two_loop_replicas as f64,
+                two_loop_seed as f64,
+            ],
+        }
+    }
+
+    /// The settings of the 1-loop integrals (q range, lattice, P13 and P22 rules), as the cache keys
+    /// of tensors built from them take them: the one place that lists them.
+    pub(crate) fn one_loop_key(&self) -> [f64; 12] {
+        self.tensor_fields().one_loop
+    }
+
+    /// The settings of the 2-loop mode-coupling integral that its basis tensors are built with (q
+    /// range, lattice, Sobol points, replicas, seed), as their cache key takes them.
+    pub(crate) fn two_loop_key(&self) -> [f64; 6] {
+        self.tensor_fields().two_loop
+    }
+}
+
 impl Precision {
     /// About twice as fast as the default, ≲ 3e-5 relative (error estimates ≲ 2e-4): coarser lattice
     /// and wider P22 panels.
@@ -422,5 +497,40 @@ mod tests {
         );
         assert!(Precision::fast().with_q_range(1.0, 0.5).is_err());
         assert!(Precision::fast().with_q_range(f64::NAN, 0.5).is_err());
+    }
+
+    #[test]
+    fn every_tensor_setting_changes_a_cache_key_and_the_others_do_not() {
+        let base = Precision::default();
+        let keys = |p: &Precision| (p.one_loop_key().to_vec(), p.two_loop_key().to_vec());
+        let changed: [(&str, Box<dyn Fn(&mut Precision)>); 15] = [
+            ("q_min", Box::new(|p| p.q_min *= 2.0)),
+            ("q_max", Box::new(|p| p.q_max /= 2.0)),
+            ("lattice_step", Box::new(|p| p.lattice_step /= 2.0)),
+            ("p13_cell_order", Box::new(|p| p.p13_cell_order += 1)),
+            ("p22_order", Box::new(|p| p.p22_order += 1)),
+            ("p22_narrow_order", Box::new(|p| p.p22_narrow_order += 1)),
+            ("p22_narrow_width", Box::new(|p| p.p22_narrow_width *= 2.0)),
+            ("p22_ln_width", Box::new(|p| p.p22_ln_width /= 2.0)),
+            ("p22_tail_growth", Box::new(|p| p.p22_tail_growth /= 2.0)),
+            ("p22_linear_width", Box::new(|p| p.p22_linear_width /= 2.0)),
+            ("p22_band_end", Box::new(|p| p.p22_band_end *= 2.0)),
+            ("p22_error_floor", Box::new(|p| p.p22_error_floor *= 2.0)),
+            ("two_loop_points", Box::new(|p| p.two_loop_points *= 2)),
+            ("two_loop_replicas", Box::new(|p| p.two_loop_replicas += 1)),
+            ("two_loop_seed", Box::new(|p| p.two_loop_seed += 1)),
+        ];
+        for (name, change) in &changed {
+            let mut p = base.clone();
+            change(&mut p);
+            assert_ne!(keys(&p), keys(&base), "{name} must be in a cache key");
+        }
+        // how the terms are computed, the direct integral's target and the memory limit shape no tensor
+        let mut p = base.clone();
+        p.preset = "mine";
+        p.two_loop_tolerance = 0.0;
+        p.two_loop = TwoLoopMethod::Basis;
+        p.max_memory = Some(1e9);
+        assert_eq!(keys(&p), keys(&base));
     }
 }

@@ -160,16 +160,9 @@ fn key(k: &[f64], precision: &Precision, family: SpectrumFamily) -> Vec<f64> {
         f64::from(VERSION),
         BASIS_SIZE as f64,
         ERROR_FUNCTIONS as f64,
-        precision.q_min,
-        precision.q_max,
-        precision.lattice_step,
-        precision.two_loop_points as f64,
-        precision.two_loop_replicas as f64,
-        precision.two_loop_seed as f64,
-        radial_width,
-        f64::from(training::VERSION),
-        k.len() as f64,
     ];
+    key.extend(precision.two_loop_key());
+    key.extend([radial_width, f64::from(training::VERSION), k.len() as f64]);
     key.extend(k);
     if family == SpectrumFamily::NoWiggle {
         key.push(1.0);

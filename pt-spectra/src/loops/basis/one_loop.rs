@@ -73,25 +73,9 @@ pub struct BasisOneLoop {
 
 /// The settings that make the tensors (their cache key), and for the no-wiggle family a marker.
 fn key(k: &[f64], precision: &Precision, family: SpectrumFamily) -> Vec<f64> {
-    let p = precision;
-    let mut key = vec![
-        f64::from(VERSION),
-        BASIS_SIZE as f64,
-        p.q_min,
-        p.q_max,
-        p.lattice_step,
-        p.p13_cell_order as f64,
-        p.p22_order as f64,
-        p.p22_narrow_order as f64,
-        p.p22_narrow_width,
-        p.p22_ln_width,
-        p.p22_tail_growth,
-        p.p22_linear_width,
-        p.p22_band_end,
-        p.p22_error_floor,
-        f64::from(super::training::VERSION),
-        k.len() as f64,
-    ];
+    let mut key = vec![f64::from(VERSION), BASIS_SIZE as f64];
+    key.extend(precision.one_loop_key());
+    key.extend([f64::from(super::training::VERSION), k.len() as f64]);
     key.extend(k);
     // The no-wiggle split is part of the basis (as for the redshift-space tensors): a change of its
     // filter must come with a new VERSION.

@@ -108,27 +108,14 @@ pub struct RedshiftBasis {
 
 /// The settings that make the tensors (their cache key).
 fn key(k: &[f64], precision: &Precision, family: RedshiftFamily) -> Vec<f64> {
-    let p = precision;
     let mut key = vec![
         f64::from(VERSION),
         family.code(),
         BASIS_SIZE as f64,
         NPAIR as f64,
-        p.q_min,
-        p.q_max,
-        p.lattice_step,
-        p.p13_cell_order as f64,
-        p.p22_order as f64,
-        p.p22_narrow_order as f64,
-        p.p22_narrow_width,
-        p.p22_ln_width,
-        p.p22_tail_growth,
-        p.p22_linear_width,
-        p.p22_band_end,
-        p.p22_error_floor,
-        f64::from(super::training::VERSION),
-        k.len() as f64,
     ];
+    key.extend(precision.one_loop_key());
+    key.extend([f64::from(super::training::VERSION), k.len() as f64]);
     key.extend(k);
     key
 }
