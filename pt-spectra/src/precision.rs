@@ -503,7 +503,8 @@ mod tests {
     fn every_tensor_setting_changes_a_cache_key_and_the_others_do_not() {
         let base = Precision::default();
         let keys = |p: &Precision| (p.one_loop_key().to_vec(), p.two_loop_key().to_vec());
-        let changed: [(&str, Box<dyn Fn(&mut Precision)>); 15] = [
+        type Change = Box<dyn Fn(&mut Precision)>;
+        let changed: [(&str, Change); 15] = [
             ("q_min", Box::new(|p| p.q_min *= 2.0)),
             ("q_max", Box::new(|p| p.q_max /= 2.0)),
             ("lattice_step", Box::new(|p| p.lattice_step /= 2.0)),

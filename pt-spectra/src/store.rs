@@ -1,4 +1,5 @@
-//! [`TableStore`]: the cosmology-independent angular tables (P15, P17), built once and cached in a
+//! [`TableStore`]: the cosmology-independent angular tables (P15, P17) and the plans' basis tensors
+//! (any [`CachedTensors`] type, through [`TableStore::for_method`]), built once and cached in a
 //! directory the caller chooses.
 //!
 //! A table file is a header (the magic `PTSTAB01`, the number of values, and the 64-bit FNV-1a hash of
@@ -24,13 +25,7 @@
 //! ```
 
 use crate::error::Result;
-use crate::loops::basis::{
-    LinearBasis, OneLoopBasis, RedshiftBasis, RedshiftFamily, SpectrumFamily, BASIS_SIZE,
-};
-use crate::loops::basis::{TnsBasis, TwoLoopBasis};
-use crate::loops::redshift::RedshiftPlan;
-use crate::loops::{OneLoopPlan, P15Table, P17Table, TnsPlan};
-use crate::precision::Precision;
+use crate::loops::{P15Table, P17Table};
 use crate::progress::{Progress, Stage};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -118,230 +113,6 @@ impl TableStore {
     }
 }
 
-impl TableStore {
-    /// Tensors from the file `file` of the directory (read, or built and written), or built in
-    /// memory without a directory.
-    fn tensors<T>(
-        &self,
-        file: &str,
-        name: &str,
-        read: impl Fn(&[f64]) -> Option<T>,
-        build: impl FnOnce() -> T,
-        write: impl Fn(&T) -> Vec<f64>,
-        progress: &dyn Progress,
-    ) -> Result<Arc<T>> {
-        Ok(Arc::new(match self.path(file) {
-            None => build(),
-            Some(path) => cached(&path, name, read, build, write, progress)?,
-        }))
-    }
-
-    /// The 2-loop basis tensors ([`TwoLoopBasis`]) of linear spectra for the wavenumbers `k` and `precision`: read
-    /// from their file, or built with the P15 `table` (reporting [`Stage::TwoLoopBasis`]; minutes)
-    /// and written. Without a directory they are built each time.
-    ///
-    /// # Errors
-    /// None from the cache (a cache that cannot be used means tensors built in memory, with a note).
-    pub fn two_loop_basis(
-        &self,
-        k: &[f64],
-        precision: &Precision,
-        table: &P15Table,
-        progress: &dyn Progress,
-    ) -> Result<Arc<TwoLoopBasis>> {
-        let lattice = TwoLoopBasis::lattice(precision);
-        let basis = || crate::loops::basis::training::camb_basis(lattice.clone(), BASIS_SIZE);
-        self.two_loop_basis_of(
-            k,
-            precision,
-            table,
-            SpectrumFamily::Linear,
-            &basis,
-            progress,
-        )
-    }
-
-    /// [`two_loop_basis`](Self::two_loop_basis) for the spectra of `family` on `basis()` (made on
-    /// the tensors' lattice).
-    ///
-    /// # Errors
-    /// As [`two_loop_basis`](Self::two_loop_basis).
-    pub fn two_loop_basis_of(
-        &self,
-        k: &[f64],
-        precision: &Precision,
-        table: &P15Table,
-        family: SpectrumFamily,
-        basis: &dyn Fn() -> LinearBasis,
-        progress: &dyn Progress,
-    ) -> Result<Arc<TwoLoopBasis>> {
-        let build = || {
-            TwoLoopBasis::build(k, precision, table, family, basis(), &|d, t| {
-                progress.update(Stage::TwoLoopBasis, d, t)
-            })
-        };
-        self.tensors(
-            &TwoLoopBasis::file_name(k, precision, family),
-            "2-loop basis",
-            |v| TwoLoopBasis::from_f64s(v, k, precision, family),
-            build,
-            TwoLoopBasis::to_f64s,
-            progress,
-        )
-    }
-
-    /// The 2-loop basis tensors for `k` and `precision` if their file is in the directory and valid
-    /// (never builds them; a corrupted file is reported to `progress` and not used).
-    pub fn cached_two_loop_basis(
-        &self,
-        k: &[f64],
-        precision: &Precision,
-        progress: &dyn Progress,
-    ) -> Option<Arc<TwoLoopBasis>> {
-        self.cached_two_loop_basis_of(k, precision, SpectrumFamily::Linear, progress)
-    }
-
-    /// [`cached_two_loop_basis`](Self::cached_two_loop_basis) for the spectra of `family`.
-    pub fn cached_two_loop_basis_of(
-        &self,
-        k: &[f64],
-        precision: &Precision,
-        family: SpectrumFamily,
-        progress: &dyn Progress,
-    ) -> Option<Arc<TwoLoopBasis>> {
-        let path = self.path(&TwoLoopBasis::file_name(k, precision, family))?;
-        read_cached(&path, "2-loop basis tensors", progress, |v| {
-            TwoLoopBasis::from_f64s(v, k, precision, family)
-        })
-    }
-
-    /// The 1-loop basis tensors ([`OneLoopBasis`]) of `plan`'s k grid and precision for the spectra
-    /// of `family` on `basis()`: read from their file, or built (reporting [`Stage::OneLoopBasis`];
-    /// about a second per 100 k) and written. Without a directory they are built each time.
-    ///
-    /// # Errors
-    /// None from the cache (a cache that cannot be used means tensors built in memory, with a note).
-    pub fn one_loop_basis(
-        &self,
-        plan: &OneLoopPlan,
-        family: SpectrumFamily,
-        basis: &dyn Fn() -> LinearBasis,
-        progress: &dyn Progress,
-    ) -> Result<Arc<OneLoopBasis>> {
-        let (k, precision) = (plan.k(), plan.precision());
-        let build = || {
-            OneLoopBasis::build(plan, family, basis(), &|d, t| {
-                progress.update(Stage::OneLoopBasis, d, t)
-            })
-        };
-        self.tensors(
-            &OneLoopBasis::file_name(k, precision, family),
-            "1-loop basis",
-            |v| OneLoopBasis::from_f64s(v, k, precision, family),
-            build,
-            OneLoopBasis::to_f64s,
-            progress,
-        )
-    }
-
-    /// The 1-loop basis tensors for `k`, `precision` and `family` if their file is in the directory
-    /// and valid (never builds them).
-    pub fn cached_one_loop_basis(
-        &self,
-        k: &[f64],
-        precision: &Precision,
-        family: SpectrumFamily,
-        progress: &dyn Progress,
-    ) -> Option<Arc<OneLoopBasis>> {
-        let path = self.path(&OneLoopBasis::file_name(k, precision, family))?;
-        read_cached(&path, "1-loop basis tensors", progress, |v| {
-            OneLoopBasis::from_f64s(v, k, precision, family)
-        })
-    }
-}
-
-impl TableStore {
-    /// The TNS basis tensors ([`TnsBasis`]) of `plan`'s k grid and precision: read from their file,
-    /// or built (reporting [`Stage::TnsBasis`]; seconds) and written. Without a directory they are
-    /// built each time.
-    ///
-    /// # Errors
-    /// None from the cache (a cache that cannot be used means tensors built in memory, with a note).
-    pub fn tns_basis(&self, plan: &TnsPlan, progress: &dyn Progress) -> Result<Arc<TnsBasis>> {
-        let (k, precision) = (plan.k(), plan.precision());
-        let build = || TnsBasis::build(plan, &|d, t| progress.update(Stage::TnsBasis, d, t));
-        self.tensors(
-            &TnsBasis::file_name(k, precision),
-            "TNS basis",
-            |v| TnsBasis::from_f64s(v, k, precision),
-            build,
-            TnsBasis::to_f64s,
-            progress,
-        )
-    }
-
-    /// The TNS basis tensors for `k` and `precision` if their file is in the directory and valid
-    /// (never builds them).
-    pub fn cached_tns_basis(
-        &self,
-        k: &[f64],
-        precision: &Precision,
-        progress: &dyn Progress,
-    ) -> Option<Arc<TnsBasis>> {
-        let path = self.path(&TnsBasis::file_name(k, precision))?;
-        read_cached(&path, "TNS basis tensors", progress, |v| {
-            TnsBasis::from_f64s(v, k, precision)
-        })
-    }
-}
-
-impl TableStore {
-    /// The basis tensors of the galaxy model's loop terms ([`RedshiftBasis`]) of `plan`'s k grid and
-    /// precision for the spectra `family`: read from their file, or built on the basis `basis()`
-    /// (reporting [`Stage::RedshiftBasis`]; seconds) and written. Without a directory they are
-    /// built each time.
-    ///
-    /// # Errors
-    /// None from the cache (a cache that cannot be used means tensors built in memory, with a note).
-    pub fn redshift_basis(
-        &self,
-        plan: &RedshiftPlan,
-        family: RedshiftFamily,
-        basis: &dyn Fn() -> LinearBasis,
-        progress: &dyn Progress,
-    ) -> Result<Arc<RedshiftBasis>> {
-        let (k, precision) = (plan.k(), plan.precision());
-        let build = || {
-            RedshiftBasis::build(plan, family, basis(), &|d, t| {
-                progress.update(Stage::RedshiftBasis, d, t)
-            })
-        };
-        self.tensors(
-            &RedshiftBasis::file_name(k, precision, family),
-            "redshift-space basis",
-            |v| RedshiftBasis::from_f64s(v, k, precision, family),
-            build,
-            RedshiftBasis::to_f64s,
-            progress,
-        )
-    }
-
-    /// The galaxy model's basis tensors for `k`, `precision` and `family` if their file is in the
-    /// directory and valid (never builds them).
-    pub fn cached_redshift_basis(
-        &self,
-        k: &[f64],
-        precision: &Precision,
-        family: RedshiftFamily,
-        progress: &dyn Progress,
-    ) -> Option<Arc<RedshiftBasis>> {
-        let path = self.path(&RedshiftBasis::file_name(k, precision, family))?;
-        read_cached(&path, "redshift-space basis tensors", progress, |v| {
-            RedshiftBasis::from_f64s(v, k, precision, family)
-        })
-    }
-}
-
 /// Tensors from the file at `path` if it is there and passes `read`'s checks; a corrupted file is
 /// reported to `progress` (as `what`) and not used.
 fn read_cached<T>(
@@ -396,13 +167,13 @@ fn load<T>(
     Ok(t)
 }
 
-mod bispectrum;
 mod file;
-mod rsd_two_loop;
+mod tensors;
 
 pub(crate) use file::cached;
 #[cfg(test)]
 use file::{fnv1a, HEADER};
 use file::{read_f64s, Stored};
+pub use tensors::{CachedTensors, RsdTwoLoopKey};
 #[cfg(test)]
 mod tests;

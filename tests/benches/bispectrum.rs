@@ -78,13 +78,17 @@ fn bispectrum(crit: &mut Criterion) {
 /// triangle directly for comparison.
 fn one_loop(crit: &mut Criterion) {
     use pt_spectra::bispectrum::one_loop::{one_loop_matter, OneLoopRule};
-    use pt_spectra::bispectrum::one_loop_basis::OneLoopMatterPlan;
+    use pt_spectra::bispectrum::one_loop_basis::{OneLoopMatterBasis, OneLoopMatterPlan};
     let triangles: Vec<[f64; 3]> = nseries().triangles().to_vec();
     let rule = OneLoopRule::default();
     let store = pt_spectra::store::TableStore::from_env();
     let start = std::time::Instant::now();
     let tensors = store
-        .one_loop_bispectrum_basis(&triangles, &rule, &pt_spectra::progress::Silent)
+        .tensors::<OneLoopMatterBasis>(
+            (&triangles, &rule),
+            |tick| OneLoopMatterBasis::build(&triangles, &rule, tick).unwrap(),
+            &pt_spectra::progress::Silent,
+        )
         .unwrap();
     eprintln!(
         "one-loop bispectrum tensors of {} triangles: {:.1} s (or read from the cache)",

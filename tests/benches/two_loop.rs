@@ -27,6 +27,7 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use pt_spectra::linear::{LinearSpectrum, LogGrid};
+use pt_spectra::loops::basis::{SpectrumFamily, TwoLoopBasis};
 use pt_spectra::loops::{p15_terms, two_loop_correction, Gamma2Plan, OneLoopPlan};
 use pt_spectra::precision::Precision;
 use pt_spectra::progress::Silent;
@@ -123,8 +124,13 @@ fn basis(c: &mut Criterion) {
     let precision = Precision::default();
     let store = TableStore::from_env();
     let table = store.p15(&Silent).expect("table");
+    let key = (&k[..], &precision, SpectrumFamily::Linear);
     let tensors = store
-        .two_loop_basis(&k, &precision, &table, &Silent)
+        .tensors::<TwoLoopBasis>(
+            key,
+            |tick| TwoLoopBasis::build_linear(&k, &precision, &table, tick),
+            &Silent,
+        )
         .expect("tensors");
     let plan = OneLoopPlan::new(&k, &precision).expect("valid");
     let data = |name: &str| {

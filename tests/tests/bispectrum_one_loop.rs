@@ -332,7 +332,9 @@ fn the_counterterms_absorb_the_change_of_the_cut_off() {
 /// thing.
 #[test]
 fn basis_terms_match_the_direct_integrals_for_spectra_not_in_the_training_set() {
-    use pt_spectra::bispectrum::one_loop_basis::{BispectrumLoopSource, OneLoopMatterPlan};
+    use pt_spectra::bispectrum::one_loop_basis::{
+        BispectrumLoopSource, OneLoopMatterBasis, OneLoopMatterPlan,
+    };
     use pt_spectra::cosmology::{Cosmology, TransferKind};
     use pt_spectra::linear::LogGrid;
     use pt_spectra::progress::Silent;
@@ -347,8 +349,11 @@ fn basis_terms_match_the_direct_integrals_for_spectra_not_in_the_training_set() 
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("one_loop_bispectrum_basis");
     let _ = std::fs::remove_dir_all(&dir);
     let start = std::time::Instant::now();
+    let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
+        OneLoopMatterBasis::build(&triangles, &rule, tick).unwrap()
+    };
     let tensors = TableStore::new(&dir)
-        .one_loop_bispectrum_basis(&triangles, &rule, &Silent)
+        .tensors::<OneLoopMatterBasis>((&triangles, &rule), build, &Silent)
         .unwrap();
     eprintln!(
         "tensors of {} triangles: {:.1} s",
@@ -356,11 +361,11 @@ fn basis_terms_match_the_direct_integrals_for_spectra_not_in_the_training_set() 
         start.elapsed().as_secs_f64()
     );
     let again = TableStore::new(&dir)
-        .cached_one_loop_bispectrum_basis(&triangles, &rule, &Silent)
+        .cached::<OneLoopMatterBasis>((&triangles, &rule), &Silent)
         .unwrap();
     assert!(*again == *tensors, "the cache file reads back the tensors");
     assert!(TableStore::new(&dir)
-        .cached_one_loop_bispectrum_basis(&triangles[1..], &rule, &Silent)
+        .cached::<OneLoopMatterBasis>((&triangles[1..], &rule), &Silent)
         .is_none());
     let direct = OneLoopMatterPlan::new(triangles.clone(), rule).unwrap();
     let plan = direct.clone().with_basis(tensors.clone()).unwrap();

@@ -10,7 +10,7 @@
 
 use pt_spectra::cosmology::{Cosmology, TransferKind};
 use pt_spectra::linear::{LinearSpectrum, LogGrid};
-use pt_spectra::loops::basis::MAX_RESIDUAL;
+use pt_spectra::loops::basis::{SpectrumFamily, TwoLoopBasis, MAX_RESIDUAL};
 use pt_spectra::loops::{p15_terms, two_loop_correction, Estimate, OneLoopPlan, Pair};
 use pt_spectra::precision::Precision;
 use pt_spectra::progress::Silent;
@@ -48,16 +48,21 @@ fn basis_two_loop_terms_match_the_direct_integrals() {
     let table = store().p15(&Silent).unwrap();
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("two_loop_basis");
     let _ = std::fs::remove_dir_all(&dir);
+    let linear = SpectrumFamily::Linear;
     let tensors = TableStore::new(&dir)
-        .two_loop_basis(&k, &precision, &table, &Silent)
+        .tensors::<TwoLoopBasis>(
+            (&k[..], &precision, linear),
+            |tick| TwoLoopBasis::build_linear(&k, &precision, &table, tick),
+            &Silent,
+        )
         .unwrap();
     // Read back from the file by a new store: the same tensors.
     let again = TableStore::new(&dir)
-        .cached_two_loop_basis(&k, &precision, &Silent)
+        .cached::<TwoLoopBasis>((&k[..], &precision, linear), &Silent)
         .unwrap();
     assert!(*again == *tensors, "the cache file reads back the tensors");
     assert!(TableStore::new(&dir)
-        .cached_two_loop_basis(&k[1..], &precision, &Silent)
+        .cached::<TwoLoopBasis>((&k[1..], &precision, linear), &Silent)
         .is_none());
     let plan = OneLoopPlan::new(&k, &precision).unwrap();
     let camb = |name: &str| LinearSpectrum::parse(&data(name), name, Default::default()).unwrap();

@@ -4,7 +4,9 @@
 
 use super::VERSION;
 use crate::bispectrum::one_loop::{OneLoopMatter, OneLoopRule, COUNTERTERMS, PARTITION_POWER};
-use crate::bispectrum::one_loop_basis::{BispectrumLoopSource, OneLoopMatterPlan};
+use crate::bispectrum::one_loop_basis::{
+    BispectrumLoopSource, OneLoopMatterBasis, OneLoopMatterPlan,
+};
 use crate::bispectrum::one_loop_rsd::{one_loop_matter_redshift, Orientation};
 use crate::bispectrum::{
     BispectrumParams, BispectrumPlan, BoxPlan, Fog, LegendreSide, PlanRules, Settings,
@@ -250,11 +252,12 @@ pub fn one_loop_bispectrum_plan(
     progress: &dyn Progress,
 ) -> Result<(OneLoopMatterPlan, bool)> {
     let plan = OneLoopMatterPlan::new(triangles.to_vec(), *rule)?;
-    let tensors = match method {
-        TwoLoopMethod::Direct => None,
-        TwoLoopMethod::Basis => Some(store.one_loop_bispectrum_basis(triangles, rule, progress)?),
-        TwoLoopMethod::Auto => store.cached_one_loop_bispectrum_basis(triangles, rule, progress),
+    // the plan above has checked the triangles and the rule: the build cannot fail
+    let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
+        OneLoopMatterBasis::build(triangles, rule, tick).expect("triangles and rule checked")
     };
+    let tensors =
+        store.for_method::<OneLoopMatterBasis>(method, (triangles, rule), build, progress)?;
     let uncached = method == TwoLoopMethod::Auto && tensors.is_none();
     Ok(match tensors {
         Some(t) => (plan.with_basis(t)?, false),

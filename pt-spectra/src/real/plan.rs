@@ -163,50 +163,47 @@ impl RealPlan {
                 &|p: &LinearSpectrum| split.no_wiggle(p).unwrap_or_else(|_| p.clone()),
             ))
         };
-        let basis_nw = match (&p15, precision.two_loop) {
-            (Some(table), method) if model.needs_two_loop() && model.needs_ir() => {
+        let method = precision.two_loop;
+        let basis_nw = match &p15 {
+            Some(table) if model.needs_two_loop() && model.needs_ir() => {
                 let nw = SpectrumFamily::NoWiggle;
-                match method {
-                    TwoLoopMethod::Direct => None,
-                    TwoLoopMethod::Auto => {
-                        store.cached_two_loop_basis_of(k, precision, nw, progress)
-                    }
-                    TwoLoopMethod::Basis => {
-                        let lattice = TwoLoopBasis::lattice(precision);
-                        let basis = || no_wiggle_basis(&lattice).expect("an IR model has a split");
-                        Some(store.two_loop_basis_of(k, precision, table, nw, &basis, progress)?)
-                    }
-                }
+                let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
+                    let lattice = TwoLoopBasis::lattice(precision);
+                    let basis = no_wiggle_basis(&lattice).expect("an IR model has a split");
+                    TwoLoopBasis::build(k, precision, table, nw, basis, tick)
+                };
+                store.for_method::<TwoLoopBasis>(method, (k, precision, nw), build, progress)?
             }
             _ => None,
         };
-        let basis = match (&p15, precision.two_loop) {
-            (Some(table), method) if model.needs_two_loop() => match method {
-                TwoLoopMethod::Direct => None,
-                TwoLoopMethod::Auto => store.cached_two_loop_basis(k, precision, progress),
-                TwoLoopMethod::Basis => Some(store.two_loop_basis(k, precision, table, progress)?),
-            },
+        let basis = match &p15 {
+            Some(table) if model.needs_two_loop() => {
+                let linear = SpectrumFamily::Linear;
+                let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
+                    TwoLoopBasis::build_linear(k, precision, table, tick)
+                };
+                store.for_method::<TwoLoopBasis>(method, (k, precision, linear), build, progress)?
+            }
             _ => None,
         };
         // The 1-loop tensors (one chunk only): built with the 2-loop ones by method basis, used by
         // auto when cached.
         let tensors = |family: SpectrumFamily| -> Result<Option<Arc<OneLoopBasis>>> {
-            let lattice = one_loop[0].rules().0.lattice.clone();
-            let basis = || match family {
-                SpectrumFamily::NoWiggle => {
-                    no_wiggle_basis(&lattice).expect("only IR models ask for it")
-                }
-                SpectrumFamily::Linear => camb_basis(lattice.clone(), BASIS_SIZE),
+            let [plan] = one_loop.as_slice() else {
+                return Ok(None);
             };
-            Ok(match (one_loop.as_slice(), precision.two_loop) {
-                ([plan], TwoLoopMethod::Basis) => {
-                    Some(store.one_loop_basis(plan, family, &basis, progress)?)
-                }
-                ([_], TwoLoopMethod::Auto) => {
-                    store.cached_one_loop_basis(k, precision, family, progress)
-                }
-                _ => None,
-            })
+            let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
+                let lattice = plan.rules().0.lattice.clone();
+                let basis = match family {
+                    SpectrumFamily::NoWiggle => {
+                        no_wiggle_basis(&lattice).expect("only IR models ask for it")
+                    }
+                    SpectrumFamily::Linear => camb_basis(lattice.clone(), BASIS_SIZE),
+                };
+                OneLoopBasis::build(plan, family, basis, tick)
+            };
+            let key = (plan.k(), plan.precision(), family);
+            store.for_method::<OneLoopBasis>(method, key, build, progress)
         };
         let one_loop_basis = tensors(SpectrumFamily::Linear)?;
         let one_loop_basis_nw = match (&one_loop_basis, &split) {

@@ -251,7 +251,7 @@ impl Eft2Plan {
     /// ([`super::spt2::Spt2Plan::with_basis`]).
     ///
     /// # Errors
-    /// As [`TableStore::rsd_two_loop_basis`] and [`TableStore::redshift_basis`].
+    /// As [`TableStore::for_method`].
     pub fn with_basis(mut self, store: &TableStore, progress: &dyn Progress) -> Result<Self> {
         let p = &self.precision;
         let lattice = RsdTwoLoopBasis::lattice((p.q_min, p.q_max), p.lattice_step);

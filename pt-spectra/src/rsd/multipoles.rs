@@ -10,7 +10,7 @@ use crate::linear::LinearSpectrum;
 use crate::loops::basis::{TnsBasis, MAX_RESIDUAL};
 use crate::loops::bias::{BiasPlan, BiasTerms, GalaxyBias};
 use crate::loops::{Pair, TnsPlan, TnsTerms};
-use crate::precision::{Precision, TwoLoopMethod};
+use crate::precision::Precision;
 use crate::progress::Progress;
 use crate::real::{counterterm, RealModel, RealPlan, RealSpectra};
 use crate::store::TableStore;
@@ -373,10 +373,14 @@ impl RsdPlan {
         } else {
             None
         };
-        let tns_basis = match (&tns, precision.two_loop) {
-            (Some(plan), TwoLoopMethod::Basis) => Some(store.tns_basis(plan, progress)?),
-            (Some(_), TwoLoopMethod::Auto) => store.cached_tns_basis(k, precision, progress),
-            _ => None,
+        let tns_basis = match &tns {
+            Some(plan) => store.for_method::<TnsBasis>(
+                precision.two_loop,
+                (plan.k(), plan.precision()),
+                |tick| TnsBasis::build(plan, tick),
+                progress,
+            )?,
+            None => None,
         };
         Ok(Self {
             real,

@@ -29,7 +29,7 @@ use crate::loops::redshift::{RedshiftPlan, RedshiftTerms};
 use crate::loops::{
     check_two_loop_ells, rsd_two_loop_of, Estimate, RsdTwoLoopTerms, TwoLoopSettings,
 };
-use crate::precision::{Precision, TwoLoopMethod};
+use crate::precision::Precision;
 use crate::progress::{stage_callback, Progress, Stage};
 use crate::store::TableStore;
 use std::sync::Arc;
@@ -66,7 +66,7 @@ impl LoopTensors {
     /// (`direct`).
     ///
     /// # Errors
-    /// As [`TableStore::rsd_two_loop_basis`] and [`TableStore::redshift_basis`].
+    /// As [`TableStore::for_method`].
     pub(crate) fn load(
         plan: &RedshiftPlan,
         families: &[(SpectrumFamily, &dyn Fn() -> LinearBasis)],
@@ -82,11 +82,16 @@ impl LoopTensors {
                 SpectrumFamily::Linear => RedshiftFamily::Linear,
                 SpectrumFamily::NoWiggle => RedshiftFamily::SplitNoWiggle,
             };
-            one_loop.extend(match precision.two_loop {
-                TwoLoopMethod::Direct => None,
-                TwoLoopMethod::Auto => store.cached_redshift_basis(k, precision, family, progress),
-                TwoLoopMethod::Basis => Some(store.redshift_basis(plan, family, basis, progress)?),
-            });
+            let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
+                RedshiftBasis::build(plan, family, basis(), tick)
+            };
+            let key = (k, precision, family);
+            one_loop.extend(store.for_method::<RedshiftBasis>(
+                precision.two_loop,
+                key,
+                build,
+                progress,
+            )?);
         }
         if two_loop.len() != families.len() {
             two_loop.clear();
@@ -225,7 +230,7 @@ fn two_loop_terms_noted(
 /// cached (`auto`), or none (`direct`).
 ///
 /// # Errors
-/// As [`TableStore::rsd_two_loop_basis`].
+/// As [`TableStore::for_method`].
 pub(crate) fn tensors_of(
     k: &[f64],
     precision: &Precision,
@@ -236,15 +241,11 @@ pub(crate) fn tensors_of(
 ) -> Result<Option<Arc<RsdTwoLoopBasis>>> {
     let (range, step) = ((precision.q_min, precision.q_max), precision.lattice_step);
     let settings = two_loop_settings(precision);
-    Ok(match precision.two_loop {
-        TwoLoopMethod::Direct => None,
-        TwoLoopMethod::Auto => {
-            store.cached_rsd_two_loop_basis(k, range, step, &settings, family, progress)
-        }
-        TwoLoopMethod::Basis => {
-            Some(store.rsd_two_loop_basis(k, range, step, &settings, family, basis, progress)?)
-        }
-    })
+    let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
+        RsdTwoLoopBasis::build(k, range, step, &settings, family, basis(), tick)
+    };
+    let key = (k, range, step, &settings, family);
+    store.for_method::<RsdTwoLoopBasis>(precision.two_loop, key, build, progress)
 }
 
 /// The plan of `spt2` on a k grid: the 1-loop weights (cosmology independent), the settings of the
@@ -304,7 +305,7 @@ impl Spt2Plan {
     /// `store`, minutes once per k grid and precision; `auto`: if cached; `direct`: none).
     ///
     /// # Errors
-    /// As [`TableStore::rsd_two_loop_basis`].
+    /// As [`TableStore::for_method`].
     pub fn with_basis(mut self, store: &TableStore, progress: &dyn Progress) -> Result<Self> {
         let lattice = RsdTwoLoopBasis::lattice(
             (self.precision.q_min, self.precision.q_max),

@@ -1,6 +1,7 @@
 //! Tests of the table store: checksums, fault injection, locks, failed writes.
 
 use super::*;
+use crate::loops::basis::LinearBasis;
 use crate::progress::Silent;
 use std::fs::{File, TryLockError};
 use std::sync::atomic::{AtomicUsize, Ordering};

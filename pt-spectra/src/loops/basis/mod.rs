@@ -5,7 +5,7 @@
 //! one). With P ≈ P̂ = Σ_a c_a φ_a on a basis of N functions ([`LinearBasis`], built from
 //! shipped CAMB spectra over the EuclidEmulator2 box, [`training`]), each term becomes a contraction of a
 //! cosmology-independent tensor with c ⊗ c ⊗ c (or c ⊗ c). The tensors are made once per k grid and
-//! [`Precision`] with the integrators of the direct path and cached ([`TableStore::two_loop_basis`]):
+//! [`Precision`] with the integrators of the direct path and cached ([`TableStore::for_method`]):
 //! * P15 and the propagator part 2P15 − P33red: the angular table's radial sums as bilinear forms
 //!   (`p15_forms`), with their error terms;
 //! * the mode-coupling part 2P24 + P33irr + 2P33red, 2P24 and P33irr: the quasi-Monte-Carlo integral
@@ -32,7 +32,7 @@
 //! spectrum by a few 1e-3 — immaterial for an error estimate from 8 shifts — at a fifteenth of the
 //! memory and time.
 //!
-//! [`TableStore::two_loop_basis`]: crate::store::TableStore::two_loop_basis
+//! [`TableStore::for_method`]: crate::store::TableStore::for_method
 
 mod cache_key;
 mod forms;
@@ -184,6 +184,17 @@ impl TwoLoopBasis {
     /// The lattice of the tensors for `precision` (what a family's basis is made on).
     pub(crate) fn lattice(precision: &Precision) -> Lattice {
         lattice_of(precision)
+    }
+
+    /// [`build`](Self::build) for linear spectra, on the CAMB basis of [`BASIS_SIZE`] functions.
+    pub fn build_linear(
+        k: &[f64],
+        precision: &Precision,
+        table: &P15Table,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Self {
+        let basis = training::camb_basis(lattice_of(precision), BASIS_SIZE);
+        Self::build(k, precision, table, SpectrumFamily::Linear, basis, progress)
     }
 
     /// Builds the tensors on `k` [h/Mpc] for `precision` with the P15 angular `table`, in parallel,

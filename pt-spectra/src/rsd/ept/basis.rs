@@ -16,7 +16,6 @@ use crate::linear::LinearSpectrum;
 use crate::loops::basis::training::camb_basis;
 use crate::loops::basis::{LinearBasis, Projection, RedshiftBasis, RedshiftFamily, BASIS_SIZE};
 use crate::loops::Estimate;
-use crate::precision::TwoLoopMethod;
 use crate::progress::Progress;
 use crate::store::TableStore;
 use std::sync::Arc;
@@ -132,22 +131,18 @@ impl EptPlan {
     /// seconds, `auto` uses them if cached, `direct` never).
     ///
     /// # Errors
-    /// As [`TableStore::redshift_basis`].
+    /// As [`TableStore::for_method`].
     pub fn with_basis(mut self, store: &TableStore, progress: &dyn Progress) -> Result<Self> {
         let precision = self.loops.precision().clone();
         let lattice = self.loops.rules().0.lattice.clone();
         let ir = self.split.is_some();
         let linear_basis = || camb_basis(lattice.clone(), BASIS_SIZE);
         let get = |family| -> Result<_> {
-            Ok(match precision.two_loop {
-                TwoLoopMethod::Basis => {
-                    Some(store.redshift_basis(&self.loops, family, &linear_basis, progress)?)
-                }
-                TwoLoopMethod::Auto => {
-                    store.cached_redshift_basis(self.loop_grid(), &precision, family, progress)
-                }
-                TwoLoopMethod::Direct => None,
-            })
+            let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
+                RedshiftBasis::build(&self.loops, family, linear_basis(), tick)
+            };
+            let key = (self.loop_grid(), &precision, family);
+            store.for_method::<RedshiftBasis>(precision.two_loop, key, build, progress)
         };
         let linear = get(RedshiftFamily::Linear)?;
         let no_wiggle = if ir {
