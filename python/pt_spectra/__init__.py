@@ -678,12 +678,14 @@ def kernel(which, vectors, exact=False, f=None, los=None):
 def bispectrum(triangles=None, bin_width=None, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None,
                b1=1.0, b2=0.0, bs=0.0, c1=0.0, n_bar=None, b_shot=1.0, p_shot=0.0, a_shot=0.0, f=None,
                q_par=1.0, q_perp=1.0, fog="none", sigma_fog=0.0, ir=True, legendre_side="largest",
-               basis="scoccimarro", pairs=None, box_size=None):
+               basis="scoccimarro", pairs=None, box_size=None, bias_convention=None):
     """Tree-level galaxy bispectrum multipoles B0, B2, B4 [(Mpc/h)^6] in redshift space.
 
     ``triangles``: an (n, 3) array of k1, k2, k3 [h/Mpc]; with ``bin_width`` [h/Mpc] each row is a bin
     of three shells averaged over all its closed triangles (what a measurement is), else a point.
-    Bias as velocileptors (b1, b2, bs; CLASS-PT's b_G2 = bs), counterterm c1 [(Mpc/h)^2], stochastic
+    Bias as velocileptors (b1, b2, bs), or with ``bias_convention="classpt"`` CLASS-PT's (b1, b2, b_G2 as
+    ``bs``) or ``"fastpt"`` (the header states both; also ``BispectrumTerms.multipoles(..., bias_convention=)``),
+    counterterm c1 [(Mpc/h)^2], stochastic
     terms (1/n_bar)[b1 b_shot + f mu^2 (1 + p_shot)] Z1 P + cyclic + (1 + a_shot)/n_bar^2 (none without
     ``n_bar``), f (default f(z)), AP q_par, q_perp, FoG none | lorentzian | gaussian with ``sigma_fog``
     [Mpc/h], IR resummation, the Legendre polynomial on the largest side (or "1", "2", "3").
@@ -701,7 +703,7 @@ def bispectrum(triangles=None, bin_width=None, linear=None, z=0.0, z_input=0.0, 
                        "bin_width (their shell width) to be averaged over", PtSpectraWarning, stacklevel=2)
     return _warn(_core.bispectrum(triangles, bin_width, linear, z, z_input, cosmology, eh, b1, b2, bs,
                                   c1, n_bar, b_shot, p_shot, a_shot, f, q_par, q_perp, fog, sigma_fog, ir,
-                                  legendre_side, basis, pairs, box_size))
+                                  legendre_side, basis, pairs, box_size, bias_convention))
 
 
 def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, q_min=1e-4,

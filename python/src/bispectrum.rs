@@ -5,6 +5,7 @@ use crate::inputs::Inputs;
 use crate::tables::Table;
 use crate::{detached, library_error, matrix_rows};
 use numpy::{IntoPyArray, PyArray2, PyArrayMethods};
+use pt_spectra::bias::{BiasConvention, BiasParams};
 use pt_spectra::bispectrum::{
     self as bk, BispectrumParams, Fog, LegendreSide, PlanRules, Settings, SugiyamaRules,
     TriangleSet,
@@ -51,7 +52,9 @@ pub(crate) fn triangle_set(
     .map_err(library_error)
 }
 
-/// The parameters of the keyword arguments.
+/// The parameters of the keyword arguments, with b1, b2, bs in `convention` (velocileptors' if
+/// None; CLASS-PT's third slot is b_G2): the parameters in velocileptors' convention, and the header
+/// line stating the conversion (None for velocileptors').
 #[allow(clippy::too_many_arguments)]
 fn params(
     b1: f64,
@@ -62,17 +65,26 @@ fn params(
     b_shot: f64,
     p_shot: f64,
     a_shot: f64,
-) -> BispectrumParams {
-    BispectrumParams {
-        b1,
-        b2,
-        bs,
+    convention: Option<&str>,
+) -> PyResult<(BispectrumParams, Option<String>)> {
+    let convention: BiasConvention = match convention {
+        Some(c) => c.parse().map_err(library_error)?,
+        None => BiasConvention::Velocileptors,
+    };
+    // the cubic slot does not enter the tree level: given as 0 in the convention
+    let bias = BiasParams::from_convention(convention, [b1, b2, bs, 0.0]);
+    let params = BispectrumParams {
+        b1: bias.b1,
+        b2: bias.b2,
+        bs: bias.bs,
         c1,
         b_shot,
         p_shot,
         a_shot,
         n_bar: n_bar.unwrap_or(f64::INFINITY),
-    }
+    };
+    let note = (convention != BiasConvention::Velocileptors).then(|| bias.describe(convention));
+    Ok((params, note))
 }
 
 /// B0, B2, B4 [(Mpc/h)^6] of the triangles (an (n, 3) array of k1 k2 k3 [h/Mpc]; bins of `bin_width`
@@ -84,7 +96,7 @@ fn params(
 #[pyo3(signature = (triangles=None, bin_width=None, linear=None, z=0.0, z_input=0.0, cosmology=None,
     eh=None, b1=1.0, b2=0.0, bs=0.0, c1=0.0, n_bar=None, b_shot=1.0, p_shot=0.0, a_shot=0.0, f=None,
     q_par=1.0, q_perp=1.0, fog="none", sigma_fog=0.0, ir=true, legendre_side="largest",
-    basis="scoccimarro", pairs=None, box_size=None))]
+    basis="scoccimarro", pairs=None, box_size=None, bias_convention=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn bispectrum(
     py: Python<'_>,
@@ -113,8 +125,19 @@ pub fn bispectrum(
     basis: &str,
     pairs: Option<&Bound<'_, PyAny>>,
     box_size: Option<f64>,
+    bias_convention: Option<&str>,
 ) -> PyResult<Table> {
-    let params = params(b1, b2, bs, c1, n_bar, b_shot, p_shot, a_shot);
+    let (params, bias_note) = params(
+        b1,
+        b2,
+        bs,
+        c1,
+        n_bar,
+        b_shot,
+        p_shot,
+        a_shot,
+        bias_convention,
+    )?;
     let fog = Fog::by_name(fog, sigma_fog).map_err(library_error)?;
     let sugiyama = match basis.to_ascii_lowercase().as_str() {
         "scoccimarro" => None,
@@ -177,11 +200,12 @@ pub fn bispectrum(
     let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
     let ((prepared, table), seconds) = detached(py, || {
         let prepared = inputs.prepare(&[])?;
-        let table = match (&scoccimarro, &sugiyama) {
+        let mut table = match (&scoccimarro, &sugiyama) {
             (Some(request), _) => bispectrum_table(&prepared, request)?,
             (None, Some(request)) => sugiyama_table(&prepared, request)?,
             (None, None) => unreachable!("one request is made above"),
         };
+        table.header.extend(bias_note);
         Ok((prepared, table))
     })?;
     let model = if sugiyama.is_some() {
@@ -312,8 +336,10 @@ pub struct BispectrumTerms {
 
 #[pymethods]
 impl BispectrumTerms {
-    /// (B, err): (n, 3) arrays of B0, B2, B4 [(Mpc/h)^6] and their quadrature errors.
-    #[pyo3(signature = (b1=1.0, b2=0.0, bs=0.0, c1=0.0, n_bar=None, b_shot=1.0, p_shot=0.0, a_shot=0.0))]
+    /// (B, err): (n, 3) arrays of B0, B2, B4 [(Mpc/h)^6] and their quadrature errors; b1, b2, bs in
+    /// `bias_convention` (velocileptors' by default; "classpt": bs is b_G2, "fastpt").
+    #[pyo3(signature = (b1=1.0, b2=0.0, bs=0.0, c1=0.0, n_bar=None, b_shot=1.0, p_shot=0.0, a_shot=0.0,
+        bias_convention=None))]
     #[allow(clippy::too_many_arguments)]
     fn multipoles<'py>(
         &self,
@@ -326,11 +352,20 @@ impl BispectrumTerms {
         b_shot: f64,
         p_shot: f64,
         a_shot: f64,
+        bias_convention: Option<&str>,
     ) -> PyResult<ValuesAndErrors<'py>> {
-        let b = self
-            .terms
-            .multipoles(&params(b1, b2, bs, c1, n_bar, b_shot, p_shot, a_shot))
-            .map_err(library_error)?;
+        let (params, _) = params(
+            b1,
+            b2,
+            bs,
+            c1,
+            n_bar,
+            b_shot,
+            p_shot,
+            a_shot,
+            bias_convention,
+        )?;
+        let b = self.terms.multipoles(&params).map_err(library_error)?;
         values_and_errors(py, &b)
     }
 }
@@ -420,8 +455,10 @@ pub struct SugiyamaTerms {
 
 #[pymethods]
 impl SugiyamaTerms {
-    /// (B, err): (n, 6) arrays of B000 B110 B202 B022 B112 B220 [(Mpc/h)^6] and their quadrature errors.
-    #[pyo3(signature = (b1=1.0, b2=0.0, bs=0.0, c1=0.0, n_bar=None, b_shot=1.0, p_shot=0.0, a_shot=0.0))]
+    /// (B, err): (n, 6) arrays of B000 B110 B202 B022 B112 B220 [(Mpc/h)^6] and their quadrature
+    /// errors; the bias as `BispectrumTerms.multipoles` takes it.
+    #[pyo3(signature = (b1=1.0, b2=0.0, bs=0.0, c1=0.0, n_bar=None, b_shot=1.0, p_shot=0.0, a_shot=0.0,
+        bias_convention=None))]
     #[allow(clippy::too_many_arguments)]
     fn multipoles<'py>(
         &self,
@@ -434,11 +471,20 @@ impl SugiyamaTerms {
         b_shot: f64,
         p_shot: f64,
         a_shot: f64,
+        bias_convention: Option<&str>,
     ) -> PyResult<ValuesAndErrors<'py>> {
-        let b = self
-            .terms
-            .multipoles(&params(b1, b2, bs, c1, n_bar, b_shot, p_shot, a_shot))
-            .map_err(library_error)?;
+        let (params, _) = params(
+            b1,
+            b2,
+            bs,
+            c1,
+            n_bar,
+            b_shot,
+            p_shot,
+            a_shot,
+            bias_convention,
+        )?;
+        let b = self.terms.multipoles(&params).map_err(library_error)?;
         values_and_errors(py, &b)
     }
 }

@@ -211,3 +211,24 @@ def test_one_loop_bispectrum_in_redshift_space_at_one_orientation():
 def test_one_loop_bad_input_raises_naming_the_problem(kwargs, needle):
     with pytest.raises(ValueError, match=needle):
         pt.one_loop_bispectrum(**kwargs)
+
+
+def test_the_bias_in_other_conventions_is_converted_and_stated():
+    """CLASS-PT's (b2, b_G2) and FAST-PT's bs given with bias_convention equal velocileptors'
+    b2 = b2 - (4/3) b_G2, bs = b_G2 and bs = bs_FAST-PT / 2, in pt.bispectrum (header line) and
+    in BispectrumTerms.multipoles; an unknown convention is a ValueError naming the valid ones."""
+    kw = dict(f=0.7, ir=False, b1=1.9)
+    with pytest.warns(pt.PtSpectraWarning, match="bin_width"):
+        ours = pt.bispectrum(TRIANGLES, b2=0.4 - 4 / 3 * (-0.3), bs=-0.3, **kw)
+        classpt = pt.bispectrum(TRIANGLES, b2=0.4, bs=-0.3, bias_convention="classpt", **kw)
+        fastpt = pt.bispectrum(TRIANGLES, b2=0.4, bs=2 * 0.25, bias_convention="fastpt", **kw)
+        ours_f = pt.bispectrum(TRIANGLES, b2=0.4, bs=0.25, **kw)
+    np.testing.assert_allclose(classpt["B0"], ours["B0"], rtol=1e-12)
+    np.testing.assert_allclose(fastpt["B2"], ours_f["B2"], rtol=1e-12)
+    assert any("given in CLASS-PT" in line for line in classpt.header)
+    terms = pt.BispectrumPlan(TRIANGLES).terms(f=0.7, ir=False)
+    a, _ = terms.multipoles(b1=1.9, b2=0.4, bs=-0.3, bias_convention="classpt")
+    b, _ = terms.multipoles(b1=1.9, b2=0.4 + 0.4, bs=-0.3)
+    np.testing.assert_allclose(a, b, rtol=1e-12)
+    with pytest.raises(ValueError, match="classpt"):
+        terms.multipoles(b1=1.9, bias_convention="pybird")

@@ -340,14 +340,7 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let mut table = table;
     if convention != pt_spectra::bias::BiasConvention::Velocileptors {
-        table.header.push(format!(
-            "--b2 {} --bs {} given in {}'s convention: b2 = {}, bs = {} in velocileptors' (the parameters above)",
-            args.b2,
-            args.bs,
-            convention.label(),
-            bias.b2,
-            bias.bs
-        ));
+        table.header.push(bias.describe(convention));
     }
     write_output(args.out.as_ref(), &table)
 }
