@@ -198,6 +198,21 @@ pub fn simpson_ln(f: impl Fn(f64) -> f64, a: f64, b: f64, intervals: usize) -> (
     let n = intervals.max(4) & !1;
     let h = (b - a) / n as f64;
     let y: Vec<f64> = (0..=n).map(|i| f(a + h * i as f64)).collect();
+    simpson_of(&y, h)
+}
+
+/// The nodes ln q = a + h i, i = 0 … n, of [`simpson_ln`] on [a, b] with `intervals` steps, and h:
+/// for integrands evaluated together (several integrals over one set of nodes, [`simpson_of`]).
+pub fn simpson_ln_nodes(a: f64, b: f64, intervals: usize) -> (Vec<f64>, f64) {
+    let n = intervals.max(4) & !1;
+    let h = (b - a) / n as f64;
+    ((0..=n).map(|i| a + h * i as f64).collect(), h)
+}
+
+/// Composite Simpson of the values `y` at equally spaced nodes h apart (an even number of intervals)
+/// with the error estimate |S_h − S_2h|, as [`simpson_ln`].
+pub fn simpson_of(y: &[f64], h: f64) -> (f64, f64) {
+    let n = y.len() - 1;
     let rule = |stride: usize| {
         let m = n / stride;
         let inner: f64 = (1..m)

@@ -141,6 +141,36 @@ pub fn delta_sigma2_bao(no_wiggle: &LinearSpectrum, q_min: f64) -> Estimate {
     Estimate::new(norm * value, norm * error)
 }
 
+/// Σ² and δΣ² of `no_wiggle` in one pass over the nodes both integrals share (one evaluation of the
+/// spectrum and of the Bessel functions per node): the same numbers as [`sigma2_bao`] and
+/// [`delta_sigma2_bao`], at half their cost together.
+pub fn bao_damping(no_wiggle: &LinearSpectrum, q_min: f64) -> (Estimate, Estimate) {
+    const INTERVALS: usize = 2048;
+    let (lo, hi) = (q_min.ln(), SIGMA_CUTOFF.ln());
+    if hi <= lo {
+        return (Estimate::new(0.0, 0.0), Estimate::new(0.0, 0.0));
+    }
+    let (nodes, h) = crate::integrate::simpson_ln_nodes(lo, hi, INTERVALS);
+    let (mut isotropic, mut anisotropic) = (Vec::with_capacity(nodes.len()), Vec::new());
+    anisotropic.reserve(nodes.len());
+    for ln_q in nodes {
+        let q = ln_q.exp();
+        let x = q * BAO_SCALE;
+        let (qp, j2x) = (q * no_wiggle.eval(q), j2(x));
+        isotropic.push(qp * (1.0 - j0(x) + 2.0 * j2x));
+        anisotropic.push(qp * j2x);
+    }
+    let ((s, es), (d, ed)) = (
+        crate::integrate::simpson_of(&isotropic, h),
+        crate::integrate::simpson_of(&anisotropic, h),
+    );
+    let (n_s, n_d) = (1.0 / (6.0 * PI * PI), 1.0 / (2.0 * PI * PI));
+    (
+        Estimate::new(n_s * s, n_s * es),
+        Estimate::new(n_d * d, n_d * ed),
+    )
+}
+
 /// Σ²_tot(μ) = [1 + fμ²(2 + f)]Σ² + f²μ²(μ² − 1)δΣ² [(Mpc/h)²], the damping of the wiggles in
 /// redshift space (see [`delta_sigma2_bao`]) from Σ² = `sigma2` and δΣ² = `delta_sigma2`.
 pub fn sigma2_total(sigma2: f64, delta_sigma2: f64, f: f64, mu: f64) -> f64 {
@@ -244,6 +274,18 @@ pub fn damping(k: f64, sigma2: Estimate) -> Estimate {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_shared_pass_gives_sigma2_and_delta_sigma2_bit_for_bit() {
+        let nw = no_wiggle(&LinearSpectrum::gm2012(0.5).unwrap()).unwrap();
+        for q_min in [1e-5, 1e-3] {
+            let (s, d) = bao_damping(&nw, q_min);
+            assert_eq!(s, sigma2_bao(&nw, q_min));
+            assert_eq!(d, delta_sigma2_bao(&nw, q_min));
+        }
+        let (s, d) = bao_damping(&nw, 1.0);
+        assert_eq!((s.value, d.value), (0.0, 0.0));
+    }
 
     #[test]
     fn the_split_leaves_no_wiggle_and_adds_up_to_the_input() {

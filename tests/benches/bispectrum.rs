@@ -50,6 +50,22 @@ fn bispectrum(crit: &mut Criterion) {
             })
         },
     );
+    // the two parts of a new spectrum: its IR inputs (the no-wiggle split and Σ², δΣ², which a
+    // P + B pipeline could share with the power spectrum) and the bin and orientation averages
+    crit.bench_function(
+        "bispectrum/IR inputs of a new spectrum (split, Σ², δΣ²)",
+        |b| b.iter(|| black_box(plan.ir_inputs(&p).unwrap())),
+    );
+    let ir = plan.ir_inputs(&p).unwrap();
+    crit.bench_function(
+        "bispectrum/terms of 62 Nseries bins with given IR inputs, new f and AP",
+        |b| {
+            b.iter(|| {
+                i += 1;
+                black_box(plan.terms_with_ir(&p, &settings(i), &ir).unwrap())
+            })
+        },
+    );
     let terms = plan.terms(&p, &settings(0)).unwrap();
     crit.bench_function(
         "bispectrum/parameter step (b1, b2, bs, c1, shot) of 62 bins",

@@ -34,13 +34,15 @@ pub(super) fn add_observed_slots(
     let inv_qp = 1.0 / s.q_par;
     let mut par_true = [0.0; 3];
     let mut k_true = [0.0; 3];
+    let mut inv_k = [0.0; 3];
     let mut p = [0.0; 3];
     let mut x = 0.0;
     for i in 0..3 {
         par_true[i] = par[i] * inv_qp;
         let perp2 = (k[i] * k[i] - par[i] * par[i]).max(0.0);
         k_true[i] = (par_true[i] * par_true[i] + perp2 * inv_qt2).sqrt();
-        p[i] = power(i, k_true[i], par_true[i] / k_true[i]);
+        inv_k[i] = 1.0 / k_true[i];
+        p[i] = power(i, k_true[i], par_true[i] * inv_k[i]);
         x += par_true[i] * par_true[i];
     }
     let mut dots_true = [0.0; 3];
@@ -52,7 +54,7 @@ pub(super) fn add_observed_slots(
     let fog = s.fog.factor(x);
     add_tree_slots(
         out,
-        k_true,
+        (k_true, inv_k),
         dots_true,
         par_true,
         p,
@@ -90,17 +92,18 @@ pub(super) fn tree_slots(
     f: f64,
 ) -> [f64; SLOTS] {
     let mut out = [0.0; SLOTS];
-    add_tree_slots(&mut out, k, dots, par, p, f, 1.0, 1.0);
+    let inv_k = k.map(|k| 1.0 / k);
+    add_tree_slots(&mut out, (k, inv_k), dots, par, p, f, 1.0, 1.0);
     out
 }
 
-/// Adds the slots of [`tree_slots`] to `out`, those of the P-dependent terms times `scale` and the
+/// Adds the slots of [`tree_slots`] to `out` (sides `k` with their inverses), those of the P-dependent terms times `scale` and the
 /// constant 1/n̄² slot as `constant`.
 #[inline]
 #[allow(clippy::too_many_arguments)]
 fn add_tree_slots(
     out: &mut [f64; SLOTS],
-    k: [f64; 3],
+    (k, inv_k): ([f64; 3], [f64; 3]),
     dots: [f64; 3],
     par: [f64; 3],
     p: [f64; 3],
@@ -108,13 +111,15 @@ fn add_tree_slots(
     scale: f64,
     constant: f64,
 ) {
-    let inv_k = [1.0 / k[0], 1.0 / k[1], 1.0 / k[2]];
     let mu = [par[0] * inv_k[0], par[1] * inv_k[1], par[2] * inv_k[2]];
     let a: [[f64; 3]; 3] = [
         [f * mu[0] * mu[0], 1.0, -par[0] * par[0]],
         [f * mu[1] * mu[1], 1.0, -par[1] * par[1]],
         [f * mu[2] * mu[2], 1.0, -par[2] * par[2]],
     ];
+    // per pair (i, j) = (0, 1), (1, 2), (2, 0): 2 P_i P_j × scale and the four coefficients of Z₂
+    let mut pp = [0.0; 3];
+    let mut c = [[0.0; 4]; 3];
     for i in 0..3 {
         let (j, l) = ((i + 1) % 3, (i + 2) % 3);
         let cos = dots[i] * inv_k[i] * inv_k[j];
@@ -123,7 +128,7 @@ fn add_tree_slots(
         let g2 = 3.0 / 7.0 + 0.5 * cos * ratio + 4.0 / 7.0 * cos * cos;
         let k_par = par[i] + par[j]; // n̂·(kᵢ + kⱼ) = −n̂·k_l
         let mu12_sq = k_par * k_par * inv_k[l] * inv_k[l];
-        let c = [
+        c[i] = [
             f * mu12_sq * g2
                 + 0.5
                     * f
@@ -134,22 +139,28 @@ fn add_tree_slots(
             0.5,
             cos * cos - 1.0 / 3.0,
         ];
-        let pp = 2.0 * p[i] * p[j] * scale;
-        for al in 0..3 {
-            let pa = pp * a[i][al];
-            for (be, a_jb) in a[j].iter().enumerate() {
-                let ab = pa * a_jb;
-                let base = (al * 3 + be) * 4;
-                for g in 0..4 {
-                    out[base + g] += ab * c[g];
-                }
+        pp[i] = 2.0 * p[i] * p[j] * scale;
+    }
+    // each slot written once per configuration, the three pairs summed in registers (a slot
+    // updated once per pair went through memory three times)
+    for al in 0..3 {
+        for be in 0..3 {
+            let w: [f64; 3] = std::array::from_fn(|i| pp[i] * a[i][al] * a[(i + 1) % 3][be]);
+            let base = (al * 3 + be) * 4;
+            for g in 0..4 {
+                out[base + g] += w[0] * c[0][g] + w[1] * c[1][g] + w[2] * c[2][g];
             }
         }
-        let ps = p[i] * scale;
-        for be in 0..3 {
-            out[36 + be] += ps * a[i][be];
-            out[39 + be] += ps * a[i][0] * a[i][be];
+    }
+    for be in 0..3 {
+        let (mut shot_b, mut shot_p) = (0.0, 0.0);
+        for i in 0..3 {
+            let ps = p[i] * scale;
+            shot_b += ps * a[i][be];
+            shot_p += ps * a[i][0] * a[i][be];
         }
+        out[36 + be] += shot_b;
+        out[39 + be] += shot_p;
     }
     out[42] += constant;
 }

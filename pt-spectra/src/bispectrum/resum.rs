@@ -3,7 +3,7 @@
 //! ([`IrInputs::new`], e.g. another code's no-wiggle spectrum to compare with).
 
 use crate::error::{Error, Result};
-use crate::ir::{delta_sigma2_bao, sigma2_bao, sigma2_total, WiggleSplit};
+use crate::ir::{bao_damping, sigma2_total, WiggleSplit};
 use crate::linear::LinearSpectrum;
 
 /// The no-wiggle spectrum P_nw and the BAO damping scales Σ², δΣ² [(Mpc/h)²] of the resummation
@@ -47,8 +47,8 @@ impl IrInputs {
     /// As [`WiggleSplit::no_wiggle`].
     pub fn split(spectrum: &LinearSpectrum, split: &WiggleSplit, q_min: f64) -> Result<Self> {
         let no_wiggle = split.no_wiggle(spectrum)?;
-        let sigma2 = sigma2_bao(&no_wiggle, q_min).value;
-        let delta_sigma2 = delta_sigma2_bao(&no_wiggle, q_min).value;
+        let (sigma2, delta_sigma2) = bao_damping(&no_wiggle, q_min);
+        let (sigma2, delta_sigma2) = (sigma2.value, delta_sigma2.value);
         Ok(Self {
             no_wiggle,
             sigma2,

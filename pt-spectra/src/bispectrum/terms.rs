@@ -76,6 +76,8 @@ const SHORTCUT_REFERENCE: (f64, f64) = (0.72, 2.0);
 #[derive(Debug, Clone)]
 struct Shape {
     k: [f64; 3],
+    /// The Legendre side: its line-of-sight component is the same for every azimuth of a group.
+    side: usize,
     dots: [f64; 3],
     groups: Vec<MuGroup>,
 }
@@ -152,7 +154,12 @@ impl BispectrumPlan {
                                     lambda: [chunk[0][3] * w, chunk[0][4] * w, chunk[0][5] * w],
                                 })
                                 .collect();
-                            Shape { k, dots, groups }
+                            Shape {
+                                k,
+                                side: a,
+                                dots,
+                                groups,
+                            }
                         })
                         .collect()
                 })
@@ -315,6 +322,20 @@ impl BispectrumPlan {
                             resummed(cached.map_or_else(|| table.eval(k), |c| c[i]), k, mu)
                         };
                         for group in &shape.groups {
+                            // the Legendre side's power once per group: its k and μ do not
+                            // depend on the azimuth
+                            let side = std::cell::Cell::new(None);
+                            let power = |i: usize, k: f64, mu: f64| {
+                                if i != shape.side {
+                                    return power(i, k, mu);
+                                }
+                                if let Some(p) = side.get() {
+                                    return p;
+                                }
+                                let p = power(i, k, mu);
+                                side.set(Some(p));
+                                p
+                            };
                             // the azimuths first (λ depends on μ only), then ℓ
                             let mut azimuths = [0.0; SLOTS];
                             for par in &group.par {

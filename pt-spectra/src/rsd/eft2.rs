@@ -39,7 +39,7 @@
 use super::spt2::{loop_terms, LoopTensors};
 use crate::error::{Error, Result};
 use crate::integrate::legendre_nodes;
-use crate::ir::{delta_sigma2_bao, sigma2_bao, sigma2_total, WiggleSplit};
+use crate::ir::{bao_damping, sigma2_total, WiggleSplit};
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::training::{camb_basis, transformed_basis};
 use crate::loops::basis::{LinearBasis, RsdTwoLoopBasis, SpectrumFamily, BASIS_SIZE};
@@ -323,7 +323,7 @@ impl Eft2Plan {
             k: k.to_vec(),
             p_nw: k.iter().map(|&k| nw.eval(k)).collect(),
             p_lin,
-            sigma2: (sigma2_bao(&nw, q_min), delta_sigma2_bao(&nw, q_min)),
+            sigma2: bao_damping(&nw, q_min),
             one_nw: one.pop(),
             one_full: one.remove(0),
             two_nw: two.pop(),
