@@ -237,7 +237,7 @@ impl HankelPlan {
 }
 
 /// Settings of [`xi_from_pk_with`] and [`pk_from_xi_with`]; `Default` gives those of [`xi_from_pk`] and
-/// [`pk_from_xi`]. With the defaults (tests/tests/hankel.rs): Gaussian pairs k^ℓ e^{−k²R²/2}, ℓ ≤ 8, are
+/// [`pk_from_xi`]. With the defaults (tests/tests/suite/hankel.rs): Gaussian pairs k^ℓ e^{−k²R²/2}, ℓ ≤ 8, are
 /// reproduced to ≲ 1e-6 of max|ξ| over 10 ≤ s ≤ 200 Mpc/h (limited by the input grid) and back to
 /// ≲ 1e-7 of max|P|, the gm2012 linear spectrum P → ξ → P to ≲ 3e-6 over 0.01 ≤ k ≤ 0.3 h/Mpc, and
 /// its ξ_0, ξ_2 (damped by e^{−k²}) agree with direct quadrature to ≲ 1e-7 of their maxima. Within

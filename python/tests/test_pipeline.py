@@ -144,7 +144,7 @@ def test_a_repeated_cosmology_is_the_nuisance_polynomial(setup):
 
 def test_the_template_jacobian_matches_differences(setup):
     """d(data vector)/d(f, apar, aperp), exact: f's against fourth-order differences (the alpha rows
-    are tested against differences in Rust, tests/tests/pipeline.rs, where alpha can be set)."""
+    are tested against differences in Rust, tests/tests/suite/pipeline.rs, where alpha can be set)."""
     obs, _, cache = setup
     fiducial = dict(h=0.676, omega_b=0.022, omega_cdm=0.31 * 0.676**2 - 0.022, n_s=0.97, sigma8=0.8)
     pipe = pt.Pipeline(obs, Z, fiducial=fiducial, precision="fast", cache_dir=cache)

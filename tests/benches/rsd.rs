@@ -17,7 +17,7 @@
 //! * `ept/terms`: the galaxy model's loop terms of a new linear spectrum with IR resummation (the
 //!   no-wiggle filter, the terms of P and P_nw, Σ²) on 50 k ([`EptPlan::terms`], rayon's pool;
 //!   `RAYON_NUM_THREADS=1` for one core), at the default and the fast precision (both within
-//!   2.7e-4 of velocileptors' REPT, tests/tests/ept.rs);
+//!   2.7e-4 of velocileptors' REPT, tests/tests/suite/ept.rs);
 //! * `ept/new spectrum through the basis`: a new CAMB table's arrays to P_0, P_2, P_4 with the loop
 //!   terms from the basis tensors (the spline, the no-wiggle filter, both projections, the
 //!   contractions, one parameter step; one core);

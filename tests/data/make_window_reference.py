@@ -1,4 +1,4 @@
-# Makes window_boss_ellipsoid.dat and window_boss_reference.dat (see README.md and tests/tests/window.rs):
+# Makes window_boss_ellipsoid.dat and window_boss_reference.dat (see README.md and tests/tests/suite/window.rs):
 # a window in the BOSS DR12 format of the CLASS-PT likelihoods, and the windowed multipoles of a Kaiser
 # model through it, computed with numpy/scipy independently of pt-spectra (no FFTLog: direct quadrature).
 # Run from this folder: python3 make_window_reference.py   (numpy and scipy; about two minutes)

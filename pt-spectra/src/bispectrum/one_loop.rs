@@ -140,7 +140,7 @@ pub struct OneLoopMatter {
 /// Mirbabayi & Pajer 2015, arXiv:1406.4135; Angulo et al. 2015, arXiv:1406.4143: four independent
 /// operators in an Einstein–de Sitter-like growth). These four shapes absorb the change of the loop
 /// cut-off: moving q_max from 1 to 10 h/Mpc changes B by up to 2.4e6 (Mpc/h)⁶ and the least-squares
-/// combination of the shapes takes it out to 0.36% over 16 triangles (`tests/tests/bispectrum_one_loop.rs`).
+/// combination of the shapes takes it out to 0.36% over 16 triangles (`tests/tests/suite/bispectrum_one_loop.rs`).
 /// The B₃₂₁ᴵᴵ part of ct_f2 is −c_s² of the power spectrum's P_ct = −2c_s²k²P; B₄₁₁ adds its own, so ct_f2
 /// is not fixed by the power spectrum alone.
 pub const COUNTERTERMS: [&str; 4] = ["ct_f2", "ct_k3", "ct_tidal", "ct_f2k3"];

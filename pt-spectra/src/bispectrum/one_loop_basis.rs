@@ -56,7 +56,7 @@ const VERSION: u32 = 2;
 /// k²σ_v² P P where their sum does not), so the factor is measured: on seven CAMB tables not in the
 /// training set at the 22 triangles of the Monte Carlo table, basis against direct, a term moved by
 /// at most 2.0 ε Σ|T| and the one-loop B by 4.5 ε Σ|T| (2.4e-4 of itself)
-/// (`tests/tests/bispectrum_one_loop.rs`).
+/// (`tests/tests/suite/bispectrum_one_loop.rs`).
 pub const PROJECTION_FACTOR: f64 = 3.0;
 
 /// The ordered pairs (a, b) of B₃₂₁ᴵ (a outside the loop, b in it), in the order of the tensors.

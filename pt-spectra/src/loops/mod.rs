@@ -17,7 +17,7 @@
 //!   Gauss–Legendre converges exponentially on smooth integrands, so |I − I′| mostly exceeds the actual
 //!   error by 1–2 orders of magnitude, but on tabulated spectra (BAO wiggles through a C² spline, table
 //!   round-off, power-law joins) convergence turns erratic at the 1e-6 level, which the floor covers.
-//! * Measured (tests/tests/one_loop.rs, CAMB gm2012 spectra, 1e-3 ≤ k ≤ 1 h/Mpc): default against reference
+//! * Measured (tests/tests/suite/one_loop.rs, CAMB gm2012 spectra, 1e-3 ≤ k ≤ 1 h/Mpc): default against reference
 //!   settings ≤ 2.5e-6 (P22) and ≤ 3e-10 (P13); against FAST-PT ≤ 9e-6 (P22) and ≤ 1.5e-6 (2P13) for
 //!   0.01 ≤ k ≤ 0.5; against an independent brute-force P22 quadrature ≤ 7e-7.
 //!

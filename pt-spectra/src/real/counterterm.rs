@@ -21,7 +21,7 @@
 //!
 //! **What this leaves out.** One c_s² cannot cancel the q_max dependence of all three 2P13 exactly:
 //! their UV limits are −(61/105, 25/21, 9/5) k²σ_v² P_lin (the P13 kernels of
-//! [`crate::loops::p13_kernels`], tested in tests/tests/one_loop.rs), in the ratios
+//! [`crate::loops::p13_kernels`], tested in tests/tests/suite/one_loop.rs), in the ratios
 //! 1 : 125/61 : 189/61 = 1 : 2.05 : 3.10, not 1 : 2 : 3.
 //! The EFT literature renormalises that remainder of the velocity with counterterms of its own
 //! (Mercolli & Pajer 2014, arXiv:1307.3220: the velocity is not a conserved density and needs

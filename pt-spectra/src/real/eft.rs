@@ -22,7 +22,7 @@
 //! That this set is complete at two loops is tested by what it must do: absorb how the loops depend on
 //! their cut-off. Between q_max = 2 h/Mpc and 10³ h/Mpc, 2-loop SPT at z = 0 changes by 12% of P_lin
 //! at k = 0.3 h/Mpc; a least-squares cs2 alone leaves 2.9e-3 of P_lin, the set leaves 2.7e-4, the
-//! level of the 2-loop integration error (tests/tests/eft.rs; docs/eft.md).
+//! level of the 2-loop integration error (tests/tests/suite/eft.rs; docs/eft.md).
 //!
 //! **Velocities.** With c ∝ D^n (the time dependence of the P13, resp. 2-loop, UV limit that each
 //! counterterm renormalises: n = 2 for cs2 and cs2_1loop, 4 for c4), mass conservation linearised in

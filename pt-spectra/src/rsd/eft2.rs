@@ -30,7 +30,7 @@
 //! resummation P and P^(1)\[P\]). Taule & Garny (2023) describe their set as covering the single- and
 //! double-hard UV limits with two parameters per multipole; this set has the same structure per power
 //! of μ (their equations were not available to us) and is checked by what it must do: absorb the
-//! dependence of the 2-loop multipoles on the loop cut-off (`tests/tests/rsd_two_loop.rs`).
+//! dependence of the 2-loop multipoles on the loop cut-off (`tests/tests/suite/rsd_two_loop.rs`).
 //!
 //! **Multipoles** by a 24-node Gauss–Legendre rule in μ on [0, 1] (error: the change from 12 nodes)
 //! for the deterministic parts, and for the 2-loop parts as functionals of their μ² nodes

@@ -147,7 +147,7 @@ pub(crate) fn loop_terms(
 }
 
 /// Points per shift at low k below which the header warns ([`few_points_caveat`]): 2^13, the
-/// count of the default precision there, checked against cosPT (`tests/cospt.rs`).
+/// count of the default precision there, checked against cosPT (`tests/tests/suite/cospt.rs`).
 const VALIDATED_LOW_K_POINTS: usize = 1 << 13;
 
 /// The header's caveat for fewer points at low k than [`VALIDATED_LOW_K_POINTS`] (`--precision

@@ -16,7 +16,7 @@
 //! [`Mixing::ClassPtBoss`] is what the CLASS-PT BOSS DR12 likelihoods do (lss_montepython, which fit
 //! P0 and P2 only): Q_ℓ'' for ℓ'' ≤ 4 only, and the ξ4 terms of ℓ = 0, 2 dropped,
 //! ξ̂0 = ξ0Q0 + ξ2Q2/5, ξ̂2 = ξ0Q2 + ξ2(Q0 + 2(Q2 + Q4)/7); ξ̂4 (and ξ̂6, ξ̂8) are Wilson's truncated at Q4.
-//! On the ellipsoidal test window (tests/tests/window.rs) the two differ by up to 1e-3 of P0 at k = 0.0025
+//! On the ellipsoidal test window (tests/tests/suite/window.rs) the two differ by up to 1e-3 of P0 at k = 0.0025
 //! h/Mpc and 1.3e-4 at 0.0075. Wide-angle terms are neglected (see [`crate::survey`]).
 //!
 //! # Method
@@ -45,7 +45,7 @@
 //! floor at s up to 1/k_min by s²: it is not done).
 //!
 //! All transforms are planned once; [`WindowPlan::apply`] costs 2 × (n_ℓ' + n_ℓ) FFTLogs (at full and
-//! half resolution). Measured (tests/tests/window.rs): a uniform sphere (R = 100, 300 Mpc/h) against the
+//! half resolution). Measured (tests/tests/suite/window.rs): a uniform sphere (R = 100, 300 Mpc/h) against the
 //! direct 3-D convolution to ≤ 1.2e-5 of P̂0 for 0.005 ≤ k ≤ 0.3 h/Mpc, a BOSS-format window against an
 //! independent numpy quadrature to ≤ 2e-5; 0.5 ms per call for P0, P2, P4 at 240 output k.
 //!

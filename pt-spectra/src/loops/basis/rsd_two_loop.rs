@@ -37,7 +37,7 @@ const BATCH: usize = 32;
 /// The projection error of a 2-loop redshift-space value is this times the smoothed projection
 /// residual times its size: on two CAMB and one CLASS spectrum outside the training set the basis
 /// multipoles differed from direct by at most 5.1 times residual × |value| (CLASS Planck 2018 at
-/// k = 0.2, residual 1.9e-4; tests/tests/rsd_two_loop.rs, which fails above this factor); about
+/// k = 0.2, residual 1.9e-4; tests/tests/suite/rsd_two_loop.rs, which fails above this factor); about
 /// twice that, to be safe.
 pub const RSD_PROJECTION_FACTOR: f64 = 10.0;
 

@@ -27,7 +27,7 @@ pub(crate) struct Sampling {
 /// never fewer than twice `points` (it halves them at k ≲ 0.13 and keeps them to 0.2). At low k the
 /// redshift-space integrand has rare large contributions that fewer points miss: with the
 /// real-space rule the default precision's 2-loop multipoles at k ≤ 0.1 (2^11 points per shift)
-/// came out 0.7–0.9% smaller in magnitude than cosPT's (an independent code, `tests/cospt.rs`) and
+/// came out 0.7–0.9% smaller in magnitude than cosPT's (an independent code, `tests/tests/suite/cospt.rs`) and
 /// than with 4 times the points, beyond their errors; with twice `points` (2^13) they agree.
 pub(crate) fn rsd_points_at(k: f64, points: usize) -> usize {
     points_at(k, points).max(rsd_min_points(points))

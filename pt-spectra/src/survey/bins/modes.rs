@@ -182,7 +182,7 @@ impl BoxModes {
 
     /// The multipoles (`[ℓ][bin]`, ℓ as in [`ells`](Self::ells)) of the model `p(k, μ)` (k in h/Mpc)
     /// averaged over the modes, evaluated once per group and sign of μ: exact sums (error 0; they
-    /// agree with a loop over every mode to 1e-14, tests/tests/bins.rs).
+    /// agree with a loop over every mode to 1e-14, tests/tests/suite/bins.rs).
     pub fn average(&self, p: impl Fn(f64, f64) -> f64) -> Vec<Vec<Estimate>> {
         let mut out = vec![vec![0.0; self.bins.len()]; self.ells.len()];
         for (b, groups) in self.bins.iter().enumerate() {

@@ -1,9 +1,7 @@
 //! Physical limits of the generated kernels: angle-averaged vertices, the eikonal and Zel'dovich limits,
 //! momentum conservation, and the P13 kernel's closed form and asymptotes.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use num_traits::Zero;
 use pt_kernels::{gram, kernels};
 use pt_kernels::{propagator_3, propagator_5, propagator_7};

@@ -10,7 +10,7 @@ use pt_spectra::real::{
     fit_counterterms, Counterterm, Counterterms, RealModel, RealPlan, RealSpectra,
 };
 
-mod support;
+use crate::support;
 
 /// The spectra of `model`, with the cached tables of the tests ([`support::store`]).
 fn spectra(model: RealModel, p: &LinearSpectrum, k: &[f64], precision: &Precision) -> RealSpectra {

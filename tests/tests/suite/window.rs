@@ -9,7 +9,7 @@
 //!   `tests/data/make_window_reference.py`, which applies the same formulae with numpy by direct
 //!   quadrature (ξ_ℓ by a k integral, P̂_ℓ by an s integral).
 
-mod support;
+use crate::support;
 
 use pt_spectra::estimate::Estimate;
 use pt_spectra::integrate::GaussLegendre;

@@ -4,9 +4,7 @@
 //! bound), against values computed without the generator: the brute-force n!-permutation reference, the
 //! textbook closed forms of F_2^s, G_2^s and F_3^s, and FAST-PT's hard-coded Legendre tables.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use num_traits::{One, Zero};
 use proptest::prelude::*;
 use pt_kernels::{gram, kernels, reference};
@@ -36,7 +34,7 @@ fn exact_against_brute_force(qs: &[[Q; 3]]) -> Result<(), TestCaseError> {
 macro_rules! brute_force_property {
     ($name:ident, $n:expr, $cases:expr) => {
         proptest! {
-            #![proptest_config(ProptestConfig { cases: $cases, max_global_rejects: 10_000, ..ProptestConfig::default() })]
+            #![proptest_config(ProptestConfig { cases: $cases, max_global_rejects: 10_000, failure_persistence: crate::regressions_beside_the_source(), ..ProptestConfig::default() })]
             #[test]
             fn $name(qs in proptest::collection::vec(rational_vector(), $n)) {
                 exact_against_brute_force(&qs)?;

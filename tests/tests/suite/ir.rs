@@ -8,7 +8,7 @@ use pt_spectra::progress::Silent;
 use pt_spectra::real::{RealModel, RealPlan, RealSpectra};
 use pt_spectra::store::TableStore;
 
-mod support;
+use crate::support;
 
 fn spectra(model: RealModel, p: &LinearSpectrum, k: &[f64]) -> RealSpectra {
     let store = TableStore::in_memory();

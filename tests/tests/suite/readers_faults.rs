@@ -114,7 +114,7 @@ fn refused_naming_origin(e: &pt_spectra::error::Error) -> Result<(), TestCaseErr
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 256, failure_persistence: crate::regressions_beside_the_source(), ..ProptestConfig::default() })]
 
     /// Windows with an s column (declared by a names line, or by the format given).
     #[test]

@@ -9,8 +9,7 @@ use pt_spectra::progress::Silent;
 use pt_spectra::real::{RealModel, RealPlan};
 use pt_spectra::store::TableStore;
 
-mod support;
-use support::*;
+use crate::support::*;
 
 /// The reference file's columns (1-based in its header) of P_RegPT_1loop for δδ, δθ, θθ.
 const REGPT_1LOOP: [(Pair, usize); 3] = [

@@ -12,8 +12,7 @@ use pt_spectra::loops::{Estimate, OneLoopPlan, OneLoopTerms, Pair};
 use pt_spectra::precision::Precision;
 use std::f64::consts::PI;
 
-mod support;
-use support::*;
+use crate::support::*;
 
 /// Required agreement with FAST-PT per term, 0.01 ≤ k ≤ 0.5 h/Mpc (the target).
 const FASTPT_TOL: f64 = 1e-4;

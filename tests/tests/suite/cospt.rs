@@ -12,8 +12,7 @@ use pt_spectra::progress::Silent;
 use pt_spectra::real::{RealModel, RealPlan};
 use pt_spectra::rsd::spt2::Spt2Plan;
 
-mod support;
-use support::*;
+use crate::support::*;
 
 /// cosPT's outputs are P/(2π)³.
 const TWO_PI_CUBED: f64 = 248.050_213_442_398_6;

@@ -12,8 +12,7 @@ use pt_spectra::rsd::ap::Distortion;
 use pt_spectra::rsd::{multipoles, Fog, Observed, RsdModel, RsdMultipoles, RsdSettings};
 use pt_spectra::store::TableStore;
 
-mod support;
-use support::*;
+use crate::support::*;
 
 /// H(z) and D_M(z) against CAMB, with its radiation (photons and 3.046 massless neutrinos): measured
 /// 3.5e-11 (the table's 11 digits); without the neutrinos' radiation it would be 2.3e-4.

@@ -8,8 +8,7 @@ use pt_spectra::precision::Precision;
 use pt_spectra::rsd::ap::Distortion;
 use pt_spectra::rsd::ept::{EptParams, EptPlan, EptSettings};
 
-mod support;
-use support::*;
+use crate::support::*;
 
 const SETS: [[f64; 11]; 2] = [
     [

@@ -8,8 +8,7 @@ use pt_spectra::loops::{k1_kernels, p17_angular_kernel, P17Table};
 use rand::{Rng, SeedableRng};
 use std::f64::consts::PI;
 
-mod support;
-use support::*;
+use crate::support::*;
 
 fn table() -> std::sync::Arc<P17Table> {
     store().p17(&pt_spectra::progress::Silent).unwrap()

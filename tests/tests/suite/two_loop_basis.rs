@@ -16,8 +16,7 @@ use pt_spectra::precision::Precision;
 use pt_spectra::progress::Silent;
 use pt_spectra::store::TableStore;
 
-mod support;
-use support::*;
+use crate::support::*;
 
 /// The basis estimate `a` within `rel` of `scale` (the direct `b`'s size, or the correction's) from
 /// the direct `b` and within its own error: both use the same points, so the difference is the

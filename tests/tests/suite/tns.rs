@@ -10,8 +10,7 @@ use pt_spectra::loops::{TnsPlan, TnsTerms};
 use pt_spectra::precision::Precision;
 use std::f64::consts::PI;
 
-mod support;
-use support::*;
+use crate::support::*;
 
 /// The target: every coefficient within 1e-3 of P_lin.
 const FASTPT_TOL: f64 = 1e-3;

@@ -14,8 +14,7 @@ use pt_spectra::resum::{n1, n2};
 use rand::{Rng, SeedableRng};
 use std::f64::consts::PI;
 
-mod support;
-use support::*;
+use crate::support::*;
 
 fn table() -> std::sync::Arc<P15Table> {
     store().p15(&pt_spectra::progress::Silent).unwrap()

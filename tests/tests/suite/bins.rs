@@ -7,8 +7,6 @@
 //!   quadrature on fine panels;
 //! * [`WindowMatrix`] files (text and `.npy` with its sidecar) holding the bin average as a matrix.
 
-mod support;
-
 use pt_spectra::integrate::GaussLegendre;
 use pt_spectra::linear::LinearSpectrum;
 use pt_spectra::survey::{legendre, BinAverage, BoxModes, WindowMatrix};

@@ -9,7 +9,7 @@ use pt_spectra::linear::LinearSpectrum;
 use pt_spectra::loops::{OneLoopPlan, Pair};
 use pt_spectra::precision::Precision;
 
-mod support;
+use crate::support;
 
 /// The rule of the reference: loop momenta 1e-4 ≤ |q| ≤ 10 h/Mpc.
 fn rule() -> OneLoopRule {
@@ -18,7 +18,7 @@ fn rule() -> OneLoopRule {
 
 /// Rows of the Monte Carlo table: sides, tree, then (value, one-σ error) of B222, B321-I, B321-II, B411.
 fn reference() -> Vec<[f64; 12]> {
-    let text = include_str!("../data/bispectrum/one_loop_mc_gm2012_z0.txt");
+    let text = include_str!("../../data/bispectrum/one_loop_mc_gm2012_z0.txt");
     text.lines()
         .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
         .map(|l| {
@@ -558,7 +558,7 @@ mod redshift {
     /// A rule of 10 × 24 × 16 nodes per panel (its errors ≤ 2e-3 of a term, below the Monte Carlo's).
     #[test]
     fn terms_agree_with_an_independent_monte_carlo_in_redshift_space() {
-        let text = include_str!("../data/bispectrum/one_loop_rsd_mc_gm2012_z0.txt");
+        let text = include_str!("../../data/bispectrum/one_loop_rsd_mc_gm2012_z0.txt");
         let header = |key: &str| {
             text.lines()
                 .find_map(|l| l.split_once(key).map(|(_, rest)| rest.to_string()))

@@ -9,8 +9,7 @@ use pt_spectra::precision::Precision;
 use pt_spectra::rsd::eft2::{Eft2Plan, Eft2Terms, RsdCounterterms};
 use pt_spectra::rsd::spt2::Spt2Plan;
 
-mod support;
-use support::*;
+use crate::support::*;
 
 fn table() -> std::sync::Arc<P15Table> {
     store().p15(&pt_spectra::progress::Silent).unwrap()

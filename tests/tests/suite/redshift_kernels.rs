@@ -3,9 +3,7 @@
 //! the closed forms of Z_1 and Z_2 (Scoccimarro, Couchman & Frieman 1999), the limit f = 0, where
 //! Z_n = F_n^s, and the highest power of f, a product of linear velocity terms.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use num_traits::{ToPrimitive, Zero};
 use proptest::prelude::*;
 use pt_kernels::redshift::{brute_force_redshift, redshift_coefficients, redshift_kernel};
@@ -26,7 +24,7 @@ fn setting() -> impl Strategy<Value = ([Q; 3], Q)> {
 macro_rules! against_brute_force {
     ($name:ident, $n:expr, $cases:expr) => {
         proptest! {
-            #![proptest_config(ProptestConfig { cases: $cases, max_global_rejects: 10_000, ..ProptestConfig::default() })]
+            #![proptest_config(ProptestConfig { cases: $cases, max_global_rejects: 10_000, failure_persistence: crate::regressions_beside_the_source(), ..ProptestConfig::default() })]
             #[test]
             fn $name(qs in proptest::collection::vec(rational_vector(), $n), (los, f) in setting()) {
                 let z = redshift_kernel(&qs, &f, &los).unwrap();

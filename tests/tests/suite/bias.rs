@@ -9,8 +9,7 @@ use pt_spectra::loops::bias::{BiasPlan, GalaxyBias, PAIR_NAMES};
 use pt_spectra::loops::Estimate;
 use pt_spectra::precision::Precision;
 
-mod support;
-use support::*;
+use crate::support::*;
 
 /// The target: each term within 1e-3 of its largest |value| over 0.01 ≤ k ≤ 0.3 h/Mpc.
 const FASTPT_TOL: f64 = 1e-3;
