@@ -58,6 +58,29 @@ def _checked(x, n, what):
     return x
 
 
+def _host_function(value, value_and_derivative, shape, derivative_shape, n, what):
+    """A JAX function of a vector of n values computed on the host: ``value(x)`` (an array of
+    ``shape``), its tangent ``t @ D`` from ``value_and_derivative(x)`` = (value, D), D of
+    ``derivative_shape`` (rows: the inputs); a ``jax.custom_jvp`` around ``jax.pure_callback``."""
+    out = jax.ShapeDtypeStruct(shape, jnp.float64)
+    derivative = jax.ShapeDtypeStruct(derivative_shape, jnp.float64)
+
+    @jax.custom_jvp
+    def f(x):
+        return jax.pure_callback(value, out, x, vmap_method="sequential")
+
+    @f.defjvp
+    def _(primals, tangents):
+        (x,), (t,) = primals, tangents
+        v, d = jax.pure_callback(value_and_derivative, (out, derivative), x, vmap_method="sequential")
+        return v, t @ d
+
+    def function(x):
+        return f(_checked(x, n, what))
+
+    return function
+
+
 def log_likelihood(likelihood):
     """ln L(x) = -(-2 ln L)/2 of ``likelihood`` (a :class:`pt_spectra.AnalysisLikelihood`) as a JAX
     function of x, a vector in the order of ``likelihood.names``, with its exact gradient.
@@ -74,8 +97,6 @@ def log_likelihood(likelihood):
         raise ValueError("this likelihood has no exact gradient (a data set with a bispectrum): "
                          "pt_spectra.jax differentiates only exact gradients")
     n = len(likelihood.names)
-    scalar = jax.ShapeDtypeStruct((), jnp.float64)
-    vector = jax.ShapeDtypeStruct((n,), jnp.float64)
 
     def value(x):
         return np.float64(-0.5 * likelihood(np.asarray(x, dtype=float)))
@@ -84,19 +105,7 @@ def log_likelihood(likelihood):
         v, g = likelihood.gradient(np.asarray(x, dtype=float))
         return np.float64(-0.5 * v), -0.5 * np.asarray(g, dtype=np.float64)
 
-    @jax.custom_jvp
-    def ln_l(x):
-        return jax.pure_callback(value, scalar, x, vmap_method="sequential")
-
-    @ln_l.defjvp
-    def _(primals, tangents):
-        (x,), (t,) = primals, tangents
-        v, g = jax.pure_callback(value_and_gradient, (scalar, vector), x, vmap_method="sequential")
-        return v, jnp.dot(g, t)
-
-    def function(x):
-        return ln_l(_checked(x, n, "log_likelihood"))
-
+    function = _host_function(value, value_and_gradient, (), (n,), n, "log_likelihood")
     function.names = list(likelihood.names)
     function.bounds = list(likelihood.bounds)
     return function
@@ -128,8 +137,6 @@ def data_vector(pipeline, names, cosmology=None, linear=None, z_input=None, **fi
     rows = [allowed.index(n) for n in names]
     where = dict(cosmology=cosmology, linear=linear, z_input=z_input)
     m = len(pipeline(**where, **fixed))
-    out = jax.ShapeDtypeStruct((m,), jnp.float64)
-    jac = jax.ShapeDtypeStruct((len(names), m), jnp.float64)
 
     def params(x):
         return {**fixed, **{n: float(v) for n, v in zip(names, np.asarray(x, dtype=float))}}
@@ -141,18 +148,7 @@ def data_vector(pipeline, names, cosmology=None, linear=None, z_input=None, **fi
         v, j = pipeline(**where, jacobian=True, **params(x))
         return np.asarray(v, dtype=np.float64), np.asarray(j, dtype=np.float64)[rows]
 
-    @jax.custom_jvp
-    def vector(x):
-        return jax.pure_callback(value, out, x, vmap_method="sequential")
-
-    @vector.defjvp
-    def _(primals, tangents):
-        (x,), (t,) = primals, tangents
-        v, j = jax.pure_callback(value_and_jacobian, (out, jac), x, vmap_method="sequential")
-        return v, t @ j
-
-    def function(x):
-        return vector(_checked(x, len(names), "data_vector"))
-
+    function = _host_function(value, value_and_jacobian, (m,), (len(names), m), len(names),
+                              "data_vector")
     function.names = names
     return function

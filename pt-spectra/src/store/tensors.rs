@@ -96,65 +96,29 @@ impl TableStore {
     }
 }
 
-impl CachedTensors for TwoLoopBasis {
-    type Key<'a> = (&'a [f64], &'a Precision, SpectrumFamily);
-    const WHAT: &'static str = "2-loop basis";
-    const STAGE: Stage = Stage::TwoLoopBasis;
-    fn cache_name((k, precision, family): Self::Key<'_>) -> String {
-        Self::file_name(k, precision, family)
-    }
-    fn read(values: &[f64], (k, precision, family): Self::Key<'_>) -> Option<Self> {
-        Self::from_f64s(values, k, precision, family)
-    }
-    fn write(&self) -> Vec<f64> {
-        self.to_f64s()
-    }
+/// Implements [`CachedTensors`] for a tensor type whose key is the tuple of the arguments its
+/// inherent `file_name(…)` and `from_f64s(values, …)` take, in that order.
+macro_rules! cached_tensors {
+    ($tensors:ty, $key:ty, $what:literal, $stage:expr, ($($arg:ident),+)) => {
+        impl CachedTensors for $tensors {
+            type Key<'a> = $key;
+            const WHAT: &'static str = $what;
+            const STAGE: Stage = $stage;
+            fn cache_name(($($arg),+): Self::Key<'_>) -> String {
+                Self::file_name($($arg),+)
+            }
+            fn read(values: &[f64], ($($arg),+): Self::Key<'_>) -> Option<Self> {
+                Self::from_f64s(values, $($arg),+)
+            }
+            fn write(&self) -> Vec<f64> {
+                self.to_f64s()
+            }
+        }
+    };
 }
 
-impl CachedTensors for OneLoopBasis {
-    type Key<'a> = (&'a [f64], &'a Precision, SpectrumFamily);
-    const WHAT: &'static str = "1-loop basis";
-    const STAGE: Stage = Stage::OneLoopBasis;
-    fn cache_name((k, precision, family): Self::Key<'_>) -> String {
-        Self::file_name(k, precision, family)
-    }
-    fn read(values: &[f64], (k, precision, family): Self::Key<'_>) -> Option<Self> {
-        Self::from_f64s(values, k, precision, family)
-    }
-    fn write(&self) -> Vec<f64> {
-        self.to_f64s()
-    }
-}
-
-impl CachedTensors for TnsBasis {
-    type Key<'a> = (&'a [f64], &'a Precision);
-    const WHAT: &'static str = "TNS basis";
-    const STAGE: Stage = Stage::TnsBasis;
-    fn cache_name((k, precision): Self::Key<'_>) -> String {
-        Self::file_name(k, precision)
-    }
-    fn read(values: &[f64], (k, precision): Self::Key<'_>) -> Option<Self> {
-        Self::from_f64s(values, k, precision)
-    }
-    fn write(&self) -> Vec<f64> {
-        self.to_f64s()
-    }
-}
-
-impl CachedTensors for RedshiftBasis {
-    type Key<'a> = (&'a [f64], &'a Precision, RedshiftFamily);
-    const WHAT: &'static str = "redshift-space basis";
-    const STAGE: Stage = Stage::RedshiftBasis;
-    fn cache_name((k, precision, family): Self::Key<'_>) -> String {
-        Self::file_name(k, precision, family)
-    }
-    fn read(values: &[f64], (k, precision, family): Self::Key<'_>) -> Option<Self> {
-        Self::from_f64s(values, k, precision, family)
-    }
-    fn write(&self) -> Vec<f64> {
-        self.to_f64s()
-    }
-}
+/// The key of the 1- and 2-loop basis tensors: k, the precision and the spectrum family.
+pub type GridKey<'a> = (&'a [f64], &'a Precision, SpectrumFamily);
 
 /// The key of [`RsdTwoLoopBasis`]: k, the q range, the lattice step, the integration settings and
 /// the spectrum family.
@@ -166,32 +130,45 @@ pub type RsdTwoLoopKey<'a> = (
     SpectrumFamily,
 );
 
-impl CachedTensors for RsdTwoLoopBasis {
-    type Key<'a> = RsdTwoLoopKey<'a>;
-    const WHAT: &'static str = "2-loop redshift-space basis";
-    const STAGE: Stage = Stage::TwoLoopBasis;
-    fn cache_name((k, range, step, settings, family): Self::Key<'_>) -> String {
-        Self::file_name(k, range, step, settings, family)
-    }
-    fn read(values: &[f64], (k, range, step, settings, family): Self::Key<'_>) -> Option<Self> {
-        Self::from_f64s(values, k, range, step, settings, family)
-    }
-    fn write(&self) -> Vec<f64> {
-        self.to_f64s()
-    }
-}
-
-impl CachedTensors for OneLoopMatterBasis {
-    type Key<'a> = (&'a [[f64; 3]], &'a OneLoopRule);
-    const WHAT: &'static str = "one-loop bispectrum basis";
-    const STAGE: Stage = Stage::OneLoopBispectrumBasis;
-    fn cache_name((triangles, rule): Self::Key<'_>) -> String {
-        Self::file_name(triangles, rule)
-    }
-    fn read(values: &[f64], (triangles, rule): Self::Key<'_>) -> Option<Self> {
-        Self::from_f64s(values, triangles, rule)
-    }
-    fn write(&self) -> Vec<f64> {
-        self.to_f64s()
-    }
-}
+cached_tensors!(
+    TwoLoopBasis,
+    GridKey<'a>,
+    "2-loop basis",
+    Stage::TwoLoopBasis,
+    (k, precision, family)
+);
+cached_tensors!(
+    OneLoopBasis,
+    GridKey<'a>,
+    "1-loop basis",
+    Stage::OneLoopBasis,
+    (k, precision, family)
+);
+cached_tensors!(
+    TnsBasis,
+    (&'a [f64], &'a Precision),
+    "TNS basis",
+    Stage::TnsBasis,
+    (k, precision)
+);
+cached_tensors!(
+    RedshiftBasis,
+    (&'a [f64], &'a Precision, RedshiftFamily),
+    "redshift-space basis",
+    Stage::RedshiftBasis,
+    (k, precision, family)
+);
+cached_tensors!(
+    RsdTwoLoopBasis,
+    RsdTwoLoopKey<'a>,
+    "2-loop redshift-space basis",
+    Stage::TwoLoopBasis,
+    (k, range, step, settings, family)
+);
+cached_tensors!(
+    OneLoopMatterBasis,
+    (&'a [[f64; 3]], &'a OneLoopRule),
+    "one-loop bispectrum basis",
+    Stage::OneLoopBispectrumBasis,
+    (triangles, rule)
+);
