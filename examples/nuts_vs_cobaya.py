@@ -29,9 +29,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from boss_cmass_fit import DEFAULT_OUT, Z, data_files, log, template  # noqa: E402
-from boss_cmass_ngc_sgc import analysis  # noqa: E402
-from posterior_vs_profile import LABELS, hessian, minimise, sample, weighted_stats  # noqa: E402
+from boss_cmass_fit import DEFAULT_OUT, log  # noqa: E402
+from posterior_vs_profile import (LABELS, hessian, minimise, ngc_likelihood, sample,  # noqa: E402
+                                  weighted_stats)
 
 import pt_spectra as pt  # noqa: E402
 
@@ -111,11 +111,7 @@ def main():
     from numpyro.diagnostics import effective_sample_size, split_gelman_rubin
 
     t0 = time.time()
-    plin, ini, _ = template(args.out)
-    data, covs, *_ = data_files(args.out, "NGC")
-    path = analysis(args.out, "boss_cmass_ngc.toml", ["NGC"], {"NGC": (data, covs)}, ini)
-    common = dict(linear=str(plin), z_input=Z, cosmology=str(ini), precision="fast")
-    lik = pt.AnalysisLikelihood(path, **common)
+    path, common, lik, _ = ngc_likelihood(args.out)
     s8 = lik.sigma8_z["ngc"]
     x, m_best = minimise(lik, lik.start)
     for start in (x, np.array([2.0 if n.startswith("b1") else v for n, v in zip(lik.names, lik.start)])):

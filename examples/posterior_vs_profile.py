@@ -154,6 +154,17 @@ def weighted_stats(x, w):
     return m, s, lo, hi, 0.5 * (peak[1][i] + peak[1][i + 1])
 
 
+def ngc_likelihood(out):
+    """The NGC analysis file of examples/boss_cmass_ngc_sgc.py written in `out` (with its template,
+    data and covariance): (its path, the likelihood's keyword arguments, the AnalysisLikelihood, the
+    template's truth)."""
+    plin, ini, truth = template(out)
+    data, covs, *_ = data_files(out, "NGC")
+    path = analysis(out, "boss_cmass_ngc.toml", ["NGC"], {"NGC": (data, covs)}, ini)
+    common = dict(linear=str(plin), z_input=Z, cosmology=str(ini), precision="fast")
+    return path, common, pt.AnalysisLikelihood(path, **common), truth
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=DEFAULT_OUT, type=Path)
@@ -162,11 +173,7 @@ def main():
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     t0 = time.time()
-    plin, ini, truth = template(args.out)
-    data, covs, *_ = data_files(args.out, "NGC")
-    path = analysis(args.out, "boss_cmass_ngc.toml", ["NGC"], {"NGC": (data, covs)}, ini)
-    common = dict(linear=str(plin), z_input=Z, cosmology=str(ini), precision="fast")
-    lik = pt.AnalysisLikelihood(path, **common)
+    path, common, lik, truth = ngc_likelihood(args.out)
     s8 = lik.sigma8_z["ngc"]
     log(f"likelihood: {', '.join(lik.names)}; {lik.points} points; exact gradient {lik.exact_gradient}")
 
