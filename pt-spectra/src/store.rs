@@ -174,6 +174,6 @@ pub(crate) use file::cached;
 #[cfg(test)]
 use file::{fnv1a, HEADER};
 use file::{read_f64s, Stored};
-pub use tensors::{CachedTensors, RsdTwoLoopKey};
+pub use tensors::{CachedTensors, GridKey, RsdTwoLoopKey};
 #[cfg(test)]
 mod tests;
