@@ -38,6 +38,7 @@
 pub mod bias;
 pub mod bispectrum;
 pub mod cosmology;
+pub mod dual;
 pub mod emulator;
 pub mod error;
 pub mod estimate;

@@ -45,6 +45,7 @@ pub const EV_PER_OMEGA_NU: f64 = 93.14;
 /// Names accepted by [`Cosmology::preset`].
 pub const PRESETS: [&str; 2] = ["gm2012", "planck2018"];
 
+pub mod background;
 pub mod distance;
 mod eisenstein_hu;
 mod growth;
