@@ -168,6 +168,7 @@ impl<const N: usize> Sub for Dual<N> {
     }
 }
 
+#[allow(clippy::suspicious_arithmetic_impl)] // the product and quotient rules
 impl<const N: usize> Mul for Dual<N> {
     type Output = Self;
     fn mul(self, o: Self) -> Self {
@@ -178,6 +179,7 @@ impl<const N: usize> Mul for Dual<N> {
     }
 }
 
+#[allow(clippy::suspicious_arithmetic_impl)] // the product and quotient rules
 impl<const N: usize> Div for Dual<N> {
     type Output = Self;
     fn div(self, o: Self) -> Self {
@@ -271,13 +273,14 @@ mod tests {
         let f = x * y / (x + y) + x.sqrt() * y.ln() - (-(x * y)).exp() + x.powf(2.5) - y.powi(-3)
             + x.recip();
         let s = a + b;
-        let dfdx = b * b / (s * s) + 0.5 / a.sqrt() * b.ln() + b * (-a * b).exp()
-            + 2.5 * a.powf(1.5)
-            - 1.0 / (a * a);
+        let dfdx =
+            b * b / (s * s) + 0.5 / a.sqrt() * b.ln() + b * (-a * b).exp() + 2.5 * a.powf(1.5)
+                - 1.0 / (a * a);
         let dfdy = a * a / (s * s) + a.sqrt() / b + a * (-a * b).exp() + 3.0 * b.powi(-4);
         assert!((f.d[0] - dfdx).abs() < 1e-14, "{} {dfdx}", f.d[0]);
         assert!((f.d[1] - dfdy).abs() < 1e-14, "{} {dfdy}", f.d[1]);
-        let value = a * b / s + a.sqrt() * b.ln() - (-a * b).exp() + a.powf(2.5) - b.powi(-3) + 1.0 / a;
+        let value =
+            a * b / s + a.sqrt() * b.ln() - (-a * b).exp() + a.powf(2.5) - b.powi(-3) + 1.0 / a;
         assert!((f.value() - value).abs() < 1e-15);
     }
 

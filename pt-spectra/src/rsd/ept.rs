@@ -488,6 +488,7 @@ mod model;
 pub mod physical;
 mod projection;
 mod range;
+pub mod tangent;
 
 /// The index of parameter `name` in [`PARAM_NAMES`], its `value` checked finite.
 ///

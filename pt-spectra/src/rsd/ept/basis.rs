@@ -24,7 +24,7 @@ use std::sync::Arc;
 /// the forms of the no-wiggle spectrum.
 #[derive(Debug, Clone)]
 pub(super) struct Tensors {
-    linear: Arc<RedshiftBasis>,
+    pub(super) linear: Arc<RedshiftBasis>,
     no_wiggle: Option<(Arc<RedshiftBasis>, NoWiggleForms)>,
 }
 
@@ -223,34 +223,53 @@ impl EptPlan {
         }
         // P_lin and P_nw on the whole grid; the loop terms on the loop grid, padded
         let p_lin: Vec<f64> = self.grid.iter().map(|&k| spectrum.eval(k)).collect();
+        Ok(Some(self.terms_of_samples(
+            tensors,
+            &samples,
+            p_lin,
+            &projection,
+        )))
+    }
+
+    /// The loop terms of a spectrum given by its lattice `samples`, its values `p_lin` on the
+    /// plan's grid and its `projection` on the basis: a polynomial of degree 2 in (samples, p_lin)
+    /// when `projection` is theirs without the soft-mode cut (its coefficients are linear in the
+    /// samples), which [`super::tangent`] relies on.
+    pub(super) fn terms_of_samples(
+        &self,
+        tensors: &Tensors,
+        samples: &[f64],
+        p_lin: Vec<f64>,
+        projection: &Projection,
+    ) -> EptTerms {
         let span = self.loop_span.clone();
         let (full, nw) = match (&self.split, &tensors.no_wiggle) {
             (Some(()), Some((nw_tensors, forms))) => {
                 let c = &projection.coefficients;
-                let (p_nw, sigma2) = forms.evaluate(&samples, c, projection.residual);
+                let (p_nw, sigma2) = forms.evaluate(samples, c, projection.residual);
                 let (full, t) = tensors.linear.evaluate_with_no_wiggle(
                     &self.loops,
-                    (&p_lin[span.clone()], &projection),
+                    (&p_lin[span.clone()], projection),
                     nw_tensors,
-                    (&p_nw[span], &projection),
+                    (&p_nw[span], projection),
                 );
                 (full, Some((self.padded(t, &p_nw), sigma2)))
             }
             _ => (
                 tensors
                     .linear
-                    .evaluate(&self.loops, &p_lin[span], &projection),
+                    .evaluate(&self.loops, &p_lin[span], projection),
                 None,
             ),
         };
         let full = self.padded(full, &p_lin);
-        Ok(Some(EptTerms {
+        EptTerms {
             grid: self.grid.clone(),
             full,
             nw,
             basis_residual: Some(projection.residual),
             basis_soft: projection.soft_delta(),
-        }))
+        }
     }
 }
 

@@ -152,6 +152,38 @@ impl EptTerms {
     }
 }
 
+/// The change of the BAO damping e^{−k'²Σ²[1 + f(2 + f)μ'²]} that comes with a tangent of
+/// [`project_many`]: its f-derivative, or its Σ²-derivative times dΣ² (a direction of the linear
+/// spectrum, [`super::tangent`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) enum DampingTangent {
+    /// ∂/∂f.
+    F,
+    /// dΣ² ∂/∂Σ².
+    Sigma2(f64),
+}
+
+impl EptTerms {
+    /// ∂/∂Σ² of the model's μ² polynomials at fixed terms and parameters (the resummation's
+    /// (1 + k²Σ²[1 + f(2 + f)μ²]) Z₁² P_w), times `d_sigma2`, added to `parts` ([`PartsDf`]).
+    pub(super) fn add_parts_dsigma2(&self, params: &EptParams, d_sigma2: f64, parts: &mut PartsDf) {
+        let Some((t, _)) = &self.nw else {
+            return;
+        };
+        let [b1, _, _, _, f] = params.monomial_params();
+        let z1 = [b1 * b1, 2.0 * b1 * f, f * f];
+        for (i, (_, dw)) in parts.iter_mut().enumerate() {
+            let k2 = self.grid[i] * self.grid[i];
+            let p_w = self.full.p_lin[i] - t.p_lin[i];
+            let (c0, c1) = (k2 * d_sigma2, k2 * d_sigma2 * f * (2.0 + f));
+            for j in 0..3 {
+                dw[j] += c0 * z1[j] * p_w;
+                dw[j + 1] += c1 * z1[j] * p_w;
+            }
+        }
+    }
+}
+
 /// The multipoles of several models of one f and Σ² (those of one terms' set) at the output `k_out`:
 /// `nodes` per μ node (ln(k'/k), (k'/k)², μ'), `weights[m][j]` the weight of the j-th ℓ at μ node
 /// m; `on_grid`: k_out is the models' grid and undistorted (each k its own grid point), else
@@ -159,10 +191,11 @@ impl EptTerms {
 /// weights on the μ² coefficients of the grid points its stencils reach, then applied to each model:
 /// `out[s][j][i]`. With `df` (models of the same f and Σ² with their [`PartsDf`]), also the
 /// f-derivatives of their multipoles: those of the polynomials, projected, and that of the damping
-/// e^{−k'²Σ²[1 + f(2 + f)μ'²]}.
+/// e^{−k'²Σ²[1 + f(2 + f)μ'²]}; or, with [`DampingTangent::Sigma2`], their tangents along a direction
+/// of the linear spectrum (the polynomials' changes, and the damping's through dΣ²).
 pub(super) fn project_many(
     models: &[Model<'_>],
-    df: &[(Model<'_>, PartsDf)],
+    df: &[(Model<'_>, PartsDf, DampingTangent)],
     k_out: &[f64],
     nodes: &[(f64, f64, f64)],
     weights: &[Vec<f64>],
@@ -175,8 +208,8 @@ pub(super) fn project_many(
     let mut out = vec![vec![vec![0.0; k_out.len()]; n_ell]; models.len()];
     let mut out_df = vec![vec![vec![0.0; k_out.len()]; n_ell]; df.len()];
     // the weights of the no-wiggle (N) and wiggle (W) coefficients: [ℓ][grid point − lo][μ² power],
-    // and of W in the damping's f-derivative
-    let (mut on, mut ow, mut owf) = (Vec::new(), Vec::new(), Vec::new());
+    // and of W in the damping's f- and Σ²-derivatives
+    let (mut on, mut ow, mut owf, mut ows) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut stencils = Vec::with_capacity(nodes.len());
     for (i, &k) in k_out.iter().enumerate() {
         let (ln_k, k2) = (k.ln(), k * k);
@@ -193,7 +226,8 @@ pub(super) fn project_many(
             let x = k2 * ratio2 * first.sigma2;
             let damping = (-x * (1.0 + first.f * (2.0 + first.f) * m2)).exp();
             let damping_df = -x * (2.0 + 2.0 * first.f) * m2 * damping;
-            stencils.push((b, l, width, m2, damping, damping_df));
+            let damping_ds = -k2 * ratio2 * (1.0 + first.f * (2.0 + first.f) * m2) * damping;
+            stencils.push((b, l, width, m2, damping, [damping_df, damping_ds]));
             lo = lo.min(b);
             hi = hi.max(b + width);
         }
@@ -202,9 +236,13 @@ pub(super) fn project_many(
         on.resize(n_ell * span * 5, 0.0);
         ow.clear();
         ow.resize(n_ell * span * 5, 0.0);
-        owf.clear();
-        owf.resize(if df.is_empty() { 0 } else { n_ell * span * 5 }, 0.0);
-        for (&(b, l, width, m2, damping, damping_df), c) in stencils.iter().zip(weights) {
+        for o in [&mut owf, &mut ows] {
+            o.clear();
+            o.resize(if df.is_empty() { 0 } else { n_ell * span * 5 }, 0.0);
+        }
+        for (&(b, l, width, m2, damping, [damping_df, damping_ds]), c) in
+            stencils.iter().zip(weights)
+        {
             let mut powers = [1.0; 5];
             for q in 1..5 {
                 powers[q] = powers[q - 1] * m2;
@@ -218,9 +256,10 @@ pub(super) fn project_many(
                         ow[base + q] += ww * powers[q];
                     }
                     if !df.is_empty() {
-                        let wf = ce * lj * damping_df;
+                        let (wf, ws) = (ce * lj * damping_df, ce * lj * damping_ds);
                         for q in 0..5 {
                             owf[base + q] += wf * powers[q];
+                            ows[base + q] += ws * powers[q];
                         }
                     }
                 }
@@ -239,7 +278,11 @@ pub(super) fn project_many(
                 oe[i] = sum;
             }
         }
-        for ((model, d), o) in df.iter().zip(out_df.iter_mut()) {
+        for ((model, d, tangent), o) in df.iter().zip(out_df.iter_mut()) {
+            let (od, scale) = match *tangent {
+                DampingTangent::F => (&owf, 1.0),
+                DampingTangent::Sigma2(ds) => (&ows, ds),
+            };
             for (e, oe) in o.iter_mut().enumerate() {
                 let mut sum = 0.0;
                 for g in 0..span {
@@ -247,7 +290,9 @@ pub(super) fn project_many(
                     let w = &model.parts[lo + g].1 .0;
                     let base = (e * span + g) * 5;
                     for q in 0..5 {
-                        sum += on[base + q] * dn[q] + ow[base + q] * dw[q] + owf[base + q] * w[q];
+                        sum += on[base + q] * dn[q]
+                            + ow[base + q] * dw[q]
+                            + scale * od[base + q] * w[q];
                     }
                 }
                 oe[i] = sum;
@@ -339,6 +384,11 @@ pub(super) fn ap_derivatives_many(
 }
 
 impl Model<'_> {
+    /// The μ² polynomials (N, W) with their errors at every grid point.
+    pub(super) fn parts(&self) -> &[(Poly, Poly)] {
+        &self.parts
+    }
+
     /// P(k, μ) at grid index `i` (k = grid[i]).
     pub(super) fn at(&self, i: usize, k: f64, mu: f64) -> Estimate {
         let (n, w) = &self.parts[i];
