@@ -17,7 +17,9 @@
 //! the hexadecapole is exact to the interpolation. Wide-angle effects are neglected.
 
 use super::{legendre_coefficients, Fog, MuPolynomial, MAX_ELL};
+use crate::cosmology::background::Background;
 use crate::cosmology::Cosmology;
+use crate::dual::Real;
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
 use crate::integrate::{lagrange4, legendre_nodes};
@@ -61,22 +63,14 @@ impl Distortion {
 
     /// The distortion of a measurement in the `fiducial` cosmology of the `truth` at redshift `z`:
     /// α∥ = H^fid(z)/H(z), α⊥ = D_M(z)/D_M^fid(z), distances in Mpc/h of each cosmology
-    /// ([`crate::cosmology::distance`]; velocileptors' and desilike's convention).
+    /// ([`crate::cosmology::distance`]; velocileptors' and desilike's convention), by
+    /// [`ap_parameters`].
     ///
     /// # Errors
     /// As [`new`](Self::new) for the ratios; [`Error::InvalidParameter`] for z ≤ 0.
     pub fn from_cosmologies(truth: &Cosmology, fiducial: &Cosmology, z: f64) -> Result<Self> {
-        if !(z.is_finite() && z > 0.0) {
-            return Err(Error::InvalidParameter {
-                name: "z",
-                value: z,
-                reason: "must be positive for the Alcock-Paczynski distortion (none at z = 0)",
-            });
-        }
-        Self::new(
-            fiducial.hubble(z) / truth.hubble(z),
-            truth.transverse_comoving_distance(z) / fiducial.transverse_comoving_distance(z),
-        )
+        let (apar, aperp) = ap_parameters(&truth.background(), fiducial, z)?;
+        Self::new(apar, aperp)
     }
 
     /// (k', μ') of the true spectrum at the observed (k, μ) (module docs).
@@ -118,6 +112,34 @@ impl Distortion {
             .map(|i| (k_min.ln() + step * (i as f64 - 2.0)).exp())
             .collect())
     }
+}
+
+/// The scaling parameters (α∥, α⊥) = (H^fid(z)/H(z), D_M(z)/D_M^fid(z)) of a measurement in the
+/// `fiducial` cosmology of the `truth` at redshift `z` (module docs), distances in Mpc/h of each
+/// cosmology ([`crate::cosmology::distance`]). Generic over the [`Real`] type of the truth's
+/// parameters: on [`Cosmology::seeded`] they carry their exact derivatives with respect to the
+/// sampled parameters (the fiducial cosmology is fixed). [`Distortion::from_cosmologies`] is this
+/// on `f64`, with the range check of [`Distortion::new`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for z ≤ 0 or not finite (there is no distortion at z = 0).
+pub fn ap_parameters<T: Real>(
+    truth: &Background<T>,
+    fiducial: &Cosmology,
+    z: f64,
+) -> Result<(T, T)> {
+    if !(z.is_finite() && z > 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "z",
+            value: z,
+            reason: "must be positive for the Alcock-Paczynski distortion (none at z = 0)",
+        });
+    }
+    let fiducial = fiducial.background();
+    Ok((
+        T::cst(fiducial.hubble(z)) / truth.hubble(z),
+        truth.transverse_comoving_distance(z) / fiducial.transverse_comoving_distance(z),
+    ))
 }
 
 /// The observed multipoles `ells` at `k_out` of the model whose P^s(k, μ) before damping is `polys`
@@ -271,5 +293,36 @@ mod tests {
             assert!((p0.value - 1000.0 * d.volume()).abs() < 1e-10);
             assert!(p2.value.abs() < 1e-10 && p4.value.abs() < 1e-10);
         }
+    }
+
+    /// The exact (dual) derivatives of α∥ and α⊥ with respect to the eight sampled parameters of the
+    /// truth against Richardson-extrapolated finite differences of [`Distortion::from_cosmologies`],
+    /// at ΛCDM, w0–wa, open, closed and massless-neutrino truths (at Σm_ν = 0 without the Σm_ν
+    /// derivative, as for the distances); the `f64` path is [`ap_parameters`] exactly.
+    #[test]
+    fn dual_ap_derivatives_match_finite_differences() {
+        use crate::cosmology::finite_difference::{check_derivatives, derivative_cosmologies};
+        let fiducial = Cosmology::flat(0.31, 0.676, 0.022, 0.965, 0.8).unwrap();
+        for (label, truth) in derivative_cosmologies() {
+            check_derivatives(
+                label,
+                &truth,
+                &["alpha_par", "alpha_perp"],
+                |b, z| {
+                    let (apar, aperp) = ap_parameters(b, &fiducial, z).unwrap();
+                    vec![apar, aperp]
+                },
+                |c, z| {
+                    let d = Distortion::from_cosmologies(c, &fiducial, z).unwrap();
+                    vec![d.apar, d.aperp]
+                },
+                true,
+            );
+            let d = Distortion::from_cosmologies(&truth, &fiducial, 1.0).unwrap();
+            let (apar, aperp) = ap_parameters(&truth.background(), &fiducial, 1.0).unwrap();
+            assert_eq!((d.apar, d.aperp), (apar, aperp));
+        }
+        let seeded = Cosmology::planck2018().seeded().unwrap();
+        assert!(ap_parameters(&seeded, &fiducial, 0.0).is_err());
     }
 }
