@@ -197,8 +197,6 @@ impl<const N: usize> Sub for Dual<N> {
 #[allow(clippy::suspicious_arithmetic_impl)] // the product and quotient rules
 impl<const N: usize> Mul for Dual<N> {
     type Output = Self;
-    // The product rule: the derivatives of a product are sums.
-    #[allow(clippy::suspicious_arithmetic_impl)]
     fn mul(self, o: Self) -> Self {
         Self {
             v: self.v * o.v,
