@@ -156,7 +156,10 @@ mod tests {
         assert!((b.omega_m.d[1] - 1.0 / h2).abs() < 1e-14);
         assert!((b.omega_m.d[2] - 1.0 / h2).abs() < 1e-14);
         assert!((b.omega_m.d[5] - 1.0 / (EV_PER_OMEGA_NU * h2)).abs() < 1e-14);
-        assert!(b.omega_m.d[3..5].iter().chain(&b.omega_m.d[6..]).all(|&d| d == 0.0));
+        assert!(b.omega_m.d[3..5]
+            .iter()
+            .chain(&b.omega_m.d[6..])
+            .all(|&d| d == 0.0));
         assert!((0..N_DERIVATIVES).all(|j| b.omega_lambda.d[j] == -b.omega_m.d[j]));
         let sigma8 = Cosmology::gm2012();
         assert!(sigma8.seeded().is_err());
