@@ -51,6 +51,14 @@ pub trait Real:
     fn powi(self, n: i32) -> Self;
     /// 1/x.
     fn recip(self) -> Self;
+    /// sin x.
+    fn sin(self) -> Self;
+    /// sinh x.
+    fn sinh(self) -> Self;
+    /// True when the number carries no derivative (always for `f64`; all derivatives zero for
+    /// [`Dual`]): code may then take a shortcut that holds at this value only, such as ρ_DE = 1 for
+    /// w0 = −1, wa = 0, without losing a derivative.
+    fn is_constant(&self) -> bool;
 }
 
 impl Real for f64 {
@@ -77,6 +85,15 @@ impl Real for f64 {
     }
     fn recip(self) -> Self {
         1.0 / self
+    }
+    fn sin(self) -> Self {
+        f64::sin(self)
+    }
+    fn sinh(self) -> Self {
+        f64::sinh(self)
+    }
+    fn is_constant(&self) -> bool {
+        true
     }
 }
 
@@ -145,6 +162,15 @@ impl<const N: usize> Real for Dual<N> {
     fn recip(self) -> Self {
         let r = 1.0 / self.v;
         self.chain(r, -r * r)
+    }
+    fn sin(self) -> Self {
+        self.chain(self.v.sin(), self.v.cos())
+    }
+    fn sinh(self) -> Self {
+        self.chain(self.v.sinh(), self.v.cosh())
+    }
+    fn is_constant(&self) -> bool {
+        self.d.iter().all(|&d| d == 0.0)
     }
 }
 
@@ -333,6 +359,35 @@ mod tests {
         let value =
             a * b / s + a.sqrt() * b.ln() - (-a * b).exp() + a.powf(2.5) - b.powi(-3) + 1.0 / a;
         assert!((f.value() - value).abs() < 1e-15);
+    }
+
+    /// sin and sinh against their closed-form derivatives, through the chain rule of a product.
+    #[test]
+    fn trigonometric_and_hyperbolic_rules() {
+        let (a, b) = (0.7, -1.3);
+        let x = D2::seed(a, 0);
+        let y = D2::seed(b, 1);
+        // f = sin(x y) + sinh(x − 2y)
+        let f = (x * y).sin() + (x - y * 2.0).sinh();
+        let dfdx = b * (a * b).cos() + (a - 2.0 * b).cosh();
+        let dfdy = a * (a * b).cos() - 2.0 * (a - 2.0 * b).cosh();
+        assert!((f.d[0] - dfdx).abs() < 1e-14, "{} {dfdx}", f.d[0]);
+        assert!((f.d[1] - dfdy).abs() < 1e-14, "{} {dfdy}", f.d[1]);
+        assert_eq!(f.value(), (a * b).sin() + (a - 2.0 * b).sinh());
+        assert_eq!(Real::sin(a), a.sin());
+        assert_eq!(Real::sinh(a), a.sinh());
+    }
+
+    /// A constant has no derivative; a seeded input and anything computed from it have one.
+    #[test]
+    fn constants_are_recognised() {
+        assert!(1.5_f64.is_constant());
+        assert!(D2::cst(-1.0).is_constant());
+        let x = D2::seed(-1.0, 1);
+        assert!(!x.is_constant());
+        assert!(!(x * 3.0).exp().is_constant());
+        assert!((x - x).is_constant());
+        assert!((D2::cst(2.0) * D2::cst(3.0)).is_constant());
     }
 
     /// The f64 implementation is the plain arithmetic.

@@ -6,6 +6,22 @@
 //! derived Ω_m = (ω_b + ω_cdm + ω_ν)/h² and Ω_DE = 1 − Ω_m − Ω_k, so [`Cosmology::seeded`] builds
 //! those from the seeded inputs: every quantity computed from a [`Background`] of [`Dual`]s then
 //! carries its derivatives with respect to the eight sampled parameters.
+//!
+//! The expansion and the linear growth (E(z), D(z), f(z), D_md(z): `growth.rs`) and the distances
+//! (H(z), D_M(z), D_A(z): [`super::distance`]) are methods of [`Background`] over any [`Real`], the
+//! one implementation that the [`Cosmology`] methods call on [`Cosmology::background`]:
+//!
+//! ```
+//! use pt_spectra::cosmology::Cosmology;
+//! let c = Cosmology::planck2018().with_dark_energy(-0.9, -0.3)?;
+//! let (d_md, f) = c.seeded()?.growth_md_and_rate(1.0);
+//! let (d_md_f64, f_f64) = c.background().growth_md_and_rate(1.0);
+//! assert!((d_md.v / d_md_f64 - 1.0).abs() < 1e-12 && (f.v / f_f64 - 1.0).abs() < 1e-12);
+//! // ∂f/∂w0 at z = 1 (slot 6 of DERIVATIVE_NAMES): a larger w0 leaves more dark energy at z = 1,
+//! // so a lower Ω_m(z) and a lower f.
+//! assert!(f.d[6] < 0.0);
+//! # Ok::<(), pt_spectra::error::Error>(())
+//! ```
 
 use super::{Amplitude, Cosmology, Neutrinos, EV_PER_OMEGA_NU};
 use crate::dual::{Dual, Real};
@@ -13,7 +29,7 @@ use crate::error::{Error, Result};
 
 /// The sampled parameters the cosmological derivatives are taken with respect to, in the order of
 /// the derivative slots of [`CosmoDual`]: h, ω_b = Ω_b h², ω_cdm = Ω_cdm h², ln(10¹⁰ A_s), n_s,
-/// Σm_ν [eV], w0, wa.
+/// Σm_ν \[eV\], w0, wa.
 pub const DERIVATIVE_NAMES: [&str; 8] = [
     "h",
     "omega_b",
@@ -44,7 +60,7 @@ pub struct Background<T> {
     pub h: T,
     /// ω_b = Ω_b h².
     pub omega_b_h2: T,
-    /// Σm_ν [eV].
+    /// Σm_ν \[eV\].
     pub m_nu: T,
     /// w0.
     pub w0: T,

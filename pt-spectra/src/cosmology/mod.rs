@@ -24,6 +24,12 @@
 //!   with D_md the growing mode normalised to a deep in matter domination: on super-horizon scales in
 //!   matter domination Φ = (3/5)ζ, and the Poisson equation k²Φ = (3/2) Ω_m H0² δ/a gives
 //!   δ = (2/5) ζ (k/H0)² D_md/Ω_m, times T(k) on smaller scales.
+//! * Exact derivatives: the expansion, the growth and the distances ([`distance`]) are written once
+//!   over a [`Real`](crate::dual::Real) type, as methods of [`background::Background`]; the
+//!   [`Cosmology`] methods run them on `f64` ([`Cosmology::background`]), and on the
+//!   [`Dual`](crate::dual::Dual)s of [`Cosmology::seeded`] they give the exact derivatives with
+//!   respect to the sampled parameters h, ω_b, ω_cdm, ln(10¹⁰A_s), n_s, Σm_ν, w0, wa (the ODE's on its
+//!   mesh, see the growth module's code docs).
 //! * Presets [`PRESETS`] ([`Cosmology::preset`]), and CLASS or CAMB parameter files ([`ini`]:
 //!   [`Cosmology::from_ini_file`], [`Cosmology::from_name_or_file`]).
 //!
@@ -48,6 +54,8 @@ pub const PRESETS: [&str; 2] = ["gm2012", "planck2018"];
 pub mod background;
 pub mod distance;
 mod eisenstein_hu;
+#[cfg(test)]
+pub(crate) mod finite_difference;
 mod growth;
 pub mod ini;
 pub mod neutrinos;
@@ -327,7 +335,8 @@ impl Cosmology {
                  at early times, where the growth starts in matter domination",
             );
         }
-        if (1..=1000).any(|i| self.a2e2(f64::from(i) / 1000.0) <= 0.0) {
+        let background = self.background();
+        if (1..=1000).any(|i| background.a2e2(f64::from(i) / 1000.0) <= 0.0) {
             return bad(
                 "Omega_k",
                 self.omega_k(),

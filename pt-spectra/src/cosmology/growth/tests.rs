@@ -327,3 +327,81 @@ fn growth_factor_and_rate_equals_the_separate_calls() {
         assert!(d.is_nan() && f.is_nan());
     }
 }
+
+/// The exact (dual) derivatives of E(z), D_md(z), f(z) and D(z)/D(0) with respect to the eight sampled
+/// parameters against Richardson-extrapolated finite differences of the `f64` path, at ΛCDM, w0–wa,
+/// open, closed and massless-neutrino cosmologies (`finite_difference`; E here is without radiation,
+/// so the Σm_ν = 0 case is differentiated from above).
+#[test]
+fn dual_growth_derivatives_match_finite_differences() {
+    use crate::cosmology::finite_difference::{check_derivatives, derivative_cosmologies};
+    for (label, c) in derivative_cosmologies() {
+        check_derivatives(
+            label,
+            &c,
+            &["E", "D_md", "f", "D/D(0)"],
+            |b, z| {
+                let (d_md, f) = b.growth_md_and_rate(z);
+                vec![b.e_of_z(z), d_md, f, b.growth_factor_and_rate(z).0]
+            },
+            |c, z| {
+                let (d_md, f) = c.growth_md_and_rate(z);
+                vec![c.e_of_z(z), d_md, f, c.growth_factor_and_rate(z).0]
+            },
+            false,
+        );
+    }
+}
+
+/// At a cosmological constant the seeded background (w0, wa carry derivatives) takes the ODE, whose
+/// values equal Heath's integral of the `f64` path; with w0, wa constant the duals take Heath's
+/// integral too, and its derivatives equal the ODE's.
+#[test]
+fn dual_growth_at_lambda_equals_heath() {
+    /// The ODE's global error (~1e-11), with a margin.
+    const HEATH_TOL: f64 = 1e-9;
+    let c = Cosmology::planck2018().with_neutrinos(0.06).unwrap();
+    let seeded = c.seeded().unwrap();
+    assert_eq!(c.method(), Method::Heath);
+    assert_eq!(seeded.method(), Method::Ode);
+    let constant_de = crate::cosmology::background::Background {
+        w0: Real::cst(-1.0),
+        wa: Real::cst(0.0),
+        ..seeded
+    };
+    assert_eq!(constant_de.method(), Method::Heath);
+    let mut worst = [0.0_f64; 2];
+    // Per z: (ODE, Heath) duals of D_md, f, D/D(0).
+    let mut pairs = Vec::new();
+    for z in [0.0, 0.5, 1.0, 2.0, 10.0] {
+        let (d_md, f) = c.growth_md_and_rate(z);
+        let d = c.growth_factor(z);
+        let (dual_md, dual_f) = seeded.growth_md_and_rate(z);
+        let dual_d = seeded.growth_factor_and_rate(z).0;
+        for (dual, heath) in [(dual_md, d_md), (dual_f, f), (dual_d, d)] {
+            worst[0] = worst[0].max(rel(dual.v, heath));
+        }
+        let (heath_md, heath_f) = constant_de.growth_md_and_rate(z);
+        let heath_d = constant_de.growth_factor_and_rate(z).0;
+        for (ode, heath) in [(dual_md, heath_md), (dual_f, heath_f), (dual_d, heath_d)] {
+            assert!(rel(heath.v, ode.v) < HEATH_TOL, "z {z}");
+        }
+        pairs.push([(dual_md, heath_md), (dual_f, heath_f), (dual_d, heath_d)]);
+    }
+    // Heath's integral has no w0, wa derivatives: the first six, relative to their largest over z.
+    for q in 0..3 {
+        let scale = pairs.iter().fold(0.0_f64, |s, p| {
+            p[q].1.d[..6].iter().fold(s, |s, d| s.max(d.abs()))
+        });
+        for p in &pairs {
+            for (a, b) in p[q].0.d.iter().zip(&p[q].1.d).take(6) {
+                worst[1] = worst[1].max((a - b).abs() / scale);
+            }
+        }
+    }
+    println!(
+        "Λ: dual ODE vs f64 Heath, worst relative {:.1e}; derivatives of the ODE vs Heath's {:.1e}",
+        worst[0], worst[1]
+    );
+    assert!(worst.iter().all(|&w| w < HEATH_TOL), "{worst:?}");
+}
