@@ -35,7 +35,6 @@
 
 mod format;
 use format::HeadOf;
-mod growth_placeholder;
 mod nodes;
 pub mod prior;
 pub mod tangent;
