@@ -283,6 +283,57 @@ impl<const N: usize> MulAssign for Dual<N> {
     }
 }
 
+/// A [`Real`] seen as [`LANES`](Self::LANES) plain numbers: its value and its derivatives.
+///
+/// A map that is linear with constant coefficients acts on each lane alone (the map of the value is
+/// the value of the map, the map of a derivative its derivative), so such a map (stored vectors
+/// weighted by computed coefficients, an interpolation through computed node values) runs lane by
+/// lane in plain `f64` code: vectorised, and on `f64` exactly the code without derivatives.
+///
+/// ```
+/// use pt_spectra::dual::{Dual, Lanes};
+/// let x = Dual::<2>::new(3.0, [1.0, -2.0]);
+/// assert_eq!((0..Dual::<2>::LANES).map(|l| x.lane(l)).collect::<Vec<_>>(), [3.0, 1.0, -2.0]);
+/// let doubled = Dual::<2>::from_lanes(|l| 2.0 * x.lane(l));
+/// assert_eq!(doubled, x * 2.0);
+/// ```
+pub trait Lanes: Real {
+    /// The number of lanes: 1 for `f64`, 1 + N for [`Dual<N>`].
+    const LANES: usize;
+    /// Lane `l`: the value for `l` = 0, the derivative `l` − 1 after it.
+    fn lane(&self, l: usize) -> f64;
+    /// The number whose lane `l` is `f(l)`, for `l` in 0..[`LANES`](Self::LANES) in order.
+    fn from_lanes(f: impl FnMut(usize) -> f64) -> Self;
+}
+
+impl Lanes for f64 {
+    const LANES: usize = 1;
+    fn lane(&self, _: usize) -> f64 {
+        *self
+    }
+    fn from_lanes(mut f: impl FnMut(usize) -> f64) -> Self {
+        f(0)
+    }
+}
+
+impl<const N: usize> Lanes for Dual<N> {
+    const LANES: usize = 1 + N;
+    fn lane(&self, l: usize) -> f64 {
+        if l == 0 {
+            self.v
+        } else {
+            self.d[l - 1]
+        }
+    }
+    fn from_lanes(mut f: impl FnMut(usize) -> f64) -> Self {
+        let v = f(0);
+        Self {
+            v,
+            d: std::array::from_fn(|j| f(j + 1)),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::{Dual, Real};

@@ -19,10 +19,12 @@
 //!   caller when this happens so that it can warn.
 
 mod grid;
+mod interpolant;
 pub(crate) mod spline;
 
 use crate::error::{Error, Result};
 pub use grid::LogGrid;
+pub use interpolant::NodeInterpolant;
 pub(crate) use spline::simpson;
 use spline::{LogSpline, PowerLaw};
 use std::f64::consts::PI;

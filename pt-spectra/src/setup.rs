@@ -312,7 +312,7 @@ fn emulate(emulator: &LinearEmulator, c: &Cosmology, z: f64) -> Result<Emulated>
     ];
     let cb = if c.m_nu > 0.0 {
         let cb = e.cb()?;
-        let f_of_k = LinearSpectrum::from_nodes(e.k.clone(), e.f_cb.clone())?;
+        let f_of_k = e.growth_rate_cb()?;
         let f = f_of_k.eval(K_GROWTH_RATE);
         description.push(format!(
             "massive neutrinos: P_cb (cold dark matter + baryons) emulated too (error {:.1e}): the \

@@ -1,5 +1,7 @@
+use super::nodes::lagrange;
 use super::*;
 use crate::cosmology::{Amplitude, Neutrinos};
+use crate::error::Error;
 
 /// One held-out CAMB cosmology of `tests/data/emulator_heldout.dat`.
 struct Heldout {

@@ -75,6 +75,28 @@ impl LogSpline {
         (self.x[0], self.x[self.x.len() - 1])
     }
 
+    /// The spline of other values `y` at the same nodes (the same not-a-knot rule: linear in `y`).
+    pub(super) fn with_values(&self, y: Vec<f64>) -> Self {
+        debug_assert_eq!(y.len(), self.x.len());
+        let m = not_a_knot_second_derivatives(&self.x, &y);
+        Self {
+            x: self.x.clone(),
+            y,
+            m,
+            inv_dx: self.inv_dx,
+        }
+    }
+
+    /// dy/dx for x inside [x_0, x_{n−1}]: (y_{i+1} − y_i)/h + ((3b² − 1) y''_{i+1} − (3a² − 1) y''_i) h/6.
+    pub(super) fn derivative(&self, x: f64) -> f64 {
+        let i = self.interval(x);
+        let h = self.x[i + 1] - self.x[i];
+        let a = (self.x[i + 1] - x) / h;
+        let b = 1.0 - a;
+        (self.y[i + 1] - self.y[i]) / h
+            + ((3.0 * b * b - 1.0) * self.m[i + 1] - (3.0 * a * a - 1.0) * self.m[i]) * h / 6.0
+    }
+
     /// y(x) for x inside [x_0, x_{n−1}].
     pub(crate) fn eval(&self, x: f64) -> f64 {
         let i = self.interval(x);
@@ -157,14 +179,10 @@ pub(super) struct PowerLaw {
 impl PowerLaw {
     /// Least-squares slope of y = ln P against x = ln k, anchored at node `anchor` of the slices.
     pub(super) fn fit(x: &[f64], y: &[f64], anchor: usize) -> Self {
-        let n = x.len() as f64;
-        let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
-        let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
-        let sxx: f64 = x.iter().map(|a| (a - mx).powi(2)).sum();
         Self {
             k0: x[anchor].exp(),
             p0: y[anchor].exp(),
-            slope: sxy / sxx,
+            slope: least_squares_slope(x, y),
             ln_k0: x[anchor],
         }
     }
@@ -178,6 +196,15 @@ impl PowerLaw {
     pub(super) fn eval_ln(&self, x: f64) -> f64 {
         self.p0 * (self.slope * (x - self.ln_k0)).exp()
     }
+}
+
+/// The least-squares slope of y against x (linear in y).
+pub(super) fn least_squares_slope(x: &[f64], y: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = x.iter().map(|a| (a - mx).powi(2)).sum();
+    sxy / sxx
 }
 
 /// Composite Simpson rule for ∫_a^b f(x) dx with `n` (rounded up to even, ≥ 4) intervals.
@@ -225,6 +252,22 @@ mod tests {
         let s = LogSpline::new(x.clone(), y);
         for t in [0.0, 0.37, 3.3, 7.77, 11.0, x[11]] {
             assert!((s.eval(t) - cubic(t)).abs() < 1e-10, "t = {t}");
+        }
+    }
+
+    /// The derivative of a cubic, and the spline of other values at the same nodes, are exact.
+    #[test]
+    fn derivative_and_other_values_are_exact_for_cubics() {
+        let x: Vec<f64> = (0..9)
+            .map(|i| f64::from(i) * 0.3 + 0.01 * f64::from(i % 3))
+            .collect();
+        let s = LogSpline::new(x.clone(), x.iter().map(|t| t.sin()).collect());
+        let cubic = |t: f64| 0.5 + t - 0.7 * t * t + 0.2 * t * t * t;
+        let d_cubic = |t: f64| 1.0 - 1.4 * t + 0.6 * t * t;
+        let c = s.with_values(x.iter().map(|&t| cubic(t)).collect());
+        for t in [0.0, 0.4, 1.3, 2.0, x[8]] {
+            assert!((c.eval(t) - cubic(t)).abs() < 1e-12, "t = {t}");
+            assert!((c.derivative(t) - d_cubic(t)).abs() < 1e-11, "t = {t}");
         }
     }
 
