@@ -28,7 +28,8 @@
 //! Derivatives, all exact (no finite differences): [`CosmologyStep::jacobian`] with respect to the
 //! nuisance parameters and f ([`JACOBIAN_NAMES`]; f through the model's μ² polynomials and the BAO
 //! damping), [`CosmologyStep::template_jacobian`] with respect to f, α∥, α⊥ (the AP projection's
-//! interpolant, damping and volume factor). The cosmological parameters' are not built.
+//! interpolant, damping and volume factor), [`Pipeline::cosmology_jacobian`] with respect to the
+//! sampled cosmological parameters (through the emulator, the growth, the loops, AP: [`cosmological`]).
 
 use crate::cosmology::Cosmology;
 use crate::emulator::LinearEmulator;
@@ -42,10 +43,12 @@ use crate::setup::{LinearSource, NamedCosmology, Prepared, Request};
 use crate::store::TableStore;
 use crate::survey::observe::{apply_matrix, Observation};
 
+mod cosmological;
 mod linearised;
 pub mod loop_range;
 use crate::bispectrum::block::{bispectrum_params, PlannedBispectrum};
 pub use crate::bispectrum::block::{BispectrumBlock, BISPECTRUM_NAMES};
+pub use cosmological::CosmologyJacobian;
 pub use linearised::{Linearised, JACOBIAN_NAMES, NUISANCE_NAMES};
 
 /// The largest smoothed projection residual for which a [`Pipeline`] evaluates the loop terms on the

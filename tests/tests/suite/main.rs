@@ -15,6 +15,7 @@ mod bias;
 mod bins;
 mod bispectrum_one_loop;
 mod bispectrum_reference;
+mod cosmology_jacobian;
 mod cospt;
 mod eft;
 mod ept;

@@ -20,13 +20,13 @@ use pt_spectra::survey::observe::{Observation, Window};
 use pt_spectra::survey::{Mixing, WindowFormat};
 use std::sync::OnceLock;
 
-const Z: f64 = 0.57;
+pub(crate) const Z: f64 = 0.57;
 /// The observation matrix against the window's own steps: 3.9e-8 of the largest element measured
 /// (the window's transform is linear up to its tail treatment, rounding aside), plus the loop range's
 /// change (≤ 1e-5 of a multipole's largest value, 1.6e-6 of P4's measured); the brief's bound.
 const ROUNDING: f64 = 1e-6;
 
-fn observation() -> Observation {
+pub(crate) fn observation() -> Observation {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../examples/data/boss_dr12_cmass_ngc/window_BOSS_CMASS_NGC_z057.dat"
@@ -38,17 +38,17 @@ fn observation() -> Observation {
     Observation::new(&[0, 2, 4], &k, Some(window), None).unwrap()
 }
 
-fn precision() -> Precision {
+pub(crate) fn precision() -> Precision {
     let mut p = Precision::preset("fast").unwrap();
     p.two_loop = TwoLoopMethod::Basis;
     p
 }
 
-fn store() -> TableStore {
+pub(crate) fn store() -> TableStore {
     TableStore::new(concat!(env!("CARGO_TARGET_TMPDIR"), "/pipeline-store"))
 }
 
-fn fiducial() -> Cosmology {
+pub(crate) fn fiducial() -> Cosmology {
     Cosmology::flat(0.31, 0.676, 0.022, 0.97, 0.80).unwrap()
 }
 
@@ -56,7 +56,7 @@ fn truth() -> Cosmology {
     Cosmology::flat(0.295, 0.69, 0.0226, 0.955, 0.83).unwrap()
 }
 
-fn pipeline() -> &'static Pipeline {
+pub(crate) fn pipeline() -> &'static Pipeline {
     static P: OnceLock<Pipeline> = OnceLock::new();
     P.get_or_init(|| {
         let settings = PipelineSettings::ept(Z, Some(fiducial()));
@@ -64,7 +64,7 @@ fn pipeline() -> &'static Pipeline {
     })
 }
 
-const PARAMS: [(&str, f64); 8] = [
+pub(crate) const PARAMS: [(&str, f64); 8] = [
     ("b1", 2.1),
     ("b2", -0.4),
     ("bs", 0.3),
@@ -75,7 +75,7 @@ const PARAMS: [(&str, f64); 8] = [
     ("sn2", -800.0),
 ];
 
-fn max_abs(v: &[f64]) -> f64 {
+pub(crate) fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |a, x| a.max(x.abs()))
 }
 

@@ -139,18 +139,17 @@ impl LowRank {
         self.rank
     }
 
-    /// V s for the products `s` in f32 (summed in f32 partial sums, as [`dot_f32`]), in f32.
-    pub(crate) fn reduce_single(&self, s: &[f32]) -> Vec<f32> {
-        let mut z = vec![0.0; self.rank];
-        matvec_f32(&self.v, &s[..self.columns], &mut z);
-        z.into_iter().map(|z| z as f32).collect()
-    }
-
-    /// Every row of U z (z = [`reduce_single`](Self::reduce_single)), summed as [`dot_f32`].
-    pub(crate) fn expand_single(&self, z: &[f32]) -> Vec<f64> {
-        let mut out = vec![0.0; self.rows];
-        matvec_f32(&self.u, z, &mut out);
-        out
+    /// U (V s) for the products `s`: the stored (f32) factors applied in f64 arithmetic ([`dot32`]),
+    /// so that the result is a fixed linear map of `s` to f64 rounding: smooth in the spectrum, as
+    /// the exact derivatives of the pipeline ([`crate::rsd::ept::tangent`]) and their finite-difference
+    /// checks need (rounding `s` and V s to f32, as this once did, left ~1e-7 of noise on every term,
+    /// which steps in the parameters of 1% turned into 1e-5 of a derivative).
+    pub(crate) fn apply(&self, s: &[f64]) -> Vec<f64> {
+        let z = self.reduce(s);
+        self.u
+            .chunks_exact(self.rank)
+            .map(|ui| dot32(ui, &z))
+            .collect()
     }
 
     /// V s for the products `s` in f64 (summed in f64, [`dot32`]).

@@ -179,12 +179,12 @@ impl OneLoopBasis {
         let n = c.len();
         let n_err = error_functions(n);
         let pairs_err = n_err * (n_err + 1) / 2;
-        let (_, s2_single) = pair_products_both(c);
+        let (s2, s2_single) = pair_products_both(c);
         let eps = projection.residual;
         let nk = self.k.len();
         // Every row at once (one detection of the instructions for all): P22 and its quadrature
         // difference (an error estimate, summed in f32 too), the P13 and σ_d² forms.
-        let p22_values = self.p22.expand_single(&self.p22.reduce_single(&s2_single));
+        let p22_values = self.p22.apply(&s2);
         let scale = self.p22.norm(c);
         let mut p22_diffs = vec![0.0; 3 * nk];
         crate::simd::matvec_f32(&self.p22_diff, &s2_single[..pairs_err], &mut p22_diffs);

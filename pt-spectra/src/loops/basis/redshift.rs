@@ -207,10 +207,8 @@ impl RedshiftBasis {
         let c = &projection.coefficients;
         let n = c.len();
         let pairs_err = error_functions(n) * (error_functions(n) + 1) / 2;
-        let (_, s2_single) = pair_products_both(c);
-        let values = self
-            .pairs
-            .expand_single(&self.pairs.reduce_single(&s2_single));
+        let (s2, s2_single) = pair_products_both(c);
+        let values = self.pairs.apply(&s2);
         let mut diffs = vec![0.0; values.len()];
         if quadrature {
             crate::simd::matvec_f32(&self.pairs_diff, &s2_single[..pairs_err], &mut diffs);

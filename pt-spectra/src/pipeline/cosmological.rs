@@ -1,0 +1,150 @@
+//! The exact derivatives of the data vector with respect to the sampled cosmological parameters
+//! ([`DERIVATIVE_NAMES`]: h, ω_b, ω_cdm, ln(10¹⁰A_s), n_s, Σm_ν, w0, wa), by the chain rule through
+//! every stage, with no finite differences:
+//!
+//! dD/dθ = M [∂m/∂P · dP/dθ] + ∂D/∂f · df/dθ + ∂D/∂α∥ · dα∥/dθ + ∂D/∂α⊥ · dα⊥/dθ,
+//!
+//! - dP/dθ and df/dθ: the emulated tracer spectrum and its growth rate over dual numbers
+//!   ([`crate::emulator::LinearEmulator::tracer_tangent`]: the principal components' polynomials, the
+//!   growth ODE, the drag horizon that places the nodes, the spline through them);
+//! - ∂m/∂P · δP: the loop terms' and multipoles' tangent along δP ([`crate::rsd::ept::tangent`]: the
+//!   basis terms are quadratic in the spectrum, Σ²'s damping written out), then the observation
+//!   matrix M;
+//! - ∂D/∂f, ∂D/∂α: the template derivatives ([`CosmologyStep::template_jacobian`]);
+//! - dα/dθ: α∥ = H_fid/H, α⊥ = D_M/D_M,fid over dual numbers ([`crate::rsd::ap::ap_parameters`]).
+//!
+//! A given `f` (a template fit's free growth rate) is a nuisance parameter: f's column then does
+//! not enter the cosmological ones.
+
+use super::{CosmologyStep, Pipeline};
+use crate::cosmology::background::{CosmoDual, DERIVATIVE_NAMES, N_DERIVATIVES};
+use crate::cosmology::Cosmology;
+use crate::dual::Real;
+use crate::error::{Error, Result};
+use crate::rsd::ap::{ap_parameters, Distortion};
+
+/// The data vector of one cosmology with its exact derivatives.
+#[derive(Debug, Clone)]
+pub struct CosmologyJacobian {
+    /// The data vector ([`Pipeline::len`]).
+    pub data_vector: Vec<f64>,
+    /// d(data vector)/dθ for θ in [`DERIVATIVE_NAMES`], one column each.
+    pub cosmological: Vec<Vec<f64>>,
+    /// The growth rate f used (the cosmology's, or the one given) with its derivatives (zero for a
+    /// given f).
+    pub growth_rate: CosmoDual,
+    /// α∥ and α⊥ of the cosmology against the fiducial with their derivatives (`None` without
+    /// fiducial).
+    pub ap: Option<(CosmoDual, CosmoDual)>,
+}
+
+impl CosmologyJacobian {
+    /// The names of [`Self::cosmological`]'s columns.
+    pub fn names(&self) -> &'static [&'static str] {
+        &DERIVATIVE_NAMES
+    }
+}
+
+impl Pipeline {
+    /// The data vector of `cosmology` (through the emulator) at the nuisance parameters `params`
+    /// (by name, as [`Self::evaluate`]; `f` defaults to f(z) of the cosmology) and its exact
+    /// derivatives with respect to [`DERIVATIVE_NAMES`] (module docs). The nuisance parameters'
+    /// derivatives are [`CosmologyStep::jacobian`]'s.
+    ///
+    /// # Errors
+    /// As [`Self::evaluate`]; [`Error::InvalidChoice`] for a cosmology normalised by σ8, a pipeline
+    /// with a bispectrum block or without basis tensors, or a spectrum outside the basis's span (the
+    /// direct integrals have no exact derivative).
+    pub fn cosmology_jacobian(
+        &self,
+        cosmology: &Cosmology,
+        params: &[(&str, f64)],
+    ) -> Result<CosmologyJacobian> {
+        if self.bispectrum.is_some() {
+            return Err(Error::InvalidChoice {
+                what: "the cosmological derivatives of a pipeline with a bispectrum block".into(),
+                reason: "they are built for the power spectrum only".into(),
+            });
+        }
+        let z = self.settings.z;
+        let seeded = cosmology.seeded()?;
+        let tangent = self.emulator.tracer_tangent(cosmology, z)?;
+        let f = match params.iter().find(|(n, _)| *n == "f") {
+            Some(&(_, f)) => CosmoDual::cst(f),
+            None => tangent.growth_rate(),
+        };
+        let ap = match &self.settings.fiducial {
+            Some(fid) => Some(ap_parameters(&seeded, fid, z)?),
+            None => None,
+        };
+        // the values of the f64 path (the duals' can differ in the last bits)
+        let distortion = match &self.settings.fiducial {
+            Some(fid) => Some(Distortion::from_cosmologies(cosmology, fid, z)?),
+            None => None,
+        };
+        let spectrum = tangent.spectrum();
+        let step = self.step_with(spectrum, f.value(), distortion)?;
+        let data_vector = step.data_vector(params)?;
+        let mut cosmological = self.spectrum_columns(&step, &tangent, params)?;
+        // f and the AP parameters by the chain rule.
+        let [d_f, d_apar, d_aperp] = if self.settings.fiducial.is_some() {
+            step.template_jacobian(params)?
+        } else {
+            let p = step.params(params)?;
+            let (_, mut df) = step.data_vectors_and_df_of(&[], std::slice::from_ref(&p))?;
+            let zero = vec![0.0; data_vector.len()];
+            [df.remove(0), zero.clone(), zero]
+        };
+        let (dapar, daperp) = ap.map_or(([0.0; N_DERIVATIVES], [0.0; N_DERIVATIVES]), |(a, b)| {
+            (a.d, b.d)
+        });
+        for (j, column) in cosmological.iter_mut().enumerate() {
+            for (i, c) in column.iter_mut().enumerate() {
+                *c += d_f[i] * f.d[j] + d_apar[i] * dapar[j] + d_aperp[i] * daperp[j];
+            }
+        }
+        Ok(CosmologyJacobian {
+            data_vector,
+            cosmological,
+            growth_rate: f,
+            ap,
+        })
+    }
+
+    /// M ∂m/∂P · dP/dθ_j for every j: the multipoles' tangents along the spectrum's derivatives.
+    fn spectrum_columns(
+        &self,
+        step: &CosmologyStep<'_>,
+        tangent: &crate::emulator::TracerTangent,
+        params: &[(&str, f64)],
+    ) -> Result<Vec<Vec<f64>>> {
+        let Some((lattice, grid)) = self.plan.tangent_nodes() else {
+            return Err(Error::InvalidChoice {
+                what: "the cosmological derivatives of a pipeline without basis tensors".into(),
+                reason: "the loop terms' derivative is built on the basis".into(),
+            });
+        };
+        let (on_lattice, on_grid) = (tangent.eval_many(&lattice), tangent.eval_many(grid));
+        let column = |values: &[CosmoDual], j: usize| -> Vec<f64> {
+            values.iter().map(|v| v.d[j]).collect()
+        };
+        let tangents = (0..N_DERIVATIVES)
+            .map(|j| {
+                self.plan.terms_tangent(
+                    tangent.spectrum(),
+                    &column(&on_lattice, j),
+                    &column(&on_grid, j),
+                )
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let p = step.params(params)?;
+        let multipoles = self.plan.multipole_tangents(
+            &step.terms,
+            &tangents,
+            &p,
+            self.observation.model_ells(),
+            step.ap,
+        )?;
+        Ok(multipoles.iter().map(|m| self.observe(m)).collect())
+    }
+}
