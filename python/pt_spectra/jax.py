@@ -8,9 +8,9 @@ to JAX, so that the functions below work under ``jax.jit``, ``jax.grad``, ``jax.
 - :func:`log_likelihood`: ln L(x) of a :class:`pt_spectra.AnalysisLikelihood` (the likelihood of an
   analysis file: data sets summed, the linear parameters marginalised analytically, every prior of
   the file included), x in the order of its ``names``; the gradient is the library's exact one.
-- :func:`data_vector`: the data vector of a :class:`pt_spectra.Pipeline` at one cosmology or linear
-  spectrum as a function of its nuisance parameters and f (by name); the Jacobian is the pipeline's
-  exact one (``pipeline(..., jacobian=True)``).
+- :func:`data_vector`: the data vector of a :class:`pt_spectra.Pipeline` as a function of its
+  nuisance parameters, f and the sampled cosmological parameters (by name); the Jacobian is the
+  pipeline's exact one (``pipeline(..., jacobian=True)``, ``pipeline.cosmology_jacobian``).
 
 Each is a ``jax.custom_jvp`` around ``jax.pure_callback``: the value and the derivative are computed
 by the library on the host (one core; not traced, not on an accelerator), the tangent is linear in
@@ -19,9 +19,8 @@ member. The library computes in float64: enable JAX's 64-bit mode first
 (``jax.config.update("jax_enable_x64", True)``, or ``numpyro.enable_x64()``); building a function
 without it raises ``ValueError``.
 
-Not yet differentiable here: the cosmological parameters through the emulator (the pipeline's
-Jacobian covers the nuisance parameters and f; ``Pipeline.template_jacobian`` gives f, α∥, α⊥), and
-likelihoods with a bispectrum (their gradient is not exact; :func:`log_likelihood` refuses them).
+Not differentiable here: likelihoods and pipelines with a bispectrum (their gradient is not
+exact; both functions refuse them).
 
 JAX is an optional dependency: ``pip install "./python[jax]"`` (jax; numpyro for the example
 ``examples/nuts_vs_cobaya.py``).
@@ -114,19 +113,28 @@ def log_likelihood(likelihood):
 def data_vector(pipeline, names, cosmology=None, linear=None, z_input=None, **fixed):
     """The data vector of ``pipeline`` (a :class:`pt_spectra.Pipeline` without a bispectrum block)
     at one cosmology or linear spectrum (``cosmology``, ``linear``, ``z_input`` as a call takes them)
-    as a JAX function of the values of ``names`` (a vector in that order; names from
-    ``pipeline.nuisance``: the nuisance parameters and f), the other parameters fixed by ``fixed``
-    (by name; unset nuisance parameters are 0, f defaults to f(z)), with its exact Jacobian.
+    as a JAX function of the values of ``names`` (a vector in that order), the other parameters
+    fixed by ``fixed`` (by name; unset nuisance parameters are 0, f defaults to f(z)), with its
+    exact Jacobian.
 
-    Raises ``ValueError`` if JAX's 64-bit mode is off, a name is not one of ``pipeline.nuisance`` or
-    repeated, or a name is both free and fixed.
+    ``names`` are from ``pipeline.nuisance`` (the nuisance parameters and f) and from
+    ``pipeline.cosmological_parameters`` (h, omega_b, omega_cdm, ln10^{10}A_s, n_s, m_nu, w0, wa:
+    through the emulator, the growth, the loops, AP; ``Pipeline.cosmology_jacobian``). With
+    cosmological names, ``cosmology`` is a dict of CLASS names (the values of the names not free,
+    e.g. ``{"h": 0.68, "omega_b": 0.0224, "omega_cdm": 0.12, "ln10^{10}A_s": 3.04, "n_s": 0.965}``)
+    and ``linear`` is not given; f, unless free or fixed, follows the cosmology.
+
+    Raises ``ValueError`` if JAX's 64-bit mode is off, a name is unknown or repeated, a name is both
+    free and fixed, or a free cosmological parameter is also spelled otherwise in ``cosmology``
+    (e.g. ``H0`` with ``h`` free).
     """
     _require_x64()
-    allowed = list(pipeline.nuisance)
+    nuisance = list(pipeline.nuisance)
+    sampled = list(pipeline.cosmological_parameters)
     names = list(names)
-    unknown = [n for n in names if n not in allowed]
+    unknown = [n for n in names if n not in nuisance + sampled]
     if unknown or len(set(names)) != len(names):
-        raise ValueError(f"data_vector: names must be distinct, from {', '.join(allowed)}"
+        raise ValueError(f"data_vector: names must be distinct, from {', '.join(nuisance + sampled)}"
                          + (f"; unknown: {', '.join(unknown)}" if unknown else ""))
     both = sorted(set(names) & set(fixed))
     if both:
@@ -134,19 +142,48 @@ def data_vector(pipeline, names, cosmology=None, linear=None, z_input=None, **fi
     if pipeline.meta["bispectrum"]:
         raise ValueError("data_vector: the pipeline has a bispectrum block, whose Jacobian is not "
                          "exact; build the pipeline without triangles")
-    rows = [allowed.index(n) for n in names]
-    where = dict(cosmology=cosmology, linear=linear, z_input=z_input)
-    m = len(pipeline(**where, **fixed))
+    free_cosmology = [n for n in names if n in sampled]
+    if free_cosmology:
+        if linear is not None or not isinstance(cosmology, dict):
+            raise ValueError("data_vector: free cosmological parameters need `cosmology` as a dict "
+                             "of CLASS names (and no `linear`)")
+        spellings = {"h": ("H0", "hubble"), "omega_b": ("Omega_b", "ombh2"),
+                     "omega_cdm": ("Omega_cdm", "omch2"),
+                     "ln10^{10}A_s": ("A_s", "As", "scalar_amp(1)", "sigma8"),
+                     "n_s": ("ns", "scalar_spectral_index(1)"),
+                     "m_nu": ("mnu", "m_ncdm", "omnuh2"), "w0": ("w0_fld", "w"), "wa": ("wa_fld",)}
+        clash = [f"{o} (with {n} free)" for n in free_cosmology for o in spellings[n] if o in cosmology]
+        if clash:
+            raise ValueError(f"data_vector: cosmology also gives {', '.join(clash)}: spell the free "
+                             "parameters by their CLASS names only")
+    nuisance_rows = [(i, nuisance.index(n)) for i, n in enumerate(names) if n in nuisance]
+    cosmology_rows = [(i, sampled.index(n)) for i, n in enumerate(names) if n in sampled]
 
-    def params(x):
-        return {**fixed, **{n: float(v) for n, v in zip(names, np.asarray(x, dtype=float))}}
+    def split(x):
+        x = np.asarray(x, dtype=float)
+        params = {**fixed, **{names[i]: float(x[i]) for i, _ in nuisance_rows}}
+        if not free_cosmology:
+            return cosmology, params
+        return {**cosmology, **{names[i]: float(x[i]) for i, _ in cosmology_rows}}, params
+
+    where = dict(linear=linear, z_input=z_input)
+    m = len(pipeline(cosmology=cosmology, **where, **fixed))
 
     def value(x):
-        return np.asarray(pipeline(**where, **params(x)), dtype=np.float64)
+        c, params = split(x)
+        return np.asarray(pipeline(cosmology=c, **where, **params), dtype=np.float64)
 
     def value_and_jacobian(x):
-        v, j = pipeline(**where, jacobian=True, **params(x))
-        return np.asarray(v, dtype=np.float64), np.asarray(j, dtype=np.float64)[rows]
+        c, params = split(x)
+        jacobian = np.zeros((len(names), m))
+        v, j = pipeline(cosmology=c, **where, jacobian=True, **params)
+        for i, r in nuisance_rows:
+            jacobian[i] = j[r]
+        if cosmology_rows:
+            v, j = pipeline.cosmology_jacobian(c, **params)
+            for i, r in cosmology_rows:
+                jacobian[i] = j[r]
+        return np.asarray(v, dtype=np.float64), jacobian
 
     function = _host_function(value, value_and_jacobian, (m,), (len(names), m), len(names),
                               "data_vector")

@@ -339,6 +339,38 @@ impl Pipeline {
         Ok(PyArray2::from_vec2(py, &rows)?)
     }
 
+    /// The data vector at `cosmology` (a preset, an ini file or a dict of CLASS/CAMB names, given
+    /// with A_s or ln10^{10}A_s) with the nuisance parameters by name (`f` defaults to f(z) and
+    /// then varies with the cosmology), and its exact derivatives with respect to the sampled
+    /// cosmological parameters `cosmological_parameters` (h, omega_b, omega_cdm, ln10^{10}A_s, n_s,
+    /// m_nu, w0, wa; Omega_k held): (data vector, array of shape (8, n)). Through the emulator, the
+    /// growth, the loop terms on the basis, the AP distortion, the window and bins; no finite
+    /// differences. The nuisance parameters' derivatives are `__call__(..., jacobian=True)`'s.
+    #[pyo3(signature = (cosmology, **params))]
+    fn cosmology_jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        cosmology: &Bound<'py, PyAny>,
+        params: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let params = pairs(params)?;
+        let z = self.inner.settings().z;
+        let inputs = Inputs::extract(None, z, z, Some(cosmology), None)?;
+        let (named, _) = inputs.cosmology().map_err(value_error)?;
+        let c = named.map_or_else(pt_spectra::cosmology::Cosmology::gm2012, |n| n.cosmology);
+        let named: Vec<(&str, f64)> = params.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+        let (result, _) = crate::detached(py, || self.inner.cosmology_jacobian(&c, &named))?;
+        let v = result.data_vector.into_pyarray(py).into_any();
+        let j = PyArray2::from_vec2(py, &result.cosmological)?;
+        Ok((v, j).into_pyobject(py)?.into_any())
+    }
+
+    /// The names of the rows of `cosmology_jacobian` (CLASS's names).
+    #[getter]
+    fn cosmological_parameters(&self) -> Vec<&'static str> {
+        pt_spectra::cosmology::background::DERIVATIVE_NAMES.to_vec()
+    }
+
     /// The parameter names a call takes.
     #[getter]
     fn parameters(&self) -> Vec<&'static str> {

@@ -104,3 +104,33 @@ def test_the_data_vector_refuses_unknown_or_doubled_names(pipeline):
         ptj.data_vector(pipeline, ["b1", "c0"], cosmology=COSMO)
     with pytest.raises(ValueError, match="both free"):
         ptj.data_vector(pipeline, ["b1"], cosmology=COSMO, b1=2.0)
+
+
+COSMO_AS = {"h": 0.69, "omega_b": 0.0224, "omega_cdm": 0.118, "ln10^{10}A_s": 3.0, "n_s": 0.96,
+            "m_nu": 0.06}
+
+
+def test_the_cosmological_parameters_are_differentiable_through_jax(pipeline):
+    assert pipeline.cosmological_parameters == ["h", "omega_b", "omega_cdm", "ln10^{10}A_s", "n_s",
+                                                "m_nu", "w0", "wa"]
+    names = ["b1", "h", "omega_cdm", "n_s"]
+    d = ptj.data_vector(pipeline, names, cosmology=COSMO_AS, b2=0.3, sn=900.0)
+    x = np.array([2.0, 0.69, 0.118, 0.96])
+    v, jc = pipeline.cosmology_jacobian(COSMO_AS, b1=2.0, b2=0.3, sn=900.0)
+    assert jc.shape == (8, len(v))
+    np.testing.assert_allclose(np.asarray(d(x)), v, rtol=1e-12)
+    jac = np.asarray(jax.jacfwd(d)(x))
+    np.testing.assert_allclose(jax.jacrev(d)(x), jac, rtol=1e-12, atol=0)
+    for i, name in enumerate(names[1:], start=1):
+        np.testing.assert_allclose(jac[:, i], jc[pipeline.cosmological_parameters.index(name)], rtol=1e-12)
+    # each cosmological column against fourth-order differences of the library's data vector
+    for i, h in ((1, 2e-3), (2, 1e-3), (3, 2e-3)):
+        at = [np.asarray(pipeline({**COSMO_AS, names[i]: x[i] + s * h}, b1=2.0, b2=0.3, sn=900.0))
+              for s in (-2, -1, 1, 2)]
+        diff = (at[0] - 8 * at[1] + 8 * at[2] - at[3]) / (12 * h)
+        assert np.max(np.abs(jac[:, i] - diff)) <= 1e-5 * np.abs(diff).max(), names[i]
+    # a free parameter also spelled otherwise, a sigma8 amplitude: errors
+    with pytest.raises(ValueError, match="H0"):
+        ptj.data_vector(pipeline, ["h"], cosmology={**COSMO_AS, "H0": 69.0})
+    with pytest.raises(ValueError, match="sigma8"):
+        pipeline.cosmology_jacobian(COSMO, b1=2.0)

@@ -24,18 +24,19 @@
 //! and each bin's free nuisance parameters.
 //!
 //! **Derivatives.** The nuisance parameters': exact (the data vector is a polynomial in them,
-//! [`crate::pipeline::Linearised::jacobian`]). f, α∥, α⊥ of the power spectrum alone: exact
-//! ([`crate::pipeline::CosmologyStep::template_jacobian`]). With the bispectrum, f, α∥, α⊥, and the
+//! [`crate::pipeline::Linearised::jacobian`]). f, α∥, α⊥ and the cosmological parameters of the
+//! power spectrum alone: exact ([`crate::pipeline::CosmologyStep::template_jacobian`],
+//! [`crate::pipeline::Pipeline::cosmology_jacobian`]). With the bispectrum, f, α∥, α⊥, and the
 //! cosmological parameters: central differences at steps h and h/2 combined by Richardson
 //! extrapolation, (4D(h/2) − D(h))/3, whose error, |D(h/2) − D(h)|/3, is reported relative to each
-//! derivative's largest element ([`Forecast::derivative_error`]). Exact cosmological derivatives
-//! are not built yet.
+//! derivative's largest element ([`Forecast::derivative_error`]).
 
 mod covariance;
 mod parameters;
 #[cfg(test)]
 mod tests;
 
+use crate::cosmology::background::DERIVATIVE_NAMES;
 use crate::cosmology::Cosmology;
 use crate::error::{Error, Result};
 use crate::pipeline::{Pipeline, PipelineSettings, NUISANCE_NAMES};
@@ -449,6 +450,20 @@ pub fn fisher(
                 }
                 let s8 = prepared.spectrum.sigma8();
                 fsigma8.push((s8, f0 * s8));
+            }
+            Parameters::Cosmology if !with_b => {
+                // the power spectrum alone: exact (Pipeline::cosmology_jacobian), logA being
+                // ln10^{10}A_s
+                let exact = pipeline.cosmology_jacobian(fiducial, &nuisance)?;
+                for name in COSMOLOGY_NAMES {
+                    let sampled = if name == "logA" { "ln10^{10}A_s" } else { name };
+                    let j = DERIVATIVE_NAMES
+                        .iter()
+                        .position(|n| *n == sampled)
+                        .expect("the forecast's names are sampled parameters");
+                    jacobian.push(select(&exact.cosmological[j]));
+                }
+                fsigma8.push((f64::NAN, f64::NAN));
             }
             Parameters::Cosmology => {
                 for name in COSMOLOGY_NAMES {

@@ -120,10 +120,10 @@ pub fn forecast_table(
         ));
     }
     header.push(format!(
-        "parameters: {}; derivatives of the nuisance parameters exact, of f, apar, aperp exact for \
-         the power spectrum alone, with the bispectrum and for the cosmological parameters by \
-         Richardson-extrapolated central differences (largest error {:.1e} of a derivative's largest \
-         element); {} data points",
+        "parameters: {}; derivatives of the nuisance parameters exact, of f, apar, aperp and the \
+         cosmological parameters exact for the power spectrum alone (through the emulator, growth, \
+         loops and AP), with the bispectrum by Richardson-extrapolated central differences (largest \
+         error {:.1e} of a derivative's largest element); {} data points",
         match parameters {
             Parameters::Template => "f, apar, aperp per bin (sigma(fsigma8) = sigma8(z) sigma(f))".to_string(),
             Parameters::Cosmology => format!(
