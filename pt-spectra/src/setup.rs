@@ -268,9 +268,7 @@ pub fn prepare_with_emulator(
     })
 }
 
-/// The wavenumber in h/Mpc at which the scale-dependent growth rate f_cb(k, z) of a cosmology with
-/// massive neutrinos gives the scalar f of the redshift-space models.
-pub const K_GROWTH_RATE: f64 = 0.1;
+pub use crate::emulator::K_GROWTH_RATE;
 
 /// What [`prepare`] takes from the emulator.
 struct Emulated {

@@ -49,6 +49,11 @@ pub use prior::{PriorPoint, PriorRange, COORDINATES, PARAMETER_NAMES, SHAPE_PARA
 use std::f64::consts::PI;
 pub use tangent::TracerTangent;
 
+/// The wavenumber in h/Mpc at which the scale-dependent growth rate f_cb(k, z) of a cosmology with
+/// massive neutrinos gives the scalar f of the redshift-space models ([`crate::setup::prepare`],
+/// [`LinearEmulator::tracer_tangent`]).
+pub const K_GROWTH_RATE: f64 = 0.1;
+
 /// The emulator file shipped with the library.
 const EMBEDDED: &[u8] = include_bytes!("../../data/linear_emulator.bin");
 
@@ -135,7 +140,7 @@ impl EmulatedSpectra {
 
     /// f_cb(k) as a function of k [h/Mpc], interpolated as a spectrum is (log-log spline, power laws
     /// beyond the nodes): what [`crate::setup::prepare`] evaluates at
-    /// [`K_GROWTH_RATE`](crate::setup::K_GROWTH_RATE) for the growth rate with massive neutrinos.
+    /// [`K_GROWTH_RATE`] for the growth rate with massive neutrinos.
     ///
     /// # Errors
     /// As [`LinearSpectrum::from_nodes`].

@@ -35,13 +35,13 @@
 //! ```
 
 use super::LinearEmulator;
+use super::K_GROWTH_RATE;
 #[cfg(doc)]
 use crate::cosmology::background::DERIVATIVE_NAMES;
 use crate::cosmology::background::{CosmoDual, N_DERIVATIVES};
 use crate::cosmology::Cosmology;
 use crate::error::Result;
 use crate::linear::{LinearSpectrum, NodeInterpolant};
-use crate::setup::K_GROWTH_RATE;
 
 /// The tracer spectrum and the growth rate the pipeline uses for one cosmology at one redshift
 /// ([`LinearEmulator::tracer_tangent`]), with their derivatives with respect to

@@ -43,7 +43,7 @@ use crate::setup::{LinearSource, NamedCosmology, Prepared, Request};
 use crate::store::TableStore;
 use crate::survey::observe::{apply_matrix, Observation};
 
-mod cosmological;
+pub mod cosmological;
 mod linearised;
 pub mod loop_range;
 use crate::bispectrum::block::{bispectrum_params, PlannedBispectrum};

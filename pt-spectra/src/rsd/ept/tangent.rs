@@ -6,11 +6,12 @@
 //! coefficients c = ⟨φ, ωs⟩ linear in s, the no-wiggle spectrum and Σ² linear forms of s and c, and
 //! the terms linear (P_lin, the counterterms' k²P) or bilinear (P22-, P13-type) in them. For such a
 //! polynomial the symmetric difference is exact: [T(s + εδs) − T(s − εδs)]/(2ε) = L(δs) + 2Q(s, δs)
-//! = DT[δs] for every ε, up to rounding (ε is chosen so that s ± εδs stays within 1e-3 of s). The
+//! = DT\[δs\] for every ε, up to rounding (steps of 100% of the largest |δs/s|, so that the
+//! single rounding of each term is not divided by a small ε). The
 //! multipoles are affine in the terms at fixed Σ², f and parameters, so the same difference of the
 //! two terms' μ² polynomials is their exact tangent; Σ² enters the resummation's polynomial
 //! (1 + k²Σ²[1 + f(2 + f)μ²]) Z₁² P_w and the damping e^{−k'²Σ²[…]}, whose derivatives are written
-//! out ([`super::model::DampingTangent::Sigma2`]).
+//! out (the model's `DampingTangent::Sigma2`).
 //!
 //! The direct integrals (the fallback when a spectrum does not project on the basis) are not
 //! written this way: a tangent there is refused with an error naming the residual.
@@ -23,8 +24,8 @@ use crate::linear::LinearSpectrum;
 use crate::rsd::ap::Distortion;
 
 /// The relative size of the symmetric difference's steps: s ± εδs with |εδs| ≤ this × |s|. Any size
-/// is exact for the polynomial; a large one keeps the rounding of the basis's single-precision pair
-/// sums (~1e-7 of each term) from being divided by a small ε.
+/// is exact for the polynomial; a large one keeps the rounding of each term from being divided by a
+/// small ε.
 const TANGENT_STEP: f64 = 1.0;
 
 /// The loop terms of a spectrum moved both ways along one direction ([module docs](self)).
@@ -199,9 +200,8 @@ mod tests {
     /// reproduce a line in ln k exactly, so P_t = P (k/0.05)^t node by node is the spectrum moved
     /// exactly along δP = P ln(k/0.05)), the multipoles' tangents equal a 6th-order central
     /// difference (steps 0.05) of the multipoles of P_t, with and without IR and AP, to 1e-6 of the
-    /// largest tangent (the bound; measured ≤ 7e-7, the single-precision pair sums of the
-    /// basis, ~1e-7 of each term, limit both sides). A direction of the wrong length and a plan
-    /// without basis are refused.
+    /// largest tangent (the bound). A direction of the wrong length and a plan without basis
+    /// are refused.
     #[test]
     fn multipole_tangents_equal_high_order_differences() {
         let k: Vec<f64> = (0..12).map(|i| 0.02 * 1.2_f64.powi(i)).collect();
