@@ -205,7 +205,7 @@ impl<T: Real> Background<T> {
             let u2 = u * u;
             T::cst(2.0 * u2 * u2) / (om + ok * u2 + ol * u2 * u2 * u2).powf(1.5)
         };
-        simpson(integrand, 0.0, a.sqrt(), GROWTH_INTERVALS)
+        crate::linear::simpson(integrand, 0.0, a.sqrt(), GROWTH_INTERVALS).0
     }
 
     /// Heath's growing mode (5Ω_m/2) E(a) I(a), equal to a deep in matter domination (Λ only).
@@ -311,25 +311,6 @@ impl Cosmology {
     pub(super) fn growth_md(&self, a: f64, method: Method) -> f64 {
         self.background().growth_md(a, method)
     }
-}
-
-/// Composite Simpson rule for ∫_a^b f(x) dx with `n` intervals (a multiple of 4, as
-/// `crate::linear::simpson`, whose value it is, without the error estimate).
-fn simpson<T: Real>(f: impl Fn(f64) -> T, a: f64, b: f64, n: usize) -> T {
-    let n = n.max(4).div_ceil(4) * 4;
-    let h = (b - a) / n as f64;
-    let mut sum = T::cst(0.0);
-    for i in 0..=n {
-        let v = f(if i == n { b } else { a + h * i as f64 });
-        let w = match i {
-            0 => 1.0,
-            _ if i == n => 1.0,
-            _ if i % 2 == 1 => 4.0,
-            _ => 2.0,
-        };
-        sum += v * w;
-    }
-    sum * h / 3.0
 }
 
 /// The scale factor a = 1/(1+z) for finite z > −1.

@@ -1,6 +1,8 @@
 //! Numerical helpers of [`LinearSpectrum`](super::LinearSpectrum): a not-a-knot cubic spline, an anchored
 //! power law and composite Simpson quadrature with an error estimate.
 
+use crate::dual::Real;
+
 /// Not-a-knot cubic spline y(x) through at least 4 nodes with strictly increasing x.
 #[derive(Debug, Clone)]
 pub(crate) struct LogSpline {
@@ -207,13 +209,14 @@ pub(super) fn least_squares_slope(x: &[f64], y: &[f64]) -> f64 {
     sxy / sxx
 }
 
-/// Composite Simpson rule for ∫_a^b f(x) dx with `n` (rounded up to even, ≥ 4) intervals.
+/// Composite Simpson rule for ∫_a^b f(x) dx with `n` (rounded up to even, ≥ 4) intervals, over any
+/// [`Real`] (dual numbers carry the derivative of the sum).
 ///
-/// Returns (S_n, |S_n − S_{n/2}|/15), the second being the Richardson error estimate.
-pub(crate) fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> (f64, f64) {
+/// Returns (S_n, |S_n − S_{n/2}|/15), the second being the Richardson error estimate (of the values).
+pub(crate) fn simpson<T: Real>(f: impl Fn(f64) -> T, a: f64, b: f64, n: usize) -> (T, f64) {
     let n = n.max(4).div_ceil(4) * 4;
     let h = (b - a) / n as f64;
-    let (mut fine, mut coarse) = (0.0, 0.0);
+    let (mut fine, mut coarse) = (T::cst(0.0), T::cst(0.0));
     for i in 0..=n {
         let v = f(if i == n { b } else { a + h * i as f64 });
         let w_fine = match i {
@@ -222,7 +225,7 @@ pub(crate) fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> (f64,
             _ if i % 2 == 1 => 4.0,
             _ => 2.0,
         };
-        fine += w_fine * v;
+        fine += v * w_fine;
         if i % 2 == 0 {
             let w_coarse = match i {
                 0 => 1.0,
@@ -230,11 +233,12 @@ pub(crate) fn simpson(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> (f64,
                 _ if i % 4 == 2 => 4.0,
                 _ => 2.0,
             };
-            coarse += w_coarse * v;
+            coarse += v * w_coarse;
         }
     }
     let (fine, coarse) = (fine * h / 3.0, coarse * 2.0 * h / 3.0);
-    (fine, (fine - coarse).abs() / 15.0)
+    let error = (fine.value() - coarse.value()).abs() / 15.0;
+    (fine, error)
 }
 
 #[cfg(test)]
