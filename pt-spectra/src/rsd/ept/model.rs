@@ -195,13 +195,13 @@ impl EptTerms {
 /// of the linear spectrum (the polynomials' changes, and the damping's through dΣ²).
 pub(super) fn project_many(
     models: &[Model<'_>],
-    df: &[(Model<'_>, PartsDf, DampingTangent)],
+    df: &[(&Model<'_>, PartsDf, DampingTangent)],
     k_out: &[f64],
     nodes: &[(f64, f64, f64)],
     weights: &[Vec<f64>],
     on_grid: bool,
 ) -> Result<Multipoles> {
-    let Some(first) = models.first().or(df.first().map(|d| &d.0)) else {
+    let Some(first) = models.first().or(df.first().map(|d| d.0)) else {
         return Ok((Vec::new(), Vec::new()));
     };
     let n_ell = weights.first().map_or(0, Vec::len);

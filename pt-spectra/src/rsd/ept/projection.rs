@@ -52,15 +52,11 @@ impl EptPlan {
         }
         let (weights, nodes) = self.projection_nodes(terms, &all, ells, ap)?;
         let models: Vec<_> = params.iter().map(|p| terms.model_values(p)).collect();
+        let df_models: Vec<_> = df.iter().map(|p| terms.model_values(p)).collect();
         let df: Vec<_> = df
             .iter()
-            .map(|p| {
-                (
-                    terms.model_values(p),
-                    terms.parts_df(p),
-                    model::DampingTangent::F,
-                )
-            })
+            .zip(&df_models)
+            .map(|(p, m)| (m, terms.parts_df(p), model::DampingTangent::F))
             .collect();
         let on_grid = ap.is_none() && self.grid_use == GridUse::Output;
         model::project_many(&models, &df, &self.k_out, &nodes, &weights, on_grid)

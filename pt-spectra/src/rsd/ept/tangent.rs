@@ -161,7 +161,8 @@ impl EptPlan {
     ) -> Result<Vec<Vec<Vec<f64>>>> {
         let (weights, nodes) =
             self.projection_nodes(terms, std::slice::from_ref(params), ells, ap)?;
-        let parts: Vec<(model::Model<'_>, PartsDf, DampingTangent)> = tangents
+        let base = terms.model_values(params);
+        let parts: Vec<(&model::Model<'_>, PartsDf, DampingTangent)> = tangents
             .iter()
             .map(|t| {
                 let (plus, minus) = (t.plus.model_values(params), t.minus.model_values(params));
@@ -177,11 +178,7 @@ impl EptPlan {
                     })
                     .collect();
                 terms.add_parts_dsigma2(params, t.d_sigma2, &mut d);
-                (
-                    terms.model_values(params),
-                    d,
-                    DampingTangent::Sigma2(t.d_sigma2),
-                )
+                (&base, d, DampingTangent::Sigma2(t.d_sigma2))
             })
             .collect();
         let on_grid = ap.is_none() && self.grid_use == GridUse::Output;
