@@ -66,6 +66,24 @@ fn benches(c: &mut Criterion) {
     c.bench_function("pipeline/emulator", |b| {
         b.iter(|| black_box(pl.evaluate(&cosmology(), &PARAMS).unwrap()))
     });
+    // the exact derivatives with respect to the eight sampled cosmological parameters (A_s-normalised)
+    let mut j = 0usize;
+    c.bench_function("pipeline/cosmology-jacobian", |b| {
+        b.iter(|| {
+            j += 1;
+            let om = 0.28 + 0.04 * ((j % 97) as f64 / 97.0);
+            let c = Cosmology::flat(om, 0.69, 0.0224, 0.965, 0.81)
+                .unwrap()
+                .with_amplitude(pt_spectra::cosmology::Amplitude::a_s(2.1e-9))
+                .unwrap();
+            black_box(
+                pl.cosmology_jacobian(&c, &PARAMS)
+                    .unwrap()
+                    .cosmological
+                    .len(),
+            )
+        })
+    });
     let named = pt_spectra::setup::NamedCosmology::gm2012();
     // The embedded CAMB table at z = 0.5, scaled to the pipeline's z by the cosmology's growth.
     let table = LinearSpectrum::gm2012(0.5).unwrap();

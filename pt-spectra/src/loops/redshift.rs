@@ -466,6 +466,20 @@ impl RedshiftPlan {
         rows: &[Row],
         sigma_v2: Estimate,
     ) -> RedshiftTerms {
+        let sv_p: Vec<Estimate> = p_lin.iter().map(|&p| sigma_v2 * p).collect();
+        self.assemble_rows_with(p_lin, rows, sigma_v2, &sv_p)
+    }
+
+    /// [`Self::assemble_rows`] with the products σ_v² P_lin at every k given (`sv_p`): the one
+    /// term that is a product of two linear functionals of the spectrum, whose tangent
+    /// ([`crate::loops::basis::RedshiftBasis::evaluate_tangent`]) is δσ_v² P + σ_v² δP.
+    pub(crate) fn assemble_rows_with(
+        &self,
+        p_lin: Vec<f64>,
+        rows: &[Row],
+        sigma_v2: Estimate,
+        sv_p: &[Estimate],
+    ) -> RedshiftTerms {
         let nk = self.k.len();
         let mut out = RedshiftTerms {
             k: self.k.clone(),
@@ -511,10 +525,7 @@ impl RedshiftPlan {
         out.push(mono(1, 0, 0, 0, 2), 2, l3.clone());
         out.push(mono(0, 0, 0, 0, 3), 3, l3);
         // −(kμfσ_v)² Z₁² P.
-        let d = column(&|i| {
-            let k2 = self.k[i] * self.k[i];
-            sigma_v2 * (-k2 * p_lin[i])
-        });
+        let d = column(&|i| sv_p[i] * (-self.k[i] * self.k[i]));
         out.push(mono(2, 0, 0, 0, 2), 1, d.clone());
         out.push(mono(1, 0, 0, 0, 3), 2, d.iter().map(|&e| 2.0 * e).collect());
         out.push(mono(0, 0, 0, 0, 4), 3, d);

@@ -245,6 +245,76 @@ impl RedshiftBasis {
         (rows, Estimate::new(sv, sv_diff.abs() + eps * sv.abs()))
     }
 
+    /// The tangent of [`Self::rows`]' values along (`dp_lin`, `dc`) at (`p_lin`, `c`): the pair rows
+    /// are the tensors applied to the products c_a c_b, whose tangent is c_a dc_b + dc_a c_b; the
+    /// P13-type rows are P_lin times a linear form of c (the product rule); with them the tangent of
+    /// σ_v² P_lin at every k. Exact (all are polynomials in (P_lin, c)); the errors are zero.
+    fn rows_tangent(
+        &self,
+        (p_lin, dp_lin): (&[f64], &[f64]),
+        (c, dc): (&[f64], &[f64]),
+    ) -> (Vec<Row>, Vec<Estimate>) {
+        let n = c.len();
+        let mut s2 = vec![0.0; n * (n + 1) / 2];
+        for b in 0..n {
+            for a in 0..=b {
+                s2[super::pair_index(a, b)] = c[a] * dc[b] + dc[a] * c[b];
+            }
+        }
+        let values = self.pairs.apply(&s2);
+        let (mut forms, mut dforms) = (
+            vec![0.0; self.linear.len() / n],
+            vec![0.0; self.linear.len() / n],
+        );
+        crate::simd::matvec(&self.linear, c, &mut forms);
+        crate::simd::matvec(&self.linear, dc, &mut dforms);
+        let exact = |v: f64| Estimate::new(v, 0.0);
+        let rows = p_lin
+            .iter()
+            .zip(dp_lin)
+            .enumerate()
+            .map(|(i, (&p, &dp))| {
+                let pair = std::array::from_fn(|m| exact(values[i * NPAIR + m]));
+                let lw = std::array::from_fn(|m| {
+                    let at = i * LINEAR + m;
+                    exact(dp * forms[at] + p * dforms[at])
+                });
+                (pair, lw)
+            })
+            .collect();
+        // (σ_v² P)' = δσ_v² P + σ_v² δP
+        let (sv, dsv) = (
+            crate::simd::dot(&self.sigma_v2[..n], c),
+            crate::simd::dot(&self.sigma_v2[..n], dc),
+        );
+        let sv_p = p_lin
+            .iter()
+            .zip(dp_lin)
+            .map(|(p, dp)| exact(dsv * p + sv * dp))
+            .collect();
+        (rows, sv_p)
+    }
+
+    /// The tangent of [`Self::evaluate_with_no_wiggle`]'s two sets of terms along (`dp_lin`,
+    /// `dp_nw`, `dc`) at (`p_lin`, `p_nw`, `c`), both families sharing the coefficients c of the
+    /// spectrum's projection ([`Self::rows_tangent`]; `no_wiggle: None` without IR resummation).
+    pub fn evaluate_tangent(
+        &self,
+        plan: &RedshiftPlan,
+        (p_lin, dp_lin): (&[f64], &[f64]),
+        no_wiggle: Option<(&RedshiftBasis, &[f64], &[f64])>,
+        (c, dc): (&[f64], &[f64]),
+    ) -> (RedshiftTerms, Option<RedshiftTerms>) {
+        let dsv = |t: &Self| Estimate::new(crate::simd::dot(&t.sigma_v2[..dc.len()], dc), 0.0);
+        let (rows, sv_p) = self.rows_tangent((p_lin, dp_lin), (c, dc));
+        let full = plan.assemble_rows_with(dp_lin.to_vec(), &rows, dsv(self), &sv_p);
+        let nw = no_wiggle.map(|(tensors, p_nw, dp_nw)| {
+            let (rows, sv_p) = tensors.rows_tangent((p_nw, dp_nw), (c, dc));
+            plan.assemble_rows_with(dp_nw.to_vec(), &rows, dsv(tensors), &sv_p)
+        });
+        (full, nw)
+    }
+
     /// The terms of `plan` (whose tensors these are) for the spectrum with P_lin = `p_lin` at the
     /// grid's k and projection `projection`.
     pub fn evaluate(

@@ -25,12 +25,12 @@ use std::sync::Arc;
 #[derive(Debug, Clone)]
 pub(super) struct Tensors {
     pub(super) linear: Arc<RedshiftBasis>,
-    no_wiggle: Option<(Arc<RedshiftBasis>, NoWiggleForms)>,
+    pub(super) no_wiggle: Option<(Arc<RedshiftBasis>, NoWiggleForms)>,
 }
 
 /// The no-wiggle spectrum of a spectrum with coefficients c as linear forms in c.
 #[derive(Debug, Clone)]
-struct NoWiggleForms {
+pub(super) struct NoWiggleForms {
     /// Per output k: P_nw(k) as weights over the lattice samples from a first index.
     at_k: Vec<(usize, Vec<f64>)>,
     /// Σ² on the lattice (Simpson), and its difference from the half-resolution rule.
@@ -88,7 +88,7 @@ impl NoWiggleForms {
 
     /// P_nw at the output k of the spectrum with lattice samples `samples` and coefficients `c`, and
     /// Σ² with its error (quadrature, and `eps` of it for the projection).
-    fn evaluate(&self, samples: &[f64], c: &[f64], eps: f64) -> (Vec<f64>, Estimate) {
+    pub(super) fn evaluate(&self, samples: &[f64], c: &[f64], eps: f64) -> (Vec<f64>, Estimate) {
         let dot = crate::simd::dot;
         let p_nw = self
             .at_k

@@ -5,11 +5,11 @@
 //! and its values p on the plan's grid: T(s, p) = L(s, p) + Q(s, p), with the projection
 //! coefficients c = ⟨φ, ωs⟩ linear in s, the no-wiggle spectrum and Σ² linear forms of s and c, and
 //! the terms linear (P_lin, the counterterms' k²P) or bilinear (P22-, P13-type) in them. For such a
-//! polynomial the symmetric difference is exact: [T(s + εδs) − T(s − εδs)]/(2ε) = L(δs) + 2Q(s, δs)
-//! = DT\[δs\] for every ε, up to rounding (steps of 100% of the largest |δs/s|, so that the
-//! single rounding of each term is not divided by a small ε). The
-//! multipoles are affine in the terms at fixed Σ², f and parameters, so the same difference of the
-//! two terms' μ² polynomials is their exact tangent; Σ² enters the resummation's polynomial
+//! polynomial the tangent DT\[δs\] = L(δs) + 2Q(s, δs) is written out
+//! ([`crate::loops::basis::RedshiftBasis::evaluate_tangent`]: the tensors applied to the symmetric
+//! products c_a δc_b + δc_a c_b, the product rule on P_lin × linear forms). The multipoles are affine
+//! in the terms at fixed Σ², f and parameters, so the model of the tangent terms without its
+//! constant (the stochastic terms) is the model's tangent; Σ² enters the resummation's polynomial
 //! (1 + k²Σ²[1 + f(2 + f)μ²]) Z₁² P_w and the damping e^{−k'²Σ²[…]}, whose derivatives are written
 //! out (the model's `DampingTangent::Sigma2`).
 //!
@@ -23,19 +23,12 @@ use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
 use crate::rsd::ap::Distortion;
 
-/// The relative size of the symmetric difference's steps: s ± εδs with |εδs| ≤ this × |s|. Any size
-/// is exact for the polynomial; a large one keeps the rounding of each term from being divided by a
-/// small ε.
-const TANGENT_STEP: f64 = 1.0;
-
-/// The loop terms of a spectrum moved both ways along one direction ([module docs](self)).
+/// The tangent of the loop terms of a spectrum along one direction ([module docs](self)).
 #[derive(Debug, Clone)]
 pub struct TermsTangent {
-    /// The terms at s ± εδs, with the Σ² of s (the damping is held; its change is `d_sigma2`).
-    plus: EptTerms,
-    minus: EptTerms,
-    /// 1/(2ε).
-    inv_two_eps: f64,
+    /// dT: the terms' tangent (values; the spectrum's own Σ² in place of dΣ², so that the model's
+    /// resummation polynomial is the spectrum's: the damping's change is `d_sigma2`).
+    tangent: EptTerms,
     /// dΣ² [(Mpc/h)²] along the direction.
     d_sigma2: f64,
 }
@@ -99,50 +92,43 @@ impl EptPlan {
             )));
         }
         let p_lin: Vec<f64> = self.grid.iter().map(|&k| spectrum.eval(k)).collect();
-        let ratio = |d: &[f64], s: &[f64]| {
-            d.iter()
-                .zip(s)
-                .map(|(d, s)| (d / s).abs())
-                .filter(|r| r.is_finite())
-                .fold(0.0, f64::max)
-        };
-        let largest = ratio(d_lattice, &samples).max(ratio(d_grid, &p_lin));
-        let eps = if largest > 0.0 {
-            TANGENT_STEP / largest
-        } else {
-            1.0
-        };
-        let moved = |sign: f64| {
-            let s: Vec<f64> = samples
-                .iter()
-                .zip(d_lattice)
-                .map(|(s, d)| s + sign * eps * d)
-                .collect();
-            let p: Vec<f64> = p_lin
-                .iter()
-                .zip(d_grid)
-                .map(|(p, d)| p + sign * eps * d)
-                .collect();
-            let projection = basis.project(&s);
-            self.terms_of_samples(tensors, &s, p, &projection)
-        };
-        let (mut plus, mut minus) = (moved(1.0), moved(-1.0));
-        let sigma2 = |t: &EptTerms| t.nw.as_ref().map_or(0.0, |(_, s)| s.value);
-        let inv_two_eps = 0.5 / eps;
-        let d_sigma2 = (sigma2(&plus) - sigma2(&minus)) * inv_two_eps;
-        // The damping is held at the spectrum's own Σ², the mean of the two (a linear form).
-        let held = Estimate::new(0.5 * (sigma2(&plus) + sigma2(&minus)), 0.0);
-        for t in [&mut plus, &mut minus] {
-            if let Some(nw) = t.nw.as_mut() {
-                nw.1 = held;
+        let projection = basis.project(&samples);
+        let (c, dc) = (
+            &projection.coefficients,
+            basis.project(d_lattice).coefficients,
+        );
+        let span = self.loop_span.clone();
+        let (full, nw, d_sigma2) = match (&self.split, &tensors.no_wiggle) {
+            (Some(()), Some((nw_tensors, forms))) => {
+                let (p_nw, sigma2) = forms.evaluate(&samples, c, 0.0);
+                let (dp_nw, d_sigma2) = forms.evaluate(d_lattice, &dc, 0.0);
+                let (full, nw) = tensors.linear.evaluate_tangent(
+                    &self.loops,
+                    (&p_lin[span.clone()], &d_grid[span.clone()]),
+                    Some((nw_tensors, &p_nw[span.clone()], &dp_nw[span])),
+                    (c, &dc),
+                );
+                let nw = nw.map(|t| (self.padded(t, &dp_nw), Estimate::new(sigma2.value, 0.0)));
+                (full, nw, d_sigma2.value)
             }
-        }
-        Ok(TermsTangent {
-            plus,
-            minus,
-            inv_two_eps,
-            d_sigma2,
-        })
+            _ => {
+                let (full, _) = tensors.linear.evaluate_tangent(
+                    &self.loops,
+                    (&p_lin[span.clone()], &d_grid[span]),
+                    None,
+                    (c, &dc),
+                );
+                (full, None, 0.0)
+            }
+        };
+        let tangent = EptTerms {
+            grid: self.grid.clone(),
+            full: self.padded(full, d_grid),
+            nw,
+            basis_residual: Some(residual),
+            basis_soft: None,
+        };
+        Ok(TermsTangent { tangent, d_sigma2 })
     }
 
     /// The tangents of the multipoles `ells` at the output k of the terms `terms` (of the spectrum
@@ -162,20 +148,21 @@ impl EptPlan {
         let (weights, nodes) =
             self.projection_nodes(terms, std::slice::from_ref(params), ells, ap)?;
         let base = terms.model_values(params);
+        // the model is affine in the terms: without its constant (the stochastic terms), the
+        // model of the tangent terms is the tangent of the model
+        let mut linear = *params;
+        for name in ["sn", "sn2", "sn4"] {
+            linear.set(name, 0.0)?;
+        }
         let parts: Vec<(&model::Model<'_>, PartsDf, DampingTangent)> = tangents
             .iter()
             .map(|t| {
-                let (plus, minus) = (t.plus.model_values(params), t.minus.model_values(params));
-                let mut d: PartsDf = plus
+                let mut d: PartsDf = t
+                    .tangent
+                    .model_values(&linear)
                     .parts()
                     .iter()
-                    .zip(minus.parts())
-                    .map(|((pn, pw), (mn, mw))| {
-                        (
-                            std::array::from_fn(|q| (pn.0[q] - mn.0[q]) * t.inv_two_eps),
-                            std::array::from_fn(|q| (pw.0[q] - mw.0[q]) * t.inv_two_eps),
-                        )
-                    })
+                    .map(|(n, w)| (n.0, w.0))
                     .collect();
                 terms.add_parts_dsigma2(params, t.d_sigma2, &mut d);
                 (&base, d, DampingTangent::Sigma2(t.d_sigma2))
