@@ -297,7 +297,7 @@ impl RedshiftBasis {
 
     /// The tangent of [`Self::evaluate_with_no_wiggle`]'s two sets of terms along (`dp_lin`,
     /// `dp_nw`, `dc`) at (`p_lin`, `p_nw`, `c`), both families sharing the coefficients c of the
-    /// spectrum's projection ([`Self::rows_tangent`]; `no_wiggle: None` without IR resummation).
+    /// spectrum's projection (`no_wiggle: None` without IR resummation).
     pub fn evaluate_tangent(
         &self,
         plan: &RedshiftPlan,
