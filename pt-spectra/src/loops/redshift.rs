@@ -472,7 +472,7 @@ impl RedshiftPlan {
 
     /// [`Self::assemble_rows`] with the products σ_v² P_lin at every k given (`sv_p`): the one
     /// term that is a product of two linear functionals of the spectrum, whose tangent
-    /// ([`crate::loops::basis::RedshiftBasis::evaluate_tangent`]) is δσ_v² P + σ_v² δP.
+    /// ([`crate::loops::basis::RedshiftBasis::evaluate_tangents`]) is δσ_v² P + σ_v² δP.
     pub(crate) fn assemble_rows_with(
         &self,
         p_lin: Vec<f64>,

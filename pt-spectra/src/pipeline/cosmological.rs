@@ -128,15 +128,10 @@ impl Pipeline {
         let column = |values: &[CosmoDual], j: usize| -> Vec<f64> {
             values.iter().map(|v| v.d[j]).collect()
         };
-        let tangents = (0..N_DERIVATIVES)
-            .map(|j| {
-                self.plan.terms_tangent(
-                    tangent.spectrum(),
-                    &column(&on_lattice, j),
-                    &column(&on_grid, j),
-                )
-            })
-            .collect::<Result<Vec<_>>>()?;
+        let directions: Vec<(Vec<f64>, Vec<f64>)> = (0..N_DERIVATIVES)
+            .map(|j| (column(&on_lattice, j), column(&on_grid, j)))
+            .collect();
+        let tangents = self.plan.terms_tangents(tangent.spectrum(), &directions)?;
         let p = step.params(params)?;
         let multipoles = self.plan.multipole_tangents(
             &step.terms,

@@ -145,11 +145,20 @@ impl LowRank {
     /// checks need (rounding `s` and V s to f32, as this once did, left ~1e-7 of noise on every term,
     /// which steps in the parameters of 1% turned into 1e-5 of a derivative).
     pub(crate) fn apply(&self, s: &[f64]) -> Vec<f64> {
-        let z = self.reduce(s);
-        self.u
-            .chunks_exact(self.rank)
-            .map(|ui| dot32(ui, &z))
-            .collect()
+        self.apply_many(std::slice::from_ref(&s.to_vec())).remove(0)
+    }
+
+    /// [`Self::apply`] of several product vectors, U read once for all (each row of U is applied to
+    /// every z while it is in the cache: reading U bounds an application).
+    pub(crate) fn apply_many(&self, s: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let z: Vec<Vec<f64>> = s.iter().map(|s| self.reduce(s)).collect();
+        let mut out = vec![vec![0.0; self.rows]; s.len()];
+        for (i, ui) in self.u.chunks_exact(self.rank).enumerate() {
+            for (o, z) in out.iter_mut().zip(&z) {
+                o[i] = dot32(ui, z);
+            }
+        }
+        out
     }
 
     /// V s for the products `s` in f64 (summed in f64, [`dot32`]).

@@ -249,19 +249,14 @@ impl RedshiftBasis {
     /// are the tensors applied to the products c_a c_b, whose tangent is c_a dc_b + dc_a c_b; the
     /// P13-type rows are P_lin times a linear form of c (the product rule); with them the tangent of
     /// σ_v² P_lin at every k. Exact (all are polynomials in (P_lin, c)); the errors are zero.
+    /// `values`: the pair rows' tangent ([`Self::pair_tangents`]).
     fn rows_tangent(
         &self,
+        values: &[f64],
         (p_lin, dp_lin): (&[f64], &[f64]),
         (c, dc): (&[f64], &[f64]),
     ) -> (Vec<Row>, Vec<Estimate>) {
         let n = c.len();
-        let mut s2 = vec![0.0; n * (n + 1) / 2];
-        for b in 0..n {
-            for a in 0..=b {
-                s2[super::pair_index(a, b)] = c[a] * dc[b] + dc[a] * c[b];
-            }
-        }
-        let values = self.pairs.apply(&s2);
         let (mut forms, mut dforms) = (
             vec![0.0; self.linear.len() / n],
             vec![0.0; self.linear.len() / n],
@@ -295,24 +290,57 @@ impl RedshiftBasis {
         (rows, sv_p)
     }
 
-    /// The tangent of [`Self::evaluate_with_no_wiggle`]'s two sets of terms along (`dp_lin`,
-    /// `dp_nw`, `dc`) at (`p_lin`, `p_nw`, `c`), both families sharing the coefficients c of the
-    /// spectrum's projection (`no_wiggle: None` without IR resummation).
-    pub fn evaluate_tangent(
+    /// The pair rows' tangents along every direction `dcs` at `c`: the tensors applied to the
+    /// symmetric products c_a dc_b + dc_a c_b, all directions in one pass over the tensors (reading
+    /// them, not the arithmetic, bounds an application).
+    fn pair_tangents(&self, c: &[f64], dcs: &[&[f64]]) -> Vec<Vec<f64>> {
+        let n = c.len();
+        let products: Vec<Vec<f64>> = dcs
+            .iter()
+            .map(|dc| {
+                let mut s2 = vec![0.0; n * (n + 1) / 2];
+                for b in 0..n {
+                    for a in 0..=b {
+                        s2[super::pair_index(a, b)] = c[a] * dc[b] + dc[a] * c[b];
+                    }
+                }
+                s2
+            })
+            .collect();
+        self.pairs.apply_many(&products)
+    }
+
+    /// The tangents of [`Self::evaluate_with_no_wiggle`]'s two sets of terms at (`p_lin`, `p_nw`,
+    /// `c`) along the directions (`dp_lin[j]`, `dp_nw[j]`, `dcs[j]`), both families sharing the
+    /// coefficients c of the spectrum's projection (`no_wiggle: None` without IR resummation).
+    #[allow(clippy::type_complexity)]
+    pub fn evaluate_tangents(
         &self,
         plan: &RedshiftPlan,
-        (p_lin, dp_lin): (&[f64], &[f64]),
-        no_wiggle: Option<(&RedshiftBasis, &[f64], &[f64])>,
-        (c, dc): (&[f64], &[f64]),
-    ) -> (RedshiftTerms, Option<RedshiftTerms>) {
-        let dsv = |t: &Self| Estimate::new(crate::simd::dot(&t.sigma_v2[..dc.len()], dc), 0.0);
-        let (rows, sv_p) = self.rows_tangent((p_lin, dp_lin), (c, dc));
-        let full = plan.assemble_rows_with(dp_lin.to_vec(), &rows, dsv(self), &sv_p);
-        let nw = no_wiggle.map(|(tensors, p_nw, dp_nw)| {
-            let (rows, sv_p) = tensors.rows_tangent((p_nw, dp_nw), (c, dc));
-            plan.assemble_rows_with(dp_nw.to_vec(), &rows, dsv(tensors), &sv_p)
-        });
-        (full, nw)
+        (p_lin, dp_lin): (&[f64], &[&[f64]]),
+        no_wiggle: Option<(&RedshiftBasis, &[f64], &[&[f64]])>,
+        (c, dcs): (&[f64], &[&[f64]]),
+    ) -> Vec<(RedshiftTerms, Option<RedshiftTerms>)> {
+        let dsv = |t: &Self, dc: &[f64]| {
+            Estimate::new(crate::simd::dot(&t.sigma_v2[..dc.len()], dc), 0.0)
+        };
+        let full_pairs = self.pair_tangents(c, dcs);
+        let nw_pairs = no_wiggle.map(|(t, _, _)| t.pair_tangents(c, dcs));
+        (0..dcs.len())
+            .map(|j| {
+                let (rows, sv_p) =
+                    self.rows_tangent(&full_pairs[j], (p_lin, dp_lin[j]), (c, dcs[j]));
+                let full =
+                    plan.assemble_rows_with(dp_lin[j].to_vec(), &rows, dsv(self, dcs[j]), &sv_p);
+                let nw = no_wiggle
+                    .zip(nw_pairs.as_ref())
+                    .map(|((t, p_nw, dp_nw), pairs)| {
+                        let (rows, sv_p) = t.rows_tangent(&pairs[j], (p_nw, dp_nw[j]), (c, dcs[j]));
+                        plan.assemble_rows_with(dp_nw[j].to_vec(), &rows, dsv(t, dcs[j]), &sv_p)
+                    });
+                (full, nw)
+            })
+            .collect()
     }
 
     /// The terms of `plan` (whose tensors these are) for the spectrum with P_lin = `p_lin` at the

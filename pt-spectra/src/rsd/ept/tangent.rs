@@ -6,7 +6,7 @@
 //! coefficients c = ⟨φ, ωs⟩ linear in s, the no-wiggle spectrum and Σ² linear forms of s and c, and
 //! the terms linear (P_lin, the counterterms' k²P) or bilinear (P22-, P13-type) in them. For such a
 //! polynomial the tangent DT\[δs\] = L(δs) + 2Q(s, δs) is written out
-//! ([`crate::loops::basis::RedshiftBasis::evaluate_tangent`]: the tensors applied to the symmetric
+//! ([`crate::loops::basis::RedshiftBasis::evaluate_tangents`]: the tensors applied to the symmetric
 //! products c_a δc_b + δc_a c_b, the product rule on P_lin × linear forms). The multipoles are affine
 //! in the terms at fixed Σ², f and parameters, so the model of the tangent terms without its
 //! constant (the stochastic terms) is the model's tangent; Σ² enters the resummation's polynomial
@@ -42,26 +42,26 @@ impl TermsTangent {
 
 impl EptPlan {
     /// The wavenumbers [h/Mpc] at which a direction δP of the linear spectrum is needed by
-    /// [`Self::terms_tangent`]: the basis lattice and the plan's grid (`None` without basis tensors).
+    /// [`Self::terms_tangents`]: the basis lattice and the plan's grid (`None` without basis tensors).
     pub fn tangent_nodes(&self) -> Option<(Vec<f64>, &[f64])> {
         let lattice = self.linear_basis()?.lattice();
         let k = (0..lattice.len).map(|j| lattice.x(j).exp()).collect();
         Some((k, &self.grid))
     }
 
-    /// The tangent of the loop terms of `spectrum` along the direction with values `d_lattice` and
-    /// `d_grid` at [`Self::tangent_nodes`] ([module docs](self)).
+    /// The tangents of the loop terms of `spectrum` along the directions `directions`, each its
+    /// values (on the lattice, on the grid) at [`Self::tangent_nodes`] ([module docs](self)); the
+    /// tensors are read once for all directions.
     ///
     /// # Errors
     /// [`Error::InvalidChoice`] without basis tensors, for a spectrum the basis does not represent
     /// within [`Self::max_residual`] (the direct integrals have no exact tangent), or for directions
     /// of the wrong lengths.
-    pub fn terms_tangent(
+    pub fn terms_tangents(
         &self,
         spectrum: &LinearSpectrum,
-        d_lattice: &[f64],
-        d_grid: &[f64],
-    ) -> Result<TermsTangent> {
+        directions: &[(Vec<f64>, Vec<f64>)],
+    ) -> Result<Vec<TermsTangent>> {
         let refuse = |reason: String| Error::InvalidChoice {
             what: "the derivative of the ept loop terms along a direction of the linear spectrum"
                 .into(),
@@ -74,16 +74,20 @@ impl EptPlan {
         };
         let basis = tensors.linear.basis();
         let samples = basis.sample(spectrum);
-        if d_lattice.len() != samples.len() || d_grid.len() != self.grid.len() {
+        if let Some((l, g)) = directions
+            .iter()
+            .find(|(l, g)| l.len() != samples.len() || g.len() != self.grid.len())
+        {
             return Err(refuse(format!(
-                "the direction has {} lattice and {} grid values where the plan has {} and {}",
-                d_lattice.len(),
-                d_grid.len(),
+                "a direction has {} lattice and {} grid values where the plan has {} and {}",
+                l.len(),
+                g.len(),
                 samples.len(),
                 self.grid.len()
             )));
         }
-        let residual = basis.project(&samples).residual;
+        let projection = basis.project(&samples);
+        let residual = projection.residual;
         if residual.is_nan() || residual > self.max_residual {
             return Err(refuse(format!(
                 "the spectrum projects on the basis with residual {residual:.1e} > {:.1e}: its \
@@ -92,47 +96,66 @@ impl EptPlan {
             )));
         }
         let p_lin: Vec<f64> = self.grid.iter().map(|&k| spectrum.eval(k)).collect();
-        let projection = basis.project(&samples);
-        let (c, dc) = (
-            &projection.coefficients,
-            basis.project(d_lattice).coefficients,
-        );
+        let c = &projection.coefficients;
+        let dcs: Vec<Vec<f64>> = directions
+            .iter()
+            .map(|(l, _)| basis.project(l).coefficients)
+            .collect();
+        let dc_refs: Vec<&[f64]> = dcs.iter().map(Vec::as_slice).collect();
         let span = self.loop_span.clone();
-        let (full, nw, d_sigma2) = match (&self.split, &tensors.no_wiggle) {
+        let d_grid: Vec<&[f64]> = directions.iter().map(|(_, g)| &g[span.clone()]).collect();
+        // with IR resummation: P_nw, Σ² and their tangents (linear forms of the samples and c)
+        let no_wiggle = match (&self.split, &tensors.no_wiggle) {
             (Some(()), Some((nw_tensors, forms))) => {
                 let (p_nw, sigma2) = forms.evaluate(&samples, c, 0.0);
-                let (dp_nw, d_sigma2) = forms.evaluate(d_lattice, &dc, 0.0);
-                let (full, nw) = tensors.linear.evaluate_tangent(
-                    &self.loops,
-                    (&p_lin[span.clone()], &d_grid[span.clone()]),
-                    Some((nw_tensors, &p_nw[span.clone()], &dp_nw[span])),
-                    (c, &dc),
-                );
-                let nw = nw.map(|t| (self.padded(t, &dp_nw), Estimate::new(sigma2.value, 0.0)));
-                (full, nw, d_sigma2.value)
+                let d: Vec<(Vec<f64>, Estimate)> = directions
+                    .iter()
+                    .zip(&dcs)
+                    .map(|((l, _), dc)| forms.evaluate(l, dc, 0.0))
+                    .collect();
+                Some((nw_tensors, p_nw, sigma2.value, d))
             }
-            _ => {
-                let (full, _) = tensors.linear.evaluate_tangent(
-                    &self.loops,
-                    (&p_lin[span.clone()], &d_grid[span]),
-                    None,
-                    (c, &dc),
-                );
-                (full, None, 0.0)
-            }
+            _ => None,
         };
-        let tangent = EptTerms {
-            grid: self.grid.clone(),
-            full: self.padded(full, d_grid),
-            nw,
-            basis_residual: Some(residual),
-            basis_soft: None,
-        };
-        Ok(TermsTangent { tangent, d_sigma2 })
+        let dp_nw: Vec<&[f64]> = no_wiggle
+            .iter()
+            .flat_map(|(_, _, _, d)| d.iter().map(|(dp, _)| &dp[span.clone()]))
+            .collect();
+        let terms = tensors.linear.evaluate_tangents(
+            &self.loops,
+            (&p_lin[span.clone()], &d_grid),
+            no_wiggle
+                .as_ref()
+                .map(|(t, p_nw, _, _)| (t.as_ref(), &p_nw[span.clone()], dp_nw.as_slice())),
+            (c, &dc_refs),
+        );
+        Ok(terms
+            .into_iter()
+            .enumerate()
+            .map(|(j, (full, nw))| {
+                let (nw, d_sigma2) = match (nw, &no_wiggle) {
+                    (Some(t), Some((_, _, sigma2, d))) => (
+                        Some((self.padded(t, &d[j].0), Estimate::new(*sigma2, 0.0))),
+                        d[j].1.value,
+                    ),
+                    _ => (None, 0.0),
+                };
+                TermsTangent {
+                    tangent: EptTerms {
+                        grid: self.grid.clone(),
+                        full: self.padded(full, &directions[j].1),
+                        nw,
+                        basis_residual: Some(residual),
+                        basis_soft: None,
+                    },
+                    d_sigma2,
+                }
+            })
+            .collect())
     }
 
     /// The tangents of the multipoles `ells` at the output k of the terms `terms` (of the spectrum
-    /// the `tangents` were made from, [`Self::terms_tangent`]) with parameters `params` and
+    /// the `tangents` were made from, [`Self::terms_tangents`]) with parameters `params` and
     /// distortion `ap`: one `[j][i]` per tangent, exact ([module docs](self)).
     ///
     /// # Errors
@@ -238,8 +261,9 @@ mod tests {
                 k.iter().map(|&k| p.eval(k) * (k / 0.05).ln()).collect()
             };
             let tangent = plan
-                .terms_tangent(&p, &direction(&lattice), &direction(grid))
-                .unwrap();
+                .terms_tangents(&p, &[(direction(&lattice), direction(grid))])
+                .unwrap()
+                .remove(0);
             assert_eq!(tangent.d_sigma2() == 0.0, !ir);
             let exact = plan
                 .multipole_tangents(&terms, &[tangent], &params, &ells, ap)
@@ -266,10 +290,10 @@ mod tests {
                 }
             }
             assert!(plan
-                .terms_tangent(&p, &direction(&lattice[1..]), &direction(grid))
+                .terms_tangents(&p, &[(direction(&lattice[1..]), direction(grid))])
                 .is_err());
         }
         let no_basis = EptPlan::new(&k, EptSettings::default(), &Precision::fast()).unwrap();
-        assert!(no_basis.terms_tangent(&p, &[], &[]).is_err());
+        assert!(no_basis.terms_tangents(&p, &[(vec![], vec![])]).is_err());
     }
 }
