@@ -203,7 +203,10 @@ impl<T: Real> Background<T> {
         let (om, ok, ol) = (self.omega_m, self.omega_k, self.omega_lambda);
         let integrand = |u: f64| {
             let u2 = u * u;
-            T::cst(2.0 * u2 * u2) / (om + ok * u2 + ol * u2 * u2 * u2).powf(1.5)
+            // x^{3/2} as x √x: the same number to rounding, a quarter of pow's time (the integral
+            // has 1,025 nodes and the chain step evaluates it several times)
+            let x = om + ok * u2 + ol * u2 * u2 * u2;
+            T::cst(2.0 * u2 * u2) / (x * x.sqrt())
         };
         crate::linear::simpson(integrand, 0.0, a.sqrt(), GROWTH_INTERVALS).0
     }
