@@ -245,23 +245,29 @@ impl RedshiftBasis {
         (rows, Estimate::new(sv, sv_diff.abs() + eps * sv.abs()))
     }
 
-    /// The tangent of [`Self::rows`]' values along (`dp_lin`, `dc`) at (`p_lin`, `c`): the pair rows
-    /// are the tensors applied to the products c_a c_b, whose tangent is c_a dc_b + dc_a c_b; the
-    /// P13-type rows are P_lin times a linear form of c (the product rule); with them the tangent of
-    /// σ_v² P_lin at every k. Exact (all are polynomials in (P_lin, c)); the errors are zero.
-    /// `values`: the pair rows' tangent ([`Self::pair_tangents`]).
+    /// The P13-type forms of `c` at every k and σ_v² of `c`: what [`Self::rows_tangent`] needs of
+    /// the spectrum itself (the same for every direction).
+    fn tangent_base(&self, c: &[f64]) -> (Vec<f64>, f64) {
+        let n = c.len();
+        let mut forms = vec![0.0; self.linear.len() / n];
+        crate::simd::matvec(&self.linear, c, &mut forms);
+        (forms, crate::simd::dot(&self.sigma_v2[..n], c))
+    }
+
+    /// The tangent of [`Self::rows`]' values along (`dp_lin`, `dc`) at (`p_lin`, c): `values`, the
+    /// pair rows' tangent ([`Self::pair_tangents`]: the tensors on c_a dc_b + dc_a c_b); the
+    /// P13-type rows P_lin times a linear form of c by the product rule (`base`: the forms of c and
+    /// σ_v², [`Self::tangent_base`]); dσ_v² and the tangent of σ_v² P_lin at every k. Exact (all are
+    /// polynomials in (P_lin, c)); the errors are zero.
     fn rows_tangent(
         &self,
         values: &[f64],
+        (forms, sv): (&[f64], f64),
         (p_lin, dp_lin): (&[f64], &[f64]),
-        (c, dc): (&[f64], &[f64]),
-    ) -> (Vec<Row>, Vec<Estimate>) {
-        let n = c.len();
-        let (mut forms, mut dforms) = (
-            vec![0.0; self.linear.len() / n],
-            vec![0.0; self.linear.len() / n],
-        );
-        crate::simd::matvec(&self.linear, c, &mut forms);
+        dc: &[f64],
+    ) -> (Vec<Row>, Estimate, Vec<Estimate>) {
+        let n = dc.len();
+        let mut dforms = vec![0.0; self.linear.len() / n];
         crate::simd::matvec(&self.linear, dc, &mut dforms);
         let exact = |v: f64| Estimate::new(v, 0.0);
         let rows = p_lin
@@ -278,16 +284,13 @@ impl RedshiftBasis {
             })
             .collect();
         // (σ_v² P)' = δσ_v² P + σ_v² δP
-        let (sv, dsv) = (
-            crate::simd::dot(&self.sigma_v2[..n], c),
-            crate::simd::dot(&self.sigma_v2[..n], dc),
-        );
+        let dsv = crate::simd::dot(&self.sigma_v2[..n], dc);
         let sv_p = p_lin
             .iter()
             .zip(dp_lin)
             .map(|(p, dp)| exact(dsv * p + sv * dp))
             .collect();
-        (rows, sv_p)
+        (rows, exact(dsv), sv_p)
     }
 
     /// The pair rows' tangents along every direction `dcs` at `c`: the tensors applied to the
@@ -321,23 +324,21 @@ impl RedshiftBasis {
         no_wiggle: Option<(&RedshiftBasis, &[f64], &[&[f64]])>,
         (c, dcs): (&[f64], &[&[f64]]),
     ) -> Vec<(RedshiftTerms, Option<RedshiftTerms>)> {
-        let dsv = |t: &Self, dc: &[f64]| {
-            Estimate::new(crate::simd::dot(&t.sigma_v2[..dc.len()], dc), 0.0)
-        };
         let full_pairs = self.pair_tangents(c, dcs);
-        let nw_pairs = no_wiggle.map(|(t, _, _)| t.pair_tangents(c, dcs));
+        let full_base = self.tangent_base(c);
+        let nw = no_wiggle
+            .map(|(t, p_nw, dp_nw)| (t, p_nw, dp_nw, t.pair_tangents(c, dcs), t.tangent_base(c)));
         (0..dcs.len())
             .map(|j| {
-                let (rows, sv_p) =
-                    self.rows_tangent(&full_pairs[j], (p_lin, dp_lin[j]), (c, dcs[j]));
-                let full =
-                    plan.assemble_rows_with(dp_lin[j].to_vec(), &rows, dsv(self, dcs[j]), &sv_p);
-                let nw = no_wiggle
-                    .zip(nw_pairs.as_ref())
-                    .map(|((t, p_nw, dp_nw), pairs)| {
-                        let (rows, sv_p) = t.rows_tangent(&pairs[j], (p_nw, dp_nw[j]), (c, dcs[j]));
-                        plan.assemble_rows_with(dp_nw[j].to_vec(), &rows, dsv(t, dcs[j]), &sv_p)
-                    });
+                let base = (full_base.0.as_slice(), full_base.1);
+                let (rows, dsv, sv_p) =
+                    self.rows_tangent(&full_pairs[j], base, (p_lin, dp_lin[j]), dcs[j]);
+                let full = plan.assemble_rows_with(dp_lin[j].to_vec(), &rows, dsv, &sv_p);
+                let nw = nw.as_ref().map(|(t, p_nw, dp_nw, pairs, (forms, sv))| {
+                    let (rows, dsv, sv_p) =
+                        t.rows_tangent(&pairs[j], (forms, *sv), (p_nw, dp_nw[j]), dcs[j]);
+                    plan.assemble_rows_with(dp_nw[j].to_vec(), &rows, dsv, &sv_p)
+                });
                 (full, nw)
             })
             .collect()
