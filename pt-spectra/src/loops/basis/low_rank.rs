@@ -19,7 +19,7 @@
 //! (median 6e-7), against a projection error of ~1e-4.
 
 use crate::linalg::dot;
-use crate::simd::{dot32, matvec_f32};
+use crate::simd::{dot32, dot32_four, matvec_f32};
 use rand::Rng;
 use rand::SeedableRng;
 use rayon::prelude::*;
@@ -156,6 +156,52 @@ impl LowRank {
         for (i, ui) in self.u.chunks_exact(self.rank).enumerate() {
             for (o, z) in out.iter_mut().zip(&z) {
                 o[i] = dot32(ui, z);
+            }
+        }
+        out
+    }
+
+    /// The tangents U (V s') of the pair products s = c_a c_b along every direction `dcs`, s' =
+    /// c_a dc_b + dc_a c_b (pair tensors only): V s' = H dc with H = ∂(V s)/∂c, made once (its
+    /// row r: H_b = Σ_a V_{r,(a,b)} c_a, the diagonal pair counted twice), so a direction costs a
+    /// product of length n instead of V's columns; then U applied to all of them, each row of U
+    /// read once and widened once per four directions ([`dot32_four`]).
+    pub(crate) fn apply_pair_tangents(&self, c: &[f64], dcs: &[&[f64]]) -> Vec<Vec<f64>> {
+        let n = c.len();
+        assert!(
+            self.degree == 2 && self.columns == n * (n + 1) / 2,
+            "pair tangents of a form of {} columns for {n} coefficients",
+            self.columns
+        );
+        let mut h = vec![0.0; n];
+        let z: Vec<Vec<f64>> = {
+            let mut z = vec![vec![0.0; self.rank]; dcs.len()];
+            for (r, va) in self.v.chunks_exact(self.columns).enumerate() {
+                h.fill(0.0);
+                for b in 0..n {
+                    let row = &va[super::pair_index(0, b)..=super::pair_index(b, b)];
+                    // Σ_{a ≤ b} V_ab c_a into H_b, and V_ab c_b into every H_a (a = b twice)
+                    h[b] += dot32(row, &c[..=b]);
+                    for (ha, &v) in h[..=b].iter_mut().zip(row) {
+                        *ha += f64::from(v) * c[b];
+                    }
+                }
+                for (zj, dc) in z.iter_mut().zip(dcs) {
+                    zj[r] = crate::linalg::dot(&h, dc);
+                }
+            }
+            z
+        };
+        let mut out = vec![vec![0.0; self.rows]; z.len()];
+        for group in (0..z.len()).step_by(4) {
+            let last = z.len() - 1;
+            let take = |q: usize| z[(group + q).min(last)].as_slice();
+            let zs = [take(0), take(1), take(2), take(3)];
+            for (i, ui) in self.u.chunks_exact(self.rank).enumerate() {
+                let d = dot32_four(ui, zs);
+                for q in 0..4.min(z.len() - group) {
+                    out[group + q][i] = d[q];
+                }
             }
         }
         out
@@ -408,6 +454,40 @@ mod tests {
         assert!(rest.is_empty());
         assert_eq!(back, form);
         assert!(LowRank::from_f64s(&v[..v.len() - 1]).is_none());
+    }
+
+    /// The tangents along five directions (one group of four and a short one) equal the form
+    /// applied to the symmetric products c_a dc_b + dc_a c_b written out.
+    #[test]
+    fn pair_tangents_equal_the_form_on_the_symmetric_products() {
+        let (rows, n) = (40, 9);
+        let a = smooth(rows, n);
+        let sigma = vec![1.0; n];
+        let form = LowRank::new(&a, rows, 2, &sigma, PAIR_TOLERANCE);
+        let c: Vec<f64> = (0..n).map(|a| 0.3 + (a as f64 * 0.7).sin()).collect();
+        let dcs: Vec<Vec<f64>> = (0..5)
+            .map(|j| (0..n).map(|a| ((a + 3 * j) as f64 * 0.45).cos()).collect())
+            .collect();
+        let products: Vec<Vec<f64>> = dcs
+            .iter()
+            .map(|dc| {
+                let mut s = vec![0.0; n * (n + 1) / 2];
+                for b in 0..n {
+                    for a in 0..=b {
+                        s[super::super::pair_index(a, b)] = c[a] * dc[b] + dc[a] * c[b];
+                    }
+                }
+                s
+            })
+            .collect();
+        let want = form.apply_many(&products);
+        let refs: Vec<&[f64]> = dcs.iter().map(Vec::as_slice).collect();
+        let got = form.apply_pair_tangents(&c, &refs);
+        assert_eq!(got.len(), 5);
+        let scale = want.iter().flatten().fold(0.0_f64, |m, v| m.max(v.abs()));
+        for (g, w) in got.iter().flatten().zip(want.iter().flatten()) {
+            assert!((g - w).abs() <= 1e-13 * scale, "{g} {w}");
+        }
     }
 
     #[test]

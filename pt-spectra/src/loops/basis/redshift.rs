@@ -267,8 +267,14 @@ impl RedshiftBasis {
         dc: &[f64],
     ) -> (Vec<Row>, Estimate, Vec<Estimate>) {
         let n = dc.len();
+        // only the forms of the values (the first LW of each k; the others are the errors')
         let mut dforms = vec![0.0; self.linear.len() / n];
-        crate::simd::matvec(&self.linear, dc, &mut dforms);
+        for (d, l) in dforms
+            .chunks_exact_mut(LINEAR)
+            .zip(self.linear.chunks_exact(LINEAR * n))
+        {
+            crate::simd::matvec(&l[..LW * n], dc, &mut d[..LW]);
+        }
         let exact = |v: f64| Estimate::new(v, 0.0);
         let rows = p_lin
             .iter()
@@ -294,23 +300,10 @@ impl RedshiftBasis {
     }
 
     /// The pair rows' tangents along every direction `dcs` at `c`: the tensors applied to the
-    /// symmetric products c_a dc_b + dc_a c_b, all directions in one pass over the tensors (reading
-    /// them, not the arithmetic, bounds an application).
+    /// symmetric products c_a dc_b + dc_a c_b ([`LowRank::apply_pair_tangents`]: the reduction's
+    /// Jacobian in c made once, U read once for all directions).
     fn pair_tangents(&self, c: &[f64], dcs: &[&[f64]]) -> Vec<Vec<f64>> {
-        let n = c.len();
-        let products: Vec<Vec<f64>> = dcs
-            .iter()
-            .map(|dc| {
-                let mut s2 = vec![0.0; n * (n + 1) / 2];
-                for b in 0..n {
-                    for a in 0..=b {
-                        s2[super::pair_index(a, b)] = c[a] * dc[b] + dc[a] * c[b];
-                    }
-                }
-                s2
-            })
-            .collect();
-        self.pairs.apply_many(&products)
+        self.pairs.apply_pair_tangents(c, dcs)
     }
 
     /// The tangents of [`Self::evaluate_with_no_wiggle`]'s two sets of terms at (`p_lin`, `p_nw`,
