@@ -29,7 +29,8 @@ import numpy as np
 from . import _core
 from ._core import (BispectrumPlan, BispectrumTerms, LinearEmulator, Observation, OneLoopBispectrumPlan,
                     Pipeline,
-                    SugiyamaPlan, SugiyamaTerms, Table, distances, eisenstein_hu, fisher, growth, log_grid,
+                    SugiyamaPlan, SugiyamaTerms, Table, distances, eisenstein_hu, fisher, fisher_kaiser,
+                    growth, log_grid,
                     num_threads, set_num_threads)
 
 __all__ = [
@@ -55,6 +56,7 @@ __all__ = [
     "fit_ept",
     "fit_joint",
     "fisher",
+    "fisher_kaiser",
     "fit_tables",
     "bispectrum",
     "one_loop_bispectrum",

@@ -95,3 +95,91 @@ pub(crate) fn fisher<'py>(
     d.set_item("points", f.points)?;
     Ok(d)
 }
+
+/// The linear-Kaiser forecast of fσ8 with the spectrum's shape and the geometry fixed (White, Song &
+/// Percival 2009; the DESI FDR's method; `pt_spectra::forecast::fisher_kaiser`): `bins` a list of
+/// dicts (z, volume [(Mpc/h)^3], k_max [h/Mpc], k_min (0.001), and either n_bar [(h/Mpc)^3] and b1
+/// for one tracer or tracers, a list of {n_bar, b1}, for several sharing the volume); the fiducial
+/// `cosmology` (default planck2018). Returns a dict: names (f_i, b1_i or b1.t_i), fiducial, sigma,
+/// covariance, fisher, fsigma8 ([(sigma, fsigma8)] per bin).
+#[pyfunction]
+#[pyo3(signature = (bins, cosmology=None))]
+pub(crate) fn fisher_kaiser<'py>(
+    py: Python<'py>,
+    bins: &Bound<'py, PyList>,
+    cosmology: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use pt_spectra::forecast::{KaiserBin, KaiserTracer};
+    let tracer = |what: &str, d: &Bound<'py, PyDict>| -> PyResult<KaiserTracer> {
+        let get = |key: &str| -> PyResult<f64> {
+            d.get_item(key)?
+                .ok_or_else(|| value_error(format!("{what}: `{key}` is required")))?
+                .extract()
+        };
+        Ok(KaiserTracer {
+            n_bar: get("n_bar")?,
+            b1: get("b1")?,
+        })
+    };
+    let mut parsed = Vec::new();
+    for (i, b) in bins.iter().enumerate() {
+        let what = format!("Kaiser bin {}", i + 1);
+        let d = b
+            .cast::<PyDict>()
+            .map_err(|_| value_error(format!("{what}: a dict is expected")))?;
+        for (key, _) in d.iter() {
+            let key: String = key.extract()?;
+            if !["z", "volume", "k_min", "k_max", "n_bar", "b1", "tracers"].contains(&key.as_str())
+            {
+                return Err(value_error(format!(
+                    "{what}: unknown key `{key}` (valid: z, volume, k_min, k_max, n_bar, b1, tracers)"
+                )));
+            }
+        }
+        let num = |key: &str| -> PyResult<Option<f64>> {
+            d.get_item(key)?.map(|v| v.extract()).transpose()
+        };
+        let required = |key: &str| -> PyResult<f64> {
+            num(key)?.ok_or_else(|| value_error(format!("{what}: `{key}` is required")))
+        };
+        let tracers = match d.get_item("tracers")? {
+            Some(list) => list
+                .cast::<PyList>()
+                .map_err(|_| value_error(format!("{what}: `tracers` is a list of dicts")))?
+                .iter()
+                .enumerate()
+                .map(|(t, x)| {
+                    let w = format!("{what}, tracer {}", t + 1);
+                    tracer(
+                        &w,
+                        x.cast::<PyDict>()
+                            .map_err(|_| value_error(format!("{w}: a dict is expected")))?,
+                    )
+                })
+                .collect::<PyResult<Vec<_>>>()?,
+            None => vec![tracer(&what, d)?],
+        };
+        parsed.push(KaiserBin {
+            z: required("z")?,
+            volume: required("volume")?,
+            k_min: num("k_min")?.unwrap_or(0.001),
+            k_max: required("k_max")?,
+            tracers,
+        });
+    }
+    let fiducial = match cosmology {
+        Some(c) => crate::inputs::cosmology_of(Some(c))?,
+        None => pt_spectra::cosmology::Cosmology::planck2018(),
+    };
+    let (f, _) = crate::detached(py, || {
+        pt_spectra::forecast::fisher_kaiser(&parsed, &fiducial)
+    })?;
+    let d = PyDict::new(py);
+    d.set_item("names", f.names)?;
+    d.set_item("fiducial", f.fiducial)?;
+    d.set_item("sigma", f.sigma)?;
+    d.set_item("covariance", f.covariance)?;
+    d.set_item("fisher", f.fisher)?;
+    d.set_item("fsigma8", f.fsigma8)?;
+    Ok(d)
+}

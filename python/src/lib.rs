@@ -657,6 +657,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<joint::AnalysisLikelihood>()?;
     m.add_function(wrap_pyfunction!(bias::convert_bias, m)?)?;
     m.add_function(wrap_pyfunction!(forecast::fisher, m)?)?;
+    m.add_function(wrap_pyfunction!(forecast::fisher_kaiser, m)?)?;
     m.add_function(wrap_pyfunction!(batch::real_batch, m)?)?;
     m.add_function(wrap_pyfunction!(batch::read_multipoles, m)?)?;
     m.add_function(wrap_pyfunction!(batch::check_memory, m)?)?;

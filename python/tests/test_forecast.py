@@ -45,3 +45,34 @@ def test_bad_input_is_named(tmp_path):
         pt.fisher([BOSS], parameters="all", cache_dir=tmp_path)
     with pytest.raises(ValueError, match="volume"):
         pt.fisher([dict(BOSS, volume=-1.0)], cache_dir=tmp_path)
+
+
+def test_fisher_kaiser_reproduces_the_desi_fdr_table_2_3_within_ten_percent():
+    # DESI FDR (arXiv:1611.00036) Table 2.3, ELG + LRG + QSO, k_max = 0.1 h/Mpc: the published
+    # σ(fσ8)/fσ8 per bin (pt-spectra/tests/data/desi_fdr_fsigma8.txt) within 10% (examples/fisher_published.py)
+    import importlib.util
+    from pathlib import Path
+    path = Path(__file__).resolve().parents[2] / "examples" / "fisher_published.py"
+    spec = importlib.util.spec_from_file_location("fisher_published", path)
+    example = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(example)
+    main = [r for r in example.forecast() if r["sample"] == "main" and r["k_max"] == 0.1]
+    assert len(main) == 13
+    for r in main:
+        assert 0.9 < r["ratio"] < 1.1, r
+
+
+def test_fisher_kaiser_one_tracer_and_bad_input():
+    one = pt.fisher_kaiser([dict(z=0.5, volume=1e9, n_bar=3e-4, b1=2.0, k_max=0.1)])
+    assert one["names"] == ["f_1", "b1_1"]
+    (s, fs8), = one["fsigma8"]
+    assert 0.01 * fs8 < s < 0.5 * fs8
+    four = pt.fisher_kaiser([dict(z=0.5, volume=4e9, n_bar=3e-4, b1=2.0, k_max=0.1)])
+    np.testing.assert_allclose(np.array(one["sigma"]) / np.array(four["sigma"]), 2.0, rtol=1e-12)
+    two = pt.fisher_kaiser([dict(z=0.5, volume=1e9, k_max=0.1, tracers=[dict(n_bar=1e-4, b1=1.2),
+                                                                         dict(n_bar=3e-4, b1=2.0)])])
+    assert two["names"] == ["f_1", "b1.1_1", "b1.2_1"]
+    with pytest.raises(ValueError, match="`n_bar` is required"):
+        pt.fisher_kaiser([dict(z=0.5, volume=1e9, b1=2.0, k_max=0.1)])
+    with pytest.raises(ValueError, match="unknown key `bias`"):
+        pt.fisher_kaiser([dict(z=0.5, volume=1e9, n_bar=3e-4, bias=2.0, k_max=0.1)])

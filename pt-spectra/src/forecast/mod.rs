@@ -32,6 +32,7 @@
 //! derivative's largest element ([`Forecast::derivative_error`]).
 
 mod covariance;
+mod kaiser;
 mod parameters;
 #[cfg(test)]
 mod tests;
@@ -46,6 +47,7 @@ use crate::rsd::ap::Distortion;
 use crate::store::TableStore;
 use crate::survey::observe::Observation;
 pub use covariance::gaussian_covariance;
+pub use kaiser::{fisher_kaiser, kaiser_fisher, KaiserBin, KaiserForecast, KaiserTracer};
 use parameters::{check_cosmology, cosmology_value, with_cosmology_value};
 
 /// The cosmological parameters a forecast can vary: ω_cdm, ω_b, h, ln(10¹⁰A_s), n_s (flat, the

@@ -358,3 +358,201 @@ fn the_bispectrum_monopole_adds_information_and_keeps_the_volume_scaling() {
         assert!((a / b - 2.0).abs() < 1e-9, "{a} {b}");
     }
 }
+
+// ---- the linear-Kaiser forecast (kaiser.rs) ----
+
+/// ∫_0^1 μ^{2m} dμ/(b + fμ²)² for m = 0, 1, 2 in closed form (arctan), independently of the
+/// module's quadrature.
+fn kaiser_mu_moments(b: f64, f: f64) -> [f64; 3] {
+    let j = (f / b).sqrt().atan() / (b * f).sqrt(); // ∫ dμ/(b + fμ²)
+    let i0 = 1.0 / (2.0 * b * (b + f)) + j / (2.0 * b); // ∫ dμ/(b + fμ²)²
+    let i1 = (j - b * i0) / f; // ∫ μ² dμ/(b + fμ²)²
+    let k1 = (1.0 - b * j) / f; // ∫ μ² dμ/(b + fμ²)
+    let i2 = (k1 - b * i1) / f; // ∫ μ⁴ dμ/(b + fμ²)²
+    [i0, i1, i2]
+}
+
+#[test]
+fn the_kaiser_fisher_matrix_is_the_closed_form_one_without_shot_noise() {
+    // one tracer, n̄ → ∞: Tr[C⁻¹∂C]² = 4 u_a u_b/(b + fμ²)², independent of P, so
+    // F = V/(4π²) (k_max³ − k_min³)/3 · 4 ∫ [μ⁰, μ², μ⁴] dμ/(b + fμ²)²
+    let (b, f, v, k0, k1) = (1.7, 0.8, 3e9, 0.002, 0.13);
+    let tracers = [KaiserTracer { n_bar: 1e12, b1: b }];
+    let p = |k: f64| 2e4 * (k / 0.05).powf(-1.3) * (1.0 + 0.05 * (100.0 * k).sin());
+    let got = crate::forecast::kaiser_fisher(&tracers, f, &p, v, k0, k1);
+    let [i0, i1, i2] = kaiser_mu_moments(b, f);
+    let pre = v / (4.0 * PI * PI) * (k1.powi(3) - k0.powi(3)) / 3.0 * 4.0;
+    // parameters (f, b): F_ff ∝ ∫μ⁴, F_fb ∝ ∫μ², F_bb ∝ ∫1
+    for (got, want) in [
+        (got[0][0], pre * i2),
+        (got[0][1], pre * i1),
+        (got[1][1], pre * i0),
+    ] {
+        assert!((got / want - 1.0).abs() < 1e-9, "{got} vs {want}");
+    }
+    assert_eq!(got[0][1], got[1][0]);
+}
+
+#[test]
+fn the_kaiser_fisher_matrix_with_shot_noise_is_the_single_tracer_integral() {
+    // one tracer with noise: F_ab = V/(4π²) ∫k²dk ∫dμ ∂_aP ∂_bP/(P + 1/n̄)², by a dense trapezoid here
+    let (b, f, n, v) = (1.4, 0.7, 2e-4, 1e9);
+    let p = |k: f64| 3e4 * k / (1.0 + (k / 0.02).powi(2)) / 0.02;
+    let got =
+        crate::forecast::kaiser_fisher(&[KaiserTracer { n_bar: n, b1: b }], f, &p, v, 0.01, 0.2);
+    let (nk, nm) = (4000, 2000);
+    let mut want = [[0.0; 2]; 2];
+    for i in 0..=nk {
+        let k = 0.01 + 0.19 * i as f64 / nk as f64;
+        let wk = if i == 0 || i == nk { 0.5 } else { 1.0 } * 0.19 / nk as f64;
+        for j in 0..=nm {
+            let mu = j as f64 / nm as f64;
+            let wm = if j == 0 || j == nm { 0.5 } else { 1.0 } / nm as f64;
+            let a = b + f * mu * mu;
+            let ps = a * a * p(k);
+            let d = [2.0 * a * mu * mu * p(k), 2.0 * a * p(k)];
+            for x in 0..2 {
+                for y in 0..2 {
+                    want[x][y] += wk * wm * k * k * v / (4.0 * PI * PI) * d[x] * d[y]
+                        / (ps + 1.0 / n).powi(2);
+                }
+            }
+        }
+    }
+    for x in 0..2 {
+        for y in 0..2 {
+            assert!(
+                (got[x][y] / want[x][y] - 1.0).abs() < 1e-5,
+                "{x}{y}: {} vs {}",
+                got[x][y],
+                want[x][y]
+            );
+        }
+    }
+}
+
+#[test]
+fn two_tracers_of_equal_bias_measure_f_as_one_of_their_summed_density() {
+    // equal biases: the difference field carries no information on f or the common bias, so σ(f)
+    // equals that of one tracer with n̄₁ + n̄₂ (b₁, b₂ free against b free)
+    let p = |k: f64| 2e4 * (k / 0.05).powf(-1.2);
+    let inv_ff = |fisher: Vec<Vec<f64>>| {
+        let n = fisher.len();
+        crate::linalg::solve_spd(&fisher, &vec![0.0; n]).unwrap().1[0][0]
+    };
+    let two = [
+        KaiserTracer {
+            n_bar: 1e-4,
+            b1: 1.5,
+        },
+        KaiserTracer {
+            n_bar: 3e-4,
+            b1: 1.5,
+        },
+    ];
+    let one = [KaiserTracer {
+        n_bar: 4e-4,
+        b1: 1.5,
+    }];
+    let s2 = inv_ff(crate::forecast::kaiser_fisher(
+        &two, 0.8, &p, 1e9, 0.005, 0.15,
+    ));
+    let s1 = inv_ff(crate::forecast::kaiser_fisher(
+        &one, 0.8, &p, 1e9, 0.005, 0.15,
+    ));
+    assert!((s2 / s1 - 1.0).abs() < 1e-9, "{s2} vs {s1}");
+    // unequal biases: the second tracer adds information (multi-tracer), never removes it
+    let unequal = [
+        KaiserTracer {
+            n_bar: 1e-4,
+            b1: 1.2,
+        },
+        KaiserTracer {
+            n_bar: 3e-4,
+            b1: 2.0,
+        },
+    ];
+    let alone = [KaiserTracer {
+        n_bar: 3e-4,
+        b1: 2.0,
+    }];
+    assert!(
+        inv_ff(crate::forecast::kaiser_fisher(
+            &unequal, 0.8, &p, 1e9, 0.005, 0.15
+        )) < inv_ff(crate::forecast::kaiser_fisher(
+            &alone, 0.8, &p, 1e9, 0.005, 0.15
+        ))
+    );
+}
+
+/// The bins of the DESI FDR (arXiv:1611.00036) Tables 2.3 and 2.5 (`tests/data/desi_fdr_fsigma8.txt`):
+/// (sample, z, bins of the forecast at k_max, published σ(fσ8)/fσ8 at k_max = 0.1 and 0.2 [%]).
+pub(super) fn desi_fdr_bins(
+    fiducial: &Cosmology,
+    k_max: f64,
+) -> Vec<(String, f64, KaiserBin, f64, f64)> {
+    let text = include_str!("../../tests/data/desi_fdr_fsigma8.txt");
+    let area = 14000.0 * (PI / 180.0).powi(2);
+    let growth_at = |z: f64| fiducial.growth_factor(z);
+    text.lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+        .map(|l| {
+            let c: Vec<&str> = l.split_whitespace().collect();
+            let x: Vec<f64> = c[1..].iter().map(|s| s.parse().unwrap()).collect();
+            let z = x[0];
+            let (lo, hi) = (z - 0.05, z + 0.05);
+            let volume = area / 3.0
+                * (fiducial.comoving_distance(hi).powi(3) - fiducial.comoving_distance(lo).powi(3));
+            let d = growth_at(z);
+            let tracers: Vec<KaiserTracer> = [(x[1], 0.84), (x[2], 1.7), (x[3], 1.2), (x[4], 1.34)]
+                .iter()
+                .filter(|(n, _)| *n > 0.0)
+                .map(|&(dndz, bd)| KaiserTracer {
+                    n_bar: dndz * 0.1 * 14000.0 / volume,
+                    b1: bd / d,
+                })
+                .collect();
+            let bin = KaiserBin {
+                z,
+                volume,
+                k_min: 0.001,
+                k_max,
+                tracers,
+            };
+            (c[0].to_string(), z, bin, x[5], x[6])
+        })
+        .collect()
+}
+
+#[test]
+fn the_desi_fdr_table_2_3_fsigma8_forecast_is_reproduced_within_ten_percent_at_k_max_0_1() {
+    // DESI FDR Table 2.3 (ELG + LRG + QSO, multi-tracer, 0.6 < z < 1.9), k_max = 0.1 h/Mpc, the
+    // like-for-like case (linear scales, the FDR's method): every bin's σ(fσ8)/fσ8 within 10% of the
+    // published one (measured 0.94 … 1.04 with Planck 2018, docs/forecast.md). Where the FDR's numbers
+    // include information loss beyond linear Kaiser (k_max = 0.2; the BGS of Table 2.5 at z < 0.5) ours
+    // are smaller; those ratios are only guarded here (measured: main 0.86 … 0.92 at 0.2; BGS 0.87 …
+    // 0.93 at 0.1 and 0.73 … 0.79 at 0.2)
+    let fiducial = Cosmology::planck2018();
+    for k_max in [0.1, 0.2] {
+        let rows = desi_fdr_bins(&fiducial, k_max);
+        let bins: Vec<KaiserBin> = rows.iter().map(|r| r.2.clone()).collect();
+        let got = fisher_kaiser(&bins, &fiducial).unwrap();
+        for (row, &(s, fs8)) in rows.iter().zip(&got.fsigma8) {
+            let published = if k_max == 0.1 { row.3 } else { row.4 };
+            let ratio = 100.0 * s / fs8 / published;
+            let (lo, hi) = match (row.0.as_str(), k_max == 0.1) {
+                ("main", true) => (0.9, 1.1),
+                ("main", false) => (0.85, 0.97),
+                (_, true) => (0.85, 0.96),
+                (_, false) => (0.7, 0.82),
+            };
+            assert!(
+                ratio > lo && ratio < hi,
+                "{} z = {}, k_max = {k_max}: {:.2}% against {published}% (ratio {ratio:.3})",
+                row.0,
+                row.1,
+                100.0 * s / fs8
+            );
+        }
+    }
+}
