@@ -189,8 +189,8 @@ pub fn prepare_with_emulator(
         }
         LinearSource::Embedded | LinearSource::Emulator => {
             let emulated = match emulator {
-                Some(e) => emulate(e, &c, z)?,
-                None => emulate(&LinearEmulator::embedded()?, &c, z)?,
+                Some(e) => emulate(e, &c, z, d)?,
+                None => emulate(&LinearEmulator::embedded()?, &c, z, d)?,
             };
             description.extend(emulated.description);
             warnings.extend(emulated.warning);
@@ -280,8 +280,9 @@ struct Emulated {
     warning: Option<String>,
 }
 
-/// The emulated spectra of `c` at `z`, with the header lines that say so.
-fn emulate(emulator: &LinearEmulator, c: &Cosmology, z: f64) -> Result<Emulated> {
+/// The emulated spectra of `c` at `z` (where D(z)/D(0) = `growth`), with the header lines that say
+/// so.
+fn emulate(emulator: &LinearEmulator, c: &Cosmology, z: f64, growth: f64) -> Result<Emulated> {
     let e = emulator.spectra(c, z)?;
     let spectrum = e.matter()?;
     let mut description = vec![
@@ -326,10 +327,20 @@ fn emulate(emulator: &LinearEmulator, c: &Cosmology, z: f64) -> Result<Emulated>
     };
     let warning = match c.amplitude {
         crate::cosmology::Amplitude::As { a_s, .. } => {
+            // σ8(0) ≈ σ8(z)/[D(z)/D(0)] (to ~1% with massive neutrinos, whose growth depends on
+            // k): a second emulation at z = 0 (as much as the first) only near the typical range's
+            // edges, where the warning's text must be exact
+            let approx = e.sigma8 / growth;
+            let (lo, hi) = crate::cosmology::SIGMA8_TYPICAL;
+            let near_edge = [lo, hi]
+                .iter()
+                .any(|edge| (approx / edge - 1.0).abs() < 0.05);
             let today = if z == 0.0 {
                 e.sigma8
-            } else {
+            } else if near_edge {
                 emulator.spectra(c, 0.0)?.sigma8
+            } else {
+                approx
             };
             crate::cosmology::sigma8_warning(today, a_s)
         }
