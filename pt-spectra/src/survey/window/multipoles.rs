@@ -255,7 +255,7 @@ impl WindowMultipoles {
         // normalisation): Q0(0) ≤ 0 is a sign flip or another column, and flipped every windowed
         // multipole with exit 0 (issue 45). (Q0(0) ≠ 1 but positive is warned about.)
         let q0 = &q[ells.iter().position(|&l| l == 0).expect("checked")];
-        if !(q0[0] > 0.0) {
+        if q0[0] <= 0.0 {
             return Err(Error::InvalidValue {
                 origin,
                 line: line(0),
