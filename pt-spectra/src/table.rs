@@ -504,6 +504,51 @@ impl KGrid {
         Ok(Self(k))
     }
 
+    /// The grid of a k file: the first column of the file at `path`, one k per line (`#` comments,
+    /// one optional row of column names, comma or blank separated, any line ends).
+    ///
+    /// A file of one row of several numbers (a row vector, `0.05 0.1 0.2` or `0.05,0.1,0.2`) is
+    /// refused: its first column is one k, and the others were dropped with exit 0 (issue 45).
+    ///
+    /// # Errors
+    /// [`Error::Io`]; [`Error::TooFewPoints`] for no values; [`Error::BadRow`] for one row of several
+    /// numbers; as [`Table::parse`] and [`check_k_grid`].
+    pub fn read(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        Self::parse(&read_text(path)?, &path.display().to_string())
+    }
+
+    /// [`read`](Self::read) from the text of a k file; `origin` names it in messages.
+    ///
+    /// # Errors
+    /// As [`read`](Self::read).
+    pub fn parse(text: &str, origin: &str) -> Result<Self> {
+        let table = Table::parse(text, origin, &[0])?;
+        if let [line] = table.lines[..] {
+            let row = numbered_lines(text)
+                .find(|(l, _)| *l == line)
+                .map_or("", |(_, raw)| raw.split_once('#').map_or(raw, |(d, _)| d));
+            let fields = row
+                .split(|c: char| c == ',' || c.is_whitespace())
+                .filter(|s| !s.is_empty())
+                .count();
+            if fields > 1 {
+                return Err(Error::BadRow {
+                    origin: origin.into(),
+                    line,
+                    problem: format!(
+                        "the only row has {fields} numbers: a k file has one k per line (in its \
+                         first column), so this row would be the single k {} (a row vector? write \
+                         one k per line)",
+                        table.columns[0][0]
+                    ),
+                });
+            }
+        }
+        let k = table.columns.into_iter().next().unwrap_or_default();
+        Self::new(origin, k, &table.lines)
+    }
+
     /// The grid of an array argument named `what` (e.g. a Python `k`).
     ///
     /// # Errors
@@ -553,6 +598,26 @@ mod tests {
         assert!(e.to_string().contains("k.dat:2"), "{e}");
         assert!(KGrid::new("k.dat", vec![], &[]).is_err());
         assert!(KGrid::new("k.dat", vec![-0.1], &[]).is_err());
+    }
+
+    /// Issue 45: a k file of one row of several numbers (a row vector) was read as its first number
+    /// alone, exit 0; it is refused naming the file, the line and the rule. One k per line (one value
+    /// or several columns), and one single k, are read as before.
+    #[test]
+    fn a_k_file_of_one_row_of_numbers_is_refused() {
+        for text in ["0.05 0.1 0.2\n", "# k\n0.05,0.1,0.2\n", "0.05, 0.1\n"] {
+            let e = KGrid::parse(text, "k.txt").unwrap_err().to_string();
+            assert!(
+                e.contains("k.txt:") && e.contains("one k per line"),
+                "{text}: {e}"
+            );
+        }
+        assert_eq!(KGrid::parse("0.1\n", "k.txt").unwrap().as_slice(), &[0.1]);
+        let g = KGrid::parse("# k P\n0.05 1\n0.1 2\n", "k.txt").unwrap();
+        assert_eq!(g.as_slice(), &[0.05, 0.1]);
+        assert!(KGrid::parse("# nothing\n", "k.txt").is_err());
+        let e = KGrid::parse("0.2\n0.1\n", "k.txt").unwrap_err().to_string();
+        assert!(e.starts_with("k.txt:2:"), "{e}");
     }
 
     /// Arrays are checked as files are, but the errors name the argument and the 0-based index.

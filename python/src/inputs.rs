@@ -84,7 +84,16 @@ impl Inputs {
                 Ok(dict) => {
                     let mut pairs = Vec::new();
                     for (key, value) in dict.iter() {
-                        pairs.push((key.str()?.to_string(), value.str()?.to_string()))
+                        // a list of numbers (CLASS's m_ncdm = [0.02, 0.02, 0.02]) as CLASS writes it
+                        let text = match value.extract::<Vec<f64>>() {
+                            Ok(list) if !value.is_instance_of::<PyString>() => list
+                                .iter()
+                                .map(f64::to_string)
+                                .collect::<Vec<_>>()
+                                .join(", "),
+                            _ => value.str()?.to_string(),
+                        };
+                        pairs.push((key.str()?.to_string(), text))
                     }
                     CosmologyArg::Keys(pairs)
                 }
@@ -115,7 +124,9 @@ impl Inputs {
                 (Some(named), ignored)
             }
             CosmologyArg::Keys(pairs) => {
-                let parsed = Cosmology::from_keys(pairs.iter().cloned(), "cosmology dict")?;
+                // strict: a key that sets nothing (a misspelt `m_ncmd`) is an error naming it, in
+                // every face that takes a dict (it changed the result silently)
+                let parsed = Cosmology::from_keys_strict(pairs.iter().cloned(), "cosmology dict")?;
                 let named = NamedCosmology {
                     name: "dict".into(),
                     cosmology: parsed.cosmology,
@@ -170,24 +181,13 @@ fn positive(values: Vec<f64>, what: &str) -> PyResult<Vec<f64>> {
 
 /// The cosmology of a Python argument (for the small helpers and the emulator), gm2012 by default.
 ///
-/// A dict is strict: a key that sets nothing (a misspelt `m_ncmd`, say) is a ValueError naming it,
-/// since it would otherwise change the result silently. An ini file's other keys (CLASS's `output`,
-/// ...) are normal there and are not an error.
+/// A dict is strict ([`Cosmology::from_keys_strict`], as in every face that takes one): a key that
+/// sets nothing (a misspelt `m_ncmd`, say) is a ValueError naming it, since it would otherwise change
+/// the result silently. An ini file's other keys (CLASS's `output`, ...) are normal there and are not
+/// an error.
 pub fn cosmology_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Cosmology> {
     let inputs = Inputs::extract(None, 0.0, 0.0, obj, None)?;
-    let (named, ignored) = inputs.cosmology().map_err(value_error)?;
-    if matches!(inputs.cosmology, CosmologyArg::Keys(_)) && !ignored.is_empty() {
-        return Err(PyValueError::new_err(format!(
-            "cosmology dict: unknown key(s) {}: they set nothing (a misspelling?); the keys read are \
-             CLASS's and CAMB's names of h, omega_b, omega_cdm, n_s, A_s or sigma8, Omega_k, w0, wa, \
-             the neutrino masses and species (see the documentation of pt_spectra.cosmology ini keys)",
-            ignored
-                .iter()
-                .map(|k| format!("`{k}`"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        )));
-    }
+    let (named, _) = inputs.cosmology().map_err(value_error)?;
     Ok(named.map_or(Cosmology::gm2012(), |n| n.cosmology))
 }
 

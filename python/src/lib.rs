@@ -535,12 +535,17 @@ fn fit(
 /// The linear growth factor D(z) (D(0) = 1) and rate f(z) of a cosmology.
 #[pyfunction]
 #[pyo3(signature = (z, cosmology=None))]
-fn growth(z: f64, cosmology: Option<&Bound<'_, PyAny>>) -> PyResult<(f64, f64)> {
+fn growth(py: Python<'_>, z: f64, cosmology: Option<&Bound<'_, PyAny>>) -> PyResult<(f64, f64)> {
     let c = inputs::cosmology_of(cosmology)?;
     if !(z.is_finite() && z > -1.0) {
         return Err(PyValueError::new_err(format!(
             "z = {z}: a redshift must be finite and > -1"
         )));
+    }
+    // radiation is neglected: refused far in z, a warning where it exceeds 1e-3 (issue 45)
+    if let Some(w) = pt_spectra::setup::radiation::check_growth(&c, z).map_err(value_error)? {
+        let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+        PyErr::warn(py, &category, &std::ffi::CString::new(w)?, 1)?;
     }
     Ok((c.growth_factor(z), c.growth_rate(z)))
 }

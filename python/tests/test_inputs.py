@@ -200,3 +200,58 @@ def test_a_prior_on_a_fixed_parameter_is_refused():
     with pytest.raises(ValueError, match=r"the prior on b2: b2 is fixed.*\(free: f, b1; marginalised: none\)"):
         pt.fit_ept(good_data(), [0.2], data_ells=(0, 2), priors={"b2": (0.0, 1.0)},
                    precision="fast")
+
+
+# Issue 45, fault sweep 2 -------------------------------------------------------------------------
+
+_C45 = {"h": 0.67, "omega_b": 0.022, "omega_cdm": 0.12, "n_s": 0.965, "A_s": 2.1e-9}
+
+
+def test_every_face_refuses_a_cosmology_dict_with_an_unknown_key():
+    # pt.real/rsd/ept warned, the Pipeline (call, batch, cosmology_jacobian) ignored the key silently
+    # and returned the massless spectrum; every dict reader now raises naming the key
+    import numpy as np
+    k = np.geomspace(0.02, 0.2, 6)
+    bad = dict(_C45, m_ncmd=0.06)
+    for call in (lambda: pt.real("linear", k=k, cosmology=bad),
+                 lambda: pt.rsd(k=k, cosmology=bad, precision="fast"),
+                 lambda: pt.LinearEmulator().spectra(bad, 0.5)):
+        with pytest.raises(ValueError, match="m_ncmd"):
+            call()
+    p = pt.Pipeline(pt.Observation([0, 2], k), 0.5, precision="fast")
+    with pytest.raises(ValueError, match="m_ncmd"):
+        p(cosmology=bad, b1=2.0)
+    with pytest.raises(ValueError, match="m_ncmd"):
+        p.batch([bad], [dict(b1=2.0)])
+    with pytest.raises(ValueError, match="m_ncmd"):
+        p.cosmology_jacobian(bad, b1=2.0)
+    # a key CLASS reads another way is refused naming it, not dropped
+    with pytest.raises(ValueError, match="T_ncdm"):
+        p(cosmology=dict(_C45, N_ncdm=1, m_ncdm=0.02, deg_ncdm=3, N_ur=0.00641, T_ncdm=0.8), b1=2.0)
+    with pytest.raises(ValueError, match="N_ncdm is not given"):
+        pt.LinearEmulator().spectra(dict(_C45, m_ncdm=0.02, deg_ncdm=3, N_ur=0.00641), 0.5)
+
+
+def test_m_ncdm_as_a_python_list_is_read_as_class_writes_it():
+    import numpy as np
+    three = dict(_C45, N_ncdm=3, N_ur=0.00641)
+    ref = pt.LinearEmulator().spectra(dict(three, m_ncdm="0.02, 0.02, 0.02"), 0.5)
+    for masses in ([0.02, 0.02, 0.02], (0.02, 0.02, 0.02), np.array([0.02, 0.02, 0.02])):
+        s = pt.LinearEmulator().spectra(dict(three, m_ncdm=masses), 0.5)
+        assert s["neutrinos"] == "three degenerate"
+        assert np.array_equal(s["P_m"], ref["P_m"])
+
+
+def test_an_observation_refuses_odd_or_repeated_multipoles_without_a_window():
+    import numpy as np
+    k = np.geomspace(0.02, 0.2, 6)
+    for ells, rule in (([0, 3], "3"), ([0, 0], "twice")):
+        with pytest.raises(ValueError, match=rule):
+            pt.Observation(ells, k)
+
+
+def test_the_growth_far_in_z_is_refused_and_warned_about_in_between():
+    with pytest.raises(ValueError, match="radiation"):
+        pt.growth(1e6)
+    with pytest.warns(UserWarning, match="radiation"):
+        pt.growth(5.0)

@@ -31,7 +31,10 @@
 //! Ω_DE = 1 − Ω_m − Ω_k. Massless species (`N_ur`) do not enter the background, like the photons; N_eff
 //! must be the standard one.
 //! Every key not in the table is ignored and listed in [`ParsedCosmology::ignored`], so that the caller
-//! can say once which were. Not followed: CAMB's `DEFAULT(file)` and `INCLUDE(file)` lines (syntax
+//! can say once which were ([`Cosmology::from_keys_strict`], for dicts, refuses them instead). Keys
+//! that would change the spectrum in a way not modelled (`T_ncdm`, `alpha_s`, `omega_ncdm`, `Omega_m`
+//! against the derived one, ...) are refused unless they state what is modelled, and a read key in the
+//! wrong case (`M_ncdm`) is refused as a misspelling (private module `ini::unmodelled`). Not followed: CAMB's `DEFAULT(file)` and `INCLUDE(file)` lines (syntax
 //! errors), CAMB's `use_physical = F` parameters, and CLASS's split of the dark energy into
 //! `Omega_Lambda` and `Omega_fld`: `w0_fld` and `wa_fld` are taken as the equation of state of all the
 //! dark energy (in CLASS they apply only when `Omega_Lambda = 0`).
@@ -260,7 +263,7 @@ impl Cosmology {
                 line,
             });
         }
-        resolve(&entries, origin)
+        resolve(&entries, origin, false)
     }
 
     /// A cosmology from key–value pairs with the keys and values of a parameter file (e.g. a Python
@@ -280,24 +283,21 @@ impl Cosmology {
         pairs: impl IntoIterator<Item = (K, V)>,
         origin: &str,
     ) -> Result<ParsedCosmology> {
-        let pairs: Vec<(K, V)> = pairs.into_iter().collect();
-        let mut entries = Vec::with_capacity(pairs.len());
-        for (index, (key, value)) in pairs.iter().enumerate() {
-            let (key, value) = (key.as_ref().trim(), value.as_ref().trim());
-            if key.is_empty() {
-                return Err(Error::IniSyntax {
-                    origin: origin.to_string(),
-                    line: index + 1,
-                    text: quote(&format!("= {value}")),
-                });
-            }
-            entries.push(Entry {
-                key,
-                value,
-                line: index + 1,
-            });
-        }
-        resolve(&entries, origin)
+        from_pairs(pairs, origin, false)
+    }
+
+    /// As [`from_keys`](Self::from_keys), for a dict a program builds (Python's `cosmology=dict(...)`):
+    /// every key must be read, so a misspelling (`m_ncmd`) is an error naming it instead of a key
+    /// listed as ignored; [`ParsedCosmology::ignored`] then holds only keys that are read but do not
+    /// matter (a pivot with σ8, the species of zero masses, a default stated).
+    ///
+    /// # Errors
+    /// As [`from_keys`](Self::from_keys), and [`Error::InvalidChoice`] naming the unknown keys.
+    pub fn from_keys_strict<K: AsRef<str>, V: AsRef<str>>(
+        pairs: impl IntoIterator<Item = (K, V)>,
+        origin: &str,
+    ) -> Result<ParsedCosmology> {
+        from_pairs(pairs, origin, true)
     }
 
     /// A preset (one of [`PRESETS`]), or else the parameter file at the path `name_or_path`.
@@ -322,6 +322,32 @@ impl Cosmology {
             ignored: Vec::new(),
         })
     }
+}
+
+/// [`Cosmology::from_keys`] and [`Cosmology::from_keys_strict`].
+fn from_pairs<K: AsRef<str>, V: AsRef<str>>(
+    pairs: impl IntoIterator<Item = (K, V)>,
+    origin: &str,
+    strict: bool,
+) -> Result<ParsedCosmology> {
+    let pairs: Vec<(K, V)> = pairs.into_iter().collect();
+    let mut entries = Vec::with_capacity(pairs.len());
+    for (index, (key, value)) in pairs.iter().enumerate() {
+        let (key, value) = (key.as_ref().trim(), value.as_ref().trim());
+        if key.is_empty() {
+            return Err(Error::IniSyntax {
+                origin: origin.to_string(),
+                line: index + 1,
+                text: quote(&format!("= {value}")),
+            });
+        }
+        entries.push(Entry {
+            key,
+            value,
+            line: index + 1,
+        });
+    }
+    resolve(&entries, origin, strict)
 }
 
 /// `text`, cut to [`QUOTE_MAX_CHARS`] characters (with `…`) for messages.
@@ -353,8 +379,10 @@ fn agree(x: f64, y: f64) -> bool {
     (x - y).abs() <= SYNONYM_TOL * x.abs().max(y.abs())
 }
 
-/// Checks the entries and builds the cosmology (see [`Cosmology::from_keys`]).
-fn resolve(entries: &[Entry<'_>], origin: &str) -> Result<ParsedCosmology> {
+/// Checks the entries and builds the cosmology (see [`Cosmology::from_keys`]); with `strict`, a key
+/// that is not read is an error naming it (a dict's misspelling) rather than listed as ignored.
+fn resolve(entries: &[Entry<'_>], origin: &str, strict: bool) -> Result<ParsedCosmology> {
+    unmodelled::check_case(entries, origin, &neutrinos::SPECIES_KEYS)?;
     let mut first_line: HashMap<&str, usize> = HashMap::new();
     let mut found: Vec<Found<'_>> = Vec::new();
     let mut ignored: Vec<(usize, &str)> = Vec::new();
@@ -375,17 +403,16 @@ fn resolve(entries: &[Entry<'_>], origin: &str) -> Result<ParsedCosmology> {
             ignored.push((entry.line, entry.key));
             continue;
         };
-        let parsed = if unit == Unit::NcdmList {
-            neutrinos::ncdm_sum(entry, entries)
+        let number = if unit == Unit::NcdmList {
+            neutrinos::ncdm_sum(entry, entries, origin)?
         } else {
-            parse_number(entry.value)
+            parse_number(entry.value).ok_or_else(|| Error::IniValue {
+                origin: origin.to_string(),
+                line: entry.line,
+                key: entry.key.to_string(),
+                value: quote(entry.value),
+            })?
         };
-        let number = parsed.ok_or_else(|| Error::IniValue {
-            origin: origin.to_string(),
-            line: entry.line,
-            key: entry.key.to_string(),
-            value: quote(entry.value),
-        })?;
         found.push(Found {
             entry,
             quantity,
@@ -454,6 +481,27 @@ fn resolve(entries: &[Entry<'_>], origin: &str) -> Result<ParsedCosmology> {
         );
     }
     let omega_m = (omega_b + omega_cdm + m_nu / super::EV_PER_OMEGA_NU) / h2;
+    unmodelled::check(entries, origin, omega_m, h, m_nu > 0.0)?;
+    if strict {
+        let unknown: Vec<String> = ignored
+            .iter()
+            .filter(|(_, key)| {
+                lookup(key).is_none()
+                    && !neutrinos::SPECIES_KEYS.contains(key)
+                    && !unmodelled::is_checked(key)
+            })
+            .map(|(line, key)| format!("`{}` ({origin}:{line})", quote(key)))
+            .collect();
+        if !unknown.is_empty() {
+            return Err(Error::InvalidChoice {
+                what: format!("{origin}: unknown key(s) {}", unknown.join(", ")),
+                reason: "they set nothing (a misspelling?); the keys read are CLASS's and CAMB's \
+                         names of h, omega_b, omega_cdm, n_s, A_s or sigma8, Omega_k, w0, wa, the \
+                         neutrino masses and species (pt_spectra::cosmology::ini)"
+                    .into(),
+            });
+        }
+    }
     let cosmology = Cosmology {
         omega_m,
         omega_lambda: 1.0 - omega_m - omega_k,
@@ -575,3 +623,4 @@ impl<'a> Values<'a> {
 mod neutrinos;
 #[cfg(test)]
 mod tests;
+mod unmodelled;

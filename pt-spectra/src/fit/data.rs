@@ -188,7 +188,33 @@ impl MultipoleData {
     /// [`Error::TooFewPoints`] for too few rows.
     pub fn parse_covariance(self, text: &str, origin: &str) -> Result<Self> {
         let n = self.ells.len() * self.k.len();
-        let table = Table::parse_exact(text, origin, n)?;
+        // A row narrower or wider than the data vector is a matrix of another size (or layout):
+        // said so, with both sizes, rather than as "column 16 was requested" (issue 45).
+        let size = |line: usize, found: usize| Error::BadRow {
+            origin: origin.into(),
+            line,
+            problem: format!(
+                "the covariance row has {found} columns, but the data vector has {n} values ({} \
+                 multipole(s) × {} k): the covariance must be {n} × {n}, one matrix row per line, \
+                 ℓ-major",
+                self.ells.len(),
+                self.k.len()
+            ),
+        };
+        let table = Table::parse_exact(text, origin, n).map_err(|e| match e {
+            Error::MissingColumn { line, found, .. } => size(line, found),
+            Error::BadRow {
+                line, ref problem, ..
+            } if problem.ends_with(" expected") => {
+                let found = problem
+                    .split_whitespace()
+                    .nth(3)
+                    .and_then(|w| w.parse().ok())
+                    .unwrap_or(0);
+                size(line, found)
+            }
+            e => e,
+        })?;
         let rows = table.lines.len();
         if rows < n {
             return Err(Error::TooFewPoints {

@@ -65,9 +65,33 @@ pub(crate) fn check_rescaling(
     Ok((note, warning))
 }
 
+/// Checks D(z) and f(z) of `c` asked for at `z` (Python's `pt.growth`): the growth neglects
+/// radiation, so D(z)/D(0) is about half of [`rescaling_error`] off (D² is rescaling_error off): a
+/// warning above [`WARN_ABOVE`] for D², returned, and a refusal above [`REFUSE_ABOVE`]
+/// (`pt.growth(1e6)` returned D = 1.3e-6, ~200 times below the growth with radiation, silently).
+///
+/// # Errors
+/// [`Error::InvalidChoice`] naming z above [`REFUSE_ABOVE`], with the largest z allowed.
+pub fn check_growth(c: &Cosmology, z: f64) -> Result<Option<String>> {
+    check_rescaling(c, "the growth D(z), f(z) (relative to z = 0)", 0.0, z).map(|(_, w)| w)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 45: the growth far in z (radiation neglected) is refused, warned about in between.
+    #[test]
+    fn the_growth_far_in_z_is_refused_or_warned_about() {
+        let c = Cosmology::gm2012();
+        assert!(check_growth(&c, 1.0).unwrap().is_none());
+        assert!(check_growth(&c, 5.0)
+            .unwrap()
+            .unwrap()
+            .contains("radiation"));
+        let e = check_growth(&c, 1e6).unwrap_err().to_string();
+        assert!(e.contains("z = 1000000") && e.contains("radiation"), "{e}");
+    }
 
     /// gm2012: Ω_r h² = 2.47e-5 (photons, T = 2.7255 K) × 1.6918 (3.046 massless neutrinos) =
     /// 4.18e-5, so Ω_r/Ω_m = 4.18e-5/(0.49 × 0.27) = 3.16e-4 and 4.2e-4 per unit of z: 4.2% at

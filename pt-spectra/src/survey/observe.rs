@@ -168,14 +168,17 @@ impl Observation {
     /// window and the bins given.
     ///
     /// # Errors
-    /// [`Error::InvalidChoice`] for a window matrix with bins or box modes with a window; as the
-    /// plans of [`crate::survey`].
+    /// [`Error::InvalidChoice`] for multipoles that are not distinct even ℓ ≤ 8, a window matrix with
+    /// bins or box modes with a window; as the plans of [`crate::survey`].
     pub fn new(
         ells: &[usize],
         k: &[f64],
         window: Option<Window>,
         bins: Option<Bins>,
     ) -> Result<Self> {
+        // every stage checks its multipoles, but without a window or bins there is none: ℓ = 3 or
+        // [0, 0] then passed the model through under a wrong name (issue 45)
+        super::check_ells("observed multipoles", ells)?;
         let refuse = |reason: &str| Error::InvalidChoice {
             what: "the window and bins".into(),
             reason: reason.into(),
@@ -527,5 +530,25 @@ mod spec_tests {
         assert!(e.contains("xi"), "{e}");
         let e = Bins::of(None, Some(1000.0)).unwrap_err().to_string();
         assert!(e.contains("give their edges"), "{e}");
+    }
+
+    /// Issue 45: without a window or bins, `Observation::new(&[0, 3], ..)` and `&[0, 0]` were
+    /// accepted and applied (the model passed through under ℓ = 3, or twice).
+    #[test]
+    fn odd_or_repeated_multipoles_are_refused_without_a_window_too() {
+        let k: Vec<f64> = (1..=10).map(|i| 0.02 * f64::from(i)).collect();
+        for (ells, rule) in [
+            (&[0, 3][..], "ℓ = 3"),
+            (&[0, 0][..], "given twice"),
+            (&[0, 10][..], "ℓ = 10"),
+            (&[][..], "at least one"),
+        ] {
+            let e = Observation::new(ells, &k, None, None)
+                .err()
+                .unwrap_or_else(|| panic!("{ells:?} accepted"))
+                .to_string();
+            assert!(e.contains("observed multipoles") && e.contains(rule), "{e}");
+        }
+        assert!(Observation::new(&[0, 2, 4], &k, None, None).is_ok());
     }
 }

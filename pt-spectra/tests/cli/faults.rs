@@ -221,3 +221,91 @@ fn a_window_names_line_with_a_wrong_ell_is_refused() {
         (args.to_vec(), "Q4 is missing below Q6"),
     ]);
 }
+
+/// A window whose Q0 column is negated (a sign flip) gave every windowed multipole with the wrong sign
+/// and exit 0 (a header warning only); Q0 at the smallest s must be positive, refused naming the file
+/// and its first data line.
+#[test]
+fn a_window_with_a_negative_q0_is_refused() {
+    let dir = scratch("faults_window_sign");
+    let text: String = boss_window()
+        .lines()
+        .map(|l| {
+            if l.starts_with('#') {
+                return format!("{l}\n");
+            }
+            let mut f: Vec<String> = l.split_whitespace().map(str::to_string).collect();
+            f[1] = format!("{}", -f[1].parse::<f64>().unwrap());
+            f.join(" ") + "\n"
+        })
+        .collect();
+    let flipped = write(&dir, "flipped.dat", &text);
+    let args = [
+        "rsd",
+        "--rsd",
+        "ept",
+        "--bias",
+        "2",
+        "--k-edges",
+        "0.02:0.2:0.02",
+        "--window",
+        &flipped,
+    ];
+    let needle = format!("{flipped}:4: Q0 at the smallest s = -1");
+    fails_naming(&[
+        (args.to_vec(), needle.as_str()),
+        (args.to_vec(), "must be positive"),
+    ]);
+}
+
+/// CLASS keys that set the neutrinos another way were listed as ignored and the spectrum emulated
+/// without them, exit 0: `N_ncdm = 1, omega_ncdm = ...` as massless, `m_ncdm` without `N_ncdm` (which
+/// CLASS does not read) as massive, `T_ncdm = 0.8` as the default. Each is refused naming the line and
+/// key.
+#[test]
+fn class_neutrino_keys_not_modelled_are_refused() {
+    let dir = scratch("faults_ini_neutrinos");
+    let base = "h = 0.67\nomega_b = 0.022\nomega_cdm = 0.12\nn_s = 0.965\nA_s = 2.1e-9\n";
+    let cases = [
+        (
+            "omega_ncdm.ini",
+            "N_ncdm = 1\nomega_ncdm = 0.000644\nN_ur = 2.0328\n",
+            ":6: `N_ncdm = 1`",
+        ),
+        (
+            "no_n_ncdm.ini",
+            "m_ncdm = 0.02\ndeg_ncdm = 3\nN_ur = 0.00641\n",
+            "N_ncdm is not given",
+        ),
+        (
+            "t_ncdm.ini",
+            "N_ncdm = 1\nm_ncdm = 0.02\ndeg_ncdm = 3\nN_ur = 0.00641\nT_ncdm = 0.8\n",
+            ":10: `T_ncdm = 0.8`",
+        ),
+        ("case.ini", "M_ncdm = 0.06\n", "did you mean `m_ncdm`"),
+    ];
+    let files: Vec<(String, &str)> = cases
+        .iter()
+        .map(|(name, extra, needle)| (write(&dir, name, &format!("{base}{extra}")), *needle))
+        .collect();
+    let args: Vec<Vec<&str>> = files
+        .iter()
+        .map(|(f, _)| {
+            vec![
+                "real",
+                "--model",
+                "linear",
+                "--nk",
+                "3",
+                "--cosmology",
+                f.as_str(),
+            ]
+        })
+        .collect();
+    let cases: Vec<(Vec<&str>, &str)> = args
+        .iter()
+        .zip(&files)
+        .map(|(a, (_, needle))| (a.clone(), *needle))
+        .collect();
+    fails_naming(&cases);
+}

@@ -550,7 +550,7 @@ fn bad_files_and_overflowing_kernels_are_errors_naming_file_and_line() {
         ),
         (
             fit_args,
-            &format!("{covariance}:2: the row has 3 columns, 2 expected"),
+            &format!("{covariance}:2: the covariance row has 3 columns, but the data vector has 2 values"),
         ),
         (
             vec!["kernel", "F", "--q", "1e200,0,0", "--q", "-1e200,1e-200,0"],

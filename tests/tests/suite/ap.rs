@@ -103,6 +103,7 @@ fn distances_with_massive_neutrinos_agree_with_camb() {
             ("h", "0.675".to_string()),
             ("omega_b", "0.0224".to_string()),
             ("omega_cdm", "0.12".to_string()),
+            ("N_ncdm", "1".to_string()),
             ("m_ncdm", (m_nu / 3.0).to_string()),
             ("deg_ncdm", "3".to_string()),
             ("N_ur", "0.00641".to_string()), // N_eff = 3.046 with three massive species (CLASS)

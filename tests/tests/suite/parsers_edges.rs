@@ -222,10 +222,18 @@ fn two_by_two() -> MultipoleData {
 #[test]
 fn covariance_shape_errors_name_file_and_line() {
     let cases = [
-        ("1 0\n0 1 0\n", ":2: the row has 3 columns, 2 expected"),
+        // a row of another width: the sizes of both, not "column 2 was requested" (issue 45)
+        (
+            "1 0\n0 1 0\n",
+            ":2: the covariance row has 3 columns, but the data vector has 2 values (1 multipole(s) × 2 k): the covariance must be 2 × 2",
+        ),
         (
             "1 0\n0\n",
-            ":2: column 2 was requested but the row has only 1",
+            ":2: the covariance row has 1 columns, but the data vector has 2 values",
+        ),
+        (
+            "1\n0\n",
+            ":1: the covariance row has 1 columns, but the data vector has 2 values",
         ),
         (
             "1 0\n0 1\n0 0\n",

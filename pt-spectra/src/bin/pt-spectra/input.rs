@@ -7,7 +7,7 @@ use pt_spectra::linear::{Columns, LinearSpectrum, LogGrid};
 use pt_spectra::precision::{Precision, TwoLoopMethod};
 use pt_spectra::setup::{self, LinearSource, NamedCosmology, Prepared, Request};
 use pt_spectra::store::TableStore;
-use pt_spectra::table::{KGrid, Table};
+use pt_spectra::table::KGrid;
 use std::path::{Path, PathBuf};
 
 /// `K,P` (1-based column numbers) as 0-based [`Columns`].
@@ -288,11 +288,7 @@ impl Input {
 /// any table (`#` comments, one optional row of column names, comma or blank separated, any line ends);
 /// every error names the file and the line.
 pub fn read_k_file(path: &PathBuf) -> Result<KGrid> {
-    let table = Table::read(path, &[0]).context("--k-file")?;
-    let Some(k) = table.columns.into_iter().next().filter(|k| !k.is_empty()) else {
-        bail!("--k-file `{}` contains no k values", path.display());
-    };
-    KGrid::new(&table.origin, k, &table.lines).context("--k-file")
+    KGrid::read(path).context("--k-file")
 }
 
 #[cfg(test)]

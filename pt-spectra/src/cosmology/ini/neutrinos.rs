@@ -20,7 +20,7 @@ use crate::cosmology::Neutrinos;
 use crate::error::{Error, Result};
 
 /// The keys read here besides the masses (`m_ncdm`, `mnu`, `omnuh2`, `m_nu` are in the key table).
-pub(super) const SPECIES_KEYS: [&str; 10] = [
+pub(super) const SPECIES_KEYS: [&str; 12] = [
     "N_ncdm",
     "deg_ncdm",
     "N_ur",
@@ -31,47 +31,111 @@ pub(super) const SPECIES_KEYS: [&str; 10] = [
     "nnu",
     "neutrinos",
     "N_eff",
+    "num_nu_massive",
+    "num_nu_massless",
 ];
 
 /// The masses of CLASS's `m_ncdm` list (eV per species), each repeated by its `deg_ncdm` (a number for
-/// all species or a list, default 1); `None` if a number does not parse, a degeneracy is not a
-/// positive integer, or the lengths disagree with each other or with `N_ncdm`.
-pub(super) fn ncdm_masses(m_ncdm: Entry<'_>, entries: &[Entry<'_>]) -> Option<Vec<f64>> {
-    let list = |text: &str| -> Option<Vec<f64>> {
-        text.split(',').map(|v| parse_number(v.trim())).collect()
+/// all species or a list, default 1).
+///
+/// # Errors
+/// Why the list is refused: a number that does not parse (the list is comma-separated, as in
+/// CLASS), a degeneracy that is not a positive integer, lengths that disagree with each other or
+/// with `N_ncdm`, or masses without `N_ncdm` (CLASS reads `m_ncdm` only when `N_ncdm` > 0: its
+/// default `N_ncdm = 0` leaves the neutrinos massless).
+pub(super) fn ncdm_masses(
+    m_ncdm: Entry<'_>,
+    entries: &[Entry<'_>],
+) -> std::result::Result<Vec<f64>, String> {
+    let list = |e: Entry<'_>| -> std::result::Result<Vec<f64>, String> {
+        e.value
+            .split(',')
+            .map(|v| {
+                parse_number(v.trim()).ok_or_else(|| {
+                    format!(
+                        "`{}` in `{}` is not a finite number ({} is a comma-separated list, as in \
+                         CLASS: e.g. `0.02, 0.02, 0.02`)",
+                        quote(v.trim()),
+                        e.key,
+                        e.key
+                    )
+                })
+            })
+            .collect()
     };
-    let masses = list(m_ncdm.value)?;
-    if let Some(n) = find(entries, "N_ncdm") {
-        if parse_number(n.value)? != masses.len() as f64 {
-            return None;
+    let masses = list(m_ncdm)?;
+    match find(entries, "N_ncdm") {
+        Some(n) => {
+            let count = parse_number(n.value)
+                .filter(|c| *c >= 0.0 && c.fract() == 0.0)
+                .ok_or_else(|| {
+                    format!(
+                        "N_ncdm = {} (line {}) is not a number of species",
+                        quote(n.value),
+                        n.line
+                    )
+                })?;
+            if count != masses.len() as f64 {
+                return Err(format!(
+                    "N_ncdm = {} (line {}) but m_ncdm lists {} mass(es): CLASS reads N_ncdm masses \
+                     (and none with N_ncdm = 0)",
+                    n.value,
+                    n.line,
+                    masses.len()
+                ));
+            }
         }
+        None if masses.iter().any(|&m| m != 0.0) => {
+            return Err(format!(
+                "N_ncdm is not given: CLASS reads m_ncdm only when N_ncdm > 0 (its default N_ncdm = 0 \
+                 leaves the neutrinos massless); give N_ncdm = {}",
+                masses.len()
+            ));
+        }
+        None => {}
     }
-    let degeneracy = match find(entries, "deg_ncdm").map(|e| list(e.value)) {
+    let degeneracy = match find(entries, "deg_ncdm") {
         None => vec![1.0; masses.len()],
-        Some(d) => {
-            let d = d?;
+        Some(e) => {
+            let d = list(e)?;
             match d.len() {
                 1 => vec![d[0]; masses.len()],
                 n if n == masses.len() => d,
-                _ => return None,
+                n => {
+                    return Err(format!(
+                        "deg_ncdm (line {}) lists {n} degeneracies for {} mass(es)",
+                        e.line,
+                        masses.len()
+                    ))
+                }
             }
         }
     };
     let mut out = Vec::new();
     for (&m, &g) in masses.iter().zip(&degeneracy) {
         if !(g >= 1.0 && g.fract() == 0.0 && g <= 10.0) {
-            return None;
+            return Err(format!(
+                "deg_ncdm = {g}: a degeneracy is a whole number of species from 1 to 10"
+            ));
         }
         out.extend(std::iter::repeat_n(m, g as usize));
     }
-    Some(out)
+    Ok(out)
 }
 
 /// Σm_ν of [`ncdm_masses`], rounded to 1e-12 eV (3 × 0.1 is 0.3, not 0.30000000000000004).
-pub(super) fn ncdm_sum(m_ncdm: Entry<'_>, entries: &[Entry<'_>]) -> Option<f64> {
-    let sum: f64 = ncdm_masses(m_ncdm, entries)?.iter().sum();
+///
+/// # Errors
+/// As [`ncdm_masses`], as an [`Error::InvalidChoice`] naming the file, line and key.
+pub(super) fn ncdm_sum(m_ncdm: Entry<'_>, entries: &[Entry<'_>], origin: &str) -> Result<f64> {
+    let masses = ncdm_masses(m_ncdm, entries).map_err(|reason| refuse(origin, m_ncdm, reason))?;
+    let sum: f64 = masses.iter().sum();
     let sum = (sum * 1e12).round() / 1e12;
-    sum.is_finite().then_some(sum)
+    if sum.is_finite() {
+        Ok(sum)
+    } else {
+        Err(refuse(origin, m_ncdm, "the masses must be finite".into()))
+    }
 }
 
 fn find<'a>(entries: &[Entry<'a>], key: &str) -> Option<Entry<'a>> {
@@ -125,17 +189,25 @@ fn camb(
     mass_key: Option<&str>,
     explicit: bool,
 ) -> Result<Option<Neutrinos>> {
-    let count = find(entries, "num_massive_neutrinos").or(find(entries, "massive_neutrinos"));
+    let count = find(entries, "num_massive_neutrinos")
+        .or(find(entries, "massive_neutrinos"))
+        .or(find(entries, "num_nu_massive"));
     let hierarchy = find(entries, "neutrino_hierarchy");
     if let Some(nnu) = find(entries, "nnu") {
         check_n_eff(origin, nnu, number(origin, nnu)?, "")?;
     }
-    if let Some(massless) = find(entries, "massless_neutrinos") {
+    if let Some(massless) = find(entries, "massless_neutrinos").or(find(entries, "num_nu_massless"))
+    {
         let massive = count.map(|c| number(origin, c)).transpose()?.unwrap_or(1.0);
         let how = format!(" (massless_neutrinos + {massive} massive)");
         check_n_eff(origin, massless, number(origin, massless)? + massive, &how)?;
     }
-    let camb_mass = matches!(mass_key, Some("mnu" | "omnuh2")) && !explicit;
+    // CAMB's mass keys mean CAMB's default (one massive species) wherever they are given: beside
+    // CLASS's keys too, whose setting must then agree (`mnu = 0.06` with three equal `m_ncdm` is two
+    // settings, not one)
+    let camb_mass = mass_key.is_some()
+        && entries.iter().any(|e| matches!(e.key, "mnu" | "omnuh2"))
+        && !explicit;
     if count.is_none() && hierarchy.is_none() && !camb_mass {
         return Ok(None);
     }
@@ -253,6 +325,20 @@ pub(super) fn setting(
     origin: &str,
     mass_key: Option<&str>,
 ) -> Result<Neutrinos> {
+    if find(entries, "m_ncdm").is_none() {
+        if let Some(n) = find(entries, "N_ncdm") {
+            if number(origin, n)? != 0.0 {
+                return Err(refuse(
+                    origin,
+                    n,
+                    "N_ncdm > 0 without m_ncdm: CLASS's masses then default to 0 (massless non-cold \
+                     species, which add to N_eff); give the masses in m_ncdm (omega_ncdm and \
+                     Omega_ncdm are not read)"
+                        .into(),
+                ));
+            }
+        }
+    }
     if let Some(e) = find(entries, "N_eff") {
         check_n_eff(origin, e, number(origin, e)?, "")?;
     }
@@ -283,7 +369,10 @@ pub(super) fn setting(
             Some(c) if c != s => {
                 let keys: Vec<String> = entries
                     .iter()
-                    .filter(|e| SPECIES_KEYS.contains(&e.key) || Some(e.key) == mass_key)
+                    .filter(|e| {
+                        SPECIES_KEYS.contains(&e.key)
+                            || matches!(e.key, "m_ncdm" | "mnu" | "omnuh2" | "m_nu")
+                    })
                     .map(|e| format!("`{}` (line {})", e.text(), e.line))
                     .collect();
                 return Err(Error::InvalidChoice {
@@ -330,7 +419,6 @@ mod tests {
         for extra in [
             "N_ncdm = 1\nm_ncdm = 0.39\nN_ur = 2.0328\n",
             "N_ncdm = 1\nm_ncdm = 0.06\nN_ur = 2.0308\n",
-            "m_ncdm = 0.06\nN_ur = 2.0328\n",
         ] {
             assert_eq!(setting(CLASS, extra), OneMassive, "{extra}");
         }

@@ -329,7 +329,7 @@ fn neutrino_masses_from_class_lists_camb_mnu_and_omnuh2() {
     let expected = (0.022 + 0.12 + 0.06 / 93.14) / (0.67 * 0.67);
     assert!((c.omega_m / expected - 1.0).abs() < 1e-14);
     assert_eq!(
-        class("m_ncdm = 0.05\ndeg_ncdm = 3\nN_ur = 0.00641\n")
+        class("N_ncdm = 1\nm_ncdm = 0.05\ndeg_ncdm = 3\nN_ur = 0.00641\n")
             .unwrap()
             .cosmology
             .m_nu,
@@ -348,4 +348,160 @@ fn neutrino_masses_from_class_lists_camb_mnu_and_omnuh2() {
     // without neutrino masses, N_ncdm and deg_ncdm are listed as ignored
     let c = class("N_ncdm = 0\n").unwrap();
     assert_eq!(c.ignored, ["N_ncdm"]);
+}
+
+/// Issue 45 (fault sweep 2): keys of CLASS and CAMB that set the neutrinos, the primordial spectrum
+/// or the matter density another way were listed as ignored and the spectrum computed without them,
+/// exit 0 (`N_ncdm = 1, omega_ncdm = 0.000644` emulated massless; `m_ncdm` without `N_ncdm`, which
+/// CLASS does not read, as massive; `T_ncdm`, `alpha_s`, `T_cmb`, `Omega_m = 0.5` dropped; CAMB's
+/// `nu_mass_eigenstates = 2` as degenerate; `mnu` beside three equal `m_ncdm` as CLASS's setting; a
+/// case slip `M_ncdm` as an unknown key). Each is refused naming the line, the key and the rule, or
+/// accepted where it states what is modelled.
+#[test]
+fn keys_that_change_the_spectrum_another_way_are_refused_naming_them() {
+    let class = "h = 0.67\nomega_b = 0.022\nomega_cdm = 0.12\nn_s = 0.96\nA_s = 2.1e-9\n";
+    let camb = "H0 = 67\nombh2 = 0.022\nomch2 = 0.12\nns = 0.96\nAs = 2.1e-9\n";
+    let refused = |base: &str, extra: &str, names: &[&str]| {
+        let e = Cosmology::from_ini_str(&format!("{base}{extra}"), "x.ini")
+            .map(|p| format!("accepted: {:?} ignored {:?}", p.cosmology, p.ignored))
+            .unwrap_err_or_text();
+        for n in names {
+            assert!(e.contains(n), "{extra}: `{n}` not in: {e}");
+        }
+    };
+    let three = "N_ncdm = 1\nm_ncdm = 0.02\ndeg_ncdm = 3\nN_ur = 0.00641\n";
+    refused(
+        class,
+        "N_ncdm = 1\nomega_ncdm = 0.000644\nN_ur = 2.0328\n",
+        &["x.ini:6", "N_ncdm", "m_ncdm"],
+    );
+    refused(
+        class,
+        "omega_ncdm = 0.000644\n",
+        &["x.ini:6", "omega_ncdm", "m_ncdm"],
+    );
+    refused(
+        class,
+        "Omega_ncdm = 0.0014\n",
+        &["x.ini:6", "Omega_ncdm", "m_ncdm"],
+    );
+    refused(
+        class,
+        "m_ncdm = 0.06\nN_ur = 2.0328\n",
+        &["x.ini:6", "N_ncdm is not given"],
+    );
+    refused(
+        class,
+        "N_ncdm = 0\nm_ncdm = 0.06\nN_ur = 2.0328\n",
+        &["x.ini:7", "N_ncdm = 0"],
+    );
+    refused(
+        class,
+        "N_ncdm = 3\nm_ncdm = 0.02 0.02 0.02\nN_ur = 0.00641\n",
+        &["x.ini:7", "comma-separated"],
+    );
+    refused(
+        class,
+        &format!("{three}T_ncdm = 0.8\n"),
+        &["x.ini:10", "T_ncdm = 0.8", "0.71611"],
+    );
+    refused(
+        class,
+        &format!("{three}ksi_ncdm = 1\n"),
+        &["x.ini:10", "ksi_ncdm"],
+    );
+    refused(
+        class,
+        "alpha_s = 0.05\n",
+        &["x.ini:6", "alpha_s", "power law"],
+    );
+    refused(camb, "nrun = 0.05\n", &["x.ini:6", "nrun"]);
+    refused(class, "T_cmb = 3.5\n", &["x.ini:6", "T_cmb", "2.7255"]);
+    refused(class, "omega_ur = 0\n", &["x.ini:6", "omega_ur", "N_ur"]);
+    refused(
+        class,
+        "Omega_m = 0.5\n",
+        &["x.ini:6", "Omega_m = 0.5", "0.316"],
+    );
+    refused(
+        class,
+        "100*theta_s = 1.04\n",
+        &["x.ini:6", "100*theta_s", "h or H0"],
+    );
+    refused(
+        class,
+        "M_ncdm = 0.06\n",
+        &["x.ini:6", "M_ncdm", "`m_ncdm`", "case"],
+    );
+    refused(camb, "omnuh2 = 0.000644\nmassless_neutrinos = 0.046\nmassive_neutrinos = 3\nnu_mass_eigenstates = 2\n", &["x.ini:9", "nu_mass_eigenstates"]);
+    refused(
+        camb,
+        "mnu = 0.06\nnum_massive_neutrinos = 3\nnu_mass_fractions = 0.5 0.5\n",
+        &["x.ini:8", "nu_mass_fractions"],
+    );
+    // CAMB's mnu (one massive species by CAMB's default) beside CLASS's three equal masses
+    refused(
+        class,
+        "N_ncdm = 3\nm_ncdm = 0.02,0.02,0.02\nN_ur = 0.00641\nmnu = 0.06\n",
+        &["mnu = 0.06", "m_ncdm", "different neutrino settings"],
+    );
+    // what is modelled anyway is accepted (and listed as ignored)
+    let ok = |base: &str, extra: &str| {
+        Cosmology::from_ini_str(&format!("{base}{extra}"), "x.ini")
+            .unwrap_or_else(|e| panic!("{extra}: {e}"))
+    };
+    let p = ok(
+        class,
+        &format!("{three}T_ncdm = 0.71611\nalpha_s = 0\nT_cmb = 2.7255\n"),
+    );
+    assert_eq!(p.ignored, ["T_ncdm", "alpha_s", "T_cmb"]);
+    assert_eq!(
+        p.cosmology.neutrinos,
+        crate::cosmology::Neutrinos::ThreeDegenerate
+    );
+    ok(class, "Omega_m = 0.3163\n");
+    ok(class, "omega_m = 0.142\n");
+    let p = ok(
+        camb,
+        "mnu = 0.06\nnum_nu_massive = 3\nnu_mass_eigenstates = 1\n",
+    );
+    assert_eq!(
+        p.cosmology.neutrinos,
+        crate::cosmology::Neutrinos::ThreeDegenerate
+    );
+    // a Python dict is strict: an unknown key is an error naming it; a read key is not
+    let pairs = [
+        ("h", "0.67"),
+        ("omega_b", "0.022"),
+        ("omega_cdm", "0.12"),
+        ("n_s", "0.96"),
+        ("A_s", "2.1e-9"),
+    ];
+    let e = Cosmology::from_keys_strict(pairs.iter().copied().chain([("m_ncmd", "0.06")]), "dict")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`m_ncmd`") && e.contains("dict:6"), "{e}");
+    assert!(Cosmology::from_keys_strict(
+        pairs.iter().copied().chain([("T_cmb", "2.7255")]),
+        "dict"
+    )
+    .is_ok());
+    assert!(
+        Cosmology::from_keys(pairs.iter().copied().chain([("m_ncmd", "0.06")]), "dict").is_ok()
+    );
+}
+
+/// `Result::unwrap_err` as text, or the accepted value's text (so that an acceptance fails the
+/// caller's `contains` with what was accepted).
+trait ErrText {
+    fn unwrap_err_or_text(self) -> String;
+}
+
+impl ErrText for std::result::Result<String, crate::error::Error> {
+    fn unwrap_err_or_text(self) -> String {
+        match self {
+            Ok(accepted) => accepted,
+            Err(e) => e.to_string(),
+        }
+    }
 }

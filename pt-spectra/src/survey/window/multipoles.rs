@@ -251,6 +251,21 @@ impl WindowMultipoles {
                 });
             }
         }
+        // Q0 → 1 as s → 0 for a normalised window (a pair count's monopole, positive for any
+        // normalisation): Q0(0) ≤ 0 is a sign flip or another column, and flipped every windowed
+        // multipole with exit 0 (issue 45). (Q0(0) ≠ 1 but positive is warned about.)
+        let q0 = &q[ells.iter().position(|&l| l == 0).expect("checked")];
+        if q0[0] <= 0.0 {
+            return Err(Error::InvalidValue {
+                origin,
+                line: line(0),
+                name: "Q0 at the smallest s",
+                value: q0[0],
+                reason:
+                    "must be positive: Q0 tends to 1 as s -> 0 for a normalised window (a sign \
+                         flip, or another quantity in the Q0 column?)",
+            });
+        }
         let ln_s: Vec<f64> = s.iter().map(|v| v.ln()).collect();
         let splines = q
             .iter()
