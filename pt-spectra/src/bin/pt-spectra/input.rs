@@ -311,7 +311,7 @@ mod tests {
             ("nan", "0.1\nNaN\n", ":2: k = NaN"),
             ("neg", "-1\n", ":1: k = -1"),
             ("txt", "0.1\nabc\n", ":2: cannot parse `abc`"),
-            ("empty", "# nothing\n", "no k values"),
+            ("empty", "# nothing\n", "0 data row(s)"),
         ] {
             let e = format!("{:#}", read_k_file(&write(name, text)).unwrap_err());
             assert!(e.contains(needle), "{name}: {e}");
@@ -357,7 +357,7 @@ mod tests {
             ),
             ("cut", b"0.1\n0.2\n0.", ":3: k = 0 h/Mpc"),
             ("esc", b"0.1\n\x1b[31m\n", ":2: cannot parse `\\u{1b}[31m`"),
-            ("blank", b"\n \t\n# only comments\n", "no k values"),
+            ("blank", b"\n \t\n# only comments\n", "0 data row(s)"),
         ];
         for (name, bytes, needle) in cases {
             let path = write(name, "");
