@@ -111,10 +111,10 @@ def crossing(grid, delta, level=1.0):
     return lo, hi
 
 
-def sample(lik, best, cov, likelihood, rminus1, seed):
+def sample(lik, best, cov, likelihood, rminus1, seed, label="ngc"):
     """cobaya's MCMC with the likelihood class `pt_spectra.likelihoods.AnalysisFile` (the options
     `likelihood`: the same file and template as `lik`), flat priors on the likelihood's bounds (its own
-    priors are in -2 ln L already), f sigma8 derived by it."""
+    priors are in -2 ln L already), f sigma8 of the data set `label` derived by it."""
     from cobaya.run import run
     from pt_spectra.likelihoods import cobaya_name
 
@@ -123,9 +123,9 @@ def sample(lik, best, cov, likelihood, rminus1, seed):
     for n, (a, b), x, s in zip(lik.names, lik.bounds, best, np.sqrt(np.diag(cov))):
         params[key[n]] = {"prior": {"min": a, "max": b}, "ref": {"dist": "norm", "loc": x, "scale": 0.3 * s},
                           "proposal": s, "latex": LABELS.get(n, n)}
-    params["fsigma8_ngc"] = {"latex": r"f\sigma_8"}
+    params[f"fsigma8_{label}"] = {"latex": r"f\sigma_8"}
     info = {
-        "likelihood": {"boss_ngc": {"class": "pt_spectra.likelihoods.AnalysisFile", **likelihood}},
+        "likelihood": {f"analysis_{label}": {"class": "pt_spectra.likelihoods.AnalysisFile", **likelihood}},
         "params": params,
         "sampler": {"mcmc": {"covmat": cov, "covmat_params": [key[n] for n in lik.names],
                              "Rminus1_stop": rminus1, "Rminus1_cl_stop": 0.1, "max_tries": 10000,
@@ -138,7 +138,7 @@ def sample(lik, best, cov, likelihood, rminus1, seed):
     table = samples.data
     burn = int(0.3 * len(table))
     chain = table.iloc[burn:]
-    key["fsigma8"] = "fsigma8_ngc"
+    key["fsigma8"] = f"fsigma8_{label}"
     return chain["weight"].to_numpy(), chain["minuslogpost"].to_numpy(), \
         {n: chain[key[n]].to_numpy() for n in lik.names + ["fsigma8"]}
 
