@@ -12,7 +12,7 @@ use pt_spectra::pipeline::{
     PIPELINE_MAX_RESIDUAL,
 };
 use pt_spectra::progress::Silent;
-use pt_spectra::setup::{LinearSource, Prepared};
+use pt_spectra::setup::{LinearSource, NamedCosmology, Prepared};
 use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -80,6 +80,11 @@ impl Pipeline {
                 .map_err(value_error);
         }
         let (named, _) = inputs.cosmology().map_err(value_error)?;
+        self.prepared_named(named)
+    }
+
+    /// The emulated spectrum of a cosmology already parsed (`None`: the default).
+    fn prepared_named(&self, named: Option<NamedCosmology>) -> PyResult<Prepared> {
         self.inner
             .prepare_source(LinearSource::Embedded, named)
             .map_err(value_error)
@@ -132,16 +137,18 @@ impl Pipeline {
         z_input: Option<f64>,
         cosmology: Option<&Bound<'_, PyAny>>,
         params: &[(String, f64)],
-    ) -> PyResult<Option<RepeatKey>> {
+    ) -> PyResult<Option<(RepeatKey, Option<NamedCosmology>)>> {
         if linear.is_some() || z_input.is_some() || self.inner.has_bispectrum() {
             return Ok(None);
         }
         let z = self.inner.settings().z;
         let inputs = Inputs::extract(None, z, z, cosmology, None)?;
         let (named, _) = inputs.cosmology().map_err(value_error)?;
-        let c = named.map_or_else(pt_spectra::cosmology::Cosmology::gm2012, |n| n.cosmology);
+        let c = named
+            .as_ref()
+            .map_or_else(pt_spectra::cosmology::Cosmology::gm2012, |n| n.cosmology);
         let f = params.iter().find(|(n, _)| n == "f").map(|p| p.1.to_bits());
-        Ok(Some((c, f)))
+        Ok(Some(((c, f), named)))
     }
 
     /// The data vector (and Jacobian) of a call repeating the last cosmology, from its nuisance
@@ -274,11 +281,18 @@ impl Pipeline {
         params: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let params = pairs(params)?;
-        let key = self.repeat_key(linear, z_input, cosmology, &params)?;
+        // the cosmology parsed once: the key of a repeated call and, if new, what is emulated
+        let (key, named) = match self.repeat_key(linear, z_input, cosmology, &params)? {
+            Some((key, named)) => (Some(key), Some(named)),
+            None => (None, None),
+        };
         let (values, jac) = match self.repeated(key.as_ref(), &params, jacobian)? {
             Some(result) => result,
             None => {
-                let prepared = self.prepared(linear, z_input, cosmology)?;
+                let prepared = match named {
+                    Some(named) => self.prepared_named(named)?,
+                    None => self.prepared(linear, z_input, cosmology)?,
+                };
                 let result = self.one(py, &prepared, &params, jacobian)?;
                 *self.repeat.lock().expect("not poisoned") = key.map(|k| (k, prepared, None));
                 result
