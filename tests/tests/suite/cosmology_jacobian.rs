@@ -88,7 +88,9 @@ fn differences(
 /// finite-difference estimate: without AP within 1e-6 of its largest element (measured ≤ 1.6e-8),
 /// with AP within 3e-6 (measured ≤ 3e-8 for ΛCDM; ≤ 1.3e-6 for w0 at the w0–wa point, where the
 /// AP projection's interpolant, a cubic in ln k′ per cell of its grid, has derivative jumps at the
-/// cell edges that the differences straddle); the data vector is `evaluate`'s.
+/// cell edges that the differences straddle, and the column is the difference of larger AP and
+/// spectrum parts; each part agrees with differences to ≤ 3.5e-7 when checked apart,
+/// docs/architecture.md); the data vector is `evaluate`'s.
 #[test]
 fn cosmological_derivatives_equal_high_order_differences() {
     let lcdm = [0.68, 0.0224, 0.12, 3.04, 0.965, 0.06, -1.0, 0.0];
