@@ -309,3 +309,39 @@ fn class_neutrino_keys_not_modelled_are_refused() {
         .collect();
     fails_naming(&cases);
 }
+
+/// A window whose Q0(0) is not 1 (a factor 1e6 here) is warned about on standard error, not only in
+/// the table's header, once.
+#[test]
+fn a_window_not_normalised_is_warned_about_on_stderr() {
+    let dir = scratch("faults_window_scale");
+    let text: String = boss_window()
+        .lines()
+        .map(|l| {
+            if l.starts_with('#') {
+                return format!("{l}\n");
+            }
+            let mut f: Vec<String> = l.split_whitespace().map(str::to_string).collect();
+            f[1] = format!("{}", 1e6 * f[1].parse::<f64>().unwrap());
+            f.join(" ") + "\n"
+        })
+        .collect();
+    let scaled = write(&dir, "scaled.dat", &text);
+    let (ok, out, err) = super::run(&[
+        "rsd",
+        "--rsd",
+        "ept",
+        "--bias",
+        "2",
+        "--k-edges",
+        "0.02:0.2:0.02",
+        "--precision",
+        "fast",
+        "--window",
+        &scaled,
+    ]);
+    assert!(ok, "{err}");
+    let needle = "is 1000000, not 1";
+    assert!(out.contains(needle), "{out}");
+    assert_eq!(err.matches(needle).count(), 1, "{err}");
+}

@@ -205,7 +205,7 @@ impl SpectrumInput {
             eprintln!("note: {w}");
         }
         for w in &prepared.warnings {
-            eprintln!("warning: {w}");
+            crate::output::warn_once(w);
         }
         let mut precision = self.precision.clone();
         precision.two_loop = self.two_loop;
@@ -278,7 +278,7 @@ impl Input {
         };
         let loaded = self.spectrum.load()?;
         for w in setup::input_warnings(&loaded.prepared, &[], &k) {
-            eprintln!("warning: {w}");
+            crate::output::warn_once(&w);
         }
         Ok((k, loaded))
     }

@@ -3,8 +3,10 @@
 
 use anyhow::{bail, Context, Result};
 use pt_spectra::output::Table;
+use std::collections::BTreeSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 /// Refuses outputs that would replace an input of the same run, or each other: `outputs` are the
 /// `(option, path)` of the files to be written, `inputs` those read. Called before any computation.
@@ -58,9 +60,27 @@ fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
+/// Prints `message` on standard error as `warning: message`, unless this run has printed it already
+/// (a warning made while reading the input is in the table's header too).
+pub fn warn_once(message: &str) {
+    static SEEN: Mutex<BTreeSet<String>> = Mutex::new(BTreeSet::new());
+    let new = SEEN
+        .lock()
+        .map_or(true, |mut seen| seen.insert(message.to_string()));
+    if new {
+        eprintln!("warning: {message}");
+    }
+}
+
 /// Writes `table` as text to `out` (atomically: an existing file is replaced only by the whole new
-/// table), or to standard output, after checking that every value is finite.
+/// table), or to standard output, after checking that every value is finite. The header's warnings
+/// (its lines `warning: …`, e.g. a window whose Q0(0) is not 1) go to standard error as well.
 pub fn write_output(out: Option<&PathBuf>, table: &Table) -> Result<()> {
+    for line in &table.header {
+        if let Some(warning) = line.strip_prefix("warning: ") {
+            warn_once(warning);
+        }
+    }
     let text = table.checked()?.to_text();
     match out {
         Some(path) => pt_spectra::output::write_atomic(path, text.as_bytes())
