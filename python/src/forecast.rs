@@ -84,15 +84,36 @@ pub(crate) fn fisher<'py>(
     let (f, _) = crate::detached(py, || {
         lib_fisher(&bins, &fiducial, parameters, &priors, store.get(), &Silent)
     })?;
-    let d = PyDict::new(py);
-    d.set_item("names", f.names)?;
-    d.set_item("fiducial", f.fiducial)?;
-    d.set_item("sigma", f.sigma)?;
-    d.set_item("covariance", f.covariance)?;
-    d.set_item("fisher", f.fisher)?;
-    d.set_item("fsigma8", f.fsigma8)?;
+    let d = result_dict(
+        py,
+        f.names,
+        f.fiducial,
+        [f.fisher, f.covariance],
+        f.sigma,
+        f.fsigma8,
+    )?;
     d.set_item("derivative_error", f.derivative_error)?;
     d.set_item("points", f.points)?;
+    Ok(d)
+}
+
+/// What every forecast returns: names, fiducial values, the Fisher matrix and its inverse, σ, and
+/// (σ(fσ8), fσ8) per bin.
+fn result_dict(
+    py: Python<'_>,
+    names: Vec<String>,
+    fiducial: Vec<f64>,
+    [fisher, covariance]: [Vec<Vec<f64>>; 2],
+    sigma: Vec<f64>,
+    fsigma8: Vec<(f64, f64)>,
+) -> PyResult<Bound<'_, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("names", names)?;
+    d.set_item("fiducial", fiducial)?;
+    d.set_item("sigma", sigma)?;
+    d.set_item("covariance", covariance)?;
+    d.set_item("fisher", fisher)?;
+    d.set_item("fsigma8", fsigma8)?;
     Ok(d)
 }
 
@@ -174,12 +195,12 @@ pub(crate) fn fisher_kaiser<'py>(
     let (f, _) = crate::detached(py, || {
         pt_spectra::forecast::fisher_kaiser(&parsed, &fiducial)
     })?;
-    let d = PyDict::new(py);
-    d.set_item("names", f.names)?;
-    d.set_item("fiducial", f.fiducial)?;
-    d.set_item("sigma", f.sigma)?;
-    d.set_item("covariance", f.covariance)?;
-    d.set_item("fisher", f.fisher)?;
-    d.set_item("fsigma8", f.fsigma8)?;
-    Ok(d)
+    result_dict(
+        py,
+        f.names,
+        f.fiducial,
+        [f.fisher, f.covariance],
+        f.sigma,
+        f.fsigma8,
+    )
 }

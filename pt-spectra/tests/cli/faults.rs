@@ -222,23 +222,28 @@ fn a_window_names_line_with_a_wrong_ell_is_refused() {
     ]);
 }
 
-/// A window whose Q0 column is negated (a sign flip) gave every windowed multipole with the wrong sign
-/// and exit 0 (a header warning only); Q0 at the smallest s must be positive, refused naming the file
-/// and its first data line.
-#[test]
-fn a_window_with_a_negative_q0_is_refused() {
-    let dir = scratch("faults_window_sign");
-    let text: String = boss_window()
+/// The BOSS window with its Q0 column changed by `change`.
+fn boss_window_with_q0(change: impl Fn(f64) -> f64) -> String {
+    boss_window()
         .lines()
         .map(|l| {
             if l.starts_with('#') {
                 return format!("{l}\n");
             }
             let mut f: Vec<String> = l.split_whitespace().map(str::to_string).collect();
-            f[1] = format!("{}", -f[1].parse::<f64>().unwrap());
+            f[1] = format!("{}", change(f[1].parse::<f64>().unwrap()));
             f.join(" ") + "\n"
         })
-        .collect();
+        .collect()
+}
+
+/// A window whose Q0 column is negated (a sign flip) gave every windowed multipole with the wrong sign
+/// and exit 0 (a header warning only); Q0 at the smallest s must be positive, refused naming the file
+/// and its first data line.
+#[test]
+fn a_window_with_a_negative_q0_is_refused() {
+    let dir = scratch("faults_window_sign");
+    let text = boss_window_with_q0(|q0| -q0);
     let flipped = write(&dir, "flipped.dat", &text);
     let args = [
         "rsd",
@@ -315,17 +320,7 @@ fn class_neutrino_keys_not_modelled_are_refused() {
 #[test]
 fn a_window_not_normalised_is_warned_about_on_stderr() {
     let dir = scratch("faults_window_scale");
-    let text: String = boss_window()
-        .lines()
-        .map(|l| {
-            if l.starts_with('#') {
-                return format!("{l}\n");
-            }
-            let mut f: Vec<String> = l.split_whitespace().map(str::to_string).collect();
-            f[1] = format!("{}", 1e6 * f[1].parse::<f64>().unwrap());
-            f.join(" ") + "\n"
-        })
-        .collect();
+    let text = boss_window_with_q0(|q0| 1e6 * q0);
     let scaled = write(&dir, "scaled.dat", &text);
     let (ok, out, err) = super::run(&[
         "rsd",
