@@ -54,6 +54,7 @@ impl Observation {
     #[pyo3(signature = (ells, k=None, window=None, window_mixing="wilson", k_edges=None, r#box=None,
         window_format=None))]
     fn new(
+        py: Python<'_>,
         ells: Vec<usize>,
         k: Option<&Bound<'_, PyAny>>,
         window: Option<PathBuf>,
@@ -79,6 +80,17 @@ impl Observation {
             (None, Some(_)) => return Err(PyValueError::new_err("box needs k_edges")),
         };
         let inner = LibObservation::new(&ells, &k, window, bins).map_err(value_error)?;
+        // what the header would warn about (a window whose Q0(0) is not 1), as a Python warning
+        for line in inner.description() {
+            if let Some(warning) = line.strip_prefix("warning: ") {
+                PyErr::warn(
+                    py,
+                    &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+                    &std::ffi::CString::new(warning)?,
+                    1,
+                )?;
+            }
+        }
         Ok(Self { inner })
     }
 

@@ -32,6 +32,20 @@ def test_a_window_that_cuts_nothing_and_fine_bins_leave_the_model(tmp_path):
     assert np.all(errors >= 0) and np.all(np.isfinite(errors))
 
 
+def test_a_window_not_normalised_is_warned_about(tmp_path):
+    """Q0(0) = 3: the windowed multipoles tend to 3 times the model; the header says so and Python
+    warns (a normalised window does not)."""
+    s = np.geomspace(1e-3, 1e9, 600)
+    path = tmp_path / "w3.txt"
+    np.savetxt(path, np.column_stack([s, 3 * np.ones_like(s), 0 * s, 0 * s]), header="s Q0 Q2 Q4")
+    k = np.linspace(0.02, 0.25, 24)
+    with pytest.warns(UserWarning, match="is 3, not 1"):
+        pt.Observation([0, 2, 4], k, window=path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pt.Observation([0, 2, 4], k, window=_nothing_cut(tmp_path / "w1.txt"))
+
+
 def test_xi_of_a_gaussian_is_the_closed_form():
     """P_2(k) = k² e^{−k²R²/2} has ξ_2(s) = −s² e^{−s²/2R²} / ((2π)^{3/2} R⁷)."""
     r, s = 10.0, np.linspace(10.0, 120.0, 23)
