@@ -53,6 +53,7 @@ impl Observation {
     #[new]
     #[pyo3(signature = (ells, k=None, window=None, window_mixing="wilson", k_edges=None, r#box=None,
         window_format=None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         ells: Vec<usize>,
