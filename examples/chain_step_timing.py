@@ -7,7 +7,8 @@ Prints the median time per call of: a new cosmology through the emulator; the sa
 Jacobian (jacobian=True: the 11 nuisance parameters and f); the same cosmology again with new nuisance parameters
 (a nuisance-only step through Python); a new cosmology from a given linear table (the emulator's own
 spectrum, passed as arrays); a new cosmology with the exact derivatives in the eight sampled
-cosmological parameters (`cosmology_jacobian`, the cosmology given with ln10^{10}A_s). Needs numpy and the Python module (`pip install ./python`); the basis tensors
+cosmological parameters (`cosmology_jacobian`, the cosmology given with ln10^{10}A_s), and with those
+and the nuisance rows of the same step (`full_jacobian`). Needs numpy and the Python module (`pip install ./python`); the basis tensors
 are built on the first run (minutes) and cached. The issue's targets: 0.5 ms per call through Python
 (0.3 ms in Rust), 2 ms with the full Jacobian, 20 us per nuisance step.
 """
@@ -70,6 +71,8 @@ def main():
          lambda i: pipe(cosmology(0), **dict(PARAMS, b1=2.0 + 1e-3 * (i % 50)))),
         ("new cosmology + cosmological Jacobian",
          lambda i: pipe.cosmology_jacobian(with_a_s(cosmology(i)), **PARAMS)),
+        ("new cosmology + full Jacobian (8 + 12 rows)",
+         lambda i: pipe.full_jacobian(with_a_s(cosmology(i)), **PARAMS)),
         ("new cosmology from a table (arrays)",
          lambda i: pipe(cosmology(i), linear=(tables[i % 97]["k"], tables[i % 97]["P_cb"]),
                         z_input=Z, **PARAMS)),

@@ -176,13 +176,15 @@ def data_vector(pipeline, names, cosmology=None, linear=None, z_input=None, **fi
     def value_and_jacobian(x):
         c, params = split(x)
         jacobian = np.zeros((len(names), m))
-        v, j = pipeline(cosmology=c, **where, jacobian=True, **params)
-        for i, r in nuisance_rows:
-            jacobian[i] = j[r]
         if cosmology_rows:
-            v, j = pipeline.cosmology_jacobian(c, **params)
+            # one step for both sets of rows
+            v, n, j = pipeline.full_jacobian(c, **params)
             for i, r in cosmology_rows:
                 jacobian[i] = j[r]
+        else:
+            v, n = pipeline(cosmology=c, **where, jacobian=True, **params)
+        for i, r in nuisance_rows:
+            jacobian[i] = n[r]
         return np.asarray(v, dtype=np.float64), jacobian
 
     function = _host_function(value, value_and_jacobian, (m,), (len(names), m), len(names),

@@ -7,6 +7,7 @@ use crate::survey::Observation;
 use crate::value_error;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pt_spectra::bispectrum::Fog;
+use pt_spectra::cosmology::Cosmology;
 use pt_spectra::pipeline::{
     BispectrumBlock, Pipeline as LibPipeline, PipelineSettings, TermsSource, JACOBIAN_NAMES,
     PIPELINE_MAX_RESIDUAL,
@@ -83,6 +84,14 @@ impl Pipeline {
         self.prepared_named(named)
     }
 
+    /// The cosmology of a `cosmology_jacobian` argument (a preset, ini path or dict).
+    fn cosmology_of(&self, cosmology: &Bound<'_, PyAny>) -> PyResult<Cosmology> {
+        let z = self.inner.settings().z;
+        let inputs = Inputs::extract(None, z, z, Some(cosmology), None)?;
+        let (named, _) = inputs.cosmology().map_err(value_error)?;
+        Ok(named.map_or_else(Cosmology::gm2012, |n| n.cosmology))
+    }
+
     /// The emulated spectrum of a cosmology already parsed (`None`: the default).
     fn prepared_named(&self, named: Option<NamedCosmology>) -> PyResult<Prepared> {
         self.inner
@@ -146,7 +155,7 @@ impl Pipeline {
         let (named, _) = inputs.cosmology().map_err(value_error)?;
         let c = named
             .as_ref()
-            .map_or_else(pt_spectra::cosmology::Cosmology::gm2012, |n| n.cosmology);
+            .map_or_else(Cosmology::gm2012, |n| n.cosmology);
         let f = params.iter().find(|(n, _)| n == "f").map(|p| p.1.to_bits());
         Ok(Some(((c, f), named)))
     }
@@ -368,15 +377,32 @@ impl Pipeline {
         params: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let params = pairs(params)?;
-        let z = self.inner.settings().z;
-        let inputs = Inputs::extract(None, z, z, Some(cosmology), None)?;
-        let (named, _) = inputs.cosmology().map_err(value_error)?;
-        let c = named.map_or_else(pt_spectra::cosmology::Cosmology::gm2012, |n| n.cosmology);
+        let c = self.cosmology_of(cosmology)?;
         let named: Vec<(&str, f64)> = params.iter().map(|(n, v)| (n.as_str(), *v)).collect();
         let (result, _) = crate::detached(py, || self.inner.cosmology_jacobian(&c, &named))?;
         let v = result.data_vector.into_pyarray(py).into_any();
         let j = PyArray2::from_vec2(py, &result.cosmological)?;
         Ok((v, j).into_pyobject(py)?.into_any())
+    }
+
+    /// `cosmology_jacobian` and the nuisance rows of `__call__(..., jacobian=True)` (`nuisance`:
+    /// the nuisance parameters, then f) of one step, made once: (data vector, array (12, n),
+    /// array (8, n)). The whole Jacobian of a sampler over cosmological and nuisance parameters.
+    #[pyo3(signature = (cosmology, **params))]
+    fn full_jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        cosmology: &Bound<'py, PyAny>,
+        params: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let params = pairs(params)?;
+        let c = self.cosmology_of(cosmology)?;
+        let named: Vec<(&str, f64)> = params.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+        let ((result, nuisance), _) = crate::detached(py, || self.inner.full_jacobian(&c, &named))?;
+        let v = result.data_vector.into_pyarray(py).into_any();
+        let n = PyArray2::from_vec2(py, &nuisance)?;
+        let j = PyArray2::from_vec2(py, &result.cosmological)?;
+        Ok((v, n, j).into_pyobject(py)?.into_any())
     }
 
     /// The names of the rows of `cosmology_jacobian` (CLASS's names).

@@ -3,7 +3,8 @@
 //! tensors cached, planned once ([`Pipeline`]):
 //!
 //! * `pipeline/emulator`: a new cosmology at every call (emulator → loop terms → AP multipoles →
-//!   window matrix);
+//!   window matrix); `pipeline/cosmology-jacobian` with the exact derivatives in the eight sampled
+//!   cosmological parameters, `pipeline/full-jacobian` with the nuisance rows of the same step too;
 //! * `pipeline/table`: the same from a given linear table (the embedded gm2012 CAMB spectrum);
 //! * `pipeline/terms`, `pipeline/multipoles`: the two cosmology-dependent stages alone;
 //! * `pipeline/linearise`: a cosmology's data vector as a polynomial in the nuisance parameters
@@ -82,6 +83,19 @@ fn benches(c: &mut Criterion) {
                     .cosmological
                     .len(),
             )
+        })
+    });
+    // the same with the nuisance rows of the same step (a sampler's whole Jacobian)
+    let mut j = 0usize;
+    c.bench_function("pipeline/full-jacobian", |b| {
+        b.iter(|| {
+            j += 1;
+            let om = 0.28 + 0.04 * ((j % 97) as f64 / 97.0);
+            let c = Cosmology::flat(om, 0.69, 0.0224, 0.965, 0.81)
+                .unwrap()
+                .with_amplitude(pt_spectra::cosmology::Amplitude::a_s(2.1e-9))
+                .unwrap();
+            black_box(pl.full_jacobian(&c, &PARAMS).unwrap().1.len())
         })
     });
     let named = pt_spectra::setup::NamedCosmology::gm2012();

@@ -60,6 +60,31 @@ impl Pipeline {
         cosmology: &Cosmology,
         params: &[(&str, f64)],
     ) -> Result<CosmologyJacobian> {
+        Ok(self.jacobians(cosmology, params, false)?.0)
+    }
+
+    /// [`Self::cosmology_jacobian`] and the nuisance parameters' rows ([`CosmologyStep::jacobian`]:
+    /// one per name of [`super::JACOBIAN_NAMES`], f's last) of the same step, made once: the whole
+    /// Jacobian of a sampler over cosmological and nuisance parameters.
+    ///
+    /// # Errors
+    /// As [`Self::cosmology_jacobian`] and [`CosmologyStep::jacobian`].
+    pub fn full_jacobian(
+        &self,
+        cosmology: &Cosmology,
+        params: &[(&str, f64)],
+    ) -> Result<(CosmologyJacobian, Vec<Vec<f64>>)> {
+        let (cosmological, nuisance) = self.jacobians(cosmology, params, true)?;
+        Ok((cosmological, nuisance.unwrap_or_default()))
+    }
+
+    /// The cosmological derivatives and, if `nuisance`, the nuisance rows of the same step.
+    fn jacobians(
+        &self,
+        cosmology: &Cosmology,
+        params: &[(&str, f64)],
+        nuisance: bool,
+    ) -> Result<(CosmologyJacobian, Option<Vec<Vec<f64>>>)> {
         if self.bispectrum.is_some() {
             return Err(Error::InvalidChoice {
                 what: "the cosmological derivatives of a pipeline with a bispectrum block".into(),
@@ -85,10 +110,22 @@ impl Pipeline {
         let spectrum = tangent.spectrum();
         let step = self.step_with(spectrum, f.value(), distortion)?;
         let data_vector = step.data_vector(params)?;
+        let nuisance = if nuisance {
+            Some(step.jacobian(params)?.1)
+        } else {
+            None
+        };
         let mut cosmological = self.spectrum_columns(&step, &tangent, params)?;
         // f and the AP parameters by the chain rule.
         let [d_f, d_apar, d_aperp] = if self.settings.fiducial.is_some() {
-            step.template_jacobian(params)?
+            match &nuisance {
+                // f's row of the nuisance rows is the template's (the same projection)
+                Some(rows) => {
+                    let [d_apar, d_aperp] = step.ap_jacobian(params)?;
+                    [rows[rows.len() - 1].clone(), d_apar, d_aperp]
+                }
+                None => step.template_jacobian(params)?,
+            }
         } else {
             let p = step.params(params)?;
             let (_, mut df) = step.data_vectors_and_df_of(&[], std::slice::from_ref(&p))?;
@@ -103,12 +140,13 @@ impl Pipeline {
                 *c += d_f[i] * f.d[j] + d_apar[i] * dapar[j] + d_aperp[i] * daperp[j];
             }
         }
-        Ok(CosmologyJacobian {
+        let jacobian = CosmologyJacobian {
             data_vector,
             cosmological,
             growth_rate: f,
             ap,
-        })
+        };
+        Ok((jacobian, nuisance))
     }
 
     /// M ∂m/∂P · dP/dθ_j for every j: the multipoles' tangents along the spectrum's derivatives.

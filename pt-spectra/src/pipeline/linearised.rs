@@ -105,17 +105,29 @@ impl CosmologyStep<'_> {
     /// As [`Self::jacobian`]; [`Error::InvalidChoice`] for a pipeline whose plan has no AP grid.
     pub fn template_jacobian(&self, params: &[(&str, f64)]) -> Result<[Vec<f64>; 3]> {
         self.refuse_bispectrum()?;
+        let p = self.params(params)?;
+        let (_, mut df) = self.data_vectors_and_df_of(&[], std::slice::from_ref(&p))?;
+        let [dpar, dperp] = self.ap_jacobian(params)?;
+        Ok([df.remove(0), dpar, dperp])
+    }
+
+    /// The α∥ and α⊥ rows of [`Self::template_jacobian`] alone (for a caller that has f's row from
+    /// [`Self::jacobian`]).
+    ///
+    /// # Errors
+    /// As [`Self::template_jacobian`].
+    pub(crate) fn ap_jacobian(&self, params: &[(&str, f64)]) -> Result<[Vec<f64>; 2]> {
+        self.refuse_bispectrum()?;
         let ap = match self.ap {
             Some(ap) => ap,
             None => crate::rsd::ap::Distortion::new(1.0, 1.0)?,
         };
         let p = self.params(params)?;
         let pl = self.pipeline;
-        let (_, mut df) = self.data_vectors_and_df_of(&[], std::slice::from_ref(&p))?;
         let [dpar, dperp] =
             pl.plan
                 .multipole_ap_derivatives(&self.terms, &p, pl.observation.model_ells(), ap)?;
-        Ok([df.remove(0), pl.observe(&dpar), pl.observe(&dperp)])
+        Ok([pl.observe(&dpar), pl.observe(&dperp)])
     }
 
     /// The polynomial is the power spectrum's.

@@ -140,3 +140,19 @@ fn the_cosmological_jacobian_refuses_what_it_cannot_differentiate() {
         .to_string();
     assert!(e.contains("sigma8") && e.contains("A_s"), "{e}");
 }
+
+/// The full Jacobian is the cosmological one and the step's nuisance rows (the nuisance parameters,
+/// then f), from one step: the same numbers as the two calls made apart.
+#[test]
+fn the_full_jacobian_is_both_jacobians_of_one_step() {
+    let pl = pipeline();
+    let c = cosmology(&[0.68, 0.0224, 0.12, 3.04, 0.965, 0.06, -1.0, 0.0]);
+    let (cosmological, nuisance) = pl.full_jacobian(&c, &PARAMS).unwrap();
+    let alone = pl.cosmology_jacobian(&c, &PARAMS).unwrap();
+    assert_eq!(cosmological.data_vector, alone.data_vector);
+    assert_eq!(cosmological.cosmological, alone.cosmological);
+    let step = pl.step(&pl.prepare(&c).unwrap()).unwrap();
+    let (_, rows) = step.jacobian(&PARAMS).unwrap();
+    assert_eq!(nuisance.len(), pt_spectra::pipeline::JACOBIAN_NAMES.len());
+    assert_eq!(nuisance, rows);
+}
