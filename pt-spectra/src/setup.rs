@@ -564,6 +564,30 @@ mod tests {
             "{:?}",
             mistyped.warnings
         );
+        // near the typical range's edge (σ8 ≈ 0.39 < 0.4) the value is the emulation's at z = 0
+        let low = Cosmology::planck2018()
+            .with_amplitude(crate::cosmology::Amplitude::a_s(4.9e-10))
+            .unwrap();
+        let exact = LinearEmulator::embedded()
+            .unwrap()
+            .spectra(&low, 0.0)
+            .unwrap()
+            .sigma8;
+        let warned = prepare(Request {
+            source: LinearSource::Emulator,
+            cosmology: Some(NamedCosmology {
+                name: "low".into(),
+                cosmology: low,
+            }),
+            z: 0.5,
+        })
+        .unwrap()
+        .warnings;
+        let text = format!("sigma8(z = 0) = {exact:.3}");
+        assert!(
+            exact < 0.4 && warned.iter().any(|w| w.contains(&text)),
+            "{warned:?}"
+        );
         // The emulated spectrum is CAMB's to its error (1e-3 here, k in [0.01, 0.3]).
         let camb = planck(0.0);
         for k in LogGrid::new(0.01, 0.3, 30).unwrap().points() {

@@ -9,8 +9,8 @@ use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pt_spectra::bispectrum::Fog;
 use pt_spectra::cosmology::Cosmology;
 use pt_spectra::pipeline::{
-    BispectrumBlock, Pipeline as LibPipeline, PipelineSettings, TermsSource, JACOBIAN_NAMES,
-    PIPELINE_MAX_RESIDUAL,
+    BispectrumBlock, CosmologyJacobian, Pipeline as LibPipeline, PipelineSettings, TermsSource,
+    JACOBIAN_NAMES, PIPELINE_MAX_RESIDUAL,
 };
 use pt_spectra::progress::Silent;
 use pt_spectra::setup::{LinearSource, NamedCosmology, Prepared};
@@ -84,12 +84,30 @@ impl Pipeline {
         self.prepared_named(named)
     }
 
-    /// The cosmology of a `cosmology_jacobian` argument (a preset, ini path or dict).
-    fn cosmology_of(&self, cosmology: &Bound<'_, PyAny>) -> PyResult<Cosmology> {
+    /// The cosmological derivatives at `cosmology` (a preset, ini path or dict) and `params`, with
+    /// the nuisance rows of the same step if `nuisance` (`cosmology_jacobian`, `full_jacobian`).
+    fn jacobians(
+        &self,
+        py: Python<'_>,
+        cosmology: &Bound<'_, PyAny>,
+        params: Option<&Bound<'_, PyDict>>,
+        nuisance: bool,
+    ) -> PyResult<(CosmologyJacobian, Option<Vec<Vec<f64>>>)> {
+        let params = pairs(params)?;
         let z = self.inner.settings().z;
         let inputs = Inputs::extract(None, z, z, Some(cosmology), None)?;
         let (named, _) = inputs.cosmology().map_err(value_error)?;
-        Ok(named.map_or_else(Cosmology::gm2012, |n| n.cosmology))
+        let c = named.map_or_else(Cosmology::gm2012, |n| n.cosmology);
+        let named: Vec<(&str, f64)> = params.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+        let (result, _) = crate::detached(py, || {
+            if nuisance {
+                let (c, n) = self.inner.full_jacobian(&c, &named)?;
+                Ok((c, Some(n)))
+            } else {
+                Ok((self.inner.cosmology_jacobian(&c, &named)?, None))
+            }
+        })?;
+        Ok(result)
     }
 
     /// The emulated spectrum of a cosmology already parsed (`None`: the default).
@@ -376,10 +394,7 @@ impl Pipeline {
         cosmology: &Bound<'py, PyAny>,
         params: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let params = pairs(params)?;
-        let c = self.cosmology_of(cosmology)?;
-        let named: Vec<(&str, f64)> = params.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-        let (result, _) = crate::detached(py, || self.inner.cosmology_jacobian(&c, &named))?;
+        let (result, _) = self.jacobians(py, cosmology, params, false)?;
         let v = result.data_vector.into_pyarray(py).into_any();
         let j = PyArray2::from_vec2(py, &result.cosmological)?;
         Ok((v, j).into_pyobject(py)?.into_any())
@@ -395,12 +410,9 @@ impl Pipeline {
         cosmology: &Bound<'py, PyAny>,
         params: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let params = pairs(params)?;
-        let c = self.cosmology_of(cosmology)?;
-        let named: Vec<(&str, f64)> = params.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-        let ((result, nuisance), _) = crate::detached(py, || self.inner.full_jacobian(&c, &named))?;
+        let (result, nuisance) = self.jacobians(py, cosmology, params, true)?;
         let v = result.data_vector.into_pyarray(py).into_any();
-        let n = PyArray2::from_vec2(py, &nuisance)?;
+        let n = PyArray2::from_vec2(py, &nuisance.unwrap_or_default())?;
         let j = PyArray2::from_vec2(py, &result.cosmological)?;
         Ok((v, n, j).into_pyobject(py)?.into_any())
     }

@@ -56,6 +56,15 @@ fn pipeline() -> Pipeline {
     Pipeline::new(obs, settings, &precision, &store, &Silent).unwrap()
 }
 
+/// The `j`-th of 97 cosmologies along Ω_m, A_s-normalised (what the cosmological derivatives take).
+fn a_s_cosmology(j: usize) -> Cosmology {
+    let om = 0.28 + 0.04 * ((j % 97) as f64 / 97.0);
+    Cosmology::flat(om, 0.69, 0.0224, 0.965, 0.81)
+        .unwrap()
+        .with_amplitude(pt_spectra::cosmology::Amplitude::a_s(2.1e-9))
+        .unwrap()
+}
+
 fn benches(c: &mut Criterion) {
     let pl = pipeline();
     let mut i = 0usize;
@@ -72,11 +81,7 @@ fn benches(c: &mut Criterion) {
     c.bench_function("pipeline/cosmology-jacobian", |b| {
         b.iter(|| {
             j += 1;
-            let om = 0.28 + 0.04 * ((j % 97) as f64 / 97.0);
-            let c = Cosmology::flat(om, 0.69, 0.0224, 0.965, 0.81)
-                .unwrap()
-                .with_amplitude(pt_spectra::cosmology::Amplitude::a_s(2.1e-9))
-                .unwrap();
+            let c = a_s_cosmology(j);
             black_box(
                 pl.cosmology_jacobian(&c, &PARAMS)
                     .unwrap()
@@ -90,11 +95,7 @@ fn benches(c: &mut Criterion) {
     c.bench_function("pipeline/full-jacobian", |b| {
         b.iter(|| {
             j += 1;
-            let om = 0.28 + 0.04 * ((j % 97) as f64 / 97.0);
-            let c = Cosmology::flat(om, 0.69, 0.0224, 0.965, 0.81)
-                .unwrap()
-                .with_amplitude(pt_spectra::cosmology::Amplitude::a_s(2.1e-9))
-                .unwrap();
+            let c = a_s_cosmology(j);
             black_box(pl.full_jacobian(&c, &PARAMS).unwrap().1.len())
         })
     });

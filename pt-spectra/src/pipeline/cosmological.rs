@@ -116,21 +116,20 @@ impl Pipeline {
             None
         };
         let mut cosmological = self.spectrum_columns(&step, &tangent, params)?;
-        // f and the AP parameters by the chain rule.
-        let [d_f, d_apar, d_aperp] = if self.settings.fiducial.is_some() {
-            match &nuisance {
-                // f's row of the nuisance rows is the template's (the same projection)
-                Some(rows) => {
-                    let [d_apar, d_aperp] = step.ap_jacobian(params)?;
-                    [rows[rows.len() - 1].clone(), d_apar, d_aperp]
-                }
-                None => step.template_jacobian(params)?,
+        // f and the AP parameters by the chain rule: f's row is the nuisance rows' last when they
+        // are made (the same projection), else made here; α's rows with a fiducial
+        let d_f = match &nuisance {
+            Some(rows) => rows[rows.len() - 1].clone(),
+            None => {
+                let p = step.params(params)?;
+                let (_, mut df) = step.data_vectors_and_df_of(&[], std::slice::from_ref(&p))?;
+                df.remove(0)
             }
+        };
+        let [d_apar, d_aperp] = if self.settings.fiducial.is_some() {
+            step.ap_jacobian(params)?
         } else {
-            let p = step.params(params)?;
-            let (_, mut df) = step.data_vectors_and_df_of(&[], std::slice::from_ref(&p))?;
-            let zero = vec![0.0; data_vector.len()];
-            [df.remove(0), zero.clone(), zero]
+            [vec![0.0; data_vector.len()], vec![0.0; data_vector.len()]]
         };
         let (dapar, daperp) = ap.map_or(([0.0; N_DERIVATIVES], [0.0; N_DERIVATIVES]), |(a, b)| {
             (a.d, b.d)

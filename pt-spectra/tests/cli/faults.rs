@@ -204,7 +204,17 @@ fn a_window_names_line_with_a_wrong_ell_is_refused() {
     let dir = scratch("faults_window_ell");
     let text = boss_window().replace("# s Q0 Q2 Q4", "# s Q0 Q2 Q6");
     let wrong = write(&dir, "wrong_ell.dat", &text);
-    let args = [
+    let args = ept_through_window(&wrong);
+    let needle = format!("window `{wrong}` with multipoles [0, 2, 6]");
+    fails_naming(&[
+        (args.to_vec(), needle.as_str()),
+        (args.to_vec(), "Q4 is missing below Q6"),
+    ]);
+}
+
+/// `rsd --rsd ept` (b1 = 2) in bins of 0.02 h/Mpc to 0.2 through the window file `window`.
+fn ept_through_window(window: &str) -> Vec<&str> {
+    vec![
         "rsd",
         "--rsd",
         "ept",
@@ -213,13 +223,8 @@ fn a_window_names_line_with_a_wrong_ell_is_refused() {
         "--k-edges",
         "0.02:0.2:0.02",
         "--window",
-        &wrong,
-    ];
-    let needle = format!("window `{wrong}` with multipoles [0, 2, 6]");
-    fails_naming(&[
-        (args.to_vec(), needle.as_str()),
-        (args.to_vec(), "Q4 is missing below Q6"),
-    ]);
+        window,
+    ]
 }
 
 /// The BOSS window with its Q0 column changed by `change`.
@@ -245,17 +250,7 @@ fn a_window_with_a_negative_q0_is_refused() {
     let dir = scratch("faults_window_sign");
     let text = boss_window_with_q0(|q0| -q0);
     let flipped = write(&dir, "flipped.dat", &text);
-    let args = [
-        "rsd",
-        "--rsd",
-        "ept",
-        "--bias",
-        "2",
-        "--k-edges",
-        "0.02:0.2:0.02",
-        "--window",
-        &flipped,
-    ];
+    let args = ept_through_window(&flipped);
     let needle = format!("{flipped}:4: Q0 at the smallest s = -1");
     fails_naming(&[
         (args.to_vec(), needle.as_str()),
@@ -322,19 +317,9 @@ fn a_window_not_normalised_is_warned_about_on_stderr() {
     let dir = scratch("faults_window_scale");
     let text = boss_window_with_q0(|q0| 1e6 * q0);
     let scaled = write(&dir, "scaled.dat", &text);
-    let (ok, out, err) = super::run(&[
-        "rsd",
-        "--rsd",
-        "ept",
-        "--bias",
-        "2",
-        "--k-edges",
-        "0.02:0.2:0.02",
-        "--precision",
-        "fast",
-        "--window",
-        &scaled,
-    ]);
+    let mut args = ept_through_window(&scaled);
+    args.extend(["--precision", "fast"]);
+    let (ok, out, err) = super::run(&args);
     assert!(ok, "{err}");
     let needle = "is 1000000, not 1";
     assert!(out.contains(needle), "{out}");
