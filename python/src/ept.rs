@@ -8,7 +8,7 @@ use crate::{detached, floats, value_error};
 use pt_spectra::bias::{BiasConvention, BiasParams};
 use pt_spectra::jobs::{self, EptRequest};
 use pt_spectra::progress::Silent;
-use pt_spectra::rsd::ap::Distortion;
+use pt_spectra::rsd::ap::{ApSpec, Distortion};
 use pt_spectra::rsd::ept::{EptParams, EptPlan as LibEptPlan, EptTerms as LibEptTerms};
 use pt_spectra::setup::Prepared;
 use pt_spectra::survey::observe::{Bins, ObservationSpec};
@@ -17,14 +17,11 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::Arc;
 
-/// The distortion of `apar`, `aperp` (both or neither).
+/// The distortion of `apar`, `aperp` (both or neither: [`ApSpec::from_options`]).
 fn distortion(apar: Option<f64>, aperp: Option<f64>) -> PyResult<Option<Distortion>> {
-    match (apar, aperp) {
-        (None, None) => Ok(None),
-        (Some(a), Some(b)) => Ok(Some(Distortion::new(a, b).map_err(value_error)?)),
-        _ => Err(pyo3::exceptions::PyValueError::new_err(
-            "give both apar and aperp (or neither)",
-        )),
+    match ApSpec::from_options(apar, aperp, None).map_err(value_error)? {
+        ApSpec::Scalings(d) => Ok(Some(d)),
+        _ => Ok(None),
     }
 }
 
@@ -348,6 +345,7 @@ pub(crate) fn fit_ept(
         bins,
         xi,
         s_edges,
+        ap: ap.map_or(ApSpec::None, ApSpec::Scalings),
     };
     let observation = spec.build(&ells, &data.k).map_err(value_error)?;
     let model_k = observation
@@ -360,7 +358,7 @@ pub(crate) fn fit_ept(
         if start.f().is_nan() {
             start.set_f(prepared.growth_rate);
         }
-        let free_ap = free.iter().any(|n| n == "apar" || n == "aperp");
+        let free_ap = ApSpec::check_free(ap.as_ref(), &free)?;
         let basis = jobs::fit_basis(
             basis,
             prepared.spectrum.sigma8(),

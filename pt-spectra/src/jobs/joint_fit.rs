@@ -12,7 +12,7 @@ use crate::fit::galaxy::{
 use crate::fit::{DataLayout, MultipoleData};
 use crate::output::Table;
 use crate::precision::Precision;
-use crate::rsd::ap::Distortion;
+use crate::rsd::ap::ApSpec;
 use crate::rsd::ept::{EptParams, EptPlan, EptTerms};
 use crate::setup::Prepared;
 use crate::store::TableStore;
@@ -212,28 +212,22 @@ pub(super) fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded>
         }
         None => None,
     };
+    let fiducial = s
+        .fiducial
+        .as_deref()
+        .map(|name| crate::setup::NamedCosmology::parse(name).map(|c| c.0.cosmology))
+        .transpose()
+        .map_err(err)?;
     let spec = ObservationSpec {
         window,
         bins: Bins::of(s.k_edges.clone(), s.box_side).map_err(err)?,
+        ap: ApSpec::from_options(s.ap.map(|a| a.0), s.ap.map(|a| a.1), fiducial).map_err(err)?,
         ..ObservationSpec::default()
     };
-    let observation = spec.build(&s.ells, &data.k).map_err(err)?;
     let cosmology = prepared.cosmology.cosmology;
-    let ap = match (s.ap, &s.fiducial) {
-        (Some((a, p)), _) => Some(Distortion::new(a, p).map_err(err)?),
-        (None, Some(name)) => {
-            let fiducial = crate::setup::NamedCosmology::parse(name).map_err(err)?.0;
-            Some(Distortion::from_cosmologies(&cosmology, &fiducial.cosmology, s.z).map_err(err)?)
-        }
-        (None, None) => None,
-    };
-    let free_ap = s.free.iter().any(|n| n == "apar" || n == "aperp");
-    if free_ap && ap.is_none() {
-        return Err(err(Error::InvalidChoice {
-            what: "free apar/aperp".into(),
-            reason: "need the measurement's distortion: apar and aperp, or fiducial".into(),
-        }));
-    }
+    let ap = spec.ap.distortion(&cosmology, s.z).map_err(err)?;
+    let free_ap = ApSpec::check_free(ap.as_ref(), &s.free).map_err(err)?;
+    let observation = spec.build(&s.ells, &data.k).map_err(err)?;
     let model_k = observation
         .as_ref()
         .map_or(data.k.as_slice(), |o| o.k_model());

@@ -114,6 +114,78 @@ impl Distortion {
     }
 }
 
+/// The Alcock–Paczynski distortion a face asks for (the options `--apar/--aperp`, `--fiducial`, the
+/// Python keywords `apar`, `aperp`, an analysis file's `ap`/`fiducial`): the one place where they become
+/// a [`Distortion`] (part of [`crate::survey::observe::ObservationSpec`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub enum ApSpec {
+    /// No distortion: the data were measured in the true cosmology.
+    #[default]
+    None,
+    /// α∥, α⊥ given.
+    Scalings(Distortion),
+    /// α∥, α⊥ of the true cosmology against this fiducial one, at the prediction's redshift.
+    Fiducial(Cosmology),
+}
+
+impl ApSpec {
+    /// The distortion of a face's options: α∥ and α⊥ (both or neither), or a fiducial cosmology, not
+    /// both.
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] for one of α∥, α⊥ alone or scalings beside a fiducial cosmology; as
+    /// [`Distortion::new`].
+    pub fn from_options(
+        apar: Option<f64>,
+        aperp: Option<f64>,
+        fiducial: Option<Cosmology>,
+    ) -> Result<Self> {
+        let refuse = |reason: &str| Error::InvalidChoice {
+            what: "the Alcock-Paczynski distortion".into(),
+            reason: reason.into(),
+        };
+        match (apar, aperp, fiducial) {
+            (None, None, None) => Ok(Self::None),
+            (None, None, Some(fiducial)) => Ok(Self::Fiducial(fiducial)),
+            (Some(a), Some(b), None) => Ok(Self::Scalings(Distortion::new(a, b)?)),
+            (Some(_), Some(_), Some(_)) => Err(refuse(
+                "give apar and aperp or a fiducial cosmology, not both",
+            )),
+            _ => Err(refuse("give both apar and aperp (or neither)")),
+        }
+    }
+
+    /// The distortion of a prediction for the `truth` at redshift `z` (`None` without one).
+    ///
+    /// # Errors
+    /// As [`Distortion::from_cosmologies`].
+    pub fn distortion(&self, truth: &Cosmology, z: f64) -> Result<Option<Distortion>> {
+        match self {
+            Self::None => Ok(None),
+            Self::Scalings(d) => Ok(Some(*d)),
+            Self::Fiducial(fiducial) => Ok(Some(Distortion::from_cosmologies(truth, fiducial, z)?)),
+        }
+    }
+
+    /// Whether a fit frees α∥ or α⊥ (`free` names the free parameters), checked to have a distortion
+    /// to start from.
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] if `free` holds `apar` or `aperp` and there is no distortion.
+    pub fn check_free(distortion: Option<&Distortion>, free: &[String]) -> Result<bool> {
+        let free_ap = free.iter().any(|n| n == "apar" || n == "aperp");
+        if free_ap && distortion.is_none() {
+            return Err(Error::InvalidChoice {
+                what: "free apar/aperp".into(),
+                reason: "they need the measurement's distortion: apar and aperp, or a fiducial \
+                         cosmology"
+                    .into(),
+            });
+        }
+        Ok(free_ap)
+    }
+}
+
 /// The scaling parameters (α∥, α⊥) = (H^fid(z)/H(z), D_M(z)/D_M^fid(z)) of a measurement in the
 /// `fiducial` cosmology of the `truth` at redshift `z` (module docs), distances in Mpc/h of each
 /// cosmology ([`crate::cosmology::distance`]). Generic over the [`Real`] type of the truth's
@@ -324,5 +396,45 @@ mod tests {
         }
         let seeded = Cosmology::planck2018().seeded().unwrap();
         assert!(ap_parameters(&seeded, &fiducial, 0.0).is_err());
+    }
+
+    #[test]
+    fn a_face_asks_for_the_distortion_one_way_and_gets_it_from_one_place() {
+        let (truth, fiducial) = (Cosmology::planck2018(), Cosmology::gm2012());
+        assert_eq!(
+            ApSpec::from_options(None, None, None).unwrap(),
+            ApSpec::None
+        );
+        assert_eq!(ApSpec::None.distortion(&truth, 0.5).unwrap(), None);
+        let given = ApSpec::from_options(Some(1.02), Some(0.98), None).unwrap();
+        assert_eq!(
+            given.distortion(&truth, 0.5).unwrap(),
+            Some(Distortion::new(1.02, 0.98).unwrap())
+        );
+        let from_fiducial = ApSpec::from_options(None, None, Some(fiducial)).unwrap();
+        assert_eq!(
+            from_fiducial.distortion(&truth, 0.5).unwrap(),
+            Some(Distortion::from_cosmologies(&truth, &fiducial, 0.5).unwrap())
+        );
+        for (apar, aperp, fid) in [
+            (Some(1.0), None, None),
+            (None, Some(1.0), None),
+            (Some(1.0), Some(1.0), Some(fiducial)),
+            (Some(1.0), None, Some(fiducial)),
+        ] {
+            let err = ApSpec::from_options(apar, aperp, fid)
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains("apar"), "{err}");
+        }
+        assert!(ApSpec::from_options(Some(3.0), Some(1.0), None).is_err());
+        let free = |names: &[&str]| names.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        let d = Distortion::new(1.0, 1.0).unwrap();
+        assert!(!ApSpec::check_free(None, &free(&["f", "b1"])).unwrap());
+        assert!(ApSpec::check_free(Some(&d), &free(&["f", "aperp"])).unwrap());
+        let err = ApSpec::check_free(None, &free(&["apar"]))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("distortion"), "{err}");
     }
 }

@@ -13,6 +13,7 @@ use super::{
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
 use crate::linear::LogGrid;
+pub use crate::rsd::ap::ApSpec;
 use std::path::Path;
 
 /// A window read from a file: Q_ℓ(s) multipoles or a matrix.
@@ -91,8 +92,9 @@ impl Bins {
 }
 
 /// What a face asks of the observation, as its options say it (the one place that turns them into
-/// an [`Observation`]): correlation-function multipoles (`xi`, with optional s bin edges), or the
-/// power spectrum through a window and/or bins, or neither (the model's own multipoles).
+/// an [`Observation`] and a distortion): correlation-function multipoles (`xi`, with optional s bin
+/// edges), or the power spectrum through a window and/or bins, or neither (the model's own
+/// multipoles); and the Alcock–Paczynski distortion of the measurement ([`ApSpec`]).
 #[derive(Debug, Clone, Default)]
 pub struct ObservationSpec {
     /// The survey window, if any.
@@ -103,6 +105,9 @@ pub struct ObservationSpec {
     pub xi: bool,
     /// With `xi`: the s bin edges [Mpc/h] (None: ξ at the given s).
     pub s_edges: Option<Vec<f64>>,
+    /// The Alcock–Paczynski distortion of the measurement ([`ApSpec::distortion`] makes it for a
+    /// prediction's cosmology and redshift).
+    pub ap: ApSpec,
 }
 
 impl ObservationSpec {

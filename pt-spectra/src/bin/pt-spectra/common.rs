@@ -122,6 +122,25 @@ pub fn parse_cs2(s: &str) -> std::result::Result<f64, String> {
     Ok(v)
 }
 
+/// The Alcock–Paczynski distortion of `--apar`/`--aperp` or `--fiducial` (a preset or a CLASS/CAMB
+/// .ini) as the library takes it ([`pt_spectra::rsd::ap::ApSpec`]).
+pub fn ap_spec(
+    apar: Option<f64>,
+    aperp: Option<f64>,
+    fiducial: Option<&str>,
+) -> Result<pt_spectra::rsd::ap::ApSpec> {
+    let fiducial = fiducial
+        .map(|name| {
+            pt_spectra::setup::NamedCosmology::parse(name)
+                .map(|c| c.0.cosmology)
+                .map_err(|e| anyhow::anyhow!("--fiducial: {e}"))
+        })
+        .transpose()?;
+    Ok(pt_spectra::rsd::ap::ApSpec::from_options(
+        apar, aperp, fiducial,
+    )?)
+}
+
 /// A comma-separated list; `what` names the option in messages.
 pub fn list<T: std::str::FromStr>(s: &str, what: &str) -> Result<Vec<T>> {
     s.split(',')

@@ -266,6 +266,10 @@ pub fn table(
         bins,
         xi: shared.xi.is_some(),
         s_edges: None,
+        ap: shared.distortion.map_or(
+            pt_spectra::rsd::ap::ApSpec::None,
+            pt_spectra::rsd::ap::ApSpec::Scalings,
+        ),
     };
     let at = shared.xi.as_deref().unwrap_or(&k);
     let Some(observation) = spec

@@ -299,28 +299,23 @@ fn run_ept(args: &Args) -> Result<()> {
         .iter()
         .map(|text| parse_prior(text))
         .collect::<Result<Vec<_>>>()?;
-    let distortion = match (args.apar, args.aperp) {
-        (Some(a), Some(b)) => Some(pt_spectra::rsd::ap::Distortion::new(a, b)?),
-        _ => None,
+    let (window, bins) = args.ept.observation()?;
+    let spec = pt_spectra::survey::observe::ObservationSpec {
+        window,
+        bins,
+        xi: args.xi,
+        ap: crate::common::ap_spec(args.apar, args.aperp, args.fiducial.as_deref())?,
+        s_edges: args
+            .s_edges
+            .as_deref()
+            .map(|t| crate::ept::edges(t, "--s-edges"))
+            .transpose()?,
     };
-    let distortion = match (&args.fiducial, distortion) {
-        (Some(name), None) => {
-            let fiducial = pt_spectra::setup::NamedCosmology::parse(name)
-                .map_err(|e| anyhow::anyhow!("--fiducial: {e}"))?
-                .0;
-            Some(pt_spectra::rsd::ap::Distortion::from_cosmologies(
-                &loaded.prepared.cosmology.cosmology,
-                &fiducial.cosmology,
-                loaded.prepared.z,
-            )?)
-        }
-        (_, d) => d,
-    };
+    let distortion = spec
+        .ap
+        .distortion(&loaded.prepared.cosmology.cosmology, loaded.prepared.z)?;
     let free = names(args.free.as_deref(), "f,b1");
-    let free_ap = free.iter().any(|n| n == "apar" || n == "aperp");
-    if free_ap && distortion.is_none() {
-        bail!("free apar/aperp need the measurement's distortion: --apar/--aperp or --fiducial");
-    }
+    let free_ap = pt_spectra::rsd::ap::ApSpec::check_free(distortion.as_ref(), &free)?;
     let marginalise = names(args.marginalise.as_deref(), "");
     let basis = fit_basis(args, loaded.prepared.spectrum.sigma8())?;
     if args.desi_priors {
@@ -342,17 +337,6 @@ fn run_ept(args: &Args) -> Result<()> {
             .collect::<Result<_>>()?,
         n_mocks: args.n_mocks,
         basis,
-    };
-    let (window, bins) = args.ept.observation()?;
-    let spec = pt_spectra::survey::observe::ObservationSpec {
-        window,
-        bins,
-        xi: args.xi,
-        s_edges: args
-            .s_edges
-            .as_deref()
-            .map(|t| crate::ept::edges(t, "--s-edges"))
-            .transpose()?,
     };
     let observation = spec
         .build(&request.ells, &data.k)

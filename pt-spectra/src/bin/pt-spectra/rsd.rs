@@ -1,6 +1,6 @@
 //! `pt-spectra rsd`: redshift-space multipoles P_ℓ(k) of a real-space model through an RSD model.
 
-use crate::common::{list, parse_cs2, parsed, BiasArgs, GalaxyBiasArgs, NoiseArgs};
+use crate::common::{ap_spec, list, parse_cs2, parsed, BiasArgs, GalaxyBiasArgs, NoiseArgs};
 use crate::ept::{self, EptArgs, RsdChoice};
 use crate::input::Input;
 use crate::output::{check_outputs, write_output};
@@ -9,11 +9,9 @@ use anyhow::{bail, Context, Result};
 use pt_spectra::jobs::{eft2_table, rsd_table, spt2_table, xi_table, NonlinearBias, RsdRequest};
 use pt_spectra::linear::LogGrid;
 use pt_spectra::real::RealModel;
-use pt_spectra::rsd::ap::Distortion;
 use pt_spectra::rsd::eft2::{Eft2Plan, RsdCounterterms};
 use pt_spectra::rsd::spt2::Spt2Plan;
 use pt_spectra::rsd::{Fog, Observed, RsdModel, RsdPlan, Sigma0};
-use pt_spectra::setup::NamedCosmology;
 use std::path::PathBuf;
 
 /// Arguments of `pt-spectra rsd`.
@@ -234,25 +232,9 @@ pub fn run(args: &Args) -> Result<()> {
         .filter(|p| p.is_file());
     inputs.push(("--fiducial", fiducial));
     check_outputs(&[("--out", args.out.as_deref())], &inputs)?;
-    let distortion = match (args.apar, args.aperp) {
-        (Some(apar), Some(aperp)) => Some(Distortion::new(apar, aperp)?),
-        _ => None,
-    };
     let (k, loaded) = args.input.load()?;
-    let distortion = match &args.fiducial {
-        None => distortion,
-        Some(name) => {
-            let fiducial = NamedCosmology::parse(name)
-                .map_err(|e| anyhow::anyhow!("--fiducial: {e}"))?
-                .0;
-            let truth = &loaded.prepared.cosmology.cosmology;
-            Some(Distortion::from_cosmologies(
-                truth,
-                &fiducial.cosmology,
-                loaded.prepared.z,
-            )?)
-        }
-    };
+    let ap = ap_spec(args.apar, args.aperp, args.fiducial.as_deref())?;
+    let distortion = ap.distortion(&loaded.prepared.cosmology.cosmology, loaded.prepared.z)?;
     // f is checked before any loop integral runs (a 2-loop plan takes seconds).
     if let Some(f) = args.f {
         pt_spectra::cosmology::check_growth_rate(f)?;
@@ -332,6 +314,7 @@ pub fn run(args: &Args) -> Result<()> {
     let spec = pt_spectra::survey::observe::ObservationSpec {
         window,
         bins,
+        ap,
         ..Default::default()
     };
     let observation = spec.build(&request.ells, &k)?;
