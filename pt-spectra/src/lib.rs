@@ -55,6 +55,7 @@ pub mod loops;
 pub mod memory;
 pub mod output;
 pub mod pipeline;
+pub mod plan;
 pub mod precision;
 pub mod progress;
 pub mod real;

@@ -1,15 +1,16 @@
-//! Memory estimates of plans, checked before they allocate, so that a grid too large for the machine
+//! Memory limits of plans, checked before they allocate, so that a grid too large for the machine
 //! is an error with the figure rather than a process that grows until the machine runs out.
 //!
-//! The estimate is the measured peak resident memory of the release binary (2 December 2026,
+//! Each plan states its own estimate (e.g. [`crate::loops::OneLoopPlan::memory_estimate`],
+//! [`crate::real::RealPlan::memory_estimate`], which sums the plans it holds; the [`crate::plan::Plan`]
+//! trait's `bytes`): the measured peak resident memory of the release binary (2 December 2026,
 //! `--precision default`, k up to 1 h/Mpc) per output k, scaled with the node density of the P22-type
-//! rules, plus fixed costs. Measured per k: 1-loop terms 0.32 MB (`fast` 0.125, `reference` 4.7),
-//! TNS A and B another 0.9 MB, RegPT's Γ2 weights 1.1 MB, the 2-loop basis tensors 0.9 MB; the
-//! constants below are those rounded up.
+//! rules ([`node_density`]), rounded up. This module holds what they share: the process's own
+//! memory ([`PROCESS`]), the limit ([`limit`]) and the check ([`check`]).
 //!
 //! ```
-//! use pt_spectra::{memory, precision::Precision, real::RealModel};
-//! let e = memory::plan_bytes(100_000, RealModel::OneLoopSpt.plan_parts(), &Precision::default());
+//! use pt_spectra::{memory, precision::Precision, real::{RealModel, RealPlan}};
+//! let e = RealPlan::memory_estimate(100_000, RealModel::OneLoopSpt, &Precision::default());
 //! assert!(e > 30e9 && e < 60e9); // ~0.4 MB per k
 //! let mut p = Precision::default();
 //! p.max_memory = Some(1e9);
@@ -18,42 +19,19 @@
 //! ```
 
 use crate::error::{Error, Result};
-use crate::precision::{Precision, TwoLoopMethod};
+use crate::precision::Precision;
 
-/// The parts of a plan that take memory (a model's are
-/// [`RealModel::plan_parts`](crate::real::RealModel::plan_parts)).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct PlanParts {
-    /// The TNS A and B terms.
-    pub tns: bool,
-    /// The bias terms ([`crate::loops::bias`]).
-    pub bias: bool,
-    /// The 1-loop redshift-space terms of the galaxy model ([`crate::loops::redshift`]).
-    pub redshift: bool,
-    /// RegPT's Γ2 weights.
-    pub gamma2: bool,
-    /// 2-loop terms (basis tensors unless integrated directly).
-    pub two_loop: bool,
-    /// The P15 angular table.
-    pub p15: bool,
-    /// The P17 angular table.
-    pub p17: bool,
+/// Bytes of the process itself (binary, runtime, the embedded tables), counted once in every plan's
+/// check.
+pub const PROCESS: f64 = 20e6;
+
+/// The node density of the P22-type rules of `precision` relative to the default, by which the
+/// plans on those rules scale their bytes per k: ~(order / panel width)² nodes per k, 20² at the
+/// default.
+pub fn node_density(precision: &Precision) -> f64 {
+    (precision.p22_order as f64 / precision.p22_ln_width / 20.0).powi(2)
 }
 
-/// Bytes per output k of the 1-loop plan at the default node density.
-const ONE_LOOP_PER_K: f64 = 0.4e6;
-/// Bytes per output k of the TNS plan at the default node density.
-const TNS_PER_K: f64 = 1.0e6;
-/// Bytes per output k of the bias plan at the default node density (7 f32 weights per P22 node).
-const BIAS_PER_K: f64 = 0.6e6;
-/// Bytes per output k of the redshift-space plan (31 f32 weights per P22 node: 3× the bias plan's bytes).
-const REDSHIFT_PER_K: f64 = 1.8e6;
-/// Bytes per output k of RegPT's Γ2 weights.
-const GAMMA2_PER_K: f64 = 1.2e6;
-/// Bytes per output k of the 2-loop basis tensors.
-const BASIS_PER_K: f64 = 1.0e6;
-/// Bytes of the process, the P15 and the P17 angular tables.
-const FIXED: (f64, f64, f64) = (20e6, 4e6, 6e6);
 /// The environment variable both faces read for the limit when it is not given (`8G`, `500M`, …).
 pub const ENV: &str = "PT_SPECTRA_MAX_MEMORY";
 
@@ -75,37 +53,6 @@ pub fn env_max_memory() -> Result<Option<f64>> {
 
 /// The fraction of the machine's memory a plan may take by default.
 pub const DEFAULT_FRACTION: f64 = 0.5;
-
-/// The estimated peak memory \[bytes\] of a plan of `parts` on `nk` output wavenumbers (the 1-loop terms
-/// are always part of it).
-pub fn plan_bytes(nk: usize, parts: PlanParts, precision: &Precision) -> f64 {
-    // The P22-type rules have ~(order / panel width)² nodes per k; 20² at the default.
-    let density = (precision.p22_order as f64 / precision.p22_ln_width / 20.0).powi(2);
-    let mut per_k = ONE_LOOP_PER_K * density;
-    if parts.tns {
-        per_k += TNS_PER_K * density;
-    }
-    if parts.bias {
-        per_k += BIAS_PER_K * density;
-    }
-    if parts.redshift {
-        per_k += REDSHIFT_PER_K * density;
-    }
-    if parts.gamma2 {
-        per_k += GAMMA2_PER_K;
-    }
-    if parts.two_loop && precision.two_loop != TwoLoopMethod::Direct {
-        per_k += BASIS_PER_K;
-    }
-    let mut fixed = FIXED.0;
-    if parts.p15 {
-        fixed += FIXED.1;
-    }
-    if parts.p17 {
-        fixed += FIXED.2;
-    }
-    fixed + per_k * nk as f64
-}
 
 /// The total memory of this machine \[bytes\] (`MemTotal` of `/proc/meminfo`), if known.
 pub fn machine_bytes() -> Option<f64> {
@@ -250,7 +197,8 @@ pub fn parse_size(text: &str) -> Result<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::real::RealModel;
+    use crate::loops::TnsPlan;
+    use crate::real::{RealModel, RealPlan};
 
     #[test]
     fn sizes_are_parsed_and_printed() {
@@ -278,16 +226,17 @@ mod tests {
             (80, RealModel::TwoLoopRegPt, false, "default", 118e6),
         ] {
             let p = Precision::preset(preset).unwrap();
-            let parts = PlanParts {
-                tns,
-                ..model.plan_parts()
+            let tns = if tns {
+                TnsPlan::memory_estimate(nk, &p)
+            } else {
+                0.0
             };
-            let e = plan_bytes(nk, parts, &p);
+            let e = RealPlan::memory_estimate(nk, model, &p) + tns;
             assert!(
                 e >= measured && e < 2.5 * measured,
                 "{model:?} {preset} {nk}: {e:e}"
             );
         }
-        assert!(plan_bytes(10_000_000, RealModel::OneLoopSpt.plan_parts(), &d) > 1e12);
+        assert!(RealPlan::memory_estimate(10_000_000, RealModel::OneLoopSpt, &d) > 1e12);
     }
 }

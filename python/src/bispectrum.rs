@@ -260,6 +260,13 @@ pub struct BispectrumPlan {
 
 #[pymethods]
 impl BispectrumPlan {
+    /// What the plan computes, how a new spectrum's terms are computed (`method`: direct or basis)
+    /// and its memory estimates in bytes (the plan, one spectrum's terms).
+    #[getter]
+    fn plan_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        crate::seam::plan_info(py, &self.plan)
+    }
+
     #[new]
     #[pyo3(signature = (triangles, bin_width=None, legendre_side="largest", effective=false))]
     fn new(
@@ -391,6 +398,13 @@ pub struct SugiyamaPlan {
 
 #[pymethods]
 impl SugiyamaPlan {
+    /// What the plan computes, how a new spectrum's terms are computed (`method`: direct or basis)
+    /// and its memory estimates in bytes (the plan, one spectrum's terms).
+    #[getter]
+    fn plan_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        crate::seam::plan_info(py, &self.plan)
+    }
+
     #[new]
     fn new(pairs: &Bound<'_, PyAny>) -> PyResult<Self> {
         let pairs = fixed_rows::<2>(pairs, "pairs", "k1, k2")?;

@@ -119,6 +119,13 @@ pub struct OneLoopBispectrumPlan {
 
 #[pymethods]
 impl OneLoopBispectrumPlan {
+    /// What the plan computes, how a new spectrum's terms are computed (`method`: direct or basis)
+    /// and its memory estimates in bytes (the plan, one spectrum's terms).
+    #[getter]
+    fn plan_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        crate::seam::plan_info(py, &self.plan)
+    }
+
     #[new]
     #[pyo3(signature = (triangles, q_min=1e-4, q_max=10.0, radial=12, mu=32, phi=24,
         two_loop="basis", cache_dir=None))]

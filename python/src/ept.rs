@@ -6,12 +6,13 @@ use crate::inputs::Inputs;
 use crate::tables::Table;
 use crate::{detached, floats, value_error};
 use pt_spectra::bias::{BiasConvention, BiasParams};
+use pt_spectra::jobs::ObservationSpec;
 use pt_spectra::jobs::{self, EptRequest};
 use pt_spectra::progress::Silent;
 use pt_spectra::rsd::ap::{ApSpec, Distortion};
 use pt_spectra::rsd::ept::{EptParams, EptPlan as LibEptPlan, EptTerms as LibEptTerms};
 use pt_spectra::setup::Prepared;
-use pt_spectra::survey::observe::{Bins, ObservationSpec};
+use pt_spectra::survey::observe::Bins;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -85,6 +86,13 @@ pub(crate) struct EptPlan {
 
 #[pymethods]
 impl EptPlan {
+    /// What the plan computes, how a new spectrum's terms are computed (`method`: direct or basis)
+    /// and its memory estimates in bytes (the plan, one spectrum's terms).
+    #[getter]
+    fn plan_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        crate::seam::plan_info(py, &*self.plan)
+    }
+
     #[new]
     #[pyo3(signature = (k, ir=true, apar=None, aperp=None, precision=pt_spectra::jobs::defaults::PRECISION, q_range=None, free_ap=false, two_loop=pt_spectra::jobs::defaults::TWO_LOOP, cache_dir=None))]
     #[allow(clippy::too_many_arguments)]

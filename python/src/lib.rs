@@ -36,6 +36,7 @@ mod joint;
 mod kernel;
 mod pipeline;
 mod redshift;
+mod seam;
 mod survey;
 mod tables;
 mod two_loop_rsd;
@@ -168,6 +169,13 @@ struct RealPlan {
 
 #[pymethods]
 impl RealPlan {
+    /// What the plan computes, how a new spectrum's terms are computed (`method`: direct or basis)
+    /// and its memory estimates in bytes (the plan, one spectrum's terms).
+    #[getter]
+    fn plan_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        crate::seam::plan_info(py, &self.plan)
+    }
+
     #[new]
     #[allow(clippy::too_many_arguments)]
     #[pyo3(signature = (k, model=pt_spectra::jobs::defaults::REAL_MODEL, precision=pt_spectra::jobs::defaults::PRECISION, q_range=None, two_loop_tolerance=None, cache_dir=None, two_loop=pt_spectra::jobs::defaults::TWO_LOOP))]

@@ -81,6 +81,13 @@ pub(crate) struct RsdPlan {
 
 #[pymethods]
 impl RsdPlan {
+    /// What the plan computes, how a new spectrum's terms are computed (`method`: direct or basis)
+    /// and its memory estimates in bytes (the plan, one spectrum's terms).
+    #[getter]
+    fn plan_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        crate::seam::plan_info(py, &self.plan)
+    }
+
     #[new]
     #[allow(clippy::too_many_arguments)]
     #[pyo3(signature = (k, real=pt_spectra::jobs::defaults::RSD_REAL_MODEL, rsd=pt_spectra::jobs::defaults::RSD_MODEL, precision=pt_spectra::jobs::defaults::PRECISION, q_range=None, cache_dir=None, two_loop=pt_spectra::jobs::defaults::TWO_LOOP))]

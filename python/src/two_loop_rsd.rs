@@ -34,6 +34,16 @@ fn counterterms(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<RsdCounterterms>
 
 #[pymethods]
 impl TwoLoopRsdPlan {
+    /// What the plan computes, how a new spectrum's terms are computed (`method`: direct or basis)
+    /// and its memory estimates in bytes (the plan, one spectrum's terms).
+    #[getter]
+    fn plan_info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        match &self.plan {
+            Plan::Spt2(p) => crate::seam::plan_info(py, &**p),
+            Plan::Eft2(p) => crate::seam::plan_info(py, &**p),
+        }
+    }
+
     #[new]
     #[pyo3(signature = (k, model="eft2", ir=true, precision=pt_spectra::jobs::defaults::PRECISION, q_range=None, two_loop=pt_spectra::jobs::defaults::TWO_LOOP, cache_dir=None))]
     #[allow(clippy::too_many_arguments)]

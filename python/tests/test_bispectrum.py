@@ -232,3 +232,13 @@ def test_the_bias_in_other_conventions_is_converted_and_stated():
     np.testing.assert_allclose(a, b, rtol=1e-12)
     with pytest.raises(ValueError, match="classpt"):
         terms.multipoles(b1=1.9, bias_convention="pybird")
+
+
+def test_a_plan_states_what_it_computes_its_method_and_memory():
+    plan = pt.BispectrumPlan(TRIANGLES)
+    info = plan.plan_info
+    assert info["method"] == "direct"
+    assert f"of {len(TRIANGLES)} configurations" in info["what"]
+    # the process's own memory and the orientation nodes; one spectrum's slots (2 rules, 3 ells, 43)
+    assert info["memory_bytes"] > 20e6
+    assert info["terms_bytes"] == 2 * len(TRIANGLES) * 3 * 43 * 8

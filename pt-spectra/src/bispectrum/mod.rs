@@ -51,6 +51,7 @@ pub mod one_loop_basis;
 pub mod one_loop_rsd;
 mod resum;
 mod sampled;
+mod seam;
 mod sugiyama;
 mod terms;
 #[cfg(test)]

@@ -524,6 +524,11 @@ impl OneLoopMatterPlan {
         &self.triangles
     }
 
+    /// Whether the plan holds basis tensors (else every spectrum is integrated directly).
+    pub fn has_basis(&self) -> bool {
+        self.basis.is_some()
+    }
+
     /// The terms of every triangle for the linear spectrum `p`, and how they were computed.
     ///
     /// # Errors

@@ -87,7 +87,7 @@ pub fn batch_memory(
     let nk = plan.k().len();
     let results = 8.0 * (columns.saturating_sub(1) * nk) as f64 * spectra as f64;
     let (per_spectrum, fixed) = in_flight(n_lin, columns, nk);
-    let plan_bytes = memory::plan_bytes(nk, plan.model().plan_parts(), plan.precision());
+    let plan_bytes = RealPlan::memory_estimate(nk, plan.model(), plan.precision());
     let mut precision = plan.precision().clone();
     precision.max_memory = max_memory.or(precision.max_memory);
     let (limit, origin) = memory::limit(&precision);
@@ -320,8 +320,7 @@ mod tests {
     #[test]
     fn batches_are_planned_against_the_limit() {
         let free = plan(None);
-        let plan_bytes =
-            memory::plan_bytes(3, RealModel::OneLoopSpt.plan_parts(), free.precision());
+        let plan_bytes = RealPlan::memory_estimate(3, RealModel::OneLoopSpt, free.precision());
         // Room for the results of 20000 spectra and ~10 in flight.
         let (n_lin, columns) = (400, 8);
         let (per_spectrum, fixed) = in_flight(n_lin, columns, 3);

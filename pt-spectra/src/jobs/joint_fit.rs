@@ -3,6 +3,7 @@
 //! a row per data set.
 
 use super::ept_fit::{row_columns, Row};
+use super::ObservationSpec;
 use crate::error::{Error, Result};
 use crate::fit::galaxy::search::{CROSSING_TOLERANCE, HESSIAN_STEP};
 use crate::fit::galaxy::{
@@ -16,7 +17,7 @@ use crate::rsd::ap::ApSpec;
 use crate::rsd::ept::{EptParams, EptPlan, EptTerms};
 use crate::setup::Prepared;
 use crate::store::TableStore;
-use crate::survey::observe::{Bins, Observation, ObservationSpec, Window};
+use crate::survey::observe::{Bins, Observation, Window};
 use std::path::PathBuf;
 
 /// The start of b1 when a data set gives none (the middle of the start box, [`crate::fit::galaxy::search::RANGES`]).

@@ -75,7 +75,7 @@ pub use forecast::{forecast_table, parse_bin};
 pub use halo::{halo_table, HaloRequest};
 pub use joint_bispectrum::BispectrumSpec;
 pub use joint_fit::{joint_fit_table, Analysis, Inputs, SetSpec, DEFAULT_B1};
-pub use observe::observed_table;
+pub use observe::{observed_table, ApSpec, ObservationSpec};
 pub use report::{contour_table, push_spectrum_errors, real_spectra_table, rsd_multipoles_table};
 pub use rsd::{
     describe_sigma0, no_wiggle_multipoles, rsd_table, rsd_table_from_terms,

@@ -222,7 +222,17 @@ pub struct BiasPlan {
     coarse: Rule,
 }
 
+/// Bytes per output k of the plan at the default node density (7 f32 weights per P22 node).
+const BYTES_PER_K: f64 = 0.6e6;
+
 impl BiasPlan {
+    /// The estimated memory of a plan on `nk` wavenumbers with `precision` \[bytes\] (its rules at
+    /// `BYTES_PER_K` per k, scaled with the node density), which [`new`](Self::new) checks against
+    /// the limit before it allocates.
+    pub fn memory_estimate(nk: usize, precision: &Precision) -> f64 {
+        BYTES_PER_K * crate::memory::node_density(precision) * nk as f64
+    }
+
     /// The plan for wavenumbers `k` [h/Mpc] with the P22 and P13 settings of `precision`.
     ///
     /// # Errors
@@ -230,12 +240,8 @@ impl BiasPlan {
     /// limit.
     pub fn new(k: &[f64], precision: &Precision) -> Result<Self> {
         validate_grid(k, precision)?;
-        let parts = crate::memory::PlanParts {
-            bias: true,
-            ..Default::default()
-        };
         crate::memory::check(
-            crate::memory::plan_bytes(k.len(), parts, precision),
+            crate::memory::PROCESS + Self::memory_estimate(k.len(), precision),
             precision,
             &format!("the bias plan on {} k", k.len()),
         )?;
@@ -256,6 +262,11 @@ impl BiasPlan {
     /// The wavenumbers [h/Mpc].
     pub fn k(&self) -> &[f64] {
         &self.k
+    }
+
+    /// The precision the plan was made with.
+    pub fn precision(&self) -> &Precision {
+        &self.precision
     }
 
     /// Every bias term of `spectrum` (over the plan's q range, through the spectrum's power-law

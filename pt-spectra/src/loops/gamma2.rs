@@ -347,7 +347,15 @@ pub struct Gamma2Plan {
     coarse: Nodes,
 }
 
+/// Bytes per output k of RegPT's Γ2 weights (measured 1.1 MB, rounded up).
+const BYTES_PER_K: f64 = 1.2e6;
+
 impl Gamma2Plan {
+    /// The estimated memory of the weights on `nk` wavenumbers \[bytes\].
+    pub fn memory_estimate(nk: usize) -> f64 {
+        BYTES_PER_K * nk as f64
+    }
+
     /// The plan for wavenumbers `k` [h/Mpc], integrals over q ∈ `q_range` with P sampled on a lattice of
     /// step `lattice_step` in ln q. Takes ~0.1 s per k on one core.
     pub fn new(k: &[f64], q_range: (f64, f64), lattice_step: f64) -> Self {

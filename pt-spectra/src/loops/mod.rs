@@ -45,6 +45,7 @@ mod p13;
 mod p15;
 mod p17;
 mod p22;
+mod plans;
 pub mod redshift;
 pub mod rsd_two_loop;
 mod tns;

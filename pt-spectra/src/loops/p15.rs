@@ -206,6 +206,11 @@ pub struct P15Table {
 }
 
 impl P15Table {
+    /// The memory the angular table holds \[bytes\] (a plan that uses it counts it once).
+    pub const MEMORY: f64 = 4e6;
+}
+
+impl P15Table {
     /// The table's file name in a [`TableStore`](crate::store::TableStore) directory:
     /// `p15-v<version>-<orders>.bin` (little-endian f64). Delete the file to rebuild the table.
     pub fn file_name() -> String {

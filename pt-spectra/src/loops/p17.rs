@@ -158,6 +158,11 @@ pub struct P17Table {
 }
 
 impl P17Table {
+    /// The memory the angular table holds \[bytes\] (a plan that uses it counts it once).
+    pub const MEMORY: f64 = 6e6;
+}
+
+impl P17Table {
     /// The table's file name in a [`TableStore`](crate::store::TableStore) directory.
     pub fn file_name() -> String {
         format!("p17-v{TABLE_VERSION}-a{ANGULAR_POINTS}-r{RADIAL_ORDER}.bin")

@@ -312,7 +312,17 @@ pub struct RedshiftPlan {
     coarse: Rule,
 }
 
+/// Bytes per output k of the plan at the default node density (31 f32 weights per P22 node).
+const BYTES_PER_K: f64 = 1.8e6;
+
 impl RedshiftPlan {
+    /// The estimated memory of a plan on `nk` wavenumbers with `precision` \[bytes\] (its rules at
+    /// `BYTES_PER_K` per k, scaled with the node density), which [`new`](Self::new) checks against
+    /// the limit before it allocates.
+    pub fn memory_estimate(nk: usize, precision: &Precision) -> f64 {
+        BYTES_PER_K * crate::memory::node_density(precision) * nk as f64
+    }
+
     /// The plan for wavenumbers `k` [h/Mpc] with the P22 and P13 settings of `precision`.
     ///
     /// # Errors
@@ -320,12 +330,8 @@ impl RedshiftPlan {
     /// limit.
     pub fn new(k: &[f64], precision: &Precision) -> Result<Self> {
         validate_grid(k, precision)?;
-        let parts = crate::memory::PlanParts {
-            redshift: true,
-            ..Default::default()
-        };
         crate::memory::check(
-            crate::memory::plan_bytes(k.len(), parts, precision),
+            crate::memory::PROCESS + Self::memory_estimate(k.len(), precision),
             precision,
             &format!("the redshift-space 1-loop plan on {} k", k.len()),
         )?;

@@ -340,7 +340,17 @@ pub struct TnsPlan {
     coarse: Rule,
 }
 
+/// Bytes per output k of the plan at the default node density (measured 0.9 MB, rounded up).
+const BYTES_PER_K: f64 = 1.0e6;
+
 impl TnsPlan {
+    /// The estimated memory of a plan on `nk` wavenumbers with `precision` \[bytes\] (its rules at
+    /// `BYTES_PER_K` per k, scaled with the node density), which the plans that hold it
+    /// ([`crate::real::RealPlan`], [`crate::rsd::RsdPlan`]) check against the limit before they allocate.
+    pub fn memory_estimate(nk: usize, precision: &Precision) -> f64 {
+        BYTES_PER_K * crate::memory::node_density(precision) * nk as f64
+    }
+
     /// The plan for wavenumbers `k` [h/Mpc], with the P22 settings of `precision`.
     ///
     /// # Errors

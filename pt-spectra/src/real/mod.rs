@@ -146,19 +146,6 @@ impl RealModel {
         }
     }
 
-    /// The parts of the model's plan that take memory, for [`crate::memory::plan_bytes`].
-    pub fn plan_parts(self) -> crate::memory::PlanParts {
-        crate::memory::PlanParts {
-            tns: false,
-            bias: false,
-            redshift: false,
-            gamma2: self.needs_gamma2(),
-            two_loop: self.needs_two_loop(),
-            p15: self.needs_p15(),
-            p17: self.needs_p17(),
-        }
-    }
-
     /// Whether the model needs the 2-loop propagator term P15 ([`crate::loops::p15_terms`]).
     pub fn needs_p15(self) -> bool {
         matches!(self.propagator(), Some(Propagator::N2 | Propagator::N3)) || self.needs_two_loop()

@@ -18,6 +18,8 @@ use crate::resum;
 use crate::store::TableStore;
 use std::sync::Arc;
 
+mod seam;
+
 /// Above this many k values the 1-loop plan is built and evaluated in chunks, reporting
 /// [`Stage::OneLoop`] progress after each.
 pub(super) const CHUNKED_GRID: usize = 2048;
@@ -83,7 +85,7 @@ impl RealPlan {
         if selection == RealSelection::All {
             precision.validate()?;
             crate::memory::check(
-                crate::memory::plan_bytes(k.len(), RealModel::TwoLoopRegPt.plan_parts(), precision),
+                Self::memory_estimate(k.len(), RealModel::TwoLoopRegPt, precision),
                 precision,
                 &format!("the plan of every model on {} k", k.len()),
             )?;
@@ -98,6 +100,27 @@ impl RealPlan {
             }
         }
         Ok(plan)
+    }
+
+    /// The estimated peak memory of the plan of `model` on `nk` wavenumbers with `precision` \[bytes\]:
+    /// the process, the 1-loop plan and what the model adds (the P15 and P17 tables, RegPT's Γ2
+    /// weights, the 2-loop basis tensors), each plan's own estimate. [`new`](Self::new) checks it
+    /// against the limit before it allocates.
+    pub fn memory_estimate(nk: usize, model: RealModel, precision: &Precision) -> f64 {
+        let mut bytes = crate::memory::PROCESS + OneLoopPlan::memory_estimate(nk, precision);
+        if model.needs_p15() {
+            bytes += P15Table::MEMORY;
+        }
+        if model.needs_p17() {
+            bytes += P17Table::MEMORY;
+        }
+        if model.needs_gamma2() {
+            bytes += Gamma2Plan::memory_estimate(nk);
+        }
+        if model.needs_two_loop() {
+            bytes += TwoLoopBasis::memory_estimate(nk, precision);
+        }
+        bytes
     }
 
     /// Whether the plan computes every model's terms (those of `real --model all`).
@@ -125,7 +148,7 @@ impl RealPlan {
         // The whole grid (the chunks below are checked one by one).
         crate::table::check_k_values("k", k)?;
         crate::memory::check(
-            crate::memory::plan_bytes(k.len(), model.plan_parts(), precision),
+            Self::memory_estimate(k.len(), model, precision),
             precision,
             &format!("the {} plan on {} k", model.name(), k.len()),
         )?;
@@ -507,7 +530,7 @@ impl RealPlan {
     pub fn evaluate_batch(&self, spectra: &[LinearSpectrum]) -> Result<Vec<Result<RealSpectra>>> {
         use rayon::prelude::*;
         let nk = self.k.len();
-        let plan = crate::memory::plan_bytes(nk, self.model.plan_parts(), &self.precision);
+        let plan = Self::memory_estimate(nk, self.model, &self.precision);
         let results = SPECTRA_BYTES_PER_K * nk as f64 * spectra.len() as f64;
         crate::memory::check(
             plan + results,

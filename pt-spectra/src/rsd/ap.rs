@@ -116,7 +116,7 @@ impl Distortion {
 
 /// The Alcock–Paczynski distortion a face asks for (the options `--apar/--aperp`, `--fiducial`, the
 /// Python keywords `apar`, `aperp`, an analysis file's `ap`/`fiducial`): the one place where they become
-/// a [`Distortion`] (part of [`crate::survey::observe::ObservationSpec`]).
+/// a [`Distortion`] (part of [`crate::jobs::ObservationSpec`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub enum ApSpec {
     /// No distortion: the data were measured in the true cosmology.

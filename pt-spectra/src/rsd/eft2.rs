@@ -36,7 +36,7 @@
 //! for the deterministic parts, and for the 2-loop parts as functionals of their μ² nodes
 //! ([`crate::loops::combined`], error the shifts' standard error).
 
-use super::spt2::{loop_terms, LoopTensors};
+use super::spt2::{loop_terms, two_loop_rsd_plan, LoopTensors};
 use crate::error::{Error, Result};
 use crate::integrate::legendre_nodes;
 use crate::ir::{bao_damping, sigma2_total, WiggleSplit};
@@ -230,6 +230,8 @@ pub struct Eft2Multipoles {
     /// ∂P_ℓ/∂X per counterterm (in the order of [`RsdCounterterm::ALL`]), per ℓ, per k.
     pub templates: Vec<Vec<Vec<f64>>>,
 }
+
+two_loop_rsd_plan!(Eft2Plan, Eft2Terms, "2-loop EFT redshift-space terms");
 
 impl Eft2Plan {
     /// The plan on `k` [h/Mpc] with IR resummation `ir`.

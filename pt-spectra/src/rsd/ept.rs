@@ -222,6 +222,54 @@ pub struct EptTerms {
     basis_soft: Option<f64>,
 }
 
+/// Bytes per internal k of one spectrum's `ept` terms (the redshift-space 1-loop terms of the spectrum
+/// and of its no-wiggle part: ~130 estimates of 16 bytes).
+const EPT_TERMS_BYTES_PER_K: f64 = 2.1e3;
+
+impl crate::plan::Plan for EptPlan {
+    type Settings<'a> = ();
+    type Terms = EptTerms;
+
+    fn describe(&self) -> String {
+        format!("the ept terms on {} k", self.k_out.len())
+    }
+
+    fn method(&self) -> crate::plan::Method {
+        match self.tensors {
+            Some(_) => crate::plan::Method::Basis,
+            None => crate::plan::Method::Direct,
+        }
+    }
+
+    /// The process, the 1-loop plan on the internal grid and, with tensors, the 1-loop tensors
+    /// counted at the 2-loop tensors' measured bytes per k (an upper bound: they hold fewer forms).
+    fn bytes(&self) -> f64 {
+        let (nk, precision) = (self.grid.len(), self.loops.precision());
+        let tensors = match self.tensors {
+            Some(_) => crate::loops::basis::TwoLoopBasis::memory_estimate(nk, precision),
+            None => 0.0,
+        };
+        crate::memory::PROCESS + RedshiftPlan::memory_estimate(nk, precision) + tensors
+    }
+
+    fn terms_bytes(&self) -> f64 {
+        EPT_TERMS_BYTES_PER_K * self.grid.len() as f64
+    }
+
+    fn max_memory(&self) -> Option<f64> {
+        self.loops.precision().max_memory
+    }
+
+    fn terms(
+        &self,
+        spectrum: &LinearSpectrum,
+        (): (),
+        _progress: &dyn crate::progress::Progress,
+    ) -> Result<EptTerms> {
+        EptPlan::terms(self, spectrum)
+    }
+}
+
 impl EptPlan {
     /// The plan for output wavenumbers `k` [h/Mpc].
     ///

@@ -339,6 +339,51 @@ pub struct RsdPlan {
     bias: Option<BiasPlan>,
 }
 
+impl crate::plan::Plan for RsdPlan {
+    type Settings<'a> = ();
+    type Terms = (RealSpectra, Option<TnsTerms>);
+
+    fn describe(&self) -> String {
+        let tns = if self.tns.is_some() { " + TNS" } else { "" };
+        format!("{}{tns}", crate::plan::Plan::describe(&self.real))
+    }
+
+    fn method(&self) -> crate::plan::Method {
+        crate::plan::Plan::method(&self.real)
+    }
+
+    fn bytes(&self) -> f64 {
+        let tns = self.tns.as_ref().map_or(0.0, |t| {
+            TnsPlan::memory_estimate(t.k().len(), t.precision())
+        });
+        let bias = self.bias.as_ref().map_or(0.0, |b| {
+            BiasPlan::memory_estimate(b.k().len(), b.precision())
+        });
+        crate::plan::Plan::bytes(&self.real) + tns + bias
+    }
+
+    fn terms_bytes(&self) -> f64 {
+        let tns = self
+            .tns
+            .as_ref()
+            .map_or(0.0, crate::plan::Plan::terms_bytes);
+        crate::plan::Plan::terms_bytes(&self.real) + tns
+    }
+
+    fn max_memory(&self) -> Option<f64> {
+        self.real.precision().max_memory
+    }
+
+    fn terms(
+        &self,
+        spectrum: &LinearSpectrum,
+        (): (),
+        progress: &dyn Progress,
+    ) -> Result<(RealSpectra, Option<TnsTerms>)> {
+        self.evaluate(spectrum, progress)
+    }
+}
+
 impl RsdPlan {
     /// The plan of real-space `real_model` with RSD model `rsd` on wavenumbers `k` [h/Mpc].
     ///
@@ -355,14 +400,8 @@ impl RsdPlan {
         if rsd.needs_tns() {
             precision.validate()?;
             crate::memory::check(
-                crate::memory::plan_bytes(
-                    k.len(),
-                    crate::memory::PlanParts {
-                        tns: true,
-                        ..real_model.plan_parts()
-                    },
-                    precision,
-                ),
+                RealPlan::memory_estimate(k.len(), real_model, precision)
+                    + TnsPlan::memory_estimate(k.len(), precision),
                 precision,
                 &format!("the {} + TNS plan on {} k", real_model.name(), k.len()),
             )?;

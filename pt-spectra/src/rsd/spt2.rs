@@ -61,6 +61,15 @@ pub(crate) struct LoopTensors {
 }
 
 impl LoopTensors {
+    /// Basis if the plan holds 2-loop tensors, else direct.
+    pub(crate) fn method(&self) -> crate::plan::Method {
+        if self.two_loop.is_empty() {
+            crate::plan::Method::Direct
+        } else {
+            crate::plan::Method::Basis
+        }
+    }
+
     /// The tensors of the spectra `families` (each with the basis its tensors are built on) for the
     /// 1-loop `plan`, as `precision.two_loop` says: built (`basis`), read if cached (`auto`), or none
     /// (`direct`).
@@ -107,6 +116,64 @@ impl LoopTensors {
         Ok(Self { two_loop, one_loop })
     }
 }
+
+/// Bytes per k of one spectrum's 2-loop redshift-space terms (the 1- and 2-loop terms of each
+/// multipole's kernel coefficients, ~200 estimates of 16 bytes).
+pub(crate) const TWO_LOOP_TERMS_BYTES_PER_K: f64 = 3.2e3;
+
+/// Implements [`crate::plan::Plan`] for a plan of 2-loop redshift-space terms `$terms` with the fields
+/// `one_loop` ([`RedshiftPlan`]), `precision` and `tensors` ([`LoopTensors`]) and an inherent
+/// `terms(spectrum, progress)`. Memory: the process, the 1-loop plan and, with tensors, the 2-loop
+/// basis's per-k estimate per spectrum family.
+macro_rules! two_loop_rsd_plan {
+    ($plan:ty, $terms:ty, $what:literal) => {
+        impl crate::plan::Plan for $plan {
+            type Settings<'a> = ();
+            type Terms = $terms;
+
+            fn describe(&self) -> String {
+                format!(concat!($what, " on {} k"), self.k().len())
+            }
+
+            fn method(&self) -> crate::plan::Method {
+                self.tensors.method()
+            }
+
+            fn bytes(&self) -> f64 {
+                let nk = self.k().len();
+                let tensors = match self.tensors.method() {
+                    crate::plan::Method::Direct => 0.0,
+                    crate::plan::Method::Basis => {
+                        crate::loops::basis::TwoLoopBasis::memory_estimate(nk, &self.precision)
+                    }
+                };
+                crate::memory::PROCESS
+                    + crate::loops::redshift::RedshiftPlan::memory_estimate(nk, &self.precision)
+                    + tensors
+            }
+
+            fn terms_bytes(&self) -> f64 {
+                super::spt2::TWO_LOOP_TERMS_BYTES_PER_K * self.k().len() as f64
+            }
+
+            fn max_memory(&self) -> Option<f64> {
+                self.precision.max_memory
+            }
+
+            fn terms(
+                &self,
+                spectrum: &LinearSpectrum,
+                (): (),
+                progress: &dyn Progress,
+            ) -> Result<$terms> {
+                <$plan>::terms(self, spectrum, progress)
+            }
+        }
+    };
+}
+pub(crate) use two_loop_rsd_plan;
+
+two_loop_rsd_plan!(Spt2Plan, Spt2Terms, "2-loop SPT redshift-space terms");
 
 /// The 1- and 2-loop redshift-space terms of `spectra` (a spectrum and, for IR resummation, its
 /// no-wiggle part): from the basis `tensors` when every spectrum is represented by its basis

@@ -13,7 +13,6 @@ use super::{
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
 use crate::linear::LogGrid;
-pub use crate::rsd::ap::ApSpec;
 use std::path::Path;
 
 /// A window read from a file: Q_ℓ(s) multipoles or a matrix.
@@ -87,52 +86,6 @@ impl Bins {
                 what: "a periodic box (box side) without k bins".into(),
                 reason: "the box modes are averaged over k bins: give their edges too".into(),
             }),
-        }
-    }
-}
-
-/// What a face asks of the observation, as its options say it (the one place that turns them into
-/// an [`Observation`] and a distortion): correlation-function multipoles (`xi`, with optional s bin
-/// edges), or the power spectrum through a window and/or bins, or neither (the model's own
-/// multipoles); and the Alcock–Paczynski distortion of the measurement ([`ApSpec`]).
-#[derive(Debug, Clone, Default)]
-pub struct ObservationSpec {
-    /// The survey window, if any.
-    pub window: Option<Window>,
-    /// The k bins, if any.
-    pub bins: Option<Bins>,
-    /// ξ_ℓ(s) instead of P_ℓ(k).
-    pub xi: bool,
-    /// With `xi`: the s bin edges [Mpc/h] (None: ξ at the given s).
-    pub s_edges: Option<Vec<f64>>,
-    /// The Alcock–Paczynski distortion of the measurement ([`ApSpec::distortion`] makes it for a
-    /// prediction's cosmology and redshift).
-    pub ap: ApSpec,
-}
-
-impl ObservationSpec {
-    /// The observation of multipoles `ells` at the data's `k` [h/Mpc] (s [Mpc/h] for ξ), or `None`
-    /// when nothing is asked for (the model's multipoles at k).
-    ///
-    /// # Errors
-    /// [`Error::InvalidChoice`] for ξ with a window or k bins (a Landy–Szalay ξ has the window divided
-    /// out), or s edges without ξ; as [`Observation::new`] and [`Observation::xi`].
-    pub fn build(self, ells: &[usize], k: &[f64]) -> Result<Option<Observation>> {
-        let refuse = |reason: &str| Error::InvalidChoice {
-            what: "the observation".into(),
-            reason: reason.into(),
-        };
-        match (self.xi, self.window, self.bins) {
-            (true, None, None) => Ok(Some(Observation::xi(ells, k, self.s_edges.as_deref())?)),
-            (true, _, _) => Err(refuse(
-                "correlation-function multipoles take no window or k bins (a Landy-Szalay xi has \
-                 the window divided out)",
-            )),
-            (false, _, _) if self.s_edges.is_some() => Err(refuse(
-                "s bin edges are for correlation-function multipoles (xi)",
-            )),
-            (false, None, None) => Ok(None),
-            (false, window, bins) => Ok(Some(Observation::new(ells, k, window, bins)?)),
         }
     }
 }
@@ -498,44 +451,6 @@ pub fn apply_matrix(matrix: &[f64], model: &[Vec<f64>]) -> Vec<f64> {
 #[cfg(test)]
 mod spec_tests {
     use super::*;
-
-    /// The spec makes the observation each face used to make by hand, and refuses the combinations
-    /// that have no meaning (one of which a face used to ignore silently: ξ with a window).
-    #[test]
-    fn the_spec_decides_the_observation_and_refuses_what_has_no_meaning() {
-        let k: Vec<f64> = (1..=20).map(|i| 0.01 * f64::from(i)).collect();
-        assert!(ObservationSpec::default()
-            .build(&[0, 2], &k)
-            .unwrap()
-            .is_none());
-        let binned = ObservationSpec {
-            bins: Bins::of(Some(vec![0.02, 0.06, 0.1]), None).unwrap(),
-            ..ObservationSpec::default()
-        };
-        let o = binned.build(&[0, 2], &k).unwrap().unwrap();
-        assert_eq!(o.k_out().len(), 2);
-        let s: Vec<f64> = (1..=10).map(|i| 20.0 * f64::from(i)).collect();
-        let xi = ObservationSpec {
-            xi: true,
-            ..ObservationSpec::default()
-        };
-        assert!(xi.build(&[0, 2], &s).unwrap().unwrap().is_xi());
-        let bad = ObservationSpec {
-            xi: true,
-            bins: Bins::of(Some(vec![0.02, 0.06]), None).unwrap(),
-            ..ObservationSpec::default()
-        };
-        let e = bad.build(&[0], &s).err().expect("refused").to_string();
-        assert!(e.contains("no window or k bins"), "{e}");
-        let stray = ObservationSpec {
-            s_edges: Some(vec![10.0, 20.0]),
-            ..ObservationSpec::default()
-        };
-        let e = stray.build(&[0], &k).err().expect("refused").to_string();
-        assert!(e.contains("xi"), "{e}");
-        let e = Bins::of(None, Some(1000.0)).unwrap_err().to_string();
-        assert!(e.contains("give their edges"), "{e}");
-    }
 
     /// Issue 45: without a window or bins, `Observation::new(&[0, 3], ..)` and `&[0, 0]` were
     /// accepted and applied (the model passed through under ℓ = 3, or twice).

@@ -261,7 +261,7 @@ pub fn table(
         bias_given: shared.galaxy.map(|g| g.given).unwrap_or_default(),
     };
     let (window, bins) = args.observation()?;
-    let spec = pt_spectra::survey::observe::ObservationSpec {
+    let spec = pt_spectra::jobs::ObservationSpec {
         window,
         bins,
         xi: shared.xi.is_some(),

@@ -300,7 +300,7 @@ fn run_ept(args: &Args) -> Result<()> {
         .map(|text| parse_prior(text))
         .collect::<Result<Vec<_>>>()?;
     let (window, bins) = args.ept.observation()?;
-    let spec = pt_spectra::survey::observe::ObservationSpec {
+    let spec = pt_spectra::jobs::ObservationSpec {
         window,
         bins,
         xi: args.xi,

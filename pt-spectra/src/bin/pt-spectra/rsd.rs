@@ -311,7 +311,7 @@ pub fn run(args: &Args) -> Result<()> {
     if (window.is_some() || bins.is_some()) && (args.xi || args.terms) {
         bail!("--window/--k-edges/--box take neither --xi nor --terms (the observed table has the multipoles only)");
     }
-    let spec = pt_spectra::survey::observe::ObservationSpec {
+    let spec = pt_spectra::jobs::ObservationSpec {
         window,
         bins,
         ap,
