@@ -18,8 +18,7 @@
 
 #[cfg(doc)]
 use crate::error::Error;
-use crate::error::Result;
-use crate::loops::{ByPair, Estimate, LoopTerms, OneLoopTerms, Pair, TwoLoopCorrection};
+use crate::loops::{ByPair, Estimate, OneLoopTerms, Pair, TwoLoopCorrection};
 
 /// Which resummed propagator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -155,22 +154,33 @@ pub fn n3(p13: Estimate, p15: Estimate, p17: Estimate, p_lin: f64) -> Estimate {
     Estimate::new(f(t), error)
 }
 
-/// The propagators (N_δ, N_θ) at every k of `terms`.
-///
-/// # Errors
-/// [`Error::MissingTerm`] (naming `needed_by`) for [`Propagator::N2`] and [`Propagator::N3`] if
-/// `terms` have no P15, and for N3 if they have no P17.
-pub fn propagators(
-    kind: Propagator,
-    terms: &LoopTerms,
-    needed_by: &dyn std::fmt::Display,
-) -> Result<(Vec<Estimate>, Vec<Estimate>)> {
-    let t = &terms.one_loop;
+/// An RPT propagator with the terms it is made of.
+#[derive(Debug, Clone, Copy)]
+pub enum PropagatorTerms<'a> {
+    /// N0 = exp(−k²σ_v²/2).
+    N0,
+    /// N1 from P13.
+    N1,
+    /// N2 from P13 and P15.
+    N2 {
+        /// P15 of δδ, δθ, θθ.
+        p15: &'a ByPair<Vec<Estimate>>,
+    },
+    /// N3 from P13, P15 and P17.
+    N3 {
+        /// P15 of δδ, δθ, θθ.
+        p15: &'a ByPair<Vec<Estimate>>,
+        /// P17 of δδ, δθ, θθ.
+        p17: &'a ByPair<Vec<Estimate>>,
+    },
+}
+
+/// The propagators (N_δ, N_θ) at every k of `t` (P_lin, P13, σ_v²) and the terms of `kind`.
+pub fn propagators(kind: PropagatorTerms<'_>, t: &OneLoopTerms) -> (Vec<Estimate>, Vec<Estimate>) {
     let n = t.k.len();
     let (p13, p_lin) = (&t.p13, &t.p_lin);
-    Ok(match kind {
-        Propagator::N3 => {
-            let (p15, p17) = (terms.p15(needed_by)?, terms.p17(needed_by)?);
+    match kind {
+        PropagatorTerms::N3 { p15, p17 } => {
             let of = |pair: Pair| -> Vec<Estimate> {
                 (0..n)
                     .map(|i| n3(p13[pair][i], p15[pair][i], p17[pair][i], p_lin[i]))
@@ -178,8 +188,7 @@ pub fn propagators(
             };
             (of(Pair::DeltaDelta), of(Pair::ThetaTheta))
         }
-        Propagator::N2 => {
-            let p15 = terms.p15(needed_by)?;
+        PropagatorTerms::N2 { p15 } => {
             let of = |pair: Pair| -> Vec<Estimate> {
                 (0..n)
                     .map(|i| n2(p13[pair][i], p15[pair][i], p_lin[i]))
@@ -187,17 +196,17 @@ pub fn propagators(
             };
             (of(Pair::DeltaDelta), of(Pair::ThetaTheta))
         }
-        Propagator::N0 => {
+        PropagatorTerms::N0 => {
             let n: Vec<Estimate> = t.k.iter().map(|&k| n0(k, t.sigma_v2)).collect();
             (n.clone(), n)
         }
-        Propagator::N1 => {
+        PropagatorTerms::N1 => {
             let of = |p13: &[Estimate]| -> Vec<Estimate> {
                 p13.iter().zip(p_lin).map(|(&p, &lin)| n1(p, lin)).collect()
             };
             (of(&p13.dd), of(&p13.tt))
         }
-    })
+    }
 }
 
 /// RegPT's running damping scale σ_d²(k) = (1/6π²)∫_{q_min}^{k/2} P(q) dq [(Mpc/h)²] at each k

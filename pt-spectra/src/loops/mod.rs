@@ -238,9 +238,10 @@ pub struct TwoLoopCorrection {
     pub points: Vec<usize>,
 }
 
-/// Every loop term a real-space model may use, on one k grid: the 1-loop terms always, the others if
-/// they were computed. A model's spectra ([`crate::real::RealSpectra`]) are built from the terms it
-/// needs, and building them fails with [`Error::MissingTerm`] if one is `None`.
+/// Every loop term a real-space plan computed, on one k grid: the 1-loop terms always, the others if
+/// a model the plan covers needs them (a plan of `real --model all` covers every model). A model
+/// takes its own terms from it as its family's type, [`crate::real::ModelTerms::of`], the one place
+/// that fails with [`Error::MissingTerm`] if one is `None`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoopTerms {
     /// P22, P13 and σ_v².

@@ -29,9 +29,11 @@ use std::str::FromStr;
 pub mod counterterm;
 pub mod eft;
 mod plan;
+mod terms;
 pub use counterterm::{check_cs2, counterterm, counterterm_factor};
 pub use eft::{fit_counterterms, Counterterm, Counterterms};
 pub use plan::{real_space, RealPlan};
+pub use terms::ModelTerms;
 
 /// A real-space model, named as on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -311,82 +313,48 @@ impl RealSpectra {
     pub fn from_terms(model: RealModel, terms: LoopTerms) -> Result<Self> {
         let t = &terms.one_loop;
         let n = t.k.len();
-        let two_loop = if model.needs_two_loop() {
-            Some(terms.two_loop(&format_args!("model {model}"))?)
-        } else {
-            None
+        let each = |f: &dyn Fn(Pair, usize) -> Estimate| {
+            ByPair::from_fn(|pair| (0..n).map(|i| f(pair, i)).collect())
         };
-        let (spectra, factors) = match model.propagator() {
-            None if model.needs_ir() => {
-                let ir = terms.ir.as_deref().ok_or_else(|| Error::MissingTerm {
-                    term: "the no-wiggle loop terms",
-                    needed_by: format!("model {model}"),
-                    hint: " (compute the terms with a RealPlan)",
-                })?;
-                let two = if model.needs_two_loop() {
-                    Some((
-                        two_loop.expect("checked above"),
-                        ir.no_wiggle.two_loop(&model)?,
-                    ))
-                } else {
-                    None
-                };
-                let spectra = ByPair::from_fn(|pair| {
-                    (0..n)
-                        .map(|i| crate::ir::resummed(t, ir, two, pair, i))
-                        .collect()
+        let (spectra, factors) = match ModelTerms::of(model, &terms)? {
+            ModelTerms::Ir {
+                one_loop,
+                ir,
+                two_loop,
+            } => (
+                each(&|pair, i| crate::ir::resummed(one_loop, ir, two_loop, pair, i)),
+                None,
+            ),
+            ModelTerms::RegPtOneLoop { one_loop, sigma_d2 } => (
+                each(&|pair, i| resum::regpt_one_loop(one_loop, pair, i, sigma_d2[i])),
+                None,
+            ),
+            ModelTerms::RegPtTwoLoop(regpt) => (each(&|pair, i| regpt.spectrum(pair, i)), None),
+            ModelTerms::Spt {
+                one_loop,
+                linear,
+                two_loop,
+            } => {
+                let spectra = each(&|pair, i| {
+                    let lin = Estimate::exact(one_loop.p_lin[i]);
+                    match (linear, two_loop) {
+                        (true, _) => lin,
+                        (false, Some(two)) => {
+                            lin + one_loop.one_loop(pair, i) + two.pairs[pair].total[i]
+                        }
+                        (false, None) => lin + one_loop.one_loop(pair, i),
+                    }
                 });
                 (spectra, None)
             }
-            None if model == RealModel::OneLoopRegPt => {
-                let sigma_d2 = terms.sigma_d2(&format_args!("model {model}"))?;
-                let spectra = ByPair::from_fn(|pair| {
-                    (0..n)
-                        .map(|i| resum::regpt_one_loop(t, pair, i, sigma_d2[i]))
-                        .collect()
-                });
-                (spectra, None)
-            }
-            None if model == RealModel::TwoLoopRegPt => {
-                let needed_by = format_args!("model {model}");
-                let regpt = resum::RegPtTwoLoop {
-                    one_loop: t,
-                    sigma_d2: terms.sigma_d2(&needed_by)?,
-                    p15: terms.p15(&needed_by)?,
-                    two_loop: two_loop.expect("checked above"),
-                    gamma2: terms.gamma2(&needed_by)?,
-                };
-                let spectra =
-                    ByPair::from_fn(|pair| (0..n).map(|i| regpt.spectrum(pair, i)).collect());
-                (spectra, None)
-            }
-            None => {
-                let spectra = ByPair::from_fn(|pair| {
-                    (0..n)
-                        .map(|i| {
-                            let lin = Estimate::exact(t.p_lin[i]);
-                            match (model, two_loop) {
-                                (RealModel::Linear, _) => lin,
-                                (_, Some(two)) => {
-                                    lin + t.one_loop(pair, i) + two.pairs[pair].total[i]
-                                }
-                                (_, None) => lin + t.one_loop(pair, i),
-                            }
-                        })
-                        .collect()
-                });
-                (spectra, None)
-            }
-            Some(kind) => {
-                let props = resum::propagators(kind, &terms, &format_args!("model {model}"))?;
-                let factors = ByPair::from_fn(|pair| {
-                    (0..n).map(|i| resum::factors(&props, i)[pair]).collect()
-                });
-                let spectra = ByPair::from_fn(|pair| {
-                    (0..n)
-                        .map(|i| resum::rpt(t, two_loop, &props, pair, i))
-                        .collect()
-                });
+            ModelTerms::Rpt {
+                one_loop,
+                propagator,
+                two_loop,
+            } => {
+                let props = resum::propagators(propagator, one_loop);
+                let factors = each(&|pair, i| resum::factors(&props, i)[pair]);
+                let spectra = each(&|pair, i| resum::rpt(one_loop, two_loop, &props, pair, i));
                 (spectra, Some(factors))
             }
         };
