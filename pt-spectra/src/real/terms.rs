@@ -103,7 +103,7 @@ impl<'a> ModelTerms<'a> {
                 one_loop,
                 sigma_d2: terms.sigma_d2(needed_by)?,
                 p15: terms.p15(needed_by)?,
-                two_loop: two_loop.expect("2l-regpt needs the 2-loop terms: taken above"),
+                two_loop: terms.two_loop(needed_by)?,
                 gamma2: terms.gamma2(needed_by)?,
             }),
             None => Self::Spt {
