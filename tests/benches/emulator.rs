@@ -53,6 +53,20 @@ fn emulator(crit: &mut Criterion) {
             })
         },
     );
+    // σ8-normalised: A_s found from σ8 at z = 0 (the shape at z = 0 without its s-derivative)
+    let sigma8: Vec<Cosmology> = all
+        .iter()
+        .map(|c| c.with_amplitude(Amplitude::Sigma8(0.8)).unwrap())
+        .collect();
+    crit.bench_function(
+        "emulator/P_m, P_cb, f_cb of a new sigma8-normalised cosmology (w0-wa, m_nu)",
+        |b| {
+            b.iter(|| {
+                i = (i + 1) % sigma8.len();
+                black_box(emulator.spectra(&sigma8[i], 0.8).unwrap())
+            })
+        },
+    );
 }
 
 criterion_group!(benches, emulator);

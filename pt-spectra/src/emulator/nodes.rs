@@ -104,7 +104,10 @@ impl LinearEmulator {
             .collect();
         let z = z.clamp(z0, z1);
         let point_coefficients = self.point_coefficients(&u, &heads);
-        let shape_at = |z: f64| self.shape(&point_coefficients, &heads, z);
+        // the derivative in s only where f_cb is made (at z); σ8's shape at z = 0 and the massless
+        // ratio need the values alone
+        let shape_at =
+            |z: f64, derivative: bool| self.shape(&point_coefficients, &heads, z, derivative);
         // The emulated ln(P_m/P_cb), continuous as Σm_ν → 0: P_m = P_cb exactly without massive
         // neutrinos (the emulated ratio is then its own error, and the neutrino head is 0 too: the
         // settings differ only in how the mass is shared); below RATIO_TAPER the ratio's value at
@@ -124,13 +127,16 @@ impl LinearEmulator {
                 return vec![T::cst(0.0); shape.ratio.len()];
             }
             match &massless {
-                Some(c) => (shape.ratio.iter().zip(&self.shape(c, &heads, z).ratio))
-                    .map(|(&r, &o)| r - taper * o)
-                    .collect(),
+                Some(c) => (shape
+                    .ratio
+                    .iter()
+                    .zip(&self.shape(c, &heads, z, false).ratio))
+                .map(|(&r, &o)| r - taper * o)
+                .collect(),
                 None => shape.ratio.clone(),
             }
         };
-        let shape = shape_at(z);
+        let shape = shape_at(z, true);
         // ln P_cb = G_cb + 2 ln(D_md/Ω_m) + ln A_s + (n_s − 1) ln(k h/k_pivot)
         let growth = |z: f64| {
             let (d_md, f) = b.growth_md_and_rate(z);
@@ -145,7 +151,7 @@ impl LinearEmulator {
         let ln_a_s = match point.ln_a_s {
             Some(ln_a_s) => ln_a_s,
             None => {
-                let today = shape_at(z0);
+                let today = shape_at(z0, false);
                 let today_ratio = ln_ratio(&today, z0);
                 let growth_0 = growth(z0).0;
                 let sigma8_unit = super::sigma8(&k, step, |i| {
@@ -208,10 +214,11 @@ impl LinearEmulator {
         (c, head_c): &PointCoefficients<T>,
         heads: &[(&format::Head, T)],
         z: f64,
+        derivative: bool,
     ) -> Shape<T> {
-        let mut shape = self.at_redshift(&self.file.targets, c, z);
+        let mut shape = self.at_redshift(&self.file.targets, c, z, derivative);
         for ((h, weight), hc) in heads.iter().zip(head_c) {
-            shape.add(&self.at_redshift(&h.targets, hc, z), *weight);
+            shape.add(&self.at_redshift(&h.targets, hc, z, derivative), *weight);
         }
         shape
     }
@@ -246,14 +253,17 @@ impl LinearEmulator {
         }
     }
 
-    /// Both targets at redshift `z` (four-node Lagrange interpolation in s = ln(1 + z)), and
-    /// ∂(first target)/∂s: per lane, the components weighted by the coefficients' lane, plus the mean
-    /// on the value lane.
+    /// Both targets at redshift `z` (four-node Lagrange interpolation in s = ln(1 + z)), and, with
+    /// `derivative`, ∂(first target)/∂s (else zeros): per lane, the components weighted by the
+    /// coefficients' lane, plus the mean on the value lane. Without the derivative a node of weight
+    /// exactly 0 is skipped (at a redshift node, e.g. z = 0, three of the four: the values are the
+    /// same, it adds 0 × its row).
     fn at_redshift<T: Lanes>(
         &self,
         targets: &[format::Target; 2],
         coefficients: &[Vec<T>; 2],
         z: f64,
+        derivative: bool,
     ) -> Shape<T> {
         let nodes: Vec<f64> = self.file.z_nodes.iter().map(|z| z.ln_1p()).collect();
         let s = z.ln_1p();
@@ -273,6 +283,9 @@ impl LinearEmulator {
                     c_lane.extend(c.iter().map(|c| c.lane(l)));
                     let stride = target.mean.len();
                     for j in 0..4 {
+                        if !derivative && w[j] == 0.0 {
+                            continue;
+                        }
                         let node = first + j;
                         let rows = &target.components[node * n_x..];
                         simd::combine_rows_f32(&mut row, &c_lane, rows, stride);
@@ -283,7 +296,7 @@ impl LinearEmulator {
                         for (o, &r) in out[t].iter_mut().zip(&row) {
                             *o += w[j] * r;
                         }
-                        if t == 0 {
+                        if t == 0 && derivative {
                             for (o, &r) in out[2].iter_mut().zip(&row) {
                                 *o += dw[j] * r;
                             }
