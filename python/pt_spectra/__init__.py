@@ -77,7 +77,19 @@ __all__ = [
 
 __version__ = _core.__version__
 
-class RealPlan:
+class _PlanInfo:
+    """What every plan says about itself (the library's one ``Plan`` seam)."""
+
+    @property
+    def plan_info(self):
+        """What the plan computes (``what``), how a new spectrum's terms are computed (``method``:
+        ``"direct"`` or ``"basis"``) and its memory estimates in bytes (``memory_bytes``: the plan;
+        ``terms_bytes``: one spectrum's terms)."""
+        plan = getattr(self, "_ept", None) or self._plan
+        return plan.plan_info
+
+
+class RealPlan(_PlanInfo):
     """A real-space model prepared for one k grid: build once, call for every linear spectrum.
 
     ``RealPlan(k, model="1l-spt", precision="default", q_range=None, two_loop_tolerance=None,
@@ -127,7 +139,7 @@ class RealPlan:
         return _core.real_batch(self._plan, np.asarray(k_lin, dtype=float), P, terms)
 
 
-class EptPlan:
+class EptPlan(_PlanInfo):
     """The galaxy model ``ept`` planned for one k grid (1-loop Eulerian PT of biased tracers in
     redshift space with the BAO resummed, velocileptors' ``REPT`` conventions).
 
@@ -183,7 +195,7 @@ def ept(k=None, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, ells=(
     return plan(linear, z, z_input, cosmology, eh, ells, **params)
 
 
-class TwoLoopRsdPlan:
+class TwoLoopRsdPlan(_PlanInfo):
     """2-loop matter multipoles in redshift space planned for one k grid: ``model="spt2"`` (plain
     2-loop SPT, kernels Z_2 … Z_5) or ``"eft2"`` (with the BAO resummed, ``ir=False`` to switch it
     off, and the counterterms c0, c2, c4, c0_1loop, c2_1loop, c4_1loop [(Mpc/h)^2], ctilde
@@ -230,7 +242,7 @@ def convert_bias(values, from_convention, to_convention="velocileptors"):
                                    to_convention))
 
 
-class RsdPlan:
+class RsdPlan(_PlanInfo):
     """The loop terms of a redshift-space model prepared for one k grid.
 
     ``RsdPlan(k, real="1l-rpt-n1", rsd="tns", precision="default", q_range=None, cache_dir=None,
