@@ -10,7 +10,7 @@
 //! b = P_mh/P_mm and P_εε = P_hh − P_mh²/P_mm, with P_hh the measured halo spectrum (noise included).
 
 use crate::error::{Error, Result};
-use crate::table::{Table, Tabulated};
+use crate::table::{DataColumns, Tabulated};
 use std::path::Path;
 
 /// The halo bias b(k) before the amplitude A_b.
@@ -184,7 +184,7 @@ impl MeasuredSpectrum {
     ) -> Result<Self> {
         let mut wanted = vec![k, p];
         wanted.extend(error);
-        let t = Table::read(path, &wanted)?;
+        let t = DataColumns::read(path, &wanted)?;
         let mut c = t.columns.into_iter();
         let (k, p, e) = (
             c.next().unwrap_or_default(),

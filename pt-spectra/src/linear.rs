@@ -194,7 +194,7 @@ impl LinearSpectrum {
                 "must differ from the k column",
             ));
         }
-        let table = crate::table::Table::parse(text, origin, &[columns.k, columns.p])?;
+        let table = crate::table::DataColumns::parse(text, origin, &[columns.k, columns.p])?;
         let [k, p]: [Vec<f64>; 2] = table.columns.try_into().expect("two columns");
         let x: Vec<f64> = k.iter().map(|v| v.ln()).collect();
         for i in 0..k.len() {

@@ -75,7 +75,7 @@ pub(crate) const K_TOO_CLOSE: &str =
 
 /// The selected columns of a table's data rows.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Table {
+pub struct DataColumns {
     /// File path or description, for messages.
     pub origin: String,
     /// Header lines (without the `#`).
@@ -86,7 +86,7 @@ pub struct Table {
     pub columns: Vec<Vec<f64>>,
 }
 
-impl Table {
+impl DataColumns {
     /// Reads the 0-based `columns` of the file at `path`.
     ///
     /// # Errors
@@ -305,14 +305,14 @@ impl Tabulated {
     /// Reads `name` from columns (k, value) of a file (0-based).
     ///
     /// # Errors
-    /// As [`Table::read`] and [`new`](Self::new).
+    /// As [`DataColumns::read`] and [`new`](Self::new).
     pub fn read(
         path: impl AsRef<Path>,
         name: &'static str,
         (k_column, value_column): (usize, usize),
         positive: bool,
     ) -> Result<Self> {
-        let table = Table::read(path, &[k_column, value_column])?;
+        let table = DataColumns::read(path, &[k_column, value_column])?;
         let [k, v]: [Vec<f64>; 2] = table.columns.try_into().expect("two columns");
         Self::new(name, &table.origin, k, v, positive, &table.lines)
     }
@@ -349,8 +349,8 @@ impl Tabulated {
         let text = read_text(path)?;
         let origin = path.display().to_string();
         let table = match named_column(&text, column) {
-            Some(c) => Table::parse(&text, &origin, &[0, c])?,
-            None => Table::parse_exact(&text, &origin, 2).map_err(|e| match e {
+            Some(c) => DataColumns::parse(&text, &origin, &[0, c])?,
+            None => DataColumns::parse_exact(&text, &origin, 2).map_err(|e| match e {
                 Error::BadRow { line, .. } => Error::InvalidChoice {
                     what: format!("`{origin}` (line {line})"),
                     reason: format!(
@@ -512,7 +512,7 @@ impl KGrid {
     ///
     /// # Errors
     /// [`Error::Io`]; [`Error::TooFewPoints`] for no values; [`Error::BadRow`] for one row of several
-    /// numbers; as [`Table::parse`] and [`check_k_grid`].
+    /// numbers; as [`DataColumns::parse`] and [`check_k_grid`].
     pub fn read(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         Self::parse(&read_text(path)?, &path.display().to_string())
@@ -523,7 +523,7 @@ impl KGrid {
     /// # Errors
     /// As [`read`](Self::read).
     pub fn parse(text: &str, origin: &str) -> Result<Self> {
-        let table = Table::parse(text, origin, &[0])?;
+        let table = DataColumns::parse(text, origin, &[0])?;
         if let [line] = table.lines[..] {
             let row = numbered_lines(text)
                 .find(|(l, _)| *l == line)
@@ -642,12 +642,12 @@ mod tests {
     #[test]
     fn columns_are_selected_and_bad_rows_named() {
         let text = "# bias\nk,b,x\n0.01 1.5 9\n0.02, 1.7, 9 # note\n\n0.04 2.1 9\n";
-        let t = Table::parse(text, "b.dat", &[0, 1]).unwrap();
+        let t = DataColumns::parse(text, "b.dat", &[0, 1]).unwrap();
         assert_eq!(t.columns[1], vec![1.5, 1.7, 2.1]);
         assert_eq!(t.lines, vec![3, 4, 6]);
-        let e = Table::parse("0.1 2\n0.2\n", "b.dat", &[0, 1]).unwrap_err();
+        let e = DataColumns::parse("0.1 2\n0.2\n", "b.dat", &[0, 1]).unwrap_err();
         assert!(e.to_string().starts_with("b.dat:2:"), "{e}");
-        let e = Table::parse("0.1 x\n", "b.dat", &[0, 1]).unwrap_err();
+        let e = DataColumns::parse("0.1 x\n", "b.dat", &[0, 1]).unwrap_err();
         assert!(e.to_string().contains("`x`"), "{e}");
     }
 

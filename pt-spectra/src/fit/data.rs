@@ -1,7 +1,7 @@
 //! Measured multipoles: reading them from tables or arrays, with checks that name the bad row.
 
 use crate::error::{Error, Result};
-use crate::table::Table;
+use crate::table::DataColumns;
 use std::path::Path;
 
 /// Measured multipoles P_ℓ(k) with their 1σ errors.
@@ -40,7 +40,10 @@ impl MultipoleData {
         k_column: usize,
         columns: &[(usize, usize, usize)],
     ) -> Result<Self> {
-        Self::from_table(&Table::read(path, &wanted(k_column, columns))?, columns)
+        Self::from_table(
+            &DataColumns::read(path, &wanted(k_column, columns))?,
+            columns,
+        )
     }
 
     /// As [`read`](Self::read), from text (`origin` names it in messages).
@@ -54,7 +57,7 @@ impl MultipoleData {
         columns: &[(usize, usize, usize)],
     ) -> Result<Self> {
         Self::from_table(
-            &Table::parse(text, origin, &wanted(k_column, columns))?,
+            &DataColumns::parse(text, origin, &wanted(k_column, columns))?,
             columns,
         )
     }
@@ -94,7 +97,7 @@ impl MultipoleData {
                 right: columns[0].len(),
             });
         }
-        let table = Table {
+        let table = DataColumns {
             origin: origin.to_string(),
             header: Vec::new(),
             lines: (1..=columns[0].len()).collect(),
@@ -108,7 +111,7 @@ impl MultipoleData {
         Self::from_table(&table, &spec)
     }
 
-    fn from_table(table: &Table, columns: &[(usize, usize, usize)]) -> Result<Self> {
+    fn from_table(table: &DataColumns, columns: &[(usize, usize, usize)]) -> Result<Self> {
         let k = table.columns[0].clone();
         let origin = &table.origin;
         if k.is_empty() {
@@ -201,7 +204,7 @@ impl MultipoleData {
                 self.k.len()
             ),
         };
-        let table = Table::parse_exact(text, origin, n).map_err(|e| match e {
+        let table = DataColumns::parse_exact(text, origin, n).map_err(|e| match e {
             Error::MissingColumn { line, found, .. } => size(line, found),
             Error::BadRow {
                 line, ref problem, ..

@@ -3,7 +3,7 @@
 
 use super::MultipoleData;
 use crate::error::{Error, Result};
-use crate::table::Table;
+use crate::table::DataColumns;
 use std::path::Path;
 
 /// The columns of a multipole file: k, then P_ℓ and σ_ℓ for each of its multipoles.
@@ -74,7 +74,7 @@ impl DataLayout {
         let data = self.read(path, &self.data_ells)?;
         let last = self.columns.iter().copied().max().unwrap_or(1);
         // Ask for the column after the last one: every row must lack it.
-        match Table::read(path, &[last]) {
+        match DataColumns::read(path, &[last]) {
             Err(Error::MissingColumn { .. }) => Ok(data),
             Err(e) => Err(e),
             Ok(_) => Err(Error::InvalidChoice {
@@ -108,7 +108,7 @@ impl DataLayout {
         if data.ells == self.data_ells || width != Some(full) {
             return data.parse_covariance(&text, &origin);
         }
-        let table = Table::parse_exact(&text, &origin, full)?;
+        let table = DataColumns::parse_exact(&text, &origin, full)?;
         if table.lines.len() != full {
             return Err(Error::BadRow {
                 origin,

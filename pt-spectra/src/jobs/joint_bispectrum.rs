@@ -13,7 +13,7 @@ use crate::error::{Error, Result};
 use crate::fit::galaxy::BispectrumFit;
 use crate::fit::{DataLayout, MultipoleData};
 use crate::linear::LinearSpectrum;
-use crate::table::Table;
+use crate::table::DataColumns;
 use std::path::{Path, PathBuf};
 
 /// The bispectrum of a data set, as the analysis file gives it (paths resolved).
@@ -65,7 +65,7 @@ pub(super) fn load_bispectrum(
     let origin = spec.data.display().to_string();
     let text = crate::table::read_text(&spec.data)?;
     let width = 3 + spec.data_ells.len();
-    let table = Table::parse_exact(&text, &origin, width)?;
+    let table = DataColumns::parse_exact(&text, &origin, width)?;
     let n_tri = table.lines.len();
     let triangles: Vec<[f64; 3]> = (0..n_tri)
         .map(|i| std::array::from_fn(|c| table.columns[c][i]))
@@ -123,7 +123,7 @@ pub(super) fn load_bispectrum(
             ),
         ));
     }
-    let c_table = Table::parse_exact(&c_text, &c_origin, n_total)?;
+    let c_table = DataColumns::parse_exact(&c_text, &c_origin, n_total)?;
     let c: Vec<Vec<f64>> = (0..n_total)
         .map(|r| (0..n_total).map(|s| c_table.columns[s][r]).collect())
         .collect();

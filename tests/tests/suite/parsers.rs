@@ -11,7 +11,7 @@ use proptest::prelude::*;
 use pt_spectra::error::Error;
 use pt_spectra::fit::MultipoleData;
 use pt_spectra::linear::{Columns, LinearSpectrum, MAX_POWER, MIN_POINTS};
-use pt_spectra::table::{Table, Tabulated};
+use pt_spectra::table::{DataColumns, Tabulated};
 
 const ORIGIN: &str = "adversarial.dat";
 
@@ -374,7 +374,7 @@ proptest! {
     #[test]
     fn table_parse_survives_anything(text in any_text(), wide in any::<bool>()) {
         let columns: &[usize] = if wide { &[0, 3, 1] } else { &[0, 1] };
-        match Table::parse(&text, ORIGIN, columns) {
+        match DataColumns::parse(&text, ORIGIN, columns) {
             Ok(t) => {
                 prop_assert_eq!(t.columns.len(), columns.len());
                 prop_assert!(t.columns.iter().all(|c| c.len() == t.lines.len()));
@@ -388,7 +388,7 @@ proptest! {
         rows in rows(2..30, 3, |c| c == 2), style in style(), spoil in spoil()
     ) {
         let file = write_file(&rows, NAMES, &style, &spoil);
-        match Table::parse(&file.text, ORIGIN, &[0, 2]) {
+        match DataColumns::parse(&file.text, ORIGIN, &[0, 2]) {
             Ok(t) => prop_assert!(t.lines.len() <= rows.len() + 1),
             Err(e) => check_error(&e, &file.text, &file.allowed(1))?,
         }
@@ -402,7 +402,7 @@ proptest! {
             rows.iter_mut().for_each(|r| r[1] = r[1].abs());
         }
         let file = write_file(&rows, NAMES, &style, &spoil);
-        let result = Table::parse(&file.text, ORIGIN, &[0, 1]).and_then(|t| {
+        let result = DataColumns::parse(&file.text, ORIGIN, &[0, 1]).and_then(|t| {
             let [k, v]: [Vec<f64>; 2] = t.columns.try_into().expect("two columns");
             Tabulated::new("b(k)", &t.origin, k, v, positive, &t.lines)
         });

@@ -7,7 +7,7 @@
 use pt_spectra::error::Error;
 use pt_spectra::fit::MultipoleData;
 use pt_spectra::linear::{Columns, LinearSpectrum};
-use pt_spectra::table::{Table, Tabulated};
+use pt_spectra::table::{DataColumns, Tabulated};
 
 const ORIGIN: &str = "adversarial.dat";
 
@@ -45,20 +45,20 @@ fn empty_and_header_only_files_count_their_rows() {
         );
         let e = MultipoleData::parse(text, ORIGIN, 0, &[(0, 1, 2)]).unwrap_err();
         assert!(message(e).starts_with(ORIGIN), "{text:?}");
-        let t = Table::parse(text, ORIGIN, &[0, 1]).unwrap();
+        let t = DataColumns::parse(text, ORIGIN, &[0, 1]).unwrap();
         assert!(t.lines.is_empty());
     }
 }
 
 #[test]
 fn a_second_row_of_names_is_an_error_on_its_line() {
-    let e = Table::parse("k P\nkh pk\n0.1 2\n", ORIGIN, &[0, 1]).unwrap_err();
+    let e = DataColumns::parse("k P\nkh pk\n0.1 2\n", ORIGIN, &[0, 1]).unwrap_err();
     assert_eq!(
         message(e),
         format!("{ORIGIN}:2: cannot parse `kh` (column 1) as a number")
     );
     // Garbage throughout: the second line is named, not "0 rows".
-    let e = Table::parse("\u{7f}ELF\u{2}\u{1}\nxx yy zz\n", ORIGIN, &[0]).unwrap_err();
+    let e = DataColumns::parse("\u{7f}ELF\u{2}\u{1}\nxx yy zz\n", ORIGIN, &[0]).unwrap_err();
     assert!(message(e).starts_with(&format!("{ORIGIN}:2:")));
 }
 
@@ -66,38 +66,38 @@ fn a_second_row_of_names_is_an_error_on_its_line() {
 fn line_ends_of_every_system_number_lines_alike() {
     for ending in ["\n", "\r\n", "\r"] {
         let text = ["# head", "0.1 1", "", "0.2 x"].join(ending);
-        let e = Table::parse(&text, ORIGIN, &[0, 1]).unwrap_err();
+        let e = DataColumns::parse(&text, ORIGIN, &[0, 1]).unwrap_err();
         assert!(
             message(e).starts_with(&format!("{ORIGIN}:4: cannot parse `x`")),
             "{ending:?}"
         );
     }
     // A classic-Mac file is read row by row, not as one long row.
-    let t = Table::parse("0.1 1\r0.2 2\r0.3 3", ORIGIN, &[0, 1]).unwrap();
+    let t = DataColumns::parse("0.1 1\r0.2 2\r0.3 3", ORIGIN, &[0, 1]).unwrap();
     assert_eq!(t.columns[0], vec![0.1, 0.2, 0.3]);
     assert_eq!(t.lines, vec![1, 2, 3]);
 }
 
 #[test]
 fn a_byte_order_mark_is_not_part_of_the_first_field() {
-    let t = Table::parse("\u{feff}0.1 1\n0.2 2\n", ORIGIN, &[0, 1]).unwrap();
+    let t = DataColumns::parse("\u{feff}0.1 1\n0.2 2\n", ORIGIN, &[0, 1]).unwrap();
     assert_eq!(t.columns[0], vec![0.1, 0.2]);
 }
 
 #[test]
 fn unreadable_fields_are_shown_escaped_and_short() {
     let long = "7".repeat(30) + &"x".repeat(100);
-    let e = Table::parse(&format!("0.1 {long}\n"), ORIGIN, &[0, 1]).unwrap_err();
+    let e = DataColumns::parse(&format!("0.1 {long}\n"), ORIGIN, &[0, 1]).unwrap_err();
     let m = message(e);
     assert!(m.contains(&format!("`{}…`", &long[..40])), "{m}");
-    let e = Table::parse("0.1 \u{1b}[2J\n", ORIGIN, &[0, 1]).unwrap_err();
+    let e = DataColumns::parse("0.1 \u{1b}[2J\n", ORIGIN, &[0, 1]).unwrap_err();
     let m = message(e);
     assert!(!m.contains('\u{1b}') && m.contains("\\u{1b}[2J"), "{m}");
 }
 
 #[test]
 fn huge_column_numbers_are_missing_columns() {
-    let e = Table::parse("0.1 1\n", ORIGIN, &[0, usize::MAX]).unwrap_err();
+    let e = DataColumns::parse("0.1 1\n", ORIGIN, &[0, usize::MAX]).unwrap_err();
     assert!(
         matches!(
             e,
@@ -285,7 +285,7 @@ fn files_that_are_not_utf8_are_read_and_refused_at_their_line() {
     let path = std::env::temp_dir().join(format!("pt-spectra-parsers-{}.dat", std::process::id()));
     // A Latin-1 µ in a comment is harmless; a stray byte in a number is named with its line.
     std::fs::write(&path, b"# \xb5m\n0.1 1\n0.2 \xff2\n").unwrap();
-    let e = Table::read(&path, &[0, 1]).unwrap_err();
+    let e = DataColumns::read(&path, &[0, 1]).unwrap_err();
     std::fs::remove_file(&path).unwrap();
     let m = message(e);
     assert!(

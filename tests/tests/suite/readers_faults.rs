@@ -12,7 +12,7 @@ use pt_spectra::fit::MultipoleData;
 use pt_spectra::linear::{Columns, LinearSpectrum};
 use pt_spectra::survey::window::{boss_s_grid, BOSS_ROWS};
 use pt_spectra::survey::{WindowFormat, WindowMultipoles};
-use pt_spectra::table::{KGrid, Table};
+use pt_spectra::table::{DataColumns, KGrid};
 
 const ORIGIN: &str = "corrupted.dat";
 
@@ -266,7 +266,7 @@ proptest! {
             .collect();
         let fields = corrupt(&rows, &fault);
         let text = text("# k P other\n", &fields);
-        let k = Table::parse(&text, ORIGIN, &[0])
+        let k = DataColumns::parse(&text, ORIGIN, &[0])
             .and_then(|t| KGrid::new(&t.origin, t.columns[0].clone(), &t.lines));
         match k {
             Ok(k) => {

@@ -13,7 +13,7 @@ use pt_spectra::bispectrum::{
 use pt_spectra::jobs::{
     bispectrum_table, one_loop_bispectrum_table, sugiyama_table, BispectrumRequest, SugiyamaRequest,
 };
-use pt_spectra::table::Table;
+use pt_spectra::table::DataColumns;
 use std::path::PathBuf;
 
 /// Arguments of `pt-spectra bispectrum`.
@@ -185,7 +185,7 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
     let Some(path) = &args.triangles else {
         bail!("--loop 1 needs --triangles FILE (columns k1 k2 k3 [h/Mpc])");
     };
-    let t = Table::read(path, &[0, 1, 2]).context("--triangles")?;
+    let t = DataColumns::read(path, &[0, 1, 2]).context("--triangles")?;
     let rows: Vec<[f64; 3]> = (0..t.columns[0].len())
         .map(|i| [t.columns[0][i], t.columns[1][i], t.columns[2][i]])
         .collect();
@@ -225,7 +225,7 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
 /// The triangle set of the options.
 fn triangles(args: &Args) -> Result<TriangleSet> {
     if let Some(path) = &args.triangles {
-        let t = Table::read(path, &[0, 1, 2]).context("--triangles")?;
+        let t = DataColumns::read(path, &[0, 1, 2]).context("--triangles")?;
         let rows: Vec<[f64; 3]> = (0..t.columns[0].len())
             .map(|i| [t.columns[0][i], t.columns[1][i], t.columns[2][i]])
             .collect();
@@ -252,7 +252,7 @@ fn triangles(args: &Args) -> Result<TriangleSet> {
 
 /// The pairs of `--pairs`.
 fn pairs(path: &std::path::Path) -> Result<Vec<[f64; 2]>> {
-    let t = Table::read(path, &[0, 1]).context("--pairs")?;
+    let t = DataColumns::read(path, &[0, 1]).context("--pairs")?;
     Ok((0..t.columns[0].len())
         .map(|i| [t.columns[0][i], t.columns[1][i]])
         .collect())

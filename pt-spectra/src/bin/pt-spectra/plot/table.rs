@@ -49,7 +49,7 @@ pub struct Measured {
 impl Measured {
     /// Measured multipoles k P0 s0 P2 s2 P4 s4 (1-based columns 1..7, as `fit` reads by default).
     pub fn multipoles(path: &Path) -> Result<Self> {
-        let t = pt_spectra::table::Table::read(path, &[0, 1, 2, 3, 4, 5, 6])
+        let t = pt_spectra::table::DataColumns::read(path, &[0, 1, 2, 3, 4, 5, 6])
             .map_err(|e| anyhow::anyhow!("--data: {e}"))?;
         let c = t.columns;
         Ok(Self {
@@ -61,10 +61,10 @@ impl Measured {
 
     /// A measured real-space spectrum k P [σ] (1-based columns 1, 2 and, if every row has it, 3).
     pub fn spectrum(path: &Path) -> Result<Self> {
-        let with_errors = pt_spectra::table::Table::read(path, &[0, 1, 2]);
+        let with_errors = pt_spectra::table::DataColumns::read(path, &[0, 1, 2]);
         let t = match with_errors {
             Ok(t) => t,
-            Err(_) => pt_spectra::table::Table::read(path, &[0, 1])
+            Err(_) => pt_spectra::table::DataColumns::read(path, &[0, 1])
                 .map_err(|e| anyhow::anyhow!("--data: {e}"))?,
         };
         let c = t.columns;
