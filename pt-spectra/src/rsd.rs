@@ -33,6 +33,22 @@ pub use sigma0::{Dispersions, Sigma0};
 
 /// Largest multipole order ℓ supported.
 pub const MAX_ELL: usize = 8;
+
+/// Checks every ℓ of `ells` is even and at most [`MAX_ELL`] (the one check of the multipoles that
+/// the redshift-space models, AP and the galaxy model take).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming the first ℓ that is odd or above [`MAX_ELL`].
+pub fn check_ells(ells: &[usize]) -> Result<()> {
+    match ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
+        Some(&bad) => Err(Error::InvalidParameter {
+            name: "multipole ell",
+            value: bad as f64,
+            reason: "must be even and at most 8",
+        }),
+        None => Ok(()),
+    }
+}
 /// Largest power n of μ^{2n} in a model polynomial (μ⁸: the TNS B term).
 pub const MAX_MU_POWER: usize = 4;
 /// Gauss–Legendre nodes on μ ∈ [0, 1] for damped multipoles: exact for the polynomial part up to
@@ -487,13 +503,7 @@ impl MultipoleRule {
                 reason: "must be at least 1",
             });
         }
-        if let Some(&bad) = ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
-            return Err(Error::InvalidParameter {
-                name: "multipole ell",
-                value: bad as f64,
-                reason: "must be even and at most 8",
-            });
-        }
+        check_ells(ells)?;
         Ok(Self {
             ells: ells.to_vec(),
             exact: ells

@@ -16,7 +16,7 @@
 //! from half as many nodes. Every ℓ ≤ 8 of the true spectrum enters (the polynomial is complete), so
 //! the hexadecapole is exact to the interpolation. Wide-angle effects are neglected.
 
-use super::{legendre_coefficients, Fog, MuPolynomial, MAX_ELL};
+use super::{legendre_coefficients, Fog, MuPolynomial};
 use crate::cosmology::background::Background;
 use crate::cosmology::Cosmology;
 use crate::dual::Real;
@@ -245,13 +245,7 @@ pub fn observed_multipoles(
             min: 4,
         });
     }
-    if let Some(&bad) = ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
-        return Err(Error::InvalidParameter {
-            name: "multipole ell",
-            value: bad as f64,
-            reason: "must be even and at most 8",
-        });
-    }
+    super::check_ells(ells)?;
     let (x0, step) = (
         grid[0].ln(),
         (grid[grid.len() - 1] / grid[0]).ln() / (grid.len() - 1) as f64,

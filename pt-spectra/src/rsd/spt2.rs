@@ -421,13 +421,7 @@ impl Spt2Terms {
     /// [`Error::InvalidParameter`] for a bad ℓ or a non-finite f.
     pub fn multipoles(&self, f: f64, ells: &[usize]) -> Result<Spt2Multipoles> {
         check_two_loop_ells(ells)?;
-        if let Some(&bad) = ells.iter().find(|&&l| l > super::MAX_ELL) {
-            return Err(Error::InvalidParameter {
-                name: "multipole ell",
-                value: bad as f64,
-                reason: "must be even and at most 8",
-            });
-        }
+        super::check_ells(ells)?;
         if !f.is_finite() {
             return Err(Error::InvalidParameter {
                 name: "growth rate f",

@@ -5,7 +5,6 @@
 use super::{model, EptParams, EptPlan, EptTerms, GridUse};
 use crate::error::{Error, Result};
 use crate::rsd::ap::Distortion;
-use crate::rsd::MAX_ELL;
 
 impl EptPlan {
     /// [`Self::multipole_values_at`] of several parameter sets of one growth rate f (e.g. the
@@ -118,13 +117,7 @@ impl EptPlan {
         }
         self.check_ap(ap)?;
         self.check_terms(terms)?;
-        if let Some(&bad) = ells.iter().find(|&&l| l % 2 == 1 || l > MAX_ELL) {
-            return Err(Error::InvalidParameter {
-                name: "multipole ell",
-                value: bad as f64,
-                reason: "must be even and at most 8",
-            });
-        }
+        crate::rsd::check_ells(ells)?;
         Ok(())
     }
 
