@@ -42,6 +42,7 @@
 //! changes form. Every B_ℓ carries an error: the
 //! difference from a coarser rule (orientation and shells).
 
+pub mod bias_kernels;
 pub mod block;
 mod box_modes;
 mod geometry;
