@@ -430,12 +430,13 @@ fn redshift_from_table(t: &Table, b: &[f64; N_BIAS], f: f64, los: &Vec3, n2: f64
     let full = (1usize << t.n) - 1;
     let nk = dot(los, &t.ks[full]);
     // U(B) and E(R) over the subsets.
-    let mut u = [0.0; 16];
-    for s in 1..=full {
-        if t.ks2[s] > 0.0 {
-            u[s] = f * nk * dot(los, &t.ks[s]) / (n2 * t.ks2[s]) * t.g[s];
+    let u: [f64; 16] = std::array::from_fn(|s| {
+        if s >= 1 && s <= full && t.ks2[s] > 0.0 {
+            f * nk * dot(los, &t.ks[s]) / (n2 * t.ks2[s]) * t.g[s]
+        } else {
+            0.0
         }
-    }
+    });
     let mut e = [0.0; 16];
     e[0] = 1.0;
     for r in 1..=full {
@@ -464,4 +465,14 @@ fn redshift_from_table(t: &Table, b: &[f64; N_BIAS], f: f64, los: &Vec3, n2: f64
         z += FACT[count(s0)] / FACT[t.n] * d * e[full ^ s0];
     }
     z
+}
+
+/// The kernel of the loop integrands: real space (`redshift` None) or Z_n^g at (f, line of sight); zero
+/// where it is not defined (a node never is: the rules avoid the loops' centres).
+pub(super) fn loop_kernel(bias: &[f64; N_BIAS], redshift: Option<(f64, Vec3)>, q: &[Vec3]) -> f64 {
+    let Ok(t) = Table::new(q) else { return 0.0 };
+    match redshift {
+        None => t.galaxy(bias, (1 << t.n) - 1),
+        Some((f, los)) => redshift_from_table(&t, bias, f, &los, dot(&los, &los)),
+    }
 }

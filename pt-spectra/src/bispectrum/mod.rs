@@ -49,6 +49,7 @@ mod geometry;
 mod observed;
 pub mod one_loop;
 pub mod one_loop_basis;
+pub mod one_loop_galaxy;
 pub mod one_loop_rsd;
 mod resum;
 mod sampled;
