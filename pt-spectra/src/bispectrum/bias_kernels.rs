@@ -11,25 +11,33 @@
 //! ```text
 //! δ_g = b1 δ + (b2/2) δ² + g2 G₂(Φ_v)
 //!     + (b3/6) δ³ + g2x δ G₂(Φ_v) + g3 G₃(Φ_v) + g21 G₂(φ₂, φ₁)
-//!     + g21x δ G₂(φ₂, φ₁) + g211 G₃(φ₂, φ₁, φ₁) + g22 G₂(φ₂, φ₂) + g31 G₃₁,
+//!     + g21x δ G₂(φ₂, φ₁) + g211 G₃(φ₂, φ₁, φ₁) + g22 G₂(φ₂, φ₂) + g31 G₂(φ₃, φ₁),
 //! ```
 //!
-//! G₃₁ (ESS19's G₂(φ₃, φ₁), fourth order only) with the kernel, unsymmetrised in (q₁ | q₂ q₃ q₄) (as in
-//! Philcox et al.'s public kernels, OneLoopBispectrum),
-//! (1/18) K(q₁, q₂₃₄)[(15/7) K(q₂₃, q₄) K(q₂, q₃) − L(q₂, q₃, q₄)] + (1/14)[M(q₁, q₂₃, q₄, q₂₃₄) −
-//! M(q₁, q₂₃₄, q₂₃, q₄)] K(q₂, q₃), M(a, b, c, d) = μ_ab μ_bc μ_cd μ_da. The four local fourth-order operators
-//! (δ⁴, δ²G₂, G₂², δG₃) are not here: at one loop they enter only B₄₁₁, as pure renormalisations of b2 and g2
-//! (ESS19; Philcox et al.), so eleven parameters remain.
+//! with ∇²φ₃ = G₃(φ₁) − (24/7) G₂(φ₂, φ₁) at its lowest order (so G₂(φ₃, φ₁) is of fourth order only, kernel
+//! K(q₁, q₂₃₄)[L(q₂, q₃, q₄) − (24/7)K(q₂₃, q₄)K(q₂, q₃)] in (q₁ | q₂ q₃ q₄)). This last operator takes the
+//! place of ESS19's G₂(φ₃, φ₁) (their third-order Lagrangian potential; the paper's text was not at hand):
+//! φ₃ is fixed here as the third-order potential the gravitationally generated operators need. Eulerian
+//! Γ₃'s fourth-order remainder is exactly −(4/49)G₂(φ₂, φ₂) + (8/63)G₂(φ₃, φ₁) (tested to round-off),
+//! whereas the G₃₁ kernel of Philcox et al.'s public (deprecated) notebook, (1/18)K(q₁, q₂₃₄)[(15/7)
+//! K(q₂₃, q₄)K(q₂, q₃) − L] + a transverse part, leaves Γ₃ out of the span (largest residual 2.4e-2 of its
+//! kernel, `tests/data/bispectrum/check_gamma3_span.py`), so a basis with it misses an operator gravity
+//! generates. The four local
+//! fourth-order operators (δ⁴, δ²G₂, G₂², δG₃) are not here: at one loop they enter only B₄₁₁, as pure
+//! renormalisations of b2 and g2 (ESS19; Philcox et al.), so eleven parameters remain (as D'Amico et al.
+//! 2022, arXiv:2206.08327, count in their basis).
 //!
 //! **Map to this crate's convention** (velocileptors': (b2/2)δ² + bs s², s² = G₂(Φ_g) + (2/3)δ² at every
-//! order; CLASS-PT's (b2/2)δ² + b_G2 G₂(Φ_g) + b_Γ3 Γ₃, Γ₃ = G₂(Φ_g) − G₂(Φ_v)): as Γ₃ = −(4/7) G₂(φ₂, φ₁)
-//! at third order, exact through third order ([`LoopBias::from_velocileptors`], [`LoopBias::from_class_pt`]):
+//! order; CLASS-PT's (b2/2)δ² + b_G2 G₂(Φ_g) + b_Γ3 Γ₃, Γ₃ = G₂(Φ_g) − G₂(Φ_v)): G₂(Φ_g) = G₂(Φ_v) + Γ₃ and
+//! Γ₃ = −(4/7)G₂(φ₂, φ₁) − (4/49)G₂(φ₂, φ₂) + (8/63)G₂(φ₃, φ₁) through fourth order, so, exactly for the
+//! one-loop bispectrum ([`LoopBias::from_velocileptors`], [`LoopBias::from_class_pt`]):
 //!
 //! ```text
-//! g2 = b_G2 = bs,   b2 = b2^CLASS-PT = b2^velocileptors + (4/3) bs,   g21 = −(4/7)(b_G2 + b_Γ3)  [= −(4/7) bs],
+//! g2 = b_G2 = bs,   b2 = b2^CLASS-PT = b2^velocileptors + (4/3) bs,
+//! (g21, g22, g31) = (−4/7, −4/49, 8/63) × (b_G2 + b_Γ3)   [× bs from velocileptors],
 //! ```
 //!
-//! the other eight zero; at fourth order the two bases differ by fourth-order operators (not derived here).
+//! the others zero.
 //!
 //! **Kernels.** Every field's symmetrised kernel on a set S of arguments is built from its subsets: a product
 //! ab is Σ_{A ⊂ S} [|A|!|S∖A|!/|S|!] a_A b_{S∖A} (the average over orderings of the cut into consecutive
@@ -70,7 +78,7 @@ pub struct LoopBias {
     pub g211: f64,
     /// γ₂₂ G₂(φ₂, φ₂).
     pub g22: f64,
-    /// γ₃₁ G₃₁.
+    /// γ₃₁ G₂(φ₃, φ₁).
     pub g31: f64,
 }
 
@@ -117,24 +125,22 @@ impl LoopBias {
         }
     }
 
-    /// From velocileptors' (b1, b2, bs) (this crate's convention; exact through third order, module docs).
+    /// From velocileptors' (b1, b2, bs) (this crate's convention; exact through fourth order, module
+    /// docs): CLASS-PT's with b_G2 = bs, b_Γ3 = 0 and b2 + (4/3)bs.
     pub fn from_velocileptors(b1: f64, b2: f64, bs: f64) -> Self {
-        Self {
-            b1,
-            b2: b2 + 4.0 / 3.0 * bs,
-            g2: bs,
-            g21: -4.0 / 7.0 * bs,
-            ..Self::default()
-        }
+        Self::from_class_pt(b1, b2 + 4.0 / 3.0 * bs, bs, 0.0)
     }
 
-    /// From CLASS-PT's (b1, b2, b_G2, b_Γ3) (exact through third order, module docs).
+    /// From CLASS-PT's (b1, b2, b_G2, b_Γ3) (exact through fourth order, module docs).
     pub fn from_class_pt(b1: f64, b2: f64, b_g2: f64, b_gamma3: f64) -> Self {
+        let gamma = b_g2 + b_gamma3;
         Self {
             b1,
             b2,
             g2: b_g2,
-            g21: -4.0 / 7.0 * (b_g2 + b_gamma3),
+            g21: -4.0 / 7.0 * gamma,
+            g22: -4.0 / 49.0 * gamma,
+            g31: 8.0 / 63.0 * gamma,
             ..Self::default()
         }
     }
@@ -186,15 +192,6 @@ fn ll(v: [&Vec3; 3], n2: [f64; 3]) -> f64 {
     let (ab, bc, ca) = (dot(a, b), dot(b, c), dot(c, a));
     let (x, y, z) = (n2[0] * n2[1], n2[1] * n2[2], n2[2] * n2[0]);
     1.0 - ab * ab / x - bc * bc / y - ca * ca / z + 2.0 * ab * bc * ca / (x * n2[2])
-}
-
-/// M(a, b, c, d) = μ_ab μ_bc μ_cd μ_da.
-fn mm(a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3) -> f64 {
-    let n = [a, b, c, d].map(|v| dot(v, v));
-    if n.contains(&0.0) {
-        return 0.0;
-    }
-    dot(a, b) * dot(b, c) * dot(c, d) * dot(d, a) / (n[0] * n[1] * n[2] * n[3])
 }
 
 /// The fields of every subset (bit mask) of the arguments.
@@ -344,20 +341,17 @@ impl Table {
     }
 }
 
-/// G₃₁'s symmetrised kernel (module docs): the average over the 24 orderings.
+/// G₂(φ₃, φ₁)'s symmetrised kernel at fourth order (module docs): the average over the 24 orderings of
+/// K(q₁, q₂₃₄)[L(q₂, q₃, q₄) − (24/7) K(q₂₃, q₄) K(q₂, q₃)].
 fn g31_kernel(q: &[Vec3]) -> f64 {
+    let n2 = |v: &Vec3| dot(v, v);
     let mut sum = 0.0;
     for p in PERMS4 {
         let [a, b, c, d] = p.map(|i| q[i]);
         let (bc, bcd) = (add(b, c), add(add(b, c), d));
-        let n2 = |v: &Vec3| dot(v, v);
-        let k_bc = kk(&b, &c, n2(&b), n2(&c));
-        let first = kk(&a, &bcd, n2(&a), n2(&bcd))
-            * (15.0 / 7.0 * kk(&bc, &d, n2(&bc), n2(&d)) * k_bc
-                - ll([&b, &c, &d], [n2(&b), n2(&c), n2(&d)]))
-            / 18.0;
-        let second = (mm(&a, &bc, &d, &bcd) - mm(&a, &bcd, &bc, &d)) * k_bc / 14.0;
-        sum += first + second;
+        let inner = ll([&b, &c, &d], [n2(&b), n2(&c), n2(&d)])
+            - 24.0 / 7.0 * kk(&bc, &d, n2(&bc), n2(&d)) * kk(&b, &c, n2(&b), n2(&c));
+        sum += kk(&a, &bcd, n2(&a), n2(&bcd)) * inner;
     }
     sum / 24.0
 }

@@ -13,11 +13,10 @@ trilinear G3(a, b, c) (kernel L = 1 - mu12^2 - mu23^2 - mu31^2 + 2 mu12 mu23 mu3
 
   delta_g = b1 delta + b2/2 delta^2 + g2 G2(Phi_v)
           + b3/6 delta^3 + g2x delta G2(Phi_v) + g3 G3(Phi_v) + g21 G2(phi_2, phi_1)
-          + g21x delta G2(phi_2, phi_1) + g211 G3(phi_2, phi_1, phi_1) + g22 G2(phi_2, phi_2) + g31 G31,
+          + g21x delta G2(phi_2, phi_1) + g211 G3(phi_2, phi_1, phi_1) + g22 G2(phi_2, phi_2) + g31 G2(phi_3, phi_1),
 
-G31 of fourth order only, with the unsymmetrised kernel (q1 | q2 q3 q4)
-  (1/18) K(q1, q234) [(15/7) K(q23, q4) K(q2, q3) - L(q2, q3, q4)]
-  + (1/14) [M(q1, q23, q4, q234) - M(q1, q234, q23, q4)] K(q2, q3),   M(a, b, c, d) = mu_ab mu_bc mu_cd mu_da.
+nabla^2 phi_3 = G3(phi_1) - (24/7) G2(phi_2, phi_1) at its lowest (third) order: G2(phi_3, phi_1) of fourth order
+only, unsymmetrised kernel (q1 | q2 q3 q4) K(q1, q234) [L(q2, q3, q4) - (24/7) K(q23, q4) K(q2, q3)].
 
 Independent of the Rust code (pt_spectra::bispectrum::bias_kernels builds symmetrised kernels on subsets with
 factorial weights): here every operator's kernel is built UNSYMMETRISED on an ordering of its arguments, each
@@ -63,10 +62,6 @@ def ll(a, b, c):
     y, g2 = _cos(b, c)
     z, g3 = _cos(c, a)
     return np.where(g1 & g2 & g3, 1.0 - x * x - y * y - z * z + 2.0 * x * y * z, 0.0)
-
-
-def mm(a, b, c, d):
-    return _cos(a, b)[0] * _cos(b, c)[0] * _cos(c, d)[0] * _cos(d, a)[0]
 
 
 class Fields:
@@ -137,9 +132,7 @@ class Fields:
             return 0.0
         q1, q2, q3, q4 = (self.v[i] for i in vs)
         q23, q234 = q2 + q3, q2 + q3 + q4
-        first = kk(q1, q234) * (15.0 / 7.0 * kk(q23, q4) * kk(q2, q3) - ll(q2, q3, q4)) / 18.0
-        second = (mm(q1, q23, q4, q234) - mm(q1, q234, q23, q4)) * kk(q2, q3) / 14.0
-        return first + second
+        return kk(q1, q234) * (ll(q2, q3, q4) - 24.0 / 7.0 * kk(q23, q4) * kk(q2, q3))
 
     def galaxy(self, vs, bias):
         """The unsymmetrised galaxy kernel of the ordered block vs (zero if its momentum vanishes)."""

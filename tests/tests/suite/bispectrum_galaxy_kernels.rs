@@ -205,7 +205,8 @@ fn third_order_closed_forms() {
 /// Fourth order against permutation averages of the unsymmetrised forms written out here: δ²/2 is
 /// (1/2) sym[F₂F₂ + 2F₃], δ³/6 is (1/6) sym 3F₂, G₂(φ₂, φ₁) is sym[K(q₁₂, q₃₄)K(q₁, q₂)F₂(q₃, q₄) +
 /// 2K(q₁₂₃, q₄)K(q₁₂, q₃)F₂(q₁, q₂)], G₃(φ₂, φ₁, φ₁) is sym L(q₁, q₂, q₃₄)K(q₃, q₄), G₂(φ₂, φ₂) is
-/// sym K(q₁₂, q₃₄)K(q₁, q₂)K(q₃, q₄) (1e-13).
+/// sym K(q₁₂, q₃₄)K(q₁, q₂)K(q₃, q₄), G₂(φ₃, φ₁) is sym K(q₁, q₂₃₄)[L(q₂, q₃, q₄) − (24/7)K(q₂₃, q₄)K(q₂, q₃)]
+/// (1e-13).
 #[test]
 fn fourth_order_against_permutation_averages() {
     for seed in 0..6 {
@@ -238,6 +239,13 @@ fn fourth_order_against_permutation_averages() {
                     kk(add(p[0], p[1]), add(p[2], p[3])) * kk(p[0], p[1]) * kk(p[2], p[3])
                 }),
             ),
+            (
+                10,
+                sym(&q, &|p| {
+                    let (s, t) = (add(p[1], p[2]), add(add(p[1], p[2]), p[3]));
+                    kk(p[0], t) * (ll(p[1], p[2], p[3]) - 24.0 / 7.0 * kk(s, p[3]) * kk(p[1], p[2]))
+                }),
+            ),
         ];
         for (i, want) in cases {
             assert!(
@@ -245,6 +253,56 @@ fn fourth_order_against_permutation_averages() {
                 "{}: {} vs {want}",
                 LoopBias::NAMES[i],
                 o[i]
+            );
+        }
+    }
+}
+
+/// The maps to CLASS-PT's and velocileptors' bases are exact through fourth order: b_G2 G₂(Φ_g) + b_Γ3 Γ₃
+/// (G₂(Φ)'s kernel sym Σ_cuts K(k_A, k_B) X_A X_B, X = F for Φ_g and G for Φ_v, Γ₃ = G₂(Φ_g) − G₂(Φ_v))
+/// and bs s² = bs [G₂(Φ_g) + (2/3)δ²], written out here from the generated F_n, G_n, equal the kernels of
+/// `from_class_pt` and `from_velocileptors` at orders 2, 3, 4 (1e-13). At fourth order this is Γ₃'s
+/// remainder −(4/49)G₂(φ₂, φ₂) + (8/63)G₂(φ₃, φ₁): the basis holds the Eulerian operators.
+#[test]
+fn the_maps_are_exact_through_fourth_order() {
+    let galileon = |p: &[V], which: usize| -> f64 {
+        (1..p.len())
+            .map(|j| {
+                let (a, b) = (&p[..j], &p[j..]);
+                let ka = a.iter().fold([0.0; 3], |s, v| add(s, *v));
+                let kb = b.iter().fold([0.0; 3], |s, v| add(s, *v));
+                let x = |s: &[V]| if s.len() == 1 { 1.0 } else { fg(s)[which] };
+                kk(ka, kb) * x(a) * x(b)
+            })
+            .sum()
+    };
+    let delta2 = |p: &[V]| -> f64 {
+        (1..p.len())
+            .map(|j| {
+                let x = |s: &[V]| if s.len() == 1 { 1.0 } else { fg(s)[0] };
+                x(&p[..j]) * x(&p[j..])
+            })
+            .sum()
+    };
+    let (b_g2, b_gamma3, bs) = (0.7, -0.45, 0.3);
+    for seed in 0..6 {
+        for n in 2..=4 {
+            let q = vectors(500 + 10 * seed + n as u64, n);
+            let want = sym(&q, &|p| {
+                let (g, v) = (galileon(p, 0), galileon(p, 1));
+                b_g2 * g + b_gamma3 * (g - v)
+            });
+            let got =
+                galaxy_kernel(&LoopBias::from_class_pt(0.0, 0.0, b_g2, b_gamma3), &q).unwrap();
+            assert!(
+                close(got, want, 1e-13),
+                "CLASS-PT, n = {n}: {got} vs {want}"
+            );
+            let want = sym(&q, &|p| bs * (galileon(p, 0) + 2.0 / 3.0 * delta2(p)));
+            let got = galaxy_kernel(&LoopBias::from_velocileptors(0.0, 0.0, bs), &q).unwrap();
+            assert!(
+                close(got, want, 1e-13),
+                "velocileptors, n = {n}: {got} vs {want}"
             );
         }
     }
