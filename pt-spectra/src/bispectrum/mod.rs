@@ -42,12 +42,14 @@
 //! changes form. Every B_ℓ carries an error: the
 //! difference from a coarser rule (orientation and shells).
 
+pub mod bias_kernels;
 pub mod block;
 mod box_modes;
 mod geometry;
 mod observed;
 pub mod one_loop;
 pub mod one_loop_basis;
+pub mod one_loop_galaxy;
 pub mod one_loop_rsd;
 mod resum;
 mod sampled;

@@ -283,6 +283,15 @@ pub(super) enum Kernels {
         /// The line of sight.
         los: Vec3,
     },
+    /// The galaxy kernels of [`super::bias_kernels`] with the coefficients `bias` (order of
+    /// [`super::bias_kernels::LoopBias::NAMES`]): K_n in real space (`redshift` None, K₁ = b1 on a
+    /// linear leg), Z_n^g at (f, line of sight) in redshift space.
+    Galaxy {
+        /// The bias coefficients.
+        bias: [f64; super::bias_kernels::N_BIAS],
+        /// (f, line of sight) in redshift space.
+        redshift: Option<(f64, Vec3)>,
+    },
 }
 
 impl Kernels {
@@ -294,6 +303,9 @@ impl Kernels {
             Kernels::Redshift { f, los } => {
                 pt_kernels::redshift::redshift_kernel(q, &f, &los).unwrap_or(0.0)
             }
+            Kernels::Galaxy { bias, redshift } => {
+                super::bias_kernels::loop_kernel(&bias, redshift, q)
+            }
         }
     }
 
@@ -303,6 +315,7 @@ impl Kernels {
         match *self {
             Kernels::Real => true,
             Kernels::Redshift { los, .. } => los[1] == 0.0,
+            Kernels::Galaxy { redshift, .. } => redshift.is_none_or(|(_, los)| los[1] == 0.0),
         }
     }
 }

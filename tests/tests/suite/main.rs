@@ -13,6 +13,8 @@ mod support;
 mod ap;
 mod bias;
 mod bins;
+mod bispectrum_galaxy;
+mod bispectrum_galaxy_kernels;
 mod bispectrum_one_loop;
 mod bispectrum_reference;
 mod cosmology_jacobian;
