@@ -45,6 +45,7 @@
 pub mod block;
 mod box_modes;
 mod geometry;
+mod lanes;
 mod observed;
 pub mod one_loop;
 pub mod one_loop_basis;
