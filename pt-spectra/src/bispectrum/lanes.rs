@@ -244,6 +244,53 @@ mod x86 {
         p * X(simd, pulp::cast(scale))
     }
 
+    /// The cubics of coefficients `o` … `o` + 3 of the lanes' `rows` at `u`.
+    #[inline(always)]
+    fn horner(simd: V3, rows: [&[f64; 8]; L], o: usize, u: X) -> X {
+        // the four lanes' rows transposed: coefficient j of every lane in one vector
+        let c = transpose(simd, rows.map(|r| [r[o], r[o + 1], r[o + 2], r[o + 3]]));
+        c[3].mul_add(u, c[2]).mul_add(u, c[1]).mul_add(u, c[0])
+    }
+
+    /// The 4 × 4 transpose: lane l of vector j is `rows[l][j]`.
+    #[inline(always)]
+    fn transpose(simd: V3, rows: [[f64; L]; 4]) -> [X; 4] {
+        use core::arch::x86_64::__m256d;
+        let r: [__m256d; 4] = [
+            pulp::cast(rows[0]),
+            pulp::cast(rows[1]),
+            pulp::cast(rows[2]),
+            pulp::cast(rows[3]),
+        ];
+        let avx = simd.avx;
+        let (lo01, hi01) = (
+            avx._mm256_unpacklo_pd(r[0], r[1]),
+            avx._mm256_unpackhi_pd(r[0], r[1]),
+        );
+        let (lo23, hi23) = (
+            avx._mm256_unpacklo_pd(r[2], r[3]),
+            avx._mm256_unpackhi_pd(r[2], r[3]),
+        );
+        [
+            X(
+                simd,
+                pulp::cast(avx._mm256_permute2f128_pd::<0x20>(lo01, lo23)),
+            ),
+            X(
+                simd,
+                pulp::cast(avx._mm256_permute2f128_pd::<0x20>(hi01, hi23)),
+            ),
+            X(
+                simd,
+                pulp::cast(avx._mm256_permute2f128_pd::<0x31>(lo01, lo23)),
+            ),
+            X(
+                simd,
+                pulp::cast(avx._mm256_permute2f128_pd::<0x31>(hi01, hi23)),
+            ),
+        ]
+    }
+
     /// The per-spectrum constants of the sums.
     pub(super) struct Consts<'a> {
         table: &'a Sampled,
@@ -302,18 +349,12 @@ mod x86 {
         let t = (k - c.table.k0) * c.table.inv_h;
         let i = t.trunc().max(1.0).min(c.table.last());
         let u = t - i;
-        let rows = i.lanes().map(|i| &c.table.rows[i as usize - 1]);
-        let coef = |j: usize| X::load(simd, rows.map(|r| r[j]));
-        let horner = |o: usize| {
-            coef(o + 3)
-                .mul_add(u, coef(o + 2))
-                .mul_add(u, coef(o + 1))
-                .mul_add(u, coef(o))
-        };
-        let mut p = horner(0);
+        let i: [i32; L] = pulp::cast(simd.convert_f64x4_to_i32x4(i.1));
+        let rows = i.map(|i| &c.table.rows[i as usize - 1]);
+        let mut p = horner(simd, rows, 0, u);
         if let Some((sigma2, delta_sigma2)) = c.ir {
             // P_nw + e^{−k²Σ²_tot(μ)}(P − P_nw), Σ²_tot as crate::ir::sigma2_total
-            let p_nw = horner(4);
+            let p_nw = horner(simd, rows, 4, u);
             let f = c.f;
             let sigma_tot = (mu2 * (f * (2.0 + f)))
                 .mul_add(X::splat(simd, sigma2), X::splat(simd, sigma2))
@@ -330,6 +371,21 @@ mod x86 {
             p,
         }
     }
+
+    /// The slots that are not 0: all but those of Z₁Z₁Z₂ (β, α), α < β.
+    const USED: [usize; SLOTS - 12] = {
+        let mut out = [0; SLOTS - 12];
+        let (mut s, mut n) = (0, 0);
+        while s < SLOTS {
+            let (al, be) = (s / 12, s / 4 % 3);
+            if s >= 36 || al <= be {
+                out[n] = s;
+                n += 1;
+            }
+            s += 1;
+        }
+        out
+    };
 
     /// Slot of Z₁Z₁Z₂ (α, β, g).
     const fn slot(al: usize, be: usize) -> usize {
@@ -452,16 +508,18 @@ mod x86 {
             }
             for (acc, lambda) in acc.iter_mut().zip(block.lambda) {
                 let lambda = ld(lambda);
-                for (a, s) in acc.iter_mut().zip(&sums) {
-                    *a = lambda.mul_add(*s, *a);
+                for s in USED {
+                    acc[s] = lambda.mul_add(sums[s], acc[s]);
                 }
             }
         }
         acc.map(|acc| {
-            acc.map(|a| {
-                let v = a.lanes();
-                (v[0] + v[1]) + (v[2] + v[3])
-            })
+            let mut out = [0.0; SLOTS];
+            for s in USED {
+                let v = acc[s].lanes();
+                out[s] = (v[0] + v[1]) + (v[2] + v[3]);
+            }
+            out
         })
     }
 }
