@@ -335,14 +335,19 @@ mod x86 {
         p: X,
     }
 
-    /// The side of observed squared length `k2` and line-of-sight component `par`.
+    /// The true line-of-sight component and squared length of the side of observed squared length
+    /// `k2` and line-of-sight component `par`.
     #[inline(always)]
-    fn side(c: &Consts, par: X, k2: X) -> Side {
-        let simd = par.0;
+    fn true_side(c: &Consts, par: X, k2: X) -> (X, X) {
         let par_true = par * c.inv_qp;
         let perp2 = (k2 - par * par).max(0.0);
-        let k = par_true.mul_add(par_true, perp2 * c.inv_qt2).sqrt();
-        let inv_k = X::splat(simd, 1.0) / k;
+        (par_true, par_true.mul_add(par_true, perp2 * c.inv_qt2))
+    }
+
+    /// The side of true line-of-sight component `par_true`, length `k` and inverse length `inv_k`.
+    #[inline(always)]
+    fn side(c: &Consts, par_true: X, k: X, inv_k: X) -> Side {
+        let simd = k.0;
         let mu = par_true * inv_k;
         let mu2 = mu * mu;
         // the cubic of the interval (Sampled::eval): row i − 1 at u = t − i
@@ -393,22 +398,11 @@ mod x86 {
     }
 
     /// Adds the slots of one node (four lanes) to `sums`: observed line-of-sight components `par`,
-    /// dot products `dots`, true sides `t`.
+    /// dot products `dots`, true sides `t`, FoG factor `fog`.
     #[inline(always)]
-    fn node(c: &Consts, t: [Side; 3], par: [X; 3], dots: [X; 3], sums: &mut [X; SLOTS]) {
+    fn node(c: &Consts, t: [Side; 3], par: [X; 3], dots: [X; 3], fog: X, sums: &mut [X; SLOTS]) {
         let simd = par[0].0;
         let f = c.f;
-        let x = t[0]
-            .par
-            .mul_add(t[0].par, t[1].par.mul_add(t[1].par, t[2].par * t[2].par));
-        let fog = match c.fog {
-            Fog::None => X::splat(simd, 1.0),
-            Fog::Lorentzian { sigma } => {
-                let d = x.mul_add(X::splat(simd, 0.5 * sigma * sigma), X::splat(simd, 1.0));
-                X::splat(simd, 1.0) / (d * d)
-            }
-            Fog::Gaussian { sigma } => exp(x * (-0.5 * sigma * sigma)),
-        };
         let scale = fog * c.volume;
         // a_i = (fμ², 1, −k²μ²)
         let a0 = t.map(|s| s.mu2 * f);
@@ -499,12 +493,35 @@ mod x86 {
             let k2 = block.k2.map(ld);
             let dots = block.dots.map(ld);
             let par0 = ld(block.par0);
-            let side0 = side(c, par0, k2[0]);
+            let (par_true, k_sq) = true_side(c, par0, k2[0]);
+            let k = k_sq.sqrt();
+            let side0 = side(c, par_true, k, X::splat(simd, 1.0) / k);
             let mut sums = [zero; SLOTS];
             for par in &b.par[n * b.n_phi..(n + 1) * b.n_phi] {
                 let (p1, p2) = (ld(par[0]), ld(par[1]));
-                let t = [side0, side(c, p1, k2[1]), side(c, p2, k2[2])];
-                node(c, t, [par0, p1, p2], dots, &mut sums);
+                let ((t1, s1), (t2, s2)) = (true_side(c, p1, k2[1]), true_side(c, p2, k2[2]));
+                let (k1, k2) = (s1.sqrt(), s2.sqrt());
+                // FoG at x = Σᵢkᵢ²μᵢ²; the Lorentzian's 1/D² and the sides' 1/k in one division
+                let x = side0.par.mul_add(side0.par, t1.mul_add(t1, t2 * t2));
+                let d2 = match c.fog {
+                    Fog::Lorentzian { sigma } => {
+                        let d = x.mul_add(X::splat(simd, 0.5 * sigma * sigma), X::splat(simd, 1.0));
+                        d * d
+                    }
+                    _ => X::splat(simd, 1.0),
+                };
+                let inv = X::splat(simd, 1.0) / (k1 * k2 * d2);
+                let fog = match c.fog {
+                    Fog::None => X::splat(simd, 1.0),
+                    Fog::Lorentzian { .. } => inv * k1 * k2,
+                    Fog::Gaussian { sigma } => exp(x * (-0.5 * sigma * sigma)),
+                };
+                let t = [
+                    side0,
+                    side(c, t1, k1, inv * k2 * d2),
+                    side(c, t2, k2, inv * k1 * d2),
+                ];
+                node(c, t, [par0, p1, p2], dots, fog, &mut sums);
             }
             for (acc, lambda) in acc.iter_mut().zip(block.lambda) {
                 let lambda = ld(lambda);
