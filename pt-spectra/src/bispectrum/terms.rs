@@ -352,6 +352,20 @@ fn per_node_sums(
                     resummed(cached.map_or_else(|| table.eval(k), |c| c[i]), k, mu)
                 };
                 for group in &shape.groups {
+                    // the Legendre side's power once per group: its k and μ do not depend on
+                    // the azimuth
+                    let side = std::cell::Cell::new(None);
+                    let power = |i: usize, k: f64, mu: f64| {
+                        if i != shape.side {
+                            return power(i, k, mu);
+                        }
+                        if let Some(p) = side.get() {
+                            return p;
+                        }
+                        let p = power(i, k, mu);
+                        side.set(Some(p));
+                        p
+                    };
                     // the azimuths first (λ depends on μ only), then ℓ
                     let mut azimuths = [0.0; SLOTS];
                     for par in &group.par {
