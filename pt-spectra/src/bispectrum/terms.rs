@@ -2,7 +2,7 @@
 //! coefficients of its parameter monomials, once per spectrum, f, AP and FoG) and their contraction
 //! with the parameters (per step, microseconds).
 
-use super::geometry::{orientations, LegendreSide, TriangleSet};
+use super::geometry::{orientations, LegendreSide, MuGroup, Shape, TriangleSet};
 use super::lanes::Blocks;
 use super::observed::{accumulate, add_observed_slots};
 pub(super) use super::observed::{tree_slots, SLOTS};
@@ -71,26 +71,6 @@ impl PlanRules {
 /// shortcut's error is measured when a plan is made (the embedded gm2012 spectrum at z = 0.5, IR
 /// resummed, no AP, no FoG, b₂ = b_s = 0, no shot noise).
 const SHORTCUT_REFERENCE: (f64, f64) = (0.72, 2.0);
-
-/// One shape of a triangle or bin in the observed (fiducial) frame: sides, their dot products (k₀·k₁,
-/// k₁·k₂, k₂·k₀) and the orientation nodes of its average, in groups of one μ of the Legendre side.
-#[derive(Debug, Clone)]
-pub(super) struct Shape {
-    pub(super) k: [f64; 3],
-    /// The Legendre side: its line-of-sight component is the same for every azimuth of a group.
-    pub(super) side: usize,
-    pub(super) dots: [f64; 3],
-    pub(super) groups: Vec<MuGroup>,
-}
-
-/// The orientations of one μ of the Legendre side (its azimuths): the sides' line-of-sight
-/// components, and the (2ℓ + 1)L_ℓ(μ) × weight of ℓ = 0, 2, 4 of each (the shape's bin weight
-/// included), the same for every azimuth.
-#[derive(Debug, Clone)]
-pub(super) struct MuGroup {
-    pub(super) par: Vec<[f64; 3]>,
-    pub(super) lambda: [f64; 3],
-}
 
 /// The tree-level bispectrum planned for one set of triangles: every node of its orientation and bin
 /// averages, made once; [`terms`](Self::terms) per linear spectrum.
