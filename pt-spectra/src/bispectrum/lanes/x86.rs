@@ -263,12 +263,13 @@ const fn slot(al: usize, be: usize) -> usize {
 }
 
 /// Adds the slots of one node (four lanes) to `sums`: observed line-of-sight components `par`,
-/// dot products `dots`, true sides `t`, FoG factor `fog`.
+/// dot products `dots` over q⊥², true sides `t`, FoG factor `fog`.
 #[inline(always)]
 fn node(c: &Consts, t: [Side; 3], par: [X; 3], dots: [X; 3], fog: X, sums: &mut [X; SLOTS]) {
     let simd = par[0].0;
     let f = c.f;
     let scale = fog * c.volume;
+    let ps = t.map(|s| s.p * scale);
     // a_i = (fμ², 1, −k²μ²)
     let a0 = t.map(|s| s.mu2 * f);
     let a2 = t.map(|s| X::splat(simd, 0.0) - s.par * s.par);
@@ -278,8 +279,8 @@ fn node(c: &Consts, t: [Side; 3], par: [X; 3], dots: [X; 3], fog: X, sums: &mut 
     for i in 0..3 {
         let (j, l) = ((i + 1) % 3, (i + 2) % 3);
         let (ti, tj) = (&t[i], &t[j]);
-        let pp_obs = par[i] * par[j];
-        let dot = pp_obs.mul_add(X::splat(simd, c.inv_qp2), (dots[i] - pp_obs) * c.inv_qt2);
+        // k_i·k_j in the true frame: n̂-parts over q∥², the rest over q⊥²
+        let dot = (par[i] * par[j]).mul_add(X::splat(simd, c.inv_qp2 - c.inv_qt2), dots[i]);
         let cos = dot * ti.inv_k * tj.inv_k;
         let ratio = ti.k.mul_add(tj.inv_k, tj.k * ti.inv_k);
         let half = cos * 0.5 * ratio;
@@ -293,8 +294,9 @@ fn node(c: &Consts, t: [Side; 3], par: [X; 3], dots: [X; 3], fog: X, sums: &mut 
             k_par * (0.5 * f * f) * ti.mu_k.mul_add(tj.mu2, tj.mu_k * ti.mu2),
         );
         let c1 = (k_par * (0.5 * f)).mul_add(ti.mu_k + tj.mu_k, f2);
-        let pp = ti.p * tj.p * scale * 2.0;
-        q[i] = [pp * c0, pp * c1, pp * 0.5, pp * (cc - 1.0 / 3.0)];
+        let pp_half = ps[i] * tj.p;
+        let pp = pp_half + pp_half;
+        q[i] = [pp * c0, pp * c1, pp_half, pp * (cc - 1.0 / 3.0)];
         w[i] = [
             a0[i] * a0[j],
             X::splat(simd, 1.0),
@@ -316,7 +318,6 @@ fn node(c: &Consts, t: [Side; 3], par: [X; 3], dots: [X; 3], fog: X, sums: &mut 
         }
     }
     // 1/n̄: Σᵢ Pᵢ a_i[β] and Σᵢ Pᵢ a_i[0] a_i[β]
-    let ps = t.map(|s| s.p * scale);
     let b0 = ps[0].mul_add(a0[0], ps[1].mul_add(a0[1], ps[2] * a0[2]));
     sums[36] = sums[36] + b0;
     sums[37] = sums[37] + (ps[0] + ps[1] + ps[2]);
@@ -356,7 +357,7 @@ fn triangle(simd: V3, b: &Blocks, range: Range<usize>, c: &Consts) -> [[f64; SLO
         let block = &b.blocks[n];
         let ld = |v: [f64; L]| X::load(simd, v);
         let k2 = block.k2.map(ld);
-        let dots = block.dots.map(ld);
+        let dots = block.dots.map(|d| ld(d) * c.inv_qt2);
         let par0 = ld(block.par0);
         let (par_true, k_sq) = true_side(c, par0, k2[0]);
         let k = k_sq.sqrt();
