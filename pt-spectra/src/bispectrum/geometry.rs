@@ -293,6 +293,26 @@ fn panels(a: f64, b: f64, breaks: &[f64], x: &[f64], w: &[f64]) -> Vec<(f64, f64
     out
 }
 
+/// One shape of a triangle or bin in the observed (fiducial) frame: sides, their dot products (k₀·k₁,
+/// k₁·k₂, k₂·k₀) and the orientation nodes of its average, in groups of one μ of the Legendre side.
+#[derive(Debug, Clone)]
+pub(super) struct Shape {
+    pub(super) k: [f64; 3],
+    /// The Legendre side: its line-of-sight component is the same for every azimuth of a group.
+    pub(super) side: usize,
+    pub(super) dots: [f64; 3],
+    pub(super) groups: Vec<MuGroup>,
+}
+
+/// The orientations of one μ of the Legendre side (its azimuths): the sides' line-of-sight
+/// components, and the (2ℓ + 1)L_ℓ(μ) × weight of ℓ = 0, 2, 4 of each (the shape's bin weight
+/// included), the same for every azimuth.
+#[derive(Debug, Clone)]
+pub(super) struct MuGroup {
+    pub(super) par: Vec<[f64; 3]>,
+    pub(super) lambda: [f64; 3],
+}
+
 /// The line-of-sight components n̂·kᵢ [h/Mpc] of the three sides of `k` for the orientations of a rule
 /// about side `a`, with the weights (2ℓ + 1) L_ℓ(μ_a) w for ℓ = 0, 2, 4 (w summing to 1 over the rule):
 /// `[par₀, par₁, par₂, λ₀, λ₂, λ₄]` per orientation. B is even in n̂ and in the azimuth φ about k_a (the

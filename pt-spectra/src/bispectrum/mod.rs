@@ -46,6 +46,7 @@ pub mod bias_kernels;
 pub mod block;
 mod box_modes;
 mod geometry;
+mod lanes;
 mod observed;
 pub mod one_loop;
 pub mod one_loop_basis;

@@ -1,8 +1,10 @@
 //! The linear spectrum (and its no-wiggle part) sampled once per spectrum on a grid uniform in k over
 //! the sides a plan can reach, so that every node of the bin and orientation averages looks P up by
-//! 4-point Lagrange interpolation without a search, a log or an exp. The interpolation error is
-//! measured when the table is made (at interval midpoints against the spectrum itself) and carried
-//! into the error estimates.
+//! 4-point Lagrange interpolation without a search, a log or an exp: on the interval
+//! [k₀ + ih, k₀ + (i + 1)h] the cubic through the samples s_{i−1} … s_{i+2}, written as
+//! s_i + c₁u + c₂u² + c₃u³ in u = (k − k₀)/h − i (one row of four coefficients per interval and
+//! spectrum, read at once). The interpolation error is measured when the table is made (at interval
+//! midpoints against the spectrum itself) and carried into the error estimates.
 
 use crate::error::{Error, Result};
 use crate::linear::LinearSpectrum;
@@ -14,13 +16,14 @@ const MAX_SPACING: f64 = 1e-4;
 /// Every `PROBE_STRIDE`-th interval midpoint is compared with the spectrum itself.
 const PROBE_STRIDE: usize = 3;
 
-/// P and P_nw at k₀ + i h, i = 0 … n − 1.
+/// P and P_nw sampled at k₀ + i h, i = 0 … n − 1, as the cubic coefficients of each interval.
 #[derive(Debug, Clone)]
 pub(crate) struct Sampled {
-    k0: f64,
-    inv_h: f64,
-    /// (P, P_nw) at each node, side by side (one cache line per lookup).
-    pairs: Vec<[f64; 2]>,
+    pub(super) k0: f64,
+    pub(super) inv_h: f64,
+    /// Row i − 1 holds the coefficients (s_i, c₁, c₂, c₃) of P, then those of P_nw, on the interval
+    /// starting at sample i, i = 1 … n − 3 (one cache line per lookup).
+    pub(super) rows: Vec<[f64; 8]>,
     /// Largest relative interpolation error measured (P or P_nw).
     pub(crate) relative_error: f64,
 }
@@ -59,7 +62,12 @@ impl Sampled {
         let mut table = Self {
             k0,
             inv_h: 1.0 / h,
-            pairs: p.into_iter().zip(p_nw).map(|(p, nw)| [p, nw]).collect(),
+            rows: (1..n - 2)
+                .map(|i| {
+                    let (a, b) = (cubic(&p[i - 1..i + 3]), cubic(&p_nw[i - 1..i + 3]));
+                    [a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]]
+                })
+                .collect(),
             relative_error: 0.0,
         };
         let mut worst = 0.0_f64;
@@ -75,25 +83,34 @@ impl Sampled {
         Ok(table)
     }
 
+    /// The last interval's first sample, n − 3 (intervals 1 … n − 3 have rows).
+    pub(super) fn last(&self) -> f64 {
+        self.rows.len() as f64
+    }
+
     /// (P, P_nw) at k [h/Mpc] inside the sampled range (clamped to its end intervals outside it).
     #[inline]
     pub(crate) fn eval(&self, k: f64) -> (f64, f64) {
         let t = (k - self.k0) * self.inv_h;
         // truncation, not floor: they differ only at t < 0, which the clamp to 1 maps alike
-        let i = (t as usize).clamp(1, self.pairs.len() - 3);
+        let i = (t as usize).clamp(1, self.rows.len());
         let u = t - i as f64;
-        let w = [
-            -u * (u - 1.0) * (u - 2.0) / 6.0,
-            (u + 1.0) * (u - 1.0) * (u - 2.0) / 2.0,
-            -(u + 1.0) * u * (u - 2.0) / 2.0,
-            (u + 1.0) * u * (u - 1.0) / 6.0,
-        ];
-        let s = &self.pairs[i - 1..i + 3];
+        let c = &self.rows[i - 1];
         (
-            w[0] * s[0][0] + w[1] * s[1][0] + w[2] * s[2][0] + w[3] * s[3][0],
-            w[0] * s[0][1] + w[1] * s[1][1] + w[2] * s[2][1] + w[3] * s[3][1],
+            c[0] + u * (c[1] + u * (c[2] + u * c[3])),
+            c[4] + u * (c[5] + u * (c[6] + u * c[7])),
         )
     }
+}
+
+/// The cubic through (−1, s₀), (0, s₁), (1, s₂), (2, s₃) as s₁ + c₁u + c₂u² + c₃u³: (s₁, c₁, c₂, c₃).
+fn cubic(s: &[f64]) -> [f64; 4] {
+    [
+        s[1],
+        s[2] - s[0] / 3.0 - s[1] / 2.0 - s[3] / 6.0,
+        (s[0] + s[2]) / 2.0 - s[1],
+        (s[3] - s[0]) / 6.0 + (s[1] - s[2]) / 2.0,
+    ]
 }
 
 #[cfg(test)]

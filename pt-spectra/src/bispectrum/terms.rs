@@ -2,7 +2,8 @@
 //! coefficients of its parameter monomials, once per spectrum, f, AP and FoG) and their contraction
 //! with the parameters (per step, microseconds).
 
-use super::geometry::{orientations, LegendreSide, TriangleSet};
+use super::geometry::{orientations, LegendreSide, MuGroup, Shape, TriangleSet};
+use super::lanes::Blocks;
 use super::observed::{accumulate, add_observed_slots};
 pub(super) use super::observed::{tree_slots, SLOTS};
 use super::resum::IrInputs;
@@ -71,26 +72,6 @@ impl PlanRules {
 /// resummed, no AP, no FoG, b₂ = b_s = 0, no shot noise).
 const SHORTCUT_REFERENCE: (f64, f64) = (0.72, 2.0);
 
-/// One shape of a triangle or bin in the observed (fiducial) frame: sides, their dot products (k₀·k₁,
-/// k₁·k₂, k₂·k₀) and the orientation nodes of its average, in groups of one μ of the Legendre side.
-#[derive(Debug, Clone)]
-struct Shape {
-    k: [f64; 3],
-    /// The Legendre side: its line-of-sight component is the same for every azimuth of a group.
-    side: usize,
-    dots: [f64; 3],
-    groups: Vec<MuGroup>,
-}
-
-/// The orientations of one μ of the Legendre side (its azimuths): the sides' line-of-sight
-/// components, and the (2ℓ + 1)L_ℓ(μ) × weight of ℓ = 0, 2, 4 of each (the shape's bin weight
-/// included), the same for every azimuth.
-#[derive(Debug, Clone)]
-struct MuGroup {
-    par: Vec<[f64; 3]>,
-    lambda: [f64; 3],
-}
-
 /// The tree-level bispectrum planned for one set of triangles: every node of its orientation and bin
 /// averages, made once; [`terms`](Self::terms) per linear spectrum.
 #[derive(Debug, Clone)]
@@ -100,6 +81,9 @@ pub struct BispectrumPlan {
     rules: PlanRules,
     fine: Vec<Vec<Shape>>,
     coarse: Vec<Vec<Shape>>,
+    /// The nodes of `fine` and `coarse` laid out four μ-groups at a time.
+    fine_blocks: Blocks,
+    coarse_blocks: Blocks,
     split: WiggleSplit,
     q_min: f64,
     /// Shortest and longest side of every node [h/Mpc] (the range the spectrum is sampled over).
@@ -175,6 +159,8 @@ impl BispectrumPlan {
                 [lo.min(k), hi.max(k)]
             });
         let mut plan = Self {
+            fine_blocks: Blocks::new(&fine),
+            coarse_blocks: Blocks::new(&coarse),
             fine,
             coarse,
             k_range,
@@ -253,7 +239,7 @@ impl BispectrumPlan {
         } else {
             None
         };
-        self.terms_resummed(spectrum, settings, ir.as_ref())
+        self.terms_resummed(spectrum, settings, ir.as_ref(), false)
     }
 
     /// The IR resummation's inputs of `spectrum` with this plan's no-wiggle split (what
@@ -280,15 +266,17 @@ impl BispectrumPlan {
     ) -> Result<BispectrumTerms> {
         settings.validate()?;
         settings.require_ir()?;
-        self.terms_resummed(spectrum, settings, Some(ir))
+        self.terms_resummed(spectrum, settings, Some(ir), false)
     }
 
-    /// The terms with IR resummation from `ir` (none for `None`).
-    fn terms_resummed(
+    /// The terms with IR resummation from `ir` (none for `None`): the nodes four μ-groups at a time
+    /// ([`Blocks::sums`]) where the processor has AVX2 and FMA, else (or with `per_node`) node by node.
+    pub(super) fn terms_resummed(
         &self,
         spectrum: &LinearSpectrum,
         settings: &Settings,
         ir: Option<&IrInputs>,
+        per_node: bool,
     ) -> Result<BispectrumTerms> {
         // P and P_nw (P_nw = P without IR resummation) sampled once over every true side a node can
         // have: k/q with q between q∥ and q⊥
@@ -302,66 +290,96 @@ impl BispectrumPlan {
             self.k_range[0] / q_hi,
             self.k_range[1] / q_lo,
         )?;
-        // the resummed P at k, μ from (P, P_nw)
-        let resummed = |(p, p_nw): (f64, f64), k: f64, mu: f64| -> f64 {
-            ir.map_or(p, |ir| ir.resum(p, p_nw, k, mu, settings.f))
-        };
-        // Without an anisotropic distortion the true sides k/q do not depend on the orientation:
-        // the spectra are looked up once per shape, not once per orientation.
-        let isotropic = settings.q_par == settings.q_perp;
-        // triangles in parallel (rayon; RAYON_NUM_THREADS=1 for one core)
-        let sum = |shapes: &Vec<Vec<Shape>>| -> Vec<[[f64; SLOTS]; 3]> {
-            shapes
-                .par_iter()
-                .map(|triangle| {
-                    let mut acc = [[0.0; SLOTS]; 3];
-                    for shape in triangle {
-                        let cached =
-                            isotropic.then(|| shape.k.map(|k| table.eval(k / settings.q_par)));
-                        let power = |i: usize, k: f64, mu: f64| {
-                            resummed(cached.map_or_else(|| table.eval(k), |c| c[i]), k, mu)
-                        };
-                        for group in &shape.groups {
-                            // the Legendre side's power once per group: its k and μ do not
-                            // depend on the azimuth
-                            let side = std::cell::Cell::new(None);
-                            let power = |i: usize, k: f64, mu: f64| {
-                                if i != shape.side {
-                                    return power(i, k, mu);
-                                }
-                                if let Some(p) = side.get() {
-                                    return p;
-                                }
-                                let p = power(i, k, mu);
-                                side.set(Some(p));
-                                p
-                            };
-                            // the azimuths first (λ depends on μ only), then ℓ
-                            let mut azimuths = [0.0; SLOTS];
-                            for par in &group.par {
-                                add_observed_slots(
-                                    &mut azimuths,
-                                    shape.k,
-                                    shape.dots,
-                                    *par,
-                                    settings,
-                                    power,
-                                );
-                            }
-                            accumulate(&mut acc, group.lambda, &azimuths);
-                        }
-                    }
-                    acc
-                })
-                .collect()
+        let sum = |shapes: &[Vec<Shape>], blocks: &Blocks| {
+            (!per_node)
+                .then(|| blocks.sums(&table, settings, ir))
+                .flatten()
+                .unwrap_or_else(|| per_node_sums(shapes, &table, settings, ir))
         };
         Ok(BispectrumTerms {
-            fine: sum(&self.fine),
-            coarse: sum(&self.coarse),
+            fine: sum(&self.fine, &self.fine_blocks),
+            coarse: sum(&self.coarse, &self.coarse_blocks),
             interpolation: table.relative_error,
             shortcut: self.shortcut.clone(),
             triangles: self.set.triangles().to_vec(),
         })
+    }
+}
+
+/// The slots of every triangle of `shapes` node by node ([`add_observed_slots`]), the Z₁Z₁Z₂ part
+/// symmetrised as [`Blocks::sums`] makes it (S_αβ + S_βα in slot (α, β), α ≤ β; slot (β, α) 0).
+fn per_node_sums(
+    shapes: &[Vec<Shape>],
+    table: &Sampled,
+    settings: &Settings,
+    ir: Option<&IrInputs>,
+) -> Vec<[[f64; SLOTS]; 3]> {
+    // the resummed P at k, μ from (P, P_nw)
+    let resummed = |(p, p_nw): (f64, f64), k: f64, mu: f64| -> f64 {
+        ir.map_or(p, |ir| ir.resum(p, p_nw, k, mu, settings.f))
+    };
+    // Without an anisotropic distortion the true sides k/q do not depend on the orientation:
+    // the spectra are looked up once per shape, not once per orientation.
+    let isotropic = settings.q_par == settings.q_perp;
+    // triangles in parallel (rayon; RAYON_NUM_THREADS=1 for one core)
+    shapes
+        .par_iter()
+        .map(|triangle| {
+            let mut acc = [[0.0; SLOTS]; 3];
+            for shape in triangle {
+                let cached = isotropic.then(|| shape.k.map(|k| table.eval(k / settings.q_par)));
+                let power = |i: usize, k: f64, mu: f64| {
+                    resummed(cached.map_or_else(|| table.eval(k), |c| c[i]), k, mu)
+                };
+                for group in &shape.groups {
+                    // the Legendre side's power once per group: its k and μ do not depend on
+                    // the azimuth
+                    let side = std::cell::Cell::new(None);
+                    let power = |i: usize, k: f64, mu: f64| {
+                        if i != shape.side {
+                            return power(i, k, mu);
+                        }
+                        if let Some(p) = side.get() {
+                            return p;
+                        }
+                        let p = power(i, k, mu);
+                        side.set(Some(p));
+                        p
+                    };
+                    // the azimuths first (λ depends on μ only), then ℓ
+                    let mut azimuths = [0.0; SLOTS];
+                    for par in &group.par {
+                        add_observed_slots(
+                            &mut azimuths,
+                            shape.k,
+                            shape.dots,
+                            *par,
+                            settings,
+                            power,
+                        );
+                    }
+                    accumulate(&mut acc, group.lambda, &azimuths);
+                }
+            }
+            acc.map(|mut slots| {
+                symmetrise(&mut slots);
+                slots
+            })
+        })
+        .collect()
+}
+
+/// S_αβ + S_βα in slot (α, β) of Z₁Z₁Z₂, α < β, and 0 in slot (β, α) (the contraction with u_α u_β
+/// is the same).
+pub(super) fn symmetrise(slots: &mut [f64; SLOTS]) {
+    for al in 0..3 {
+        for be in al + 1..3 {
+            for g in 0..4 {
+                let (upper, lower) = ((al * 3 + be) * 4 + g, (be * 3 + al) * 4 + g);
+                slots[upper] += slots[lower];
+                slots[lower] = 0.0;
+            }
+        }
     }
 }
 
@@ -428,6 +446,12 @@ impl BispectrumTerms {
             shortcut: Vec::new(),
             triangles,
         }
+    }
+
+    /// The slots of the fine and the coarse rule.
+    #[cfg(test)]
+    pub(super) fn slots(&self) -> [&[[[f64; SLOTS]; 3]]; 2] {
+        [&self.fine, &self.coarse]
     }
 
     /// The triangles (bin centres) [h/Mpc].
