@@ -15,14 +15,35 @@
 //! ```
 //!
 //! with ∇²φ₃ = G₃(φ₁) − (24/7) G₂(φ₂, φ₁) at its lowest order (so G₂(φ₃, φ₁) is of fourth order only, kernel
-//! K(q₁, q₂₃₄)[L(q₂, q₃, q₄) − (24/7)K(q₂₃, q₄)K(q₂, q₃)] in (q₁ | q₂ q₃ q₄)). This last operator takes the
-//! place of ESS19's G₂(φ₃, φ₁) (their third-order Lagrangian potential; the paper's text was not at hand):
-//! φ₃ is fixed here as the third-order potential the gravitationally generated operators need. Eulerian
-//! Γ₃'s fourth-order remainder is exactly −(4/49)G₂(φ₂, φ₂) + (8/63)G₂(φ₃, φ₁) (tested to round-off),
-//! whereas the G₃₁ kernel of Philcox et al.'s public (deprecated) notebook, (1/18)K(q₁, q₂₃₄)[(15/7)
-//! K(q₂₃, q₄)K(q₂, q₃) − L] + a transverse part, leaves Γ₃ out of the span (largest residual 2.4e-2 of its
-//! kernel, `tests/data/bispectrum/check_gamma3_span.py`), so a basis with it misses an operator gravity
-//! generates. The four local
+//! K(q₁, q₂₃₄)[L(q₂, q₃, q₄) − (24/7)K(q₂₃, q₄)K(q₂, q₃)] in (q₁ | q₂ q₃ q₄)), and G₂(φ₂, φ₁) built from the
+//! nonlinear Eulerian fields (δ = Σ F_n inside φ₁ and φ₂) at fourth order.
+//!
+//! **Against ESS19** (their text was not readable here, so no equation numbers; checked instead against the
+//! kernels of Philcox et al.'s `Kernels.nb`, which "follows 1812.03208", Eggemeier's talk slides for G₂, G₃
+//! and γ₂, and own derivations, `tests/data/bispectrum/check_bias_basis_conventions.py`): G₂ = (∇_ijΦ)² −
+//! (∇²Φ)² and G₃ = (∇²Φ)³ + 2∇_ijΦ∇_jkΦ∇_kiΦ − 3(∇_ijΦ)²∇²Φ give the kernels K and L used here; ∇²φ₁ = δ,
+//! ∇²φ₂ = G₂(φ₁) (not the 2LPT potential's −(3/14)G₂(φ₁)); the kernels of b2, g2, b3, g2x, g3, g21 (third and
+//! fourth order), g21x, g211 and g22 are the notebook's. Lagrangian local bias b₁ᴸ gives g2 = −(2/7)b₁ᴸ and
+//! g21 = −(22/147)b₁ᴸ, which the map below reproduces from CLASS-PT's b_G2 = −(2/7)b₁ᴸ, b_Γ3 = (23/42)b₁ᴸ.
+//! G₂(φ₃, φ₁) differs, and not by a relabelling: the notebook's φ₃ is the 3LPT potential, ∇²φ₃ = −∇_q·Ψ⁽³⁾ =
+//! (1/18)[(15/7)G₂(φ₂, φ₁) − G₃(φ₁)] (it reproduces F₃ through 3LPT to 5e-15), with a transverse part
+//! (1/14)[M(q₁, q₂₃, q₄, q₂₃₄) − M(q₁, q₂₃₄, q₂₃, q₄)]K(q₂, q₃), M(a, b, c, d) = â·b̂ b̂·ĉ ĉ·d̂ d̂·â; this
+//! crate's G₂(φ₃, φ₁) = −18 G₂(φ₃^3LPT,∥, φ₁) − (9/7) G₂(φ₁, ∇⁻²G₂(φ₂, φ₁)), the last operator in no other
+//! slot, so no coefficient map exists.
+//!
+//! **Completeness (open).** Fourth-order remainders of three generated Galilean-invariant fields, after their
+//! lower orders: Γ₃ = G₂(Φ_g) − G₂(Φ_v) and G₂(Φ_g, Φ_v) − G₂(Φ_v) are held exactly by this basis, but δ − θ is
+//! not (1.2% residual): Γ₃ needs C₂ − (24/7)C₁ and δ − θ needs C₁/C₂ = −41/14 plus the transverse M part
+//! (C₁ = K(q₁, q₂₃₄)K(q₂₃, q₄)K(q₂, q₃), C₂ = K(q₁, q₂₃₄)L(q₂, q₃, q₄)), so with the Eulerian nonlinear
+//! G₂(φ₂, φ₁) no single G₃₁ completes the basis (∇⁻² of a nonlinear field is not a generated operator). The
+//! Lagrangian convention holds all three exactly: G₂(φ₂, φ₁) of the linear potentials carried by the flow
+//! with the number density (fourth-order kernel sym K(q₁, q₂₃)K(q₂, q₃)·k·q₄/q₄², k the total) and the 3LPT
+//! G₂(φ₃, φ₁) with its transverse part, where Γ₃'s remainder is −(4/7)G₃(φ₂, φ₁, φ₁) + (16/49)G₂(φ₂, φ₂) +
+//! 8 G₂(φ₃, φ₁). The notebook mixes the two (Eulerian G₂(φ₂, φ₁), 3LPT φ₃) and holds neither Γ₃ (2.4e-2 of its
+//! kernel, `check_gamma3_span.py`) nor δ − θ. The CLASS-PT and velocileptors maps below stay exact (Γ₃ is in the
+//! span); a general tracer's B₄₁₁ is not fully covered until the kernels move to the Lagrangian convention
+//! (with the maps (g21, g211, g22, g31) = (−4/7, −4/7, 16/49, 8)(b_G2 + b_Γ3) and new Monte Carlo tables).
+//! The four local
 //! fourth-order operators (δ⁴, δ²G₂, G₂², δG₃) are not here: at one loop they enter only B₄₁₁, as pure
 //! renormalisations of b2 and g2 (ESS19; Philcox et al.), so eleven parameters remain (as D'Amico et al.
 //! 2022, arXiv:2206.08327, count in their basis).
