@@ -144,7 +144,7 @@ mod x86;
 #[cfg(test)]
 mod tests {
     use super::super::terms::BispectrumPlan;
-    use super::super::{BispectrumParams, Fog, LegendreSide, PlanRules, Settings, TriangleSet};
+    use super::super::{Fog, LegendreSide, PlanRules, Settings, TriangleSet};
     use crate::linear::LinearSpectrum;
 
     /// The blocks' sums against the node-by-node sums of `observed_slots` on a few bins (an
@@ -168,16 +168,7 @@ mod tests {
         let plan = BispectrumPlan::new(set, LegendreSide::Largest, PlanRules::default()).unwrap();
         let spectrum = LinearSpectrum::gm2012(0.5).unwrap();
         let ir = plan.ir_inputs(&spectrum).unwrap();
-        let params = BispectrumParams {
-            b1: 2.1,
-            b2: 0.7,
-            bs: -0.31,
-            c1: 3.0,
-            b_shot: 0.8,
-            p_shot: 0.2,
-            a_shot: -0.1,
-            n_bar: 3e-4,
-        };
+        let params = super::super::tests::galaxy();
         let cases = [
             (1.04, 0.97, Fog::Lorentzian { sigma: 4.0 }, true),
             (0.98, 1.03, Fog::Gaussian { sigma: 3.0 }, true),

@@ -18,7 +18,8 @@ fn settings(f: f64) -> Settings {
     }
 }
 
-fn galaxy() -> BispectrumParams {
+/// A galaxy sample's parameters with every slot non-zero (shared by the lanes' test).
+pub(super) fn galaxy() -> BispectrumParams {
     BispectrumParams {
         b1: 2.1,
         b2: 0.7,
