@@ -4,7 +4,8 @@
 //! triangles, pairs of sides) and one [`crate::precision::Precision`]: quadrature nodes and weights,
 //! angular tables, basis tensors. [`Plan::terms`] then gives the terms of one linear spectrum (the
 //! coefficients of the model's parameters, or its spectra), cheaply. Every plan states:
-//! - its terms type ([`Plan::Terms`]: one type per model family, not a bag of optional parts),
+//! - its terms type ([`Plan::Terms`]; a real-space plan's `LoopTerms` holds the terms of every model
+//!   it covers, from which each model takes its family's type, [`crate::real::ModelTerms`]),
 //! - what an evaluation takes besides the spectrum ([`Plan::Settings`]: nothing for the loop terms;
 //!   f, AP, FoG and IR for the bispectrum),
 //! - how it computes a new spectrum's terms ([`Plan::method`]: integrated directly or contracted
