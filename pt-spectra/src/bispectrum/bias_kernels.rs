@@ -71,6 +71,7 @@
 //! U(B) = f(kμ)(μ_B/k_B)G_B, so Z₁ = b1 + fμ² and Z_n^g is affine in the bias coefficients.
 
 use crate::error::{Error, Result};
+use crate::loops::rsd_two_loop::{kernel_at, redshift_polynomial};
 use crate::vec3::{add, dot};
 
 type Vec3 = [f64; 3];
@@ -441,45 +442,15 @@ pub fn galaxy_redshift_kernel(bias: &LoopBias, q: &[Vec3], f: f64, los: &Vec3) -
     Ok(redshift_from_table(&t, &bias.values(), f, los, n2))
 }
 
+/// Z_n^g from the subsets' fields: the redshift-space assembly of the matter kernels
+/// ([`redshift_polynomial`], Scoccimarro et al.'s set-partition sums) with the tracer's kernel in place
+/// of F_S, along the unit line of sight `los`/|los| (`n2` = |los|²), evaluated at `f`.
 fn redshift_from_table(t: &Table, b: &[f64; N_BIAS], f: f64, los: &Vec3, n2: f64) -> f64 {
+    let norm = n2.sqrt();
+    let unit = los.map(|x| x / norm);
     let full = (1usize << t.n) - 1;
-    let nk = dot(los, &t.ks[full]);
-    // U(B) and E(R) over the subsets.
-    let u: [f64; 16] = std::array::from_fn(|s| {
-        if s >= 1 && s <= full && t.ks2[s] > 0.0 {
-            f * nk * dot(los, &t.ks[s]) / (n2 * t.ks2[s]) * t.g[s]
-        } else {
-            0.0
-        }
-    });
-    let mut e = [0.0; 16];
-    e[0] = 1.0;
-    for r in 1..=full {
-        let low = r & r.wrapping_neg();
-        let mut sum = 0.0;
-        // blocks B ⊂ r containing the lowest member
-        let rest = r ^ low;
-        let mut sub = rest;
-        loop {
-            let block = sub | low;
-            sum += FACT[count(block)] * u[block] * e[r ^ block];
-            if sub == 0 {
-                break;
-            }
-            sub = (sub - 1) & rest;
-        }
-        e[r] = sum;
-    }
-    let mut z = 0.0;
-    for s0 in 1..=full {
-        if t.ks2[s0] == 0.0 {
-            continue;
-        }
-        let ns = dot(los, &t.ks[s0]);
-        let d = t.galaxy(b, s0) + f * ns * ns / (n2 * t.ks2[s0]) * t.g[s0];
-        z += FACT[count(s0)] / FACT[t.n] * d * e[full ^ s0];
-    }
-    z
+    let z = redshift_polynomial(&t.ks, &t.ks2, full, &unit, |s| [t.galaxy(b, s), t.g[s]]);
+    kernel_at(&z, f)
 }
 
 /// The kernel of the loop integrands: real space (`redshift` None) or Z_n^g at (f, line of sight); zero

@@ -35,7 +35,7 @@ use super::one_loop::{
     Vec3,
 };
 use super::one_loop_rsd::Orientation;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
 use crate::vec3::{neg, norm};
@@ -160,13 +160,7 @@ pub fn one_loop_galaxy(
     let rsd = match redshift {
         None => None,
         Some((f, o)) => {
-            if !(0.0..=2.0).contains(&f) {
-                return Err(Error::InvalidParameter {
-                    name: "f",
-                    value: f,
-                    reason: "the growth rate must lie in [0, 2]",
-                });
-            }
+            crate::cosmology::check_growth_rate(f)?;
             Some((f, o.line_of_sight()?))
         }
     };

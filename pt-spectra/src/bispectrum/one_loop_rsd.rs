@@ -121,13 +121,7 @@ pub fn one_loop_matter_redshift(
     rule: &OneLoopRule,
 ) -> Result<OneLoopRedshift> {
     rule.validate()?;
-    if !(0.0..=2.0).contains(&f) {
-        return Err(Error::InvalidParameter {
-            name: "f",
-            value: f,
-            reason: "the growth rate must lie in [0, 2]",
-        });
-    }
+    crate::cosmology::check_growth_rate(f)?;
     let kv = triangle_vectors(k)?;
     let kernels = Kernels::Redshift {
         f,

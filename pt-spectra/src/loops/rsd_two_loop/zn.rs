@@ -97,66 +97,86 @@ impl SubsetKernels {
     /// Z_n of the vectors in `args` (a bitmask, n = its size) along the unit line of sight `los`, as
     /// coefficients of f⁰ … fⁿ (the rest zero).
     pub fn redshift(&self, args: usize, los: &[f64; 3]) -> FPoly {
-        let nk = dot(los, &self.v[args]);
-        // D(S) = d0 + f d1 and U(S) = f u of every subset of args
-        let (mut d0, mut d1, mut u) = ([0.0; SUBSETS], [0.0; SUBSETS], [0.0; SUBSETS]);
-        let mut sub = args;
-        while sub != 0 {
-            let norm = self.norm[sub];
-            if norm != 0.0 {
-                let ns = dot(los, &self.v[sub]);
-                let [f, g] = self.fg[sub];
-                d0[sub] = f;
-                d1[sub] = ns * ns / norm * g;
-                u[sub] = FACTORIAL[sub.count_ones() as usize] * nk * ns / norm * g;
-            }
-            sub = (sub - 1) & args;
-        }
-        // E(R) for the subsets R of args, smaller masks first: the block holding R's lowest member,
-        // then the partitions of the rest
-        let mut e = [[0.0; 6]; SUBSETS];
-        e[0][0] = 1.0;
-        for r in 1..=args {
-            if r & !args != 0 {
-                continue;
-            }
-            let low = r & r.wrapping_neg();
-            let rest = r ^ low;
-            let mut sub = rest;
-            let mut er = [0.0; 6];
-            loop {
-                let block = sub | low;
-                let c = u[block];
-                if c != 0.0 {
-                    let other = &e[r ^ block];
-                    for j in 0..5 {
-                        er[j + 1] += c * other[j];
-                    }
-                }
-                if sub == 0 {
-                    break;
-                }
-                sub = (sub - 1) & rest;
-            }
-            e[r] = er;
-        }
-        let mut z = [0.0; 7];
-        let n = args.count_ones() as usize;
-        let mut s0 = args;
-        while s0 != 0 {
-            let c = FACTORIAL[s0.count_ones() as usize] / FACTORIAL[n];
-            let (a, b) = (c * d0[s0], c * d1[s0]);
-            if a != 0.0 || b != 0.0 {
-                let er = &e[args ^ s0];
-                for (j, e) in er.iter().enumerate() {
-                    z[j] += a * e;
-                    z[j + 1] += b * e;
-                }
-            }
-            s0 = (s0 - 1) & args;
-        }
-        z
+        redshift_polynomial(&self.v, &self.norm, args, los, |s| self.fg[s])
     }
+}
+
+/// Z_n of the vectors in `args` (a bitmask, n = its size) along the unit line of sight `los`, as
+/// coefficients of f⁰ … fⁿ, from every subset S's total momentum `v[S]`, its square `norm[S]` and
+/// `dg(S)` = [density kernel, G_S] (the module's D(S) = density + fμ_S²G_S; F_S for matter, a
+/// tracer's kernel for galaxies): the set-partition sums E(R) of the module docs. A subset of zero
+/// total momentum contributes nothing.
+pub(crate) fn redshift_polynomial(
+    v: &[[f64; 3]],
+    norm: &[f64],
+    args: usize,
+    los: &[f64; 3],
+    dg: impl Fn(usize) -> [f64; 2],
+) -> FPoly {
+    let nk = dot(los, &v[args]);
+    // D(S) = d0 + f d1 and U(S) = f u of every subset of args
+    let (mut d0, mut d1, mut u) = ([0.0; SUBSETS], [0.0; SUBSETS], [0.0; SUBSETS]);
+    let mut sub = args;
+    while sub != 0 {
+        let n2 = norm[sub];
+        if n2 != 0.0 {
+            let ns = dot(los, &v[sub]);
+            let [f, g] = dg(sub);
+            d0[sub] = f;
+            d1[sub] = ns * ns / n2 * g;
+            u[sub] = FACTORIAL[sub.count_ones() as usize] * nk * ns / n2 * g;
+        }
+        sub = (sub - 1) & args;
+    }
+    // E(R) for the subsets R of args, smaller masks first: the block holding R's lowest member,
+    // then the partitions of the rest
+    let mut e = [[0.0; 6]; SUBSETS];
+    e[0][0] = 1.0;
+    for r in 1..=args {
+        if r & !args != 0 {
+            continue;
+        }
+        let low = r & r.wrapping_neg();
+        let rest = r ^ low;
+        let mut sub = rest;
+        let mut er = [0.0; 6];
+        loop {
+            let block = sub | low;
+            let c = u[block];
+            if c != 0.0 {
+                let other = &e[r ^ block];
+                for j in 0..5 {
+                    er[j + 1] += c * other[j];
+                }
+            }
+            if sub == 0 {
+                break;
+            }
+            sub = (sub - 1) & rest;
+        }
+        e[r] = er;
+    }
+    let mut z = [0.0; 7];
+    let n = args.count_ones() as usize;
+    let mut s0 = args;
+    while s0 != 0 {
+        let c = FACTORIAL[s0.count_ones() as usize] / FACTORIAL[n];
+        let (a, b) = (c * d0[s0], c * d1[s0]);
+        if a != 0.0 || b != 0.0 {
+            let er = &e[args ^ s0];
+            for (j, e) in er.iter().enumerate() {
+                z[j] += a * e;
+                z[j + 1] += b * e;
+            }
+        }
+        s0 = (s0 - 1) & args;
+    }
+    z
+}
+
+/// The value at f of a kernel's polynomial (Horner).
+pub(crate) fn at(p: &FPoly, f: f64) -> f64 {
+    p.iter().rev().fold(0.0, |acc, &c| acc * f + c)
 }
 
 /// The product of two kernels' polynomials in f (degrees adding to at most 6).
