@@ -145,7 +145,7 @@ fn uv_constants(
 /// nodes.
 ///
 /// # Errors
-/// As [`triangle_vectors`] for sides that do not close; a bad rule; [`Error::InvalidParameter`] for a bias
+/// As [`triangle_vectors`] for sides that do not close; a bad rule; [`crate::error::Error::InvalidParameter`] for a bias
 /// coefficient that is not finite, f outside [0, 2] or a bad orientation.
 pub fn one_loop_galaxy(
     p: &LinearSpectrum,
