@@ -9,7 +9,7 @@ The Python face of the Rust library: the same entry points, names and columns as
 True
 
 Every function returns a :class:`Table`: ``t.columns`` (the command line's column names), ``t[name]``
-(numpy arrays), ``t.units``, ``t.header``, ``t.meta`` (z, f, D, cosmology, precision, q range, model)
+(numpy arrays), ``t.units``, ``t.header``, ``t.meta`` (z, f, D, cosmology, precision, q range, model, methods)
 and ``t.to_text()``. Bad input raises ``ValueError`` with the library's message: every k array (``k``,
 the ``k`` of ``linear``, ``k_lin``, the k of tables and measured spectra, ``data["k"]``) must be 1-D,
 non-empty, finite, positive and strictly increasing, and the message names the argument, the index

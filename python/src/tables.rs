@@ -52,10 +52,12 @@ impl Table {
         meta.set_item("linear", prepared.spectrum.origin())?;
         // The wall time of the library call alone (GIL released), to measure the Python overhead.
         meta.set_item("seconds", seconds)?;
+        let mut warnings = prepared.warnings.clone();
+        set_methods(&meta, &table, &mut warnings)?;
         Ok(Self {
             table,
             meta: meta.unbind(),
-            warnings: prepared.warnings.clone(),
+            warnings,
         })
     }
 
@@ -75,12 +77,32 @@ impl Table {
         let meta = PyDict::new(py);
         meta.set_item("model", model)?;
         meta.set_item("seconds", seconds)?;
+        let mut warnings = Vec::new();
+        set_methods(&meta, &table, &mut warnings)?;
         Ok(Self {
             table,
             meta: meta.unbind(),
-            warnings: Vec::new(),
+            warnings,
         })
     }
+}
+
+/// `meta["methods"]`: how each part of `table` was computed (`{"1-loop terms": "basis", …}`, the
+/// library's [`output::MethodNote`]s, which the header states with figures); a fallback to a slower
+/// or less accurate path is also a warning.
+fn set_methods(
+    meta: &Bound<'_, PyDict>,
+    table: &output::Table,
+    warnings: &mut Vec<String>,
+) -> PyResult<()> {
+    let methods = PyDict::new(meta.py());
+    for note in &table.methods {
+        methods.set_item(&note.part, &note.method)?;
+        if note.method.contains("fallback") {
+            warnings.push(format!("{}: {} (see the header)", note.part, note.method));
+        }
+    }
+    meta.set_item("methods", methods)
 }
 
 /// A `ValueError` if a value of `table` is not finite (the check the command line makes before it
@@ -121,7 +143,8 @@ impl Table {
         self.table.header.clone()
     }
 
-    /// z, f, D, cosmology, precision, q range, model, linear spectrum, seconds (of the library call).
+    /// z, f, D, cosmology, precision, q range, model, linear spectrum, seconds (of the library call),
+    /// methods (how each part was computed: `{"1-loop terms": "basis", …}`).
     #[getter]
     fn meta<'py>(&self, py: Python<'py>) -> Bound<'py, PyDict> {
         self.meta.bind(py).clone()

@@ -28,9 +28,11 @@ def test_batch_rows_equal_single_calls_and_basis_is_close_to_direct(camb, tmp_pa
     for i, row in enumerate(P):
         one = plan(linear=(k_lin, row), cosmology="planck2018", terms=True)
         assert any("basis tensors" in line for line in one.header)
+        assert one.meta["methods"] == {"1-loop terms": "basis"}
         for name in ("P_dd", "P_dt", "P_tt", "err_P_dd", "P22_dd", "P13_tt"):
             assert np.array_equal(out[name][i], one[name]), name
         ref = direct(linear=(k_lin, row), cosmology="planck2018", terms=True)
+        assert ref.meta["methods"] == {"1-loop terms": "direct"}
         for name in ("P_dd", "P_dt", "P_tt", "P22_dd", "P13_dd"):
             assert np.abs(out[name][i] / ref[name] - 1).max() < 1e-4, name
     # A 1-D P is one spectrum.
@@ -59,6 +61,8 @@ def test_tns_multipoles_through_the_basis_match_direct(camb, tmp_path):
     a, d = on_basis(**call), direct(**call)
     assert any("TNS A and B: basis tensors" in line for line in a.header)
     assert any("1-loop terms (P22" in line for line in a.header)
+    assert a.meta["methods"] == {"1-loop terms": "basis", "TNS A and B": "basis"}
+    assert d.meta["methods"] == {"1-loop terms": "direct", "TNS A and B": "direct"}
     for ell in ("P0", "P2"):
         assert np.abs(a[ell] - d[ell]).max() < 1e-4 * np.abs(d["P0"]).max(), ell
         assert (np.abs(a[ell] - d[ell]) <= a["err_" + ell] + d["err_" + ell]).all(), ell
@@ -73,9 +77,22 @@ def test_ept_through_the_basis_matches_direct(camb, tmp_path):
     a, d = on_basis(**call), direct(**call)
     assert any("loop terms: basis tensors" in line for line in a.header)
     assert not any("basis tensors" in line for line in d.header)
+    assert a.meta["methods"] == {"loop terms": "basis"} and d.meta["methods"] == {"loop terms": "direct"}
     # the plans say so themselves, from the library's one Plan seam
     assert on_basis.plan_info["method"] == "basis" and direct.plan_info["method"] == "direct"
     assert on_basis.plan_info["memory_bytes"] > direct.plan_info["memory_bytes"] > 20e6
     for ell in ("P0", "P2", "P4"):
         assert np.abs(a[ell] - d[ell]).max() < 1e-4 * np.abs(d["P0"]).max(), ell
         assert (np.abs(a[ell] - d[ell]) <= a["err_" + ell] + d["err_" + ell]).all(), ell
+
+
+def test_a_spectrum_outside_the_basis_falls_back_to_direct_and_says_so(camb, tmp_path):
+    # wiggles of 30% in ln k are far outside the span of the CAMB basis: the plan integrates directly,
+    # and the table states it in its header, in meta["methods"] and as a warning
+    k_lin, p = camb
+    odd = p * (1 + 0.3 * np.sin(12 * np.log(k_lin)))
+    plan = pt.EptPlan(np.geomspace(0.01, 0.3, 6), precision="fast", two_loop="basis", cache_dir=tmp_path)
+    with pytest.warns(pt.PtSpectraWarning, match="loop terms: direct \\(fallback"):
+        t = plan(linear=(k_lin, odd), cosmology="planck2018", b1=1.9)
+    assert t.meta["methods"]["loop terms"].startswith("direct (fallback")
+    assert not any("loop terms: basis tensors" in line for line in t.header)

@@ -337,6 +337,14 @@ def test_two_loop_basis_matches_direct_and_bad_methods_raise():
                      two_loop="direct", terms=True)
     assert any("basis tensors on 36 functions" in line for line in basis.header)
     assert any(line == "2-loop terms: direct integration" for line in direct.header)
+    # meta["methods"] says the same, part by part (1-loop: basis with two_loop="basis")
+    assert basis.meta["methods"] == {"2-loop terms": "basis", "1-loop terms": "basis"}
+    assert direct.meta["methods"] == {"2-loop terms": "direct", "1-loop terms": "direct"}
+    ir = pt.real(model="1l-spt-ir", k=k, linear=planck0, cosmology="planck2018", precision="fast")
+    methods = ir.meta["methods"]
+    assert set(methods) == {"1-loop terms", "no-wiggle 1-loop terms"}
+    nw_direct = "no-wiggle spectrum: 1-loop terms: direct integration" in ir.header
+    assert (methods["no-wiggle 1-loop terms"] == "direct") == nw_direct
     for x in ("dd", "dt", "tt"):
         b, d, e = basis[f"P2loop_{x}"], direct[f"P2loop_{x}"], basis[f"err_P2loop_{x}"]
         assert np.all(np.abs(b - d) <= 1e-3 * np.abs(d)) and np.all(np.abs(b - d) <= e)

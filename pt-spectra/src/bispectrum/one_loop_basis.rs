@@ -441,6 +441,18 @@ pub enum BispectrumLoopSource {
 }
 
 impl BispectrumLoopSource {
+    /// The method in a word or two, for Python's `meta["methods"]` (the header line has the figures).
+    pub fn method(&self) -> &'static str {
+        match self {
+            Self::Direct => "direct",
+            Self::DirectUncached => "direct (fallback: no basis tensors cached, method auto)",
+            Self::Basis { .. } => "basis",
+            Self::Fallback { .. } => {
+                "direct (fallback: projection residual above the basis's limit)"
+            }
+        }
+    }
+
     /// One line for table headers.
     pub fn describe(&self) -> String {
         match *self {

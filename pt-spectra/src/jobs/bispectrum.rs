@@ -14,7 +14,7 @@ use crate::bispectrum::{
 };
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
-use crate::output::{Table, BISPECTRUM, BISPECTRUM_SHAPE, WAVENUMBER};
+use crate::output::{MethodNote, Table, BISPECTRUM, BISPECTRUM_SHAPE, WAVENUMBER};
 use crate::precision::TwoLoopMethod;
 use crate::progress::{Progress, Stage};
 use crate::setup::Prepared;
@@ -314,6 +314,8 @@ pub fn one_loop_bispectrum_table(
     }
     header.extend(prepared.description.iter().cloned());
     let mut t = Table::new(header);
+    t.methods
+        .push(MethodNote::new("loop terms", source.method()));
     let terms = |b: &OneLoopMatter| [b.tree, b.b222, b.b321_i, b.b321_ii, b.b411, b.total()];
     one_loop_columns(
         &mut t,
@@ -402,6 +404,7 @@ pub fn one_loop_redshift_table(
     ];
     header.extend(prepared.description.iter().cloned());
     let mut t = Table::new(header);
+    t.methods.push(MethodNote::new("loop terms", "direct"));
     one_loop_columns(&mut t, &rows);
     Ok(t)
 }

@@ -132,6 +132,7 @@ pub fn ept_table_from_terms(
     header.extend(describe_inputs(prepared, precision));
     header.extend(terms.describe_source());
     let mut t = Table::new(header);
+    t.methods.push(terms.method_note());
     t.push("k", WAVENUMBER, plan.k().to_vec());
     for (l, p) in request.ells.iter().zip(&m) {
         t.push(format!("P{l}"), POWER, p.iter().map(|e| e.value).collect());

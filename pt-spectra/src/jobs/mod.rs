@@ -234,6 +234,9 @@ pub fn real_table_with_bias(
             header.extend(model_header(model, &spectra, precision, terms));
             let spectra = spectra.with_counterterms(counterterms)?;
             let mut t = real_spectra_table(&spectra, header, terms);
+            t.methods = spectra
+                .terms
+                .methods(model.needs_two_loop(), model.needs_ir());
             if let Some(cb) = &prepared.spectrum_cb {
                 t.push(
                     "P_cb",
@@ -267,7 +270,9 @@ pub fn real_table_with_bias(
                     .into(),
             );
             header.extend(counterterms.describe(RealModel::Linear));
-            all_models(header, &spectra, counterterms.cs2, &prepared.no_wiggle()?)
+            let mut t = all_models(header, &spectra, counterterms.cs2, &prepared.no_wiggle()?)?;
+            t.methods = spectra.terms.methods(true, true);
+            Ok(t)
         }
     }
 }

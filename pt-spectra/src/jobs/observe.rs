@@ -50,6 +50,7 @@ pub fn observed_table(model: &Table, observation: &Observation) -> Result<Table>
     let mut header: Vec<String> = model.header.clone();
     header.extend(observation.description().iter().cloned());
     let mut t = Table::new(header);
+    t.methods = model.methods.clone();
     let (x, name, unit) = if observation.is_xi() {
         (("s", "Mpc/h"), "xi", "1")
     } else {

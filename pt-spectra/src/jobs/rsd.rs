@@ -8,7 +8,7 @@ use crate::halo::{crossings, Bias, Noise};
 use crate::linear::LinearSpectrum;
 use crate::loops::bias::BiasTerms;
 use crate::loops::TnsTerms;
-use crate::output::{Table, POWER};
+use crate::output::{MethodNote, Table, POWER};
 use crate::precision::Precision;
 use crate::progress::Progress;
 use crate::real::RealSpectra;
@@ -404,6 +404,17 @@ fn rsd_table_memo(
         ));
     }
     let mut t = super::rsd_multipoles_table(&m, header);
+    let model = spectra.model;
+    t.methods = spectra
+        .terms
+        .methods(model.needs_two_loop(), model.needs_ir());
+    if rsd.needs_tns() {
+        let basis = tns.is_some_and(|t| t.basis_residual.is_some());
+        t.methods.push(MethodNote::new(
+            "TNS A and B",
+            if basis { "basis" } else { "direct" },
+        ));
+    }
     if request.no_wiggle {
         let (k, bias) = match &request.ap {
             None => (k.clone(), bias.clone()),

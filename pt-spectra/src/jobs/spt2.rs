@@ -50,6 +50,7 @@ pub fn spt2_table(
         terms.source.clone(),
     ];
     let mut t = multipole_table(header, &terms.k, ells, &m.total, prepared, precision);
+    t.methods.push(terms.method.clone());
     let values = |p: &[Estimate]| p.iter().map(|e| e.value).collect::<Vec<_>>();
     let errors = |p: &[Estimate]| p.iter().map(|e| e.error).collect::<Vec<_>>();
     if parts {
@@ -134,6 +135,7 @@ pub fn eft2_table(
     ));
     header.push(terms.source.clone());
     let mut t = multipole_table(header, &terms.k, ells, &m.total, prepared, precision);
+    t.methods.push(terms.method.clone());
     if parts {
         for (c, per_ell) in RsdCounterterm::ALL.iter().zip(&m.templates) {
             let unit = if *c == RsdCounterterm::Ctilde {

@@ -70,6 +70,7 @@ pub use two_loop::{
 use crate::error::{Error, Result};
 pub use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
+use crate::output::MethodNote;
 use crate::precision::Precision;
 use std::ops::{Index, IndexMut};
 
@@ -287,6 +288,16 @@ pub enum OneLoopSource {
 }
 
 impl OneLoopSource {
+    /// The method in a word or two, for Python's `meta["methods"]` (the header line has the figures).
+    pub fn method(&self) -> &'static str {
+        match self {
+            Self::Basis { .. } => "basis",
+            Self::Fallback { .. } => {
+                "direct (fallback: projection residual above the basis's limit)"
+            }
+        }
+    }
+
     /// One line for table headers.
     pub fn describe(&self) -> String {
         match *self {
@@ -341,6 +352,18 @@ pub enum TwoLoopSource {
 }
 
 impl TwoLoopSource {
+    /// The method in a word or two, for Python's `meta["methods"]` (the header line has the figures).
+    pub fn method(&self) -> &'static str {
+        match self {
+            Self::Direct => "direct",
+            Self::DirectUncached => "direct (fallback: no basis tensors cached, method auto)",
+            Self::Basis { .. } => "basis",
+            Self::Fallback { .. } => {
+                "direct (fallback: projection residual above the basis's limit)"
+            }
+        }
+    }
+
     /// One line for table headers.
     pub fn describe(&self) -> String {
         match *self {
@@ -386,6 +409,28 @@ pub struct IrTerms {
 }
 
 impl LoopTerms {
+    /// How each part of these terms was computed (the header lines' [`OneLoopSource::describe`] and
+    /// [`TwoLoopSource::describe`] in a word): the 1-loop terms always, the 2-loop terms and the
+    /// no-wiggle spectrum's terms of the IR-resummed models if present and `with_two_loop`/`with_ir`
+    /// (whether the table's model uses them).
+    pub fn methods(&self, with_two_loop: bool, with_ir: bool) -> Vec<MethodNote> {
+        let mut notes = Vec::new();
+        let mut push = |prefix: &str, terms: &LoopTerms| {
+            if with_two_loop {
+                if let Some(s) = terms.two_loop_source {
+                    notes.push(MethodNote::new(format!("{prefix}2-loop terms"), s.method()));
+                }
+            }
+            let one = terms.one_loop_source.map_or("direct", |s| s.method());
+            notes.push(MethodNote::new(format!("{prefix}1-loop terms"), one));
+        };
+        push("", self);
+        if let (Some(ir), true) = (&self.ir, with_ir) {
+            push("no-wiggle ", &ir.no_wiggle);
+        }
+        notes
+    }
+
     /// The 1-loop terms alone.
     pub fn new(one_loop: OneLoopTerms) -> Self {
         Self {

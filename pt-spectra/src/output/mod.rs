@@ -50,6 +50,27 @@ pub struct Column {
     pub undefined: Option<&'static str>,
 }
 
+/// How one part of a table was computed: by direct integration or from basis tensors, and why a
+/// slower path was taken. The header states the same with its figures; Python's `meta["methods"]`
+/// gives these (one record, so the two cannot disagree: both come from the loop terms' sources).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MethodNote {
+    /// The part, e.g. `1-loop terms`, `no-wiggle 2-loop terms`.
+    pub part: String,
+    /// `direct`, `basis`, or `direct (…)` with the reason for a fallback.
+    pub method: String,
+}
+
+impl MethodNote {
+    /// The note of `part` computed by `method`.
+    pub fn new(part: impl Into<String>, method: impl Into<String>) -> Self {
+        Self {
+            part: part.into(),
+            method: method.into(),
+        }
+    }
+}
+
 /// A table: header lines (without the `#`) and columns of equal length.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Table {
@@ -57,6 +78,8 @@ pub struct Table {
     pub header: Vec<String>,
     /// The columns, in order.
     pub columns: Vec<Column>,
+    /// How its parts were computed (empty for tables that integrate nothing by two methods).
+    pub methods: Vec<MethodNote>,
 }
 
 impl Table {
@@ -65,6 +88,7 @@ impl Table {
         Self {
             header,
             columns: Vec::new(),
+            methods: Vec::new(),
         }
     }
 

@@ -46,6 +46,7 @@ use crate::loops::basis::{LinearBasis, RsdTwoLoopBasis, SpectrumFamily, BASIS_SI
 use crate::loops::redshift::{RedshiftPlan, RedshiftTerms};
 use crate::loops::rsd_two_loop::legendre;
 use crate::loops::{combined, node_weights_on, Estimate, NodeRule, RsdTwoLoopTerms};
+use crate::output::MethodNote;
 use crate::precision::Precision;
 use crate::progress::Progress;
 use crate::store::TableStore;
@@ -220,6 +221,8 @@ pub struct Eft2Terms {
     two_nw: Option<RsdTwoLoopTerms>,
     /// Where the 2-loop terms came from (basis tensors or direct), for a header.
     pub source: String,
+    /// The same in a word, for Python's `meta["methods"]`.
+    pub method: MethodNote,
 }
 
 /// The multipoles of `eft2` per ℓ then per k, and those of each counterterm template.
@@ -303,7 +306,7 @@ impl Eft2Plan {
         let k = self.k();
         let p_lin: Vec<f64> = k.iter().map(|&k| spectrum.eval(k)).collect();
         if !self.ir {
-            let (mut one, mut two, source) =
+            let (mut one, mut two, source, method) =
                 loop_terms(&self.one_loop, &[spectrum], &self.tensors, progress)?;
             return Ok(Eft2Terms {
                 k: k.to_vec(),
@@ -315,10 +318,11 @@ impl Eft2Plan {
                 two_full: two.remove(0),
                 two_nw: None,
                 source,
+                method,
             });
         }
         let nw = self.split.no_wiggle(spectrum)?;
-        let (mut one, mut two, source) =
+        let (mut one, mut two, source, method) =
             loop_terms(&self.one_loop, &[spectrum, &nw], &self.tensors, progress)?;
         let q_min = self.precision.q_min;
         Ok(Eft2Terms {
@@ -331,6 +335,7 @@ impl Eft2Plan {
             two_nw: two.pop(),
             two_full: two.remove(0),
             source,
+            method,
         })
     }
 }

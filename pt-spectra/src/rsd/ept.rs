@@ -220,6 +220,9 @@ pub struct EptTerms {
     basis_residual: Option<f64>,
     /// Δ [(Mpc/h)²] if the spectrum was projected cut below the soft modes.
     basis_soft: Option<f64>,
+    /// The projection residual of a spectrum the plan's tensors did not accept (integrated directly
+    /// instead); `None` otherwise.
+    fallback_residual: Option<f64>,
 }
 
 /// Bytes per internal k of one spectrum's `ept` terms (the redshift-space 1-loop terms of the spectrum
@@ -347,9 +350,10 @@ impl EptPlan {
     /// # Errors
     /// As [`savitzky_golay_no_wiggle`].
     pub fn terms(&self, spectrum: &LinearSpectrum) -> Result<EptTerms> {
-        if let Some(terms) = self.terms_on_basis(spectrum)? {
-            return Ok(terms);
-        }
+        let fallback_residual = match self.terms_on_basis(spectrum)? {
+            Ok(terms) => return Ok(terms),
+            Err(refused) => refused,
+        };
         let at_grid =
             |p: &LinearSpectrum| -> Vec<f64> { self.grid.iter().map(|&k| p.eval(k)).collect() };
         let p_lin = at_grid(spectrum);
@@ -369,6 +373,7 @@ impl EptPlan {
             nw,
             basis_residual: None,
             basis_soft: None,
+            fallback_residual,
         })
     }
 

@@ -29,6 +29,7 @@ use crate::loops::redshift::{RedshiftPlan, RedshiftTerms};
 use crate::loops::{
     check_two_loop_ells, rsd_two_loop_of, Estimate, RsdTwoLoopTerms, TwoLoopSettings,
 };
+use crate::output::MethodNote;
 use crate::precision::Precision;
 use crate::progress::{stage_callback, Progress, Stage};
 use crate::store::TableStore;
@@ -183,12 +184,13 @@ two_loop_rsd_plan!(Spt2Plan, Spt2Terms, "2-loop SPT redshift-space terms");
 ///
 /// # Errors
 /// As [`rsd_two_loop_of`].
+#[allow(clippy::type_complexity)]
 pub(crate) fn loop_terms(
     plan: &RedshiftPlan,
     spectra: &[&LinearSpectrum],
     tensors: &LoopTensors,
     progress: &dyn Progress,
-) -> Result<(Vec<RedshiftTerms>, Vec<RsdTwoLoopTerms>, String)> {
+) -> Result<(Vec<RedshiftTerms>, Vec<RsdTwoLoopTerms>, String, MethodNote)> {
     let (k, precision) = (plan.k(), plan.precision());
     let one_on_basis = tensors.one_loop.len() == spectra.len();
     let subject = if one_on_basis {
@@ -198,6 +200,12 @@ pub(crate) fn loop_terms(
     };
     let (two, note, projections) =
         two_loop_terms_noted(k, spectra, &tensors.two_loop, subject, precision, progress)?;
+    let method = match (&projections, tensors.two_loop.is_empty()) {
+        (Some(_), _) => "basis",
+        (None, false) => "direct (fallback: projection residual above the basis's limit)",
+        (None, true) => "direct",
+    };
+    let method = MethodNote::new(subject, method);
     let one = match projections {
         Some(projections) if one_on_basis => spectra
             .iter()
@@ -210,7 +218,7 @@ pub(crate) fn loop_terms(
             .collect(),
         _ => spectra.iter().map(|s| plan.evaluate(s)).collect(),
     };
-    Ok((one, two, note + &few_points_caveat(precision)))
+    Ok((one, two, note + &few_points_caveat(precision), method))
 }
 
 /// Points per shift at low k below which the header warns ([`few_points_caveat`]): 2^13, the
@@ -337,6 +345,8 @@ pub struct Spt2Terms {
     pub two_loop: RsdTwoLoopTerms,
     /// Where the 2-loop terms came from (basis tensors or direct), for a header.
     pub source: String,
+    /// The same in a word, for Python's `meta["methods"]`.
+    pub method: MethodNote,
 }
 
 /// The multipoles of one part or of the whole, per ℓ then per k.
@@ -402,7 +412,7 @@ impl Spt2Plan {
     /// As [`rsd_two_loop_of`].
     pub fn terms(&self, spectrum: &LinearSpectrum, progress: &dyn Progress) -> Result<Spt2Terms> {
         let k = self.k();
-        let (mut one, mut two, source) =
+        let (mut one, mut two, source, method) =
             loop_terms(&self.one_loop, &[spectrum], &self.tensors, progress)?;
         Ok(Spt2Terms {
             k: k.to_vec(),
@@ -410,6 +420,7 @@ impl Spt2Plan {
             one_loop: one.remove(0),
             two_loop: two.remove(0),
             source,
+            method,
         })
     }
 }

@@ -16,6 +16,7 @@ use crate::linear::LinearSpectrum;
 use crate::loops::basis::training::camb_basis;
 use crate::loops::basis::{LinearBasis, Projection, RedshiftBasis, RedshiftFamily, BASIS_SIZE};
 use crate::loops::Estimate;
+use crate::output::MethodNote;
 use crate::progress::Progress;
 use crate::store::TableStore;
 use std::sync::Arc;
@@ -209,21 +210,24 @@ impl EptPlan {
         Some(self.tensors.as_ref()?.linear.basis())
     }
 
-    /// The loop terms from the basis tensors, or `None` without tensors or for a spectrum its basis
-    /// does not represent well enough.
-    pub(super) fn terms_on_basis(&self, spectrum: &LinearSpectrum) -> Result<Option<EptTerms>> {
+    /// The loop terms from the basis tensors (`Ok`), or why not (`Err`): `None` without tensors, the
+    /// projection residual of a spectrum the basis does not represent well enough.
+    pub(super) fn terms_on_basis(
+        &self,
+        spectrum: &LinearSpectrum,
+    ) -> Result<std::result::Result<EptTerms, Option<f64>>> {
         let Some(tensors) = &self.tensors else {
-            return Ok(None);
+            return Ok(Err(None));
         };
         let basis = tensors.linear.basis();
         let samples = basis.sample(spectrum);
         let projection = basis.project_spectrum_sampled(spectrum, &samples, self.max_residual);
         if projection.residual.is_nan() || projection.residual > self.max_residual {
-            return Ok(None);
+            return Ok(Err(Some(projection.residual)));
         }
         // P_lin and P_nw on the whole grid; the loop terms on the loop grid, padded
         let p_lin: Vec<f64> = self.grid.iter().map(|&k| spectrum.eval(k)).collect();
-        Ok(Some(self.terms_of_samples(
+        Ok(Ok(self.terms_of_samples(
             tensors,
             &samples,
             p_lin,
@@ -269,6 +273,7 @@ impl EptPlan {
             nw,
             basis_residual: Some(projection.residual),
             basis_soft: projection.soft_delta(),
+            fallback_residual: None,
         }
     }
 }
@@ -279,8 +284,27 @@ impl EptTerms {
         self.basis_residual
     }
 
-    /// One header line if the terms come from basis tensors: the projection residuals.
+    /// How the loop terms were computed: from the tensors, directly, or directly because the plan's
+    /// tensors did not accept the spectrum ([`Self::describe_source`] with the figures).
+    pub fn method_note(&self) -> MethodNote {
+        let method = match (self.basis_residual, self.fallback_residual) {
+            (Some(_), _) => "basis",
+            (None, Some(_)) => "direct (fallback: projection residual above the basis's limit)",
+            (None, None) => "direct",
+        };
+        MethodNote::new("loop terms", method)
+    }
+
+    /// One header line if the terms come from basis tensors (the projection residuals) or were
+    /// integrated directly because the tensors did not accept the spectrum (its residual).
     pub fn describe_source(&self) -> Option<String> {
+        if let Some(residual) = self.fallback_residual {
+            return Some(format!(
+                "loop terms: direct integration, since the spectrum's projection residual on the \
+                 basis, {residual:.1e}, exceeds the plan's limit (a spectrum unlike the CAMB tables \
+                 of the basis)"
+            ));
+        }
         let residual = self.basis_residual?;
         Some(format!(
             "loop terms: basis tensors on the same quadrature nodes as direct (no-wiggle terms: the \

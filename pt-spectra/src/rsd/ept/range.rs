@@ -112,6 +112,7 @@ impl EptTerms {
             nw: self.nw.as_ref().map(|(t, s)| (cut(t), *s)),
             basis_residual: self.basis_residual,
             basis_soft: self.basis_soft,
+            fallback_residual: self.fallback_residual,
         }
     }
 }

@@ -147,6 +147,7 @@ impl EptPlan {
                         nw,
                         basis_residual: Some(residual),
                         basis_soft: None,
+                        fallback_residual: None,
                     },
                     d_sigma2,
                 }

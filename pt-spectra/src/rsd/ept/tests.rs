@@ -329,7 +329,13 @@ fn the_basis_gives_the_direct_multipoles_and_falls_back_outside_its_span() {
             }
         }
         let fallback = plan.terms(&eh).unwrap();
-        assert!(fallback.describe_source().is_none());
+        // the fallback is stated, with the residual, in the header line and the method note
+        let line = fallback.describe_source().unwrap();
+        assert!(
+            line.starts_with("loop terms: direct integration, since"),
+            "{line}"
+        );
+        assert!(fallback.method_note().method.contains("fallback"));
         assert_eq!(
             plan.multipole_values(&fallback, &params, &[0, 2]).unwrap(),
             direct
