@@ -39,10 +39,8 @@ pub enum Stage {
     TnsBasis,
     /// The basis tensors of the galaxy model's loop terms on a k grid (once; cached).
     RedshiftBasis,
-    /// The one-loop bispectrum's integrals (per triangle).
-    OneLoopBispectrum,
-    /// The one-loop bispectrum's basis tensors of a triangle set (once; cached).
-    OneLoopBispectrumBasis,
+    /// A stage a module names itself (e.g. `bispectrum::seam::ONE_LOOP_STAGE`): what it shows.
+    Named(&'static str),
 }
 
 impl fmt::Display for Stage {
@@ -57,10 +55,7 @@ impl fmt::Display for Stage {
             Stage::OneLoopBasis => "1-loop basis tensors (once per k grid; cached)",
             Stage::TnsBasis => "TNS basis tensors (once per k grid; cached)",
             Stage::RedshiftBasis => "galaxy-model basis tensors (once per k grid; cached)",
-            Stage::OneLoopBispectrum => "one-loop bispectrum (per triangle)",
-            Stage::OneLoopBispectrumBasis => {
-                "one-loop bispectrum basis tensors (once per triangle set; cached)"
-            }
+            Stage::Named(what) => what,
         })
     }
 }

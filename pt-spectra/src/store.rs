@@ -174,6 +174,7 @@ pub(crate) use file::cached;
 #[cfg(test)]
 use file::{fnv1a, HEADER};
 use file::{read_f64s, Stored};
+pub(crate) use tensors::cached_tensors;
 pub use tensors::{CachedTensors, GridKey, RsdTwoLoopKey};
 #[cfg(test)]
 mod tests;

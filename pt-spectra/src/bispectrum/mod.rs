@@ -54,7 +54,7 @@ pub mod one_loop_galaxy;
 pub mod one_loop_rsd;
 mod resum;
 mod sampled;
-mod seam;
+pub mod seam;
 mod sugiyama;
 mod terms;
 #[cfg(test)]

@@ -1,6 +1,7 @@
 //! The [`Plan`] seam of the bispectrum plans: the tree-level multipoles' terms (orientation and bin
 //! averages, a periodic box's modes, the Sugiyama multipoles), with f, AP, FoG and IR as their
-//! settings, and the one-loop matter terms.
+//! settings, and the one-loop matter terms; the bispectrum's progress stages and its tensors in the
+//! store's cache ([`crate::store::CachedTensors`]), so that neither `progress` nor `store` names it.
 
 use super::one_loop_basis::{BispectrumLoopSource, OneLoopMatterPlan};
 use super::{BispectrumPlan, BispectrumTerms, BoxPlan, Settings, SugiyamaPlan, SugiyamaTerms};
@@ -8,7 +9,8 @@ use crate::bispectrum::one_loop::OneLoopMatter;
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
 use crate::plan::{Method, Plan};
-use crate::progress::Progress;
+use crate::progress::{Progress, Stage};
+use crate::store::cached_tensors;
 
 /// Bytes of one orientation node of an average (three line-of-sight components and its share of a
 /// group's weights).
@@ -142,8 +144,23 @@ impl Plan for OneLoopMatterPlan {
         (): (),
         progress: &dyn Progress,
     ) -> Result<Self::Terms> {
-        let stage =
-            crate::progress::stage_callback(progress, crate::progress::Stage::OneLoopBispectrum);
+        let stage = crate::progress::stage_callback(progress, ONE_LOOP_STAGE);
         self.evaluate_reporting(spectrum, &stage)
     }
 }
+
+/// The progress stage of the one-loop bispectrum's direct integrals (per triangle).
+pub const ONE_LOOP_STAGE: Stage = Stage::Named("one-loop bispectrum (per triangle)");
+
+/// The progress stage of a build of the one-loop bispectrum's basis tensors.
+pub const ONE_LOOP_BASIS_STAGE: Stage =
+    Stage::Named("one-loop bispectrum basis tensors (once per triangle set; cached)");
+
+// The one-loop basis tensors in the store's cache, keyed by the triangles and the rule.
+cached_tensors!(
+    super::one_loop_basis::OneLoopMatterBasis,
+    (&'a [[f64; 3]], &'a super::one_loop::OneLoopRule),
+    "one-loop bispectrum basis",
+    ONE_LOOP_BASIS_STAGE,
+    (triangles, rule)
+);

@@ -16,7 +16,7 @@ use crate::error::{Error, Result};
 use crate::estimate::Estimate;
 use crate::output::{MethodNote, Table, BISPECTRUM, BISPECTRUM_SHAPE, WAVENUMBER};
 use crate::precision::TwoLoopMethod;
-use crate::progress::{Progress, Stage};
+use crate::progress::Progress;
 use crate::setup::Prepared;
 use crate::store::TableStore;
 
@@ -283,7 +283,7 @@ pub fn one_loop_bispectrum_table(
 ) -> Result<Table> {
     let (plan, uncached) = one_loop_bispectrum_plan(triangles, rule, method, store, progress)?;
     let (rows, mut source) = plan.evaluate_reporting(&prepared.spectrum, &|d, t| {
-        progress.update(Stage::OneLoopBispectrum, d, t);
+        progress.update(crate::bispectrum::seam::ONE_LOOP_STAGE, d, t);
     })?;
     if uncached {
         source = BispectrumLoopSource::DirectUncached;
@@ -380,7 +380,11 @@ pub fn one_loop_redshift_table(
                 }
             })?;
         rows.push((k, [b.tree, b.b222, b.b321_i, b.b321_ii, b.b411, b.total()]));
-        progress.update(Stage::OneLoopBispectrum, i + 1, triangles.len());
+        progress.update(
+            crate::bispectrum::seam::ONE_LOOP_STAGE,
+            i + 1,
+            triangles.len(),
+        );
     }
     let mut header = vec![
         format!(

@@ -5,8 +5,6 @@
 //! every plan asks it rather than deciding for itself.
 
 use super::{cached, read_cached, TableStore};
-use crate::bispectrum::one_loop::OneLoopRule;
-use crate::bispectrum::one_loop_basis::OneLoopMatterBasis;
 use crate::error::Result;
 use crate::loops::basis::{
     OneLoopBasis, RedshiftBasis, RedshiftFamily, RsdTwoLoopBasis, SpectrumFamily, TnsBasis,
@@ -98,12 +96,15 @@ impl TableStore {
 
 /// Implements [`CachedTensors`] for a tensor type whose key is the tuple of the arguments its
 /// inherent `file_name(…)` and `from_f64s(values, …)` take, in that order.
+/// `impl CachedTensors` for a tensor type with inherent `file_name(key…)`, `from_f64s(values, key…)`
+/// and `to_f64s()`: a statistic's module implements its own cache (e.g. `bispectrum::seam`), so the
+/// store names none of them.
 macro_rules! cached_tensors {
     ($tensors:ty, $key:ty, $what:literal, $stage:expr, ($($arg:ident),+)) => {
-        impl CachedTensors for $tensors {
+        impl $crate::store::CachedTensors for $tensors {
             type Key<'a> = $key;
             const WHAT: &'static str = $what;
-            const STAGE: Stage = $stage;
+            const STAGE: $crate::progress::Stage = $stage;
             fn cache_name(($($arg),+): Self::Key<'_>) -> String {
                 Self::file_name($($arg),+)
             }
@@ -116,6 +117,7 @@ macro_rules! cached_tensors {
         }
     };
 }
+pub(crate) use cached_tensors;
 
 /// The key of the 1- and 2-loop basis tensors: k, the precision and the spectrum family.
 pub type GridKey<'a> = (&'a [f64], &'a Precision, SpectrumFamily);
@@ -164,11 +166,4 @@ cached_tensors!(
     "2-loop redshift-space basis",
     Stage::TwoLoopBasis,
     (k, range, step, settings, family)
-);
-cached_tensors!(
-    OneLoopMatterBasis,
-    (&'a [[f64; 3]], &'a OneLoopRule),
-    "one-loop bispectrum basis",
-    Stage::OneLoopBispectrumBasis,
-    (triangles, rule)
 );
