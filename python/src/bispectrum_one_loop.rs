@@ -22,11 +22,14 @@ use pyo3::types::PyDict;
 /// says how the loop terms are computed, as everywhere: "basis" (tensors built once per triangle
 /// set and rule, ~0.7 s per triangle and core, cached in `cache_dir`; then ~10 us per triangle;
 /// their projection error is in the errors), "direct" (~0.5 s per triangle), "auto" (the tensors if
-/// cached, else direct). The header says which was used (its line `loop terms: ...`).
+/// cached, else direct). The header says which was used (its line `loop terms: ...`). With a bias
+/// (`b1`, `b2`, `bs` in `bias_convention`, CLASS-PT's `b_gamma3`, `loop_bias` a dict of fourth-order
+/// coefficients by name), the galaxy bispectrum ([`pt_spectra::jobs::one_loop_galaxy_table`]).
 #[pyfunction]
 #[pyo3(signature = (triangles, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None,
     q_min=1e-4, q_max=10.0, radial=12, mu=32, phi=24,
-    two_loop=pt_spectra::jobs::defaults::TWO_LOOP, cache_dir=None, mu1=None, phi_los=0.0, f=None))]
+    two_loop=pt_spectra::jobs::defaults::TWO_LOOP, cache_dir=None, mu1=None, phi_los=0.0, f=None,
+    b1=None, b2=0.0, bs=0.0, b_gamma3=0.0, bias_convention=None, loop_bias=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn one_loop_bispectrum(
     py: Python<'_>,
@@ -46,9 +49,35 @@ pub fn one_loop_bispectrum(
     mu1: Option<f64>,
     phi_los: f64,
     f: Option<f64>,
+    b1: Option<f64>,
+    b2: f64,
+    bs: f64,
+    b_gamma3: f64,
+    bias_convention: Option<&str>,
+    loop_bias: Option<std::collections::BTreeMap<String, f64>>,
 ) -> PyResult<Table> {
     let rows = fixed_rows::<3>(triangles, "triangles", "k1, k2, k3")?;
     let method: TwoLoopMethod = two_loop.parse().map_err(library_error)?;
+    let galaxy = b1.is_some()
+        || b2 != 0.0
+        || bs != 0.0
+        || b_gamma3 != 0.0
+        || bias_convention.is_some()
+        || loop_bias.is_some();
+    let bias = if galaxy {
+        let convention = crate::bias::convention(py, bias_convention, None, None, None)?;
+        let given = [b1.unwrap_or(1.0), b2, bs, 0.0];
+        let bias = pt_spectra::bias::BiasParams::from_convention(convention, given);
+        let overrides: Vec<(String, f64)> = loop_bias.unwrap_or_default().into_iter().collect();
+        if method == TwoLoopMethod::Basis {
+            return Err(crate::value_error(
+                "two_loop=\"basis\": the one-loop bispectrum's tensors are built for matter only",
+            ));
+        }
+        Some(pt_spectra::jobs::loop_bias(&bias, b_gamma3, &overrides).map_err(library_error)?)
+    } else {
+        None
+    };
     let store = crate::Store::new(cache_dir);
     let rule = rule_of(q_min, q_max, radial, mu, phi);
     let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
@@ -64,6 +93,17 @@ pub fn one_loop_bispectrum(
     }
     let ((prepared, table), seconds) = detached(py, || {
         let prepared = inputs.prepare(&[])?;
+        if let Some(bias) = &bias {
+            let redshift = mu1.map(|mu1| {
+                let orientation =
+                    pt_spectra::bispectrum::one_loop_rsd::Orientation { mu1, phi: phi_los };
+                (f, orientation)
+            });
+            let table = pt_spectra::jobs::one_loop_galaxy_table(
+                &prepared, &rows, bias, redshift, &rule, &Silent,
+            )?;
+            return Ok((prepared, table));
+        }
         if let Some(mu1) = mu1 {
             let orientation =
                 pt_spectra::bispectrum::one_loop_rsd::Orientation { mu1, phi: phi_los };
@@ -92,7 +132,11 @@ pub fn one_loop_bispectrum(
         table,
         &prepared,
         &Precision::default(),
-        "bispectrum one-loop matter",
+        if bias.is_some() {
+            "bispectrum one-loop galaxy"
+        } else {
+            "bispectrum one-loop matter"
+        },
         seconds,
     )
 }

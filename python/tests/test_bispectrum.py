@@ -203,6 +203,39 @@ def test_one_loop_bispectrum_in_redshift_space_at_one_orientation():
         pt.one_loop_bispectrum(tri, f=0.7, **rule)
 
 
+def test_one_loop_galaxy_bispectrum_through_the_python_face():
+    tri = np.array([[0.1, 0.1, 0.1], [0.05, 0.1, 0.12]])
+    rule = dict(radial=6, mu=12, phi=8, two_loop="direct")
+    k = np.unique(tri)
+    p = dict(zip(k, pt.real(model="linear", k=k)["P_lin"]))
+    matter = pt.one_loop_bispectrum(tri, **rule)
+    # b1 = 1 alone: the galaxy kernels are F_n (the galaxy code against the matter code)
+    unit = pt.one_loop_bispectrum(tri, b1=1.0, **rule)
+    assert unit.meta["model"] == "bispectrum one-loop galaxy"
+    for name in ["B_tree", "B222", "B321_I", "B321_II", "B411"]:
+        np.testing.assert_allclose(unit[name], matter[name], rtol=1e-12)
+    # the tree level of a biased tracer is the closed form b1^2 [b1 F2 + b2/2 + bs (mu^2 - 1/3)] P P + cyclic
+    g = pt.one_loop_bispectrum(tri, b1=2.0, b2=0.4, bs=-0.3, **rule)
+    for row, tree in zip(tri, g["B_tree"]):
+        assert tree == pytest.approx(closed_form(row, p.__getitem__, 2.0, 0.4, -0.3), rel=1e-10)
+    assert any("b1 = 2, b2 = 0" in line for line in g.header)  # the ESS19 b2 = b2 + (4/3) bs, stated
+    assert np.all(g["uv_B411"] != 0)
+    # CLASS-PT's convention: bs is b_G2 = velocileptors' bs, b2 is b2 + (4/3) bs
+    c = pt.one_loop_bispectrum(tri, b1=2.0, b2=0.4 + 4 / 3 * -0.3, bs=-0.3, bias_convention="classpt", **rule)
+    np.testing.assert_allclose(c["B_1loop"], g["B_1loop"], rtol=1e-12)
+    # b_gamma3 and the fourth-order coefficients move the loops only
+    h = pt.one_loop_bispectrum(tri, b1=2.0, b_gamma3=0.2, loop_bias={"g2x": 0.1}, **rule)
+    assert np.all(h["B411"] != pt.one_loop_bispectrum(tri, b1=2.0, **rule)["B411"])
+    # f = 0 at an orientation is real space
+    zero = pt.one_loop_bispectrum(tri, b1=2.0, b2=0.4, bs=-0.3, mu1=0.4, f=0.0, **rule)
+    for name in ["B_tree", "B222", "B321_I", "B321_II", "B411"]:
+        np.testing.assert_allclose(zero[name], g[name], rtol=1e-10, err_msg=name)
+    with pytest.raises(ValueError, match="valid: b3, g2x"):
+        pt.one_loop_bispectrum(tri, b1=2.0, loop_bias={"b2": 1.0}, **rule)
+    with pytest.raises(ValueError, match="matter only"):
+        pt.one_loop_bispectrum(tri, b1=2.0, two_loop="basis", radial=6, mu=12, phi=8)
+
+
 @pytest.mark.parametrize("kwargs, needle", [
     (dict(triangles=[[0.1, 0.1, 0.3]]), "does not close"),
     (dict(triangles=[[0.1, 0.1]]), "k1, k2, k3"),

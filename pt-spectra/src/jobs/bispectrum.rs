@@ -333,7 +333,7 @@ pub fn one_loop_bispectrum_table(
 
 /// The columns `k1 k2 k3 B_tree B222 B321_I B321_II B411 B_1loop` and their `err_` of one-loop terms,
 /// per triangle its sides and (tree, B222, B321_I, B321_II, B411, total).
-fn one_loop_columns(t: &mut Table, rows: &[([f64; 3], [Estimate; 6])]) {
+pub(super) fn one_loop_columns(t: &mut Table, rows: &[([f64; 3], [Estimate; 6])]) {
     for (i, name) in ["k1", "k2", "k3"].iter().enumerate() {
         t.push(*name, WAVENUMBER, rows.iter().map(|r| r.0[i]).collect());
     }

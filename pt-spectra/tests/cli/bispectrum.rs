@@ -459,8 +459,51 @@ fn one_loop_matter_terms_at_triangles_and_refusals() {
         a.extend(extra);
         a
     };
+    // Galaxies (any bias option): with matter's bias the galaxy kernels are F_n, so the galaxy path
+    // gives the matter columns (its own kernels and renormalisation, nothing subtracted for b1 alone);
+    // b2 alone adds b2 sum_(a<b) P_a P_b to the tree (K2 += b2/2), exactly.
+    let (ok, galaxy, err) = run(&with(&["--bias-convention", "velocileptors"]));
+    assert!(ok, "{err}");
+    assert!(
+        galaxy.contains("one-loop galaxy bispectrum in real space"),
+        "{galaxy}"
+    );
+    assert!(galaxy.contains("b1 = 1, b2 = 0, g2 = 0"), "{galaxy}");
+    for (g, m) in rows(&galaxy).iter().zip(rows(&out)) {
+        for j in 3..9 {
+            assert!(
+                (g[j] - m[j]).abs() <= 1e-12 * m[j].abs(),
+                "column {j}: {} vs {}",
+                g[j],
+                m[j]
+            );
+        }
+        assert!(g[15] == 0.0 && g[16] == 0.0, "uv of matter: {g:?}");
+    }
+    let (ok, b2, err) = run(&with(&["--b2", "0.5"]));
+    assert!(ok, "{err}");
+    for (t, (g, m)) in [[0.05, 0.1, 0.12], [0.1, 0.1, 0.1]]
+        .iter()
+        .zip(rows(&b2).iter().zip(rows(&out)))
+    {
+        let pp = p_lin(t[0]) * p_lin(t[1]) + p_lin(t[1]) * p_lin(t[2]) + p_lin(t[2]) * p_lin(t[0]);
+        let expected = m[3] + 0.5 * pp;
+        // the table prints 10 significant digits
+        assert!(
+            (g[3] - expected).abs() < 2e-9 * expected,
+            "{t:?}: {} vs {expected}",
+            g[3]
+        );
+    }
     fails_naming(&[
-        (with(&["--b1", "2"]), "--b1"),
+        (with(&["--loop-bias", "b2=1"]), "valid: b3, g2x"),
+        (with(&["--loop-bias", "g21"]), "NAME=VALUE"),
+        (with(&["--loop-bias", "g21=1,g21=2"]), "given twice"),
+        (with(&["--b1", "2", "--two-loop", "basis"]), "matter only"),
+        (
+            vec!["bispectrum", "--triangles", path, "--b-gamma3", "0.1"],
+            "give --loop 1",
+        ),
         (with(&["--f", "0.5"]), "--f"),
         (with(&["--bin-width", "0.01"]), "not built yet"),
         (

@@ -115,9 +115,10 @@ pub struct Args {
     /// Switch off the IR resummation of the BAO in every leg.
     #[arg(long)]
     no_ir: bool,
-    /// Loop order: 0 (the tree-level galaxy model in redshift space) or 1 (the one-loop matter
-    /// bispectrum in real space, SPT: B_tree, B222, B321_I, B321_II, B411 at the points of --triangles;
-    /// no bias, redshift space, bins or counterterms yet; --two-loop basis makes it ~10 us per
+    /// Loop order: 0 (the tree-level galaxy model in redshift space) or 1 (the one-loop bispectrum,
+    /// SPT: B_tree, B222, B321_I, B321_II, B411 at the points of --triangles, of matter or, with
+    /// --b1/--b2/--bs/--b-gamma3/--loop-bias, of galaxies; real space, or one orientation with --mu1;
+    /// no bins or counterterms yet; for matter in real space --two-loop basis makes it ~10 us per
     /// triangle after a one-off ~0.7 s per triangle).
     #[arg(long = "loop", value_name = "N", default_value_t = 0)]
     loop_order: u32,
@@ -134,12 +135,20 @@ pub struct Args {
     /// the side of k2 [rad] (default 0: in the plane).
     #[arg(long, value_name = "PHI", allow_hyphen_values = true, requires = "mu1")]
     phi_los: Option<f64>,
+    /// --loop 1: CLASS-PT's b_Gamma3 (Gamma3 = G2(Phi_g) - G2(Phi_v)), with --b1, --b2, --bs.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    b_gamma3: f64,
+    /// --loop 1: fourth-order bias coefficients of Eggemeier, Scoccimarro & Smith (2019) by name,
+    /// NAME=VALUE[,NAME=VALUE...] with NAME one of b3, g2x, g3, g21, g21x, g211, g22, g31, each in
+    /// place of the value mapped from --bs and --b-gamma3 (docs/bispectrum.md).
+    #[arg(long, value_name = "NAME=VALUE,...", allow_hyphen_values = true)]
+    loop_bias: Option<String>,
     /// Write the table to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
 }
 
-/// The options that the one-loop matter bispectrum does not take, set away from their defaults.
+/// The options that the one-loop bispectrum does not take, set away from their defaults.
 fn galaxy_options_given(args: &Args) -> Vec<&'static str> {
     let mut given = Vec::new();
     let mut flag = |set: bool, name: &'static str| {
@@ -154,10 +163,6 @@ fn galaxy_options_given(args: &Args) -> Vec<&'static str> {
     flag(args.box_size.is_some(), "--box");
     flag(args.effective, "--effective");
     flag(args.legendre_side != "largest", "--legendre-side");
-    flag(args.b1 != 1.0, "--b1");
-    flag(args.b2 != 0.0, "--b2");
-    flag(args.bs != 0.0, "--bs");
-    flag(args.bias_convention.is_some(), "--bias-convention");
     flag(args.c1 != 0.0, "--c1");
     flag(args.n_bar.is_some(), "--n-bar");
     flag(args.f.is_some(), "--f");
@@ -177,8 +182,8 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
         .collect();
     if !given.is_empty() {
         bail!(
-            "--loop 1 is the one-loop matter bispectrum in real space at single triangles; it does not take {} \
-             (bias, redshift space, AP and bin averages of the one-loop bispectrum are not built yet)",
+            "--loop 1 is the one-loop bispectrum at single triangles; it does not take {} (counterterms, \
+             stochastic terms, FoG, AP and bin averages of the one-loop bispectrum are not built yet)",
             given.join(", ")
         );
     }
@@ -191,6 +196,27 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
         .collect();
     let loaded = args.spectrum.load()?;
     let bars = crate::progress::Bars::default();
+    if let Some(bias) = galaxy_bias(args)? {
+        if loaded.precision.two_loop == pt_spectra::precision::TwoLoopMethod::Basis {
+            bail!("--two-loop basis: the one-loop bispectrum's tensors are built for matter only");
+        }
+        let redshift = args.mu1.map(|mu1| {
+            let phi = args.phi_los.unwrap_or(0.0);
+            (
+                args.f,
+                pt_spectra::bispectrum::one_loop_rsd::Orientation { mu1, phi },
+            )
+        });
+        return pt_spectra::jobs::one_loop_galaxy_table(
+            &loaded.prepared,
+            &rows,
+            &bias,
+            redshift,
+            &OneLoopRule::default(),
+            &bars,
+        )
+        .with_context(|| format!("--triangles {}", path.display()));
+    }
     if let Some(mu1) = args.mu1 {
         if loaded.precision.two_loop == pt_spectra::precision::TwoLoopMethod::Basis {
             bail!(
@@ -220,6 +246,43 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
         &bars,
     )
     .with_context(|| format!("--triangles {}", path.display()))
+}
+
+/// `--loop 1`'s galaxy bias, if any bias option is given (else the matter bispectrum).
+fn galaxy_bias(args: &Args) -> Result<Option<pt_spectra::bispectrum::bias_kernels::LoopBias>> {
+    let overrides = match &args.loop_bias {
+        None => Vec::new(),
+        Some(list) => {
+            list.split(',')
+                .map(|item| {
+                    let (name, value) = item
+                        .split_once('=')
+                        .with_context(|| format!("--loop-bias {item:?}: expected NAME=VALUE"))?;
+                    let value: f64 = value.trim().parse().with_context(|| {
+                        format!("--loop-bias {item:?}: the value is not a number")
+                    })?;
+                    Ok((name.trim().to_string(), value))
+                })
+                .collect::<Result<Vec<_>>>()?
+        }
+    };
+    let matter = args.b1 == 1.0
+        && args.b2 == 0.0
+        && args.bs == 0.0
+        && args.b_gamma3 == 0.0
+        && args.bias_convention.is_none()
+        && overrides.is_empty();
+    if matter {
+        return Ok(None);
+    }
+    let convention = args.bias_convention.unwrap_or_default();
+    let bias =
+        pt_spectra::bias::BiasParams::from_convention(convention, [args.b1, args.b2, args.bs, 0.0]);
+    Ok(Some(pt_spectra::jobs::loop_bias(
+        &bias,
+        args.b_gamma3,
+        &overrides,
+    )?))
 }
 
 /// The triangle set of the options.
@@ -284,11 +347,15 @@ pub fn run(args: &Args) -> Result<()> {
             bail!("--mu1 is the orientation of the one-loop matter bispectrum: give --loop 1 (the tree \
                    level averages over orientations: B0, B2, B4)")
         }
+        0 if args.b_gamma3 != 0.0 || args.loop_bias.is_some() => {
+            bail!("--b-gamma3 and --loop-bias are the one-loop bispectrum's bias: give --loop 1 (the \
+                   tree level takes --b1, --b2, --bs)")
+        }
         0 => {}
         1 => return write_output(args.out.as_ref(), &one_loop(args)?),
         n => bail!(
-            "--loop {n}: valid: 0 (tree level), 1 (one-loop matter, real space, or redshift space at \
-             one orientation with --mu1)"
+            "--loop {n}: valid: 0 (tree level), 1 (one-loop matter or galaxies, real space, or redshift \
+             space at one orientation with --mu1)"
         ),
     }
     let table = match args.basis.to_ascii_lowercase().as_str() {

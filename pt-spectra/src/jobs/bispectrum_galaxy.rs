@@ -1,0 +1,184 @@
+//! `bispectrum --loop 1` with a bias: the one-loop GALAXY bispectrum at single triangles, in real space
+//! or in redshift space at one orientation ([`crate::bispectrum::one_loop_galaxy`]), as a table with its
+//! header; and the one place where the faces' bias options become the fourth-order bias basis.
+
+use super::bispectrum::one_loop_columns;
+use super::VERSION;
+use crate::bias::BiasParams;
+use crate::bispectrum::bias_kernels::LoopBias;
+use crate::bispectrum::one_loop::{OneLoopRule, PARTITION_POWER};
+use crate::bispectrum::one_loop_galaxy::one_loop_galaxy;
+use crate::bispectrum::one_loop_rsd::Orientation;
+use crate::error::{Error, Result};
+use crate::output::{MethodNote, Table, BISPECTRUM};
+use crate::progress::Progress;
+use crate::setup::Prepared;
+
+/// The coefficients of the fourth-order basis that the faces set by name (`--loop-bias NAME=VALUE`,
+/// Python `loop_bias={...}`): those that (b1, b2, bs) and b_Γ3 do not already fix. b1, b2 and g2 are
+/// set through the bias of every command (velocileptors' b1, b2, bs, or another convention), whose
+/// ESS19 b2 differs from velocileptors' b2: naming them here would be ambiguous.
+pub const LOOP_BIAS_NAMES: [&str; 8] = ["b3", "g2x", "g3", "g21", "g21x", "g211", "g22", "g31"];
+
+/// The one-loop bias of the faces' options: `bias` (velocileptors' b1, b2, bs; any convention is
+/// converted before) and CLASS-PT's `b_gamma3` give the basis exactly through fourth order
+/// ([`LoopBias::from_class_pt`] with b2 + (4/3) bs, b_G2 = bs); each of `overrides` then sets one
+/// coefficient of [`LOOP_BIAS_NAMES`] in place of its mapped value.
+///
+/// # Errors
+/// [`Error::InvalidChoice`] for a name not in [`LOOP_BIAS_NAMES`] or given twice;
+/// [`Error::InvalidParameter`] for a value that is not finite.
+pub fn loop_bias(
+    bias: &BiasParams,
+    b_gamma3: f64,
+    overrides: &[(String, f64)],
+) -> Result<LoopBias> {
+    let mut values =
+        LoopBias::from_class_pt(bias.b1, bias.b2 + 4.0 / 3.0 * bias.bs, bias.bs, b_gamma3).values();
+    for (i, (name, value)) in overrides.iter().enumerate() {
+        let slot = LOOP_BIAS_NAMES.contains(&name.as_str()).then(|| {
+            LoopBias::NAMES
+                .iter()
+                .position(|n| n == name)
+                .expect("every settable name is a coefficient")
+        });
+        let Some(slot) = slot else {
+            return Err(Error::InvalidChoice {
+                what: format!("one-loop bias coefficient {name:?}"),
+                reason: format!(
+                    "valid: {} (b1, b2, g2 = bs come from the bias options)",
+                    LOOP_BIAS_NAMES.join(", ")
+                ),
+            });
+        };
+        if overrides[..i].iter().any(|(n, _)| n == name) {
+            return Err(Error::InvalidChoice {
+                what: format!("one-loop bias coefficient {name}"),
+                reason: "is given twice".into(),
+            });
+        }
+        values[slot] = *value;
+    }
+    let out = LoopBias::from_values(values);
+    out.check_finite()?;
+    Ok(out)
+}
+
+/// The table `k1 k2 k3 B_tree B222 B321_I B321_II B411 B_1loop`, their `err_` columns and the
+/// amounts subtracted by the renormalisation (`uv_B321_II`, `uv_B411`: the bare terms are the
+/// renormalised ones plus these) of the one-loop galaxy bispectrum with `bias` at `triangles`
+/// (points), in real space (`redshift` None) or at the growth rate (default f(z)) and orientation of
+/// `redshift`, for the linear spectrum of `prepared`, directly, each triangle reported to `progress`.
+///
+/// # Errors
+/// As [`one_loop_galaxy`], naming the triangle.
+pub fn one_loop_galaxy_table(
+    prepared: &Prepared,
+    triangles: &[[f64; 3]],
+    bias: &LoopBias,
+    redshift: Option<(Option<f64>, Orientation)>,
+    rule: &OneLoopRule,
+    progress: &dyn Progress,
+) -> Result<Table> {
+    let redshift = redshift.map(|(f, o)| (f.unwrap_or(prepared.growth_rate), o));
+    let mut rows = Vec::with_capacity(triangles.len());
+    let mut uv = Vec::with_capacity(triangles.len());
+    for (i, &k) in triangles.iter().enumerate() {
+        let b = one_loop_galaxy(&prepared.spectrum, k, bias, redshift, rule).map_err(|e| {
+            Error::InvalidChoice {
+                what: format!("triangle {} ({}, {}, {})", i + 1, k[0], k[1], k[2]),
+                reason: e.to_string(),
+            }
+        })?;
+        rows.push((k, [b.tree, b.b222, b.b321_i, b.b321_ii, b.b411, b.total()]));
+        uv.push([b.uv_b321_ii, b.uv_b411]);
+        progress.update(
+            crate::bispectrum::seam::ONE_LOOP_STAGE,
+            i + 1,
+            triangles.len(),
+        );
+    }
+    let space = match redshift {
+        None => "real space".to_string(),
+        Some((f, o)) => format!(
+            "redshift space, f = {f}, line of sight at mu1 = {} (cosine to k1), phi = {} rad (azimuth \
+             about k1 from the triangle's plane, on the side of k2)",
+            o.mu1, o.phi
+        ),
+    };
+    let values: Vec<String> = LoopBias::NAMES
+        .iter()
+        .zip(bias.values())
+        .map(|(n, v)| format!("{n} = {v}"))
+        .collect();
+    let mut header = vec![
+        format!(
+            "pt-spectra {VERSION} bispectrum --loop 1: one-loop galaxy bispectrum in {space}, z = {}",
+            prepared.z
+        ),
+        format!(
+            "bias (the fourth-order basis of Eggemeier, Scoccimarro & Smith 2019; docs/bispectrum.md): {}",
+            values.join(", ")
+        ),
+        "B_1loop = B_tree + B222 + B321_I + B321_II + B411 with the galaxy kernels K_n (Z_n^g in redshift \
+         space) in place of F_n (Z_n); B321_II and B411 renormalised: their q -> infinity constants times \
+         sigma^2 = int P over the loop range subtracted (uv_B321_II, uv_B411; bare = renormalised + uv); \
+         no counterterms, stochastic terms, IR resummation, orientation average or bins yet"
+            .into(),
+        format!(
+            "loop integrals over {} <= |q| <= {} h/Mpc about each cusp (smooth partition of unity, power {}); \
+             {} ln q x {} cos(theta) x {} phi nodes per panel; err_: difference from the rule with half the \
+             nodes; loop terms: direct integration",
+            rule.q_min, rule.q_max, PARTITION_POWER, rule.radial, rule.mu, rule.phi
+        ),
+        "at the given triangles (not averaged over bins); linear spectrum: all matter".into(),
+    ];
+    header.extend(prepared.description.iter().cloned());
+    let mut t = Table::new(header);
+    t.methods.push(MethodNote::new("loop terms", "direct"));
+    one_loop_columns(&mut t, &rows);
+    for (j, name) in ["uv_B321_II", "uv_B411"].iter().enumerate() {
+        t.push(*name, BISPECTRUM, uv.iter().map(|u| u[j]).collect());
+    }
+    Ok(t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{loop_bias, LOOP_BIAS_NAMES};
+    use crate::bias::BiasParams;
+    use crate::bispectrum::bias_kernels::LoopBias;
+
+    #[test]
+    fn the_faces_bias_is_the_velocileptors_map_with_named_coefficients_in_place() {
+        let bias = BiasParams {
+            b1: 2.0,
+            b2: 0.5,
+            bs: -0.3,
+            b3: 0.0,
+        };
+        // without b_Γ3 or overrides: the library's map from velocileptors' (b1, b2, bs)
+        assert_eq!(
+            loop_bias(&bias, 0.0, &[]).unwrap(),
+            LoopBias::from_velocileptors(2.0, 0.5, -0.3)
+        );
+        // each settable name replaces its coefficient and nothing else
+        let base = loop_bias(&bias, 0.1, &[]).unwrap().values();
+        for name in LOOP_BIAS_NAMES {
+            let set = loop_bias(&bias, 0.1, &[(name.to_string(), 7.5)])
+                .unwrap()
+                .values();
+            for (i, (s, b)) in set.iter().zip(base).enumerate() {
+                let expected = if LoopBias::NAMES[i] == name { 7.5 } else { b };
+                assert_eq!(*s, expected, "{name}: slot {}", LoopBias::NAMES[i]);
+            }
+        }
+        for bad in ["b1", "b2", "g2", "bs", "g4"] {
+            let e = loop_bias(&bias, 0.0, &[(bad.to_string(), 1.0)]).unwrap_err();
+            assert!(e.to_string().contains("valid: b3, g2x"), "{e}");
+        }
+        let twice = [("g21".to_string(), 1.0), ("g21".to_string(), 2.0)];
+        assert!(loop_bias(&bias, 0.0, &twice).is_err());
+        assert!(loop_bias(&bias, f64::NAN, &[]).is_err());
+    }
+}
