@@ -41,16 +41,21 @@
 //! exactly (L21), (L31) is unchecked.
 //!
 //! **Completeness.** The fourth-order remainders (after their lower orders) of three generated Galilean
-//! invariant fields are exactly in this basis (`check_bias_basis_conventions.py`, 80 configurations, residuals
-//! ≤ 9e-16 of remainders 0.03–0.4; `check_gamma3_span.py`; the Rust tests `the_maps_are_exact_through_fourth_order`,
-//! `delta_minus_theta_is_in_the_span`): Γ₃ = G₂(Φ_g) − G₂(Φ_v) = −(4/7)G₂(φ₂, φ₁) − (4/7)G₃(φ₂, φ₁, φ₁) +
-//! (16/49)G₂(φ₂, φ₂) + 8G₂(φ₃, φ₁), G₂(Φ_g, Φ_v) − G₂(Φ_v) (half of each) and δ − θ = −(2/7)G₂(Φ_v) +
-//! (4/63)G₃(Φ_v) − (8/147)G₂(φ₂, φ₁) − (16/539)G₃(φ₂, φ₁, φ₁) + (72/3773)G₂(φ₂, φ₂) + (48/77)G₂(φ₃, φ₁)
-//! (through fourth order). With the Eulerian fourth order of G₂(φ₂, φ₁) instead, no single G₂(φ₃, φ₁) holds
-//! both Γ₃ and δ − θ (residual 1.2% of δ − θ's remainder). The four local fourth-order operators (δ⁴,
-//! δ²G₂, G₂², δG₃) are not here: at one loop they enter only B₄₁₁, as pure renormalisations of b2 and g2
-//! (ESS19; Philcox et al.), so eleven parameters remain (as D'Amico et al. 2022, arXiv:2206.08327, count in
-//! their basis).
+//! invariant fields are exactly in this basis (`check_bias_basis_conventions.py`, 80 configurations,
+//! residuals ≤ 9e-16 of remainders 0.03–0.4; `check_gamma3_span.py`; the Rust tests
+//! `the_maps_are_exact_through_fourth_order`, `delta_minus_theta_is_in_the_span`), through fourth order:
+//!
+//! ```text
+//! Γ₃ = G₂(Φ_g) − G₂(Φ_v) = −(4/7)G₂(φ₂, φ₁) − (4/7)G₃(φ₂, φ₁, φ₁) + (16/49)G₂(φ₂, φ₂) + 8 G₂(φ₃, φ₁),
+//! G₂(Φ_g, Φ_v) − G₂(Φ_v) = −(2/7)G₂(φ₂, φ₁) − (2/7)G₃(φ₂, φ₁, φ₁) + (6/49)G₂(φ₂, φ₂) + 4 G₂(φ₃, φ₁),
+//! δ − θ = −(2/7)G₂(Φ_v) + (4/63)G₃(Φ_v) − (8/147)G₂(φ₂, φ₁)
+//!         − (16/539)G₃(φ₂, φ₁, φ₁) + (72/3773)G₂(φ₂, φ₂) + (48/77)G₂(φ₃, φ₁).
+//! ```
+//!
+//! With the Eulerian fourth order of G₂(φ₂, φ₁) instead, no single G₂(φ₃, φ₁) holds both Γ₃ and δ − θ
+//! (residual 1.2% of δ − θ's remainder). The four local fourth-order operators (δ⁴, δ²G₂, G₂², δG₃) are not
+//! here: at one loop they enter only B₄₁₁, as pure renormalisations of b2 and g2 (ESS19; Philcox et al.), so
+//! eleven parameters remain (as D'Amico et al. 2022, arXiv:2206.08327, count in their basis).
 //!
 //! **Map to this crate's convention** (velocileptors': (b2/2)δ² + bs s², s² = G₂(Φ_g) + (2/3)δ² at every
 //! order; CLASS-PT's (b2/2)δ² + b_G2 G₂(Φ_g) + b_Γ3 Γ₃, Γ₃ = G₂(Φ_g) − G₂(Φ_v)): G₂(Φ_g) = G₂(Φ_v) + Γ₃ and Γ₃

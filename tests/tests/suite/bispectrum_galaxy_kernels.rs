@@ -312,7 +312,7 @@ fn the_maps_are_exact_through_fourth_order() {
             assert!(note(got, want), "velocileptors, n = {n}: {got} vs {want}");
         }
     }
-    eprintln!("maps against the written-out CLASS-PT and velocileptors kernels: largest difference {worst:.1e}");
+    eprintln!("maps against the written-out CLASS-PT, velocileptors kernels: largest difference {worst:.1e}");
 }
 
 /// The basis holds δ − θ, the generated Galilean-invariant field that the Eulerian G₂(φ₂, φ₁) of fourth
