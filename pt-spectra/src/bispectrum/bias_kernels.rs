@@ -14,48 +14,57 @@
 //!     + g21x δ G₂(φ₂, φ₁) + g211 G₃(φ₂, φ₁, φ₁) + g22 G₂(φ₂, φ₂) + g31 G₂(φ₃, φ₁),
 //! ```
 //!
-//! with ∇²φ₃ = G₃(φ₁) − (24/7) G₂(φ₂, φ₁) at its lowest order (so G₂(φ₃, φ₁) is of fourth order only, kernel
-//! K(q₁, q₂₃₄)[L(q₂, q₃, q₄) − (24/7)K(q₂₃, q₄)K(q₂, q₃)] in (q₁ | q₂ q₃ q₄)), and G₂(φ₂, φ₁) built from the
-//! nonlinear Eulerian fields (δ = Σ F_n inside φ₁ and φ₂) at fourth order.
+//! with two operators defined in Lagrangian space (the "L" convention of
+//! `tests/data/bispectrum/check_bias_basis_conventions.py`):
+//!
+//! - (L21) G₂(φ₂, φ₁) is the operator of the linear (Lagrangian) potentials carried to x by the flow with the
+//!   number density, FT = ∫d³q e^{−ik·(q+Ψ)} O(q): third-order kernel sym K(q₁, q₂₃)K(q₂, q₃) (the same as
+//!   the Eulerian one), fourth-order kernel sym K(q₁, q₂₃)K(q₂, q₃) k·q₄/q₄² (k the total momentum; the
+//!   Zel'dovich displacement −ik·Ψ₁ of the fourth argument);
+//! - (L31) φ₃ is the 3LPT potential with its transverse part, ∇²φ₃ = −∇_q·Ψ⁽³⁾ = (1/18)[(15/7)G₂(φ₂, φ₁) −
+//!   G₃(φ₁)] (1LPT–3LPT with it reproduce F₃ to 5e-15), so G₂(φ₃, φ₁) is of fourth order only, kernel
+//!   sym (1/18)K(q₁, q₂₃₄)[(15/7)K(q₂₃, q₄)K(q₂, q₃) − L(q₂, q₃, q₄)] + (1/14)[M(q₁, q₂₃, q₄, q₂₃₄) −
+//!   M(q₁, q₂₃₄, q₂₃, q₄)]K(q₂, q₃), M(a, b, c, d) = (â·b̂)(b̂·ĉ)(ĉ·d̂)(d̂·â): Philcox et al.'s `Kernels.nb`
+//!   G₃₁ kernel.
+//!
+//! The other operators are products and Galileons of the nonlinear Eulerian fields (δ = Σ F_n, θ = Σ G_n);
+//! the fourth-order ones g21x, g211, g22 at their lowest order (the same in either convention).
 //!
 //! **Against ESS19** (their text was not readable here, so no equation numbers; checked instead against the
 //! kernels of Philcox et al.'s `Kernels.nb`, which "follows 1812.03208", Eggemeier's talk slides for G₂, G₃
-//! and γ₂, and own derivations, `tests/data/bispectrum/check_bias_basis_conventions.py`): G₂ = (∇_ijΦ)² −
-//! (∇²Φ)² and G₃ = (∇²Φ)³ + 2∇_ijΦ∇_jkΦ∇_kiΦ − 3(∇_ijΦ)²∇²Φ give the kernels K and L used here; ∇²φ₁ = δ,
-//! ∇²φ₂ = G₂(φ₁) (not the 2LPT potential's −(3/14)G₂(φ₁)); the kernels of b2, g2, b3, g2x, g3, g21 (third and
-//! fourth order), g21x, g211 and g22 are the notebook's. Lagrangian local bias b₁ᴸ gives g2 = −(2/7)b₁ᴸ and
-//! g21 = −(22/147)b₁ᴸ, which the map below reproduces from CLASS-PT's b_G2 = −(2/7)b₁ᴸ, b_Γ3 = (23/42)b₁ᴸ.
-//! G₂(φ₃, φ₁) differs, and not by a relabelling: the notebook's φ₃ is the 3LPT potential, ∇²φ₃ = −∇_q·Ψ⁽³⁾ =
-//! (1/18)[(15/7)G₂(φ₂, φ₁) − G₃(φ₁)] (it reproduces F₃ through 3LPT to 5e-15), with a transverse part
-//! (1/14)[M(q₁, q₂₃, q₄, q₂₃₄) − M(q₁, q₂₃₄, q₂₃, q₄)]K(q₂, q₃), M(a, b, c, d) = â·b̂ b̂·ĉ ĉ·d̂ d̂·â; this
-//! crate's G₂(φ₃, φ₁) = −18 G₂(φ₃^3LPT,∥, φ₁) − (9/7) G₂(φ₁, ∇⁻²G₂(φ₂, φ₁)), the last operator in no other
-//! slot, so no coefficient map exists.
+//! and γ₂, and own derivations, `check_bias_basis_conventions.py`): G₂ = (∇_ijΦ)² − (∇²Φ)² and G₃ = (∇²Φ)³ +
+//! 2∇_ijΦ∇_jkΦ∇_kiΦ − 3(∇_ijΦ)²∇²Φ give the kernels K and L used here; ∇²φ₁ = δ, ∇²φ₂ = G₂(φ₁) (not the 2LPT
+//! potential's −(3/14)G₂(φ₁)); the kernels of b2, g2, b3, g2x, g3, g21 (third order), g21x, g211, g22 and
+//! g31 are the notebook's; its G₂(φ₂, φ₁) at fourth order is the Eulerian one (δ = Σ F_n inside φ₁, φ₂),
+//! not (L21). Lagrangian local bias b₁ᴸ gives g2 = −(2/7)b₁ᴸ and g21 = −(22/147)b₁ᴸ, which the map below
+//! reproduces from CLASS-PT's b_G2 = −(2/7)b₁ᴸ, b_Γ3 = (23/42)b₁ᴸ. Whether ESS19's own prescription is
+//! exactly (L21), (L31) is unchecked.
 //!
-//! **Completeness (open).** Fourth-order remainders of three generated Galilean-invariant fields, after their
-//! lower orders: Γ₃ = G₂(Φ_g) − G₂(Φ_v) and G₂(Φ_g, Φ_v) − G₂(Φ_v) are held exactly by this basis, but δ − θ is
-//! not (1.2% residual): Γ₃ needs C₂ − (24/7)C₁ and δ − θ needs C₁/C₂ = −41/14 plus the transverse M part
-//! (C₁ = K(q₁, q₂₃₄)K(q₂₃, q₄)K(q₂, q₃), C₂ = K(q₁, q₂₃₄)L(q₂, q₃, q₄)), so with the Eulerian nonlinear
-//! G₂(φ₂, φ₁) no single G₃₁ completes the basis (∇⁻² of a nonlinear field is not a generated operator). The
-//! Lagrangian convention holds all three exactly: G₂(φ₂, φ₁) of the linear potentials carried by the flow
-//! with the number density (fourth-order kernel sym K(q₁, q₂₃)K(q₂, q₃)·k·q₄/q₄², k the total) and the 3LPT
-//! G₂(φ₃, φ₁) with its transverse part, where Γ₃'s remainder is −(4/7)G₃(φ₂, φ₁, φ₁) + (16/49)G₂(φ₂, φ₂) +
-//! 8 G₂(φ₃, φ₁). The notebook mixes the two (Eulerian G₂(φ₂, φ₁), 3LPT φ₃) and holds neither Γ₃ (2.4e-2 of its
-//! kernel, `check_gamma3_span.py`) nor δ − θ. The CLASS-PT and velocileptors maps below stay exact (Γ₃ is in the
-//! span); a general tracer's B₄₁₁ is not fully covered until the kernels move to the Lagrangian convention
-//! (with the maps (g21, g211, g22, g31) = (−4/7, −4/7, 16/49, 8)(b_G2 + b_Γ3) and new Monte Carlo tables).
-//! The four local
-//! fourth-order operators (δ⁴, δ²G₂, G₂², δG₃) are not here: at one loop they enter only B₄₁₁, as pure
-//! renormalisations of b2 and g2 (ESS19; Philcox et al.), so eleven parameters remain (as D'Amico et al.
-//! 2022, arXiv:2206.08327, count in their basis).
+//! **Completeness.** The fourth-order remainders (after their lower orders) of three generated Galilean
+//! invariant fields are exactly in this basis (`check_bias_basis_conventions.py`, 80 configurations,
+//! residuals ≤ 9e-16 of remainders 0.03–0.4; `check_gamma3_span.py`; the Rust tests
+//! `the_maps_are_exact_through_fourth_order`, `delta_minus_theta_is_in_the_span`), through fourth order:
+//!
+//! ```text
+//! Γ₃ = G₂(Φ_g) − G₂(Φ_v) = −(4/7)G₂(φ₂, φ₁) − (4/7)G₃(φ₂, φ₁, φ₁) + (16/49)G₂(φ₂, φ₂) + 8 G₂(φ₃, φ₁),
+//! G₂(Φ_g, Φ_v) − G₂(Φ_v) = −(2/7)G₂(φ₂, φ₁) − (2/7)G₃(φ₂, φ₁, φ₁) + (6/49)G₂(φ₂, φ₂) + 4 G₂(φ₃, φ₁),
+//! δ − θ = −(2/7)G₂(Φ_v) + (4/63)G₃(Φ_v) − (8/147)G₂(φ₂, φ₁)
+//!         − (16/539)G₃(φ₂, φ₁, φ₁) + (72/3773)G₂(φ₂, φ₂) + (48/77)G₂(φ₃, φ₁).
+//! ```
+//!
+//! With the Eulerian fourth order of G₂(φ₂, φ₁) instead, no single G₂(φ₃, φ₁) holds both Γ₃ and δ − θ
+//! (residual 1.2% of δ − θ's remainder). The four local fourth-order operators (δ⁴, δ²G₂, G₂², δG₃) are not
+//! here: at one loop they enter only B₄₁₁, as pure renormalisations of b2 and g2 (ESS19; Philcox et al.), so
+//! eleven parameters remain (as D'Amico et al. 2022, arXiv:2206.08327, count in their basis).
 //!
 //! **Map to this crate's convention** (velocileptors': (b2/2)δ² + bs s², s² = G₂(Φ_g) + (2/3)δ² at every
-//! order; CLASS-PT's (b2/2)δ² + b_G2 G₂(Φ_g) + b_Γ3 Γ₃, Γ₃ = G₂(Φ_g) − G₂(Φ_v)): G₂(Φ_g) = G₂(Φ_v) + Γ₃ and
-//! Γ₃ = −(4/7)G₂(φ₂, φ₁) − (4/49)G₂(φ₂, φ₂) + (8/63)G₂(φ₃, φ₁) through fourth order, so, exactly for the
-//! one-loop bispectrum ([`LoopBias::from_velocileptors`], [`LoopBias::from_class_pt`]):
+//! order; CLASS-PT's (b2/2)δ² + b_G2 G₂(Φ_g) + b_Γ3 Γ₃, Γ₃ = G₂(Φ_g) − G₂(Φ_v)): G₂(Φ_g) = G₂(Φ_v) + Γ₃ and Γ₃
+//! as above through fourth order, so, exactly for the one-loop bispectrum ([`LoopBias::from_velocileptors`],
+//! [`LoopBias::from_class_pt`]):
 //!
 //! ```text
 //! g2 = b_G2 = bs,   b2 = b2^CLASS-PT = b2^velocileptors + (4/3) bs,
-//! (g21, g22, g31) = (−4/7, −4/49, 8/63) × (b_G2 + b_Γ3)   [× bs from velocileptors],
+//! (g21, g211, g22, g31) = (−4/7, −4/7, 16/49, 8) × (b_G2 + b_Γ3)   [× bs from velocileptors],
 //! ```
 //!
 //! the others zero.
@@ -161,8 +170,9 @@ impl LoopBias {
             b2,
             g2: b_g2,
             g21: -4.0 / 7.0 * gamma,
-            g22: -4.0 / 49.0 * gamma,
-            g31: 8.0 / 63.0 * gamma,
+            g211: -4.0 / 7.0 * gamma,
+            g22: 16.0 / 49.0 * gamma,
+            g31: 8.0 * gamma,
             ..Self::default()
         }
     }
@@ -332,8 +342,15 @@ impl Table {
         }
         self.p2[s] = p2;
         self.g2v[s] = g2v;
+        // G₂(φ₂, φ₁) is the Lagrangian operator carried by the flow with the number density (module docs):
+        // its fourth order is the third order of three arguments times the Zel'dovich displacement of the
+        // fourth, the product Σ_A [3!1!/4!] G21_A (k_S·k_B/k_B²) over the three-element subsets A, B = S∖A.
+        let (g21, g31) = if m == 4 {
+            (self.g21_carried(s), g31_kernel(&members))
+        } else {
+            (g21, 0.0)
+        };
         self.g21[s] = g21;
-        let g31 = if m == 4 { g31_kernel(&members) } else { 0.0 };
         self.ops[s] = [
             self.f[s],
             0.5 * dd,
@@ -347,6 +364,19 @@ impl Table {
             g22,
             g31,
         ];
+    }
+
+    /// G₂(φ₂, φ₁)'s fourth order on the four-element set `s` (module docs, eq. (L21)): the average over
+    /// orderings of K(q₁, q₂₃)K(q₂, q₃) k·q₄/q₄², k = k_S, as the subset product of the third-order operator
+    /// (zero on a block of zero momentum: normal ordering) and the first-order displacement −ik·Ψ₁.
+    fn g21_carried(&self, s: usize) -> f64 {
+        let ks = &self.ks[s];
+        let mut sum = 0.0;
+        for a in submasks(s).filter(|&a| count(a) == 3 && self.ks2[a] > 0.0) {
+            let b = s ^ a;
+            sum += self.g21[a] * dot(ks, &self.ks[b]) / self.ks2[b];
+        }
+        sum * FACT[3] * FACT[1] / FACT[4]
     }
 
     /// The galaxy kernel of the subset `s` (zero if its momentum vanishes).
@@ -363,17 +393,36 @@ impl Table {
     }
 }
 
-/// G₂(φ₃, φ₁)'s symmetrised kernel at fourth order (module docs): the average over the 24 orderings of
-/// K(q₁, q₂₃₄)[L(q₂, q₃, q₄) − (24/7) K(q₂₃, q₄) K(q₂, q₃)].
+/// â·b̂, zero if either vector vanishes.
+fn cosine(a: &Vec3, b: &Vec3) -> f64 {
+    let (a2, b2) = (dot(a, a), dot(b, b));
+    if a2 == 0.0 || b2 == 0.0 {
+        return 0.0;
+    }
+    dot(a, b) / (a2 * b2).sqrt()
+}
+
+/// M(a, b, c, d) = (â·b̂)(b̂·ĉ)(ĉ·d̂)(d̂·â), zero if a vector vanishes.
+fn mm(a: &Vec3, b: &Vec3, c: &Vec3, d: &Vec3) -> f64 {
+    cosine(a, b) * cosine(b, c) * cosine(c, d) * cosine(d, a)
+}
+
+/// G₂(φ₃, φ₁)'s symmetrised kernel at fourth order, φ₃ the 3LPT potential with its transverse part (module
+/// docs, eq. (L31)): the average over the 24 orderings of (1/18)K(q₁, q₂₃₄)[(15/7)K(q₂₃, q₄)K(q₂, q₃) −
+/// L(q₂, q₃, q₄)] + (1/14)[M(q₁, q₂₃, q₄, q₂₃₄) − M(q₁, q₂₃₄, q₂₃, q₄)]K(q₂, q₃).
 fn g31_kernel(q: &[Vec3]) -> f64 {
     let n2 = |v: &Vec3| dot(v, v);
     let mut sum = 0.0;
     for p in PERMS4 {
         let [a, b, c, d] = p.map(|i| q[i]);
         let (bc, bcd) = (add(b, c), add(add(b, c), d));
-        let inner = ll([&b, &c, &d], [n2(&b), n2(&c), n2(&d)])
-            - 24.0 / 7.0 * kk(&bc, &d, n2(&bc), n2(&d)) * kk(&b, &c, n2(&b), n2(&c));
-        sum += kk(&a, &bcd, n2(&a), n2(&bcd)) * inner;
+        let kbc = kk(&b, &c, n2(&b), n2(&c));
+        let longitudinal = kk(&a, &bcd, n2(&a), n2(&bcd))
+            * (15.0 / 7.0 * kk(&bc, &d, n2(&bc), n2(&d)) * kbc
+                - ll([&b, &c, &d], [n2(&b), n2(&c), n2(&d)]))
+            / 18.0;
+        let transverse = (mm(&a, &bc, &d, &bcd) - mm(&a, &bcd, &bc, &d)) * kbc / 14.0;
+        sum += longitudinal + transverse;
     }
     sum / 24.0
 }

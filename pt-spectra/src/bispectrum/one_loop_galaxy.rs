@@ -1,7 +1,8 @@
 //! The one-loop GALAXY bispectrum (biased tracers), real space and redshift space at one orientation, by
 //! direct integrals: the terms of [`super::one_loop`] and [`super::one_loop_rsd`] with the galaxy kernels
 //! K_n (real space) or Z_n^g (redshift space) of [`super::bias_kernels`] (the bias basis of Eggemeier,
-//! Scoccimarro & Smith 2019, [`LoopBias`]) in place of F_n or Z_n, and K₁ = b1 (Z₁ = b1 + fμ²) on every
+//! Scoccimarro & Smith 2019, [`LoopBias`], with G₂(φ₂, φ₁) and G₂(φ₃, φ₁) in the Lagrangian convention, in
+//! which it holds Γ₃ and δ − θ at fourth order) in place of F_n or Z_n, and K₁ = b1 (Z₁ = b1 + fμ²) on every
 //! linear leg; the same quadrature, partition of unity and error estimates:
 //!
 //! ```text

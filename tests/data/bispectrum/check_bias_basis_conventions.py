@@ -3,10 +3,12 @@ G₂(φ₂, φ₁) (issue 50 follow-up). Own EdS recursion and operator kernels 
 orderings of the arguments, every product on consecutive blocks), 80 random configurations.
 
 Two conventions for the pair (G₂(φ₂, φ₁) at fourth order, G₂(φ₃, φ₁)):
-  E (this crate): G₂(φ₂, φ₁) of the nonlinear Eulerian fields (∇²φ₁ = δ, ∇²φ₂ = G₂(φ₁) with δ = Σ F_n), as
-    also in Philcox et al.'s OneLoopBispectrum `Kernels.nb`; ∇²φ₃ = G₃(φ₁) − (24/7) G₂(φ₂, φ₁).
-  L (Lagrangian potentials): G₂(φ₂, φ₁) built from the linear (Lagrangian) potentials and carried to x by the
-    flow with the number density, FT = ∫d³q e^{−ik·(q+Ψ)} O(q) (fourth order: its kernel times k·q₄/q₄²);
+  E (Eulerian): G₂(φ₂, φ₁) of the nonlinear Eulerian fields (∇²φ₁ = δ, ∇²φ₂ = G₂(φ₁) with δ = Σ F_n), as
+    in Philcox et al.'s OneLoopBispectrum `Kernels.nb`; ∇²φ₃ = G₃(φ₁) − (24/7) G₂(φ₂, φ₁) (the one G₃₁ that
+    holds Γ₃ in E).
+  L (Lagrangian potentials; pt_spectra::bispectrum::bias_kernels, make_one_loop_galaxy_mc.py): G₂(φ₂, φ₁)
+    built from the linear (Lagrangian) potentials and carried to x by the flow with the number density,
+    FT = ∫d³q e^{−ik·(q+Ψ)} O(q) (fourth order: its kernel times k·q₄/q₄²);
     φ₃ the 3LPT potential, the `Kernels.nb` G₃₁ kernel (1/18)K(q₁, q₂₃₄)[(15/7)K(q₂₃, q₄)K(q₂, q₃) −
     L(q₂, q₃, q₄)] + (1/14)[M(q₁, q₂₃, q₄, q₂₃₄) − M(q₁, q₂₃₄, q₂₃, q₄)]K(q₂, q₃) (with the transverse part).
 
@@ -132,7 +134,7 @@ def g3v(p):
 
 
 def rat(x):
-    return str(Fraction(float(x)).limit_denominator(2000))
+    return str(Fraction(float(x)).limit_denominator(100000))
 
 
 # 1. 3LPT

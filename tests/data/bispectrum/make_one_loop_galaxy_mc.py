@@ -15,8 +15,14 @@ trilinear G3(a, b, c) (kernel L = 1 - mu12^2 - mu23^2 - mu31^2 + 2 mu12 mu23 mu3
           + b3/6 delta^3 + g2x delta G2(Phi_v) + g3 G3(Phi_v) + g21 G2(phi_2, phi_1)
           + g21x delta G2(phi_2, phi_1) + g211 G3(phi_2, phi_1, phi_1) + g22 G2(phi_2, phi_2) + g31 G2(phi_3, phi_1),
 
-nabla^2 phi_3 = G3(phi_1) - (24/7) G2(phi_2, phi_1) at its lowest (third) order: G2(phi_3, phi_1) of fourth order
-only, unsymmetrised kernel (q1 | q2 q3 q4) K(q1, q234) [L(q2, q3, q4) - (24/7) K(q23, q4) K(q2, q3)].
+in the Lagrangian convention of check_bias_basis_conventions.py ("L", complete at fourth order):
+  G2(phi_2, phi_1) is the operator of the linear potentials carried by the flow with the number density,
+    FT = int d^3q e^{-ik.(q + Psi)} O(q): unsymmetrised third order K(q12, q3) K(q1, q2), fourth order the same
+    on (q1, q2, q3) times k.q4/q4^2 (k the total momentum: the Zel'dovich displacement of q4);
+  phi_3 is the 3LPT potential with its transverse part, G2(phi_3, phi_1) of fourth order only, unsymmetrised
+    kernel (q1 | q2 q3 q4) (1/18) K(q1, q234) [(15/7) K(q23, q4) K(q2, q3) - L(q2, q3, q4)]
+    + (1/14) [M(q1, q23, q4, q234) - M(q1, q234, q23, q4)] K(q2, q3), M(a, b, c, d) = (a.b)(b.c)(c.d)(d.a) of
+    the unit vectors.
 
 Independent of the Rust code (pt_spectra::bispectrum::bias_kernels builds symmetrised kernels on subsets with
 factorial weights): here every operator's kernel is built UNSYMMETRISED on an ordering of its arguments, each
@@ -28,8 +34,8 @@ K4(q, -q, -k_b, -k_c) less their q -> infinity angular averages of the non-b1 pa
 rule over the whole sphere, Richardson from q = 1e3 and 2e3 k_max). In redshift space the mapping of make_one_loop_rsd_mc.py with
 D(S) = K_S + f mu_S^2 G_S (the galaxy density replaces the matter's, the velocity is unbiased).
 
-    python3 tests/data/bispectrum/make_one_loop_galaxy_mc.py --f 0 --samples 131072     (~8 min per triangle)
-    python3 tests/data/bispectrum/make_one_loop_galaxy_mc.py --f 0.7 --samples 65536    (numpy, scipy)
+    python3 tests/data/bispectrum/make_one_loop_galaxy_mc.py --f 0 --samples 131072     (numpy, scipy; 5.6 min
+    python3 tests/data/bispectrum/make_one_loop_galaxy_mc.py --f 0.7 --samples 65536    and 3.6 min on one core)
 """
 
 import argparse
@@ -114,7 +120,19 @@ class Fields:
         return sum((self.d(a) * self.get("g2v", b) for a, b in self.cuts2(vs)), 0.0)
 
     def _g21(self, vs):
-        return sum((kk(self.k(a), self.k(b)) * self.get("p2", a) * self.d(b) for a, b in self.cuts2(vs)), 0.0)
+        """G2(phi_2, phi_1) of the linear (Lagrangian) potentials, carried to x by the flow with the number
+        density: FT = int d^3q e^{-ik.(q + Psi)} O(q). Third order: the operator itself (K(q12, q3) K(q1, q2)
+        on this ordering); fourth order: the third order of the first three arguments times the Zel'dovich
+        displacement of the last, -ik.Psi_1(q4) -> k.q4/q4^2 (k the total momentum)."""
+        if len(vs) < 3:
+            return 0.0
+        q = [self.v[i] for i in vs]
+        lagrangian = kk(q[0] + q[1], q[2]) * kk(q[0], q[1])
+        if len(vs) == 3:
+            return lagrangian
+        inner, q4 = q[0] + q[1] + q[2], q[3]
+        block = dot(inner, inner) > 0  # a zero-momentum operator block is normal-ordered away
+        return np.where(block, lagrangian * dot(inner + q4, q4) / dot(q4, q4), 0.0)
 
     def _dg21(self, vs):
         return sum((self.d(a) * self.get("g21", b) for a, b in self.cuts2(vs)), 0.0)
@@ -132,7 +150,13 @@ class Fields:
             return 0.0
         q1, q2, q3, q4 = (self.v[i] for i in vs)
         q23, q234 = q2 + q3, q2 + q3 + q4
-        return kk(q1, q234) * (ll(q2, q3, q4) - 24.0 / 7.0 * kk(q23, q4) * kk(q2, q3))
+        longitudinal = kk(q1, q234) * (15.0 / 7.0 * kk(q23, q4) * kk(q2, q3) - ll(q2, q3, q4)) / 18.0
+
+        def m(a, b, c, d):  # (a.b)(b.c)(c.d)(d.a) of the unit vectors, zero if one vanishes
+            return _cos(a, b)[0] * _cos(b, c)[0] * _cos(c, d)[0] * _cos(d, a)[0]
+
+        transverse = (m(q1, q23, q4, q234) - m(q1, q234, q23, q4)) * kk(q2, q3) / 14.0
+        return longitudinal + transverse
 
     def galaxy(self, vs, bias):
         """The unsymmetrised galaxy kernel of the ordered block vs (zero if its momentum vanishes)."""
