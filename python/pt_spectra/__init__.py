@@ -500,7 +500,7 @@ def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=No
     ``radial`` x ``mu`` x ``phi`` nodes per panel (errors: the difference from half the nodes; about
     0.25 s per triangle on 2 cores). Returns a ``Table``: k1 k2 k3 B_tree B222 B321_I B321_II B411
     B_1loop, their err_ columns, and the four EFT counterterm shapes shape_ct_f2, shape_ct_k3,
-    shape_ct_tidal, shape_ct_f2k3 [(Mpc/h)^8] (B_ct = sum of ct_c * shape_ct_c, ct_c in (Mpc/h)^2, not
+    shape_ct_tidal, shape_ct_f2k3 [(Mpc/h)^4] (B_ct = sum of ct_c * shape_ct_c, ct_c in (Mpc/h)^2, not
     included in B_1loop). No bias or redshift space yet (docs/bispectrum.md).
 
     ``two_loop`` says how the loop terms are computed, as for the power spectra: ``"basis"`` (tensors

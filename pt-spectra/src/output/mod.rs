@@ -33,8 +33,8 @@ pub const POWER: &str = "(Mpc/h)^3";
 pub const BISPECTRUM: &str = "(Mpc/h)^6";
 /// The unit of wavenumbers.
 pub const WAVENUMBER: &str = "h/Mpc";
-/// Unit of a bispectrum counterterm shape (a bispectrum per coefficient in (Mpc/h)²).
-pub const BISPECTRUM_SHAPE: &str = "(Mpc/h)^8";
+/// Unit of a bispectrum counterterm shape: P P k², a bispectrum per coefficient in (Mpc/h)².
+pub const BISPECTRUM_SHAPE: &str = "(Mpc/h)^4";
 
 /// One column: its name, unit and a value per row.
 #[derive(Debug, Clone, PartialEq)]
