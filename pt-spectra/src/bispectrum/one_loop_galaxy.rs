@@ -88,7 +88,7 @@ impl OneLoopGalaxy {
 }
 
 /// σ² = ∫_q P(q) on the radial and angular nodes of the loop terms about q = 0.
-fn sigma2(p: &LinearSpectrum, k: &[f64; 3], rule: &OneLoopRule, mirror: bool) -> f64 {
+pub(super) fn sigma2(p: &LinearSpectrum, k: &[f64; 3], rule: &OneLoopRule, mirror: bool) -> f64 {
     let angular: f64 = angular_nodes(rule, mirror).iter().map(|(_, w)| w).sum();
     let radial: f64 = radial_nodes(rule, &breaks(k))
         .iter()
