@@ -197,7 +197,7 @@ fn support(n: usize, redshift: bool) -> Vec<usize> {
         .collect()
 }
 
-fn monomial(p: usize, q: usize, r: usize) -> Monomial {
+pub(super) fn monomial(p: usize, q: usize, r: usize) -> Monomial {
     let mut m = [p as u8, q as u8, r as u8];
     m.sort_unstable();
     m
@@ -212,16 +212,16 @@ fn put(sums: &mut BTreeMap<Monomial, [f64; 2]>, m: Monomial, fine: f64, coarse: 
 
 /// The supports of the kernels of orders 1 to 4 and where each integral's sums lie in one flat vector:
 /// B₂₂₂'s [s₂]³, B₃₂₁ᴵ's [3 a][3 b][s₃][s₂], B₄₁₁'s [3][s₄], J's [3][s₃].
-struct Layout {
-    s: [Vec<usize>; 5],
-    o321: usize,
-    o411: usize,
-    oj: usize,
-    len: usize,
+pub(super) struct Layout {
+    pub(super) s: [Vec<usize>; 5],
+    pub(super) o321: usize,
+    pub(super) o411: usize,
+    pub(super) oj: usize,
+    pub(super) len: usize,
 }
 
 impl Layout {
-    fn new(redshift: bool) -> Self {
+    pub(super) fn new(redshift: bool) -> Self {
         let s: [Vec<usize>; 5] = std::array::from_fn(|n| support(n, redshift));
         let (n2, n3, n4) = (s[2].len(), s[3].len(), s[4].len());
         let o321 = n2 * n2 * n2;
@@ -236,7 +236,7 @@ impl Layout {
         }
     }
 
-    fn i321(&self, a: usize, b: usize, i: usize, j: usize) -> usize {
+    pub(super) fn i321(&self, a: usize, b: usize, i: usize, j: usize) -> usize {
         self.o321 + ((3 * a + b) * self.s[3].len() + i) * self.s[2].len() + j
     }
 }
@@ -321,14 +321,17 @@ fn loop_sums(
         )
 }
 
+/// c₃(k_a)[p] and c₄(k_b, k_c)[p] of [`uv_parts`].
+pub(super) type UvParts = ([[f64; N_PARTS]; 3], [[f64; N_PARTS]; 3]);
+
 /// The UV constants per part, c₃(k_a)[p] and c₄(k_b, k_c)[p], of the bias operators' parts (p ≥ 2; zero for
 /// the constant and b1), as [`super::one_loop_galaxy`]'s (the same angular rule, radii and extrapolation).
-fn uv_parts(
+pub(super) fn uv_parts(
     redshift: Option<(f64, Vec3)>,
     kv: &[Vec3; 3],
     rule: &OneLoopRule,
     mirror: bool,
-) -> ([[f64; N_PARTS]; 3], [[f64; N_PARTS]; 3]) {
+) -> UvParts {
     let angular = angular_nodes(rule, mirror);
     let total: f64 = angular.iter().map(|(_, w)| w).sum();
     let k_max = kv.iter().map(|v| norm(*v)).fold(0.0, f64::max);
@@ -381,19 +384,49 @@ pub fn one_loop_galaxy_polynomial(
     };
     let mirror = rsd.is_none_or(|(_, los)| los[1] == 0.0);
     let lay = Layout::new(rsd.is_some());
-    let (s1, s2, s3, s4) = (&lay.s[1], &lay.s[2], &lay.s[3], &lay.s[4]);
     let pk = kv.map(|v| p.eval(norm(v)));
+    let half = rule.half();
+    let sums = LoopSums {
+        fine: loop_sums(p, &kv, rule, rsd, &lay),
+        coarse: loop_sums(p, &kv, &half, rsd, &lay),
+        sigma2: [sigma2(p, &k, rule, mirror), sigma2(p, &k, &half, mirror)],
+    };
+    let uv = uv_parts(rsd, &kv, rule, mirror);
+    Ok(assemble(k, redshift, rsd, &lay, &pk, &pk, &sums, &uv))
+}
+
+/// The loop integrals' sums on the rule and the half rule (in the layout of [`Layout`]) and σ² on both.
+pub(super) struct LoopSums {
+    pub(super) fine: Vec<f64>,
+    pub(super) coarse: Vec<f64>,
+    pub(super) sigma2: [f64; 2],
+}
+
+/// The terms per monomial from the loop sums, the UV constants per part `uv` = (c₃, c₄), the spectrum at the
+/// sides for the tree level (`pk_tree`) and for the factors of the loop terms outside the integrals
+/// (`pk_loop`).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn assemble(
+    k: [f64; 3],
+    redshift: Option<(f64, Orientation)>,
+    rsd: Option<(f64, Vec3)>,
+    lay: &Layout,
+    pk_tree: &[f64; 3],
+    pk: &[f64; 3],
+    sums: &LoopSums,
+    uv: &UvParts,
+) -> GalaxyLoopPolynomial {
+    let kv = triangle_vectors(k).expect("checked by the caller");
+    let (s1, s2, s3, s4) = (&lay.s[1], &lay.s[2], &lay.s[3], &lay.s[4]);
     let z1 = kv.map(|v| loop_kernel_parts(rsd, &[v]));
     let z2 = |a: usize, b: usize| loop_kernel_parts(rsd, &[kv[a], kv[b]]);
-    let half = rule.half();
-    let fine = loop_sums(p, &kv, rule, rsd, &lay);
-    let coarse = loop_sums(p, &kv, &half, rsd, &lay);
-    let (s_fine, s_coarse) = (sigma2(p, &k, rule, mirror), sigma2(p, &k, &half, mirror));
-    let (c3, c4) = uv_parts(rsd, &kv, rule, mirror);
+    let (fine, coarse) = (&sums.fine, &sums.coarse);
+    let [s_fine, s_coarse] = sums.sigma2;
+    let (c3, c4) = uv;
     let mut terms: [BTreeMap<Monomial, [f64; 2]>; 7] = Default::default();
     let [tree, b222, b321_i, b321_ii, b411, uv_ii, uv_411] = &mut terms;
     for (a, b) in [(0, 1), (1, 2), (2, 0)] {
-        let c = 2.0 * pk[a] * pk[b];
+        let c = 2.0 * pk_tree[a] * pk_tree[b];
         let z = z2(a, b);
         for &i in s2 {
             for &l in s1 {
@@ -471,7 +504,7 @@ pub fn one_loop_galaxy_polynomial(
     }
     let [tree, b222, b321_i, b321_ii, b411, uv_b321_ii, uv_b411] =
         terms.map(TermPolynomial::from_sums);
-    Ok(GalaxyLoopPolynomial {
+    GalaxyLoopPolynomial {
         k,
         redshift,
         tree,
@@ -481,5 +514,5 @@ pub fn one_loop_galaxy_polynomial(
         b411,
         uv_b321_ii,
         uv_b411,
-    })
+    }
 }
