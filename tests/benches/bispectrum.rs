@@ -186,9 +186,44 @@ fn one_loop_galaxy_step(crit: &mut Criterion) {
     }
 }
 
+/// The real-space one-loop galaxy polynomials of the 62 Nseries triangles for a new linear spectrum from the
+/// basis tensors per monomial (built here on a cheap rule: the contraction's cost does not depend on the
+/// rule; the build time of one triangle at the default rule is printed).
+fn one_loop_galaxy_basis(crit: &mut Criterion) {
+    use pt_spectra::bispectrum::one_loop::OneLoopRule;
+    use pt_spectra::bispectrum::one_loop_galaxy_basis::GalaxyLoopBasis;
+    let start = std::time::Instant::now();
+    GalaxyLoopBasis::build(&[[0.1, 0.1, 0.1]], &OneLoopRule::default()).unwrap();
+    eprintln!(
+        "galaxy tensors of one triangle at the default rule: {:.1} s",
+        start.elapsed().as_secs_f64()
+    );
+    let rule = OneLoopRule {
+        radial: 2,
+        mu: 4,
+        phi: 4,
+        ..OneLoopRule::default()
+    };
+    let basis = GalaxyLoopBasis::build(nseries().triangles(), &rule).unwrap();
+    let spectra: Vec<LinearSpectrum> = [0.0, 0.5, 1.0, 1.5]
+        .iter()
+        .map(|&z| LinearSpectrum::gm2012(z).unwrap())
+        .collect();
+    let mut i = 0;
+    crit.bench_function(
+        "bispectrum/one-loop galaxy polynomials of 62 Nseries triangles, new spectrum, basis, real space",
+        |b| {
+            b.iter(|| {
+                i += 1;
+                black_box(basis.evaluate(&spectra[i % spectra.len()]))
+            })
+        },
+    );
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(10);
-    targets = bispectrum, one_loop, one_loop_galaxy_step
+    targets = bispectrum, one_loop, one_loop_galaxy_step, one_loop_galaxy_basis
 }
 criterion_main!(benches);
