@@ -17,8 +17,8 @@
 //! on the same nodes as the direct path, made radial node by radial node as the matter tensors are; the UV
 //! constants per part do not depend on P and are stored. So the polynomial from the tensors equals the
 //! direct polynomial for P̂ (to round-off and the lattice interpolation); for P the difference is the
-//! response to the projection residual ε ([`GalaxyLoopBasis::evaluate`] returns ε; the matter terms' bound
-//! is [`PROJECTION_FACTOR`] × ε × Σ|loop terms|). Per triangle and rule (fine and fine − coarse) the tensors
+//! response to the projection residual ε, which the loop terms' errors include as the matter terms' do:
+//! [`PROJECTION_FACTOR`] × ε × Σ|loop terms| at the bias evaluated ([`GalaxyLoopPolynomial::projection`]). Per triangle and rule (fine and fine − coarse) the tensors
 //! hold 2 × (10 × 8436 + 6 × 18 × 666 + 3 × (11 + 7) × 36 + 36) ≈ 3.2e5 values for 36 functions (2.6 MB;
 //! 160 MB for the 62 Nseries triangles) against the matter's 2.5e4. Not cached yet.
 
@@ -174,16 +174,15 @@ impl GalaxyLoopBasis {
     }
 
     /// The polynomials of every triangle for the spectrum `p` (P at the sides of the tree level, P̂ elsewhere),
-    /// and [`PROJECTION_FACTOR`] × the projection residual (the matter terms' relative bound on the response to
-    /// it, of the sum of the loop terms' sizes).
-    pub fn evaluate(&self, p: &LinearSpectrum) -> (Vec<GalaxyLoopPolynomial>, f64) {
+    /// with [`GalaxyLoopPolynomial::projection`] = [`PROJECTION_FACTOR`] × the projection residual (the matter
+    /// terms' bound on the response to it, relative to the sum of the loop terms' sizes).
+    pub fn evaluate(&self, p: &LinearSpectrum) -> Vec<GalaxyLoopPolynomial> {
         let projection = self.project(p);
         let c = &projection.coefficients;
         let n = c.len();
         let shape = Shape::new(n);
         let (c2, c3) = (pair_products(c), triple_products(c));
-        let polys = self
-            .triangles
+        self.triangles
             .iter()
             .zip(self.tensors.iter().zip(&self.uv))
             .map(|(&k, (t, uv))| {
@@ -198,10 +197,12 @@ impl GalaxyLoopBasis {
                     sigma2: [sf, sf - sd],
                 };
                 let pk = k.map(|v| p.eval(v));
-                assemble(k, None, None, &shape.lay, &pk, &ph, &sums, uv)
+                GalaxyLoopPolynomial {
+                    projection: PROJECTION_FACTOR * projection.residual,
+                    ..assemble(k, None, None, &shape.lay, &pk, &ph, &sums, uv)
+                }
             })
-            .collect();
-        (polys, PROJECTION_FACTOR * projection.residual)
+            .collect()
     }
 }
 

@@ -145,6 +145,10 @@ pub struct GalaxyLoopPolynomial {
     pub uv_b321_ii: TermPolynomial,
     /// The amount subtracted from the bare B₄₁₁.
     pub uv_b411: TermPolynomial,
+    /// The relative bound of the basis's projection (zero on the direct path): each loop term's error at a
+    /// bias includes this × the sum of the four loop terms' sizes there
+    /// ([`super::one_loop_galaxy_basis`]).
+    pub projection: f64,
 }
 
 impl GalaxyLoopPolynomial {
@@ -156,15 +160,24 @@ impl GalaxyLoopPolynomial {
         bias.check_finite()?;
         let mut x = [1.0; N_PARTS];
         x[1..].copy_from_slice(&bias.values());
+        let mut loops =
+            [&self.b222, &self.b321_i, &self.b321_ii, &self.b411].map(|t| t.evaluate_parts(&x));
+        if self.projection != 0.0 {
+            let size: f64 = loops.iter().map(|t| t.value.abs()).sum();
+            loops
+                .iter_mut()
+                .for_each(|t| t.error += self.projection * size);
+        }
+        let [b222, b321_i, b321_ii, b411] = loops;
         Ok(OneLoopGalaxy {
             k: self.k,
             bias: *bias,
             redshift: self.redshift,
             tree: self.tree.evaluate_parts(&x),
-            b222: self.b222.evaluate_parts(&x),
-            b321_i: self.b321_i.evaluate_parts(&x),
-            b321_ii: self.b321_ii.evaluate_parts(&x),
-            b411: self.b411.evaluate_parts(&x),
+            b222,
+            b321_i,
+            b321_ii,
+            b411,
             uv_b321_ii: self.uv_b321_ii.evaluate_parts(&x).value,
             uv_b411: self.uv_b411.evaluate_parts(&x).value,
         })
@@ -514,5 +527,6 @@ pub(super) fn assemble(
         b411,
         uv_b321_ii,
         uv_b411,
+        projection: 0.0,
     }
 }
