@@ -193,7 +193,7 @@ fn one_loop_galaxy_basis(crit: &mut Criterion) {
     use pt_spectra::bispectrum::one_loop::OneLoopRule;
     use pt_spectra::bispectrum::one_loop_galaxy_basis::GalaxyLoopBasis;
     let start = std::time::Instant::now();
-    GalaxyLoopBasis::build(&[[0.1, 0.1, 0.1]], &OneLoopRule::default()).unwrap();
+    GalaxyLoopBasis::build(&[[0.1, 0.1, 0.1]], &OneLoopRule::default(), &|_, _| {}).unwrap();
     eprintln!(
         "galaxy tensors of one triangle at the default rule: {:.1} s",
         start.elapsed().as_secs_f64()
@@ -204,7 +204,7 @@ fn one_loop_galaxy_basis(crit: &mut Criterion) {
         phi: 4,
         ..OneLoopRule::default()
     };
-    let basis = GalaxyLoopBasis::build(nseries().triangles(), &rule).unwrap();
+    let basis = GalaxyLoopBasis::build(nseries().triangles(), &rule, &|_, _| {}).unwrap();
     let spectra: Vec<LinearSpectrum> = [0.0, 0.5, 1.0, 1.5]
         .iter()
         .map(|&z| LinearSpectrum::gm2012(z).unwrap())

@@ -20,11 +20,13 @@
 //! response to the projection residual ε, which the loop terms' errors include as the matter terms' do:
 //! [`PROJECTION_FACTOR`] × ε × Σ|loop terms| at the bias evaluated ([`GalaxyLoopPolynomial::projection`]). Per triangle and rule (fine and fine − coarse) the tensors
 //! hold 2 × (10 × 8436 + 6 × 18 × 666 + 3 × (11 + 7) × 36 + 36) ≈ 3.2e5 values for 36 functions (2.6 MB;
-//! 160 MB for the 62 Nseries triangles) against the matter's 2.5e4. Not cached yet.
+//! 157 MB for the 62 Nseries triangles) against the matter's 2.5e4; cached by [`crate::store::TableStore`] as
+//! the matter tensors are (the key includes the kernels' values at fixed arguments).
 
-use super::bias_kernels::loop_kernel_parts;
+use super::bias_kernels::{loop_kernel_parts, N_PARTS};
 use super::one_loop::{
     angular_nodes, breaks, partition, radial_nodes, triangle_vectors, OneLoopRule, Vec3,
+    PARTITION_POWER,
 };
 use super::one_loop_basis::{pack_pairs, pack_triples, PROJECTION_FACTOR};
 use super::one_loop_galaxy_poly::{
@@ -32,12 +34,13 @@ use super::one_loop_galaxy_poly::{
 };
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
+use crate::loops::basis::{after_key, cache_file_name, Projection, BASIS_SIZE};
 use crate::loops::basis::{pair_products, training, triple_products, triples, LinearBasis};
-use crate::loops::basis::{Projection, BASIS_SIZE};
 use crate::loops::lattice::Lattice;
 use crate::simd::{axpy, dot};
 use crate::vec3::{add, neg, norm, sub};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The monomials of a product of kernel parts from the supports `sets` (sorted index tuples), and for each
 /// ordered choice of parts (indices into the supports) its monomial's slot.
@@ -126,25 +129,86 @@ impl GalaxyLoopBasis {
     ///
     /// # Errors
     /// As [`triangle_vectors`] for sides that do not close; a bad rule.
-    pub fn build(triangles: &[[f64; 3]], rule: &OneLoopRule) -> Result<Self> {
+    pub fn build(
+        triangles: &[[f64; 3]],
+        rule: &OneLoopRule,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<Self> {
         rule.validate()?;
         let vectors = triangles
             .iter()
             .map(|&k| triangle_vectors(k))
             .collect::<Result<Vec<_>>>()?;
-        let k_max = triangles.iter().flatten().copied().fold(0.0, f64::max);
-        let lattice = Lattice::new(0.1 * rule.q_min, rule.q_max + 2.0 * k_max, 0.01);
-        let basis = training::camb_basis(lattice, BASIS_SIZE);
+        let basis = training::camb_basis(lattice(triangles, rule), BASIS_SIZE);
         let shape = Shape::new(basis.len());
+        let done = AtomicUsize::new(0);
         let tensors = vectors
             .par_iter()
-            .map(|kv| triangle_tensors(&basis, &shape, kv, rule))
+            .map(|kv| {
+                let t = triangle_tensors(&basis, &shape, kv, rule);
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, triangles.len());
+                t
+            })
             .collect();
         let uv = vectors
             .iter()
             .map(|kv| uv_parts(None, kv, rule, true))
             .collect();
         Ok(Self {
+            triangles: triangles.to_vec(),
+            rule: *rule,
+            basis,
+            tensors,
+            uv,
+        })
+    }
+
+    /// The cache file name of the tensors of `triangles` and `rule` (and of the present kernels: their values
+    /// at fixed arguments are part of the key, so a change of the kernels makes new tensors).
+    pub fn file_name(triangles: &[[f64; 3]], rule: &OneLoopRule) -> String {
+        cache_file_name("bispectrum-galaxy-basis", VERSION, &key(triangles, rule))
+    }
+
+    /// The cache file's values: the key, the basis, per triangle the tensors and the UV constants.
+    pub(crate) fn to_f64s(&self) -> Vec<f64> {
+        let key = key(&self.triangles, &self.rule);
+        let mut v = vec![key.len() as f64];
+        v.extend(&key);
+        v.extend(self.basis.to_f64s());
+        for (t, (c3, c4)) in self.tensors.iter().zip(&self.uv) {
+            v.extend(t);
+            v.extend(c3.iter().chain(c4).flatten());
+        }
+        v
+    }
+
+    /// The tensors of `triangles` and `rule` from the values of their file, or `None` if the file was made for
+    /// other settings or does not fit them.
+    pub(crate) fn from_f64s(
+        values: &[f64],
+        triangles: &[[f64; 3]],
+        rule: &OneLoopRule,
+    ) -> Option<Self> {
+        let rest = after_key(values, &key(triangles, rule))?;
+        let (basis, rest) = LinearBasis::from_f64s(lattice(triangles, rule), rest)?;
+        let n = basis.len();
+        let per = 3 * n + 2 * Shape::new(n).len();
+        let uv_len = 6 * N_PARTS;
+        if rest.len() != triangles.len() * (per + uv_len) {
+            return None;
+        }
+        let mut tensors = Vec::with_capacity(triangles.len());
+        let mut uv = Vec::with_capacity(triangles.len());
+        for chunk in rest.chunks_exact(per + uv_len) {
+            let (t, c) = chunk.split_at(per);
+            tensors.push(t.to_vec());
+            let part = |i: usize| -> [f64; N_PARTS] { std::array::from_fn(|p| c[i * N_PARTS + p]) };
+            uv.push((
+                std::array::from_fn(&part),
+                std::array::from_fn(|a| part(3 + a)),
+            ));
+        }
+        Some(Self {
             triangles: triangles.to_vec(),
             rule: *rule,
             basis,
@@ -204,6 +268,43 @@ impl GalaxyLoopBasis {
             })
             .collect()
     }
+}
+
+/// Version of the tensor layout, part of the cache file name.
+const VERSION: u32 = 1;
+
+/// The lattice of the basis (as the matter tensors').
+fn lattice(triangles: &[[f64; 3]], rule: &OneLoopRule) -> Lattice {
+    let k_max = triangles.iter().flatten().copied().fold(0.0, f64::max);
+    Lattice::new(0.1 * rule.q_min, rule.q_max + 2.0 * k_max, 0.01)
+}
+
+/// The settings that make the tensors (their cache key): the version, the basis, the rule, the triangles,
+/// and the kernels' parts at fixed arguments of orders 2, 3 and 4 (the kernels' fingerprint).
+fn key(triangles: &[[f64; 3]], rule: &OneLoopRule) -> Vec<f64> {
+    let mut key = vec![
+        f64::from(VERSION),
+        BASIS_SIZE as f64,
+        f64::from(training::VERSION),
+        f64::from(PARTITION_POWER),
+        rule.radial as f64,
+        rule.mu as f64,
+        rule.phi as f64,
+        rule.q_min,
+        rule.q_max,
+        triangles.len() as f64,
+    ];
+    let q = [
+        [0.31, -0.12, 0.57],
+        [-0.22, 0.41, 0.13],
+        [0.05, -0.37, -0.29],
+        [0.44, 0.18, -0.61],
+    ];
+    for order in 2..=4 {
+        key.extend(loop_kernel_parts(None, &q[..order]));
+    }
+    key.extend(triangles.iter().flatten());
+    key
 }
 
 /// One rule's tensors contracted with the coefficients `c` (pair and triple products `c2`, `c3`): the loop

@@ -7,6 +7,7 @@
 use super::{cached, read_cached, TableStore};
 use crate::bispectrum::one_loop::OneLoopRule;
 use crate::bispectrum::one_loop_basis::OneLoopMatterBasis;
+use crate::bispectrum::one_loop_galaxy_basis::GalaxyLoopBasis;
 use crate::error::Result;
 use crate::loops::basis::{
     OneLoopBasis, RedshiftBasis, RedshiftFamily, RsdTwoLoopBasis, SpectrumFamily, TnsBasis,
@@ -169,6 +170,13 @@ cached_tensors!(
     OneLoopMatterBasis,
     (&'a [[f64; 3]], &'a OneLoopRule),
     "one-loop bispectrum basis",
+    Stage::OneLoopBispectrumBasis,
+    (triangles, rule)
+);
+cached_tensors!(
+    GalaxyLoopBasis,
+    (&'a [[f64; 3]], &'a OneLoopRule),
+    "one-loop galaxy bispectrum basis",
     Stage::OneLoopBispectrumBasis,
     (triangles, rule)
 );

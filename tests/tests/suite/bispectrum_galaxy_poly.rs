@@ -260,20 +260,24 @@ fn bad_input_is_an_error() {
     assert!(one_loop_galaxy_polynomial(&p, [0.1, 0.1, 0.1], Some((-0.1, o)), &small()).is_err());
     assert!(one_loop_galaxy_polynomial(&p, [0.1, 0.1, 0.5], None, &small()).is_err());
     use pt_spectra::bispectrum::one_loop_galaxy_basis::GalaxyLoopBasis;
-    assert!(GalaxyLoopBasis::build(&[[0.1, 0.1, 0.1], [0.1, 0.1, 0.5]], &small()).is_err());
+    let tick = |_, _| {};
+    assert!(GalaxyLoopBasis::build(&[[0.1, 0.1, 0.1], [0.1, 0.1, 0.5]], &small(), &tick).is_err());
     let no_nodes = OneLoopRule { mu: 1, ..small() };
-    assert!(GalaxyLoopBasis::build(&[[0.1, 0.1, 0.1]], &no_nodes).is_err());
+    assert!(GalaxyLoopBasis::build(&[[0.1, 0.1, 0.1]], &no_nodes, &tick).is_err());
 }
 
 /// Basis tensors per monomial (`bispectrum::one_loop_galaxy_basis`, real space) against the direct
 /// polynomials on the same nodes, for CAMB spectra not in the basis's training set (Planck 2018 at z = 0, a
 /// held-out cosmology of the prior) at three triangles, evaluated at three random 11-coefficient biases:
 /// every loop term within its error (quadrature plus the matter bound 3ε Σ|loop terms|, ε the projection
-/// residual), the one-loop B within 1e-3 of itself, the tree level exact; the same monomials.
+/// residual), the one-loop B within 1e-3 of itself, the tree level exact; the same monomials; the cache
+/// file reads back the same tensors, and not for other triangles.
 #[test]
 fn basis_polynomials_match_the_direct_ones_for_spectra_not_in_the_training_set() {
     use crate::support;
     use pt_spectra::bispectrum::one_loop_galaxy_basis::GalaxyLoopBasis;
+    use pt_spectra::progress::Silent;
+    use pt_spectra::store::TableStore;
     let rule = OneLoopRule {
         radial: 4,
         mu: 8,
@@ -281,14 +285,28 @@ fn basis_polynomials_match_the_direct_ones_for_spectra_not_in_the_training_set()
         ..OneLoopRule::default()
     };
     let triangles = vec![[0.05, 0.1, 0.12], [0.02, 0.1, 0.1], [0.1, 0.1, 0.1]];
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("one_loop_galaxy_basis");
+    let _ = std::fs::remove_dir_all(&dir);
     let start = std::time::Instant::now();
-    let basis = GalaxyLoopBasis::build(&triangles, &rule).unwrap();
+    let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
+        GalaxyLoopBasis::build(&triangles, &rule, tick).unwrap()
+    };
+    let basis = TableStore::new(&dir)
+        .tensors::<GalaxyLoopBasis>((&triangles, &rule), build, &Silent)
+        .unwrap();
     eprintln!(
         "galaxy tensors of {} triangles: {:.1} s, {} values",
         triangles.len(),
         start.elapsed().as_secs_f64(),
         basis.values()
     );
+    let again = TableStore::new(&dir)
+        .cached::<GalaxyLoopBasis>((&triangles, &rule), &Silent)
+        .unwrap();
+    assert!(*again == *basis, "the cache file reads back the tensors");
+    assert!(TableStore::new(&dir)
+        .cached::<GalaxyLoopBasis>((&triangles[1..], &rule), &Silent)
+        .is_none());
     let camb =
         |name: &str| LinearSpectrum::parse(&support::data(name), name, Default::default()).unwrap();
     let spectra = [
