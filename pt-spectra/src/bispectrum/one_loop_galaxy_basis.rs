@@ -232,6 +232,20 @@ impl GalaxyLoopBasis {
         self.tensors.iter().map(Vec::len).sum()
     }
 
+    /// P̂, the projection of `p` on the basis, as a spectrum on the basis's lattice (what the tensors integrate
+    /// in place of P: the direct polynomials of it equal the tensors' up to the two interpolations).
+    ///
+    /// # Errors
+    /// As [`LinearSpectrum::from_nodes`] (a projection that is not positive on the lattice).
+    pub fn projected_spectrum(&self, p: &LinearSpectrum) -> Result<LinearSpectrum> {
+        let projection = self.project(p);
+        let l = lattice(&self.triangles, &self.rule);
+        LinearSpectrum::from_nodes(
+            (0..l.len).map(|j| l.x(j).exp()).collect(),
+            projection.samples,
+        )
+    }
+
     /// The projection of `p` on the basis.
     pub fn project(&self, p: &LinearSpectrum) -> Projection {
         self.basis.project(&self.basis.sample(p))
