@@ -2,7 +2,8 @@
 //! linear spectrum ≤ 0.2 ms; a parameter step ≤ 20 µs): the terms of a new spectrum (f, AP, FoG and IR
 //! resummation as a fit varies them) and the contraction with new bias and stochastic parameters.
 //!
-//! The one-loop matter bispectrum (issue 50) through its basis tensors and directly.
+//! The one-loop matter bispectrum (issue 50) through its basis tensors and directly; a parameter step of the
+//! one-loop galaxy bispectrum per bias monomial.
 //!
 //! Run with `RAYON_NUM_THREADS=1 cargo bench -p pt-spectra-tests --bench bispectrum` for one core (the
 //! terms are computed triangle by triangle in parallel otherwise).
@@ -135,9 +136,94 @@ fn one_loop(crit: &mut Criterion) {
     );
 }
 
+/// A parameter step of the one-loop galaxy bispectrum per bias monomial (issue 50): the terms of the 62
+/// Nseries triangles (their centres) at a new set of the 11 bias coefficients, real space and redshift space
+/// at one orientation, from the polynomials (built here on a cheap rule: the number of monomials, and so the
+/// cost of a step, does not depend on the rule).
+fn one_loop_galaxy_step(crit: &mut Criterion) {
+    use pt_spectra::bispectrum::bias_kernels::LoopBias;
+    use pt_spectra::bispectrum::one_loop::OneLoopRule;
+    use pt_spectra::bispectrum::one_loop_galaxy_poly::one_loop_galaxy_polynomial;
+    use pt_spectra::bispectrum::one_loop_rsd::Orientation;
+    let rule = OneLoopRule {
+        radial: 2,
+        mu: 4,
+        phi: 4,
+        ..OneLoopRule::default()
+    };
+    let p = LinearSpectrum::gm2012(0.5).unwrap();
+    let o = Orientation { mu1: 0.4, phi: 0.7 };
+    for (name, redshift) in [("real space", None), ("redshift space", Some((0.7, o)))] {
+        let polys: Vec<_> = nseries()
+            .triangles()
+            .iter()
+            .map(|&k| one_loop_galaxy_polynomial(&p, k, redshift, &rule).unwrap())
+            .collect();
+        let mut i = 0;
+        crit.bench_function(
+            &format!("bispectrum/one-loop galaxy B of 62 Nseries triangles, new bias, {name}"),
+            |b| {
+                b.iter(|| {
+                    i += 1;
+                    let bias = LoopBias::from_values([
+                        1.8 + 1e-6 * i as f64,
+                        0.6,
+                        -0.3,
+                        0.4,
+                        0.5,
+                        -0.2,
+                        0.35,
+                        0.3,
+                        -0.4,
+                        0.25,
+                        0.6,
+                    ]);
+                    let terms: Vec<_> = polys.iter().map(|t| t.evaluate(&bias).unwrap()).collect();
+                    black_box(terms)
+                })
+            },
+        );
+    }
+}
+
+/// The real-space one-loop galaxy polynomials of the 62 Nseries triangles for a new linear spectrum from the
+/// basis tensors per monomial (built here on a cheap rule: the contraction's cost does not depend on the
+/// rule; the build time of one triangle at the default rule is printed).
+fn one_loop_galaxy_basis(crit: &mut Criterion) {
+    use pt_spectra::bispectrum::one_loop::OneLoopRule;
+    use pt_spectra::bispectrum::one_loop_galaxy_basis::GalaxyLoopBasis;
+    let start = std::time::Instant::now();
+    GalaxyLoopBasis::build(&[[0.1, 0.1, 0.1]], &OneLoopRule::default(), &|_, _| {}).unwrap();
+    eprintln!(
+        "galaxy tensors of one triangle at the default rule: {:.1} s",
+        start.elapsed().as_secs_f64()
+    );
+    let rule = OneLoopRule {
+        radial: 2,
+        mu: 4,
+        phi: 4,
+        ..OneLoopRule::default()
+    };
+    let basis = GalaxyLoopBasis::build(nseries().triangles(), &rule, &|_, _| {}).unwrap();
+    let spectra: Vec<LinearSpectrum> = [0.0, 0.5, 1.0, 1.5]
+        .iter()
+        .map(|&z| LinearSpectrum::gm2012(z).unwrap())
+        .collect();
+    let mut i = 0;
+    crit.bench_function(
+        "bispectrum/one-loop galaxy polynomials of 62 Nseries triangles, new spectrum, basis, real space",
+        |b| {
+            b.iter(|| {
+                i += 1;
+                black_box(basis.evaluate(&spectra[i % spectra.len()]))
+            })
+        },
+    );
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(10);
-    targets = bispectrum, one_loop
+    targets = bispectrum, one_loop, one_loop_galaxy_step, one_loop_galaxy_basis
 }
 criterion_main!(benches);

@@ -80,7 +80,7 @@
 //! U(B) = f(kμ)(μ_B/k_B)G_B, so Z₁ = b1 + fμ² and Z_n^g is affine in the bias coefficients.
 
 use crate::error::{Error, Result};
-use crate::loops::rsd_two_loop::{kernel_at, redshift_polynomial};
+use crate::loops::rsd_two_loop::{kernel_at, redshift_polynomial, redshift_weights};
 use crate::vec3::{add, dot};
 
 type Vec3 = [f64; 3];
@@ -464,6 +464,62 @@ pub fn operator_kernels(q: &[Vec3]) -> Result<[f64; N_BIAS]> {
     Ok(t.ops[(1 << t.n) - 1])
 }
 
+/// The number of parts of a galaxy kernel ([`galaxy_kernel_parts`]): the bias-independent part and one per
+/// coefficient.
+pub const N_PARTS: usize = N_BIAS + 1;
+
+/// The lowest order at which each operator's kernel is non-zero, in the order of [`LoopBias::NAMES`]: b1 at
+/// first order, b2 and g2 at second, b3, g2x, g3 and g21 at third, the rest at fourth (so a product of
+/// kernels of orders n₁, n₂, … holds only the coefficients whose lowest orders fit).
+pub const LOWEST_ORDER: [usize; N_BIAS] = [1, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4];
+
+/// The galaxy kernel of order n = `q.len()` (1..=4) split by bias coefficient: K_n (real space, `redshift`
+/// None) or Z_n^g at (f, line of sight `los`, any non-zero vector along it) is `parts[0]` + Σ_i b_i `parts[1 + i]`
+/// (i in the order of [`LoopBias::NAMES`]). `parts[0]`, the part without bias, is zero in real space and the
+/// velocities' in redshift space (fμ² at first order); in real space `parts[1 + i]` is [`operator_kernels`]'s
+/// O_i; zero where the q's sum to zero.
+///
+/// # Errors
+/// As [`operator_kernels`]; as [`galaxy_redshift_kernel`] for a bad line of sight or f.
+pub fn galaxy_kernel_parts(q: &[Vec3], redshift: Option<(f64, &Vec3)>) -> Result<[f64; N_PARTS]> {
+    if let Some((f, los)) = redshift {
+        let n2 = dot(los, los);
+        if !(n2 > 0.0 && n2.is_finite() && f.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "line of sight, f",
+                value: n2,
+                reason: "need a finite non-zero line of sight and a finite f",
+            });
+        }
+    }
+    let t = Table::new(q)?;
+    Ok(parts_from_table(&t, redshift))
+}
+
+/// [`galaxy_kernel_parts`] from the subsets' fields.
+fn parts_from_table(t: &Table, redshift: Option<(f64, &Vec3)>) -> [f64; N_PARTS] {
+    let full = (1usize << t.n) - 1;
+    let mut parts = [0.0; N_PARTS];
+    match redshift {
+        None if t.ks2[full] != 0.0 => parts[1..].copy_from_slice(&t.ops[full]),
+        None => {}
+        Some((f, los)) => {
+            let norm = dot(los, los).sqrt();
+            let unit = los.map(|x| x / norm);
+            let (weights, velocity) = redshift_weights(&t.ks, &t.ks2, full, &unit, |s| t.g[s], f);
+            parts[0] = velocity;
+            for (s, w) in weights.iter().enumerate().take(full + 1) {
+                if *w != 0.0 {
+                    for (p, o) in parts[1..].iter_mut().zip(&t.ops[s]) {
+                        *p += w * o;
+                    }
+                }
+            }
+        }
+    }
+    parts
+}
+
 /// The real-space galaxy kernel K_n(q₁, …, q_n), n = 1..=4 (module docs); zero if the q's sum to zero.
 ///
 /// # Errors
@@ -500,6 +556,15 @@ fn redshift_from_table(t: &Table, b: &[f64; N_BIAS], f: f64, los: &Vec3, n2: f64
     let full = (1usize << t.n) - 1;
     let z = redshift_polynomial(&t.ks, &t.ks2, full, &unit, |s| [t.galaxy(b, s), t.g[s]]);
     kernel_at(&z, f)
+}
+
+/// [`galaxy_kernel_parts`] in the loop integrands (`los` a unit vector): zero where it is not defined (a node
+/// never is).
+pub(super) fn loop_kernel_parts(redshift: Option<(f64, Vec3)>, q: &[Vec3]) -> [f64; N_PARTS] {
+    let Ok(t) = Table::new(q) else {
+        return [0.0; N_PARTS];
+    };
+    parts_from_table(&t, redshift.as_ref().map(|(f, los)| (*f, los)))
 }
 
 /// The kernel of the loop integrands: real space (`redshift` None) or Z_n^g at (f, line of sight); zero

@@ -51,6 +51,8 @@ mod observed;
 pub mod one_loop;
 pub mod one_loop_basis;
 pub mod one_loop_galaxy;
+pub mod one_loop_galaxy_basis;
+pub mod one_loop_galaxy_poly;
 pub mod one_loop_rsd;
 mod resum;
 mod sampled;

@@ -249,7 +249,7 @@ pub(super) fn breaks(k: &[f64; 3]) -> Vec<f64> {
 
 /// The nodes q and weights of one piece's rule (weights include q² dq dΩ/(2π)³ and the φ symmetry):
 /// the product of [`radial_nodes`] and [`angular_nodes`].
-fn nodes(rule: &OneLoopRule, breaks: &[f64], mirror: bool) -> Vec<(Vec3, f64)> {
+pub(super) fn nodes(rule: &OneLoopRule, breaks: &[f64], mirror: bool) -> Vec<(Vec3, f64)> {
     let angular = angular_nodes(rule, mirror);
     radial_nodes(rule, breaks)
         .into_iter()

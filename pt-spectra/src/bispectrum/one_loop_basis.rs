@@ -376,7 +376,7 @@ fn rule_tensors(basis: &LinearBasis, kv: &[Vec3; 3], rule: &OneLoopRule) -> Vec<
 
 /// The symmetric form of a full n³ tensor on the triples a ≤ b ≤ c (at [`triple_index`]): Σ over
 /// the distinct permutations, so that Σ_{a≤b≤c} packed c_a c_b c_c = Σ_{abc} T_abc c_a c_b c_c.
-fn pack_triples(t: &[f64], n: usize) -> Vec<f64> {
+pub(super) fn pack_triples(t: &[f64], n: usize) -> Vec<f64> {
     let at = |a: usize, b: usize, c: usize| t[(a * n + b) * n + c];
     let mut out = vec![0.0; triples(n)];
     for c in 0..n {
@@ -402,7 +402,7 @@ fn pack_triples(t: &[f64], n: usize) -> Vec<f64> {
 }
 
 /// The symmetric form of an n × n matrix on the pairs a ≤ b (at [`pair_index`]).
-fn pack_pairs(m: &[f64], n: usize) -> Vec<f64> {
+pub(super) fn pack_pairs(m: &[f64], n: usize) -> Vec<f64> {
     let mut out = vec![0.0; pairs(n)];
     for b in 0..n {
         for a in 0..=b {

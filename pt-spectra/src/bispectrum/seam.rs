@@ -164,3 +164,10 @@ cached_tensors!(
     ONE_LOOP_BASIS_STAGE,
     (triangles, rule)
 );
+cached_tensors!(
+    super::one_loop_galaxy_basis::GalaxyLoopBasis,
+    (&'a [[f64; 3]], &'a super::one_loop::OneLoopRule),
+    "one-loop galaxy bispectrum basis",
+    ONE_LOOP_BASIS_STAGE,
+    (triangles, rule)
+);

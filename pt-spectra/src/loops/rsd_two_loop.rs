@@ -37,7 +37,7 @@
 
 mod integrand;
 mod zn;
-pub(crate) use zn::{at as kernel_at, redshift_polynomial};
+pub(crate) use zn::{at as kernel_at, redshift_polynomial, redshift_weights};
 
 pub(crate) use integrand::{rsd_min_points, rsd_points_at, Sampling};
 

@@ -15,6 +15,7 @@ mod bias;
 mod bins;
 mod bispectrum_galaxy;
 mod bispectrum_galaxy_kernels;
+mod bispectrum_galaxy_poly;
 mod bispectrum_one_loop;
 mod bispectrum_reference;
 mod cosmology_jacobian;

@@ -128,8 +128,29 @@ pub(crate) fn redshift_polynomial(
         }
         sub = (sub - 1) & args;
     }
-    // E(R) for the subsets R of args, smaller masks first: the block holding R's lowest member,
-    // then the partitions of the rest
+    let e = partition_sums(&u, args);
+    let mut z = [0.0; 7];
+    let n = args.count_ones() as usize;
+    let mut s0 = args;
+    while s0 != 0 {
+        let c = FACTORIAL[s0.count_ones() as usize] / FACTORIAL[n];
+        let (a, b) = (c * d0[s0], c * d1[s0]);
+        if a != 0.0 || b != 0.0 {
+            let er = &e[args ^ s0];
+            for (j, e) in er.iter().enumerate() {
+                z[j] += a * e;
+                z[j + 1] += b * e;
+            }
+        }
+        s0 = (s0 - 1) & args;
+    }
+    z
+}
+
+/// E(R) of the module docs for every subset R of `args`, as coefficients of f⁰ … f⁵, from U(S) = f `u[S]`:
+/// smaller masks first, the block holding R's lowest member, then the partitions of the rest.
+#[inline]
+fn partition_sums(u: &[f64; SUBSETS], args: usize) -> [[f64; 6]; SUBSETS] {
     let mut e = [[0.0; 6]; SUBSETS];
     e[0][0] = 1.0;
     for r in 1..=args {
@@ -156,22 +177,48 @@ pub(crate) fn redshift_polynomial(
         }
         e[r] = er;
     }
-    let mut z = [0.0; 7];
+    e
+}
+
+/// Z_n of [`redshift_polynomial`] split by what multiplies the density kernels, at `f`: Z_n = Σ_{S₀}
+/// `weights[S₀]` × density(S₀) + `velocity`, with `weights[S₀]` = (|S₀|!/n!) E(args∖S₀) (zero for S₀ of zero
+/// total momentum) and `velocity` = Σ_{S₀} (|S₀|!/n!) fμ_{S₀}²G_{S₀} E(args∖S₀), from G_S = `g(S)`. Z_n is
+/// linear in the density kernels: a tracer's kernel affine in its bias coefficients gives Z_n^g affine in them.
+pub(crate) fn redshift_weights(
+    v: &[[f64; 3]],
+    norm: &[f64],
+    args: usize,
+    los: &[f64; 3],
+    g: impl Fn(usize) -> f64,
+    f: f64,
+) -> ([f64; SUBSETS], f64) {
+    let nk = dot(los, &v[args]);
+    let (mut d1, mut u) = ([0.0; SUBSETS], [0.0; SUBSETS]);
+    let mut sub = args;
+    while sub != 0 {
+        let n2 = norm[sub];
+        if n2 != 0.0 {
+            let ns = dot(los, &v[sub]);
+            let gs = g(sub);
+            d1[sub] = ns * ns / n2 * gs;
+            u[sub] = FACTORIAL[sub.count_ones() as usize] * nk * ns / n2 * gs;
+        }
+        sub = (sub - 1) & args;
+    }
+    let e = partition_sums(&u, args);
+    let at_f = |p: &[f64; 6]| p.iter().rev().fold(0.0, |acc, &c| acc * f + c);
     let n = args.count_ones() as usize;
+    let (mut weights, mut velocity) = ([0.0; SUBSETS], 0.0);
     let mut s0 = args;
     while s0 != 0 {
-        let c = FACTORIAL[s0.count_ones() as usize] / FACTORIAL[n];
-        let (a, b) = (c * d0[s0], c * d1[s0]);
-        if a != 0.0 || b != 0.0 {
-            let er = &e[args ^ s0];
-            for (j, e) in er.iter().enumerate() {
-                z[j] += a * e;
-                z[j + 1] += b * e;
-            }
+        if norm[s0] != 0.0 {
+            let c = FACTORIAL[s0.count_ones() as usize] / FACTORIAL[n] * at_f(&e[args ^ s0]);
+            weights[s0] = c;
+            velocity += c * f * d1[s0];
         }
         s0 = (s0 - 1) & args;
     }
-    z
+    (weights, velocity)
 }
 
 /// The value at f of a kernel's polynomial (Horner).
