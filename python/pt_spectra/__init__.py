@@ -520,8 +520,10 @@ def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=No
     Eggemeier, Scoccimarro & Smith 2019 by name: b3, g2x, g3, g21, g21x, g211, g22, g31, each in place
     of the value mapped from bs and b_gamma3) gives the one-loop galaxy bispectrum, real space or at
     ``mu1``, directly (2.8-3.3 s per triangle in real space, 6 s in redshift space on 2 cores): the same
-    columns and uv_B321_II, uv_B411 (the renormalisation's subtracted amounts); no counterterms,
-    stochastic terms, IR resummation or multipoles yet (docs/bispectrum.md).
+    columns, uv_B321_II, uv_B411 (the renormalisation's subtracted amounts) and, in real space, the seven
+    counterterm and stochastic shapes shape_ct_k2, shape_ct_k3, shape_ct_kk, shape_ct_tidal, shape_ct_f2k3
+    [(Mpc/h)^4], shape_st_p [(Mpc/h)^3], shape_st_1 (not included in B_1loop); no IR resummation or
+    multipoles yet (docs/bispectrum.md).
     """
     return _warn(_core.one_loop_bispectrum(triangles, linear, z, z_input, cosmology, eh, q_min, q_max,
                                            radial, mu, phi, two_loop, cache_dir, mu1, phi_los, f, b1, b2,

@@ -45,6 +45,7 @@
 pub mod bias_kernels;
 pub mod block;
 mod box_modes;
+pub mod galaxy_counterterms;
 mod geometry;
 mod lanes;
 mod observed;

@@ -6,11 +6,12 @@ use super::bispectrum::one_loop_columns;
 use super::VERSION;
 use crate::bias::BiasParams;
 use crate::bispectrum::bias_kernels::LoopBias;
+use crate::bispectrum::galaxy_counterterms::{galaxy_counterterm_shapes, GALAXY_COUNTERTERMS};
 use crate::bispectrum::one_loop::{OneLoopRule, PARTITION_POWER};
 use crate::bispectrum::one_loop_galaxy::one_loop_galaxy;
 use crate::bispectrum::one_loop_rsd::Orientation;
 use crate::error::{Error, Result};
-use crate::output::{MethodNote, Table, BISPECTRUM};
+use crate::output::{MethodNote, Table, BISPECTRUM, BISPECTRUM_SHAPE, POWER};
 use crate::progress::Progress;
 use crate::setup::Prepared;
 
@@ -68,7 +69,9 @@ pub fn loop_bias(
 /// amounts subtracted by the renormalisation (`uv_B321_II`, `uv_B411`: the bare terms are the
 /// renormalised ones plus these) of the one-loop galaxy bispectrum with `bias` at `triangles`
 /// (points), in real space (`redshift` None) or at the growth rate (default f(z)) and orientation of
-/// `redshift`, for the linear spectrum of `prepared`, directly, each triangle reported to `progress`.
+/// `redshift`, for the linear spectrum of `prepared`, directly, each triangle reported to `progress`;
+/// in real space also the seven counterterm and stochastic shapes `shape_<name>`
+/// ([`crate::bispectrum::galaxy_counterterms`]).
 ///
 /// # Errors
 /// As [`one_loop_galaxy`], naming the triangle.
@@ -83,6 +86,7 @@ pub fn one_loop_galaxy_table(
     let redshift = redshift.map(|(f, o)| (f.unwrap_or(prepared.growth_rate), o));
     let mut rows = Vec::with_capacity(triangles.len());
     let mut uv = Vec::with_capacity(triangles.len());
+    let mut shapes = Vec::new();
     for (i, &k) in triangles.iter().enumerate() {
         let b = one_loop_galaxy(&prepared.spectrum, k, bias, redshift, rule).map_err(|e| {
             Error::InvalidChoice {
@@ -92,6 +96,9 @@ pub fn one_loop_galaxy_table(
         })?;
         rows.push((k, [b.tree, b.b222, b.b321_i, b.b321_ii, b.b411, b.total()]));
         uv.push([b.uv_b321_ii, b.uv_b411]);
+        if redshift.is_none() {
+            shapes.push(galaxy_counterterm_shapes(&prepared.spectrum, k, bias)?);
+        }
         progress.update(
             crate::bispectrum::seam::ONE_LOOP_STAGE,
             i + 1,
@@ -123,7 +130,7 @@ pub fn one_loop_galaxy_table(
         "B_1loop = B_tree + B222 + B321_I + B321_II + B411 with the galaxy kernels K_n (Z_n^g in redshift \
          space) in place of F_n (Z_n); B321_II and B411 renormalised: their q -> infinity constants times \
          sigma^2 = int P over the loop range subtracted (uv_B321_II, uv_B411; bare = renormalised + uv); \
-         no counterterms, stochastic terms, IR resummation, orientation average or bins yet"
+         no IR resummation, orientation average or bins yet"
             .into(),
         format!(
             "loop integrals over {} <= |q| <= {} h/Mpc about each cusp (smooth partition of unity, power {}); \
@@ -139,6 +146,28 @@ pub fn one_loop_galaxy_table(
     one_loop_columns(&mut t, &rows);
     for (j, name) in ["uv_B321_II", "uv_B411"].iter().enumerate() {
         t.push(*name, BISPECTRUM, uv.iter().map(|u| u[j]).collect());
+    }
+    if redshift.is_none() {
+        t.header.push(
+            "counterterms and stochastic terms not in B_1loop: B_ct = sum_c c_c shape_c, shape_ct_k2 = sum_cyc 2 \
+             b1 K2 (ki^2 + kj^2) Pi Pj, shape_ct_k3 = ... 2 b1^2 kl^2 Pi Pj, shape_ct_kk = ... 2 b1^2 (ki^2 + kj^2) \
+             Pi Pj, shape_ct_tidal = ... 2 b1^2 kl^2 (mu_ij^2 - 1/3) Pi Pj, shape_ct_f2k3 = ... 2 b1^2 F2 kl^2 Pi Pj \
+             (coefficients in (Mpc/h)^2), shape_st_p = sum_a b1^2 Pa ((Mpc/h)^3), shape_st_1 = 1 ((Mpc/h)^6); \
+             together they absorb the loops' cut-off (docs/bispectrum.md)"
+                .into(),
+        );
+        for (j, name) in GALAXY_COUNTERTERMS.iter().enumerate() {
+            let unit = match j {
+                5 => POWER,
+                6 => "1",
+                _ => BISPECTRUM_SHAPE,
+            };
+            t.push(
+                format!("shape_{name}"),
+                unit,
+                shapes.iter().map(|s| s[j]).collect(),
+            );
+        }
     }
     Ok(t)
 }

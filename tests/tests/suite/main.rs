@@ -14,6 +14,7 @@ mod ap;
 mod bias;
 mod bins;
 mod bispectrum_galaxy;
+mod bispectrum_galaxy_ct;
 mod bispectrum_galaxy_kernels;
 mod bispectrum_galaxy_poly;
 mod bispectrum_one_loop;
