@@ -69,11 +69,6 @@ pub fn one_loop_bispectrum(
         let given = [b1.unwrap_or(1.0), b2, bs, 0.0];
         let bias = pt_spectra::bias::BiasParams::from_convention(convention, given);
         let overrides: Vec<(String, f64)> = loop_bias.unwrap_or_default().into_iter().collect();
-        if method == TwoLoopMethod::Basis {
-            return Err(crate::value_error(
-                "two_loop=\"basis\": the one-loop bispectrum's tensors are built for matter only",
-            ));
-        }
         Some(pt_spectra::jobs::loop_bias(&bias, b_gamma3, &overrides).map_err(library_error)?)
     } else {
         None
@@ -100,7 +95,14 @@ pub fn one_loop_bispectrum(
                 (f, orientation)
             });
             let table = pt_spectra::jobs::one_loop_galaxy_table(
-                &prepared, &rows, bias, redshift, &rule, &Silent,
+                &prepared,
+                &rows,
+                bias,
+                redshift,
+                &rule,
+                method,
+                store.get(),
+                &Silent,
             )?;
             return Ok((prepared, table));
         }

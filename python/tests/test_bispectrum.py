@@ -203,7 +203,7 @@ def test_one_loop_bispectrum_in_redshift_space_at_one_orientation():
         pt.one_loop_bispectrum(tri, f=0.7, **rule)
 
 
-def test_one_loop_galaxy_bispectrum_through_the_python_face():
+def test_one_loop_galaxy_bispectrum_through_the_python_face(tmp_path):
     tri = np.array([[0.1, 0.1, 0.1], [0.05, 0.1, 0.12]])
     rule = dict(radial=6, mu=12, phi=8, two_loop="direct")
     k = np.unique(tri)
@@ -232,8 +232,16 @@ def test_one_loop_galaxy_bispectrum_through_the_python_face():
         np.testing.assert_allclose(zero[name], g[name], rtol=1e-10, err_msg=name)
     with pytest.raises(ValueError, match="valid: b3, g2x"):
         pt.one_loop_bispectrum(tri, b1=2.0, loop_bias={"b2": 1.0}, **rule)
-    with pytest.raises(ValueError, match="matter only"):
-        pt.one_loop_bispectrum(tri, b1=2.0, two_loop="basis", radial=6, mu=12, phi=8)
+    # through the basis tensors (real space): the same terms within their errors, the method stated
+    small = dict(radial=6, mu=12, phi=8)
+    basis = pt.one_loop_bispectrum(tri, b1=2.0, b2=0.4, bs=-0.3, two_loop="basis", cache_dir=tmp_path, **small)
+    assert basis.meta["methods"] == {"loop terms": "basis"} and g.meta["methods"] == {"loop terms": "direct"}
+    assert any(line.startswith("loop terms: basis tensors") for line in basis.header)
+    for name in ["B222", "B321_I", "B321_II", "B411", "B_1loop"]:
+        assert np.all(np.abs(basis[name] - g[name]) <= basis["err_" + name] + g["err_" + name]), name
+    np.testing.assert_allclose(basis["shape_ct_k2"], g["shape_ct_k2"], rtol=1e-12)
+    with pytest.raises(ValueError, match="real space only"):
+        pt.one_loop_bispectrum(tri, b1=2.0, mu1=0.4, two_loop="basis", **small)
 
 
 @pytest.mark.parametrize("kwargs, needle", [

@@ -75,7 +75,11 @@ impl Default for OneLoopRule {
 }
 
 impl OneLoopRule {
-    pub(super) fn validate(&self) -> Result<()> {
+    /// Checks the rule: at least 2 nodes in each direction and 0 < q_min < q_max.
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] naming what is wrong.
+    pub fn validate(&self) -> Result<()> {
         if self.radial < 2 || self.mu < 2 || self.phi < 2 {
             return Err(Error::InvalidChoice {
                 what: format!(

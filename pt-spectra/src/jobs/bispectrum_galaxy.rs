@@ -8,12 +8,16 @@ use crate::bias::BiasParams;
 use crate::bispectrum::bias_kernels::LoopBias;
 use crate::bispectrum::galaxy_counterterms::{galaxy_counterterm_shapes, GALAXY_COUNTERTERMS};
 use crate::bispectrum::one_loop::{OneLoopRule, PARTITION_POWER};
-use crate::bispectrum::one_loop_galaxy::one_loop_galaxy;
+use crate::bispectrum::one_loop_basis::BispectrumLoopSource;
+use crate::bispectrum::one_loop_galaxy::{one_loop_galaxy, OneLoopGalaxy};
+use crate::bispectrum::one_loop_galaxy_basis::GalaxyLoopBasis;
 use crate::bispectrum::one_loop_rsd::Orientation;
 use crate::error::{Error, Result};
 use crate::output::{MethodNote, Table, BISPECTRUM, BISPECTRUM_SHAPE, POWER};
+use crate::precision::TwoLoopMethod;
 use crate::progress::Progress;
 use crate::setup::Prepared;
+use crate::store::TableStore;
 
 /// The coefficients of the fourth-order basis that the faces set by name (`--loop-bias NAME=VALUE`,
 /// Python `loop_bias={...}`): those that (b1, b2, bs) and b_Γ3 do not already fix. b1, b2 and g2 are
@@ -69,41 +73,39 @@ pub fn loop_bias(
 /// amounts subtracted by the renormalisation (`uv_B321_II`, `uv_B411`: the bare terms are the
 /// renormalised ones plus these) of the one-loop galaxy bispectrum with `bias` at `triangles`
 /// (points), in real space (`redshift` None) or at the growth rate (default f(z)) and orientation of
-/// `redshift`, for the linear spectrum of `prepared`, directly, each triangle reported to `progress`;
-/// in real space also the seven counterterm and stochastic shapes `shape_<name>`
-/// ([`crate::bispectrum::galaxy_counterterms`]).
+/// `redshift`, for the linear spectrum of `prepared`, each triangle of a direct evaluation reported to
+/// `progress`; in real space also the seven counterterm and stochastic shapes `shape_<name>`
+/// ([`crate::bispectrum::galaxy_counterterms`]). The loop terms by `method` in real space: `basis` (the
+/// tensors of [`crate::bispectrum::one_loop_galaxy_basis`] from `store`, built once, ~4 s per triangle and
+/// core, and cached), `auto` (the tensors if cached) or `direct`; a spectrum the basis does not represent
+/// is integrated directly, as the header says. Redshift space is direct.
 ///
 /// # Errors
-/// As [`one_loop_galaxy`], naming the triangle.
+/// As [`one_loop_galaxy`], naming the triangle; [`Error::InvalidChoice`] for `basis` in redshift space.
+#[allow(clippy::too_many_arguments)]
 pub fn one_loop_galaxy_table(
     prepared: &Prepared,
     triangles: &[[f64; 3]],
     bias: &LoopBias,
     redshift: Option<(Option<f64>, Orientation)>,
     rule: &OneLoopRule,
+    method: TwoLoopMethod,
+    store: &TableStore,
     progress: &dyn Progress,
 ) -> Result<Table> {
     let redshift = redshift.map(|(f, o)| (f.unwrap_or(prepared.growth_rate), o));
+    let (terms, source) = galaxy_terms(
+        prepared, triangles, bias, redshift, rule, method, store, progress,
+    )?;
     let mut rows = Vec::with_capacity(triangles.len());
     let mut uv = Vec::with_capacity(triangles.len());
     let mut shapes = Vec::new();
-    for (i, &k) in triangles.iter().enumerate() {
-        let b = one_loop_galaxy(&prepared.spectrum, k, bias, redshift, rule).map_err(|e| {
-            Error::InvalidChoice {
-                what: format!("triangle {} ({}, {}, {})", i + 1, k[0], k[1], k[2]),
-                reason: e.to_string(),
-            }
-        })?;
+    for (&k, b) in triangles.iter().zip(&terms) {
         rows.push((k, [b.tree, b.b222, b.b321_i, b.b321_ii, b.b411, b.total()]));
         uv.push([b.uv_b321_ii, b.uv_b411]);
         if redshift.is_none() {
             shapes.push(galaxy_counterterm_shapes(&prepared.spectrum, k, bias)?);
         }
-        progress.update(
-            crate::bispectrum::seam::ONE_LOOP_STAGE,
-            i + 1,
-            triangles.len(),
-        );
     }
     let space = match redshift {
         None => "real space".to_string(),
@@ -135,14 +137,22 @@ pub fn one_loop_galaxy_table(
         format!(
             "loop integrals over {} <= |q| <= {} h/Mpc about each cusp (smooth partition of unity, power {}); \
              {} ln q x {} cos(theta) x {} phi nodes per panel; err_: difference from the rule with half the \
-             nodes; loop terms: direct integration",
+             nodes",
             rule.q_min, rule.q_max, PARTITION_POWER, rule.radial, rule.mu, rule.phi
         ),
+        match source {
+            BispectrumLoopSource::DirectUncached => "loop terms: direct integration (method auto: no basis \
+                tensors cached for these triangles and rule; method basis builds them once, ~4 s per triangle \
+                and core, then ~0.15 ms per triangle)"
+                .into(),
+            s => s.describe(),
+        },
         "at the given triangles (not averaged over bins); linear spectrum: all matter".into(),
     ];
     header.extend(prepared.description.iter().cloned());
     let mut t = Table::new(header);
-    t.methods.push(MethodNote::new("loop terms", "direct"));
+    t.methods
+        .push(MethodNote::new("loop terms", source.method()));
     one_loop_columns(&mut t, &rows);
     for (j, name) in ["uv_B321_II", "uv_B411"].iter().enumerate() {
         t.push(*name, BISPECTRUM, uv.iter().map(|u| u[j]).collect());
@@ -170,6 +180,85 @@ pub fn one_loop_galaxy_table(
         }
     }
     Ok(t)
+}
+
+/// The terms of every triangle and how they were computed ([`one_loop_galaxy_table`]).
+#[allow(clippy::too_many_arguments)]
+fn galaxy_terms(
+    prepared: &Prepared,
+    triangles: &[[f64; 3]],
+    bias: &LoopBias,
+    redshift: Option<(f64, Orientation)>,
+    rule: &OneLoopRule,
+    method: TwoLoopMethod,
+    store: &TableStore,
+    progress: &dyn Progress,
+) -> Result<(Vec<OneLoopGalaxy>, BispectrumLoopSource)> {
+    let name = |i: usize, k: [f64; 3]| format!("triangle {} ({}, {}, {})", i + 1, k[0], k[1], k[2]);
+    let mut source = BispectrumLoopSource::Direct;
+    if redshift.is_some() {
+        if method == TwoLoopMethod::Basis {
+            return Err(Error::InvalidChoice {
+                what: "the one-loop galaxy bispectrum's basis tensors".into(),
+                reason: "are built for real space only (give method direct or auto)".into(),
+            });
+        }
+    } else if method != TwoLoopMethod::Direct {
+        // the tensors' build checks what the direct path checks: name a bad triangle first
+        for (i, &k) in triangles.iter().enumerate() {
+            crate::bispectrum::one_loop::triangle_vectors(k).map_err(|e| Error::InvalidChoice {
+                what: name(i, k),
+                reason: e.to_string(),
+            })?;
+        }
+        rule.validate()?;
+        let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
+            GalaxyLoopBasis::build(triangles, rule, tick).expect("triangles and rule checked")
+        };
+        match store.for_method::<GalaxyLoopBasis>(method, (triangles, rule), build, progress)? {
+            None => source = BispectrumLoopSource::DirectUncached,
+            Some(tensors) => {
+                let projection = tensors.project(&prepared.spectrum);
+                let max = crate::loops::basis::MAX_RESIDUAL;
+                if projection.residual <= max {
+                    let terms = tensors
+                        .evaluate(&prepared.spectrum)
+                        .iter()
+                        .map(|p| p.evaluate(bias))
+                        .collect::<Result<Vec<_>>>()?;
+                    let functions = projection.coefficients.len();
+                    let residual = projection.residual;
+                    return Ok((
+                        terms,
+                        BispectrumLoopSource::Basis {
+                            functions,
+                            residual,
+                        },
+                    ));
+                }
+                source = BispectrumLoopSource::Fallback {
+                    residual: projection.residual,
+                    max_residual: max,
+                };
+            }
+        }
+    }
+    let mut terms = Vec::with_capacity(triangles.len());
+    for (i, &k) in triangles.iter().enumerate() {
+        let b = one_loop_galaxy(&prepared.spectrum, k, bias, redshift, rule).map_err(|e| {
+            Error::InvalidChoice {
+                what: name(i, k),
+                reason: e.to_string(),
+            }
+        })?;
+        terms.push(b);
+        progress.update(
+            crate::bispectrum::seam::ONE_LOOP_STAGE,
+            i + 1,
+            triangles.len(),
+        );
+    }
+    Ok((terms, source))
 }
 
 #[cfg(test)]

@@ -95,10 +95,9 @@ impl TableStore {
 }
 
 /// Implements [`CachedTensors`] for a tensor type whose key is the tuple of the arguments its
-/// inherent `file_name(…)` and `from_f64s(values, …)` take, in that order.
-/// `impl CachedTensors` for a tensor type with inherent `file_name(key…)`, `from_f64s(values, key…)`
-/// and `to_f64s()`: a statistic's module implements its own cache (e.g. `bispectrum::seam`), so the
-/// store names none of them.
+/// inherent `file_name(…)` and `from_f64s(values, …)` take, in that order (and `to_f64s()`); exported
+/// so that a statistic's module implements its own cache (e.g. `bispectrum::seam`) and the store names
+/// none of them.
 macro_rules! cached_tensors {
     ($tensors:ty, $key:ty, $what:literal, $stage:expr, ($($arg:ident),+)) => {
         impl $crate::store::CachedTensors for $tensors {

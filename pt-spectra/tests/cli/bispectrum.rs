@@ -499,7 +499,10 @@ fn one_loop_matter_terms_at_triangles_and_refusals() {
         (with(&["--loop-bias", "b2=1"]), "valid: b3, g2x"),
         (with(&["--loop-bias", "g21"]), "NAME=VALUE"),
         (with(&["--loop-bias", "g21=1,g21=2"]), "given twice"),
-        (with(&["--b1", "2", "--two-loop", "basis"]), "matter only"),
+        (
+            with(&["--b1", "2", "--mu1", "0.5", "--two-loop", "basis"]),
+            "real space only",
+        ),
         (
             vec!["bispectrum", "--triangles", path, "--b-gamma3", "0.1"],
             "give --loop 1",

@@ -197,9 +197,6 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
     let loaded = args.spectrum.load()?;
     let bars = crate::progress::Bars::default();
     if let Some(bias) = galaxy_bias(args)? {
-        if loaded.precision.two_loop == pt_spectra::precision::TwoLoopMethod::Basis {
-            bail!("--two-loop basis: the one-loop bispectrum's tensors are built for matter only");
-        }
         let redshift = args.mu1.map(|mu1| {
             let phi = args.phi_los.unwrap_or(0.0);
             (
@@ -213,6 +210,8 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
             &bias,
             redshift,
             &OneLoopRule::default(),
+            loaded.precision.two_loop,
+            &loaded.store,
             &bars,
         )
         .with_context(|| format!("--triangles {}", path.display()));
