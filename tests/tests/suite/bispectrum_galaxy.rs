@@ -228,14 +228,10 @@ fn renormalised_terms_hardly_depend_on_the_cut() {
     }
 }
 
-/// Every term (B321-II and B411 renormalised) against the independent plain Monte Carlo
-/// (make_one_loop_galaxy_mc.py: its own unsymmetrised operator kernels averaged over orderings, its own
-/// UV constants, the whole sphere), real space and f = 0.7 with a line of sight out of the plane, 4
-/// triangles each: within 3.5σ plus the direct error, the tree level to 1e-6, χ² plausible (measured 30.6
-/// for 32 terms, largest pull 3.15). A rule of 8 × 16 × 12 nodes per panel (errors ≤ 5e-3 of the tree, far
-/// below the Monte Carlo's).
-#[test]
-fn terms_agree_with_an_independent_monte_carlo() {
+/// The line of sight of the galaxy Monte Carlo tables and their rows: f, the sides, the tree level, then
+/// (value, one-σ error) of B222, B321-I, B321-II, B411 (the last two renormalised); real space (f = 0)
+/// first, then f = 0.7.
+fn galaxy_monte_carlo() -> (Orientation, Vec<[f64; 13]>) {
     let text = [
         include_str!("../../data/bispectrum/one_loop_galaxy_mc_gm2012_z0_f0.txt"),
         include_str!("../../data/bispectrum/one_loop_galaxy_mc_gm2012_z0_f0.7.txt"),
@@ -253,12 +249,62 @@ fn terms_agree_with_an_independent_monte_carlo() {
         mu1: los[2],
         phi: los[1].atan2(los[0]),
     };
-    let rows: Vec<Vec<f64>> = text
+    let rows = text
         .lines()
         .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
-        .map(|l| l.split_whitespace().map(|x| x.parse().unwrap()).collect())
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            v.try_into().unwrap()
+        })
         .collect();
-    assert!(rows.len() >= 8, "{} rows", rows.len());
+    (orientation, rows)
+}
+
+/// The triangles of the matter Monte Carlo table (22, squeezed (0.01, 0.1, 0.1) through equilateral to
+/// folded), sorted.
+fn matter_monte_carlo_triangles() -> Vec<[f64; 3]> {
+    let mut t: Vec<[f64; 3]> = include_str!("../../data/bispectrum/one_loop_mc_gm2012_z0.txt")
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    t.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    t
+}
+
+/// Every term (B321-II and B411 renormalised) against the independent plain Monte Carlo
+/// (make_one_loop_galaxy_mc.py: its own unsymmetrised operator kernels averaged over orderings, its own
+/// UV constants, the whole sphere) at the 22 triangles of the matter table, squeezed (0.01, 0.1, 0.1)
+/// through equilateral to folded, in real space and at f = 0.7 with a line of sight out of the plane: 176
+/// terms. Each within 4σ plus the direct error: for Gaussian pulls P(|pull| > 4) = 6.3e-5, so a correct
+/// code fails somewhere among the 176 with probability 1.1% (3.5σ would be 8%). The χ² of all terms, and
+/// that of each term over the 44 rows, below n + 4√(2n); the mean pull of each term over its 44 rows (the
+/// rows have independent samples) |Σ pull|/√44 ≤ 4, which sees a common offset of a term down to 0.6σ per
+/// row — how the renormalised B321-II, whose Monte Carlo errors are 20% to several times its value (the
+/// subtraction leaves the kernel's angular fluctuation at large q), is held beyond its loose single
+/// pulls (B321-II and B411 of one row share samples: their pulls are correlated). The tree level to 1e-6.
+/// A rule of 8 × 16 × 12 nodes per panel (errors ≤ 5e-3 of the tree, far below the Monte Carlo's).
+/// Measured: χ² = 177.1 for 176 (75.4 for 88 real, 101.7 for 88 redshift), largest pull 2.40 real, 3.15
+/// redshift (B321-I, equilateral 0.1); Σ pull/√44 +0.66, +0.61, −1.63, −1.61 (B222, B321-I, B321-II,
+/// B411); 33.5 s for the 44 rows (load 3 on 2 cores). It fails with B321-I × 1.05 (pull 5.9), B411 × 1.1
+/// (11), B321-II × 1.3 (18), g31 × 1.3 (B411's χ² 88.8 > 81.5, Σ pull/√44 = −5.6), g2 × 1.05 (tree).
+#[test]
+fn terms_agree_with_an_independent_monte_carlo() {
+    let (orientation, rows) = galaxy_monte_carlo();
+    let want = matter_monte_carlo_triangles();
+    assert!(want.len() >= 20, "{} matter triangles", want.len());
+    for f in [0.0, 0.7] {
+        let mut got: Vec<[f64; 3]> = rows
+            .iter()
+            .filter(|r| r[0] == f)
+            .map(|r| [r[1], r[2], r[3]])
+            .collect();
+        got.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        assert_eq!(got, want, "f = {f}: not the matter table's triangles");
+    }
     let r = OneLoopRule {
         radial: 8,
         mu: 16,
@@ -266,41 +312,89 @@ fn terms_agree_with_an_independent_monte_carlo() {
         ..OneLoopRule::default()
     };
     let p = LinearSpectrum::gm2012_z0();
-    let (mut chi2, mut n, mut largest) = (0.0, 0, 0.0f64);
+    let names = ["B222", "B321-I", "B321-II", "B411"];
+    // Pulls by space (0 real, 1 redshift) and term.
+    let mut pulls = [
+        [Vec::new(), Vec::new(), Vec::new(), Vec::new()],
+        Default::default(),
+    ];
+    let start = std::time::Instant::now();
     for row in &rows {
         let (f, k) = (row[0], [row[1], row[2], row[3]]);
+        let space = usize::from(f > 0.0);
         let redshift = (f > 0.0).then_some((f, orientation));
-        let start = std::time::Instant::now();
         let b = one_loop_galaxy(&p, k, &galaxy_bias(), redshift, &r).unwrap();
-        eprintln!("f = {f}, {k:?}: {:.2} s", start.elapsed().as_secs_f64());
         assert!(
             close(b.tree.value, row[4], 1e-6),
             "{k:?}: tree {} vs {}",
             b.tree.value,
             row[4]
         );
+        let mut line = format!("f = {f}, {k:?}:");
         for (j, t) in terms(&b)[1..].iter().enumerate() {
             let (mc, sigma) = (row[5 + 2 * j], row[6 + 2 * j]);
             let pull = (t.value - mc) / sigma;
-            eprintln!(
-                "  term {j}: {:.6e} ± {:.1e} vs {mc:.6e} ± {sigma:.1e} ({pull:+.2} σ)",
-                t.value, t.error
-            );
+            line += &format!(" {} {pull:+.2}", names[j]);
             assert!(
-                (t.value - mc).abs() <= 3.5 * sigma + t.error,
-                "f = {f}, {k:?} term {j}: {} vs {mc} ± {sigma} ({pull:.1} sigma)",
-                t.value
+                (t.value - mc).abs() <= 4.0 * sigma + t.error,
+                "f = {f}, {k:?} {}: {} ± {} vs {mc} ± {sigma} ({pull:.1} sigma)",
+                names[j],
+                t.value,
+                t.error
             );
-            chi2 += pull * pull;
-            largest = largest.max(pull.abs());
-            n += 1;
+            pulls[space][j].push(pull);
         }
+        eprintln!("{line}");
     }
-    eprintln!("chi2 = {chi2:.1} for {n} terms, largest pull {largest:.2}");
-    let bound = n as f64 + 4.0 * (2.0 * n as f64).sqrt();
+    eprintln!(
+        "{} rows in {:.1} s",
+        rows.len(),
+        start.elapsed().as_secs_f64()
+    );
+    let chi2 = |x: &[f64]| x.iter().map(|p| p * p).sum::<f64>();
+    let bound = |n: usize| n as f64 + 4.0 * (2.0 * n as f64).sqrt();
+    let (mut all, mut n) = (0.0, 0);
+    for (space, by_term) in pulls.iter().enumerate() {
+        let flat: Vec<f64> = by_term.iter().flatten().copied().collect();
+        let largest = flat.iter().fold(0.0f64, |m, p| m.max(p.abs()));
+        eprintln!(
+            "{}: chi2 = {:.1} for {} terms ({:.2} per term), largest pull {largest:.2}",
+            ["real space", "f = 0.7"][space],
+            chi2(&flat),
+            flat.len(),
+            chi2(&flat) / flat.len() as f64
+        );
+        all += chi2(&flat);
+        n += flat.len();
+    }
+    for (j, name) in names.iter().enumerate() {
+        let x: Vec<f64> = pulls.iter().flat_map(|s| s[j].iter().copied()).collect();
+        let mean = x.iter().sum::<f64>() / (x.len() as f64).sqrt();
+        eprintln!(
+            "{name}: chi2 = {:.1} for {}, sum of pulls / sqrt(n) = {mean:+.2}",
+            chi2(&x),
+            x.len()
+        );
+        assert!(
+            chi2(&x) < bound(x.len()),
+            "{name}: chi2 = {:.1} for {} (bound {:.1})",
+            chi2(&x),
+            x.len(),
+            bound(x.len())
+        );
+        assert!(
+            mean.abs() <= 4.0,
+            "{name}: a common offset, mean pull × sqrt(n) = {mean:.2}"
+        );
+    }
+    eprintln!(
+        "chi2 = {all:.1} for {n} terms ({:.2} per term)",
+        all / n as f64
+    );
     assert!(
-        chi2 < bound,
-        "chi2 = {chi2:.1} for {n} terms (bound {bound:.1})"
+        all < bound(n),
+        "chi2 = {all:.1} for {n} terms (bound {:.1})",
+        bound(n)
     );
 }
 
