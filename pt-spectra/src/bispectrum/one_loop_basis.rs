@@ -65,11 +65,11 @@ const PAIRS: [(usize, usize); 6] = [(1, 0), (2, 0), (0, 1), (2, 1), (0, 2), (1, 
 /// The lattice of the basis for `rule` and sides up to `k_max`: every radius the integrands see
 /// (|q| up to q_max + 2 k_max), from q_min/10 (radii below q_min come with partition weights
 /// ≤ 1e-6: the lattice is zero below its start, the direct path extrapolates).
-fn lattice(rule: &OneLoopRule, k_max: f64) -> Lattice {
+pub(super) fn lattice(rule: &OneLoopRule, k_max: f64) -> Lattice {
     Lattice::new(0.1 * rule.q_min, rule.q_max + 2.0 * k_max, 0.01)
 }
 
-fn k_max(triangles: &[[f64; 3]]) -> f64 {
+pub(super) fn k_max(triangles: &[[f64; 3]]) -> f64 {
     triangles.iter().flatten().copied().fold(0.0, f64::max)
 }
 
@@ -100,8 +100,16 @@ pub struct OneLoopMatterBasis {
 
 /// The settings that make the tensors (their cache key).
 fn key(triangles: &[[f64; 3]], rule: &OneLoopRule) -> Vec<f64> {
-    let mut key = vec![
-        f64::from(VERSION),
+    let mut key = key_head(VERSION, triangles, rule);
+    key.extend(triangles.iter().flatten());
+    key
+}
+
+/// The head of a one-loop bispectrum tensors' cache key (matter's and galaxies'): the layout `version`,
+/// the basis, the partition and the rule, and the number of triangles.
+pub(super) fn key_head(version: u32, triangles: &[[f64; 3]], rule: &OneLoopRule) -> Vec<f64> {
+    vec![
+        f64::from(version),
         BASIS_SIZE as f64,
         f64::from(training::VERSION),
         f64::from(PARTITION_POWER),
@@ -111,9 +119,7 @@ fn key(triangles: &[[f64; 3]], rule: &OneLoopRule) -> Vec<f64> {
         rule.q_min,
         rule.q_max,
         triangles.len() as f64,
-    ];
-    key.extend(triangles.iter().flatten());
-    key
+    ]
 }
 
 impl OneLoopMatterBasis {
@@ -445,11 +451,9 @@ impl BispectrumLoopSource {
     pub fn method(&self) -> &'static str {
         match self {
             Self::Direct => "direct",
-            Self::DirectUncached => "direct (fallback: no basis tensors cached, method auto)",
+            Self::DirectUncached => crate::output::FALLBACK_UNCACHED,
             Self::Basis { .. } => "basis",
-            Self::Fallback { .. } => {
-                "direct (fallback: projection residual above the basis's limit)"
-            }
+            Self::Fallback { .. } => crate::output::FALLBACK_RESIDUAL,
         }
     }
 

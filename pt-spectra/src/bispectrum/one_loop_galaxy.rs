@@ -31,7 +31,7 @@
 //! round-off. Not here yet (issue 50): the counterterms and stochastic terms of the galaxy bispectrum, IR
 //! resummation, multipoles, bins, basis tensors.
 
-use super::bias_kernels::LoopBias;
+use super::bias_kernels::{loop_kernel_parts, LoopBias, N_PARTS};
 use super::one_loop::{
     angular_nodes, breaks, loop_integrals, radial_nodes, triangle_vectors, Kernels, OneLoopRule,
     Vec3,
@@ -99,40 +99,52 @@ pub(super) fn sigma2(p: &LinearSpectrum, k: &[f64; 3], rule: &OneLoopRule, mirro
     radial * angular
 }
 
-/// The UV constants [c₃(k_a); 3] and [c₄(k_b, k_c); 3] of the bias operators (module docs).
+/// The UV constants [c₃(k_a); 3] and [c₄(k_b, k_c); 3] of the bias operators (module docs): the
+/// parts' ([`uv_parts`]) at the coefficients `bias`.
 fn uv_constants(
     bias: &LoopBias,
     redshift: Option<(f64, Vec3)>,
     kv: &[Vec3; 3],
     rule: &OneLoopRule,
 ) -> ([f64; 3], [f64; 3]) {
-    let full = Kernels::Galaxy {
-        bias: bias.values(),
-        redshift,
-    };
-    let linear = Kernels::Galaxy {
-        bias: bias.linear_only().values(),
-        redshift,
-    };
-    let angular = angular_nodes(rule, full.mirror());
+    let mirror = redshift.is_none_or(|(_, los)| los[1] == 0.0);
+    let (c3, c4) = uv_parts(redshift, kv, rule, mirror);
+    let mut x = [1.0; N_PARTS];
+    x[1..].copy_from_slice(&bias.values());
+    let at = |c: &[f64; N_PARTS]| c.iter().zip(&x).map(|(c, x)| c * x).sum::<f64>();
+    (c3.map(|c| at(&c)), c4.map(|c| at(&c)))
+}
+
+/// c₃(k_a)[p] and c₄(k_b, k_c)[p] of [`uv_parts`].
+pub(super) type UvParts = ([[f64; N_PARTS]; 3], [[f64; N_PARTS]; 3]);
+
+/// The UV constants per part, c₃(k_a)[p] and c₄(k_b, k_c)[p], of the bias operators' parts (p ≥ 2; zero for
+/// the constant and b1), each the angular average at q = 10³ and 2 × 10³ times the largest side, the 1/q² term extrapolated away.
+pub(super) fn uv_parts(
+    redshift: Option<(f64, Vec3)>,
+    kv: &[Vec3; 3],
+    rule: &OneLoopRule,
+    mirror: bool,
+) -> UvParts {
+    let angular = angular_nodes(rule, mirror);
     let total: f64 = angular.iter().map(|(_, w)| w).sum();
     let k_max = kv.iter().map(|v| norm(*v)).fold(0.0, f64::max);
     let average = |big: f64, args: &dyn Fn(Vec3) -> Vec<Vec3>| {
-        angular
-            .iter()
-            .map(|&(u, w)| {
-                let q = args(u.map(|x| x * big));
-                w * (full.eval(&q) - linear.eval(&q))
-            })
-            .sum::<f64>()
-            / total
+        let mut s = [0.0; N_PARTS];
+        for &(u, w) in &angular {
+            let parts = loop_kernel_parts(redshift, &args(u.map(|x| x * big)));
+            for (s, x) in s.iter_mut().zip(parts).skip(2) {
+                *s += w * x;
+            }
+        }
+        s.map(|x| x / total)
     };
     let limit = |args: &dyn Fn(Vec3) -> Vec<Vec3>| {
         let (a, b) = (average(1e3 * k_max, args), average(2e3 * k_max, args));
-        (4.0 * b - a) / 3.0
+        std::array::from_fn(|p| (4.0 * b[p] - a[p]) / 3.0)
     };
-    let mut c3 = [0.0; 3];
-    let mut c4 = [0.0; 3];
+    let mut c3 = [[0.0; N_PARTS]; 3];
+    let mut c4 = [[0.0; N_PARTS]; 3];
     for a in 0..3 {
         let (b, c) = ((a + 1) % 3, (a + 2) % 3);
         c3[a] = limit(&|q| vec![kv[a], q, neg(q)]);

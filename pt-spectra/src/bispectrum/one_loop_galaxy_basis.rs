@@ -26,12 +26,10 @@
 use super::bias_kernels::{loop_kernel_parts, N_PARTS};
 use super::one_loop::{
     angular_nodes, breaks, partition, radial_nodes, triangle_vectors, OneLoopRule, Vec3,
-    PARTITION_POWER,
 };
-use super::one_loop_basis::{pack_pairs, pack_triples, PROJECTION_FACTOR};
-use super::one_loop_galaxy_poly::{
-    assemble, uv_parts, GalaxyLoopPolynomial, Layout, LoopSums, UvParts,
-};
+use super::one_loop_basis::{self, pack_pairs, pack_triples, PROJECTION_FACTOR};
+use super::one_loop_galaxy::{uv_parts, UvParts};
+use super::one_loop_galaxy_poly::{assemble, GalaxyLoopPolynomial, Layout, LoopSums};
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::{after_key, cache_file_name, Projection, BASIS_SIZE};
@@ -287,27 +285,16 @@ impl GalaxyLoopBasis {
 /// Version of the tensor layout, part of the cache file name.
 const VERSION: u32 = 1;
 
-/// The lattice of the basis (as the matter tensors').
+/// The lattice of the basis (the matter tensors').
 fn lattice(triangles: &[[f64; 3]], rule: &OneLoopRule) -> Lattice {
-    let k_max = triangles.iter().flatten().copied().fold(0.0, f64::max);
-    Lattice::new(0.1 * rule.q_min, rule.q_max + 2.0 * k_max, 0.01)
+    one_loop_basis::lattice(rule, one_loop_basis::k_max(triangles))
 }
 
-/// The settings that make the tensors (their cache key): the version, the basis, the rule, the triangles,
-/// and the kernels' parts at fixed arguments of orders 2, 3 and 4 (the kernels' fingerprint).
+/// The settings that make the tensors (their cache key): the head of the matter tensors' key with this
+/// layout's version, the kernels' parts at fixed arguments of orders 2, 3 and 4 (the kernels'
+/// fingerprint), the triangles.
 fn key(triangles: &[[f64; 3]], rule: &OneLoopRule) -> Vec<f64> {
-    let mut key = vec![
-        f64::from(VERSION),
-        BASIS_SIZE as f64,
-        f64::from(training::VERSION),
-        f64::from(PARTITION_POWER),
-        rule.radial as f64,
-        rule.mu as f64,
-        rule.phi as f64,
-        rule.q_min,
-        rule.q_max,
-        triangles.len() as f64,
-    ];
+    let mut key = one_loop_basis::key_head(VERSION, triangles, rule);
     let q = [
         [0.31, -0.12, 0.57],
         [-0.22, 0.41, 0.13],

@@ -32,10 +32,8 @@
 //! B₄₁₁ have them subtracted coefficient by coefficient.
 
 use super::bias_kernels::{loop_kernel_parts, LoopBias, LOWEST_ORDER, N_PARTS};
-use super::one_loop::{
-    angular_nodes, breaks, nodes, partition, triangle_vectors, OneLoopRule, Vec3,
-};
-use super::one_loop_galaxy::{sigma2, OneLoopGalaxy};
+use super::one_loop::{breaks, nodes, partition, triangle_vectors, OneLoopRule, Vec3};
+use super::one_loop_galaxy::{sigma2, uv_parts, OneLoopGalaxy, UvParts};
 use super::one_loop_rsd::Orientation;
 use crate::error::Result;
 use crate::estimate::Estimate;
@@ -332,44 +330,6 @@ fn loop_sums(
                 a
             },
         )
-}
-
-/// c₃(k_a)[p] and c₄(k_b, k_c)[p] of [`uv_parts`].
-pub(super) type UvParts = ([[f64; N_PARTS]; 3], [[f64; N_PARTS]; 3]);
-
-/// The UV constants per part, c₃(k_a)[p] and c₄(k_b, k_c)[p], of the bias operators' parts (p ≥ 2; zero for
-/// the constant and b1), as [`super::one_loop_galaxy`]'s (the same angular rule, radii and extrapolation).
-pub(super) fn uv_parts(
-    redshift: Option<(f64, Vec3)>,
-    kv: &[Vec3; 3],
-    rule: &OneLoopRule,
-    mirror: bool,
-) -> UvParts {
-    let angular = angular_nodes(rule, mirror);
-    let total: f64 = angular.iter().map(|(_, w)| w).sum();
-    let k_max = kv.iter().map(|v| norm(*v)).fold(0.0, f64::max);
-    let average = |big: f64, args: &dyn Fn(Vec3) -> Vec<Vec3>| {
-        let mut s = [0.0; N_PARTS];
-        for &(u, w) in &angular {
-            let parts = loop_kernel_parts(redshift, &args(u.map(|x| x * big)));
-            for (s, x) in s.iter_mut().zip(parts).skip(2) {
-                *s += w * x;
-            }
-        }
-        s.map(|x| x / total)
-    };
-    let limit = |args: &dyn Fn(Vec3) -> Vec<Vec3>| {
-        let (a, b) = (average(1e3 * k_max, args), average(2e3 * k_max, args));
-        std::array::from_fn(|p| (4.0 * b[p] - a[p]) / 3.0)
-    };
-    let mut c3 = [[0.0; N_PARTS]; 3];
-    let mut c4 = [[0.0; N_PARTS]; 3];
-    for a in 0..3 {
-        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
-        c3[a] = limit(&|q| vec![kv[a], q, neg(q)]);
-        c4[a] = limit(&|q| vec![q, neg(q), neg(kv[b]), neg(kv[c])]);
-    }
-    (c3, c4)
 }
 
 /// The one-loop galaxy bispectrum terms of the triangle of sides `k` [h/Mpc] per bias monomial, in real space

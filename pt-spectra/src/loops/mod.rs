@@ -292,9 +292,7 @@ impl OneLoopSource {
     pub fn method(&self) -> &'static str {
         match self {
             Self::Basis { .. } => "basis",
-            Self::Fallback { .. } => {
-                "direct (fallback: projection residual above the basis's limit)"
-            }
+            Self::Fallback { .. } => crate::output::FALLBACK_RESIDUAL,
         }
     }
 
@@ -356,11 +354,9 @@ impl TwoLoopSource {
     pub fn method(&self) -> &'static str {
         match self {
             Self::Direct => "direct",
-            Self::DirectUncached => "direct (fallback: no basis tensors cached, method auto)",
+            Self::DirectUncached => crate::output::FALLBACK_UNCACHED,
             Self::Basis { .. } => "basis",
-            Self::Fallback { .. } => {
-                "direct (fallback: projection residual above the basis's limit)"
-            }
+            Self::Fallback { .. } => crate::output::FALLBACK_RESIDUAL,
         }
     }
 

@@ -50,6 +50,15 @@ pub struct Column {
     pub undefined: Option<&'static str>,
 }
 
+/// [`MethodNote::method`] of a part integrated directly because the spectrum's projection on the basis
+/// tensors was not accurate enough.
+pub const FALLBACK_RESIDUAL: &str =
+    "direct (fallback: projection residual above the basis's limit)";
+
+/// [`MethodNote::method`] of a part integrated directly under method `auto` because no basis tensors
+/// were cached.
+pub const FALLBACK_UNCACHED: &str = "direct (fallback: no basis tensors cached, method auto)";
+
 /// How one part of a table was computed: by direct integration or from basis tensors, and why a
 /// slower path was taken. The header states the same with its figures; Python's `meta["methods"]`
 /// gives these (one record, so the two cannot disagree: both come from the loop terms' sources).

@@ -202,7 +202,7 @@ pub(crate) fn loop_terms(
         two_loop_terms_noted(k, spectra, &tensors.two_loop, subject, precision, progress)?;
     let method = match (&projections, tensors.two_loop.is_empty()) {
         (Some(_), _) => "basis",
-        (None, false) => "direct (fallback: projection residual above the basis's limit)",
+        (None, false) => crate::output::FALLBACK_RESIDUAL,
         (None, true) => "direct",
     };
     let method = MethodNote::new(subject, method);

@@ -289,7 +289,7 @@ impl EptTerms {
     pub fn method_note(&self) -> MethodNote {
         let method = match (self.basis_residual, self.fallback_residual) {
             (Some(_), _) => "basis",
-            (None, Some(_)) => "direct (fallback: projection residual above the basis's limit)",
+            (None, Some(_)) => crate::output::FALLBACK_RESIDUAL,
             (None, None) => "direct",
         };
         MethodNote::new("loop terms", method)
