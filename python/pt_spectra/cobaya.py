@@ -163,6 +163,7 @@ B_ELLS = (0, 2, 4)
 # not apply here: z_input = z (the spectrum is used as given, rescaling factor 1), f is passed, and
 # the only other use of D(z), the FoG scale σ0 D(z) f, gets D_boltzmann(z) as `growth_factor`.
 _NO_COSMOLOGY = "no cosmology was given for the linear spectrum"
+_FALLBACK = r".*: direct \(fallback"
 
 
 def _close_index(values, x, what):
@@ -528,6 +529,8 @@ class PTMultipoles(Theory):
                 # the default-cosmology growth the warning is about is not used.
                 warnings.filterwarnings("ignore", message=_NO_COSMOLOGY,
                                         category=pt.PtSpectraWarning)
+                # a fallback to direct integrals is stated once in the log (below), not at every step
+                warnings.filterwarnings("ignore", message=_FALLBACK, category=pt.PtSpectraWarning)
                 cached = self._terms.get(i)
                 if cached is None or cached[0] != digest:
                     cached = (digest, self._plan.terms(linear=(k_lin, p_lin), z=z, z_input=z))
@@ -546,6 +549,7 @@ class PTMultipoles(Theory):
                     t = cached[1].multipoles(f=f, bias=nu["b"], amplitude=nu["A_b"], fog=self.fog,
                                              sigma0=nu["sigma0"], ells=self.ells,
                                              growth_factor=d, cs2=nu["cs2"])
+            self._note_fallbacks(t)
             if z in self._b_requests:
                 ap = alphas.get(z, (1.0, 1.0))
                 bk = self._bispectrum(z, digest, (k_lin, p_lin), f, ap, nu)
@@ -564,6 +568,15 @@ class PTMultipoles(Theory):
         state["pt_bk_ell_err"] = b_errors
         if want_derived:
             state["derived"] = derived
+
+    def _note_fallbacks(self, table):
+        """States in the log, once per part and method, a part of the model integrated directly because
+        the spectrum is not one the basis tensors represent (``meta["methods"]``; slower, same accuracy)."""
+        noted = self.__dict__.setdefault("_fallbacks_noted", set())
+        for part, method in table.meta.get("methods", {}).items():
+            if "fallback" in method and (part, method) not in noted:
+                noted.add((part, method))
+                self.log.info("%s: %s (slower; stated once)", part, method)
 
     def _bispectrum(self, z, digest, linear, f, ap, nu):
         """(B, err) [len(ells), n_triangles] of the requested triangles at z: the terms are kept while

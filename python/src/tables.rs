@@ -89,7 +89,8 @@ impl Table {
 
 /// `meta["methods"]`: how each part of `table` was computed (`{"1-loop terms": "basis", …}`, the
 /// library's [`output::MethodNote`]s, which the header states with figures); a fallback to a slower
-/// or less accurate path is also a warning.
+/// path because the spectrum is not one the basis represents is also a warning (not `auto` without
+/// cached tensors: that is what `auto` says it does).
 fn set_methods(
     meta: &Bound<'_, PyDict>,
     table: &output::Table,

@@ -56,8 +56,8 @@ pub const FALLBACK_RESIDUAL: &str =
     "direct (fallback: projection residual above the basis's limit)";
 
 /// [`MethodNote::method`] of a part integrated directly under method `auto` because no basis tensors
-/// were cached.
-pub const FALLBACK_UNCACHED: &str = "direct (fallback: no basis tensors cached, method auto)";
+/// were cached: what `auto` promises (no build), so not called a fallback (no Python warning).
+pub const FALLBACK_UNCACHED: &str = "direct (method auto: no basis tensors cached)";
 
 /// How one part of a table was computed: by direct integration or from basis tensors, and why a
 /// slower path was taken. The header states the same with its figures; Python's `meta["methods"]`
