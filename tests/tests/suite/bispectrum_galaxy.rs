@@ -300,7 +300,7 @@ fn terms_agree_with_an_independent_monte_carlo_in_real_space() {
 
 /// [`terms_agree_with_an_independent_monte_carlo_in_real_space`] at f = 0.7 (ignored: the slow checks).
 #[test]
-#[ignore = "20 s: the slow exhaustive checks"]
+#[ignore = "slow exhaustive check (20 s): `cargo test --release --workspace -- --ignored`"]
 fn terms_agree_with_an_independent_monte_carlo_in_redshift_space() {
     compare_with_the_monte_carlo(0.7);
 }

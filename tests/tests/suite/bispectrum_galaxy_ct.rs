@@ -102,7 +102,7 @@ fn fitted_residual(a: &[Vec<f64>], d: &[f64]) -> f64 {
 /// change is a small difference of the terms: coarser rules leave 1–7% of noise); about 2 min on 2 cores,
 /// so ignored in the quick suite (`cargo test --release --workspace -- --ignored` runs it).
 #[test]
-#[ignore = "2 minutes: the slow exhaustive checks"]
+#[ignore = "slow exhaustive check (2 min): `cargo test --release --workspace -- --ignored`"]
 fn the_galaxy_counterterms_absorb_the_cut_off() {
     let p = spectrum();
     let triangles = [
