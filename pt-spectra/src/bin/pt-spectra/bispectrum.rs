@@ -118,12 +118,13 @@ pub struct Args {
     /// Loop order: 0 (the tree-level galaxy model in redshift space) or 1 (the one-loop bispectrum,
     /// SPT: B_tree, B222, B321_I, B321_II, B411 at the points of --triangles, of matter or, with
     /// --b1/--b2/--bs/--b-gamma3/--loop-bias, of galaxies; real space, or one orientation with --mu1;
-    /// no bins or counterterms yet; for matter in real space --two-loop basis makes it ~10 us per
-    /// triangle after a one-off ~0.7 s per triangle).
+    /// the counterterm shapes as columns in real space; no bins yet; in real space --two-loop basis
+    /// makes it ~10 us (matter) or ~0.15 ms (galaxies) per triangle after a one-off ~0.7 s (4 s) per
+    /// triangle and core).
     #[arg(long = "loop", value_name = "N", default_value_t = 0)]
     loop_order: u32,
     /// --loop 1 in redshift space: the cosine between k1 and the line of sight (with --f, default
-    /// f(z); the matter bispectrum at this one orientation, directly).
+    /// f(z); the matter or galaxy bispectrum at this one orientation, directly).
     #[arg(
         long,
         value_name = "MU1",
