@@ -483,14 +483,7 @@ pub const LOWEST_ORDER: [usize; N_BIAS] = [1, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4];
 /// As [`operator_kernels`]; as [`galaxy_redshift_kernel`] for a bad line of sight or f.
 pub fn galaxy_kernel_parts(q: &[Vec3], redshift: Option<(f64, &Vec3)>) -> Result<[f64; N_PARTS]> {
     if let Some((f, los)) = redshift {
-        let n2 = dot(los, los);
-        if !(n2 > 0.0 && n2.is_finite() && f.is_finite()) {
-            return Err(Error::InvalidParameter {
-                name: "line of sight, f",
-                value: n2,
-                reason: "need a finite non-zero line of sight and a finite f",
-            });
-        }
+        check_line_of_sight(f, los)?;
     }
     let t = Table::new(q)?;
     Ok(parts_from_table(&t, redshift))
@@ -535,6 +528,16 @@ pub fn galaxy_kernel(bias: &LoopBias, q: &[Vec3]) -> Result<f64> {
 /// # Errors
 /// As [`operator_kernels`]; [`Error::InvalidParameter`] for a zero or non-finite line of sight or f.
 pub fn galaxy_redshift_kernel(bias: &LoopBias, q: &[Vec3], f: f64, los: &Vec3) -> Result<f64> {
+    let n2 = check_line_of_sight(f, los)?;
+    let t = Table::new(q)?;
+    Ok(redshift_from_table(&t, &bias.values(), f, los, n2))
+}
+
+/// |`los`|² if `los` is a finite non-zero line of sight and `f` finite.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] otherwise.
+fn check_line_of_sight(f: f64, los: &Vec3) -> Result<f64> {
     let n2 = dot(los, los);
     if !(n2 > 0.0 && n2.is_finite() && f.is_finite()) {
         return Err(Error::InvalidParameter {
@@ -543,8 +546,7 @@ pub fn galaxy_redshift_kernel(bias: &LoopBias, q: &[Vec3], f: f64, los: &Vec3) -
             reason: "need a finite non-zero line of sight and a finite f",
         });
     }
-    let t = Table::new(q)?;
-    Ok(redshift_from_table(&t, &bias.values(), f, los, n2))
+    Ok(n2)
 }
 
 /// Z_n^g from the subsets' fields: the redshift-space assembly of the matter kernels

@@ -73,6 +73,18 @@ pub(super) fn k_max(triangles: &[[f64; 3]]) -> f64 {
     triangles.iter().flatten().copied().fold(0.0, f64::max)
 }
 
+/// B₂₂₂'s loop momentum q at the node `v` of piece `piece` (centred on q = 0, −k₁, k₂: the piece's
+/// radius is the argument of its spectrum), the other two arguments q + k₁, k₂ − q, and the three radii.
+pub(super) fn b222_node(piece: usize, v: Vec3, k1: Vec3, k2: Vec3) -> (Vec3, Vec3, Vec3, [f64; 3]) {
+    let q = match piece {
+        0 => v,
+        1 => sub(v, k1),
+        _ => sub(k2, v),
+    };
+    let (a, b) = (add(q, k1), sub(k2, q));
+    (q, a, b, [norm(q), norm(a), norm(b)])
+}
+
 /// The number of index pairs a ≤ b of n functions.
 fn pairs(n: usize) -> usize {
     n * (n + 1) / 2
@@ -317,14 +329,7 @@ fn rule_tensors(basis: &LinearBasis, kv: &[Vec3; 3], rule: &OneLoopRule) -> Vec<
             m.iter_mut().for_each(|x| *x = 0.0);
             let (x, y) = [(1, 2), (0, 2), (0, 1)][piece];
             for &(unit, wu) in &angular {
-                let v = unit.map(|c| c * p);
-                let q = match piece {
-                    0 => v,
-                    1 => sub(v, k1),
-                    _ => sub(k2, v),
-                };
-                let (a, b) = (add(q, k1), sub(k2, q));
-                let r = [norm(q), norm(a), norm(b)];
+                let (q, a, b, r) = b222_node(piece, unit.map(|c| c * p), k1, k2);
                 let kern = f_n(&[neg(q), a]) * f_n(&[neg(a), neg(b)]) * f_n(&[b, q]);
                 let s = 8.0 * wu * partition(&r, piece) * kern;
                 if s == 0.0 {

@@ -171,13 +171,7 @@ pub fn one_loop_galaxy(
     rule.validate()?;
     bias.check_finite()?;
     let kv = triangle_vectors(k)?;
-    let rsd = match redshift {
-        None => None,
-        Some((f, o)) => {
-            crate::cosmology::check_growth_rate(f)?;
-            Some((f, o.line_of_sight()?))
-        }
-    };
+    let rsd = redshift.map(Orientation::checked_with).transpose()?;
     let kernels = Kernels::Galaxy {
         bias: bias.values(),
         redshift: rsd,

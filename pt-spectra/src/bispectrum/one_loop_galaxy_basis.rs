@@ -27,7 +27,7 @@ use super::bias_kernels::{loop_kernel_parts, N_PARTS};
 use super::one_loop::{
     angular_nodes, breaks, partition, radial_nodes, triangle_vectors, OneLoopRule, Vec3,
 };
-use super::one_loop_basis::{self, pack_pairs, pack_triples, PROJECTION_FACTOR};
+use super::one_loop_basis::{self, b222_node, pack_pairs, pack_triples, PROJECTION_FACTOR};
 use super::one_loop_galaxy::{uv_parts, UvParts};
 use super::one_loop_galaxy_poly::{assemble, GalaxyLoopPolynomial, Layout, LoopSums};
 use crate::error::Result;
@@ -36,7 +36,7 @@ use crate::loops::basis::{after_key, cache_file_name, Projection, BASIS_SIZE};
 use crate::loops::basis::{pair_products, training, triple_products, triples, LinearBasis};
 use crate::loops::lattice::Lattice;
 use crate::simd::{axpy, dot};
-use crate::vec3::{add, neg, norm, sub};
+use crate::vec3::{neg, norm, sub};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -403,14 +403,7 @@ fn rule_tensors(
             m.iter_mut().for_each(|x| *x = 0.0);
             let (x, y) = [(1, 2), (0, 2), (0, 1)][piece];
             for &(unit, wu) in &angular {
-                let v = unit.map(|c| c * p);
-                let q = match piece {
-                    0 => v,
-                    1 => sub(v, k1),
-                    _ => sub(k2, v),
-                };
-                let (a, b) = (add(q, k1), sub(k2, q));
-                let r = [norm(q), norm(a), norm(b)];
+                let (q, a, b, r) = b222_node(piece, unit.map(|c| c * p), k1, k2);
                 let s = 8.0 * wu * partition(&r, piece);
                 let (za, zb, zc) = (z(&[neg(q), a]), z(&[neg(a), neg(b)]), z(&[b, q]));
                 w222.iter_mut().for_each(|x| *x = 0.0);

@@ -348,13 +348,7 @@ pub fn one_loop_galaxy_polynomial(
 ) -> Result<GalaxyLoopPolynomial> {
     rule.validate()?;
     let kv = triangle_vectors(k)?;
-    let rsd = match redshift {
-        None => None,
-        Some((f, o)) => {
-            crate::cosmology::check_growth_rate(f)?;
-            Some((f, o.line_of_sight()?))
-        }
-    };
+    let rsd = redshift.map(Orientation::checked_with).transpose()?;
     let mirror = rsd.is_none_or(|(_, los)| los[1] == 0.0);
     let lay = Layout::new(rsd.is_some());
     let pk = kv.map(|v| p.eval(norm(v)));

@@ -39,6 +39,16 @@ pub struct Orientation {
 }
 
 impl Orientation {
+    /// The growth rate and line of sight of `(f, orientation)`, both checked: what the redshift-space
+    /// terms take (`Option::map` over an optional redshift-space setting).
+    ///
+    /// # Errors
+    /// As [`crate::cosmology::check_growth_rate`] (f outside [0, 2]) and [`Self::line_of_sight`].
+    pub fn checked_with((f, orientation): (f64, Orientation)) -> Result<(f64, Vec3)> {
+        crate::cosmology::check_growth_rate(f)?;
+        Ok((f, orientation.line_of_sight()?))
+    }
+
     /// The line of sight in the triangle's frame.
     ///
     /// # Errors
