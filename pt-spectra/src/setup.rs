@@ -190,7 +190,7 @@ pub fn prepare_with_emulator(
         LinearSource::Embedded | LinearSource::Emulator => {
             let emulated = match emulator {
                 Some(e) => emulate(e, &c, z, d)?,
-                None => emulate(&LinearEmulator::embedded()?, &c, z, d)?,
+                None => emulate(LinearEmulator::shared()?, &c, z, d)?,
             };
             description.extend(emulated.description);
             warnings.extend(emulated.warning);

@@ -20,8 +20,9 @@ Options (yaml or class attributes):
   57 h/Mpc over the prior's h); a step whose spectrum the basis does not represent is integrated
   directly, with a warning. With classy, give CLASS ``k_per_decade_for_pk: 40`` in the theory's
   ``extra_args``: its default sampling (10 per decade above the BAO range) leaves a projection residual
-  of 1.1e-3 (a spline of 10 points per decade at 10 to 50 h/Mpc), so every step would be integrated
-  directly; with 40, 1.8e-4, and the basis is used (measured with classy 3.4.1, Planck 2018 at z = 0).
+  of 1.1e-3 (a spline of 10 points per decade at 10 to 50 h/Mpc), which the basis accepts (limit 2e-3)
+  with that much more in the loop terms' errors; with 40, 1.8e-4 (measured with classy 3.4.1, Planck
+  2018 at z = 0).
 - ``k_max_linear`` (10): the k_max [1/Mpc] asked of the Boltzmann code; as h < 1 this covers k up to
   ``k_max_linear`` h/Mpc. The library extends the spectrum beyond both ends by power laws. Raised to
   35 for 2-loop models with ``two_loop: basis``.

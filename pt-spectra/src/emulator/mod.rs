@@ -41,7 +41,6 @@ pub mod tangent;
 
 use crate::cosmology::{Cosmology, Neutrinos, EV_PER_OMEGA_NU};
 use crate::dual::Real;
-#[cfg(doc)]
 use crate::error::Error;
 use crate::error::Result;
 use crate::linear::{top_hat, LinearSpectrum};
@@ -156,6 +155,32 @@ impl LinearEmulator {
     /// [`Error::BadDataFile`] if the embedded file is malformed (a build error, tested).
     pub fn embedded() -> Result<Self> {
         Self::from_bytes(EMBEDDED, "embedded linear-spectrum emulator")
+    }
+
+    /// The embedded emulator, parsed once per process and shared (parsing its 2 MB costs about
+    /// 0.15 ms, twice an emulation: callers that emulate one cosmology per call, such as
+    /// [`crate::setup::prepare`], take it from here). A read-only cache of constant bytes, not
+    /// state: every call sees the same parsed file.
+    ///
+    /// # Errors
+    /// As [`Self::embedded`] (each call reports the same failure).
+    pub fn shared() -> Result<&'static Self> {
+        static PARSED: std::sync::OnceLock<
+            std::result::Result<LinearEmulator, (usize, &'static str)>,
+        > = std::sync::OnceLock::new();
+        let parsed = PARSED.get_or_init(|| {
+            Self::embedded().map_err(|e| match e {
+                Error::BadDataFile { offset, reason, .. } => (offset, reason),
+                _ => (0, "the embedded emulator could not be read"),
+            })
+        });
+        parsed
+            .as_ref()
+            .map_err(|&(offset, reason)| Error::BadDataFile {
+                what: "embedded linear-spectrum emulator".into(),
+                offset,
+                reason,
+            })
     }
 
     /// An emulator from the bytes of a file written by `fit_emulator.py`; `origin` names it.

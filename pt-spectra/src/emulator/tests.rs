@@ -548,3 +548,24 @@ fn small_neutrino_masses_agree_with_camb() {
     assert!(massive < 8e-4, "{massive}");
     assert!(massless < 5e-4, "{massless}");
 }
+
+/// The shared emulator is parsed once (the same object at every call) and emulates as a freshly
+/// parsed one does, to the bit.
+#[test]
+fn the_shared_emulator_is_parsed_once_and_equals_a_fresh_one() {
+    let (a, b) = (
+        LinearEmulator::shared().unwrap(),
+        LinearEmulator::shared().unwrap(),
+    );
+    assert!(std::ptr::eq(a, b));
+    let c = Cosmology::planck2018().with_neutrinos(0.1).unwrap();
+    let fresh = LinearEmulator::embedded()
+        .unwrap()
+        .spectra(&c, 0.7)
+        .unwrap();
+    let shared = a.spectra(&c, 0.7).unwrap();
+    assert_eq!(
+        (fresh.k, fresh.p_m, fresh.p_cb),
+        (shared.k, shared.p_m, shared.p_cb)
+    );
+}

@@ -218,7 +218,7 @@ pub fn fisher_kaiser(bins: &[KaiserBin], fiducial: &Cosmology) -> Result<KaiserF
     for (i, b) in bins.iter().enumerate() {
         b.validate(i)?;
     }
-    let emulator = LinearEmulator::embedded()?;
+    let emulator = LinearEmulator::shared()?;
     let n: usize = bins.iter().map(|b| b.tracers.len() + 1).sum();
     let mut fisher = vec![vec![0.0; n]; n];
     let mut covariance = vec![vec![0.0; n]; n];

@@ -52,12 +52,9 @@ pub use cosmological::CosmologyJacobian;
 pub use linearised::{Linearised, JACOBIAN_NAMES, NUISANCE_NAMES};
 
 /// The largest smoothed projection residual for which a [`Pipeline`] evaluates the loop terms on the
-/// basis: 2e-3, twice the emulator's own worst |Δ ln P| (~1e-3, [`LinearEmulator::describe`]).
-/// Emulated spectra project with 5e-4 to 7e-4 (the kink where the emulated table, ending at
-/// k ≈ 8.9 h/Mpc, meets its power-law extrapolation), above the 3e-4 of
-/// [`crate::loops::basis::MAX_RESIDUAL`], which sent them to the direct integrals (5–50 ms instead
-/// of < 1 ms). The terms' errors include ε|T| for a residual ε, whatever it is.
-pub const PIPELINE_MAX_RESIDUAL: f64 = 2e-3;
+/// basis: the plans' own, [`crate::loops::basis::MAX_RESIDUAL`] (2e-3; emulated spectra project with
+/// 4e-4 to 8e-4). The terms' errors include ε|T| for a residual ε, whatever it is.
+pub const PIPELINE_MAX_RESIDUAL: f64 = crate::loops::basis::MAX_RESIDUAL;
 
 /// The models a [`Pipeline`] can evaluate (the place of TNS, eft2 and the bispectrum later).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -7,7 +7,7 @@
 //! Ω_k = ±0.01, 0.05: to three digits at k = 1e-4 h/Mpc, within 1e-4 of P at k ≥ 1e-3): +0.7% at
 //! k = 1e-3 h/Mpc for Ω_k = 0.01, +78% at 1e-4. No small basis of flat
 //! spectra follows that, but cut at 1e-3 (the library's power law below, as the training set's cut
-//! tables have) it projects: smoothed residual 9e-5 for Ω_k = ±0.01, 2.6e-4 for 0.03 (4.3e-4, refused,
+//! tables have) it projects: smoothed residual 9e-5 for Ω_k = ±0.01, 2.6e-4 for 0.03 (4.3e-4
 //! for 0.05).
 //!
 //! The loop terms see modes q ≪ k through their infrared limits only. With δP = P − P_cut (non-zero

@@ -177,11 +177,11 @@ mod tests {
     }
 
     #[test]
-    fn tables_of_other_ranges_project_and_short_ones_do_not() {
+    fn tables_of_other_ranges_project_and_short_ones_less_well() {
         // CAMB tables not in the training set, ending at 15 or 50 h/Mpc, starting at 1e-4 or 3e-4:
-        // within the basis's limit (measured 5e-5 to 1.9e-4; without the tail functions, ending at
-        // 15 gave 1e-3).
-        // Ending at 5 h/Mpc, the power law beyond is too far from any CAMB tail: refused.
+        // measured 5e-5 to 1.9e-4 (without the tail functions, ending at 15 gave 1e-3).
+        // Ending at 5 h/Mpc, the power law beyond is farther from any CAMB tail: 8.9e-4, within the
+        // limit (its terms carry ε|T| in their errors) but above every complete table.
         let lattice = Lattice::new(1e-5, 1e3, 0.01);
         let basis = camb_basis(lattice.clone(), super::super::BASIS_SIZE);
         assert_eq!(basis.len(), super::super::BASIS_SIZE);
@@ -191,24 +191,45 @@ mod tests {
         ] {
             for (lo, hi) in [(1e-4, 50.0), (1e-4, 15.0), (3e-4, 50.0)] {
                 let r = basis.project(&lattice.sample(&cut(name, lo, hi))).residual;
-                assert!(
-                    r < super::super::MAX_RESIDUAL,
-                    "{name} [{lo}, {hi}]: {r:.2e}"
-                );
+                assert!(r < 2.5e-4, "{name} [{lo}, {hi}]: {r:.2e}");
             }
             let r = basis
                 .project(&lattice.sample(&cut(name, 1e-4, 5.0)))
                 .residual;
-            assert!(r > super::super::MAX_RESIDUAL, "{name} to 5 h/Mpc: {r:.2e}");
+            assert!(
+                r > 2.5e-4 && r < super::super::MAX_RESIDUAL,
+                "{name} to 5 h/Mpc: {r:.2e}"
+            );
+        }
+    }
+
+    #[test]
+    fn emulated_spectra_project_within_the_limit() {
+        // The embedded emulator's tables end at ~9 h/Mpc (a power law beyond): within the limit
+        // (measured 4e-4 to 8e-4): the whole spectrum is projected, not its soft-mode cut.
+        let lattice = Lattice::new(1e-5, 1e3, 0.01);
+        let basis = camb_basis(lattice.clone(), super::super::BASIS_SIZE);
+        let emulator = crate::emulator::LinearEmulator::shared().unwrap();
+        for (om, z) in [(0.26, 0.0), (0.31, 0.5), (0.36, 2.0)] {
+            let c = crate::cosmology::Cosmology::flat(om, 0.68, 0.0224, 0.965, 0.8).unwrap();
+            let p = emulator.spectra(&c, z).unwrap().matter().unwrap();
+            let whole = basis.project(&basis.sample(&p));
+            assert!(
+                whole.residual > 2.5e-4 && whole.residual < super::super::MAX_RESIDUAL,
+                "Ω_m {om} z {z}: {:.2e}",
+                whole.residual
+            );
+            let chosen = basis.project_spectrum(&p, super::super::MAX_RESIDUAL);
+            assert!(chosen.soft.is_none() && chosen.residual == whole.residual);
         }
     }
 
     #[test]
     fn class_tables_project_when_class_samples_k_densely() {
         // CLASS (not CAMB, which made the training set), Planck 2018 at z = 0: from `pk_lin` on 600
-        // points, or CLASS's own k sampling at k_per_decade_for_pk = 40, within the limit (measured
-        // 1.9e-4, 1.8e-4); at CLASS's default 10 per decade the spline between 10 and 50 h/Mpc is
-        // refused (1.1e-3), which the README and the cobaya theory tell classy users.
+        // points, or CLASS's own k sampling at k_per_decade_for_pk = 40 (measured 1.9e-4, 1.8e-4);
+        // at CLASS's default 10 per decade the spline between 10 and 50 h/Mpc projects less well
+        // (1.1e-3), still within the limit: the basis is used and the errors carry ε|T|.
         let lattice = Lattice::new(1e-5, 1e3, 0.01);
         let basis = camb_basis(lattice.clone(), super::super::BASIS_SIZE);
         let residual = |suffix: &str| {
@@ -218,10 +239,10 @@ mod tests {
         };
         for suffix in ["pk_lin", "kpd40"] {
             let r = residual(suffix);
-            assert!(r < super::super::MAX_RESIDUAL, "{suffix}: {r:.2e}");
+            assert!(r < 2.5e-4, "{suffix}: {r:.2e}");
         }
         let r = residual("kpd10");
-        assert!(r > 2.0 * super::super::MAX_RESIDUAL, "kpd10: {r:.2e}");
+        assert!(r > 5e-4 && r < super::super::MAX_RESIDUAL, "kpd10: {r:.2e}");
     }
 
     #[test]
