@@ -11,8 +11,15 @@
 //!
 //! Numerics: the model's P^s(k, μ) (a polynomial in μ² per k, and its Fingers-of-God damping) is
 //! computed on an internal log-uniform grid ([`Distortion::internal_grid`], [`POINTS_PER_DECADE`]
-//! per decade over the k' that the output needs) and interpolated in ln k by four-point Lagrange
-//! polynomials; the μ integral is a [`MU_NODES`]-point Gauss–Legendre rule, its error the difference
+//! per decade over the k' that the output needs) and interpolated in ln k by a cubic B-spline
+//! ([`spline`]: the μ² coefficients prefiltered once per evaluation by a tridiagonal solve planned
+//! once per grid, not-a-knot ends, four weights per cell). The spline is C², so the exact
+//! derivatives in α∥, α⊥ (the ept template and cosmological Jacobians) are continuous where k'
+//! crosses a cell edge and agree with finite differences to ≤ 7.3e-8 of each column's largest
+//! element (the four-point Lagrange polynomials it replaced jumped there: 1.3e-6 for w0); on the
+//! BAO-wiggled CAMB spectrum its mid-cell error is 2.4e-5 against Lagrange's 7.3e-5. The grid's
+//! error estimates are carried to k by the same weights on their spline coefficients in absolute
+//! value. The μ integral is a [`MU_NODES`]-point Gauss–Legendre rule, its error the difference
 //! from half as many nodes. Every ℓ ≤ 8 of the true spectrum enters (the polynomial is complete), so
 //! the hexadecapole is exact to the interpolation. Wide-angle effects are neglected.
 
@@ -25,7 +32,7 @@ use crate::estimate::Estimate;
 use crate::integrate::legendre_nodes;
 use spline::UniformSpline;
 
-pub(crate) mod spline;
+pub mod spline;
 
 /// Points per decade of the internal k grid.
 pub const POINTS_PER_DECADE: f64 = 100.0;

@@ -27,7 +27,8 @@
 //!
 //! Multipoles ℓ ≤ 8: Gauss–Legendre in μ on [0, 1] ([`MU_NODES`]; the error the change from half as
 //! many nodes), exact when the model is a polynomial in μ (no IR, no AP). With AP
-//! ([`super::ap::Distortion`]) the terms are computed on the internal log grid and interpolated in ln k.
+//! ([`super::ap::Distortion`]) the terms are computed on the internal log grid and interpolated in ln k
+//! (the C² cubic B-spline of [`super::ap::spline`]: the exact derivatives in α∥, α⊥ have no jumps).
 
 use super::ap::spline::UniformSpline;
 use super::ap::Distortion;

@@ -86,7 +86,7 @@ fn differences(
 /// At a ΛCDM and a w0–wa cosmology with massive neutrinos (neither a training node), and with f
 /// given (then f's dependence is not in the cosmological columns), every column agrees with the
 /// finite-difference estimate within 1e-6 of its largest element, with and without AP (measured
-/// ≤ 1.6e-8 without AP, ≤ 7.4e-8 with, w0 ≤ 4.1e-8: the AP projection's interpolant in ln k′ is a
+/// ≤ 1.6e-8 without AP, ≤ 7.3e-8 with, w0 ≤ 4.1e-8: the AP projection's interpolant in ln k′ is a
 /// cubic B-spline, C², so differences that straddle its cell edges see no derivative jumps; with
 /// the four-point Lagrange interpolant it replaced, w0 was 1.3e-6 off, docs/architecture.md); the
 /// data vector is `evaluate`'s.
