@@ -122,7 +122,7 @@ pub fn ept_table_from_terms(
     if let Some(d) = ap {
         header.push(format!(
             "Alcock-Paczynski: apar = {}, aperp = {}; the model on the log grid of the AP projection \
-             (interpolated cubically in ln k), {}-point Gauss-Legendre in mu (error from half as many); \
+             (a cubic B-spline in ln k), {}-point Gauss-Legendre in mu (error from half as many); \
              wide-angle terms neglected",
             d.apar,
             d.aperp,

@@ -393,7 +393,7 @@ fn rsd_table_memo(
             "Alcock-Paczynski: apar = {}, aperp = {}; observed P_l(k) = (2l+1) int_0^1 dmu L_l(mu) \
              P^s(k', mu')/(apar aperp^2), k' = (k/aperp) sqrt(1 + mu^2 (F^-2 - 1)), mu' = mu/(F sqrt(1 + \
              mu^2 (F^-2 - 1))), F = apar/aperp; the model on {} k in [{:.6e}, {:.6e}] h/Mpc \
-             (interpolated cubically in ln k), {}-point Gauss-Legendre in mu (error from half as many); \
+             (a cubic B-spline in ln k), {}-point Gauss-Legendre in mu (error from half as many); \
              wide-angle terms neglected",
             d.apar,
             d.aperp,

@@ -11,18 +11,28 @@
 //!
 //! Numerics: the model's P^s(k, μ) (a polynomial in μ² per k, and its Fingers-of-God damping) is
 //! computed on an internal log-uniform grid ([`Distortion::internal_grid`], [`POINTS_PER_DECADE`]
-//! per decade over the k' that the output needs) and interpolated in ln k by four-point Lagrange
-//! polynomials; the μ integral is a [`MU_NODES`]-point Gauss–Legendre rule, its error the difference
+//! per decade over the k' that the output needs) and interpolated in ln k by a cubic B-spline
+//! ([`spline`]: the μ² coefficients prefiltered once per evaluation by a tridiagonal solve planned
+//! once per grid, not-a-knot ends, four weights per cell). The spline is C², so the exact
+//! derivatives in α∥, α⊥ (the ept template and cosmological Jacobians) are continuous where k'
+//! crosses a cell edge and agree with finite differences to ≤ 7.3e-8 of each column's largest
+//! element (the four-point Lagrange polynomials it replaced jumped there: 1.3e-6 for w0); on the
+//! BAO-wiggled CAMB spectrum its mid-cell error is 2.4e-5 against Lagrange's 7.3e-5. The grid's
+//! error estimates are carried to k by the same weights on their spline coefficients in absolute
+//! value. The μ integral is a [`MU_NODES`]-point Gauss–Legendre rule, its error the difference
 //! from half as many nodes. Every ℓ ≤ 8 of the true spectrum enters (the polynomial is complete), so
 //! the hexadecapole is exact to the interpolation. Wide-angle effects are neglected.
 
-use super::{legendre_coefficients, Fog, MuPolynomial};
+use super::{legendre_coefficients, Fog, MuPolynomial, MAX_MU_POWER};
 use crate::cosmology::background::Background;
 use crate::cosmology::Cosmology;
 use crate::dual::Real;
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
-use crate::integrate::{lagrange4, legendre_nodes};
+use crate::integrate::legendre_nodes;
+use spline::UniformSpline;
+
+pub mod spline;
 
 /// Points per decade of the internal k grid.
 pub const POINTS_PER_DECADE: f64 = 100.0;
@@ -250,26 +260,32 @@ pub fn observed_multipoles(
         grid[0].ln(),
         (grid[grid.len() - 1] / grid[0]).ln() / (grid.len() - 1) as f64,
     );
-    // The polynomial (value and error coefficients) at ln k = x, cubic Lagrange on the grid.
+    // The spline coefficients (module spline) of the polynomials' value and error coefficients.
+    let spline = UniformSpline::new(grid.len());
+    let prefilter = |column: fn(&MuPolynomial) -> &[f64; MAX_MU_POWER + 1]| {
+        let mut c: Vec<[f64; MAX_MU_POWER + 1]> = polys.iter().map(|p| *column(p)).collect();
+        spline.prefilter(&mut c);
+        c
+    };
+    let (values, errors) = (prefilter(|p| &p.value), prefilter(|p| &p.error));
+    // The polynomial (value and error coefficients) at ln k = x: the cubic B-spline on the grid,
+    // the errors' spline coefficients in absolute value (the grid's error estimates carried to k as
+    // the values are).
     let at = |k: f64| -> Result<MuPolynomial> {
-        let u = (k.ln() - x0) / step;
-        let last = (grid.len() - 1) as f64;
-        if !(1.0 - 1e-9..=last - 1.0 + 1e-9).contains(&u) {
-            return Err(Error::OutOfRange {
+        let (b, t) = spline
+            .cell((k.ln() - x0) / step)
+            .ok_or_else(|| Error::OutOfRange {
                 what: "the true spectrum of the Alcock-Paczynski projection".into(),
                 k,
                 min: grid[1],
                 max: grid[grid.len() - 2],
-            });
-        }
-        let b = (u.floor() as usize).saturating_sub(1).min(grid.len() - 4);
-        let w = lagrange4(u - b as f64);
+            })?;
+        let w = spline::weights(t);
         let mut p = MuPolynomial::default();
         for (j, wj) in w.iter().enumerate() {
-            let q = &polys[b + j];
             for n in 0..p.value.len() {
-                p.value[n] += wj * q.value[n];
-                p.error[n] += wj.abs() * q.error[n];
+                p.value[n] += wj * values[b + j][n];
+                p.error[n] += wj * errors[b + j][n].abs();
             }
         }
         Ok(p)

@@ -27,8 +27,10 @@
 //!
 //! Multipoles ℓ ≤ 8: Gauss–Legendre in μ on [0, 1] ([`MU_NODES`]; the error the change from half as
 //! many nodes), exact when the model is a polynomial in μ (no IR, no AP). With AP
-//! ([`super::ap::Distortion`]) the terms are computed on the internal log grid and interpolated in ln k.
+//! ([`super::ap::Distortion`]) the terms are computed on the internal log grid and interpolated in ln k
+//! (the C² cubic B-spline of [`super::ap::spline`]: the exact derivatives in α∥, α⊥ have no jumps).
 
+use super::ap::spline::UniformSpline;
 use super::ap::Distortion;
 use super::{legendre_coefficients, MAX_ELL};
 use crate::bias::BiasParams;
@@ -40,6 +42,7 @@ use crate::linear::LinearSpectrum;
 use crate::loops::redshift::{RedshiftPlan, RedshiftTerms};
 use crate::precision::Precision;
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// Gauss–Legendre nodes of the μ integral on [0, 1].
 pub const MU_NODES: usize = 24;
@@ -188,6 +191,9 @@ pub struct EptPlan {
     /// Whether `grid` is `k_out` itself or the AP grid the terms are interpolated on: told by how
     /// the plan was built, never by comparing lengths (an output grid may have the AP grid's length).
     grid_use: GridUse,
+    /// The prefilter of the interpolant in ln k on `grid` (the cubic B-spline of [`crate::rsd::ap`]),
+    /// planned once, shared with the terms.
+    spline: Arc<UniformSpline>,
     settings: EptSettings,
     /// The indices of `grid` where the loop terms are computed ([`EptSettings::loop_range`]).
     loop_span: std::ops::Range<usize>,
@@ -213,6 +219,8 @@ enum GridUse {
 #[derive(Debug, Clone)]
 pub struct EptTerms {
     grid: Vec<f64>,
+    /// The plan's prefilter of the interpolant on `grid`.
+    spline: Arc<UniformSpline>,
     full: RedshiftTerms,
     /// The no-wiggle terms and Σ² [(Mpc/h)²], with IR resummation.
     nw: Option<(RedshiftTerms, Estimate)>,
@@ -324,6 +332,7 @@ impl EptPlan {
         Ok(Self {
             rules,
             k_out: k.to_vec(),
+            spline: Arc::new(UniformSpline::new(grid.len())),
             grid,
             grid_use,
             settings,
@@ -369,6 +378,7 @@ impl EptPlan {
         let full = self.padded(full, &p_lin);
         Ok(EptTerms {
             grid: self.grid.clone(),
+            spline: self.spline.clone(),
             full,
             nw,
             basis_residual: None,

@@ -269,6 +269,7 @@ impl EptPlan {
         let full = self.padded(full, &p_lin);
         EptTerms {
             grid: self.grid.clone(),
+            spline: self.spline.clone(),
             full,
             nw,
             basis_residual: Some(projection.residual),

@@ -4,21 +4,41 @@
 use super::{EptParams, EptTerms};
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
-use crate::integrate::lagrange4;
+use crate::rsd::ap::spline::{self, UniformSpline};
 use crate::rsd::MAX_MU_POWER;
+use std::borrow::Cow;
+use std::sync::OnceLock;
 
 /// Polynomials in μ² (coefficient n of μ^{2n}) with coefficient errors.
 type Poly = ([f64; MAX_MU_POWER + 1], [f64; MAX_MU_POWER + 1]);
 
+/// The μ² coefficients of N then those of W at one grid point: what the interpolant in ln k is
+/// applied to (samples, or their cubic B-spline coefficients, [`crate::rsd::ap::spline`]).
+type Columns = [f64; 2 * (MAX_MU_POWER + 1)];
+
 /// The model at fixed parameters on the terms' grid: P = N(μ²) + e^{−k²Σ²(1 + f(2+f)μ²)} W(μ²).
+/// Between grid points, N and W are interpolated in ln k by the cubic B-spline of
+/// [`crate::rsd::ap::spline`]: its coefficients are made on first use, once per model, and every
+/// path (values, errors, f-derivatives, tangents, AP derivatives) applies the same weights to them.
 pub(super) struct Model<'a> {
     grid: &'a [f64],
+    spline: &'a UniformSpline,
     /// ln of the first grid point and the grid's step in ln k (log-uniform).
     ln_k0: f64,
     ln_step: f64,
     parts: Vec<(Poly, Poly)>,
+    /// The spline coefficients of the parts' values and of their errors.
+    coefficients: OnceLock<Vec<Columns>>,
+    error_coefficients: OnceLock<Vec<Columns>>,
     sigma2: f64,
     f: f64,
+}
+
+/// The columns of (N, W) pairs.
+fn columns<'b>(parts: impl Iterator<Item = (&'b [f64; 5], &'b [f64; 5])>) -> Vec<Columns> {
+    parts
+        .map(|(n, w)| std::array::from_fn(|q| if q < 5 { n[q] } else { w[q - 5] }))
+        .collect()
 }
 
 impl EptTerms {
@@ -96,9 +116,12 @@ impl EptTerms {
         let g = &self.grid;
         Model {
             grid: g,
+            spline: &self.spline,
             ln_k0: g[0].ln(),
             ln_step: (g[g.len() - 1] / g[0]).ln() / (g.len() - 1) as f64,
             parts,
+            coefficients: OnceLock::new(),
+            error_coefficients: OnceLock::new(),
             sigma2: s2,
             f: params.f(),
         }
@@ -187,8 +210,9 @@ impl EptTerms {
 /// The multipoles of several models of one f and Σ² (those of one terms' set) at the output `k_out`:
 /// `nodes` per μ node (ln(k'/k), (k'/k)², μ'), `weights[m][j]` the weight of the j-th ℓ at μ node
 /// m; `on_grid`: k_out is the models' grid and undistorted (each k its own grid point), else
-/// P(k', μ') is interpolated (four-point Lagrange in ln k). Per k, the projection is made once as
-/// weights on the μ² coefficients of the grid points its stencils reach, then applied to each model:
+/// P(k', μ') is interpolated (the cubic B-spline in ln k of [`Model`]). Per k, the projection is
+/// made once as weights on the μ² coefficients of the grid points its stencils reach (on the
+/// samples on the grid, else on their spline coefficients), then applied to each model:
 /// `out[s][j][i]`. With `df` (models of the same f and Σ² with their [`PartsDf`]), also the
 /// f-derivatives of their multipoles: those of the polynomials, projected, and that of the damping
 /// e^{−k'²Σ²[1 + f(2 + f)μ'²]}; or, with [`DampingTangent::Sigma2`], their tangents along a direction
@@ -211,6 +235,20 @@ pub(super) fn project_many(
     // and of W in the damping's f- and Σ²-derivatives
     let (mut on, mut ow, mut owf, mut ows) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut stencils = Vec::with_capacity(nodes.len());
+    // what the weights apply to: the samples on the grid, else their spline coefficients (the
+    // f-derivatives' and tangents' as the values')
+    let model_columns: Vec<Cow<'_, [Columns]>> =
+        models.iter().map(|m| m.columns(on_grid)).collect();
+    let df_columns: Vec<(Vec<Columns>, Cow<'_, [Columns]>)> = df
+        .iter()
+        .map(|(m, d, _)| {
+            let mut c = columns(d.iter().map(|(n, w)| (n, w)));
+            if !on_grid {
+                m.spline.prefilter(&mut c);
+            }
+            (c, m.columns(on_grid))
+        })
+        .collect();
     for (i, &k) in k_out.iter().enumerate() {
         let (ln_k, k2) = (k.ln(), k * k);
         stencils.clear();
@@ -219,8 +257,8 @@ pub(super) fn project_many(
             let (b, l, width) = if on_grid {
                 (i, [1.0, 0.0, 0.0, 0.0], 1)
             } else {
-                let (b, l) = first.stencil_ln(ln_k + ln_ratio)?;
-                (b, l, 4)
+                let (b, t) = first.stencil_ln(ln_k + ln_ratio)?;
+                (b, spline::weights(t), 4)
             };
             let m2 = mt * mt;
             let x = k2 * ratio2 * first.sigma2;
@@ -265,20 +303,20 @@ pub(super) fn project_many(
                 }
             }
         }
-        for (model, o) in models.iter().zip(out.iter_mut()) {
+        for (cols, o) in model_columns.iter().zip(out.iter_mut()) {
             for (e, oe) in o.iter_mut().enumerate() {
                 let mut sum = 0.0;
                 for g in 0..span {
-                    let (n, w) = &model.parts[lo + g];
+                    let c = &cols[lo + g];
                     let base = (e * span + g) * 5;
                     for q in 0..5 {
-                        sum += on[base + q] * n.0[q] + ow[base + q] * w.0[q];
+                        sum += on[base + q] * c[q] + ow[base + q] * c[5 + q];
                     }
                 }
                 oe[i] = sum;
             }
         }
-        for ((model, d, tangent), o) in df.iter().zip(out_df.iter_mut()) {
+        for (((_, _, tangent), (d, cols)), o) in df.iter().zip(&df_columns).zip(out_df.iter_mut()) {
             let (od, scale) = match *tangent {
                 DampingTangent::F => (&owf, 1.0),
                 DampingTangent::Sigma2(ds) => (&ows, ds),
@@ -286,13 +324,12 @@ pub(super) fn project_many(
             for (e, oe) in o.iter_mut().enumerate() {
                 let mut sum = 0.0;
                 for g in 0..span {
-                    let (dn, dw) = &d[lo + g];
-                    let w = &model.parts[lo + g].1 .0;
+                    let (d, c) = (&d[lo + g], &cols[lo + g]);
                     let base = (e * span + g) * 5;
                     for q in 0..5 {
-                        sum += on[base + q] * dn[q]
-                            + ow[base + q] * dw[q]
-                            + scale * od[base + q] * w[q];
+                        sum += on[base + q] * d[q]
+                            + ow[base + q] * d[5 + q]
+                            + scale * od[base + q] * c[5 + q];
                     }
                 }
                 oe[i] = sum;
@@ -302,19 +339,14 @@ pub(super) fn project_many(
     Ok((out, out_df))
 }
 
+/// The polynomial in μ² of the five coefficients of `c` from `offset` (N: 0, W: 5) at μ² = `m2`.
+#[inline(always)]
+fn horner(c: &Columns, offset: usize, m2: f64) -> f64 {
+    (0..5).rev().fold(0.0, |a, q| a * m2 + c[offset + q])
+}
+
 /// Multipoles of several sets, `[s][j][i]`, and the f-derivatives of others.
 pub(super) type Multipoles = (Vec<Vec<Vec<f64>>>, Vec<Vec<Vec<f64>>>);
-
-/// ∂/∂t of the weights of [`lagrange4`] at `t`.
-fn lagrange4_derivative(t: f64) -> [f64; 4] {
-    let (a, b, c, d) = (t, t - 1.0, t - 2.0, t - 3.0);
-    [
-        -(c * d + b * d + b * c) / 6.0,
-        (c * d + a * d + a * c) * 0.5,
-        -(b * d + a * d + a * b) * 0.5,
-        (b * c + a * c + a * b) / 6.0,
-    ]
-}
 
 /// The exact derivatives of the multipoles of every model of `models` (one growth rate f, one
 /// Σ²: the sets of one spectrum and f) with respect to α∥ and α⊥ at (`apar`, `aperp`): `nodes` and
@@ -322,8 +354,9 @@ fn lagrange4_derivative(t: f64) -> [f64; 4] {
 /// the damping made once for all models. With A = μ²/α∥², B = (1 − μ²)/α⊥², k'² = k²(A + B) and
 /// μ'² = A/(A + B), so ∂ln k'/∂α∥ = −μ'²/α∥, ∂ln k'/∂α⊥ = −(1 − μ'²)/α⊥, ∂μ'²/∂α∥ = −2μ'²(1 − μ'²)/α∥
 /// = −(α⊥/α∥) ∂μ'²/∂α⊥, and the volume 1/(α∥α⊥²) gives −1/α∥, −2/α⊥ times the value. P(k', μ') is
-/// the four-point Lagrange interpolant in ln k' of the μ² polynomials with the BAO damping: its
-/// derivative is that of the interpolant (the weights' derivatives) and of the damping.
+/// the cubic B-spline in ln k' of the μ² polynomials ([`Model`]) with the BAO damping: its
+/// derivative is that of the spline (the weights' derivatives on the same coefficients, continuous
+/// across cell edges) and of the damping.
 pub(super) fn ap_derivatives_many(
     models: &[Model<'_>],
     k_out: &[f64],
@@ -342,31 +375,32 @@ pub(super) fn ap_derivatives_many(
         ];
         models.len()
     ];
-    let horner = |c: &[f64; 5], m2: f64| c.iter().rev().fold(0.0, |a, c| a * m2 + c);
-    let horner_d = |c: &[f64; 5], m2: f64| (1..5).rev().fold(0.0, |a, q| a * m2 + q as f64 * c[q]);
+    let coefficients: Vec<&[Columns]> = models.iter().map(|m| m.coefficients()).collect();
+    let horner_d = |c: &Columns, o: usize, m2: f64| {
+        (1..5).rev().fold(0.0, |a, q| a * m2 + q as f64 * c[o + q])
+    };
     let growth = first.f * (2.0 + first.f);
     for (i, &k) in k_out.iter().enumerate() {
         let (ln_k, k2) = (k.ln(), k * k);
         for (&(ln_ratio, ratio2, mt), c) in nodes.iter().zip(weights) {
-            let ln_kt = ln_k + ln_ratio;
-            let (b, l) = first.stencil_ln(ln_kt)?;
-            let t = (ln_kt - first.ln_k0) / first.ln_step - b as f64;
-            let dl = lagrange4_derivative(t).map(|d| d / first.ln_step);
+            let (b, t) = first.stencil_ln(ln_k + ln_ratio)?;
+            let l = spline::weights(t);
+            let dl = spline::weights_derivative(t).map(|d| d / first.ln_step);
             let m2 = mt * mt;
             let x = k2 * ratio2 * first.sigma2;
             let damping = (-x * (1.0 + growth * m2)).exp();
             let d_lnk = -2.0 * x * (1.0 + growth * m2) * damping;
             let d_m2 = -x * growth * damping;
             let dm2 = 2.0 * m2 * (1.0 - m2);
-            for (model, o) in models.iter().zip(out.iter_mut()) {
+            for (cols, o) in coefficients.iter().zip(out.iter_mut()) {
                 // P, ∂P/∂ln k', ∂P/∂μ'²
                 let (mut p, mut p_lnk, mut p_m2) = (0.0, 0.0, 0.0);
                 for j in 0..4 {
-                    let (n, w) = &model.parts[b + j];
-                    let (nv, wv) = (horner(&n.0, m2), horner(&w.0, m2));
+                    let c = &cols[b + j];
+                    let (nv, wv) = (horner(c, 0, m2), horner(c, 5, m2));
                     p += l[j] * (nv + damping * wv);
                     p_lnk += dl[j] * (nv + damping * wv) + l[j] * d_lnk * wv;
-                    p_m2 += l[j] * (horner_d(&n.0, m2) + damping * horner_d(&w.0, m2) + d_m2 * wv);
+                    p_m2 += l[j] * (horner_d(c, 0, m2) + damping * horner_d(c, 5, m2) + d_m2 * wv);
                 }
                 let derivatives = [
                     -p_lnk * m2 / apar - p_m2 * dm2 / apar - p / apar,
@@ -387,6 +421,35 @@ impl Model<'_> {
     /// The μ² polynomials (N, W) with their errors at every grid point.
     pub(super) fn parts(&self) -> &[(Poly, Poly)] {
         &self.parts
+    }
+
+    /// The cubic B-spline coefficients in ln k of the values of N and W, made on first use.
+    fn coefficients(&self) -> &[Columns] {
+        self.coefficients.get_or_init(|| {
+            let mut c = columns(self.parts.iter().map(|(n, w)| (&n.0, &w.0)));
+            self.spline.prefilter(&mut c);
+            c
+        })
+    }
+
+    /// The spline coefficients of the errors of N and W (the grid's error estimates carried to k
+    /// as the values are; used in absolute value).
+    fn error_coefficients(&self) -> &[Columns] {
+        self.error_coefficients.get_or_init(|| {
+            let mut c = columns(self.parts.iter().map(|(n, w)| (&n.1, &w.1)));
+            self.spline.prefilter(&mut c);
+            c
+        })
+    }
+
+    /// What [`project_many`]'s weights apply to: the values of N and W at the grid points
+    /// (`on_grid`), else their spline coefficients.
+    fn columns(&self, on_grid: bool) -> Cow<'_, [Columns]> {
+        if on_grid {
+            Cow::Owned(columns(self.parts.iter().map(|(n, w)| (&n.0, &w.0))))
+        } else {
+            Cow::Borrowed(self.coefficients())
+        }
     }
 
     /// P(k, μ) at grid index `i` (k = grid[i]).
@@ -414,18 +477,21 @@ impl Model<'_> {
         )
     }
 
-    /// P(k, μ) at any k inside the grid: the polynomials interpolated in ln k (four-point Lagrange).
+    /// P(k, μ) at any k inside the grid: the polynomials interpolated in ln k (the cubic B-spline;
+    /// their errors by the same weights on the absolute spline coefficients of the errors).
     pub(super) fn interpolated(&self, k: f64, mu: f64) -> Result<Estimate> {
-        let (b, l) = self.stencil(k)?;
+        let (b, t) = self.stencil_ln(k.ln())?;
+        let l = spline::weights(t);
+        let (values, errors) = (self.coefficients(), self.error_coefficients());
         let mut n: Poly = ([0.0; 5], [0.0; 5]);
         let mut w: Poly = ([0.0; 5], [0.0; 5]);
         for (j, lj) in l.iter().enumerate() {
-            let (pn, pw) = &self.parts[b + j];
+            let (v, e) = (&values[b + j], &errors[b + j]);
             for c in 0..5 {
-                n.0[c] += lj * pn.0[c];
-                n.1[c] += lj.abs() * pn.1[c];
-                w.0[c] += lj * pw.0[c];
-                w.1[c] += lj.abs() * pw.1[c];
+                n.0[c] += lj * v[c];
+                n.1[c] += lj * e[c].abs();
+                w.0[c] += lj * v[5 + c];
+                w.1[c] += lj * e[5 + c].abs();
             }
         }
         Ok(self.combine(&n, &w, k, mu))
@@ -434,38 +500,31 @@ impl Model<'_> {
     /// The value only of [`Self::interpolated`], at k given as ln k and k² (the AP projection has
     /// them per μ node without a logarithm or a square root per point).
     pub(super) fn interpolated_value_ln(&self, ln_k: f64, k2: f64, mu: f64) -> Result<f64> {
-        let (b, l) = self.stencil_ln(ln_k)?;
+        let (b, t) = self.stencil_ln(ln_k)?;
+        let l = spline::weights(t);
+        let values = self.coefficients();
         let m2 = mu * mu;
         let (mut n, mut w) = (0.0, 0.0);
         for (j, lj) in l.iter().enumerate() {
-            let (pn, pw) = &self.parts[b + j];
-            n += lj * pn.0.iter().rev().fold(0.0, |a, c| a * m2 + c);
-            w += lj * pw.0.iter().rev().fold(0.0, |a, c| a * m2 + c);
+            let c = &values[b + j];
+            n += lj * horner(c, 0, m2);
+            w += lj * horner(c, 5, m2);
         }
         let damping = (-k2 * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
         Ok(n + damping * w)
     }
 
-    /// The first grid index and the Lagrange weights of the four-point stencil of k.
-    fn stencil(&self, k: f64) -> Result<(usize, [f64; 4])> {
-        self.stencil_ln(k.ln())
-    }
-
-    /// [`Self::stencil`] of ln k.
-    fn stencil_ln(&self, ln_k: f64) -> Result<(usize, [f64; 4])> {
+    /// The cell of ln k on the grid: the first of the four spline coefficients it reads and the
+    /// position t ∈ [0, 1] in it ([`UniformSpline::cell`]).
+    fn stencil_ln(&self, ln_k: f64) -> Result<(usize, f64)> {
         let g = self.grid;
-        let (x0, step) = (self.ln_k0, self.ln_step);
-        let u = (ln_k - x0) / step;
-        let last = (g.len() - 1) as f64;
-        if !(1.0 - 1e-9..=last - 1.0 + 1e-9).contains(&u) {
-            return Err(Error::OutOfRange {
+        self.spline
+            .cell((ln_k - self.ln_k0) / self.ln_step)
+            .ok_or_else(|| Error::OutOfRange {
                 what: "the true spectrum of the Alcock-Paczynski projection".into(),
                 k: ln_k.exp(),
                 min: g[1],
                 max: g[g.len() - 2],
-            });
-        }
-        let b = (u.floor() as usize).saturating_sub(1).min(g.len() - 4);
-        Ok((b, lagrange4(u - b as f64)))
+            })
     }
 }

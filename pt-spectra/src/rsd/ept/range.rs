@@ -108,6 +108,7 @@ impl EptTerms {
         };
         EptTerms {
             grid: self.grid.clone(),
+            spline: self.spline.clone(),
             full: cut(&self.full),
             nw: self.nw.as_ref().map(|(t, s)| (cut(t), *s)),
             basis_residual: self.basis_residual,

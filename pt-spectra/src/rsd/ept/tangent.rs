@@ -143,6 +143,7 @@ impl EptPlan {
                 TermsTangent {
                     tangent: EptTerms {
                         grid: self.grid.clone(),
+                        spline: self.spline.clone(),
                         full: self.padded(full, &directions[j].1),
                         nw,
                         basis_residual: Some(residual),
