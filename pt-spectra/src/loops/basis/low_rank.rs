@@ -128,6 +128,11 @@ impl LowRank {
         }
     }
 
+    /// The number of rows.
+    pub(crate) fn rows(&self) -> usize {
+        self.rows
+    }
+
     /// Whether the form is of a matrix of `rows` × `columns`.
     pub(crate) fn has_shape(&self, rows: usize, columns: usize) -> bool {
         (self.rows, self.columns) == (rows, columns)

@@ -44,6 +44,7 @@ mod redshift;
 mod rsd_two_loop;
 pub mod soft;
 mod tensors;
+mod thin;
 mod tns;
 pub mod training;
 

@@ -25,13 +25,14 @@
 
 use super::forms::{concat, linear_form, pair_forms, pair_products_both, per_k, RuleRows};
 use super::low_rank::{LowRank, PAIR_TOLERANCE};
+use super::thin::Thinning;
 use super::{error_functions, LinearBasis, Projection, BASIS_SIZE};
 use crate::loops::redshift::{RedshiftPlan, RedshiftTerms, Row, NPAIR};
 use crate::loops::Estimate;
 use crate::precision::Precision;
 
 /// Version of the tensor layout and rules, part of the cache file name.
-const VERSION: u32 = 3;
+const VERSION: u32 = 4;
 
 /// Lattice-weight terms per k.
 const LW: usize = 6;
@@ -93,6 +94,12 @@ pub struct RedshiftBasis {
     k: Vec<f64>,
     key: Vec<f64>,
     basis: LinearBasis,
+    /// On a dense log-uniform grid, the tensors are made at every other k and the rows interpolated
+    /// between (module `thin`); `None`: at every k. Below, "per k" means per node.
+    thin: Option<Thinning>,
+    /// Per k and pair column: the bound of the low-rank truncation per unit of
+    /// [`LowRank::norm`] (the low-rank form's own at the nodes, carried to every k).
+    truncation: Vec<f64>,
     /// The pair columns of the fine rule on the pairs of all n functions, row k × column, in
     /// low-rank form ([`LowRank`]: its truncation bound is added to the errors).
     pairs: LowRank,
@@ -118,6 +125,15 @@ fn key(k: &[f64], precision: &Precision, family: RedshiftFamily) -> Vec<f64> {
     key.extend([f64::from(super::training::VERSION), k.len() as f64]);
     key.extend(k);
     key
+}
+
+/// [`RedshiftBasis::truncation`] of the low-rank form `pairs` (rows per node × pair column).
+fn truncation_on_grid(pairs: &LowRank, thin: Option<&Thinning>) -> Vec<f64> {
+    let at_nodes: Vec<f64> = (0..pairs.rows()).map(|row| pairs.bound(row, 1.0)).collect();
+    match thin {
+        Some(t) => t.sizes(&at_nodes, NPAIR),
+        None => at_nodes,
+    }
 }
 
 impl RedshiftBasis {
@@ -149,7 +165,13 @@ impl RedshiftBasis {
             }
         };
         let (fine_rows, coarse_rows) = rows.on(&fine.lattice, &coarse.lattice);
-        let per_k = per_k(k.len(), progress, |i| {
+        let thin = Thinning::of(k);
+        let nodes: Vec<usize> = match &thin {
+            Some(t) => t.nodes().to_vec(),
+            None => (0..k.len()).collect(),
+        };
+        let per_k = per_k(nodes.len(), progress, |j| {
+            let i = nodes[j];
             let f = pair_forms(&fine.pairs, i, &fine_rows, n, 0..NPAIR, 0..0, 0..0).pairs;
             let c = pair_forms(&coarse.pairs, i, &coarse_rows, n_err, 0..NPAIR, 0..0, 0..0);
             let pairs: Vec<f64> = f.concat();
@@ -177,11 +199,13 @@ impl RedshiftBasis {
         sigma_v2.extend(sv_fine.iter().zip(&sv_coarse).map(|(f, c)| f - c));
         let (pairs, pairs_diff, linear) = concat(per_k);
         let sigma = super::training::coefficient_scale(&basis);
-        let pairs = LowRank::new(&pairs, k.len() * NPAIR, 2, &sigma, PAIR_TOLERANCE);
+        let pairs = LowRank::new(&pairs, nodes.len() * NPAIR, 2, &sigma, PAIR_TOLERANCE);
         Self {
             k: k.to_vec(),
             key: key(k, precision, family),
             basis,
+            truncation: truncation_on_grid(&pairs, thin.as_ref()),
+            thin,
             pairs,
             pairs_diff,
             linear,
@@ -216,6 +240,23 @@ impl RedshiftBasis {
         let mut forms = vec![0.0; self.linear.len() / n];
         crate::simd::matvec(&self.linear, c, &mut forms);
         let norm = self.pairs.norm(c);
+        // on a thinned grid, every k from the nodes, with the interpolation's error estimate
+        let (values, values_err, diffs, forms, forms_err) = match &self.thin {
+            Some(t) => {
+                let (values, values_err) = t.interpolate(&values, NPAIR, NPAIR);
+                let (forms, forms_err) = t.interpolate(&forms, LINEAR, LW);
+                let diffs = if quadrature {
+                    t.values(&diffs, NPAIR)
+                } else {
+                    vec![0.0; values.len()]
+                };
+                (values, values_err, diffs, forms, forms_err)
+            }
+            None => {
+                let (nv, nf) = (vec![0.0; values.len()], vec![0.0; p_lin.len() * LW]);
+                (values, nv, diffs, forms, nf)
+            }
+        };
         let eps = projection.residual;
         let floor = self.p22_error_floor;
         // A spectrum cut below the soft modes (module `soft`): every column and σ_v² are the cut
@@ -230,12 +271,15 @@ impl RedshiftBasis {
                     let row = i * NPAIR + m;
                     let (a, diff) = (values[row], diffs[row]);
                     let quadrature = diff.abs().max(floor * a.abs());
-                    let truncation = self.pairs.bound(row, norm);
-                    Estimate::new(a, quadrature + 2.0 * eps * a.abs() + truncation + soft)
+                    let truncation = self.truncation[row] * norm;
+                    let error = quadrature + 2.0 * eps * a.abs() + truncation + soft;
+                    Estimate::new(a, error + values_err[row])
                 });
                 let lw = std::array::from_fn(|m| {
                     let (s, sc, abs) = (form(m), form(LW + m), form(2 * LW + m));
-                    Estimate::new(p * s, (p * (s - sc)).abs() + eps * (p * abs).abs() + soft)
+                    let thinning = p.abs() * forms_err[i * LW + m];
+                    let error = (p * (s - sc)).abs() + eps * (p * abs).abs() + soft;
+                    Estimate::new(p * s, error + thinning)
                 });
                 (pair, lw)
             })
@@ -251,7 +295,19 @@ impl RedshiftBasis {
         let n = c.len();
         let mut forms = vec![0.0; self.linear.len() / n];
         crate::simd::matvec(&self.linear, c, &mut forms);
-        (forms, crate::simd::dot(&self.sigma_v2[..n], c))
+        (
+            self.at_grid(forms, LINEAR),
+            crate::simd::dot(&self.sigma_v2[..n], c),
+        )
+    }
+
+    /// Values given per node, `width` per node, at every k of the grid (the identity unless the
+    /// grid is thinned): a fixed linear map, so tangents go through it exactly.
+    fn at_grid(&self, at_nodes: Vec<f64>, width: usize) -> Vec<f64> {
+        match &self.thin {
+            Some(t) => t.values(&at_nodes, width),
+            None => at_nodes,
+        }
     }
 
     /// The tangent of [`Self::rows`]' values along (`dp_lin`, `dc`) at (`p_lin`, c): `values`, the
@@ -275,6 +331,7 @@ impl RedshiftBasis {
         {
             crate::simd::matvec(&l[..LW * n], dc, &mut d[..LW]);
         }
+        let dforms = self.at_grid(dforms, LINEAR);
         let exact = |v: f64| Estimate::new(v, 0.0);
         let rows = p_lin
             .iter()
@@ -303,7 +360,11 @@ impl RedshiftBasis {
     /// symmetric products c_a dc_b + dc_a c_b ([`LowRank::apply_pair_tangents`]: the reduction's
     /// Jacobian in c made once, U read once for all directions).
     fn pair_tangents(&self, c: &[f64], dcs: &[&[f64]]) -> Vec<Vec<f64>> {
-        self.pairs.apply_pair_tangents(c, dcs)
+        let at_nodes = self.pairs.apply_pair_tangents(c, dcs);
+        at_nodes
+            .into_iter()
+            .map(|v| self.at_grid(v, NPAIR))
+            .collect()
     }
 
     /// The tangents of [`Self::evaluate_with_no_wiggle`]'s two sets of terms at (`p_lin`, `p_nw`,
@@ -401,7 +462,8 @@ impl RedshiftBasis {
         let (pairs, rest) = LowRank::from_f64s(rest)?;
         let n = basis.len();
         let n_err = error_functions(n);
-        let nk = k.len();
+        let thin = Thinning::of(k);
+        let nk = thin.as_ref().map_or(k.len(), |t| t.nodes().len());
         let sizes = [nk * NPAIR * n_err * (n_err + 1) / 2, nk * LINEAR * n, 2 * n];
         if rest.len() != sizes.iter().sum::<usize>()
             || !pairs.has_shape(nk * NPAIR, n * (n + 1) / 2)
@@ -414,6 +476,8 @@ impl RedshiftBasis {
             k: k.to_vec(),
             key: expected,
             basis,
+            truncation: truncation_on_grid(&pairs, thin.as_ref()),
+            thin,
             pairs,
             pairs_diff: pairs_diff.iter().map(|&t| t as f32).collect(),
             linear: linear.to_vec(),
