@@ -19,6 +19,9 @@
 //!   FAST-PT's and CLASS-PT's.
 //! * [`bispectrum`]: the tree-level galaxy bispectrum in redshift space, B₀, B₂, B₄ over the orientations
 //!   of a triangle and the triangle bins of a measurement, with AP, IR resummation, FoG and shot noise.
+//! * [`statistic`]: the seam of a block of the data vector after the power spectrum (its parameters,
+//!   terms, values, Gaussian covariance), which the pipeline, fits and forecasts hold; [`blocks`] lists
+//!   the statistics that implement it.
 //! * [`fit`]: χ² fits of f, σ0 and A_b to measured multipoles, with Δχ² contour errors, versus k_max.
 //! * [`halo`]: scale-dependent bias, stochasticity (shot noise) and signal-to-noise of haloes.
 //! * [`hankel`]: FFTLog Hankel transforms between power-spectrum multipoles P_ℓ(k) and correlation-function
@@ -37,6 +40,7 @@
 
 pub mod bias;
 pub mod bispectrum;
+pub mod blocks;
 pub mod cosmology;
 pub mod dual;
 pub mod emulator;
@@ -64,6 +68,7 @@ pub mod rsd;
 mod savgol;
 pub mod setup;
 mod simd;
+pub mod statistic;
 pub mod store;
 pub mod survey;
 pub mod table;

@@ -129,7 +129,7 @@ impl Pipeline {
         // polynomial in f)
         let f_given = params.iter().find(|(n, _)| n == "f").map(|p| p.1);
         let step = match f_given {
-            Some(f) if self.inner.has_bispectrum() => self.inner.step_at_growth_rate(prepared, f),
+            Some(f) if self.inner.has_blocks() => self.inner.step_at_growth_rate(prepared, f),
             _ => self.inner.step(prepared),
         }
         .map_err(value_error)?;
@@ -165,7 +165,7 @@ impl Pipeline {
         cosmology: Option<&Bound<'_, PyAny>>,
         params: &[(String, f64)],
     ) -> PyResult<Option<(RepeatKey, Option<NamedCosmology>)>> {
-        if linear.is_some() || z_input.is_some() || self.inner.has_bispectrum() {
+        if linear.is_some() || z_input.is_some() || self.inner.has_blocks() {
             return Ok(None);
         }
         let z = self.inner.settings().z;
@@ -453,7 +453,7 @@ impl Pipeline {
         d.set_item("ells", self.inner.observation().ells().to_vec())?;
         d.set_item("len", self.inner.len())?;
         d.set_item("power_len", self.inner.power_len())?;
-        d.set_item("bispectrum", self.inner.has_bispectrum())?;
+        d.set_item("bispectrum", self.inner.has_blocks())?;
         d.set_item("ap", s.fiducial.is_some())?;
         d.set_item("ir", s.ir)?;
         d.set_item("max_residual", s.max_residual)?;

@@ -7,17 +7,47 @@
 //! The block's terms are computed once per growth rate and distortion: the IR damping makes B depend
 //! on f beyond a polynomial, so another `f` needs new terms (the pipeline's
 //! `step_at_growth_rate`); a parameter step is then a contraction (microseconds).
+//!
+//! Its Gaussian covariance in a forecast (the monopole of triangle bins of shells) is the variance of
+//! Scoccimarro, Sefusatti & Zaldarriaga (2004).
 
 use super::{
-    BispectrumParams, BispectrumPlan, BispectrumTerms, Fog, LegendreSide, PlanRules, Settings,
-    TriangleSet, ELLS,
+    BispectrumParams, BispectrumPlan, BispectrumTerms, Fog, IrInputs, LegendreSide, PlanRules,
+    Settings, TriangleSet, ELLS,
 };
 use crate::error::{Error, Result};
 use crate::linear::LinearSpectrum;
+use crate::statistic::{foreign, Block, Kind, Prepared, Shared, Spec, Survey, Terms};
+use std::f64::consts::PI;
 
 /// The parameters of the bispectrum block besides the shared b1, b2, bs (velocileptors' convention):
 /// the counterterm c1 [(Mpc/h)²] and the stochastic amplitudes of [`BispectrumParams`].
 pub const BISPECTRUM_NAMES: [&str; 4] = ["c1", "b_shot", "p_shot", "a_shot"];
+
+/// The bispectrum parameters that enter B linearly (affinely): the objective marginalises them as
+/// it does the power spectrum's counterterms.
+pub const BISPECTRUM_LINEAR: [&str; 3] = ["b_shot", "p_shot", "a_shot"];
+
+/// The bispectrum's own parameters in a forecast with B0 (c1 [(Mpc/h)²], the stochastic amplitudes in
+/// units of 1/n̄; fiducial 0, 1 (Poisson), 0, 0): free by default, p_shot fixed.
+pub const BISPECTRUM_FREE: [&str; 3] = ["c1", "b_shot", "a_shot"];
+
+/// The bispectrum's [`Kind`]: [`BISPECTRUM_NAMES`], not given c1 = 0, Poisson b_shot = 1, p_shot =
+/// a_shot = 0 (as [`BispectrumParams::default`]); in a fit c1 within ±10³ (Mpc/h)² (start box ±10), the
+/// stochastic amplitudes within ±20 (of order one in units of 1/n̄).
+pub const KIND: Kind = Kind {
+    name: "bispectrum",
+    own: &BISPECTRUM_NAMES,
+    defaults: &[0.0, 1.0, 0.0, 0.0],
+    linear: &BISPECTRUM_LINEAR,
+    ranges: &[
+        (-1e3, 1e3, -10.0, 10.0, 3.0),
+        (-20.0, 20.0, 0.0, 2.0, 0.3),
+        (-20.0, 20.0, -1.0, 1.0, 0.3),
+        (-20.0, 20.0, -1.0, 1.0, 0.3),
+    ],
+    forecast_free: &BISPECTRUM_FREE,
+};
 
 /// What the bispectrum block is built from.
 #[derive(Debug, Clone)]
@@ -51,14 +81,22 @@ impl BispectrumBlock {
     }
 }
 
+impl Spec for BispectrumBlock {
+    fn plan(self) -> Result<Box<dyn Block>> {
+        Ok(Box::new(PlannedBispectrum::new(self)?))
+    }
+}
+
 /// The block planned: the bispectrum plan and where each multipole sits in [`ELLS`].
 #[derive(Debug, Clone)]
-pub(crate) struct PlannedBispectrum {
+struct PlannedBispectrum {
     plan: BispectrumPlan,
     /// Indices into [`ELLS`] of the block's multipoles.
     ells: Vec<usize>,
     fog: Fog,
     n_bar: f64,
+    /// One line for a header.
+    description: String,
 }
 
 impl PlannedBispectrum {
@@ -67,7 +105,17 @@ impl PlannedBispectrum {
     /// # Errors
     /// [`Error::InvalidChoice`] for multipoles that are not an increasing subset of 0, 2, 4, or a bad
     /// n̄; as [`BispectrumPlan::new`].
-    pub(crate) fn new(block: BispectrumBlock) -> Result<Self> {
+    fn new(block: BispectrumBlock) -> Result<Self> {
+        let description = format!(
+            "bispectrum: B_l for l in {:?} of {} triangles, tree level (Legendre side {:?}, {:?}, \
+             FoG {:?}, n_bar {} (h/Mpc)^3), b1, b2, bs shared with the power spectrum",
+            block.ells,
+            block.triangles.len(),
+            block.side,
+            block.rules,
+            block.fog,
+            block.n_bar
+        );
         let bad = |reason: &str| Error::InvalidChoice {
             what: format!("bispectrum multipoles {:?}", block.ells),
             reason: reason.into(),
@@ -93,17 +141,23 @@ impl PlannedBispectrum {
             ells,
             fog: block.fog,
             n_bar: block.n_bar,
+            description,
         })
     }
+}
 
-    /// The number of entries: multipoles × triangles.
-    pub(crate) fn len(&self) -> usize {
+impl Block for PlannedBispectrum {
+    fn kind(&self) -> &'static Kind {
+        &KIND
+    }
+
+    /// Multipoles × triangles.
+    fn len(&self) -> usize {
         self.ells.len() * self.plan.triangles().len()
     }
 
-    /// Entry `j` (multipole, then triangle) in words, e.g. "B2 of the triangle (0.015, 0.025, 0.035)
-    /// h/Mpc" (for messages).
-    pub(crate) fn entry(&self, j: usize) -> String {
+    /// Entry `j` (multipole, then triangle), e.g. "B2 of the triangle (0.015, 0.025, 0.035) h/Mpc".
+    fn entry(&self, j: usize) -> String {
         let triangles = self.plan.triangles().triangles();
         let n = triangles.len().max(1);
         match (self.ells.get(j / n), triangles.get(j % n)) {
@@ -115,49 +169,32 @@ impl PlannedBispectrum {
         }
     }
 
-    /// The terms of `spectrum` at growth rate `f` with the distortion `ap` = (α∥, α⊥) (none: 1).
-    ///
-    /// # Errors
-    /// As [`BispectrumPlan::terms`].
-    pub(crate) fn terms(
-        &self,
-        spectrum: &LinearSpectrum,
-        f: f64,
-        ap: Option<(f64, f64)>,
-        ir: bool,
-    ) -> Result<BispectrumTerms> {
-        let (q_par, q_perp) = ap.unwrap_or((1.0, 1.0));
-        self.plan.terms(
-            spectrum,
-            &Settings {
-                f,
-                q_par,
-                q_perp,
-                fog: self.fog,
-                ir,
-            },
-        )
+    fn describe(&self) -> String {
+        self.description.clone()
     }
 
-    /// The IR resummation's inputs of `spectrum` ([`BispectrumPlan::ir_inputs`]).
-    ///
-    /// # Errors
-    /// As [`BispectrumPlan::ir_inputs`].
-    pub(crate) fn ir_inputs(&self, spectrum: &LinearSpectrum) -> Result<super::IrInputs> {
-        self.plan.ir_inputs(spectrum)
+    /// The IR resummation's inputs of `spectrum` ([`BispectrumPlan::ir_inputs`]; `None` without).
+    fn prepare(&self, spectrum: &LinearSpectrum, ir: bool) -> Result<Prepared> {
+        let inputs: Option<IrInputs> = if ir {
+            Some(self.plan.ir_inputs(spectrum)?)
+        } else {
+            None
+        };
+        Ok(std::sync::Arc::new(inputs))
     }
 
-    /// [`Self::terms`] with the IR inputs given (`None`: no resummation).
-    ///
-    /// # Errors
-    /// As [`BispectrumPlan::terms_with_ir`].
-    pub(crate) fn terms_resummed(
+    /// [`BispectrumPlan::terms_with_ir`] with the prepared IR inputs, [`BispectrumPlan::terms`]
+    /// without (the same numbers as `terms` with IR: it makes those inputs first).
+    fn terms(
         &self,
         spectrum: &LinearSpectrum,
+        prepared: &Prepared,
         f: f64,
         (q_par, q_perp): (f64, f64),
-        ir: Option<&super::IrInputs>,
-    ) -> Result<BispectrumTerms> {
+    ) -> Result<Box<dyn Terms>> {
+        let ir = prepared
+            .downcast_ref::<Option<IrInputs>>()
+            .ok_or_else(|| foreign(&KIND))?;
         let settings = Settings {
             f,
             q_par,
@@ -165,49 +202,87 @@ impl PlannedBispectrum {
             fog: self.fog,
             ir: ir.is_some(),
         };
-        match ir {
-            Some(ir) => self.plan.terms_with_ir(spectrum, &settings, ir),
-            None => self.plan.terms(spectrum, &settings),
-        }
+        let terms = match ir {
+            Some(ir) => self.plan.terms_with_ir(spectrum, &settings, ir)?,
+            None => self.plan.terms(spectrum, &settings)?,
+        };
+        Ok(Box::new(BlockTerms {
+            terms,
+            ells: self.ells.clone(),
+            n_bar: self.n_bar,
+        }))
     }
 
-    /// The block's entries (multipole, then triangle) at the parameters `b` (its n̄ set here).
-    ///
-    /// # Errors
-    /// As [`BispectrumTerms::multipoles`].
-    pub(crate) fn values(&self, terms: &BispectrumTerms, b: BispectrumParams) -> Result<Vec<f64>> {
-        let b = BispectrumParams {
-            n_bar: self.n_bar,
-            ..b
+    /// The Gaussian variance of the monopole of each triangle bin (Scoccimarro, Sefusatti &
+    /// Zaldarriaga 2004; Sefusatti et al. 2006, arXiv:astro-ph/0604505): ΔB² = s₁₂₃ k_f³ Π_i [P(k_i) +
+    /// 1/n̄] / V_B, k_f³ = (2π)³/V, V_B the volume of the bin's closed triangles
+    /// ([`triangle_bin_volume`]), s₁₂₃ = 6, 2, 1 for equilateral, isosceles and other bins; P the
+    /// monopole (the redshift-space variance to leading order in the multipoles).
+    fn gaussian_variances(&self, survey: &Survey) -> Result<Vec<f64>> {
+        if self.ells != [0] {
+            return Err(Error::InvalidChoice {
+                what: "the Gaussian covariance of bispectrum multipoles other than B0".into(),
+                reason: "only the monopole's variance is implemented".into(),
+            });
+        }
+        let k_f3 = (2.0 * PI).powi(3) / survey.volume;
+        let power = survey.power;
+        Ok(self
+            .plan
+            .triangles()
+            .triangles()
+            .iter()
+            .map(|t| {
+                let equal = |a: f64, b: f64| (a - b).abs() < 1e-9 * a;
+                let s = match (equal(t[0], t[1]), equal(t[1], t[2]), equal(t[0], t[2])) {
+                    (true, true, _) => 6.0,
+                    (false, false, false) => 1.0,
+                    _ => 2.0,
+                };
+                s * k_f3 * power(t[0]) * power(t[1]) * power(t[2])
+                    / triangle_bin_volume(*t, survey.dk)
+            })
+            .collect())
+    }
+}
+
+/// The volume of the closed triangles of a bin of shells of width `dk` centred on `k`,
+/// ∫d³q₁d³q₂ over q₁, q₂, |q₁ + q₂| in the shells ≈ 8π² k₁k₂k₃ Δk³ (thin shells).
+pub fn triangle_bin_volume(k: [f64; 3], dk: f64) -> f64 {
+    8.0 * PI * PI * k[0] * k[1] * k[2] * dk.powi(3)
+}
+
+/// The block's terms at one (spectrum, f, distortion).
+struct BlockTerms {
+    terms: BispectrumTerms,
+    ells: Vec<usize>,
+    n_bar: f64,
+}
+
+impl Terms for BlockTerms {
+    /// The entries (multipole, then triangle) at b1, b2, bs and [`BISPECTRUM_NAMES`] (n̄ the block's).
+    fn values(&self, shared: Shared, own: &[f64]) -> Result<Vec<f64>> {
+        let &[c1, b_shot, p_shot, a_shot] = own else {
+            return Err(Error::InvalidChoice {
+                what: format!("{} own bispectrum parameters", own.len()),
+                reason: format!("they are {}", BISPECTRUM_NAMES.join(", ")),
+            });
         };
-        let m = terms.multipoles(&b)?;
+        let b = BispectrumParams {
+            b1: shared.b1,
+            b2: shared.b2,
+            bs: shared.bs,
+            c1,
+            b_shot,
+            p_shot,
+            a_shot,
+            n_bar: self.n_bar,
+        };
+        let m = self.terms.multipoles(&b)?;
         Ok(self
             .ells
             .iter()
             .flat_map(|&l| m.iter().map(move |row| row[l].value))
             .collect())
     }
-}
-
-/// The bispectrum's parameters of `params`: b1, b2, bs (shared; 0 when not given, as the galaxy
-/// model's) and [`BISPECTRUM_NAMES`] (not given: c1 = 0, Poisson b_shot = 1, p_shot = a_shot = 0, as
-/// [`BispectrumParams::default`]); other names are the galaxy model's and are skipped here.
-pub(crate) fn bispectrum_params(params: &[(&str, f64)]) -> BispectrumParams {
-    let mut b = BispectrumParams {
-        b1: 0.0,
-        ..BispectrumParams::default()
-    };
-    for &(name, v) in params {
-        match name {
-            "b1" => b.b1 = v,
-            "b2" => b.b2 = v,
-            "bs" => b.bs = v,
-            "c1" => b.c1 = v,
-            "b_shot" => b.b_shot = v,
-            "p_shot" => b.p_shot = v,
-            "a_shot" => b.a_shot = v,
-            _ => {}
-        }
-    }
-    b
 }

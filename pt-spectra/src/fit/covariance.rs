@@ -94,7 +94,7 @@ pub fn validate_whole(
                 condition,
                 &format!(
                     "row {} (point {} of block {} of the data vector: the multipoles in order, then \
-                     any bispectrum)",
+                     any statistic after them)",
                     row + 1,
                     point + 1,
                     block + 1

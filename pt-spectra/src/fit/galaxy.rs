@@ -32,6 +32,7 @@ use crate::survey::observe::Observation;
 
 mod basis;
 mod bispectrum;
+mod block;
 mod derived;
 mod gradient;
 pub mod joint;
@@ -41,6 +42,7 @@ mod request;
 pub mod search;
 pub use basis::{FitBasis, CLASSPT_NAMES};
 pub use bispectrum::{BispectrumFit, BISPECTRUM_LINEAR, BISPECTRUM_NAMES};
+pub use block::BlockFit;
 pub use derived::{derived, sound_horizon, Derived, Template};
 pub use joint::{default_shared, fit_joint, DataSet, JointFit, JointLikelihood};
 pub use priors::{desi_priors, Prior, PriorShape};
@@ -56,11 +58,9 @@ pub const AP_NAMES: [&str; 2] = ["apar", "aperp"];
 /// The slot of α∥ (α⊥ the next).
 const AP_SLOT: usize = PARAM_NAMES.len();
 
-/// The first slot of the bispectrum's own parameters ([`BISPECTRUM_NAMES`]).
-const B_SLOT: usize = AP_SLOT + AP_NAMES.len();
-
-/// Slots of the fitted vector: the model's parameters, then α∥, α⊥, then the bispectrum's own.
-const SLOTS: usize = B_SLOT + BISPECTRUM_NAMES.len();
+/// The first slot of a block's own parameters ([`crate::statistic::Kind::own`]): the fitted
+/// vector's slots are the model's parameters, then α∥, α⊥, then those of the data set's block.
+const OWN_SLOT: usize = AP_SLOT + AP_NAMES.len();
 
 /// What to fit.
 #[derive(Debug, Clone, PartialEq)]
@@ -131,15 +131,16 @@ pub struct GalaxyFit {
     pub spread: f64,
     /// Whether the profile check found a lower minimum than the starts did (then taken).
     pub moved_by_profile: bool,
-    /// Whether the minimiser used the exact gradient of −2 ln L (a power spectrum without a
-    /// bispectrum), or central differences of it.
+    /// Whether the minimiser used the exact gradient of −2 ln L (a power spectrum without a block
+    /// after it), or central differences of it.
     pub exact_gradient: bool,
     /// Objective evaluations used (every start, the Hessian and the profiles).
     pub evaluations: usize,
     /// In a basis other than the model's: every parameter at the best fit in it (the order of its
     /// [`FitBasis::names`]; [`Self::best`] holds the model's parameters they map to).
     pub in_basis: Option<[f64; 12]>,
-    /// With a bispectrum: its own parameters at the best fit ([`BISPECTRUM_NAMES`]).
+    /// With a block after the power spectrum (the bispectrum's, [`BISPECTRUM_NAMES`]): its own
+    /// parameters at the best fit.
     pub bispectrum: Option<[f64; 4]>,
 }
 
@@ -148,31 +149,47 @@ pub fn slot_names(basis: &FitBasis) -> &'static [&'static str; 12] {
     basis.names()
 }
 
-/// The parameters of the power spectrum's model that enter it linearly, in `basis` (and
-/// [`BISPECTRUM_LINEAR`] with a bispectrum).
+/// The parameters of the power spectrum's model that enter it linearly, in `basis` (and a block's
+/// [`crate::statistic::Kind::linear`] with a block).
 pub fn linear_names(basis: &FitBasis) -> &'static [&'static str] {
     basis.linear_names()
 }
 
-/// The slot of parameter `name` in `basis` (its model parameters, then apar, aperp, then the
-/// bispectrum's own, which no basis changes).
-pub(crate) fn slot_index(name: &str, basis: &FitBasis) -> Result<usize> {
+/// The slot of parameter `name` in `basis` (its model parameters, then apar, aperp, then `own`: the
+/// data set's block's own parameters, which no basis changes).
+pub(crate) fn slot_index(name: &str, basis: &FitBasis, own: &[&str]) -> Result<usize> {
     basis.check_name(name)?;
     let names = slot_names(basis);
-    names
+    if let Some(i) = names
         .iter()
         .chain(&AP_NAMES)
-        .chain(&BISPECTRUM_NAMES)
+        .chain(own)
         .position(|&n| n == name)
-        .ok_or_else(|| Error::InvalidChoice {
-            what: format!("fit parameter `{name}`"),
+    {
+        return Ok(i);
+    }
+    let what = format!("fit parameter `{name}`");
+    Err(match crate::blocks::owner(name) {
+        Some(kind) => Error::InvalidChoice {
+            what,
             reason: format!(
-                "the parameters are {} (and apar, aperp; with a bispectrum {}){}",
+                "is a {0} parameter, and this data set has no {0}",
+                kind.name
+            ),
+        },
+        None => Error::InvalidChoice {
+            what,
+            reason: format!(
+                "the parameters are {} (and apar, aperp{}){}",
                 names.join(", "),
-                BISPECTRUM_NAMES.join(", "),
+                crate::blocks::AVAILABLE
+                    .iter()
+                    .map(|k| format!("; with a {} {}", k.name, k.own.join(", ")))
+                    .collect::<String>(),
                 basis.hint(name)
             ),
-        })
+        },
+    })
 }
 
 /// How a fit applies an observation (window, bins, ξ), for its header.

@@ -98,39 +98,34 @@ pub(super) fn add_fisher(
     }
 }
 
-/// The Gaussian variance of the bispectrum monopole of each triangle bin (Scoccimarro, Sefusatti &
-/// Zaldarriaga 2004; Sefusatti et al. 2006, arXiv:astro-ph/0604505): ΔB² = s₁₂₃ k_f³ Π_i [P(k_i) +
-/// 1/n̄] / V_B, k_f³ = (2π)³/V, V_B = 8π² k₁k₂k₃ Δk³ the volume of the bin's closed triangles, s₁₂₃ = 6,
-/// 2, 1 for equilateral, isosceles and other bins; P the monopole (the redshift-space variance to
-/// leading order in the multipoles), `p0` at the power spectrum's shell centres, on which the sides lie.
-pub(super) fn bispectrum_variances(
+/// The Gaussian variances of the entries of `blocks` (in the data vector's order, after the power
+/// spectrum), in `bin`, with the monopole `p0` at the power spectrum's shell centres (the measured
+/// power P + 1/n̄ at a side k is that of its shell).
+pub(super) fn block_variances(
+    blocks: &[Box<dyn crate::statistic::Block>],
     p0: &[f64],
-    triangles: &crate::bispectrum::TriangleSet,
     bin: &SurveyBin,
-) -> Vec<f64> {
-    let k_f3 = (2.0 * PI).powi(3) / bin.volume;
+) -> Result<Vec<f64>> {
     let power = |k: f64| {
         let i = ((k - bin.k_min) / bin.dk - 0.5).round().max(0.0) as usize;
         p0[i.min(p0.len() - 1)] + 1.0 / bin.n_bar
     };
-    triangles
-        .triangles()
-        .iter()
-        .map(|t| {
-            let equal = |a: f64, b: f64| (a - b).abs() < 1e-9 * a;
-            let s = match (equal(t[0], t[1]), equal(t[1], t[2]), equal(t[0], t[2])) {
-                (true, true, _) => 6.0,
-                (false, false, false) => 1.0,
-                _ => 2.0,
-            };
-            s * k_f3 * power(t[0]) * power(t[1]) * power(t[2]) / triangle_bin_volume(*t, bin.dk)
-        })
-        .collect()
+    let survey = crate::statistic::Survey {
+        volume: bin.volume,
+        dk: bin.dk,
+        power: &power,
+    };
+    let mut out = Vec::new();
+    for b in blocks {
+        out.extend(b.gaussian_variances(&survey)?);
+    }
+    Ok(out)
 }
 
-/// Adds Σ_t ∂B_t/∂θ_p ∂B_t/∂θ_q / ΔB_t² to `fisher` at `index` (the B rows of each `jacobian` row
-/// follow its first `start` power-spectrum rows; no cross-covariance with P, Gaussian).
-pub(super) fn add_bispectrum_fisher(
+/// Adds Σ_t ∂B_t/∂θ_p ∂B_t/∂θ_q / ΔB_t² to `fisher` at `index` (the blocks' rows B of each
+/// `jacobian` row follow its first `start` power-spectrum rows; no cross-covariance with P or
+/// between entries, Gaussian).
+pub(super) fn add_block_fisher(
     fisher: &mut [Vec<f64>],
     index: &[usize],
     jacobian: &[Vec<f64>],
@@ -149,8 +144,5 @@ pub(super) fn add_bispectrum_fisher(
     }
 }
 
-/// The volume of the closed triangles of a bin of shells of width `dk` centred on `k`,
-/// ∫d³q₁d³q₂ over q₁, q₂, |q₁ + q₂| in the shells ≈ 8π² k₁k₂k₃ Δk³ (thin shells).
-pub(super) fn triangle_bin_volume(k: [f64; 3], dk: f64) -> f64 {
-    8.0 * PI * PI * k[0] * k[1] * k[2] * dk.powi(3)
-}
+#[cfg(test)]
+pub(super) use crate::bispectrum::block::triangle_bin_volume;

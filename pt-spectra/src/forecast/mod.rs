@@ -26,8 +26,10 @@
 //! **Derivatives.** The nuisance parameters': exact (the data vector is a polynomial in them,
 //! [`crate::pipeline::Linearised::jacobian`]). f, α∥, α⊥ and the cosmological parameters of the
 //! power spectrum alone: exact ([`crate::pipeline::CosmologyStep::template_jacobian`],
-//! [`crate::pipeline::Pipeline::cosmology_jacobian`]). With the bispectrum, f, α∥, α⊥, and the
-//! cosmological parameters: central differences at steps h and h/2 combined by Richardson
+//! [`crate::pipeline::Pipeline::cosmology_jacobian`]). With a block after the power spectrum (the
+//! bispectrum monopole, [`SurveyBin::with_bispectrum`]; its Gaussian variance from the block,
+//! [`crate::statistic::Block::gaussian_variances`]), f, α∥, α⊥, the cosmological parameters and the
+//! nuisance parameters: central differences at steps h and h/2 combined by Richardson
 //! extrapolation, (4D(h/2) − D(h))/3, whose error, |D(h/2) − D(h)|/3, is reported relative to each
 //! derivative's largest element ([`Forecast::derivative_error`]).
 
@@ -93,9 +95,7 @@ pub struct SurveyBin {
     pub b_k_max: Option<f64>,
 }
 
-/// The bispectrum's own parameters in a forecast with B0 (c1 [(Mpc/h)²], the stochastic amplitudes in
-/// units of 1/n̄; fiducial 0, 1 (Poisson), 0, 0): free by default, p_shot fixed.
-pub const BISPECTRUM_FREE: [&str; 3] = ["c1", "b_shot", "a_shot"];
+pub use crate::bispectrum::block::BISPECTRUM_FREE;
 
 impl SurveyBin {
     /// A bin with k from 0.01 to `k_max` in shells of 0.01 h/Mpc, P0 and P2, b1, the
@@ -170,9 +170,9 @@ impl SurveyBin {
     /// [`BISPECTRUM_FREE`] parameters free.
     pub fn with_bispectrum(mut self, b_k_max: f64) -> Self {
         self.b_k_max = Some(b_k_max);
-        for name in BISPECTRUM_FREE {
+        for name in crate::bispectrum::block::KIND.forecast_free {
             if !self.free.iter().any(|n| n == name) {
-                self.free.push(name.into());
+                self.free.push(name.to_string());
             }
         }
         self
@@ -190,25 +190,32 @@ impl SurveyBin {
     }
 
     /// The nuisance parameters of the bin's data vector: the power spectrum's, and with B0 the
-    /// bispectrum's ([`crate::pipeline::BISPECTRUM_NAMES`]).
+    /// bispectrum's own.
     pub fn parameter_names(&self) -> Vec<&'static str> {
         let mut names = NUISANCE_NAMES.to_vec();
         if self.b_k_max.is_some() {
-            names.extend(crate::pipeline::BISPECTRUM_NAMES);
+            names.extend(crate::bispectrum::block::KIND.own);
         }
         names
     }
 
-    /// The triangle bins of B0: all closed bins of the power spectrum's shells up to `b_k_max`.
-    fn triangles(&self) -> Result<Option<crate::bispectrum::TriangleSet>> {
-        let Some(b_max) = self.b_k_max else {
-            return Ok(None);
-        };
-        let edges: Vec<f64> = std::iter::once(self.k_min)
-            .chain(self.shells().iter().map(|s| s.2))
-            .filter(|&e| e <= b_max + 1e-12)
-            .collect();
-        Ok(Some(crate::bispectrum::TriangleSet::from_edges(&edges)?))
+    /// The pipeline's settings of the bin: `ept` at its z with the AP distortion against `fiducial`
+    /// and with B0, the monopole of all closed triangle bins of the power spectrum's shells up to
+    /// `b_k_max`, with the bin's n̄.
+    fn pipeline_settings(&self, fiducial: &Cosmology) -> Result<PipelineSettings> {
+        let mut settings = PipelineSettings::ept(self.z, Some(*fiducial));
+        if let Some(b_max) = self.b_k_max {
+            let edges: Vec<f64> = std::iter::once(self.k_min)
+                .chain(self.shells().iter().map(|s| s.2))
+                .filter(|&e| e <= b_max + 1e-12)
+                .collect();
+            let triangles = crate::bispectrum::TriangleSet::from_edges(&edges)?;
+            settings.bispectrum = Some(crate::pipeline::BispectrumBlock {
+                n_bar: self.n_bar,
+                ..crate::pipeline::BispectrumBlock::monopole(triangles)
+            });
+        }
+        Ok(settings)
     }
 
     /// Checks the values and names; the error names the bin (1-based) and the value.
@@ -370,14 +377,7 @@ pub fn fisher(
         let shells = bin.shells();
         let k: Vec<f64> = shells.iter().map(|s| s.0).collect();
         let observation = Observation::new(&[0, 2, 4, 6, 8], &k, None, None)?;
-        let triangles = bin.triangles()?;
-        let settings = PipelineSettings {
-            bispectrum: triangles.clone().map(|t| crate::pipeline::BispectrumBlock {
-                n_bar: bin.n_bar,
-                ..crate::pipeline::BispectrumBlock::monopole(t)
-            }),
-            ..PipelineSettings::ept(bin.z, Some(*fiducial))
-        };
+        let settings = bin.pipeline_settings(fiducial)?;
         let pipeline = Pipeline::new(observation, settings, &precision, store, progress)?;
         let prepared = pipeline.prepare(fiducial)?;
         let step = pipeline.step(&prepared)?;
@@ -393,11 +393,11 @@ pub fn fisher(
                 (0..n_k).map(move |j| (l / 2) * n_k + j)
             })
             .collect();
-        // and with B0, its rows after the power spectrum's ℓ = 0 … 8
+        // and with blocks, their rows after the power spectrum's ℓ = 0 … 8
         let n_p = 5 * k.len();
         let rows: Vec<usize> = rows.into_iter().chain(n_p..all.len()).collect();
         let select = |d: &[f64]| -> Vec<f64> { rows.iter().map(|&r| d[r]).collect() };
-        let with_b = triangles.is_some();
+        let with_b = pipeline.has_blocks();
         let mut jacobian: Vec<Vec<f64>> = Vec::new();
         let f0 = step.growth_rate;
         let ap0 = step.ap.unwrap_or(Distortion::new(1.0, 1.0)?);
@@ -420,7 +420,7 @@ pub fn fisher(
             }
             Parameters::Template => {
                 // f: the data vector at f ± h (the power spectrum's terms do not depend on f; the
-                // bispectrum's, through the IR damping, do: a step at that f)
+                // blocks' do beyond a polynomial: a step at that f)
                 let with_f = |f: f64| -> Result<Vec<f64>> {
                     if with_b {
                         return step_at(f, ap0);
@@ -481,21 +481,21 @@ pub fn fisher(
                 fsigma8.push((f64::NAN, f64::NAN));
             }
         }
-        // the free nuisance parameters: exact (P alone: the linearised polynomial; with B0, which is
-        // quartic in them, Richardson-extrapolated central differences, exact for a polynomial of
-        // degree ≤ 4 up to rounding)
+        // the free nuisance parameters: exact (P alone: the linearised polynomial; with blocks (B0
+        // is quartic in them), Richardson-extrapolated central differences, exact for a polynomial
+        // of degree ≤ 4 up to rounding)
         let exact = if with_b {
             None
         } else {
             Some(step.linearise(None)?.jacobian(&nuisance)?)
         };
         for name in &bin.free {
-            // unset: 0, but the bispectrum's Poisson b_shot
-            let default = if name == "b_shot" {
-                crate::bispectrum::BispectrumParams::default().b_shot
-            } else {
-                0.0
-            };
+            // unset: 0, but a block's own default (the bispectrum's Poisson b_shot)
+            let default = pipeline
+                .blocks()
+                .iter()
+                .find_map(|b| b.kind().index(name).map(|i| b.kind().defaults[i]))
+                .unwrap_or(0.0);
             let x0 = nuisance
                 .iter()
                 .find(|(n, _)| n == name)
@@ -526,10 +526,7 @@ pub fn fisher(
             values.push(x0);
         }
         let covariances = covariance::shell_covariances(&all, &shells, bin)?;
-        let b_variance = match &triangles {
-            Some(t) => covariance::bispectrum_variances(&all[..k.len()], t, bin),
-            None => Vec::new(),
-        };
+        let b_variance = covariance::block_variances(pipeline.blocks(), &all[..k.len()], bin)?;
         points += rows.len();
         blocks.push((jacobian, covariances, b_variance, bin.ells.len(), k.len()));
     }
@@ -546,7 +543,7 @@ pub fn fisher(
         let own = jacobian.len() - shared;
         let index: Vec<usize> = (0..shared).chain(offset..offset + own).collect();
         covariance::add_fisher(&mut fisher, &index, jacobian, covariances, *n_ell, *n_k);
-        covariance::add_bispectrum_fisher(&mut fisher, &index, jacobian, b_variance, n_ell * n_k);
+        covariance::add_block_fisher(&mut fisher, &index, jacobian, b_variance, n_ell * n_k);
         for (name, sigma) in &bins[b].priors {
             let at = names
                 .iter()

@@ -7,8 +7,8 @@ use super::ObservationSpec;
 use crate::error::{Error, Result};
 use crate::fit::galaxy::search::{CROSSING_TOLERANCE, HESSIAN_STEP};
 use crate::fit::galaxy::{
-    default_shared, fit_joint, BispectrumFit, DataSet, GalaxyFitRequest, JointFit, Linear, Prior,
-    Search, Template, BISPECTRUM_NAMES,
+    default_shared, fit_joint, BlockFit, DataSet, GalaxyFitRequest, JointFit, Linear, Prior,
+    Search, Template,
 };
 use crate::fit::{DataLayout, MultipoleData};
 use crate::output::Table;
@@ -129,7 +129,8 @@ pub(super) struct Loaded {
     request: GalaxyFitRequest,
     pub(super) template: Template,
     pub(super) description: Vec<String>,
-    bispectrum: Option<BispectrumFit>,
+    /// Its block after the power spectrum, if any.
+    block: Option<BlockFit>,
 }
 
 /// The data sets of `analysis` on their `loaded` data.
@@ -147,7 +148,7 @@ pub(super) fn data_sets<'a>(analysis: &Analysis, loaded: &'a [Loaded]) -> Vec<Da
             data: &l.data,
             request: l.request.clone(),
             observation: l.observation.as_ref(),
-            bispectrum: l.bispectrum.as_ref(),
+            bispectrum: l.block.as_ref(),
         })
         .collect()
 }
@@ -182,7 +183,8 @@ pub(super) fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded>
         }
         data = layout.read_covariance(data, path).map_err(err)?;
     }
-    let mut bispectrum = None;
+    // the block after the power spectrum and its header line
+    let mut block = None;
     if let Some(spec) = &s.bispectrum {
         let (with_cov, fit, line) = super::joint_bispectrum::load_bispectrum(
             spec,
@@ -194,7 +196,7 @@ pub(super) fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded>
         )
         .map_err(err)?;
         data = with_cov;
-        bispectrum = Some((fit, line));
+        block = Some((fit, line));
     }
     let mixing = match s.window_mixing.as_str() {
         "wilson" => crate::survey::Mixing::Wilson,
@@ -246,14 +248,14 @@ pub(super) fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded>
     let mut start = EptParams::new(DEFAULT_B1, prepared.growth_rate);
     for (name, v) in &s.start {
         match name.as_str() {
-            b if BISPECTRUM_NAMES.contains(&b) => match bispectrum.take() {
-                Some((fit, line)) => bispectrum = Some((fit.with_start(b, *v).map_err(err)?, line)),
+            b if crate::blocks::owner(b).is_some() => match block.take() {
+                Some((fit, line)) => block = Some((fit.with_start(b, *v).map_err(err)?, line)),
                 None => {
+                    let kind = crate::blocks::owner(b).map_or("", |k| k.name);
                     return Err(err(Error::InvalidChoice {
                         what: format!("start.{name}"),
-                        reason: "is a bispectrum parameter, and this data set has no bispectrum"
-                            .into(),
-                    }))
+                        reason: format!("is a {kind} parameter, and this data set has no {kind}"),
+                    }));
                 }
             },
             "apar" | "aperp" => {
@@ -328,7 +330,7 @@ pub(super) fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded>
     if let Some(line) = request.basis.describe() {
         description.push(format!("data set {}: {line}", s.label));
     }
-    if let Some((_, line)) = &bispectrum {
+    if let Some((_, line)) = &block {
         description.push(format!("data set {}: {line}", s.label));
     }
     if let Some(d) = ap {
@@ -364,7 +366,7 @@ pub(super) fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded>
         request,
         template,
         description,
-        bispectrum: bispectrum.map(|b| b.0),
+        block: block.map(|b| b.0),
     })
 }
 

@@ -53,7 +53,7 @@ impl Pipeline {
     ///
     /// # Errors
     /// As [`Self::evaluate`]; [`Error::InvalidChoice`] for a cosmology normalised by σ8, a pipeline
-    /// with a bispectrum block or without basis tensors, or a spectrum outside the basis's span (the
+    /// with blocks after the power spectrum or without basis tensors, or a spectrum outside the basis's span (the
     /// direct integrals have no exact derivative).
     pub fn cosmology_jacobian(
         &self,
@@ -85,9 +85,12 @@ impl Pipeline {
         params: &[(&str, f64)],
         nuisance: bool,
     ) -> Result<(CosmologyJacobian, Option<Vec<Vec<f64>>>)> {
-        if self.bispectrum.is_some() {
+        if let Some(b) = self.blocks.first() {
             return Err(Error::InvalidChoice {
-                what: "the cosmological derivatives of a pipeline with a bispectrum block".into(),
+                what: format!(
+                    "the cosmological derivatives of a pipeline with a {} block",
+                    b.kind().name
+                ),
                 reason: "they are built for the power spectrum only".into(),
             });
         }

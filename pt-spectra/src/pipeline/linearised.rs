@@ -56,7 +56,8 @@ impl CosmologyStep<'_> {
     /// nuisance step is a few thousand multiplications ([`Linearised::data_vector`]).
     ///
     /// # Errors
-    /// As [`CosmologyStep::data_vector`]; [`Error::InvalidChoice`] with a bispectrum block.
+    /// As [`CosmologyStep::data_vector`]; [`Error::InvalidChoice`] with blocks after the power
+    /// spectrum.
     pub fn linearise(&self, f: Option<f64>) -> Result<Linearised> {
         self.polynomial(f, false)
     }
@@ -79,7 +80,7 @@ impl CosmologyStep<'_> {
     /// # Errors
     /// As [`Self::linearise`] and [`Linearised::jacobian`].
     pub fn jacobian(&self, params: &[(&str, f64)]) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
-        self.refuse_bispectrum()?;
+        self.refuse_blocks()?;
         let p = self.params(params)?;
         let (vectors, df) =
             self.data_vectors_and_df_of(&unit_sets(p.f()), std::slice::from_ref(&p))?;
@@ -104,7 +105,7 @@ impl CosmologyStep<'_> {
     /// # Errors
     /// As [`Self::jacobian`]; [`Error::InvalidChoice`] for a pipeline whose plan has no AP grid.
     pub fn template_jacobian(&self, params: &[(&str, f64)]) -> Result<[Vec<f64>; 3]> {
-        self.refuse_bispectrum()?;
+        self.refuse_blocks()?;
         let p = self.params(params)?;
         let (_, mut df) = self.data_vectors_and_df_of(&[], std::slice::from_ref(&p))?;
         let [dpar, dperp] = self.ap_jacobian(params)?;
@@ -117,7 +118,7 @@ impl CosmologyStep<'_> {
     /// # Errors
     /// As [`Self::template_jacobian`].
     pub(crate) fn ap_jacobian(&self, params: &[(&str, f64)]) -> Result<[Vec<f64>; 2]> {
-        self.refuse_bispectrum()?;
+        self.refuse_blocks()?;
         let ap = match self.ap {
             Some(ap) => ap,
             None => crate::rsd::ap::Distortion::new(1.0, 1.0)?,
@@ -131,21 +132,25 @@ impl CosmologyStep<'_> {
     }
 
     /// The polynomial is the power spectrum's.
-    fn refuse_bispectrum(&self) -> Result<()> {
-        if self.has_bispectrum() {
+    fn refuse_blocks(&self) -> Result<()> {
+        if let Some(b) = self.pipeline.blocks.first() {
             return Err(Error::InvalidChoice {
-                what: "the nuisance polynomial of a pipeline with a bispectrum block".into(),
-                reason:
-                    "it is the power spectrum's (quadratic in b1, b2, bs, b3); the bispectrum is \
-                         cubic in b1: evaluate the data vector instead"
-                        .into(),
+                what: format!(
+                    "the nuisance polynomial of a pipeline with a {} block",
+                    b.kind().name
+                ),
+                reason: format!(
+                    "it is the power spectrum's (quadratic in b1, b2, bs, b3), not the {}'s: \
+                     evaluate the data vector instead",
+                    b.kind().name
+                ),
             });
         }
         Ok(())
     }
 
     fn polynomial(&self, f: Option<f64>, with_df: bool) -> Result<Linearised> {
-        self.refuse_bispectrum()?;
+        self.refuse_blocks()?;
         let f = f.unwrap_or(self.growth_rate);
         let params = unit_sets(f);
         // their data vectors (and f-derivatives), the projection onto the multipoles made once

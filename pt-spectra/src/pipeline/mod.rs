@@ -40,14 +40,14 @@ use crate::progress::Progress;
 use crate::rsd::ap::{Distortion, AP_FIT_RANGE};
 use crate::rsd::ept::{EptParams, EptPlan, EptSettings, EptTerms, PARAM_NAMES};
 use crate::setup::{LinearSource, NamedCosmology, Prepared, Request};
+use crate::statistic::{Block, Shared, Spec, Terms};
 use crate::store::TableStore;
 use crate::survey::observe::{apply_matrix, Observation};
 
 pub mod cosmological;
 mod linearised;
 pub mod loop_range;
-use crate::bispectrum::block::{bispectrum_params, PlannedBispectrum};
-pub use crate::bispectrum::block::{BispectrumBlock, BISPECTRUM_NAMES};
+pub use crate::bispectrum::block::BispectrumBlock;
 pub use cosmological::CosmologyJacobian;
 pub use linearised::{Linearised, JACOBIAN_NAMES, NUISANCE_NAMES};
 
@@ -56,7 +56,8 @@ pub use linearised::{Linearised, JACOBIAN_NAMES, NUISANCE_NAMES};
 /// 4e-4 to 8e-4). The terms' errors include ε|T| for a residual ε, whatever it is.
 pub const PIPELINE_MAX_RESIDUAL: f64 = crate::loops::basis::MAX_RESIDUAL;
 
-/// The models a [`Pipeline`] can evaluate (the place of TNS, eft2 and the bispectrum later).
+/// The models of the power spectrum a [`Pipeline`] can evaluate (the place of TNS and eft2 later;
+/// other statistics are blocks after it, [`crate::statistic`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Model {
     /// The 1-loop Eulerian galaxy model in redshift space ([`crate::rsd::ept`]).
@@ -77,7 +78,7 @@ pub struct PipelineSettings {
     /// The largest projection residual evaluated on the basis ([`PIPELINE_MAX_RESIDUAL`]).
     pub max_residual: f64,
     /// The tree-level bispectrum multipoles after the power spectrum in the data vector (`None`:
-    /// the power spectrum alone).
+    /// the power spectrum alone): the registered block of [`Self::blocks`].
     pub bispectrum: Option<BispectrumBlock>,
     /// Whether the loop terms are computed only where the observation weighs them, the range chosen
     /// by measurement at build time ([`loop_range`]; default true). False: everywhere.
@@ -85,6 +86,14 @@ pub struct PipelineSettings {
 }
 
 impl PipelineSettings {
+    /// The blocks after the power spectrum, planned, in the order of the data vector.
+    ///
+    /// # Errors
+    /// As each block's planning ([`Spec::plan`]).
+    pub fn blocks(&self) -> crate::error::Result<Vec<Box<dyn Block>>> {
+        self.bispectrum.iter().cloned().map(Spec::plan).collect()
+    }
+
     /// `ept` at `z` with IR resummation, the AP distortion against `fiducial`, and
     /// [`PIPELINE_MAX_RESIDUAL`].
     pub fn ept(z: f64, fiducial: Option<Cosmology>) -> Self {
@@ -109,8 +118,8 @@ pub struct Pipeline {
     matrix: Vec<f64>,
     rows: usize,
     emulator: LinearEmulator,
-    /// The bispectrum block, planned.
-    bispectrum: Option<PlannedBispectrum>,
+    /// The blocks after the power spectrum, planned ([`PipelineSettings::blocks`]).
+    blocks: Vec<Box<dyn Block>>,
     /// The measured change of the reference data vector by the loop range, if restricted
     /// ([`loop_range`]).
     loop_truncation: Option<f64>,
@@ -160,8 +169,8 @@ pub struct CosmologyStep<'a> {
     pub ap: Option<Distortion>,
     /// Where the loop terms came from.
     pub source: TermsSource,
-    /// The bispectrum block's terms at [`Self::growth_rate`] (with a block).
-    bispectrum: Option<crate::bispectrum::BispectrumTerms>,
+    /// Each block's terms at [`Self::growth_rate`] and [`Self::ap`].
+    blocks: Vec<Box<dyn Terms>>,
 }
 
 impl Pipeline {
@@ -213,11 +222,7 @@ impl Pipeline {
         )?
         .with_basis(store, progress)?
         .with_max_residual(settings.max_residual)?;
-        let bispectrum = settings
-            .bispectrum
-            .clone()
-            .map(PlannedBispectrum::new)
-            .transpose()?;
+        let blocks = settings.blocks()?;
         Ok(Self {
             settings,
             plan,
@@ -225,7 +230,7 @@ impl Pipeline {
             matrix,
             rows,
             emulator: LinearEmulator::embedded()?,
-            bispectrum,
+            blocks,
             loop_truncation: chosen.map(|(_, change)| change),
         })
     }
@@ -240,10 +245,9 @@ impl Pipeline {
         &self.observation
     }
 
-    /// The length of the data vector: output ℓ's × output k, then with a bispectrum block its
-    /// multipoles × triangles.
+    /// The length of the data vector: output ℓ's × output k, then each block's entries.
     pub fn len(&self) -> usize {
-        self.rows + self.bispectrum.as_ref().map_or(0, PlannedBispectrum::len)
+        self.rows + self.blocks.iter().map(|b| b.len()).sum::<usize>()
     }
 
     /// The length of the power-spectrum part of the data vector (output ℓ's × output k).
@@ -256,9 +260,14 @@ impl Pipeline {
         self.len() == 0
     }
 
-    /// Whether the data vector has a bispectrum block.
-    pub fn has_bispectrum(&self) -> bool {
-        self.bispectrum.is_some()
+    /// Whether the data vector has blocks after the power spectrum.
+    pub fn has_blocks(&self) -> bool {
+        !self.blocks.is_empty()
+    }
+
+    /// The blocks after the power spectrum, in the data vector's order.
+    pub fn blocks(&self) -> &[Box<dyn Block>] {
+        &self.blocks
     }
 
     /// The observation's matrix (row-major, [`Self::len`] rows, model ℓ's × model k columns): the
@@ -340,7 +349,7 @@ impl Pipeline {
     }
 
     /// [`Self::step`] at the growth rate `f` instead of the cosmology's f(z) (a template fit's free
-    /// f; with a bispectrum block the only way to change f, whose IR damping is not a polynomial in it).
+    /// f; with blocks the only way to change f, on which their terms depend beyond a polynomial).
     ///
     /// # Errors
     /// As [`Self::step`].
@@ -384,22 +393,22 @@ impl Pipeline {
             (None, Some(_)) => Some(Distortion::new(1.0, 1.0)?),
             (None, None) => None,
         };
-        let bispectrum = match &self.bispectrum {
-            Some(b) => Some(b.terms(
-                spectrum,
-                growth_rate,
-                ap.map(|d| (d.apar, d.aperp)),
-                self.settings.ir,
-            )?),
-            None => None,
-        };
+        let distortion = ap.map_or((1.0, 1.0), |d| (d.apar, d.aperp));
+        let blocks = self
+            .blocks
+            .iter()
+            .map(|b| {
+                let prepared = b.prepare(spectrum, self.settings.ir)?;
+                b.terms(spectrum, &prepared, growth_rate, distortion)
+            })
+            .collect::<Result<_>>()?;
         Ok(CosmologyStep {
             pipeline: self,
             terms,
             growth_rate,
             ap,
             source,
-            bispectrum,
+            blocks,
         })
     }
 
@@ -439,31 +448,35 @@ impl CosmologyStep<'_> {
     /// The ept parameters of `params` by name, `f` defaulting to the step's growth rate.
     fn params(&self, params: &[(&str, f64)]) -> Result<EptParams> {
         let mut p = EptParams::new(0.0, self.growth_rate);
-        let with_b = self.bispectrum.is_some();
+        let blocks = &self.pipeline.blocks;
         for &(name, value) in params {
-            if with_b && BISPECTRUM_NAMES.contains(&name) {
+            if blocks.iter().any(|b| b.kind().index(name).is_some()) {
                 continue;
             }
-            if with_b && name == "f" && value != self.growth_rate {
-                return Err(Error::InvalidChoice {
-                    what: format!("f = {value} with a bispectrum block"),
-                    reason: format!(
-                        "the step's bispectrum terms are at f = {}: make the step at this f \
-                         (Pipeline::step_at_growth_rate; in Python, f is passed there)",
-                        self.growth_rate
-                    ),
-                });
+            if let (Some(b), "f") = (blocks.first(), name) {
+                if value != self.growth_rate {
+                    let block = b.kind().name;
+                    return Err(Error::InvalidChoice {
+                        what: format!("f = {value} with a {block} block"),
+                        reason: format!(
+                            "the step's {block} terms are at f = {}: make the step at this f \
+                             (Pipeline::step_at_growth_rate; in Python, f is passed there)",
+                            self.growth_rate
+                        ),
+                    });
+                }
             }
-            p.set(name, value).map_err(|e| match (with_b, e) {
-                (
-                    false,
-                    Error::InvalidChoice { what, reason },
-                ) if BISPECTRUM_NAMES.contains(&name) => Error::InvalidChoice {
-                    what,
-                    reason: format!("{reason} ({name} is a bispectrum parameter: this pipeline has no bispectrum block)"),
-                },
-                (_, e) => e,
-            })?;
+            p.set(name, value)
+                .map_err(|e| match (crate::blocks::owner(name), e) {
+                    (Some(kind), Error::InvalidChoice { what, reason }) => Error::InvalidChoice {
+                        what,
+                        reason: format!(
+                            "{reason} ({name} is a {0} parameter: this pipeline has no {0} block)",
+                            kind.name
+                        ),
+                    },
+                    (_, e) => e,
+                })?;
         }
         p.validate()?;
         Ok(p)
@@ -478,8 +491,9 @@ impl CosmologyStep<'_> {
     pub fn data_vector(&self, params: &[(&str, f64)]) -> Result<Vec<f64>> {
         let p = self.params(params)?;
         let mut out = self.data_vector_of(&p)?;
-        if let (Some(block), Some(terms)) = (&self.pipeline.bispectrum, &self.bispectrum) {
-            out.extend(block.values(terms, bispectrum_params(params))?);
+        let shared = Shared::from_params(params);
+        for (block, terms) in self.pipeline.blocks.iter().zip(&self.blocks) {
+            out.extend(terms.values(shared, &block.kind().own_values(params))?);
         }
         Ok(out)
     }
@@ -529,9 +543,9 @@ impl CosmologyStep<'_> {
         &self.terms
     }
 
-    /// Whether the step has the terms of a bispectrum block.
-    pub fn has_bispectrum(&self) -> bool {
-        self.bispectrum.is_some()
+    /// Whether the step has the terms of blocks after the power spectrum.
+    pub fn has_blocks(&self) -> bool {
+        !self.blocks.is_empty()
     }
 }
 
@@ -541,12 +555,11 @@ pub fn parameter_names() -> &'static [&'static str] {
 }
 
 impl Pipeline {
-    /// The names a call of this pipeline takes: [`PARAM_NAMES`], and with a bispectrum block
-    /// [`BISPECTRUM_NAMES`].
+    /// The names a call of this pipeline takes: [`PARAM_NAMES`], then each block's own.
     pub fn parameters(&self) -> Vec<&'static str> {
         let mut names = PARAM_NAMES.to_vec();
-        if self.bispectrum.is_some() {
-            names.extend(BISPECTRUM_NAMES);
+        for b in &self.blocks {
+            names.extend(b.kind().own);
         }
         names
     }

@@ -7,7 +7,7 @@
 //!   defined on the multipoles, which no map of P(k, μ) reproduces exactly).
 //! * [`FitBasis::Desi`]: the DESI DR1 physical basis ([`crate::rsd::ept::physical`]).
 
-use super::{BISPECTRUM_NAMES, LINEAR};
+use super::LINEAR;
 use crate::bias::{BiasConvention, BiasParams};
 use crate::error::Result;
 use crate::rsd::ept::physical::{
@@ -115,14 +115,14 @@ impl FitBasis {
         j
     }
 
-    /// Checks that `name` (a slot of this basis or the bispectrum's) may be used: the DESI basis has
+    /// Checks that `name` (a slot of this basis or a block's) may be used: the DESI basis has
     /// no `alpha6p` of its own.
     ///
     /// # Errors
     /// As [`check_physical_name`].
     pub fn check_name(&self, name: &str) -> Result<()> {
         match self {
-            Self::Desi(_) if !BISPECTRUM_NAMES.contains(&name) => check_physical_name(name),
+            Self::Desi(_) if crate::blocks::owner(name).is_none() => check_physical_name(name),
             _ => Ok(()),
         }
     }

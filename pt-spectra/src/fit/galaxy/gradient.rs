@@ -26,11 +26,11 @@
 //! the prior's, with Jⱼ the column above: the diagonal of the profiled χ²'s Hessian without the
 //! model's second derivatives.
 //!
-//! Not covered (the minimiser differences the objective there, and the output says so): a bispectrum
-//! beside the power spectrum, and a model that fails the checks above.
+//! Not covered (the minimiser differences the objective there, and the output says so): a block
+//! after the power spectrum ([`crate::statistic`]), and a model that fails the checks above.
 
 use super::objective::Objective;
-use super::{AP_SLOT, SLOTS};
+use super::AP_SLOT;
 use crate::error::Result;
 use crate::linalg::dot;
 use crate::rsd::ap::Distortion;
@@ -52,7 +52,7 @@ type Jacobian = [[f64; F_SLOT + 1]; F_SLOT + 1];
 
 impl Objective<'_> {
     /// ∂p/∂v at the slots `v`: the basis's Jacobian (the identity in the model's).
-    fn basis_jacobian(&self, v: &[f64; SLOTS]) -> Jacobian {
+    fn basis_jacobian(&self, v: &[f64]) -> Jacobian {
         let mut u = [0.0; F_SLOT + 1];
         u.copy_from_slice(&v[..=F_SLOT]);
         self.basis.jacobian(&u)
@@ -68,13 +68,13 @@ impl Objective<'_> {
     }
 
     /// Whether [`Self::value_and_gradient`] is exact for this objective (module docs): no
-    /// bispectrum, the model at most quadratic in each polynomial parameter and none of their
+    /// block, the model at most quadratic in each polynomial parameter and none of their
     /// derivatives changed by the linear ones, checked at the start.
     pub(super) fn check_exact_gradient(&self) -> Result<bool> {
-        if self.bispectrum.is_some() {
+        if self.has_block() {
             return Ok(false);
         }
-        let mut v = self.start;
+        let mut v = self.start.clone();
         for &i in &self.marg {
             v[i] = 0.0;
         }
@@ -132,9 +132,9 @@ impl Objective<'_> {
         }
         // The base sets: the point, then each template's (its slot at 1).
         let nm = self.marg.len();
-        let mut base = vec![v];
+        let mut base = vec![v.clone()];
         for &a in &self.marg {
-            let mut w = v;
+            let mut w = v.clone();
             w[a] = 1.0;
             base.push(w);
         }

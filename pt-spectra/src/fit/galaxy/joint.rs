@@ -22,8 +22,7 @@
 use super::objective::{objective, Objective};
 use super::search::{bound, find, package, Space};
 use super::{
-    slot_index, BispectrumFit, FitBasis, GalaxyFit, GalaxyFitRequest, Linear, MultipoleData,
-    Observation, Search,
+    slot_index, BlockFit, GalaxyFit, GalaxyFitRequest, Linear, MultipoleData, Observation, Search,
 };
 use crate::error::{Error, Result};
 use crate::rsd::ept::{EptPlan, EptTerms};
@@ -53,8 +52,8 @@ pub struct DataSet<'a> {
     pub request: GalaxyFitRequest,
     /// Its window and bins, if any.
     pub observation: Option<&'a Observation>,
-    /// Its bispectrum beside the power spectrum, if any (fitted with one covariance).
-    pub bispectrum: Option<&'a BispectrumFit>,
+    /// Its block after the power spectrum (the bispectrum), if any (fitted with one covariance).
+    pub bispectrum: Option<&'a BlockFit>,
 }
 
 /// The result of a joint fit.
@@ -121,8 +120,6 @@ pub struct JointLikelihood<'a> {
     scale: Vec<f64>,
     /// Per joint parameter: its slot (in its first set).
     slots: Vec<usize>,
-    /// The basis of every set.
-    basis: FitBasis,
     /// The sets' labels.
     labels: Vec<String>,
 }
@@ -167,8 +164,8 @@ impl<'a> JointLikelihood<'a> {
         Ok(sum)
     }
 
-    /// −2 ln L and its exact gradient at `x`; `None` where a set has no exact gradient (a
-    /// bispectrum: [`Self::exact_gradient`]).
+    /// −2 ln L and its exact gradient at `x`; `None` where a set has no exact gradient (a block
+    /// after the power spectrum: [`Self::exact_gradient`]).
     ///
     /// # Errors
     /// As [`Self::minus_two_log_l`].
@@ -249,7 +246,7 @@ impl<'a> JointLikelihood<'a> {
 
     /// The search space of the fit: per parameter its slot and prior, the bounds, σ and start.
     fn space(&self) -> Space<'_> {
-        let params = self
+        let (params, boxes) = self
             .slots
             .iter()
             .enumerate()
@@ -257,16 +254,17 @@ impl<'a> JointLikelihood<'a> {
                 let s = (0..self.map.len())
                     .find(|&s| self.map[s].contains(&j))
                     .expect("every joint parameter is some set's");
-                (slot, self.objectives[s].priors[slot].as_ref())
+                let o = &self.objectives[s];
+                ((slot, o.priors[slot].as_ref()), o.start_box(slot))
             })
-            .collect();
+            .unzip();
         Space {
             params,
             lo: self.lower.clone(),
             hi: self.upper.clone(),
             scale: self.scale.clone(),
             x0: self.start.clone(),
-            basis: self.basis,
+            boxes,
         }
     }
 }
@@ -376,12 +374,26 @@ fn build<'a>(
             ),
         });
     }
+    // per set, the slots of the shared parameters (a block's own sit after the model's and AP's)
+    let shared_slots: Vec<Vec<usize>> = objectives
+        .iter()
+        .map(|o| {
+            let own = o.block.as_ref().map_or(&[][..], |b| b.fit.kind().own);
+            shared
+                .iter()
+                .map(|n| slot_index(n, &basis, own))
+                .collect::<Result<_>>()
+        })
+        .collect::<Result<_>>()?;
     for (n, name) in shared.iter().enumerate() {
-        let slot = slot_index(name, &basis)?;
         if shared[..n].contains(name) {
             return Err(sharing(name, "is declared shared twice".into()));
         }
-        let frees: Vec<bool> = objectives.iter().map(|o| o.free.contains(&slot)).collect();
+        let frees: Vec<bool> = objectives
+            .iter()
+            .zip(&shared_slots)
+            .map(|(o, slots)| o.free.contains(&slots[n]))
+            .collect();
         if let Some(s) = sets.iter().find(|s| s.request.marginalise.contains(name)) {
             return Err(sharing(
                 name,
@@ -409,7 +421,8 @@ fn build<'a>(
         }
         // Its prior: one, counted once (kept in the first set that gives it).
         let mut prior = None;
-        for (o, s) in objectives.iter_mut().zip(sets) {
+        for ((o, s), slots) in objectives.iter_mut().zip(sets).zip(&shared_slots) {
+            let slot = slots[n];
             match (prior.as_ref(), o.priors[slot].take()) {
                 (_, None) => {}
                 (None, Some(p)) => {
@@ -431,21 +444,19 @@ fn build<'a>(
         }
     }
     // The joint parameters, in the sets' order of their free ones; a shared one at its first.
-    let slots_shared: Vec<usize> = shared
-        .iter()
-        .map(|n| slot_index(n, &basis))
-        .collect::<Result<_>>()?;
     let mut names = Vec::new();
     let mut slots = Vec::new();
     let (mut lo, mut hi, mut scale, mut x0) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut map = Vec::with_capacity(sets.len());
     for (s, o) in objectives.iter().enumerate() {
-        let ap = o.plan.settings().ap_range;
         let mut own = Vec::with_capacity(o.free.len());
         for (j, &slot) in o.free.iter().enumerate() {
-            let (a, b, sc) = bound(slot, o.priors[slot].as_ref(), ap, &o.basis);
-            let is_shared = slots_shared.contains(&slot);
-            if let Some(g) = (is_shared && s > 0).then(|| map_of(&map, slot, &objectives)) {
+            let (a, b, sc) = bound(o, slot);
+            let at = shared_slots[s].iter().position(|&i| i == slot);
+            if let Some(g) = at
+                .filter(|_| s > 0)
+                .map(|n| map_of(&map, shared_slots[0][n], &objectives))
+            {
                 let g = g.expect("a shared parameter is free in the first set");
                 lo[g] = f64::max(lo[g], a);
                 hi[g] = f64::min(hi[g], b);
@@ -453,7 +464,7 @@ fn build<'a>(
                 continue;
             }
             own.push(names.len());
-            names.push(if is_shared {
+            names.push(if at.is_some() {
                 sets[s].request.free[j].clone()
             } else {
                 format!("{}[{}]", sets[s].request.free[j], sets[s].label)
@@ -484,7 +495,6 @@ fn build<'a>(
         start: x0,
         scale,
         slots,
-        basis,
         labels: sets.iter().map(|s| s.label.clone()).collect(),
     })
 }

@@ -1,8 +1,9 @@
 //! The objective of a galaxy fit: −2 ln L of the free parameters with the linear ones marginalised
 //! analytically (the module docs of [`super`]), on one window of data.
 
-use super::bispectrum::{BispectrumFit, BispectrumModel, BISPECTRUM_NAMES};
-use super::{GalaxyFitRequest, PriorShape, AP_SLOT, B_SLOT, SLOTS};
+use super::block::{BlockFit, BlockModel};
+use super::search::{ranges, Range};
+use super::{GalaxyFitRequest, PriorShape, AP_SLOT, OWN_SLOT};
 use crate::error::{Error, Result};
 use crate::fit::MultipoleData;
 use crate::linalg::{cholesky, dot, invert_lower, solve_spd};
@@ -30,8 +31,8 @@ pub(super) struct Objective<'a> {
     pub(super) terms: &'a EptTerms,
     /// The window and bins between the model and the data, if any.
     pub(super) observation: Option<&'a Observation>,
-    /// Every slot's start or fixed value (the model's parameters, α∥, α⊥).
-    pub(super) start: [f64; SLOTS],
+    /// Every slot's start or fixed value (the model's parameters, α∥, α⊥, the block's own).
+    pub(super) start: Vec<f64>,
     /// Whether the measurement has a distortion.
     pub(super) has_ap: bool,
     /// The parameter basis of the slots, converted to the model's at every evaluation.
@@ -55,14 +56,14 @@ pub(super) struct Objective<'a> {
     pub(super) whiten: Vec<Vec<f64>>,
     /// L⁻¹ d.
     pub(super) data: Vec<f64>,
-    /// The bispectrum beside the power spectrum, if the data set has one: its entries follow the
+    /// The block after the power spectrum, if the data set has one: its entries follow the
     /// power spectrum's in the model and data vectors.
-    pub(super) bispectrum: Option<BispectrumModel<'a>>,
+    pub(super) block: Option<BlockModel<'a>>,
 }
 
 impl Objective<'_> {
-    pub(super) fn slots(&self, x: &[f64]) -> [f64; SLOTS] {
-        let mut v = self.start;
+    pub(super) fn slots(&self, x: &[f64]) -> Vec<f64> {
+        let mut v = self.start.clone();
         for (&i, &value) in self.free.iter().zip(x) {
             v[i] = value;
         }
@@ -71,7 +72,7 @@ impl Objective<'_> {
 
     pub(super) fn split(
         &self,
-        v: &[f64; SLOTS],
+        v: &[f64],
     ) -> Result<(EptParams, Option<crate::rsd::ap::Distortion>)> {
         let n = PARAM_NAMES.len();
         let mut model = [0.0; PARAM_NAMES.len()];
@@ -85,9 +86,24 @@ impl Objective<'_> {
         Ok((p, ap))
     }
 
-    /// Whether the data set has a bispectrum.
-    pub(super) fn has_bispectrum(&self) -> bool {
-        self.bispectrum.is_some()
+    /// Whether the data set has a block after the power spectrum.
+    pub(super) fn has_block(&self) -> bool {
+        self.block.is_some()
+    }
+
+    /// The range of slot `i` in a fit: the basis's ([`super::search::RANGES`]), a block's own from
+    /// its kind.
+    pub(super) fn range(&self, i: usize) -> Range {
+        match (i.checked_sub(OWN_SLOT), &self.block) {
+            (Some(j), Some(b)) => b.fit.kind().ranges[j],
+            _ => ranges(&self.basis)[i],
+        }
+    }
+
+    /// The start box (lower, upper) of slot `i` ([`Self::range`]).
+    pub(super) fn start_box(&self, i: usize) -> (f64, f64) {
+        let (_, _, from, to, _) = self.range(i);
+        (from, to)
     }
 
     /// The multipoles the plan evaluates: the window's model multipoles, or the fitted ones.
@@ -122,27 +138,26 @@ impl Objective<'_> {
     }
 
     /// The whitened model at the slots `v` (L⁻¹ m): the power spectrum's fitted points, then the
-    /// bispectrum's entries.
-    pub(super) fn model(&self, v: &[f64; SLOTS]) -> Result<Vec<f64>> {
+    /// block's entries.
+    pub(super) fn model(&self, v: &[f64]) -> Result<Vec<f64>> {
         let (p, ap) = self.split(v)?;
         let m = self
             .plan
             .multipole_values_at(self.terms, &p, self.plan_ells(), ap)?;
         let mut raw = self.fitted_points(m)?;
-        if let Some(b) = &self.bispectrum {
-            let own: [f64; 4] = std::array::from_fn(|i| v[B_SLOT + i]);
-            raw.extend(b.values(&p, ap, &own)?);
+        if let Some(b) = &self.block {
+            raw.extend(b.values(&p, ap, &v[OWN_SLOT..])?);
         }
         Ok(self.whitened(&raw))
     }
 
     /// The whitened templates Tᵢ = m(v, aᵢ = 1) − m(v, aᵢ = 0) of the marginalised parameters at the
     /// slots `v` (theirs at 0), `m0` the model at `v` (the model is linear in them in either basis).
-    fn templates(&self, v: &[f64; SLOTS], m0: &[f64]) -> Result<Vec<Vec<f64>>> {
+    fn templates(&self, v: &[f64], m0: &[f64]) -> Result<Vec<Vec<f64>>> {
         self.marg
             .iter()
             .map(|&i| {
-                let mut w = *v;
+                let mut w = v.to_vec();
                 w[i] = 1.0;
                 self.model(&w)
                     .map(|m| m.iter().zip(m0).map(|(a, b)| a - b).collect())
@@ -151,8 +166,8 @@ impl Objective<'_> {
     }
 
     /// The slots the templates can depend on: all but the biases and the marginalised ones.
-    fn template_key(&self, v: &[f64; SLOTS]) -> Vec<u64> {
-        (0..SLOTS)
+    fn template_key(&self, v: &[f64]) -> Vec<u64> {
+        (0..v.len())
             .filter(|i| !BIASES.contains(i) && !self.marg.contains(i))
             .map(|i| v[i].to_bits())
             .collect()
@@ -165,11 +180,11 @@ impl Objective<'_> {
         if self.marg.is_empty() {
             return Ok(());
         }
-        let mut v = self.start;
+        let mut v = self.start.clone();
         for &i in &self.marg {
             v[i] = 0.0;
         }
-        let at = |v: &[f64; SLOTS]| -> Result<Vec<Vec<f64>>> { self.templates(v, &self.model(v)?) };
+        let at = |v: &[f64]| -> Result<Vec<Vec<f64>>> { self.templates(v, &self.model(v)?) };
         let t0 = at(&v)?;
         for (&i, shift) in BIASES.iter().zip([0.37, -0.41, 0.23, 0.11]) {
             v[i] += shift;
@@ -208,7 +223,7 @@ impl Objective<'_> {
     ///
     /// # Errors
     /// As the model's evaluation (e.g. f or α outside the plan's range).
-    pub(super) fn evaluate(&self, x: &[f64]) -> Result<(f64, f64, [f64; SLOTS], Vec<f64>)> {
+    pub(super) fn evaluate(&self, x: &[f64]) -> Result<(f64, f64, Vec<f64>, Vec<f64>)> {
         let mut v = self.slots(x);
         for &i in &self.marg {
             v[i] = 0.0;
@@ -247,7 +262,7 @@ impl Objective<'_> {
     /// the residual L⁻¹(d − m0) − Σ âₐTₐ.
     pub(super) fn marginalise(
         &self,
-        v: &mut [f64; SLOTS],
+        v: &mut [f64],
         m0: &[f64],
         templates: &[Vec<f64>],
     ) -> Result<Marginal> {
@@ -320,20 +335,10 @@ pub(super) fn objective<'a>(
     data: &MultipoleData,
     request: &GalaxyFitRequest,
     observation: Option<&'a Observation>,
-    bispectrum: Option<&'a BispectrumFit>,
+    block: Option<&'a BlockFit>,
 ) -> Result<Objective<'a>> {
-    let (free, marg, priors) = super::request::validate(request)?;
-    if bispectrum.is_none() {
-        let with_prior = (0..SLOTS).filter(|&i| priors[i].is_some());
-        let used = free.iter().chain(&marg).copied().chain(with_prior);
-        if let Some(i) = used.into_iter().find(|&i| i >= B_SLOT) {
-            return Err(Error::InvalidChoice {
-                what: format!("fit parameter `{}`", BISPECTRUM_NAMES[i - B_SLOT]),
-                reason: "is a bispectrum parameter, and this data set has no bispectrum".into(),
-            });
-        }
-    }
-    if request.ap.is_none() && free.iter().any(|&i| (AP_SLOT..B_SLOT).contains(&i)) {
+    let (free, marg, priors) = super::request::validate(request, block.map(BlockFit::kind))?;
+    if request.ap.is_none() && free.iter().any(|&i| (AP_SLOT..OWN_SLOT).contains(&i)) {
         return Err(Error::InvalidChoice {
             what: "free apar/aperp".into(),
             reason: "the fit needs a distortion to start from (the measurement's AP)".into(),
@@ -390,8 +395,7 @@ pub(super) fn objective<'a>(
                 .collect::<Vec<usize>>(),
         );
     }
-    let points: usize =
-        window.iter().map(Vec::len).sum::<usize>() + bispectrum.map_or(0, BispectrumFit::len);
+    let points: usize = window.iter().map(Vec::len).sum::<usize>() + block.map_or(0, BlockFit::len);
     if points <= free.len() + marg.len() {
         return Err(Error::InvalidParameter {
             name: "k_max [h/Mpc]",
@@ -420,11 +424,11 @@ pub(super) fn objective<'a>(
                 .collect()
         })
         .collect();
-    // With a bispectrum: its entries after the power spectrum's, with the cross terms.
-    if let Some(b) = bispectrum {
+    // With a block: its entries after the power spectrum's, with the cross terms.
+    if let Some(b) = block {
         if data.covariance.is_none() {
             return Err(Error::InvalidChoice {
-                what: "a fit of the power spectrum and the bispectrum".into(),
+                what: format!("a fit of the power spectrum and the {}", b.kind().name),
                 reason: "needs their joint covariance (the cross terms), not diagonal errors"
                     .into(),
             });
@@ -449,7 +453,7 @@ pub(super) fn objective<'a>(
     crate::fit::covariance::check_conditioning(
         &cov,
         &format!("the {points} fitted points"),
-        &|i| match (fitted.get(i), bispectrum) {
+        &|i| match (fitted.get(i), block) {
             (Some(&(r, j)), _) => format!("P{} at k = {} h/Mpc", data.ells[r], k[j]),
             (None, Some(b)) => b.entry(i - fitted.len()),
             (None, None) => format!("point {}", i + 1),
@@ -477,9 +481,9 @@ pub(super) fn objective<'a>(
     })?;
     let whiten = invert_lower(&l);
     let mut raw: Vec<f64> = fitted.iter().map(|&(r, i)| data.values[r][i]).collect();
-    raw.extend(bispectrum.map_or(&[][..], BispectrumFit::values));
+    raw.extend(block.map_or(&[][..], BlockFit::values));
     let data_vector = whiten.iter().map(|row| dot(row, &raw)).collect();
-    let mut start = [0.0; SLOTS];
+    let mut start = vec![0.0; OWN_SLOT];
     let in_basis = request.basis.from_ept(&request.start);
     if let Some(i) = in_basis.iter().position(|v| !v.is_finite()) {
         return Err(Error::InvalidParameter {
@@ -493,8 +497,8 @@ pub(super) fn objective<'a>(
         start[AP_SLOT] = d.apar;
         start[AP_SLOT + 1] = d.aperp;
     }
-    if let Some(b) = bispectrum {
-        start[B_SLOT..].copy_from_slice(b.start());
+    if let Some(b) = block {
+        start.extend(b.start());
     }
     let mut objective = Objective {
         plan,
@@ -514,7 +518,7 @@ pub(super) fn objective<'a>(
         cache: std::cell::RefCell::new(Vec::new()),
         whiten,
         data: data_vector,
-        bispectrum: bispectrum.map(BispectrumModel::new),
+        block: block.map(BlockModel::new),
     };
     objective.check_bias_free_templates()?;
     // (a model the checks cannot evaluate falls back to differences; its errors surface at the start)

@@ -1,29 +1,34 @@
 //! The checks of a galaxy fit's request: its parameter names, the free and marginalised sets, the
 //! per-multipole k ranges and the priors.
 
-use super::bispectrum::BISPECTRUM_LINEAR;
-use super::{linear_names, slot_index, GalaxyFitRequest, PriorShape, SLOTS};
+use super::{linear_names, slot_index, GalaxyFitRequest, PriorShape, OWN_SLOT};
 use crate::error::{Error, Result};
+use crate::statistic::Kind;
 
 /// The free and marginalised parameter indices, and per parameter its prior (mean, 1/σ²).
 type Validated = (Vec<usize>, Vec<usize>, Vec<Option<PriorShape>>);
 
-/// Checks the request's names and values.
-pub(super) fn validate(request: &GalaxyFitRequest) -> Result<Validated> {
+/// Checks the request's names and values, for a data set with a block of kind `block` (if any).
+pub(super) fn validate(request: &GalaxyFitRequest, block: Option<&Kind>) -> Result<Validated> {
     let basis = &request.basis;
+    let own = block.map_or(&[][..], |k| k.own);
+    let slot = |name: &str| slot_index(name, basis, own);
     let free = request
         .free
         .iter()
-        .map(|n| slot_index(n, basis))
+        .map(|n| slot(n))
         .collect::<Result<Vec<_>>>()?;
     let mut marg = Vec::new();
     let linear: Vec<&str> = linear_names(basis)
         .iter()
-        .chain(&BISPECTRUM_LINEAR)
+        .chain(block.map_or(&[][..], |k| k.linear))
         .copied()
         .collect();
     for name in &request.marginalise {
         if !linear.contains(&name.as_str()) {
+            if crate::blocks::owner(name).is_some() {
+                slot(name)?; // a block's parameter: is the block there?
+            }
             return Err(Error::InvalidChoice {
                 what: format!("--marginalise {name}"),
                 reason: format!(
@@ -32,7 +37,7 @@ pub(super) fn validate(request: &GalaxyFitRequest) -> Result<Validated> {
                 ),
             });
         }
-        marg.push(slot_index(name, basis)?);
+        marg.push(slot(name)?);
     }
     let mut seen = std::collections::HashSet::new();
     for name in request.free.iter().chain(&request.marginalise) {
@@ -64,9 +69,9 @@ pub(super) fn validate(request: &GalaxyFitRequest) -> Result<Validated> {
             });
         }
     }
-    let mut priors = vec![None; SLOTS];
+    let mut priors = vec![None; OWN_SLOT + own.len()];
     for p in &request.priors {
-        let i = slot_index(&p.name, basis)?;
+        let i = slot(&p.name)?;
         p.shape.check(&p.name)?;
         if !free.contains(&i) && !marg.contains(&i) {
             return Err(Error::InvalidChoice {

@@ -16,13 +16,14 @@
 //!   by more than 0.01 means the starts missed the global minimum: the search restarts there.
 
 use super::objective::Objective;
-use super::{FitBasis, GalaxyFit, PriorShape, AP_SLOT, B_SLOT, SLOTS};
+use super::{FitBasis, GalaxyFit, PriorShape, AP_SLOT, OWN_SLOT};
 use crate::error::{Error, Result};
 use crate::fit::bounded::{
     hessian_from_gradient, multistart, Minimum, Problem, ValueGradient, AGREEMENT,
     EXPECTED_DECREASE,
 };
 use crate::linalg::solve_spd;
+pub use crate::statistic::Range;
 use rand::{Rng, SeedableRng};
 
 mod profile;
@@ -47,12 +48,12 @@ pub const PROFILE_DECREASE: f64 = 1e-4;
 /// Re-searches after a profile found a lower minimum, at most.
 const RESTARTS: usize = 3;
 
-/// Per slot ([`crate::rsd::ept::PARAM_NAMES`], then α∥, α⊥, then the bispectrum's c1, b_shot,
-/// p_shot, a_shot): (lower bound, upper bound, start box lower, upper, typical σ). The bounds are
-/// wide physical ranges (f: the plausible range [0, 2]); the start box is where galaxy samples' best
-/// fits lie (b1 1–3, |b2| ≲ 2 in velocileptors' units; counterterms tens of (Mpc/h)², shot noise
-/// ~1/n̄ ~ 10³ (Mpc/h)³; the bispectrum's stochastic amplitudes of order one in units of 1/n̄).
-pub const RANGES: [(f64, f64, f64, f64, f64); SLOTS] = [
+/// Per slot ([`crate::rsd::ept::PARAM_NAMES`], then α∥, α⊥; a block's own from its
+/// [`crate::statistic::Kind::ranges`]): (lower bound, upper bound, start box lower, upper, typical σ).
+/// The bounds are wide physical ranges (f: the plausible range [0, 2]); the start box is where galaxy
+/// samples' best fits lie (b1 1–3, |b2| ≲ 2 in velocileptors' units; counterterms tens of (Mpc/h)²,
+/// shot noise ~1/n̄ ~ 10³ (Mpc/h)³).
+pub const RANGES: [Range; OWN_SLOT] = [
     (0.05, 10.0, 1.0, 3.0, 0.1),
     (-50.0, 50.0, -2.0, 2.0, 1.0),
     (-50.0, 50.0, -1.0, 1.0, 1.0),
@@ -67,16 +68,12 @@ pub const RANGES: [(f64, f64, f64, f64, f64); SLOTS] = [
     (0.0, 2.0, 0.4, 1.0, 0.05),
     (0.5, 2.0, 0.9, 1.1, 0.03),
     (0.5, 2.0, 0.9, 1.1, 0.03),
-    (-1e3, 1e3, -10.0, 10.0, 3.0),
-    (-20.0, 20.0, 0.0, 2.0, 0.3),
-    (-20.0, 20.0, -1.0, 1.0, 0.3),
-    (-20.0, 20.0, -1.0, 1.0, 0.3),
 ];
 
 /// [`RANGES`] for the slots of the DESI physical basis ([`crate::rsd::ept::physical`]): b1p = b1 σ₈(z)
 /// (start box 0.6–1.8), b2p, bsp, b3p in σ₈²-scaled units, the counterterms as fractions of linear
 /// theory per (h/Mpc)² (tens), the stochastic terms in units of 1/n̄ (of order one).
-pub const PHYSICAL_RANGES: [(f64, f64, f64, f64, f64); SLOTS] = [
+pub const PHYSICAL_RANGES: [Range; OWN_SLOT] = [
     (0.01, 10.0, 0.6, 1.8, 0.05),
     (-50.0, 50.0, -1.0, 1.0, 0.5),
     (-50.0, 50.0, -0.5, 0.5, 0.5),
@@ -91,14 +88,10 @@ pub const PHYSICAL_RANGES: [(f64, f64, f64, f64, f64); SLOTS] = [
     (0.0, 2.0, 0.4, 1.0, 0.05),
     (0.5, 2.0, 0.9, 1.1, 0.03),
     (0.5, 2.0, 0.9, 1.1, 0.03),
-    (-1e3, 1e3, -10.0, 10.0, 3.0),
-    (-20.0, 20.0, 0.0, 2.0, 0.3),
-    (-20.0, 20.0, -1.0, 1.0, 0.3),
-    (-20.0, 20.0, -1.0, 1.0, 0.3),
 ];
 
 /// [`PHYSICAL_RANGES`] in the DESI basis, else [`RANGES`].
-fn ranges(basis: &FitBasis) -> &'static [(f64, f64, f64, f64, f64); SLOTS] {
+pub(super) fn ranges(basis: &FitBasis) -> &'static [Range; OWN_SLOT] {
     match basis {
         FitBasis::Desi(_) => &PHYSICAL_RANGES,
         _ => &RANGES,
@@ -138,19 +131,15 @@ impl Default for Search {
     }
 }
 
-/// The bounds (lower, upper) and typical σ of slot `i` with `prior`, on a plan of AP range `ap`:
-/// [`RANGES`], α∥, α⊥ within the AP range, narrowed by the prior's support.
-pub(super) fn bound(
-    i: usize,
-    prior: Option<&PriorShape>,
-    ap: Option<(f64, f64)>,
-    basis: &FitBasis,
-) -> (f64, f64, f64) {
-    let (mut a, mut b, _, _, s) = ranges(basis)[i];
-    if let (true, Some((x, y))) = ((AP_SLOT..B_SLOT).contains(&i), ap) {
+/// The bounds (lower, upper) and typical σ of slot `i` of `objective`: its range
+/// ([`Objective::range`]), α∥, α⊥ within the plan's AP range, narrowed by the slot's prior's support.
+pub(super) fn bound(objective: &Objective, i: usize) -> (f64, f64, f64) {
+    let (mut a, mut b, _, _, s) = objective.range(i);
+    let ap = objective.plan.settings().ap_range;
+    if let (true, Some((x, y))) = ((AP_SLOT..OWN_SLOT).contains(&i), ap) {
         (a, b) = (x, y);
     }
-    if let Some(p) = prior {
+    if let Some(p) = &objective.priors[i] {
         let (x, y) = p.support();
         (a, b) = (a.max(x), b.min(y));
     }
@@ -159,12 +148,11 @@ pub(super) fn bound(
 
 /// The bounds (lower, upper) and typical σ of the free parameters of `objective`.
 fn bounds(objective: &Objective) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    let ap = objective.plan.settings().ap_range;
     let mut lo = Vec::new();
     let mut hi = Vec::new();
     let mut scale = Vec::new();
     for &i in &objective.free {
-        let (a, b, s) = bound(i, objective.priors[i].as_ref(), ap, &objective.basis);
+        let (a, b, s) = bound(objective, i);
         lo.push(a);
         hi.push(b);
         scale.push(s);
@@ -183,18 +171,18 @@ fn draws(rng: &mut rand_chacha::ChaCha8Rng) -> (f64, f64) {
 /// slot and prior of each free parameter.
 fn starts(space: &Space, search: &Search) -> Vec<Vec<f64>> {
     let (params, x0, lo, hi) = (&space.params, &space.x0, &space.lo, &space.hi);
-    let box_of = ranges(&space.basis);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(search.seed);
     let mut all = vec![x0.to_vec()];
     while all.len() < search.starts {
         let x = params
             .iter()
             .enumerate()
-            .map(|(j, &(i, prior))| {
+            .map(|(j, &(_, prior))| {
                 let (z, u) = draws(&mut rng);
+                let (from, to) = space.boxes[j];
                 let v = match prior {
                     Some(p) => p.draw(z.clamp(-2.0, 2.0), u),
-                    None => box_of[i].2 + (box_of[i].3 - box_of[i].2) * u,
+                    None => from + (to - from) * u,
                 };
                 v.clamp(lo[j], hi[j])
             })
@@ -357,8 +345,8 @@ pub(super) struct Space<'p> {
     pub(super) scale: Vec<f64>,
     /// The start.
     pub(super) x0: Vec<f64>,
-    /// The basis of the slots (the DESI one has the start box of [`PHYSICAL_RANGES`]).
-    pub(super) basis: FitBasis,
+    /// Per parameter, its start box (lower, upper: [`Objective::range`]).
+    pub(super) boxes: Vec<(f64, f64)>,
 }
 
 /// The errors of a search's free parameters (or of a selection of them: [`Errors::select`]).
@@ -437,7 +425,11 @@ pub(super) fn solve(objective: &Objective, search: &Search) -> Result<GalaxyFit>
         hi,
         scale,
         x0,
-        basis: objective.basis,
+        boxes: objective
+            .free
+            .iter()
+            .map(|&i| objective.start_box(i))
+            .collect(),
     };
     let exact = |x: &[f64]| objective.cost_and_gradient(x);
     let grad = objective.exact_gradient.then_some(&exact as &ValueGradient);
@@ -478,8 +470,9 @@ pub(super) fn package(
         evaluations: found.evaluations,
         in_basis: (!objective.basis.is_model()).then(|| std::array::from_fn(|i| slots[i])),
         bispectrum: objective
-            .has_bispectrum()
-            .then(|| std::array::from_fn(|i| slots[B_SLOT + i])),
+            .has_block()
+            .then(|| slots[OWN_SLOT..].try_into().ok())
+            .flatten(),
     })
 }
 

@@ -64,7 +64,7 @@ pub fn profile_galaxy(
     name: &str,
     grid: &ProfileGrid,
 ) -> Result<GalaxyProfile> {
-    let slot = slot_index(name, &request.basis)?;
+    let slot = slot_index(name, &request.basis, &[])?;
     if !(3..=401).contains(&grid.points) {
         return Err(Error::InvalidParameter {
             name: "profile grid points",

@@ -1,0 +1,13 @@
+//! The statistics a data vector can hold after the power spectrum: the registration list of the
+//! [`crate::statistic::Block`]s (docs/architecture.md, "Adding a statistic"). The pipeline and the
+//! fits read it to say which block a parameter name belongs to when the data vector has none.
+
+use crate::statistic::Kind;
+
+/// Every kind of block, in the order of their registration.
+pub const AVAILABLE: [&Kind; 1] = [&crate::bispectrum::block::KIND];
+
+/// The kind of block whose own parameter `name` is (`None`: no block's).
+pub fn owner(name: &str) -> Option<&'static Kind> {
+    AVAILABLE.into_iter().find(|k| k.index(name).is_some())
+}
