@@ -59,6 +59,6 @@ fn two_loop_basis_is_built_once_then_used_and_refuses_spectra_outside_its_span()
         err.contains("note: 2-loop terms: direct integration, since"),
         "{err}"
     );
-    assert!(eh.contains("exceeds 3.0e-4"), "{eh}");
+    assert!(eh.contains("exceeds 2.0e-3"), "{eh}");
     fails_naming(&[([&grid[..], &["--two-loop", "fancy"]].concat(), "fancy")]);
 }

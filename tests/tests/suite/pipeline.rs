@@ -133,8 +133,8 @@ fn the_pipeline_equals_the_chain_of_plan_multipoles_and_observation() {
     let pl = pipeline();
     assert_eq!(pl.len(), 3 * 38);
     let (expected, residual) = chain(PIPELINE_MAX_RESIDUAL, &truth());
-    // The emulated spectrum projects on the basis within the pipeline's residual (not within
-    // loops::basis::MAX_RESIDUAL = 3e-4, which sent it to the direct integrals).
+    // The emulated spectrum projects on the basis within the limit (loops::basis::MAX_RESIDUAL, the
+    // pipeline's too; the plans' old 3e-4 sent it to the direct integrals).
     let residual = residual.expect("an emulated spectrum is evaluated on the basis");
     assert!(
         residual > 0.0 && residual <= PIPELINE_MAX_RESIDUAL,
