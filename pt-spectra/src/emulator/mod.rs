@@ -285,9 +285,15 @@ impl LinearEmulator {
     pub fn spectra(&self, cosmology: &Cosmology, z: f64) -> Result<EmulatedSpectra> {
         let nodes = self.nodes(cosmology, &cosmology.background(), z)?;
         let p_cb: Vec<f64> = nodes.ln_p_cb.iter().map(|v| v.exp()).collect();
-        let p_m: Vec<f64> = (nodes.ln_p_cb.iter().zip(&nodes.ln_ratio))
-            .map(|(p, r)| (p + r).exp())
-            .collect();
+        // without massive neutrinos the ratio is zero and P_m is P_cb to the bit (no second
+        // exponential per node)
+        let p_m: Vec<f64> = if nodes.ln_ratio.iter().all(|&r| r == 0.0) {
+            p_cb.clone()
+        } else {
+            (nodes.ln_p_cb.iter().zip(&nodes.ln_ratio))
+                .map(|(p, r)| (p + r).exp())
+                .collect()
+        };
         let sigma8 = sigma8(&nodes.k, nodes.step, |i| p_m[i]);
         Ok(EmulatedSpectra {
             z: nodes.z,
