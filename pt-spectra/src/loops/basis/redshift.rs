@@ -219,6 +219,11 @@ impl RedshiftBasis {
         &self.basis
     }
 
+    /// Whether the tensors sit on every other k of the grid (module `thin`).
+    pub fn is_thinned(&self) -> bool {
+        self.thin.is_some()
+    }
+
     /// The rows (pair columns and lattice-weight terms with errors) and σ_v² of the spectrum with
     /// P_lin = `p_lin` at the grid's k and projection `projection`; the pair columns' quadrature
     /// error only if `quadrature` (the no-wiggle terms take the full ones' errors instead).
