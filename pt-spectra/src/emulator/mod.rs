@@ -294,7 +294,7 @@ impl LinearEmulator {
                 .map(|(p, r)| (p + r).exp())
                 .collect()
         };
-        let sigma8 = sigma8(&nodes.k, nodes.step, |i| p_m[i]);
+        let sigma8 = sigma8(&nodes.sigma8_weights, nodes.step, |i| p_m[i]);
         Ok(EmulatedSpectra {
             z: nodes.z,
             k: nodes.k,
@@ -351,17 +351,26 @@ impl LinearEmulator {
 
 /// σ8 from P on k uniform in ln k with spacing `step`: σ² = (1/2π²) ∫ k³ P W²(8k) d ln k by the
 /// trapezoidal rule (the integrand vanishes at both ends of the emulator's range).
-fn sigma8(k: &[f64], step: f64, p: impl Fn(usize) -> f64) -> f64 {
-    let last = k.len() - 1;
-    let sum: f64 = k
+fn sigma8(weights: &[(f64, f64)], step: f64, p: impl Fn(usize) -> f64) -> f64 {
+    let sum: f64 = weights
         .iter()
+        .enumerate()
+        .map(|(i, (end_k3, w2))| end_k3 * p(i) * w2)
+        .sum();
+    (sum * step / (2.0 * PI * PI)).sqrt()
+}
+
+/// The factors of [`sigma8`]'s trapezoid sum at the nodes `k`: (end weight × k³, W²(8k)), made once
+/// per emulation (the top hat's sine and cosine per node) for both of its σ8 integrals.
+fn sigma8_weights(k: &[f64]) -> Vec<(f64, f64)> {
+    let last = k.len() - 1;
+    k.iter()
         .enumerate()
         .map(|(i, &k)| {
             let end = if i == 0 || i == last { 0.5 } else { 1.0 };
-            end * k.powi(3) * p(i) * top_hat(8.0 * k).powi(2)
+            (end * k.powi(3), top_hat(8.0 * k).powi(2))
         })
-        .sum();
-    (sum * step / (2.0 * PI * PI)).sqrt()
+        .collect()
 }
 
 #[cfg(test)]

@@ -29,6 +29,8 @@ pub(super) struct Nodes<T> {
     pub k: Vec<f64>,
     /// The spacing of the nodes in ln k.
     pub step: f64,
+    /// The factors of the σ8 integral at the nodes (`super::sigma8_weights`).
+    pub sigma8_weights: Vec<(f64, f64)>,
     /// ln P_cb(k_i) with P_cb in (Mpc/h)³.
     pub ln_p_cb: Vec<T>,
     /// ln(P_m/P_cb)(k_i): exactly 0 without massive neutrinos.
@@ -103,6 +105,7 @@ impl LinearEmulator {
             .take(n_x)
             .collect();
         let z = z.clamp(z0, z1);
+        let sigma8_weights = super::sigma8_weights(&k);
         let point_coefficients = self.point_coefficients(&u, &heads);
         // the derivative in s only where f_cb is made (at z); σ8's shape at z = 0 and the massless
         // ratio need the values alone
@@ -154,7 +157,7 @@ impl LinearEmulator {
                 let today = shape_at(z0, false);
                 let today_ratio = ln_ratio(&today, z0);
                 let growth_0 = growth(z0).0;
-                let sigma8_unit = super::sigma8(&k, step, |i| {
+                let sigma8_unit = super::sigma8(&sigma8_weights, step, |i| {
                     (today.cb[i] + growth_0 + today_ratio[i] + tilt[i])
                         .value()
                         .exp()
@@ -173,6 +176,7 @@ impl LinearEmulator {
             ln_r_d,
             k,
             step,
+            sigma8_weights,
             ln_p_cb,
             ln_ratio: ln_ratio(&shape, z),
             f_cb: shape.d_cb_ds.iter().map(|&d| f_md - d * 0.5).collect(),
