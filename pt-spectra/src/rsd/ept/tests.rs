@@ -265,6 +265,28 @@ fn the_ap_derivatives_are_the_differences_of_the_values() {
     }
 }
 
+/// The plan of `k` with IR and the AP range `ap_range` at the fast precision, by the direct integrals
+/// and with basis tensors (built in memory).
+fn direct_and_basis(k: &[f64], ap_range: Option<(f64, f64)>) -> (EptPlan, EptPlan) {
+    let settings = EptSettings {
+        ir: true,
+        ap: None,
+        ap_range,
+        loop_range: None,
+    };
+    let mut precision = Precision::fast();
+    let direct = EptPlan::new(k, settings, &precision).unwrap();
+    precision.two_loop = crate::precision::TwoLoopMethod::Basis;
+    let plan = EptPlan::new(k, settings, &precision)
+        .unwrap()
+        .with_basis(
+            &crate::store::TableStore::in_memory(),
+            &crate::progress::Silent,
+        )
+        .unwrap();
+    (direct, plan)
+}
+
 /// Emulated spectra (Planck-like ΛCDM, a w0–wa one with 0.1 eV of neutrinos, z = 0 and 1) lie in
 /// the basis's span within [`crate::loops::basis::MAX_RESIDUAL`]: the plan evaluates them on the
 /// tensors, and their multipoles agree with the direct integrals of the same spectra within 2e-4 of
@@ -273,7 +295,6 @@ fn the_ap_derivatives_are_the_differences_of_the_values() {
 #[test]
 fn emulated_spectra_use_the_basis_within_their_errors() {
     use crate::cosmology::Cosmology;
-    use crate::precision::TwoLoopMethod;
     let k: Vec<f64> = (0..8).map(|i| 0.01 * 1.5_f64.powi(i)).collect();
     let emulator = crate::emulator::LinearEmulator::embedded().unwrap();
     let cosmologies = [
@@ -285,22 +306,7 @@ fn emulated_spectra_use_the_basis_within_their_errors() {
             .with_neutrinos(0.1)
             .unwrap(),
     ];
-    let settings = EptSettings {
-        ir: true,
-        ap: None,
-        ap_range: None,
-        loop_range: None,
-    };
-    let mut precision = Precision::fast();
-    let direct = EptPlan::new(&k, settings, &precision).unwrap();
-    precision.two_loop = TwoLoopMethod::Basis;
-    let plan = EptPlan::new(&k, settings, &precision)
-        .unwrap()
-        .with_basis(
-            &crate::store::TableStore::in_memory(),
-            &crate::progress::Silent,
-        )
-        .unwrap();
+    let (direct, plan) = direct_and_basis(&k, None);
     let mut params = EptParams::new(1.9, 0.6);
     params.set("b2", 0.4).unwrap();
     params.set("bs", -0.3).unwrap();
@@ -333,26 +339,10 @@ fn emulated_spectra_use_the_basis_within_their_errors() {
 /// inside the range, agree with the direct integrals within 3e-4 of P0 and inside the errors, with IR.
 #[test]
 fn thinned_tensors_give_the_direct_multipoles_with_ap() {
-    use crate::precision::TwoLoopMethod;
     let k: Vec<f64> = (0..8).map(|i| 0.02 * 1.45_f64.powi(i)).collect();
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
     let p = LinearSpectrum::from_file(format!("{dir}linear_pk_camb_heldout_1.dat")).unwrap();
-    let settings = EptSettings {
-        ir: true,
-        ap: None,
-        ap_range: Some((0.9, 1.1)),
-        loop_range: None,
-    };
-    let mut precision = Precision::fast();
-    let direct = EptPlan::new(&k, settings, &precision).unwrap();
-    precision.two_loop = TwoLoopMethod::Basis;
-    let plan = EptPlan::new(&k, settings, &precision)
-        .unwrap()
-        .with_basis(
-            &crate::store::TableStore::in_memory(),
-            &crate::progress::Silent,
-        )
-        .unwrap();
+    let (direct, plan) = direct_and_basis(&k, Some((0.9, 1.1)));
     assert!(plan.tensors.as_ref().unwrap().linear.is_thinned());
     let mut params = EptParams::new(2.1, 0.75);
     params.set("b2", -0.4).unwrap();
