@@ -238,10 +238,11 @@ impl RedshiftBasis {
         let pairs_err = error_functions(n) * (error_functions(n) + 1) / 2;
         let (s2, s2_single) = pair_products_both(c);
         let values = self.pairs.apply(&s2);
-        let mut diffs = vec![0.0; values.len()];
-        if quadrature {
+        let diffs = quadrature.then(|| {
+            let mut diffs = vec![0.0; values.len()];
             crate::simd::matvec_f32(&self.pairs_diff, &s2_single[..pairs_err], &mut diffs);
-        }
+            diffs
+        });
         let mut forms = vec![0.0; self.linear.len() / n];
         crate::simd::matvec(&self.linear, c, &mut forms);
         let norm = self.pairs.norm(c);
@@ -250,18 +251,12 @@ impl RedshiftBasis {
             Some(t) => {
                 let (values, values_err) = t.interpolate(&values, NPAIR, NPAIR);
                 let (forms, forms_err) = t.interpolate(&forms, LINEAR, LW);
-                let diffs = if quadrature {
-                    t.values(&diffs, NPAIR)
-                } else {
-                    vec![0.0; values.len()]
-                };
-                (values, values_err, diffs, forms, forms_err)
+                let diffs = diffs.map(|d| t.values(&d, NPAIR));
+                (values, Some(values_err), diffs, forms, Some(forms_err))
             }
-            None => {
-                let (nv, nf) = (vec![0.0; values.len()], vec![0.0; p_lin.len() * LW]);
-                (values, nv, diffs, forms, nf)
-            }
+            None => (values, None, diffs, forms, None),
         };
+        let at = |v: &Option<Vec<f64>>, i: usize| v.as_ref().map_or(0.0, |v| v[i]);
         let eps = projection.residual;
         let floor = self.p22_error_floor;
         // A spectrum cut below the soft modes (module `soft`): every column and σ_v² are the cut
@@ -274,15 +269,15 @@ impl RedshiftBasis {
                 let form = |m: usize| forms[i * LINEAR + m];
                 let pair = std::array::from_fn(|m| {
                     let row = i * NPAIR + m;
-                    let (a, diff) = (values[row], diffs[row]);
+                    let (a, diff) = (values[row], at(&diffs, row));
                     let quadrature = diff.abs().max(floor * a.abs());
                     let truncation = self.truncation[row] * norm;
                     let error = quadrature + 2.0 * eps * a.abs() + truncation + soft;
-                    Estimate::new(a, error + values_err[row])
+                    Estimate::new(a, error + at(&values_err, row))
                 });
                 let lw = std::array::from_fn(|m| {
                     let (s, sc, abs) = (form(m), form(LW + m), form(2 * LW + m));
-                    let thinning = p.abs() * forms_err[i * LW + m];
+                    let thinning = p.abs() * at(&forms_err, i * LW + m);
                     let error = (p * (s - sc)).abs() + eps * (p * abs).abs() + soft;
                     Estimate::new(p * s, error + thinning)
                 });
