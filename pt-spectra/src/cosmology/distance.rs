@@ -23,6 +23,11 @@ use super::Cosmology;
 use crate::dual::Real;
 use crate::integrate::GaussLegendre;
 
+/// The 16-point Gauss–Legendre rule of each panel of the comoving distance's integral (its nodes
+/// are constants: made once per process, not at every distance of a chain step).
+static PANEL_RULE: std::sync::LazyLock<GaussLegendre> =
+    std::sync::LazyLock::new(|| GaussLegendre::new(16));
+
 /// The CMB temperature today \[K\] (Fixsen 2009).
 pub const T_CMB: f64 = 2.7255;
 /// The effective number of neutrino species, all massless.
@@ -88,7 +93,7 @@ impl<T: Real> Background<T> {
         }
         let o_r = self.omega_radiation();
         let panels = ((z / 0.05).ceil() as usize).max(1);
-        let rule = GaussLegendre::new(16);
+        let rule = &*PANEL_RULE;
         let width = z / panels as f64;
         let mut integral = T::cst(0.0);
         for i in 0..panels {

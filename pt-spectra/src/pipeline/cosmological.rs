@@ -10,18 +10,20 @@
 //! - ∂m/∂P · δP: the loop terms' and multipoles' tangent along δP ([`crate::rsd::ept::tangent`]: the
 //!   basis terms are quadratic in the spectrum, Σ²'s damping written out), then the observation
 //!   matrix M;
-//! - ∂D/∂f, ∂D/∂α: the template derivatives ([`CosmologyStep::template_jacobian`]);
+//! - ∂D/∂f, ∂D/∂α: the template derivatives ([`CosmologyStep::template_jacobian`](super::CosmologyStep::template_jacobian));
 //! - dα/dθ: α∥ = H_fid/H, α⊥ = D_M/D_M,fid over dual numbers ([`crate::rsd::ap::ap_parameters`]).
 //!
 //! A given `f` (a template fit's free growth rate) is a nuisance parameter: f's column then does
 //! not enter the cosmological ones.
 
-use super::{CosmologyStep, Pipeline};
+use super::linearised::{nuisance_jacobian, unit_sets};
+use super::Pipeline;
 use crate::cosmology::background::{CosmoDual, DERIVATIVE_NAMES, N_DERIVATIVES};
 use crate::cosmology::Cosmology;
 use crate::dual::Real;
 use crate::error::{Error, Result};
 use crate::rsd::ap::{ap_parameters, Distortion};
+use crate::rsd::ept::tangent::TermsTangent;
 
 /// The data vector of one cosmology with its exact derivatives.
 #[derive(Debug, Clone)]
@@ -49,7 +51,7 @@ impl Pipeline {
     /// The data vector of `cosmology` (through the emulator) at the nuisance parameters `params`
     /// (by name, as [`Self::evaluate`]; `f` defaults to f(z) of the cosmology) and its exact
     /// derivatives with respect to [`DERIVATIVE_NAMES`] (module docs). The nuisance parameters'
-    /// derivatives are [`CosmologyStep::jacobian`]'s.
+    /// derivatives are [`CosmologyStep::jacobian`](super::CosmologyStep::jacobian)'s.
     ///
     /// # Errors
     /// As [`Self::evaluate`]; [`Error::InvalidChoice`] for a cosmology normalised by σ8, a pipeline
@@ -63,12 +65,12 @@ impl Pipeline {
         Ok(self.jacobians(cosmology, params, false)?.0)
     }
 
-    /// [`Self::cosmology_jacobian`] and the nuisance parameters' rows ([`CosmologyStep::jacobian`]:
+    /// [`Self::cosmology_jacobian`] and the nuisance parameters' rows ([`CosmologyStep::jacobian`](super::CosmologyStep::jacobian):
     /// one per name of [`super::JACOBIAN_NAMES`], f's last) of the same step, made once: the whole
     /// Jacobian of a sampler over cosmological and nuisance parameters.
     ///
     /// # Errors
-    /// As [`Self::cosmology_jacobian`] and [`CosmologyStep::jacobian`].
+    /// As [`Self::cosmology_jacobian`] and [`CosmologyStep::jacobian`](super::CosmologyStep::jacobian).
     pub fn full_jacobian(
         &self,
         cosmology: &Cosmology,
@@ -112,23 +114,36 @@ impl Pipeline {
         };
         let spectrum = tangent.spectrum();
         let step = self.step_with(spectrum, f.value(), distortion)?;
+        let p = step.params(params)?;
+        // the nuisance polynomial's sets, f's row and the spectrum's columns in one projection
+        // onto the multipoles (its weights cost more than applying them); the data vector by the
+        // path of `evaluate`, so that the two are the same numbers
+        let tangents = self.terms_tangents(&tangent)?;
+        let sets = if nuisance {
+            unit_sets(p.f())
+        } else {
+            Vec::new()
+        };
+        let projected = self.plan.multipoles_with_tangents(
+            &step.terms,
+            &sets,
+            std::slice::from_ref(&p),
+            (&tangents, &p),
+            self.observation.model_ells(),
+            step.ap,
+        )?;
+        let observe =
+            |m: &[Vec<Vec<f64>>]| -> Vec<Vec<f64>> { m.iter().map(|m| self.observe(m)).collect() };
+        let mut d_f = observe(&projected.df);
+        let mut cosmological = observe(&projected.tangents);
         let data_vector = step.data_vector(params)?;
         let nuisance = if nuisance {
-            Some(step.jacobian(params)?.1)
+            let vectors = observe(&projected.values);
+            Some(nuisance_jacobian(vectors, d_f.clone(), p.f(), params)?.1)
         } else {
             None
         };
-        let mut cosmological = self.spectrum_columns(&step, &tangent, params)?;
-        // f and the AP parameters by the chain rule: f's row is the nuisance rows' last when they
-        // are made (the same projection), else made here; α's rows with a fiducial
-        let d_f = match &nuisance {
-            Some(rows) => rows[rows.len() - 1].clone(),
-            None => {
-                let p = step.params(params)?;
-                let (_, mut df) = step.data_vectors_and_df_of(&[], std::slice::from_ref(&p))?;
-                df.remove(0)
-            }
-        };
+        let d_f = d_f.remove(0);
         let [d_apar, d_aperp] = if self.settings.fiducial.is_some() {
             step.ap_jacobian(params)?
         } else {
@@ -151,13 +166,11 @@ impl Pipeline {
         Ok((jacobian, nuisance))
     }
 
-    /// M ∂m/∂P · dP/dθ_j for every j: the multipoles' tangents along the spectrum's derivatives.
-    fn spectrum_columns(
+    /// The loop terms' tangents along the spectrum's derivatives dP/dθ_j, every j.
+    fn terms_tangents(
         &self,
-        step: &CosmologyStep<'_>,
         tangent: &crate::emulator::TracerTangent,
-        params: &[(&str, f64)],
-    ) -> Result<Vec<Vec<f64>>> {
+    ) -> Result<Vec<TermsTangent>> {
         let Some((lattice, grid)) = self.plan.tangent_nodes() else {
             return Err(Error::InvalidChoice {
                 what: "the cosmological derivatives of a pipeline without basis tensors".into(),
@@ -171,15 +184,6 @@ impl Pipeline {
         let directions: Vec<(Vec<f64>, Vec<f64>)> = (0..N_DERIVATIVES)
             .map(|j| (column(&on_lattice, j), column(&on_grid, j)))
             .collect();
-        let tangents = self.plan.terms_tangents(tangent.spectrum(), &directions)?;
-        let p = step.params(params)?;
-        let multipoles = self.plan.multipole_tangents(
-            &step.terms,
-            &tangents,
-            &p,
-            self.observation.model_ells(),
-            step.ap,
-        )?;
-        Ok(multipoles.iter().map(|m| self.observe(m)).collect())
+        self.plan.terms_tangents(tangent.spectrum(), &directions)
     }
 }

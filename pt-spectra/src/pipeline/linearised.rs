@@ -84,16 +84,7 @@ impl CosmologyStep<'_> {
         let p = self.params(params)?;
         let (vectors, df) =
             self.data_vectors_and_df_of(&unit_sets(p.f()), std::slice::from_ref(&p))?;
-        let (quadratic, linear) = polynomial(vectors);
-        let lin = Linearised {
-            quadratic,
-            linear,
-            df: None,
-            f: p.f(),
-        };
-        let mut rows = lin.jacobian(params)?;
-        rows.extend(df);
-        Ok((lin.data_vector(params)?, rows))
+        nuisance_jacobian(vectors, df, p.f(), params)
     }
 
     /// The exact derivatives of the data vector at `params` by name with respect to the template
@@ -171,12 +162,32 @@ impl CosmologyStep<'_> {
     }
 }
 
+/// [`CosmologyStep::jacobian`] from the data vectors of the [`unit_sets`] at f (their order) and f's
+/// rows `df`: the data vector at `params` and the rows of [`JACOBIAN_NAMES`].
+pub(super) fn nuisance_jacobian(
+    vectors: Vec<Vec<f64>>,
+    df: Vec<Vec<f64>>,
+    f: f64,
+    params: &[(&str, f64)],
+) -> Result<(Vec<f64>, Vec<Vec<f64>>)> {
+    let (quadratic, linear) = polynomial(vectors);
+    let lin = Linearised {
+        quadratic,
+        linear,
+        df: None,
+        f,
+    };
+    let mut rows = lin.jacobian(params)?;
+    rows.extend(df);
+    Ok((lin.data_vector(params)?, rows))
+}
+
 /// The vectors of a polynomial: A_ij (i ≤ j, [`pair`] order) and C_c.
 type Polynomial = (Vec<Vec<f64>>, Vec<Vec<f64>>);
 
 /// The 22 parameter sets of the polynomial at growth rate f: none, ±1 of each bias, each pair of
 /// biases at 1, each linear parameter at 1.
-fn unit_sets(f: f64) -> Vec<EptParams> {
+pub(super) fn unit_sets(f: f64) -> Vec<EptParams> {
     let mut sets: Vec<Vec<(usize, f64)>> = vec![Vec::new()];
     for i in 0..BIASES {
         sets.push(vec![(i, 1.0)]);

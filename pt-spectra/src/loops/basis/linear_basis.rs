@@ -267,6 +267,23 @@ impl LinearBasis {
         }
     }
 
+    /// The coefficients alone of [`Self::project`] of each of `samples` (e.g. directions of a
+    /// spectrum's tangent, for which a residual relative to the samples means nothing), the basis
+    /// functions read once for all.
+    pub fn coefficients_many(&self, samples: &[&[f64]]) -> Vec<Vec<f64>> {
+        let weighted: Vec<Vec<f64>> = samples
+            .iter()
+            .map(|s| s.iter().zip(&self.weights).map(|(p, w)| w * p).collect())
+            .collect();
+        let mut c = vec![Vec::with_capacity(self.columns.len() / self.lattice.len); samples.len()];
+        for phi in self.columns.chunks_exact(self.lattice.len) {
+            for (c, wp) in c.iter_mut().zip(&weighted) {
+                c.push(crate::simd::dot(phi, wp));
+            }
+        }
+        c
+    }
+
     /// The projection of `spectrum`; if its residual exceeds `max_residual` (or is NaN), that of the
     /// spectrum cut below [`super::soft::SOFT_CUT`] with what the cut changed
     /// ([`super::soft`]), if that one is within `max_residual` (else the first).

@@ -2,6 +2,7 @@
 //! nuisance polynomial's), their exact f-derivatives, and the exact derivatives with respect to α∥,
 //! α⊥ ([`EptPlan::multipole_ap_derivatives`]).
 
+use super::tangent::TermsTangent;
 use super::{model, EptParams, EptPlan, EptTerms, GridUse};
 use crate::error::{Error, Result};
 use crate::rsd::ap::Distortion;
@@ -42,7 +43,28 @@ impl EptPlan {
         ells: &[usize],
         ap: Option<Distortion>,
     ) -> Result<(Vec<Vec<Vec<f64>>>, Vec<Vec<Vec<f64>>>)> {
-        let all: Vec<EptParams> = params.iter().chain(df).copied().collect();
+        self.project_sets(terms, params, df, None, ells, ap)
+    }
+
+    /// The projection of [`Self::multipole_values_and_df_many`] and, with `tangents`, of
+    /// [`Self::multipoles_with_tangents`] (the tangents' multipoles after the f-derivatives):
+    /// every set of one f, the weights made once.
+    #[allow(clippy::type_complexity)]
+    pub(super) fn project_sets(
+        &self,
+        terms: &EptTerms,
+        params: &[EptParams],
+        df: &[EptParams],
+        tangents: Option<(&[TermsTangent], &EptParams)>,
+        ells: &[usize],
+        ap: Option<Distortion>,
+    ) -> Result<(Vec<Vec<Vec<f64>>>, Vec<Vec<Vec<f64>>>)> {
+        let all: Vec<EptParams> = params
+            .iter()
+            .chain(df)
+            .chain(tangents.map(|(_, p)| p))
+            .copied()
+            .collect();
         if let Some(p) = all.iter().find(|p| p.f() != all[0].f()) {
             return Err(Error::InvalidChoice {
                 what: format!("parameter sets with f = {} and {}", all[0].f(), p.f()),
@@ -52,13 +74,20 @@ impl EptPlan {
         let (weights, nodes) = self.projection_nodes(terms, &all, ells, ap)?;
         let models: Vec<_> = params.iter().map(|p| terms.model_values(p)).collect();
         let df_models: Vec<_> = df.iter().map(|p| terms.model_values(p)).collect();
-        let df: Vec<_> = df
+        let base = tangents.map(|(_, p)| terms.model_values(p));
+        let mut parts: Vec<_> = df
             .iter()
             .zip(&df_models)
             .map(|(p, m)| (m, terms.parts_df(p), model::DampingTangent::F))
             .collect();
+        if let (Some((tangents, params)), Some(base)) = (tangents, &base) {
+            for t in tangents {
+                let (d, damping) = t.model_parts(terms, params)?;
+                parts.push((base, d, damping));
+            }
+        }
         let on_grid = ap.is_none() && self.grid_use == GridUse::Output;
-        model::project_many(&models, &df, &self.k_out, &nodes, &weights, on_grid)
+        model::project_many(&models, &parts, &self.k_out, &nodes, &weights, on_grid)
     }
 
     /// The exact derivatives of [`Self::multipole_values_at`] with respect to α∥ and α⊥ at the

@@ -16,8 +16,8 @@
 //! The direct integrals (the fallback when a spectrum does not project on the basis) are not
 //! written this way: a tangent there is refused with an error naming the residual.
 
-use super::model::{self, DampingTangent, PartsDf};
-use super::{EptParams, EptPlan, EptTerms, GridUse};
+use super::model::{DampingTangent, PartsDf};
+use super::{EptParams, EptPlan, EptTerms};
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
@@ -37,6 +37,30 @@ impl TermsTangent {
     /// dΣ² along the direction [(Mpc/h)²] (0 without IR resummation).
     pub fn d_sigma2(&self) -> f64 {
         self.d_sigma2
+    }
+
+    /// The model's tangent at `params` as the projection takes it: the μ² polynomials of the
+    /// tangent terms (the model is affine in the terms: without its constant, the stochastic terms,
+    /// the model of the tangent terms is the tangent of the model) with Σ²'s change in the
+    /// resummation polynomial, and the damping's change through dΣ².
+    pub(super) fn model_parts(
+        &self,
+        terms: &EptTerms,
+        params: &EptParams,
+    ) -> Result<(PartsDf, DampingTangent)> {
+        let mut linear = *params;
+        for name in ["sn", "sn2", "sn4"] {
+            linear.set(name, 0.0)?;
+        }
+        let mut d: PartsDf = self
+            .tangent
+            .model_values(&linear)
+            .parts()
+            .iter()
+            .map(|(n, w)| (n.0, w.0))
+            .collect();
+        terms.add_parts_dsigma2(params, self.d_sigma2, &mut d);
+        Ok((d, DampingTangent::Sigma2(self.d_sigma2)))
     }
 }
 
@@ -97,10 +121,8 @@ impl EptPlan {
         }
         let p_lin: Vec<f64> = self.grid.iter().map(|&k| spectrum.eval(k)).collect();
         let c = &projection.coefficients;
-        let dcs: Vec<Vec<f64>> = directions
-            .iter()
-            .map(|(l, _)| basis.project(l).coefficients)
-            .collect();
+        let on_lattice: Vec<&[f64]> = directions.iter().map(|(l, _)| l.as_slice()).collect();
+        let dcs = basis.coefficients_many(&on_lattice);
         let dc_refs: Vec<&[f64]> = dcs.iter().map(Vec::as_slice).collect();
         let span = self.loop_span.clone();
         let d_grid: Vec<&[f64]> = directions.iter().map(|(_, g)| &g[span.clone()]).collect();
@@ -170,32 +192,48 @@ impl EptPlan {
         ells: &[usize],
         ap: Option<Distortion>,
     ) -> Result<Vec<Vec<Vec<f64>>>> {
-        let (weights, nodes) =
-            self.projection_nodes(terms, std::slice::from_ref(params), ells, ap)?;
-        let base = terms.model_values(params);
-        // the model is affine in the terms: without its constant (the stochastic terms), the
-        // model of the tangent terms is the tangent of the model
-        let mut linear = *params;
-        for name in ["sn", "sn2", "sn4"] {
-            linear.set(name, 0.0)?;
-        }
-        let parts: Vec<(&model::Model<'_>, PartsDf, DampingTangent)> = tangents
-            .iter()
-            .map(|t| {
-                let mut d: PartsDf = t
-                    .tangent
-                    .model_values(&linear)
-                    .parts()
-                    .iter()
-                    .map(|(n, w)| (n.0, w.0))
-                    .collect();
-                terms.add_parts_dsigma2(params, t.d_sigma2, &mut d);
-                (&base, d, DampingTangent::Sigma2(t.d_sigma2))
-            })
-            .collect();
-        let on_grid = ap.is_none() && self.grid_use == GridUse::Output;
-        Ok(model::project_many(&[], &parts, &self.k_out, &nodes, &weights, on_grid)?.1)
+        Ok(self
+            .multipoles_with_tangents(terms, &[], &[], (tangents, params), ells, ap)?
+            .tangents)
     }
+
+    /// In one projection (its stencils, damping and weights made once per output k,
+    /// [`Self::multipole_values_and_df_many`]): the multipoles of the parameter sets `values`, the
+    /// exact f-derivatives of those of the sets `df` and the tangents of those of `params` along
+    /// `tangents` ([`Self::multipole_tangents`]); every set of one f. The chain step's Jacobian
+    /// needs all three of one spectrum, and the weights cost more than applying them.
+    ///
+    /// # Errors
+    /// As [`Self::multipole_values_and_df_many`].
+    pub fn multipoles_with_tangents(
+        &self,
+        terms: &EptTerms,
+        values: &[EptParams],
+        df: &[EptParams],
+        (tangents, params): (&[TermsTangent], &EptParams),
+        ells: &[usize],
+        ap: Option<Distortion>,
+    ) -> Result<ProjectedTangents> {
+        let (values, mut derivatives) =
+            self.project_sets(terms, values, df, Some((tangents, params)), ells, ap)?;
+        let tangents = derivatives.split_off(df.len());
+        Ok(ProjectedTangents {
+            values,
+            df: derivatives,
+            tangents,
+        })
+    }
+}
+
+/// The multipoles of [`EptPlan::multipoles_with_tangents`], each `[j][i]` (j-th ℓ, i-th output k).
+#[derive(Debug, Clone)]
+pub struct ProjectedTangents {
+    /// Of each set of `values`.
+    pub values: Vec<Vec<Vec<f64>>>,
+    /// The f-derivatives of each set of `df`.
+    pub df: Vec<Vec<Vec<f64>>>,
+    /// The tangents along each direction.
+    pub tangents: Vec<Vec<Vec<f64>>>,
 }
 
 #[cfg(test)]
