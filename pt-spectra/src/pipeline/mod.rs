@@ -147,8 +147,9 @@ impl TermsSource {
     pub fn describe(&self, max_residual: f64) -> String {
         match self {
             Self::Basis { residual } => format!(
-                "loop terms: basis (projection residual {residual:.1e} <= {max_residual:.1e}; its \
-                 error is in the terms' errors)"
+                "loop terms: basis (projection residual {residual:.1e} <= {max_residual:.1e}, \
+                 which bounds their relative error by about twice itself; values only: the chain \
+                 step estimates no error per step, EptPlan::terms does)"
             ),
             Self::DirectFallback { residual } => format!(
                 "loop terms: direct integrals (fallback: the spectrum projects on the basis with \
@@ -377,7 +378,8 @@ impl Pipeline {
         growth_rate: f64,
         ap: Option<Distortion>,
     ) -> Result<CosmologyStep<'_>> {
-        let terms = self.plan.terms(spectrum)?;
+        // values only: a step reads no error (the header states the basis's bound)
+        let terms = self.plan.term_values(spectrum)?;
         let source = match (terms.basis_residual(), self.plan.has_basis()) {
             (Some(residual), _) => TermsSource::Basis { residual },
             (None, true) => TermsSource::DirectFallback {
@@ -538,7 +540,9 @@ impl CosmologyStep<'_> {
         Ok(pl.observe(&model))
     }
 
-    /// The loop terms.
+    /// The loop terms: their values (on the basis, their errors are NaN, not estimated: a chain step
+    /// reads values only; [`EptPlan::terms`] of the same spectrum has them, and
+    /// [`TermsSource::describe`] states the basis's bound).
     pub fn terms(&self) -> &EptTerms {
         &self.terms
     }

@@ -359,7 +359,23 @@ impl EptPlan {
     /// # Errors
     /// As [`savitzky_golay_no_wiggle`].
     pub fn terms(&self, spectrum: &LinearSpectrum) -> Result<EptTerms> {
-        let fallback_residual = match self.terms_on_basis(spectrum)? {
+        self.terms_with(spectrum, true)
+    }
+
+    /// [`Self::terms`] without error estimates on the basis path (every error NaN: not estimated),
+    /// for a caller that reads the values only, as the chain step ([`crate::pipeline`]) does: the
+    /// tensors of the quadrature differences, the error forms and the thinning's error
+    /// interpolation are not applied (the same values to the bit). A spectrum outside the basis's
+    /// span takes the direct integrals, with their errors, as [`Self::terms`].
+    ///
+    /// # Errors
+    /// As [`Self::terms`].
+    pub fn term_values(&self, spectrum: &LinearSpectrum) -> Result<EptTerms> {
+        self.terms_with(spectrum, false)
+    }
+
+    fn terms_with(&self, spectrum: &LinearSpectrum, errors: bool) -> Result<EptTerms> {
+        let fallback_residual = match self.terms_on_basis(spectrum, errors)? {
             Ok(terms) => return Ok(terms),
             Err(refused) => refused,
         };

@@ -23,7 +23,9 @@
 //! (not a linear filter), on the split training set's basis ([`RedshiftFamily::SplitNoWiggle`]),
 //! with the projections their 2-loop tensors already made.
 
-use super::forms::{concat, linear_form, pair_forms, pair_products_both, per_k, RuleRows};
+use super::forms::{
+    concat, linear_form, pair_forms, pair_products, pair_products_both, per_k, RuleRows,
+};
 use super::low_rank::{LowRank, PAIR_TOLERANCE};
 use super::thin::Thinning;
 use super::{error_functions, LinearBasis, Projection, BASIS_SIZE};
@@ -289,15 +291,46 @@ impl RedshiftBasis {
         (rows, Estimate::new(sv, sv_diff.abs() + eps * sv.abs()))
     }
 
+    /// [`Self::rows`]' values alone, every error NaN (not estimated): the chain step's path, which
+    /// reads no error. It skips the pair tensors' quadrature differences, the forms of the errors,
+    /// the thinning's error interpolation and the truncation bounds (a third of the terms' cost).
+    fn row_values(&self, p_lin: &[f64], c: &[f64]) -> (Vec<Row>, Estimate) {
+        let values = self.at_grid(self.pairs.apply(&pair_products(c)), NPAIR);
+        let forms = self.value_forms(c);
+        let unknown = |v: f64| Estimate::new(v, f64::NAN);
+        let rows = p_lin
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| {
+                let pair = std::array::from_fn(|m| unknown(values[i * NPAIR + m]));
+                let lw = std::array::from_fn(|m| unknown(p * forms[i * LINEAR + m]));
+                (pair, lw)
+            })
+            .collect();
+        let sv = crate::simd::dot(&self.sigma_v2[..c.len()], c);
+        (rows, unknown(sv))
+    }
+
+    /// The forms of the values of `c` (the first LW of each k's LINEAR; the others, of the errors,
+    /// left 0) at every k of the grid.
+    fn value_forms(&self, c: &[f64]) -> Vec<f64> {
+        let n = c.len();
+        let mut forms = vec![0.0; self.linear.len() / n];
+        for (d, l) in forms
+            .chunks_exact_mut(LINEAR)
+            .zip(self.linear.chunks_exact(LINEAR * n))
+        {
+            crate::simd::matvec(&l[..LW * n], c, &mut d[..LW]);
+        }
+        self.at_grid(forms, LINEAR)
+    }
+
     /// The P13-type forms of `c` at every k and σ_v² of `c`: what [`Self::rows_tangent`] needs of
     /// the spectrum itself (the same for every direction).
     fn tangent_base(&self, c: &[f64]) -> (Vec<f64>, f64) {
-        let n = c.len();
-        let mut forms = vec![0.0; self.linear.len() / n];
-        crate::simd::matvec(&self.linear, c, &mut forms);
         (
-            self.at_grid(forms, LINEAR),
-            crate::simd::dot(&self.sigma_v2[..n], c),
+            self.value_forms(c),
+            crate::simd::dot(&self.sigma_v2[..c.len()], c),
         )
     }
 
@@ -323,15 +356,7 @@ impl RedshiftBasis {
         dc: &[f64],
     ) -> (Vec<Row>, Estimate, Vec<Estimate>) {
         let n = dc.len();
-        // only the forms of the values (the first LW of each k; the others are the errors')
-        let mut dforms = vec![0.0; self.linear.len() / n];
-        for (d, l) in dforms
-            .chunks_exact_mut(LINEAR)
-            .zip(self.linear.chunks_exact(LINEAR * n))
-        {
-            crate::simd::matvec(&l[..LW * n], dc, &mut d[..LW]);
-        }
-        let dforms = self.at_grid(dforms, LINEAR);
+        let dforms = self.value_forms(dc);
         let exact = |v: f64| Estimate::new(v, 0.0);
         let rows = p_lin
             .iter()
@@ -408,6 +433,22 @@ impl RedshiftBasis {
     ) -> RedshiftTerms {
         let (rows, sigma_v2) = self.rows(p_lin, projection, true);
         plan.assemble_rows(p_lin.to_vec(), &rows, sigma_v2)
+    }
+
+    /// [`Self::evaluate_with_no_wiggle`]'s values alone, every error NaN ([`Self::row_values`]):
+    /// the chain step's terms; `no_wiggle` `None` for [`Self::evaluate`]'s.
+    pub fn evaluate_values(
+        &self,
+        plan: &RedshiftPlan,
+        (p_lin, c): (&[f64], &[f64]),
+        no_wiggle: Option<(&RedshiftBasis, &[f64])>,
+    ) -> (RedshiftTerms, Option<RedshiftTerms>) {
+        let (rows, sigma_v2) = self.row_values(p_lin, c);
+        let nw = no_wiggle.map(|(t, p_nw)| {
+            let (rows, sigma_v2) = t.row_values(p_nw, c);
+            plan.assemble_rows(p_nw.to_vec(), &rows, sigma_v2)
+        });
+        (plan.assemble_rows(p_lin.to_vec(), &rows, sigma_v2), nw)
     }
 
     /// The terms of a spectrum and of its no-wiggle part (as

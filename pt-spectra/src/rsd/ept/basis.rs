@@ -215,6 +215,7 @@ impl EptPlan {
     pub(super) fn terms_on_basis(
         &self,
         spectrum: &LinearSpectrum,
+        errors: bool,
     ) -> Result<std::result::Result<EptTerms, Option<f64>>> {
         let Some(tensors) = &self.tensors else {
             return Ok(Err(None));
@@ -232,6 +233,7 @@ impl EptPlan {
             &samples,
             p_lin,
             &projection,
+            errors,
         )))
     }
 
@@ -245,24 +247,46 @@ impl EptPlan {
         samples: &[f64],
         p_lin: Vec<f64>,
         projection: &Projection,
+        errors: bool,
     ) -> EptTerms {
         let span = self.loop_span.clone();
+        let c = &projection.coefficients;
         let (full, nw) = match (&self.split, &tensors.no_wiggle) {
             (Some(()), Some((nw_tensors, forms))) => {
-                let c = &projection.coefficients;
                 let (p_nw, sigma2) = forms.evaluate(samples, c, projection.residual);
-                let (full, t) = tensors.linear.evaluate_with_no_wiggle(
-                    &self.loops,
-                    (&p_lin[span.clone()], projection),
-                    nw_tensors,
-                    (&p_nw[span], projection),
-                );
+                let (full, t) = if errors {
+                    tensors.linear.evaluate_with_no_wiggle(
+                        &self.loops,
+                        (&p_lin[span.clone()], projection),
+                        nw_tensors,
+                        (&p_nw[span], projection),
+                    )
+                } else {
+                    let (full, t) = tensors.linear.evaluate_values(
+                        &self.loops,
+                        (&p_lin[span.clone()], c),
+                        Some((nw_tensors, &p_nw[span])),
+                    );
+                    (full, t.expect("asked for"))
+                };
+                let sigma2 = if errors {
+                    sigma2
+                } else {
+                    Estimate::new(sigma2.value, f64::NAN)
+                };
                 (full, Some((self.padded(t, &p_nw), sigma2)))
             }
-            _ => (
+            _ if errors => (
                 tensors
                     .linear
                     .evaluate(&self.loops, &p_lin[span], projection),
+                None,
+            ),
+            _ => (
+                tensors
+                    .linear
+                    .evaluate_values(&self.loops, (&p_lin[span], c), None)
+                    .0,
                 None,
             ),
         };

@@ -287,6 +287,26 @@ fn direct_and_basis(k: &[f64], ap_range: Option<(f64, f64)>) -> (EptPlan, EptPla
     (direct, plan)
 }
 
+/// The chain step's terms without errors ([`EptPlan::term_values`]) give the multipoles of the
+/// terms with errors to the bit, and every error they carry is NaN (not estimated).
+fn same_values_without_errors(
+    plan: &EptPlan,
+    p: &LinearSpectrum,
+    params: &EptParams,
+    ap: Option<crate::rsd::ap::Distortion>,
+) {
+    let (with, without) = (plan.terms(p).unwrap(), plan.term_values(p).unwrap());
+    assert!(without.basis_residual().is_some());
+    let ells = [0, 2, 4];
+    assert_eq!(
+        plan.multipole_values_at(&with, params, &ells, ap).unwrap(),
+        plan.multipole_values_at(&without, params, &ells, ap)
+            .unwrap()
+    );
+    let estimates = plan.multipoles_at(&without, params, &ells, ap).unwrap();
+    assert!(estimates.iter().flatten().all(|e| e.error.is_nan()));
+}
+
 /// Emulated spectra (Planck-like ΛCDM, a w0–wa one with 0.1 eV of neutrinos, z = 0 and 1) lie in
 /// the basis's span within [`crate::loops::basis::MAX_RESIDUAL`]: the plan evaluates them on the
 /// tensors, and their multipoles agree with the direct integrals of the same spectra within 2e-4 of
@@ -354,6 +374,7 @@ fn thinned_tensors_give_the_direct_multipoles_with_ap() {
     let d = direct
         .multipoles_at(&direct.terms(&p).unwrap(), &params, &[0, 2, 4], ap)
         .unwrap();
+    same_values_without_errors(&plan, &p, &params, ap);
     let p0: Vec<f64> = d[0].iter().map(|e| e.value).collect();
     for (ell, (a, d)) in a.iter().zip(&d).enumerate() {
         for (i, (a, d)) in a.iter().zip(d).enumerate() {
@@ -416,6 +437,7 @@ fn the_basis_gives_the_direct_multipoles_and_falls_back_outside_its_span() {
             let p = LinearSpectrum::from_file(format!("{dir}{name}")).unwrap();
             let terms = plan.terms(&p).unwrap();
             assert!(terms.describe_source().is_some(), "{name}");
+            same_values_without_errors(&plan, &p, &params, None);
             let a = plan.multipoles(&terms, &params, &[0, 2, 4]).unwrap();
             let d = direct
                 .multipoles(&direct.terms(&p).unwrap(), &params, &[0, 2, 4])
