@@ -44,9 +44,123 @@ fn dot32_four_v3(simd: pulp::x86::V3, a: &[f32], b: [&[f64]; 4]) -> [f64; 4] {
     })
 }
 
+/// `out[i]` = [`super::dot32`] of row i of the f32 matrix `a` (rows of `x.len()`) with `x`, to the
+/// bit, with one dispatch for all rows: the low-rank tensors' U applied to one reduced vector, whose
+/// rows are short (the rank), so that a dispatch and a call per row cost as much as the row.
+pub(crate) fn matvec32(a: &[f32], x: &[f64], out: &mut [f64]) {
+    let n = x.len();
+    assert!(a.len() >= n * out.len(), "a matrix of {} rows", out.len());
+    if n == 0 {
+        out.iter_mut().for_each(|o| *o = 0.0);
+        return;
+    }
+    #[cfg(target_arch = "x86_64")]
+    if let Some(simd) = pulp::x86::V3::try_new() {
+        return simd.vectorize(MatVec32 { simd, a, x, out });
+    }
+    for (o, row) in out.iter_mut().zip(a.chunks_exact(n)) {
+        *o = super::dot32(row, x);
+    }
+}
+
+/// [`matvec32`] with AVX2 and FMA: a type rather than a closure, so that the loop over rows is
+/// compiled inside the dispatch (as `super::MatVecV3`).
+#[cfg(target_arch = "x86_64")]
+struct MatVec32<'a> {
+    simd: pulp::x86::V3,
+    a: &'a [f32],
+    x: &'a [f64],
+    out: &'a mut [f64],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl pulp::NullaryFnOnce for MatVec32<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn call(self) {
+        for (o, row) in self.out.iter_mut().zip(self.a.chunks_exact(self.x.len())) {
+            *o = super::dot32_v3(self.simd, row, self.x);
+        }
+    }
+}
+
+/// `out[q][i]` = [`dot32_four`] of row i of `a` (rows of the vectors' length) with the four `b`, to
+/// the bit, with one dispatch for all rows.
+pub(crate) fn matvec32_four(a: &[f32], b: [&[f64]; 4], out: &mut [Vec<f64>; 4]) {
+    let n = b[0].len();
+    assert!(
+        b.iter().all(|b| b.len() == n) && out.iter().all(|o| a.len() >= n * o.len()),
+        "vectors of one length and a matrix of their rows"
+    );
+    if n == 0 {
+        out.iter_mut().flatten().for_each(|o| *o = 0.0);
+        return;
+    }
+    #[cfg(target_arch = "x86_64")]
+    if let Some(simd) = pulp::x86::V3::try_new() {
+        return simd.vectorize(MatVec32Four { simd, a, b, out });
+    }
+    for (i, row) in a.chunks_exact(n).take(out[0].len()).enumerate() {
+        let d = dot32_four(row, b);
+        for q in 0..4 {
+            out[q][i] = d[q];
+        }
+    }
+}
+
+/// [`matvec32_four`] with AVX2 and FMA (as [`MatVec32`]).
+#[cfg(target_arch = "x86_64")]
+struct MatVec32Four<'a> {
+    simd: pulp::x86::V3,
+    a: &'a [f32],
+    b: [&'a [f64]; 4],
+    out: &'a mut [Vec<f64>; 4],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl pulp::NullaryFnOnce for MatVec32Four<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn call(self) {
+        let n = self.b[0].len();
+        for (i, row) in self.a.chunks_exact(n).take(self.out[0].len()).enumerate() {
+            let d = dot32_four_v3(self.simd, row, self.b);
+            for q in 0..4 {
+                self.out[q][i] = d[q];
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The matrix–vector products are the row-by-row dot products to the bit.
+    #[test]
+    fn matrix_products_are_the_dot_products() {
+        for n in [0, 3, 37, 160] {
+            let rows = 5;
+            let a: Vec<f32> = (0..n * rows).map(|i| (i as f32 * 0.37).sin()).collect();
+            let b: Vec<Vec<f64>> = (0..4)
+                .map(|q| (0..n).map(|i| ((i + 7 * q) as f64 * 0.11).cos()).collect())
+                .collect();
+            let mut one = vec![1.0; rows];
+            matvec32(&a, &b[0], &mut one);
+            let mut four = std::array::from_fn(|_| vec![1.0; rows]);
+            matvec32_four(&a, [&b[0], &b[1], &b[2], &b[3]], &mut four);
+            for i in 0..rows {
+                let row = &a[i * n..(i + 1) * n];
+                assert_eq!(one[i].to_bits(), super::super::dot32(row, &b[0]).to_bits());
+                let d = dot32_four(row, [&b[0], &b[1], &b[2], &b[3]]);
+                for q in 0..4 {
+                    assert_eq!(four[q][i].to_bits(), d[q].to_bits(), "{n} {i} {q}");
+                }
+            }
+        }
+    }
 
     /// Against the plain sums, at lengths with and without a tail.
     #[test]

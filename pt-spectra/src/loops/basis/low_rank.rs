@@ -19,7 +19,7 @@
 //! (median 6e-7), against a projection error of ~1e-4.
 
 use crate::linalg::dot;
-use crate::simd::{dot32, dot32_four, matvec_f32};
+use crate::simd::{dot32, matvec_f32};
 use rand::Rng;
 use rand::SeedableRng;
 use rayon::prelude::*;
@@ -158,10 +158,8 @@ impl LowRank {
     pub(crate) fn apply_many(&self, s: &[Vec<f64>]) -> Vec<Vec<f64>> {
         let z: Vec<Vec<f64>> = s.iter().map(|s| self.reduce(s)).collect();
         let mut out = vec![vec![0.0; self.rows]; s.len()];
-        for (i, ui) in self.u.chunks_exact(self.rank).enumerate() {
-            for (o, z) in out.iter_mut().zip(&z) {
-                o[i] = dot32(ui, z);
-            }
+        for (o, z) in out.iter_mut().zip(&z) {
+            crate::simd::matvec32(&self.u, z, o);
         }
         out
     }
@@ -170,7 +168,7 @@ impl LowRank {
     /// c_a dc_b + dc_a c_b (pair tensors only): V s' = H dc with H = ∂(V s)/∂c, made once (its
     /// row r: H_b = Σ_a V_{r,(a,b)} c_a, the diagonal pair counted twice), so a direction costs a
     /// product of length n instead of V's columns; then U applied to all of them, each row of U
-    /// read once and widened once per four directions ([`dot32_four`]).
+    /// read once and widened once per four directions (`simd::matvec32_four`).
     pub(crate) fn apply_pair_tangents(&self, c: &[f64], dcs: &[&[f64]]) -> Vec<Vec<f64>> {
         let n = c.len();
         assert!(
@@ -197,27 +195,22 @@ impl LowRank {
             }
             z
         };
-        let mut out = vec![vec![0.0; self.rows]; z.len()];
+        let mut out = Vec::with_capacity(z.len());
         for group in (0..z.len()).step_by(4) {
             let last = z.len() - 1;
             let take = |q: usize| z[(group + q).min(last)].as_slice();
-            let zs = [take(0), take(1), take(2), take(3)];
-            for (i, ui) in self.u.chunks_exact(self.rank).enumerate() {
-                let d = dot32_four(ui, zs);
-                for q in 0..4.min(z.len() - group) {
-                    out[group + q][i] = d[q];
-                }
-            }
+            let mut four = std::array::from_fn(|_| vec![0.0; self.rows]);
+            crate::simd::matvec32_four(&self.u, [take(0), take(1), take(2), take(3)], &mut four);
+            out.extend(four.into_iter().take(z.len() - group));
         }
         out
     }
 
     /// V s for the products `s` in f64 (summed in f64, [`dot32`]).
     pub(crate) fn reduce(&self, s: &[f64]) -> Vec<f64> {
-        self.v
-            .chunks_exact(self.columns)
-            .map(|va| dot32(va, s))
-            .collect()
+        let mut z = vec![0.0; self.rank];
+        crate::simd::matvec32(&self.v, &s[..self.columns], &mut z);
+        z
     }
 
     /// V s for the products `s` in f32, summed as [`dot_f32`] (32 partial sums in f32, then f64):
