@@ -102,9 +102,8 @@ pub(crate) fn matvec32_four(a: &[f32], b: [&[f64]; 4], out: &mut [Vec<f64>; 4]) 
         return simd.vectorize(MatVec32Four { simd, a, b, out });
     }
     for (i, row) in a.chunks_exact(n).take(out[0].len()).enumerate() {
-        let d = dot32_four(row, b);
-        for q in 0..4 {
-            out[q][i] = d[q];
+        for (o, d) in out.iter_mut().zip(dot32_four(row, b)) {
+            o[i] = d;
         }
     }
 }
@@ -127,8 +126,8 @@ impl pulp::NullaryFnOnce for MatVec32Four<'_> {
         let n = self.b[0].len();
         for (i, row) in self.a.chunks_exact(n).take(self.out[0].len()).enumerate() {
             let d = dot32_four_v3(self.simd, row, self.b);
-            for q in 0..4 {
-                self.out[q][i] = d[q];
+            for (o, d) in self.out.iter_mut().zip(d) {
+                o[i] = d;
             }
         }
     }
