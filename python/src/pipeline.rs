@@ -461,6 +461,7 @@ impl Pipeline {
         // where the loop terms are computed: the true k range and its measured change, or None
         d.set_item("loop_range", self.inner.loop_range())?;
         d.set_item("loop_range_note", self.inner.describe_loop_range())?;
+        d.set_item("mu_rule_note", self.inner.describe_mu_rule())?;
         d.set_item(
             "observation",
             self.inner.observation().description().to_vec(),

@@ -16,7 +16,8 @@ use super::apply_matrix;
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
 use crate::precision::Precision;
-use crate::rsd::ept::{EptParams, EptPlan, EptSettings};
+use crate::rsd::ap::Distortion;
+use crate::rsd::ept::{EptParams, EptPlan, EptSettings, EptTerms};
 use crate::survey::observe::Observation;
 
 /// The largest change of the reference data vector the loop range may cause, relative to the
@@ -35,8 +36,8 @@ const HIGH_FACTORS: [f64; 3] = [2.0, 1.5, 1.25];
 pub(super) fn choose(
     observation: &Observation,
     matrix: &[f64],
+    reference: &Reference,
     settings: &EptSettings,
-    z: f64,
 ) -> Result<Option<((f64, f64), f64)>> {
     let k_out = observation.k_out();
     let k_model = observation.k_model();
@@ -48,47 +49,15 @@ pub(super) fn choose(
     let (model_lo, model_hi) = (k_model[0], k_model[k_model.len() - 1]);
     // observed k to true k: the loops must cover k/α for every α of the plan's AP range
     let (a_lo, a_hi) = settings.ap_range.unwrap_or((1.0, 1.0));
-    let spectrum = reference_spectrum(z)?;
-
-    let ells = observation.model_ells();
-    let f = crate::cosmology::Cosmology::gm2012().growth_rate(z);
-    let ap = settings
-        .ap_range
-        .map(|_| crate::rsd::ap::Distortion::new(1.0, 1.0))
-        .transpose()?;
-    // the reference terms once (the loops everywhere, at the fast precision: the range needs the
-    // loops' size, not their last digit), and the data vector with the loops in [lo, hi] (observed k,
-    // None: no bound)
-    let plan = EptPlan::new(k_model, *settings, &Precision::fast())?;
-    let terms = plan.terms(&spectrum)?;
-    let params = EptParams::new(2.0, f);
     let data = |lo: Option<f64>, hi: Option<f64>| -> Result<Vec<f64>> {
-        let cut = terms.with_loops_only_in(
+        let cut = reference.terms.with_loops_only_in(
             lo.map_or(0.0, |l| l / a_hi),
             hi.map_or(f64::INFINITY, |h| h / a_lo),
         );
-        Ok(apply_matrix(
-            matrix,
-            &plan.multipole_values_at(&cut, &params, ells, ap)?,
-        ))
+        reference.data_vector(&cut, matrix, observation.model_ells(), reference.identity)
     };
     let full = data(None, None)?;
-    // per row, the largest |value| of its output multipole's block
-    let block = full.len() / observation.ells().len();
-    let scale: Vec<f64> = full
-        .chunks(block)
-        .flat_map(|b| {
-            let m = b.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-            std::iter::repeat_n(m, b.len())
-        })
-        .collect();
-    let change = |d: &[f64]| -> f64 {
-        d.iter()
-            .zip(&full)
-            .zip(&scale)
-            .map(|((a, b), s)| (a - b).abs() / s)
-            .fold(0.0, f64::max)
-    };
+    let change = relative_change(&full, observation.ells().len());
     // the lower end with the loops to the top, then the upper end with that lower end
     let (mut lo, mut hi, mut measured) = (None, None, 0.0);
     for factor in LOW_FACTORS {
@@ -121,6 +90,72 @@ pub(super) fn choose(
         hi.map_or(f64::MAX, |h| h / a_lo),
     );
     Ok(Some((range, measured)))
+}
+
+/// The reference of the build-time measurements ([module docs](self), [`super::mu_rule`]): the
+/// embedded gm2012 spectrum at z, its terms at the fast precision (the measurements need the
+/// loops' size, not their last digit), b1 = 2 and f = f(z).
+pub(super) struct Reference {
+    pub(super) plan: EptPlan,
+    pub(super) terms: EptTerms,
+    pub(super) params: EptParams,
+    /// The identity distortion with an AP range, else none.
+    pub(super) identity: Option<Distortion>,
+}
+
+impl Reference {
+    pub(super) fn new(k_model: &[f64], settings: &EptSettings, z: f64) -> Result<Self> {
+        let plan = EptPlan::new(k_model, *settings, &Precision::fast())?;
+        let terms = plan.terms(&reference_spectrum(z)?)?;
+        let f = crate::cosmology::Cosmology::gm2012().growth_rate(z);
+        let identity = settings
+            .ap_range
+            .map(|_| Distortion::new(1.0, 1.0))
+            .transpose()?;
+        Ok(Self {
+            plan,
+            terms,
+            params: EptParams::new(2.0, f),
+            identity,
+        })
+    }
+
+    /// The data vector of `terms` (the reference's, or changed) through the observation `matrix`
+    /// with the distortion `ap`.
+    pub(super) fn data_vector(
+        &self,
+        terms: &EptTerms,
+        matrix: &[f64],
+        ells: &[usize],
+        ap: Option<Distortion>,
+    ) -> Result<Vec<f64>> {
+        Ok(apply_matrix(
+            matrix,
+            &self
+                .plan
+                .multipole_values_at(terms, &self.params, ells, ap)?,
+        ))
+    }
+}
+
+/// The largest change of a data vector from `full` (of `n_ells` output multipoles' blocks), each row
+/// relative to the largest |value| of its block.
+pub(super) fn relative_change(full: &[f64], n_ells: usize) -> impl Fn(&[f64]) -> f64 + '_ {
+    let block = full.len() / n_ells.max(1);
+    let scale: Vec<f64> = full
+        .chunks(block.max(1))
+        .flat_map(|b| {
+            let m = b.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            std::iter::repeat_n(m, b.len())
+        })
+        .collect();
+    move |d: &[f64]| -> f64 {
+        d.iter()
+            .zip(full)
+            .zip(&scale)
+            .map(|((a, b), s)| (a - b).abs() / s)
+            .fold(0.0, f64::max)
+    }
 }
 
 /// The embedded gm2012 spectrum at z (rescaled by its growth from the nearest table).

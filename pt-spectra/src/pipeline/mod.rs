@@ -47,6 +47,7 @@ use crate::survey::observe::{apply_matrix, Observation};
 pub mod cosmological;
 mod linearised;
 pub mod loop_range;
+pub mod mu_rule;
 pub use crate::bispectrum::block::BispectrumBlock;
 pub use cosmological::CosmologyJacobian;
 pub use linearised::{Linearised, JACOBIAN_NAMES, NUISANCE_NAMES};
@@ -123,6 +124,9 @@ pub struct Pipeline {
     /// The measured change of the reference data vector by the loop range, if restricted
     /// ([`loop_range`]).
     loop_truncation: Option<f64>,
+    /// The nodes of the rule in μ and their measured change of the reference data vector, if fewer
+    /// than [`crate::rsd::ept::MU_NODES`] ([`mu_rule`]).
+    mu_rule: Option<(usize, f64)>,
 }
 
 /// Where the loop terms of one spectrum came from.
@@ -208,12 +212,16 @@ impl Pipeline {
             loop_range: None,
         };
         let (matrix, rows) = observation.matrix().map(|(m, r)| (m.to_vec(), r))?;
+        // the build-time measurements of what the step may skip: the loops where the observation
+        // weighs little, the μ nodes a smaller rule integrates as well
+        let reference = loop_range::Reference::new(observation.k_model(), &ept, settings.z)?;
         let chosen = if settings.restrict_loops {
-            loop_range::choose(&observation, &matrix, &ept, settings.z)?
+            loop_range::choose(&observation, &matrix, &reference, &ept)?
         } else {
             None
         };
-        let plan = EptPlan::new(
+        let mu_rule = mu_rule::choose(&observation, &matrix, &reference, &ept)?;
+        let mut plan = EptPlan::new(
             observation.k_model(),
             EptSettings {
                 loop_range: chosen.map(|(range, _)| range),
@@ -223,6 +231,9 @@ impl Pipeline {
         )?
         .with_basis(store, progress)?
         .with_max_residual(settings.max_residual)?;
+        if let Some((n, _)) = mu_rule {
+            plan = plan.with_value_nodes(n)?;
+        }
         let blocks = settings.blocks()?;
         Ok(Self {
             settings,
@@ -233,6 +244,7 @@ impl Pipeline {
             emulator: LinearEmulator::embedded()?,
             blocks,
             loop_truncation: chosen.map(|(_, change)| change),
+            mu_rule,
         })
     }
 
@@ -297,6 +309,31 @@ impl Pipeline {
                 loop_range::LOOP_RANGE_TOLERANCE
             ),
             None => "loop terms on the whole grid of the observation's model k".into(),
+        }
+    }
+
+    /// The nodes of the rule in μ of the multipoles and the change of the reference data vector
+    /// they measured at build time, relative to each multipole's largest |value| at the worst
+    /// distortion ([`mu_rule::MU_RULE_TOLERANCE`]); `None` if the step keeps
+    /// [`crate::rsd::ept::MU_NODES`].
+    pub fn mu_rule(&self) -> Option<(usize, f64)> {
+        self.mu_rule
+    }
+
+    /// One line for a header, a `meta` entry or a log: the rule in μ of the multipoles ([`mu_rule`]).
+    pub fn describe_mu_rule(&self) -> String {
+        match self.mu_rule {
+            Some((n, change)) => format!(
+                "multipoles: {n}-point Gauss-Legendre rule in mu (measured at build: the reference \
+                 data vector changes from the {}-point rule's by {change:.1e} of each multipole's \
+                 largest value at the worst corner of the AP range, <= {:.0e})",
+                crate::rsd::ept::MU_NODES,
+                mu_rule::MU_RULE_TOLERANCE
+            ),
+            None => format!(
+                "multipoles: {}-point Gauss-Legendre rule in mu",
+                crate::rsd::ept::MU_NODES
+            ),
         }
     }
 

@@ -185,7 +185,10 @@ impl Default for EptSettings {
 #[derive(Debug, Clone)]
 pub struct EptPlan {
     /// Gauss–Legendre rules on [0, 1] ([`MU_NODES`] and half as many): (μ, w, L_0…L_8(μ)).
-    rules: [Vec<(f64, f64, [f64; MAX_ELL + 1])>; 2],
+    rules: [MuRule; 2],
+    /// The rule of the values-only paths ([`Self::with_value_nodes`]; the first of `rules` unless
+    /// chosen).
+    value_rule: MuRule,
     k_out: Vec<f64>,
     grid: Vec<f64>,
     /// Whether `grid` is `k_out` itself or the AP grid the terms are interpolated on: told by how
@@ -315,21 +318,9 @@ impl EptPlan {
         let loop_span = range::loop_span(&grid, settings.loop_range)?;
         let loops = RedshiftPlan::new(&grid[loop_span.clone()], precision)?;
         let split = settings.ir.then_some(());
-        let legendre: Vec<Vec<f64>> = (0..=MAX_ELL).map(legendre_coefficients).collect();
-        let rules = [MU_NODES, MU_NODES / 2].map(|n| {
-            let (x, w) = legendre_nodes(n);
-            x.iter()
-                .zip(&w)
-                .map(|(&x, &w)| {
-                    let mu = 0.5 * (x + 1.0);
-                    let l = std::array::from_fn(|ell| {
-                        legendre[ell].iter().rev().fold(0.0, |a, c| a * mu + c)
-                    });
-                    (mu, 0.5 * w, l)
-                })
-                .collect()
-        });
+        let rules = [MU_NODES, MU_NODES / 2].map(mu_rule);
         Ok(Self {
+            value_rule: rules[0].clone(),
             rules,
             k_out: k.to_vec(),
             spline: Arc::new(UniformSpline::new(grid.len())),
@@ -342,6 +333,31 @@ impl EptPlan {
             tensors: None,
             max_residual: crate::loops::basis::MAX_RESIDUAL,
         })
+    }
+
+    /// This plan with an n-point Gauss–Legendre rule in μ for the values-only multipoles
+    /// ([`Self::multipole_values_at`] and the batches, f-derivatives, tangents and AP derivatives
+    /// built on them; [`Self::multipoles`] keeps [`MU_NODES`] and its error): a chain step whose
+    /// data vector a smaller rule changes by less than its tolerance (measured at build,
+    /// [`crate::pipeline`]) projects faster.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] unless 8 ≤ n ≤ [`MU_NODES`].
+    pub fn with_value_nodes(mut self, n: usize) -> Result<Self> {
+        if !(8..=MU_NODES).contains(&n) {
+            return Err(Error::InvalidParameter {
+                name: "value_nodes",
+                value: n as f64,
+                reason: "the values' rule in mu takes 8 to 24 nodes",
+            });
+        }
+        self.value_rule = mu_rule(n);
+        Ok(self)
+    }
+
+    /// The number of nodes in μ of the values-only multipoles ([`Self::with_value_nodes`]).
+    pub fn value_nodes(&self) -> usize {
+        self.value_rule.len()
     }
 
     /// The output wavenumbers [h/Mpc].
@@ -498,7 +514,7 @@ impl EptPlan {
         for (i, &k) in self.k_out.iter().enumerate() {
             let (ln_k, k2) = (k.ln(), k * k);
             for (((mu, _, _), c), &(ln_ratio, ratio2, mt)) in
-                self.rules[0].iter().zip(&weights).zip(&nodes)
+                self.value_rule.iter().zip(&weights).zip(&nodes)
             {
                 let p = match &ap {
                     None if self.grid_use == GridUse::Output => model.value_at(i, k, *mu),
@@ -537,6 +553,24 @@ impl EptPlan {
         }
         Ok(())
     }
+}
+
+/// A Gauss–Legendre rule in μ on [0, 1]: (μ, w, L_0…L_8(μ)) per node.
+type MuRule = Vec<(f64, f64, [f64; MAX_ELL + 1])>;
+
+/// The n-point Gauss–Legendre rule on [0, 1] with the Legendre polynomials at its nodes.
+fn mu_rule(n: usize) -> MuRule {
+    let legendre: Vec<Vec<f64>> = (0..=MAX_ELL).map(legendre_coefficients).collect();
+    let (x, w) = legendre_nodes(n);
+    x.iter()
+        .zip(&w)
+        .map(|(&x, &w)| {
+            let mu = 0.5 * (x + 1.0);
+            let l =
+                std::array::from_fn(|ell| legendre[ell].iter().rev().fold(0.0, |a, c| a * mu + c));
+            (mu, 0.5 * w, l)
+        })
+        .collect()
 }
 
 /// Σ² = (1/6π²)∫dq P_nw(q)[1 − j₀(q r_BAO)] over [1e-5, 1e3] h/Mpc: Simpson in ln q, error against

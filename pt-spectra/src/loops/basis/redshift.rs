@@ -435,7 +435,7 @@ impl RedshiftBasis {
         plan.assemble_rows(p_lin.to_vec(), &rows, sigma_v2)
     }
 
-    /// [`Self::evaluate_with_no_wiggle`]'s values alone, every error NaN ([`Self::row_values`]):
+    /// [`Self::evaluate_with_no_wiggle`]'s values alone, every error NaN (not estimated):
     /// the chain step's terms; `no_wiggle` `None` for [`Self::evaluate`]'s.
     pub fn evaluate_values(
         &self,

@@ -151,8 +151,9 @@ impl EptPlan {
     }
 
     /// The checks of a projection onto the multipoles `ells` with distortion `ap`
-    /// ([`Self::check_projection`]), and per μ node of the rule the weights (2ℓ + 1) w L_ℓ(μ) × the
-    /// AP volume factor, and the distortion's ln(k'/k), (k'/k)² and μ' (the same at every k).
+    /// ([`Self::check_projection`]), and per μ node of the values' rule ([`Self::value_nodes`]) the
+    /// weights (2ℓ + 1) w L_ℓ(μ) × the AP volume factor, and the distortion's ln(k'/k), (k'/k)² and
+    /// μ' (the same at every k).
     #[allow(clippy::type_complexity)]
     pub(super) fn projection_nodes(
         &self,
@@ -163,7 +164,8 @@ impl EptPlan {
     ) -> Result<(Vec<Vec<f64>>, Vec<(f64, f64, f64)>)> {
         self.check_projection(terms, params, ells, ap)?;
         let volume = ap.map_or(1.0, |d| d.volume());
-        let weights: Vec<Vec<f64>> = self.rules[0]
+        let weights: Vec<Vec<f64>> = self
+            .value_rule
             .iter()
             .map(|(_, w, legendre)| {
                 ells.iter()
@@ -173,7 +175,8 @@ impl EptPlan {
             .collect();
         // per μ node, the distortion's k'/k and μ' (Distortion::true_coordinates): ln(k'/k),
         // (k'/k)² and μ', the same at every k
-        let nodes: Vec<(f64, f64, f64)> = self.rules[0]
+        let nodes: Vec<(f64, f64, f64)> = self
+            .value_rule
             .iter()
             .map(|(mu, _, _)| match &ap {
                 None => (0.0, 1.0, *mu),
