@@ -2,10 +2,30 @@
 //! [`crate::statistic::Block`]s (docs/architecture.md, "Adding a statistic"). The pipeline and the
 //! fits read it to say which block a parameter name belongs to when the data vector has none.
 
+use crate::error::{Error, Result};
 use crate::statistic::Kind;
 
 /// Every kind of block, in the order of their registration.
 pub const AVAILABLE: [&Kind; 1] = [&crate::bispectrum::block::KIND];
+
+/// The kind of block named `name` (its [`Kind::name`]).
+///
+/// # Errors
+/// [`Error::InvalidChoice`] for another name, listing the registered ones.
+pub fn by_name(name: &str) -> Result<&'static Kind> {
+    AVAILABLE
+        .into_iter()
+        .find(|k| k.name == name)
+        .ok_or_else(|| Error::InvalidChoice {
+            what: format!("block `{name}`"),
+            reason: format!("the blocks are {}", names().join(", ")),
+        })
+}
+
+/// The names of the registered kinds.
+pub fn names() -> Vec<&'static str> {
+    AVAILABLE.iter().map(|k| k.name).collect()
+}
 
 /// The kind of block whose own parameter `name` is (`None`: no block's).
 pub fn owner(name: &str) -> Option<&'static Kind> {

@@ -6,11 +6,10 @@ use crate::inputs::Inputs;
 use crate::survey::Observation;
 use crate::value_error;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
-use pt_spectra::bispectrum::Fog;
 use pt_spectra::cosmology::Cosmology;
 use pt_spectra::pipeline::{
-    BispectrumBlock, CosmologyJacobian, Pipeline as LibPipeline, PipelineSettings, TermsSource,
-    JACOBIAN_NAMES, PIPELINE_MAX_RESIDUAL,
+    CosmologyJacobian, Pipeline as LibPipeline, PipelineSettings, TermsSource, JACOBIAN_NAMES,
+    PIPELINE_MAX_RESIDUAL,
 };
 use pt_spectra::progress::Silent;
 use pt_spectra::setup::{LinearSource, NamedCosmology, Prepared};
@@ -24,11 +23,12 @@ type LastCall = (TermsSource, f64, Option<(f64, f64)>);
 /// A data vector and, if asked for, its Jacobian (one row per nuisance parameter).
 type VectorAndJacobian = (Vec<f64>, Option<Vec<Vec<f64>>>);
 
-/// The chain step: observation, model, redshift and AP fiducial fixed at construction. With
-/// `triangles` (an (n, 3) array of k1 k2 k3 [h/Mpc]; bins with `bin_width`) the data vector goes on
-/// with the tree-level bispectrum multipoles `b_ells` (default (0,)) of those triangles (multipole,
-/// then triangle) from the same spectrum, f, distortion and IR, sharing b1, b2, bs and adding c1,
-/// b_shot, p_shot, a_shot (stochastic terms at `n_bar`; FoG `fog`, `sigma_fog` [Mpc/h]).
+/// The chain step: observation, model, redshift and AP fiducial fixed at construction. The other
+/// keywords are the blocks after the power spectrum ([`pt_spectra::blocks::AVAILABLE`]): a block's
+/// name with a dict of its options, or its own keywords ([`pt_spectra::statistic::Faces::keywords`];
+/// e.g. the bispectrum's `triangles`, an (n, 3) array of k1 k2 k3 [h/Mpc], with `bin_width`, `b_ells`,
+/// `n_bar`, `fog`, `sigma_fog`); the data vector goes on with each block's entries, from the same
+/// spectrum, f, distortion and IR, sharing b1, b2, bs and adding the block's own parameters.
 /// `restrict_loops` (default True): the loop terms only where the observation weighs them, the range
 /// chosen by measurement at construction (`meta["loop_range"]`: the range and the change it made,
 /// at most 1e-5 of each multipole's largest value); False computes them on the whole window grid.
@@ -229,8 +229,7 @@ impl Pipeline {
 impl Pipeline {
     #[new]
     #[pyo3(signature = (observation, z, fiducial=None, ir=true, precision=pt_spectra::jobs::defaults::PRECISION,
-        max_residual=PIPELINE_MAX_RESIDUAL, cache_dir=None, triangles=None, bin_width=None,
-        b_ells=vec![0], n_bar=None, fog="none", sigma_fog=0.0, restrict_loops=true))]
+        max_residual=PIPELINE_MAX_RESIDUAL, cache_dir=None, restrict_loops=true, **blocks))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -241,30 +240,10 @@ impl Pipeline {
         precision: &str,
         max_residual: f64,
         cache_dir: Option<std::path::PathBuf>,
-        triangles: Option<&Bound<'_, PyAny>>,
-        bin_width: Option<f64>,
-        b_ells: Vec<usize>,
-        n_bar: Option<f64>,
-        fog: &str,
-        sigma_fog: f64,
         restrict_loops: bool,
+        blocks: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let bispectrum = match triangles {
-            Some(t) => Some(BispectrumBlock {
-                ells: b_ells,
-                fog: Fog::by_name(fog, sigma_fog).map_err(value_error)?,
-                n_bar: n_bar.unwrap_or(f64::INFINITY),
-                ..BispectrumBlock::monopole(crate::bispectrum::triangle_set(t, bin_width)?)
-            }),
-            None => {
-                if bin_width.is_some() || n_bar.is_some() || fog != "none" {
-                    return Err(value_error(
-                        "bin_width, n_bar and fog are for the bispectrum block: give triangles",
-                    ));
-                }
-                None
-            }
-        };
+        let blocks = crate::options::pipeline_blocks(blocks)?;
         let fiducial = match fiducial {
             Some(f) => Some(crate::inputs::cosmology_of(Some(f))?),
             None => None,
@@ -275,7 +254,7 @@ impl Pipeline {
         let settings = PipelineSettings {
             ir,
             max_residual,
-            bispectrum,
+            blocks,
             restrict_loops,
             ..PipelineSettings::ept(z, fiducial)
         };
@@ -453,7 +432,15 @@ impl Pipeline {
         d.set_item("ells", self.inner.observation().ells().to_vec())?;
         d.set_item("len", self.inner.len())?;
         d.set_item("power_len", self.inner.power_len())?;
-        d.set_item("bispectrum", self.inner.has_blocks())?;
+        // per registered kind: whether the data vector holds its block
+        for kind in pt_spectra::blocks::AVAILABLE {
+            let held = self
+                .inner
+                .blocks()
+                .iter()
+                .any(|b| b.kind().name == kind.name);
+            d.set_item(kind.name, held)?;
+        }
         d.set_item("ap", s.fiducial.is_some())?;
         d.set_item("ir", s.ir)?;
         d.set_item("max_residual", s.max_residual)?;
