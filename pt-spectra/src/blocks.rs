@@ -31,3 +31,43 @@ pub fn names() -> Vec<&'static str> {
 pub fn owner(name: &str) -> Option<&'static Kind> {
     AVAILABLE.into_iter().find(|k| k.index(name).is_some())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_name_not_registered_is_refused_listing_the_registered_ones() {
+        for kind in AVAILABLE {
+            assert_eq!(by_name(kind.name).unwrap().name, kind.name);
+        }
+        let e = by_name("trispectrum").unwrap_err().to_string();
+        assert!(e.contains("trispectrum"), "{e}");
+        for name in names() {
+            assert!(e.contains(name), "{e}");
+        }
+    }
+
+    #[test]
+    fn every_face_builds_nothing_from_no_options_and_refuses_unknown_keys() {
+        use crate::statistic::{OptionValue, Options};
+        for kind in AVAILABLE {
+            assert!((kind.faces.pipeline)(&Options::default())
+                .unwrap()
+                .is_none());
+            let unknown = Options {
+                entries: vec![("no_such_key".into(), OptionValue::Flag(true))],
+                ..Options::default()
+            };
+            let e = (kind.faces.pipeline)(&unknown).unwrap_err().to_string();
+            assert!(
+                e.contains("no_such_key") && e.contains("unknown key"),
+                "{e}"
+            );
+            if let Some(face) = kind.faces.analysis {
+                let e = (face.check)(&unknown).unwrap_err().to_string();
+                assert!(e.contains("no_such_key"), "{e}");
+            }
+        }
+    }
+}

@@ -125,8 +125,8 @@ impl Pipeline {
         params: &[(String, f64)],
         jacobian: bool,
     ) -> PyResult<VectorAndJacobian> {
-        // with a bispectrum block a given f makes the step at that f (its IR damping is not a
-        // polynomial in f)
+        // with a block after the power spectrum a given f makes the step at that f (a block's terms
+        // are not a polynomial in f, e.g. the IR damping)
         let f_given = params.iter().find(|(n, _)| n == "f").map(|p| p.1);
         let step = match f_given {
             Some(f) if self.inner.has_blocks() => self.inner.step_at_growth_rate(prepared, f),
@@ -157,7 +157,7 @@ impl Pipeline {
     }
 
     /// The cache key of a call: (cosmology, f given) when it names a cosmology without a table and
-    /// the pipeline has no bispectrum block (whose f is not a polynomial), else `None`.
+    /// the pipeline has no block after the power spectrum (whose f is not a polynomial), else `None`.
     fn repeat_key(
         &self,
         linear: Option<&Bound<'_, PyAny>>,
@@ -200,7 +200,7 @@ impl Pipeline {
             .as_ref()
             .is_none_or(|l| jacobian && l.names().len() < JACOBIAN_NAMES.len())
         {
-            // the power spectrum's terms do not depend on f (no bispectrum block here): the step of
+            // the power spectrum's terms do not depend on f (no block after them here): the step of
             // the cosmology, linearised at the given f (with the f-derivative for a Jacobian)
             let step = self.inner.step(prepared).map_err(value_error)?;
             let f = key.1.map(f64::from_bits);
@@ -274,7 +274,7 @@ impl Pipeline {
     /// name (`pt_spectra.Pipeline.parameters`; `f` defaults to f(z)). With `jacobian=True`:
     /// (data vector, d data/d θ as an array of shape (12, n) in the order of `nuisance`: the 11
     /// nuisance parameters, then f; all exact). A call that repeats the last call's cosmology (no
-    /// `linear`, no bispectrum block) evaluates that cosmology's nuisance polynomial (made at the
+    /// `linear`, no block after the power spectrum) evaluates that cosmology's nuisance polynomial (made at the
     /// first repeat, ~1.5 ms; then microseconds): the same numbers to rounding (~1e-13 relative).
     #[pyo3(signature = (cosmology=None, linear=None, z_input=None, jacobian=false, **params))]
     fn __call__<'py>(
@@ -341,7 +341,7 @@ impl Pipeline {
     /// aperp (rows in that order; an array of shape (3, n)) at `cosmology` or `linear` as a call
     /// takes them, with the nuisance parameters by name (`f` defaults to f(z); the distortion is the
     /// cosmology's against the fiducial, none without one: the derivatives at apar = aperp = 1). For
-    /// template fits and forecasts: the power spectrum only (no bispectrum block).
+    /// template fits and forecasts: the power spectrum only (no block after it).
     #[pyo3(signature = (cosmology=None, linear=None, z_input=None, **params))]
     fn template_jacobian<'py>(
         &self,

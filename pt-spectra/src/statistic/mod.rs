@@ -75,8 +75,8 @@ pub struct Kind {
 /// Settings of a block as the pipeline's settings hold them.
 pub type SharedSpec = Arc<dyn Spec>;
 
-/// How the faces build a kind of block from their text, each from [`Options`] (module
-/// [`options`]): the pipeline's keywords, a forecast's survey bin, an analysis file's data set.
+/// How the faces build a kind of block from their text, each from [`Options`]: the pipeline's
+/// keywords, a forecast's survey bin, an analysis file's data set.
 #[derive(Debug, Clone, Copy)]
 pub struct Faces {
     /// Its keywords in a pipeline's face besides its name (e.g. Python's `pt.Pipeline`): given, they

@@ -203,3 +203,54 @@ impl Options {
         Ok(Some(p))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn options(entries: Vec<(&str, OptionValue)>) -> Options {
+        Options {
+            origin: "a.toml".into(),
+            at: "dataset[1].block.".into(),
+            entries: entries.into_iter().map(|(k, v)| (k.into(), v)).collect(),
+            parent: vec![("n_bar".into(), OptionValue::Number(3e-4))],
+            base: None,
+        }
+    }
+
+    #[test]
+    fn values_are_read_by_type_and_errors_name_origin_and_key() {
+        use OptionValue::*;
+        let o = options(vec![
+            ("k", Integer(2)),
+            ("x", Number(0.5)),
+            ("name", Text("none".into())),
+            ("ells", List(vec![Integer(0), Integer(2)])),
+            ("rows", List(vec![List(vec![Number(0.1), Integer(1)])])),
+            ("bad", List(vec![Number(0.5)])),
+        ]);
+        assert_eq!(o.number("k").unwrap(), Some(2.0));
+        assert_eq!(o.number("x").unwrap(), Some(0.5));
+        assert_eq!(o.number("absent").unwrap(), None);
+        assert_eq!(o.text("name").unwrap(), Some("none"));
+        assert_eq!(o.counts("ells").unwrap(), Some(vec![0, 2]));
+        assert_eq!(o.rows::<2>("rows", "a, b").unwrap(), Some(vec![[0.1, 1.0]]));
+        assert_eq!(o.inherited("n_bar"), Some(&Number(3e-4)));
+        let e = o.counts("bad").unwrap_err().to_string();
+        assert!(
+            e.contains("a.toml: `dataset[1].block.bad`") && e.contains("non-negative integer"),
+            "{e}"
+        );
+        let e = o.number("name").unwrap_err().to_string();
+        assert!(e.contains("finite number"), "{e}");
+        let e = o.rows::<3>("rows", "k1, k2, k3").unwrap_err().to_string();
+        assert!(e.contains("(n, 3) array of k1, k2, k3"), "{e}");
+        let e = o.known(&["k", "x"]).unwrap_err().to_string();
+        assert!(
+            e.contains("`dataset[1].block.name`") && e.contains("k, x"),
+            "{e}"
+        );
+        let e = o.need("absent").unwrap_err().to_string();
+        assert!(e.contains("required"), "{e}");
+    }
+}
