@@ -52,6 +52,13 @@ mod tests {
     fn every_face_builds_nothing_from_no_options_and_refuses_unknown_keys() {
         use crate::statistic::{OptionValue, Options};
         for kind in AVAILABLE {
+            let n = kind.own.len();
+            assert_eq!(
+                (kind.defaults.len(), kind.units.len(), kind.ranges.len()),
+                (n, n, n),
+                "{}",
+                kind.name
+            );
             assert!((kind.faces.pipeline)(&Options::default())
                 .unwrap()
                 .is_none());

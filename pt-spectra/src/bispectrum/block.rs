@@ -41,6 +41,7 @@ pub const KIND: Kind = Kind {
     name: "bispectrum",
     own: &BISPECTRUM_NAMES,
     defaults: &[0.0, 1.0, 0.0, 0.0],
+    units: &["(Mpc/h)^2", "1", "1", "1"],
     linear: &BISPECTRUM_LINEAR,
     ranges: &[
         (-1e3, 1e3, -10.0, 10.0, 3.0),

@@ -528,14 +528,16 @@ fn free_columns(t: &mut Table, rows: &[Row], name: &str, js: &[Option<usize>]) {
     );
 }
 
-/// The unit of an ept parameter.
+/// The unit of an ept parameter or a block's own ([`crate::statistic::Kind::units`]).
 fn unit(name: &str) -> &'static str {
+    if let Some(kind) = crate::blocks::owner(name) {
+        return kind.index(name).map_or("1", |i| kind.units[i]);
+    }
     match name {
         "alpha0" | "alpha2" | "alpha4" | "alpha6" | "alpha0p" | "alpha2p" | "alpha4p" => {
             "(Mpc/h)^2"
         }
         "sn" => "(Mpc/h)^3",
-        "c1" => "(Mpc/h)^2",
         "sn2" => "(Mpc/h)^5",
         "sn4" => "(Mpc/h)^7",
         _ => "1",

@@ -62,6 +62,8 @@ pub struct Kind {
     pub own: &'static [&'static str],
     /// Their values when not given.
     pub defaults: &'static [f64],
+    /// Their units in tables ("1": none).
+    pub units: &'static [&'static str],
     /// Those that enter the block linearly (affinely): a fit marginalises them analytically.
     pub linear: &'static [&'static str],
     /// Per own parameter, its range in a fit ([`Range`]).
