@@ -192,10 +192,15 @@ impl Options {
             None => PathBuf::from(name),
         };
         if !p.is_file() {
+            let relative = if self.base.is_some() {
+                "the analysis file's directory"
+            } else {
+                "the working directory"
+            };
             return Err(self.bad(
                 key,
                 format!(
-                    "the file {} does not exist (paths are relative to the analysis file's directory)",
+                    "the file {} does not exist (paths are relative to {relative})",
                     p.display()
                 ),
             ));
