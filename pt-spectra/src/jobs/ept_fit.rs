@@ -530,9 +530,6 @@ fn free_columns(t: &mut Table, rows: &[Row], name: &str, js: &[Option<usize>]) {
 
 /// The unit of an ept parameter or a block's own ([`crate::statistic::Kind::units`]).
 fn unit(name: &str) -> &'static str {
-    if let Some(kind) = crate::blocks::owner(name) {
-        return kind.index(name).map_or("1", |i| kind.units[i]);
-    }
     match name {
         "alpha0" | "alpha2" | "alpha4" | "alpha6" | "alpha0p" | "alpha2p" | "alpha4p" => {
             "(Mpc/h)^2"
@@ -540,7 +537,9 @@ fn unit(name: &str) -> &'static str {
         "sn" => "(Mpc/h)^3",
         "sn2" => "(Mpc/h)^5",
         "sn4" => "(Mpc/h)^7",
-        _ => "1",
+        _ => crate::blocks::owner(name)
+            .and_then(|k| k.units.get(k.index(name)?).copied())
+            .unwrap_or("1"),
     }
 }
 
