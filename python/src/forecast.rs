@@ -7,7 +7,7 @@ use pt_spectra::progress::Silent;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-/// The keys of a bin dict that are not numbers (the numbers: `SurveyBin::KEYS` and the nuisance
+/// The keys of a bin dict that are not numbers (the numbers: `SurveyBin::keys` and the nuisance
 /// parameters).
 const LIST_KEYS: [&str; 3] = ["ells", "free", "priors"];
 

@@ -34,6 +34,7 @@ mod halo;
 mod inputs;
 mod joint;
 mod kernel;
+mod options;
 mod pipeline;
 mod redshift;
 mod seam;

@@ -6,11 +6,10 @@ use crate::inputs::Inputs;
 use crate::survey::Observation;
 use crate::value_error;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
-use pt_spectra::bispectrum::Fog;
 use pt_spectra::cosmology::Cosmology;
 use pt_spectra::pipeline::{
-    BispectrumBlock, CosmologyJacobian, Pipeline as LibPipeline, PipelineSettings, TermsSource,
-    JACOBIAN_NAMES, PIPELINE_MAX_RESIDUAL,
+    CosmologyJacobian, Pipeline as LibPipeline, PipelineSettings, TermsSource, JACOBIAN_NAMES,
+    PIPELINE_MAX_RESIDUAL,
 };
 use pt_spectra::progress::Silent;
 use pt_spectra::setup::{LinearSource, NamedCosmology, Prepared};
@@ -24,11 +23,12 @@ type LastCall = (TermsSource, f64, Option<(f64, f64)>);
 /// A data vector and, if asked for, its Jacobian (one row per nuisance parameter).
 type VectorAndJacobian = (Vec<f64>, Option<Vec<Vec<f64>>>);
 
-/// The chain step: observation, model, redshift and AP fiducial fixed at construction. With
-/// `triangles` (an (n, 3) array of k1 k2 k3 [h/Mpc]; bins with `bin_width`) the data vector goes on
-/// with the tree-level bispectrum multipoles `b_ells` (default (0,)) of those triangles (multipole,
-/// then triangle) from the same spectrum, f, distortion and IR, sharing b1, b2, bs and adding c1,
-/// b_shot, p_shot, a_shot (stochastic terms at `n_bar`; FoG `fog`, `sigma_fog` [Mpc/h]).
+/// The chain step: observation, model, redshift and AP fiducial fixed at construction. The other
+/// keywords are the blocks after the power spectrum ([`pt_spectra::blocks::AVAILABLE`]): a block's
+/// name with a dict of its options, or its own keywords ([`pt_spectra::statistic::Faces::keywords`];
+/// e.g. the bispectrum's `triangles`, an (n, 3) array of k1 k2 k3 [h/Mpc], with `bin_width`, `b_ells`,
+/// `n_bar`, `fog`, `sigma_fog`); the data vector goes on with each block's entries, from the same
+/// spectrum, f, distortion and IR, sharing b1, b2, bs and adding the block's own parameters.
 /// `restrict_loops` (default True): the loop terms only where the observation weighs them, the range
 /// chosen by measurement at construction (`meta["loop_range"]`: the range and the change it made,
 /// at most 1e-5 of each multipole's largest value); False computes them on the whole window grid.
@@ -125,8 +125,8 @@ impl Pipeline {
         params: &[(String, f64)],
         jacobian: bool,
     ) -> PyResult<VectorAndJacobian> {
-        // with a bispectrum block a given f makes the step at that f (its IR damping is not a
-        // polynomial in f)
+        // with a block after the power spectrum a given f makes the step at that f (a block's terms
+        // are not a polynomial in f, e.g. the IR damping)
         let f_given = params.iter().find(|(n, _)| n == "f").map(|p| p.1);
         let step = match f_given {
             Some(f) if self.inner.has_blocks() => self.inner.step_at_growth_rate(prepared, f),
@@ -157,7 +157,7 @@ impl Pipeline {
     }
 
     /// The cache key of a call: (cosmology, f given) when it names a cosmology without a table and
-    /// the pipeline has no bispectrum block (whose f is not a polynomial), else `None`.
+    /// the pipeline has no block after the power spectrum (whose f is not a polynomial), else `None`.
     fn repeat_key(
         &self,
         linear: Option<&Bound<'_, PyAny>>,
@@ -200,7 +200,7 @@ impl Pipeline {
             .as_ref()
             .is_none_or(|l| jacobian && l.names().len() < JACOBIAN_NAMES.len())
         {
-            // the power spectrum's terms do not depend on f (no bispectrum block here): the step of
+            // the power spectrum's terms do not depend on f (no block after them here): the step of
             // the cosmology, linearised at the given f (with the f-derivative for a Jacobian)
             let step = self.inner.step(prepared).map_err(value_error)?;
             let f = key.1.map(f64::from_bits);
@@ -229,8 +229,7 @@ impl Pipeline {
 impl Pipeline {
     #[new]
     #[pyo3(signature = (observation, z, fiducial=None, ir=true, precision=pt_spectra::jobs::defaults::PRECISION,
-        max_residual=PIPELINE_MAX_RESIDUAL, cache_dir=None, triangles=None, bin_width=None,
-        b_ells=vec![0], n_bar=None, fog="none", sigma_fog=0.0, restrict_loops=true))]
+        max_residual=PIPELINE_MAX_RESIDUAL, cache_dir=None, restrict_loops=true, **blocks))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -241,30 +240,10 @@ impl Pipeline {
         precision: &str,
         max_residual: f64,
         cache_dir: Option<std::path::PathBuf>,
-        triangles: Option<&Bound<'_, PyAny>>,
-        bin_width: Option<f64>,
-        b_ells: Vec<usize>,
-        n_bar: Option<f64>,
-        fog: &str,
-        sigma_fog: f64,
         restrict_loops: bool,
+        blocks: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let bispectrum = match triangles {
-            Some(t) => Some(BispectrumBlock {
-                ells: b_ells,
-                fog: Fog::by_name(fog, sigma_fog).map_err(value_error)?,
-                n_bar: n_bar.unwrap_or(f64::INFINITY),
-                ..BispectrumBlock::monopole(crate::bispectrum::triangle_set(t, bin_width)?)
-            }),
-            None => {
-                if bin_width.is_some() || n_bar.is_some() || fog != "none" {
-                    return Err(value_error(
-                        "bin_width, n_bar and fog are for the bispectrum block: give triangles",
-                    ));
-                }
-                None
-            }
-        };
+        let blocks = crate::options::pipeline_blocks(blocks)?;
         let fiducial = match fiducial {
             Some(f) => Some(crate::inputs::cosmology_of(Some(f))?),
             None => None,
@@ -275,7 +254,7 @@ impl Pipeline {
         let settings = PipelineSettings {
             ir,
             max_residual,
-            bispectrum,
+            blocks,
             restrict_loops,
             ..PipelineSettings::ept(z, fiducial)
         };
@@ -295,7 +274,7 @@ impl Pipeline {
     /// name (`pt_spectra.Pipeline.parameters`; `f` defaults to f(z)). With `jacobian=True`:
     /// (data vector, d data/d θ as an array of shape (12, n) in the order of `nuisance`: the 11
     /// nuisance parameters, then f; all exact). A call that repeats the last call's cosmology (no
-    /// `linear`, no bispectrum block) evaluates that cosmology's nuisance polynomial (made at the
+    /// `linear`, no block after the power spectrum) evaluates that cosmology's nuisance polynomial (made at the
     /// first repeat, ~1.5 ms; then microseconds): the same numbers to rounding (~1e-13 relative).
     #[pyo3(signature = (cosmology=None, linear=None, z_input=None, jacobian=false, **params))]
     fn __call__<'py>(
@@ -362,7 +341,7 @@ impl Pipeline {
     /// aperp (rows in that order; an array of shape (3, n)) at `cosmology` or `linear` as a call
     /// takes them, with the nuisance parameters by name (`f` defaults to f(z); the distortion is the
     /// cosmology's against the fiducial, none without one: the derivatives at apar = aperp = 1). For
-    /// template fits and forecasts: the power spectrum only (no bispectrum block).
+    /// template fits and forecasts: the power spectrum only (no block after it).
     #[pyo3(signature = (cosmology=None, linear=None, z_input=None, **params))]
     fn template_jacobian<'py>(
         &self,
@@ -453,7 +432,15 @@ impl Pipeline {
         d.set_item("ells", self.inner.observation().ells().to_vec())?;
         d.set_item("len", self.inner.len())?;
         d.set_item("power_len", self.inner.power_len())?;
-        d.set_item("bispectrum", self.inner.has_blocks())?;
+        // per registered kind: whether the data vector holds its block
+        for kind in pt_spectra::blocks::AVAILABLE {
+            let held = self
+                .inner
+                .blocks()
+                .iter()
+                .any(|b| b.kind().name == kind.name);
+            d.set_item(kind.name, held)?;
+        }
         d.set_item("ap", s.fiducial.is_some())?;
         d.set_item("ir", s.ir)?;
         d.set_item("max_residual", s.max_residual)?;

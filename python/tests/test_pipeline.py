@@ -106,6 +106,13 @@ def test_a_bispectrum_block_follows_the_power_spectrum(setup):
         joint(COSMO, jacobian=True, **PARAMS)
     with pytest.raises(ValueError, match="triangles"):
         pt.Pipeline(obs, Z, precision="fast", cache_dir=cache, n_bar=3e-4)
+    # the block by its name with a dict of its options: the same data vector
+    named = pt.Pipeline(obs, Z, precision="fast", cache_dir=cache,
+                        bispectrum=dict(triangles=bins, bin_width=0.01, b_ells=[0, 2], n_bar=3e-4))
+    np.testing.assert_allclose(named(COSMO, **PARAMS, **b), got, rtol=1e-12)
+    # a keyword of no block names the blocks and their keywords
+    with pytest.raises(TypeError, match="bispectrum"):
+        pt.Pipeline(obs, Z, precision="fast", cache_dir=cache, trinagles=bins)
 
 
 def test_the_loop_range_is_stated_and_can_be_switched_off(setup):

@@ -20,6 +20,8 @@ use crate::linear::LinearSpectrum;
 use crate::statistic::{foreign, Block, Kind, Prepared, Shared, Spec, Survey, Terms};
 use std::f64::consts::PI;
 
+mod faces;
+
 /// The parameters of the bispectrum block besides the shared b1, b2, bs (velocileptors' convention):
 /// the counterterm c1 [(Mpc/h)²] and the stochastic amplitudes of [`BispectrumParams`].
 pub const BISPECTRUM_NAMES: [&str; 4] = ["c1", "b_shot", "p_shot", "a_shot"];
@@ -39,6 +41,7 @@ pub const KIND: Kind = Kind {
     name: "bispectrum",
     own: &BISPECTRUM_NAMES,
     defaults: &[0.0, 1.0, 0.0, 0.0],
+    units: &["(Mpc/h)^2", "1", "1", "1"],
     linear: &BISPECTRUM_LINEAR,
     ranges: &[
         (-1e3, 1e3, -10.0, 10.0, 3.0),
@@ -47,6 +50,7 @@ pub const KIND: Kind = Kind {
         (-20.0, 20.0, -1.0, 1.0, 0.3),
     ],
     forecast_free: &BISPECTRUM_FREE,
+    faces: faces::FACES,
 };
 
 /// What the bispectrum block is built from.
@@ -82,8 +86,8 @@ impl BispectrumBlock {
 }
 
 impl Spec for BispectrumBlock {
-    fn plan(self) -> Result<Box<dyn Block>> {
-        Ok(Box::new(PlannedBispectrum::new(self)?))
+    fn plan(&self) -> Result<Box<dyn Block>> {
+        Ok(Box::new(PlannedBispectrum::new(self.clone())?))
     }
 }
 

@@ -1,3 +1,6 @@
+mod fits;
+mod forecast;
+
 use super::terms::tree_level_at;
 use super::*;
 use crate::estimate::Estimate;

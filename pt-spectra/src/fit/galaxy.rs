@@ -31,7 +31,6 @@ use crate::rsd::ept::{EptParams, EptPlan, EptTerms, PARAM_NAMES};
 use crate::survey::observe::Observation;
 
 mod basis;
-mod bispectrum;
 mod block;
 mod derived;
 mod gradient;
@@ -41,8 +40,7 @@ mod priors;
 mod request;
 pub mod search;
 pub use basis::{FitBasis, CLASSPT_NAMES};
-pub use bispectrum::{BispectrumFit, BISPECTRUM_LINEAR, BISPECTRUM_NAMES};
-pub use block::BlockFit;
+pub use block::{BlockFit, OwnValues};
 pub use derived::{derived, sound_horizon, Derived, Template};
 pub use joint::{default_shared, fit_joint, DataSet, JointFit, JointLikelihood};
 pub use priors::{desi_priors, Prior, PriorShape};
@@ -139,9 +137,8 @@ pub struct GalaxyFit {
     /// In a basis other than the model's: every parameter at the best fit in it (the order of its
     /// [`FitBasis::names`]; [`Self::best`] holds the model's parameters they map to).
     pub in_basis: Option<[f64; 12]>,
-    /// With a block after the power spectrum (the bispectrum's, [`BISPECTRUM_NAMES`]): its own
-    /// parameters at the best fit.
-    pub bispectrum: Option<[f64; 4]>,
+    /// With a block after the power spectrum: its own parameters at the best fit.
+    pub block: Option<OwnValues>,
 }
 
 /// The names of the model's slots in `basis`.
@@ -247,10 +244,8 @@ pub fn fit_galaxy_search(
 }
 
 #[cfg(test)]
-mod bispectrum_tests;
-#[cfg(test)]
 mod joint_tests;
 #[cfg(test)]
 mod search_tests;
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

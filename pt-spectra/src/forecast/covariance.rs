@@ -143,6 +143,3 @@ pub(super) fn add_block_fisher(
         }
     }
 }
-
-#[cfg(test)]
-pub(super) use crate::bispectrum::block::triangle_bin_volume;

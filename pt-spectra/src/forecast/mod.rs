@@ -26,8 +26,9 @@
 //! **Derivatives.** The nuisance parameters': exact (the data vector is a polynomial in them,
 //! [`crate::pipeline::Linearised::jacobian`]). f, α∥, α⊥ and the cosmological parameters of the
 //! power spectrum alone: exact ([`crate::pipeline::CosmologyStep::template_jacobian`],
-//! [`crate::pipeline::Pipeline::cosmology_jacobian`]). With a block after the power spectrum (the
-//! bispectrum monopole, [`SurveyBin::with_bispectrum`]; its Gaussian variance from the block,
+//! [`crate::pipeline::Pipeline::cosmology_jacobian`]). With a block after the power spectrum
+//! ([`SurveyBin::with_block`], a registered [`crate::statistic::Kind`] with a
+//! [`crate::statistic::SurveyFace`]; its Gaussian variance from the block,
 //! [`crate::statistic::Block::gaussian_variances`]), f, α∥, α⊥, the cosmological parameters and the
 //! nuisance parameters: central differences at steps h and h/2 combined by Richardson
 //! extrapolation, (4D(h/2) − D(h))/3, whose error, |D(h/2) − D(h)|/3, is reported relative to each
@@ -36,13 +37,14 @@
 mod covariance;
 mod kaiser;
 mod parameters;
+mod survey_bin;
 #[cfg(test)]
 mod tests;
 
 use crate::cosmology::background::DERIVATIVE_NAMES;
 use crate::cosmology::Cosmology;
 use crate::error::{Error, Result};
-use crate::pipeline::{Pipeline, PipelineSettings, NUISANCE_NAMES};
+use crate::pipeline::{Pipeline, NUISANCE_NAMES};
 use crate::precision::Precision;
 use crate::progress::Progress;
 use crate::rsd::ap::Distortion;
@@ -51,6 +53,7 @@ use crate::survey::observe::Observation;
 pub use covariance::gaussian_covariance;
 pub use kaiser::{fisher_kaiser, kaiser_fisher, KaiserBin, KaiserForecast, KaiserTracer};
 use parameters::{check_cosmology, cosmology_value, with_cosmology_value};
+pub use survey_bin::SurveyBin;
 
 /// The cosmological parameters a forecast can vary: ω_cdm, ω_b, h, ln(10¹⁰A_s), n_s (flat, the
 /// fiducial's neutrinos and dark energy kept).
@@ -66,231 +69,6 @@ pub const DEFAULT_FREE_NUISANCE: [&str; 6] = ["b1", "b2", "bs", "alpha0", "alpha
 /// Relative steps of the finite differences (h; the extrapolation also uses h/2): of the parameter's
 /// value for the cosmological ones and f, absolute for α∥, α⊥.
 const STEP: f64 = 0.01;
-
-/// One redshift bin of a survey.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SurveyBin {
-    /// Effective redshift.
-    pub z: f64,
-    /// Comoving volume [(Mpc/h)³].
-    pub volume: f64,
-    /// Number density [(h/Mpc)³].
-    pub n_bar: f64,
-    /// The first shell's lower edge [h/Mpc].
-    pub k_min: f64,
-    /// The last shell's upper edge [h/Mpc] (shells of width `dk` up to it).
-    pub k_max: f64,
-    /// The shell width [h/Mpc].
-    pub dk: f64,
-    /// The multipoles measured (even, ≤ 4).
-    pub ells: Vec<usize>,
-    /// Fiducial nuisance parameters by name ([`NUISANCE_NAMES`]; unset: 0; b1 is required).
-    pub nuisance: Vec<(String, f64)>,
-    /// The free nuisance parameters (the others are fixed).
-    pub free: Vec<String>,
-    /// Gaussian priors (name, σ) on free nuisance parameters, centred on the fiducial.
-    pub priors: Vec<(String, f64)>,
-    /// With the bispectrum monopole B0: the largest side [h/Mpc] of its triangle bins (the bins of
-    /// the power spectrum's shells, all closed triangles up to it); `None`: P alone.
-    pub b_k_max: Option<f64>,
-}
-
-pub use crate::bispectrum::block::BISPECTRUM_FREE;
-
-impl SurveyBin {
-    /// A bin with k from 0.01 to `k_max` in shells of 0.01 h/Mpc, P0 and P2, b1, the
-    /// [`DEFAULT_FREE_NUISANCE`] free with no priors.
-    pub fn new(z: f64, volume: f64, n_bar: f64, k_max: f64, b1: f64) -> Self {
-        Self {
-            z,
-            volume,
-            n_bar,
-            k_min: 0.01,
-            k_max,
-            dk: 0.01,
-            ells: vec![0, 2],
-            nuisance: vec![("b1".into(), b1)],
-            free: DEFAULT_FREE_NUISANCE
-                .iter()
-                .map(|s| s.to_string())
-                .collect(),
-            priors: Vec::new(),
-            b_k_max: None,
-        }
-    }
-
-    /// The numeric keys of a bin besides the nuisance parameters ([`Self::from_values`]).
-    pub const KEYS: [&'static str; 8] = [
-        "z", "volume", "n_bar", "k_max", "b1", "k_min", "dk", "b_k_max",
-    ];
-
-    /// A bin from its values by name, as the faces take them: `z`, `volume`, `n_bar`, `k_max`, `b1`
-    /// (required), `k_min`, `dk`, `b_k_max` ([`Self::with_bispectrum`]) and fiducial nuisance values
-    /// by name; `what` names the bin in errors.
-    ///
-    /// # Errors
-    /// [`Error::InvalidChoice`] naming a missing or unknown key.
-    pub fn from_values(what: &str, values: &[(String, f64)]) -> Result<Self> {
-        let bad = |reason: String| Error::InvalidChoice {
-            what: what.to_string(),
-            reason,
-        };
-        let get = |key: &str| values.iter().find(|(k, _)| k == key).map(|p| p.1);
-        let required = |key: &str| get(key).ok_or_else(|| bad(format!("`{key}` is required")));
-        let mut bin = Self::new(
-            required("z")?,
-            required("volume")?,
-            required("n_bar")?,
-            required("k_max")?,
-            required("b1")?,
-        );
-        if let Some(b) = get("b_k_max") {
-            bin = bin.with_bispectrum(b);
-        }
-        bin.k_min = get("k_min").unwrap_or(bin.k_min);
-        bin.dk = get("dk").unwrap_or(bin.dk);
-        let valid = bin.parameter_names();
-        for (key, value) in values {
-            if Self::KEYS.contains(&key.as_str()) {
-                continue;
-            }
-            if !valid.contains(&key.as_str()) {
-                return Err(bad(format!(
-                    "unknown key `{key}` (valid: {}, and the nuisance parameters {})",
-                    Self::KEYS.join(", "),
-                    valid.join(", ")
-                )));
-            }
-            bin.nuisance.push((key.clone(), *value));
-        }
-        Ok(bin)
-    }
-
-    /// With the bispectrum monopole of the triangle bins up to `b_k_max` [h/Mpc], and its
-    /// [`BISPECTRUM_FREE`] parameters free.
-    pub fn with_bispectrum(mut self, b_k_max: f64) -> Self {
-        self.b_k_max = Some(b_k_max);
-        for name in crate::bispectrum::block::KIND.forecast_free {
-            if !self.free.iter().any(|n| n == name) {
-                self.free.push(name.to_string());
-            }
-        }
-        self
-    }
-
-    /// The shell centres [h/Mpc] and their lower and upper edges.
-    fn shells(&self) -> Vec<(f64, f64, f64)> {
-        let n = ((self.k_max - self.k_min) / self.dk + 1e-9).floor() as usize;
-        (0..n)
-            .map(|i| {
-                let lo = self.k_min + i as f64 * self.dk;
-                (lo + 0.5 * self.dk, lo, lo + self.dk)
-            })
-            .collect()
-    }
-
-    /// The nuisance parameters of the bin's data vector: the power spectrum's, and with B0 the
-    /// bispectrum's own.
-    pub fn parameter_names(&self) -> Vec<&'static str> {
-        let mut names = NUISANCE_NAMES.to_vec();
-        if self.b_k_max.is_some() {
-            names.extend(crate::bispectrum::block::KIND.own);
-        }
-        names
-    }
-
-    /// The pipeline's settings of the bin: `ept` at its z with the AP distortion against `fiducial`
-    /// and with B0, the monopole of all closed triangle bins of the power spectrum's shells up to
-    /// `b_k_max`, with the bin's n̄.
-    fn pipeline_settings(&self, fiducial: &Cosmology) -> Result<PipelineSettings> {
-        let mut settings = PipelineSettings::ept(self.z, Some(*fiducial));
-        if let Some(b_max) = self.b_k_max {
-            let edges: Vec<f64> = std::iter::once(self.k_min)
-                .chain(self.shells().iter().map(|s| s.2))
-                .filter(|&e| e <= b_max + 1e-12)
-                .collect();
-            let triangles = crate::bispectrum::TriangleSet::from_edges(&edges)?;
-            settings.bispectrum = Some(crate::pipeline::BispectrumBlock {
-                n_bar: self.n_bar,
-                ..crate::pipeline::BispectrumBlock::monopole(triangles)
-            });
-        }
-        Ok(settings)
-    }
-
-    /// Checks the values and names; the error names the bin (1-based) and the value.
-    fn validate(&self, index: usize) -> Result<()> {
-        let bad = |what: String, reason: &str| Error::InvalidChoice {
-            what: format!("survey bin {}: {what}", index + 1),
-            reason: reason.into(),
-        };
-        for (name, v) in [
-            ("volume [(Mpc/h)^3]", self.volume),
-            ("n_bar [(h/Mpc)^3]", self.n_bar),
-            ("k_min [h/Mpc]", self.k_min),
-            ("dk [h/Mpc]", self.dk),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(bad(format!("{name} = {v}"), "must be finite and > 0"));
-            }
-        }
-        if !(self.z.is_finite() && self.z >= 0.0) {
-            return Err(bad(format!("z = {}", self.z), "must be finite and >= 0"));
-        }
-        if !(self.k_max.is_finite() && self.k_max >= self.k_min + self.dk) {
-            return Err(bad(
-                format!("k_max = {}", self.k_max),
-                "must reach at least one shell above k_min",
-            ));
-        }
-        if let Some(b) = self.b_k_max {
-            if !(b.is_finite() && b >= self.k_min + self.dk && b <= self.k_max + 1e-12) {
-                return Err(bad(
-                    format!("b_k_max = {b}"),
-                    "the bispectrum's bins are the power spectrum's shells: k_min + dk <= b_k_max <= k_max",
-                ));
-            }
-        }
-        if self.ells.is_empty() || self.ells.iter().any(|&l| l % 2 == 1 || l > 4) {
-            return Err(bad(
-                format!("ells = {:?}", self.ells),
-                "must be among 0, 2, 4",
-            ));
-        }
-        let valid = self.parameter_names();
-        for (name, _) in &self.nuisance {
-            if !valid.contains(&name.as_str()) {
-                return Err(bad(
-                    format!("nuisance parameter `{name}`"),
-                    &format!("valid: {}", valid.join(", ")),
-                ));
-            }
-        }
-        if !self.nuisance.iter().any(|(n, _)| n == "b1") {
-            return Err(bad("b1".into(), "the fiducial linear bias is required"));
-        }
-        for name in self.free.iter().chain(self.priors.iter().map(|p| &p.0)) {
-            if !valid.contains(&name.as_str()) {
-                return Err(bad(
-                    format!("free parameter `{name}`"),
-                    &format!(
-                        "the free nuisance parameters are among {}",
-                        valid.join(", ")
-                    ),
-                ));
-            }
-        }
-        for (name, sigma) in &self.priors {
-            if !(sigma.is_finite() && *sigma > 0.0 && self.free.contains(name)) {
-                return Err(bad(
-                    format!("prior on `{name}` (sigma {sigma})"),
-                    "a prior needs sigma > 0 on a free parameter",
-                ));
-            }
-        }
-        Ok(())
-    }
-}
 
 /// What a forecast varies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

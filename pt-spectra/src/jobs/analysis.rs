@@ -6,9 +6,9 @@
 //! analysis file's directory.
 
 use super::joint_fit::{Analysis, SetSpec};
-use super::BispectrumSpec;
 use crate::error::{Error, Result};
 use crate::fit::galaxy::{Linear, Prior, Search};
+use crate::statistic::{OptionValue, Options};
 use std::path::{Path, PathBuf};
 use toml::value::Table as Map;
 use toml::Value;
@@ -17,8 +17,8 @@ use toml::Value;
 const TOP: [&str; 3] = ["shared", "search", "dataset"];
 /// The keys of `[search]`.
 const SEARCH: [&str; 4] = ["starts", "seed", "profile_check", "linear"];
-/// The keys of a `[[dataset]]`.
-const SET: [&str; 30] = [
+/// The keys of a `[[dataset]]` besides the registered blocks' tables (`[dataset.<kind name>]`).
+const SET: [&str; 29] = [
     "label",
     "z",
     "tracer",
@@ -48,19 +48,6 @@ const SET: [&str; 30] = [
     "n_bar",
     "satellites",
     "desi_priors",
-    "bispectrum",
-];
-
-/// The keys of a `[dataset.bispectrum]`.
-const BISPECTRUM: [&str; 8] = [
-    "data",
-    "data_ells",
-    "ells",
-    "k_min",
-    "k_max",
-    "bin_width",
-    "covariance",
-    "n_bar",
 ];
 
 /// The error at `key` of `origin`.
@@ -282,7 +269,14 @@ fn optional<T>(
 
 fn data_set(origin: &str, base: &Path, n: usize, t: &Map) -> Result<SetSpec> {
     let at = format!("dataset[{n}].");
-    known(origin, &at, t, &SET)?;
+    let mut keys = SET.to_vec();
+    keys.extend(
+        crate::blocks::AVAILABLE
+            .iter()
+            .filter(|k| k.faces.analysis.is_some())
+            .map(|k| k.name),
+    );
+    known(origin, &at, t, &keys)?;
     let key = |k: &str| format!("{at}{k}");
     let need = |k: &str| {
         t.get(k)
@@ -421,71 +415,69 @@ fn data_set(origin: &str, base: &Path, n: usize, t: &Map) -> Result<SetSpec> {
             },
         },
         desi_priors: flag("desi_priors")?.unwrap_or(false),
-        bispectrum: match opt("bispectrum") {
-            None => None,
-            Some(Value::Table(b)) => Some(bispectrum(origin, base, &key("bispectrum."), b, t)?),
-            Some(_) => {
-                return Err(bad(
-                    origin,
-                    &key("bispectrum"),
-                    "must be a table `[dataset.bispectrum]`",
-                ))
-            }
-        },
+        block: block(origin, base, &at, t)?,
     })
 }
 
-/// A data set's `[dataset.bispectrum]` table `b` (at key prefix `at`; `set` the data set's table, whose
-/// n_bar is the default).
-fn bispectrum(origin: &str, base: &Path, at: &str, b: &Map, set: &Map) -> Result<BispectrumSpec> {
-    known(origin, at, b, &BISPECTRUM)?;
-    let key = |k: &str| format!("{at}{k}");
-    let need = |k: &str| {
-        b.get(k)
-            .ok_or_else(|| bad(origin, &key(k), "is required (missing)"))
-    };
-    let ells_of = |k: &str, default: Vec<usize>| -> Result<Vec<usize>> {
-        let v = match b.get(k) {
-            Some(v) => counts(origin, &key(k), v)?,
-            None => default,
+/// `v` as a block's option value.
+fn option_value(v: &Value) -> OptionValue {
+    match v {
+        Value::Integer(n) => OptionValue::Integer(*n),
+        Value::Float(x) => OptionValue::Number(*x),
+        Value::String(s) => OptionValue::Text(s.clone()),
+        Value::Boolean(b) => OptionValue::Flag(*b),
+        Value::Array(a) => OptionValue::List(a.iter().map(option_value).collect()),
+        Value::Table(_) => OptionValue::Other("table".into()),
+        Value::Datetime(_) => OptionValue::Other("date".into()),
+    }
+}
+
+/// The entries of `t` as block options.
+fn option_entries(t: &Map) -> Vec<(String, OptionValue)> {
+    t.iter()
+        .map(|(k, v)| (k.clone(), option_value(v)))
+        .collect()
+}
+
+/// A data set's block: the table `[dataset.<kind name>]` of a registered kind that can be fitted,
+/// checked by the kind ([`crate::statistic::AnalysisFace::check`]); the data set's table `set` (at
+/// `at`) is its parent (e.g. its n_bar a default).
+fn block(
+    origin: &str,
+    base: &Path,
+    at: &str,
+    set: &Map,
+) -> Result<Option<(&'static str, Options)>> {
+    let mut found = None;
+    for kind in crate::blocks::AVAILABLE {
+        let (Some(face), Some(v)) = (kind.faces.analysis, set.get(kind.name)) else {
+            continue;
         };
-        if v.is_empty() || v.iter().any(|l| ![0, 2, 4].contains(l)) {
+        let Value::Table(b) = v else {
             return Err(bad(
                 origin,
-                &key(k),
-                "the bispectrum multipoles are 0, 2, 4",
+                &format!("{at}{}", kind.name),
+                format!("must be a table `[dataset.{}]`", kind.name),
+            ));
+        };
+        if let Some((other, _)) = found {
+            return Err(bad(
+                origin,
+                &format!("{at}{}", kind.name),
+                format!(
+                    "a data set holds one block after the power spectrum (and it has a {other})"
+                ),
             ));
         }
-        Ok(v)
-    };
-    let n_bar = match b.get("n_bar").or_else(|| set.get("n_bar")) {
-        Some(v) => Some(number(origin, &key("n_bar"), v)?),
-        None => None,
-    };
-    if let Some(n) = n_bar {
-        if !(n.is_finite() && n > 0.0) {
-            return Err(bad(origin, &key("n_bar"), "must be > 0 [(h/Mpc)^3]"));
-        }
+        let options = Options {
+            origin: origin.to_string(),
+            at: format!("{at}{}.", kind.name),
+            entries: option_entries(b),
+            parent: option_entries(set),
+            base: Some(base.to_path_buf()),
+        };
+        (face.check)(&options)?;
+        found = Some((kind.name, options));
     }
-    let k_min = match b.get("k_min") {
-        Some(v) => number(origin, &key("k_min"), v)?,
-        None => 0.0,
-    };
-    let k_max = number(origin, &key("k_max"), need("k_max")?)?;
-    if k_max <= k_min {
-        return Err(bad(origin, &key("k_max"), "must exceed k_min"));
-    }
-    Ok(BispectrumSpec {
-        data: file(origin, &key("data"), base, need("data")?)?,
-        data_ells: ells_of("data_ells", vec![0, 2, 4])?,
-        ells: ells_of("ells", vec![0])?,
-        k_min,
-        k_max,
-        bin_width: match b.get("bin_width") {
-            Some(v) => Some(number(origin, &key("bin_width"), v)?),
-            None => None,
-        },
-        covariance: file(origin, &key("covariance"), base, need("covariance")?)?,
-        n_bar,
-    })
+    Ok(found)
 }

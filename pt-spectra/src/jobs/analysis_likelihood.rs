@@ -114,7 +114,7 @@ impl AnalysisLikelihood {
         self.cell.with_dependent(|_, l| l.value_and_gradient(x))
     }
 
-    /// Whether the exact gradient is available (every set without a bispectrum).
+    /// Whether the exact gradient is available (every set without a block after its power spectrum).
     pub fn exact_gradient(&self) -> bool {
         self.cell.with_dependent(|_, l| l.exact_gradient())
     }

@@ -14,11 +14,17 @@ use crate::bispectrum::{
 };
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
-use crate::output::{MethodNote, Table, BISPECTRUM, BISPECTRUM_SHAPE, WAVENUMBER};
+use crate::output::{MethodNote, Table, WAVENUMBER};
+
 use crate::precision::TwoLoopMethod;
 use crate::progress::Progress;
 use crate::setup::Prepared;
 use crate::store::TableStore;
+
+/// The unit of bispectra.
+pub(super) const BISPECTRUM: &str = "(Mpc/h)^6";
+/// Unit of a bispectrum counterterm shape: P P k², a bispectrum per coefficient in (Mpc/h)².
+pub(super) const BISPECTRUM_SHAPE: &str = "(Mpc/h)^4";
 
 /// What `bispectrum` computes beyond the linear spectrum.
 #[derive(Debug, Clone)]

@@ -3,6 +3,7 @@
 //! header; and the one place where the faces' bias options become the fourth-order bias basis.
 
 use super::bispectrum::one_loop_columns;
+use super::bispectrum::{BISPECTRUM, BISPECTRUM_SHAPE};
 use super::VERSION;
 use crate::bias::BiasParams;
 use crate::bispectrum::bias_kernels::LoopBias;
@@ -13,7 +14,7 @@ use crate::bispectrum::one_loop_galaxy::{one_loop_galaxy, OneLoopGalaxy};
 use crate::bispectrum::one_loop_galaxy_basis::GalaxyLoopBasis;
 use crate::bispectrum::one_loop_rsd::Orientation;
 use crate::error::{Error, Result};
-use crate::output::{MethodNote, Table, BISPECTRUM, BISPECTRUM_SHAPE, POWER};
+use crate::output::{MethodNote, Table, POWER};
 use crate::precision::TwoLoopMethod;
 use crate::progress::Progress;
 use crate::setup::Prepared;

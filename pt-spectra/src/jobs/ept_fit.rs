@@ -301,6 +301,15 @@ fn fit_header(
     header
 }
 
+/// The header's words for fits without their exact gradient: those with a block (e.g. "… with a
+/// bispectrum", the registered kinds' names).
+static NO_EXACT_GRADIENT: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
+    format!(
+        "central-difference gradients (no exact gradient with a {})",
+        crate::blocks::names().join(" or a ")
+    )
+});
+
 /// How the minimiser's gradients of the fits `exact` (one per fit) were made, for a header.
 pub(super) fn gradient_source(exact: impl Iterator<Item = bool>) -> &'static str {
     let (mut any, mut all) = (false, true);
@@ -314,7 +323,7 @@ pub(super) fn gradient_source(exact: impl Iterator<Item = bool>) -> &'static str
              and stochastic parameters, the marginalised ones through the envelope theorem and \
              d ln det F"
         }
-        (false, _) => "central-difference gradients (no exact gradient with a bispectrum)",
+        (false, _) => NO_EXACT_GRADIENT.as_str(),
         (true, false) => "exact gradients for some fits, central differences for the others",
     }
 }
@@ -371,14 +380,21 @@ pub(super) fn row_columns(t: &mut Table, rows: &[Row]) {
         .find(|b| !b.is_model())
         .unwrap_or_default();
     let physical = matches!(basis, FitBasis::Desi(_));
-    // with a bispectrum, its own parameters after the distortion's
-    let b_names: &[&str] = if rows.iter().any(|r| r.fit.bispectrum.is_some()) {
-        &crate::fit::galaxy::BISPECTRUM_NAMES
-    } else {
-        &[]
-    };
+    // with a block, its own parameters after the distortion's (the first row's block's)
+    let b_names: &[&str] = rows
+        .iter()
+        .find_map(|r| r.fit.block.as_ref())
+        .map_or(&[], |b| b.names);
     let value = |i: usize, f: &GalaxyFit| match (i.checked_sub(12), f.ap) {
-        (Some(b), _) if b >= 2 => f.bispectrum.map_or(f64::NAN, |v| v[b - 2]),
+        (Some(b), _) if b >= 2 => f
+            .block
+            .as_ref()
+            .and_then(|v| {
+                let n = b_names.get(b - 2)?;
+                let j = v.names.iter().position(|m| m == n)?;
+                v.values.get(j).copied()
+            })
+            .unwrap_or(f64::NAN),
         (None, _) if !basis.is_model() => f.in_basis.map_or(f64::NAN, |v| v[i]),
         (None, _) => f.best.values[i],
         (Some(0), Some(d)) => d.apar,
@@ -388,13 +404,13 @@ pub(super) fn row_columns(t: &mut Table, rows: &[Row]) {
     let names = slot_names(&basis)
         .iter()
         .filter(|&&n| !(physical && n == "alpha6p"));
-    // the columns in slot order: the model's parameters, α∥, α⊥ (if any), the bispectrum's (if any)
+    // the columns in slot order: the model's parameters, α∥, α⊥ (if any), the block's (if any)
     let ap_slots = [12, 13];
-    let b_slots = [14, 15, 16, 17];
+    let b_slots = 14..14 + b_names.len();
     let model_slots = (0..12).filter(|&i| !(physical && i == 7));
     let slots = model_slots
         .chain(ap_slots.into_iter().take(ap_names.len()))
-        .chain(b_slots.into_iter().take(b_names.len()));
+        .chain(b_slots);
     for (i, name) in slots.zip(names.chain(ap_names).chain(b_names)) {
         t.push(
             *name,
@@ -512,17 +528,18 @@ fn free_columns(t: &mut Table, rows: &[Row], name: &str, js: &[Option<usize>]) {
     );
 }
 
-/// The unit of an ept parameter.
+/// The unit of an ept parameter or a block's own ([`crate::statistic::Kind::units`]).
 fn unit(name: &str) -> &'static str {
     match name {
         "alpha0" | "alpha2" | "alpha4" | "alpha6" | "alpha0p" | "alpha2p" | "alpha4p" => {
             "(Mpc/h)^2"
         }
         "sn" => "(Mpc/h)^3",
-        "c1" => "(Mpc/h)^2",
         "sn2" => "(Mpc/h)^5",
         "sn4" => "(Mpc/h)^7",
-        _ => "1",
+        _ => crate::blocks::owner(name)
+            .and_then(|k| k.units.get(k.index(name)?).copied())
+            .unwrap_or("1"),
     }
 }
 

@@ -9,7 +9,7 @@ use crate::setup::NamedCosmology;
 use crate::store::TableStore;
 
 /// Parses a bin given as `z=0.57,volume=2.6e9,n_bar=3e-4,k_max=0.15,b1=2` (and optionally k_min,
-/// dk, b_k_max and nuisance values by name: [`SurveyBin::from_values`]); `ells` and `free` apply to
+/// dk, a block's survey key (e.g. b_k_max) and nuisance values by name: [`SurveyBin::from_values`]); `ells` and `free` apply to
 /// it.
 ///
 /// # Errors
@@ -34,12 +34,10 @@ pub fn parse_bin(text: &str, ells: &[usize], free: &[String]) -> Result<SurveyBi
     bin.ells = ells.to_vec();
     if !free.is_empty() {
         bin.free = free.to_vec();
-        if bin.b_k_max.is_some() {
-            bin.free.extend(
-                crate::forecast::BISPECTRUM_FREE
-                    .iter()
-                    .map(|s| s.to_string()),
-            );
+        for (name, _) in &bin.blocks {
+            let kind = crate::blocks::by_name(name)?;
+            bin.free
+                .extend(kind.forecast_free.iter().map(|s| s.to_string()));
         }
     }
     Ok(bin)
@@ -80,6 +78,18 @@ pub fn forecast_table(
          no super-sample or trispectrum terms), from the fiducial P(k, mu) of l <= 8"
             .into(),
     ];
+    // the registered blocks' own defaults other than 0 (e.g. "; b_shot 1"), and their names
+    let other_defaults: String = crate::blocks::AVAILABLE
+        .iter()
+        .flat_map(|k| k.own.iter().zip(k.defaults))
+        .filter(|(_, &v)| v != 0.0)
+        .map(|(n, v)| format!("; {n} {v}"))
+        .collect();
+    let blocks_named = crate::blocks::names()
+        .iter()
+        .map(|n| format!("the {n}"))
+        .collect::<Vec<_>>()
+        .join(", ");
     for (i, b) in bins.iter().enumerate() {
         let fixed: Vec<String> = b
             .nuisance
@@ -88,7 +98,7 @@ pub fn forecast_table(
             .collect();
         header.push(format!(
                         "bin {}: z = {}, V = {:e} (Mpc/h)^3, n_bar = {:e} (h/Mpc)^3, shells of {} h/Mpc from {} to \
-             {} h/Mpc, multipoles {:?}{}; fiducial {} (others 0; b_shot 1); free nuisance {} \
+             {} h/Mpc, multipoles {:?}{}; fiducial {} (others 0{}); free nuisance {} \
              (marginalised){}",
             i + 1,
             b.z,
@@ -98,12 +108,9 @@ pub fn forecast_table(
             b.k_min,
             b.k_max,
                         b.ells,
-            b.b_k_max.map_or(String::new(), |m| format!(
-                " and the bispectrum monopole B0 of every closed triangle bin of these shells up to \
-                 {m} h/Mpc (tree level, IR resummed; Gaussian variance s123 k_f^3 P_t P_t P_t / V_B \
-                 with the monopole, no P-B cross-covariance: an optimistic bound on what B adds)"
-            )),
+            b.block_notes(),
             fixed.join(", "),
+            other_defaults,
             b.free.join(", "),
             if b.priors.is_empty() {
                 String::new()
@@ -122,10 +129,11 @@ pub fn forecast_table(
     header.push(format!(
         "parameters: {}; derivatives of the nuisance parameters exact, of f, apar, aperp and the \
          cosmological parameters exact for the power spectrum alone (through the emulator, growth, \
-         loops and AP), with the bispectrum by Richardson-extrapolated central differences (largest \
+         loops and AP), with {} by Richardson-extrapolated central differences (largest \
          error {:.1e} of a derivative's largest element); {} data points",
         match parameters {
-            Parameters::Template => "f, apar, aperp per bin (sigma(fsigma8) = sigma8(z) sigma(f))".to_string(),
+            Parameters::Template =>
+                "f, apar, aperp per bin (sigma(fsigma8) = sigma8(z) sigma(f))".to_string(),
             Parameters::Cosmology => format!(
                 "{} shared{}",
                 COSMOLOGY_NAMES.join(", "),
@@ -143,6 +151,7 @@ pub fn forecast_table(
                 }
             ),
         },
+        blocks_named,
         f.derivative_error,
         f.points
     ));

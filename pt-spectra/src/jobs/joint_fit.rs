@@ -82,9 +82,9 @@ pub struct SetSpec {
     pub box_side: Option<f64>,
     /// IR resummation.
     pub ir: bool,
-    /// The bispectrum beside the power spectrum, with their joint covariance (then `covariance`
-    /// is not given), if any.
-    pub bispectrum: Option<super::BispectrumSpec>,
+    /// The block beside the power spectrum, with their joint covariance (then `covariance` is not
+    /// given), if any: its kind's name and its table (`[dataset.<kind name>]`).
+    pub block: Option<(&'static str, crate::statistic::Options)>,
 }
 
 /// A joint analysis: its data sets, the shared parameters and the search.
@@ -148,7 +148,7 @@ pub(super) fn data_sets<'a>(analysis: &Analysis, loaded: &'a [Loaded]) -> Vec<Da
             data: &l.data,
             request: l.request.clone(),
             observation: l.observation.as_ref(),
-            bispectrum: l.block.as_ref(),
+            block: l.block.as_ref(),
         })
         .collect()
 }
@@ -173,21 +173,24 @@ pub(super) fn load(s: &SetSpec, origin: &str, inputs: &Inputs) -> Result<Loaded>
     let layout = DataLayout::new(&s.data_ells, s.data_columns.as_deref()).map_err(err)?;
     let mut data = layout.read(&s.data, &s.ells).map_err(err)?;
     if let Some(path) = &s.covariance {
-        if s.bispectrum.is_some() {
+        if let Some((name, _)) = &s.block {
             return Err(err(Error::InvalidChoice {
-                what: "covariance with a bispectrum".into(),
-                reason: "the power spectrum's covariance is the joint one's block: give only \
-                         bispectrum.covariance"
-                    .into(),
+                what: format!("covariance with a {name}"),
+                reason: format!(
+                    "the power spectrum's covariance is the joint one's block: give only \
+                     {name}.covariance"
+                ),
             }));
         }
         data = layout.read_covariance(data, path).map_err(err)?;
     }
     // the block after the power spectrum and its header line
     let mut block = None;
-    if let Some(spec) = &s.bispectrum {
-        let (with_cov, fit, line) = super::joint_bispectrum::load_bispectrum(
-            spec,
+    if let Some((name, options)) = &s.block {
+        let kind = crate::blocks::by_name(name).map_err(err)?;
+        let (with_cov, fit, line) = super::joint_block::load_block(
+            kind,
+            options,
             &layout,
             &s.data,
             data,

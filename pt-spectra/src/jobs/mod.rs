@@ -51,7 +51,7 @@ mod ept_fit;
 mod fit;
 mod forecast;
 mod halo;
-mod joint_bispectrum;
+mod joint_block;
 mod joint_fit;
 mod observe;
 mod report;
@@ -75,7 +75,6 @@ pub use ept_fit::{
 pub use fit::{fit_table, fit_tables, FitOutputs, FitRequest, FitTables};
 pub use forecast::{forecast_table, parse_bin};
 pub use halo::{halo_table, HaloRequest};
-pub use joint_bispectrum::BispectrumSpec;
 pub use joint_fit::{joint_fit_table, Analysis, Inputs, SetSpec, DEFAULT_B1};
 pub use observe::{observed_table, ApSpec, ObservationSpec};
 pub use report::{contour_table, push_spectrum_errors, real_spectra_table, rsd_multipoles_table};

@@ -29,12 +29,8 @@ use crate::estimate::Estimate;
 
 /// The unit of spectra.
 pub const POWER: &str = "(Mpc/h)^3";
-/// The unit of bispectra.
-pub const BISPECTRUM: &str = "(Mpc/h)^6";
 /// The unit of wavenumbers.
 pub const WAVENUMBER: &str = "h/Mpc";
-/// Unit of a bispectrum counterterm shape: P P k², a bispectrum per coefficient in (Mpc/h)².
-pub const BISPECTRUM_SHAPE: &str = "(Mpc/h)^4";
 
 /// One column: its name, unit and a value per row.
 #[derive(Debug, Clone, PartialEq)]

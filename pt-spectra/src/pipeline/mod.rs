@@ -43,12 +43,12 @@ use crate::setup::{LinearSource, NamedCosmology, Prepared, Request};
 use crate::statistic::{Block, Shared, Spec, Terms};
 use crate::store::TableStore;
 use crate::survey::observe::{apply_matrix, Observation};
+use std::sync::Arc;
 
 pub mod cosmological;
 mod linearised;
 pub mod loop_range;
 pub mod mu_rule;
-pub use crate::bispectrum::block::BispectrumBlock;
 pub use cosmological::CosmologyJacobian;
 pub use linearised::{Linearised, JACOBIAN_NAMES, NUISANCE_NAMES};
 
@@ -78,9 +78,9 @@ pub struct PipelineSettings {
     pub ir: bool,
     /// The largest projection residual evaluated on the basis ([`PIPELINE_MAX_RESIDUAL`]).
     pub max_residual: f64,
-    /// The tree-level bispectrum multipoles after the power spectrum in the data vector (`None`:
-    /// the power spectrum alone): the registered block of [`Self::blocks`].
-    pub bispectrum: Option<BispectrumBlock>,
+    /// The blocks after the power spectrum in the data vector, in its order (none: the power
+    /// spectrum alone), each planned by [`Self::planned_blocks`].
+    pub blocks: Vec<Arc<dyn Spec>>,
     /// Whether the loop terms are computed only where the observation weighs them, the range chosen
     /// by measurement at build time ([`loop_range`]; default true). False: everywhere.
     pub restrict_loops: bool,
@@ -91,8 +91,8 @@ impl PipelineSettings {
     ///
     /// # Errors
     /// As each block's planning ([`Spec::plan`]).
-    pub fn blocks(&self) -> crate::error::Result<Vec<Box<dyn Block>>> {
-        self.bispectrum.iter().cloned().map(Spec::plan).collect()
+    pub fn planned_blocks(&self) -> crate::error::Result<Vec<Box<dyn Block>>> {
+        self.blocks.iter().map(|s| s.plan()).collect()
     }
 
     /// `ept` at `z` with IR resummation, the AP distortion against `fiducial`, and
@@ -104,7 +104,7 @@ impl PipelineSettings {
             fiducial,
             ir: true,
             max_residual: PIPELINE_MAX_RESIDUAL,
-            bispectrum: None,
+            blocks: Vec::new(),
             restrict_loops: true,
         }
     }
@@ -119,7 +119,7 @@ pub struct Pipeline {
     matrix: Vec<f64>,
     rows: usize,
     emulator: LinearEmulator,
-    /// The blocks after the power spectrum, planned ([`PipelineSettings::blocks`]).
+    /// The blocks after the power spectrum, planned ([`PipelineSettings::planned_blocks`]).
     blocks: Vec<Box<dyn Block>>,
     /// The measured change of the reference data vector by the loop range, if restricted
     /// ([`loop_range`]).
@@ -234,7 +234,7 @@ impl Pipeline {
         if let Some((n, _)) = mu_rule {
             plan = plan.with_value_nodes(n)?;
         }
-        let blocks = settings.blocks()?;
+        let blocks = settings.planned_blocks()?;
         Ok(Self {
             settings,
             plan,

@@ -2,14 +2,14 @@
 //! multipoles with the AP distortion, and the observation (BOSS CMASS NGC window, 38 k); with a
 //! bispectrum block, against the bispectrum plan on the same spectrum.
 
+use pt_spectra::bispectrum::block::BispectrumBlock;
 use pt_spectra::bispectrum::{BispectrumParams, BispectrumPlan, Fog, Settings, TriangleSet};
 use pt_spectra::cosmology::Cosmology;
 use pt_spectra::jobs::ept_plan;
 use pt_spectra::pipeline::loop_range::LOOP_RANGE_TOLERANCE;
 use pt_spectra::pipeline::mu_rule::MU_RULE_TOLERANCE;
 use pt_spectra::pipeline::{
-    BispectrumBlock, Pipeline, PipelineSettings, TermsSource, JACOBIAN_NAMES, NUISANCE_NAMES,
-    PIPELINE_MAX_RESIDUAL,
+    Pipeline, PipelineSettings, TermsSource, JACOBIAN_NAMES, NUISANCE_NAMES, PIPELINE_MAX_RESIDUAL,
 };
 use pt_spectra::precision::{Precision, TwoLoopMethod};
 use pt_spectra::progress::Silent;
@@ -294,7 +294,7 @@ fn bispectrum_block() -> BispectrumBlock {
 #[test]
 fn a_bispectrum_block_follows_the_power_spectrum_with_the_same_spectrum_f_and_distortion() {
     let mut settings = PipelineSettings::ept(Z, Some(fiducial()));
-    settings.bispectrum = Some(bispectrum_block());
+    settings.blocks = vec![std::sync::Arc::new(bispectrum_block())];
     let pl = Pipeline::new(observation(), settings, &precision(), &store(), &Silent).unwrap();
     assert_eq!((pl.len(), pl.power_len()), (3 * 38 + 2 * 4, 3 * 38));
     let b_params = [("c1", 2.0), ("b_shot", 0.9), ("a_shot", 0.1)];

@@ -20,6 +20,15 @@ use std::sync::Arc;
 /// Terms kept: a gradient's steps of f, α∥, α⊥ each make their own; the centre's is found again.
 const TERMS_CACHE: usize = 4;
 
+/// A block's own parameters at a fit's best fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OwnValues {
+    /// Their names ([`Kind::own`]).
+    pub names: &'static [&'static str],
+    /// Their values, in that order.
+    pub values: Vec<f64>,
+}
+
 /// A data set's block: the model and the measured entries with their covariance.
 #[derive(Clone)]
 pub struct BlockFit {
@@ -55,7 +64,7 @@ impl BlockFit {
     /// As the block's planning and preparation; [`Error::InvalidChoice`] for sizes that do not match
     /// the block or a value that is not finite.
     pub fn new(
-        spec: impl Spec,
+        spec: &dyn Spec,
         spectrum: LinearSpectrum,
         ir: bool,
         values: Vec<f64>,

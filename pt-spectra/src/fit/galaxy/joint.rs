@@ -52,8 +52,8 @@ pub struct DataSet<'a> {
     pub request: GalaxyFitRequest,
     /// Its window and bins, if any.
     pub observation: Option<&'a Observation>,
-    /// Its block after the power spectrum (the bispectrum), if any (fitted with one covariance).
-    pub bispectrum: Option<&'a BlockFit>,
+    /// Its block after the power spectrum, if any (fitted with one covariance).
+    pub block: Option<&'a BlockFit>,
 }
 
 /// The result of a joint fit.
@@ -343,18 +343,11 @@ fn build<'a>(
     }
     let mut objectives = Vec::with_capacity(sets.len());
     for s in sets {
-        let mut o = objective(
-            s.plan,
-            s.terms,
-            s.data,
-            &s.request,
-            s.observation,
-            s.bispectrum,
-        )
-        .map_err(|e| Error::InvalidChoice {
-            what: format!("data set `{}`", s.label),
-            reason: e.to_string(),
-        })?;
+        let mut o = objective(s.plan, s.terms, s.data, &s.request, s.observation, s.block)
+            .map_err(|e| Error::InvalidChoice {
+                what: format!("data set `{}`", s.label),
+                reason: e.to_string(),
+            })?;
         o.log_det = linear == Linear::Marginalised;
         objectives.push(o);
     }

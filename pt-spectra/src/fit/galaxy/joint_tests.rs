@@ -61,7 +61,7 @@ fn set<'a>(
         data,
         request: request.clone(),
         observation: None,
-        bispectrum: None,
+        block: None,
     }
 }
 

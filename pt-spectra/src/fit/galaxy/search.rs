@@ -16,7 +16,7 @@
 //!   by more than 0.01 means the starts missed the global minimum: the search restarts there.
 
 use super::objective::Objective;
-use super::{FitBasis, GalaxyFit, PriorShape, AP_SLOT, OWN_SLOT};
+use super::{FitBasis, GalaxyFit, OwnValues, PriorShape, AP_SLOT, OWN_SLOT};
 use crate::error::{Error, Result};
 use crate::fit::bounded::{
     hessian_from_gradient, multistart, Minimum, Problem, ValueGradient, AGREEMENT,
@@ -469,10 +469,13 @@ pub(super) fn package(
         exact_gradient: found.exact_gradient,
         evaluations: found.evaluations,
         in_basis: (!objective.basis.is_model()).then(|| std::array::from_fn(|i| slots[i])),
-        bispectrum: objective
-            .has_block()
-            .then(|| slots[OWN_SLOT..].try_into().ok())
-            .flatten(),
+        block: objective.block.as_ref().and_then(|b| {
+            let own = b.fit.kind().own;
+            Some(OwnValues {
+                names: own,
+                values: slots.get(OWN_SLOT..OWN_SLOT + own.len())?.to_vec(),
+            })
+        }),
     })
 }
 

@@ -6,7 +6,7 @@ use crate::linear::{LinearSpectrum, LogGrid};
 use crate::precision::Precision;
 use crate::rsd::ept::EptSettings;
 
-pub(super) fn setup() -> (EptPlan, EptTerms, EptParams, MultipoleData) {
+pub(crate) fn setup() -> (EptPlan, EptTerms, EptParams, MultipoleData) {
     let k = LogGrid::new(0.02, 0.2, 24).unwrap().points();
     let plan = EptPlan::new(
         &k,

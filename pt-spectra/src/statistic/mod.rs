@@ -15,7 +15,11 @@
 use crate::error::{Error, Result};
 use crate::linear::LinearSpectrum;
 use std::any::Any;
+use std::path::PathBuf;
 use std::sync::Arc;
+
+mod options;
+pub use options::{OptionValue, Options};
 
 /// The galaxy model's parameters a block shares (velocileptors' bias convention); f and the
 /// distortion are where its terms are made ([`Block::terms`]).
@@ -51,18 +55,100 @@ pub type Range = (f64, f64, f64, f64, f64);
 /// What kind of block, independently of its configurations: its name and its own parameters.
 #[derive(Debug)]
 pub struct Kind {
-    /// Its name in messages and headers (e.g. "bispectrum").
+    /// Its name in messages and headers, and its key in the faces (an analysis file's
+    /// `[dataset.<name>]`, a Python keyword).
     pub name: &'static str,
     /// Its own parameters, in the order of [`Terms::values`]' `own`.
     pub own: &'static [&'static str],
     /// Their values when not given.
     pub defaults: &'static [f64],
+    /// Their units in tables ("1": none).
+    pub units: &'static [&'static str],
     /// Those that enter the block linearly (affinely): a fit marginalises them analytically.
     pub linear: &'static [&'static str],
     /// Per own parameter, its range in a fit ([`Range`]).
     pub ranges: &'static [Range],
     /// Those a forecast frees by default.
     pub forecast_free: &'static [&'static str],
+    /// How the faces build it from their text ([`Options`]).
+    pub faces: Faces,
+}
+
+/// Settings of a block as the pipeline's settings hold them.
+pub type SharedSpec = Arc<dyn Spec>;
+
+/// How the faces build a kind of block from their text, each from [`Options`]: the pipeline's
+/// keywords, a forecast's survey bin, an analysis file's data set.
+#[derive(Debug, Clone, Copy)]
+pub struct Faces {
+    /// Its keywords in a pipeline's face besides its name (e.g. Python's `pt.Pipeline`): given, they
+    /// are its options.
+    pub keywords: &'static [&'static str],
+    /// The block of a pipeline from its options; `None` where they do not ask for it.
+    pub pipeline: fn(&Options) -> Result<Option<SharedSpec>>,
+    /// Its face in a forecast's survey bin, if a forecast can hold it.
+    pub survey: Option<SurveyFace>,
+    /// Its measurement in an analysis file's data set, if a fit can hold it.
+    pub analysis: Option<AnalysisFace>,
+}
+
+/// A block in a forecast's survey bin, switched on by one number of the bin (its key).
+#[derive(Debug, Clone, Copy)]
+pub struct SurveyFace {
+    /// The key of the bin that holds the number (e.g. the largest side of the triangle bins).
+    pub key: &'static str,
+    /// Checks the number against the bin's shells.
+    pub check: fn(f64, &Shells) -> Result<()>,
+    /// The block of the bin.
+    pub plan: fn(f64, &Shells) -> Result<Arc<dyn Spec>>,
+    /// What the block is, for the forecast's header (a phrase after the power spectrum's).
+    pub note: fn(f64) -> String,
+}
+
+/// A forecast bin's k shells and density, which its blocks are planned on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Shells {
+    /// The first shell's lower edge [h/Mpc].
+    pub k_min: f64,
+    /// The last shell's upper edge [h/Mpc].
+    pub k_max: f64,
+    /// The shell width [h/Mpc].
+    pub dk: f64,
+    /// The edges: `k_min`, then every shell's upper edge [h/Mpc].
+    pub edges: Vec<f64>,
+    /// The number density [(h/Mpc)³].
+    pub n_bar: f64,
+}
+
+/// A block measured beside a data set's power spectrum in an analysis file's table
+/// (`[dataset.<kind name>]`).
+#[derive(Debug, Clone, Copy)]
+pub struct AnalysisFace {
+    /// Checks the table when the file is read (keys, types, that the files exist).
+    pub check: fn(&Options) -> Result<()>,
+    /// Reads the measurement when the data set is loaded.
+    pub measure: fn(&Options) -> Result<Measured>,
+}
+
+/// A block's measurement, as read by [`AnalysisFace::measure`]: the generic fit reads the joint
+/// covariance of the power spectrum and the block (square over every power-spectrum entry of the
+/// data file, then every entry of the block's file) and keeps the fitted entries.
+#[derive(Debug)]
+pub struct Measured {
+    /// The block fitted.
+    pub spec: Arc<dyn Spec>,
+    /// Every entry of its file in the joint covariance's order, in columns (e.g. a multipole's
+    /// values at every triangle).
+    pub columns: Vec<Vec<f64>>,
+    /// The fitted entries (in the block's order): their positions among the file's (columns
+    /// concatenated).
+    pub fitted: Vec<usize>,
+    /// The joint covariance file.
+    pub covariance: PathBuf,
+    /// The file's entries in words, for the covariance's error (e.g. "3 multipoles x 40 triangles").
+    pub layout: String,
+    /// The header line after the block's description (the data, the selection, the covariance).
+    pub note: String,
 }
 
 impl Kind {
@@ -161,11 +247,12 @@ pub fn foreign(kind: &Kind) -> Error {
     }
 }
 
-/// Settings that plan into a [`Block`] (e.g. a statistic's configurations from an analysis file).
-pub trait Spec {
+/// Settings that plan into a [`Block`] (e.g. a statistic's configurations from an analysis file),
+/// held by the pipeline's settings as `Arc<dyn Spec>`.
+pub trait Spec: std::fmt::Debug + Send + Sync {
     /// The planned block.
     ///
     /// # Errors
     /// As the statistic's planning.
-    fn plan(self) -> Result<Box<dyn Block>>;
+    fn plan(&self) -> Result<Box<dyn Block>>;
 }

@@ -2,11 +2,19 @@
 //! the bispectrum tightening f and b2, the cross-covariance entering the likelihood as it must, and
 //! the refusals.
 
-use super::tests::setup;
-use super::*;
 use crate::bispectrum::block::BispectrumBlock;
 use crate::bispectrum::{Fog, LegendreSide, PlanRules, TriangleSet};
+use crate::fit::galaxy::tests::setup;
+use crate::fit::galaxy::{
+    fit_joint, BlockFit, DataSet, FitBasis, GalaxyFitRequest, JointFit, JointLikelihood, Linear,
+    Search,
+};
+use crate::fit::MultipoleData;
 use crate::linear::LinearSpectrum;
+use crate::rsd::ept::{EptParams, EptPlan, EptTerms};
+use crate::statistic::{Shared, Spec};
+
+type BispectrumFit = BlockFit;
 
 /// Number density of the model data's stochastic terms [(h/Mpc)³].
 const N_BAR: f64 = 3e-4;
@@ -57,7 +65,7 @@ fn data(cross: f64) -> (EptPlan, EptTerms, EptParams, MultipoleData, BispectrumF
     );
     let spectrum = LinearSpectrum::gm2012(0.5).unwrap();
     let model = BispectrumFit::new(
-        block(),
+        &block(),
         spectrum.clone(),
         false,
         vec![0.0; 20],
@@ -76,7 +84,7 @@ fn data(cross: f64) -> (EptPlan, EptTerms, EptParams, MultipoleData, BispectrumF
         c[0][j] = cross * sigma_p[0] * sigma_b[j];
     }
     let fit = BispectrumFit::new(
-        block(),
+        &block(),
         spectrum,
         false,
         values,
@@ -103,8 +111,19 @@ fn diagonal(v: &[f64]) -> Vec<Vec<f64>> {
 
 /// B of `fit`'s block at `truth` and `fit`'s start values of its own parameters.
 fn bispectrum_of(fit: &BispectrumFit, truth: &EptParams) -> Vec<f64> {
-    let model = bispectrum::BispectrumModel::new(fit);
-    model.values(truth, None, fit.start()).unwrap()
+    let spectrum = LinearSpectrum::gm2012(0.5).unwrap();
+    let block = block().plan().unwrap();
+    let prepared = block.prepare(&spectrum, false).unwrap();
+    let terms = block
+        .terms(&spectrum, &prepared, truth.f(), (1.0, 1.0))
+        .unwrap();
+    let bias = truth.bias();
+    let shared = Shared {
+        b1: bias.b1,
+        b2: bias.b2,
+        bs: bias.bs,
+    };
+    terms.values(shared, fit.start()).unwrap()
 }
 
 fn request(truth: &EptParams, marginalise: &[&str]) -> GalaxyFitRequest {
@@ -143,7 +162,7 @@ fn set<'a>(
         data,
         request: request.clone(),
         observation: None,
-        bispectrum,
+        block: bispectrum,
     }
 }
 
@@ -171,7 +190,7 @@ fn the_truth_is_recovered_and_the_bispectrum_tightens_f_and_b2() {
         let got = fit.best.get(name).unwrap();
         assert!((got - want).abs() < 1e-3, "{name}: {got} vs {want}");
     }
-    let own = fit.bispectrum.unwrap();
+    let own = fit.block.as_ref().unwrap().values.clone();
     assert!((own[0] - 5.0).abs() < 0.05, "c1 {own:?}");
     assert!((own[1] - 1.2).abs() < 1e-3, "b_shot {own:?}");
     // the power spectrum alone: no bispectrum parameter, wider errors
@@ -207,8 +226,10 @@ fn the_cross_covariance_enters_the_likelihood() {
         let mut r = request(&truth, &[]);
         r.free = vec!["b2".into()];
         r.start = truth;
-        let o = objective::objective(&plan, &terms, &data, &r, None, Some(&b)).unwrap();
-        o.evaluate(&[truth.get("b2").unwrap()]).unwrap().1
+        let sets = [set(&plan, &terms, &data, &r, Some(&b))];
+        // no prior, no marginalised parameter, no ln det: −2 ln L is χ²
+        let o = JointLikelihood::new(&sets, &[], Linear::Profiled).unwrap();
+        o.minus_two_log_l(&[truth.get("b2").unwrap()]).unwrap()
     };
     let uncorrelated = chi2_at_truth(0.0);
     assert!((uncorrelated - 1.0).abs() < 1e-9, "{uncorrelated}");
@@ -244,7 +265,7 @@ fn refusals_name_the_problem() {
     assert!(e.contains("joint covariance"), "{e}");
     let spectrum = LinearSpectrum::gm2012(0.5).unwrap();
     let e = BispectrumFit::new(
-        block(),
+        &block(),
         spectrum,
         false,
         vec![1.0; 19],
