@@ -123,6 +123,8 @@ def test_the_loop_range_is_stated_and_can_be_switched_off(setup):
     (lo, hi), change = pipe.meta["loop_range"]
     assert obs.k_model[0] < lo < 0.015 and 0.38 < hi < obs.k_model[-1]
     assert 0 <= change <= 1e-5 and "loop terms on true k" in pipe.meta["loop_range_note"]
+    # the rule in mu, chosen at construction by the same kind of measurement, is stated too
+    assert pipe.meta["mu_rule_note"].startswith("multipoles: 16-point Gauss-Legendre rule in mu")
     everywhere = pt.Pipeline(obs, Z, precision="fast", cache_dir=cache, restrict_loops=False)
     assert everywhere.meta["loop_range"] is None
     a, b = pipe(COSMO, **PARAMS), everywhere(COSMO, **PARAMS)
