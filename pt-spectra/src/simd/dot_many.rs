@@ -79,10 +79,51 @@ impl pulp::NullaryFnOnce for MatVec32<'_> {
 
     #[inline(always)]
     fn call(self) {
-        for (o, row) in self.out.iter_mut().zip(self.a.chunks_exact(self.x.len())) {
-            *o = super::dot32_v3(self.simd, row, self.x);
+        let n = self.x.len();
+        let full = self.out.len() / 4 * 4;
+        let (head, rest) = self.out.split_at_mut(full);
+        for (i, o) in head.chunks_exact_mut(4).enumerate() {
+            let a = &self.a[4 * i * n..4 * (i + 1) * n];
+            let four = std::array::from_fn(|q| &a[q * n..(q + 1) * n]);
+            o.copy_from_slice(&dot32_rows_four_v3(self.simd, four, self.x));
+        }
+        for (j, o) in rest.iter_mut().enumerate() {
+            let r = full + j;
+            *o = super::dot32_v3(self.simd, &self.a[r * n..(r + 1) * n], self.x);
         }
     }
+}
+
+/// [`super::dot32`] of four rows with one vector, each row's sums in [`super::dot32_v3`]'s order (the
+/// same numbers to the bit), the vector's entries loaded once for the four: short rows (a low-rank
+/// tensor's rank) spend as much on a row's loop and final sums as on its products.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn dot32_rows_four_v3(simd: pulp::x86::V3, a: [&[f32]; 4], b: &[f64]) -> [f64; 4] {
+    use pulp::{f32x4, f64x4};
+    let (b8, b_rest) = pulp::as_arrays::<8, _>(b);
+    let a8 = a.map(|a| pulp::as_arrays::<8, _>(a).0);
+    let mut acc = [[simd.splat_f64x4(0.0); 2]; 4];
+    for (c, y) in b8.iter().enumerate() {
+        for h in 0..2 {
+            let y: f64x4 = pulp::cast([y[4 * h], y[4 * h + 1], y[4 * h + 2], y[4 * h + 3]]);
+            for q in 0..4 {
+                let x = &a8[q][c];
+                let x: f32x4 = pulp::cast([x[4 * h], x[4 * h + 1], x[4 * h + 2], x[4 * h + 3]]);
+                acc[q][h] = simd.mul_add_f64x4(simd.convert_f32x4_to_f64x4(x), y, acc[q][h]);
+            }
+        }
+    }
+    let head = b8.len() * 8;
+    std::array::from_fn(|q| {
+        let s: [f64; 4] = pulp::cast(simd.add_f64x4(acc[q][0], acc[q][1]));
+        let tail: f64 = a[q][head..]
+            .iter()
+            .zip(b_rest)
+            .map(|(x, y)| f64::from(*x) * y)
+            .sum();
+        (s[0] + s[1]) + (s[2] + s[3]) + tail
+    })
 }
 
 /// `out[q][i]` = [`dot32_four`] of row i of `a` (rows of the vectors' length) with the four `b`, to
