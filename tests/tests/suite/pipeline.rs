@@ -93,6 +93,29 @@ fn assert_close(a: &[f64], b: &[f64], tol: f64, what: &str) {
 
 /// The existing path: the prepared emulated spectrum, the plan on the AP range, its multipoles at
 /// the distortion of the cosmology, then the observation's own steps.
+/// The ept plan of the observation's model k with IR and the AP range, on the basis (24 μ nodes).
+fn observation_plan(obs: &Observation) -> pt_spectra::rsd::ept::EptPlan {
+    ept_plan(
+        obs.k_model(),
+        true,
+        None,
+        true,
+        &precision(),
+        &store(),
+        &Silent,
+    )
+    .unwrap()
+}
+
+/// [`PARAMS`] at growth rate f.
+fn params_at(f: f64) -> EptParams {
+    let mut p = EptParams::new(0.0, f);
+    for (n, v) in PARAMS {
+        p.set(n, v).unwrap();
+    }
+    p
+}
+
 fn chain(max_residual: f64, c: &Cosmology) -> (Vec<f64>, Option<f64>) {
     let obs = observation();
     let prepared = prepare(Request {
@@ -104,23 +127,11 @@ fn chain(max_residual: f64, c: &Cosmology) -> (Vec<f64>, Option<f64>) {
         z: Z,
     })
     .unwrap();
-    let plan = ept_plan(
-        obs.k_model(),
-        true,
-        None,
-        true,
-        &precision(),
-        &store(),
-        &Silent,
-    )
-    .unwrap()
-    .with_max_residual(max_residual)
-    .unwrap();
+    let plan = observation_plan(&obs)
+        .with_max_residual(max_residual)
+        .unwrap();
     let terms = plan.terms(prepared.tracer_spectrum()).unwrap();
-    let mut p = EptParams::new(0.0, prepared.growth_rate);
-    for (n, v) in PARAMS {
-        p.set(n, v).unwrap();
-    }
+    let p = params_at(prepared.growth_rate);
     let ap = Distortion::from_cosmologies(c, &fiducial(), Z).unwrap();
     let m = plan
         .multipole_values_at(&terms, &p, obs.model_ells(), Some(ap))
@@ -416,24 +427,12 @@ fn the_mu_rule_is_measured_at_build_and_changes_the_data_vector_by_little() {
         .describe_mu_rule()
         .starts_with(&format!("multipoles: {n}-point")));
     let obs = observation();
-    let plan = ept_plan(
-        obs.k_model(),
-        true,
-        None,
-        true,
-        &precision(),
-        &store(),
-        &Silent,
-    )
-    .unwrap();
+    let plan = observation_plan(&obs);
     let fewer = plan.clone().with_value_nodes(n).unwrap();
     assert_eq!((plan.value_nodes(), fewer.value_nodes()), (MU_NODES, n));
     let prepared = pl.prepare(&truth()).unwrap();
     let terms = plan.terms(prepared.tracer_spectrum()).unwrap();
-    let mut p = EptParams::new(0.0, 0.9);
-    for (name, v) in PARAMS {
-        p.set(name, v).unwrap();
-    }
+    let p = params_at(0.9);
     let ap = Some(Distortion::new(1.2, 0.85).unwrap());
     let data = |plan: &pt_spectra::rsd::ept::EptPlan| {
         let m = plan
