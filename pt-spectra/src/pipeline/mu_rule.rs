@@ -11,6 +11,7 @@
 //! largest |value| (at the same distortion) is taken, and the change is kept and stated.
 
 use super::loop_range::{relative_change, Reference};
+use super::Pipeline;
 use crate::error::Result;
 use crate::rsd::ap::Distortion;
 use crate::rsd::ept::{EptSettings, MU_NODES};
@@ -59,4 +60,31 @@ pub(super) fn choose(
         }
     }
     Ok(None)
+}
+
+impl Pipeline {
+    /// The nodes of the rule in μ of the multipoles and the change of the reference data vector
+    /// they measured at build time, relative to each multipole's largest |value| at the worst
+    /// distortion ([`MU_RULE_TOLERANCE`]); `None` if the step keeps
+    /// [`crate::rsd::ept::MU_NODES`].
+    pub fn mu_rule(&self) -> Option<(usize, f64)> {
+        self.mu_rule
+    }
+
+    /// One line for a header, a `meta` entry or a log: the rule in μ of the multipoles ([module docs](self)).
+    pub fn describe_mu_rule(&self) -> String {
+        match self.mu_rule {
+            Some((n, change)) => format!(
+                "multipoles: {n}-point Gauss-Legendre rule in mu (measured at build: the reference \
+                 data vector changes from the {}-point rule's by {change:.1e} of each multipole's \
+                 largest value at the worst corner of the AP range, <= {:.0e})",
+                crate::rsd::ept::MU_NODES,
+                MU_RULE_TOLERANCE
+            ),
+            None => format!(
+                "multipoles: {}-point Gauss-Legendre rule in mu",
+                crate::rsd::ept::MU_NODES
+            ),
+        }
+    }
 }

@@ -32,11 +32,9 @@
 
 use super::ap::spline::UniformSpline;
 use super::ap::Distortion;
-use super::{legendre_coefficients, MAX_ELL};
 use crate::bias::BiasParams;
 use crate::error::{Error, Result};
 use crate::estimate::Estimate;
-use crate::integrate::legendre_nodes;
 use crate::ir::savitzky_golay_no_wiggle;
 use crate::linear::LinearSpectrum;
 use crate::loops::redshift::{RedshiftPlan, RedshiftTerms};
@@ -185,10 +183,10 @@ impl Default for EptSettings {
 #[derive(Debug, Clone)]
 pub struct EptPlan {
     /// Gauss–Legendre rules on [0, 1] ([`MU_NODES`] and half as many): (μ, w, L_0…L_8(μ)).
-    rules: [MuRule; 2],
+    rules: [projection::MuRule; 2],
     /// The rule of the values-only paths ([`Self::with_value_nodes`]; the first of `rules` unless
     /// chosen).
-    value_rule: MuRule,
+    value_rule: projection::MuRule,
     k_out: Vec<f64>,
     grid: Vec<f64>,
     /// Whether `grid` is `k_out` itself or the AP grid the terms are interpolated on: told by how
@@ -318,7 +316,7 @@ impl EptPlan {
         let loop_span = range::loop_span(&grid, settings.loop_range)?;
         let loops = RedshiftPlan::new(&grid[loop_span.clone()], precision)?;
         let split = settings.ir.then_some(());
-        let rules = [MU_NODES, MU_NODES / 2].map(mu_rule);
+        let rules = [MU_NODES, MU_NODES / 2].map(projection::mu_rule);
         Ok(Self {
             value_rule: rules[0].clone(),
             rules,
@@ -333,31 +331,6 @@ impl EptPlan {
             tensors: None,
             max_residual: crate::loops::basis::MAX_RESIDUAL,
         })
-    }
-
-    /// This plan with an n-point Gauss–Legendre rule in μ for the values-only multipoles
-    /// ([`Self::multipole_values_at`] and the batches, f-derivatives, tangents and AP derivatives
-    /// built on them; [`Self::multipoles`] keeps [`MU_NODES`] and its error): a chain step whose
-    /// data vector a smaller rule changes by less than its tolerance (measured at build,
-    /// [`crate::pipeline`]) projects faster.
-    ///
-    /// # Errors
-    /// [`Error::InvalidParameter`] unless 8 ≤ n ≤ [`MU_NODES`].
-    pub fn with_value_nodes(mut self, n: usize) -> Result<Self> {
-        if !(8..=MU_NODES).contains(&n) {
-            return Err(Error::InvalidParameter {
-                name: "value_nodes",
-                value: n as f64,
-                reason: "the values' rule in mu takes 8 to 24 nodes",
-            });
-        }
-        self.value_rule = mu_rule(n);
-        Ok(self)
-    }
-
-    /// The number of nodes in μ of the values-only multipoles ([`Self::with_value_nodes`]).
-    pub fn value_nodes(&self) -> usize {
-        self.value_rule.len()
     }
 
     /// The output wavenumbers [h/Mpc].
@@ -553,24 +526,6 @@ impl EptPlan {
         }
         Ok(())
     }
-}
-
-/// A Gauss–Legendre rule in μ on [0, 1]: (μ, w, L_0…L_8(μ)) per node.
-type MuRule = Vec<(f64, f64, [f64; MAX_ELL + 1])>;
-
-/// The n-point Gauss–Legendre rule on [0, 1] with the Legendre polynomials at its nodes.
-fn mu_rule(n: usize) -> MuRule {
-    let legendre: Vec<Vec<f64>> = (0..=MAX_ELL).map(legendre_coefficients).collect();
-    let (x, w) = legendre_nodes(n);
-    x.iter()
-        .zip(&w)
-        .map(|(&x, &w)| {
-            let mu = 0.5 * (x + 1.0);
-            let l =
-                std::array::from_fn(|ell| legendre[ell].iter().rev().fold(0.0, |a, c| a * mu + c));
-            (mu, 0.5 * w, l)
-        })
-        .collect()
 }
 
 /// Σ² = (1/6π²)∫dq P_nw(q)[1 − j₀(q r_BAO)] over [1e-5, 1e3] h/Mpc: Simpson in ln q, error against
