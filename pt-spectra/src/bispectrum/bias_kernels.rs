@@ -569,6 +569,19 @@ pub(super) fn loop_kernel_parts(redshift: Option<(f64, Vec3)>, q: &[Vec3]) -> [f
     parts_from_table(&t, redshift.as_ref().map(|(f, los)| (*f, los)))
 }
 
+/// [`loop_kernel_parts`] in redshift space at growth rate `f` along each unit line of sight of `los`, the
+/// subsets' fields built once (the orientation average of the multipoles): `out[o]` for `los[o]`.
+pub(super) fn loop_kernel_parts_los(f: f64, los: &[Vec3], q: &[Vec3], out: &mut [[f64; N_PARTS]]) {
+    match Table::new(q) {
+        Ok(t) => {
+            for (o, n) in out.iter_mut().zip(los) {
+                *o = parts_from_table(&t, Some((f, n)));
+            }
+        }
+        Err(_) => out.iter_mut().for_each(|o| *o = [0.0; N_PARTS]),
+    }
+}
+
 /// The kernel of the loop integrands: real space (`redshift` None) or Z_n^g at (f, line of sight); zero
 /// where it is not defined (a node never is: the rules avoid the loops' centres).
 pub(super) fn loop_kernel(bias: &[f64; N_BIAS], redshift: Option<(f64, Vec3)>, q: &[Vec3]) -> f64 {

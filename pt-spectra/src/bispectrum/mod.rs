@@ -53,6 +53,7 @@ pub mod one_loop;
 pub mod one_loop_basis;
 pub mod one_loop_galaxy;
 pub mod one_loop_galaxy_basis;
+pub mod one_loop_galaxy_multipoles;
 pub mod one_loop_galaxy_poly;
 pub mod one_loop_rsd;
 mod resum;

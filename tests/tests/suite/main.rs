@@ -16,6 +16,7 @@ mod bins;
 mod bispectrum_galaxy;
 mod bispectrum_galaxy_ct;
 mod bispectrum_galaxy_kernels;
+mod bispectrum_galaxy_multipoles;
 mod bispectrum_galaxy_poly;
 mod bispectrum_one_loop;
 mod bispectrum_reference;
