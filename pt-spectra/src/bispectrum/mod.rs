@@ -46,6 +46,7 @@ pub mod bias_kernels;
 pub mod block;
 mod box_modes;
 pub mod galaxy_counterterms;
+pub mod galaxy_counterterms_rsd;
 mod geometry;
 mod lanes;
 mod observed;

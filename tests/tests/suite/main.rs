@@ -15,6 +15,7 @@ mod bias;
 mod bins;
 mod bispectrum_galaxy;
 mod bispectrum_galaxy_ct;
+mod bispectrum_galaxy_ct_rsd;
 mod bispectrum_galaxy_kernels;
 mod bispectrum_galaxy_multipoles;
 mod bispectrum_galaxy_poly;
