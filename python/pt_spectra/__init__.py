@@ -527,8 +527,8 @@ def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=No
 
     ``multipoles=True``: the multipoles B0, B2, B4 in redshift space at ``f`` (default f(z)), the Legendre
     polynomial on ``legendre_side`` ("largest", "1", "2", "3"), of the galaxies (or matter without a bias),
-    all orientations in one pass over the loop nodes (the orientation rule is exact; about 12 times one
-    orientation's cost, ~75 s per triangle at the default rule on 2 cores): columns k1 k2 k3, B{l}_tree,
+    all orientations in one pass over the loop nodes (the orientation rule is exact; about 6 times one
+    orientation's cost, ~35 s per triangle at the default rule on 2 cores): columns k1 k2 k3, B{l}_tree,
     B{l}_222, B{l}_321_I, B{l}_321_II, B{l}_411, B{l} (the total) for l = 0, 2, 4, their err_ columns, and
     the multipoles of the 20 redshift-space counterterm and stochastic shapes shape_B{l}_<name>.
     """

@@ -79,8 +79,9 @@
 //! Z_n^g = (1/n!) Σ_{S₀ ≠ ∅} |S₀|! D(S₀) E(N∖S₀), E(R) = Σ over set partitions of R of Π_B |B|! U(B),
 //! U(B) = f(kμ)(μ_B/k_B)G_B, so Z₁ = b1 + fμ² and Z_n^g is affine in the bias coefficients.
 
+use super::redshift_weights::redshift_weights_4;
 use crate::error::{Error, Result};
-use crate::loops::rsd_two_loop::{kernel_at, redshift_polynomial, redshift_weights};
+use crate::loops::rsd_two_loop::{kernel_at, redshift_polynomial};
 use crate::vec3::{add, dot};
 
 type Vec3 = [f64; 3];
@@ -499,7 +500,7 @@ fn parts_from_table(t: &Table, redshift: Option<(f64, &Vec3)>) -> [f64; N_PARTS]
         Some((f, los)) => {
             let norm = dot(los, los).sqrt();
             let unit = los.map(|x| x / norm);
-            let (weights, velocity) = redshift_weights(&t.ks, &t.ks2, full, &unit, |s| t.g[s], f);
+            let (weights, velocity) = redshift_weights_4(&t.ks, &t.ks2, &t.g, full, &unit, f);
             parts[0] = velocity;
             for (s, w) in weights.iter().enumerate().take(full + 1) {
                 if *w != 0.0 {

@@ -57,6 +57,7 @@ pub mod one_loop_galaxy_basis;
 pub mod one_loop_galaxy_multipoles;
 pub mod one_loop_galaxy_poly;
 pub mod one_loop_rsd;
+mod redshift_weights;
 mod resum;
 mod sampled;
 pub mod seam;

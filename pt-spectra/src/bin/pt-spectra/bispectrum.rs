@@ -140,8 +140,8 @@ pub struct Args {
     /// --loop 1: the multipoles B0, B2, B4 of the one-loop galaxy (or, without bias options, matter)
     /// bispectrum in redshift space at the points of --triangles (with --f, default f(z), and
     /// --legendre-side), all orientations in one pass over the loop nodes (the orientation rule exact),
-    /// with the multipoles of the redshift-space counterterm and stochastic shapes; direct, ~12 times one
-    /// orientation's cost.
+    /// with the multipoles of the redshift-space counterterm and stochastic shapes; direct, ~6 times one
+    /// orientation's cost (~35 s per triangle on 2 cores).
     #[arg(long, conflicts_with = "mu1", requires = "triangles")]
     multipoles: bool,
     /// --loop 1: CLASS-PT's b_Gamma3 (Gamma3 = G2(Phi_g) - G2(Phi_v)), with --b1, --b2, --bs.
