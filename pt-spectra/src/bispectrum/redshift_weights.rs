@@ -11,15 +11,22 @@ type Vec3 = [f64; 3];
 /// k! for k = 0..=4.
 const FACT: [f64; 5] = [1.0, 1.0, 2.0, 6.0, 24.0];
 
+/// G_S/k_S² of every subset (zero where k_S = 0): what [`redshift_weights_4`] takes, the same for every line
+/// of sight.
+pub(super) fn velocity_over_k2(ks2: &[f64; 16], g: &[f64; 16]) -> [f64; 16] {
+    std::array::from_fn(|s| if ks2[s] != 0.0 { g[s] / ks2[s] } else { 0.0 })
+}
+
 /// Z_n = Σ_{S₀ ⊆ args} `weights[S₀]` × density(S₀) + `velocity` along the unit line of sight `los` at `f`,
-/// for the subsets' total momenta `ks`, their squares `ks2` and velocity kernels `g` (Scoccimarro,
+/// for the subsets' total momenta `ks`, their squares `ks2` and `h` = G_S/k_S² ([`velocity_over_k2`], with
+/// G_S the velocity kernels) (Scoccimarro,
 /// Couchman & Frieman 1999: `weights[S₀]` = (|S₀|!/n!) E(args∖S₀), E(R) the sum over the set partitions of R
 /// of Π_B f |B|! (k·n̂)(k_B·n̂)/k_B² G_B, `velocity` = Σ_{S₀} (|S₀|!/n!) fμ_{S₀}² G_{S₀} E(args∖S₀); subsets of
 /// zero momentum contribute zero).
 pub(super) fn redshift_weights_4(
     ks: &[Vec3; 16],
     ks2: &[f64; 16],
-    g: &[f64; 16],
+    h: &[f64; 16],
     args: usize,
     los: &Vec3,
     f: f64,
@@ -28,11 +35,10 @@ pub(super) fn redshift_weights_4(
     let (mut d1, mut u) = ([0.0; 16], [0.0; 16]);
     let mut sub = args;
     while sub != 0 {
-        let n2 = ks2[sub];
-        if n2 != 0.0 {
+        if ks2[sub] != 0.0 {
             let ns = dot(los, &ks[sub]);
-            d1[sub] = ns * ns / n2 * g[sub];
-            u[sub] = FACT[sub.count_ones() as usize] * nk * ns / n2 * g[sub];
+            d1[sub] = ns * ns * h[sub];
+            u[sub] = FACT[sub.count_ones() as usize] * nk * ns * h[sub];
         }
         sub = (sub - 1) & args;
     }
@@ -60,12 +66,12 @@ pub(super) fn redshift_weights_4(
         }
         e[r] = f * er;
     }
-    let n = args.count_ones() as usize;
+    let inverse = 1.0 / FACT[args.count_ones() as usize];
     let (mut weights, mut velocity) = ([0.0; 16], 0.0);
     let mut s0 = args;
     while s0 != 0 {
         if ks2[s0] != 0.0 {
-            let c = FACT[s0.count_ones() as usize] / FACT[n] * e[args ^ s0];
+            let c = FACT[s0.count_ones() as usize] * inverse * e[args ^ s0];
             weights[s0] = c;
             velocity += c * f * d1[s0];
         }
@@ -76,7 +82,7 @@ pub(super) fn redshift_weights_4(
 
 #[cfg(test)]
 mod tests {
-    use super::redshift_weights_4;
+    use super::{redshift_weights_4, velocity_over_k2};
     use crate::loops::rsd_two_loop::redshift_weights;
 
     /// Equal to the general (five-argument, polynomial in f) weights of the two-loop code to 1e-14, for
@@ -119,7 +125,8 @@ mod tests {
             }
             let full = (1usize << n) - 1;
             for f in [0.0, 0.7, 1.3] {
-                let (w, vel) = redshift_weights_4(&ks, &ks2, &g, full, &los, f);
+                let h = velocity_over_k2(&ks2, &g);
+                let (w, vel) = redshift_weights_4(&ks, &ks2, &h, full, &los, f);
                 let (w0, vel0) = redshift_weights(&ks32, &ks232, full, &los, |s| g[s], f);
                 for s in 0..16 {
                     assert!(
