@@ -261,10 +261,10 @@ fn the_redshift_space_counterterms_absorb_the_cut_off() {
 
 /// The same for B₀, B₂, B₄ (the Legendre polynomial on the largest side) at the 16 triangles (48 rows for
 /// 20 coefficients): one set of coefficients for the three multipoles and all triangles, with the shapes'
-/// multipoles, leaves ≤ 3e-3 of the largest change; the real-space seven ≥ 10%. About 3 min (the one pass
-/// at the shell rule, ~9 s per triangle on 2 shared cores).
+/// multipoles, leaves ≤ 3e-3 of the largest change; the real-space seven ≥ 10%. About 1 min (the one pass
+/// at the shell rule, ~3.4 s per triangle on 2 shared cores).
 #[test]
-#[ignore = "slow exhaustive check (about 3 min): `cargo test --release --workspace -- --ignored`"]
+#[ignore = "slow exhaustive check (about 1 min): `cargo test --release --workspace -- --ignored`"]
 fn the_counterterm_multipoles_absorb_the_cut_off_of_the_multipoles() {
     let p = LinearSpectrum::gm2012_z0();
     let f = 0.7;

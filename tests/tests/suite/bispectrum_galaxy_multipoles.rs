@@ -180,7 +180,7 @@ fn legendre(x: f64) -> [f64; 3] {
 /// same to 1e-11. Both are exact for B(n̂) L_ℓ, so they agree to round-off: the test checks the fold, the
 /// weights and the Legendre side. 240 orientations at a small loop rule: slow checks.
 #[test]
-#[ignore = "slow exhaustive check (about 1 min): `cargo test --release --workspace -- --ignored`"]
+#[ignore = "slow exhaustive check (about 1.5 min): `cargo test --release --workspace -- --ignored`"]
 fn the_one_pass_equals_the_average_of_single_orientations() {
     let p = LinearSpectrum::gm2012_z0();
     let f = 0.7;
@@ -330,7 +330,7 @@ fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     (x, w)
 }
 
-/// Timing at the default rule (one triangle, 2 shared cores): printed, not asserted.
+/// Timing at the default rule (two triangles, ~30 s each on 2 shared cores): printed, not asserted.
 #[test]
 #[ignore = "timing (about 1 min): `cargo test --release -p pt-spectra-tests multipoles_timing -- --ignored --nocapture`"]
 fn multipoles_timing_at_the_default_rule() {
