@@ -24,12 +24,16 @@ use pyo3::types::PyDict;
 /// their projection error is in the errors), "direct" (~0.5 s per triangle), "auto" (the tensors if
 /// cached, else direct). The header says which was used (its line `loop terms: ...`). With a bias
 /// (`b1`, `b2`, `bs` in `bias_convention`, CLASS-PT's `b_gamma3`, `loop_bias` a dict of fourth-order
-/// coefficients by name), the galaxy bispectrum ([`pt_spectra::jobs::one_loop_galaxy_table`]).
+/// coefficients by name), the galaxy bispectrum ([`pt_spectra::jobs::one_loop_galaxy_table`]). With
+/// `multipoles=True` the multipoles B0, B2, B4 in redshift space at `f` (default f(z)), the Legendre
+/// polynomial on `legendre_side` ([`pt_spectra::jobs::one_loop_galaxy_multipoles_table`]; matter without a
+/// bias).
 #[pyfunction]
 #[pyo3(signature = (triangles, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None,
     q_min=1e-4, q_max=10.0, radial=12, mu=32, phi=24,
     two_loop=pt_spectra::jobs::defaults::TWO_LOOP, cache_dir=None, mu1=None, phi_los=0.0, f=None,
-    b1=None, b2=0.0, bs=0.0, b_gamma3=0.0, bias_convention=None, loop_bias=None))]
+    b1=None, b2=0.0, bs=0.0, b_gamma3=0.0, bias_convention=None, loop_bias=None, multipoles=false,
+    legendre_side="largest"))]
 #[allow(clippy::too_many_arguments)]
 pub fn one_loop_bispectrum(
     py: Python<'_>,
@@ -55,6 +59,8 @@ pub fn one_loop_bispectrum(
     b_gamma3: f64,
     bias_convention: Option<&str>,
     loop_bias: Option<std::collections::BTreeMap<String, f64>>,
+    multipoles: bool,
+    legendre_side: &str,
 ) -> PyResult<Table> {
     let rows = fixed_rows::<3>(triangles, "triangles", "k1, k2, k3")?;
     let method: TwoLoopMethod = two_loop.parse().map_err(library_error)?;
@@ -76,6 +82,36 @@ pub fn one_loop_bispectrum(
     let store = crate::Store::new(cache_dir);
     let rule = rule_of(q_min, q_max, radial, mu, phi);
     let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
+    let side =
+        pt_spectra::bispectrum::LegendreSide::by_name(legendre_side).map_err(library_error)?;
+    if multipoles && (mu1.is_some() || method == TwoLoopMethod::Basis) {
+        return Err(crate::value_error(
+            "multipoles=True averages over the orientations (no mu1) and is direct (two_loop \"direct\" or \"auto\")",
+        ));
+    }
+    if !multipoles && legendre_side != "largest" {
+        return Err(crate::value_error(
+            "legendre_side is the multipoles' (multipoles=True)",
+        ));
+    }
+    if multipoles {
+        let bias = bias.unwrap_or_else(pt_spectra::bispectrum::bias_kernels::LoopBias::matter);
+        let ((prepared, table), seconds) = detached(py, || {
+            let prepared = inputs.prepare(&[])?;
+            let table = pt_spectra::jobs::one_loop_galaxy_multipoles_table(
+                &prepared, &rows, &bias, f, side, &rule, &Silent,
+            )?;
+            Ok((prepared, table))
+        })?;
+        return Table::new(
+            py,
+            table,
+            &prepared,
+            &Precision::default(),
+            "bispectrum one-loop galaxy multipoles",
+            seconds,
+        );
+    }
     if mu1.is_none() && f.is_some() {
         return Err(crate::value_error(
             "f is the growth rate of the redshift-space one-loop bispectrum: give mu1 too",

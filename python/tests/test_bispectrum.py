@@ -203,6 +203,26 @@ def test_one_loop_bispectrum_in_redshift_space_at_one_orientation():
         pt.one_loop_bispectrum(tri, f=0.7, **rule)
 
 
+def test_one_loop_galaxy_multipoles_through_the_python_face():
+    tri = np.array([[0.1, 0.1, 0.1], [0.05, 0.08, 0.1]])
+    rule = dict(radial=2, mu=2, phi=2)
+    bias = dict(b1=2.0, b2=0.3, bs=-0.2)
+    real = pt.one_loop_bispectrum(tri, two_loop="direct", **bias, **rule)
+    zero = pt.one_loop_bispectrum(tri, multipoles=True, f=0.0, **bias, **rule)  # f = 0: B0 is real space
+    assert zero.meta["model"] == "bispectrum one-loop galaxy multipoles"
+    for name, mono in [("B_tree", "B0_tree"), ("B222", "B0_222"), ("B321_I", "B0_321_I")]:
+        np.testing.assert_allclose(zero[mono], real[name], rtol=1e-10)
+    np.testing.assert_allclose(zero["B0"], real["B_1loop"], rtol=1e-7)  # B411's UV constant: round-off
+    assert np.all(np.abs(zero["B2"]) < 1e-12 * np.abs(zero["B0"]))
+    rsd = pt.one_loop_bispectrum(tri, multipoles=True, f=0.7, legendre_side="1", **bias, **rule)
+    assert np.all(rsd["B0"] > zero["B0"]) and np.all(rsd["err_B0"] >= 0)
+    assert "shape_B2_ct_fog" in rsd.columns
+    with pytest.raises(ValueError, match="no mu1"):
+        pt.one_loop_bispectrum(tri, multipoles=True, mu1=0.3, **rule)
+    with pytest.raises(ValueError, match="legendre side|valid"):
+        pt.one_loop_bispectrum(tri, multipoles=True, legendre_side="4", **rule)
+
+
 def test_one_loop_galaxy_bispectrum_through_the_python_face(tmp_path):
     tri = np.array([[0.1, 0.1, 0.1], [0.05, 0.1, 0.12]])
     rule = dict(radial=6, mu=12, phi=8, two_loop="direct")

@@ -79,8 +79,9 @@
 //! Z_n^g = (1/n!) Σ_{S₀ ≠ ∅} |S₀|! D(S₀) E(N∖S₀), E(R) = Σ over set partitions of R of Π_B |B|! U(B),
 //! U(B) = f(kμ)(μ_B/k_B)G_B, so Z₁ = b1 + fμ² and Z_n^g is affine in the bias coefficients.
 
+use super::redshift_weights::{redshift_weights_4, velocity_over_k2};
 use crate::error::{Error, Result};
-use crate::loops::rsd_two_loop::{kernel_at, redshift_polynomial, redshift_weights};
+use crate::loops::rsd_two_loop::{kernel_at, redshift_polynomial};
 use crate::vec3::{add, dot};
 
 type Vec3 = [f64; 3];
@@ -499,14 +500,22 @@ fn parts_from_table(t: &Table, redshift: Option<(f64, &Vec3)>) -> [f64; N_PARTS]
         Some((f, los)) => {
             let norm = dot(los, los).sqrt();
             let unit = los.map(|x| x / norm);
-            let (weights, velocity) = redshift_weights(&t.ks, &t.ks2, full, &unit, |s| t.g[s], f);
-            parts[0] = velocity;
-            for (s, w) in weights.iter().enumerate().take(full + 1) {
-                if *w != 0.0 {
-                    for (p, o) in parts[1..].iter_mut().zip(&t.ops[s]) {
-                        *p += w * o;
-                    }
-                }
+            parts = redshift_parts(t, &velocity_over_k2(&t.ks2, &t.g), f, &unit);
+        }
+    }
+    parts
+}
+
+/// The redshift-space parts at `f` along the unit line of sight `unit`, with `h` = G_S/k_S² of the table.
+fn redshift_parts(t: &Table, h: &[f64; 16], f: f64, unit: &Vec3) -> [f64; N_PARTS] {
+    let full = (1usize << t.n) - 1;
+    let mut parts = [0.0; N_PARTS];
+    let (weights, velocity) = redshift_weights_4(&t.ks, &t.ks2, h, full, unit, f);
+    parts[0] = velocity;
+    for (s, w) in weights.iter().enumerate().take(full + 1) {
+        if *w != 0.0 {
+            for (p, o) in parts[1..].iter_mut().zip(&t.ops[s]) {
+                *p += w * o;
             }
         }
     }
@@ -567,6 +576,20 @@ pub(super) fn loop_kernel_parts(redshift: Option<(f64, Vec3)>, q: &[Vec3]) -> [f
         return [0.0; N_PARTS];
     };
     parts_from_table(&t, redshift.as_ref().map(|(f, los)| (*f, los)))
+}
+
+/// [`loop_kernel_parts`] in redshift space at growth rate `f` along each UNIT line of sight of `los`, the
+/// subsets' fields built once (the orientation average of the multipoles): `out[o]` for `los[o]`.
+pub(super) fn loop_kernel_parts_los(f: f64, los: &[Vec3], q: &[Vec3], out: &mut [[f64; N_PARTS]]) {
+    match Table::new(q) {
+        Ok(t) => {
+            let h = velocity_over_k2(&t.ks2, &t.g);
+            for (o, n) in out.iter_mut().zip(los) {
+                *o = redshift_parts(&t, &h, f, n);
+            }
+        }
+        Err(_) => out.iter_mut().for_each(|o| *o = [0.0; N_PARTS]),
+    }
 }
 
 /// The kernel of the loop integrands: real space (`redshift` None) or Z_n^g at (f, line of sight); zero

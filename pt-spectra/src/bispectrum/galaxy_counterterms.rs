@@ -23,7 +23,7 @@
 //! one-loop galaxy B by up to 5e7 (Mpc/h)⁶ at 20 triangles (0.01–0.16 h/Mpc), and one set of these seven
 //! coefficients takes the change out to 3–5e-4 of it for three bias sets (all eleven coefficients, or
 //! velocileptors' b1, b2, bs); without the stochastic shapes 25–43% is left, without ct_kk 4–4.5%. In
-//! redshift space more shapes enter (powers of μ on the legs): not built yet.
+//! redshift space: [`super::galaxy_counterterms_rsd`] (these seven at f = 0, and thirteen more).
 
 use super::bias_kernels::{galaxy_kernel, LoopBias};
 use super::one_loop::{f_n, triangle_vectors};

@@ -28,8 +28,10 @@
 //!
 //! The terms per bias monomial (every term a polynomial of degree 3 in the coefficients, computed in one pass
 //! and evaluated for a new bias in microseconds): [`super::one_loop_galaxy_poly`], equal to these to
-//! round-off. Not here yet (issue 50): the counterterms and stochastic terms of the galaxy bispectrum, IR
-//! resummation, multipoles, bins, basis tensors.
+//! round-off. Elsewhere: the counterterms and stochastic terms ([`super::galaxy_counterterms`],
+//! [`super::galaxy_counterterms_rsd`]), the multipoles ([`super::one_loop_galaxy_multipoles`]), the real-space
+//! basis tensors ([`super::one_loop_galaxy_basis`]). Not yet (issue 50): IR resummation, bins, basis tensors in
+//! redshift space.
 
 use super::bias_kernels::{loop_kernel_parts, LoopBias, N_PARTS};
 use super::one_loop::{

@@ -8,13 +8,18 @@ use super::VERSION;
 use crate::bias::BiasParams;
 use crate::bispectrum::bias_kernels::LoopBias;
 use crate::bispectrum::galaxy_counterterms::{galaxy_counterterm_shapes, GALAXY_COUNTERTERMS};
+use crate::bispectrum::galaxy_counterterms_rsd::{
+    redshift_counterterm_multipoles, REDSHIFT_COUNTERTERMS,
+};
 use crate::bispectrum::one_loop::{OneLoopRule, PARTITION_POWER};
 use crate::bispectrum::one_loop_basis::BispectrumLoopSource;
 use crate::bispectrum::one_loop_galaxy::{one_loop_galaxy, OneLoopGalaxy};
 use crate::bispectrum::one_loop_galaxy_basis::GalaxyLoopBasis;
+use crate::bispectrum::one_loop_galaxy_multipoles::{one_loop_galaxy_multipoles, ORIENTATION_RULE};
 use crate::bispectrum::one_loop_rsd::Orientation;
+use crate::bispectrum::LegendreSide;
 use crate::error::{Error, Result};
-use crate::output::{MethodNote, Table, POWER};
+use crate::output::{MethodNote, Table, POWER, WAVENUMBER};
 use crate::precision::TwoLoopMethod;
 use crate::progress::Progress;
 use crate::setup::Prepared;
@@ -177,6 +182,129 @@ pub fn one_loop_galaxy_table(
                 format!("shape_{name}"),
                 unit,
                 shapes.iter().map(|s| s[j]).collect(),
+            );
+        }
+    }
+    Ok(t)
+}
+
+/// The table of the multipoles of the one-loop galaxy bispectrum with `bias` at `triangles` (points) in
+/// redshift space at growth rate `f` (default f(z)), the Legendre polynomial on `side`
+/// ([`crate::bispectrum::one_loop_galaxy_multipoles`]: one pass over the loop nodes, the orientation rule
+/// exact): `k1 k2 k3`, then per ℓ = 0, 2, 4 `B{ℓ}_tree B{ℓ}_222 B{ℓ}_321_I B{ℓ}_321_II B{ℓ}_411 B{ℓ}` (B{ℓ} the
+/// one-loop total, as the tree level's column names), their `err_` columns, and the multipoles of the
+/// redshift-space counterterm and stochastic shapes `shape_B{ℓ}_<name>`
+/// ([`crate::bispectrum::galaxy_counterterms_rsd`]), each triangle reported to `progress`.
+///
+/// # Errors
+/// As [`crate::bispectrum::one_loop_galaxy_multipoles::one_loop_galaxy_multipoles`], naming the triangle.
+#[allow(clippy::too_many_arguments)]
+pub fn one_loop_galaxy_multipoles_table(
+    prepared: &Prepared,
+    triangles: &[[f64; 3]],
+    bias: &LoopBias,
+    f: Option<f64>,
+    side: LegendreSide,
+    rule: &OneLoopRule,
+    progress: &dyn Progress,
+) -> Result<Table> {
+    let f = f.unwrap_or(prepared.growth_rate);
+    let p = &prepared.spectrum;
+    let mut rows = Vec::with_capacity(triangles.len());
+    let mut shapes = Vec::with_capacity(triangles.len());
+    for (i, &k) in triangles.iter().enumerate() {
+        let named = |e: Error| Error::InvalidChoice {
+            what: format!("triangle {} ({}, {}, {})", i + 1, k[0], k[1], k[2]),
+            reason: e.to_string(),
+        };
+        let m = one_loop_galaxy_multipoles(p, k, f, side, rule, None).map_err(named)?;
+        rows.push(m.evaluate(bias)?);
+        shapes.push(redshift_counterterm_multipoles(p, k, bias, f, side).map_err(named)?);
+        progress.update(
+            crate::bispectrum::seam::ONE_LOOP_STAGE,
+            i + 1,
+            triangles.len(),
+        );
+    }
+    let values: Vec<String> = LoopBias::NAMES
+        .iter()
+        .zip(bias.values())
+        .map(|(n, v)| format!("{n} = {v}"))
+        .collect();
+    let (n_mu, n_phi) = ORIENTATION_RULE;
+    let mut header = vec![
+        format!(
+            "pt-spectra {VERSION} bispectrum --loop 1 --multipoles: multipoles B0, B2, B4 (Scoccimarro et al. \
+             1999) of the one-loop galaxy bispectrum in redshift space, f = {f}, z = {}",
+            prepared.z
+        ),
+        format!(
+            "bias (the fourth-order basis of Eggemeier, Scoccimarro & Smith 2019; docs/bispectrum.md): {}",
+            values.join(", ")
+        ),
+        format!(
+            "Legendre polynomial on {}; orientations: Gauss-Legendre in mu1 ({} nodes in (0, 1)) x midpoints in \
+             phi ({} in (0, pi)), exact for B(n) L_l (degree <= 16 in n): no orientation error",
+            match side {
+                LegendreSide::Largest => "the largest side (as the window-free estimator)".to_string(),
+                LegendreSide::Index(a) => format!("side k{}", a + 1),
+            },
+            n_mu,
+            n_phi
+        ),
+        "B{l} = B{l}_tree + B{l}_222 + B{l}_321_I + B{l}_321_II + B{l}_411 with the kernels Z_n^g; B321_II and \
+         B411 renormalised (their q -> infinity constants times sigma^2 subtracted); no IR resummation, FoG, AP \
+         or bins"
+            .into(),
+        format!(
+            "loop integrals over {} <= |q| <= {} h/Mpc about each cusp (smooth partition of unity, power {}); \
+             {} ln q x {} cos(theta) x {} phi nodes per panel, one pass for all orientations; err_: difference \
+             from the rule with half the nodes",
+            rule.q_min, rule.q_max, PARTITION_POWER, rule.radial, rule.mu, 2 * rule.phi
+        ),
+        format!(
+            "counterterms and stochastic terms not in B{{l}}: B_ct = sum_c c_c shape_B{{l}}_c, the multipoles of \
+             the shapes {} (docs/bispectrum.md; coefficients ct_* in (Mpc/h)^2, st_p* in (Mpc/h)^3, st_1 in \
+             (Mpc/h)^6)",
+            REDSHIFT_COUNTERTERMS.join(", ")
+        ),
+        "at the given triangles (not averaged over bins); linear spectrum: all matter".into(),
+    ];
+    header.extend(prepared.description.iter().cloned());
+    let mut t = Table::new(header);
+    t.methods.push(MethodNote::new("loop terms", "direct"));
+    for (i, name) in ["k1", "k2", "k3"].iter().enumerate() {
+        t.push(*name, WAVENUMBER, triangles.iter().map(|k| k[i]).collect());
+    }
+    let terms = |b: &OneLoopGalaxy| [b.tree, b.b222, b.b321_i, b.b321_ii, b.b411, b.total()];
+    let suffix = ["_tree", "_222", "_321_I", "_321_II", "_411", ""];
+    for err in [false, true] {
+        for (l, ell) in [0, 2, 4].iter().enumerate() {
+            for (j, s) in suffix.iter().enumerate() {
+                let name = format!("{}B{ell}{s}", if err { "err_" } else { "" });
+                let column = rows.iter().map(|r| {
+                    let e = terms(&r[l])[j];
+                    if err {
+                        e.error
+                    } else {
+                        e.value
+                    }
+                });
+                t.push(name, BISPECTRUM, column.collect());
+            }
+        }
+    }
+    for (l, ell) in [0, 2, 4].iter().enumerate() {
+        for (j, name) in REDSHIFT_COUNTERTERMS.iter().enumerate() {
+            let unit = match *name {
+                "st_1" => "1",
+                n if n.starts_with("st_p") => POWER,
+                _ => BISPECTRUM_SHAPE,
+            };
+            t.push(
+                format!("shape_B{ell}_{name}"),
+                unit,
+                shapes.iter().map(|s| s[l][j]).collect(),
             );
         }
     }

@@ -37,7 +37,9 @@
 
 mod integrand;
 mod zn;
-pub(crate) use zn::{at as kernel_at, redshift_polynomial, redshift_weights};
+#[cfg(test)]
+pub(crate) use zn::redshift_weights;
+pub(crate) use zn::{at as kernel_at, redshift_polynomial};
 
 pub(crate) use integrand::{rsd_min_points, rsd_points_at, Sampling};
 

@@ -8,6 +8,7 @@ use std::process::Command;
 mod analysis;
 mod bias;
 mod bispectrum;
+mod bispectrum_multipoles;
 mod counterterm;
 mod emulator;
 mod ept;

@@ -56,7 +56,7 @@ fn galaxy_shapes_reduce_to_the_matter_ones_and_scale_with_the_bias() {
 
 /// Least squares of `d` on the columns `a` (rows: triangles), each column scaled to its largest element:
 /// the largest residual over the largest |d|.
-fn fitted_residual(a: &[Vec<f64>], d: &[f64]) -> f64 {
+pub(crate) fn fitted_residual(a: &[Vec<f64>], d: &[f64]) -> f64 {
     let n = a[0].len();
     let scale: Vec<f64> = (0..n)
         .map(|j| a.iter().fold(0.0_f64, |m, r| m.max(r[j].abs())))

@@ -184,6 +184,8 @@ fn partition_sums(u: &[f64; SUBSETS], args: usize) -> [[f64; 6]; SUBSETS] {
 /// `weights[S₀]` × density(S₀) + `velocity`, with `weights[S₀]` = (|S₀|!/n!) E(args∖S₀) (zero for S₀ of zero
 /// total momentum) and `velocity` = Σ_{S₀} (|S₀|!/n!) fμ_{S₀}²G_{S₀} E(args∖S₀), from G_S = `g(S)`. Z_n is
 /// linear in the density kernels: a tracer's kernel affine in its bias coefficients gives Z_n^g affine in them.
+/// (The galaxy bispectrum uses its four-argument form, `bispectrum::redshift_weights`, tested against this.)
+#[cfg(test)]
 pub(crate) fn redshift_weights(
     v: &[[f64; 3]],
     norm: &[f64],
