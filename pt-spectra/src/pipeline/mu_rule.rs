@@ -71,13 +71,19 @@ impl Pipeline {
         self.mu_rule
     }
 
-    /// One line for a header, a `meta` entry or a log: the rule in μ of the multipoles ([module docs](self)).
+    /// One line for a header, a `meta` entry or a log: the rule in μ of the multipoles
+    /// ([module docs](self)).
     pub fn describe_mu_rule(&self) -> String {
+        let at = if self.settings.fiducial.is_some() {
+            "at the worst of the identity and the AP range's corners"
+        } else {
+            "without AP"
+        };
         match self.mu_rule {
             Some((n, change)) => format!(
                 "multipoles: {n}-point Gauss-Legendre rule in mu (measured at build: the reference \
                  data vector changes from the {}-point rule's by {change:.1e} of each multipole's \
-                 largest value at the worst corner of the AP range, <= {:.0e})",
+                 largest value {at}, <= {:.0e})",
                 crate::rsd::ept::MU_NODES,
                 MU_RULE_TOLERANCE
             ),
