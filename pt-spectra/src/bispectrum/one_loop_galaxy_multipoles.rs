@@ -30,7 +30,7 @@ use super::one_loop::{
 };
 use super::one_loop_galaxy::{sigma2, OneLoopGalaxy, UvParts};
 use super::one_loop_galaxy_poly::{
-    assemble, GalaxyLoopPolynomial, Layout, LoopSums, TermPolynomial,
+    add_triple_products, assemble, GalaxyLoopPolynomial, Layout, LoopSums, TermPolynomial,
 };
 use super::one_loop_rsd::Orientation;
 use crate::error::{Error, Result};
@@ -167,16 +167,7 @@ fn loop_sums_los(
                     loop_kernel_parts_los(f, los, &[b, q], t);
                     for o in 0..no {
                         let acc = &mut acc[o * len..(o + 1) * len];
-                        for (i, &pi) in s2.iter().enumerate() {
-                            let xi = s * x[o][pi];
-                            for (l, &pl) in s2.iter().enumerate() {
-                                let xy = xi * y[o][pl];
-                                let row = &mut acc[(i * n2 + l) * n2..(i * n2 + l + 1) * n2];
-                                for (c, &pm) in row.iter_mut().zip(s2) {
-                                    *c += xy * t[o][pm];
-                                }
-                            }
-                        }
+                        add_triple_products(acc, s, [&x[o][..], &y[o][..], &t[o][..]], s2);
                     }
                 }
                 let pq = p.eval(norm(v));

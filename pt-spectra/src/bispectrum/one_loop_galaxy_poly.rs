@@ -277,16 +277,7 @@ fn loop_sums(
                     let r = [norm(q), norm(a), norm(b)];
                     let s = w * 8.0 * partition(&r, j) * p.eval(r[0]) * p.eval(r[1]) * p.eval(r[2]);
                     let (x, y, t) = (z(&[neg(q), a]), z(&[neg(a), neg(b)]), z(&[b, q]));
-                    for (i, &pi) in s2.iter().enumerate() {
-                        let xi = s * x[pi];
-                        for (l, &pl) in s2.iter().enumerate() {
-                            let xy = xi * y[pl];
-                            let row = &mut acc[(i * n2 + l) * n2..(i * n2 + l + 1) * n2];
-                            for (c, &pm) in row.iter_mut().zip(s2) {
-                                *c += xy * t[pm];
-                            }
-                        }
-                    }
+                    add_triple_products(&mut acc, s, [&x[..], &y[..], &t[..]], s2);
                 }
                 // B321ᴵ: Z₃ ⊗ Z₂ per ordered pair (a outer, b in the loop), twice the piece about q = 0.
                 let pq = p.eval(norm(v));
@@ -482,5 +473,22 @@ pub(super) fn assemble(
         uv_b321_ii,
         uv_b411,
         projection: 0.0,
+    }
+}
+
+/// B222's monomials at one loop node: `acc[(i n + l) n + m] += s x[s2[i]] y[s2[l]] t[s2[m]]` for the
+/// second-order slots `s2` (n of them) of the three kernels' parts `x`, `y`, `t` (one orientation's).
+#[inline(always)]
+pub(super) fn add_triple_products(acc: &mut [f64], s: f64, [x, y, t]: [&[f64]; 3], s2: &[usize]) {
+    let n2 = s2.len();
+    for (i, &pi) in s2.iter().enumerate() {
+        let xi = s * x[pi];
+        for (l, &pl) in s2.iter().enumerate() {
+            let xy = xi * y[pl];
+            let row = &mut acc[(i * n2 + l) * n2..(i * n2 + l + 1) * n2];
+            for (c, &pm) in row.iter_mut().zip(s2) {
+                *c += xy * t[pm];
+            }
+        }
     }
 }
