@@ -407,53 +407,6 @@ fn compare_with_the_monte_carlo(only: f64) {
     );
 }
 
-/// The run time per triangle at the default rule (12 × 32 × 24 nodes per panel, the error's half rule
-/// included), real space and redshift space out of the plane, with the term errors, and that of the terms
-/// per bias monomial (`one_loop_galaxy_polynomial`, one pass) and of their evaluation at one bias (ignored: a
-/// timing; `cargo test --release -p pt-spectra-tests --test suite bispectrum_galaxy::timing -- --ignored
-/// --nocapture`).
-#[test]
-#[ignore]
-fn timing_at_the_default_rule() {
-    use pt_spectra::bispectrum::one_loop_galaxy_poly::one_loop_galaxy_polynomial;
-    let p = LinearSpectrum::gm2012_z0();
-    let o = Orientation { mu1: 0.4, phi: 0.7 };
-    for redshift in [None, Some((0.7, o))] {
-        for k in [[0.1, 0.1, 0.1], [0.02, 0.1, 0.1]] {
-            let start = std::time::Instant::now();
-            let b =
-                one_loop_galaxy(&p, k, &galaxy_bias(), redshift, &OneLoopRule::default()).unwrap();
-            let direct = start.elapsed().as_secs_f64();
-            let rel: Vec<String> = terms(&b)[1..]
-                .iter()
-                .map(|t| format!("{:.1e}", t.error / t.value.abs()))
-                .collect();
-            let start = std::time::Instant::now();
-            let poly =
-                one_loop_galaxy_polynomial(&p, k, redshift, &OneLoopRule::default()).unwrap();
-            let one_pass = start.elapsed().as_secs_f64();
-            let start = std::time::Instant::now();
-            let n = 10_000;
-            let mut sum = 0.0;
-            for i in 0..n {
-                let bias = LoopBias {
-                    b2: 0.6 + 1e-6 * i as f64,
-                    ..galaxy_bias()
-                };
-                sum += poly.evaluate(&bias).unwrap().total().value;
-            }
-            let step = start.elapsed().as_secs_f64() / n as f64;
-            eprintln!(
-                "{k:?} f = {:?}: direct {direct:.2} s, relative errors {rel:?}, loop/tree {:.3}; per monomial \
-                 {one_pass:.2} s, evaluation {:.2} µs ({sum:.1e})",
-                redshift.map(|r| r.0),
-                b.loop_correction().value / b.tree.value,
-                step * 1e6
-            );
-        }
-    }
-}
-
 /// Infrared safety of the galaxy terms (the bias operators are Galilean invariant): power added far above
 /// the triangle (a bump at q_b ≪ k, as the matter test `long_wavelength_power_cancels_in_the_sum_of_the_loop_terms`)
 /// shifts each term by ∝ k²σ_d² times the tree level, and the shifts cancel in the sum down to the (q_b/k)²

@@ -329,35 +329,3 @@ fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     }
     (x, w)
 }
-
-/// Timing at the default rule (two triangles, ~30 s each on 2 shared cores): printed, not asserted.
-#[test]
-#[ignore = "timing (about 1 min): `cargo test --release -p pt-spectra-tests multipoles_timing -- --ignored --nocapture`"]
-fn multipoles_timing_at_the_default_rule() {
-    let p = LinearSpectrum::gm2012_z0();
-    for k in [[0.05, 0.08, 0.1], [0.1, 0.1, 0.1]] {
-        let start = Instant::now();
-        let m = one_loop_galaxy_multipoles(
-            &p,
-            k,
-            0.7,
-            LegendreSide::Largest,
-            &OneLoopRule::default(),
-            None,
-        )
-        .unwrap();
-        let t = start.elapsed().as_secs_f64();
-        let b = m.evaluate(&biases()[0]).unwrap();
-        let rel: Vec<String> = b
-            .iter()
-            .map(|x| {
-                format!(
-                    "{:.3e} ± {:.1e}",
-                    x.total().value,
-                    x.loop_correction().error
-                )
-            })
-            .collect();
-        eprintln!("{k:?}: {t:.1} s; B0, B2, B4 = {rel:?}");
-    }
-}
