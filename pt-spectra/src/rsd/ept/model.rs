@@ -231,9 +231,11 @@ pub(super) fn project_many(
     let n_ell = weights.first().map_or(0, Vec::len);
     let mut out = vec![vec![vec![0.0; k_out.len()]; n_ell]; models.len()];
     let mut out_df = vec![vec![vec![0.0; k_out.len()]; n_ell]; df.len()];
-    // the weights of the no-wiggle (N) and wiggle (W) coefficients: [ℓ][grid point − lo][μ² power],
-    // and of W in the damping's f- and Σ²-derivatives
-    let (mut on, mut ow, mut owf, mut ows) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    // The weights of one output k, [ℓ][grid point − lo][N's five μ² powers, then W's] (`wv`), so that
+    // a set's multipole is one contiguous dot product with its columns from `lo`; and of W in the
+    // damping's f- and Σ²-derivatives (`wf`, `ws`: N's half zero), applied to the values' columns.
+    const WIDTH: usize = 2 * (MAX_MU_POWER + 1);
+    let (mut wv, mut wf, mut ws) = (Vec::new(), Vec::new(), Vec::new());
     let mut stencils = Vec::with_capacity(nodes.len());
     // what the weights apply to: the samples on the grid, else their spline coefficients (the
     // f-derivatives' and tangents' as the values')
@@ -270,13 +272,12 @@ pub(super) fn project_many(
             hi = hi.max(b + width);
         }
         let span = hi - lo;
-        on.clear();
-        on.resize(n_ell * span * 5, 0.0);
-        ow.clear();
-        ow.resize(n_ell * span * 5, 0.0);
-        for o in [&mut owf, &mut ows] {
+        let block = span * WIDTH;
+        wv.clear();
+        wv.resize(n_ell * block, 0.0);
+        for o in [&mut wf, &mut ws] {
             o.clear();
-            o.resize(if df.is_empty() { 0 } else { n_ell * span * 5 }, 0.0);
+            o.resize(if df.is_empty() { 0 } else { n_ell * block }, 0.0);
         }
         for (&(b, l, width, m2, damping, [damping_df, damping_ds]), c) in
             stencils.iter().zip(weights)
@@ -287,52 +288,45 @@ pub(super) fn project_many(
             }
             for (j, lj) in l.iter().enumerate().take(width) {
                 for (e, ce) in c.iter().enumerate() {
-                    let base = (e * span + b + j - lo) * 5;
+                    let base = e * block + (b + j - lo) * WIDTH;
                     let (wn, ww) = (ce * lj, ce * lj * damping);
+                    let w = &mut wv[base..base + WIDTH];
                     for q in 0..5 {
-                        on[base + q] += wn * powers[q];
-                        ow[base + q] += ww * powers[q];
+                        w[q] += wn * powers[q];
+                        w[5 + q] += ww * powers[q];
                     }
                     if !df.is_empty() {
-                        let (wf, ws) = (ce * lj * damping_df, ce * lj * damping_ds);
+                        let (a_f, a_s) = (ce * lj * damping_df, ce * lj * damping_ds);
                         for q in 0..5 {
-                            owf[base + q] += wf * powers[q];
-                            ows[base + q] += ws * powers[q];
+                            wf[base + 5 + q] += a_f * powers[q];
+                            ws[base + 5 + q] += a_s * powers[q];
                         }
                     }
                 }
             }
         }
+        let range = lo * WIDTH..hi * WIDTH;
         for (cols, o) in model_columns.iter().zip(out.iter_mut()) {
-            for (e, oe) in o.iter_mut().enumerate() {
-                let mut sum = 0.0;
-                for g in 0..span {
-                    let c = &cols[lo + g];
-                    let base = (e * span + g) * 5;
-                    for q in 0..5 {
-                        sum += on[base + q] * c[q] + ow[base + q] * c[5 + q];
-                    }
-                }
-                oe[i] = sum;
+            let c = &cols.as_flattened()[range.clone()];
+            for (oe, w) in o.iter_mut().zip(wv.chunks_exact(block)) {
+                oe[i] = crate::simd::dot(w, c);
             }
         }
         for (((_, _, tangent), (d, cols)), o) in df.iter().zip(&df_columns).zip(out_df.iter_mut()) {
             let (od, scale) = match *tangent {
-                DampingTangent::F => (&owf, 1.0),
-                DampingTangent::Sigma2(ds) => (&ows, ds),
+                DampingTangent::F => (&wf, 1.0),
+                DampingTangent::Sigma2(ds) => (&ws, ds),
             };
-            for (e, oe) in o.iter_mut().enumerate() {
-                let mut sum = 0.0;
-                for g in 0..span {
-                    let (d, c) = (&d[lo + g], &cols[lo + g]);
-                    let base = (e * span + g) * 5;
-                    for q in 0..5 {
-                        sum += on[base + q] * d[q]
-                            + ow[base + q] * d[5 + q]
-                            + scale * od[base + q] * c[5 + q];
-                    }
-                }
-                oe[i] = sum;
+            let (d, c) = (
+                &d.as_flattened()[range.clone()],
+                &cols.as_flattened()[range.clone()],
+            );
+            for ((oe, w), wd) in o
+                .iter_mut()
+                .zip(wv.chunks_exact(block))
+                .zip(od.chunks_exact(block))
+            {
+                oe[i] = crate::simd::dot(w, d) + scale * crate::simd::dot(wd, c);
             }
         }
     }
