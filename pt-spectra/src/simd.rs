@@ -12,7 +12,9 @@
 use pulp::{Arch, Simd, WithSimd};
 
 mod dot_many;
+mod exp;
 pub(crate) use dot_many::{matvec32, matvec32_four};
+pub(crate) use exp::exp_nonpositive;
 
 /// Σ a_i b_i over the common length with four partial sums in a fixed order: vectorised by the
 /// compiler and the same rounding on every machine (unlike [`dot`], whose lanes follow the processor),

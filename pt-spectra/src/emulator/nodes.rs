@@ -106,11 +106,15 @@ impl LinearEmulator {
             .collect();
         let z = z.clamp(z0, z1);
         let sigma8_weights = super::sigma8_weights(&k);
-        let point_coefficients = self.point_coefficients(&u, &heads);
+        // the second target, ln(P_m/P_cb), only with massive neutrinos (below, `ln_ratio` is zero
+        // without them, its derivative in Σm_ν at 0 included)
+        let with_ratio = m_nu.value() > 0.0;
+        let point_coefficients = self.point_coefficients(&u, &heads, with_ratio);
         // the derivative in s only where f_cb is made (at z); σ8's shape at z = 0 and the massless
         // ratio need the values alone
-        let shape_at =
-            |z: f64, derivative: bool| self.shape(&point_coefficients, &heads, z, derivative);
+        let shape_at = |z: f64, derivative: bool| {
+            self.shape(&point_coefficients, &heads, z, derivative, with_ratio)
+        };
         // The emulated ln(P_m/P_cb), continuous as Σm_ν → 0: P_m = P_cb exactly without massive
         // neutrinos (the emulated ratio is then its own error, and the neutrino head is 0 too: the
         // settings differ only in how the mass is shared); below RATIO_TAPER the ratio's value at
@@ -121,7 +125,7 @@ impl LinearEmulator {
         let massless = if m_nu.value() > 0.0 && taper.value() > 0.0 {
             let mut p = point;
             p.values[3] = T::cst(0.0);
-            Some(self.point_coefficients(&self.coordinates(&p)?, &heads))
+            Some(self.point_coefficients(&self.coordinates(&p)?, &heads, true))
         } else {
             None
         };
@@ -133,7 +137,7 @@ impl LinearEmulator {
                 Some(c) => (shape
                     .ratio
                     .iter()
-                    .zip(&self.shape(c, &heads, z, false).ratio))
+                    .zip(&self.shape(c, &heads, z, false, true).ratio))
                 .map(|(&r, &o)| r - taper * o)
                 .collect(),
                 None => shape.ratio.clone(),
@@ -196,17 +200,26 @@ impl LinearEmulator {
         )
     }
 
-    /// The polynomial coefficients of the targets and of the `heads`' at coordinates `u`.
+    /// The polynomial coefficients of the targets and of the `heads`' at coordinates `u` (the second
+    /// target's left empty unless `with_ratio`).
     fn point_coefficients<T: Lanes>(
         &self,
         u: &[T; COORDINATES],
         heads: &[(&format::Head, T)],
+        with_ratio: bool,
     ) -> PointCoefficients<T> {
+        let targets = if with_ratio { 2 } else { 1 };
         (
-            coefficients(&self.file.exponents, &self.file.targets, u, self.max_degree),
+            coefficients(
+                &self.file.exponents,
+                &self.file.targets,
+                u,
+                self.max_degree,
+                targets,
+            ),
             heads
                 .iter()
-                .map(|(h, _)| coefficients(&h.exponents, &h.targets, u, self.max_degree))
+                .map(|(h, _)| coefficients(&h.exponents, &h.targets, u, self.max_degree, targets))
                 .collect(),
         )
     }
@@ -219,10 +232,15 @@ impl LinearEmulator {
         heads: &[(&format::Head, T)],
         z: f64,
         derivative: bool,
+        with_ratio: bool,
     ) -> Shape<T> {
-        let mut shape = self.at_redshift(&self.file.targets, c, z, derivative);
+        let targets = if with_ratio { 2 } else { 1 };
+        let mut shape = self.at_redshift(&self.file.targets, c, z, derivative, targets);
         for ((h, weight), hc) in heads.iter().zip(head_c) {
-            shape.add(&self.at_redshift(&h.targets, hc, z, derivative), *weight);
+            shape.add(
+                &self.at_redshift(&h.targets, hc, z, derivative, targets),
+                *weight,
+            );
         }
         shape
     }
@@ -257,7 +275,7 @@ impl LinearEmulator {
         }
     }
 
-    /// Both targets at redshift `z` (four-node Lagrange interpolation in s = ln(1 + z)), and, with
+    /// The first `targets_used` targets (the others zero) at redshift `z` (four-node Lagrange interpolation in s = ln(1 + z)), and, with
     /// `derivative`, ∂(first target)/∂s (else zeros): per lane, the components weighted by the
     /// coefficients' lane, plus the mean on the value lane. Without the derivative a node of weight
     /// exactly 0 is skipped (at a redshift node, e.g. z = 0, three of the four: the values are the
@@ -268,6 +286,7 @@ impl LinearEmulator {
         coefficients: &[Vec<T>; 2],
         z: f64,
         derivative: bool,
+        targets_used: usize,
     ) -> Shape<T> {
         let nodes: Vec<f64> = self.file.z_nodes.iter().map(|z| z.ln_1p()).collect();
         let s = z.ln_1p();
@@ -282,7 +301,8 @@ impl LinearEmulator {
         let lanes: Vec<[Vec<f64>; 3]> = (0..T::LANES)
             .map(|l| {
                 let mut out = [vec![0.0; n_x], vec![0.0; n_x], vec![0.0; n_x]];
-                for (t, (target, c)) in targets.iter().zip(coefficients).enumerate() {
+                let used = targets.iter().zip(coefficients).take(targets_used);
+                for (t, (target, c)) in used.enumerate() {
                     c_lane.clear();
                     c_lane.extend(c.iter().map(|c| c.lane(l)));
                     let stride = target.mean.len();
@@ -344,12 +364,13 @@ impl<T: Real> Shape<T> {
 
 /// The principal-component coefficients of two targets with polynomial terms `exponents` at the unit
 /// point `u` (Legendre polynomials to `max_degree`): the features over `T`, then per lane the
-/// features' lane times the stored coefficients.
+/// features' lane times the stored coefficients; targets from `targets_used` on are left empty.
 fn coefficients<T: Lanes>(
     exponents: &[[u8; COORDINATES]],
     targets: &[format::Target; 2],
     u: &[T; COORDINATES],
     max_degree: usize,
+    targets_used: usize,
 ) -> [Vec<T>; 2] {
     let legendre: Vec<Vec<T>> = u.iter().map(|&x| legendre(x, max_degree)).collect();
     let features: Vec<T> = exponents
@@ -362,6 +383,9 @@ fn coefficients<T: Lanes>(
         })
         .collect();
     [0, 1].map(|t| {
+        if t >= targets_used {
+            return Vec::new();
+        }
         let t = &targets[t];
         let lanes: Vec<Vec<f64>> = (0..T::LANES)
             .map(|l| {

@@ -98,7 +98,8 @@ impl UniformSpline {
         if self.n < 4 || !(1.0 - 1e-9..=last - 1.0 + 1e-9).contains(&u) {
             return None;
         }
-        let b = (u.floor() as usize).saturating_sub(1).min(self.n - 4);
+        // u > 0 here: truncation is the floor (without a library call)
+        let b = (u as usize).saturating_sub(1).min(self.n - 4);
         Some((b, u - (b + 1) as f64))
     }
 }
