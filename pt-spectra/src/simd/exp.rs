@@ -1,7 +1,7 @@
-//! The exponential without a library call, written so that it vectorises: a spectrum's samples on
-//! the loop lattice ([`exp_in_place`]), and the BAO damping e^{−k²Σ²(…)} of the galaxy model's AP
-//! projection at every (k, μ) node of every step ([`exp_nonpositive`]), where the library's
-//! exponential was a sixth of the multipoles' cost.
+//! The exponential of many values without a library call, written so that it vectorises
+//! ([`exp_in_place`]). One at a time the library's is faster: this one's degree-13 Horner chain is
+//! latency-bound (measured on the BOSS step's BAO damping: the multipoles 94 µs with the library's,
+//! 108 µs with this one).
 
 /// e^v for every v in `values`, in place, to within 2 ulp of [`f64::exp`] for v ∈ [−708, 709]
 /// (clamped there): the samples of a spectrum on the loop lattice are exp of its ln-spline, a few
@@ -52,64 +52,5 @@ fn exp_reduced(v: f64) -> f64 {
         v
     } else {
         e_r * two_n
-    }
-}
-
-/// e^x for x ≤ 0, within 2 ulp of [`f64::exp`] (as [`exp_in_place`]); `f64::exp` itself outside
-/// [−708, 0] (below it [`exp_in_place`] clamps).
-#[inline]
-pub(crate) fn exp_nonpositive(x: f64) -> f64 {
-    if !(-708.0..=0.0).contains(&x) {
-        return x.exp();
-    }
-    exp_reduced(x)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::exp_nonpositive;
-
-    /// Distance in units in the last place.
-    fn ulps(a: f64, b: f64) -> u64 {
-        (a.to_bits() as i64 - b.to_bits() as i64).unsigned_abs()
-    }
-
-    #[test]
-    fn within_two_ulp_of_the_library_exponential() {
-        let mut worst = 0;
-        // a dense sweep of the whole range and the neighbourhoods of the reduction's boundaries
-        let sweep = (0..=200_000).map(|i| -708.0 * (i as f64 / 200_000.0).powi(3));
-        let edges = (0..1022).flat_map(|n| {
-            let x = -(n as f64 + 0.5) * std::f64::consts::LN_2;
-            [x, x.next_up(), x.next_down()]
-        });
-        for x in sweep
-            .chain(edges)
-            .chain([0.0, -0.0, -1e-300, -5e-324, -1e-12])
-        {
-            let (fast, exact) = (exp_nonpositive(x), x.exp());
-            worst = worst.max(ulps(fast, exact));
-            assert!(
-                ulps(fast, exact) <= 2,
-                "x = {x:e}: {fast:e} against {exact:e}"
-            );
-        }
-        assert!(worst >= 1, "the sweep should meet some rounding difference");
-    }
-
-    #[test]
-    fn outside_the_range_is_the_library_exponential() {
-        for x in [
-            1.0,
-            1e-300,
-            -708.5,
-            -745.0,
-            -746.0,
-            -1e300,
-            f64::NEG_INFINITY,
-        ] {
-            assert_eq!(exp_nonpositive(x).to_bits(), x.exp().to_bits(), "x = {x:e}");
-        }
-        assert!(exp_nonpositive(f64::NAN).is_nan());
     }
 }

@@ -6,7 +6,6 @@ use crate::error::{Error, Result};
 use crate::estimate::Estimate;
 use crate::rsd::ap::spline::{self, UniformSpline};
 use crate::rsd::MAX_MU_POWER;
-use crate::simd::exp_nonpositive;
 use std::borrow::Cow;
 use std::sync::OnceLock;
 
@@ -265,7 +264,7 @@ pub(super) fn project_many(
             };
             let m2 = mt * mt;
             let x = k2 * ratio2 * first.sigma2;
-            let damping = exp_nonpositive(-x * (1.0 + first.f * (2.0 + first.f) * m2));
+            let damping = (-x * (1.0 + first.f * (2.0 + first.f) * m2)).exp();
             let damping_df = -x * (2.0 + 2.0 * first.f) * m2 * damping;
             let damping_ds = -k2 * ratio2 * (1.0 + first.f * (2.0 + first.f) * m2) * damping;
             stencils.push((b, l, width, m2, damping, [damping_df, damping_ds]));
@@ -383,7 +382,7 @@ pub(super) fn ap_derivatives_many(
             let dl = spline::weights_derivative(t).map(|d| d / first.ln_step);
             let m2 = mt * mt;
             let x = k2 * ratio2 * first.sigma2;
-            let damping = exp_nonpositive(-x * (1.0 + growth * m2));
+            let damping = (-x * (1.0 + growth * m2)).exp();
             let d_lnk = -2.0 * x * (1.0 + growth * m2) * damping;
             let d_m2 = -x * growth * damping;
             let dm2 = 2.0 * m2 * (1.0 - m2);
@@ -458,14 +457,14 @@ impl Model<'_> {
         let (n, w) = &self.parts[i];
         let m2 = mu * mu;
         let horner = |c: &[f64; 5]| c.iter().rev().fold(0.0, |a, c| a * m2 + c);
-        let damping = exp_nonpositive(-k * k * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2));
+        let damping = (-k * k * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
         horner(&n.0) + damping * horner(&w.0)
     }
 
     fn combine(&self, n: &Poly, w: &Poly, k: f64, mu: f64) -> Estimate {
         let m2 = mu * mu;
         let horner = |c: &[f64; 5]| c.iter().rev().fold(0.0, |a, c| a * m2 + c);
-        let damping = exp_nonpositive(-k * k * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2));
+        let damping = (-k * k * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
         Estimate::new(
             horner(&n.0) + damping * horner(&w.0),
             horner(&n.1) + damping * horner(&w.1),
@@ -505,7 +504,7 @@ impl Model<'_> {
             n += lj * horner(c, 0, m2);
             w += lj * horner(c, 5, m2);
         }
-        let damping = exp_nonpositive(-k2 * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2));
+        let damping = (-k2 * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
         Ok(n + damping * w)
     }
 
