@@ -484,15 +484,31 @@ impl EptPlan {
             self.projection_nodes(terms, std::slice::from_ref(params), ells, ap)?;
         let model = terms.model_values(params);
         let mut out = vec![vec![0.0; self.k_out.len()]; ells.len()];
-        for (i, &k) in self.k_out.iter().enumerate() {
-            let (ln_k, k2) = (k.ln(), k * k);
-            for (((mu, _, _), c), &(ln_ratio, ratio2, mt)) in
-                self.value_rule.iter().zip(&weights).zip(&nodes)
-            {
-                let p = match &ap {
-                    None if self.grid_use == GridUse::Output => model.value_at(i, k, *mu),
-                    _ => model.interpolated_value_ln(ln_k + ln_ratio, k2 * ratio2, mt)?,
-                };
+        if ap.is_none() && self.grid_use == GridUse::Output {
+            for (i, &k) in self.k_out.iter().enumerate() {
+                for ((mu, _, _), c) in self.value_rule.iter().zip(&weights) {
+                    let p = model.value_at(i, k, *mu);
+                    for (o, c) in out.iter_mut().zip(c) {
+                        o[i] += c * p;
+                    }
+                }
+            }
+            return Ok(out);
+        }
+        // node by node in μ (each k's sum in the same order), the BAO damping of all k of a node
+        // in one vectorised pass
+        let ln_k: Vec<f64> = self.k_out.iter().map(|k| k.ln()).collect();
+        let mut damping = vec![0.0; self.k_out.len()];
+        for (c, &(ln_ratio, ratio2, mt)) in weights.iter().zip(&nodes) {
+            let exponent = ratio2 * model.damping_exponent(mt);
+            damping
+                .iter_mut()
+                .zip(&self.k_out)
+                .for_each(|(d, k)| *d = k * k * exponent);
+            crate::simd::exp_in_place(&mut damping);
+            for (i, (&ln_k, damping)) in ln_k.iter().zip(&damping).enumerate() {
+                let (n, w) = model.interpolated_parts_ln(ln_k + ln_ratio, mt)?;
+                let p = n + damping * w;
                 for (o, c) in out.iter_mut().zip(c) {
                     o[i] += c * p;
                 }

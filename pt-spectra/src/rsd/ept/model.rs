@@ -491,9 +491,10 @@ impl Model<'_> {
         Ok(self.combine(&n, &w, k, mu))
     }
 
-    /// The value only of [`Self::interpolated`], at k given as ln k and k² (the AP projection has
-    /// them per μ node without a logarithm or a square root per point).
-    pub(super) fn interpolated_value_ln(&self, ln_k: f64, k2: f64, mu: f64) -> Result<f64> {
+    /// N(μ²) and W(μ²) of [`Self::interpolated`]'s values at ln k (the AP projection has it per μ
+    /// node without a logarithm per point), without the damping, which the projection makes for all
+    /// k of a μ node at once ([`Self::damping_exponent`]).
+    pub(super) fn interpolated_parts_ln(&self, ln_k: f64, mu: f64) -> Result<(f64, f64)> {
         let (b, t) = self.stencil_ln(ln_k)?;
         let l = spline::weights(t);
         let values = self.coefficients();
@@ -504,8 +505,12 @@ impl Model<'_> {
             n += lj * horner(c, 0, m2);
             w += lj * horner(c, 5, m2);
         }
-        let damping = (-k2 * self.sigma2 * (1.0 + self.f * (2.0 + self.f) * m2)).exp();
-        Ok(n + damping * w)
+        Ok((n, w))
+    }
+
+    /// The damping's exponent per unit k² at μ: P = N + e^{k² × this} W.
+    pub(super) fn damping_exponent(&self, mu: f64) -> f64 {
+        -self.sigma2 * (1.0 + self.f * (2.0 + self.f) * mu * mu)
     }
 
     /// The cell of ln k on the grid: the first of the four spline coefficients it reads and the
