@@ -16,6 +16,7 @@ mod bins;
 mod bispectrum_galaxy;
 mod bispectrum_galaxy_ct;
 mod bispectrum_galaxy_ct_rsd;
+mod bispectrum_galaxy_ir;
 mod bispectrum_galaxy_kernels;
 mod bispectrum_galaxy_multipoles;
 mod bispectrum_galaxy_poly;
