@@ -1,7 +1,7 @@
 //! The infrared (IR) resummation of the BAO in the one-loop galaxy bispectrum, at leading order: the
 //! prescription of the one-loop EFT analyses (Ivanov & Sibiryakov 2018, arXiv:1804.05080; Philcox et al.
 //! 2022, arXiv:2206.02800, whose one-loop templates are computed on the IR-resummed linear spectrum; the
-//! power spectrum's P_nw + e^{−x}(1 + x)P_w + P_1loop[P_nw + e^{−x}P_w] of CLASS-PT). With the no-wiggle
+//! power spectrum's P_nw + e^{−x}(1 + x)P_w + P_1loop(P_nw + e^{−x}P_w) of CLASS-PT). With the no-wiggle
 //! split P = P_nw + P_w and the damping scales Σ², δΣ² of [`IrInputs`]:
 //!
 //! ```text
@@ -11,7 +11,7 @@
 //! Σ²_tot(μ) = [1 + fμ²(2 + f)] Σ² + f²μ²(μ² − 1) δΣ²,
 //! ```
 //!
-//! B_1loop[P_LO] being B₂₂₂ + B₃₂₁ᴵ + B₃₂₁ᴵᴵ + B₄₁₁ with P_LO in place of P on every spectrum, inside the
+//! B_1loop(P_LO) being B₂₂₂ + B₃₂₁ᴵ + B₃₂₁ᴵᴵ + B₄₁₁ with P_LO in place of P on every spectrum, inside the
 //! integrals and at the sides (the renormalisation's σ² = ∫P_LO too). The (1 + x) of the tree level takes
 //! out what the one-loop terms' own IR-enhanced part (≈ −x_a × the tree level's wiggles in leg a) would
 //! count twice: to first order in x the wiggles of B_IR are those of the unresummed B_tree + B_1loop, and
@@ -54,7 +54,7 @@ use crate::loops::basis::Projection;
 
 /// The IR-resummed [`super::one_loop_galaxy::one_loop_galaxy`]: the terms of the triangle `k` [h/Mpc] with
 /// `bias`, real space (`redshift` None) or at (f, orientation), for the linear spectrum `p` resummed with
-/// `ir` (module docs); `tree` is B_tree[P_NLO], the loop terms B_1loop[P_LO] (their errors the rule's).
+/// `ir` (module docs); `tree` is B_tree(P_NLO), the loop terms B_1loop(P_LO) (their errors the rule's).
 ///
 /// # Errors
 /// As [`super::one_loop_galaxy::one_loop_galaxy`].
