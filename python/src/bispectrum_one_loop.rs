@@ -27,13 +27,15 @@ use pyo3::types::PyDict;
 /// coefficients by name), the galaxy bispectrum ([`pt_spectra::jobs::one_loop_galaxy_table`]). With
 /// `multipoles=True` the multipoles B0, B2, B4 in redshift space at `f` (default f(z)), the Legendre
 /// polynomial on `legendre_side` ([`pt_spectra::jobs::one_loop_galaxy_multipoles_table`]; matter without a
-/// bias).
+/// bias). `ir`: the IR resummation of the BAO ([`pt_spectra::bispectrum::one_loop_ir`]) of the galaxy
+/// bispectrum and the multipoles, on unless False (None: on there; the matter tables without a bias are
+/// plain SPT, and `ir=True` there is refused).
 #[pyfunction]
 #[pyo3(signature = (triangles, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None,
     q_min=1e-4, q_max=10.0, radial=12, mu=32, phi=24,
     two_loop=pt_spectra::jobs::defaults::TWO_LOOP, cache_dir=None, mu1=None, phi_los=0.0, f=None,
     b1=None, b2=0.0, bs=0.0, b_gamma3=0.0, bias_convention=None, loop_bias=None, multipoles=false,
-    legendre_side="largest"))]
+    legendre_side="largest", ir=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn one_loop_bispectrum(
     py: Python<'_>,
@@ -61,6 +63,7 @@ pub fn one_loop_bispectrum(
     loop_bias: Option<std::collections::BTreeMap<String, f64>>,
     multipoles: bool,
     legendre_side: &str,
+    ir: Option<bool>,
 ) -> PyResult<Table> {
     let rows = fixed_rows::<3>(triangles, "triangles", "k1, k2, k3")?;
     let method: TwoLoopMethod = two_loop.parse().map_err(library_error)?;
@@ -84,6 +87,13 @@ pub fn one_loop_bispectrum(
     let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
     let side =
         pt_spectra::bispectrum::LegendreSide::by_name(legendre_side).map_err(library_error)?;
+    if ir == Some(true) && !galaxy && !multipoles {
+        return Err(crate::value_error(
+            "ir=True: the one-loop matter tables (no bias, no multipoles) are plain SPT; the IR resummation is \
+             the galaxy bispectrum's (give b1=1 for matter through the galaxy code) and the multipoles'",
+        ));
+    }
+    let ir = ir.unwrap_or(true);
     if multipoles && (mu1.is_some() || method == TwoLoopMethod::Basis) {
         return Err(crate::value_error(
             "multipoles=True averages over the orientations (no mu1) and is direct (two_loop \"direct\" or \"auto\")",
@@ -99,7 +109,7 @@ pub fn one_loop_bispectrum(
         let ((prepared, table), seconds) = detached(py, || {
             let prepared = inputs.prepare(&[])?;
             let table = pt_spectra::jobs::one_loop_galaxy_multipoles_table(
-                &prepared, &rows, &bias, f, side, &rule, &Silent,
+                &prepared, &rows, &bias, f, side, ir, &rule, &Silent,
             )?;
             Ok((prepared, table))
         })?;
@@ -135,6 +145,7 @@ pub fn one_loop_bispectrum(
                 &rows,
                 bias,
                 redshift,
+                ir,
                 &rule,
                 method,
                 store.get(),

@@ -229,15 +229,24 @@ def test_one_loop_galaxy_bispectrum_through_the_python_face(tmp_path):
     k = np.unique(tri)
     p = dict(zip(k, pt.real(model="linear", k=k)["P_lin"]))
     matter = pt.one_loop_bispectrum(tri, **rule)
-    # b1 = 1 alone: the galaxy kernels are F_n (the galaxy code against the matter code)
-    unit = pt.one_loop_bispectrum(tri, b1=1.0, **rule)
+    # b1 = 1 alone, without the IR resummation (the galaxy bispectrum's default, not the matter table's):
+    # the galaxy kernels are F_n (the galaxy code against the matter code)
+    unit = pt.one_loop_bispectrum(tri, b1=1.0, ir=False, **rule)
     assert unit.meta["model"] == "bispectrum one-loop galaxy"
     for name in ["B_tree", "B222", "B321_I", "B321_II", "B411"]:
         np.testing.assert_allclose(unit[name], matter[name], rtol=1e-12)
     # the tree level of a biased tracer is the closed form b1^2 [b1 F2 + b2/2 + bs (mu^2 - 1/3)] P P + cyclic
-    g = pt.one_loop_bispectrum(tri, b1=2.0, b2=0.4, bs=-0.3, **rule)
-    for row, tree in zip(tri, g["B_tree"]):
+    plain = pt.one_loop_bispectrum(tri, b1=2.0, b2=0.4, bs=-0.3, ir=False, **rule)
+    assert any(line.startswith("no IR resummation") for line in plain.header)
+    for row, tree in zip(tri, plain["B_tree"]):
         assert tree == pytest.approx(closed_form(row, p.__getitem__, 2.0, 0.4, -0.3), rel=1e-10)
+    # resummed by default: the header states it with Sigma^2, every term moves
+    g = pt.one_loop_bispectrum(tri, b1=2.0, b2=0.4, bs=-0.3, **rule)
+    assert any(line.startswith("IR resummation of the BAO") and "Sigma^2 = " in line for line in g.header)
+    for name in ["B_tree", "B222", "B321_I", "B321_II", "B411"]:
+        assert np.all(np.abs(g[name] - plain[name]) > 1e-6 * np.abs(plain[name])), name
+    with pytest.raises(ValueError, match="plain SPT"):
+        pt.one_loop_bispectrum(tri, ir=True, **rule)
     assert any("b1 = 2, b2 = 0" in line for line in g.header)  # the ESS19 b2 = b2 + (4/3) bs, stated
     assert np.all(g["uv_B411"] != 0)
     # CLASS-PT's convention: bs is b_G2 = velocileptors' bs, b2 is b2 + (4/3) bs

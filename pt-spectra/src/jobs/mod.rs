@@ -66,7 +66,8 @@ pub use bispectrum::{
     sugiyama_table, BispectrumRequest, SugiyamaRequest,
 };
 pub use bispectrum_galaxy::{
-    loop_bias, one_loop_galaxy_multipoles_table, one_loop_galaxy_table, LOOP_BIAS_NAMES,
+    loop_bias, one_loop_galaxy_multipoles_table, one_loop_galaxy_table, one_loop_ir_inputs,
+    LOOP_BIAS_NAMES,
 };
 pub use ept::{
     ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest, AP_FIT_RANGE,

@@ -112,7 +112,10 @@ pub struct Args {
     /// sigma_B of the Fingers of God [Mpc/h].
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     sigma_fog: f64,
-    /// Switch off the IR resummation of the BAO in every leg.
+    /// Switch off the IR resummation of the BAO in every leg (tree level) and, with --loop 1, of the
+    /// one-loop galaxy bispectrum (any bias option, or --multipoles): on by default, B_tree with
+    /// P_nw + e^-x (1 + x) P_w per leg and the loops on P_nw + e^(-q^2 Sigma^2) P_w (the matter tables
+    /// of --loop 1 without a bias option are plain SPT, not resummed).
     #[arg(long)]
     no_ir: bool,
     /// Loop order: 0 (the tree-level galaxy model in redshift space) or 1 (the one-loop bispectrum,
@@ -121,7 +124,7 @@ pub struct Args {
     /// the multipoles with --multipoles; the counterterm shapes as columns in real space and with
     /// --multipoles; no bins yet; in real space --two-loop basis
     /// makes it ~10 us (matter) or ~0.15 ms (galaxies) per triangle after a one-off ~0.7 s (4 s) per
-    /// triangle and core).
+    /// triangle and core). The galaxy bispectrum's BAO are IR-resummed unless --no-ir.
     #[arg(long = "loop", value_name = "N", default_value_t = 0)]
     loop_order: u32,
     /// --loop 1 in redshift space: the cosine between k1 and the line of sight (with --f, default
@@ -189,6 +192,7 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
         .into_iter()
         .filter(|&o| !(redshift && o == "--f"))
         .filter(|&o| !(args.multipoles && o == "--legendre-side"))
+        .filter(|&o| o != "--no-ir")
         .collect();
     if !given.is_empty() {
         bail!(
@@ -220,6 +224,7 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
             &bias,
             args.f,
             LegendreSide::by_name(&args.legendre_side).context("--legendre-side")?,
+            !args.no_ir,
             &OneLoopRule::default(),
             &bars,
         )
@@ -238,6 +243,7 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
             &rows,
             &bias,
             redshift,
+            !args.no_ir,
             &OneLoopRule::default(),
             loaded.precision.two_loop,
             &loaded.store,
