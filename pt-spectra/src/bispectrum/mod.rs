@@ -53,6 +53,7 @@ mod lanes;
 mod observed;
 pub mod one_loop;
 pub mod one_loop_basis;
+pub mod one_loop_bins;
 pub mod one_loop_galaxy;
 pub mod one_loop_galaxy_basis;
 pub mod one_loop_galaxy_multipoles;

@@ -14,6 +14,7 @@ mod ap;
 mod bias;
 mod bins;
 mod bispectrum_galaxy;
+mod bispectrum_galaxy_bins;
 mod bispectrum_galaxy_ct;
 mod bispectrum_galaxy_ct_rsd;
 mod bispectrum_galaxy_ir;
