@@ -492,7 +492,7 @@ def bispectrum(triangles=None, bin_width=None, linear=None, z=0.0, z_input=0.0, 
 def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, q_min=1e-4,
                         q_max=10.0, radial=12, mu=32, phi=24, two_loop="auto", cache_dir=None, mu1=None,
                         phi_los=0.0, f=None, b1=None, b2=0.0, bs=0.0, b_gamma3=0.0, bias_convention=None,
-                        loop_bias=None, multipoles=False, legendre_side="largest", ir=None):
+                        loop_bias=None, multipoles=False, legendre_side="largest", ir=None, bin_width=None):
     """One-loop matter or galaxy bispectrum (SPT) [(Mpc/h)^6] at single triangles.
 
     ``triangles``: an (n, 3) array of k1, k2, k3 [h/Mpc] (points, not bins). The linear spectrum as in
@@ -529,7 +529,11 @@ def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=No
     all orientations in one pass over the loop nodes (the orientation rule is exact; about 6 times one
     orientation's cost, ~35 s per triangle at the default rule on 2 cores): columns k1 k2 k3, B{l}_tree,
     B{l}_222, B{l}_321_I, B{l}_321_II, B{l}_411, B{l} (the total) for l = 0, 2, 4, their err_ columns, and
-    the multipoles of the 20 redshift-space counterterm and stochastic shapes shape_B{l}_<name>.
+    the multipoles of the 20 redshift-space counterterm and stochastic shapes shape_B{l}_<name>. With
+    ``bin_width`` [h/Mpc] (and ``multipoles=True``) each triangle is a bin of three shells of that width: the
+    tree level averaged over the bin exactly, the loops at its effective triangle (columns k1_eff, k2_eff,
+    k3_eff) with that shortcut's error in their err_ columns, the shapes averaged over the bin
+    (docs/bispectrum.md).
 
     ``ir``: the IR resummation of the BAO of the galaxy bispectrum and of the multipoles, on by default as
     the tree level's (``ir=False`` for plain SPT): B_tree with P_nw + exp(-x)(1 + x) P_w in every leg,
@@ -540,7 +544,7 @@ def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=No
     return _warn(_core.one_loop_bispectrum(triangles, linear, z, z_input, cosmology, eh, q_min, q_max,
                                            radial, mu, phi, two_loop, cache_dir, mu1, phi_los, f, b1, b2,
                                            bs, b_gamma3, bias_convention, loop_bias, multipoles,
-                                           legendre_side, ir))
+                                           legendre_side, ir, bin_width))
 
 
 def from_desi_physical(physical, sigma8, n_bar, satellites=None):

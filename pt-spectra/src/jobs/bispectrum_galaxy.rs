@@ -9,7 +9,7 @@ use crate::bias::BiasParams;
 use crate::bispectrum::bias_kernels::LoopBias;
 use crate::bispectrum::galaxy_counterterms::{galaxy_counterterm_shapes, GALAXY_COUNTERTERMS};
 use crate::bispectrum::galaxy_counterterms_rsd::{
-    redshift_counterterm_multipoles, REDSHIFT_COUNTERTERMS,
+    redshift_counterterm_multipoles, N_REDSHIFT_CT, REDSHIFT_COUNTERTERMS,
 };
 use crate::bispectrum::one_loop::{OneLoopRule, PARTITION_POWER};
 use crate::bispectrum::one_loop_basis::BispectrumLoopSource;
@@ -297,6 +297,18 @@ pub fn one_loop_galaxy_multipoles_table(
     header.extend(prepared.description.iter().cloned());
     let mut t = Table::new(header);
     t.methods.push(MethodNote::new("loop terms", "direct"));
+    multipole_columns(&mut t, triangles, &rows, &shapes);
+    Ok(t)
+}
+
+/// The columns of the multipoles' table: `k1 k2 k3` (`triangles`), per ℓ = 0, 2, 4 the terms of `rows`
+/// and their `err_`, the counterterm shapes' multipoles `shapes`.
+pub(super) fn multipole_columns(
+    t: &mut Table,
+    triangles: &[[f64; 3]],
+    rows: &[[OneLoopGalaxy; 3]],
+    shapes: &[[[f64; N_REDSHIFT_CT]; 3]],
+) {
     for (i, name) in ["k1", "k2", "k3"].iter().enumerate() {
         t.push(*name, WAVENUMBER, triangles.iter().map(|k| k[i]).collect());
     }
@@ -332,7 +344,6 @@ pub fn one_loop_galaxy_multipoles_table(
             );
         }
     }
-    Ok(t)
 }
 
 /// The IR inputs of the one-loop galaxy bispectrum: the no-wiggle split and Σ², δΣ² of `prepared`'s
@@ -349,7 +360,7 @@ pub fn one_loop_ir_inputs(prepared: &Prepared) -> Result<IrInputs> {
 }
 
 /// The header line of the IR resummation (on, with its Σ², or off).
-fn ir_line(ir: Option<&IrInputs>) -> String {
+pub(super) fn ir_line(ir: Option<&IrInputs>) -> String {
     match ir {
         Some(ir) => crate::bispectrum::one_loop_ir::describe(ir),
         None => "no IR resummation (--no-ir / ir=False): the linear spectrum in every leg and loop"

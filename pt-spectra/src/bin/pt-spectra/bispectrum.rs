@@ -144,8 +144,10 @@ pub struct Args {
     /// bispectrum in redshift space at the points of --triangles (with --f, default f(z), and
     /// --legendre-side), all orientations in one pass over the loop nodes (the orientation rule exact),
     /// with the multipoles of the redshift-space counterterm and stochastic shapes; direct, ~6 times one
-    /// orientation's cost (~35 s per triangle on 2 cores).
-    #[arg(long, conflicts_with = "mu1", requires = "triangles")]
+    /// orientation's cost (~35 s per triangle on 2 cores). With bins (--bin-width or --k-edges): the
+    /// tree level averaged over each bin exactly, the loops at its effective triangle (mean sides), the
+    /// shortcut's error in err_ (docs/bispectrum.md).
+    #[arg(long, conflicts_with = "mu1")]
     multipoles: bool,
     /// --loop 1: CLASS-PT's b_Gamma3 (Gamma3 = G2(Phi_g) - G2(Phi_v)), with --b1, --b2, --bs.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
@@ -193,13 +195,17 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
         .filter(|&o| !(redshift && o == "--f"))
         .filter(|&o| !(args.multipoles && o == "--legendre-side"))
         .filter(|&o| o != "--no-ir")
+        .filter(|&o| !(args.multipoles && (o == "--bin-width" || o == "--k-edges")))
         .collect();
     if !given.is_empty() {
         bail!(
-            "--loop 1 is the one-loop bispectrum at single triangles; it does not take {} (counterterms, \
-             stochastic terms, FoG, AP and bin averages of the one-loop bispectrum are not built yet)",
+            "--loop 1 is the one-loop bispectrum at single triangles (bins: with --multipoles); it does not \
+             take {} (counterterms, stochastic terms, FoG and AP of the one-loop bispectrum are not built yet)",
             given.join(", ")
         );
+    }
+    if args.multipoles && (args.bin_width.is_some() || args.k_edges.is_some()) {
+        return binned_multipoles(args);
     }
     let Some(path) = &args.triangles else {
         bail!("--loop 1 needs --triangles FILE (columns k1 k2 k3 [h/Mpc])");
@@ -280,6 +286,29 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
         &bars,
     )
     .with_context(|| format!("--triangles {}", path.display()))
+}
+
+/// `--loop 1 --multipoles` with bins (`--triangles FILE --bin-width DK` or `--k-edges`): the loops at each
+/// bin's effective triangle, the tree level averaged over the bin.
+fn binned_multipoles(args: &Args) -> Result<pt_spectra::output::Table> {
+    let set = triangles(args)?;
+    let loaded = args.spectrum.load()?;
+    if loaded.precision.two_loop == pt_spectra::precision::TwoLoopMethod::Basis {
+        bail!("--two-loop basis: the one-loop bispectrum's tensors are built for real space only");
+    }
+    let bias =
+        galaxy_bias(args)?.unwrap_or_else(pt_spectra::bispectrum::bias_kernels::LoopBias::matter);
+    pt_spectra::jobs::one_loop_galaxy_binned_multipoles_table(
+        &loaded.prepared,
+        &set,
+        &bias,
+        args.f,
+        LegendreSide::by_name(&args.legendre_side).context("--legendre-side")?,
+        !args.no_ir,
+        &OneLoopRule::default(),
+        &crate::progress::Bars::default(),
+    )
+    .context("--loop 1 --multipoles with bins")
 }
 
 /// `--loop 1`'s galaxy bias, if any bias option is given (else the matter bispectrum).
