@@ -223,6 +223,28 @@ def test_one_loop_galaxy_multipoles_through_the_python_face():
         pt.one_loop_bispectrum(tri, multipoles=True, legendre_side="4", **rule)
 
 
+def test_one_loop_galaxy_multipoles_over_bins_through_the_python_face():
+    # two Nseries bins at a tiny loop rule: without IR the tree columns are the tree-level bin averages,
+    # the loops come from the effective triangle (its columns inside the shells), the shortcut is in err_
+    tri = np.array([[0.035, 0.055, 0.065], [0.045, 0.045, 0.045]])
+    rule = dict(radial=2, mu=2, phi=2)
+    bias = dict(b1=2.0, b2=0.3, bs=-0.2)
+    t = pt.one_loop_bispectrum(tri, multipoles=True, bin_width=0.01, f=0.7, ir=False, **bias, **rule)
+    assert t.meta["model"] == "bispectrum one-loop galaxy multipoles over bins"
+    assert any("effective triangle" in line for line in t.header)
+    tree = pt.bispectrum(tri, bin_width=0.01, f=0.7, ir=False, **bias)
+    for ell in ["B0", "B2"]:
+        np.testing.assert_allclose(t[ell + "_tree"], tree[ell], rtol=1e-8, atol=1e-9 * np.abs(tree["B0"]).max())
+    for i, side in enumerate(["k1_eff", "k2_eff", "k3_eff"]):
+        assert np.all(np.abs(t[side] - tri[:, i]) < 0.005)
+    at = pt.one_loop_bispectrum(np.stack([t["k1_eff"], t["k2_eff"], t["k3_eff"]], axis=1), multipoles=True,
+                                f=0.7, ir=False, legendre_side="3", **bias, **rule)
+    np.testing.assert_allclose(t["B0_222"], at["B0_222"], rtol=1e-12)
+    assert np.all(t["err_B0_222"] > at["err_B0_222"])
+    with pytest.raises(ValueError, match="multipoles=True"):
+        pt.one_loop_bispectrum(tri, bin_width=0.01, **bias, **rule)
+
+
 def test_one_loop_galaxy_bispectrum_through_the_python_face(tmp_path):
     tri = np.array([[0.1, 0.1, 0.1], [0.05, 0.1, 0.12]])
     rule = dict(radial=6, mu=12, phi=8, two_loop="direct")
