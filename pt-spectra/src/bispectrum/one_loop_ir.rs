@@ -25,8 +25,8 @@
 //! damped with Σ² where the tree level's are with Σ²_tot(μ_a) — a difference of
 //! (Σ²_tot(μ) − Σ²)k² × the one-loop terms' wiggly part, of the order of the two-loop wiggles (bounded in
 //! the tests: damping the loops with the largest Σ²_tot(μ = 1) moves B₀, B₂, B₄ by ≤ 6e-3 of B₀ at
-//! 0.05–0.2 h/Mpc, z = 0.5). The
-//! wiggles' damping of the tree level is exact to leading order in each leg (Σ²_tot(μ_a)).
+//! 0.05–0.2 h/Mpc, z = 0.5). The wiggles' damping of the tree level is exact to leading order in each leg
+//! (Σ²_tot(μ_a)).
 //!
 //! **Properties** (tested): with P_w = 0 (a smooth spectrum) B_IR is the unresummed B (the P_LO table equals
 //! P to round-off); Σ² = δΣ² = 0 gives the unresummed B; at f = 0 the redshift-space terms are the
