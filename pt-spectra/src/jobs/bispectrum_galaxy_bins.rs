@@ -1,6 +1,6 @@
 //! `bispectrum --loop 1 --multipoles` with bins (`--bin-width`, `--k-edges`): the one-loop galaxy
-//! multipoles averaged over triangle bins by the effective-triangle shortcut for the loops
-//! ([`crate::bispectrum::one_loop_bins`]), as a table with its header.
+//! multipoles averaged over triangle bins: the effective triangle plus the bin average's departure from it
+//! on a coarse loop rule ([`crate::bispectrum::one_loop_bins`]), as a table with its header.
 
 use super::bispectrum_galaxy::{ir_line, multipole_columns, one_loop_ir_inputs};
 use super::VERSION;
@@ -9,8 +9,8 @@ use crate::bispectrum::galaxy_counterterms_rsd::{
     redshift_counterterm_multipoles, N_REDSHIFT_CT, REDSHIFT_COUNTERTERMS,
 };
 use crate::bispectrum::one_loop::{OneLoopRule, PARTITION_POWER};
-use crate::bispectrum::one_loop_bins::{binned_multipoles, LOOP_SHORTCUT_FACTOR};
-use crate::bispectrum::{LegendreSide, PlanRules, TriangleSet};
+use crate::bispectrum::one_loop_bins::{binned_multipoles, correction_rule, CORRECTION_NODES};
+use crate::bispectrum::{LegendreSide, TriangleSet};
 use crate::error::Result;
 use crate::output::{MethodNote, Table, WAVENUMBER};
 use crate::progress::Progress;
@@ -19,9 +19,10 @@ use crate::setup::Prepared;
 /// The table of the multipoles of the one-loop galaxy bispectrum with `bias` averaged over the bins `set`
 /// (shells) in redshift space at growth rate `f` (default f(z)), the Legendre polynomial on `side`, IR-resummed
 /// with `ir`: the columns of [`super::one_loop_galaxy_multipoles_table`] (`k1 k2 k3` the bins' centres),
-/// then the effective triangles `k1_eff k2_eff k3_eff`; the tree level averaged over each bin exactly, the
-/// loops at its effective triangle with the shortcut's error in their `err_`, the counterterm shapes'
-/// multipoles averaged over the bin ([`crate::bispectrum::one_loop_bins`]); each bin reported to `progress`.
+/// then the effective triangles `k1_eff k2_eff k3_eff`: the one-loop multipoles at each bin's effective
+/// triangle plus their departure from the bin average on a coarse loop rule, with its error in `err_`, the
+/// counterterm shapes' multipoles averaged over the bin ([`crate::bispectrum::one_loop_bins`]); each bin
+/// reported to `progress`.
 ///
 /// # Errors
 /// As [`binned_multipoles`] and [`redshift_counterterm_multipoles`].
@@ -43,8 +44,9 @@ pub fn one_loop_galaxy_binned_multipoles_table(
         progress.update(crate::bispectrum::seam::ONE_LOOP_STAGE, done, total);
     };
     let binned = binned_multipoles(p, ir.as_ref(), set, f, side, rule, &tick)?;
+    let coarse = correction_rule(rule);
     let rows = binned.evaluate(bias)?;
-    let n_shell = PlanRules::default().n_shell;
+    let n_shell = CORRECTION_NODES;
     let mut shapes = Vec::with_capacity(set.len());
     for i in 0..set.len() {
         let a = LegendreSide::Index(set.legendre_index(i, side));
@@ -75,12 +77,16 @@ pub fn one_loop_galaxy_binned_multipoles_table(
             values.join(", ")
         ),
         format!(
-            "bin average: B_l,bin = B_l(k_eff) + [T_l,bin - T_l(k_eff)]: the one-loop multipoles at each bin's \
-             effective triangle (k_eff columns: its mean sides over the closed triangles, weight k1 k2 k3) plus \
-             the tree-level code's multipoles T (velocileptors' b1, b2, bs) averaged over the bin ({n_shell} nodes \
-             per shell panel) minus at k_eff, in B_l_tree; the loops at k_eff, their err_ with the shortcut's \
-             error {LOOP_SHORTCUT_FACTOR} x max_l |T_l,bin - T_l(k_eff)| / |T_0,bin| x |the term's B0| \
-             (docs/bispectrum.md); Legendre polynomial on {}",
+            "bin average: B_l,bin = B_l(k_eff) + Delta_l, Delta_l = sum_n w_n B_l(k_n; coarse) - B_l(k_eff; coarse): \
+             the one-loop multipoles at each bin's effective triangle (k_eff columns: its mean sides over the \
+             closed triangles, weight k1 k2 k3) plus their departure from the bin average on the closed \
+             triangles k_n ({CORRECTION_NODES} nodes per shell panel) with the coarse loop rule {} x {} x {} per \
+             panel (the tree level's Delta is exact: the bin average of the tree); err_ adds 2 (|Delta - \
+             Delta(one node fewer)| + |Delta - Delta(2 x 2 x 2 rule)|) to the loop terms, |Delta - Delta(one node \
+             fewer)| to the tree (docs/bispectrum.md); Legendre polynomial on {}",
+            coarse.radial,
+            coarse.mu,
+            coarse.phi,
             match side {
                 LegendreSide::Largest => "the largest bin (as the window-free estimator)".to_string(),
                 LegendreSide::Index(a) => format!("side k{}", a + 1),
@@ -93,7 +99,7 @@ pub fn one_loop_galaxy_binned_multipoles_table(
         format!(
             "loop integrals over {} <= |q| <= {} h/Mpc about each cusp (smooth partition of unity, power {}); \
              {} ln q x {} cos(theta) x {} phi nodes per panel, one pass for all orientations (exact rule); err_: \
-             difference from the rule with half the nodes, plus the shortcut's",
+             difference from the rule with half the nodes, plus the bin correction's",
             rule.q_min, rule.q_max, PARTITION_POWER, rule.radial, rule.mu, 2 * rule.phi
         ),
         format!(

@@ -144,9 +144,10 @@ pub struct Args {
     /// bispectrum in redshift space at the points of --triangles (with --f, default f(z), and
     /// --legendre-side), all orientations in one pass over the loop nodes (the orientation rule exact),
     /// with the multipoles of the redshift-space counterterm and stochastic shapes; direct, ~6 times one
-    /// orientation's cost (~35 s per triangle on 2 cores). With bins (--bin-width or --k-edges): the
-    /// tree level averaged over each bin exactly, the loops at its effective triangle (mean sides), the
-    /// shortcut's error in err_ (docs/bispectrum.md).
+    /// orientation's cost (~35 s per triangle on 2 cores). With bins (--bin-width or --k-edges): each
+    /// bin at its effective triangle (mean sides) plus the departure of the bin average from it on a
+    /// coarse loop rule (exact for the tree level), its error in err_; ~33 s per bin on one core
+    /// (docs/bispectrum.md).
     #[arg(long, conflicts_with = "mu1")]
     multipoles: bool,
     /// --loop 1: CLASS-PT's b_Gamma3 (Gamma3 = G2(Phi_g) - G2(Phi_v)), with --b1, --b2, --bs.
