@@ -531,9 +531,9 @@ def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=No
     B{l}_222, B{l}_321_I, B{l}_321_II, B{l}_411, B{l} (the total) for l = 0, 2, 4, their err_ columns, and
     the multipoles of the 20 redshift-space counterterm and stochastic shapes shape_B{l}_<name>. With
     ``bin_width`` [h/Mpc] (and ``multipoles=True``) each triangle is a bin of three shells of that width: the
-    tree level averaged over the bin exactly, the loops at its effective triangle (columns k1_eff, k2_eff,
-    k3_eff) with that shortcut's error in their err_ columns, the shapes averaged over the bin
-    (docs/bispectrum.md).
+    multipoles at its effective triangle (columns k1_eff, k2_eff, k3_eff) plus the departure of the bin
+    average from them on a coarse loop rule (exact for the tree level), its error in the err_ columns, the
+    shapes averaged over the bin (docs/bispectrum.md).
 
     ``ir``: the IR resummation of the BAO of the galaxy bispectrum and of the multipoles, on by default as
     the tree level's (``ir=False`` for plain SPT): B_tree with P_nw + exp(-x)(1 + x) P_w in every leg,

@@ -27,8 +27,8 @@ use pyo3::types::PyDict;
 /// coefficients by name), the galaxy bispectrum ([`pt_spectra::jobs::one_loop_galaxy_table`]). With
 /// `multipoles=True` the multipoles B0, B2, B4 in redshift space at `f` (default f(z)), the Legendre
 /// polynomial on `legendre_side` ([`pt_spectra::jobs::one_loop_galaxy_multipoles_table`]; matter without a
-/// bias; with `bin_width` [h/Mpc] averaged over the bins of that width centred on the triangles, the loops
-/// at each bin's effective triangle, [`pt_spectra::jobs::one_loop_galaxy_binned_multipoles_table`]). `ir`:
+/// bias; with `bin_width` [h/Mpc] averaged over the bins of that width centred on the triangles: the
+/// effective triangle plus a coarse-rule correction, [`pt_spectra::jobs::one_loop_galaxy_binned_multipoles_table`]). `ir`:
 /// the IR resummation of the BAO ([`pt_spectra::bispectrum::one_loop_ir`]) of the galaxy
 /// bispectrum and the multipoles, on unless False (None: on there; the matter tables without a bias are
 /// plain SPT, and `ir=True` there is refused).

@@ -225,7 +225,8 @@ def test_one_loop_galaxy_multipoles_through_the_python_face():
 
 def test_one_loop_galaxy_multipoles_over_bins_through_the_python_face():
     # two Nseries bins at a tiny loop rule: without IR the tree columns are the tree-level bin averages,
-    # the loops come from the effective triangle (its columns inside the shells), the shortcut is in err_
+    # the loops are the effective triangle's (its columns inside the shells) corrected by a few per cent,
+    # the correction's error in err_
     tri = np.array([[0.035, 0.055, 0.065], [0.045, 0.045, 0.045]])
     rule = dict(radial=2, mu=2, phi=2)
     bias = dict(b1=2.0, b2=0.3, bs=-0.2)
@@ -239,8 +240,8 @@ def test_one_loop_galaxy_multipoles_over_bins_through_the_python_face():
         assert np.all(np.abs(t[side] - tri[:, i]) < 0.005)
     at = pt.one_loop_bispectrum(np.stack([t["k1_eff"], t["k2_eff"], t["k3_eff"]], axis=1), multipoles=True,
                                 f=0.7, ir=False, legendre_side="3", **bias, **rule)
-    np.testing.assert_allclose(t["B0_222"], at["B0_222"], rtol=1e-12)
-    assert np.all(t["err_B0_222"] > at["err_B0_222"])
+    assert np.all(np.abs(t["B0_222"] - at["B0_222"]) < 0.2 * np.abs(at["B0_222"]))
+    assert np.all(t["B0_222"] != at["B0_222"]) and np.all(t["err_B0_222"] > at["err_B0_222"])
     with pytest.raises(ValueError, match="multipoles=True"):
         pt.one_loop_bispectrum(tri, bin_width=0.01, **bias, **rule)
 
