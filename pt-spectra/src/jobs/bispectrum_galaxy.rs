@@ -292,7 +292,7 @@ pub fn one_loop_galaxy_multipoles_table(
              (Mpc/h)^6)",
             REDSHIFT_COUNTERTERMS.join(", ")
         ),
-        "at the given triangles (not averaged over bins); linear spectrum: all matter".into(),
+        "at the given triangles (not averaged over bins: --bin-width or --k-edges average them); linear spectrum: all matter".into(),
     ];
     header.extend(prepared.description.iter().cloned());
     let mut t = Table::new(header);
