@@ -73,7 +73,8 @@ pub struct BinnedLoopMultipoles {
 
 impl BinnedLoopMultipoles {
     /// B₀, B₂, B₄ of every bin at the coefficients `bias` (module docs): each term at the effective triangle
-    /// plus its correction, the errors as the module docs say.
+    /// plus its correction, the errors as the module docs say (the renormalisation's subtracted amounts
+    /// `uv_b321_ii`, `uv_b411` are the effective triangle's).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for a coefficient that is not finite.
