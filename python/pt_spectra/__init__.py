@@ -492,7 +492,7 @@ def bispectrum(triangles=None, bin_width=None, linear=None, z=0.0, z_input=0.0, 
 def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None, q_min=1e-4,
                         q_max=10.0, radial=12, mu=32, phi=24, two_loop="auto", cache_dir=None, mu1=None,
                         phi_los=0.0, f=None, b1=None, b2=0.0, bs=0.0, b_gamma3=0.0, bias_convention=None,
-                        loop_bias=None, multipoles=False, legendre_side="largest"):
+                        loop_bias=None, multipoles=False, legendre_side="largest", ir=None, bin_width=None):
     """One-loop matter or galaxy bispectrum (SPT) [(Mpc/h)^6] at single triangles.
 
     ``triangles``: an (n, 3) array of k1, k2, k3 [h/Mpc] (points, not bins). The linear spectrum as in
@@ -522,20 +522,29 @@ def one_loop_bispectrum(triangles, linear=None, z=0.0, z_input=0.0, cosmology=No
     ``mu1``, directly (2.8-3.3 s per triangle in real space, 6 s in redshift space on 2 cores): the same
     columns, uv_B321_II, uv_B411 (the renormalisation's subtracted amounts) and, in real space, the seven
     counterterm and stochastic shapes shape_ct_k2, shape_ct_k3, shape_ct_kk, shape_ct_tidal, shape_ct_f2k3
-    [(Mpc/h)^4], shape_st_p [(Mpc/h)^3], shape_st_1 (not included in B_1loop); no IR resummation yet
-    (docs/bispectrum.md).
+    [(Mpc/h)^4], shape_st_p [(Mpc/h)^3], shape_st_1 (not included in B_1loop) (docs/bispectrum.md).
 
     ``multipoles=True``: the multipoles B0, B2, B4 in redshift space at ``f`` (default f(z)), the Legendre
     polynomial on ``legendre_side`` ("largest", "1", "2", "3"), of the galaxies (or matter without a bias),
     all orientations in one pass over the loop nodes (the orientation rule is exact; about 6 times one
     orientation's cost, ~35 s per triangle at the default rule on 2 cores): columns k1 k2 k3, B{l}_tree,
     B{l}_222, B{l}_321_I, B{l}_321_II, B{l}_411, B{l} (the total) for l = 0, 2, 4, their err_ columns, and
-    the multipoles of the 20 redshift-space counterterm and stochastic shapes shape_B{l}_<name>.
+    the multipoles of the 20 redshift-space counterterm and stochastic shapes shape_B{l}_<name>. With
+    ``bin_width`` [h/Mpc] (and ``multipoles=True``) each triangle is a bin of three shells of that width: the
+    multipoles at its effective triangle (columns k1_eff, k2_eff, k3_eff) plus the departure of the bin
+    average from them on a coarse loop rule (exact for the tree level), its error in the err_ columns, the
+    shapes averaged over the bin (docs/bispectrum.md).
+
+    ``ir``: the IR resummation of the BAO of the galaxy bispectrum and of the multipoles, on by default as
+    the tree level's (``ir=False`` for plain SPT): B_tree with P_nw + exp(-x)(1 + x) P_w in every leg,
+    x = k^2 Sigma_tot^2(mu), the loops with P_nw + exp(-q^2 Sigma^2) P_w in every leg (the header states
+    Sigma^2 and what the prescription neglects). The matter tables without a bias are plain SPT (``ir=True``
+    there is refused; ``b1=1`` gives matter through the galaxy code).
     """
     return _warn(_core.one_loop_bispectrum(triangles, linear, z, z_input, cosmology, eh, q_min, q_max,
                                            radial, mu, phi, two_loop, cache_dir, mu1, phi_los, f, b1, b2,
                                            bs, b_gamma3, bias_convention, loop_bias, multipoles,
-                                           legendre_side))
+                                           legendre_side, ir, bin_width))
 
 
 def from_desi_physical(physical, sigma8, n_bar, satellites=None):

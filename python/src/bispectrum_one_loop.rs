@@ -27,13 +27,17 @@ use pyo3::types::PyDict;
 /// coefficients by name), the galaxy bispectrum ([`pt_spectra::jobs::one_loop_galaxy_table`]). With
 /// `multipoles=True` the multipoles B0, B2, B4 in redshift space at `f` (default f(z)), the Legendre
 /// polynomial on `legendre_side` ([`pt_spectra::jobs::one_loop_galaxy_multipoles_table`]; matter without a
-/// bias).
+/// bias; with `bin_width` [h/Mpc] averaged over the bins of that width centred on the triangles: the
+/// effective triangle plus a coarse-rule correction, [`pt_spectra::jobs::one_loop_galaxy_binned_multipoles_table`]). `ir`:
+/// the IR resummation of the BAO ([`pt_spectra::bispectrum::one_loop_ir`]) of the galaxy
+/// bispectrum and the multipoles, on unless False (None: on there; the matter tables without a bias are
+/// plain SPT, and `ir=True` there is refused).
 #[pyfunction]
 #[pyo3(signature = (triangles, linear=None, z=0.0, z_input=0.0, cosmology=None, eh=None,
     q_min=1e-4, q_max=10.0, radial=12, mu=32, phi=24,
     two_loop=pt_spectra::jobs::defaults::TWO_LOOP, cache_dir=None, mu1=None, phi_los=0.0, f=None,
     b1=None, b2=0.0, bs=0.0, b_gamma3=0.0, bias_convention=None, loop_bias=None, multipoles=false,
-    legendre_side="largest"))]
+    legendre_side="largest", ir=None, bin_width=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn one_loop_bispectrum(
     py: Python<'_>,
@@ -61,6 +65,8 @@ pub fn one_loop_bispectrum(
     loop_bias: Option<std::collections::BTreeMap<String, f64>>,
     multipoles: bool,
     legendre_side: &str,
+    ir: Option<bool>,
+    bin_width: Option<f64>,
 ) -> PyResult<Table> {
     let rows = fixed_rows::<3>(triangles, "triangles", "k1, k2, k3")?;
     let method: TwoLoopMethod = two_loop.parse().map_err(library_error)?;
@@ -84,6 +90,13 @@ pub fn one_loop_bispectrum(
     let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
     let side =
         pt_spectra::bispectrum::LegendreSide::by_name(legendre_side).map_err(library_error)?;
+    if ir == Some(true) && !galaxy && !multipoles {
+        return Err(crate::value_error(
+            "ir=True: the one-loop matter tables (no bias, no multipoles) are plain SPT; the IR resummation is \
+             the galaxy bispectrum's (give b1=1 for matter through the galaxy code) and the multipoles'",
+        ));
+    }
+    let ir = ir.unwrap_or(true);
     if multipoles && (mu1.is_some() || method == TwoLoopMethod::Basis) {
         return Err(crate::value_error(
             "multipoles=True averages over the orientations (no mu1) and is direct (two_loop \"direct\" or \"auto\")",
@@ -94,12 +107,37 @@ pub fn one_loop_bispectrum(
             "legendre_side is the multipoles' (multipoles=True)",
         ));
     }
+    if bin_width.is_some() && !multipoles {
+        return Err(crate::value_error(
+            "bin_width: the one-loop bispectrum's bin averages are the multipoles' (multipoles=True)",
+        ));
+    }
+    if let (true, Some(width)) = (multipoles, bin_width) {
+        let bias = bias.unwrap_or_else(pt_spectra::bispectrum::bias_kernels::LoopBias::matter);
+        let set = pt_spectra::bispectrum::TriangleSet::shells(rows.clone(), width)
+            .map_err(library_error)?;
+        let ((prepared, table), seconds) = detached(py, || {
+            let prepared = inputs.prepare(&[])?;
+            let table = pt_spectra::jobs::one_loop_galaxy_binned_multipoles_table(
+                &prepared, &set, &bias, f, side, ir, &rule, &Silent,
+            )?;
+            Ok((prepared, table))
+        })?;
+        return Table::new(
+            py,
+            table,
+            &prepared,
+            &Precision::default(),
+            "bispectrum one-loop galaxy multipoles over bins",
+            seconds,
+        );
+    }
     if multipoles {
         let bias = bias.unwrap_or_else(pt_spectra::bispectrum::bias_kernels::LoopBias::matter);
         let ((prepared, table), seconds) = detached(py, || {
             let prepared = inputs.prepare(&[])?;
             let table = pt_spectra::jobs::one_loop_galaxy_multipoles_table(
-                &prepared, &rows, &bias, f, side, &rule, &Silent,
+                &prepared, &rows, &bias, f, side, ir, &rule, &Silent,
             )?;
             Ok((prepared, table))
         })?;
@@ -135,6 +173,7 @@ pub fn one_loop_bispectrum(
                 &rows,
                 bias,
                 redshift,
+                ir,
                 &rule,
                 method,
                 store.get(),

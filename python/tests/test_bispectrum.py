@@ -223,21 +223,53 @@ def test_one_loop_galaxy_multipoles_through_the_python_face():
         pt.one_loop_bispectrum(tri, multipoles=True, legendre_side="4", **rule)
 
 
+def test_one_loop_galaxy_multipoles_over_bins_through_the_python_face():
+    # two Nseries bins at a tiny loop rule: without IR the tree columns are the tree-level bin averages,
+    # the loops are the effective triangle's (its columns inside the shells) corrected by a few per cent,
+    # the correction's error in err_
+    tri = np.array([[0.035, 0.055, 0.065], [0.045, 0.045, 0.045]])
+    rule = dict(radial=2, mu=2, phi=2)
+    bias = dict(b1=2.0, b2=0.3, bs=-0.2)
+    t = pt.one_loop_bispectrum(tri, multipoles=True, bin_width=0.01, f=0.7, ir=False, **bias, **rule)
+    assert t.meta["model"] == "bispectrum one-loop galaxy multipoles over bins"
+    assert any("effective triangle" in line for line in t.header)
+    tree = pt.bispectrum(tri, bin_width=0.01, f=0.7, ir=False, **bias)
+    for ell in ["B0", "B2"]:
+        np.testing.assert_allclose(t[ell + "_tree"], tree[ell], rtol=1e-8, atol=1e-9 * np.abs(tree["B0"]).max())
+    for i, side in enumerate(["k1_eff", "k2_eff", "k3_eff"]):
+        assert np.all(np.abs(t[side] - tri[:, i]) < 0.005)
+    at = pt.one_loop_bispectrum(np.stack([t["k1_eff"], t["k2_eff"], t["k3_eff"]], axis=1), multipoles=True,
+                                f=0.7, ir=False, legendre_side="3", **bias, **rule)
+    assert np.all(np.abs(t["B0_222"] - at["B0_222"]) < 0.2 * np.abs(at["B0_222"]))
+    assert np.all(t["B0_222"] != at["B0_222"]) and np.all(t["err_B0_222"] > at["err_B0_222"])
+    with pytest.raises(ValueError, match="multipoles=True"):
+        pt.one_loop_bispectrum(tri, bin_width=0.01, **bias, **rule)
+
+
 def test_one_loop_galaxy_bispectrum_through_the_python_face(tmp_path):
     tri = np.array([[0.1, 0.1, 0.1], [0.05, 0.1, 0.12]])
     rule = dict(radial=6, mu=12, phi=8, two_loop="direct")
     k = np.unique(tri)
     p = dict(zip(k, pt.real(model="linear", k=k)["P_lin"]))
     matter = pt.one_loop_bispectrum(tri, **rule)
-    # b1 = 1 alone: the galaxy kernels are F_n (the galaxy code against the matter code)
-    unit = pt.one_loop_bispectrum(tri, b1=1.0, **rule)
+    # b1 = 1 alone, without the IR resummation (the galaxy bispectrum's default, not the matter table's):
+    # the galaxy kernels are F_n (the galaxy code against the matter code)
+    unit = pt.one_loop_bispectrum(tri, b1=1.0, ir=False, **rule)
     assert unit.meta["model"] == "bispectrum one-loop galaxy"
     for name in ["B_tree", "B222", "B321_I", "B321_II", "B411"]:
         np.testing.assert_allclose(unit[name], matter[name], rtol=1e-12)
     # the tree level of a biased tracer is the closed form b1^2 [b1 F2 + b2/2 + bs (mu^2 - 1/3)] P P + cyclic
-    g = pt.one_loop_bispectrum(tri, b1=2.0, b2=0.4, bs=-0.3, **rule)
-    for row, tree in zip(tri, g["B_tree"]):
+    plain = pt.one_loop_bispectrum(tri, b1=2.0, b2=0.4, bs=-0.3, ir=False, **rule)
+    assert any(line.startswith("no IR resummation") for line in plain.header)
+    for row, tree in zip(tri, plain["B_tree"]):
         assert tree == pytest.approx(closed_form(row, p.__getitem__, 2.0, 0.4, -0.3), rel=1e-10)
+    # resummed by default: the header states it with Sigma^2, every term moves
+    g = pt.one_loop_bispectrum(tri, b1=2.0, b2=0.4, bs=-0.3, **rule)
+    assert any(line.startswith("IR resummation of the BAO") and "Sigma^2 = " in line for line in g.header)
+    for name in ["B_tree", "B222", "B321_I", "B321_II", "B411"]:
+        assert np.all(np.abs(g[name] - plain[name]) > 1e-6 * np.abs(plain[name])), name
+    with pytest.raises(ValueError, match="plain SPT"):
+        pt.one_loop_bispectrum(tri, ir=True, **rule)
     assert any("b1 = 2, b2 = 0" in line for line in g.header)  # the ESS19 b2 = b2 + (4/3) bs, stated
     assert np.all(g["uv_B411"] != 0)
     # CLASS-PT's convention: bs is b_G2 = velocileptors' bs, b2 is b2 + (4/3) bs

@@ -185,7 +185,7 @@ impl TriangleSet {
 
     /// The sides (k, weight) of triangle `i`, weights summing to 1 (`n` Gauss–Legendre nodes per side
     /// for bins).
-    pub(crate) fn shapes(&self, i: usize, n: usize) -> Vec<([f64; 3], f64)> {
+    pub fn shapes(&self, i: usize, n: usize) -> Vec<([f64; 3], f64)> {
         if self.shells.is_empty() {
             vec![(self.centres[i], 1.0)]
         } else {
@@ -194,7 +194,7 @@ impl TriangleSet {
     }
 
     /// The index of the Legendre side of triangle `i`.
-    pub(crate) fn legendre_index(&self, i: usize, side: LegendreSide) -> usize {
+    pub fn legendre_index(&self, i: usize, side: LegendreSide) -> usize {
         match side {
             LegendreSide::Index(a) => a,
             LegendreSide::Largest => {

@@ -30,15 +30,17 @@
 //! and evaluated for a new bias in microseconds): [`super::one_loop_galaxy_poly`], equal to these to
 //! round-off. Elsewhere: the counterterms and stochastic terms ([`super::galaxy_counterterms`],
 //! [`super::galaxy_counterterms_rsd`]), the multipoles ([`super::one_loop_galaxy_multipoles`]), the real-space
-//! basis tensors ([`super::one_loop_galaxy_basis`]). Not yet (issue 50): IR resummation, bins, basis tensors in
-//! redshift space.
+//! basis tensors ([`super::one_loop_galaxy_basis`]), the infrared resummation of the BAO
+//! ([`super::one_loop_ir`]). Not yet (issue 50): bins, basis tensors in redshift space.
 
 use super::bias_kernels::{loop_kernel_parts, LoopBias, N_PARTS};
+use super::ir_legs::{leading_order_spectrum, tree_legs};
 use super::one_loop::{
     angular_nodes, breaks, loop_integrals, radial_nodes, triangle_vectors, Kernels, OneLoopRule,
     Vec3,
 };
 use super::one_loop_rsd::Orientation;
+use super::resum::IrInputs;
 use crate::error::Result;
 use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
@@ -170,6 +172,19 @@ pub fn one_loop_galaxy(
     redshift: Option<(f64, Orientation)>,
     rule: &OneLoopRule,
 ) -> Result<OneLoopGalaxy> {
+    galaxy_terms(p, None, k, bias, redshift, rule)
+}
+
+/// [`one_loop_galaxy`] without (`ir` None) or with the infrared resummation of
+/// [`super::one_loop_ir`]: the loops on P_LO, the tree level's legs P_NLO.
+pub(super) fn galaxy_terms(
+    p: &LinearSpectrum,
+    ir: Option<&IrInputs>,
+    k: [f64; 3],
+    bias: &LoopBias,
+    redshift: Option<(f64, Orientation)>,
+    rule: &OneLoopRule,
+) -> Result<OneLoopGalaxy> {
     rule.validate()?;
     bias.check_finite()?;
     let kv = triangle_vectors(k)?;
@@ -178,12 +193,18 @@ pub fn one_loop_galaxy(
         bias: bias.values(),
         redshift: rsd,
     };
+    let resummed = ir.map(|ir| leading_order_spectrum(p, ir)).transpose()?;
+    let (tree_pk, p) = match (ir, &resummed) {
+        (Some(ir), Some(lo)) => (Some(tree_legs(p, ir, &kv, rsd)), lo),
+        _ => (None, p),
+    };
     let pk = kv.map(|v| p.eval(norm(v)));
+    let pk_tree = tree_pk.unwrap_or(pk);
     let z1 = kv.map(|v| kernels.eval(&[v]));
     let z2 = |a: usize, b: usize| kernels.eval(&[kv[a], kv[b]]);
     let tree: f64 = [(0, 1), (1, 2), (2, 0)]
         .iter()
-        .map(|&(a, b)| 2.0 * z2(a, b) * z1[a] * z1[b] * pk[a] * pk[b])
+        .map(|&(a, b)| 2.0 * z2(a, b) * z1[a] * z1[b] * pk_tree[a] * pk_tree[b])
         .sum();
     let (c3, c4) = uv_constants(bias, rsd, &kv, rule);
     let mirror = kernels.mirror();

@@ -25,6 +25,7 @@
 
 use super::bias_kernels::{loop_kernel_parts_los, LoopBias, N_PARTS};
 use super::geometry::LegendreSide;
+use super::ir_legs::{leading_order_spectrum, tree_legs};
 use super::one_loop::{
     angular_nodes, breaks, nodes, partition, triangle_vectors, OneLoopRule, Vec3,
 };
@@ -33,6 +34,7 @@ use super::one_loop_galaxy_poly::{
     add_triple_products, assemble, GalaxyLoopPolynomial, Layout, LoopSums, TermPolynomial,
 };
 use super::one_loop_rsd::Orientation;
+use super::resum::IrInputs;
 use crate::error::{Error, Result};
 use crate::integrate::legendre_nodes;
 use crate::linear::LinearSpectrum;
@@ -303,6 +305,21 @@ pub fn one_loop_galaxy_multipoles(
     rule: &OneLoopRule,
     orientations: Option<(usize, usize)>,
 ) -> Result<GalaxyLoopMultipoles> {
+    galaxy_multipoles(p, None, k, f, side, rule, orientations)
+}
+
+/// [`one_loop_galaxy_multipoles`] without (`ir` None) or with the infrared resummation of
+/// [`super::one_loop_ir`]: the loops on P_LO (one pass, shared by the orientations), each orientation's
+/// tree level with its legs P_NLO(k_a, μ_a).
+pub(super) fn galaxy_multipoles(
+    p: &LinearSpectrum,
+    ir: Option<&IrInputs>,
+    k: [f64; 3],
+    f: f64,
+    side: LegendreSide,
+    rule: &OneLoopRule,
+    orientations: Option<(usize, usize)>,
+) -> Result<GalaxyLoopMultipoles> {
     rule.validate()?;
     crate::cosmology::check_growth_rate(f)?;
     let kv = triangle_vectors(k)?;
@@ -317,6 +334,9 @@ pub fn one_loop_galaxy_multipoles(
     let nodes_o = orientation_nodes(n_mu, n_phi);
     let (los, weights) = multipole_weights(&nodes_o, &kv, a)?;
     let lay = Layout::new(true);
+    let resummed = ir.map(|ir| leading_order_spectrum(p, ir)).transpose()?;
+    let linear = p;
+    let p = resummed.as_ref().unwrap_or(p);
     let pk = kv.map(|v| p.eval(norm(v)));
     let half = rule.half();
     let fine = loop_sums_los(p, &kv, rule, f, &los, &lay);
@@ -331,12 +351,16 @@ pub fn one_loop_galaxy_multipoles(
                 sigma2: sigma,
             };
             let orientation = nodes_o[o].0;
+            let pk_tree = match ir {
+                Some(ir) => tree_legs(linear, ir, &kv, Some((f, los[o]))),
+                None => pk,
+            };
             assemble(
                 k,
                 Some((f, orientation)),
                 Some((f, los[o])),
                 &lay,
-                &pk,
+                &pk_tree,
                 &pk,
                 &sums,
                 &uv[o],

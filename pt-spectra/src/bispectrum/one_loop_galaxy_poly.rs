@@ -32,9 +32,11 @@
 //! B₄₁₁ have them subtracted coefficient by coefficient.
 
 use super::bias_kernels::{loop_kernel_parts, LoopBias, LOWEST_ORDER, N_PARTS};
+use super::ir_legs::{leading_order_spectrum, tree_legs};
 use super::one_loop::{breaks, nodes, partition, triangle_vectors, OneLoopRule, Vec3};
 use super::one_loop_galaxy::{sigma2, uv_parts, OneLoopGalaxy, UvParts};
 use super::one_loop_rsd::Orientation;
+use super::resum::IrInputs;
 use crate::error::Result;
 use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
@@ -337,12 +339,30 @@ pub fn one_loop_galaxy_polynomial(
     redshift: Option<(f64, Orientation)>,
     rule: &OneLoopRule,
 ) -> Result<GalaxyLoopPolynomial> {
+    galaxy_polynomial(p, None, k, redshift, rule)
+}
+
+/// [`one_loop_galaxy_polynomial`] without (`ir` None) or with the infrared resummation of
+/// [`super::one_loop_ir`]: the loops on P_LO, the tree level's legs P_NLO.
+pub(super) fn galaxy_polynomial(
+    p: &LinearSpectrum,
+    ir: Option<&IrInputs>,
+    k: [f64; 3],
+    redshift: Option<(f64, Orientation)>,
+    rule: &OneLoopRule,
+) -> Result<GalaxyLoopPolynomial> {
     rule.validate()?;
     let kv = triangle_vectors(k)?;
     let rsd = redshift.map(Orientation::checked_with).transpose()?;
     let mirror = rsd.is_none_or(|(_, los)| los[1] == 0.0);
     let lay = Layout::new(rsd.is_some());
+    let resummed = ir.map(|ir| leading_order_spectrum(p, ir)).transpose()?;
+    let (tree_pk, p) = match (ir, &resummed) {
+        (Some(ir), Some(lo)) => (Some(tree_legs(p, ir, &kv, rsd)), lo),
+        _ => (None, p),
+    };
     let pk = kv.map(|v| p.eval(norm(v)));
+    let pk_tree = tree_pk.unwrap_or(pk);
     let half = rule.half();
     let sums = LoopSums {
         fine: loop_sums(p, &kv, rule, rsd, &lay),
@@ -350,7 +370,7 @@ pub fn one_loop_galaxy_polynomial(
         sigma2: [sigma2(p, &k, rule, mirror), sigma2(p, &k, &half, mirror)],
     };
     let uv = uv_parts(rsd, &kv, rule, mirror);
-    Ok(assemble(k, redshift, rsd, &lay, &pk, &pk, &sums, &uv))
+    Ok(assemble(k, redshift, rsd, &lay, &pk_tree, &pk, &sums, &uv))
 }
 
 /// The loop integrals' sums on the rule and the half rule (in the layout of [`Layout`]) and σ² on both.
@@ -383,18 +403,7 @@ pub(super) fn assemble(
     let (c3, c4) = uv;
     let mut terms: [BTreeMap<Monomial, [f64; 2]>; 7] = Default::default();
     let [tree, b222, b321_i, b321_ii, b411, uv_ii, uv_411] = &mut terms;
-    for (a, b) in [(0, 1), (1, 2), (2, 0)] {
-        let c = 2.0 * pk_tree[a] * pk_tree[b];
-        let z = z2(a, b);
-        for &i in s2 {
-            for &l in s1 {
-                for &m in s1 {
-                    let t = c * z[i] * z1[a][l] * z1[b][m];
-                    put(tree, monomial(i, l, m), t, t);
-                }
-            }
-        }
-    }
+    *tree = tree_sums(&kv, rsd, lay, pk_tree);
     for (i, &pi) in s2.iter().enumerate() {
         for (l, &pl) in s2.iter().enumerate() {
             for (m, &pm) in s2.iter().enumerate() {
@@ -474,6 +483,46 @@ pub(super) fn assemble(
         uv_b411,
         projection: 0.0,
     }
+}
+
+/// The tree level B₁₁₂ = Σ_{a<b} 2 Z₂(k_a, k_b) Z₁(k_a) Z₁(k_b) P_a P_b per monomial, with the spectrum
+/// `pk_tree` at the sides `kv` (the linear one, or the resummed legs of [`super::one_loop_ir`]).
+fn tree_sums(
+    kv: &[Vec3; 3],
+    rsd: Option<(f64, Vec3)>,
+    lay: &Layout,
+    pk_tree: &[f64; 3],
+) -> BTreeMap<Monomial, [f64; 2]> {
+    let (s1, s2) = (&lay.s[1], &lay.s[2]);
+    let z1 = kv.map(|v| loop_kernel_parts(rsd, &[v]));
+    let mut tree = BTreeMap::new();
+    for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+        let c = 2.0 * pk_tree[a] * pk_tree[b];
+        let z = loop_kernel_parts(rsd, &[kv[a], kv[b]]);
+        for &i in s2 {
+            for &l in s1 {
+                for &m in s1 {
+                    let t = c * z[i] * z1[a][l] * z1[b][m];
+                    put(&mut tree, monomial(i, l, m), t, t);
+                }
+            }
+        }
+    }
+    tree
+}
+
+/// The tree level's polynomial (as [`assemble`] makes it) of the triangle `k` in real space (`redshift`
+/// None) or at (f, line of sight), with the spectrum `pk_tree` at the sides.
+pub(super) fn tree_polynomial(
+    k: [f64; 3],
+    redshift: Option<(f64, Vec3)>,
+    pk_tree: &[f64; 3],
+) -> Result<TermPolynomial> {
+    let kv = triangle_vectors(k)?;
+    let lay = Layout::new(redshift.is_some());
+    Ok(TermPolynomial::from_sums(tree_sums(
+        &kv, redshift, &lay, pk_tree,
+    )))
 }
 
 /// B222's monomials at one loop node: `acc[(i n + l) n + m] += s x[s2[i]] y[s2[l]] t[s2[m]]` for the

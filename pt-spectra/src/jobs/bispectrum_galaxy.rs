@@ -9,16 +9,20 @@ use crate::bias::BiasParams;
 use crate::bispectrum::bias_kernels::LoopBias;
 use crate::bispectrum::galaxy_counterterms::{galaxy_counterterm_shapes, GALAXY_COUNTERTERMS};
 use crate::bispectrum::galaxy_counterterms_rsd::{
-    redshift_counterterm_multipoles, REDSHIFT_COUNTERTERMS,
+    redshift_counterterm_multipoles, N_REDSHIFT_CT, REDSHIFT_COUNTERTERMS,
 };
 use crate::bispectrum::one_loop::{OneLoopRule, PARTITION_POWER};
 use crate::bispectrum::one_loop_basis::BispectrumLoopSource;
 use crate::bispectrum::one_loop_galaxy::{one_loop_galaxy, OneLoopGalaxy};
 use crate::bispectrum::one_loop_galaxy_basis::GalaxyLoopBasis;
 use crate::bispectrum::one_loop_galaxy_multipoles::{one_loop_galaxy_multipoles, ORIENTATION_RULE};
+use crate::bispectrum::one_loop_ir::{
+    galaxy_basis_ir, one_loop_galaxy_ir, one_loop_galaxy_multipoles_ir,
+};
 use crate::bispectrum::one_loop_rsd::Orientation;
-use crate::bispectrum::LegendreSide;
+use crate::bispectrum::{IrInputs, LegendreSide};
 use crate::error::{Error, Result};
+use crate::ir::WiggleSplit;
 use crate::output::{MethodNote, Table, POWER, WAVENUMBER};
 use crate::precision::TwoLoopMethod;
 use crate::progress::Progress;
@@ -84,7 +88,9 @@ pub fn loop_bias(
 /// ([`crate::bispectrum::galaxy_counterterms`]). The loop terms by `method` in real space: `basis` (the
 /// tensors of [`crate::bispectrum::one_loop_galaxy_basis`] from `store`, built once, ~4 s per triangle and
 /// core, and cached), `auto` (the tensors if cached) or `direct`; a spectrum the basis does not represent
-/// is integrated directly, as the header says. Redshift space is direct.
+/// is integrated directly, as the header says. Redshift space is direct. With `ir` the BAO are resummed
+/// ([`crate::bispectrum::one_loop_ir`], the split and Σ² of [`one_loop_ir_inputs`]; the tensors then take the
+/// resummed spectrum of the loops), as the tree level does by default.
 ///
 /// # Errors
 /// As [`one_loop_galaxy`], naming the triangle; [`Error::InvalidChoice`] for `basis` in redshift space.
@@ -94,14 +100,24 @@ pub fn one_loop_galaxy_table(
     triangles: &[[f64; 3]],
     bias: &LoopBias,
     redshift: Option<(Option<f64>, Orientation)>,
+    ir: bool,
     rule: &OneLoopRule,
     method: TwoLoopMethod,
     store: &TableStore,
     progress: &dyn Progress,
 ) -> Result<Table> {
     let redshift = redshift.map(|(f, o)| (f.unwrap_or(prepared.growth_rate), o));
+    let ir = ir.then(|| one_loop_ir_inputs(prepared)).transpose()?;
     let (terms, source) = galaxy_terms(
-        prepared, triangles, bias, redshift, rule, method, store, progress,
+        prepared,
+        triangles,
+        bias,
+        redshift,
+        ir.as_ref(),
+        rule,
+        method,
+        store,
+        progress,
     )?;
     let mut rows = Vec::with_capacity(triangles.len());
     let mut uv = Vec::with_capacity(triangles.len());
@@ -138,8 +154,9 @@ pub fn one_loop_galaxy_table(
         "B_1loop = B_tree + B222 + B321_I + B321_II + B411 with the galaxy kernels K_n (Z_n^g in redshift \
          space) in place of F_n (Z_n); B321_II and B411 renormalised: their q -> infinity constants times \
          sigma^2 = int P over the loop range subtracted (uv_B321_II, uv_B411; bare = renormalised + uv); \
-         no IR resummation, orientation average or bins yet"
+         no orientation average or bins yet"
             .into(),
+        ir_line(ir.as_ref()),
         format!(
             "loop integrals over {} <= |q| <= {} h/Mpc about each cusp (smooth partition of unity, power {}); \
              {} ln q x {} cos(theta) x {} phi nodes per panel; err_: difference from the rule with half the \
@@ -194,7 +211,8 @@ pub fn one_loop_galaxy_table(
 /// exact): `k1 k2 k3`, then per ℓ = 0, 2, 4 `B{ℓ}_tree B{ℓ}_222 B{ℓ}_321_I B{ℓ}_321_II B{ℓ}_411 B{ℓ}` (B{ℓ} the
 /// one-loop total, as the tree level's column names), their `err_` columns, and the multipoles of the
 /// redshift-space counterterm and stochastic shapes `shape_B{ℓ}_<name>`
-/// ([`crate::bispectrum::galaxy_counterterms_rsd`]), each triangle reported to `progress`.
+/// ([`crate::bispectrum::galaxy_counterterms_rsd`]), each triangle reported to `progress`. With `ir` the BAO
+/// are resummed ([`crate::bispectrum::one_loop_ir`], the inputs of [`one_loop_ir_inputs`]).
 ///
 /// # Errors
 /// As [`crate::bispectrum::one_loop_galaxy_multipoles::one_loop_galaxy_multipoles`], naming the triangle.
@@ -205,11 +223,13 @@ pub fn one_loop_galaxy_multipoles_table(
     bias: &LoopBias,
     f: Option<f64>,
     side: LegendreSide,
+    ir: bool,
     rule: &OneLoopRule,
     progress: &dyn Progress,
 ) -> Result<Table> {
     let f = f.unwrap_or(prepared.growth_rate);
     let p = &prepared.spectrum;
+    let ir = ir.then(|| one_loop_ir_inputs(prepared)).transpose()?;
     let mut rows = Vec::with_capacity(triangles.len());
     let mut shapes = Vec::with_capacity(triangles.len());
     for (i, &k) in triangles.iter().enumerate() {
@@ -217,7 +237,11 @@ pub fn one_loop_galaxy_multipoles_table(
             what: format!("triangle {} ({}, {}, {})", i + 1, k[0], k[1], k[2]),
             reason: e.to_string(),
         };
-        let m = one_loop_galaxy_multipoles(p, k, f, side, rule, None).map_err(named)?;
+        let m = match &ir {
+            None => one_loop_galaxy_multipoles(p, k, f, side, rule, None),
+            Some(ir) => one_loop_galaxy_multipoles_ir(p, ir, k, f, side, rule, None),
+        }
+        .map_err(named)?;
         rows.push(m.evaluate(bias)?);
         shapes.push(redshift_counterterm_multipoles(p, k, bias, f, side).map_err(named)?);
         progress.update(
@@ -253,9 +277,9 @@ pub fn one_loop_galaxy_multipoles_table(
             n_phi
         ),
         "B{l} = B{l}_tree + B{l}_222 + B{l}_321_I + B{l}_321_II + B{l}_411 with the kernels Z_n^g; B321_II and \
-         B411 renormalised (their q -> infinity constants times sigma^2 subtracted); no IR resummation, FoG, AP \
-         or bins"
+         B411 renormalised (their q -> infinity constants times sigma^2 subtracted); no FoG, AP or bins"
             .into(),
+        ir_line(ir.as_ref()),
         format!(
             "loop integrals over {} <= |q| <= {} h/Mpc about each cusp (smooth partition of unity, power {}); \
              {} ln q x {} cos(theta) x {} phi nodes per panel, one pass for all orientations; err_: difference \
@@ -268,11 +292,23 @@ pub fn one_loop_galaxy_multipoles_table(
              (Mpc/h)^6)",
             REDSHIFT_COUNTERTERMS.join(", ")
         ),
-        "at the given triangles (not averaged over bins); linear spectrum: all matter".into(),
+        "at the given triangles (not averaged over bins: --bin-width or --k-edges average them); linear spectrum: all matter".into(),
     ];
     header.extend(prepared.description.iter().cloned());
     let mut t = Table::new(header);
     t.methods.push(MethodNote::new("loop terms", "direct"));
+    multipole_columns(&mut t, triangles, &rows, &shapes);
+    Ok(t)
+}
+
+/// The columns of the multipoles' table: `k1 k2 k3` (`triangles`), per ℓ = 0, 2, 4 the terms of `rows`
+/// and their `err_`, the counterterm shapes' multipoles `shapes`.
+pub(super) fn multipole_columns(
+    t: &mut Table,
+    triangles: &[[f64; 3]],
+    rows: &[[OneLoopGalaxy; 3]],
+    shapes: &[[[f64; N_REDSHIFT_CT]; 3]],
+) {
     for (i, name) in ["k1", "k2", "k3"].iter().enumerate() {
         t.push(*name, WAVENUMBER, triangles.iter().map(|k| k[i]).collect());
     }
@@ -308,7 +344,28 @@ pub fn one_loop_galaxy_multipoles_table(
             );
         }
     }
-    Ok(t)
+}
+
+/// The IR inputs of the one-loop galaxy bispectrum: the no-wiggle split and Σ², δΣ² of `prepared`'s
+/// spectrum, as the tree level computes them ([`IrInputs::split`] with the default q_min).
+///
+/// # Errors
+/// As [`IrInputs::split`].
+pub fn one_loop_ir_inputs(prepared: &Prepared) -> Result<IrInputs> {
+    IrInputs::split(
+        &prepared.spectrum,
+        &WiggleSplit::new()?,
+        crate::precision::Precision::default().q_min,
+    )
+}
+
+/// The header line of the IR resummation (on, with its Σ², or off).
+pub(super) fn ir_line(ir: Option<&IrInputs>) -> String {
+    match ir {
+        Some(ir) => crate::bispectrum::one_loop_ir::describe(ir),
+        None => "no IR resummation (--no-ir / ir=False): the linear spectrum in every leg and loop"
+            .into(),
+    }
 }
 
 /// The terms of every triangle and how they were computed ([`one_loop_galaxy_table`]).
@@ -318,6 +375,7 @@ fn galaxy_terms(
     triangles: &[[f64; 3]],
     bias: &LoopBias,
     redshift: Option<(f64, Orientation)>,
+    ir: Option<&IrInputs>,
     rule: &OneLoopRule,
     method: TwoLoopMethod,
     store: &TableStore,
@@ -347,11 +405,16 @@ fn galaxy_terms(
         match store.for_method::<GalaxyLoopBasis>(method, (triangles, rule), build, progress)? {
             None => source = BispectrumLoopSource::DirectUncached,
             Some(tensors) => {
-                let projection = tensors.project(&prepared.spectrum);
+                let (polys, projection) = match ir {
+                    None => (
+                        tensors.evaluate(&prepared.spectrum),
+                        tensors.project(&prepared.spectrum),
+                    ),
+                    Some(ir) => galaxy_basis_ir(&tensors, &prepared.spectrum, ir)?,
+                };
                 let max = crate::loops::basis::MAX_RESIDUAL;
                 if projection.residual <= max {
-                    let terms = tensors
-                        .evaluate(&prepared.spectrum)
+                    let terms = polys
                         .iter()
                         .map(|p| p.evaluate(bias))
                         .collect::<Result<Vec<_>>>()?;
@@ -374,11 +437,13 @@ fn galaxy_terms(
     }
     let mut terms = Vec::with_capacity(triangles.len());
     for (i, &k) in triangles.iter().enumerate() {
-        let b = one_loop_galaxy(&prepared.spectrum, k, bias, redshift, rule).map_err(|e| {
-            Error::InvalidChoice {
-                what: name(i, k),
-                reason: e.to_string(),
-            }
+        let b = match ir {
+            None => one_loop_galaxy(&prepared.spectrum, k, bias, redshift, rule),
+            Some(ir) => one_loop_galaxy_ir(&prepared.spectrum, ir, k, bias, redshift, rule),
+        }
+        .map_err(|e| Error::InvalidChoice {
+            what: name(i, k),
+            reason: e.to_string(),
         })?;
         terms.push(b);
         progress.update(

@@ -45,6 +45,7 @@ mod batch;
 mod bias;
 mod bispectrum;
 mod bispectrum_galaxy;
+mod bispectrum_galaxy_bins;
 pub mod defaults;
 mod ept;
 mod ept_fit;
@@ -66,8 +67,10 @@ pub use bispectrum::{
     sugiyama_table, BispectrumRequest, SugiyamaRequest,
 };
 pub use bispectrum_galaxy::{
-    loop_bias, one_loop_galaxy_multipoles_table, one_loop_galaxy_table, LOOP_BIAS_NAMES,
+    loop_bias, one_loop_galaxy_multipoles_table, one_loop_galaxy_table, one_loop_ir_inputs,
+    LOOP_BIAS_NAMES,
 };
+pub use bispectrum_galaxy_bins::one_loop_galaxy_binned_multipoles_table;
 pub use ept::{
     ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest, AP_FIT_RANGE,
 };

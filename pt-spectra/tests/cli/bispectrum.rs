@@ -460,14 +460,58 @@ fn one_loop_matter_terms_at_triangles_and_refusals() {
         a
     };
     // Galaxies (any bias option): with matter's bias the galaxy kernels are F_n, so the galaxy path
-    // gives the matter columns (its own kernels and renormalisation, nothing subtracted for b1 alone);
-    // b2 alone adds b2 sum_(a<b) P_a P_b to the tree (K2 += b2/2), exactly.
-    let (ok, galaxy, err) = run(&with(&["--bias-convention", "velocileptors"]));
+    // without the IR resummation gives the matter columns (its own kernels and renormalisation, nothing
+    // subtracted for b1 alone); b2 alone adds b2 sum_(a<b) P_a P_b to the tree (K2 += b2/2), exactly.
+    let (ok, galaxy, err) = run(&with(&["--bias-convention", "velocileptors", "--no-ir"]));
     assert!(ok, "{err}");
     assert!(
-        galaxy.contains("one-loop galaxy bispectrum in real space"),
+        galaxy.contains("one-loop galaxy bispectrum in real space")
+            && galaxy.contains("no IR resummation (--no-ir"),
         "{galaxy}"
     );
+    // By default (as the tree level) the galaxy bispectrum is IR-resummed: the header says so with its
+    // Sigma^2; the tree column is the library's resummed tree (legs P_nw + e^-x (1 + x) P_w, the split
+    // of the default spectrum, gm2012 at z = 0), the loops differ from the plain ones, the total sums.
+    let (ok, resummed, err) = run(&with(&["--bias-convention", "velocileptors"]));
+    assert!(ok, "{err}");
+    assert!(
+        resummed.contains("IR resummation of the BAO (leading order")
+            && resummed.contains("Sigma^2 = ")
+            && resummed.contains("not in err_"),
+        "{resummed}"
+    );
+    {
+        use pt_spectra::bispectrum::one_loop::OneLoopRule;
+        use pt_spectra::bispectrum::{bias_kernels::LoopBias, one_loop_ir, IrInputs};
+        let p = pt_spectra::linear::LinearSpectrum::gm2012_z0();
+        let split = pt_spectra::ir::WiggleSplit::new().unwrap();
+        let q_min = pt_spectra::precision::Precision::default().q_min;
+        let ir = IrInputs::split(&p, &split, q_min).unwrap();
+        let tiny = OneLoopRule {
+            radial: 2,
+            mu: 2,
+            phi: 2,
+            ..OneLoopRule::default()
+        };
+        let triangles = [[0.05, 0.1, 0.12], [0.1, 0.1, 0.1]];
+        for ((t, r), g) in triangles.iter().zip(rows(&resummed)).zip(rows(&galaxy)) {
+            let b = one_loop_ir::one_loop_galaxy_ir(&p, &ir, *t, &LoopBias::matter(), None, &tiny)
+                .unwrap();
+            assert!(
+                (r[3] - b.tree.value).abs() < 2e-9 * r[3].abs(),
+                "{t:?}: {r:?}"
+            );
+            assert!(
+                (r[3] - g[3]).abs() > 1e-4 * g[3].abs(),
+                "{t:?}: the tree resummed"
+            );
+            for j in 4..8 {
+                assert!((r[j] - g[j]).abs() > 1e-6 * g[j].abs(), "{t:?}: column {j}");
+            }
+            let sum: f64 = r[3..8].iter().sum();
+            assert!((r[8] - sum).abs() < 1e-8 * sum.abs(), "{t:?}");
+        }
+    }
     assert!(galaxy.contains("b1 = 1, b2 = 0, g2 = 0"), "{galaxy}");
     for (g, m) in rows(&galaxy).iter().zip(rows(&out)) {
         for j in 3..9 {
@@ -480,7 +524,7 @@ fn one_loop_matter_terms_at_triangles_and_refusals() {
         }
         assert!(g[15] == 0.0 && g[16] == 0.0, "uv of matter: {g:?}");
     }
-    let (ok, b2, err) = run(&with(&["--b2", "0.5"]));
+    let (ok, b2, err) = run(&with(&["--b2", "0.5", "--no-ir"]));
     assert!(ok, "{err}");
     for (t, (g, m)) in [[0.05, 0.1, 0.12], [0.1, 0.1, 0.1]]
         .iter()

@@ -112,7 +112,10 @@ pub struct Args {
     /// sigma_B of the Fingers of God [Mpc/h].
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     sigma_fog: f64,
-    /// Switch off the IR resummation of the BAO in every leg.
+    /// Switch off the IR resummation of the BAO in every leg (tree level) and, with --loop 1, of the
+    /// one-loop galaxy bispectrum (any bias option, or --multipoles): on by default, B_tree with
+    /// P_nw + e^-x (1 + x) P_w per leg and the loops on P_nw + e^(-q^2 Sigma^2) P_w (the matter tables
+    /// of --loop 1 without a bias option are plain SPT, not resummed).
     #[arg(long)]
     no_ir: bool,
     /// Loop order: 0 (the tree-level galaxy model in redshift space) or 1 (the one-loop bispectrum,
@@ -121,7 +124,7 @@ pub struct Args {
     /// the multipoles with --multipoles; the counterterm shapes as columns in real space and with
     /// --multipoles; no bins yet; in real space --two-loop basis
     /// makes it ~10 us (matter) or ~0.15 ms (galaxies) per triangle after a one-off ~0.7 s (4 s) per
-    /// triangle and core).
+    /// triangle and core). The galaxy bispectrum's BAO are IR-resummed unless --no-ir.
     #[arg(long = "loop", value_name = "N", default_value_t = 0)]
     loop_order: u32,
     /// --loop 1 in redshift space: the cosine between k1 and the line of sight (with --f, default
@@ -141,8 +144,11 @@ pub struct Args {
     /// bispectrum in redshift space at the points of --triangles (with --f, default f(z), and
     /// --legendre-side), all orientations in one pass over the loop nodes (the orientation rule exact),
     /// with the multipoles of the redshift-space counterterm and stochastic shapes; direct, ~6 times one
-    /// orientation's cost (~35 s per triangle on 2 cores).
-    #[arg(long, conflicts_with = "mu1", requires = "triangles")]
+    /// orientation's cost (~35 s per triangle on 2 cores). With bins (--bin-width or --k-edges): each
+    /// bin at its effective triangle (mean sides) plus the departure of the bin average from it on a
+    /// coarse loop rule (exact for the tree level), its error in err_; ~33 s per bin on one core
+    /// (docs/bispectrum.md).
+    #[arg(long, conflicts_with = "mu1")]
     multipoles: bool,
     /// --loop 1: CLASS-PT's b_Gamma3 (Gamma3 = G2(Phi_g) - G2(Phi_v)), with --b1, --b2, --bs.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
@@ -189,13 +195,18 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
         .into_iter()
         .filter(|&o| !(redshift && o == "--f"))
         .filter(|&o| !(args.multipoles && o == "--legendre-side"))
+        .filter(|&o| o != "--no-ir")
+        .filter(|&o| !(args.multipoles && (o == "--bin-width" || o == "--k-edges")))
         .collect();
     if !given.is_empty() {
         bail!(
-            "--loop 1 is the one-loop bispectrum at single triangles; it does not take {} (counterterms, \
-             stochastic terms, FoG, AP and bin averages of the one-loop bispectrum are not built yet)",
+            "--loop 1 is the one-loop bispectrum at single triangles (bins: with --multipoles); it does not \
+             take {} (counterterms, stochastic terms, FoG and AP of the one-loop bispectrum are not built yet)",
             given.join(", ")
         );
+    }
+    if args.multipoles && (args.bin_width.is_some() || args.k_edges.is_some()) {
+        return binned_multipoles(args);
     }
     let Some(path) = &args.triangles else {
         bail!("--loop 1 needs --triangles FILE (columns k1 k2 k3 [h/Mpc])");
@@ -220,6 +231,7 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
             &bias,
             args.f,
             LegendreSide::by_name(&args.legendre_side).context("--legendre-side")?,
+            !args.no_ir,
             &OneLoopRule::default(),
             &bars,
         )
@@ -238,6 +250,7 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
             &rows,
             &bias,
             redshift,
+            !args.no_ir,
             &OneLoopRule::default(),
             loaded.precision.two_loop,
             &loaded.store,
@@ -274,6 +287,29 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
         &bars,
     )
     .with_context(|| format!("--triangles {}", path.display()))
+}
+
+/// `--loop 1 --multipoles` with bins (`--triangles FILE --bin-width DK` or `--k-edges`): the loops at each
+/// bin's effective triangle, the tree level averaged over the bin.
+fn binned_multipoles(args: &Args) -> Result<pt_spectra::output::Table> {
+    let set = triangles(args)?;
+    let loaded = args.spectrum.load()?;
+    if loaded.precision.two_loop == pt_spectra::precision::TwoLoopMethod::Basis {
+        bail!("--two-loop basis: the one-loop bispectrum's tensors are built for real space only");
+    }
+    let bias =
+        galaxy_bias(args)?.unwrap_or_else(pt_spectra::bispectrum::bias_kernels::LoopBias::matter);
+    pt_spectra::jobs::one_loop_galaxy_binned_multipoles_table(
+        &loaded.prepared,
+        &set,
+        &bias,
+        args.f,
+        LegendreSide::by_name(&args.legendre_side).context("--legendre-side")?,
+        !args.no_ir,
+        &OneLoopRule::default(),
+        &crate::progress::Bars::default(),
+    )
+    .context("--loop 1 --multipoles with bins")
 }
 
 /// `--loop 1`'s galaxy bias, if any bias option is given (else the matter bispectrum).
