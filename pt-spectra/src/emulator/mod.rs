@@ -77,6 +77,8 @@ pub struct LinearEmulator {
     file: format::Parsed,
     max_degree: usize,
     origin: String,
+    /// [`Self::describe`]'s line, made on first use (every emulated spectrum's header carries it).
+    description: std::sync::OnceLock<String>,
 }
 
 /// The emulated linear spectra of one cosmology at one redshift.
@@ -201,6 +203,7 @@ impl LinearEmulator {
             file,
             max_degree,
             origin: origin.to_string(),
+            description: std::sync::OnceLock::new(),
         })
     }
 
@@ -220,6 +223,12 @@ impl LinearEmulator {
 
     /// One line for output headers: what the emulator is and where it is valid.
     pub fn describe(&self) -> String {
+        self.description
+            .get_or_init(|| self.make_description())
+            .clone()
+    }
+
+    fn make_description(&self) -> String {
         let prior: Vec<String> = self
             .file
             .stated
@@ -284,15 +293,19 @@ impl LinearEmulator {
     /// emulated ([`neutrino_settings`](Self::neutrino_settings)).
     pub fn spectra(&self, cosmology: &Cosmology, z: f64) -> Result<EmulatedSpectra> {
         let nodes = self.nodes(cosmology, &cosmology.background(), z)?;
-        let p_cb: Vec<f64> = nodes.ln_p_cb.iter().map(|v| v.exp()).collect();
+        // the exponentials of 500 nodes in one vectorised pass (2 ulp of the library's)
+        let mut p_cb = nodes.ln_p_cb.clone();
+        crate::simd::exp_in_place(&mut p_cb);
         // without massive neutrinos the ratio is zero and P_m is P_cb to the bit (no second
         // exponential per node)
         let p_m: Vec<f64> = if nodes.ln_ratio.iter().all(|&r| r == 0.0) {
             p_cb.clone()
         } else {
-            (nodes.ln_p_cb.iter().zip(&nodes.ln_ratio))
-                .map(|(p, r)| (p + r).exp())
-                .collect()
+            let mut p_m: Vec<f64> = (nodes.ln_p_cb.iter().zip(&nodes.ln_ratio))
+                .map(|(p, r)| p + r)
+                .collect();
+            crate::simd::exp_in_place(&mut p_m);
+            p_m
         };
         let sigma8 = sigma8(&nodes.sigma8_weights, nodes.step, |i| p_m[i]);
         Ok(EmulatedSpectra {

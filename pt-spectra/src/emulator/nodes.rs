@@ -161,11 +161,11 @@ impl LinearEmulator {
                 let today = shape_at(z0, false);
                 let today_ratio = ln_ratio(&today, z0);
                 let growth_0 = growth(z0).0;
-                let sigma8_unit = super::sigma8(&sigma8_weights, step, |i| {
-                    (today.cb[i] + growth_0 + today_ratio[i] + tilt[i])
-                        .value()
-                        .exp()
-                });
+                let mut p_today: Vec<f64> = (0..n_x)
+                    .map(|i| (today.cb[i] + growth_0 + today_ratio[i] + tilt[i]).value())
+                    .collect();
+                crate::simd::exp_in_place(&mut p_today);
+                let sigma8_unit = super::sigma8(&sigma8_weights, step, |i| p_today[i]);
                 let Amplitude::Sigma8(target) = cosmology.amplitude else {
                     unreachable!("ln A_s is None only for a σ8 amplitude")
                 };
