@@ -194,6 +194,18 @@ impl OneLoopMatterBasis {
         self.basis.project(&self.basis.sample(p))
     }
 
+    /// The basis functions' samples (the CAMB basis on the tensors' lattice).
+    pub fn linear_basis(&self) -> &LinearBasis {
+        &self.basis
+    }
+
+    /// The projection of `p` on the basis's first `n` functions ([`LinearBasis::project_first`]):
+    /// [`evaluate`](Self::evaluate) with it gives the terms of the basis of `n` functions (the
+    /// tensors' entries with every index < n), their errors with that projection's residual.
+    pub fn project_first(&self, p: &LinearSpectrum, n: usize) -> Projection {
+        self.basis.project_first(&self.basis.sample(p), n)
+    }
+
     /// The terms of every triangle for the spectrum `p` whose projection is `projection`.
     pub fn evaluate(&self, p: &LinearSpectrum, projection: &Projection) -> Vec<OneLoopMatter> {
         let c = &projection.coefficients;

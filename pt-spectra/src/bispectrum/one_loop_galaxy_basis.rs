@@ -253,7 +253,28 @@ impl GalaxyLoopBasis {
     /// with [`GalaxyLoopPolynomial::projection`] = [`PROJECTION_FACTOR`] × the projection residual (the matter
     /// terms' bound on the response to it, relative to the sum of the loop terms' sizes).
     pub fn evaluate(&self, p: &LinearSpectrum) -> Vec<GalaxyLoopPolynomial> {
-        let projection = self.project(p);
+        self.evaluate_projected(p, &self.project(p))
+    }
+
+    /// The basis functions' samples (the CAMB basis on the tensors' lattice).
+    pub fn linear_basis(&self) -> &LinearBasis {
+        &self.basis
+    }
+
+    /// The projection of `p` on the basis's first `n` functions ([`LinearBasis::project_first`]):
+    /// [`evaluate_projected`](Self::evaluate_projected) with it gives the polynomials of the basis of `n`
+    /// functions (the tensors' entries with every index < n).
+    pub fn project_first(&self, p: &LinearSpectrum, n: usize) -> Projection {
+        self.basis.project_first(&self.basis.sample(p), n)
+    }
+
+    /// [`evaluate`](Self::evaluate) with the coefficients and residual of `projection` (of `p`, on this basis:
+    /// [`project`](Self::project) or [`project_first`](Self::project_first)).
+    pub fn evaluate_projected(
+        &self,
+        p: &LinearSpectrum,
+        projection: &Projection,
+    ) -> Vec<GalaxyLoopPolynomial> {
         let c = &projection.coefficients;
         let n = c.len();
         let shape = Shape::new(n);
