@@ -31,7 +31,8 @@ fn loops(b: &OneLoopMatter) -> [f64; 4] {
 /// term within 1e-6 of the sum of the loop terms' sizes (the two lattice interpolations), matter
 /// and every coefficient of the galaxy polynomials, at n = 12 and 24; and truncating changes the
 /// terms by far more than that (the comparison sees n). The coefficients below n are the whole
-/// projection's (orthonormal basis), and those from n on zero.
+/// projection's (orthonormal basis), and those from n on zero; the contraction, which then reads only
+/// the entries below n, gives the terms of the full contraction (a negligible last coefficient).
 #[test]
 fn truncated_tensors_are_the_direct_terms_of_the_truncated_projection() {
     let rule = OneLoopRule {
@@ -79,9 +80,32 @@ fn truncated_tensors_are_the_direct_terms_of_the_truncated_projection() {
                 "n {n} {k:?}: the truncation changes the terms"
             );
         }
+        // The contraction reads the entries below n only (it stops at the last non-zero
+        // coefficient): a negligible last coefficient makes it read every entry, the same terms.
+        let mut every = proj.clone();
+        *every.coefficients.last_mut().unwrap() = 1e-300;
+        for (a, b) in from_tensors.iter().zip(matter.evaluate(&p, &every)) {
+            for (x, y) in loops(a).iter().zip(loops(&b)) {
+                assert!((x - y).abs() <= 1e-12 * y.abs(), "n {n}: {x} vs {y}");
+            }
+        }
         let proj = galaxy.project_first(&p, n);
         let pn = galaxy.linear_basis().spectrum_of(&proj).unwrap();
-        for (t, &k) in galaxy.evaluate_projected(&p, &proj).iter().zip(&triangles) {
+        let mut every = proj.clone();
+        *every.coefficients.last_mut().unwrap() = 1e-300;
+        let read_all = galaxy.evaluate_projected(&p, &every);
+        for ((t, &k), all) in galaxy
+            .evaluate_projected(&p, &proj)
+            .iter()
+            .zip(&triangles)
+            .zip(&read_all)
+        {
+            for (a, b) in t.terms().iter().zip(all.terms()) {
+                let scale = b.values.iter().map(|x| x.abs()).fold(0.0, f64::max);
+                for (x, y) in a.values.iter().zip(&b.values) {
+                    assert!((x - y).abs() <= 1e-12 * scale, "n {n} {k:?}: {x} vs {y}");
+                }
+            }
             let d = one_loop_galaxy_polynomial(&pn, k, None, &rule).unwrap();
             // the loop terms (the tree uses P in the tensors' polynomials, P̂ₙ directly)
             for (a, b) in t.terms().iter().zip(d.terms()).skip(1) {

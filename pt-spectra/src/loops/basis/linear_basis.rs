@@ -258,7 +258,7 @@ impl LinearBasis {
     /// The projection of `samples` on the functions a with `keep(a)` alone (the others' coefficients
     /// zero), as [`project_first`](Self::project_first) on any subset.
     pub fn project_on(&self, samples: &[f64], keep: impl Fn(usize) -> bool) -> Projection {
-        let mut c = self.project(samples).coefficients;
+        let mut c = self.coefficients_many(&[samples]).remove(0);
         c.iter_mut()
             .enumerate()
             .filter(|(a, _)| !keep(*a))
