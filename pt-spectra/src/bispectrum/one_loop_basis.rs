@@ -38,7 +38,9 @@ use crate::error::Result;
 use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::{after_key, cache_file_name, training, LinearBasis, Projection};
-use crate::loops::basis::{pair_index, pair_products, triple_index, triple_products, triples};
+use crate::loops::basis::{
+    leading, pack_pairs, pack_triples, pair_products, triple_products, triples,
+};
 use crate::loops::basis::{BASIS_SIZE, MAX_RESIDUAL};
 use crate::loops::lattice::Lattice;
 use crate::simd::{axpy, dot};
@@ -277,11 +279,6 @@ impl OneLoopMatterBasis {
     }
 }
 
-/// The coefficients up to the last non-zero one (those after it contribute nothing).
-pub(super) fn leading(c: &[f64]) -> &[f64] {
-    &c[..c.iter().rposition(|&x| x != 0.0).map_or(0, |i| i + 1)]
-}
-
 /// [B₂₂₂, B₃₂₁ᴵ, B₃₂₁ᴵᴵ, B₄₁₁] of one triangle's tensors `t` (fine, or fine − coarse) on `n` functions,
 /// with P̂ at the sides `ph`, the first m ≤ n coefficients `c`, their pair and triple products (the
 /// entries with every index < m: the first of the packed pairs and triples).
@@ -406,48 +403,6 @@ fn rule_tensors(basis: &LinearBasis, kv: &[Vec3; 3], rule: &OneLoopRule) -> Vec<
     }
     out.extend(&l411);
     out.extend(&j);
-    out
-}
-
-/// The symmetric form of a full n³ tensor on the triples a ≤ b ≤ c (at [`triple_index`]): Σ over
-/// the distinct permutations, so that Σ_{a≤b≤c} packed c_a c_b c_c = Σ_{abc} T_abc c_a c_b c_c.
-pub(super) fn pack_triples(t: &[f64], n: usize) -> Vec<f64> {
-    let at = |a: usize, b: usize, c: usize| t[(a * n + b) * n + c];
-    let mut out = vec![0.0; triples(n)];
-    for c in 0..n {
-        for b in 0..=c {
-            for a in 0..=b {
-                let all = at(a, b, c)
-                    + at(a, c, b)
-                    + at(b, a, c)
-                    + at(b, c, a)
-                    + at(c, a, b)
-                    + at(c, b, a);
-                // Each distinct permutation appears 6 / (number of distinct ones) times in `all`.
-                let repeats = match (a == b, b == c) {
-                    (true, true) => 6.0,
-                    (false, false) if a != c => 1.0,
-                    _ => 2.0,
-                };
-                out[triple_index(a, b, c)] = all / repeats;
-            }
-        }
-    }
-    out
-}
-
-/// The symmetric form of an n × n matrix on the pairs a ≤ b (at [`pair_index`]).
-pub(super) fn pack_pairs(m: &[f64], n: usize) -> Vec<f64> {
-    let mut out = vec![0.0; pairs(n)];
-    for b in 0..n {
-        for a in 0..=b {
-            out[pair_index(a, b)] = if a == b {
-                m[a * n + a]
-            } else {
-                m[a * n + b] + m[b * n + a]
-            };
-        }
-    }
     out
 }
 

@@ -27,13 +27,14 @@ use super::bias_kernels::{loop_kernel_parts, N_PARTS};
 use super::one_loop::{
     angular_nodes, breaks, partition, radial_nodes, triangle_vectors, OneLoopRule, Vec3,
 };
-use super::one_loop_basis::{self, b222_node, pack_pairs, pack_triples, PROJECTION_FACTOR};
+use super::one_loop_basis::{self, b222_node, PROJECTION_FACTOR};
 use super::one_loop_galaxy::{uv_parts, UvParts};
 use super::one_loop_galaxy_poly::{assemble, GalaxyLoopPolynomial, Layout, LoopSums};
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::{after_key, cache_file_name, Projection, BASIS_SIZE};
-use crate::loops::basis::{pair_products, training, triple_products, triples, LinearBasis};
+use crate::loops::basis::{leading, pack_pairs, pack_triples, pair_products, training};
+use crate::loops::basis::{triple_products, triples, LinearBasis};
 use crate::loops::lattice::Lattice;
 use crate::simd::{axpy, dot};
 use crate::vec3::{neg, norm, sub};
@@ -276,7 +277,7 @@ impl GalaxyLoopBasis {
         projection: &Projection,
     ) -> Vec<GalaxyLoopPolynomial> {
         let n = self.basis.len();
-        let c = one_loop_basis::leading(&projection.coefficients);
+        let c = leading(&projection.coefficients);
         let m = c.len();
         let shape = Shape::new(n);
         let (c2, c3) = (pair_products(c), triple_products(c));
