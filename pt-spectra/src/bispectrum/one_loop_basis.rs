@@ -38,7 +38,9 @@ use crate::error::Result;
 use crate::estimate::Estimate;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::{after_key, cache_file_name, training, LinearBasis, Projection};
-use crate::loops::basis::{pair_index, pair_products, triple_index, triple_products, triples};
+use crate::loops::basis::{
+    leading, pack_pairs, pack_triples, pair_products, triple_products, triples,
+};
 use crate::loops::basis::{BASIS_SIZE, MAX_RESIDUAL};
 use crate::loops::lattice::Lattice;
 use crate::simd::{axpy, dot};
@@ -194,10 +196,27 @@ impl OneLoopMatterBasis {
         self.basis.project(&self.basis.sample(p))
     }
 
+    /// The basis functions' samples (the CAMB basis on the tensors' lattice).
+    pub fn linear_basis(&self) -> &LinearBasis {
+        &self.basis
+    }
+
+    /// The projection of `p` on the basis's first `n` functions ([`LinearBasis::project_first`]):
+    /// [`evaluate`](Self::evaluate) with it gives the terms of the basis of `n` functions (the
+    /// tensors' entries with every index < n), their errors with that projection's residual.
+    pub fn project_first(&self, p: &LinearSpectrum, n: usize) -> Projection {
+        self.basis.project_first(&self.basis.sample(p), n)
+    }
+
     /// The terms of every triangle for the spectrum `p` whose projection is `projection`.
+    ///
+    /// The contraction stops at the last non-zero coefficient: with a projection on the first n functions
+    /// ([`project_first`](Self::project_first)) it reads only the entries with every index < n (the
+    /// packed triples and pairs of those come first), n(n+1)(n+2)/6 of B₂₂₂'s.
     pub fn evaluate(&self, p: &LinearSpectrum, projection: &Projection) -> Vec<OneLoopMatter> {
-        let c = &projection.coefficients;
-        let n = c.len();
+        let n = self.basis.len();
+        let c = leading(&projection.coefficients);
+        let m = c.len();
         // The products on the packed pairs and triples of the power-spectrum tensors' layout.
         let (c2, c3) = (pair_products(c), triple_products(c));
         let eps = PROJECTION_FACTOR * projection.residual;
@@ -207,10 +226,10 @@ impl OneLoopMatterBasis {
             .map(|(&k, t)| {
                 let kv = triangle_vectors(k).expect("checked at build");
                 let (sides, rest) = t.split_at(3 * n);
-                let ph: [f64; 3] = std::array::from_fn(|i| dot(&sides[i * n..(i + 1) * n], c));
+                let ph: [f64; 3] = std::array::from_fn(|i| dot(&sides[i * n..i * n + m], c));
                 let (fine, diff) = rest.split_at(tensor_len(n));
-                let fine = contract(fine, &kv, &ph, c, &c2, &c3);
-                let diff = contract(diff, &kv, &ph, c, &c2, &c3);
+                let fine = contract(fine, n, &kv, &ph, c, &c2, &c3);
+                let diff = contract(diff, n, &kv, &ph, c, &c2, &c3);
                 let projection = eps * fine.iter().map(|t| t.abs()).sum::<f64>();
                 let est = |i: usize| Estimate::new(fine[i], diff[i].abs() + projection);
                 let pk = k.map(|v| p.eval(v));
@@ -260,35 +279,37 @@ impl OneLoopMatterBasis {
     }
 }
 
-/// [B₂₂₂, B₃₂₁ᴵ, B₃₂₁ᴵᴵ, B₄₁₁] of one triangle's tensors `t` (fine, or fine − coarse), with P̂ at
-/// the sides `ph`, the coefficients `c`, their pair and triple products.
+/// [B₂₂₂, B₃₂₁ᴵ, B₃₂₁ᴵᴵ, B₄₁₁] of one triangle's tensors `t` (fine, or fine − coarse) on `n` functions,
+/// with P̂ at the sides `ph`, the first m ≤ n coefficients `c`, their pair and triple products (the
+/// entries with every index < m: the first of the packed pairs and triples).
 fn contract(
     t: &[f64],
+    n: usize,
     kv: &[Vec3; 3],
     ph: &[f64; 3],
     c: &[f64],
     c2: &[f64],
     c3: &[f64],
 ) -> [f64; 4] {
-    let n = c.len();
+    let m = c.len();
     let (t222, rest) = t.split_at(triples(n));
-    let (m, rest) = rest.split_at(6 * pairs(n));
+    let (m321, rest) = rest.split_at(6 * pairs(n));
     let (l, j) = rest.split_at(3 * n);
-    let b222 = dot(t222, c3);
+    let b222 = dot(&t222[..c3.len()], c3);
     let b321_i = PAIRS
         .iter()
-        .zip(m.chunks_exact(pairs(n)))
-        .map(|(&(a, _), m)| ph[a] * dot(m, c2))
+        .zip(m321.chunks_exact(pairs(n)))
+        .map(|(&(a, _), block)| ph[a] * dot(&block[..c2.len()], c2))
         .sum();
     let mut b321_ii = 0.0;
     let mut b411 = 0.0;
     for a in 0..3 {
         let (b, cc) = ((a + 1) % 3, (a + 2) % 3);
-        let ja = dot(&j[a * n..(a + 1) * n], c);
+        let ja = dot(&j[a * n..a * n + m], c);
         for other in [b, cc] {
             b321_ii += 6.0 * f_n(&[kv[a], kv[other]]) * ph[a] * ph[other] * ja;
         }
-        b411 += ph[b] * ph[cc] * dot(&l[a * n..(a + 1) * n], c);
+        b411 += ph[b] * ph[cc] * dot(&l[a * n..a * n + m], c);
     }
     [b222, b321_i, b321_ii, b411]
 }
@@ -382,48 +403,6 @@ fn rule_tensors(basis: &LinearBasis, kv: &[Vec3; 3], rule: &OneLoopRule) -> Vec<
     }
     out.extend(&l411);
     out.extend(&j);
-    out
-}
-
-/// The symmetric form of a full n³ tensor on the triples a ≤ b ≤ c (at [`triple_index`]): Σ over
-/// the distinct permutations, so that Σ_{a≤b≤c} packed c_a c_b c_c = Σ_{abc} T_abc c_a c_b c_c.
-pub(super) fn pack_triples(t: &[f64], n: usize) -> Vec<f64> {
-    let at = |a: usize, b: usize, c: usize| t[(a * n + b) * n + c];
-    let mut out = vec![0.0; triples(n)];
-    for c in 0..n {
-        for b in 0..=c {
-            for a in 0..=b {
-                let all = at(a, b, c)
-                    + at(a, c, b)
-                    + at(b, a, c)
-                    + at(b, c, a)
-                    + at(c, a, b)
-                    + at(c, b, a);
-                // Each distinct permutation appears 6 / (number of distinct ones) times in `all`.
-                let repeats = match (a == b, b == c) {
-                    (true, true) => 6.0,
-                    (false, false) if a != c => 1.0,
-                    _ => 2.0,
-                };
-                out[triple_index(a, b, c)] = all / repeats;
-            }
-        }
-    }
-    out
-}
-
-/// The symmetric form of an n × n matrix on the pairs a ≤ b (at [`pair_index`]).
-pub(super) fn pack_pairs(m: &[f64], n: usize) -> Vec<f64> {
-    let mut out = vec![0.0; pairs(n)];
-    for b in 0..n {
-        for a in 0..=b {
-            out[pair_index(a, b)] = if a == b {
-                m[a * n + a]
-            } else {
-                m[a * n + b] + m[b * n + a]
-            };
-        }
-    }
     out
 }
 

@@ -27,13 +27,14 @@ use super::bias_kernels::{loop_kernel_parts, N_PARTS};
 use super::one_loop::{
     angular_nodes, breaks, partition, radial_nodes, triangle_vectors, OneLoopRule, Vec3,
 };
-use super::one_loop_basis::{self, b222_node, pack_pairs, pack_triples, PROJECTION_FACTOR};
+use super::one_loop_basis::{self, b222_node, PROJECTION_FACTOR};
 use super::one_loop_galaxy::{uv_parts, UvParts};
 use super::one_loop_galaxy_poly::{assemble, GalaxyLoopPolynomial, Layout, LoopSums};
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::{after_key, cache_file_name, Projection, BASIS_SIZE};
-use crate::loops::basis::{pair_products, training, triple_products, triples, LinearBasis};
+use crate::loops::basis::{leading, pack_pairs, pack_triples, pair_products, training};
+use crate::loops::basis::{triple_products, triples, LinearBasis};
 use crate::loops::lattice::Lattice;
 use crate::simd::{axpy, dot};
 use crate::vec3::{neg, norm, sub};
@@ -253,9 +254,31 @@ impl GalaxyLoopBasis {
     /// with [`GalaxyLoopPolynomial::projection`] = [`PROJECTION_FACTOR`] × the projection residual (the matter
     /// terms' bound on the response to it, relative to the sum of the loop terms' sizes).
     pub fn evaluate(&self, p: &LinearSpectrum) -> Vec<GalaxyLoopPolynomial> {
-        let projection = self.project(p);
-        let c = &projection.coefficients;
-        let n = c.len();
+        self.evaluate_projected(p, &self.project(p))
+    }
+
+    /// The basis functions' samples (the CAMB basis on the tensors' lattice).
+    pub fn linear_basis(&self) -> &LinearBasis {
+        &self.basis
+    }
+
+    /// The projection of `p` on the basis's first `n` functions ([`LinearBasis::project_first`]):
+    /// [`evaluate_projected`](Self::evaluate_projected) with it gives the polynomials of the basis of `n`
+    /// functions (the tensors' entries with every index < n).
+    pub fn project_first(&self, p: &LinearSpectrum, n: usize) -> Projection {
+        self.basis.project_first(&self.basis.sample(p), n)
+    }
+
+    /// [`evaluate`](Self::evaluate) with the coefficients and residual of `projection` (of `p`, on this basis:
+    /// [`project`](Self::project) or [`project_first`](Self::project_first)).
+    pub fn evaluate_projected(
+        &self,
+        p: &LinearSpectrum,
+        projection: &Projection,
+    ) -> Vec<GalaxyLoopPolynomial> {
+        let n = self.basis.len();
+        let c = leading(&projection.coefficients);
+        let m = c.len();
         let shape = Shape::new(n);
         let (c2, c3) = (pair_products(c), triple_products(c));
         self.triangles
@@ -263,7 +286,7 @@ impl GalaxyLoopBasis {
             .zip(self.tensors.iter().zip(&self.uv))
             .map(|(&k, (t, uv))| {
                 let (sides, rest) = t.split_at(3 * n);
-                let ph: [f64; 3] = std::array::from_fn(|i| dot(&sides[i * n..(i + 1) * n], c));
+                let ph: [f64; 3] = std::array::from_fn(|i| dot(&sides[i * n..i * n + m], c));
                 let (fine, diff) = rest.split_at(shape.len());
                 let (f, sf) = contract(&shape, fine, c, &c2, &c3);
                 let (d, sd) = contract(&shape, diff, c, &c2, &c3);
@@ -308,23 +331,24 @@ fn key(triangles: &[[f64; 3]], rule: &OneLoopRule) -> Vec<f64> {
     key
 }
 
-/// One rule's tensors contracted with the coefficients `c` (pair and triple products `c2`, `c3`): the loop
-/// sums in the layout of [`Layout`] (each monomial's value at one ordered choice of its parts), and σ².
+/// One rule's tensors contracted with the first m ≤ n coefficients `c` (pair and triple products `c2`, `c3`;
+/// the entries with every index < m, the first of the packed pairs and triples): the loop sums in the layout
+/// of [`Layout`] (each monomial's value at one ordered choice of its parts), and σ².
 fn contract(shape: &Shape, t: &[f64], c: &[f64], c2: &[f64], c3: &[f64]) -> (Vec<f64>, f64) {
-    let (n, lay) = (shape.n, &shape.lay);
+    let (n, lay, used) = (shape.n, &shape.lay, c.len());
     let (s2, s3, s4) = (&lay.s[2], &lay.s[3], &lay.s[4]);
     let mut out = vec![0.0; lay.len];
     let (t222, rest) = t.split_at(shape.m222.len() * triples(n));
     for (m, t) in shape.m222.iter().zip(t222.chunks_exact(triples(n))) {
         let at = |p: usize| s2.iter().position(|&x| x == p).expect("a part of Z₂");
-        out[(at(m[0]) * s2.len() + at(m[1])) * s2.len() + at(m[2])] = dot(t, c3);
+        out[(at(m[0]) * s2.len() + at(m[1])) * s2.len() + at(m[2])] = dot(&t[..c3.len()], c3);
     }
     let (t321, rest) = rest.split_at(6 * shape.m321.len() * shape.pairs());
     let mut blocks = t321.chunks_exact(shape.pairs());
     for a in 0..3 {
         for b in (0..3).filter(|&b| b != a) {
             for m in &shape.m321 {
-                let v = dot(blocks.next().expect("the layout's blocks"), c2);
+                let v = dot(&blocks.next().expect("the layout's blocks")[..c2.len()], c2);
                 // one ordered choice (a part of Z₃, one of Z₂) with this pair of parts
                 let (i, j) = s3
                     .iter()
@@ -342,13 +366,13 @@ fn contract(shape: &Shape, t: &[f64], c: &[f64], c2: &[f64], c3: &[f64]) -> (Vec
     }
     let (l, rest) = rest.split_at(3 * s4.len() * n);
     for (s, l) in out[lay.o411..lay.oj].iter_mut().zip(l.chunks_exact(n)) {
-        *s = dot(l, c);
+        *s = dot(&l[..used], c);
     }
     let (j, sigma) = rest.split_at(3 * s3.len() * n);
     for (s, j) in out[lay.oj..].iter_mut().zip(j.chunks_exact(n)) {
-        *s = dot(j, c);
+        *s = dot(&j[..used], c);
     }
-    (out, dot(sigma, c))
+    (out, dot(&sigma[..used], c))
 }
 
 /// One triangle's values: φ at the sides, the fine tensors, fine − coarse.

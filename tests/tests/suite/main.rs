@@ -13,6 +13,7 @@ mod support;
 mod ap;
 mod bias;
 mod bins;
+mod bispectrum_basis_truncation;
 mod bispectrum_galaxy;
 mod bispectrum_galaxy_bins;
 mod bispectrum_galaxy_ct;

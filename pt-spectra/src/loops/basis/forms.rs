@@ -8,7 +8,7 @@
 //! P(q) or P(p) leave linear forms ([`NodeForms::inner`]: Σ_outer Σ_inner w φ̃(p), and
 //! [`NodeForms::outer`]: Σ_outer φ̃(q) Σ_inner w).
 
-use super::pair_index;
+use super::{pair_index, triple_index, triples};
 use crate::integrate::lagrange4;
 use crate::loops::lattice::Lattice;
 use crate::loops::p22::PairNodes;
@@ -244,4 +244,51 @@ pub(crate) fn concat<A, B, C>(per_k: Vec<(Vec<A>, Vec<B>, Vec<C>)>) -> (Vec<A>, 
         c.extend(z);
     }
     (a, b, c)
+}
+
+/// The coefficients up to the last non-zero one (those after it contribute nothing).
+pub(crate) fn leading(c: &[f64]) -> &[f64] {
+    &c[..c.iter().rposition(|&x| x != 0.0).map_or(0, |i| i + 1)]
+}
+
+/// The symmetric form of a full n³ tensor on the triples a ≤ b ≤ c (at [`triple_index`]): Σ over
+/// the distinct permutations, so that Σ_{a≤b≤c} packed c_a c_b c_c = Σ_{abc} T_abc c_a c_b c_c.
+pub(crate) fn pack_triples(t: &[f64], n: usize) -> Vec<f64> {
+    let at = |a: usize, b: usize, c: usize| t[(a * n + b) * n + c];
+    let mut out = vec![0.0; triples(n)];
+    for c in 0..n {
+        for b in 0..=c {
+            for a in 0..=b {
+                let all = at(a, b, c)
+                    + at(a, c, b)
+                    + at(b, a, c)
+                    + at(b, c, a)
+                    + at(c, a, b)
+                    + at(c, b, a);
+                // Each distinct permutation appears 6 / (number of distinct ones) times in `all`.
+                let repeats = match (a == b, b == c) {
+                    (true, true) => 6.0,
+                    (false, false) if a != c => 1.0,
+                    _ => 2.0,
+                };
+                out[triple_index(a, b, c)] = all / repeats;
+            }
+        }
+    }
+    out
+}
+
+/// The symmetric form of an n × n matrix on the pairs a ≤ b (at [`pair_index`]).
+pub(crate) fn pack_pairs(m: &[f64], n: usize) -> Vec<f64> {
+    let mut out = vec![0.0; n * (n + 1) / 2];
+    for b in 0..n {
+        for a in 0..=b {
+            out[pair_index(a, b)] = if a == b {
+                m[a * n + a]
+            } else {
+                m[a * n + b] + m[b * n + a]
+            };
+        }
+    }
+    out
 }

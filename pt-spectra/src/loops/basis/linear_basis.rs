@@ -239,12 +239,53 @@ impl LinearBasis {
             .map(|(p, w)| w * p)
             .collect();
         let columns = self.columns.chunks_exact(len);
-        let c: Vec<f64> = columns
-            .clone()
-            .map(|phi| crate::simd::dot(phi, &wp))
-            .collect();
+        let c: Vec<f64> = columns.map(|phi| crate::simd::dot(phi, &wp)).collect();
+        self.with_coefficients(samples, c)
+    }
+
+    /// The projection of `samples` on the first `n` functions alone: [`project`](Self::project)'s
+    /// coefficients with those of the functions from `n` on set to zero (the coefficients of an
+    /// orthonormal basis do not depend on the others), the samples and residuals of that sum. The
+    /// basis is nested (greedy), so this is the projection on the basis of `n` functions, and a loop
+    /// term evaluated from tensors with these coefficients is the term of that basis's P̂ (the tensor
+    /// entries with an index ≥ n are multiplied by zero). The first
+    /// [`TAIL_FUNCTIONS`](super::training::TAIL_FUNCTIONS) functions of the CAMB basis are its tail
+    /// functions (zero below 3 h/Mpc).
+    pub fn project_first(&self, samples: &[f64], n: usize) -> Projection {
+        self.project_on(samples, |a| a < n)
+    }
+
+    /// The projection of `samples` on the functions a with `keep(a)` alone (the others' coefficients
+    /// zero), as [`project_first`](Self::project_first) on any subset.
+    pub fn project_on(&self, samples: &[f64], keep: impl Fn(usize) -> bool) -> Projection {
+        let mut c = self.coefficients_many(&[samples]).remove(0);
+        c.iter_mut()
+            .enumerate()
+            .filter(|(a, _)| !keep(*a))
+            .for_each(|(_, x)| *x = 0.0);
+        self.with_coefficients(samples, c)
+    }
+
+    /// The projected samples of `projection` (of a spectrum on this basis) as a spectrum on the lattice
+    /// (what loop terms from tensors integrate in place of P), for direct integrals of it.
+    ///
+    /// # Errors
+    /// As [`LinearSpectrum::from_nodes`](crate::linear::LinearSpectrum::from_nodes): a projection that
+    /// is not positive on the lattice.
+    pub fn spectrum_of(
+        &self,
+        projection: &Projection,
+    ) -> crate::error::Result<crate::linear::LinearSpectrum> {
+        crate::linear::LinearSpectrum::from_nodes(self.q(), projection.samples.clone())
+    }
+
+    /// The projection of `samples` with the coefficients `c` (one per function; e.g. the projection's
+    /// coefficients mapped onto a subspace): Σ_a c_a φ_a on the lattice and its residuals relative to
+    /// `samples`.
+    pub fn with_coefficients(&self, samples: &[f64], c: Vec<f64>) -> Projection {
+        let len = self.lattice.len;
         let mut projected = vec![0.0; len];
-        for (phi, &ca) in columns.zip(&c) {
+        for (phi, &ca) in self.columns.chunks_exact(len).zip(&c) {
             crate::simd::axpy(&mut projected, ca, phi);
         }
         let relative: Vec<f64> = projected

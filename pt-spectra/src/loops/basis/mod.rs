@@ -51,7 +51,7 @@ pub mod training;
 pub(crate) use cache_key::{
     after_key, after_points, cache_file_name, stored_count, MAX_STORED_BASIS,
 };
-pub(crate) use forms::pair_products;
+pub(crate) use forms::{leading, pack_pairs, pack_triples, pair_products};
 #[cfg(test)]
 pub(crate) use linear_basis::wrapping_basis_size;
 pub use linear_basis::{LinearBasis, Projection, SMOOTHING};
