@@ -495,16 +495,14 @@ impl EptPlan {
             }
             return Ok(out);
         }
-        // node by node in μ (each k's sum in the same order), the BAO damping of all k of a node
-        // in one vectorised pass
+        // node by node in μ: the BAO damping of all k of a node in one vectorised pass
         let ln_k: Vec<f64> = self.k_out.iter().map(|k| k.ln()).collect();
         let mut damping = vec![0.0; self.k_out.len()];
         for (c, &(ln_ratio, ratio2, mt)) in weights.iter().zip(&nodes) {
             let exponent = ratio2 * model.damping_exponent(mt);
-            damping
-                .iter_mut()
-                .zip(&self.k_out)
-                .for_each(|(d, k)| *d = k * k * exponent);
+            for (d, k) in damping.iter_mut().zip(&self.k_out) {
+                *d = k * k * exponent;
+            }
             crate::simd::exp_in_place(&mut damping);
             for (i, (&ln_k, damping)) in ln_k.iter().zip(&damping).enumerate() {
                 let (n, w) = model.interpolated_parts_ln(ln_k + ln_ratio, mt)?;
