@@ -112,43 +112,31 @@ pub fn one_loop_bispectrum(
             "bin_width: the one-loop bispectrum's bin averages are the multipoles' (multipoles=True)",
         ));
     }
-    if let (true, Some(width)) = (multipoles, bin_width) {
+    if multipoles {
         let bias = bias.unwrap_or_else(pt_spectra::bispectrum::bias_kernels::LoopBias::matter);
-        let set = pt_spectra::bispectrum::TriangleSet::shells(rows.clone(), width)
+        // over bins of `bin_width` around each triangle, or at the triangles
+        let set = bin_width
+            .map(|width| pt_spectra::bispectrum::TriangleSet::shells(rows.clone(), width))
+            .transpose()
             .map_err(library_error)?;
         let ((prepared, table), seconds) = detached(py, || {
             let prepared = inputs.prepare(&[])?;
-            let table = pt_spectra::jobs::one_loop_galaxy_binned_multipoles_table(
-                &prepared, &set, &bias, f, side, ir, &rule, &Silent,
-            )?;
+            let table = match &set {
+                Some(set) => pt_spectra::jobs::one_loop_galaxy_binned_multipoles_table(
+                    &prepared, set, &bias, f, side, ir, &rule, &Silent,
+                )?,
+                None => pt_spectra::jobs::one_loop_galaxy_multipoles_table(
+                    &prepared, &rows, &bias, f, side, ir, &rule, &Silent,
+                )?,
+            };
             Ok((prepared, table))
         })?;
-        return Table::new(
-            py,
-            table,
-            &prepared,
-            &Precision::default(),
-            "bispectrum one-loop galaxy multipoles over bins",
-            seconds,
-        );
-    }
-    if multipoles {
-        let bias = bias.unwrap_or_else(pt_spectra::bispectrum::bias_kernels::LoopBias::matter);
-        let ((prepared, table), seconds) = detached(py, || {
-            let prepared = inputs.prepare(&[])?;
-            let table = pt_spectra::jobs::one_loop_galaxy_multipoles_table(
-                &prepared, &rows, &bias, f, side, ir, &rule, &Silent,
-            )?;
-            Ok((prepared, table))
-        })?;
-        return Table::new(
-            py,
-            table,
-            &prepared,
-            &Precision::default(),
-            "bispectrum one-loop galaxy multipoles",
-            seconds,
-        );
+        let title = if set.is_some() {
+            "bispectrum one-loop galaxy multipoles over bins"
+        } else {
+            "bispectrum one-loop galaxy multipoles"
+        };
+        return Table::new(py, table, &prepared, &Precision::default(), title, seconds);
     }
     if mu1.is_none() && f.is_some() {
         return Err(crate::value_error(
