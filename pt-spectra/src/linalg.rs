@@ -116,3 +116,79 @@ mod tests {
         assert!(cholesky(&[vec![f64::NAN]]).is_none());
     }
 }
+
+/// The eigenpairs of the symmetric matrix `a` (rows) by cyclic Jacobi rotations, by decreasing
+/// eigenvalue: (λ, unit eigenvector) (the SVD templates of the one-loop multipole tensors).
+pub(crate) fn symmetric_eigen(a: &[Vec<f64>]) -> Vec<(f64, Vec<f64>)> {
+    let n = a.len();
+    let mut a = a.to_vec();
+    let mut v: Vec<Vec<f64>> = (0..n)
+        .map(|i| (0..n).map(|j| f64::from(u8::from(i == j))).collect())
+        .collect();
+    let scale: f64 = a.iter().flatten().map(|x| x * x).sum();
+    for _sweep in 0..100 {
+        let off: f64 = (0..n)
+            .flat_map(|i| (0..n).filter(move |&j| j != i).map(move |j| (i, j)))
+            .map(|(i, j)| a[i][j] * a[i][j])
+            .sum();
+        if off <= 1e-30 * scale {
+            break;
+        }
+        for p in 0..n {
+            for q in p + 1..n {
+                if a[p][q] == 0.0 {
+                    continue;
+                }
+                // the rotation in the (p, q) plane that zeroes a[p][q]
+                let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let (c, s) = (1.0 / (t * t + 1.0).sqrt(), t / (t * t + 1.0).sqrt());
+                for row in a.iter_mut().chain(v.iter_mut()) {
+                    let (x, y) = (row[p], row[q]);
+                    row[p] = c * x - s * y;
+                    row[q] = s * x + c * y;
+                }
+                for k in 0..n {
+                    let (x, y) = (a[p][k], a[q][k]);
+                    a[p][k] = c * x - s * y;
+                    a[q][k] = s * x + c * y;
+                }
+            }
+        }
+    }
+    let mut out: Vec<(f64, Vec<f64>)> = (0..n)
+        .map(|i| (a[i][i], v.iter().map(|row| row[i]).collect()))
+        .collect();
+    out.sort_by(|x, y| y.0.total_cmp(&x.0));
+    out
+}
+
+#[cfg(test)]
+mod eigen_tests {
+    /// A u = λ u for every pair of a 5 × 5 symmetric matrix, and the eigenvalues of diag(3, 1, 2) in
+    /// decreasing order.
+    #[test]
+    fn eigenpairs_satisfy_their_equation() {
+        let a: Vec<Vec<f64>> = (0..5)
+            .map(|i| {
+                (0..5)
+                    .map(|j| 1.0 / (1.0 + i as f64 + j as f64) + f64::from(u8::from(i == j)))
+                    .collect()
+            })
+            .collect();
+        for (lambda, u) in super::symmetric_eigen(&a) {
+            for (row, ui) in a.iter().zip(&u) {
+                let au: f64 = row.iter().zip(&u).map(|(x, y)| x * y).sum();
+                assert!((au - lambda * ui).abs() < 1e-12, "{au} {lambda} {ui}");
+            }
+            assert!((u.iter().map(|x| x * x).sum::<f64>() - 1.0).abs() < 1e-12);
+        }
+        let d = vec![
+            vec![3.0, 0.0, 0.0],
+            vec![0.0, 1.0, 0.0],
+            vec![0.0, 0.0, 2.0],
+        ];
+        let l: Vec<f64> = super::symmetric_eigen(&d).iter().map(|x| x.0).collect();
+        assert_eq!(l, vec![3.0, 2.0, 1.0]);
+    }
+}

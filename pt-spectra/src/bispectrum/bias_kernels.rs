@@ -578,14 +578,22 @@ pub(super) fn loop_kernel_parts(redshift: Option<(f64, Vec3)>, q: &[Vec3]) -> [f
     parts_from_table(&t, redshift.as_ref().map(|(f, los)| (*f, los)))
 }
 
-/// [`loop_kernel_parts`] in redshift space at growth rate `f` along each UNIT line of sight of `los`, the
-/// subsets' fields built once (the orientation average of the multipoles): `out[o]` for `los[o]`.
-pub(super) fn loop_kernel_parts_los(f: f64, los: &[Vec3], q: &[Vec3], out: &mut [[f64; N_PARTS]]) {
+/// [`loop_kernel_parts`] in redshift space at each growth rate of `fs` along each UNIT line of sight of
+/// `los`, the subsets' fields built once (the multipoles' orientation average; the multipole tensors'
+/// nodes in f): `out[j × los.len() + o]` for `fs[j]`, `los[o]`.
+pub(super) fn loop_kernel_parts_los(
+    fs: &[f64],
+    los: &[Vec3],
+    q: &[Vec3],
+    out: &mut [[f64; N_PARTS]],
+) {
     match Table::new(q) {
         Ok(t) => {
             let h = velocity_over_k2(&t.ks2, &t.g);
-            for (o, n) in out.iter_mut().zip(los) {
-                *o = redshift_parts(&t, &h, f, n);
+            for (out, &f) in out.chunks_exact_mut(los.len()).zip(fs) {
+                for (o, n) in out.iter_mut().zip(los) {
+                    *o = redshift_parts(&t, &h, f, n);
+                }
             }
         }
         Err(_) => out.iter_mut().for_each(|o| *o = [0.0; N_PARTS]),

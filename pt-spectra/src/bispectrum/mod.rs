@@ -50,6 +50,8 @@ pub mod galaxy_counterterms_rsd;
 mod geometry;
 mod ir_legs;
 mod lanes;
+pub mod multipole_basis;
+mod multipole_tensors;
 mod observed;
 pub mod one_loop;
 pub mod one_loop_basis;

@@ -43,7 +43,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The monomials of a product of kernel parts from the supports `sets` (sorted index tuples), and for each
 /// ordered choice of parts (indices into the supports) its monomial's slot.
-fn slots(sets: &[&[usize]]) -> (Vec<Vec<usize>>, Vec<usize>) {
+pub(super) fn slots(sets: &[&[usize]]) -> (Vec<Vec<usize>>, Vec<usize>) {
     let mut list: Vec<Vec<usize>> = Vec::new();
     let mut slot = Vec::new();
     let mut choice = vec![0; sets.len()];

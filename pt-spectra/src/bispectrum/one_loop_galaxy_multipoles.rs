@@ -164,9 +164,9 @@ fn loop_sums_los(
                     let (a, b) = (add(q, k1), sub(k2, q));
                     let r = [norm(q), norm(a), norm(b)];
                     let s = w * 8.0 * partition(&r, j) * p.eval(r[0]) * p.eval(r[1]) * p.eval(r[2]);
-                    loop_kernel_parts_los(f, los, &[neg(q), a], x);
-                    loop_kernel_parts_los(f, los, &[neg(a), neg(b)], y);
-                    loop_kernel_parts_los(f, los, &[b, q], t);
+                    loop_kernel_parts_los(&[f], los, &[neg(q), a], x);
+                    loop_kernel_parts_los(&[f], los, &[neg(a), neg(b)], y);
+                    loop_kernel_parts_los(&[f], los, &[b, q], t);
                     for o in 0..no {
                         let acc = &mut acc[o * len..(o + 1) * len];
                         add_triple_products(acc, s, [&x[o][..], &y[o][..], &t[o][..]], s2);
@@ -177,9 +177,9 @@ fn loop_sums_los(
                     let d = sub(kv[b], v);
                     let r = [norm(v), norm(d)];
                     let leg = w * 2.0 * 6.0 * partition(&r, 0) * pq * p.eval(r[1]);
-                    loop_kernel_parts_los(f, los, &[v, d], y);
+                    loop_kernel_parts_los(&[f], los, &[v, d], y);
                     for a in (0..3).filter(|&a| a != b) {
-                        loop_kernel_parts_los(f, los, &[neg(v), neg(d), neg(kv[a])], x);
+                        loop_kernel_parts_los(&[f], los, &[neg(v), neg(d), neg(kv[a])], x);
                         for o in 0..no {
                             let acc = &mut acc[o * len..(o + 1) * len];
                             for (i, &pi) in s3.iter().enumerate() {
@@ -194,8 +194,8 @@ fn loop_sums_los(
                 }
                 for a in 0..3 {
                     let (b, c) = ((a + 1) % 3, (a + 2) % 3);
-                    loop_kernel_parts_los(f, los, &[v, neg(v), neg(kv[b]), neg(kv[c])], x);
-                    loop_kernel_parts_los(f, los, &[kv[a], v, neg(v)], y);
+                    loop_kernel_parts_los(&[f], los, &[v, neg(v), neg(kv[b]), neg(kv[c])], x);
+                    loop_kernel_parts_los(&[f], los, &[kv[a], v, neg(v)], y);
                     for o in 0..no {
                         let acc = &mut acc[o * len..(o + 1) * len];
                         let at = lay.o411 + a * s4.len();
@@ -223,7 +223,12 @@ fn loop_sums_los(
 }
 
 /// The UV constants per part (as [`super::one_loop_galaxy`]'s `uv_parts`) of every orientation `los[o]`.
-fn uv_parts_los(f: f64, los: &[Vec3], kv: &[Vec3; 3], rule: &OneLoopRule) -> Vec<UvParts> {
+pub(super) fn uv_parts_los(
+    f: f64,
+    los: &[Vec3],
+    kv: &[Vec3; 3],
+    rule: &OneLoopRule,
+) -> Vec<UvParts> {
     let angular = angular_nodes(rule, false);
     let total: f64 = angular.iter().map(|(_, w)| w).sum();
     let k_max = kv.iter().map(|v| norm(*v)).fold(0.0, f64::max);
@@ -232,7 +237,7 @@ fn uv_parts_los(f: f64, los: &[Vec3], kv: &[Vec3; 3], rule: &OneLoopRule) -> Vec
     let mut average = |big: f64, args: &dyn Fn(Vec3) -> Vec<Vec3>| {
         let mut s = vec![[0.0; N_PARTS]; no];
         for &(u, w) in &angular {
-            loop_kernel_parts_los(f, los, &args(u.map(|x| x * big)), &mut parts);
+            loop_kernel_parts_los(&[f], los, &args(u.map(|x| x * big)), &mut parts);
             for (s, x) in s.iter_mut().zip(&parts) {
                 for p in 2..N_PARTS {
                     s[p] += w * x[p] / total;
