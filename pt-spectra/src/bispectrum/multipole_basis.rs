@@ -30,7 +30,7 @@ use crate::error::Result;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::training::{camb_basis, camb_samples};
 use crate::loops::basis::{pair_products, triple_products, LinearBasis, Projection, BASIS_SIZE};
-use crate::simd::dot;
+use crate::simd::{dot, matvec_f32};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -118,7 +118,9 @@ impl MultipoleLoopBasis {
         let tensors = setups
             .par_iter()
             .map(|s| {
-                let t = triangle_tensors(s, rule);
+                let mut t = triangle_tensors(s, rule);
+                t.b222.to_single();
+                t.b321.to_single();
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, triangles.len());
                 t
             })
@@ -148,7 +150,7 @@ impl MultipoleLoopBasis {
         self.tensors
             .iter()
             .map(|t| {
-                let rows = |r: &Rows| r.fine.len() + r.diff.len() + r.uv.len();
+                let rows = |r: &Rows| r.fine.len() + r.diff.len() + r.uv.len() + 2 * r.single.0.len();
                 t.sides.len()
                     + t.sigma[0].len() * 2
                     + rows(&t.b222)
@@ -193,7 +195,8 @@ impl MultipoleLoopBasis {
         crate::cosmology::check_growth_rate(f)?;
         let (c, projection) = self.project(p);
         let names = Names::new();
-        let (c2, c3) = (pair_products(&c), triple_products(&c));
+        let single = |v: Vec<f64>| -> Vec<f32> { v.iter().map(|&x| x as f32).collect() };
+        let (c2_32, c3_32) = (single(pair_products(&c)), single(triple_products(&c)));
         let fp: [f64; F_NODES] = std::array::from_fn(|i| f.powi(i as i32));
         let bound = PROJECTION_FACTOR * projection.residual;
         Ok(self
@@ -208,13 +211,13 @@ impl MultipoleLoopBasis {
                 // the products of the two sides other than s, for the loop terms and the tree level
                 let other = |x: &[f64; 3], s: usize| x[(s + 1) % 3] * x[(s + 2) % 3];
                 let mut acc = Acc::new(&names);
-                for (idx, (fine, diff)) in rows(&t.b222, c3.len()) {
+                for (idx, (fine, diff)) in single_rows(&t.b222, &c3_32) {
                     let w = fp[idx[3] as usize];
-                    acc.add(idx, 1, w * dot(fine, &c3), w * dot(diff, &c3));
+                    acc.add(idx, 1, w * fine, w * diff);
                 }
-                for (idx, (fine, diff)) in rows(&t.b321, c2.len()) {
+                for (idx, (fine, diff)) in single_rows(&t.b321, &c2_32) {
                     let w = fp[idx[3] as usize] * ph[idx[1] as usize];
-                    acc.add(idx, 2, w * dot(fine, &c2), w * dot(diff, &c2));
+                    acc.add(idx, 2, w * fine, w * diff);
                 }
                 for (family, (term, uv_term)) in [(&t.j, (3, 5)), (&t.l, (4, 6))] {
                     for ((idx, (fine, diff)), &u) in rows(family, m).zip(&family.uv) {
@@ -244,6 +247,16 @@ fn rows(r: &Rows, len: usize) -> impl Iterator<Item = (&[u16; 4], (&[f64], &[f64
     r.index
         .iter()
         .zip(r.fine.chunks_exact(len).zip(r.diff.chunks_exact(len)))
+}
+
+/// The rows of a family held in f32 contracted with `x` (the pair or triple products): (index, (value on
+/// the rule, rule − half rule)).
+fn single_rows<'a>(r: &'a Rows, x: &[f32]) -> impl Iterator<Item = (&'a [u16; 4], (f64, f64))> {
+    let mut fine = vec![0.0; r.index.len()];
+    let mut diff = vec![0.0; r.index.len()];
+    matvec_f32(&r.single.0, x, &mut fine);
+    matvec_f32(&r.single.1, x, &mut diff);
+    r.index.iter().zip(fine.into_iter().zip(diff))
 }
 
 /// The monomials of the seven terms (tree, B₂₂₂, B₃₂₁ᴵ, B₃₂₁ᴵᴵ, B₄₁₁, and the two subtracted amounts, which
