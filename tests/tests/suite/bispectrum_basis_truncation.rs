@@ -136,7 +136,7 @@ const SIZES: [usize; 9] = [6, 8, 10, 12, 16, 20, 24, 28, 36];
 /// Spectra not in the training set: CAMB tables of the tests' data and emulated spectra across the
 /// emulator's stated prior (massive neutrinos and wa included, which the massless w0-only training set
 /// does not hold).
-fn spectra() -> Vec<(String, LinearSpectrum)> {
+pub(crate) fn spectra() -> Vec<(String, LinearSpectrum)> {
     let mut out: Vec<(String, LinearSpectrum)> = [
         "linear_pk_planck2018_z0.0.dat",
         "linear_pk_planck2018_z1.0.dat",
