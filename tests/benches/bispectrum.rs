@@ -252,8 +252,12 @@ fn one_loop_multipole_basis(crit: &mut Criterion) {
         ..OneLoopRule::default()
     };
     let triangles = nseries().triangles().to_vec();
-    let basis = MultipoleLoopBasis::build(&triangles, LegendreSide::Largest, &rule, &|_, _| {}).unwrap();
-    eprintln!("multipole tensors of 62 triangles: {} values", basis.values());
+    let basis =
+        MultipoleLoopBasis::build(&triangles, LegendreSide::Largest, &rule, &|_, _| {}).unwrap();
+    eprintln!(
+        "multipole tensors of 62 triangles: {} values",
+        basis.values()
+    );
     let spectra: Vec<LinearSpectrum> = [0.0, 0.5, 1.0, 1.5]
         .iter()
         .map(|&z| LinearSpectrum::gm2012(z).unwrap())
@@ -266,6 +270,23 @@ fn one_loop_multipole_basis(crit: &mut Criterion) {
                 i += 1;
                 let f = 0.6 + 0.01 * f64::from(i % 30);
                 black_box(basis.evaluate(&spectra[i as usize % spectra.len()], f).unwrap())
+            })
+        },
+    );
+    let split = pt_spectra::ir::WiggleSplit::new().unwrap();
+    let q_min = pt_spectra::precision::Precision::default().q_min;
+    let inputs: Vec<_> = spectra
+        .iter()
+        .map(|p| pt_spectra::bispectrum::IrInputs::split(p, &split, q_min).unwrap())
+        .collect();
+    crit.bench_function(
+        "bispectrum/one-loop galaxy B0 B2 B4 of 62 Nseries triangles, new spectrum and f, multipole tensors, IR",
+        |b| {
+            b.iter(|| {
+                i += 1;
+                let f = 0.6 + 0.01 * f64::from(i % 30);
+                let at = i as usize % spectra.len();
+                black_box(basis.evaluate_ir(&spectra[at], &inputs[at], f).unwrap())
             })
         },
     );

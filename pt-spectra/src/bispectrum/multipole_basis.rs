@@ -13,19 +13,23 @@
 //!
 //! **f free.** The tensors hold each term's powers f⁰ … f⁶ ([`super::multipole_tensors`]), so f is a
 //! per-call input as the spectrum is (both change with the cosmology). The tree level is exact with the
-//! true P at the sides. Not in this path (stated, and the direct path has them): the IR resummation (the
-//! tensors integrate the spectrum given, as `ir=False`), and bin averages (the triangles given are
-//! evaluated as such).
+//! true P at the sides. The IR resummation of [`super::one_loop_ir`] ([`MultipoleLoopBasis::evaluate_ir`]):
+//! the loops are the tensors contracted with P_LO's projection, the tree level is kept per orientation
+//! (without the multipole weights, 45 × 3 sides × monomials × powers of f per triangle) and multiplied by
+//! each orientation's legs P_NLO(k_a, μ_a). Not in this path: bin averages (the triangles given are
+//! evaluated as such; [`super::one_loop_bins`] corrects the direct path's effective triangles).
 
 use super::geometry::LegendreSide;
+use super::ir_legs::{leading_order_spectrum, tree_legs};
 use super::multipole_tensors::{triangle_tensors, Products, Rows, Setup, TriangleTensors, F_NODES};
-use super::one_loop::{triangle_vectors, OneLoopRule};
+use super::one_loop::{triangle_vectors, OneLoopRule, Vec3};
 use super::one_loop_basis::{self, PROJECTION_FACTOR};
 use super::one_loop_galaxy_multipoles::{
     legendre_side_index, multipole_weights, orientation_nodes, GalaxyLoopMultipoles,
     ORIENTATION_RULE,
 };
 use super::one_loop_galaxy_poly::{GalaxyLoopPolynomial, Monomial, TermPolynomial};
+use super::resum::IrInputs;
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::training::{camb_basis, camb_samples};
@@ -66,6 +70,8 @@ pub struct MultipoleLoopBasis {
     rule: OneLoopRule,
     /// The Legendre side of each triangle.
     sides: Vec<usize>,
+    /// Per triangle, the orientations' lines of sight and multipole weights (the IR resummation's tree).
+    orientations: Vec<(Vec<Vec3>, Vec<[f64; 3]>)>,
     basis: LinearBasis,
     /// R: the templates' coefficients on the basis, m rows.
     templates: Vec<Vec<f64>>,
@@ -100,11 +106,13 @@ impl MultipoleLoopBasis {
         let nodes = orientation_nodes(n_mu, n_phi);
         let mut setups = Vec::with_capacity(triangles.len());
         let mut sides = Vec::with_capacity(triangles.len());
+        let mut orientations = Vec::with_capacity(triangles.len());
         for &k in triangles {
             let kv = triangle_vectors(k)?;
             let a = legendre_side_index(&k, side)?;
             let (los, weights) = multipole_weights(&nodes, &kv, a)?;
             sides.push(a);
+            orientations.push((los.clone(), weights.clone()));
             setups.push(Setup {
                 kv,
                 los,
@@ -129,6 +137,7 @@ impl MultipoleLoopBasis {
             triangles: triangles.to_vec(),
             rule: *rule,
             sides,
+            orientations,
             basis,
             templates,
             tensors,
@@ -150,7 +159,8 @@ impl MultipoleLoopBasis {
         self.tensors
             .iter()
             .map(|t| {
-                let rows = |r: &Rows| r.fine.len() + r.diff.len() + r.uv.len() + 2 * r.single.0.len();
+                let rows =
+                    |r: &Rows| r.fine.len() + r.diff.len() + r.uv.len() + 2 * r.single.0.len();
                 t.sides.len()
                     + t.sigma[0].len() * 2
                     + rows(&t.b222)
@@ -158,6 +168,7 @@ impl MultipoleLoopBasis {
                     + rows(&t.j)
                     + rows(&t.l)
                     + rows(&t.tree)
+                    + rows(&t.tree_o)
             })
             .sum()
     }
@@ -192,6 +203,32 @@ impl MultipoleLoopBasis {
     /// # Errors
     /// [`crate::error::Error::InvalidParameter`] for f outside [0, 2].
     pub fn evaluate(&self, p: &LinearSpectrum, f: f64) -> Result<Vec<GalaxyLoopMultipoles>> {
+        self.evaluate_with(p, f, None)
+    }
+
+    /// [`evaluate`](Self::evaluate) with the infrared resummation of [`super::one_loop_ir`]: the loops on
+    /// P_LO (projected on the templates), each orientation's tree level with its legs P_NLO(k_a, μ_a) of `p`.
+    ///
+    /// # Errors
+    /// As [`evaluate`](Self::evaluate); as [`leading_order_spectrum`].
+    pub fn evaluate_ir(
+        &self,
+        p: &LinearSpectrum,
+        ir: &IrInputs,
+        f: f64,
+    ) -> Result<Vec<GalaxyLoopMultipoles>> {
+        let lo = leading_order_spectrum(p, ir)?;
+        self.evaluate_with(&lo, f, Some((p, ir)))
+    }
+
+    /// The multipoles with the loops of `p`, the tree level of `p` or (`ir` Some((linear, inputs))) of the
+    /// resummed legs of `linear`.
+    fn evaluate_with(
+        &self,
+        p: &LinearSpectrum,
+        f: f64,
+        ir: Option<(&LinearSpectrum, &IrInputs)>,
+    ) -> Result<Vec<GalaxyLoopMultipoles>> {
         crate::cosmology::check_growth_rate(f)?;
         let (c, projection) = self.project(p);
         let names = Names::new();
@@ -202,8 +239,8 @@ impl MultipoleLoopBasis {
         Ok(self
             .triangles
             .iter()
-            .zip(self.tensors.iter().zip(&self.sides))
-            .map(|(&k, (t, &side))| {
+            .zip(self.tensors.iter().zip(&self.sides).zip(&self.orientations))
+            .map(|(&k, ((t, &side), (los, weights)))| {
                 let m = c.len();
                 let ph: [f64; 3] = std::array::from_fn(|a| dot(&t.sides[a * m..(a + 1) * m], &c));
                 let pk = k.map(|v| p.eval(v));
@@ -227,9 +264,27 @@ impl MultipoleLoopBasis {
                         acc.add(idx, uv_term, w * u * sigma[0], 0.0);
                     }
                 }
-                for (idx, (fine, _)) in rows(&t.tree, 1) {
-                    let w = fp[idx[3] as usize] * other(&pk, idx[1] as usize);
-                    acc.add(idx, 0, w * fine[0], 0.0);
+                match ir {
+                    None => {
+                        for (idx, (fine, _)) in rows(&t.tree, 1) {
+                            let w = fp[idx[3] as usize] * other(&pk, idx[1] as usize);
+                            acc.add(idx, 0, w * fine[0], 0.0);
+                        }
+                    }
+                    Some((linear, inputs)) => {
+                        let kv = triangle_vectors(k).expect("checked at the build");
+                        let legs: Vec<[f64; 3]> = los
+                            .iter()
+                            .map(|n| tree_legs(linear, inputs, &kv, Some((f, *n))))
+                            .collect();
+                        for (idx, (fine, _)) in rows(&t.tree_o, 1) {
+                            let (o, s) = (idx[1] as usize / 3, idx[1] as usize % 3);
+                            let v = fp[idx[3] as usize] * other(&legs[o], s) * fine[0];
+                            for (ell, w) in weights[o].iter().enumerate() {
+                                acc.add(&[ell as u16, 0, idx[2], 0], 0, w * v, 0.0);
+                            }
+                        }
+                    }
                 }
                 GalaxyLoopMultipoles {
                     k,

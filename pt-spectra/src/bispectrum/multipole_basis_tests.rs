@@ -22,7 +22,7 @@ fn rule() -> OneLoopRule {
 }
 
 /// Every term of B₀, B₂, B₄ at two growth rates and a full bias: the loop terms equal the direct one pass
-/// of P̂ (the templates' projection) to 2e-8 of the loop terms' sizes with the subtracted amounts (the lattice interpolations of P̂ differ: σ² reaches the lattice's tail), the tree
+/// of P̂ (the templates' projection) to 5e-8 of the loop terms' sizes with the subtracted amounts (the lattice interpolations of P̂ differ: σ² reaches the lattice's tail), the tree
 /// level the direct one of P to 1e-12; the errors (rule − half rule) likewise.
 #[test]
 fn tensors_are_the_direct_multipoles_of_the_projection() {
@@ -72,13 +72,13 @@ fn tensors_are_the_direct_multipoles_of_the_projection() {
                 ];
                 for (name, x, y) in pairs {
                     assert!(
-                        (x.value - y.value).abs() <= 2e-8 * size,
+                        (x.value - y.value).abs() <= 5e-8 * size,
                         "{name} f {f} {k:?} l {ell}: {} vs {} (size {size})",
                         x.value,
                         y.value
                     );
                     assert!(
-                        (x.error - y.error).abs() <= 2e-8 * size,
+                        (x.error - y.error).abs() <= 5e-8 * size,
                         "{name} error f {f} {k:?} l {ell}: {} vs {}",
                         x.error,
                         y.error
@@ -95,6 +95,77 @@ fn tensors_are_the_direct_multipoles_of_the_projection() {
                     c[ell].tree.value
                 );
             }
+        }
+    }
+}
+
+/// With the IR resummation: the tree level equals the direct resummed multipoles' (each orientation's legs
+/// P_NLO(k_a, μ_a)) to 1e-12 of B₀'s, the loops are the tensors' of P_LO (the direct one pass of P̂_LO
+/// to 5e-8), and resumming changes the tree level by far more than that.
+#[test]
+fn resummed_tree_and_loops() {
+    use super::super::ir_legs::leading_order_spectrum;
+    use super::super::one_loop_ir::one_loop_galaxy_multipoles_ir;
+    use super::super::resum::IrInputs;
+    let p = spectrum();
+    let ir = IrInputs::split(
+        &p,
+        &crate::ir::WiggleSplit::new().unwrap(),
+        crate::precision::Precision::default().q_min,
+    )
+    .unwrap();
+    let k = [0.05, 0.07, 0.1];
+    let r = rule();
+    let basis = MultipoleLoopBasis::build(&[k], LegendreSide::Largest, &r, &|_, _| {}).unwrap();
+    let bias = LoopBias::from_velocileptors(1.9, 0.4, -0.3);
+    let f = 0.8;
+    let fast = basis.evaluate_ir(&p, &ir, f).unwrap()[0]
+        .evaluate(&bias)
+        .unwrap();
+    let plain = basis.evaluate(&p, f).unwrap()[0].evaluate(&bias).unwrap();
+    let direct = one_loop_galaxy_multipoles_ir(&p, &ir, k, f, LegendreSide::Largest, &r, None)
+        .unwrap()
+        .evaluate(&bias)
+        .unwrap();
+    let lo_hat = basis
+        .projected_spectrum(&leading_order_spectrum(&p, &ir).unwrap())
+        .unwrap();
+    let loops = one_loop_galaxy_multipoles(&lo_hat, k, f, LegendreSide::Largest, &r, None)
+        .unwrap()
+        .evaluate(&bias)
+        .unwrap();
+    let b0 = direct[0].tree.value.abs();
+    for ell in 0..3 {
+        let d = (fast[ell].tree.value - direct[ell].tree.value).abs();
+        assert!(
+            d <= 1e-12 * b0,
+            "tree l {ell}: {} vs {}",
+            fast[ell].tree.value,
+            direct[ell].tree.value
+        );
+        assert!(
+            (plain[ell].tree.value - direct[ell].tree.value).abs() > 1e-4 * b0,
+            "l {ell}"
+        );
+        let l0 = &loops[0];
+        let size = l0.b222.value.abs()
+            + l0.b321_i.value.abs()
+            + l0.b321_ii.value.abs()
+            + l0.b411.value.abs()
+            + l0.uv_b321_ii.abs()
+            + l0.uv_b411.abs();
+        for (x, y) in [
+            (fast[ell].b222, loops[ell].b222),
+            (fast[ell].b321_i, loops[ell].b321_i),
+            (fast[ell].b321_ii, loops[ell].b321_ii),
+            (fast[ell].b411, loops[ell].b411),
+        ] {
+            assert!(
+                (x.value - y.value).abs() <= 5e-8 * size,
+                "l {ell}: {} vs {} of {size}",
+                x.value,
+                y.value
+            );
         }
     }
 }

@@ -121,13 +121,16 @@ pub(super) struct Rows {
 impl Rows {
     /// Moves the values to f32 (each entry rounded to 6e-8 of itself).
     pub(super) fn to_single(&mut self) {
-        let single = |v: &mut Vec<f64>| -> Vec<f32> { std::mem::take(v).iter().map(|&x| x as f32).collect() };
+        let single = |v: &mut Vec<f64>| -> Vec<f32> {
+            std::mem::take(v).iter().map(|&x| x as f32).collect()
+        };
         self.single = (single(&mut self.fine), single(&mut self.diff));
     }
 
-    /// Keeps the powers of f of `node` (fine) and `half` values laid out [ℓ][key][f node][monomial][len]
+    /// Keeps the powers of f of `node` (fine) and `half` values laid out [`ells`][key][f node][monomial][len]
     /// whose coefficients are not all zero (relative to the largest of the row's monomial scaled by 2^p).
     fn from_nodes(
+        ells: usize,
         keys: usize,
         monos: usize,
         len: usize,
@@ -137,7 +140,7 @@ impl Rows {
     ) -> Self {
         let a = powers();
         let mut out = Self::default();
-        for ell in 0..3 {
+        for ell in 0..ells {
             for key in 0..keys {
                 for mono in 0..monos {
                     let at = |j: usize, i: usize| {
@@ -204,6 +207,9 @@ pub(super) struct TriangleTensors {
     pub(super) j: Rows,
     pub(super) l: Rows,
     pub(super) tree: Rows,
+    /// The tree level per orientation o and side left out t (key 3o + t), without the multipole weights
+    /// (the IR resummation's legs depend on the orientation).
+    pub(super) tree_o: Rows,
 }
 
 /// The orientation-averaged loop sums of one rule at the nodes in f, laid out as [`Rows::from_nodes`]
@@ -259,6 +265,7 @@ pub(super) fn triangle_tensors(s: &Setup, rule: &OneLoopRule) -> TriangleTensors
     // The tree level, B₃₂₁ᴵᴵ's and B₄₁₁'s factors outside the integrals, per side left out t.
     let (nt, nj, nl) = (pr.tree.0.len(), pr.j.0.len(), pr.l.0.len());
     let mut tree = vec![0.0; 3 * 3 * F_NODES * nt];
+    let mut tree_o = vec![0.0; no * 3 * F_NODES * nt];
     let mut j = vec![0.0; 3 * 3 * F_NODES * nj * m];
     let mut jh = j.clone();
     let mut l = vec![0.0; 3 * 3 * F_NODES * nl * m];
@@ -284,6 +291,7 @@ pub(super) fn triangle_tensors(s: &Setup, rule: &OneLoopRule) -> TriangleTensors
                         for (ell, w) in w.iter().enumerate() {
                             tree[((ell * 3 + t) * F_NODES + jn) * nt + mono] += w * v;
                         }
+                        tree_o[((o * 3 + t) * F_NODES + jn) * nt + mono] += v;
                     }
                 }
             }
@@ -353,11 +361,12 @@ pub(super) fn triangle_tensors(s: &Setup, rule: &OneLoopRule) -> TriangleTensors
                 .map(|(a, b)| a - b)
                 .collect(),
         ],
-        b222: Rows::from_nodes(1, pr.b222.0.len(), triples, &fine.b222, &half.b222, None),
-        b321: Rows::from_nodes(3, pr.b321.0.len(), pairs, &fine.b321, &half.b321, None),
-        j: Rows::from_nodes(3, nj, m, &j, &jh, Some(&uj)),
-        l: Rows::from_nodes(3, nl, m, &l, &lh, Some(&ul)),
-        tree: Rows::from_nodes(3, nt, 1, &tree, &tree, None),
+        b222: Rows::from_nodes(3, 1, pr.b222.0.len(), triples, &fine.b222, &half.b222, None),
+        b321: Rows::from_nodes(3, 3, pr.b321.0.len(), pairs, &fine.b321, &half.b321, None),
+        j: Rows::from_nodes(3, 3, nj, m, &j, &jh, Some(&uj)),
+        l: Rows::from_nodes(3, 3, nl, m, &l, &lh, Some(&ul)),
+        tree: Rows::from_nodes(3, 3, nt, 1, &tree, &tree, None),
+        tree_o: Rows::from_nodes(1, 3 * no, nt, 1, &tree_o, &tree_o, None),
     }
 }
 

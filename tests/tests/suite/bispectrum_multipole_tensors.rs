@@ -31,7 +31,8 @@ fn multipole_tensors_against_direct_on_spectra_not_trained_on() {
         phi: 6,
         ..OneLoopRule::default()
     };
-    let basis = MultipoleLoopBasis::build(&TRIANGLES, LegendreSide::Largest, &rule, &|_, _| {}).unwrap();
+    let basis =
+        MultipoleLoopBasis::build(&TRIANGLES, LegendreSide::Largest, &rule, &|_, _| {}).unwrap();
     let biases = [
         LoopBias::from_velocileptors(2.0, 0.3, -0.2),
         LoopBias::from_class_pt(1.6, -0.5, -0.3, 0.2),
@@ -45,7 +46,9 @@ fn multipole_tensors_against_direct_on_spectra_not_trained_on() {
         for f in [0.5, 0.9] {
             let fast = basis.evaluate(&p, f).unwrap();
             for (t, &k) in TRIANGLES.iter().enumerate() {
-                let direct = one_loop_galaxy_multipoles(&p, k, f, LegendreSide::Largest, &rule, None).unwrap();
+                let direct =
+                    one_loop_galaxy_multipoles(&p, k, f, LegendreSide::Largest, &rule, None)
+                        .unwrap();
                 for bias in &biases {
                     let a = fast[t].evaluate(bias).unwrap();
                     let b = direct.evaluate(bias).unwrap();
@@ -62,11 +65,18 @@ fn multipole_tensors_against_direct_on_spectra_not_trained_on() {
         println!(
             "{name:<42} {:9.2e} {rel:12.2e} {of_error:16.2}{}",
             projection.residual,
-            if represented { "" } else { "   (not represented)" }
+            if represented {
+                ""
+            } else {
+                "   (not represented)"
+            }
         );
         if represented {
             worst = worst.max(rel);
-            assert!(of_error <= 1.0, "{name}: the difference exceeds the stated error ({of_error})");
+            assert!(
+                of_error <= 1.0,
+                "{name}: the difference exceeds the stated error ({of_error})"
+            );
         }
     }
     assert!(worst <= 1e-3, "worst {worst}");
