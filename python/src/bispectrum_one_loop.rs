@@ -97,9 +97,10 @@ pub fn one_loop_bispectrum(
         ));
     }
     let ir = ir.unwrap_or(true);
-    if multipoles && (mu1.is_some() || method == TwoLoopMethod::Basis) {
+    if multipoles && (mu1.is_some() || (bin_width.is_some() && method == TwoLoopMethod::Basis)) {
         return Err(crate::value_error(
-            "multipoles=True averages over the orientations (no mu1) and is direct (two_loop \"direct\" or \"auto\")",
+            "multipoles=True averages over the orientations (no mu1); over bins (bin_width) it is direct \
+             (two_loop \"direct\" or \"auto\")",
         ));
     }
     if !multipoles && legendre_side != "largest" {
@@ -126,7 +127,15 @@ pub fn one_loop_bispectrum(
                     &prepared, set, &bias, f, side, ir, &rule, &Silent,
                 )?,
                 None => pt_spectra::jobs::one_loop_galaxy_multipoles_table(
-                    &prepared, &rows, &bias, f, side, ir, &rule, &Silent,
+                    &prepared,
+                    &rows,
+                    &bias,
+                    f,
+                    side,
+                    ir,
+                    &rule,
+                    (method, store.get()),
+                    &Silent,
                 )?,
             };
             Ok((prepared, table))

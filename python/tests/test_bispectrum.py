@@ -223,6 +223,33 @@ def test_one_loop_galaxy_multipoles_through_the_python_face():
         pt.one_loop_bispectrum(tri, multipoles=True, legendre_side="4", **rule)
 
 
+def test_one_loop_galaxy_multipoles_from_tensors_through_the_python_face(tmp_path):
+    # two_loop="basis" builds the multipole tensors (16 templates, f free) once into the cache; auto then
+    # uses them; both agree with the direct pass within 1e-3 of B0 and their stated errors. With the IR
+    # resummation the default spectrum's P_LO lies outside the templates' span (residual 2.5e-3): the
+    # direct fallback is stated
+    tri = np.array([[0.05, 0.07, 0.1], [0.03, 0.03, 0.03]])
+    rule = dict(radial=2, mu=2, phi=2)
+    bias = dict(b1=2.0, b2=0.3, bs=-0.2)
+    direct = pt.one_loop_bispectrum(tri, multipoles=True, f=0.7, ir=False, two_loop="direct", **bias, **rule)
+    fast = pt.one_loop_bispectrum(tri, multipoles=True, f=0.7, ir=False, two_loop="basis",
+                                  cache_dir=str(tmp_path), **bias, **rule)
+    assert any("multipole tensors on 16 SVD templates" in line for line in fast.header), fast.header
+    assert "direct" in str(direct.meta["methods"]) and "basis" in str(fast.meta["methods"])
+    for ell in ["B0", "B2", "B4"]:
+        diff = np.abs(fast[ell] - direct[ell])
+        assert np.all(diff < 1e-3 * np.abs(direct["B0"])), (ell, diff / np.abs(direct["B0"]))
+        assert np.all(diff <= fast["err_" + ell])
+    auto = pt.one_loop_bispectrum(tri, multipoles=True, f=0.7, ir=False, cache_dir=str(tmp_path), **bias, **rule)
+    np.testing.assert_allclose(auto["B0"], fast["B0"], rtol=1e-12)
+    with pytest.warns(pt.PtSpectraWarning, match="fallback"):
+        resummed = pt.one_loop_bispectrum(tri, multipoles=True, f=0.7, two_loop="basis",
+                                          cache_dir=str(tmp_path), **bias, **rule)
+    assert any("residual on the basis" in line and "exceeds" in line for line in resummed.header)
+    with pytest.raises(ValueError, match="over bins"):
+        pt.one_loop_bispectrum(tri, multipoles=True, bin_width=0.01, two_loop="basis", **rule)
+
+
 def test_one_loop_galaxy_multipoles_over_bins_through_the_python_face():
     # two Nseries bins at a tiny loop rule: without IR the tree columns are the tree-level bin averages,
     # the loops are the effective triangle's (its columns inside the shells) corrected by a few per cent,

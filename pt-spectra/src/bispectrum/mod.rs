@@ -51,6 +51,7 @@ mod geometry;
 mod ir_legs;
 mod lanes;
 pub mod multipole_basis;
+mod multipole_cache;
 mod multipole_tensors;
 mod observed;
 pub mod one_loop;

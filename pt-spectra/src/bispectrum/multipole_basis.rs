@@ -21,6 +21,7 @@
 
 use super::geometry::LegendreSide;
 use super::ir_legs::{leading_order_spectrum, tree_legs};
+use super::multipole_cache::{write_triangle, Reader};
 use super::multipole_tensors::{triangle_tensors, Products, Rows, Setup, TriangleTensors, F_NODES};
 use super::one_loop::{triangle_vectors, OneLoopRule, Vec3};
 use super::one_loop_basis::{self, PROJECTION_FACTOR};
@@ -33,7 +34,9 @@ use super::resum::IrInputs;
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::training::{camb_basis, camb_samples};
-use crate::loops::basis::{pair_products, triple_products, LinearBasis, Projection, BASIS_SIZE};
+use crate::loops::basis::{
+    after_key, cache_file_name, pair_products, triple_products, LinearBasis, Projection, BASIS_SIZE,
+};
 use crate::simd::{dot, matvec_f32};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -68,7 +71,8 @@ fn templates(basis: &LinearBasis, m: usize) -> Vec<Vec<f64>> {
 pub struct MultipoleLoopBasis {
     triangles: Vec<[f64; 3]>,
     rule: OneLoopRule,
-    /// The Legendre side of each triangle.
+    /// The Legendre side asked for, and its index on each triangle.
+    side: LegendreSide,
     sides: Vec<usize>,
     /// Per triangle, the orientations' lines of sight and multipole weights (the IR resummation's tree).
     orientations: Vec<(Vec<Vec3>, Vec<[f64; 3]>)>,
@@ -136,11 +140,85 @@ impl MultipoleLoopBasis {
         Ok(Self {
             triangles: triangles.to_vec(),
             rule: *rule,
+            side,
             sides,
             orientations,
             basis,
             templates,
             tensors,
+        })
+    }
+
+    /// The cache file name of the tensors of `triangles`, `side` and `rule` (and of the present kernels).
+    pub fn file_name(triangles: &[[f64; 3]], side: LegendreSide, rule: &OneLoopRule) -> String {
+        cache_file_name(
+            "bispectrum-multipole-basis",
+            VERSION,
+            &key(triangles, side, rule),
+        )
+    }
+
+    /// The cache file's values ([`super::multipole_cache`]): the key, the basis, the templates, per
+    /// triangle its side, orientations and tensors.
+    pub(crate) fn to_f64s(&self) -> Vec<f64> {
+        let mut v = key(&self.triangles, self.side, &self.rule);
+        v.insert(0, v.len() as f64);
+        v.extend(self.basis.to_f64s());
+        v.extend(self.templates.iter().flatten());
+        let m = self.templates.len();
+        for ((&s, o), t) in self.sides.iter().zip(&self.orientations).zip(&self.tensors) {
+            write_triangle(s, o, t, m, &mut v);
+        }
+        v
+    }
+
+    /// The tensors of `triangles`, `side` and `rule` from their file's values, or `None` if the file was
+    /// made for other settings or does not fit them.
+    pub(crate) fn from_f64s(
+        values: &[f64],
+        triangles: &[[f64; 3]],
+        side: LegendreSide,
+        rule: &OneLoopRule,
+    ) -> Option<Self> {
+        let rest = after_key(values, &key(triangles, side, rule))?;
+        let lattice = one_loop_basis::lattice(rule, one_loop_basis::k_max(triangles));
+        let (basis, rest) = LinearBasis::from_f64s(lattice, rest)?;
+        let mut r = Reader { values: rest };
+        let n = basis.len();
+        let templates: Vec<Vec<f64>> = r
+            .take(TEMPLATES * n)?
+            .chunks_exact(n)
+            .map(<[f64]>::to_vec)
+            .collect();
+        let no = ORIENTATION_RULE.0 * ORIENTATION_RULE.1;
+        let (mut sides, mut orientations, mut tensors) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in triangles {
+            let (s, o, t) = r.triangle(TEMPLATES, no)?;
+            sides.push(s);
+            orientations.push(o);
+            tensors.push(t);
+        }
+        r.values.is_empty().then(|| Self {
+            triangles: triangles.to_vec(),
+            rule: *rule,
+            side,
+            sides,
+            orientations,
+            basis,
+            templates,
+            tensors,
+        })
+    }
+
+    /// The projection on the templates of the spectrum the loops integrate: `p`, or P_LO with `ir` (its
+    /// residual decides whether the tensors represent it).
+    ///
+    /// # Errors
+    /// As [`leading_order_spectrum`].
+    pub fn loop_projection(&self, p: &LinearSpectrum, ir: Option<&IrInputs>) -> Result<Projection> {
+        Ok(match ir {
+            None => self.project(p).1,
+            Some(ir) => self.project(&leading_order_spectrum(p, ir)?).1,
         })
     }
 
@@ -295,6 +373,22 @@ impl MultipoleLoopBasis {
             })
             .collect())
     }
+}
+
+/// Version of the layout, part of the cache file name.
+const VERSION: u32 = 1;
+
+/// The settings that make the tensors (their cache key): the real-space galaxy tensors' key (the basis, the
+/// rule, the kernels' fingerprint, the triangles) with this layout's version, the number of templates and
+/// the Legendre side (−1 for the largest).
+fn key(triangles: &[[f64; 3]], side: LegendreSide, rule: &OneLoopRule) -> Vec<f64> {
+    let mut key = super::one_loop_galaxy_basis::key(triangles, rule);
+    let side = match side {
+        LegendreSide::Largest => -1.0,
+        LegendreSide::Index(a) => a as f64,
+    };
+    key.extend([f64::from(VERSION), TEMPLATES as f64, side]);
+    key
 }
 
 /// The rows of a family with their values on the rule and rule − half rule, `len` each.

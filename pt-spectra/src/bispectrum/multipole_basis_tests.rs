@@ -169,3 +169,33 @@ fn resummed_tree_and_loops() {
         }
     }
 }
+
+/// The cache file's values read back give the same tensors; other settings or a cut file give none.
+#[test]
+fn cache_values_round_trip() {
+    let triangles = [[0.05, 0.07, 0.1]];
+    let r = OneLoopRule {
+        radial: 2,
+        mu: 2,
+        phi: 2,
+        ..OneLoopRule::default()
+    };
+    let basis =
+        MultipoleLoopBasis::build(&triangles, LegendreSide::Largest, &r, &|_, _| {}).unwrap();
+    let v = basis.to_f64s();
+    let back = MultipoleLoopBasis::from_f64s(&v, &triangles, LegendreSide::Largest, &r).unwrap();
+    assert_eq!(back, basis);
+    assert!(MultipoleLoopBasis::from_f64s(&v, &triangles, LegendreSide::Index(0), &r).is_none());
+    assert!(MultipoleLoopBasis::from_f64s(
+        &v[..v.len() - 1],
+        &triangles,
+        LegendreSide::Largest,
+        &r
+    )
+    .is_none());
+    let mut longer = v.clone();
+    longer.push(0.0);
+    assert!(
+        MultipoleLoopBasis::from_f64s(&longer, &triangles, LegendreSide::Largest, &r).is_none()
+    );
+}

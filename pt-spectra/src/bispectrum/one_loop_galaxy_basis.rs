@@ -316,7 +316,7 @@ fn lattice(triangles: &[[f64; 3]], rule: &OneLoopRule) -> Lattice {
 /// The settings that make the tensors (their cache key): the head of the matter tensors' key with this
 /// layout's version, the kernels' parts at fixed arguments of orders 2, 3 and 4 (the kernels'
 /// fingerprint), the triangles.
-fn key(triangles: &[[f64; 3]], rule: &OneLoopRule) -> Vec<f64> {
+pub(super) fn key(triangles: &[[f64; 3]], rule: &OneLoopRule) -> Vec<f64> {
     let mut key = one_loop_basis::key_head(VERSION, triangles, rule);
     let q = [
         [0.31, -0.12, 0.57],

@@ -171,3 +171,14 @@ cached_tensors!(
     ONE_LOOP_BASIS_STAGE,
     (triangles, rule)
 );
+cached_tensors!(
+    super::multipole_basis::MultipoleLoopBasis,
+    (
+        &'a [[f64; 3]],
+        super::geometry::LegendreSide,
+        &'a super::one_loop::OneLoopRule
+    ),
+    "one-loop galaxy multipole tensors",
+    ONE_LOOP_BASIS_STAGE,
+    (triangles, side, rule)
+);

@@ -218,11 +218,6 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
     let loaded = args.spectrum.load()?;
     let bars = crate::progress::Bars::default();
     if args.multipoles {
-        if loaded.precision.two_loop == pt_spectra::precision::TwoLoopMethod::Basis {
-            bail!(
-                "--two-loop basis: the one-loop bispectrum's tensors are built for real space only"
-            );
-        }
         let bias = galaxy_bias(args)?
             .unwrap_or_else(pt_spectra::bispectrum::bias_kernels::LoopBias::matter);
         return pt_spectra::jobs::one_loop_galaxy_multipoles_table(
@@ -233,6 +228,7 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
             LegendreSide::by_name(&args.legendre_side).context("--legendre-side")?,
             !args.no_ir,
             &OneLoopRule::default(),
+            (loaded.precision.two_loop, &loaded.store),
             &bars,
         )
         .with_context(|| format!("--triangles {}", path.display()));
@@ -295,7 +291,10 @@ fn binned_multipoles(args: &Args) -> Result<pt_spectra::output::Table> {
     let set = triangles(args)?;
     let loaded = args.spectrum.load()?;
     if loaded.precision.two_loop == pt_spectra::precision::TwoLoopMethod::Basis {
-        bail!("--two-loop basis: the one-loop bispectrum's tensors are built for real space only");
+        bail!(
+            "--two-loop basis: the one-loop multipole tensors are built at the triangles given, not over \
+             bins (give --two-loop direct or auto with --bin-width/--k-edges)"
+        );
     }
     let bias =
         galaxy_bias(args)?.unwrap_or_else(pt_spectra::bispectrum::bias_kernels::LoopBias::matter);

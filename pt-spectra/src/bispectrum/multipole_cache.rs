@@ -1,0 +1,139 @@
+//! The multipole tensors' cache file ([`super::multipole_basis::MultipoleLoopBasis`] in
+//! [`crate::store::TableStore`]): one declared layout of f64 values, read back only if every count fits.
+//!
+//! Per triangle: its Legendre side, its orientations (3 components of the line of sight and 3 multipole
+//! weights each), the templates at the sides (3m), σ²'s two vectors (2m), then the families B₂₂₂, B₃₂₁ᴵ,
+//! J, L, the tree level and the tree level per orientation, each as: the number of rows r, the row length
+//! ℓ, whether its values are f32 (0 or 1), 4r indices, then the values on the rule and rule − half rule
+//! (2rℓ) and U (r or 0).
+
+use super::multipole_tensors::{Rows, TriangleTensors};
+use super::one_loop::Vec3;
+
+/// Appends `rows` with row length `len`.
+pub(super) fn write_rows(rows: &Rows, len: usize, out: &mut Vec<f64>) {
+    let single = !rows.single.0.is_empty();
+    out.extend([
+        rows.index.len() as f64,
+        len as f64,
+        f64::from(u8::from(single)),
+    ]);
+    out.extend(rows.index.iter().flatten().map(|&i| f64::from(i)));
+    if single {
+        out.extend(
+            rows.single
+                .0
+                .iter()
+                .chain(&rows.single.1)
+                .map(|&x| f64::from(x)),
+        );
+    } else {
+        out.extend(rows.fine.iter().chain(&rows.diff));
+    }
+    out.extend(&rows.uv);
+}
+
+/// A reader of the values, `None` past their end.
+pub(super) struct Reader<'a> {
+    pub(super) values: &'a [f64],
+}
+
+impl<'a> Reader<'a> {
+    pub(super) fn take(&mut self, n: usize) -> Option<&'a [f64]> {
+        if n > self.values.len() {
+            return None;
+        }
+        let (head, rest) = self.values.split_at(n);
+        self.values = rest;
+        Some(head)
+    }
+
+    /// A count stored as f64: a non-negative integer below `max`.
+    pub(super) fn count(&mut self, max: usize) -> Option<usize> {
+        let v = self.take(1)?[0];
+        (v >= 0.0 && v.fract() == 0.0 && v < max as f64).then_some(v as usize)
+    }
+
+    /// Rows of length `len` with or without U.
+    fn rows(&mut self, len: usize, with_uv: bool) -> Option<Rows> {
+        let r = self.count(1 << 24)?;
+        if self.count(1 << 24)? != len {
+            return None;
+        }
+        let single = self.count(2)? == 1;
+        let index = self
+            .take(4 * r)?
+            .chunks_exact(4)
+            .map(|c| {
+                let ok = c
+                    .iter()
+                    .all(|&x| x >= 0.0 && x.fract() == 0.0 && x < 65536.0);
+                ok.then(|| std::array::from_fn(|i| c[i] as u16))
+            })
+            .collect::<Option<Vec<[u16; 4]>>>()?;
+        let fine = self.take(r * len)?.to_vec();
+        let diff = self.take(r * len)?.to_vec();
+        let uv = if with_uv {
+            self.take(r)?.to_vec()
+        } else {
+            Vec::new()
+        };
+        let mut rows = Rows {
+            index,
+            fine,
+            diff,
+            uv,
+            single: (Vec::new(), Vec::new()),
+        };
+        if single {
+            rows.to_single();
+        }
+        Some(rows)
+    }
+
+    /// One triangle's side, orientations and tensors on `m` templates with `no` orientations.
+    pub(super) fn triangle(
+        &mut self,
+        m: usize,
+        no: usize,
+    ) -> Option<(usize, (Vec<Vec3>, Vec<[f64; 3]>), TriangleTensors)> {
+        let side = self.count(3)?;
+        let o = self.take(6 * no)?;
+        let los = o.chunks_exact(6).map(|c| [c[0], c[1], c[2]]).collect();
+        let weights = o.chunks_exact(6).map(|c| [c[3], c[4], c[5]]).collect();
+        let sides = self.take(3 * m)?.to_vec();
+        let sigma = [self.take(m)?.to_vec(), self.take(m)?.to_vec()];
+        let t = TriangleTensors {
+            sides,
+            sigma,
+            b222: self.rows(m * (m + 1) * (m + 2) / 6, false)?,
+            b321: self.rows(m * (m + 1) / 2, false)?,
+            j: self.rows(m, true)?,
+            l: self.rows(m, true)?,
+            tree: self.rows(1, false)?,
+            tree_o: self.rows(1, false)?,
+        };
+        Some((side, (los, weights), t))
+    }
+}
+
+/// Appends one triangle's side, orientations and tensors (the layout of the module docs).
+pub(super) fn write_triangle(
+    side: usize,
+    (los, weights): &(Vec<Vec3>, Vec<[f64; 3]>),
+    t: &TriangleTensors,
+    m: usize,
+    out: &mut Vec<f64>,
+) {
+    out.push(side as f64);
+    for (n, w) in los.iter().zip(weights) {
+        out.extend(n.iter().chain(w));
+    }
+    out.extend(t.sides.iter().chain(&t.sigma[0]).chain(&t.sigma[1]));
+    write_rows(&t.b222, m * (m + 1) * (m + 2) / 6, out);
+    write_rows(&t.b321, m * (m + 1) / 2, out);
+    write_rows(&t.j, m, out);
+    write_rows(&t.l, m, out);
+    write_rows(&t.tree, 1, out);
+    write_rows(&t.tree_o, 1, out);
+}
