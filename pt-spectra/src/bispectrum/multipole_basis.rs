@@ -11,7 +11,7 @@
 //! Σ c_a t_a against P goes into every loop term's error ([`PROJECTION_FACTOR`] × residual × Σ|loop terms|,
 //! as the real-space tensors').
 //!
-//! **f free.** The tensors hold each term's powers f⁰ … f⁶ ([`super::multipole_tensors`]), so f is a
+//! **f free.** The tensors hold each term's powers f⁰ … f⁶ (`multipole_tensors`), so f is a
 //! per-call input as the spectrum is (both change with the cosmology). The tree level is exact with the
 //! true P at the sides. The IR resummation of [`super::one_loop_ir`] ([`MultipoleLoopBasis::evaluate_ir`]):
 //! the loops are the tensors contracted with P_LO's projection, the tree level is kept per orientation
@@ -131,8 +131,8 @@ impl MultipoleLoopBasis {
             .par_iter()
             .map(|s| {
                 let mut t = triangle_tensors(s, rule);
-                t.b222.to_single();
-                t.b321.to_single();
+                t.b222.make_single();
+                t.b321.make_single();
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, triangles.len());
                 t
             })

@@ -10,6 +10,9 @@
 use super::multipole_tensors::{Rows, TriangleTensors};
 use super::one_loop::Vec3;
 
+/// A triangle's orientations: lines of sight and multipole weights.
+pub(super) type Orientations = (Vec<Vec3>, Vec<[f64; 3]>);
+
 /// Appends `rows` with row length `len`.
 pub(super) fn write_rows(rows: &Rows, len: usize, out: &mut Vec<f64>) {
     let single = !rows.single.0.is_empty();
@@ -86,7 +89,7 @@ impl<'a> Reader<'a> {
             single: (Vec::new(), Vec::new()),
         };
         if single {
-            rows.to_single();
+            rows.make_single();
         }
         Some(rows)
     }
@@ -96,7 +99,7 @@ impl<'a> Reader<'a> {
         &mut self,
         m: usize,
         no: usize,
-    ) -> Option<(usize, (Vec<Vec3>, Vec<[f64; 3]>), TriangleTensors)> {
+    ) -> Option<(usize, Orientations, TriangleTensors)> {
         let side = self.count(3)?;
         let o = self.take(6 * no)?;
         let los = o.chunks_exact(6).map(|c| [c[0], c[1], c[2]]).collect();
@@ -120,7 +123,7 @@ impl<'a> Reader<'a> {
 /// Appends one triangle's side, orientations and tensors (the layout of the module docs).
 pub(super) fn write_triangle(
     side: usize,
-    (los, weights): &(Vec<Vec3>, Vec<[f64; 3]>),
+    (los, weights): &Orientations,
     t: &TriangleTensors,
     m: usize,
     out: &mut Vec<f64>,

@@ -113,14 +113,14 @@ pub(super) struct Rows {
     pub(super) diff: Vec<f64>,
     /// U per row (B₃₂₁ᴵᴵ, B₄₁₁; empty otherwise).
     pub(super) uv: Vec<f64>,
-    /// `fine` and `diff` in f32 once [`Rows::to_single`] has moved them there (the long rows of B₂₂₂ and
+    /// `fine` and `diff` in f32 once [`Rows::make_single`] has moved them there (the long rows of B₂₂₂ and
     /// B₃₂₁ᴵ, read at every evaluation: half the bytes).
     pub(super) single: (Vec<f32>, Vec<f32>),
 }
 
 impl Rows {
     /// Moves the values to f32 (each entry rounded to 6e-8 of itself).
-    pub(super) fn to_single(&mut self) {
+    pub(super) fn make_single(&mut self) {
         let single = |v: &mut Vec<f64>| -> Vec<f32> {
             std::mem::take(v).iter().map(|&x| x as f32).collect()
         };
