@@ -28,7 +28,7 @@ import numpy as np
 
 from . import _core
 from ._common import _D, EPT_PARAMETERS, PtSpectraWarning, _ept_params, _grid, _warn
-from ._core import (BispectrumPlan, BispectrumTerms, LinearEmulator, Observation, OneLoopBispectrumPlan,
+from ._core import (BispectrumPlan, BispectrumTerms, LinearEmulator, Observation, OneLoopBispectrumPlan, OneLoopMultipolePlan,
                     Pipeline,
                     SugiyamaPlan, SugiyamaTerms, Table, distances, eisenstein_hu, fisher, fisher_kaiser,
                     growth, log_grid,
@@ -37,6 +37,7 @@ from ._core import (BispectrumPlan, BispectrumTerms, LinearEmulator, Observation
 __all__ = [
     "BispectrumPlan",
     "OneLoopBispectrumPlan",
+    "OneLoopMultipolePlan",
     "BispectrumTerms",
     "EptPlan",
     "Observation",

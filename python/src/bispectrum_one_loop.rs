@@ -70,21 +70,8 @@ pub fn one_loop_bispectrum(
 ) -> PyResult<Table> {
     let rows = fixed_rows::<3>(triangles, "triangles", "k1, k2, k3")?;
     let method: TwoLoopMethod = two_loop.parse().map_err(library_error)?;
-    let galaxy = b1.is_some()
-        || b2 != 0.0
-        || bs != 0.0
-        || b_gamma3 != 0.0
-        || bias_convention.is_some()
-        || loop_bias.is_some();
-    let bias = if galaxy {
-        let convention = crate::bias::convention(py, bias_convention, None, None, None)?;
-        let given = [b1.unwrap_or(1.0), b2, bs, 0.0];
-        let bias = pt_spectra::bias::BiasParams::from_convention(convention, given);
-        let overrides: Vec<(String, f64)> = loop_bias.unwrap_or_default().into_iter().collect();
-        Some(pt_spectra::jobs::loop_bias(&bias, b_gamma3, &overrides).map_err(library_error)?)
-    } else {
-        None
-    };
+    let bias = galaxy_bias(py, b1, [b2, bs, b_gamma3], bias_convention, loop_bias)?;
+    let galaxy = bias.is_some();
     let store = crate::Store::new(cache_dir);
     let rule = rule_of(q_min, q_max, radial, mu, phi);
     let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
@@ -215,8 +202,35 @@ pub fn one_loop_bispectrum(
     )
 }
 
+/// The one-loop bias of the keyword arguments (`b1`, then `b2`, `bs` in `bias_convention` and CLASS-PT's
+/// `b_gamma3`, `loop_bias` the fourth-order coefficients by name), `None` if none is given (matter).
+pub(crate) fn galaxy_bias(
+    py: Python<'_>,
+    b1: Option<f64>,
+    [b2, bs, b_gamma3]: [f64; 3],
+    bias_convention: Option<&str>,
+    loop_bias: Option<std::collections::BTreeMap<String, f64>>,
+) -> PyResult<Option<pt_spectra::bispectrum::bias_kernels::LoopBias>> {
+    let galaxy = b1.is_some()
+        || b2 != 0.0
+        || bs != 0.0
+        || b_gamma3 != 0.0
+        || bias_convention.is_some()
+        || loop_bias.is_some();
+    if !galaxy {
+        return Ok(None);
+    }
+    let convention = crate::bias::convention(py, bias_convention, None, None, None)?;
+    let given = [b1.unwrap_or(1.0), b2, bs, 0.0];
+    let bias = pt_spectra::bias::BiasParams::from_convention(convention, given);
+    let overrides: Vec<(String, f64)> = loop_bias.unwrap_or_default().into_iter().collect();
+    Ok(Some(
+        pt_spectra::jobs::loop_bias(&bias, b_gamma3, &overrides).map_err(library_error)?,
+    ))
+}
+
 /// The rule of the keyword arguments (checked where it is used).
-fn rule_of(q_min: f64, q_max: f64, radial: usize, mu: usize, phi: usize) -> OneLoopRule {
+pub(crate) fn rule_of(q_min: f64, q_max: f64, radial: usize, mu: usize, phi: usize) -> OneLoopRule {
     OneLoopRule {
         radial,
         mu,

@@ -26,6 +26,7 @@ use std::sync::OnceLock;
 mod batch;
 mod bias;
 mod bispectrum;
+mod bispectrum_multipole_plan;
 mod bispectrum_one_loop;
 mod emulator;
 mod ept;
@@ -661,6 +662,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m
     )?)?;
     m.add_class::<bispectrum_one_loop::OneLoopBispectrumPlan>()?;
+    m.add_class::<bispectrum_multipole_plan::OneLoopMultipolePlan>()?;
     m.add_class::<ept::EptTerms>()?;
     m.add_class::<two_loop_rsd::TwoLoopRsdPlan>()?;
     m.add_class::<survey::Observation>()?;

@@ -250,6 +250,39 @@ def test_one_loop_galaxy_multipoles_from_tensors_through_the_python_face(tmp_pat
         pt.one_loop_bispectrum(tri, multipoles=True, bin_width=0.01, two_loop="basis", **rule)
 
 
+def test_one_loop_multipole_plan(tmp_path):
+    # the plan reads the tensors once (here built at a tiny rule); each call then takes a new spectrum, f and
+    # bias: the same multipoles as the table function on the same rule, direct where they are not
+    # represented (ir=True), and f's default is f(z)
+    tri = np.array([[0.05, 0.07, 0.1], [0.03, 0.03, 0.03]])
+    rule = dict(radial=2, mu=2, phi=2)
+    plan = pt.OneLoopMultipolePlan(tri, cache_dir=str(tmp_path), **rule)
+    assert len(plan) == 2
+    bias = dict(b1=2.0, b2=0.3, bs=-0.2)
+    for z, f in [(0.5, 0.7), (1.0, 0.9)]:
+        got = plan(z=z, f=f, **bias)
+        table = pt.one_loop_bispectrum(tri, z=z, multipoles=True, f=f, ir=False, two_loop="basis",
+                                       cache_dir=str(tmp_path), **bias, **rule)
+        assert "multipole tensors" in got["loop_terms"]
+        for name in ["B0", "B2", "B4", "B0_222", "err_B2"]:
+            np.testing.assert_allclose(got[name], table[name], rtol=1e-12)
+    default_f = plan(z=0.5, **bias)
+    assert 0.5 < default_f["f"] < 1.0
+    for z in [0.0, 0.5]:  # P_LO's residual on the templates: 2.5e-3 (above the limit: direct), 1.5e-3
+        resummed = plan(z=z, f=0.7, ir=True, **bias)
+        direct = pt.one_loop_bispectrum(tri, z=z, multipoles=True, f=0.7, two_loop="direct", **bias, **rule)
+        if z == 0.0:
+            assert "direct integration, since" in resummed["loop_terms"], resummed["loop_terms"]
+            np.testing.assert_allclose(resummed["B0"], direct["B0"], rtol=1e-10)
+        else:
+            assert "multipole tensors" in resummed["loop_terms"], resummed["loop_terms"]
+            assert np.all(np.abs(resummed["B0"] - direct["B0"]) < 1e-3 * np.abs(direct["B0"]))
+    with pytest.raises(ValueError, match="f"):
+        plan(z=0.5, f=3.0, **bias)
+    with pytest.raises(ValueError, match="triangle 1"):
+        pt.OneLoopMultipolePlan([[0.1, 0.01, 0.01]], cache_dir=str(tmp_path), **rule)
+
+
 def test_one_loop_galaxy_multipoles_over_bins_through_the_python_face():
     # two Nseries bins at a tiny loop rule: without IR the tree columns are the tree-level bin averages,
     # the loops are the effective triangle's (its columns inside the shells) corrected by a few per cent,

@@ -222,6 +222,11 @@ impl MultipoleLoopBasis {
         })
     }
 
+    /// The Legendre side asked for at the build.
+    pub fn side(&self) -> LegendreSide {
+        self.side
+    }
+
     /// The triangles [h/Mpc].
     pub fn triangles(&self) -> &[[f64; 3]] {
         &self.triangles

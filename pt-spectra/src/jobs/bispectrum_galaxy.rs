@@ -11,9 +11,9 @@ use crate::bispectrum::galaxy_counterterms::{galaxy_counterterm_shapes, GALAXY_C
 use crate::bispectrum::galaxy_counterterms_rsd::{
     redshift_counterterm_multipoles, N_REDSHIFT_CT, REDSHIFT_COUNTERTERMS,
 };
-use crate::bispectrum::multipole_basis::{MultipoleLoopBasis, TEMPLATES};
+use crate::bispectrum::multipole_basis::MultipoleLoopBasis;
 use crate::bispectrum::one_loop::{OneLoopRule, PARTITION_POWER};
-use crate::bispectrum::one_loop_basis::{BispectrumLoopSource, PROJECTION_FACTOR};
+use crate::bispectrum::one_loop_basis::BispectrumLoopSource;
 use crate::bispectrum::one_loop_galaxy::{one_loop_galaxy, OneLoopGalaxy};
 use crate::bispectrum::one_loop_galaxy_basis::GalaxyLoopBasis;
 use crate::bispectrum::one_loop_galaxy_multipoles::{one_loop_galaxy_multipoles, ORIENTATION_RULE};
@@ -308,18 +308,7 @@ pub fn one_loop_galaxy_multipoles_table(
              (Mpc/h)^6)",
             REDSHIFT_COUNTERTERMS.join(", ")
         ),
-        match source {
-            BispectrumLoopSource::DirectUncached => "loop terms: direct integration (method auto: no multipole \
-                tensors cached for these triangles, side and rule; method basis builds them once, ~190 s per \
-                triangle and core at the default rule, then ~0.13 ms per triangle with f free)"
-                .into(),
-            BispectrumLoopSource::Basis { residual, .. } => format!(
-                "loop terms: multipole tensors on {TEMPLATES} SVD templates of the CAMB basis, f free (powers f^0 \
-                 to f^6), the same nodes as direct; projection residual {residual:.1e}; err_ includes \
-                 {PROJECTION_FACTOR} x residual x (sum of |loop terms|)"
-            ),
-            s => s.describe(),
-        },
+        super::bispectrum_multipole_plan::describe_source(&source),
         "at the given triangles (not averaged over bins: --bin-width or --k-edges average them); linear spectrum: all matter".into(),
     ];
     if let Some(r) = tensor_rows {
@@ -353,17 +342,7 @@ fn multipole_tensor_rows(
         return Ok((None, BispectrumLoopSource::Direct));
     }
     // the build checks what the direct path checks: name a bad triangle first
-    for (i, &k) in triangles.iter().enumerate() {
-        crate::bispectrum::one_loop::triangle_vectors(k)
-            .and_then(|_| {
-                crate::bispectrum::one_loop_galaxy_multipoles::legendre_side_index(&k, side)
-            })
-            .map_err(|e| Error::InvalidChoice {
-                what: format!("triangle {} ({}, {}, {})", i + 1, k[0], k[1], k[2]),
-                reason: e.to_string(),
-            })?;
-    }
-    rule.validate()?;
+    super::bispectrum_multipole_plan::check_triangles(triangles, side, rule)?;
     crate::cosmology::check_growth_rate(f)?;
     let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
         MultipoleLoopBasis::build(triangles, side, rule, tick)
@@ -374,31 +353,13 @@ fn multipole_tensor_rows(
     else {
         return Ok((None, BispectrumLoopSource::DirectUncached));
     };
-    let p = &prepared.spectrum;
-    let polys = match ir {
-        None => tensors.evaluate(p, f)?,
-        Some(ir) => tensors.evaluate_ir(p, ir, f)?,
-    };
-    let projected = tensors.loop_projection(p, ir)?;
-    let max = crate::loops::basis::MAX_RESIDUAL;
-    if projected.residual > max {
-        return Ok((
-            None,
-            BispectrumLoopSource::Fallback {
-                residual: projected.residual,
-                max_residual: max,
-            },
-        ));
-    }
-    let rows = polys
-        .iter()
-        .map(|m| m.evaluate(bias))
-        .collect::<Result<Vec<_>>>()?;
-    let source = BispectrumLoopSource::Basis {
-        functions: TEMPLATES,
-        residual: projected.residual,
-    };
-    Ok((Some(rows), source))
+    super::bispectrum_multipole_plan::multipoles_from_tensors(
+        &tensors,
+        &prepared.spectrum,
+        bias,
+        f,
+        ir,
+    )
 }
 
 /// The columns of the multipoles' table: `k1 k2 k3` (`triangles`), per ℓ = 0, 2, 4 the terms of `rows`

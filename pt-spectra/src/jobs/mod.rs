@@ -46,6 +46,7 @@ mod bias;
 mod bispectrum;
 mod bispectrum_galaxy;
 mod bispectrum_galaxy_bins;
+mod bispectrum_multipole_plan;
 pub mod defaults;
 mod ept;
 mod ept_fit;
@@ -71,6 +72,10 @@ pub use bispectrum_galaxy::{
     LOOP_BIAS_NAMES,
 };
 pub use bispectrum_galaxy_bins::one_loop_galaxy_binned_multipoles_table;
+pub use bispectrum_multipole_plan::{
+    describe_source as describe_multipole_source, multipole_plan_rows, multipoles_from_tensors,
+    one_loop_multipole_tensors,
+};
 pub use ept::{
     ept_observed_table, ept_plan, ept_table, ept_table_from_terms, EptRequest, AP_FIT_RANGE,
 };
