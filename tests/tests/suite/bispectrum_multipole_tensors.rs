@@ -81,3 +81,54 @@ fn multipole_tensors_against_direct_on_spectra_not_trained_on() {
     }
     assert!(worst <= 1e-3, "worst {worst}");
 }
+
+/// The same with the IR resummation (the loops on P_LO, whose residual on the templates is larger: up to
+/// 3.4e-3 of B₀, docs/bispectrum.md): prints the worst |ΔB_ℓ|/|B₀| and |ΔB_ℓ|/error per spectrum; every
+/// difference of a represented spectrum within the stated error.
+#[test]
+#[ignore = "2 min: the accuracy of the resummed multipole tensors (run with --ignored)"]
+fn resummed_multipole_tensors_against_direct() {
+    use pt_spectra::bispectrum::one_loop_ir::one_loop_galaxy_multipoles_ir;
+    use pt_spectra::bispectrum::IrInputs;
+    let rule = OneLoopRule {
+        radial: 4,
+        mu: 8,
+        phi: 6,
+        ..OneLoopRule::default()
+    };
+    let basis =
+        MultipoleLoopBasis::build(&TRIANGLES, LegendreSide::Largest, &rule, &|_, _| {}).unwrap();
+    let bias = LoopBias::from_velocileptors(2.0, 0.3, -0.2);
+    let split = pt_spectra::ir::WiggleSplit::new().unwrap();
+    let q_min = pt_spectra::precision::Precision::default().q_min;
+    for (name, p) in spectra() {
+        let Ok(ir) = IrInputs::split(&p, &split, q_min) else {
+            continue;
+        };
+        let residual = basis.loop_projection(&p, Some(&ir)).unwrap().residual;
+        let (mut rel, mut of_error) = (0.0f64, 0.0f64);
+        let f = 0.7;
+        let fast = basis.evaluate_ir(&p, &ir, f).unwrap();
+        for (t, &k) in TRIANGLES.iter().enumerate() {
+            let direct =
+                one_loop_galaxy_multipoles_ir(&p, &ir, k, f, LegendreSide::Largest, &rule, None)
+                    .unwrap();
+            let a = fast[t].evaluate(&bias).unwrap();
+            let b = direct.evaluate(&bias).unwrap();
+            let b0 = b[0].total().value.abs();
+            for ell in 0..3 {
+                let (x, y) = (a[ell].total(), b[ell].total());
+                let d = (x.value - y.value).abs();
+                rel = rel.max(d / b0);
+                of_error = of_error.max(d / x.error);
+            }
+        }
+        println!("IR {name:<42} {residual:9.2e} {rel:12.2e} {of_error:16.2}");
+        if residual <= pt_spectra::loops::basis::MAX_RESIDUAL {
+            assert!(
+                of_error <= 1.0,
+                "{name}: the difference exceeds the stated error ({of_error})"
+            );
+        }
+    }
+}
