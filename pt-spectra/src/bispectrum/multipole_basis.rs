@@ -22,7 +22,9 @@
 use super::geometry::LegendreSide;
 use super::ir_legs::{leading_order_spectrum, tree_legs};
 use super::multipole_cache::{write_triangle, Reader};
-use super::multipole_tensors::{triangle_tensors, Products, Rows, Setup, TriangleTensors, F_NODES};
+use super::multipole_tensors::{
+    triangle_tensors, Products, Rows, Setup, TriangleTensors, DIFF_TEMPLATES, F_NODES,
+};
 use super::one_loop::{triangle_vectors, OneLoopRule, Vec3};
 use super::one_loop_basis::{self, PROJECTION_FACTOR};
 use super::one_loop_galaxy_multipoles::{
@@ -131,8 +133,9 @@ impl MultipoleLoopBasis {
             .par_iter()
             .map(|s| {
                 let mut t = triangle_tensors(s, rule);
-                t.b222.make_single();
-                t.b321.make_single();
+                let (m, d) = (s.m, DIFF_TEMPLATES.min(s.m));
+                t.b222.make_single(triples(m), triples(d));
+                t.b321.make_single(pairs(m), pairs(d));
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, triangles.len());
                 t
             })
@@ -242,8 +245,9 @@ impl MultipoleLoopBasis {
         self.tensors
             .iter()
             .map(|t| {
-                let rows =
-                    |r: &Rows| r.fine.len() + r.diff.len() + r.uv.len() + 2 * r.single.0.len();
+                let rows = |r: &Rows| {
+                    r.fine.len() + r.diff.len() + r.uv.len() + r.single.0.len() + r.single.1.len()
+                };
                 t.sides.len()
                     + t.sigma[0].len() * 2
                     + rows(&t.b222)
@@ -331,11 +335,12 @@ impl MultipoleLoopBasis {
                 // the products of the two sides other than s, for the loop terms and the tree level
                 let other = |x: &[f64; 3], s: usize| x[(s + 1) % 3] * x[(s + 2) % 3];
                 let mut acc = Acc::new(&names);
-                for (idx, (fine, diff)) in single_rows(&t.b222, &c3_32) {
+                let d = DIFF_TEMPLATES.min(m);
+                for (idx, (fine, diff)) in single_rows(&t.b222, &c3_32, &c3_32[..triples(d)]) {
                     let w = fp[idx[3] as usize];
                     acc.add(idx, 1, w * fine, w * diff);
                 }
-                for (idx, (fine, diff)) in single_rows(&t.b321, &c2_32) {
+                for (idx, (fine, diff)) in single_rows(&t.b321, &c2_32, &c2_32[..pairs(d)]) {
                     let w = fp[idx[3] as usize] * ph[idx[1] as usize];
                     acc.add(idx, 2, w * fine, w * diff);
                 }
@@ -381,7 +386,7 @@ impl MultipoleLoopBasis {
 }
 
 /// Version of the layout, part of the cache file name.
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 /// The settings that make the tensors (their cache key): the real-space galaxy tensors' key (the basis, the
 /// rule, the kernels' fingerprint, the triangles) with this layout's version, the number of templates and
@@ -403,13 +408,17 @@ fn rows(r: &Rows, len: usize) -> impl Iterator<Item = (&[u16; 4], (&[f64], &[f64
         .zip(r.fine.chunks_exact(len).zip(r.diff.chunks_exact(len)))
 }
 
-/// The rows of a family held in f32 contracted with `x` (the pair or triple products): (index, (value on
-/// the rule, rule − half rule)).
-fn single_rows<'a>(r: &'a Rows, x: &[f32]) -> impl Iterator<Item = (&'a [u16; 4], (f64, f64))> {
+/// The rows of a family held in f32 contracted with `x` (the pair or triple products) and their rule − half
+/// rule with `x_diff` (the products on the first [`DIFF_TEMPLATES`] templates): (index, (value, difference)).
+fn single_rows<'a>(
+    r: &'a Rows,
+    x: &[f32],
+    x_diff: &[f32],
+) -> impl Iterator<Item = (&'a [u16; 4], (f64, f64))> {
     let mut fine = vec![0.0; r.index.len()];
     let mut diff = vec![0.0; r.index.len()];
     matvec_f32(&r.single.0, x, &mut fine);
-    matvec_f32(&r.single.1, x, &mut diff);
+    matvec_f32(&r.single.1, x_diff, &mut diff);
     r.index.iter().zip(fine.into_iter().zip(diff))
 }
 
@@ -499,3 +508,13 @@ impl<'a> Acc<'a> {
 #[cfg(test)]
 #[path = "multipole_basis_tests.rs"]
 mod tests;
+
+/// The number of packed pairs a ≤ b of m functions.
+fn pairs(m: usize) -> usize {
+    m * (m + 1) / 2
+}
+
+/// The number of packed triples a ≤ b ≤ c of m functions.
+fn triples(m: usize) -> usize {
+    m * (m + 1) * (m + 2) / 6
+}

@@ -22,7 +22,8 @@ fn rule() -> OneLoopRule {
 }
 
 /// Every term of B₀, B₂, B₄ at two growth rates and a full bias: the loop terms equal the direct one pass
-/// of P̂ (the templates' projection) to 5e-8 of the loop terms' sizes with the subtracted amounts (the lattice interpolations of P̂ differ: σ² reaches the lattice's tail), the tree
+/// of P̂ (the templates' projection) to 5e-8 of the loop terms' sizes with the subtracted amounts (the lattice interpolations of P̂ differ: σ² reaches the lattice's tail; B₂₂₂'s and B₃₂₁ᴵ's errors, kept on
+/// the first 8 templates, within 5% of the direct ones), the tree
 /// level the direct one of P to 1e-12; the errors (rule − half rule) likewise.
 #[test]
 fn tensors_are_the_direct_multipoles_of_the_projection() {
@@ -77,8 +78,14 @@ fn tensors_are_the_direct_multipoles_of_the_projection() {
                         x.value,
                         y.value
                     );
+                    // B₂₂₂'s and B₃₂₁ᴵ's errors on the first 8 templates: within 5% of the direct ones
+                    let kept = if matches!(name, "b222" | "b321_i") {
+                        0.05 * y.error
+                    } else {
+                        0.0
+                    };
                     assert!(
-                        (x.error - y.error).abs() <= 5e-8 * size,
+                        (x.error - y.error).abs() <= 5e-8 * size + kept,
                         "{name} error f {f} {k:?} l {ell}: {} vs {}",
                         x.error,
                         y.error

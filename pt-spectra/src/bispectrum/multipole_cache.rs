@@ -4,8 +4,8 @@
 //! Per triangle: its Legendre side, its orientations (3 components of the line of sight and 3 multipole
 //! weights each), the templates at the sides (3m), σ²'s two vectors (2m), then the families B₂₂₂, B₃₂₁ᴵ,
 //! J, L, the tree level and the tree level per orientation, each as: the number of rows r, the row length
-//! ℓ, whether its values are f32 (0 or 1), 4r indices, then the values on the rule and rule − half rule
-//! (2rℓ) and U (r or 0).
+//! ℓ, whether its values are f32 (0 or 1), the length d of the rows of rule − half rule (ℓ for f64 rows), 4r
+//! indices, then the values on the rule (rℓ) and rule − half rule (rd) and U (r or 0).
 
 use super::multipole_tensors::{Rows, TriangleTensors};
 use super::one_loop::Vec3;
@@ -16,10 +16,16 @@ pub(super) type Orientations = (Vec<Vec3>, Vec<[f64; 3]>);
 /// Appends `rows` with row length `len`.
 pub(super) fn write_rows(rows: &Rows, len: usize, out: &mut Vec<f64>) {
     let single = !rows.single.0.is_empty();
+    let diff_len = if single && !rows.index.is_empty() {
+        rows.single.1.len() / rows.index.len()
+    } else {
+        len
+    };
     out.extend([
         rows.index.len() as f64,
         len as f64,
         f64::from(u8::from(single)),
+        diff_len as f64,
     ]);
     out.extend(rows.index.iter().flatten().map(|&i| f64::from(i)));
     if single {
@@ -64,6 +70,7 @@ impl<'a> Reader<'a> {
             return None;
         }
         let single = self.count(2)? == 1;
+        let diff_len = self.count(len + 1)?;
         let index = self
             .take(4 * r)?
             .chunks_exact(4)
@@ -75,23 +82,28 @@ impl<'a> Reader<'a> {
             })
             .collect::<Option<Vec<[u16; 4]>>>()?;
         let fine = self.take(r * len)?.to_vec();
-        let diff = self.take(r * len)?.to_vec();
+        let diff = self.take(r * diff_len)?.to_vec();
         let uv = if with_uv {
             self.take(r)?.to_vec()
         } else {
             Vec::new()
         };
-        let mut rows = Rows {
+        let to32 = |v: Vec<f64>| v.into_iter().map(|x| x as f32).collect::<Vec<f32>>();
+        if single {
+            return Some(Rows {
+                index,
+                uv,
+                single: (to32(fine), to32(diff)),
+                ..Rows::default()
+            });
+        }
+        (diff_len == len).then_some(Rows {
             index,
             fine,
             diff,
             uv,
             single: (Vec::new(), Vec::new()),
-        };
-        if single {
-            rows.make_single();
-        }
-        Some(rows)
+        })
     }
 
     /// One triangle's side, orientations and tensors on `m` templates with `no` orientations.

@@ -30,6 +30,10 @@ use super::one_loop_galaxy_poly::Layout;
 use crate::simd::axpy;
 use crate::vec3::{neg, norm, sub};
 
+/// The templates on which the long rows' rule − half rule (the quadrature errors of B₂₂₂ and B₃₂₁ᴵ) are
+/// kept: the error of an error, ~1% of it (the leading 8 templates leave ~7e-3 of B).
+pub(super) const DIFF_TEMPLATES: usize = 8;
+
 /// The number of nodes in f: a polynomial of degree 6 is fixed by 7 values.
 pub(super) const F_NODES: usize = 7;
 
@@ -114,17 +118,23 @@ pub(super) struct Rows {
     /// U per row (B₃₂₁ᴵᴵ, B₄₁₁; empty otherwise).
     pub(super) uv: Vec<f64>,
     /// `fine` and `diff` in f32 once [`Rows::make_single`] has moved them there (the long rows of B₂₂₂ and
-    /// B₃₂₁ᴵ, read at every evaluation: half the bytes).
+    /// B₃₂₁ᴵ, read at every evaluation: half the bytes), `diff` on the first [`DIFF_TEMPLATES`] templates.
     pub(super) single: (Vec<f32>, Vec<f32>),
 }
 
 impl Rows {
-    /// Moves the values to f32 (each entry rounded to 6e-8 of itself).
-    pub(super) fn make_single(&mut self) {
-        let single = |v: &mut Vec<f64>| -> Vec<f32> {
-            std::mem::take(v).iter().map(|&x| x as f32).collect()
-        };
-        self.single = (single(&mut self.fine), single(&mut self.diff));
+    /// Moves the values to f32 (each entry rounded to 6e-8 of itself), keeping of each row of rule − half
+    /// rule (length `len`) its first `diff_len` entries: those on the first [`DIFF_TEMPLATES`] templates.
+    pub(super) fn make_single(&mut self, len: usize, diff_len: usize) {
+        let single = |v: &[f64]| -> Vec<f32> { v.iter().map(|&x| x as f32).collect() };
+        let diff: Vec<f32> = self
+            .diff
+            .chunks_exact(len)
+            .flat_map(|row| single(&row[..diff_len]))
+            .collect();
+        self.single = (single(&self.fine), diff);
+        self.fine.clear();
+        self.diff.clear();
     }
 
     /// Keeps the powers of f of `node` (fine) and `half` values laid out [`ells`][key][f node][monomial][len]
