@@ -51,6 +51,7 @@ mod geometry;
 mod ir_legs;
 mod lanes;
 pub mod multipole_basis;
+pub mod multipole_bins;
 mod multipole_cache;
 mod multipole_tensors;
 mod observed;

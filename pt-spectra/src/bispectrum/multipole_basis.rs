@@ -97,37 +97,39 @@ impl MultipoleLoopBasis {
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<Self> {
         rule.validate()?;
-        let lattice = one_loop_basis::lattice(rule, one_loop_basis::k_max(triangles));
+        let indices = triangles
+            .iter()
+            .map(|k| legendre_side_index(k, side))
+            .collect::<Result<Vec<_>>>()?;
+        let k_max = one_loop_basis::k_max(triangles);
+        Self::build_at(triangles, side, &indices, rule, k_max, progress)
+    }
+
+    /// [`build`](Self::build) with the Legendre side's index of each triangle given (`side` is what the cache
+    /// key records) and the basis's lattice for sides up to `k_max` [h/Mpc] (the bins' nodes reach beyond
+    /// their effective triangles).
+    pub(super) fn build_at(
+        triangles: &[[f64; 3]],
+        side: LegendreSide,
+        indices: &[usize],
+        rule: &OneLoopRule,
+        k_max: f64,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<Self> {
+        rule.validate()?;
+        let lattice = one_loop_basis::lattice(rule, k_max);
         let basis = camb_basis(lattice, BASIS_SIZE);
         let templates = templates(&basis, TEMPLATES);
-        let phi = |x: f64, out: &mut [f64]| {
-            let mut all = vec![0.0; basis.len()];
-            basis.at_ln(x, &mut all);
-            for (o, r) in out.iter_mut().zip(&templates) {
-                *o = dot(r, &all);
-            }
-        };
+        let phi = |x: f64, out: &mut [f64]| template_values(&basis, &templates, x, out);
         let products = Products::new();
-        let (n_mu, n_phi) = ORIENTATION_RULE;
-        let nodes = orientation_nodes(n_mu, n_phi);
         let mut setups = Vec::with_capacity(triangles.len());
-        let mut sides = Vec::with_capacity(triangles.len());
         let mut orientations = Vec::with_capacity(triangles.len());
-        for &k in triangles {
-            let kv = triangle_vectors(k)?;
-            let a = legendre_side_index(&k, side)?;
-            let (los, weights) = multipole_weights(&nodes, &kv, a)?;
-            sides.push(a);
-            orientations.push((los.clone(), weights.clone()));
-            setups.push(Setup {
-                kv,
-                los,
-                weights,
-                phi: &phi,
-                m: templates.len(),
-                products: &products,
-            });
+        for (&k, &a) in triangles.iter().zip(indices) {
+            let s = setup(k, a, &phi, templates.len(), &products)?;
+            orientations.push((s.los.clone(), s.weights.clone()));
+            setups.push(s);
         }
+        let sides = indices.to_vec();
         let done = AtomicUsize::new(0);
         let tensors = setups
             .par_iter()
@@ -150,6 +152,11 @@ impl MultipoleLoopBasis {
             templates,
             tensors,
         })
+    }
+
+    /// The templates at ln q = `x` (m values into `out`).
+    pub(super) fn phi(&self, x: f64, out: &mut [f64]) {
+        template_values(&self.basis, &self.templates, x, out);
     }
 
     /// The cache file name of the tensors of `triangles`, `side` and `rule` (and of the present kernels).
@@ -385,6 +392,37 @@ impl MultipoleLoopBasis {
     }
 }
 
+/// The templates `templates` (rows on `basis`) at ln q = `x` into `out`.
+fn template_values(basis: &LinearBasis, templates: &[Vec<f64>], x: f64, out: &mut [f64]) {
+    let mut all = vec![0.0; basis.len()];
+    basis.at_ln(x, &mut all);
+    for (o, r) in out.iter_mut().zip(templates) {
+        *o = dot(r, &all);
+    }
+}
+
+/// The build's inputs for the triangle `k` with the Legendre polynomial on its side `a`: the exact
+/// orientation rule's lines of sight and multipole weights.
+pub(super) fn setup<'a>(
+    k: [f64; 3],
+    a: usize,
+    phi: &'a (dyn Fn(f64, &mut [f64]) + Sync),
+    m: usize,
+    products: &'a Products,
+) -> Result<Setup<'a>> {
+    let kv = triangle_vectors(k)?;
+    let (n_mu, n_phi) = ORIENTATION_RULE;
+    let (los, weights) = multipole_weights(&orientation_nodes(n_mu, n_phi), &kv, a)?;
+    Ok(Setup {
+        kv,
+        los,
+        weights,
+        phi,
+        m,
+        products,
+    })
+}
+
 /// Version of the layout, part of the cache file name.
 const VERSION: u32 = 2;
 
@@ -424,13 +462,13 @@ fn single_rows<'a>(
 
 /// The monomials of the seven terms (tree, B₂₂₂, B₃₂₁ᴵ, B₃₂₁ᴵᴵ, B₄₁₁, and the two subtracted amounts, which
 /// have B₃₂₁ᴵᴵ's and B₄₁₁'s), in the order of the families' monomial indices, and the ascending order.
-struct Names {
+pub(super) struct Names {
     monomials: [Vec<Monomial>; 7],
     ascending: [Vec<usize>; 7],
 }
 
 impl Names {
-    fn new() -> Self {
+    pub(super) fn new() -> Self {
         let pr = Products::new();
         let list = |s: &[Vec<usize>]| -> Vec<Monomial> {
             s.iter()
@@ -459,13 +497,13 @@ impl Names {
 }
 
 /// One triangle's coefficients per ℓ, term and monomial: values and rule − half rule.
-struct Acc<'a> {
+pub(super) struct Acc<'a> {
     names: &'a Names,
     sums: [[Vec<[f64; 2]>; 7]; 3],
 }
 
 impl<'a> Acc<'a> {
-    fn new(names: &'a Names) -> Self {
+    pub(super) fn new(names: &'a Names) -> Self {
         Self {
             names,
             sums: std::array::from_fn(|_| {
@@ -474,13 +512,18 @@ impl<'a> Acc<'a> {
         }
     }
 
-    fn add(&mut self, idx: &[u16; 4], term: usize, value: f64, diff: f64) {
+    pub(super) fn add(&mut self, idx: &[u16; 4], term: usize, value: f64, diff: f64) {
         let s = &mut self.sums[idx[0] as usize][term][idx[2] as usize];
         s[0] += value;
         s[1] += diff;
     }
 
-    fn polynomial(&self, ell: usize, k: [f64; 3], projection: f64) -> GalaxyLoopPolynomial {
+    pub(super) fn polynomial(
+        &self,
+        ell: usize,
+        k: [f64; 3],
+        projection: f64,
+    ) -> GalaxyLoopPolynomial {
         let term = |t: usize| {
             let order = &self.names.ascending[t];
             let sums = &self.sums[ell][t];
@@ -510,11 +553,11 @@ impl<'a> Acc<'a> {
 mod tests;
 
 /// The number of packed pairs a ≤ b of m functions.
-fn pairs(m: usize) -> usize {
+pub(super) fn pairs(m: usize) -> usize {
     m * (m + 1) / 2
 }
 
 /// The number of packed triples a ≤ b ≤ c of m functions.
-fn triples(m: usize) -> usize {
+pub(super) fn triples(m: usize) -> usize {
     m * (m + 1) * (m + 2) / 6
 }

@@ -49,7 +49,7 @@ pub fn correction_rule(rule: &OneLoopRule) -> OneLoopRule {
 }
 
 /// The rule of the correction's rule check: 2 × 2 × 2 nodes per panel.
-fn check_rule(rule: &OneLoopRule) -> OneLoopRule {
+pub(super) fn check_rule(rule: &OneLoopRule) -> OneLoopRule {
     OneLoopRule {
         radial: 2,
         mu: 2,
