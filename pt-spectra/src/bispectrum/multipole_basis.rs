@@ -497,6 +497,7 @@ impl Names {
 }
 
 /// One triangle's coefficients per ℓ, term and monomial: values and rule − half rule.
+#[derive(Clone)]
 pub(super) struct Acc<'a> {
     names: &'a Names,
     sums: [[Vec<[f64; 2]>; 7]; 3],

@@ -43,13 +43,19 @@ pub const CHECK_TEMPLATES: usize = 4;
 /// Folded loop rows: per (term 1–4, [ℓ, key (unused, 0), monomial, power]) a packed triple on m templates.
 type Folded = BTreeMap<(usize, [u16; 4]), Vec<f64>>;
 
+/// A bin's node triangles and weights.
+type Nodes = Vec<([f64; 3], f64)>;
+
+/// [`Folded`]'s rows as a list.
+type FoldedRows = Vec<((usize, [u16; 4]), Vec<f64>)>;
+
 /// A bin's correction: the folded loops of Δ and of its two error estimates' differences, and the tree
 /// level's nodes (weight, sides, tree rows) for Δ and for Δ on one node fewer.
 #[derive(Debug, Clone, PartialEq)]
 struct BinCorrection {
-    delta: Vec<((usize, [u16; 4]), Vec<f64>)>,
-    minus_nodes: Vec<((usize, [u16; 4]), Vec<f64>)>,
-    minus_rule: Vec<((usize, [u16; 4]), Vec<f64>)>,
+    delta: FoldedRows,
+    minus_nodes: FoldedRows,
+    minus_rule: FoldedRows,
     tree: [Vec<(f64, [f64; 3], Rows)>; 2],
 }
 
@@ -73,6 +79,28 @@ impl MultipoleBinBasis {
         rule: &OneLoopRule,
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<Self> {
+        Self::build_with(
+            set,
+            side,
+            rule,
+            [correction_rule(rule), check_rule(rule)],
+            progress,
+        )
+    }
+
+    /// [`build`](Self::build) with the correction's rules [coarse, check] given (those of
+    /// [`super::one_loop_bins`] by default; other rules for benchmarks of the evaluation, whose cost does not
+    /// depend on them).
+    ///
+    /// # Errors
+    /// As [`build`](Self::build).
+    pub fn build_with(
+        set: &TriangleSet,
+        side: LegendreSide,
+        rule: &OneLoopRule,
+        [coarse, check]: [OneLoopRule; 2],
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<Self> {
         if set.width().is_none() {
             return Err(Error::InvalidChoice {
                 what: "a triangle set of points".into(),
@@ -82,7 +110,7 @@ impl MultipoleBinBasis {
         let bins = 0..set.len();
         let effective: Vec<[f64; 3]> = bins.clone().map(|i| effective_triangle(set, i)).collect();
         let indices: Vec<usize> = bins.clone().map(|i| set.legendre_index(i, side)).collect();
-        let nodes: Vec<[Vec<([f64; 3], f64)>; 2]> = bins
+        let nodes: Vec<[Nodes; 2]> = bins
             .map(|i| {
                 [
                     set.shapes(i, CORRECTION_NODES),
@@ -102,7 +130,6 @@ impl MultipoleBinBasis {
         let products = Products::new();
         let phi = |x: f64, out: &mut [f64]| main.phi(x, out);
         let m = super::multipole_basis::TEMPLATES;
-        let (coarse, check) = (correction_rule(rule), check_rule(rule));
         let done = AtomicUsize::new(0);
         let corrections = (0..set.len())
             .into_par_iter()
@@ -184,10 +211,7 @@ impl MultipoleBinBasis {
             .iter()
             .zip(&at_effective)
             .map(|(b, m)| {
-                let loops = |acc: &mut Acc,
-                             rows: &[((usize, [u16; 4]), Vec<f64>)],
-                             x: &[f64],
-                             sign: f64| {
+                let loops = |acc: &mut Acc, rows: &FoldedRows, x: &[f64], sign: f64| {
                     for ((term, idx), v) in rows {
                         acc.add(idx, *term, sign * fp[idx[3] as usize] * dot(v, x), 0.0);
                     }
@@ -202,18 +226,17 @@ impl MultipoleBinBasis {
                         }
                     }
                 };
-                let mut delta = Acc::new(&names);
-                loops(&mut delta, &b.delta, &c3, 1.0);
+                // Δ's loops once; Δ_nodes = Δ − (Δ − Δ_nodes), Δ_rule likewise; the tree level does not
+                // depend on the rule
+                let mut base = Acc::new(&names);
+                loops(&mut base, &b.delta, &c3, 1.0);
+                let mut delta = base.clone();
                 tree(&mut delta, &b.tree[0]);
-                // Δ_nodes = Δ − (Δ − Δ_nodes), Δ_rule likewise; the tree level does not depend on the rule
-                let mut fewer = Acc::new(&names);
-                loops(&mut fewer, &b.delta, &c3, 1.0);
+                let mut checked = delta.clone();
+                loops(&mut checked, &b.minus_rule, &c3_check, -1.0);
+                let mut fewer = base;
                 loops(&mut fewer, &b.minus_nodes, &c3_check, -1.0);
                 tree(&mut fewer, &b.tree[1]);
-                let mut checked = Acc::new(&names);
-                loops(&mut checked, &b.delta, &c3, 1.0);
-                loops(&mut checked, &b.minus_rule, &c3_check, -1.0);
-                tree(&mut checked, &b.tree[0]);
                 let ells = |acc: &Acc| -> [GalaxyLoopPolynomial; 3] {
                     std::array::from_fn(|l| acc.polynomial(l, m.k, 0.0))
                 };
