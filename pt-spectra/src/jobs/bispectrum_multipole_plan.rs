@@ -30,17 +30,7 @@ pub fn one_loop_multipole_tensors(
     store: &TableStore,
     progress: &dyn Progress,
 ) -> Result<Arc<MultipoleLoopBasis>> {
-    for (i, &k) in triangles.iter().enumerate() {
-        crate::bispectrum::one_loop::triangle_vectors(k)
-            .and_then(|_| {
-                crate::bispectrum::one_loop_galaxy_multipoles::legendre_side_index(&k, side)
-            })
-            .map_err(|e| Error::InvalidChoice {
-                what: format!("triangle {} ({}, {}, {})", i + 1, k[0], k[1], k[2]),
-                reason: e.to_string(),
-            })?;
-    }
-    rule.validate()?;
+    check_triangles(triangles, side, rule)?;
     let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
         MultipoleLoopBasis::build(triangles, side, rule, tick)
             .expect("triangles, side and rule checked")
