@@ -220,18 +220,6 @@ impl MultipoleLoopBasis {
         })
     }
 
-    /// The projection on the templates of the spectrum the loops integrate: `p`, or P_LO with `ir` (its
-    /// residual decides whether the tensors represent it).
-    ///
-    /// # Errors
-    /// As [`leading_order_spectrum`].
-    pub fn loop_projection(&self, p: &LinearSpectrum, ir: Option<&IrInputs>) -> Result<Projection> {
-        Ok(match ir {
-            None => self.project(p).1,
-            Some(ir) => self.project(&leading_order_spectrum(p, ir)?).1,
-        })
-    }
-
     /// The Legendre side asked for at the build.
     pub fn side(&self) -> LegendreSide {
         self.side
@@ -297,7 +285,25 @@ impl MultipoleLoopBasis {
     /// # Errors
     /// [`crate::error::Error::InvalidParameter`] for f outside [0, 2].
     pub fn evaluate(&self, p: &LinearSpectrum, f: f64) -> Result<Vec<GalaxyLoopMultipoles>> {
-        self.evaluate_with(p, f, None)
+        Ok(self.evaluate_projected(p, f, None)?.0)
+    }
+
+    /// [`evaluate`](Self::evaluate) (`ir` None) or [`evaluate_ir`](Self::evaluate_ir), with the projection
+    /// on the templates of the spectrum the loops integrated (`p`, or P_LO): its residual decides whether
+    /// the tensors represent it, and nothing is projected twice.
+    ///
+    /// # Errors
+    /// As [`evaluate_ir`](Self::evaluate_ir).
+    pub fn evaluate_projected(
+        &self,
+        p: &LinearSpectrum,
+        f: f64,
+        ir: Option<&IrInputs>,
+    ) -> Result<(Vec<GalaxyLoopMultipoles>, Projection)> {
+        match ir {
+            None => self.evaluate_with(p, f, None),
+            Some(ir) => self.evaluate_with(&leading_order_spectrum(p, ir)?, f, Some((p, ir))),
+        }
     }
 
     /// [`evaluate`](Self::evaluate) with the infrared resummation of [`super::one_loop_ir`]: the loops on
@@ -311,8 +317,7 @@ impl MultipoleLoopBasis {
         ir: &IrInputs,
         f: f64,
     ) -> Result<Vec<GalaxyLoopMultipoles>> {
-        let lo = leading_order_spectrum(p, ir)?;
-        self.evaluate_with(&lo, f, Some((p, ir)))
+        Ok(self.evaluate_projected(p, f, Some(ir))?.0)
     }
 
     /// The multipoles with the loops of `p`, the tree level of `p` or (`ir` Some((linear, inputs))) of the
@@ -322,7 +327,7 @@ impl MultipoleLoopBasis {
         p: &LinearSpectrum,
         f: f64,
         ir: Option<(&LinearSpectrum, &IrInputs)>,
-    ) -> Result<Vec<GalaxyLoopMultipoles>> {
+    ) -> Result<(Vec<GalaxyLoopMultipoles>, Projection)> {
         crate::cosmology::check_growth_rate(f)?;
         let (c, projection) = self.project(p);
         let names = Names::new();
@@ -330,7 +335,7 @@ impl MultipoleLoopBasis {
         let (c2_32, c3_32) = (single(pair_products(&c)), single(triple_products(&c)));
         let fp: [f64; F_NODES] = std::array::from_fn(|i| f.powi(i as i32));
         let bound = PROJECTION_FACTOR * projection.residual;
-        Ok(self
+        let multipoles = self
             .triangles
             .iter()
             .zip(self.tensors.iter().zip(&self.sides).zip(&self.orientations))
@@ -388,7 +393,8 @@ impl MultipoleLoopBasis {
                     ells: std::array::from_fn(|ell| acc.polynomial(ell, k, bound)),
                 }
             })
-            .collect())
+            .collect();
+        Ok((multipoles, projection))
     }
 }
 

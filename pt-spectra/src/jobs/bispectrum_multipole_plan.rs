@@ -95,20 +95,15 @@ pub fn multipoles_from_tensors(
     f: f64,
     ir: Option<&IrInputs>,
 ) -> Result<(Option<Vec<[OneLoopGalaxy; 3]>>, BispectrumLoopSource)> {
-    let projected = tensors.loop_projection(p, ir)?;
+    let (polys, projected) = tensors.evaluate_projected(p, f, ir)?;
     let max = crate::loops::basis::MAX_RESIDUAL;
     if projected.residual > max {
-        crate::cosmology::check_growth_rate(f)?;
         let source = BispectrumLoopSource::Fallback {
             residual: projected.residual,
             max_residual: max,
         };
         return Ok((None, source));
     }
-    let polys = match ir {
-        None => tensors.evaluate(p, f)?,
-        Some(ir) => tensors.evaluate_ir(p, ir, f)?,
-    };
     let rows = polys
         .iter()
         .map(|m| m.evaluate(bias))

@@ -101,14 +101,14 @@ fn resummed_multipole_tensors_against_direct() {
     let bias = LoopBias::from_velocileptors(2.0, 0.3, -0.2);
     let split = pt_spectra::ir::WiggleSplit::new().unwrap();
     let q_min = pt_spectra::precision::Precision::default().q_min;
+    let f = 0.7;
     for (name, p) in spectra() {
         let Ok(ir) = IrInputs::split(&p, &split, q_min) else {
             continue;
         };
-        let residual = basis.loop_projection(&p, Some(&ir)).unwrap().residual;
+        let (fast, projection) = basis.evaluate_projected(&p, f, Some(&ir)).unwrap();
+        let residual = projection.residual;
         let (mut rel, mut of_error) = (0.0f64, 0.0f64);
-        let f = 0.7;
-        let fast = basis.evaluate_ir(&p, &ir, f).unwrap();
         for (t, &k) in TRIANGLES.iter().enumerate() {
             let direct =
                 one_loop_galaxy_multipoles_ir(&p, &ir, k, f, LegendreSide::Largest, &rule, None)
