@@ -292,58 +292,9 @@ fn one_loop_multipole_basis(crit: &mut Criterion) {
     );
 }
 
-/// The bin averages of the one-loop galaxy multipoles of the 62 Nseries bins from tensors (the effective
-/// triangles' multipole tensors and the correction's folded rows; built here on 2 x 2 x 2 rules: the
-/// evaluation's cost does not depend on them), no IR: a new spectrum and f per call, then a bias.
-fn one_loop_multipole_bins(crit: &mut Criterion) {
-    use pt_spectra::bispectrum::multipole_bins::MultipoleBinBasis;
-    use pt_spectra::bispectrum::one_loop::OneLoopRule;
-    let rule = OneLoopRule {
-        radial: 2,
-        mu: 2,
-        phi: 2,
-        ..OneLoopRule::default()
-    };
-    // PT_BENCH_BINS=n: the first n bins only (the build takes ~16 min for the 62 on two cores)
-    let set = match std::env::var("PT_BENCH_BINS")
-        .ok()
-        .and_then(|n| n.parse::<usize>().ok())
-    {
-        Some(n) => TriangleSet::shells(nseries().triangles()[..n].to_vec(), 0.01).unwrap(),
-        None => nseries(),
-    };
-    let start = std::time::Instant::now();
-    let bins =
-        MultipoleBinBasis::build_with(&set, LegendreSide::Largest, &rule, [rule, rule], &|_, _| {})
-            .unwrap();
-    eprintln!(
-        "multipole bin tensors of {} bins on 2 x 2 x 2 rules: {:.1} s",
-        set.len(),
-        start.elapsed().as_secs_f64()
-    );
-    let spectra: Vec<LinearSpectrum> = [0.0, 0.5, 1.0, 1.5]
-        .iter()
-        .map(|&z| LinearSpectrum::gm2012(z).unwrap())
-        .collect();
-    let bias = pt_spectra::bispectrum::bias_kernels::LoopBias::from_velocileptors(2.0, 0.3, -0.2);
-    let mut i = 0;
-    crit.bench_function(
-        "bispectrum/one-loop galaxy B0 B2 B4 of 62 Nseries bins, new spectrum and f, multipole bin tensors",
-        |b| {
-            b.iter(|| {
-                i += 1;
-                let f = 0.6 + 0.01 * f64::from(i % 30);
-                let m = bins.evaluate(&spectra[i as usize % spectra.len()], f).unwrap();
-                black_box(m.evaluate(&bias).unwrap())
-            })
-        },
-    );
-}
-
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(10);
-    targets = bispectrum, one_loop, one_loop_galaxy_step, one_loop_galaxy_basis, one_loop_multipole_basis,
-        one_loop_multipole_bins
+    targets = bispectrum, one_loop, one_loop_galaxy_step, one_loop_galaxy_basis, one_loop_multipole_basis
 }
 criterion_main!(benches);

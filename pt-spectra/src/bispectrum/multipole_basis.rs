@@ -190,8 +190,26 @@ impl MultipoleLoopBasis {
         side: LegendreSide,
         rule: &OneLoopRule,
     ) -> Option<Self> {
+        Self::from_f64s_at(
+            values,
+            triangles,
+            side,
+            rule,
+            one_loop_basis::k_max(triangles),
+        )
+    }
+
+    /// [`from_f64s`](Self::from_f64s) for tensors built with the basis's lattice up to `k_max` [h/Mpc]
+    /// ([`build_at`](Self::build_at)).
+    pub(super) fn from_f64s_at(
+        values: &[f64],
+        triangles: &[[f64; 3]],
+        side: LegendreSide,
+        rule: &OneLoopRule,
+        k_max: f64,
+    ) -> Option<Self> {
         let rest = after_key(values, &key(triangles, side, rule))?;
-        let lattice = one_loop_basis::lattice(rule, one_loop_basis::k_max(triangles));
+        let lattice = one_loop_basis::lattice(rule, k_max);
         let (basis, rest) = LinearBasis::from_f64s(lattice, rest)?;
         let mut r = Reader { values: rest };
         let n = basis.len();
@@ -330,20 +348,33 @@ impl MultipoleLoopBasis {
     ) -> Result<(Vec<GalaxyLoopMultipoles>, Projection)> {
         crate::cosmology::check_growth_rate(f)?;
         let (c, projection) = self.project(p);
+        let multipoles = self.contract(&c, projection.residual, p, f, ir);
+        Ok((multipoles, projection))
+    }
+
+    /// The multipoles of the templates' coefficients `c` (the projection of the loops' spectrum, whose
+    /// projection residual is `residual`), the tree level of `p` or of the resummed legs (`ir`); f checked.
+    pub(super) fn contract(
+        &self,
+        c: &[f64],
+        residual: f64,
+        p: &LinearSpectrum,
+        f: f64,
+        ir: Option<(&LinearSpectrum, &IrInputs)>,
+    ) -> Vec<GalaxyLoopMultipoles> {
         let names = Names::new();
         let single = |v: Vec<f64>| -> Vec<f32> { v.iter().map(|&x| x as f32).collect() };
-        let (c2_32, c3_32) = (single(pair_products(&c)), single(triple_products(&c)));
+        let (c2_32, c3_32) = (single(pair_products(c)), single(triple_products(c)));
         let fp: [f64; F_NODES] = std::array::from_fn(|i| f.powi(i as i32));
-        let bound = PROJECTION_FACTOR * projection.residual;
-        let multipoles = self
-            .triangles
+        let bound = PROJECTION_FACTOR * residual;
+        self.triangles
             .iter()
             .zip(self.tensors.iter().zip(&self.sides).zip(&self.orientations))
             .map(|(&k, ((t, &side), (los, weights)))| {
                 let m = c.len();
-                let ph: [f64; 3] = std::array::from_fn(|a| dot(&t.sides[a * m..(a + 1) * m], &c));
+                let ph: [f64; 3] = std::array::from_fn(|a| dot(&t.sides[a * m..(a + 1) * m], c));
                 let pk = k.map(|v| p.eval(v));
-                let sigma = [dot(&t.sigma[0], &c), dot(&t.sigma[1], &c)];
+                let sigma = [dot(&t.sigma[0], c), dot(&t.sigma[1], c)];
                 // the products of the two sides other than s, for the loop terms and the tree level
                 let other = |x: &[f64; 3], s: usize| x[(s + 1) % 3] * x[(s + 2) % 3];
                 let mut acc = Acc::new(&names);
@@ -359,7 +390,7 @@ impl MultipoleLoopBasis {
                 for (family, (term, uv_term)) in [(&t.j, (3, 5)), (&t.l, (4, 6))] {
                     for ((idx, (fine, diff)), &u) in rows(family, m).zip(&family.uv) {
                         let w = fp[idx[3] as usize] * other(&ph, idx[1] as usize);
-                        let (jf, jd) = (dot(fine, &c), dot(diff, &c));
+                        let (jf, jd) = (dot(fine, c), dot(diff, c));
                         acc.add(idx, term, w * (jf - u * sigma[0]), w * (jd - u * sigma[1]));
                         acc.add(idx, uv_term, w * u * sigma[0], 0.0);
                     }
@@ -393,8 +424,7 @@ impl MultipoleLoopBasis {
                     ells: std::array::from_fn(|ell| acc.polynomial(ell, k, bound)),
                 }
             })
-            .collect();
-        Ok((multipoles, projection))
+            .collect()
     }
 }
 

@@ -273,3 +273,36 @@ fn bins_from_tensors_are_the_direct_bins() {
         }
     }
 }
+
+/// The bins' cache file read back gives the same tensors; another width, rule or side, or a cut or longer
+/// file, gives none.
+#[test]
+fn bins_cache_values_round_trip() {
+    use super::super::geometry::TriangleSet;
+    use super::super::multipole_bins::MultipoleBinBasis;
+    let r = OneLoopRule {
+        radial: 2,
+        mu: 2,
+        phi: 2,
+        ..OneLoopRule::default()
+    };
+    let rules = [r, r];
+    let set = TriangleSet::shells(vec![[0.05, 0.06, 0.07]], 0.01).unwrap();
+    let bins =
+        MultipoleBinBasis::build_with(&set, LegendreSide::Largest, &r, rules, &|_, _| {}).unwrap();
+    let v = bins.to_f64s();
+    let read = |v: &[f64], set: &TriangleSet, side, rules: &[OneLoopRule; 2]| {
+        MultipoleBinBasis::from_f64s(v, set, side, &r, rules)
+    };
+    let largest = LegendreSide::Largest;
+    assert_eq!(read(&v, &set, largest, &rules).unwrap(), bins);
+    let wider = TriangleSet::shells(vec![[0.05, 0.06, 0.07]], 0.02).unwrap();
+    assert!(read(&v, &wider, largest, &rules).is_none());
+    assert!(read(&v, &set, LegendreSide::Index(0), &rules).is_none());
+    let other = OneLoopRule { mu: 3, ..r };
+    assert!(read(&v, &set, largest, &[other, r]).is_none());
+    assert!(read(&v[..v.len() - 1], &set, largest, &rules).is_none());
+    let mut longer = v.clone();
+    longer.push(0.0);
+    assert!(read(&longer, &set, largest, &rules).is_none());
+}

@@ -20,6 +20,7 @@
 
 use super::geometry::{LegendreSide, TriangleSet};
 use super::multipole_basis::{setup, triples, Acc, MultipoleLoopBasis, Names};
+use super::multipole_cache::Reader;
 use super::multipole_tensors::{triangle_tensors, Products, Rows, TriangleTensors, F_NODES};
 use super::one_loop::OneLoopRule;
 use super::one_loop_bins::{
@@ -28,8 +29,8 @@ use super::one_loop_bins::{
 use super::one_loop_galaxy_poly::GalaxyLoopPolynomial;
 use crate::error::{Error, Result};
 use crate::linear::LinearSpectrum;
-use crate::loops::basis::{pair_index, triple_index, triple_products};
-use crate::simd::dot;
+use crate::loops::basis::{after_key, cache_file_name, pair_index, triple_index, triple_products};
+use crate::simd::{matvec, matvec_f32};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -46,22 +47,111 @@ type Folded = BTreeMap<(usize, [u16; 4]), Vec<f64>>;
 /// A bin's node triangles and weights.
 type Nodes = Vec<([f64; 3], f64)>;
 
-/// [`Folded`]'s rows as a list.
-type FoldedRows = Vec<((usize, [u16; 4]), Vec<f64>)>;
+/// [`Folded`]'s rows in f32 as one matrix (a row of `len` values per key), contracted by one
+/// matrix–vector product.
+#[derive(Debug, Clone, PartialEq, Default)]
+struct FoldedRows {
+    keys: Vec<(usize, [u16; 4])>,
+    values: Vec<f32>,
+    len: usize,
+}
+
+impl FoldedRows {
+    fn new(folded: Folded, len: usize) -> Self {
+        let mut rows = Self {
+            len,
+            ..Self::default()
+        };
+        for (key, v) in folded {
+            rows.keys.push(key);
+            rows.values.extend(v.iter().map(|&x| x as f32));
+        }
+        rows
+    }
+
+    /// Adds `sign` × each row contracted with the products `x` (f32, `len`) × f^power to `acc`.
+    fn add_to(&self, acc: &mut Acc, x: &[f32], fp: &[f64; F_NODES], sign: f64, out: &mut Vec<f64>) {
+        out.clear();
+        out.resize(self.keys.len(), 0.0);
+        matvec_f32(&self.values, x, out);
+        for ((term, idx), v) in self.keys.iter().zip(out.iter()) {
+            acc.add(idx, *term, sign * fp[idx[3] as usize] * v, 0.0);
+        }
+    }
+}
 
 /// A bin's correction: the folded loops of Δ and of its two error estimates' differences, and the tree
-/// level's nodes (weight, sides, tree rows) for Δ and for Δ on one node fewer.
+/// level's nodes for Δ and for Δ on one node fewer.
 #[derive(Debug, Clone, PartialEq)]
 struct BinCorrection {
     delta: FoldedRows,
     minus_nodes: FoldedRows,
     minus_rule: FoldedRows,
-    tree: [Vec<(f64, [f64; 3], Rows)>; 2],
+    tree: [TreeNodes; 2],
+}
+
+/// The tree level's rows of a bin's node triangles (the effective triangle among them with weight −1) as
+/// one matrix per side s whose legs multiply them: Δ_tree = Σ_n w_n P(k_n,s+1) P(k_n,s+2) M_s[row, n] for
+/// the rows (ℓ, s, monomial, power) of that side, exact with the true P.
+#[derive(Debug, Clone, PartialEq, Default)]
+struct TreeNodes {
+    weights: Vec<f64>,
+    sides: Vec<[f64; 3]>,
+    /// The rows' indices, by side s (`idx[1]`) then (ℓ, monomial, power).
+    keys: Vec<[u16; 4]>,
+    /// Row-major, one value per node.
+    values: Vec<f64>,
+}
+
+impl TreeNodes {
+    fn new(nodes: Vec<(f64, [f64; 3], Rows)>) -> Self {
+        let mut rows: BTreeMap<[u16; 4], Vec<f64>> = BTreeMap::new();
+        for (n, (_, _, r)) in nodes.iter().enumerate() {
+            for (idx, v) in r.index.iter().zip(&r.fine) {
+                let key = [idx[1], idx[0], idx[2], idx[3]];
+                rows.entry(key).or_insert_with(|| vec![0.0; nodes.len()])[n] += v;
+            }
+        }
+        Self {
+            weights: nodes.iter().map(|n| n.0).collect(),
+            sides: nodes.iter().map(|n| n.1).collect(),
+            keys: rows.keys().map(|k| [k[1], k[0], k[2], k[3]]).collect(),
+            values: rows.into_values().flatten().collect(),
+        }
+    }
+
+    /// Adds the tree level's Δ for the spectrum `p` to `acc`.
+    fn add_to(&self, acc: &mut Acc, p: &LinearSpectrum, fp: &[f64; F_NODES], out: &mut Vec<f64>) {
+        let n = self.weights.len();
+        let pk: Vec<[f64; 3]> = self.sides.iter().map(|k| k.map(|v| p.eval(v))).collect();
+        let mut start = 0;
+        for s in 0..3 {
+            let rows = self.keys[start..]
+                .iter()
+                .take_while(|idx| idx[1] as usize == s)
+                .count();
+            let legs: Vec<f64> = pk
+                .iter()
+                .zip(&self.weights)
+                .map(|(pk, w)| w * pk[(s + 1) % 3] * pk[(s + 2) % 3])
+                .collect();
+            out.clear();
+            out.resize(rows, 0.0);
+            matvec(&self.values[start * n..(start + rows) * n], &legs, out);
+            for (idx, v) in self.keys[start..start + rows].iter().zip(out.iter()) {
+                acc.add(idx, 0, fp[idx[3] as usize] * v, 0.0);
+            }
+            start += rows;
+        }
+    }
 }
 
 /// The one-loop galaxy multipoles of a set of bins from tensors (module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct MultipoleBinBasis {
+    set: TriangleSet,
+    /// The correction's rules: coarse and check.
+    rules: [OneLoopRule; 2],
     /// The tensors at the bins' effective triangles.
     main: MultipoleLoopBasis,
     corrections: Vec<BinCorrection>,
@@ -79,13 +169,7 @@ impl MultipoleBinBasis {
         rule: &OneLoopRule,
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<Self> {
-        Self::build_with(
-            set,
-            side,
-            rule,
-            [correction_rule(rule), check_rule(rule)],
-            progress,
-        )
+        Self::build_with(set, side, rule, correction_rules(rule), progress)
     }
 
     /// [`build`](Self::build) with the correction's rules [coarse, check] given (those of
@@ -101,30 +185,12 @@ impl MultipoleBinBasis {
         [coarse, check]: [OneLoopRule; 2],
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> Result<Self> {
-        if set.width().is_none() {
-            return Err(Error::InvalidChoice {
-                what: "a triangle set of points".into(),
-                reason: "bin averages need bins (shells of a width)".into(),
-            });
-        }
-        let bins = 0..set.len();
-        let effective: Vec<[f64; 3]> = bins.clone().map(|i| effective_triangle(set, i)).collect();
-        let indices: Vec<usize> = bins.clone().map(|i| set.legendre_index(i, side)).collect();
-        let nodes: Vec<[Nodes; 2]> = bins
-            .map(|i| {
-                [
-                    set.shapes(i, CORRECTION_NODES),
-                    set.shapes(i, CORRECTION_NODES - 1),
-                ]
-            })
-            .collect();
-        let k_max = nodes
-            .iter()
-            .flatten()
-            .flatten()
-            .flat_map(|(k, _)| *k)
-            .chain(effective.iter().flatten().copied())
-            .fold(0.0, f64::max);
+        let Layout {
+            effective,
+            indices,
+            nodes,
+            k_max,
+        } = Layout::of(set, side)?;
         let main =
             MultipoleLoopBasis::build_at(&effective, side, &indices, rule, k_max, &|_, _| {})?;
         let products = Products::new();
@@ -166,8 +232,8 @@ impl MultipoleBinBasis {
                 for &(k, w) in nodes[i][0].iter().chain([&(effective[i], -1.0)]) {
                     fold(&tensors(k, &check)?, w, CHECK_TEMPLATES, &mut checked);
                 }
-                let minus = |x: &Folded| -> Vec<_> {
-                    small
+                let minus = |x: &Folded| -> FoldedRows {
+                    let d = small
                         .iter()
                         .map(|(key, v)| {
                             let o = x.get(key);
@@ -178,19 +244,95 @@ impl MultipoleBinBasis {
                                 .collect();
                             (*key, d)
                         })
-                        .collect()
+                        .collect();
+                    FoldedRows::new(d, triples(CHECK_TEMPLATES))
                 };
                 let c = BinCorrection {
                     minus_nodes: minus(&fewer),
                     minus_rule: minus(&checked),
-                    delta: delta.into_iter().collect(),
-                    tree: [tree, tree_fewer],
+                    delta: FoldedRows::new(delta, triples(DELTA_TEMPLATES)),
+                    tree: [TreeNodes::new(tree), TreeNodes::new(tree_fewer)],
                 };
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, set.len());
                 Ok(c)
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(Self { main, corrections })
+        Ok(Self {
+            set: set.clone(),
+            rules: [coarse, check],
+            main,
+            corrections,
+        })
+    }
+
+    /// The cache file name of the tensors of the bins `set`, `side`, `rule` and the correction's `rules`
+    /// (and of the present kernels).
+    pub fn file_name(
+        set: &TriangleSet,
+        side: LegendreSide,
+        rule: &OneLoopRule,
+        rules: &[OneLoopRule; 2],
+    ) -> String {
+        cache_file_name(
+            "bispectrum-multipole-bins",
+            VERSION,
+            &key(set, side, rule, rules),
+        )
+    }
+
+    /// The cache file's values: the key, the effective triangles' tensors (their count, then
+    /// [`MultipoleLoopBasis::to_f64s`]), per bin its correction ([`write_correction`]).
+    pub(crate) fn to_f64s(&self) -> Vec<f64> {
+        let mut v = key(&self.set, self.main.side(), self.main.rule(), &self.rules);
+        v.insert(0, v.len() as f64);
+        let main = self.main.to_f64s();
+        v.push(main.len() as f64);
+        v.extend(main);
+        for c in &self.corrections {
+            write_correction(c, &mut v);
+        }
+        v
+    }
+
+    /// The tensors of the bins `set`, `side`, `rule` and `rules` from their file's values, or `None` if the
+    /// file was made for other settings or does not fit them.
+    pub(crate) fn from_f64s(
+        values: &[f64],
+        set: &TriangleSet,
+        side: LegendreSide,
+        rule: &OneLoopRule,
+        rules: &[OneLoopRule; 2],
+    ) -> Option<Self> {
+        let rest = after_key(values, &key(set, side, rule, rules))?;
+        let layout = Layout::of(set, side).ok()?;
+        let mut r = Reader { values: rest };
+        let n = r.count(usize::MAX)?;
+        let main = MultipoleLoopBasis::from_f64s_at(
+            r.take(n)?,
+            &layout.effective,
+            side,
+            rule,
+            layout.k_max,
+        )?;
+        let corrections = (0..set.len())
+            .map(|_| read_correction(&mut r))
+            .collect::<Option<Vec<_>>>()?;
+        r.values.is_empty().then(|| Self {
+            set: set.clone(),
+            rules: *rules,
+            main,
+            corrections,
+        })
+    }
+
+    /// The triangle bins.
+    pub fn set(&self) -> &TriangleSet {
+        &self.set
+    }
+
+    /// The tensors at the bins' effective triangles.
+    pub fn effective(&self) -> &MultipoleLoopBasis {
+        &self.main
     }
 
     /// The binned multipoles per bias monomial for the spectrum `p` at growth rate `f` (no IR resummation):
@@ -200,31 +342,26 @@ impl MultipoleBinBasis {
     /// # Errors
     /// As [`MultipoleLoopBasis::evaluate`].
     pub fn evaluate(&self, p: &LinearSpectrum, f: f64) -> Result<BinnedLoopMultipoles> {
-        let at_effective = self.main.evaluate(p, f)?;
-        let (c, _) = self.main.project(p);
-        let c3 = triple_products(&c[..DELTA_TEMPLATES]);
-        let c3_check = triple_products(&c[..CHECK_TEMPLATES]);
+        crate::cosmology::check_growth_rate(f)?;
+        let (c, projection) = self.main.project(p);
+        let at_effective = self.main.contract(&c, projection.residual, p, f, None);
+        let single = |v: Vec<f64>| -> Vec<f32> { v.iter().map(|&x| x as f32).collect() };
+        let c3 = single(triple_products(&c[..DELTA_TEMPLATES]));
+        let c3_check = single(triple_products(&c[..CHECK_TEMPLATES]));
         let fp: [f64; F_NODES] = std::array::from_fn(|i| f.powi(i as i32));
         let names = Names::new();
+        let mut out = Vec::new();
         let corrections = self
             .corrections
             .iter()
             .zip(&at_effective)
             .map(|(b, m)| {
-                let loops = |acc: &mut Acc, rows: &FoldedRows, x: &[f64], sign: f64| {
-                    for ((term, idx), v) in rows {
-                        acc.add(idx, *term, sign * fp[idx[3] as usize] * dot(v, x), 0.0);
-                    }
+                let mut loops = |acc: &mut Acc, rows: &FoldedRows, x: &[f32], sign: f64| {
+                    rows.add_to(acc, x, &fp, sign, &mut out);
                 };
-                let tree = |acc: &mut Acc, nodes: &[(f64, [f64; 3], Rows)]| {
-                    for (w, k, rows) in nodes {
-                        let pk = k.map(|v| p.eval(v));
-                        for (idx, value) in rows.index.iter().zip(&rows.fine) {
-                            let s = idx[1] as usize;
-                            let legs = pk[(s + 1) % 3] * pk[(s + 2) % 3];
-                            acc.add(idx, 0, w * fp[idx[3] as usize] * legs * value, 0.0);
-                        }
-                    }
+                let mut tree_out = Vec::new();
+                let mut tree = |acc: &mut Acc, nodes: &TreeNodes| {
+                    nodes.add_to(acc, p, &fp, &mut tree_out);
                 };
                 // Δ's loops once; Δ_nodes = Δ − (Δ − Δ_nodes), Δ_rule likewise; the tree level does not
                 // depend on the rule
@@ -247,6 +384,156 @@ impl MultipoleBinBasis {
             effective: self.main.triangles().to_vec(),
             at_effective,
             corrections,
+        })
+    }
+}
+
+/// The correction's rules [coarse, check] for the main `rule` ([`super::one_loop_bins`]'s): the cache key's
+/// `rules` of a default build.
+pub fn correction_rules(rule: &OneLoopRule) -> [OneLoopRule; 2] {
+    [correction_rule(rule), check_rule(rule)]
+}
+
+/// Version of the layout, part of the cache file name.
+const VERSION: u32 = 1;
+
+/// The settings that make the bins' tensors (their cache key): the layout's version, the templates of Δ and
+/// of its errors, the nodes per shell panel, the rule, the correction's rules, the Legendre side (−1 for the
+/// largest), the width and the bins' centres (the effective triangles' tensors carry their own key).
+fn key(
+    set: &TriangleSet,
+    side: LegendreSide,
+    rule: &OneLoopRule,
+    rules: &[OneLoopRule; 2],
+) -> Vec<f64> {
+    let mut key = vec![
+        f64::from(VERSION),
+        DELTA_TEMPLATES as f64,
+        CHECK_TEMPLATES as f64,
+        CORRECTION_NODES as f64,
+    ];
+    for r in std::iter::once(rule).chain(rules) {
+        key.extend([r.radial as f64, r.mu as f64, r.phi as f64, r.q_min, r.q_max]);
+    }
+    key.push(match side {
+        LegendreSide::Largest => -1.0,
+        LegendreSide::Index(a) => a as f64,
+    });
+    key.push(set.width().unwrap_or(0.0));
+    key.extend(set.triangles().iter().flatten());
+    key
+}
+
+/// Appends a bin's correction: each folded family (Δ, its differences on one node fewer and on the check
+/// rule) as its row count r, row length, 5r keys (term, ℓ, 0, monomial, power) and r × length values; then
+/// the tree level's two node lists as their count and per node its weight, sides and tree rows.
+fn write_correction(c: &BinCorrection, out: &mut Vec<f64>) {
+    for rows in [&c.delta, &c.minus_nodes, &c.minus_rule] {
+        out.extend([rows.keys.len() as f64, rows.len as f64]);
+        for (term, idx) in &rows.keys {
+            out.push(*term as f64);
+            out.extend(idx.iter().map(|&i| f64::from(i)));
+        }
+        out.extend(rows.values.iter().map(|&x| f64::from(x)));
+    }
+    for nodes in &c.tree {
+        out.extend([nodes.weights.len() as f64, nodes.keys.len() as f64]);
+        for (w, k) in nodes.weights.iter().zip(&nodes.sides) {
+            out.push(*w);
+            out.extend(k);
+        }
+        out.extend(nodes.keys.iter().flatten().map(|&i| f64::from(i)));
+        out.extend(&nodes.values);
+    }
+}
+
+/// A bin's correction as [`write_correction`] wrote it.
+fn read_correction(r: &mut Reader) -> Option<BinCorrection> {
+    let mut folded = [DELTA_TEMPLATES, CHECK_TEMPLATES, CHECK_TEMPLATES].map(|m| {
+        let n = r.count(1 << 24)?;
+        let len = r.count(triples(m) + 1)?;
+        (len == triples(m)).then_some(())?;
+        let mut keys = Vec::with_capacity(n);
+        for key in r.take(5 * n)?.chunks_exact(5) {
+            let ok = key
+                .iter()
+                .all(|&x| x >= 0.0 && x.fract() == 0.0 && x < 65536.0);
+            (ok && key[0] < 5.0).then_some(())?;
+            keys.push((key[0] as usize, std::array::from_fn(|i| key[i + 1] as u16)));
+        }
+        let values = r.take(n * len)?.iter().map(|&x| x as f32).collect();
+        Some(FoldedRows { keys, values, len })
+    });
+    let mut tree = [0, 1].map(|_| {
+        let (n, rows) = (r.count(1 << 16)?, r.count(1 << 16)?);
+        let nodes = r.take(4 * n)?;
+        let keys = r
+            .take(4 * rows)?
+            .chunks_exact(4)
+            .map(|c| {
+                let ok = c
+                    .iter()
+                    .all(|&x| x >= 0.0 && x.fract() == 0.0 && x < 65536.0);
+                (ok && c[1] < 3.0).then(|| std::array::from_fn(|i| c[i] as u16))
+            })
+            .collect::<Option<Vec<[u16; 4]>>>()?;
+        Some(TreeNodes {
+            weights: nodes.chunks_exact(4).map(|c| c[0]).collect(),
+            sides: nodes.chunks_exact(4).map(|c| [c[1], c[2], c[3]]).collect(),
+            keys,
+            values: r.take(rows * n)?.to_vec(),
+        })
+    });
+    let mut take = |i: usize| folded[i].take();
+    let (delta, minus_nodes, minus_rule) = (take(0)?, take(1)?, take(2)?);
+    Some(BinCorrection {
+        delta,
+        minus_nodes,
+        minus_rule,
+        tree: [tree[0].take()?, tree[1].take()?],
+    })
+}
+
+/// Where a set's bins are evaluated: the effective triangles, the Legendre side's index, the nodes of Δ and
+/// of Δ on one node fewer per shell panel, and the largest side (the basis's lattice reaches it).
+struct Layout {
+    effective: Vec<[f64; 3]>,
+    indices: Vec<usize>,
+    nodes: Vec<[Nodes; 2]>,
+    k_max: f64,
+}
+
+impl Layout {
+    fn of(set: &TriangleSet, side: LegendreSide) -> Result<Self> {
+        if set.width().is_none() {
+            return Err(Error::InvalidChoice {
+                what: "a triangle set of points".into(),
+                reason: "bin averages need bins (shells of a width)".into(),
+            });
+        }
+        let bins = 0..set.len();
+        let effective: Vec<[f64; 3]> = bins.clone().map(|i| effective_triangle(set, i)).collect();
+        let indices = bins.clone().map(|i| set.legendre_index(i, side)).collect();
+        let nodes: Vec<[Nodes; 2]> = bins
+            .map(|i| {
+                [
+                    set.shapes(i, CORRECTION_NODES),
+                    set.shapes(i, CORRECTION_NODES - 1),
+                ]
+            })
+            .collect();
+        let k_max = nodes
+            .iter()
+            .flatten()
+            .flatten()
+            .flat_map(|(k, _)| *k)
+            .chain(effective.iter().flatten().copied())
+            .fold(0.0, f64::max);
+        Ok(Self {
+            effective,
+            indices,
+            nodes,
+            k_max,
         })
     }
 }

@@ -64,7 +64,7 @@ impl<'a> Reader<'a> {
     }
 
     /// Rows of length `len` with or without U.
-    fn rows(&mut self, len: usize, with_uv: bool) -> Option<Rows> {
+    pub(super) fn rows(&mut self, len: usize, with_uv: bool) -> Option<Rows> {
         let r = self.count(1 << 24)?;
         if self.count(1 << 24)? != len {
             return None;

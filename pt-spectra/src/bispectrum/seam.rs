@@ -182,3 +182,15 @@ cached_tensors!(
     ONE_LOOP_BASIS_STAGE,
     (triangles, side, rule)
 );
+cached_tensors!(
+    super::multipole_bins::MultipoleBinBasis,
+    (
+        &'a super::geometry::TriangleSet,
+        super::geometry::LegendreSide,
+        &'a super::one_loop::OneLoopRule,
+        &'a [super::one_loop::OneLoopRule; 2]
+    ),
+    "one-loop galaxy multipole bin tensors",
+    ONE_LOOP_BASIS_STAGE,
+    (set, side, rule, rules)
+);
