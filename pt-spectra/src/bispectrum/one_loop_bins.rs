@@ -86,6 +86,10 @@ impl BinnedLoopMultipoles {
             .map(|(m, c)| {
                 let mut ells = m.evaluate(bias)?;
                 let [main, nodes, rule] = c;
+                // the tree level's Δ is exact but for a stated approximation's bound (the tensors'
+                // resummed legs, `multipole_bins`: the damping's anisotropy also moves the monopole's
+                // wiggles into B₂, B₄, so every ℓ carries the monopole's bound too)
+                let monopole_bound = value(&main[0])?.tree.error;
                 for (l, b) in ells.iter_mut().enumerate() {
                     let (d, dn, dr) = (value(&main[l])?, value(&nodes[l])?, value(&rule[l])?);
                     let term = |x: &OneLoopGalaxy| {
@@ -97,6 +101,11 @@ impl BinnedLoopMultipoles {
                             x.b411.value,
                         ]
                     };
+                    let tree_error = if l == 0 {
+                        monopole_bound
+                    } else {
+                        d.tree.error + monopole_bound
+                    };
                     let (d, dn, dr) = (term(&d), term(&dn), term(&dr));
                     let terms = [
                         &mut b.tree,
@@ -107,7 +116,7 @@ impl BinnedLoopMultipoles {
                     ];
                     for (j, t) in terms.into_iter().enumerate() {
                         let error = if j == 0 {
-                            (d[0] - dn[0]).abs()
+                            (d[0] - dn[0]).abs() + tree_error
                         } else {
                             2.0 * ((d[j] - dn[j]).abs() + (d[j] - dr[j]).abs())
                         };
