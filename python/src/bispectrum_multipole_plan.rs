@@ -1,6 +1,7 @@
 //! `pt.OneLoopMultipolePlan`: the one-loop galaxy multipoles B0, B2, B4 planned for a triangle set, from the
 //! multipole tensors ([`pt_spectra::jobs::one_loop_multipole_tensors`], built once and cached), so that a
-//! call per spectrum, f and bias costs ~0.12 ms per triangle.
+//! call per spectrum, f and bias costs ~0.12 ms per triangle; over bins the multipole bin tensors
+//! ([`pt_spectra::jobs::one_loop_multipole_bin_tensors`]).
 
 use crate::bispectrum::fixed_rows;
 use crate::bispectrum_one_loop::{galaxy_bias, rule_of};
@@ -9,7 +10,10 @@ use crate::{detached, library_error};
 use numpy::IntoPyArray;
 use pt_spectra::bispectrum::bias_kernels::LoopBias;
 use pt_spectra::bispectrum::multipole_basis::MultipoleLoopBasis;
+use pt_spectra::bispectrum::multipole_bins::MultipoleBinBasis;
 use pt_spectra::bispectrum::one_loop_galaxy::OneLoopGalaxy;
+use pt_spectra::bispectrum::TriangleSet;
+use pt_spectra::precision::TwoLoopMethod;
 use pt_spectra::progress::Silent;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -21,16 +25,27 @@ use std::sync::Arc;
 /// then a call per linear spectrum, growth rate and bias costs ~0.12 ms per triangle. Where the tensors do
 /// not represent the spectrum (projection residual above the basis's limit: with `ir=True` the resummed
 /// spectrum often is) the call integrates directly and `loop_terms` says so.
+///
+/// `bin_width` [h/Mpc]: bins of three shells of that width centred on each triangle instead (the bin
+/// averages of `pt.one_loop_bispectrum(..., bin_width=...)`: each bin's effective triangle from the multipole
+/// tensors plus the bin average's departure from it from folded tensors, `k1_eff k2_eff k3_eff` in the
+/// result; ~0.15 ms per bin).
 #[pyclass(module = "pt_spectra._core", frozen)]
 pub struct OneLoopMultipolePlan {
-    tensors: Arc<MultipoleLoopBasis>,
+    tensors: Tensors,
+}
+
+/// The plan's tensors: of triangles, or of bins.
+enum Tensors {
+    Points(Arc<MultipoleLoopBasis>),
+    Bins(Arc<MultipoleBinBasis>),
 }
 
 #[pymethods]
 impl OneLoopMultipolePlan {
     #[new]
     #[pyo3(signature = (triangles, legendre_side="largest", q_min=1e-4, q_max=10.0, radial=12, mu=32, phi=24,
-        cache_dir=None))]
+        cache_dir=None, bin_width=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -42,21 +57,42 @@ impl OneLoopMultipolePlan {
         mu: usize,
         phi: usize,
         cache_dir: Option<std::path::PathBuf>,
+        bin_width: Option<f64>,
     ) -> PyResult<Self> {
         let rows = fixed_rows::<3>(triangles, "triangles", "k1, k2, k3")?;
         let rule = rule_of(q_min, q_max, radial, mu, phi);
         let side =
             pt_spectra::bispectrum::LegendreSide::by_name(legendre_side).map_err(library_error)?;
         let store = crate::Store::new(cache_dir);
-        let (tensors, _) = detached(py, || {
-            pt_spectra::jobs::one_loop_multipole_tensors(&rows, side, &rule, store.get(), &Silent)
+        let set = bin_width
+            .map(|width| TriangleSet::shells(rows.clone(), width))
+            .transpose()
+            .map_err(library_error)?;
+        let (tensors, _) = detached(py, || match &set {
+            None => pt_spectra::jobs::one_loop_multipole_tensors(
+                &rows,
+                side,
+                &rule,
+                store.get(),
+                &Silent,
+            )
+            .map(Tensors::Points),
+            Some(set) => pt_spectra::jobs::one_loop_multipole_bin_tensors(
+                set,
+                side,
+                &rule,
+                TwoLoopMethod::Basis,
+                store.get(),
+                &Silent,
+            )
+            .map(|t| Tensors::Bins(t.expect("method basis reads or builds"))),
         })?;
         Ok(Self { tensors })
     }
 
-    /// The number of triangles.
+    /// The number of triangles (or bins).
     fn __len__(&self) -> usize {
-        self.tensors.triangles().len()
+        self.triangles().len()
     }
 
     /// B0, B2, B4 at every triangle for the linear spectrum of the inputs (all matter, as
@@ -88,25 +124,49 @@ impl OneLoopMultipolePlan {
         let bias = galaxy_bias(py, b1, [b2, bs, b_gamma3], bias_convention, loop_bias)?
             .unwrap_or_else(LoopBias::matter);
         let inputs = Inputs::extract(linear, z, z_input, cosmology, eh)?;
-        let (((rows, source), f), _) = detached(py, || {
+        let (((rows, effective, source), f), _) = detached(py, || {
             let prepared = inputs.prepare(&[])?;
             let f = f.unwrap_or(prepared.growth_rate);
             let ir = ir
                 .then(|| pt_spectra::jobs::one_loop_ir_inputs(&prepared))
                 .transpose()?;
-            let out = pt_spectra::jobs::multipole_plan_rows(
-                &self.tensors,
-                &prepared.spectrum,
-                &bias,
-                f,
-                ir.as_ref(),
-            )?;
+            let p = &prepared.spectrum;
+            let out = match &self.tensors {
+                Tensors::Points(t) => {
+                    let (rows, source) =
+                        pt_spectra::jobs::multipole_plan_rows(t, p, &bias, f, ir.as_ref())?;
+                    (rows, None, source)
+                }
+                Tensors::Bins(t) => {
+                    let main = t.effective();
+                    let (binned, source) = pt_spectra::jobs::binned_plan_multipoles(
+                        Some(t),
+                        false,
+                        p,
+                        ir.as_ref(),
+                        t.set(),
+                        f,
+                        main.side(),
+                        main.rule(),
+                        &|_, _| {},
+                    )?;
+                    (binned.evaluate(&bias)?, Some(binned.effective), source)
+                }
+            };
             Ok((out, f))
         })?;
         let out = PyDict::new(py);
-        for (i, name) in ["k1", "k2", "k3"].iter().enumerate() {
-            let v: Vec<f64> = self.tensors.triangles().iter().map(|k| k[i]).collect();
-            out.set_item(*name, v.into_pyarray(py))?;
+        let columns =
+            |out: &Bound<'py, PyDict>, names: [&str; 3], k: &[[f64; 3]]| -> PyResult<()> {
+                for (i, name) in names.iter().enumerate() {
+                    let v: Vec<f64> = k.iter().map(|k| k[i]).collect();
+                    out.set_item(*name, v.into_pyarray(py))?;
+                }
+                Ok(())
+            };
+        columns(&out, ["k1", "k2", "k3"], self.triangles())?;
+        if let Some(k) = &effective {
+            columns(&out, ["k1_eff", "k2_eff", "k3_eff"], k)?;
         }
         let terms = |b: &OneLoopGalaxy| [b.tree, b.b222, b.b321_i, b.b321_ii, b.b411, b.total()];
         for (ell, l) in [0, 2, 4].iter().enumerate() {
@@ -121,10 +181,21 @@ impl OneLoopMultipolePlan {
             }
         }
         out.set_item("f", f)?;
-        out.set_item(
-            "loop_terms",
-            pt_spectra::jobs::describe_multipole_source(&source),
-        )?;
+        let loop_terms = match self.tensors {
+            Tensors::Points(_) => pt_spectra::jobs::describe_multipole_source(&source),
+            Tensors::Bins(_) => pt_spectra::jobs::describe_bin_source(&source),
+        };
+        out.set_item("loop_terms", loop_terms)?;
         Ok(out)
+    }
+}
+
+impl OneLoopMultipolePlan {
+    /// The triangles, or the bins' centres [h/Mpc].
+    fn triangles(&self) -> &[[f64; 3]] {
+        match &self.tensors {
+            Tensors::Points(t) => t.triangles(),
+            Tensors::Bins(t) => t.set().triangles(),
+        }
     }
 }

@@ -84,10 +84,9 @@ pub fn one_loop_bispectrum(
         ));
     }
     let ir = ir.unwrap_or(true);
-    if multipoles && (mu1.is_some() || (bin_width.is_some() && method == TwoLoopMethod::Basis)) {
+    if multipoles && mu1.is_some() {
         return Err(crate::value_error(
-            "multipoles=True averages over the orientations (no mu1); over bins (bin_width) it is direct \
-             (two_loop \"direct\" or \"auto\")",
+            "multipoles=True averages over the orientations (no mu1)",
         ));
     }
     if !multipoles && legendre_side != "largest" {
@@ -111,7 +110,15 @@ pub fn one_loop_bispectrum(
             let prepared = inputs.prepare(&[])?;
             let table = match &set {
                 Some(set) => pt_spectra::jobs::one_loop_galaxy_binned_multipoles_table(
-                    &prepared, set, &bias, f, side, ir, &rule, &Silent,
+                    &prepared,
+                    set,
+                    &bias,
+                    f,
+                    side,
+                    ir,
+                    &rule,
+                    (method, store.get()),
+                    &Silent,
                 )?,
                 None => pt_spectra::jobs::one_loop_galaxy_multipoles_table(
                     &prepared,

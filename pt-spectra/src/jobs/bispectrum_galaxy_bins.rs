@@ -3,18 +3,23 @@
 //! on a coarse loop rule ([`crate::bispectrum::one_loop_bins`]), as a table with its header.
 
 use super::bispectrum_galaxy::{ir_line, multipole_columns, one_loop_ir_inputs};
+use super::bispectrum_multipole_plan::{
+    binned_plan_multipoles, describe_bin_source, one_loop_multipole_bin_tensors,
+};
 use super::VERSION;
 use crate::bispectrum::bias_kernels::LoopBias;
 use crate::bispectrum::galaxy_counterterms_rsd::{
     redshift_counterterm_multipoles, N_REDSHIFT_CT, REDSHIFT_COUNTERTERMS,
 };
 use crate::bispectrum::one_loop::{OneLoopRule, PARTITION_POWER};
-use crate::bispectrum::one_loop_bins::{binned_multipoles, correction_rule, CORRECTION_NODES};
+use crate::bispectrum::one_loop_bins::{correction_rule, CORRECTION_NODES};
 use crate::bispectrum::{LegendreSide, TriangleSet};
 use crate::error::Result;
 use crate::output::{MethodNote, Table, WAVENUMBER};
+use crate::precision::TwoLoopMethod;
 use crate::progress::Progress;
 use crate::setup::Prepared;
+use crate::store::TableStore;
 
 /// The table of the multipoles of the one-loop galaxy bispectrum with `bias` averaged over the bins `set`
 /// (shells) in redshift space at growth rate `f` (default f(z)), the Legendre polynomial on `side`, IR-resummed
@@ -22,10 +27,12 @@ use crate::setup::Prepared;
 /// then the effective triangles `k1_eff k2_eff k3_eff`: the one-loop multipoles at each bin's effective
 /// triangle plus their departure from the bin average on a coarse loop rule, with its error in `err_`, the
 /// counterterm shapes' multipoles averaged over the bin ([`crate::bispectrum::one_loop_bins`]); each bin
-/// reported to `progress`.
+/// reported to `progress`. `method` basis reads or builds the multipole bin tensors
+/// ([`crate::bispectrum::multipole_bins`]), auto uses them if cached; where they do not represent the
+/// spectrum the bins are integrated directly (the header says which).
 ///
 /// # Errors
-/// As [`binned_multipoles`] and [`redshift_counterterm_multipoles`].
+/// As [`binned_plan_multipoles`] and [`redshift_counterterm_multipoles`].
 #[allow(clippy::too_many_arguments)]
 pub fn one_loop_galaxy_binned_multipoles_table(
     prepared: &Prepared,
@@ -35,15 +42,28 @@ pub fn one_loop_galaxy_binned_multipoles_table(
     side: LegendreSide,
     ir: bool,
     rule: &OneLoopRule,
+    (method, store): (TwoLoopMethod, &TableStore),
     progress: &dyn Progress,
 ) -> Result<Table> {
     let f = f.unwrap_or(prepared.growth_rate);
+    crate::cosmology::check_growth_rate(f)?;
     let p = &prepared.spectrum;
     let ir = ir.then(|| one_loop_ir_inputs(prepared)).transpose()?;
     let tick = |done: usize, total: usize| {
         progress.update(crate::bispectrum::seam::ONE_LOOP_STAGE, done, total);
     };
-    let binned = binned_multipoles(p, ir.as_ref(), set, f, side, rule, &tick)?;
+    let tensors = one_loop_multipole_bin_tensors(set, side, rule, method, store, progress)?;
+    let (binned, source) = binned_plan_multipoles(
+        tensors.as_deref(),
+        method == TwoLoopMethod::Auto,
+        p,
+        ir.as_ref(),
+        set,
+        f,
+        side,
+        rule,
+        &tick,
+    )?;
     let coarse = correction_rule(rule);
     let rows = binned.evaluate(bias)?;
     let n_shell = CORRECTION_NODES;
@@ -107,14 +127,13 @@ pub fn one_loop_galaxy_binned_multipoles_table(
              multipoles averaged over the bin ({n_shell} nodes per shell panel) {} (docs/bispectrum.md)",
             REDSHIFT_COUNTERTERMS.join(", ")
         ),
+        describe_bin_source(&source),
         "linear spectrum: all matter".into(),
     ];
     header.extend(prepared.description.iter().cloned());
     let mut t = Table::new(header);
-    t.methods.push(MethodNote::new(
-        "loop terms",
-        "direct (effective triangles)",
-    ));
+    t.methods
+        .push(MethodNote::new("loop terms", source.method()));
     multipole_columns(&mut t, set.triangles(), &rows, &shapes);
     for (i, name) in ["k1_eff", "k2_eff", "k3_eff"].iter().enumerate() {
         t.push(

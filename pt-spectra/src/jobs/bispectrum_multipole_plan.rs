@@ -5,12 +5,16 @@
 
 use crate::bispectrum::bias_kernels::LoopBias;
 use crate::bispectrum::multipole_basis::{MultipoleLoopBasis, TEMPLATES};
+use crate::bispectrum::multipole_bins::{
+    correction_rules, MultipoleBinBasis, CHECK_TEMPLATES, DELTA_TEMPLATES,
+};
 use crate::bispectrum::one_loop::OneLoopRule;
 use crate::bispectrum::one_loop_basis::{BispectrumLoopSource, PROJECTION_FACTOR};
+use crate::bispectrum::one_loop_bins::{binned_multipoles, BinnedLoopMultipoles};
 use crate::bispectrum::one_loop_galaxy::OneLoopGalaxy;
 use crate::bispectrum::one_loop_galaxy_multipoles::one_loop_galaxy_multipoles;
 use crate::bispectrum::one_loop_ir::one_loop_galaxy_multipoles_ir;
-use crate::bispectrum::{IrInputs, LegendreSide};
+use crate::bispectrum::{IrInputs, LegendreSide, TriangleSet};
 use crate::error::{Error, Result};
 use crate::linear::LinearSpectrum;
 use crate::precision::TwoLoopMethod;
@@ -145,4 +149,98 @@ pub fn multipole_plan_rows(
         })
         .collect::<Result<Vec<_>>>()?;
     Ok((rows, source))
+}
+
+/// The multipole bin tensors of the bins `set` (shells; Legendre polynomial on `side`, loop `rule`) as
+/// `method` asks: basis reads or builds them (once: the effective triangles' ~190 s per bin and core at the
+/// default rule, and each bin's ~64 node triangles on the correction's coarse rules, ~0.75 s each), auto
+/// reads them if cached, direct none.
+///
+/// # Errors
+/// A set of points; a bin centre that does not close (named), a bad side or rule; the store's errors.
+pub fn one_loop_multipole_bin_tensors(
+    set: &TriangleSet,
+    side: LegendreSide,
+    rule: &OneLoopRule,
+    method: TwoLoopMethod,
+    store: &TableStore,
+    progress: &dyn Progress,
+) -> Result<Option<Arc<MultipoleBinBasis>>> {
+    if set.width().is_none() {
+        return Err(Error::InvalidChoice {
+            what: "a triangle set of points".into(),
+            reason: "bin averages need bins (shells of a width)".into(),
+        });
+    }
+    check_triangles(set.triangles(), side, rule)?;
+    let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
+        MultipoleBinBasis::build(set, side, rule, tick).expect("bins, side and rule checked")
+    };
+    store.for_method::<MultipoleBinBasis>(
+        method,
+        (set, side, rule, &correction_rules(rule)),
+        build,
+        progress,
+    )
+}
+
+/// The binned multipoles per bias monomial of the bins `set` for the spectrum `p` (resummed with `ir`) at
+/// growth rate `f`: from `tensors` if given and they represent the loops' spectrum (P, or P_LO with `ir`),
+/// else directly on `rule` ([`binned_multipoles`], `tick` per bin; `uncached` says why there are no
+/// tensors: auto found none cached), with how the loop terms were computed.
+///
+/// # Errors
+/// As [`MultipoleBinBasis::evaluate_projected`] and [`binned_multipoles`].
+#[allow(clippy::too_many_arguments)]
+pub fn binned_plan_multipoles(
+    tensors: Option<&MultipoleBinBasis>,
+    uncached: bool,
+    p: &LinearSpectrum,
+    ir: Option<&IrInputs>,
+    set: &TriangleSet,
+    f: f64,
+    side: LegendreSide,
+    rule: &OneLoopRule,
+    tick: &dyn Fn(usize, usize),
+) -> Result<(BinnedLoopMultipoles, BispectrumLoopSource)> {
+    let source = match tensors {
+        Some(t) => {
+            let (binned, projected) = t.evaluate_projected(p, f, ir)?;
+            let max = crate::loops::basis::MAX_RESIDUAL;
+            if projected.residual <= max {
+                let source = BispectrumLoopSource::Basis {
+                    functions: TEMPLATES,
+                    residual: projected.residual,
+                };
+                return Ok((binned, source));
+            }
+            BispectrumLoopSource::Fallback {
+                residual: projected.residual,
+                max_residual: max,
+            }
+        }
+        None if uncached => BispectrumLoopSource::DirectUncached,
+        None => BispectrumLoopSource::Direct,
+    };
+    let binned = binned_multipoles(p, ir, set, f, side, rule, tick)?;
+    Ok((binned, source))
+}
+
+/// The header line of how the binned multipoles' loop terms were computed.
+pub fn describe_bin_source(source: &BispectrumLoopSource) -> String {
+    match source {
+        BispectrumLoopSource::Direct => "loop terms: direct integration".into(),
+        BispectrumLoopSource::DirectUncached => "loop terms: direct integration (method auto: no multipole \
+            bin tensors cached for these bins, side and rule; method basis builds them once, ~190 s per bin \
+            and core at the default rule, then ~0.15 ms per bin with f free)"
+            .into(),
+        BispectrumLoopSource::Basis { residual, .. } => format!(
+            "loop terms: multipole bin tensors, f free: the effective triangles' on {TEMPLATES} SVD templates \
+             of the CAMB basis, the correction Delta's loops on the first {DELTA_TEMPLATES} (its error \
+             estimates' on {CHECK_TEMPLATES}), the tree level's Delta exact (with IR: legs damped at \
+             mu^2 = 1/3, the damping's range in err_); projection residual {residual:.1e}; err_ includes \
+             {PROJECTION_FACTOR} x residual x (sum of |loop terms|)"
+        ),
+        s => s.describe(),
+    }
 }

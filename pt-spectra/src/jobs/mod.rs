@@ -73,7 +73,8 @@ pub use bispectrum_galaxy::{
 };
 pub use bispectrum_galaxy_bins::one_loop_galaxy_binned_multipoles_table;
 pub use bispectrum_multipole_plan::{
-    describe_source as describe_multipole_source, multipole_plan_rows, multipoles_from_tensors,
+    binned_plan_multipoles, describe_bin_source, describe_source as describe_multipole_source,
+    multipole_plan_rows, multipoles_from_tensors, one_loop_multipole_bin_tensors,
     one_loop_multipole_tensors,
 };
 pub use ept::{

@@ -28,8 +28,8 @@ fn one_loop_multipoles_refusals() {
     fails_naming(&[
         (with(&["--mu1", "0.5"]), "--mu1"),
         (
-            with(&["--two-loop", "basis", "--bin-width", "0.01"]),
-            "not over bins",
+            with(&["--two-loop", "basis", "--bin-width", "0.01", "--f", "2.5"]),
+            "f",
         ),
         (with(&["--legendre-side", "4"]), "valid: largest, 1, 2, 3"),
         (with(&["--f", "3"]), "f"),

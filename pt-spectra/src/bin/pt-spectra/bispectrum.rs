@@ -122,7 +122,7 @@ pub struct Args {
     /// SPT: B_tree, B222, B321_I, B321_II, B411 at the points of --triangles, of matter or, with
     /// --b1/--b2/--bs/--b-gamma3/--loop-bias, of galaxies; real space, one orientation with --mu1, or
     /// the multipoles with --multipoles; the counterterm shapes as columns in real space and with
-    /// --multipoles; no bins yet; in real space --two-loop basis
+    /// --multipoles; bins with --multipoles; in real space --two-loop basis
     /// makes it ~10 us (matter) or ~0.15 ms (galaxies) per triangle after a one-off ~0.7 s (4 s) per
     /// triangle and core). The galaxy bispectrum's BAO are IR-resummed unless --no-ir.
     #[arg(long = "loop", value_name = "N", default_value_t = 0)]
@@ -147,7 +147,9 @@ pub struct Args {
     /// orientation's cost (~35 s per triangle on 2 cores). With bins (--bin-width or --k-edges): each
     /// bin at its effective triangle (mean sides) plus the departure of the bin average from it on a
     /// coarse loop rule (exact for the tree level), its error in err_; ~33 s per bin on one core
-    /// (docs/bispectrum.md).
+    /// (docs/bispectrum.md). --two-loop basis: from the multipole tensors (of the triangles, or of the
+    /// bins), f free, ~0.1-0.15 ms per triangle or bin after a one-off ~190 s per triangle and core at
+    /// the default rule (cached; auto uses them if cached).
     #[arg(long, conflicts_with = "mu1")]
     multipoles: bool,
     /// --loop 1: CLASS-PT's b_Gamma3 (Gamma3 = G2(Phi_g) - G2(Phi_v)), with --b1, --b2, --bs.
@@ -290,12 +292,6 @@ fn one_loop(args: &Args) -> Result<pt_spectra::output::Table> {
 fn binned_multipoles(args: &Args) -> Result<pt_spectra::output::Table> {
     let set = triangles(args)?;
     let loaded = args.spectrum.load()?;
-    if loaded.precision.two_loop == pt_spectra::precision::TwoLoopMethod::Basis {
-        bail!(
-            "--two-loop basis: the one-loop multipole tensors are built at the triangles given, not over \
-             bins (give --two-loop direct or auto with --bin-width/--k-edges)"
-        );
-    }
     let bias =
         galaxy_bias(args)?.unwrap_or_else(pt_spectra::bispectrum::bias_kernels::LoopBias::matter);
     pt_spectra::jobs::one_loop_galaxy_binned_multipoles_table(
@@ -306,6 +302,7 @@ fn binned_multipoles(args: &Args) -> Result<pt_spectra::output::Table> {
         LegendreSide::by_name(&args.legendre_side).context("--legendre-side")?,
         !args.no_ir,
         &OneLoopRule::default(),
+        (loaded.precision.two_loop, &loaded.store),
         &crate::progress::Bars::default(),
     )
     .context("--loop 1 --multipoles with bins")
