@@ -138,6 +138,8 @@ impl MultipoleLoopBasis {
                 let (m, d) = (s.m, DIFF_TEMPLATES.min(s.m));
                 t.b222.make_single(triples(m), triples(d));
                 t.b321.make_single(pairs(m), pairs(d));
+                t.j.make_single_renormalised(&t.sigma);
+                t.l.make_single_renormalised(&t.sigma);
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, triangles.len());
                 t
             })
@@ -221,7 +223,13 @@ impl MultipoleLoopBasis {
         let no = ORIENTATION_RULE.0 * ORIENTATION_RULE.1;
         let (mut sides, mut orientations, mut tensors) = (Vec::new(), Vec::new(), Vec::new());
         for _ in triangles {
-            let (s, o, t) = r.triangle(TEMPLATES, no)?;
+            let (s, o, mut t) = r.triangle(TEMPLATES, no)?;
+            // files written when J and L were kept bare in f64 (their flag says so)
+            for family in [&mut t.j, &mut t.l] {
+                if family.single.0.is_empty() && !family.index.is_empty() {
+                    family.make_single_renormalised(&t.sigma);
+                }
+            }
             sides.push(s);
             orientations.push(o);
             tensors.push(t);
@@ -365,6 +373,7 @@ impl MultipoleLoopBasis {
         let names = Names::new();
         let single = |v: Vec<f64>| -> Vec<f32> { v.iter().map(|&x| x as f32).collect() };
         let (c2_32, c3_32) = (single(pair_products(c)), single(triple_products(c)));
+        let c_32 = single(c.to_vec());
         let fp: [f64; F_NODES] = std::array::from_fn(|i| f.powi(i as i32));
         let bound = PROJECTION_FACTOR * residual;
         self.triangles
@@ -374,7 +383,7 @@ impl MultipoleLoopBasis {
                 let m = c.len();
                 let ph: [f64; 3] = std::array::from_fn(|a| dot(&t.sides[a * m..(a + 1) * m], c));
                 let pk = k.map(|v| p.eval(v));
-                let sigma = [dot(&t.sigma[0], c), dot(&t.sigma[1], c)];
+                let sigma = dot(&t.sigma[0], c);
                 // the products of the two sides other than s, for the loop terms and the tree level
                 let other = |x: &[f64; 3], s: usize| x[(s + 1) % 3] * x[(s + 2) % 3];
                 let mut acc = Acc::new(&names);
@@ -388,11 +397,11 @@ impl MultipoleLoopBasis {
                     acc.add(idx, 2, w * fine, w * diff);
                 }
                 for (family, (term, uv_term)) in [(&t.j, (3, 5)), (&t.l, (4, 6))] {
-                    for ((idx, (fine, diff)), &u) in rows(family, m).zip(&family.uv) {
+                    // the rows hold J − U s: the renormalised terms
+                    for ((idx, (jf, jd)), &u) in single_rows(family, &c_32, &c_32).zip(&family.uv) {
                         let w = fp[idx[3] as usize] * other(&ph, idx[1] as usize);
-                        let (jf, jd) = (dot(fine, c), dot(diff, c));
-                        acc.add(idx, term, w * (jf - u * sigma[0]), w * (jd - u * sigma[1]));
-                        acc.add(idx, uv_term, w * u * sigma[0], 0.0);
+                        acc.add(idx, term, w * jf, w * jd);
+                        acc.add(idx, uv_term, w * u * sigma, 0.0);
                     }
                 }
                 match ir {

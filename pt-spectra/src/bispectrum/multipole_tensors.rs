@@ -118,7 +118,8 @@ pub(super) struct Rows {
     /// U per row (B₃₂₁ᴵᴵ, B₄₁₁; empty otherwise).
     pub(super) uv: Vec<f64>,
     /// `fine` and `diff` in f32 once [`Rows::make_single`] has moved them there (the long rows of B₂₂₂ and
-    /// B₃₂₁ᴵ, read at every evaluation: half the bytes), `diff` on the first [`DIFF_TEMPLATES`] templates.
+    /// B₃₂₁ᴵ, read at every evaluation: half the bytes), `diff` on the first [`DIFF_TEMPLATES`] templates;
+    /// for B₃₂₁ᴵᴵ and B₄₁₁ renormalised ([`Rows::make_single_renormalised`]).
     pub(super) single: (Vec<f32>, Vec<f32>),
 }
 
@@ -135,6 +136,19 @@ impl Rows {
         self.single = (single(&self.fine), diff);
         self.fine.clear();
         self.diff.clear();
+    }
+
+    /// [`make_single`](Self::make_single) of B₃₂₁ᴵᴵ's or B₄₁₁'s vectors (length m) renormalised first:
+    /// J − U s on the rule and J_diff − U s_diff on rule − half rule (`sigma`: σ²'s vectors), so that f32
+    /// rounds the renormalised term, not the bare one that nearly cancels against U σ².
+    pub(super) fn make_single_renormalised(&mut self, sigma: &[Vec<f64>; 2]) {
+        let m = sigma[0].len();
+        for (slot, s) in [(&mut self.fine, &sigma[0]), (&mut self.diff, &sigma[1])] {
+            for (row, u) in slot.chunks_exact_mut(m).zip(&self.uv) {
+                row.iter_mut().zip(s).for_each(|(j, s)| *j -= u * s);
+            }
+        }
+        self.make_single(m, m);
     }
 
     /// Keeps the powers of f of `node` (fine) and `half` values laid out [`ells`][key][f node][monomial][len]
