@@ -5,7 +5,9 @@
 //! weights each), the templates at the sides (3m), σ²'s two vectors (2m), then the families B₂₂₂, B₃₂₁ᴵ,
 //! J, L, the tree level and the tree level per orientation, each as: the number of rows r, the row length
 //! ℓ, whether its values are f32 (0 or 1), the length d of the rows of rule − half rule (ℓ for f64 rows), 4r
-//! indices, then the values on the rule (rℓ) and rule − half rule (rd) and U (r or 0).
+//! indices, then the values on the rule (rℓ) and rule − half rule (rd) and U (r or 0). J and L in f32
+//! (flag 1) hold the renormalised rows J − U s; in f64 (flag 0, files written before they were stored in
+//! f32) the bare J, renormalised and moved to f32 when read.
 
 use super::multipole_tensors::{Rows, TriangleTensors};
 use super::one_loop::Vec3;
