@@ -86,6 +86,29 @@ fn one_loop_multipole_bins(crit: &mut Criterion) {
             })
         },
     );
+    let split = pt_spectra::ir::WiggleSplit::new().unwrap();
+    let q_min = pt_spectra::precision::Precision::default().q_min;
+    let inputs: Vec<_> = spectra
+        .iter()
+        .map(|p| pt_spectra::bispectrum::IrInputs::split(p, &split, q_min).unwrap())
+        .collect();
+    crit.bench_function(
+        &format!(
+            "bispectrum/one-loop galaxy B0 B2 B4 of {} Nseries bins, new spectrum and f, multipole bin \
+             tensors, IR",
+            set.len()
+        ),
+        |b| {
+            b.iter(|| {
+                i += 1;
+                let at = i as usize % spectra.len();
+                let (m, _) = bins
+                    .evaluate_projected(&spectra[at], f(i), Some(&inputs[at]))
+                    .unwrap();
+                black_box(m.evaluate(&bias).unwrap())
+            })
+        },
+    );
     crit.bench_function(
         &format!(
             "bispectrum/one-loop galaxy B0 B2 B4 of {} Nseries bins: the effective triangles only",

@@ -25,11 +25,12 @@ use super::multipole_cache::Reader;
 use super::multipole_tensors::{triangle_tensors, Products, Rows, TriangleTensors, F_NODES};
 use super::one_loop::OneLoopRule;
 use super::one_loop_bins::{
-    check_rule, correction_rule, effective_triangle, BinnedLoopMultipoles, CORRECTION_NODES,
+    check_rule, correction_rule, effective_triangle, require_bins, BinnedLoopMultipoles,
+    CORRECTION_NODES,
 };
 use super::one_loop_galaxy_poly::GalaxyLoopPolynomial;
 use super::resum::IrInputs;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::ir::sigma2_total;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::{
@@ -178,7 +179,7 @@ impl MultipoleBinBasis {
     /// as the tree level's), the loop `rule` at the effective triangles; `progress(done, total)` per bin.
     ///
     /// # Errors
-    /// [`Error::InvalidChoice`] for a set of points; as [`MultipoleLoopBasis::build`].
+    /// [`crate::error::Error::InvalidChoice`] for a set of points; as [`MultipoleLoopBasis::build`].
     pub fn build(
         set: &TriangleSet,
         side: LegendreSide,
@@ -520,30 +521,19 @@ fn read_correction(r: &mut Reader) -> Option<BinCorrection> {
         let n = r.count(1 << 24)?;
         let len = r.count(triples(m) + 1)?;
         (len == triples(m)).then_some(())?;
-        let mut keys = Vec::with_capacity(n);
-        for key in r.take(5 * n)?.chunks_exact(5) {
-            let ok = key
-                .iter()
-                .all(|&x| x >= 0.0 && x.fract() == 0.0 && x < 65536.0);
-            (ok && key[0] < 5.0).then_some(())?;
-            keys.push((key[0] as usize, std::array::from_fn(|i| key[i + 1] as u16)));
-        }
+        let keys = r
+            .indices::<5>(n)?
+            .into_iter()
+            .map(|k| (k[0] < 5).then(|| (usize::from(k[0]), [k[1], k[2], k[3], k[4]])))
+            .collect::<Option<Vec<_>>>()?;
         let values = r.take(n * len)?.iter().map(|&x| x as f32).collect();
         Some(FoldedRows { keys, values, len })
     });
     let mut tree = [0, 1].map(|_| {
         let (n, rows) = (r.count(1 << 16)?, r.count(1 << 16)?);
         let nodes = r.take(4 * n)?;
-        let keys = r
-            .take(4 * rows)?
-            .chunks_exact(4)
-            .map(|c| {
-                let ok = c
-                    .iter()
-                    .all(|&x| x >= 0.0 && x.fract() == 0.0 && x < 65536.0);
-                (ok && c[1] < 3.0).then(|| std::array::from_fn(|i| c[i] as u16))
-            })
-            .collect::<Option<Vec<[u16; 4]>>>()?;
+        let keys = r.indices::<4>(rows)?;
+        keys.iter().all(|k| k[1] < 3).then_some(())?;
         Some(TreeNodes {
             weights: nodes.chunks_exact(4).map(|c| c[0]).collect(),
             sides: nodes.chunks_exact(4).map(|c| [c[1], c[2], c[3]]).collect(),
@@ -572,12 +562,7 @@ struct Layout {
 
 impl Layout {
     fn of(set: &TriangleSet, side: LegendreSide) -> Result<Self> {
-        if set.width().is_none() {
-            return Err(Error::InvalidChoice {
-                what: "a triangle set of points".into(),
-                reason: "bin averages need bins (shells of a width)".into(),
-            });
-        }
+        require_bins(set)?;
         let bins = 0..set.len();
         let effective: Vec<[f64; 3]> = bins.clone().map(|i| effective_triangle(set, i)).collect();
         let indices = bins.clone().map(|i| set.legendre_index(i, side)).collect();

@@ -65,6 +65,19 @@ impl<'a> Reader<'a> {
         (v >= 0.0 && v.fract() == 0.0 && v < max as f64).then_some(v as usize)
     }
 
+    /// `n` indices of `N` entries each, every entry an integer in [0, 65536).
+    pub(super) fn indices<const N: usize>(&mut self, n: usize) -> Option<Vec<[u16; N]>> {
+        self.take(N * n)?
+            .chunks_exact(N)
+            .map(|c| {
+                let ok = c
+                    .iter()
+                    .all(|&x| x >= 0.0 && x.fract() == 0.0 && x < 65536.0);
+                ok.then(|| std::array::from_fn(|i| c[i] as u16))
+            })
+            .collect()
+    }
+
     /// Rows of length `len` with or without U.
     pub(super) fn rows(&mut self, len: usize, with_uv: bool) -> Option<Rows> {
         let r = self.count(1 << 24)?;
@@ -73,16 +86,7 @@ impl<'a> Reader<'a> {
         }
         let single = self.count(2)? == 1;
         let diff_len = self.count(len + 1)?;
-        let index = self
-            .take(4 * r)?
-            .chunks_exact(4)
-            .map(|c| {
-                let ok = c
-                    .iter()
-                    .all(|&x| x >= 0.0 && x.fract() == 0.0 && x < 65536.0);
-                ok.then(|| std::array::from_fn(|i| c[i] as u16))
-            })
-            .collect::<Option<Vec<[u16; 4]>>>()?;
+        let index = self.indices::<4>(r)?;
         let fine = self.take(r * len)?.to_vec();
         let diff = self.take(r * diff_len)?.to_vec();
         let uv = if with_uv {

@@ -139,6 +139,20 @@ pub fn effective_triangle(set: &TriangleSet, i: usize) -> [f64; 3] {
         })
 }
 
+/// That `set` is bins (shells of a width), as bin averages need.
+///
+/// # Errors
+/// [`Error::InvalidChoice`] for a set of points.
+pub fn require_bins(set: &TriangleSet) -> Result<()> {
+    match set.width() {
+        Some(_) => Ok(()),
+        None => Err(Error::InvalidChoice {
+            what: "a triangle set of points".into(),
+            reason: "bin averages need bins (shells of a width)".into(),
+        }),
+    }
+}
+
 /// Σ_n w_n M_ℓ(k_n) − M_ℓ(k_eff) on `rule` with `n` nodes per shell panel of bin `i` (module docs).
 #[allow(clippy::too_many_arguments)]
 fn correction(
@@ -181,12 +195,7 @@ pub fn binned_multipoles(
     rule: &OneLoopRule,
     tick: &dyn Fn(usize, usize),
 ) -> Result<BinnedLoopMultipoles> {
-    if set.width().is_none() {
-        return Err(Error::InvalidChoice {
-            what: "a triangle set of points".into(),
-            reason: "bin averages need bins (shells of a width)".into(),
-        });
-    }
+    require_bins(set)?;
     let (coarse, check) = (correction_rule(rule), check_rule(rule));
     let mut effective = Vec::with_capacity(set.len());
     let mut at_effective = Vec::with_capacity(set.len());

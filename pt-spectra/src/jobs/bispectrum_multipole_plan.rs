@@ -166,12 +166,7 @@ pub fn one_loop_multipole_bin_tensors(
     store: &TableStore,
     progress: &dyn Progress,
 ) -> Result<Option<Arc<MultipoleBinBasis>>> {
-    if set.width().is_none() {
-        return Err(Error::InvalidChoice {
-            what: "a triangle set of points".into(),
-            reason: "bin averages need bins (shells of a width)".into(),
-        });
-    }
+    crate::bispectrum::one_loop_bins::require_bins(set)?;
     check_triangles(set.triangles(), side, rule)?;
     let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
         MultipoleBinBasis::build(set, side, rule, tick).expect("bins, side and rule checked")

@@ -132,3 +132,64 @@ fn resummed_multipole_tensors_against_direct() {
         }
     }
 }
+
+/// The bins from tensors (`MultipoleBinBasis`: the effective triangle's tensors plus the folded correction)
+/// against the direct bins (`binned_multipoles`, the same rules) on spectra not in the training set: one
+/// Nseries-like bin of width 0.01 h/Mpc, f = 0.7, without IR; every |ΔB_ℓ| ≤ 1e-3 of |B₀| and within the
+/// stated error (the issue's ≤ 1e-3 of direct for the binned multipoles). Prints the table of
+/// docs/bispectrum.md.
+#[test]
+#[ignore = "2 min: the accuracy of the multipole bin tensors (run with --ignored)"]
+fn multipole_bins_against_direct_bins_on_spectra_not_trained_on() {
+    use pt_spectra::bispectrum::multipole_bins::MultipoleBinBasis;
+    use pt_spectra::bispectrum::one_loop_bins::binned_multipoles;
+    use pt_spectra::bispectrum::TriangleSet;
+    let rule = OneLoopRule {
+        radial: 2,
+        mu: 4,
+        phi: 3,
+        ..OneLoopRule::default()
+    };
+    let set = TriangleSet::shells(vec![[0.035, 0.055, 0.065]], 0.01).unwrap();
+    let bins = MultipoleBinBasis::build(&set, LegendreSide::Largest, &rule, &|_, _| {}).unwrap();
+    let bias = LoopBias::from_class_pt(1.8, -0.4, -0.3, 0.2);
+    let f = 0.7;
+    let names = [
+        "planck2018_z0.0.dat",
+        "camb_heldout_0.dat",
+        "camb_w0wa_z1.0.dat",
+    ];
+    println!(
+        "bins: spectrum                          residual   worst |ΔB_l|/|B0|   worst |ΔB_l|/error"
+    );
+    for (name, p) in spectra()
+        .into_iter()
+        .filter(|(n, _)| names.contains(&n.as_str()))
+    {
+        let (fast, projection) = bins.evaluate_projected(&p, f, None).unwrap();
+        let direct =
+            binned_multipoles(&p, None, &set, f, LegendreSide::Largest, &rule, &|_, _| {}).unwrap();
+        let (a, b) = (
+            fast.evaluate(&bias).unwrap(),
+            direct.evaluate(&bias).unwrap(),
+        );
+        let b0 = b[0][0].total().value.abs();
+        let (mut rel, mut of_error) = (0.0f64, 0.0f64);
+        for ell in 0..3 {
+            let (x, y) = (a[0][ell].total(), b[0][ell].total());
+            let d = (x.value - y.value).abs();
+            rel = rel.max(d / b0);
+            of_error = of_error.max(d / x.error);
+        }
+        println!(
+            "bins: {name:<34} {:9.2e} {rel:12.2e} {of_error:16.2}",
+            projection.residual
+        );
+        assert!(projection.residual <= pt_spectra::loops::basis::MAX_RESIDUAL);
+        assert!(rel <= 1e-3, "{name}: {rel} of B0");
+        assert!(
+            of_error <= 1.0,
+            "{name}: beyond the stated error ({of_error})"
+        );
+    }
+}
