@@ -15,8 +15,9 @@
 //! weighted sum over the bin's nodes is one such row. Δ is ≤ 6.3e-3 of B₀ on the Nseries bins, so it is kept
 //! on the first [`DELTA_TEMPLATES`] templates (their truncation leaves ~1e-2 of Δ, ~1e-4 of B₀), and its two
 //! error estimates (Δ on one node fewer per shell panel, Δ on the check rule; [`super::one_loop_bins`]) as
-//! their differences from Δ on the first [`CHECK_TEMPLATES`]. The tree level's Δ is exact: each node
-//! triangle's tree rows (numbers per power of f) with the true P at its sides.
+//! their differences from Δ on the first [`CHECK_TEMPLATES`] (in bfloat16: an error's estimate). The tree
+//! level's Δ is exact: the node triangles' tree rows (numbers per power of f) with the true P at their sides,
+//! one matrix per side.
 
 use super::geometry::{LegendreSide, TriangleSet};
 use super::ir_legs::leading_order_spectrum;
@@ -36,7 +37,7 @@ use crate::linear::LinearSpectrum;
 use crate::loops::basis::{
     after_key, cache_file_name, pair_index, triple_index, triple_products, Projection,
 };
-use crate::simd::{matvec, matvec_f32};
+use crate::simd::{from_bf16, matvec, matvec_bf16, matvec_f32, to_bf16};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -53,33 +54,56 @@ type Folded = BTreeMap<(usize, [u16; 4]), Vec<f64>>;
 /// A bin's node triangles and weights.
 type Nodes = Vec<([f64; 3], f64)>;
 
-/// [`Folded`]'s rows in f32 as one matrix (a row of `len` values per key), contracted by one
-/// matrix–vector product.
+/// [`Folded`]'s rows as one matrix (a row of `len` values per key), contracted by one matrix–vector
+/// product: in f32 (Δ), or in bfloat16 (`half`: the error estimates' differences, an error of an error,
+/// rounded to 2^-9 of each entry).
 #[derive(Debug, Clone, PartialEq, Default)]
 struct FoldedRows {
     keys: Vec<(usize, [u16; 4])>,
     values: Vec<f32>,
+    half: Vec<u16>,
     len: usize,
 }
 
 impl FoldedRows {
-    fn new(folded: Folded, len: usize) -> Self {
+    fn new(folded: Folded, len: usize, bf16: bool) -> Self {
         let mut rows = Self {
             len,
             ..Self::default()
         };
         for (key, v) in folded {
             rows.keys.push(key);
-            rows.values.extend(v.iter().map(|&x| x as f32));
+            rows.push_values(v.iter().map(|&x| x as f32), bf16);
         }
         rows
+    }
+
+    fn push_values(&mut self, v: impl Iterator<Item = f32>, bf16: bool) {
+        if bf16 {
+            self.half.extend(v.map(to_bf16));
+        } else {
+            self.values.extend(v);
+        }
+    }
+
+    /// The values as f32, whichever the storage.
+    fn values_f32(&self) -> Vec<f32> {
+        if self.half.is_empty() {
+            self.values.clone()
+        } else {
+            self.half.iter().map(|&h| from_bf16(h)).collect()
+        }
     }
 
     /// Adds `sign` × each row contracted with the products `x` (f32, `len`) × f^power to `acc`.
     fn add_to(&self, acc: &mut Acc, x: &[f32], fp: &[f64; F_NODES], sign: f64, out: &mut Vec<f64>) {
         out.clear();
         out.resize(self.keys.len(), 0.0);
-        matvec_f32(&self.values, x, out);
+        if self.half.is_empty() {
+            matvec_f32(&self.values, x, out);
+        } else {
+            matvec_bf16(&self.half, x, out);
+        }
         for ((term, idx), v) in self.keys.iter().zip(out.iter()) {
             acc.add(idx, *term, sign * fp[idx[3] as usize] * v, 0.0);
         }
@@ -107,9 +131,43 @@ struct TreeNodes {
     keys: Vec<[u16; 4]>,
     /// Row-major, one value per node.
     values: Vec<f64>,
+    /// The distinct side lengths of the nodes (a shell's few Gauss nodes recur across its triangles)
+    /// and each node's sides as indices into them: the legs are evaluated once per distinct k.
+    distinct: Vec<f64>,
+    at: Vec<[usize; 3]>,
 }
 
 impl TreeNodes {
+    /// The nodes with their weights, sides and row matrix, and the distinct sides found.
+    fn with_rows(
+        weights: Vec<f64>,
+        sides: Vec<[f64; 3]>,
+        keys: Vec<[u16; 4]>,
+        values: Vec<f64>,
+    ) -> Self {
+        let mut distinct: Vec<f64> = Vec::new();
+        let at = sides
+            .iter()
+            .map(|k| {
+                k.map(|v| match distinct.iter().position(|&d| d == v) {
+                    Some(i) => i,
+                    None => {
+                        distinct.push(v);
+                        distinct.len() - 1
+                    }
+                })
+            })
+            .collect();
+        Self {
+            weights,
+            sides,
+            keys,
+            values,
+            distinct,
+            at,
+        }
+    }
+
     fn new(nodes: Vec<(f64, [f64; 3], Rows)>) -> Self {
         let mut rows: BTreeMap<[u16; 4], Vec<f64>> = BTreeMap::new();
         for (n, (_, _, r)) in nodes.iter().enumerate() {
@@ -118,12 +176,12 @@ impl TreeNodes {
                 rows.entry(key).or_insert_with(|| vec![0.0; nodes.len()])[n] += v;
             }
         }
-        Self {
-            weights: nodes.iter().map(|n| n.0).collect(),
-            sides: nodes.iter().map(|n| n.1).collect(),
-            keys: rows.keys().map(|k| [k[1], k[0], k[2], k[3]]).collect(),
-            values: rows.into_values().flatten().collect(),
-        }
+        Self::with_rows(
+            nodes.iter().map(|n| n.0).collect(),
+            nodes.iter().map(|n| n.1).collect(),
+            rows.keys().map(|k| [k[1], k[0], k[2], k[3]]).collect(),
+            rows.into_values().flatten().collect(),
+        )
     }
 
     /// Adds the tree level's Δ with the legs `leg(k)` to `acc` in `slot`.
@@ -136,7 +194,8 @@ impl TreeNodes {
         out: &mut Vec<f64>,
     ) {
         let n = self.weights.len();
-        let pk: Vec<[f64; 3]> = self.sides.iter().map(|k| k.map(leg)).collect();
+        let legs_k: Vec<f64> = self.distinct.iter().map(|&k| leg(k)).collect();
+        let pk: Vec<[f64; 3]> = self.at.iter().map(|a| a.map(|i| legs_k[i])).collect();
         let mut start = 0;
         for s in 0..3 {
             let rows = self.keys[start..]
@@ -262,12 +321,12 @@ impl MultipoleBinBasis {
                             (*key, d)
                         })
                         .collect();
-                    FoldedRows::new(d, triples(CHECK_TEMPLATES))
+                    FoldedRows::new(d, triples(CHECK_TEMPLATES), true)
                 };
                 let c = BinCorrection {
                     minus_nodes: minus(&fewer),
                     minus_rule: minus(&checked),
-                    delta: FoldedRows::new(delta, triples(DELTA_TEMPLATES)),
+                    delta: FoldedRows::new(delta, triples(DELTA_TEMPLATES), false),
                     tree: [TreeNodes::new(tree), TreeNodes::new(tree_fewer)],
                 };
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, set.len());
@@ -502,7 +561,7 @@ fn write_correction(c: &BinCorrection, out: &mut Vec<f64>) {
             out.push(*term as f64);
             out.extend(idx.iter().map(|&i| f64::from(i)));
         }
-        out.extend(rows.values.iter().map(|&x| f64::from(x)));
+        out.extend(rows.values_f32().iter().map(|&x| f64::from(x)));
     }
     for nodes in &c.tree {
         out.extend([nodes.weights.len() as f64, nodes.keys.len() as f64]);
@@ -517,7 +576,12 @@ fn write_correction(c: &BinCorrection, out: &mut Vec<f64>) {
 
 /// A bin's correction as [`write_correction`] wrote it.
 fn read_correction(r: &mut Reader) -> Option<BinCorrection> {
-    let mut folded = [DELTA_TEMPLATES, CHECK_TEMPLATES, CHECK_TEMPLATES].map(|m| {
+    let mut folded = [
+        (DELTA_TEMPLATES, false),
+        (CHECK_TEMPLATES, true),
+        (CHECK_TEMPLATES, true),
+    ]
+    .map(|(m, bf16)| {
         let n = r.count(1 << 24)?;
         let len = r.count(triples(m) + 1)?;
         (len == triples(m)).then_some(())?;
@@ -526,20 +590,25 @@ fn read_correction(r: &mut Reader) -> Option<BinCorrection> {
             .into_iter()
             .map(|k| (k[0] < 5).then(|| (usize::from(k[0]), [k[1], k[2], k[3], k[4]])))
             .collect::<Option<Vec<_>>>()?;
-        let values = r.take(n * len)?.iter().map(|&x| x as f32).collect();
-        Some(FoldedRows { keys, values, len })
+        let mut rows = FoldedRows {
+            keys,
+            len,
+            ..FoldedRows::default()
+        };
+        rows.push_values(r.take(n * len)?.iter().map(|&x| x as f32), bf16);
+        Some(rows)
     });
     let mut tree = [0, 1].map(|_| {
         let (n, rows) = (r.count(1 << 16)?, r.count(1 << 16)?);
         let nodes = r.take(4 * n)?;
         let keys = r.indices::<4>(rows)?;
         keys.iter().all(|k| k[1] < 3).then_some(())?;
-        Some(TreeNodes {
-            weights: nodes.chunks_exact(4).map(|c| c[0]).collect(),
-            sides: nodes.chunks_exact(4).map(|c| [c[1], c[2], c[3]]).collect(),
+        Some(TreeNodes::with_rows(
+            nodes.chunks_exact(4).map(|c| c[0]).collect(),
+            nodes.chunks_exact(4).map(|c| [c[1], c[2], c[3]]).collect(),
             keys,
-            values: r.take(rows * n)?.to_vec(),
-        })
+            r.take(rows * n)?.to_vec(),
+        ))
     });
     let mut take = |i: usize| folded[i].take();
     let (delta, minus_nodes, minus_rule) = (take(0)?, take(1)?, take(2)?);
