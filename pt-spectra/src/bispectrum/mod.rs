@@ -43,6 +43,7 @@
 //! difference from a coarser rule (orientation and shells).
 
 pub mod bias_kernels;
+mod bin_rows;
 pub mod block;
 mod box_modes;
 pub mod galaxy_counterterms;
@@ -50,6 +51,7 @@ pub mod galaxy_counterterms_rsd;
 mod geometry;
 mod ir_legs;
 mod lanes;
+mod multipole_acc;
 pub mod multipole_basis;
 pub mod multipole_bins;
 mod multipole_cache;

@@ -21,6 +21,7 @@
 
 use super::geometry::LegendreSide;
 use super::ir_legs::{leading_order_spectrum, tree_legs};
+pub(super) use super::multipole_acc::{Acc, Names};
 use super::multipole_cache::{write_triangle, Reader};
 use super::multipole_tensors::{
     triangle_tensors, Products, Rows, Setup, TriangleTensors, DIFF_TEMPLATES, F_NODES,
@@ -31,7 +32,6 @@ use super::one_loop_galaxy_multipoles::{
     legendre_side_index, multipole_weights, orientation_nodes, GalaxyLoopMultipoles,
     ORIENTATION_RULE,
 };
-use super::one_loop_galaxy_poly::{GalaxyLoopPolynomial, Monomial, TermPolynomial};
 use super::resum::IrInputs;
 use crate::error::Result;
 use crate::linear::LinearSpectrum;
@@ -305,8 +305,9 @@ impl MultipoleLoopBasis {
     }
 
     /// B₀, B₂, B₄ per bias monomial of every triangle for the spectrum `p` at growth rate `f` (P at the
-    /// sides of the tree level, P̂ elsewhere), with [`GalaxyLoopPolynomial::projection`] =
-    /// [`PROJECTION_FACTOR`] × the templates' projection residual.
+    /// sides of the tree level, P̂ elsewhere), with their
+    /// [`super::one_loop_galaxy_poly::GalaxyLoopPolynomial::projection`] = [`PROJECTION_FACTOR`] × the
+    /// templates' projection residual.
     ///
     /// # Errors
     /// [`crate::error::Error::InvalidParameter`] for f outside [0, 2].
@@ -503,95 +504,6 @@ fn single_rows<'a>(
     matvec_f32(&r.single.0, x, &mut fine);
     matvec_f32(&r.single.1, x_diff, &mut diff);
     r.index.iter().zip(fine.into_iter().zip(diff))
-}
-
-/// The monomials of the seven terms (tree, B₂₂₂, B₃₂₁ᴵ, B₃₂₁ᴵᴵ, B₄₁₁, and the two subtracted amounts, which
-/// have B₃₂₁ᴵᴵ's and B₄₁₁'s), in the order of the families' monomial indices, and the ascending order.
-pub(super) struct Names {
-    monomials: [Vec<Monomial>; 7],
-    ascending: [Vec<usize>; 7],
-}
-
-impl Names {
-    pub(super) fn new() -> Self {
-        let pr = Products::new();
-        let list = |s: &[Vec<usize>]| -> Vec<Monomial> {
-            s.iter()
-                .map(|m| [m[0] as u8, m[1] as u8, m[2] as u8])
-                .collect()
-        };
-        let monomials = [
-            list(&pr.tree.0),
-            list(&pr.b222.0),
-            list(&pr.b321.0),
-            list(&pr.j.0),
-            list(&pr.l.0),
-            list(&pr.j.0),
-            list(&pr.l.0),
-        ];
-        let ascending = std::array::from_fn(|t| {
-            let mut order: Vec<usize> = (0..monomials[t].len()).collect();
-            order.sort_by_key(|&i| monomials[t][i]);
-            order
-        });
-        Self {
-            monomials,
-            ascending,
-        }
-    }
-}
-
-/// One triangle's coefficients per ℓ, term and monomial: values and rule − half rule.
-#[derive(Clone)]
-pub(super) struct Acc<'a> {
-    names: &'a Names,
-    sums: [[Vec<[f64; 2]>; 7]; 3],
-}
-
-impl<'a> Acc<'a> {
-    pub(super) fn new(names: &'a Names) -> Self {
-        Self {
-            names,
-            sums: std::array::from_fn(|_| {
-                std::array::from_fn(|t| vec![[0.0; 2]; names.monomials[t].len()])
-            }),
-        }
-    }
-
-    pub(super) fn add(&mut self, idx: &[u16; 4], term: usize, value: f64, diff: f64) {
-        let s = &mut self.sums[idx[0] as usize][term][idx[2] as usize];
-        s[0] += value;
-        s[1] += diff;
-    }
-
-    pub(super) fn polynomial(
-        &self,
-        ell: usize,
-        k: [f64; 3],
-        projection: f64,
-    ) -> GalaxyLoopPolynomial {
-        let term = |t: usize| {
-            let order = &self.names.ascending[t];
-            let sums = &self.sums[ell][t];
-            TermPolynomial {
-                monomials: order.iter().map(|&i| self.names.monomials[t][i]).collect(),
-                values: order.iter().map(|&i| sums[i][0]).collect(),
-                differences: order.iter().map(|&i| sums[i][1]).collect(),
-            }
-        };
-        GalaxyLoopPolynomial {
-            k,
-            redshift: None,
-            tree: term(0),
-            b222: term(1),
-            b321_i: term(2),
-            b321_ii: term(3),
-            b411: term(4),
-            uv_b321_ii: term(5),
-            uv_b411: term(6),
-            projection,
-        }
-    }
 }
 
 #[cfg(test)]
