@@ -1,6 +1,6 @@
 //! `pt.OneLoopMultipolePlan`: the one-loop galaxy multipoles B0, B2, B4 planned for a triangle set, from the
 //! multipole tensors ([`pt_spectra::jobs::one_loop_multipole_tensors`], built once and cached), so that a
-//! call per spectrum, f and bias costs ~0.12 ms per triangle; over bins the multipole bin tensors
+//! call per spectrum, f and bias costs ~0.07 ms per triangle; over bins the multipole bin tensors
 //! ([`pt_spectra::jobs::one_loop_multipole_bin_tensors`]).
 
 use crate::bispectrum::fixed_rows;
@@ -22,14 +22,14 @@ use std::sync::Arc;
 /// The one-loop galaxy multipoles B0, B2, B4 in redshift space planned for a set of triangles (points,
 /// [h/Mpc]) with the Legendre polynomial on `legendre_side`: the multipole tensors (16 SVD templates, f free;
 /// built once on the loop rule, ~190 s per triangle and core at the default rule, cached in `cache_dir`),
-/// then a call per linear spectrum, growth rate and bias costs ~0.12 ms per triangle. Where the tensors do
+/// then a call per linear spectrum, growth rate and bias costs ~0.07 ms per triangle. Where the tensors do
 /// not represent the spectrum (projection residual above the basis's limit: with `ir=True` the resummed
 /// spectrum often is) the call integrates directly and `loop_terms` says so.
 ///
 /// `bin_width` [h/Mpc]: bins of three shells of that width centred on each triangle instead (the bin
 /// averages of `pt.one_loop_bispectrum(..., bin_width=...)`: each bin's effective triangle from the multipole
 /// tensors plus the bin average's departure from it from folded tensors, `k1_eff k2_eff k3_eff` in the
-/// result; ~0.15 ms per bin).
+/// result; ~0.13 ms per bin).
 #[pyclass(module = "pt_spectra._core", frozen)]
 pub struct OneLoopMultipolePlan {
     tensors: Tensors,

@@ -201,8 +201,10 @@ pub(super) enum Slot {
 }
 
 /// Appends a bin's correction: each folded family (Δ, its differences on one node fewer and on the check
-/// rule) as its row count r, row length, 5r keys (term, ℓ, 0, monomial, power) and r × length values; then
-/// the tree level's two node lists as their count and per node its weight, sides and tree rows.
+/// rule) as its row count r, row length, 5r keys (term, ℓ, 0, monomial, power) and r × length values (the
+/// f32 or bfloat16 values, exact in f64); then the tree level's two node lists, each as its node count n,
+/// row count r, per node its weight and three sides, 4r row keys (ℓ, s, monomial, power) and the r × n
+/// matrix, row-major.
 pub(super) fn write_correction(c: &BinCorrection, out: &mut Vec<f64>) {
     for rows in [&c.delta, &c.minus_nodes, &c.minus_rule] {
         out.extend([rows.keys.len() as f64, rows.len as f64]);

@@ -362,7 +362,8 @@ impl MultipoleLoopBasis {
     }
 
     /// The multipoles of the templates' coefficients `c` (the projection of the loops' spectrum, whose
-    /// projection residual is `residual`), the tree level of `p` or of the resummed legs (`ir`); f checked.
+    /// projection residual is `residual`), the tree level of `p` or of the resummed legs (`ir`), at a growth
+    /// rate `f` the caller has checked.
     pub(super) fn contract(
         &self,
         c: &[f64],
@@ -477,12 +478,16 @@ const VERSION: u32 = 2;
 /// the Legendre side (−1 for the largest).
 fn key(triangles: &[[f64; 3]], side: LegendreSide, rule: &OneLoopRule) -> Vec<f64> {
     let mut key = super::one_loop_galaxy_basis::key(triangles, rule);
-    let side = match side {
+    key.extend([f64::from(VERSION), TEMPLATES as f64, side_code(side)]);
+    key
+}
+
+/// The Legendre side as a cache key's number: −1 for the largest, else its index.
+pub(super) fn side_code(side: LegendreSide) -> f64 {
+    match side {
         LegendreSide::Largest => -1.0,
         LegendreSide::Index(a) => a as f64,
-    };
-    key.extend([f64::from(VERSION), TEMPLATES as f64, side]);
-    key
+    }
 }
 
 /// The rows of a family with their values on the rule and rule − half rule, `len` each.

@@ -335,3 +335,68 @@ fn bins_cache_values_round_trip() {
     longer.push(0.0);
     assert!(read(&longer, &set, largest, &rules).is_none());
 }
+
+/// A cache file written when B₃₂₁ᴵᴵ's and B₄₁₁'s vectors were kept bare in f64 (flag 0) is renormalised
+/// (J − U s on the rule, J_diff − U s_diff on rule − half rule) and moved to f32 when read: every entry
+/// equals the current layout's to 1e-6 of the family's largest entry, where U s itself is > 0.1 of the
+/// largest renormalised entry (so a conversion that skipped the subtraction, or took the other σ² vector,
+/// is caught; the multipoles alone would not catch it: the UV amounts, U σ², are ~1e-8 of B₄₁₁ here).
+#[test]
+fn bare_f64_vectors_of_older_files_are_renormalised_when_read() {
+    let triangles = [[0.05, 0.07, 0.1]];
+    let r = OneLoopRule {
+        radial: 2,
+        mu: 2,
+        phi: 2,
+        ..OneLoopRule::default()
+    };
+    let basis =
+        MultipoleLoopBasis::build(&triangles, LegendreSide::Largest, &r, &|_, _| {}).unwrap();
+    let mut old = basis.clone();
+    for t in &mut old.tensors {
+        let sigma = t.sigma.clone();
+        let m = sigma[0].len();
+        for family in [&mut t.j, &mut t.l] {
+            let bare = |rows: &[f32], s: &[f64]| -> Vec<f64> {
+                rows.chunks_exact(m)
+                    .zip(&family.uv)
+                    .flat_map(|(row, u)| row.iter().zip(s).map(move |(j, s)| f64::from(*j) + u * s))
+                    .collect()
+            };
+            let (fine, diff) = (
+                bare(&family.single.0, &sigma[0]),
+                bare(&family.single.1, &sigma[1]),
+            );
+            family.fine = fine;
+            family.diff = diff;
+            family.single = (Vec::new(), Vec::new());
+        }
+    }
+    let read = MultipoleLoopBasis::from_f64s(&old.to_f64s(), &triangles, LegendreSide::Largest, &r)
+        .unwrap();
+    for (x, y) in read.tensors.iter().zip(&basis.tensors) {
+        let m = y.sigma[0].len();
+        for (fx, fy) in [(&x.j, &y.j), (&x.l, &y.l)] {
+            for (slot, sigma) in [(0, &y.sigma[0]), (1, &y.sigma[1])] {
+                let pick = |f: &'_ super::Rows| -> Vec<f32> {
+                    if slot == 0 {
+                        f.single.0.clone()
+                    } else {
+                        f.single.1.clone()
+                    }
+                };
+                let (a, b) = (pick(fx), pick(fy));
+                let scale = b.iter().fold(0.0f64, |s, &v| s.max(f64::from(v.abs())));
+                let (mut worst, mut subtracted) = (0.0f64, 0.0f64);
+                for ((ra, rb), u) in a.chunks_exact(m).zip(b.chunks_exact(m)).zip(&fy.uv) {
+                    for ((p, q), s) in ra.iter().zip(rb).zip(sigma) {
+                        worst = worst.max(f64::from((p - q).abs()) / scale);
+                        subtracted = subtracted.max((u * s).abs() / scale);
+                    }
+                }
+                assert!(worst <= 1e-6, "slot {slot}: {worst} of the largest entry");
+                assert!(subtracted > 0.1, "slot {slot}: U s is {subtracted} of it");
+            }
+        }
+    }
+}

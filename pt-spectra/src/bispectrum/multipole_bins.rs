@@ -25,7 +25,7 @@ use super::bin_rows::{
 pub use super::bin_rows::{CHECK_TEMPLATES, DELTA_TEMPLATES};
 use super::geometry::{LegendreSide, TriangleSet};
 use super::ir_legs::leading_order_spectrum;
-use super::multipole_basis::{setup, triples, Acc, MultipoleLoopBasis, Names};
+use super::multipole_basis::{setup, side_code, triples, Acc, MultipoleLoopBasis, Names};
 use super::multipole_cache::Reader;
 use super::multipole_tensors::{triangle_tensors, Products, TriangleTensors, F_NODES};
 use super::one_loop::OneLoopRule;
@@ -40,6 +40,7 @@ use crate::ir::sigma2_total;
 use crate::linear::LinearSpectrum;
 use crate::loops::basis::{after_key, cache_file_name, triple_products, Projection};
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// A bin's node triangles and weights.
@@ -108,27 +109,29 @@ impl MultipoleBinBasis {
                 let (mut delta, mut small, mut fewer, mut checked) =
                     (Folded::new(), Folded::new(), Folded::new(), Folded::new());
                 let (mut tree, mut tree_fewer) = (Vec::new(), Vec::new());
+                // each list of nodes with the effective triangle at weight −1 (its coarse tensors built once)
+                let with_effective =
+                    |n: usize| nodes[i][n].iter().copied().chain([(effective[i], -1.0)]);
                 let eff = tensors(effective[i], &coarse)?;
-                for &(k, w) in nodes[i][0].iter().chain([&(effective[i], -1.0)]) {
-                    let t = if w < 0.0 {
-                        eff.clone()
+                let coarse_at = |k: [f64; 3], w: f64| -> Result<Cow<TriangleTensors>> {
+                    Ok(if w < 0.0 {
+                        Cow::Borrowed(&eff)
                     } else {
-                        tensors(k, &coarse)?
-                    };
+                        Cow::Owned(tensors(k, &coarse)?)
+                    })
+                };
+                for (k, w) in with_effective(0) {
+                    let t = coarse_at(k, w)?;
                     fold(&t, w, DELTA_TEMPLATES, &mut delta);
                     fold(&t, w, CHECK_TEMPLATES, &mut small);
-                    tree.push((w, k, t.tree));
+                    tree.push((w, k, t.tree.clone()));
                 }
-                for &(k, w) in nodes[i][1].iter().chain([&(effective[i], -1.0)]) {
-                    let t = if w < 0.0 {
-                        eff.clone()
-                    } else {
-                        tensors(k, &coarse)?
-                    };
+                for (k, w) in with_effective(1) {
+                    let t = coarse_at(k, w)?;
                     fold(&t, w, CHECK_TEMPLATES, &mut fewer);
-                    tree_fewer.push((w, k, t.tree));
+                    tree_fewer.push((w, k, t.tree.clone()));
                 }
-                for &(k, w) in nodes[i][0].iter().chain([&(effective[i], -1.0)]) {
+                for (k, w) in with_effective(0) {
                     fold(&tensors(k, &check)?, w, CHECK_TEMPLATES, &mut checked);
                 }
                 let minus = |x: &Folded| -> FoldedRows {
@@ -283,7 +286,7 @@ impl MultipoleBinBasis {
         };
         let (damped, weakest, strongest) = (leg(MEAN_MU), leg(0.0), leg(1.0));
         let names = Names::new();
-        let mut out = Vec::new();
+        let (mut out, mut tree_out) = (Vec::new(), Vec::new());
         let corrections = self
             .corrections
             .iter()
@@ -292,7 +295,6 @@ impl MultipoleBinBasis {
                 let mut loops = |acc: &mut Acc, rows: &FoldedRows, x: &[f32], sign: f64| {
                     rows.add_to(acc, x, &fp, sign, &mut out);
                 };
-                let mut tree_out = Vec::new();
                 let mut tree =
                     |acc: &mut Acc, nodes: &TreeNodes, leg: &dyn Fn(f64) -> f64, slot| {
                         nodes.add_to(acc, leg, &fp, slot, &mut tree_out);
@@ -358,10 +360,7 @@ fn key(
     for r in std::iter::once(rule).chain(rules) {
         key.extend([r.radial as f64, r.mu as f64, r.phi as f64, r.q_min, r.q_max]);
     }
-    key.push(match side {
-        LegendreSide::Largest => -1.0,
-        LegendreSide::Index(a) => a as f64,
-    });
+    key.push(side_code(side));
     key.push(set.width().unwrap_or(0.0));
     key.extend(set.triangles().iter().flatten());
     key

@@ -53,7 +53,7 @@ pub fn describe_source(source: &BispectrumLoopSource) -> String {
     match source {
         BispectrumLoopSource::DirectUncached => "loop terms: direct integration (method auto: no multipole \
             tensors cached for these triangles, side and rule; method basis builds them once, ~190 s per \
-            triangle and core at the default rule, then ~0.13 ms per triangle with f free)"
+            triangle and core at the default rule, then ~0.07 ms per triangle with f free)"
             .into(),
         BispectrumLoopSource::Basis { residual, .. } => format!(
             "loop terms: multipole tensors on {TEMPLATES} SVD templates of the CAMB basis, f free (powers f^0 \
@@ -100,23 +100,33 @@ pub fn multipoles_from_tensors(
     ir: Option<&IrInputs>,
 ) -> Result<(Option<Vec<[OneLoopGalaxy; 3]>>, BispectrumLoopSource)> {
     let (polys, projected) = tensors.evaluate_projected(p, f, ir)?;
-    let max = crate::loops::basis::MAX_RESIDUAL;
-    if projected.residual > max {
-        let source = BispectrumLoopSource::Fallback {
-            residual: projected.residual,
-            max_residual: max,
-        };
+    let source = tensor_source(projected.residual);
+    if !matches!(source, BispectrumLoopSource::Basis { .. }) {
         return Ok((None, source));
     }
     let rows = polys
         .iter()
         .map(|m| m.evaluate(bias))
         .collect::<Result<Vec<_>>>()?;
-    let source = BispectrumLoopSource::Basis {
-        functions: TEMPLATES,
-        residual: projected.residual,
-    };
     Ok((Some(rows), source))
+}
+
+/// Whether the multipole tensors (of triangles or bins) represent a spectrum whose projection residual on
+/// their templates is `residual`: the basis source up to [`crate::loops::basis::MAX_RESIDUAL`], the direct
+/// fallback above.
+fn tensor_source(residual: f64) -> BispectrumLoopSource {
+    let max = crate::loops::basis::MAX_RESIDUAL;
+    if residual <= max {
+        BispectrumLoopSource::Basis {
+            functions: TEMPLATES,
+            residual,
+        }
+    } else {
+        BispectrumLoopSource::Fallback {
+            residual,
+            max_residual: max,
+        }
+    }
 }
 
 /// [`multipoles_from_tensors`], or where the tensors do not represent the spectrum the direct one pass of
@@ -201,18 +211,11 @@ pub fn binned_plan_multipoles(
     let source = match tensors {
         Some(t) => {
             let (binned, projected) = t.evaluate_projected(p, f, ir)?;
-            let max = crate::loops::basis::MAX_RESIDUAL;
-            if projected.residual <= max {
-                let source = BispectrumLoopSource::Basis {
-                    functions: TEMPLATES,
-                    residual: projected.residual,
-                };
+            let source = tensor_source(projected.residual);
+            if matches!(source, BispectrumLoopSource::Basis { .. }) {
                 return Ok((binned, source));
             }
-            BispectrumLoopSource::Fallback {
-                residual: projected.residual,
-                max_residual: max,
-            }
+            source
         }
         None if uncached => BispectrumLoopSource::DirectUncached,
         None => BispectrumLoopSource::Direct,
@@ -227,7 +230,7 @@ pub fn describe_bin_source(source: &BispectrumLoopSource) -> String {
         BispectrumLoopSource::Direct => "loop terms: direct integration".into(),
         BispectrumLoopSource::DirectUncached => "loop terms: direct integration (method auto: no multipole \
             bin tensors cached for these bins, side and rule; method basis builds them once, ~190 s per bin \
-            and core at the default rule, then ~0.15 ms per bin with f free)"
+            and core at the default rule, then ~0.13 ms per bin with f free)"
             .into(),
         BispectrumLoopSource::Basis { residual, .. } => format!(
             "loop terms: multipole bin tensors, f free: the effective triangles' on {TEMPLATES} SVD templates \
