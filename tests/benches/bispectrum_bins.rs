@@ -122,6 +122,29 @@ fn one_loop_multipole_bins(crit: &mut Criterion) {
             })
         },
     );
+    let start = std::time::Instant::now();
+    let counterterms =
+        pt_spectra::bispectrum::counterterm_plan::CountertermPlan::new(&set, LegendreSide::Largest)
+            .unwrap();
+    eprintln!(
+        "counterterm plan of {} bins: {:.1} s",
+        set.len(),
+        start.elapsed().as_secs_f64()
+    );
+    crit.bench_function(
+        &format!(
+            "bispectrum/one-loop counterterm and stochastic multipoles of {} Nseries bins, new spectrum \
+             and f",
+            set.len()
+        ),
+        |b| {
+            b.iter(|| {
+                i += 1;
+                let p = &spectra[i as usize % spectra.len()];
+                black_box(counterterms.evaluate(p, f(i)).unwrap().at(&bias))
+            })
+        },
+    );
 }
 
 criterion_group! {

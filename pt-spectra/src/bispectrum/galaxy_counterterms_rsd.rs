@@ -34,6 +34,7 @@
 //! literature and the cut-off test).
 
 use super::bias_kernels::{galaxy_kernel, galaxy_redshift_kernel, LoopBias};
+use super::bias_poly::Ring;
 use super::galaxy_counterterms::galaxy_counterterm_shapes;
 use super::geometry::LegendreSide;
 use super::one_loop::{f_n, triangle_vectors};
@@ -108,43 +109,101 @@ fn shapes_at(
     }
     let k = kv.map(norm);
     let pk = k.map(|k| p.eval(k));
-    let par = [0, 1, 2].map(|a| dot(&kv[a], n));
-    let mu2 = [0, 1, 2].map(|a| par[a] * par[a] / (k[a] * k[a]));
-    let z1 = mu2.map(|m| bias.b1 + f * m);
+    let sight = Sight::new(kv, n);
     let mut s = [0.0; N_REDSHIFT_CT];
     for i in 0..3 {
-        let (j, l) = ((i + 1) % 3, (i + 2) % 3);
-        let pp = 2.0 * pk[i] * pk[j];
-        let zz = pp * z1[i] * z1[j];
-        let (ki2, kj2, kl2) = (k[i] * k[i], k[j] * k[j], k[l] * k[l]);
-        let mu = (kl2 - ki2 - kj2) / (2.0 * k[i] * k[j]);
+        let j = (i + 1) % 3;
         let z2 = galaxy_redshift_kernel(bias, &[kv[i], kv[j]], f, n)?;
-        let f2 = f_n(&[kv[i], kv[j]]);
-        let g2 = 3.0 / 7.0 + 0.5 * mu * (k[i] / k[j] + k[j] / k[i]) + 4.0 / 7.0 * mu * mu;
-        let leg = |wi: f64, wj: f64| pp * z2 * (ki2 * wi * z1[j] + kj2 * wj * z1[i]);
-        s[0] += leg(1.0, 1.0);
-        s[1] += zz * kl2;
-        s[2] += zz * (ki2 + kj2);
-        s[3] += zz * kl2 * (mu * mu - 1.0 / 3.0);
-        s[4] += zz * f2 * kl2;
-        s[7] += leg(f * mu2[i], f * mu2[j]);
-        s[8] += leg(f * f * mu2[i] * mu2[i], f * f * mu2[j] * mu2[j]);
-        s[9] += zz * f * kl2 * mu2[l];
-        s[10] += zz * f * (ki2 * mu2[i] + kj2 * mu2[j]);
-        s[11] += zz * f * g2 * kl2 * mu2[l];
-        let kpar = 0.5 * f * (par[i] + par[j]);
-        s[12] += zz * kpar * (par[i] * kj2 / ki2 + par[j] * ki2 / kj2);
-        s[13] += zz * kpar * f * (par[i] * kj2 * mu2[j] / ki2 + par[j] * ki2 * mu2[i] / kj2);
-        s[14] += zz * kpar * (par[i] * z1[j] + par[j] * z1[i]);
-        s[17] += zz * f * f * kl2 * mu2[l] * mu2[l];
-        s[18] += zz * z2 * f * f * kl2 * mu2[l];
-        s[19] += zz * (z2 - galaxy_kernel(bias, &[kv[i], kv[j]])?) * kl2;
-        s[5] += bias.b1 * z1[i] * pk[i];
-        s[15] += f * mu2[i] * z1[i] * pk[i];
-        s[16] += f * f * mu2[i] * mu2[i] * z1[i] * pk[i];
+        let z2_real = galaxy_kernel(bias, &[kv[i], kv[j]])?;
+        let parts = pair_parts(&sight, i, &bias.b1, &f, &z2, &z2_real);
+        let pp = 2.0 * pk[i] * pk[j];
+        for (c, (s, x)) in s.iter_mut().zip(parts).enumerate() {
+            *s += x * if STOCHASTIC_LEGS.contains(&c) {
+                pk[i]
+            } else {
+                pp
+            };
+        }
     }
     s[6] = 1.0;
     Ok(s)
+}
+
+/// The shapes whose part of pair i ([`pair_parts`]) multiplies P(k_i) (st_p, st_p_mu2, st_p_mu4); the
+/// others' multiplies 2 P(k_i) P(k_j), and st_1 (index 6) is 1.
+pub const STOCHASTIC_LEGS: [usize; 3] = [5, 15, 16];
+
+/// What the shapes need of a triangle `kv` and a unit line of sight: the sides, their parts along the line
+/// of sight k_a·n̂ and μ_a².
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Sight<'a> {
+    kv: &'a [[f64; 3]; 3],
+    k: [f64; 3],
+    par: [f64; 3],
+    mu2: [f64; 3],
+}
+
+impl<'a> Sight<'a> {
+    /// The triangle `kv` seen along the unit vector `n`.
+    pub(super) fn new(kv: &'a [[f64; 3]; 3], n: &[f64; 3]) -> Self {
+        let k = kv.map(norm);
+        let par = [0, 1, 2].map(|a| dot(&kv[a], n));
+        let mu2 = [0, 1, 2].map(|a| par[a] * par[a] / (k[a] * k[a]));
+        Self { kv, k, par, mu2 }
+    }
+}
+
+/// The part of each shape (module docs) from the pair of sides (i, j = i + 1 mod 3) and the leg i,
+/// without the linear spectrum (2 P_i P_j for the pair's, P_i for [`STOCHASTIC_LEGS`]; st_1 zero), at the
+/// coefficients b1, f and the second-order kernels Z₂ (redshift space) and Z₂(f = 0) of the pair: numbers
+/// or polynomials in them ([`Ring`]).
+pub(super) fn pair_parts<T: Ring>(
+    sight: &Sight,
+    i: usize,
+    b1: &T,
+    f: &T,
+    z2: &T,
+    z2_real: &T,
+) -> [T; N_REDSHIFT_CT] {
+    let (j, l) = ((i + 1) % 3, (i + 2) % 3);
+    let (k, par, mu2) = (sight.k, sight.par, sight.mu2);
+    let z1 = |a: usize| b1.clone() + f.clone() * mu2[a];
+    let zz = z1(i) * z1(j);
+    let (ki2, kj2, kl2) = (k[i] * k[i], k[j] * k[j], k[l] * k[l]);
+    let mu = (kl2 - ki2 - kj2) / (2.0 * k[i] * k[j]);
+    let f2 = f_n(&[sight.kv[i], sight.kv[j]]);
+    let g2 = 3.0 / 7.0 + 0.5 * mu * (k[i] / k[j] + k[j] / k[i]) + 4.0 / 7.0 * mu * mu;
+    let ff = f.clone() * f.clone();
+    let leg = |wi: T, wj: T| z2.clone() * (wi * ki2 * z1(j) + wj * kj2 * z1(i));
+    let one = || T::from(1.0);
+    let kpar = f.clone() * (0.5 * (par[i] + par[j]));
+    let mut s: [T; N_REDSHIFT_CT] = std::array::from_fn(|_| T::from(0.0));
+    s[0] = leg(one(), one());
+    s[1] = zz.clone() * kl2;
+    s[2] = zz.clone() * (ki2 + kj2);
+    s[3] = zz.clone() * (kl2 * (mu * mu - 1.0 / 3.0));
+    s[4] = zz.clone() * (f2 * kl2);
+    s[7] = leg(f.clone() * mu2[i], f.clone() * mu2[j]);
+    s[8] = leg(
+        ff.clone() * (mu2[i] * mu2[i]),
+        ff.clone() * (mu2[j] * mu2[j]),
+    );
+    s[9] = zz.clone() * f.clone() * (kl2 * mu2[l]);
+    s[10] = zz.clone() * f.clone() * (ki2 * mu2[i] + kj2 * mu2[j]);
+    s[11] = zz.clone() * f.clone() * (g2 * kl2 * mu2[l]);
+    s[12] = zz.clone() * kpar.clone() * (par[i] * kj2 / ki2 + par[j] * ki2 / kj2);
+    s[13] = zz.clone()
+        * kpar.clone()
+        * f.clone()
+        * (par[i] * kj2 * mu2[j] / ki2 + par[j] * ki2 * mu2[i] / kj2);
+    s[14] = zz.clone() * kpar * (z1(j) * par[i] + z1(i) * par[j]);
+    s[17] = zz.clone() * ff.clone() * (kl2 * mu2[l] * mu2[l]);
+    s[18] = zz.clone() * z2.clone() * ff.clone() * (kl2 * mu2[l]);
+    s[19] = zz * (z2.clone() - z2_real.clone()) * kl2;
+    s[5] = b1.clone() * z1(i);
+    s[15] = f.clone() * mu2[i] * z1(i);
+    s[16] = ff * (mu2[i] * mu2[i]) * z1(i);
+    s
 }
 
 /// The multipoles ℓ = 0, 2, 4 of [`redshift_counterterm_shapes`] (the Legendre polynomial on `side`), on

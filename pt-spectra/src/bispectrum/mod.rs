@@ -43,9 +43,11 @@
 //! difference from a coarser rule (orientation and shells).
 
 pub mod bias_kernels;
+pub mod bias_poly;
 mod bin_rows;
 pub mod block;
 mod box_modes;
+pub mod counterterm_plan;
 pub mod galaxy_counterterms;
 pub mod galaxy_counterterms_rsd;
 mod geometry;
