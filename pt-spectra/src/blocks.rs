@@ -6,7 +6,10 @@ use crate::error::{Error, Result};
 use crate::statistic::Kind;
 
 /// Every kind of block, in the order of their registration.
-pub const AVAILABLE: [&Kind; 1] = [&crate::bispectrum::block::KIND];
+pub const AVAILABLE: [&Kind; 2] = [
+    &crate::bispectrum::block::KIND,
+    &crate::bispectrum::loop_block::KIND,
+];
 
 /// The kind of block named `name` (its [`Kind::name`]).
 ///

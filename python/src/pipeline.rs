@@ -441,6 +441,9 @@ impl Pipeline {
                 .any(|b| b.kind().name == kind.name);
             d.set_item(kind.name, held)?;
         }
+        // what each block is and how it is computed (its header line)
+        let blocks: Vec<String> = self.inner.blocks().iter().map(|b| b.describe()).collect();
+        d.set_item("blocks", blocks)?;
         d.set_item("ap", s.fiducial.is_some())?;
         d.set_item("ir", s.ir)?;
         d.set_item("max_residual", s.max_residual)?;

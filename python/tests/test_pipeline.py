@@ -115,6 +115,35 @@ def test_a_bispectrum_block_follows_the_power_spectrum(setup):
         pt.Pipeline(obs, Z, precision="fast", cache_dir=cache, trinagles=bins)
 
 
+def test_a_one_loop_bispectrum_block_follows_the_power_spectrum(setup):
+    """The one-loop block reads the multipole tensors cached by pt.OneLoopMultipolePlan (refused before,
+    saying how to build them) and equals the plan's B0, B2 at the pipeline's f, IR setting and bias; a
+    counterterm adds its shape (st_1: a constant in B0 only); AP is refused."""
+    obs, _, cache = setup
+    tri = np.array([[0.05, 0.07, 0.1], [0.04, 0.04, 0.06]])
+    opts = dict(triangles=tri, rule=[2, 2, 2], ells=[0, 2], cache_dir=str(cache))
+    with pytest.raises(ValueError, match="not cached"):
+        pt.Pipeline(obs, Z, precision="fast", cache_dir=cache, one_loop_bispectrum=opts)
+    plan = pt.OneLoopMultipolePlan(tri, radial=2, mu=2, phi=2, cache_dir=cache)
+    for ir in [False, True]:
+        joint = pt.Pipeline(obs, Z, precision="fast", cache_dir=cache, ir=ir, one_loop_bispectrum=opts)
+        n = joint.meta["power_len"]
+        got = joint(COSMO, **PARAMS)
+        assert len(got) == n + 4 and joint.meta["one_loop_bispectrum"]
+        assert "one-loop bispectrum" in joint.meta["blocks"][0]
+        ref = plan(cosmology=COSMO, z=Z, f=joint.meta["f"], b1=2.1, b2=-0.4, bs=0.3, ir=ir)
+        assert ref["loop_terms"].startswith("loop terms: multipole tensors")
+        np.testing.assert_allclose(got[n:], np.concatenate([ref["B0"], ref["B2"]]), rtol=1e-6)
+        st = joint(COSMO, **PARAMS, st_1=1e6)
+        np.testing.assert_allclose(st[n:n + 2] - got[n:n + 2], 1e6, rtol=1e-9)
+        np.testing.assert_array_equal(st[n + 2:], got[n + 2:])
+    assert "ct_k2" in joint.parameters and "b_gamma3" in joint.parameters
+    fid = dict(COSMO, omega_cdm=COSMO["omega_cdm"] * 1.05)
+    ap = pt.Pipeline(obs, Z, fiducial=fid, precision="fast", cache_dir=cache, one_loop_bispectrum=opts)
+    with pytest.raises(ValueError, match="Alcock-Paczynski"):
+        ap(COSMO, **PARAMS)
+
+
 def test_the_loop_range_is_stated_and_can_be_switched_off(setup):
     """The BOSS window reaches 1e-4 ... 4 h/Mpc; the loops are computed on about 3e-3 ... 0.6 h/Mpc, the
     change measured at construction (<= 1e-5 of each multipole's largest value) is in meta, and

@@ -91,6 +91,24 @@ impl Spec for BispectrumBlock {
     }
 }
 
+/// The indices into [`ELLS`] of the multipoles `ells` of a block.
+///
+/// # Errors
+/// [`Error::InvalidChoice`] for multipoles that are not an increasing subset of 0, 2, 4.
+pub(super) fn ell_indices(ells: &[usize]) -> Result<Vec<usize>> {
+    let bad = |reason: &str| Error::InvalidChoice {
+        what: format!("bispectrum multipoles {ells:?}"),
+        reason: reason.into(),
+    };
+    if ells.is_empty() || ells.windows(2).any(|w| w[0] >= w[1]) {
+        return Err(bad("give at least one, in increasing order"));
+    }
+    ells.iter()
+        .map(|l| ELLS.iter().position(|e| e == l))
+        .collect::<Option<Vec<usize>>>()
+        .ok_or_else(|| bad("valid: 0, 2, 4"))
+}
+
 /// The block planned: the bispectrum plan and where each multipole sits in [`ELLS`].
 #[derive(Debug, Clone)]
 struct PlannedBispectrum {
@@ -120,19 +138,7 @@ impl PlannedBispectrum {
             block.fog,
             block.n_bar
         );
-        let bad = |reason: &str| Error::InvalidChoice {
-            what: format!("bispectrum multipoles {:?}", block.ells),
-            reason: reason.into(),
-        };
-        if block.ells.is_empty() || block.ells.windows(2).any(|w| w[0] >= w[1]) {
-            return Err(bad("give at least one, in increasing order"));
-        }
-        let ells = block
-            .ells
-            .iter()
-            .map(|l| ELLS.iter().position(|e| e == l))
-            .collect::<Option<Vec<usize>>>()
-            .ok_or_else(|| bad("valid: 0, 2, 4"))?;
+        let ells = ell_indices(&block.ells)?;
         if block.n_bar.is_nan() || block.n_bar <= 0.0 {
             return Err(Error::InvalidChoice {
                 what: format!("n_bar = {}", block.n_bar),

@@ -53,6 +53,8 @@ pub mod galaxy_counterterms_rsd;
 mod geometry;
 mod ir_legs;
 mod lanes;
+pub mod loop_block;
+pub mod loop_tensors;
 mod multipole_acc;
 pub mod multipole_basis;
 pub mod multipole_bins;

@@ -4,10 +4,11 @@
 //! `pt.OneLoopMultipolePlan` calls.
 
 use crate::bispectrum::bias_kernels::LoopBias;
-use crate::bispectrum::multipole_basis::{MultipoleLoopBasis, TEMPLATES};
-use crate::bispectrum::multipole_bins::{
-    correction_rules, MultipoleBinBasis, CHECK_TEMPLATES, DELTA_TEMPLATES,
+pub use crate::bispectrum::loop_tensors::{
+    check_triangles, one_loop_multipole_bin_tensors, one_loop_multipole_tensors, tensor_source,
 };
+use crate::bispectrum::multipole_basis::{MultipoleLoopBasis, TEMPLATES};
+use crate::bispectrum::multipole_bins::{MultipoleBinBasis, CHECK_TEMPLATES, DELTA_TEMPLATES};
 use crate::bispectrum::one_loop::OneLoopRule;
 use crate::bispectrum::one_loop_basis::{BispectrumLoopSource, PROJECTION_FACTOR};
 use crate::bispectrum::one_loop_bins::{binned_multipoles, BinnedLoopMultipoles};
@@ -15,38 +16,8 @@ use crate::bispectrum::one_loop_galaxy::OneLoopGalaxy;
 use crate::bispectrum::one_loop_galaxy_multipoles::one_loop_galaxy_multipoles;
 use crate::bispectrum::one_loop_ir::one_loop_galaxy_multipoles_ir;
 use crate::bispectrum::{IrInputs, LegendreSide, TriangleSet};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::linear::LinearSpectrum;
-use crate::precision::TwoLoopMethod;
-use crate::progress::Progress;
-use crate::store::TableStore;
-use std::sync::Arc;
-
-/// The multipole tensors of `triangles` (Legendre polynomial on `side`, loop `rule`): read from `store`'s
-/// cache or built (once: ~190 s per triangle and core at the default rule) and cached.
-///
-/// # Errors
-/// A triangle that does not close (named), a bad side or rule; the store's errors.
-pub fn one_loop_multipole_tensors(
-    triangles: &[[f64; 3]],
-    side: LegendreSide,
-    rule: &OneLoopRule,
-    store: &TableStore,
-    progress: &dyn Progress,
-) -> Result<Arc<MultipoleLoopBasis>> {
-    check_triangles(triangles, side, rule)?;
-    let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
-        MultipoleLoopBasis::build(triangles, side, rule, tick)
-            .expect("triangles, side and rule checked")
-    };
-    let tensors = store.for_method::<MultipoleLoopBasis>(
-        TwoLoopMethod::Basis,
-        (triangles, side, rule),
-        build,
-        progress,
-    )?;
-    Ok(tensors.expect("method basis reads or builds"))
-}
 
 /// The header line of how the multipoles' loop terms were computed.
 pub fn describe_source(source: &BispectrumLoopSource) -> String {
@@ -62,28 +33,6 @@ pub fn describe_source(source: &BispectrumLoopSource) -> String {
         ),
         s => s.describe(),
     }
-}
-
-/// What the tensors' build checks, named: every triangle closes and has the Legendre side; the rule.
-///
-/// # Errors
-/// [`Error::InvalidChoice`] naming the first bad triangle; the rule's error.
-pub(super) fn check_triangles(
-    triangles: &[[f64; 3]],
-    side: LegendreSide,
-    rule: &OneLoopRule,
-) -> Result<()> {
-    for (i, &k) in triangles.iter().enumerate() {
-        crate::bispectrum::one_loop::triangle_vectors(k)
-            .and_then(|_| {
-                crate::bispectrum::one_loop_galaxy_multipoles::legendre_side_index(&k, side)
-            })
-            .map_err(|e| Error::InvalidChoice {
-                what: format!("triangle {} ({}, {}, {})", i + 1, k[0], k[1], k[2]),
-                reason: e.to_string(),
-            })?;
-    }
-    rule.validate()
 }
 
 /// B₀, B₂, B₄ of every triangle of `tensors` for the spectrum `p` (resummed with `ir`), growth rate `f` and
@@ -109,24 +58,6 @@ pub fn multipoles_from_tensors(
         .map(|m| m.evaluate(bias))
         .collect::<Result<Vec<_>>>()?;
     Ok((Some(rows), source))
-}
-
-/// Whether the multipole tensors (of triangles or bins) represent a spectrum whose projection residual on
-/// their templates is `residual`: the basis source up to [`crate::loops::basis::MAX_RESIDUAL`], the direct
-/// fallback above.
-fn tensor_source(residual: f64) -> BispectrumLoopSource {
-    let max = crate::loops::basis::MAX_RESIDUAL;
-    if residual <= max {
-        BispectrumLoopSource::Basis {
-            functions: TEMPLATES,
-            residual,
-        }
-    } else {
-        BispectrumLoopSource::Fallback {
-            residual,
-            max_residual: max,
-        }
-    }
 }
 
 /// [`multipoles_from_tensors`], or where the tensors do not represent the spectrum the direct one pass of
@@ -159,34 +90,6 @@ pub fn multipole_plan_rows(
         })
         .collect::<Result<Vec<_>>>()?;
     Ok((rows, source))
-}
-
-/// The multipole bin tensors of the bins `set` (shells; Legendre polynomial on `side`, loop `rule`) as
-/// `method` asks: basis reads or builds them (once: the effective triangles' ~190 s per bin and core at the
-/// default rule, and each bin's ~64 node triangles on the correction's coarse rules, ~0.75 s each), auto
-/// reads them if cached, direct none.
-///
-/// # Errors
-/// A set of points; a bin centre that does not close (named), a bad side or rule; the store's errors.
-pub fn one_loop_multipole_bin_tensors(
-    set: &TriangleSet,
-    side: LegendreSide,
-    rule: &OneLoopRule,
-    method: TwoLoopMethod,
-    store: &TableStore,
-    progress: &dyn Progress,
-) -> Result<Option<Arc<MultipoleBinBasis>>> {
-    crate::bispectrum::one_loop_bins::require_bins(set)?;
-    check_triangles(set.triangles(), side, rule)?;
-    let build = |tick: &(dyn Fn(usize, usize) + Sync)| {
-        MultipoleBinBasis::build(set, side, rule, tick).expect("bins, side and rule checked")
-    };
-    store.for_method::<MultipoleBinBasis>(
-        method,
-        (set, side, rule, &correction_rules(rule)),
-        build,
-        progress,
-    )
 }
 
 /// The binned multipoles per bias monomial of the bins `set` for the spectrum `p` (resummed with `ir`) at

@@ -1,0 +1,406 @@
+//! The one-loop bispectrum block of a data vector (issue 50, item 4): the one-loop galaxy bispectrum
+//! multipoles B₀, B₂, B₄ of a triangle set (points, or bins of shells) beside the power spectrum's, from the
+//! same linear spectrum, growth rate and IR setting, sharing b1, b2, bs with the galaxy model and adding
+//! its own higher-order biases and the counterterm and stochastic coefficients ([`LOOP_NAMES`]).
+//!
+//! - **Loops**: the multipole tensors of the set ([`super::multipole_basis`], [`super::multipole_bins`]),
+//!   read from the cache when the block is planned (never built there: a build takes ~190 s per triangle
+//!   and core at the default rule, with its progress shown by `pt-spectra bispectrum --loop 1 --multipoles
+//!   --two-loop basis` or `pt.OneLoopMultipolePlan`). A spectrum the tensors do not represent is an error,
+//!   not a silent fallback: the direct integrals take ~30 s per triangle.
+//! - **Counterterms and stochastic terms**: planned once ([`super::counterterm_plan`]), exact.
+//! - **Bias**: b1, b2, bs in velocileptors' convention mapped exactly to the fourth-order basis
+//!   ([`LoopBias::from_class_pt`] with b2 + (4/3)bs, b_G2 = bs) with CLASS-PT's b_Γ3 (`b_gamma3`) and the
+//!   coefficients b3, g2x, g3, g21x of Eggemeier, Scoccimarro & Smith (2019) as own parameters.
+//! - **Not here**: the Alcock–Paczynski distortion (the tensors are at fixed triangles: α∥ = α⊥ = 1 is
+//!   required, anything else is an error) and Fingers of God beyond the counterterm ct_fog.
+//!
+//! Every own parameter enters B linearly (the higher biases through one kernel Z₃ or Z₄ of each term), so a
+//! fit marginalises all of them analytically. A step: new terms per (spectrum, f), ~10 ms for the 62
+//! Nseries bins on one core; a new bias, a contraction.
+
+use super::bias_kernels::LoopBias;
+use super::counterterm_plan::{CountertermPlan, CountertermTerms};
+use super::galaxy_counterterms_rsd::N_REDSHIFT_CT;
+use super::loop_tensors::tensor_source;
+use super::multipole_basis::MultipoleLoopBasis;
+use super::multipole_bins::{correction_rules, MultipoleBinBasis};
+use super::one_loop::OneLoopRule;
+use super::one_loop_basis::BispectrumLoopSource;
+use super::one_loop_bins::BinnedLoopMultipoles;
+use super::one_loop_galaxy::OneLoopGalaxy;
+use super::one_loop_galaxy_multipoles::GalaxyLoopMultipoles;
+use super::{IrInputs, LegendreSide, TriangleSet, ELLS};
+use crate::error::{Error, Result};
+use crate::ir::WiggleSplit;
+use crate::linear::LinearSpectrum;
+use crate::progress::Silent;
+use crate::statistic::{foreign, Block, Kind, Prepared, Range, Shared, Spec, Survey, Terms};
+use crate::store::TableStore;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+mod faces;
+
+/// The block's own bias coefficients (before the counterterms of [`REDSHIFT_COUNTERTERMS`]).
+pub const LOOP_BIASES: [&str; 5] = ["b_gamma3", "b3", "g2x", "g3", "g21x"];
+
+/// The block's own parameters: [`LOOP_BIASES`], then the counterterm and stochastic coefficients in the
+/// order of [`REDSHIFT_COUNTERTERMS`] (ct_* in (Mpc/h)², st_p* in (Mpc/h)³, st_1 in (Mpc/h)⁶).
+pub const LOOP_NAMES: [&str; 25] = [
+    "b_gamma3",
+    "b3",
+    "g2x",
+    "g3",
+    "g21x",
+    "ct_k2",
+    "ct_k3",
+    "ct_kk",
+    "ct_tidal",
+    "ct_f2k3",
+    "st_p",
+    "st_1",
+    "ct_k2_mu2",
+    "ct_k2_mu4",
+    "ct_k3_mu2",
+    "ct_kk_mu2",
+    "ct_g2k3_mu2",
+    "ct_map",
+    "ct_map_mu2",
+    "ct_vel",
+    "st_p_mu2",
+    "st_p_mu4",
+    "ct_k3_mu4",
+    "ct_fog",
+    "ct_z2k3",
+];
+
+const BIAS_RANGE: Range = (-50.0, 50.0, -1.0, 1.0, 1.0);
+const CT_RANGE: Range = (-1e5, 1e5, -10.0, 10.0, 10.0);
+const ST_P_RANGE: Range = (-1e7, 1e7, -1e3, 1e3, 1e3);
+const ST_1_RANGE: Range = (-1e12, 1e12, -1e6, 1e6, 1e6);
+
+/// The one-loop bispectrum's [`Kind`]: [`LOOP_NAMES`], all 0 when not given, all linear.
+pub const KIND: Kind = Kind {
+    name: "one_loop_bispectrum",
+    own: &LOOP_NAMES,
+    defaults: &[0.0; 25],
+    units: &[
+        "1",
+        "1",
+        "1",
+        "1",
+        "1",
+        "(Mpc/h)^2",
+        "(Mpc/h)^2",
+        "(Mpc/h)^2",
+        "(Mpc/h)^2",
+        "(Mpc/h)^2",
+        "(Mpc/h)^3",
+        "(Mpc/h)^6",
+        "(Mpc/h)^2",
+        "(Mpc/h)^2",
+        "(Mpc/h)^2",
+        "(Mpc/h)^2",
+        "(Mpc/h)^2",
+        "(Mpc/h)^2",
+        "(Mpc/h)^2",
+        "(Mpc/h)^2",
+        "(Mpc/h)^3",
+        "(Mpc/h)^3",
+        "(Mpc/h)^2",
+        "(Mpc/h)^2",
+        "(Mpc/h)^2",
+    ],
+    linear: &LOOP_NAMES,
+    ranges: &[
+        BIAS_RANGE, BIAS_RANGE, BIAS_RANGE, BIAS_RANGE, BIAS_RANGE, CT_RANGE, CT_RANGE, CT_RANGE,
+        CT_RANGE, CT_RANGE, ST_P_RANGE, ST_1_RANGE, CT_RANGE, CT_RANGE, CT_RANGE, CT_RANGE,
+        CT_RANGE, CT_RANGE, CT_RANGE, CT_RANGE, ST_P_RANGE, ST_P_RANGE, CT_RANGE, CT_RANGE,
+        CT_RANGE,
+    ],
+    forecast_free: &[],
+    faces: faces::FACES,
+};
+
+/// What the one-loop bispectrum block is built from.
+#[derive(Debug, Clone)]
+pub struct LoopBispectrumBlock {
+    /// The triangles (bins of shells, or points) in the order of the data vector.
+    pub triangles: TriangleSet,
+    /// The side that carries the Legendre polynomial.
+    pub side: LegendreSide,
+    /// The loop rule the tensors were built on.
+    pub rule: OneLoopRule,
+    /// The multipoles in the data vector: a subset of 0, 2, 4, increasing.
+    pub ells: Vec<usize>,
+    /// Where the tensors are cached (`None`: [`TableStore::from_env`]).
+    pub cache_dir: Option<PathBuf>,
+}
+
+impl Spec for LoopBispectrumBlock {
+    fn plan(&self) -> Result<Box<dyn Block>> {
+        Ok(Box::new(PlannedLoop::new(self)?))
+    }
+}
+
+/// The tensors of the loops.
+#[derive(Debug, Clone)]
+enum Tensors {
+    Points(Arc<MultipoleLoopBasis>),
+    Bins(Arc<MultipoleBinBasis>),
+}
+
+/// The block planned: the loops' tensors, the counterterms' plan, the multipoles' indices into [`ELLS`].
+#[derive(Debug, Clone)]
+struct PlannedLoop {
+    tensors: Tensors,
+    counterterms: Arc<CountertermPlan>,
+    triangles: Vec<[f64; 3]>,
+    ells: Vec<usize>,
+    description: String,
+}
+
+impl PlannedLoop {
+    /// Reads the tensors of `block` from its cache and plans the counterterms.
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] for multipoles that are not an increasing subset of 0, 2, 4, or tensors not
+    /// cached (saying how to build them); as the counterterm plan.
+    fn new(block: &LoopBispectrumBlock) -> Result<Self> {
+        let ells = super::block::ell_indices(&block.ells)?;
+        let set = &block.triangles;
+        let (side, rule) = (block.side, &block.rule);
+        super::loop_tensors::check_triangles(set.triangles(), side, rule)?;
+        let store = match &block.cache_dir {
+            Some(dir) => TableStore::new(dir),
+            None => TableStore::from_env(),
+        };
+        let tensors = if set.width().is_some() {
+            let key = (set, side, rule, &correction_rules(rule));
+            store
+                .cached::<MultipoleBinBasis>(key, &Silent)
+                .map(Tensors::Bins)
+        } else {
+            store
+                .cached::<MultipoleLoopBasis>((set.triangles(), side, rule), &Silent)
+                .map(Tensors::Points)
+        };
+        let what = if set.width().is_some() {
+            "bins"
+        } else {
+            "triangles"
+        };
+        let tensors = tensors.ok_or_else(|| Error::InvalidChoice {
+            what: format!(
+                "the one-loop bispectrum block of {} {what} on the loop rule {} x {} x {} (q in [{}, {}] \
+                 h/Mpc)",
+                set.len(),
+                rule.radial,
+                rule.mu,
+                rule.phi,
+                rule.q_min,
+                rule.q_max
+            ),
+            reason: format!(
+                "its multipole tensors are not cached in {}: build them once (~190 s per {} and core at \
+                 the default rule) with `pt-spectra bispectrum --loop 1 --multipoles --two-loop basis \
+                 --triangles FILE{}` or Python's pt.OneLoopMultipolePlan, with the same cache directory",
+                store
+                    .dir()
+                    .map_or("(no cache directory)".into(), |d| d.display().to_string()),
+                &what[..what.len() - 1],
+                set.width()
+                    .map_or(String::new(), |w| format!(" --bin-width {w}"))
+            ),
+        })?;
+        let description = format!(
+            "one-loop bispectrum: B_l for l in {:?} of {} {what}{} (Legendre side {:?}), one-loop galaxy \
+             multipoles from tensors on the loop rule {} x {} x {} (q in [{}, {}] h/Mpc), the redshift-space \
+             counterterm and stochastic shapes exact; b1, b2, bs shared (velocileptors' map to the \
+             fourth-order basis), own: {}; no AP (alpha = 1), no FoG beyond ct_fog",
+            block.ells,
+            set.len(),
+            set.width()
+                .map_or(String::new(), |w| format!(" of width {w} h/Mpc")),
+            side,
+            rule.radial,
+            rule.mu,
+            rule.phi,
+            rule.q_min,
+            rule.q_max,
+            LOOP_NAMES.join(", ")
+        );
+        Ok(Self {
+            tensors,
+            counterterms: Arc::new(CountertermPlan::new(set, side)?),
+            triangles: set.triangles().to_vec(),
+            ells,
+            description,
+        })
+    }
+}
+
+impl Block for PlannedLoop {
+    fn kind(&self) -> &'static Kind {
+        &KIND
+    }
+
+    /// Multipoles × triangles.
+    fn len(&self) -> usize {
+        self.ells.len() * self.triangles.len()
+    }
+
+    /// Entry `j` (multipole, then triangle).
+    fn entry(&self, j: usize) -> String {
+        let n = self.triangles.len().max(1);
+        match (self.ells.get(j / n), self.triangles.get(j % n)) {
+            (Some(&l), Some(t)) => format!(
+                "one-loop B{} of the triangle ({}, {}, {}) h/Mpc",
+                ELLS[l], t[0], t[1], t[2]
+            ),
+            _ => format!("one-loop bispectrum entry {}", j + 1),
+        }
+    }
+
+    fn describe(&self) -> String {
+        self.description.clone()
+    }
+
+    /// The IR resummation's inputs of `spectrum` (the default split and q_min; `None` without).
+    fn prepare(&self, spectrum: &LinearSpectrum, ir: bool) -> Result<Prepared> {
+        let inputs: Option<IrInputs> = if ir {
+            Some(IrInputs::split(
+                spectrum,
+                &WiggleSplit::new()?,
+                crate::precision::Precision::default().q_min,
+            )?)
+        } else {
+            None
+        };
+        Ok(Arc::new(inputs))
+    }
+
+    /// The loops per bias monomial from the tensors and the counterterm shapes per bias monomial.
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] for a distortion other than α∥ = α⊥ = 1 or a spectrum the tensors do not
+    /// represent; f outside [0, 2].
+    fn terms(
+        &self,
+        spectrum: &LinearSpectrum,
+        prepared: &Prepared,
+        f: f64,
+        (q_par, q_perp): (f64, f64),
+    ) -> Result<Box<dyn Terms>> {
+        if (q_par - 1.0).abs() > 1e-12 || (q_perp - 1.0).abs() > 1e-12 {
+            return Err(Error::InvalidChoice {
+                what: format!(
+                    "the one-loop bispectrum block at alpha_par = {q_par}, alpha_perp = {q_perp}"
+                ),
+                reason:
+                    "its Alcock-Paczynski distortion is not implemented (the tensors are at fixed \
+                         triangles): fit it without a fiducial cosmology (alpha = 1), or use the \
+                         tree-level bispectrum block"
+                        .into(),
+            });
+        }
+        let ir = prepared
+            .downcast_ref::<Option<IrInputs>>()
+            .ok_or_else(|| foreign(&KIND))?
+            .as_ref();
+        let (loops, residual) = match &self.tensors {
+            Tensors::Points(t) => {
+                let (m, p) = t.evaluate_projected(spectrum, f, ir)?;
+                (Loops::Points(m), p.residual)
+            }
+            Tensors::Bins(t) => {
+                let (m, p) = t.evaluate_projected(spectrum, f, ir)?;
+                (Loops::Bins(m), p.residual)
+            }
+        };
+        if let s @ BispectrumLoopSource::Fallback { .. } = tensor_source(residual) {
+            return Err(Error::InvalidChoice {
+                what: "the linear spectrum of the one-loop bispectrum block".into(),
+                reason: format!(
+                    "{}; the block does not fall back to the direct integrals (~30 s per triangle): \
+                     compute this spectrum's table with `pt-spectra bispectrum --loop 1 --multipoles \
+                     --two-loop direct`",
+                    s.describe()
+                ),
+            });
+        }
+        Ok(Box::new(LoopTerms {
+            loops,
+            counterterms: self.counterterms.evaluate(spectrum, f)?,
+            ells: self.ells.clone(),
+        }))
+    }
+
+    fn gaussian_variances(&self, _: &Survey) -> Result<Vec<f64>> {
+        Err(Error::InvalidChoice {
+            what: "the Gaussian covariance of the one-loop bispectrum block".into(),
+            reason: "not implemented: a forecast holds the tree-level bispectrum block".into(),
+        })
+    }
+}
+
+/// The loops per bias monomial at one (spectrum, f).
+enum Loops {
+    Points(Vec<GalaxyLoopMultipoles>),
+    Bins(BinnedLoopMultipoles),
+}
+
+/// The block's terms at one (spectrum, f).
+struct LoopTerms {
+    loops: Loops,
+    counterterms: CountertermTerms,
+    ells: Vec<usize>,
+}
+
+/// The fourth-order bias of the shared b1, b2, bs (velocileptors') and the own [`LOOP_BIASES`].
+pub fn loop_bias(shared: Shared, own: &[f64]) -> LoopBias {
+    let mut bias = LoopBias::from_class_pt(
+        shared.b1,
+        shared.b2 + 4.0 / 3.0 * shared.bs,
+        shared.bs,
+        own[0],
+    );
+    bias.b3 = own[1];
+    bias.g2x = own[2];
+    bias.g3 = own[3];
+    bias.g21x = own[4];
+    bias
+}
+
+impl Terms for LoopTerms {
+    /// The entries (multipole, then triangle) at b1, b2, bs and [`LOOP_NAMES`].
+    fn values(&self, shared: Shared, own: &[f64]) -> Result<Vec<f64>> {
+        if own.len() != LOOP_NAMES.len() {
+            return Err(Error::InvalidChoice {
+                what: format!("{} own one-loop bispectrum parameters", own.len()),
+                reason: format!("they are {}", LOOP_NAMES.join(", ")),
+            });
+        }
+        let bias = loop_bias(shared, own);
+        let rows: Vec<[OneLoopGalaxy; 3]> = match &self.loops {
+            Loops::Points(m) => m.iter().map(|m| m.evaluate(&bias)).collect::<Result<_>>()?,
+            Loops::Bins(b) => b.evaluate(&bias)?,
+        };
+        let shapes = self.counterterms.at(&bias);
+        let ct: &[f64; N_REDSHIFT_CT] =
+            own[LOOP_BIASES.len()..].try_into().expect("length checked");
+        Ok(self
+            .ells
+            .iter()
+            .flat_map(|&l| {
+                rows.iter().zip(&shapes).map(move |(row, s)| {
+                    row[l].total().value + ct.iter().zip(&s[l]).map(|(c, s)| c * s).sum::<f64>()
+                })
+            })
+            .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests;

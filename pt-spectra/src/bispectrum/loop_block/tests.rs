@@ -1,0 +1,141 @@
+//! The one-loop bispectrum block against its parts computed independently: the tensors' loops at the bias
+//! of the exact map, and the direct counterterm shapes.
+
+use super::*;
+use crate::bispectrum::galaxy_counterterms_rsd::{
+    redshift_counterterm_multipoles, REDSHIFT_COUNTERTERMS,
+};
+use crate::statistic::{OptionValue, Options};
+
+const TRIANGLES: [[f64; 3]; 2] = [[0.05, 0.07, 0.1], [0.04, 0.04, 0.06]];
+
+fn rule() -> OneLoopRule {
+    OneLoopRule {
+        radial: 2,
+        mu: 2,
+        phi: 2,
+        ..OneLoopRule::default()
+    }
+}
+
+/// The pipeline face's options for `TRIANGLES` on `rule()` in `dir`.
+fn options(dir: &std::path::Path, ells: &[i64]) -> Options {
+    let list = |v: &[f64]| OptionValue::List(v.iter().map(|&x| OptionValue::Number(x)).collect());
+    Options {
+        entries: vec![
+            (
+                "triangles".into(),
+                OptionValue::List(TRIANGLES.iter().map(|t| list(t)).collect()),
+            ),
+            (
+                "rule".into(),
+                OptionValue::List(vec![OptionValue::Integer(2); 3]),
+            ),
+            (
+                "ells".into(),
+                OptionValue::List(ells.iter().map(|&l| OptionValue::Integer(l)).collect()),
+            ),
+            (
+                "cache_dir".into(),
+                OptionValue::Text(dir.display().to_string()),
+            ),
+        ],
+        ..Options::default()
+    }
+}
+
+/// The block from the pipeline face reads the tensors a table job cached (refusing before they are), and
+/// its entries are the tensors' loops at the exact bias map plus Σ c_s × the direct counterterm
+/// multipoles (1e-10); every own parameter enters linearly (the fit marginalises all of them); AP refused.
+#[test]
+fn the_block_is_its_parts_and_linear_in_its_own_parameters() {
+    assert_eq!(&LOOP_NAMES[LOOP_BIASES.len()..], &REDSHIFT_COUNTERTERMS[..]);
+    assert_eq!(LOOP_NAMES[..LOOP_BIASES.len()], LOOP_BIASES);
+    let dir = std::env::temp_dir().join(format!("pt-loop-block-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let spec = (faces::FACES.pipeline)(&options(&dir, &[0, 2]))
+        .unwrap()
+        .unwrap();
+    let e = spec.plan().unwrap_err().to_string();
+    assert!(
+        e.contains("not cached") && e.contains("--two-loop basis"),
+        "{e}"
+    );
+    let store = TableStore::new(&dir);
+    let set = TriangleSet::points(TRIANGLES.to_vec()).unwrap();
+    let tensors = super::super::loop_tensors::one_loop_multipole_tensors(
+        set.triangles(),
+        LegendreSide::Largest,
+        &rule(),
+        &store,
+        &Silent,
+    )
+    .unwrap();
+    let block = spec.plan().unwrap();
+    assert_eq!(block.len(), 4);
+    assert!(block.entry(3).contains("B2"), "{}", block.entry(3));
+    let p = LinearSpectrum::gm2012(0.5).unwrap();
+    let prepared = block.prepare(&p, false).unwrap();
+    let f = 0.74;
+    let e = block
+        .terms(&p, &prepared, f, (1.02, 0.99))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("Alcock-Paczynski"), "{e}");
+    let terms = block.terms(&p, &prepared, f, (1.0, 1.0)).unwrap();
+    let shared = Shared {
+        b1: 2.1,
+        b2: -0.4,
+        bs: 0.3,
+    };
+    let own: Vec<f64> = (0..LOOP_NAMES.len())
+        .map(|i| 0.3 * (i as f64 - 7.0) * if i < 5 { 0.3 } else { 20.0 })
+        .collect();
+    let got = terms.values(shared, &own).unwrap();
+    // the parts: the exact map of velocileptors' b1, b2, bs and CLASS-PT's b_Gamma3
+    let mut bias = LoopBias::from_class_pt(2.1, -0.4 + 0.4, 0.3, own[0]);
+    (bias.b3, bias.g2x, bias.g3, bias.g21x) = (own[1], own[2], own[3], own[4]);
+    let loops = tensors.evaluate(&p, f).unwrap();
+    for (j, (&l, t)) in [0usize, 1]
+        .iter()
+        .flat_map(|l| TRIANGLES.iter().enumerate().map(move |t| (l, t)))
+        .enumerate()
+    {
+        let (i, k) = t;
+        let row = loops[i].evaluate(&bias).unwrap();
+        let shapes =
+            redshift_counterterm_multipoles(&p, *k, &bias, f, LegendreSide::Largest).unwrap();
+        let ct: f64 = own[5..].iter().zip(&shapes[l]).map(|(c, s)| c * s).sum();
+        let want = row[l].total().value + ct;
+        assert!(
+            (got[j] - want).abs() <= 1e-10 * want.abs().max(row[0].total().value.abs()),
+            "entry {j}: {} vs {want}",
+            got[j]
+        );
+    }
+    // linear in every own parameter: v(2 e_i) - v(0) = 2 (v(e_i) - v(0))
+    let zero = terms.values(shared, &[0.0; 25]).unwrap();
+    for i in 0..LOOP_NAMES.len() {
+        let at = |x: f64| {
+            let mut v = [0.0; 25];
+            v[i] = x;
+            terms.values(shared, &v).unwrap()
+        };
+        let (one, two) = (at(1.0), at(2.0));
+        let scale = one
+            .iter()
+            .zip(&zero)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(scale > 0.0, "{} does not enter", LOOP_NAMES[i]);
+        for ((o, t), z) in one.iter().zip(&two).zip(&zero) {
+            assert!(
+                ((t - z) - 2.0 * (o - z)).abs() <= 1e-9 * (scale + z.abs()),
+                "{} is not linear",
+                LOOP_NAMES[i]
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
