@@ -145,6 +145,61 @@ fn one_loop_multipole_bins(crit: &mut Criterion) {
             })
         },
     );
+    // the one-loop block of a data vector: a new spectrum and f (loops + counterterms), then a new bias
+    let block = pt_spectra::bispectrum::loop_block::LoopBispectrumBlock {
+        triangles: set.clone(),
+        side: LegendreSide::Largest,
+        rule,
+        ells: vec![0, 2, 4],
+        cache_dir: None,
+    }
+    .plan_with_bins(bins.clone())
+    .unwrap();
+    let shared = pt_spectra::statistic::Shared {
+        b1: 2.0,
+        b2: 0.3,
+        bs: -0.2,
+    };
+    let own: Vec<f64> = (0..25).map(|i| 0.1 * f64::from(i)).collect();
+    let prepared: Vec<_> = spectra
+        .iter()
+        .map(|p| block.prepare(p, false).unwrap())
+        .collect();
+    crit.bench_function(
+        &format!(
+            "bispectrum/one-loop block of {} Nseries bins (B0 B2 B4, counterterms), new spectrum and f",
+            set.len()
+        ),
+        |b| {
+            b.iter(|| {
+                i += 1;
+                let at = i as usize % spectra.len();
+                let terms = block
+                    .terms(&spectra[at], &prepared[at], f(i), (1.0, 1.0))
+                    .unwrap();
+                black_box(terms.values(shared, &own).unwrap())
+            })
+        },
+    );
+    let terms = block
+        .terms(&spectra[0], &prepared[0], f(0), (1.0, 1.0))
+        .unwrap();
+    crit.bench_function(
+        &format!(
+            "bispectrum/one-loop block of {} Nseries bins, new bias and counterterms",
+            set.len()
+        ),
+        |b| {
+            b.iter(|| {
+                i += 1;
+                let s = pt_spectra::statistic::Shared {
+                    b1: 2.0 + 1e-3 * f64::from(i % 50),
+                    ..shared
+                };
+                black_box(terms.values(s, &own).unwrap())
+            })
+        },
+    );
 }
 
 criterion_group! {

@@ -138,6 +138,27 @@ pub struct LoopBispectrumBlock {
     pub cache_dir: Option<PathBuf>,
 }
 
+impl LoopBispectrumBlock {
+    /// The block planned with bin tensors held in memory (e.g. built on other correction rules than
+    /// the cache's): their set, side and rule replace `self`'s, `self.cache_dir` is not read.
+    ///
+    /// # Errors
+    /// As [`Spec::plan`] but for the cache.
+    pub fn plan_with_bins(&self, tensors: Arc<MultipoleBinBasis>) -> Result<Box<dyn Block>> {
+        let main = tensors.effective();
+        let block = Self {
+            triangles: tensors.set().clone(),
+            side: main.side(),
+            rule: *main.rule(),
+            ..self.clone()
+        };
+        Ok(Box::new(PlannedLoop::with_tensors(
+            Tensors::Bins(tensors),
+            &block,
+        )?))
+    }
+}
+
 impl Spec for LoopBispectrumBlock {
     fn plan(&self) -> Result<Box<dyn Block>> {
         Ok(Box::new(PlannedLoop::new(self)?))
@@ -168,7 +189,7 @@ impl PlannedLoop {
     /// [`Error::InvalidChoice`] for multipoles that are not an increasing subset of 0, 2, 4, or tensors not
     /// cached (saying how to build them); as the counterterm plan.
     fn new(block: &LoopBispectrumBlock) -> Result<Self> {
-        let ells = super::block::ell_indices(&block.ells)?;
+        super::block::ell_indices(&block.ells)?;
         let set = &block.triangles;
         let (side, rule) = (block.side, &block.rule);
         super::loop_tensors::check_triangles(set.triangles(), side, rule)?;
@@ -214,6 +235,22 @@ impl PlannedLoop {
                     .map_or(String::new(), |w| format!(" --bin-width {w}"))
             ),
         })?;
+        Self::with_tensors(tensors, block)
+    }
+
+    /// The block of `block`'s settings with the loops' `tensors` (of its triangles, side and rule).
+    ///
+    /// # Errors
+    /// As [`Self::new`] but for the cache.
+    fn with_tensors(tensors: Tensors, block: &LoopBispectrumBlock) -> Result<Self> {
+        let ells = super::block::ell_indices(&block.ells)?;
+        let set = &block.triangles;
+        let (side, rule) = (block.side, &block.rule);
+        let what = if set.width().is_some() {
+            "bins"
+        } else {
+            "triangles"
+        };
         let description = format!(
             "one-loop bispectrum: B_l for l in {:?} of {} {what}{} (Legendre side {:?}), one-loop galaxy \
              multipoles from tensors on the loop rule {} x {} x {} (q in [{}, {}] h/Mpc), the redshift-space \
