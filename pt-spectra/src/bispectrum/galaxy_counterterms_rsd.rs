@@ -129,7 +129,7 @@ fn shapes_at(
     Ok(s)
 }
 
-/// The shapes whose part of pair i ([`pair_parts`]) multiplies P(k_i) (st_p, st_p_mu2, st_p_mu4); the
+/// The shapes whose part of pair i (`pair_parts`) multiplies P(k_i) (st_p, st_p_mu2, st_p_mu4); the
 /// others' multiplies 2 P(k_i) P(k_j), and st_1 (index 6) is 1.
 pub const STOCHASTIC_LEGS: [usize; 3] = [5, 15, 16];
 

@@ -42,11 +42,11 @@ use std::sync::Arc;
 
 mod faces;
 
-/// The block's own bias coefficients (before the counterterms of [`REDSHIFT_COUNTERTERMS`]).
+/// The block's own bias coefficients (before the counterterms of [`super::galaxy_counterterms_rsd::REDSHIFT_COUNTERTERMS`]).
 pub const LOOP_BIASES: [&str; 5] = ["b_gamma3", "b3", "g2x", "g3", "g21x"];
 
 /// The block's own parameters: [`LOOP_BIASES`], then the counterterm and stochastic coefficients in the
-/// order of [`REDSHIFT_COUNTERTERMS`] (ct_* in (Mpc/h)², st_p* in (Mpc/h)³, st_1 in (Mpc/h)⁶).
+/// order of [`super::galaxy_counterterms_rsd::REDSHIFT_COUNTERTERMS`] (ct_* in (Mpc/h)², st_p* in (Mpc/h)³, st_1 in (Mpc/h)⁶).
 pub const LOOP_NAMES: [&str; 25] = [
     "b_gamma3",
     "b3",
