@@ -55,6 +55,7 @@ mod ir_legs;
 mod lanes;
 pub mod loop_block;
 pub mod loop_tensors;
+mod measured;
 mod multipole_acc;
 pub mod multipole_basis;
 pub mod multipole_bins;

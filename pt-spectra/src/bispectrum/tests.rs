@@ -1,5 +1,6 @@
 mod fits;
 mod forecast;
+mod loop_fits;
 
 use super::terms::tree_level_at;
 use super::*;

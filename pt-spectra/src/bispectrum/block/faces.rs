@@ -9,11 +9,10 @@
 //! covariance.
 
 use super::BispectrumBlock;
+use crate::bispectrum::measured::data_spec;
 use crate::bispectrum::{Fog, LegendreSide, PlanRules, TriangleSet};
 use crate::error::{Error, Result};
 use crate::statistic::{AnalysisFace, Faces, Measured, Options, Shells, Spec, SurveyFace};
-use crate::table::DataColumns;
-use std::path::PathBuf;
 use std::sync::Arc;
 
 /// The bispectrum's faces.
@@ -108,40 +107,11 @@ fn survey_note(m: f64) -> String {
     )
 }
 
-/// The keys of a `[dataset.bispectrum]`.
-const ANALYSIS_KEYS: [&str; 8] = [
-    "data",
-    "data_ells",
-    "ells",
-    "k_min",
-    "k_max",
-    "bin_width",
-    "covariance",
-    "n_bar",
-];
+/// The tree-level block's own keys of a `[dataset.bispectrum]` (besides the measurement's).
+const ANALYSIS_KEYS: [&str; 1] = ["n_bar"];
 
-/// The bispectrum of a data set, as the analysis file gives it (paths resolved).
-struct DataSpec {
-    data: PathBuf,
-    data_ells: Vec<usize>,
-    ells: Vec<usize>,
-    k_min: f64,
-    k_max: f64,
-    bin_width: Option<f64>,
-    covariance: PathBuf,
-    n_bar: Option<f64>,
-}
-
-/// A `[dataset.bispectrum]` table (n_bar by default the data set's).
-fn data_spec(o: &Options) -> Result<DataSpec> {
-    o.known(&ANALYSIS_KEYS)?;
-    let ells_of = |k: &str, default: Vec<usize>| -> Result<Vec<usize>> {
-        let v = o.counts(k)?.unwrap_or(default);
-        if v.is_empty() || v.iter().any(|l| ![0, 2, 4].contains(l)) {
-            return Err(o.bad(k, "the bispectrum multipoles are 0, 2, 4"));
-        }
-        Ok(v)
-    };
+/// The data set's n̄ (the table's, else the data set's) if given.
+fn n_bar(o: &Options) -> Result<Option<f64>> {
     let n_bar = o
         .inherited("n_bar")
         .map(|v| o.number_of("n_bar", v))
@@ -151,119 +121,37 @@ fn data_spec(o: &Options) -> Result<DataSpec> {
             return Err(o.bad("n_bar", "must be > 0 [(h/Mpc)^3]"));
         }
     }
-    let k_min = o.number("k_min")?.unwrap_or(0.0);
-    let k_max = o.number_of("k_max", o.need("k_max")?)?;
-    if k_max <= k_min {
-        return Err(o.bad("k_max", "must exceed k_min"));
-    }
-    let file = |k: &str| {
-        o.need(k)?;
-        Ok::<_, Error>(o.file(k)?.expect("given"))
-    };
-    Ok(DataSpec {
-        data: file("data")?,
-        data_ells: ells_of("data_ells", vec![0, 2, 4])?,
-        ells: ells_of("ells", vec![0])?,
-        k_min,
-        k_max,
-        bin_width: o.number("bin_width")?,
-        covariance: file("covariance")?,
-        n_bar,
-    })
+    Ok(n_bar)
 }
 
 fn analysis_check(o: &Options) -> Result<()> {
-    data_spec(o).map(|_| ())
-}
-
-/// The error about `what`.
-fn bad(what: String, reason: impl Into<String>) -> Error {
-    Error::InvalidChoice {
-        what,
-        reason: reason.into(),
-    }
+    data_spec(o, &ANALYSIS_KEYS)?;
+    n_bar(o).map(|_| ())
 }
 
 /// The measured multipoles of the table's file at the triangles fitted (every side in [k_min,
-/// k_max]) and the block of those triangles.
+/// k_max]) and the block of those triangles ([`crate::bispectrum::measured`]).
 ///
 /// # Errors
-/// [`Error::BadRow`], [`Error::InvalidChoice`] naming the file and the rule for a file not of its
-/// layout, a fitted multipole not in the file, no triangle in the range.
+/// As [`measured::measure`](crate::bispectrum::measured); a bad n̄.
 fn measure(o: &Options) -> Result<Measured> {
-    let spec = data_spec(o)?;
-    let origin = spec.data.display().to_string();
-    let text = crate::table::read_text(&spec.data)?;
-    let table = DataColumns::parse_exact(&text, &origin, 3 + spec.data_ells.len())?;
-    let n_tri = table.lines.len();
-    let triangles: Vec<[f64; 3]> = (0..n_tri)
-        .map(|i| std::array::from_fn(|c| table.columns[c][i]))
-        .collect();
-    let fitted: Vec<usize> = (0..n_tri)
-        .filter(|&i| {
-            triangles[i]
-                .iter()
-                .all(|&k| k >= spec.k_min && k <= spec.k_max)
-        })
-        .collect();
-    if fitted.is_empty() {
-        return Err(bad(
-            format!("{origin}: k_min = {}, k_max = {}", spec.k_min, spec.k_max),
-            "no triangle has every side in the range",
-        ));
-    }
-    let b_rows = spec
-        .ells
-        .iter()
-        .map(|l| {
-            spec.data_ells.iter().position(|d| d == l).ok_or_else(|| {
-                bad(
-                    format!("the fitted bispectrum multipole {l}"),
-                    format!("is not in {origin} (its multipoles {:?})", spec.data_ells),
-                )
-            })
-        })
-        .collect::<Result<Vec<usize>>>()?;
-    let centres: Vec<[f64; 3]> = fitted.iter().map(|&t| triangles[t]).collect();
-    let set = match spec.bin_width {
-        Some(w) => TriangleSet::shells(centres, w)?,
-        None => TriangleSet::points(centres)?,
+    let spec = data_spec(o, &ANALYSIS_KEYS)?;
+    let n_bar = n_bar(o)?;
+    let ells = spec.ells.clone();
+    let block = |triangles| -> Result<Arc<dyn Spec>> {
+        Ok(Arc::new(BispectrumBlock {
+            triangles,
+            side: LegendreSide::Largest,
+            rules: PlanRules::default(),
+            ells,
+            fog: Fog::None,
+            n_bar: n_bar.unwrap_or(f64::INFINITY),
+        }))
     };
-    let block = BispectrumBlock {
-        triangles: set,
-        side: LegendreSide::Largest,
-        rules: PlanRules::default(),
-        ells: spec.ells.clone(),
-        fog: Fog::None,
-        n_bar: spec.n_bar.unwrap_or(f64::INFINITY),
+    let note = if n_bar.is_none() {
+        "; no stochastic terms (n_bar not given)"
+    } else {
+        ""
     };
-    let note = format!(
-        "data {origin} ({} of its {n_tri} triangles: every side in [{}, {}] h/Mpc{}), joint \
-         covariance {} (P then B, cross terms included){}",
-        fitted.len(),
-        spec.k_min,
-        spec.k_max,
-        spec.bin_width
-            .map_or(", at the triangles given".into(), |w| format!(
-                ", averaged over bins of width {w}"
-            )),
-        spec.covariance.display(),
-        if spec.n_bar.is_none() {
-            "; no stochastic terms (n_bar not given)"
-        } else {
-            ""
-        }
-    );
-    Ok(Measured {
-        spec: Arc::new(block),
-        // the fitted entries: multipole, then triangle
-        fitted: b_rows
-            .iter()
-            .flat_map(|&j| fitted.iter().map(move |&t| j * n_tri + t))
-            .collect(),
-        columns: table.columns[3..].to_vec(),
-        covariance: spec.covariance,
-        layout: format!("{} multipoles x {n_tri} triangles", spec.data_ells.len()),
-        note,
-    })
+    crate::bispectrum::measured::measure(&spec, block, note)
 }

@@ -1,12 +1,14 @@
 //! How the faces build the one-loop bispectrum block from their text ([`crate::statistic::Faces`]): a
-//! pipeline's options (Python's `pt.Pipeline(..., one_loop_bispectrum={...})`). No forecast face (its
-//! Gaussian covariance is the tree-level block's) and no analysis-file face yet.
+//! pipeline's options (Python's `pt.Pipeline(..., one_loop_bispectrum={...})`) and an analysis file's
+//! `[dataset.one_loop_bispectrum]` (the measurement's layout of [`crate::bispectrum::measured`], plus the
+//! loop options). No forecast face (its Gaussian covariance is the tree-level block's).
 
 use super::LoopBispectrumBlock;
+use crate::bispectrum::measured::data_spec;
 use crate::bispectrum::one_loop::OneLoopRule;
 use crate::bispectrum::{LegendreSide, TriangleSet};
 use crate::error::Result;
-use crate::statistic::{Faces, OptionValue, Options, Spec};
+use crate::statistic::{AnalysisFace, Faces, Measured, OptionValue, Options, Spec};
 use std::sync::Arc;
 
 /// The one-loop bispectrum's faces.
@@ -14,8 +16,14 @@ pub const FACES: Faces = Faces {
     keywords: &[],
     pipeline,
     survey: None,
-    analysis: None,
+    analysis: Some(AnalysisFace {
+        check: analysis_check,
+        measure,
+    }),
 };
+
+/// The loop options of the block, in a pipeline and in an analysis file.
+const LOOP_KEYS: [&str; 3] = ["rule", "q_range", "cache_dir"];
 
 /// The options of the block in a pipeline.
 const PIPELINE_KEYS: [&str; 6] = [
@@ -46,6 +54,22 @@ fn pipeline(o: &Options) -> Result<Option<Arc<dyn Spec>>> {
         Some(w) => TriangleSet::shells(triangles, w)?,
         None => TriangleSet::points(triangles)?,
     };
+    let rule = loop_rule(o)?;
+    Ok(Some(Arc::new(LoopBispectrumBlock {
+        triangles,
+        side: LegendreSide::Largest,
+        rule,
+        ells: o.counts("ells")?.unwrap_or_else(|| vec![0, 2, 4]),
+        cache_dir: o.text("cache_dir")?.map(Into::into),
+    })))
+}
+
+/// The loop rule of the options `rule` and `q_range` (defaults: [`OneLoopRule::default`]).
+///
+/// # Errors
+/// [`crate::error::Error::InvalidChoice`] naming the key for a rule that is not three counts or a q range
+/// that is not two numbers; the rule's check.
+fn loop_rule(o: &Options) -> Result<OneLoopRule> {
     let mut rule = OneLoopRule::default();
     if let Some(n) = o.counts("rule")? {
         let &[radial, mu, phi] = &n[..] else {
@@ -60,13 +84,34 @@ fn pipeline(o: &Options) -> Result<Option<Arc<dyn Spec>>> {
         (rule.q_min, rule.q_max) = (q_min, q_max);
     }
     rule.validate()?;
-    Ok(Some(Arc::new(LoopBispectrumBlock {
-        triangles,
-        side: LegendreSide::Largest,
-        rule,
-        ells: o.counts("ells")?.unwrap_or_else(|| vec![0, 2, 4]),
-        cache_dir: o.text("cache_dir")?.map(Into::into),
-    })))
+    Ok(rule)
+}
+
+fn analysis_check(o: &Options) -> Result<()> {
+    data_spec(o, &LOOP_KEYS)?;
+    loop_rule(o).map(|_| ())
+}
+
+/// The measured multipoles of the table's file at the triangles fitted and the one-loop block of those
+/// triangles on the table's rule, its tensors read from `cache_dir` when the fit is set up.
+///
+/// # Errors
+/// As [`crate::bispectrum::measured`]'s reading; a bad rule.
+fn measure(o: &Options) -> Result<Measured> {
+    let spec = data_spec(o, &LOOP_KEYS)?;
+    let rule = loop_rule(o)?;
+    let cache_dir = o.text("cache_dir")?.map(Into::into);
+    let ells = spec.ells.clone();
+    let block = |triangles| -> Result<Arc<dyn Spec>> {
+        Ok(Arc::new(LoopBispectrumBlock {
+            triangles,
+            side: LegendreSide::Largest,
+            rule,
+            ells,
+            cache_dir,
+        }))
+    };
+    crate::bispectrum::measured::measure(&spec, block, "; the one-loop model")
 }
 
 /// The numbers at `key`, if given.

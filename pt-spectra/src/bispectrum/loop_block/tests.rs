@@ -139,3 +139,56 @@ fn the_block_is_its_parts_and_linear_in_its_own_parameters() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// An analysis file's `[dataset.one_loop_bispectrum]`: the fitted triangles' block on the table's rule,
+/// the entries of the file; a bad rule and a key of the tree-level block are refused, named.
+#[test]
+fn the_analysis_face_reads_the_measurement_and_the_rule() {
+    let dir = std::env::temp_dir().join(format!("pt-loop-face-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let data = dir.join("bk.dat");
+    std::fs::write(
+        &data,
+        "# k1 k2 k3 B0 B2\n0.05 0.07 0.1 1e9 2e8\n0.04 0.04 0.06 2e9 3e8\n0.1 0.12 0.2 1e8 1e7\n",
+    )
+    .unwrap();
+    let cov = dir.join("cov.dat");
+    std::fs::write(&cov, "1\n").unwrap();
+    let text = |k: &str, v: &str| (k.to_string(), OptionValue::Text(v.into()));
+    let ints = |k: &str, v: &[i64]| {
+        (
+            k.to_string(),
+            OptionValue::List(v.iter().map(|&x| OptionValue::Integer(x)).collect()),
+        )
+    };
+    let mut o = Options {
+        entries: vec![
+            text("data", "bk.dat"),
+            ints("data_ells", &[0, 2]),
+            ints("ells", &[0, 2]),
+            ("k_max".into(), OptionValue::Number(0.15)),
+            text("covariance", "cov.dat"),
+            ints("rule", &[2, 2, 2]),
+            text("cache_dir", &dir.display().to_string()),
+        ],
+        base: Some(dir.clone()),
+        ..Options::default()
+    };
+    let face = faces::FACES.analysis.unwrap();
+    (face.check)(&o).unwrap();
+    let m = (face.measure)(&o).unwrap();
+    // the two triangles within k_max, multipole then triangle, among the file's 2 x 3 entries
+    assert_eq!(m.fitted, vec![0, 1, 3, 4]);
+    assert_eq!(m.columns.len(), 2);
+    let e = m.spec.plan().unwrap_err().to_string();
+    assert!(e.contains("2 triangles") && e.contains("2 x 2 x 2"), "{e}");
+    o.entries.push(ints("rule", &[2, 2]));
+    o.entries.remove(5);
+    let e = (face.check)(&o).unwrap_err().to_string();
+    assert!(e.contains("rule"), "{e}");
+    o.entries.pop();
+    o.entries.push(("n_bar".into(), OptionValue::Number(3e-4)));
+    let e = (face.check)(&o).unwrap_err().to_string();
+    assert!(e.contains("n_bar") && e.contains("unknown key"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
