@@ -12,8 +12,13 @@
 //! - **Bias**: b1, b2, bs in velocileptors' convention mapped exactly to the fourth-order basis
 //!   ([`LoopBias::from_class_pt`] with b2 + (4/3)bs, b_G2 = bs) with CLASS-PT's b_Γ3 (`b_gamma3`) and the
 //!   coefficients b3, g2x, g3, g21x of Eggemeier, Scoccimarro & Smith (2019) as own parameters.
-//! - **Not here**: the Alcock–Paczynski distortion (the tensors are at fixed triangles: α∥ = α⊥ = 1 is
-//!   required, anything else is an error) and Fingers of God beyond the counterterm ct_fog.
+//! - **Alcock–Paczynski**: the tensors are at fixed triangles, so the distortion is exact on the tree level
+//!   only: B = B_1loop(1) + [B_tree(α) − B_tree(1)] + (1/(α∥²α⊥⁴) − 1)(B_1loop − B_tree + counterterms)(1),
+//!   the tree's change from the tree-level plan ([`super::BispectrumPlan`]: the same bins, IR and bias).
+//!   The loop correction and the counterterms keep their undistorted shape and take the volume factor; the
+//!   neglected change of their shape is of order |α − 1| times the loop correction (docs/bispectrum.md gives
+//!   its measured size). At α∥ = α⊥ = 1 the block is the one-loop multipoles exactly.
+//! - **Not here**: Fingers of God beyond the counterterm ct_fog.
 //!
 //! Every own parameter enters B linearly (the higher biases through one kernel Z₃ or Z₄ of each term), so a
 //! fit marginalises all of them analytically. A step: new terms per (spectrum, f), ~10 ms for the 62
@@ -30,7 +35,10 @@ use super::one_loop_basis::BispectrumLoopSource;
 use super::one_loop_bins::BinnedLoopMultipoles;
 use super::one_loop_galaxy::OneLoopGalaxy;
 use super::one_loop_galaxy_multipoles::GalaxyLoopMultipoles;
-use super::{IrInputs, LegendreSide, TriangleSet, ELLS};
+use super::{
+    BispectrumParams, BispectrumPlan, BispectrumTerms, Fog, IrInputs, LegendreSide, PlanRules,
+    Settings, TriangleSet, ELLS,
+};
 use crate::error::{Error, Result};
 use crate::ir::WiggleSplit;
 use crate::linear::LinearSpectrum;
@@ -176,6 +184,8 @@ enum Tensors {
 #[derive(Debug, Clone)]
 struct PlannedLoop {
     tensors: Tensors,
+    /// The tree level's plan on the same triangles: its change under the distortion.
+    tree: BispectrumPlan,
     counterterms: Arc<CountertermPlan>,
     triangles: Vec<[f64; 3]>,
     ells: Vec<usize>,
@@ -255,7 +265,8 @@ impl PlannedLoop {
             "one-loop bispectrum: B_l for l in {:?} of {} {what}{} (Legendre side {:?}), one-loop galaxy \
              multipoles from tensors on the loop rule {} x {} x {} (q in [{}, {}] h/Mpc), the redshift-space \
              counterterm and stochastic shapes exact; b1, b2, bs shared (velocileptors' map to the \
-             fourth-order basis), own: {}; no AP (alpha = 1), no FoG beyond ct_fog",
+             fourth-order basis), own: {}; AP exact on the tree level only (the loop correction and \
+             counterterms undistorted times 1/(apar^2 aperp^4)), no FoG beyond ct_fog",
             block.ells,
             set.len(),
             set.width()
@@ -270,6 +281,7 @@ impl PlannedLoop {
         );
         Ok(Self {
             tensors,
+            tree: BispectrumPlan::new(set.clone(), side, PlanRules::default())?,
             counterterms: Arc::new(CountertermPlan::new(set, side)?),
             triangles: set.triangles().to_vec(),
             ells,
@@ -321,8 +333,8 @@ impl Block for PlannedLoop {
     /// The loops per bias monomial from the tensors and the counterterm shapes per bias monomial.
     ///
     /// # Errors
-    /// [`Error::InvalidChoice`] for a distortion other than α∥ = α⊥ = 1 or a spectrum the tensors do not
-    /// represent; f outside [0, 2].
+    /// [`Error::InvalidChoice`] for a spectrum the tensors do not represent; f outside [0, 2], a distortion
+    /// that is not finite and > 0 (as the tree-level plan's).
     fn terms(
         &self,
         spectrum: &LinearSpectrum,
@@ -330,18 +342,6 @@ impl Block for PlannedLoop {
         f: f64,
         (q_par, q_perp): (f64, f64),
     ) -> Result<Box<dyn Terms>> {
-        if (q_par - 1.0).abs() > 1e-12 || (q_perp - 1.0).abs() > 1e-12 {
-            return Err(Error::InvalidChoice {
-                what: format!(
-                    "the one-loop bispectrum block at alpha_par = {q_par}, alpha_perp = {q_perp}"
-                ),
-                reason:
-                    "its Alcock-Paczynski distortion is not implemented (the tensors are at fixed \
-                         triangles): fit it without a fiducial cosmology (alpha = 1), or use the \
-                         tree-level bispectrum block"
-                        .into(),
-            });
-        }
         let ir = prepared
             .downcast_ref::<Option<IrInputs>>()
             .ok_or_else(|| foreign(&KIND))?
@@ -367,10 +367,33 @@ impl Block for PlannedLoop {
                 ),
             });
         }
+        let distorted = if q_par == 1.0 && q_perp == 1.0 {
+            None
+        } else {
+            let tree = |q_par: f64, q_perp: f64| {
+                let settings = Settings {
+                    f,
+                    q_par,
+                    q_perp,
+                    fog: Fog::None,
+                    ir: ir.is_some(),
+                };
+                match ir {
+                    Some(ir) => self.tree.terms_with_ir(spectrum, &settings, ir),
+                    None => self.tree.terms(spectrum, &settings),
+                }
+            };
+            Some(Distorted {
+                at: tree(q_par, q_perp)?,
+                undistorted: tree(1.0, 1.0)?,
+                volume: 1.0 / (q_par * q_par * q_perp.powi(4)),
+            })
+        };
         Ok(Box::new(LoopTerms {
             loops,
             counterterms: self.counterterms.evaluate(spectrum, f)?,
             ells: self.ells.clone(),
+            distorted,
         }))
     }
 
@@ -388,11 +411,19 @@ enum Loops {
     Bins(BinnedLoopMultipoles),
 }
 
-/// The block's terms at one (spectrum, f).
+/// The tree level at a distortion and without, and the volume factor 1/(α∥²α⊥⁴).
+struct Distorted {
+    at: BispectrumTerms,
+    undistorted: BispectrumTerms,
+    volume: f64,
+}
+
+/// The block's terms at one (spectrum, f, distortion).
 struct LoopTerms {
     loops: Loops,
     counterterms: CountertermTerms,
     ells: Vec<usize>,
+    distorted: Option<Distorted>,
 }
 
 /// The fourth-order bias of the shared b1, b2, bs (velocileptors') and the own [`LOOP_BIASES`].
@@ -427,13 +458,41 @@ impl Terms for LoopTerms {
         let shapes = self.counterterms.at(&bias);
         let ct: &[f64; N_REDSHIFT_CT] =
             own[LOOP_BIASES.len()..].try_into().expect("length checked");
+        // the tree's change under the distortion, per triangle and ℓ (none: zero), and the volume factor
+        let (change, volume) = match &self.distorted {
+            None => (vec![[0.0; 3]; rows.len()], 1.0),
+            Some(d) => {
+                let b = BispectrumParams {
+                    b1: shared.b1,
+                    b2: shared.b2,
+                    bs: shared.bs,
+                    c1: 0.0,
+                    b_shot: 0.0,
+                    p_shot: 0.0,
+                    a_shot: 0.0,
+                    n_bar: f64::INFINITY,
+                };
+                let (at, one) = (d.at.multipoles(&b)?, d.undistorted.multipoles(&b)?);
+                let change = at
+                    .iter()
+                    .zip(&one)
+                    .map(|(a, o)| std::array::from_fn(|l| a[l].value - o[l].value))
+                    .collect();
+                (change, d.volume)
+            }
+        };
         Ok(self
             .ells
             .iter()
             .flat_map(|&l| {
-                rows.iter().zip(&shapes).map(move |(row, s)| {
-                    row[l].total().value + ct.iter().zip(&s[l]).map(|(c, s)| c * s).sum::<f64>()
-                })
+                rows.iter()
+                    .zip(&shapes)
+                    .zip(&change)
+                    .map(move |((row, s), change)| {
+                        let ct: f64 = ct.iter().zip(&s[l]).map(|(c, s)| c * s).sum();
+                        let tree = row[l].tree.value;
+                        tree + change[l] + volume * (row[l].total().value - tree + ct)
+                    })
             })
             .collect())
     }
