@@ -89,6 +89,23 @@ def python_results(out):
     return found, path
 
 
+def write_inputs(out, data, cov_file):
+    """The analysis files' inputs in `out`: the mean P and B of the mocks, the joint covariance and its P
+    block, the true cosmology."""
+    pk, bk = read_data(data)
+    cov = np.loadtxt(cov_file)
+    n_k = len(pk)
+    sigma = np.sqrt(np.diag(cov)[: 3 * n_k]).reshape(3, n_k)
+    np.savetxt(out / "nseries_pb_p.dat",
+               np.column_stack([pk[:, 0]] + [c for l in range(3) for c in (pk[:, 1 + l], sigma[l])]),
+               header="mean of the 84 Nseries mocks: k P0 s0 P2 s2 P4 s4 (s from the Patchy covariance)")
+    np.savetxt(out / "nseries_pb_b.dat", bk[:, :6], header="mean of the 84 Nseries mocks: k1 k2 k3 B0 B2 B4")
+    np.savetxt(out / "nseries_pb_cov.dat", cov, header="Patchy NGC z3 P + B covariance (P0 P2 P4, B0 B2 B4)")
+    np.savetxt(out / "nseries_pb_pcov.dat", cov[: 3 * n_k, : 3 * n_k], header="its P0 P2 P4 block")
+    (out / "nseries_true.ini").write_text(
+        "# the true cosmology of the Nseries mocks\n" + "".join(f"{k} = {v}\n" for k, v in TRUE.items()))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--data", type=Path, default=DEFAULT_DATA)
@@ -101,18 +118,7 @@ def main():
             sys.exit(f"{p} not found: see examples/nseries_pb_fit.py for where the data come from")
     a.out.mkdir(parents=True, exist_ok=True)
     t0 = time.time()
-    pk, bk = read_data(a.data)
-    cov = np.loadtxt(a.cov)
-    n_k = len(pk)
-    sigma = np.sqrt(np.diag(cov)[: 3 * n_k]).reshape(3, n_k)
-    np.savetxt(a.out / "nseries_pb_p.dat",
-               np.column_stack([pk[:, 0]] + [c for l in range(3) for c in (pk[:, 1 + l], sigma[l])]),
-               header="mean of the 84 Nseries mocks: k P0 s0 P2 s2 P4 s4 (s from the Patchy covariance)")
-    np.savetxt(a.out / "nseries_pb_b.dat", bk[:, :6], header="mean of the 84 Nseries mocks: k1 k2 k3 B0 B2 B4")
-    np.savetxt(a.out / "nseries_pb_cov.dat", cov, header="Patchy NGC z3 P + B covariance (P0 P2 P4, B0 B2 B4)")
-    np.savetxt(a.out / "nseries_pb_pcov.dat", cov[: 3 * n_k, : 3 * n_k], header="its P0 P2 P4 block")
-    (a.out / "nseries_true.ini").write_text(
-        "# the true cosmology of the Nseries mocks\n" + "".join(f"{k} = {v}\n" for k, v in TRUE.items()))
+    write_inputs(a.out, a.data, a.cov)
     qpar, qperp = ap_truth()
     results = {}
     for label, k_max_b in [("P", None)] + [(f"P+B0 (k_max,B = {k})", k) for k in K_MAX_B]:

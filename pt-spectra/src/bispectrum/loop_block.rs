@@ -26,7 +26,7 @@
 
 use super::bias_kernels::LoopBias;
 use super::counterterm_plan::{CountertermPlan, CountertermTerms};
-use super::galaxy_counterterms_rsd::N_REDSHIFT_CT;
+use super::galaxy_counterterms_rsd::{N_REDSHIFT_CT, REDSHIFT_COUNTERTERMS};
 use super::loop_tensors::tensor_source;
 use super::multipole_basis::MultipoleLoopBasis;
 use super::multipole_bins::{correction_rules, MultipoleBinBasis};
@@ -50,38 +50,23 @@ use std::sync::Arc;
 
 mod faces;
 
-/// The block's own bias coefficients (before the counterterms of [`super::galaxy_counterterms_rsd::REDSHIFT_COUNTERTERMS`]).
+/// The block's own bias coefficients (before the counterterms of [`REDSHIFT_COUNTERTERMS`]).
 pub const LOOP_BIASES: [&str; 5] = ["b_gamma3", "b3", "g2x", "g3", "g21x"];
 
 /// The block's own parameters: [`LOOP_BIASES`], then the counterterm and stochastic coefficients in the
-/// order of [`super::galaxy_counterterms_rsd::REDSHIFT_COUNTERTERMS`] (ct_* in (Mpc/h)², st_p* in (Mpc/h)³, st_1 in (Mpc/h)⁶).
-pub const LOOP_NAMES: [&str; 25] = [
-    "b_gamma3",
-    "b3",
-    "g2x",
-    "g3",
-    "g21x",
-    "ct_k2",
-    "ct_k3",
-    "ct_kk",
-    "ct_tidal",
-    "ct_f2k3",
-    "st_p",
-    "st_1",
-    "ct_k2_mu2",
-    "ct_k2_mu4",
-    "ct_k3_mu2",
-    "ct_kk_mu2",
-    "ct_g2k3_mu2",
-    "ct_map",
-    "ct_map_mu2",
-    "ct_vel",
-    "st_p_mu2",
-    "st_p_mu4",
-    "ct_k3_mu4",
-    "ct_fog",
-    "ct_z2k3",
-];
+/// order of [`REDSHIFT_COUNTERTERMS`] (ct_* in (Mpc/h)², st_p* in (Mpc/h)³, st_1 in (Mpc/h)⁶).
+pub const LOOP_NAMES: [&str; 25] = concat(LOOP_BIASES, REDSHIFT_COUNTERTERMS);
+
+/// `a` then `b`.
+const fn concat(a: [&'static str; 5], b: [&'static str; N_REDSHIFT_CT]) -> [&'static str; 25] {
+    let mut out = [""; 25];
+    let mut i = 0;
+    while i < 25 {
+        out[i] = if i < 5 { a[i] } else { b[i - 5] };
+        i += 1;
+    }
+    out
+}
 
 const BIAS_RANGE: Range = (-50.0, 50.0, -1.0, 1.0, 1.0);
 const CT_RANGE: Range = (-1e5, 1e5, -10.0, 10.0, 10.0);
