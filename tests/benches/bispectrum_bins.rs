@@ -152,6 +152,7 @@ fn one_loop_multipole_bins(crit: &mut Criterion) {
         rule,
         ells: vec![0, 2, 4],
         cache_dir: None,
+        fitted: None,
     }
     .plan_with_bins(bins.clone())
     .unwrap();

@@ -129,6 +129,9 @@ pub struct LoopBispectrumBlock {
     pub ells: Vec<usize>,
     /// Where the tensors are cached (`None`: [`TableStore::from_env`]).
     pub cache_dir: Option<PathBuf>,
+    /// The triangles in the data vector, by index into `triangles` (`None`: all): a fit of some bins of
+    /// a file whose tensors were built for all of them.
+    pub fitted: Option<Vec<usize>>,
 }
 
 impl LoopBispectrumBlock {
@@ -172,7 +175,10 @@ struct PlannedLoop {
     /// The tree level's plan on the same triangles: its change under the distortion.
     tree: BispectrumPlan,
     counterterms: Arc<CountertermPlan>,
+    /// The triangles in the data vector.
     triangles: Vec<[f64; 3]>,
+    /// Their indices among the planned ones.
+    fitted: Vec<usize>,
     ells: Vec<usize>,
     description: String,
 }
@@ -241,21 +247,35 @@ impl PlannedLoop {
         let ells = super::block::ell_indices(&block.ells)?;
         let set = &block.triangles;
         let (side, rule) = (block.side, &block.rule);
+        let fitted = match &block.fitted {
+            None => (0..set.len()).collect(),
+            Some(f) => {
+                if f.is_empty() || f.windows(2).any(|w| w[0] >= w[1]) || f[f.len() - 1] >= set.len()
+                {
+                    return Err(Error::InvalidChoice {
+                        what: format!("the fitted triangles {f:?} of a one-loop bispectrum block"),
+                        reason: format!("give increasing indices below {}", set.len()),
+                    });
+                }
+                f.clone()
+            }
+        };
         let what = if set.width().is_some() {
             "bins"
         } else {
             "triangles"
         };
         let description = format!(
-            "one-loop bispectrum: B_l for l in {:?} of {} {what}{} (Legendre side {:?}), one-loop galaxy \
+            "one-loop bispectrum: B_l for l in {:?} of {} {what}{} (of {} planned; Legendre side {:?}), one-loop galaxy \
              multipoles from tensors on the loop rule {} x {} x {} (q in [{}, {}] h/Mpc), the redshift-space \
              counterterm and stochastic shapes exact; b1, b2, bs shared (velocileptors' map to the \
              fourth-order basis), own: {}; AP exact on the tree level only (the loop correction and \
              counterterms undistorted times 1/(apar^2 aperp^4)), no FoG beyond ct_fog",
             block.ells,
-            set.len(),
+            fitted.len(),
             set.width()
                 .map_or(String::new(), |w| format!(" of width {w} h/Mpc")),
+            set.len(),
             side,
             rule.radial,
             rule.mu,
@@ -268,7 +288,8 @@ impl PlannedLoop {
             tensors,
             tree: BispectrumPlan::new(set.clone(), side, PlanRules::default())?,
             counterterms: Arc::new(CountertermPlan::new(set, side)?),
-            triangles: set.triangles().to_vec(),
+            triangles: fitted.iter().map(|&i| set.triangles()[i]).collect(),
+            fitted,
             ells,
             description,
         })
@@ -378,6 +399,7 @@ impl Block for PlannedLoop {
             loops,
             counterterms: self.counterterms.evaluate(spectrum, f)?,
             ells: self.ells.clone(),
+            fitted: self.fitted.clone(),
             distorted,
         }))
     }
@@ -408,6 +430,7 @@ struct LoopTerms {
     loops: Loops,
     counterterms: CountertermTerms,
     ells: Vec<usize>,
+    fitted: Vec<usize>,
     distorted: Option<Distorted>,
 }
 
@@ -470,14 +493,13 @@ impl Terms for LoopTerms {
             .ells
             .iter()
             .flat_map(|&l| {
-                rows.iter()
-                    .zip(&shapes)
-                    .zip(&change)
-                    .map(move |((row, s), change)| {
-                        let ct: f64 = ct.iter().zip(&s[l]).map(|(c, s)| c * s).sum();
-                        let tree = row[l].tree.value;
-                        tree + change[l] + volume * (row[l].total().value - tree + ct)
-                    })
+                let (rows, shapes, change) = (&rows, &shapes, &change);
+                self.fitted.iter().map(move |&i| {
+                    let (row, s) = (&rows[i], &shapes[i]);
+                    let ct: f64 = ct.iter().zip(&s[l]).map(|(c, s)| c * s).sum();
+                    let tree = row[l].tree.value;
+                    tree + change[i][l] + volume * (row[l].total().value - tree + ct)
+                })
             })
             .collect())
     }

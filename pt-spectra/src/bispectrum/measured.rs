@@ -71,6 +71,17 @@ pub(super) fn data_spec(o: &Options, own: &[&str]) -> Result<DataSpec> {
     })
 }
 
+/// The triangles of a measurement: those fitted, and all of the file with the fitted ones' indices (a block
+/// whose tensors were built for the whole file selects from them).
+pub(super) struct Selection {
+    /// The fitted triangles (bins of the measurement's width, or points).
+    pub fitted: TriangleSet,
+    /// Every triangle of the file [h/Mpc].
+    pub all: Vec<[f64; 3]>,
+    /// The fitted ones' indices among them, increasing.
+    pub rows: Vec<usize>,
+}
+
 /// The error about `what`.
 fn bad(what: String, reason: impl Into<String>) -> Error {
     Error::InvalidChoice {
@@ -87,7 +98,7 @@ fn bad(what: String, reason: impl Into<String>) -> Error {
 /// fitted multipole not in the file, no triangle in the range; as `block`.
 pub(super) fn measure(
     spec: &DataSpec,
-    block: impl FnOnce(TriangleSet) -> Result<Arc<dyn Spec>>,
+    block: impl FnOnce(Selection) -> Result<Arc<dyn Spec>>,
     note: &str,
 ) -> Result<Measured> {
     let origin = spec.data.display().to_string();
@@ -140,7 +151,11 @@ pub(super) fn measure(
         spec.covariance.display(),
     );
     Ok(Measured {
-        spec: block(set)?,
+        spec: block(Selection {
+            fitted: set,
+            all: triangles,
+            rows: fitted.clone(),
+        })?,
         // the fitted entries: multipole, then triangle
         fitted: b_rows
             .iter()

@@ -9,7 +9,7 @@
 //! covariance.
 
 use super::BispectrumBlock;
-use crate::bispectrum::measured::data_spec;
+use crate::bispectrum::measured::{data_spec, Selection};
 use crate::bispectrum::{Fog, LegendreSide, PlanRules, TriangleSet};
 use crate::error::{Error, Result};
 use crate::statistic::{AnalysisFace, Faces, Measured, Options, Shells, Spec, SurveyFace};
@@ -138,9 +138,9 @@ fn measure(o: &Options) -> Result<Measured> {
     let spec = data_spec(o, &ANALYSIS_KEYS)?;
     let n_bar = n_bar(o)?;
     let ells = spec.ells.clone();
-    let block = |triangles| -> Result<Arc<dyn Spec>> {
+    let block = |s: Selection| -> Result<Arc<dyn Spec>> {
         Ok(Arc::new(BispectrumBlock {
-            triangles,
+            triangles: s.fitted,
             side: LegendreSide::Largest,
             rules: PlanRules::default(),
             ells,

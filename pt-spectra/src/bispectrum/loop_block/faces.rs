@@ -4,7 +4,7 @@
 //! loop options). No forecast face (its Gaussian covariance is the tree-level block's).
 
 use super::LoopBispectrumBlock;
-use crate::bispectrum::measured::data_spec;
+use crate::bispectrum::measured::{data_spec, Selection};
 use crate::bispectrum::one_loop::OneLoopRule;
 use crate::bispectrum::{LegendreSide, TriangleSet};
 use crate::error::Result;
@@ -60,6 +60,7 @@ fn pipeline(o: &Options) -> Result<Option<Arc<dyn Spec>>> {
         side: LegendreSide::Largest,
         rule,
         ells: o.counts("ells")?.unwrap_or_else(|| vec![0, 2, 4]),
+        fitted: None,
         cache_dir: o.text("cache_dir")?.map(Into::into),
     })))
 }
@@ -102,13 +103,20 @@ fn measure(o: &Options) -> Result<Measured> {
     let rule = loop_rule(o)?;
     let cache_dir = o.text("cache_dir")?.map(Into::into);
     let ells = spec.ells.clone();
-    let block = |triangles| -> Result<Arc<dyn Spec>> {
+    let width = spec.bin_width;
+    // the tensors are of the file's triangles (what a user builds them from); the block selects
+    let block = |s: Selection| -> Result<Arc<dyn Spec>> {
+        let triangles = match width {
+            Some(w) => TriangleSet::shells(s.all, w)?,
+            None => TriangleSet::points(s.all)?,
+        };
         Ok(Arc::new(LoopBispectrumBlock {
             triangles,
             side: LegendreSide::Largest,
             rule,
             ells,
             cache_dir,
+            fitted: Some(s.rows),
         }))
     };
     crate::bispectrum::measured::measure(&spec, block, "; the one-loop model")

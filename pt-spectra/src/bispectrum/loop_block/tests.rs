@@ -132,6 +132,25 @@ fn the_block_is_its_parts_and_linear_in_its_own_parameters() {
             );
         }
     }
+    // a selection of the planned triangles: their rows of the whole block
+    let second = LoopBispectrumBlock {
+        triangles: set.clone(),
+        side: LegendreSide::Largest,
+        rule: rule(),
+        ells: vec![0, 2],
+        cache_dir: Some(dir.clone()),
+        fitted: Some(vec![1]),
+    }
+    .plan()
+    .unwrap();
+    assert_eq!(second.len(), 2);
+    let prepared_second = second.prepare(&p, false).unwrap();
+    let picked = second
+        .terms(&p, &prepared_second, f, (1.0, 1.0))
+        .unwrap()
+        .values(shared, &own)
+        .unwrap();
+    assert_eq!(picked, vec![got[1], got[3]]);
     // AP: the tree's change is the tree-level block's, the rest takes the volume factor
     let (q_par, q_perp): (f64, f64) = (1.03, 0.98);
     let volume = 1.0 / (q_par * q_par * q_perp.powi(4));
@@ -221,8 +240,9 @@ fn the_analysis_face_reads_the_measurement_and_the_rule() {
     // the two triangles within k_max, multipole then triangle, among the file's 2 x 3 entries
     assert_eq!(m.fitted, vec![0, 1, 3, 4]);
     assert_eq!(m.columns.len(), 2);
+    // its tensors are the file's three triangles', of which it fits two
     let e = m.spec.plan().unwrap_err().to_string();
-    assert!(e.contains("2 triangles") && e.contains("2 x 2 x 2"), "{e}");
+    assert!(e.contains("3 triangles") && e.contains("2 x 2 x 2"), "{e}");
     o.entries.push(ints("rule", &[2, 2]));
     o.entries.remove(5);
     let e = (face.check)(&o).unwrap_err().to_string();

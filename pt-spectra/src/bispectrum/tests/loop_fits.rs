@@ -58,6 +58,7 @@ fn the_truth_is_recovered_with_the_loop_block_marginalised() {
         rule,
         ells: vec![0, 2],
         cache_dir: Some(dir.clone()),
+        fitted: None,
     };
     let (plan, terms, truth, mut data) = setup();
     let n_p: usize = data.values.iter().map(Vec::len).sum();
