@@ -93,6 +93,9 @@ def write_inputs(out, data, cov_file):
     """The analysis files' inputs in `out`: the mean P and B of the mocks, the joint covariance and its P
     block, the true cosmology."""
     pk, bk = read_data(data)
+    # the sides as the files give them (the mean of 84 equal numbers can differ in the last bit, and the
+    # one-loop block's tensors are keyed by the sides' exact values)
+    bk[:, :3] = np.round(bk[:, :3], 10)
     cov = np.loadtxt(cov_file)
     n_k = len(pk)
     sigma = np.sqrt(np.diag(cov)[: 3 * n_k]).reshape(3, n_k)
