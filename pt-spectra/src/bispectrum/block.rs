@@ -109,6 +109,24 @@ pub(super) fn ell_indices(ells: &[usize]) -> Result<Vec<usize>> {
         .ok_or_else(|| bad("valid: 0, 2, 4"))
 }
 
+/// Entry `j` of a bispectrum block of the multipoles `ells` (indices into [`ELLS`]) at `triangles`
+/// (multipole, then triangle) in words, its multipole named after `prefix` (e.g. "one-loop ").
+pub(super) fn entry_words(
+    prefix: &str,
+    ells: &[usize],
+    triangles: &[[f64; 3]],
+    j: usize,
+) -> String {
+    let n = triangles.len().max(1);
+    match (ells.get(j / n), triangles.get(j % n)) {
+        (Some(&l), Some(t)) => format!(
+            "{prefix}B{} of the triangle ({}, {}, {}) h/Mpc",
+            ELLS[l], t[0], t[1], t[2]
+        ),
+        _ => format!("{prefix}bispectrum entry {}", j + 1),
+    }
+}
+
 /// The block planned: the bispectrum plan and where each multipole sits in [`ELLS`].
 #[derive(Debug, Clone)]
 struct PlannedBispectrum {
@@ -168,15 +186,7 @@ impl Block for PlannedBispectrum {
 
     /// Entry `j` (multipole, then triangle), e.g. "B2 of the triangle (0.015, 0.025, 0.035) h/Mpc".
     fn entry(&self, j: usize) -> String {
-        let triangles = self.plan.triangles().triangles();
-        let n = triangles.len().max(1);
-        match (self.ells.get(j / n), triangles.get(j % n)) {
-            (Some(&l), Some(t)) => format!(
-                "B{} of the triangle ({}, {}, {}) h/Mpc",
-                ELLS[l], t[0], t[1], t[2]
-            ),
-            _ => format!("bispectrum entry {}", j + 1),
-        }
+        entry_words("", &self.ells, self.plan.triangles().triangles(), j)
     }
 
     fn describe(&self) -> String {

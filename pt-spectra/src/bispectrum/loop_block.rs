@@ -37,7 +37,7 @@ use super::one_loop_galaxy::OneLoopGalaxy;
 use super::one_loop_galaxy_multipoles::GalaxyLoopMultipoles;
 use super::{
     BispectrumParams, BispectrumPlan, BispectrumTerms, Fog, IrInputs, LegendreSide, PlanRules,
-    Settings, TriangleSet, ELLS,
+    Settings, TriangleSet,
 };
 use crate::error::{Error, Result};
 use crate::ir::WiggleSplit;
@@ -168,7 +168,7 @@ enum Tensors {
     Bins(Arc<MultipoleBinBasis>),
 }
 
-/// The block planned: the loops' tensors, the counterterms' plan, the multipoles' indices into [`ELLS`].
+/// The block planned: the loops' tensors, the counterterms' plan, the multipoles' indices into [`super::ELLS`].
 #[derive(Debug, Clone)]
 struct PlannedLoop {
     tensors: Tensors,
@@ -308,14 +308,7 @@ impl Block for PlannedLoop {
 
     /// Entry `j` (multipole, then triangle).
     fn entry(&self, j: usize) -> String {
-        let n = self.triangles.len().max(1);
-        match (self.ells.get(j / n), self.triangles.get(j % n)) {
-            (Some(&l), Some(t)) => format!(
-                "one-loop B{} of the triangle ({}, {}, {}) h/Mpc",
-                ELLS[l], t[0], t[1], t[2]
-            ),
-            _ => format!("one-loop bispectrum entry {}", j + 1),
-        }
+        super::block::entry_words("one-loop ", &self.ells, &self.triangles, j)
     }
 
     fn describe(&self) -> String {
