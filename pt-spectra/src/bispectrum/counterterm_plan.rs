@@ -168,6 +168,7 @@ impl CountertermTerms {
 /// Z₂ of the pair `q` along `n` as a polynomial in f, b1, b2, g2 (and Z₂ at f = 0): affine in the bias,
 /// quadratic in f, read from the kernel at the unit biases and f = 0, 1, 2.
 fn z2_polys(q: &[[f64; 3]; 2], n: &[f64; 3]) -> Result<(Poly, Poly)> {
+    // LoopBias' b1, b2, g2 are its values 0, 1, 2; the polynomial's variables 1, 2, 3
     let unit = |c: Option<usize>| {
         let mut v = [0.0; super::bias_kernels::N_BIAS];
         if let Some(c) = c {
@@ -175,26 +176,30 @@ fn z2_polys(q: &[[f64; 3]; 2], n: &[f64; 3]) -> Result<(Poly, Poly)> {
         }
         LoopBias::from_values(v)
     };
-    // LoopBias' b1, b2, g2 are its values 0, 1, 2; the polynomial's variables 1, 2, 3
+    // each kernel once: at no bias and at each unit bias, f = 0, 1, 2
+    let redshift = |c| -> Result<[f64; 3]> {
+        let b = unit(c);
+        Ok([
+            galaxy_redshift_kernel(&b, q, 0.0, n)?,
+            galaxy_redshift_kernel(&b, q, 1.0, n)?,
+            galaxy_redshift_kernel(&b, q, 2.0, n)?,
+        ])
+    };
+    let (base, base_real) = (redshift(None)?, galaxy_kernel(&unit(None), q)?);
     let mut terms = Vec::new();
-    let mut real = Vec::new();
+    let mut real = vec![([0; 4], base_real)];
     for c in [None, Some(0), Some(1), Some(2)] {
-        let z = |f: f64| -> Result<f64> {
-            let at = galaxy_redshift_kernel(&unit(c), q, f, n)?;
-            Ok(match c {
-                None => at,
-                Some(_) => at - galaxy_redshift_kernel(&unit(None), q, f, n)?,
-            })
-        };
-        let (z0, z1, z2) = (z(0.0)?, z(1.0)?, z(2.0)?);
         let mut e = [0u8; 4];
-        if let Some(c) = c {
-            e[c + 1] = 1;
-            real.push((
-                e,
-                galaxy_kernel(&unit(Some(c)), q)? - galaxy_kernel(&unit(None), q)?,
-            ));
-        }
+        let [z0, z1, z2] = match c {
+            None => base,
+            Some(c) => {
+                e[c + 1] = 1;
+                real.push((e, galaxy_kernel(&unit(Some(c)), q)? - base_real));
+                let z = redshift(Some(c))?;
+                std::array::from_fn(|m| z[m] - base[m])
+            }
+        };
+        // the quadratic in f through f = 0, 1, 2
         for (m, coefficient) in [
             z0,
             (-3.0 * z0 + 4.0 * z1 - z2) / 2.0,
@@ -208,7 +213,6 @@ fn z2_polys(q: &[[f64; 3]; 2], n: &[f64; 3]) -> Result<(Poly, Poly)> {
             terms.push((e, coefficient));
         }
     }
-    real.push(([0; 4], galaxy_kernel(&unit(None), q)?));
     Ok((Poly::from_terms(terms), Poly::from_terms(real)))
 }
 

@@ -126,6 +126,28 @@ impl Options {
         }
     }
 
+    /// The list of numbers at `key`, if given.
+    ///
+    /// # Errors
+    /// [`Error::InvalidChoice`] for another value.
+    pub fn numbers(&self, key: &str) -> Result<Option<Vec<f64>>> {
+        let Some(v) = self.get(key) else {
+            return Ok(None);
+        };
+        let OptionValue::List(items) = v else {
+            return Err(self.bad(key, "must be an array `[…]` of numbers"));
+        };
+        items
+            .iter()
+            .map(|x| match x {
+                OptionValue::Number(v) => Ok(*v),
+                OptionValue::Integer(n) => Ok(*n as f64),
+                _ => Err(self.bad(key, "must be an array `[…]` of numbers")),
+            })
+            .collect::<Result<Vec<_>>>()
+            .map(Some)
+    }
+
     /// The list of non-negative integers at `key`, if given.
     ///
     /// # Errors

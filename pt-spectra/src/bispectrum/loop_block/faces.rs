@@ -8,7 +8,7 @@ use crate::bispectrum::measured::{data_spec, Selection};
 use crate::bispectrum::one_loop::OneLoopRule;
 use crate::bispectrum::{LegendreSide, TriangleSet};
 use crate::error::Result;
-use crate::statistic::{AnalysisFace, Faces, Measured, OptionValue, Options, Spec};
+use crate::statistic::{AnalysisFace, Faces, Measured, Options, Spec};
 use std::sync::Arc;
 
 /// The one-loop bispectrum's faces.
@@ -78,7 +78,7 @@ fn loop_rule(o: &Options) -> Result<OneLoopRule> {
         };
         (rule.radial, rule.mu, rule.phi) = (radial, mu, phi);
     }
-    if let Some(q) = numbers(o, "q_range")? {
+    if let Some(q) = o.numbers("q_range")? {
         let &[q_min, q_max] = &q[..] else {
             return Err(o.bad("q_range", "two numbers q_min, q_max [h/Mpc]"));
         };
@@ -120,27 +120,4 @@ fn measure(o: &Options) -> Result<Measured> {
         }))
     };
     crate::bispectrum::measured::measure(&spec, block, "; the one-loop model")
-}
-
-/// The numbers at `key`, if given.
-///
-/// # Errors
-/// [`crate::error::Error::InvalidChoice`] for another value.
-fn numbers(o: &Options, key: &str) -> Result<Option<Vec<f64>>> {
-    let Some(v) = o.get(key) else {
-        return Ok(None);
-    };
-    let bad = || o.bad(key, "must be a list of numbers");
-    let OptionValue::List(items) = v else {
-        return Err(bad());
-    };
-    items
-        .iter()
-        .map(|x| match x {
-            OptionValue::Number(v) => Ok(*v),
-            OptionValue::Integer(n) => Ok(*n as f64),
-            _ => Err(bad()),
-        })
-        .collect::<Result<Vec<_>>>()
-        .map(Some)
 }
