@@ -12,7 +12,8 @@ default rule's on two Nseries triangles):
         cache_dir='TENSORS')"
     python3 examples/nseries_pb_one_loop.py --tensors TENSORS [--data DIR] [--cov FILE] [--bin PATH]
 
-Model of B0: the one-loop galaxy multipole (IR resummed, AP exact on its tree level) with b1, b2, bs shared,
+Model of B0: the one-loop galaxy multipole (IR resummed, AP: its isotropic dilation exact, the anisotropic rest
+on the tree level) with b1, b2, bs shared,
 b_gamma3 and the leading counterterms and stochastic terms marginalised with Gaussian priors: b_gamma3 0 ± 1,
 ct_k2, ct_k2_mu2 0 ± 50 (Mpc/h)^2, st_p (1/n) ± (1/n), st_1 (1/n^2) ± (1/n^2); st_p_mu2 fixed at Poisson 1/n
 (as the tree-level fit's p_shot = 0); the other own parameters 0. Writes examples/out/nseries_pb_one_loop.md.
@@ -108,7 +109,7 @@ def write_report(out, rows, f_true, qpar, qperp, seconds):
         "NGC volume with its Hartlap factor, the true cosmology as template, AP fixed at the truth "
         f"(apar = {qpar:.4f}, aperp = {qperp:.4f}), P0, P2 at {K_MIN_P} ≤ k ≤ {K_MAX_P}, B0 bin-averaged) with "
         "B0 from the tree-level block or the one-loop block (tensors on the rule "
-        f"{' x '.join(map(str, RULE))}, IR resummed, AP exact on the tree level; b_gamma3, ct_k2, ct_k2_mu2, "
+        f"{' x '.join(map(str, RULE))}, IR resummed, AP isotropic exact, anisotropic on the tree; b_gamma3, ct_k2, ct_k2_mu2, "
         "st_p, st_1 marginalised with Gaussian priors, st_p_mu2 at Poisson). Truth: "
         f"f = {f_true:.4f} (the mocks' cosmology at z = {Z}).",
         "",

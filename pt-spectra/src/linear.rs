@@ -450,6 +450,20 @@ impl LinearSpectrum {
         Ok(out)
     }
 
+    /// P(s k) as a spectrum: the nodes at k/s with the same P (the spline in ln k and the power laws move
+    /// with them). A loop integral at the sides s k of P is s³ times the one at k of this spectrum: the
+    /// isotropic Alcock–Paczynski dilation of the one-loop bispectrum block.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] unless `s` is finite and positive.
+    pub fn dilated(&self, s: f64) -> Result<Self> {
+        check_positive("dilation", s)?;
+        let mut out = Self::from_nodes(self.k.iter().map(|k| k / s).collect(), self.p.clone())?;
+        out.header.clone_from(&self.header);
+        out.origin = format!("{} at k x {s}", self.origin);
+        Ok(out)
+    }
+
     /// RMS linear density contrast in a top-hat sphere of radius `r` [Mpc/h], with its error estimate.
     ///
     /// σ²(R) = (1/2π²) ∫ k³ P(k) W²(kR) d ln k, W(x) = 3(sin x − x cos x)/x³. The integral runs over

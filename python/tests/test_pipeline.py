@@ -118,7 +118,7 @@ def test_a_bispectrum_block_follows_the_power_spectrum(setup):
 def test_a_one_loop_bispectrum_block_follows_the_power_spectrum(setup):
     """The one-loop block reads the multipole tensors cached by pt.OneLoopMultipolePlan (refused before,
     saying how to build them) and equals the plan's B0, B2 at the pipeline's f, IR setting and bias; a
-    counterterm adds its shape (st_1: a constant in B0 only); AP moves it (the tree exactly)."""
+    counterterm adds its shape (st_1: a constant in B0 only); AP moves it."""
     obs, _, cache = setup
     tri = np.array([[0.05, 0.07, 0.1], [0.04, 0.04, 0.06]])
     opts = dict(triangles=tri, rule=[2, 2, 2], ells=[0, 2], cache_dir=str(cache))
@@ -138,10 +138,11 @@ def test_a_one_loop_bispectrum_block_follows_the_power_spectrum(setup):
         np.testing.assert_allclose(st[n:n + 2] - got[n:n + 2], 1e6, rtol=1e-9)
         np.testing.assert_array_equal(st[n + 2:], got[n + 2:])
     assert "ct_k2" in joint.parameters and "b_gamma3" in joint.parameters
-    # AP against a fiducial: exact on the tree level only, stated; the entries move by the distortion
+    # AP against a fiducial: its isotropic dilation exact on every term, the anisotropic rest on the tree
+    # level only, stated; the entries move by the distortion
     fid = dict(COSMO, omega_cdm=COSMO["omega_cdm"] * 1.05)
     ap = pt.Pipeline(obs, Z, fiducial=fid, precision="fast", cache_dir=cache, one_loop_bispectrum=opts)
-    assert "AP exact on the tree level only" in ap.meta["blocks"][0]
+    assert "the anisotropic rest on the tree level only" in ap.meta["blocks"][0]
     moved = ap(COSMO, **PARAMS)[n:]
     assert 1e-3 < np.max(np.abs(moved / got[n:] - 1)) < 0.2
 

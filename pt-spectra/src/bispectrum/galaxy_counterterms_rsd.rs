@@ -74,6 +74,24 @@ pub const REDSHIFT_COUNTERTERMS: [&str; 20] = [
 /// The number of redshift-space shapes.
 pub const N_REDSHIFT_CT: usize = REDSHIFT_COUNTERTERMS.len();
 
+/// The power d of k in each shape of [`REDSHIFT_COUNTERTERMS`] beside its linear spectra: the shape at the
+/// sides s k with P is s^d times the shape at k with P(s ·) (the isotropic dilation of the Alcock–Paczynski
+/// effect). 2 for the ct_* (coefficients in (Mpc/h)², two linear spectra: B in (Mpc/h)⁶), 0 for the st_*.
+pub const REDSHIFT_COUNTERTERM_K_POWERS: [i32; N_REDSHIFT_CT] = {
+    let mut out = [0; N_REDSHIFT_CT];
+    let mut i = 0;
+    while i < N_REDSHIFT_CT {
+        // "ct_" against "st_": the first byte
+        out[i] = if REDSHIFT_COUNTERTERMS[i].as_bytes()[0] == b'c' {
+            2
+        } else {
+            0
+        };
+        i += 1;
+    }
+    out
+};
+
 /// The shapes of the module docs at the triangle of sides `k` [h/Mpc] with `bias`, growth rate and
 /// orientation `redshift`, for the linear spectrum `p`; at f = 0 the first seven are
 /// [`galaxy_counterterm_shapes`]' and the rest zero.

@@ -12,12 +12,18 @@
 //! - **Bias**: b1, b2, bs in velocileptors' convention mapped exactly to the fourth-order basis
 //!   ([`LoopBias::from_class_pt`] with b2 + (4/3)bs, b_G2 = bs) with CLASS-PT's b_Γ3 (`b_gamma3`) and the
 //!   coefficients b3, g2x, g3, g21x of Eggemeier, Scoccimarro & Smith (2019) as own parameters.
-//! - **Alcock–Paczynski**: the tensors are at fixed triangles, so the distortion is exact on the tree level
-//!   only: B = B_1loop(1) + [B_tree(α) − B_tree(1)] + (1/(α∥²α⊥⁴) − 1)(B_1loop − B_tree + counterterms)(1),
-//!   the tree's change from the tree-level plan ([`super::BispectrumPlan`]: the same bins, IR and bias).
-//!   The loop correction and the counterterms keep their undistorted shape and take the volume factor; the
-//!   neglected change of their shape is of order |α − 1| times the loop correction (docs/bispectrum.md gives
-//!   its measured size). At α∥ = α⊥ = 1 the block is the one-loop multipoles exactly.
+//! - **Alcock–Paczynski**: the tensors are at fixed triangles, but a loop at the sides k/α of P is α⁻³ times
+//!   the loop at k of P(k/α) (q → q/α in ∫d³q; a counterterm shape with k^d: α^−d; the tree level: 1), so
+//!   the isotropic part α = (α∥α⊥²)^{1/3} is exact on every term: the tensors and the counterterm plan
+//!   take the dilated spectrum ([`LinearSpectrum::dilated`], IR's Σ² with it, [`IrInputs::dilated`]) and
+//!   B = α⁻⁶[B_tree + α⁻³ B_loop + Σ c_s α^−d_s S_s](P(·/α)) + [B_tree(α∥, α⊥) − B_tree(α, α)], the
+//!   anisotropic rest from the tree-level plan ([`super::BispectrumPlan`]: the same bins, IR and bias).
+//!   The loop rule's cut-offs move with the sides (q_max/α in the true frame: a change the counterterms
+//!   absorb). Neglected: the anisotropic change of the loops' shape, of order |α∥/α⊥ − 1|/3 times the loop
+//!   correction (docs/bispectrum.md gives its measured size). At α∥ = α⊥ = 1 the block is the one-loop
+//!   multipoles exactly. The spectrum must be represented by the templates as at α = 1; its dilation moves
+//!   the BAO out of their span, so the dilated one may reach [`DILATED_MAX_RESIDUAL`] (measured: the
+//!   loops' error ≤ 0.4 × the residual of B₀, far below the undistorted loops' error).
 //! - **Not here**: Fingers of God beyond the counterterm ct_fog.
 //!
 //! Every own parameter enters B linearly (the higher biases through one kernel Z₃ or Z₄ of each term), so a
@@ -26,7 +32,9 @@
 
 use super::bias_kernels::LoopBias;
 use super::counterterm_plan::{CountertermPlan, CountertermTerms};
-use super::galaxy_counterterms_rsd::{N_REDSHIFT_CT, REDSHIFT_COUNTERTERMS};
+use super::galaxy_counterterms_rsd::{
+    N_REDSHIFT_CT, REDSHIFT_COUNTERTERMS, REDSHIFT_COUNTERTERM_K_POWERS,
+};
 use super::loop_tensors::tensor_source;
 use super::multipole_basis::MultipoleLoopBasis;
 use super::multipole_bins::{correction_rules, MultipoleBinBasis};
@@ -49,6 +57,13 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 mod faces;
+
+/// The largest projection residual of the dilated spectrum P(k/α) that the block contracts (module docs):
+/// the templates' [`MAX_RESIDUAL`](crate::loops::basis::MAX_RESIDUAL) is for the spectrum itself, and a
+/// dilation moves the BAO out of the templates' span (residual to 1.1e-2 at |α − 1| = 0.1 on CAMB tables
+/// not trained on). Measured: the loops' error ≤ 0.4 × the residual of B₀, where keeping the loops of P
+/// undistorted was 3e-3 to 4e-2 off (`the_dilated_loops_are_the_loops_of_the_true_sides`).
+pub const DILATED_MAX_RESIDUAL: f64 = 2e-2;
 
 /// The block's own bias coefficients (before the counterterms of [`REDSHIFT_COUNTERTERMS`]).
 pub const LOOP_BIASES: [&str; 5] = ["b_gamma3", "b3", "g2x", "g3", "g21x"];
@@ -269,8 +284,9 @@ impl PlannedLoop {
             "one-loop bispectrum: B_l for l in {:?} of {} {what}{} (of {} planned; Legendre side {:?}), one-loop galaxy \
              multipoles from tensors on the loop rule {} x {} x {} (q in [{}, {}] h/Mpc), the redshift-space \
              counterterm and stochastic shapes exact; b1, b2, bs shared (velocileptors' map to the \
-             fourth-order basis), own: {}; AP exact on the tree level only (the loop correction and \
-             counterterms undistorted times 1/(apar^2 aperp^4)), no FoG beyond ct_fog",
+             fourth-order basis), own: {}; AP: the isotropic dilation (apar aperp^2)^(1/3) exact on every \
+             term (the loops and counterterms of the dilated spectrum), the anisotropic rest on the tree \
+             level only, no FoG beyond ct_fog",
             block.ells,
             fitted.len(),
             set.width()
@@ -345,17 +361,48 @@ impl Block for PlannedLoop {
             .downcast_ref::<Option<IrInputs>>()
             .ok_or_else(|| foreign(&KIND))?
             .as_ref();
+        // the isotropic part of the distortion, exact on every term: the sides k/α_iso seen as the sides k
+        // of P(k/α_iso) (module docs)
+        let alpha = (q_par * q_perp * q_perp).cbrt();
+        let dilated = if q_par == 1.0 && q_perp == 1.0 {
+            None
+        } else {
+            let s = 1.0 / alpha;
+            Some((
+                spectrum.dilated(s)?,
+                ir.map(|ir| ir.dilated(s)).transpose()?,
+            ))
+        };
+        let (at, ir_at) = match &dilated {
+            Some((p, ir)) => (p, ir.as_ref()),
+            None => (spectrum, ir),
+        };
         let (loops, residual) = match &self.tensors {
             Tensors::Points(t) => {
-                let (m, p) = t.evaluate_projected(spectrum, f, ir)?;
+                let (m, p) = t.evaluate_projected(at, f, ir_at)?;
                 (Loops::Points(m), p.residual)
             }
             Tensors::Bins(t) => {
-                let (m, p) = t.evaluate_projected(spectrum, f, ir)?;
+                let (m, p) = t.evaluate_projected(at, f, ir_at)?;
                 (Loops::Bins(m), p.residual)
             }
         };
-        if let s @ BispectrumLoopSource::Fallback { .. } = tensor_source(residual) {
+        // the cosmology's own spectrum represented, as at α = 1 (its projection alone when dilated)
+        let own = if dilated.is_some() {
+            let main = match &self.tensors {
+                Tensors::Points(t) => t.as_ref(),
+                Tensors::Bins(t) => t.effective(),
+            };
+            match ir {
+                Some(ir) => main.project(&super::ir_legs::leading_order_spectrum(spectrum, ir)?),
+                None => main.project(spectrum),
+            }
+            .1
+            .residual
+        } else {
+            residual
+        };
+        if let s @ BispectrumLoopSource::Fallback { .. } = tensor_source(own) {
             return Err(Error::InvalidChoice {
                 what: "the linear spectrum of the one-loop bispectrum block".into(),
                 reason: format!(
@@ -366,7 +413,20 @@ impl Block for PlannedLoop {
                 ),
             });
         }
-        let distorted = if q_par == 1.0 && q_perp == 1.0 {
+        if dilated.is_some() && residual > DILATED_MAX_RESIDUAL {
+            return Err(Error::InvalidChoice {
+                what: format!(
+                    "the linear spectrum of the one-loop bispectrum block at k/{alpha} (AP's isotropic \
+                     dilation)"
+                ),
+                reason: format!(
+                    "its projection on the tensors' templates leaves a residual of {residual:.1e}, above \
+                     {DILATED_MAX_RESIDUAL:.0e}: the distortion is too large for the tensors"
+                ),
+            });
+        }
+        // the anisotropic rest on the tree level: B_tree(α∥, α⊥) − B_tree(α_iso, α_iso)
+        let anisotropic = if q_par == q_perp {
             None
         } else {
             let tree = |q_par: f64, q_perp: f64| {
@@ -382,18 +442,15 @@ impl Block for PlannedLoop {
                     None => self.tree.terms(spectrum, &settings),
                 }
             };
-            Some(Distorted {
-                at: tree(q_par, q_perp)?,
-                undistorted: tree(1.0, 1.0)?,
-                volume: 1.0 / (q_par * q_par * q_perp.powi(4)),
-            })
+            Some((tree(q_par, q_perp)?, tree(alpha, alpha)?))
         };
         Ok(Box::new(LoopTerms {
             loops,
-            counterterms: self.counterterms.evaluate(spectrum, f)?,
+            counterterms: self.counterterms.evaluate(at, f)?,
             ells: self.ells.clone(),
             fitted: self.fitted.clone(),
-            distorted,
+            alpha: if dilated.is_some() { alpha } else { 1.0 },
+            anisotropic,
         }))
     }
 
@@ -411,20 +468,17 @@ enum Loops {
     Bins(BinnedLoopMultipoles),
 }
 
-/// The tree level at a distortion and without, and the volume factor 1/(α∥²α⊥⁴).
-struct Distorted {
-    at: BispectrumTerms,
-    undistorted: BispectrumTerms,
-    volume: f64,
-}
-
 /// The block's terms at one (spectrum, f, distortion).
 struct LoopTerms {
+    /// The loops and counterterms of P(k/α_iso).
     loops: Loops,
     counterterms: CountertermTerms,
     ells: Vec<usize>,
     fitted: Vec<usize>,
-    distorted: Option<Distorted>,
+    /// α_iso = (α∥α⊥²)^{1/3} (1: none).
+    alpha: f64,
+    /// The tree level at (α∥, α⊥) and at (α_iso, α_iso), if α∥ ≠ α⊥.
+    anisotropic: Option<(BispectrumTerms, BispectrumTerms)>,
 }
 
 /// The fourth-order bias of the shared b1, b2, bs (velocileptors') and the own [`LOOP_BIASES`].
@@ -459,10 +513,10 @@ impl Terms for LoopTerms {
         let shapes = self.counterterms.at(&bias);
         let ct: &[f64; N_REDSHIFT_CT] =
             own[LOOP_BIASES.len()..].try_into().expect("length checked");
-        // the tree's change under the distortion, per triangle and ℓ (none: zero), and the volume factor
-        let (change, volume) = match &self.distorted {
-            None => (vec![[0.0; 3]; rows.len()], 1.0),
-            Some(d) => {
+        // the tree's anisotropic change, per triangle and ℓ (none: zero)
+        let change: Vec<[f64; 3]> = match &self.anisotropic {
+            None => vec![[0.0; 3]; rows.len()],
+            Some((at, iso)) => {
                 let b = BispectrumParams {
                     b1: shared.b1,
                     b2: shared.b2,
@@ -473,25 +527,32 @@ impl Terms for LoopTerms {
                     a_shot: 0.0,
                     n_bar: f64::INFINITY,
                 };
-                let (at, one) = (d.at.multipoles(&b)?, d.undistorted.multipoles(&b)?);
-                let change = at
-                    .iter()
-                    .zip(&one)
+                let (at, iso) = (at.multipoles(&b)?, iso.multipoles(&b)?);
+                at.iter()
+                    .zip(&iso)
                     .map(|(a, o)| std::array::from_fn(|l| a[l].value - o[l].value))
-                    .collect();
-                (change, d.volume)
+                    .collect()
             }
         };
+        // the isotropic dilation s = 1/α_iso: the volume 1/α_iso⁶, s³ on the loops, s^d on a shape with k^d
+        let s = 1.0 / self.alpha;
+        let volume = s.powi(6);
+        let ct: Vec<f64> = ct
+            .iter()
+            .zip(REDSHIFT_COUNTERTERM_K_POWERS)
+            .map(|(c, d)| c * s.powi(d))
+            .collect();
         Ok(self
             .ells
             .iter()
             .flat_map(|&l| {
-                let (rows, shapes, change) = (&rows, &shapes, &change);
+                let (rows, shapes, change, ct) = (&rows, &shapes, &change, &ct);
                 self.fitted.iter().map(move |&i| {
-                    let (row, s) = (&rows[i], &shapes[i]);
-                    let ct: f64 = ct.iter().zip(&s[l]).map(|(c, s)| c * s).sum();
+                    let (row, shape) = (&rows[i], &shapes[i]);
+                    let ct: f64 = ct.iter().zip(&shape[l]).map(|(c, s)| c * s).sum();
                     let tree = row[l].tree.value;
-                    tree + change[i][l] + volume * (row[l].total().value - tree + ct)
+                    let loops = row[l].total().value - tree;
+                    volume * (tree + s.powi(3) * loops + ct) + change[i][l]
                 })
             })
             .collect())

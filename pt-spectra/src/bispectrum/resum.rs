@@ -40,6 +40,19 @@ impl IrInputs {
         })
     }
 
+    /// The inputs of P(s k) ([`LinearSpectrum::dilated`]): the no-wiggle spectrum dilated alike, Σ² and δΣ²
+    /// times s² (the damping e^{−k²Σ²} of a side s k is that of a side k with s²Σ²).
+    ///
+    /// # Errors
+    /// As [`LinearSpectrum::dilated`].
+    pub fn dilated(&self, s: f64) -> Result<Self> {
+        Self::new(
+            self.no_wiggle.dilated(s)?,
+            self.sigma2 * s * s,
+            self.delta_sigma2 * s * s,
+        )
+    }
+
     /// The project's split of `spectrum` ([`WiggleSplit`]) and its Σ², δΣ² with the integrals from
     /// `q_min` [h/Mpc] (as the galaxy power spectrum does it).
     ///

@@ -14,6 +14,7 @@ mod ap;
 mod bias;
 mod bins;
 mod bispectrum_basis_truncation;
+mod bispectrum_dilation;
 mod bispectrum_galaxy;
 mod bispectrum_galaxy_bins;
 mod bispectrum_galaxy_ct;
