@@ -28,7 +28,7 @@ import numpy as np
 
 from . import _core
 from ._common import _D, EPT_PARAMETERS, PtSpectraWarning, _ept_params, _grid, _warn
-from ._core import (BispectrumPlan, BispectrumTerms, LinearEmulator, Observation, OneLoopBispectrumPlan, OneLoopMultipolePlan,
+from ._core import (BispectrumTerms, LinearEmulator, Observation, OneLoopBispectrumPlan, OneLoopMultipolePlan,
                     Pipeline,
                     SugiyamaPlan, SugiyamaTerms, Table, distances, eisenstein_hu, fisher, fisher_kaiser,
                     growth, log_grid,
@@ -77,6 +77,35 @@ __all__ = [
 ]
 
 __version__ = _core.__version__
+
+class BispectrumPlan(_core.BispectrumPlan):
+    """The bispectrum planned for a set of triangles ([h/Mpc], rows k1 k2 k3; ``bin_width`` [h/Mpc]: bins
+    of three shells).
+
+    ``BispectrumPlan(triangles, bin_width=None, legendre_side="largest", effective=False)``: the tree level;
+    ``plan.terms(...)`` per linear spectrum (f, AP, FoG, IR), then ``terms.multipoles(b1=..., ...)`` per
+    parameter step (microseconds).
+
+    ``BispectrumPlan(triangles, ..., loop=1, cache_dir=None, radial=12, mu=32, phi=24, q_min=1e-4,
+    q_max=10.0)``: the one-loop galaxy multipoles B0, B2, B4 from their tensors (built once per triangle set
+    and loop rule, ~190 s per triangle and core at the default rule, cached): a :class:`OneLoopMultipolePlan`,
+    whose call takes the spectrum, f and bias.
+    """
+
+    def __new__(cls, triangles, bin_width=None, legendre_side="largest", effective=False, loop=0,
+                **one_loop):
+        if loop == 1:
+            if effective:
+                raise ValueError("effective=True is the tree level's shortcut; the one-loop bins average "
+                                 "their own way (loop=1 without effective)")
+            return OneLoopMultipolePlan(triangles, legendre_side=legendre_side, bin_width=bin_width,
+                                        **one_loop)
+        if loop != 0:
+            raise ValueError(f"loop = {loop!r}: give 0 (tree level) or 1 (one loop)")
+        if one_loop:
+            raise TypeError(f"{', '.join(sorted(one_loop))}: options of loop=1 only")
+        return super().__new__(cls, triangles, bin_width, legendre_side, effective)
+
 
 class _PlanInfo:
     """What every plan says about itself (the library's one ``Plan`` seam)."""

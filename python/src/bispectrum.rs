@@ -252,8 +252,9 @@ fn with_spectrum<T: Send>(
 }
 
 /// A tree-level bispectrum planned for a set of triangles: `plan.terms(...)` per linear spectrum (f,
-/// AP, FoG, IR), then `terms.multipoles(b1=..., ...)` per parameter step (microseconds).
-#[pyclass(module = "pt_spectra._core", frozen)]
+/// AP, FoG, IR), then `terms.multipoles(b1=..., ...)` per parameter step (microseconds). A subclass in
+/// Python (`pt.BispectrumPlan`) adds `loop=1`.
+#[pyclass(module = "pt_spectra._core", frozen, subclass)]
 pub struct BispectrumPlan {
     plan: bk::BispectrumPlan,
 }

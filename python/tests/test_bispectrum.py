@@ -306,6 +306,30 @@ def test_one_loop_multipole_plan(tmp_path):
         pt.OneLoopMultipolePlan([[0.1, 0.01, 0.01]], cache_dir=str(tmp_path), **rule)
 
 
+def test_the_bispectrum_plan_with_loop_1_is_the_one_loop_multipole_plan(tmp_path):
+    # pt.BispectrumPlan(..., loop=1) plans the one-loop multipoles (the face); loop=0 (the default)
+    # stays the tree-level plan; a wrong order or a one-loop option at tree level is refused, named
+    tri = np.array([[0.05, 0.07, 0.1], [0.03, 0.03, 0.03]])
+    rule = dict(radial=2, mu=2, phi=2)
+    one_loop = pt.BispectrumPlan(tri, loop=1, cache_dir=str(tmp_path), **rule)
+    assert isinstance(one_loop, pt.OneLoopMultipolePlan)
+    bias = dict(b1=2.0, b2=0.3, bs=-0.2)
+    got = one_loop(z=0.5, f=0.7, **bias)
+    want = pt.OneLoopMultipolePlan(tri, cache_dir=str(tmp_path), **rule)(z=0.5, f=0.7, **bias)
+    for name in ["B0", "B2", "B4"]:
+        np.testing.assert_array_equal(got[name], want[name])
+    tree = pt.BispectrumPlan(tri)
+    assert isinstance(tree, pt.BispectrumPlan)
+    b, _ = tree.terms(z=0.5, f=0.7, ir=False).multipoles(**bias)
+    np.testing.assert_allclose(b[:, 0], got["B0_tree"], rtol=1e-9)
+    with pytest.raises(ValueError, match="loop = 2"):
+        pt.BispectrumPlan(tri, loop=2)
+    with pytest.raises(TypeError, match="cache_dir"):
+        pt.BispectrumPlan(tri, cache_dir=str(tmp_path))
+    with pytest.raises(ValueError, match="effective"):
+        pt.BispectrumPlan(tri, bin_width=0.01, effective=True, loop=1)
+
+
 def test_one_loop_galaxy_multipoles_over_bins_through_the_python_face():
     # two Nseries bins at a tiny loop rule: without IR the tree columns are the tree-level bin averages,
     # the loops are the effective triangle's (its columns inside the shells) corrected by a few per cent,
