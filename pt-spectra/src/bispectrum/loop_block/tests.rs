@@ -18,6 +18,27 @@ fn rule() -> OneLoopRule {
     }
 }
 
+/// B₀, B₂, B₄ of the one-loop galaxy bispectrum of the sides `k` by the direct one pass on `rule`.
+fn direct_multipoles(
+    p: &LinearSpectrum,
+    k: [f64; 3],
+    f: f64,
+    rule: &OneLoopRule,
+    bias: &LoopBias,
+) -> [OneLoopGalaxy; 3] {
+    crate::bispectrum::one_loop_galaxy_multipoles::one_loop_galaxy_multipoles(
+        p,
+        k,
+        f,
+        LegendreSide::Largest,
+        rule,
+        None,
+    )
+    .unwrap()
+    .evaluate(bias)
+    .unwrap()
+}
+
 /// The pipeline face's options for `TRIANGLES` on `rule()` in `dir`.
 fn options(dir: &std::path::Path, ells: &[i64]) -> Options {
     let list = |v: &[f64]| OptionValue::List(v.iter().map(|&x| OptionValue::Number(x)).collect());
@@ -183,17 +204,7 @@ fn the_block_is_its_parts_and_linear_in_its_own_parameters() {
             (iso[j] - iso_no_ct[j] - volume * ct).abs() <= 1e-10 * (volume * ct).abs(),
             "counterterms under AP, entry {j}"
         );
-        let direct = crate::bispectrum::one_loop_galaxy_multipoles::one_loop_galaxy_multipoles(
-            &p,
-            k_true,
-            f,
-            LegendreSide::Largest,
-            &true_rule,
-            None,
-        )
-        .unwrap()
-        .evaluate(&bias)
-        .unwrap();
+        let direct = direct_multipoles(&p, k_true, f, &true_rule, &bias);
         let want = volume * direct[l].total().value;
         let b0 = volume * direct[0].total().value;
         // the former approximation: the loops undistorted, the tree exact
@@ -366,18 +377,7 @@ fn the_dilated_loops_are_the_loops_of_the_true_sides() {
             };
             let (mut error, mut former) = (0.0f64, 0.0f64);
             for (i, k) in TRIANGLES.iter().enumerate() {
-                let direct =
-                    crate::bispectrum::one_loop_galaxy_multipoles::one_loop_galaxy_multipoles(
-                        p,
-                        k.map(|x| x * s),
-                        f,
-                        LegendreSide::Largest,
-                        &true_rule,
-                        None,
-                    )
-                    .unwrap()
-                    .evaluate(&bias)
-                    .unwrap();
+                let direct = direct_multipoles(p, k.map(|x| x * s), f, &true_rule, &bias);
                 let (dilated, plain) = (
                     rows[i].evaluate(&bias).unwrap(),
                     undistorted[i].evaluate(&bias).unwrap(),
