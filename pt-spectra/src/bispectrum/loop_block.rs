@@ -54,7 +54,7 @@ use crate::progress::Silent;
 use crate::statistic::{foreign, Block, Kind, Prepared, Range, Shared, Spec, Survey, Terms};
 use crate::store::TableStore;
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 mod faces;
 
@@ -331,7 +331,8 @@ impl Block for PlannedLoop {
         self.description.clone()
     }
 
-    /// The IR resummation's inputs of `spectrum` (the default split and q_min; `None` without).
+    /// The IR resummation's inputs of `spectrum` (the default split and q_min; `None` without), and room for
+    /// its own projection residual, made when a distortion first needs it.
     fn prepare(&self, spectrum: &LinearSpectrum, ir: bool) -> Result<Prepared> {
         let inputs: Option<IrInputs> = if ir {
             Some(IrInputs::split(
@@ -342,7 +343,10 @@ impl Block for PlannedLoop {
         } else {
             None
         };
-        Ok(Arc::new(inputs))
+        Ok(Arc::new(PreparedLoop {
+            ir: inputs,
+            own_residual: OnceLock::new(),
+        }))
     }
 
     /// The loops per bias monomial from the tensors and the counterterm shapes per bias monomial.
@@ -357,10 +361,10 @@ impl Block for PlannedLoop {
         f: f64,
         (q_par, q_perp): (f64, f64),
     ) -> Result<Box<dyn Terms>> {
-        let ir = prepared
-            .downcast_ref::<Option<IrInputs>>()
-            .ok_or_else(|| foreign(&KIND))?
-            .as_ref();
+        let prepared = prepared
+            .downcast_ref::<PreparedLoop>()
+            .ok_or_else(|| foreign(&KIND))?;
+        let ir = prepared.ir.as_ref();
         // the isotropic part of the distortion, exact on every term: the sides k/α_iso seen as the sides k
         // of P(k/α_iso) (module docs)
         let alpha = (q_par * q_perp * q_perp).cbrt();
@@ -387,20 +391,28 @@ impl Block for PlannedLoop {
                 (Loops::Bins(m), p.residual)
             }
         };
-        // the cosmology's own spectrum represented, as at α = 1 (its projection alone when dilated)
-        let own = if dilated.is_some() {
-            let main = match &self.tensors {
-                Tensors::Points(t) => t.as_ref(),
-                Tensors::Bins(t) => t.effective(),
-            };
-            match ir {
-                Some(ir) => main.project(&super::ir_legs::leading_order_spectrum(spectrum, ir)?),
-                None => main.project(spectrum),
+        // the cosmology's own spectrum represented, as at α = 1 (when dilated, its projection alone,
+        // made once per prepared spectrum: a template fit varies f and α on one spectrum)
+        let own = match (&dilated, prepared.own_residual.get()) {
+            (None, _) => residual,
+            (Some(_), Some(&r)) => r,
+            (Some(_), None) => {
+                let main = match &self.tensors {
+                    Tensors::Points(t) => t.as_ref(),
+                    Tensors::Bins(t) => t.effective(),
+                };
+                let r = match ir {
+                    Some(ir) => {
+                        main.project(&super::ir_legs::leading_order_spectrum(spectrum, ir)?)
+                    }
+                    None => main.project(spectrum),
+                }
+                .1
+                .residual;
+                // set by another thread in between: the same number
+                let _ = prepared.own_residual.set(r);
+                r
             }
-            .1
-            .residual
-        } else {
-            residual
         };
         if let s @ BispectrumLoopSource::Fallback { .. } = tensor_source(own) {
             return Err(Error::InvalidChoice {
@@ -460,6 +472,13 @@ impl Block for PlannedLoop {
             reason: "not implemented: a forecast holds the tree-level bispectrum block".into(),
         })
     }
+}
+
+/// What the block prepares of a spectrum: its IR inputs (`None` without IR), and its own projection
+/// residual on the templates once a distortion needs it (the loops then contract the dilated spectrum).
+struct PreparedLoop {
+    ir: Option<IrInputs>,
+    own_residual: OnceLock<f64>,
 }
 
 /// The loops per bias monomial at one (spectrum, f).

@@ -134,15 +134,16 @@ impl Options {
         let Some(v) = self.get(key) else {
             return Ok(None);
         };
+        let bad = || self.bad(key, "must be an array `[…]` of numbers");
         let OptionValue::List(items) = v else {
-            return Err(self.bad(key, "must be an array `[…]` of numbers"));
+            return Err(bad());
         };
         items
             .iter()
             .map(|x| match x {
                 OptionValue::Number(v) => Ok(*v),
                 OptionValue::Integer(n) => Ok(*n as f64),
-                _ => Err(self.bad(key, "must be an array `[…]` of numbers")),
+                _ => Err(bad()),
             })
             .collect::<Result<Vec<_>>>()
             .map(Some)
