@@ -23,8 +23,8 @@ use std::sync::Arc;
 /// [h/Mpc]) with the Legendre polynomial on `legendre_side`: the multipole tensors (16 SVD templates, f free;
 /// built once on the loop rule, ~190 s per triangle and core at the default rule, cached in `cache_dir`),
 /// then a call per linear spectrum, growth rate and bias costs ~0.07 ms per triangle. Where the tensors do
-/// not represent the spectrum (projection residual above the basis's limit: with `ir=True` the resummed
-/// spectrum often is) the call integrates directly and `loop_terms` says so.
+/// not represent the spectrum (projection residual above the basis's limit: 2e-3 for P, 1e-2 for the
+/// resummed P_LO with `ir=True`) the call integrates directly and `loop_terms` says so.
 ///
 /// `bin_width` [h/Mpc]: bins of three shells of that width centred on each triangle instead (the bin
 /// averages of `pt.one_loop_bispectrum(..., bin_width=...)`: each bin's effective triangle from the multipole

@@ -7,6 +7,8 @@ import pytest
 
 import pt_spectra as pt
 
+DATA = Path(__file__).resolve().parents[2] / "pt-spectra" / "tests" / "data"
+
 TRIANGLES = np.array([[0.02, 0.03, 0.04], [0.05, 0.05, 0.05], [0.01, 0.1, 0.105]])
 
 
@@ -226,8 +228,8 @@ def test_one_loop_galaxy_multipoles_through_the_python_face():
 def test_one_loop_galaxy_multipoles_from_tensors_through_the_python_face(tmp_path):
     # two_loop="basis" builds the multipole tensors (16 templates, f free) once into the cache; auto then
     # uses them; both agree with the direct pass within 1e-3 of B0 and their stated errors. With the IR
-    # resummation the default spectrum's P_LO lies outside the templates' span (residual 2.5e-3): the
-    # direct fallback is stated
+    # resummation the default spectrum's P_LO (residual 2.5e-3, under IR_MAX_RESIDUAL 1e-2) is represented;
+    # a curved-space CAMB table (P_LO residual 0.17) is not: the direct fallback is stated
     tri = np.array([[0.05, 0.07, 0.1], [0.03, 0.03, 0.03]])
     rule = dict(radial=2, mu=2, phi=2)
     bias = dict(b1=2.0, b2=0.3, bs=-0.2)
@@ -242,10 +244,14 @@ def test_one_loop_galaxy_multipoles_from_tensors_through_the_python_face(tmp_pat
         assert np.all(diff <= fast["err_" + ell])
     auto = pt.one_loop_bispectrum(tri, multipoles=True, f=0.7, ir=False, cache_dir=str(tmp_path), **bias, **rule)
     np.testing.assert_allclose(auto["B0"], fast["B0"], rtol=1e-12)
+    resummed = pt.one_loop_bispectrum(tri, multipoles=True, f=0.7, two_loop="basis",
+                                      cache_dir=str(tmp_path), **bias, **rule)
+    assert "basis" in str(resummed.meta["methods"]), resummed.header
+    curved = np.loadtxt(DATA / "linear_pk_camb_curved_wa_z0.5.dat")
     with pytest.warns(pt.PtSpectraWarning, match="fallback"):
-        resummed = pt.one_loop_bispectrum(tri, multipoles=True, f=0.7, two_loop="basis",
-                                          cache_dir=str(tmp_path), **bias, **rule)
-    assert any("residual on the basis" in line and "exceeds" in line for line in resummed.header)
+        outside = pt.one_loop_bispectrum(tri, linear=(curved[:, 0], curved[:, 1]), multipoles=True, f=0.7,
+                                         two_loop="basis", cache_dir=str(tmp_path), **bias, **rule)
+    assert any("residual on the basis" in line and "exceeds 1.0e-2" in line for line in outside.header)
 
 
 def test_one_loop_multipoles_over_bins_from_tensors(tmp_path):
@@ -275,8 +281,8 @@ def test_one_loop_multipoles_over_bins_from_tensors(tmp_path):
 
 def test_one_loop_multipole_plan(tmp_path):
     # the plan reads the tensors once (here built at a tiny rule); each call then takes a new spectrum, f and
-    # bias: the same multipoles as the table function on the same rule, direct where they are not
-    # represented (ir=True), and f's default is f(z)
+    # bias: the same multipoles as the table function on the same rule, resummed within 1e-3 of B0 of the
+    # direct pass, direct where the spectrum is not represented (a curved-space table), and f's default is f(z)
     tri = np.array([[0.05, 0.07, 0.1], [0.03, 0.03, 0.03]])
     rule = dict(radial=2, mu=2, phi=2)
     plan = pt.OneLoopMultipolePlan(tri, cache_dir=str(tmp_path), **rule)
@@ -291,15 +297,17 @@ def test_one_loop_multipole_plan(tmp_path):
             np.testing.assert_allclose(got[name], table[name], rtol=1e-12)
     default_f = plan(z=0.5, **bias)
     assert 0.5 < default_f["f"] < 1.0
-    for z in [0.0, 0.5]:  # P_LO's residual on the templates: 2.5e-3 (above the limit: direct), 1.5e-3
+    for z in [0.0, 0.5]:  # P_LO's residual on the templates: 2.5e-3, 1.5e-3 (under IR_MAX_RESIDUAL 1e-2)
         resummed = plan(z=z, f=0.7, ir=True, **bias)
         direct = pt.one_loop_bispectrum(tri, z=z, multipoles=True, f=0.7, two_loop="direct", **bias, **rule)
-        if z == 0.0:
-            assert "direct integration, since" in resummed["loop_terms"], resummed["loop_terms"]
-            np.testing.assert_allclose(resummed["B0"], direct["B0"], rtol=1e-10)
-        else:
-            assert "multipole tensors" in resummed["loop_terms"], resummed["loop_terms"]
-            assert np.all(np.abs(resummed["B0"] - direct["B0"]) < 1e-3 * np.abs(direct["B0"]))
+        assert "multipole tensors" in resummed["loop_terms"], resummed["loop_terms"]
+        assert np.all(np.abs(resummed["B0"] - direct["B0"]) < 1e-3 * np.abs(direct["B0"]))
+    curved = np.loadtxt(DATA / "linear_pk_camb_curved_wa_z0.5.dat")
+    linear = (curved[:, 0], curved[:, 1])
+    outside = plan(linear=linear, f=0.7, ir=True, **bias)
+    direct = pt.one_loop_bispectrum(tri, linear=linear, multipoles=True, f=0.7, two_loop="direct", **bias, **rule)
+    assert "direct integration, since" in outside["loop_terms"], outside["loop_terms"]
+    np.testing.assert_allclose(outside["B0"], direct["B0"], rtol=1e-10)
     with pytest.raises(ValueError, match="f"):
         plan(z=0.5, f=3.0, **bias)
     with pytest.raises(ValueError, match="triangle 1"):

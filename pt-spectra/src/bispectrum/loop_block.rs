@@ -21,7 +21,8 @@
 //!   The loop rule's cut-offs move with the sides (q_max/α in the true frame: a change the counterterms
 //!   absorb). Neglected: the anisotropic change of the loops' shape, of order |α∥/α⊥ − 1|/3 times the loop
 //!   correction (docs/bispectrum.md gives its measured size). At α∥ = α⊥ = 1 the block is the one-loop
-//!   multipoles exactly. The spectrum must be represented by the templates as at α = 1; its dilation moves
+//!   multipoles exactly. The spectrum must be represented by the templates as at α = 1
+//!   ([`super::loop_tensors::tensor_source`]: P, or P_LO with IR); its dilation moves
 //!   the BAO out of their span, so the dilated one may reach [`DILATED_MAX_RESIDUAL`] (measured: the
 //!   loops' error ≤ 0.4 × the residual of B₀, far below the undistorted loops' error).
 //! - **Not here**: Fingers of God beyond the counterterm ct_fog.
@@ -414,7 +415,7 @@ impl Block for PlannedLoop {
                 r
             }
         };
-        if let s @ BispectrumLoopSource::Fallback { .. } = tensor_source(own) {
+        if let s @ BispectrumLoopSource::Fallback { .. } = tensor_source(own, ir.is_some()) {
             return Err(Error::InvalidChoice {
                 what: "the linear spectrum of the one-loop bispectrum block".into(),
                 reason: format!(

@@ -36,8 +36,8 @@ pub fn describe_source(source: &BispectrumLoopSource) -> String {
 }
 
 /// B₀, B₂, B₄ of every triangle of `tensors` for the spectrum `p` (resummed with `ir`), growth rate `f` and
-/// `bias`, if the tensors represent the loops' spectrum (P, or P_LO with `ir`; residual ≤
-/// [`crate::loops::basis::MAX_RESIDUAL`]); `None` with the reason otherwise.
+/// `bias`, if the tensors represent the loops' spectrum (P, or P_LO with `ir`: [`tensor_source`]); `None`
+/// with the reason otherwise.
 ///
 /// # Errors
 /// f outside [0, 2]; a bias coefficient that is not finite.
@@ -49,7 +49,7 @@ pub fn multipoles_from_tensors(
     ir: Option<&IrInputs>,
 ) -> Result<(Option<Vec<[OneLoopGalaxy; 3]>>, BispectrumLoopSource)> {
     let (polys, projected) = tensors.evaluate_projected(p, f, ir)?;
-    let source = tensor_source(projected.residual);
+    let source = tensor_source(projected.residual, ir.is_some());
     if !matches!(source, BispectrumLoopSource::Basis { .. }) {
         return Ok((None, source));
     }
@@ -114,7 +114,7 @@ pub fn binned_plan_multipoles(
     let source = match tensors {
         Some(t) => {
             let (binned, projected) = t.evaluate_projected(p, f, ir)?;
-            let source = tensor_source(projected.residual);
+            let source = tensor_source(projected.residual, ir.is_some());
             if matches!(source, BispectrumLoopSource::Basis { .. }) {
                 return Ok((binned, source));
             }
