@@ -44,3 +44,53 @@ pub(super) fn tree_legs(
         nw + (-x).exp() * (1.0 + x) * (pk - nw)
     })
 }
+
+/// [`tree_legs`] in redshift space at growth rate `f` along each line of sight of `los`, the same numbers:
+/// P and P_nw at the sides evaluated once for all lines of sight (the multipole tensors' tree level takes
+/// 45 orientations of each triangle).
+pub(super) fn tree_legs_along(
+    p: &LinearSpectrum,
+    ir: &IrInputs,
+    kv: &[Vec3; 3],
+    f: f64,
+    los: &[Vec3],
+) -> Vec<[f64; 3]> {
+    let k = kv.map(norm);
+    let (pk, nw) = (k.map(|k| p.eval(k)), k.map(|k| ir.no_wiggle.eval(k)));
+    los.iter()
+        .map(|n| {
+            std::array::from_fn(|a| {
+                let mu = dot(&kv[a], n) / k[a];
+                let x = k[a] * k[a] * sigma2_total(ir.sigma2, ir.delta_sigma2, f, mu);
+                nw[a] + (-x).exp() * (1.0 + x) * (pk[a] - nw[a])
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The legs along many lines of sight are each line's [`tree_legs`] to the bit.
+    #[test]
+    fn legs_along_many_lines_of_sight_are_the_single_ones() {
+        let p = LinearSpectrum::gm2012(0.5).unwrap();
+        let split = crate::ir::WiggleSplit::new().unwrap();
+        let ir = IrInputs::split(&p, &split, 1e-4).unwrap();
+        let kv = super::super::one_loop::triangle_vectors([0.05, 0.07, 0.1]).unwrap();
+        let los: Vec<Vec3> = (0..7)
+            .map(|i| {
+                let (mu, phi) = (-0.9 + 0.3 * f64::from(i), 0.7 * f64::from(i));
+                let s = (1.0 - mu * mu).sqrt();
+                [s * phi.cos(), s * phi.sin(), mu]
+            })
+            .collect();
+        let many = tree_legs_along(&p, &ir, &kv, 0.7, &los);
+        for (n, legs) in los.iter().zip(&many) {
+            let one = tree_legs(&p, &ir, &kv, Some((0.7, *n)));
+            assert_eq!(one.map(f64::to_bits), legs.map(f64::to_bits));
+            assert!(legs.iter().all(|&l| l > 0.0));
+        }
+    }
+}

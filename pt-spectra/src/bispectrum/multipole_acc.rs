@@ -13,7 +13,19 @@ pub(super) struct Names {
 }
 
 impl Names {
-    pub(super) fn new() -> Self {
+    /// The table, made once per process (a constant of the kernels' generated products, which take
+    /// ~0.1 ms to list: as much as a few bins' contraction).
+    pub(super) fn get() -> &'static Self {
+        static NAMES: std::sync::OnceLock<Names> = std::sync::OnceLock::new();
+        NAMES.get_or_init(Self::new)
+    }
+
+    /// The number of monomials of term `t`.
+    pub(super) fn len(&self, t: usize) -> usize {
+        self.monomials[t].len()
+    }
+
+    fn new() -> Self {
         let pr = Products::new();
         let list = |s: &[Vec<usize>]| -> Vec<Monomial> {
             s.iter()

@@ -25,7 +25,7 @@
 //! evaluated as such; [`super::one_loop_bins`] corrects the direct path's effective triangles).
 
 use super::geometry::LegendreSide;
-use super::ir_legs::{leading_order_spectrum, tree_legs};
+use super::ir_legs::{leading_order_spectrum, tree_legs_along};
 pub(super) use super::multipole_acc::{Acc, Names};
 use super::multipole_cache::{write_triangle, Reader};
 use super::multipole_tensors::{
@@ -377,7 +377,7 @@ impl MultipoleLoopBasis {
         f: f64,
         ir: Option<(&LinearSpectrum, &IrInputs)>,
     ) -> Vec<GalaxyLoopMultipoles> {
-        let names = Names::new();
+        let names = Names::get();
         let single = |v: Vec<f64>| -> Vec<f32> { v.iter().map(|&x| x as f32).collect() };
         let (c2_32, c3_32) = (single(pair_products(c)), single(triple_products(c)));
         let c_32 = single(c.to_vec());
@@ -400,7 +400,7 @@ impl MultipoleLoopBasis {
                 let sigma = dot(&t.sigma[0], c);
                 // the products of the two sides other than s, for the loop terms and the tree level
                 let other = |x: &[f64; 3], s: usize| x[(s + 1) % 3] * x[(s + 2) % 3];
-                let mut acc = Acc::new(&names);
+                let mut acc = Acc::new(names);
                 let d = DIFF_TEMPLATES.min(m);
                 for (idx, (fine, diff)) in single_rows(&t.b222, &c3_32, &c3_32[..triples(d)]) {
                     let w = fp[idx[3] as usize];
@@ -427,15 +427,27 @@ impl MultipoleLoopBasis {
                     }
                     Some((linear, inputs)) => {
                         let kv = triangle_vectors(k).expect("checked at the build");
-                        let legs: Vec<[f64; 3]> = los
-                            .iter()
-                            .map(|n| tree_legs(linear, inputs, &kv, Some((f, *n))))
-                            .collect();
+                        let legs = tree_legs_along(linear, inputs, &kv, f, los);
+                        // Σ over orientations o and sides s of w_ℓ(o) P(k_s+1, μ) P(k_s+2, μ) × the row:
+                        // the three weights of an (o, s) made once, then per row one product per ℓ
+                        // into the monomial's sum (rows come by (o, s))
+                        let mut sums = [(); 3].map(|_| vec![0.0; names.len(0)]);
+                        let (mut at, mut g) = (u16::MAX, [0.0; 3]);
                         for (idx, (fine, _)) in rows(&t.tree_o, 1) {
-                            let (o, s) = (idx[1] as usize / 3, idx[1] as usize % 3);
-                            let v = fp[idx[3] as usize] * other(&legs[o], s) * fine[0];
-                            for (ell, w) in weights[o].iter().enumerate() {
-                                acc.add(&[ell as u16, 0, idx[2], 0], 0, w * v, 0.0);
+                            if idx[1] != at {
+                                at = idx[1];
+                                let (o, s) = (at as usize / 3, at as usize % 3);
+                                let legs = other(&legs[o], s);
+                                g = weights[o].map(|w| w * legs);
+                            }
+                            let v = fp[idx[3] as usize] * fine[0];
+                            for (sum, g) in sums.iter_mut().zip(g) {
+                                sum[idx[2] as usize] += g * v;
+                            }
+                        }
+                        for (ell, sum) in sums.iter().enumerate() {
+                            for (m, &v) in sum.iter().enumerate() {
+                                acc.add(&[ell as u16, 0, m as u16, 0], 0, v, 0.0);
                             }
                         }
                     }

@@ -285,7 +285,7 @@ impl MultipoleBinBasis {
             }
         };
         let (damped, weakest, strongest) = (leg(MEAN_MU), leg(0.0), leg(1.0));
-        let names = Names::new();
+        let names = Names::get();
         let (mut out, mut tree_out) = (Vec::new(), Vec::new());
         let corrections = self
             .corrections
@@ -301,7 +301,7 @@ impl MultipoleBinBasis {
                     };
                 // Δ's loops once; Δ_nodes = Δ − (Δ − Δ_nodes), Δ_rule likewise; the tree level does not
                 // depend on the rule
-                let mut base = Acc::new(&names);
+                let mut base = Acc::new(names);
                 loops(&mut base, &b.delta, &c3, 1.0);
                 let mut delta = base.clone();
                 tree(&mut delta, &b.tree[0], &damped, Slot::Value);
