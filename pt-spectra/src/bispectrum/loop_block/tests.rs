@@ -463,3 +463,27 @@ fn the_resummed_spectra_are_represented_at_and_around_alpha_one() {
     assert!(above_p_limit >= 3, "{above_p_limit}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The block's units and ranges follow from each name (module docs of `galaxy_counterterms_rsd`): the
+/// biases dimensionless, ct_* in (Mpc/h)² (k² shapes), st_p* in (Mpc/h)³ (× P), st_1 in (Mpc/h)⁶; one
+/// entry per name.
+#[test]
+fn the_units_and_ranges_follow_from_the_names() {
+    assert_eq!(KIND.units.len(), KIND.own.len());
+    assert_eq!(KIND.ranges.len(), KIND.own.len());
+    for ((name, unit), range) in KIND.own.iter().zip(KIND.units).zip(KIND.ranges) {
+        let (want, want_range) = if LOOP_BIASES.contains(name) {
+            ("1", BIAS_RANGE)
+        } else if name.starts_with("ct_") {
+            ("(Mpc/h)^2", CT_RANGE)
+        } else if name.starts_with("st_p") {
+            ("(Mpc/h)^3", ST_P_RANGE)
+        } else if *name == "st_1" {
+            ("(Mpc/h)^6", ST_1_RANGE)
+        } else {
+            panic!("{name}: no rule for its unit");
+        };
+        assert_eq!(*unit, want, "{name}");
+        assert_eq!(*range, want_range, "{name}");
+    }
+}
