@@ -330,6 +330,44 @@ fn the_analysis_face_reads_the_measurement_and_the_rule() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// CAMB tables in `tests/data/` that the basis was not trained on.
+const HELD_OUT: [&str; 5] = [
+    "linear_pk_camb_heldout_0.dat",
+    "linear_pk_camb_heldout_1.dat",
+    "linear_pk_camb_heldout_2.dat",
+    "linear_pk_planck2018_z1.0.dat",
+    "linear_pk_planck2018_z0.0.dat",
+];
+
+/// The spectra of the tables `names` in `tests/data/`.
+fn tables(names: &[&str]) -> Vec<LinearSpectrum> {
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
+    names
+        .iter()
+        .map(|f| LinearSpectrum::from_file(format!("{data}{f}")).unwrap())
+        .collect()
+}
+
+/// The multipole tensors of [`TRIANGLES`] on [`rule`], built into a new store in the temporary directory
+/// named `tag` (and the process), which the caller removes.
+fn tensors_in(
+    tag: &str,
+) -> (
+    std::path::PathBuf,
+    Arc<super::super::multipole_basis::MultipoleLoopBasis>,
+) {
+    let dir = std::env::temp_dir().join(format!("{tag}-{}", std::process::id()));
+    let tensors = super::super::loop_tensors::one_loop_multipole_tensors(
+        &TRIANGLES,
+        LegendreSide::Largest,
+        &rule(),
+        &TableStore::new(&dir),
+        &Silent,
+    )
+    .unwrap();
+    (dir, tensors)
+}
+
 /// The loops of the dilated spectrum P(k/α) from the tensors, times α⁻³, against the direct loops of the
 /// true sides k/α (the rule's cut-offs with them), for five spectra (four CAMB tables not trained on) and
 /// α from 0.9 to 1.1: the dilated spectrum's projection residual grows with |α − 1| (to 1.1e-2, beyond the
@@ -338,26 +376,9 @@ fn the_analysis_face_reads_the_measurement_and_the_rule() {
 /// the dilation is ≥ 2× better in every case.
 #[test]
 fn the_dilated_loops_are_the_loops_of_the_true_sides() {
-    let dir = std::env::temp_dir().join(format!("pt-loop-dilated-{}", std::process::id()));
-    let store = TableStore::new(&dir);
-    let tensors = super::super::loop_tensors::one_loop_multipole_tensors(
-        &TRIANGLES,
-        LegendreSide::Largest,
-        &rule(),
-        &store,
-        &Silent,
-    )
-    .unwrap();
-    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
+    let (dir, tensors) = tensors_in("pt-loop-dilated");
     let mut spectra = vec![LinearSpectrum::gm2012(0.5).unwrap()];
-    for f in [
-        "linear_pk_camb_heldout_0.dat",
-        "linear_pk_camb_heldout_1.dat",
-        "linear_pk_camb_heldout_2.dat",
-        "linear_pk_planck2018_z1.0.dat",
-    ] {
-        spectra.push(LinearSpectrum::from_file(format!("{data}{f}")).unwrap());
-    }
+    spectra.extend(tables(&HELD_OUT[..4]));
     let bias = LoopBias::from_velocileptors(2.0, 0.4, -0.3);
     let f = 0.76;
     let mut largest = 0.0f64;
@@ -411,30 +432,12 @@ fn the_dilated_loops_are_the_loops_of_the_true_sides() {
 #[test]
 fn the_resummed_spectra_are_represented_at_and_around_alpha_one() {
     use super::super::loop_tensors::IR_MAX_RESIDUAL;
-    let dir = std::env::temp_dir().join(format!("pt-loop-dilated-ir-{}", std::process::id()));
-    let store = TableStore::new(&dir);
-    let tensors = super::super::loop_tensors::one_loop_multipole_tensors(
-        &TRIANGLES,
-        LegendreSide::Largest,
-        &rule(),
-        &store,
-        &Silent,
-    )
-    .unwrap();
-    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
+    let (dir, tensors) = tensors_in("pt-loop-dilated-ir");
     let mut spectra = vec![
         LinearSpectrum::gm2012(0.5).unwrap(),
         LinearSpectrum::gm2012(0.0).unwrap(),
     ];
-    for f in [
-        "linear_pk_camb_heldout_0.dat",
-        "linear_pk_camb_heldout_1.dat",
-        "linear_pk_camb_heldout_2.dat",
-        "linear_pk_planck2018_z1.0.dat",
-        "linear_pk_planck2018_z0.0.dat",
-    ] {
-        spectra.push(LinearSpectrum::from_file(format!("{data}{f}")).unwrap());
-    }
+    spectra.extend(tables(&HELD_OUT));
     let emulator = crate::emulator::LinearEmulator::embedded().unwrap();
     for (om, z) in [(0.26, 0.0), (0.31, 0.5), (0.38, 1.0), (0.3, 0.3)] {
         let c = crate::cosmology::Cosmology::flat(om, 0.68, 0.0224, 0.965, 0.8).unwrap();
