@@ -177,10 +177,10 @@ def data_vector(pipeline, names, cosmology=None, linear=None, z_input=None, **fi
         c, params = split(x)
         jacobian = np.zeros((len(names), m))
         if cosmology_rows:
-            # one step for both sets of rows
-            v, n, j = pipeline.full_jacobian(c, **params)
-            for i, r in cosmology_rows:
-                jacobian[i] = j[r]
+            # one step for both sets of rows, the free cosmological columns only
+            v, n, j = pipeline.full_jacobian(c, derivatives=free_cosmology, **params)
+            for row, (i, _) in enumerate(cosmology_rows):
+                jacobian[i] = j[row]
         else:
             v, n = pipeline(cosmology=c, **where, jacobian=True, **params)
         for i, r in nuisance_rows:

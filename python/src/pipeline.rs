@@ -84,12 +84,14 @@ impl Pipeline {
         self.prepared_named(named)
     }
 
-    /// The cosmological derivatives at `cosmology` (a preset, ini path or dict) and `params`, with
-    /// the nuisance rows of the same step if `nuisance` (`cosmology_jacobian`, `full_jacobian`).
+    /// The cosmological derivatives along `derivatives` (names; `None`: all) at `cosmology` (a preset,
+    /// ini path or dict) and `params`, with the nuisance rows of the same step if `nuisance`
+    /// (`cosmology_jacobian`, `full_jacobian`).
     fn jacobians(
         &self,
         py: Python<'_>,
         cosmology: &Bound<'_, PyAny>,
+        derivatives: Option<Vec<String>>,
         params: Option<&Bound<'_, PyDict>>,
         nuisance: bool,
     ) -> PyResult<(CosmologyJacobian, Option<Vec<Vec<f64>>>)> {
@@ -99,12 +101,19 @@ impl Pipeline {
         let (named, _) = inputs.cosmology().map_err(value_error)?;
         let c = named.map_or_else(Cosmology::gm2012, |n| n.cosmology);
         let named: Vec<(&str, f64)> = params.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+        let derivatives: Vec<&str> = match &derivatives {
+            Some(d) => d.iter().map(String::as_str).collect(),
+            None => pt_spectra::cosmology::background::DERIVATIVE_NAMES.to_vec(),
+        };
         let (result, _) = crate::detached(py, || {
             if nuisance {
-                let (c, n) = self.inner.full_jacobian(&c, &named)?;
+                let (c, n) = self.inner.full_jacobian_of(&c, &named, &derivatives)?;
                 Ok((c, Some(n)))
             } else {
-                Ok((self.inner.cosmology_jacobian(&c, &named)?, None))
+                Ok((
+                    self.inner.cosmology_jacobian_of(&c, &named, &derivatives)?,
+                    None,
+                ))
             }
         })?;
         Ok(result)
@@ -366,14 +375,17 @@ impl Pipeline {
     /// m_nu, w0, wa; Omega_k held): (data vector, array of shape (8, n)). Through the emulator, the
     /// growth, the loop terms on the basis, the AP distortion, the window and bins; no finite
     /// differences. The nuisance parameters' derivatives are `__call__(..., jacobian=True)`'s.
-    #[pyo3(signature = (cosmology, **params))]
+    /// `derivatives`: the names of the rows wanted, in that order (default all eight); each row costs
+    /// about a tenth of the call, so a flat-ΛCDM sampler asks for its five.
+    #[pyo3(signature = (cosmology, derivatives=None, **params))]
     fn cosmology_jacobian<'py>(
         &self,
         py: Python<'py>,
         cosmology: &Bound<'py, PyAny>,
+        derivatives: Option<Vec<String>>,
         params: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (result, _) = self.jacobians(py, cosmology, params, false)?;
+        let (result, _) = self.jacobians(py, cosmology, derivatives, params, false)?;
         let v = result.data_vector.into_pyarray(py).into_any();
         let j = PyArray2::from_vec2(py, &result.cosmological)?;
         Ok((v, j).into_pyobject(py)?.into_any())
@@ -382,14 +394,16 @@ impl Pipeline {
     /// `cosmology_jacobian` and the nuisance rows of `__call__(..., jacobian=True)` (`nuisance`:
     /// the nuisance parameters, then f) of one step, made once: (data vector, array (12, n),
     /// array (8, n)). The whole Jacobian of a sampler over cosmological and nuisance parameters.
-    #[pyo3(signature = (cosmology, **params))]
+    /// `derivatives` as `cosmology_jacobian`'s (the last array then has one row per name).
+    #[pyo3(signature = (cosmology, derivatives=None, **params))]
     fn full_jacobian<'py>(
         &self,
         py: Python<'py>,
         cosmology: &Bound<'py, PyAny>,
+        derivatives: Option<Vec<String>>,
         params: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (result, nuisance) = self.jacobians(py, cosmology, params, true)?;
+        let (result, nuisance) = self.jacobians(py, cosmology, derivatives, params, true)?;
         let v = result.data_vector.into_pyarray(py).into_any();
         let n = PyArray2::from_vec2(py, &nuisance.unwrap_or_default())?;
         let j = PyArray2::from_vec2(py, &result.cosmological)?;

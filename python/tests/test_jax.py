@@ -134,3 +134,23 @@ def test_the_cosmological_parameters_are_differentiable_through_jax(pipeline):
         ptj.data_vector(pipeline, ["h"], cosmology={**COSMO_AS, "H0": 69.0})
     with pytest.raises(ValueError, match="sigma8"):
         pipeline.cosmology_jacobian(COSMO, b1=2.0)
+
+
+def test_the_cosmological_rows_asked_for_are_those_of_all_eight(pipeline):
+    # derivatives= computes only the rows a sampler needs (a flat-LCDM chain: five): the same numbers
+    # as the full call's rows, with the same data vector and nuisance rows; unknown or doubled names refused
+    kw = dict(b1=2.0, b2=0.3, sn=900.0)
+    v, n, j = pipeline.full_jacobian(COSMO_AS, **kw)
+    asked = ["n_s", "h", "ln10^{10}A_s"]
+    v5, n5, j5 = pipeline.full_jacobian(COSMO_AS, derivatives=asked, **kw)
+    assert j5.shape == (3, len(v))
+    np.testing.assert_array_equal(v5, v)
+    np.testing.assert_array_equal(n5, n)
+    for row, name in enumerate(asked):
+        np.testing.assert_array_equal(j5[row], j[pipeline.cosmological_parameters.index(name)])
+    _, jc = pipeline.cosmology_jacobian(COSMO_AS, derivatives=asked, **kw)
+    np.testing.assert_array_equal(jc, j5)
+    with pytest.raises(ValueError, match="not a sampled parameter"):
+        pipeline.cosmology_jacobian(COSMO_AS, derivatives=["sigma8"], **kw)
+    with pytest.raises(ValueError, match="twice"):
+        pipeline.full_jacobian(COSMO_AS, derivatives=["h", "h"], **kw)

@@ -30,8 +30,11 @@ use crate::rsd::ept::tangent::TermsTangent;
 pub struct CosmologyJacobian {
     /// The data vector ([`Pipeline::len`]).
     pub data_vector: Vec<f64>,
-    /// d(data vector)/dθ for θ in [`DERIVATIVE_NAMES`], one column each.
+    /// d(data vector)/dθ for θ in [`Self::names`] (all of [`DERIVATIVE_NAMES`], or those asked of
+    /// [`Pipeline::full_jacobian_of`]), one column each.
     pub cosmological: Vec<Vec<f64>>,
+    /// The names of [`Self::cosmological`]'s columns, in their order.
+    names: Vec<&'static str>,
     /// The growth rate f used (the cosmology's, or the one given) with its derivatives (zero for a
     /// given f).
     pub growth_rate: CosmoDual,
@@ -42,8 +45,8 @@ pub struct CosmologyJacobian {
 
 impl CosmologyJacobian {
     /// The names of [`Self::cosmological`]'s columns.
-    pub fn names(&self) -> &'static [&'static str] {
-        &DERIVATIVE_NAMES
+    pub fn names(&self) -> &[&'static str] {
+        &self.names
     }
 }
 
@@ -62,7 +65,9 @@ impl Pipeline {
         cosmology: &Cosmology,
         params: &[(&str, f64)],
     ) -> Result<CosmologyJacobian> {
-        Ok(self.jacobians(cosmology, params, false)?.0)
+        Ok(self
+            .jacobians(cosmology, params, &DERIVATIVE_NAMES, false)?
+            .0)
     }
 
     /// [`Self::cosmology_jacobian`] and the nuisance parameters' rows ([`CosmologyStep::jacobian`](super::CosmologyStep::jacobian):
@@ -76,17 +81,51 @@ impl Pipeline {
         cosmology: &Cosmology,
         params: &[(&str, f64)],
     ) -> Result<(CosmologyJacobian, Vec<Vec<f64>>)> {
-        let (cosmological, nuisance) = self.jacobians(cosmology, params, true)?;
+        self.full_jacobian_of(cosmology, params, &DERIVATIVE_NAMES)
+    }
+
+    /// [`Self::full_jacobian`] with the cosmological columns of `derivatives` only (names of
+    /// [`DERIVATIVE_NAMES`], in the order wanted): a sampler of flat ΛCDM needs no Σm_ν, w0 or wa
+    /// column, and each column costs its own loop terms' tangent, projection and observation (about a
+    /// tenth of the whole Jacobian each). The columns asked for are the same numbers as
+    /// [`Self::full_jacobian`]'s.
+    ///
+    /// # Errors
+    /// As [`Self::full_jacobian`]; [`Error::InvalidChoice`] naming a name that is not in
+    /// [`DERIVATIVE_NAMES`] or is given twice.
+    pub fn full_jacobian_of(
+        &self,
+        cosmology: &Cosmology,
+        params: &[(&str, f64)],
+        derivatives: &[&str],
+    ) -> Result<(CosmologyJacobian, Vec<Vec<f64>>)> {
+        let (cosmological, nuisance) = self.jacobians(cosmology, params, derivatives, true)?;
         Ok((cosmological, nuisance.unwrap_or_default()))
     }
 
-    /// The cosmological derivatives and, if `nuisance`, the nuisance rows of the same step.
+    /// [`Self::cosmology_jacobian`] with the columns of `derivatives` only ([`Self::full_jacobian_of`]).
+    ///
+    /// # Errors
+    /// As [`Self::full_jacobian_of`].
+    pub fn cosmology_jacobian_of(
+        &self,
+        cosmology: &Cosmology,
+        params: &[(&str, f64)],
+        derivatives: &[&str],
+    ) -> Result<CosmologyJacobian> {
+        Ok(self.jacobians(cosmology, params, derivatives, false)?.0)
+    }
+
+    /// The cosmological derivatives along `derivatives` and, if `nuisance`, the nuisance rows of the
+    /// same step.
     fn jacobians(
         &self,
         cosmology: &Cosmology,
         params: &[(&str, f64)],
+        derivatives: &[&str],
         nuisance: bool,
     ) -> Result<(CosmologyJacobian, Option<Vec<Vec<f64>>>)> {
+        let columns = derivative_columns(derivatives)?;
         if let Some(b) = self.blocks.first() {
             return Err(Error::InvalidChoice {
                 what: format!(
@@ -118,7 +157,7 @@ impl Pipeline {
         // the nuisance polynomial's sets, f's row and the spectrum's columns in one projection
         // onto the multipoles (its weights cost more than applying them); the data vector by the
         // path of `evaluate`, so that the two are the same numbers
-        let tangents = self.terms_tangents(&tangent)?;
+        let tangents = self.terms_tangents(&tangent, &columns)?;
         let sets = if nuisance {
             unit_sets(p.f())
         } else {
@@ -152,7 +191,7 @@ impl Pipeline {
         let (dapar, daperp) = ap.map_or(([0.0; N_DERIVATIVES], [0.0; N_DERIVATIVES]), |(a, b)| {
             (a.d, b.d)
         });
-        for (j, column) in cosmological.iter_mut().enumerate() {
+        for (&j, column) in columns.iter().zip(cosmological.iter_mut()) {
             for (i, c) in column.iter_mut().enumerate() {
                 *c += d_f[i] * f.d[j] + d_apar[i] * dapar[j] + d_aperp[i] * daperp[j];
             }
@@ -160,16 +199,18 @@ impl Pipeline {
         let jacobian = CosmologyJacobian {
             data_vector,
             cosmological,
+            names: columns.iter().map(|&j| DERIVATIVE_NAMES[j]).collect(),
             growth_rate: f,
             ap,
         };
         Ok((jacobian, nuisance))
     }
 
-    /// The loop terms' tangents along the spectrum's derivatives dP/dθ_j, every j.
+    /// The loop terms' tangents along the spectrum's derivatives dP/dθ_j, j in `columns`.
     fn terms_tangents(
         &self,
         tangent: &crate::emulator::TracerTangent,
+        columns: &[usize],
     ) -> Result<Vec<TermsTangent>> {
         let Some((lattice, grid)) = self.plan.tangent_nodes() else {
             return Err(Error::InvalidChoice {
@@ -181,9 +222,39 @@ impl Pipeline {
         let column = |values: &[CosmoDual], j: usize| -> Vec<f64> {
             values.iter().map(|v| v.d[j]).collect()
         };
-        let directions: Vec<(Vec<f64>, Vec<f64>)> = (0..N_DERIVATIVES)
-            .map(|j| (column(&on_lattice, j), column(&on_grid, j)))
+        let directions: Vec<(Vec<f64>, Vec<f64>)> = columns
+            .iter()
+            .map(|&j| (column(&on_lattice, j), column(&on_grid, j)))
             .collect();
         self.plan.terms_tangents(tangent.spectrum(), &directions)
     }
+}
+
+/// The indices in [`DERIVATIVE_NAMES`] of `names`, in their order.
+///
+/// # Errors
+/// [`Error::InvalidChoice`] naming a name that is not a sampled cosmological parameter, or one given
+/// twice.
+fn derivative_columns(names: &[&str]) -> Result<Vec<usize>> {
+    let mut columns = Vec::with_capacity(names.len());
+    for (i, name) in names.iter().enumerate() {
+        let bad = |reason: String| Error::InvalidChoice {
+            what: format!("the cosmological derivative `{name}`"),
+            reason,
+        };
+        let j = DERIVATIVE_NAMES
+            .iter()
+            .position(|n| n == name)
+            .ok_or_else(|| {
+                bad(format!(
+                    "not a sampled parameter (they are {})",
+                    DERIVATIVE_NAMES.join(", ")
+                ))
+            })?;
+        if names[..i].contains(name) {
+            return Err(bad("asked for twice".into()));
+        }
+        columns.push(j);
+    }
+    Ok(columns)
 }

@@ -154,3 +154,40 @@ fn the_full_jacobian_is_both_jacobians_of_one_step() {
     assert_eq!(nuisance.len(), pt_spectra::pipeline::JACOBIAN_NAMES.len());
     assert_eq!(nuisance, rows);
 }
+
+/// The columns asked of `full_jacobian_of` (any subset, any order) are the full Jacobian's columns to
+/// the bit, with the same data vector and nuisance rows; a name that is not sampled, or one given twice,
+/// is refused by name.
+#[test]
+fn the_columns_asked_for_are_those_of_the_full_jacobian() {
+    let pl = pipeline();
+    let c = cosmology(&[0.69, 0.0223, 0.118, 3.05, 0.96, 0.1, -0.95, 0.05]);
+    let (all, all_rows) = pl.full_jacobian(&c, &PARAMS).unwrap();
+    assert_eq!(all.names(), &DERIVATIVE_NAMES);
+    for asked in [
+        vec!["h", "omega_b", "omega_cdm", "ln10^{10}A_s", "n_s"],
+        vec!["wa", "h"],
+        vec![],
+    ] {
+        let (some, rows) = pl.full_jacobian_of(&c, &PARAMS, &asked).unwrap();
+        assert_eq!(some.names(), asked.as_slice());
+        assert_eq!(some.data_vector, all.data_vector);
+        assert_eq!(rows, all_rows);
+        for (name, column) in asked.iter().zip(&some.cosmological) {
+            let j = DERIVATIVE_NAMES.iter().position(|n| n == name).unwrap();
+            assert_eq!(column, &all.cosmological[j], "{name}");
+        }
+        let alone = pl.cosmology_jacobian_of(&c, &PARAMS, &asked).unwrap();
+        assert_eq!(alone.cosmological, some.cosmological);
+    }
+    for (asked, says) in [
+        (vec!["h", "sigma8"], "`sigma8`: not a sampled parameter"),
+        (vec!["h", "n_s", "h"], "`h`: asked for twice"),
+    ] {
+        let e = pl
+            .full_jacobian_of(&c, &PARAMS, &asked)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(says), "{e}");
+    }
+}
