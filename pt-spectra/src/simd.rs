@@ -13,7 +13,7 @@ use pulp::{Arch, Simd, WithSimd};
 
 mod dot_many;
 mod exp;
-pub(crate) use dot_many::{matvec32, matvec32_four};
+pub(crate) use dot_many::{matvec32, matvec32_many};
 pub(crate) use exp::exp_in_place;
 
 /// Σ a_i b_i over the common length with four partial sums in a fixed order: vectorised by the

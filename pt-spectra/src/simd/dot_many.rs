@@ -2,8 +2,9 @@
 //! reduced products of several directions at once ([`crate::loops::basis::low_rank`]), each entry of
 //! the row widened to f64 once for all of them.
 
-/// Σ_i a_i b_q,i for each of the four vectors `b` (each at least as long as `a`), summed in f64.
-pub(crate) fn dot32_four(a: &[f32], b: [&[f64]; 4]) -> [f64; 4] {
+/// Σ_i a_i b_q,i for each of the `N` vectors `b` (each at least as long as `a`), summed in f64; each
+/// sum in the same order whatever N (the same numbers to the bit).
+pub(crate) fn dot32_many<const N: usize>(a: &[f32], b: [&[f64]; N]) -> [f64; N] {
     let n = a.len();
     assert!(
         b.iter().all(|b| b.len() >= n),
@@ -11,23 +12,23 @@ pub(crate) fn dot32_four(a: &[f32], b: [&[f64]; 4]) -> [f64; 4] {
     );
     #[cfg(target_arch = "x86_64")]
     if let Some(simd) = pulp::x86::V3::try_new() {
-        return simd.vectorize(|| dot32_four_v3(simd, a, b.map(|b| &b[..n])));
+        return simd.vectorize(|| dot32_many_v3(simd, a, b.map(|b| &b[..n])));
     }
     b.map(|b| a.iter().zip(b).map(|(x, y)| f64::from(*x) * y).sum::<f64>())
 }
 
-/// [`dot32_four`] with AVX2 and FMA: four entries of the row widened once per four products.
+/// [`dot32_many`] with AVX2 and FMA: four entries of the row widened once per N products.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-fn dot32_four_v3(simd: pulp::x86::V3, a: &[f32], b: [&[f64]; 4]) -> [f64; 4] {
+fn dot32_many_v3<const N: usize>(simd: pulp::x86::V3, a: &[f32], b: [&[f64]; N]) -> [f64; N] {
     use pulp::{f32x4, f64x4};
     let (a4, a_rest) = pulp::as_arrays::<4, _>(a);
     let chunks = b.map(|b| pulp::as_arrays::<4, _>(b).0);
-    let mut acc = [simd.splat_f64x4(0.0); 4];
+    let mut acc = [simd.splat_f64x4(0.0); N];
     for (c, x) in a4.iter().enumerate() {
         let x: f32x4 = pulp::cast(*x);
         let x = simd.convert_f32x4_to_f64x4(x);
-        for q in 0..4 {
+        for q in 0..N {
             let y: f64x4 = pulp::cast(chunks[q][c]);
             acc[q] = simd.mul_add_f64x4(x, y, acc[q]);
         }
@@ -126,10 +127,10 @@ fn dot32_rows_four_v3(simd: pulp::x86::V3, a: [&[f32]; 4], b: &[f64]) -> [f64; 4
     })
 }
 
-/// `out[q][i]` = [`dot32_four`] of row i of `a` (rows of the vectors' length) with the four `b`, to
-/// the bit, with one dispatch for all rows.
-pub(crate) fn matvec32_four(a: &[f32], b: [&[f64]; 4], out: &mut [Vec<f64>; 4]) {
-    let n = b[0].len();
+/// `out[q][i]` = [`dot32_many`] of row i of `a` (rows of the vectors' length) with the `N` vectors `b`,
+/// to the bit, with one dispatch for all rows and each row widened once for all N.
+pub(crate) fn matvec32_many<const N: usize>(a: &[f32], b: [&[f64]; N], out: &mut [Vec<f64>; N]) {
+    let n = b.first().map_or(0, |b| b.len());
     assert!(
         b.iter().all(|b| b.len() == n) && out.iter().all(|o| a.len() >= n * o.len()),
         "vectors of one length and a matrix of their rows"
@@ -140,33 +141,33 @@ pub(crate) fn matvec32_four(a: &[f32], b: [&[f64]; 4], out: &mut [Vec<f64>; 4]) 
     }
     #[cfg(target_arch = "x86_64")]
     if let Some(simd) = pulp::x86::V3::try_new() {
-        return simd.vectorize(MatVec32Four { simd, a, b, out });
+        return simd.vectorize(MatVec32Many { simd, a, b, out });
     }
     for (i, row) in a.chunks_exact(n).take(out[0].len()).enumerate() {
-        for (o, d) in out.iter_mut().zip(dot32_four(row, b)) {
+        for (o, d) in out.iter_mut().zip(dot32_many(row, b)) {
             o[i] = d;
         }
     }
 }
 
-/// [`matvec32_four`] with AVX2 and FMA (as [`MatVec32`]).
+/// [`matvec32_many`] with AVX2 and FMA (as [`MatVec32`]).
 #[cfg(target_arch = "x86_64")]
-struct MatVec32Four<'a> {
+struct MatVec32Many<'a, const N: usize> {
     simd: pulp::x86::V3,
     a: &'a [f32],
-    b: [&'a [f64]; 4],
-    out: &'a mut [Vec<f64>; 4],
+    b: [&'a [f64]; N],
+    out: &'a mut [Vec<f64>; N],
 }
 
 #[cfg(target_arch = "x86_64")]
-impl pulp::NullaryFnOnce for MatVec32Four<'_> {
+impl<const N: usize> pulp::NullaryFnOnce for MatVec32Many<'_, N> {
     type Output = ();
 
     #[inline(always)]
     fn call(self) {
         let n = self.b[0].len();
         for (i, row) in self.a.chunks_exact(n).take(self.out[0].len()).enumerate() {
-            let d = dot32_four_v3(self.simd, row, self.b);
+            let d = dot32_many_v3(self.simd, row, self.b);
             for (o, d) in self.out.iter_mut().zip(d) {
                 o[i] = d;
             }
@@ -190,14 +191,22 @@ mod tests {
             let mut one = vec![1.0; rows];
             matvec32(&a, &b[0], &mut one);
             let mut four = std::array::from_fn(|_| vec![1.0; rows]);
-            matvec32_four(&a, [&b[0], &b[1], &b[2], &b[3]], &mut four);
+            matvec32_many(&a, [&b[0], &b[1], &b[2], &b[3]], &mut four);
+            let mut two = std::array::from_fn(|_| vec![1.0; rows]);
+            matvec32_many(&a, [&b[2], &b[3]], &mut two);
+            let mut single = [vec![1.0; rows]];
+            matvec32_many(&a, [&b[1]], &mut single);
             for i in 0..rows {
                 let row = &a[i * n..(i + 1) * n];
                 assert_eq!(one[i].to_bits(), super::super::dot32(row, &b[0]).to_bits());
-                let d = dot32_four(row, [&b[0], &b[1], &b[2], &b[3]]);
+                let d = dot32_many(row, [&b[0], &b[1], &b[2], &b[3]]);
                 for q in 0..4 {
                     assert_eq!(four[q][i].to_bits(), d[q].to_bits(), "{n} {i} {q}");
                 }
+                // each sum in the same order whatever the number of vectors
+                assert_eq!(two[0][i].to_bits(), d[2].to_bits());
+                assert_eq!(two[1][i].to_bits(), d[3].to_bits());
+                assert_eq!(single[0][i].to_bits(), d[1].to_bits());
             }
         }
     }
@@ -210,7 +219,7 @@ mod tests {
             let b: Vec<Vec<f64>> = (0..4)
                 .map(|q| (0..n).map(|i| ((i + 7 * q) as f64 * 0.11).cos()).collect())
                 .collect();
-            let got = dot32_four(&a, [&b[0], &b[1], &b[2], &b[3]]);
+            let got = dot32_many(&a, [&b[0], &b[1], &b[2], &b[3]]);
             for q in 0..4 {
                 let want: f64 = a.iter().zip(&b[q]).map(|(x, y)| f64::from(*x) * y).sum();
                 assert!(

@@ -168,7 +168,7 @@ impl LowRank {
     /// c_a dc_b + dc_a c_b (pair tensors only): V s' = H dc with H = ∂(V s)/∂c, made once (its
     /// row r: H_b = Σ_a V_{r,(a,b)} c_a, the diagonal pair counted twice), so a direction costs a
     /// product of length n instead of V's columns; then U applied to all of them, each row of U
-    /// read once and widened once per four directions (`simd::matvec32_four`).
+    /// read once and widened once per four directions (`simd::matvec32_many`).
     pub(crate) fn apply_pair_tangents(&self, c: &[f64], dcs: &[&[f64]]) -> Vec<Vec<f64>> {
         let n = c.len();
         assert!(
@@ -195,13 +195,21 @@ impl LowRank {
             }
             z
         };
+        // four directions per pass, the last pass as many as remain (each direction's sums in the
+        // same order whatever the pass: the same numbers for any set of directions)
+        fn pass<const N: usize>(u: &[f32], rows: usize, z: &[Vec<f64>], out: &mut Vec<Vec<f64>>) {
+            let mut many = std::array::from_fn(|_| vec![0.0; rows]);
+            crate::simd::matvec32_many::<N>(u, std::array::from_fn(|q| z[q].as_slice()), &mut many);
+            out.extend(many);
+        }
         let mut out = Vec::with_capacity(z.len());
-        for group in (0..z.len()).step_by(4) {
-            let last = z.len() - 1;
-            let take = |q: usize| z[(group + q).min(last)].as_slice();
-            let mut four = std::array::from_fn(|_| vec![0.0; self.rows]);
-            crate::simd::matvec32_four(&self.u, [take(0), take(1), take(2), take(3)], &mut four);
-            out.extend(four.into_iter().take(z.len() - group));
+        for group in z.chunks(4) {
+            match group.len() {
+                4 => pass::<4>(&self.u, self.rows, group, &mut out),
+                3 => pass::<3>(&self.u, self.rows, group, &mut out),
+                2 => pass::<2>(&self.u, self.rows, group, &mut out),
+                _ => pass::<1>(&self.u, self.rows, group, &mut out),
+            }
         }
         out
     }
