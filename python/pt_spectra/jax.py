@@ -157,14 +157,14 @@ def data_vector(pipeline, names, cosmology=None, linear=None, z_input=None, **fi
             raise ValueError(f"data_vector: cosmology also gives {', '.join(clash)}: spell the free "
                              "parameters by their CLASS names only")
     nuisance_rows = [(i, nuisance.index(n)) for i, n in enumerate(names) if n in nuisance]
-    cosmology_rows = [(i, sampled.index(n)) for i, n in enumerate(names) if n in sampled]
+    cosmology_rows = [i for i, n in enumerate(names) if n in sampled]  # the order of free_cosmology
 
     def split(x):
         x = np.asarray(x, dtype=float)
         params = {**fixed, **{names[i]: float(x[i]) for i, _ in nuisance_rows}}
         if not free_cosmology:
             return cosmology, params
-        return {**cosmology, **{names[i]: float(x[i]) for i, _ in cosmology_rows}}, params
+        return {**cosmology, **{names[i]: float(x[i]) for i in cosmology_rows}}, params
 
     where = dict(linear=linear, z_input=z_input)
     m = len(pipeline(cosmology=cosmology, **where, **fixed))
@@ -179,7 +179,7 @@ def data_vector(pipeline, names, cosmology=None, linear=None, z_input=None, **fi
         if cosmology_rows:
             # one step for both sets of rows, the free cosmological columns only
             v, n, j = pipeline.full_jacobian(c, derivatives=free_cosmology, **params)
-            for row, (i, _) in enumerate(cosmology_rows):
+            for row, i in enumerate(cosmology_rows):
                 jacobian[i] = j[row]
         else:
             v, n = pipeline(cosmology=c, **where, jacobian=True, **params)

@@ -40,9 +40,13 @@ pub(super) fn tree_legs(
             Some((f, los)) => (f, dot(&v, &los) / k),
         };
         let x = k * k * sigma2_total(ir.sigma2, ir.delta_sigma2, f, mu);
-        let (pk, nw) = (p.eval(k), ir.no_wiggle.eval(k));
-        nw + (-x).exp() * (1.0 + x) * (pk - nw)
+        next_to_leading(p.eval(k), ir.no_wiggle.eval(k), x)
     })
+}
+
+/// P_NLO = P_nw + e^{−x}(1 + x)(P − P_nw) of P and P_nw at a side, x = k²Σ²_tot(μ).
+fn next_to_leading(pk: f64, nw: f64, x: f64) -> f64 {
+    nw + (-x).exp() * (1.0 + x) * (pk - nw)
 }
 
 /// [`tree_legs`] in redshift space at growth rate `f` along each line of sight of `los`, the same numbers:
@@ -62,7 +66,7 @@ pub(super) fn tree_legs_along(
             std::array::from_fn(|a| {
                 let mu = dot(&kv[a], n) / k[a];
                 let x = k[a] * k[a] * sigma2_total(ir.sigma2, ir.delta_sigma2, f, mu);
-                nw[a] + (-x).exp() * (1.0 + x) * (pk[a] - nw[a])
+                next_to_leading(pk[a], nw[a], x)
             })
         })
         .collect()
